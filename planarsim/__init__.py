@@ -1,0 +1,15 @@
+"""planarsim: an exact, fast planar physics engine for walking machines."""
+__version__ = "0.1.0"
+
+from .builder import ModelBuilder
+from .errors import ModelError, SimulationDiverged
+from .model import Model
+from .options import ContactMode, ModeStrategy, StepOptions, make_options
+from .sim import Simulator
+from .state import State, make_state
+from . import terrain
+from .energy import kinetic_energy, potential_energy, total_energy
+
+__all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "Simulator", "State",
+           "StepOptions", "ContactMode", "ModeStrategy", "make_options", "make_state", "terrain",
+           "kinetic_energy", "potential_energy", "total_energy", "__version__"]

@@ -1,0 +1,412 @@
+"""ModelBuilder: describe bodies, pins, rods, feet and actuators, then ``compile()`` a Model.
+
+Every ``add_*`` returns a small integer id. All checking happens here; errors are
+``ModelError`` naming the element kind, its name and index, the field, the value and the rule.
+
+>>> from planarsim import ModelBuilder
+>>> b = ModelBuilder(dt=1e-3)
+>>> rod = b.add_body("rod", mass=1.0, inertia=1.0 / 12, pos=(0.5, 0.0))
+>>> pivot = b.add_pin("pivot", rod, None, anchor_world=(0.0, 0.0))
+>>> model = b.compile()
+>>> model.n_body, model.n_pin
+(1, 1)
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import model as M
+from .errors import ModelError
+from .terrain import Terrain, flat
+
+PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
+
+
+def _finite(kind, name, idx, fieldname, value):
+    arr = np.asarray(value, dtype=np.float64)
+    if not np.all(np.isfinite(arr)):
+        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={value} must be finite")
+    return arr
+
+
+def _vec2(kind, name, idx, fieldname, value):
+    try:
+        arr = np.asarray(value, dtype=np.float64).reshape(2)
+    except (TypeError, ValueError):
+        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={value!r} must be a pair (x, y)") from None
+    return _finite(kind, name, idx, fieldname, arr)
+
+
+def _scalar(kind, name, idx, fieldname, value):
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={value!r} must be a number") from None
+    if not math.isfinite(x):
+        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={x} must be finite")
+    return x
+
+
+class ModelBuilder:
+    """Mutable description of a planar model; see the module docstring.
+
+    Parameters
+    ----------
+    dt : float        step size [s], > 0
+    gravity : (2,)    gravity vector [m/s^2]
+    terrain : Terrain ground profile (default: flat ground at y = 0)
+    """
+
+    def __init__(self, dt: float = 1e-3, gravity=(0.0, -9.81), terrain: Terrain | None = None):
+        self.dt = dt
+        self.gravity = gravity
+        self.terrain = terrain if terrain is not None else flat()
+        self._bodies, self._pins, self._rods, self._contacts, self._acts = [], [], [], [], []
+        self._shapes = []
+        self._names = {"body": {}, "pin": {}, "rod": {}, "contact": {}, "actuator": {}}
+
+    # naming ---------------------------------------------------------------------------------
+    def _register(self, kind, name, idx):
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"{kind} ({idx}): name={name!r} must be a non-empty string")
+        if name in self._names[kind]:
+            raise ModelError(f"{kind} {name!r} ({idx}): duplicate name (already used by {kind} "
+                             f"{self._names[kind][name]})")
+        self._names[kind][name] = idx
+
+    def _body_id(self, kind, name, idx, fieldname, body, allow_world=False):
+        if body is None and allow_world:
+            return -1
+        if isinstance(body, str):
+            if body not in self._names["body"]:
+                raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={body!r} names no body")
+            return self._names["body"][body]
+        if isinstance(body, (int, np.integer)) and 0 <= body < len(self._bodies):
+            return int(body)
+        if isinstance(body, (int, np.integer)) and body == -1 and allow_world:
+            return -1
+        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={body!r} is not a body id "
+                         f"(0..{len(self._bodies) - 1}){' or None for the world' if allow_world else ''}")
+
+    # bodies ---------------------------------------------------------------------------------
+    def add_body(self, name, mass, inertia, pos=(0.0, 0.0), angle=0.0, vel=(0.0, 0.0), omega=0.0,
+                 shapes=()) -> int:
+        """Rigid body: mass [kg] > 0, inertia about its COM [kg m^2] > 0, pose of its COM."""
+        idx = len(self._bodies)
+        self._register("body", name, idx)
+        mass = _scalar("body", name, idx, "mass", mass)
+        inertia = _scalar("body", name, idx, "inertia", inertia)
+        if not mass > 0:
+            raise ModelError(f"body {name!r} ({idx}): mass={mass} must be finite and > 0")
+        if not inertia > 0:
+            raise ModelError(f"body {name!r} ({idx}): inertia={inertia} must be finite and > 0 "
+                             f"(use add_point_mass for a body without rotation)")
+        q = np.r_[_vec2("body", name, idx, "pos", pos), _scalar("body", name, idx, "angle", angle)]
+        v = np.r_[_vec2("body", name, idx, "vel", vel), _scalar("body", name, idx, "omega", omega)]
+        self._bodies.append(dict(name=name, mass=mass, inertia=inertia, q=q, v=v, point=False))
+        for s in shapes:
+            self.add_shape(idx, *s)
+        return idx
+
+    def add_point_mass(self, name, mass, pos=(0.0, 0.0), vel=(0.0, 0.0), radius=None) -> int:
+        """Point mass [kg] > 0 at pos [m]: no rotational degree of freedom, takes no torque."""
+        idx = len(self._bodies)
+        self._register("body", name, idx)
+        mass = _scalar("body", name, idx, "mass", mass)
+        if not mass > 0:
+            raise ModelError(f"body {name!r} ({idx}): mass={mass} must be finite and > 0")
+        q = np.r_[_vec2("body", name, idx, "pos", pos), 0.0]
+        v = np.r_[_vec2("body", name, idx, "vel", vel), 0.0]
+        self._bodies.append(dict(name=name, mass=mass, inertia=0.0, q=q, v=v, point=True))
+        r = radius if radius is not None else 0.04 * (mass / 1.0) ** (1 / 3)
+        self._shapes.append(M.Shape(idx, "circle", ((0.0, 0.0), float(r))))
+        return idx
+
+    def add_shape(self, body, kind, *params):
+        """Drawing shape on a body: ('capsule', p0, p1, radius) | ('box', center, w, h[, angle])
+        | ('circle', center, radius); local frame, metres. Shapes do not collide."""
+        if kind not in ("capsule", "box", "circle"):
+            raise ModelError(f"shape on body {body}: kind={kind!r} must be capsule, box or circle")
+        self._shapes.append(M.Shape(int(body), kind, tuple(params)))
+
+    # world <-> local ------------------------------------------------------------------------
+    def _local(self, body, p_world):
+        if body < 0:
+            return np.asarray(p_world, dtype=np.float64)
+        x, y, th = self._bodies[body]["q"]
+        c, s = math.cos(th), math.sin(th)
+        dx, dy = p_world[0] - x, p_world[1] - y
+        return np.array([c * dx + s * dy, -s * dx + c * dy])
+
+    def _world(self, body, p_local):
+        if body < 0:
+            return np.asarray(p_local, dtype=np.float64)
+        x, y, th = self._bodies[body]["q"]
+        c, s = math.cos(th), math.sin(th)
+        return np.array([x + c * p_local[0] - s * p_local[1], y + s * p_local[0] + c * p_local[1]])
+
+    def _angle(self, body):
+        return 0.0 if body < 0 else self._bodies[body]["q"][2]
+
+    def _anchors(self, kind, name, idx, a, b, anchor_world, anchor_a, anchor_b):
+        if anchor_world is not None:
+            pw = _vec2(kind, name, idx, "anchor_world", anchor_world)
+            la = self._local(a, pw) if anchor_a is None else _vec2(kind, name, idx, "anchor_a", anchor_a)
+            lb = self._local(b, pw) if anchor_b is None else _vec2(kind, name, idx, "anchor_b", anchor_b)
+        else:
+            la = np.zeros(2) if anchor_a is None else _vec2(kind, name, idx, "anchor_a", anchor_a)
+            lb = np.zeros(2) if anchor_b is None else _vec2(kind, name, idx, "anchor_b", anchor_b)
+        for body, lp, f in ((a, la, "anchor_a"), (b, lb, "anchor_b")):
+            if body >= 0 and self._bodies[body]["point"] and np.any(lp != 0.0):
+                if np.hypot(*lp) > 1e-12:
+                    raise ModelError(f"{kind} {name!r} ({idx}): {f}={tuple(lp)} must be (0, 0) on "
+                                     f"point mass {self._bodies[body]['name']!r}")
+        return la, lb
+
+    # joints ---------------------------------------------------------------------------------
+    def add_pin(self, name, body_a, body_b, anchor_world=None, anchor_a=None, anchor_b=None,
+                limit=None, stiffness=0.0, damping=0.0, rest_angle=0.0, ref_angle=None) -> int:
+        """Pin joint between body_a and body_b (None: the world).
+
+        Anchors: give ``anchor_world`` (a point both bodies share at the build pose), or local
+        ``anchor_a`` / ``anchor_b``. The pin angle is theta_b - theta_a - ref_angle [rad];
+        ref_angle defaults to the relative angle at the build pose (pin angle 0 there).
+        ``limit=(lower, upper)`` [rad] adds unilateral limits; stiffness [N m/rad] and
+        damping [N m s/rad] add a passive spring-damper toward ``rest_angle``.
+        """
+        idx = len(self._pins)
+        self._register("pin", name, idx)
+        a = self._body_id("pin", name, idx, "body_a", body_a, allow_world=True)
+        b = self._body_id("pin", name, idx, "body_b", body_b, allow_world=True)
+        if a == b:
+            raise ModelError(f"pin {name!r} ({idx}): body_a and body_b are the same ({a})")
+        if a < 0 and b < 0:
+            raise ModelError(f"pin {name!r} ({idx}): cannot pin the world to itself")
+        if a >= 0 and b < 0:  # keep the world as body a
+            a, b = b, a
+            anchor_a, anchor_b = anchor_b, anchor_a
+        la, lb = self._anchors("pin", name, idx, a, b, anchor_world, anchor_a, anchor_b)
+        gap = np.hypot(*(self._world(a, la) - self._world(b, lb)))
+        if gap > PIN_ANCHOR_TOL:
+            raise ModelError(f"pin {name!r} ({idx}): anchors are {gap:.3g} m apart at the build pose "
+                             f"(must be <= {PIN_ANCHOR_TOL:g} m)")
+        ref = self._angle(b) - self._angle(a) if ref_angle is None else _scalar("pin", name, idx, "ref_angle", ref_angle)
+        lo, hi = (-math.inf, math.inf) if limit is None else limit
+        lo = float(lo)
+        hi = float(hi)
+        if math.isnan(lo) or math.isnan(hi):
+            raise ModelError(f"pin {name!r} ({idx}): limit=({lo}, {hi}) must not be NaN")
+        if lo > hi:
+            raise ModelError(f"pin {name!r} ({idx}): limit lower={lo} > upper={hi}")
+        k = _scalar("pin", name, idx, "stiffness", stiffness)
+        c = _scalar("pin", name, idx, "damping", damping)
+        if k < 0 or c < 0:
+            raise ModelError(f"pin {name!r} ({idx}): stiffness={k} and damping={c} must be >= 0")
+        self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=ref, limit=(lo, hi),
+                               k=k, c=c, rest=_scalar("pin", name, idx, "rest_angle", rest_angle)))
+        return idx
+
+    def add_rod(self, name, body_a, body_b, anchor_a=(0.0, 0.0), anchor_b=(0.0, 0.0), length=None) -> int:
+        """Massless rigid rod: keeps |p_b - p_a| = length [m] (default: the build-pose distance)."""
+        idx = len(self._rods)
+        self._register("rod", name, idx)
+        a = self._body_id("rod", name, idx, "body_a", body_a, allow_world=True)
+        b = self._body_id("rod", name, idx, "body_b", body_b, allow_world=True)
+        if a == b:
+            raise ModelError(f"rod {name!r} ({idx}): body_a and body_b are the same ({a})")
+        la, lb = self._anchors("rod", name, idx, a, b, None, anchor_a, anchor_b)
+        dist = float(np.hypot(*(self._world(b, lb) - self._world(a, la))))
+        length = dist if length is None else _scalar("rod", name, idx, "length", length)
+        if not length > 1e-9:
+            raise ModelError(f"rod {name!r} ({idx}): length={length} must be > 0")
+        self._rods.append(dict(name=name, body=(a, b), anchor=(la, lb), length=length))
+        return idx
+
+    # contacts -------------------------------------------------------------------------------
+    def _contact(self, name, body, kind, local, radius, span, mu, verts):
+        idx = len(self._contacts)
+        self._register("contact", name, idx)
+        bid = self._body_id("contact", name, idx, "body", body)
+        mu = _scalar("contact", name, idx, "mu", mu)
+        if mu < 0:
+            raise ModelError(f"contact {name!r} ({idx}): mu={mu} must be >= 0")
+        local = _vec2("contact", name, idx, "local", local)
+        verts = [_vec2("contact", name, idx, f"vertex[{i}]", v) for i, v in enumerate(verts)]
+        point = self._bodies[bid]["point"]
+        if point and (kind != M.CONTACT_POINT or np.hypot(*local) > 1e-12):
+            raise ModelError(f"contact {name!r} ({idx}): a point mass can only carry a point contact at (0, 0)")
+        self._contacts.append(dict(name=name, body=bid, kind=kind, local=local, radius=radius,
+                                   span=span, mu=mu, verts=verts,
+                                   ccd=1 if point else 0))
+        return idx
+
+    def add_point_contact(self, name, body, local=(0.0, 0.0), mu=1.0) -> int:
+        """A point of `body` (local [m]) that touches the ground; on a point mass it uses
+        continuous collision detection."""
+        return self._contact(name, body, M.CONTACT_POINT, local, 0.0, (0.0, 0.0), mu, [])
+
+    def add_arc_contact(self, name, body, center, radius, span=(-math.pi, math.pi), vertices=(),
+                        mu=1.0) -> int:
+        """Circular-arc sole: centre (local [m]), radius [m] > 0, span (a0, a1) [rad] of body-frame
+        directions from the centre to the sole (full circle by default). Where the sole's lowest
+        point lies outside the span, the lowest of `vertices` (heel, toe, back; local [m]) is
+        used instead, so a tipped foot rests on its corners. The foot rolls."""
+        idx = len(self._contacts)
+        r = _scalar("contact", name, idx, "radius", radius)
+        if not r > 0:
+            raise ModelError(f"contact {name!r} ({idx}): radius={r} must be > 0")
+        a0 = _scalar("contact", name, idx, "span[0]", span[0])
+        a1 = _scalar("contact", name, idx, "span[1]", span[1])
+        if not a1 > a0:
+            raise ModelError(f"contact {name!r} ({idx}): span=({a0}, {a1}) must have span[1] > span[0]")
+        cid = self._contact(name, body, M.CONTACT_ARC, center, r, (a0, a1), mu, list(vertices))
+        b = self._contacts[cid]["body"]
+        self._shapes.append(M.Shape(b, "arc", (tuple(self._contacts[cid]["local"]), r, (a0, a1),
+                                                tuple(tuple(v) for v in self._contacts[cid]["verts"]))))
+        return cid
+
+    def add_box_contacts(self, name, body, center, width, height, mu=1.0, angle=0.0) -> list:
+        """Four corner point contacts of a box (local centre [m], width x height [m]).
+        Returns the four contact ids, named ``name/0..3``; also draws the box."""
+        c = np.asarray(center, dtype=np.float64)
+        ca, sa = math.cos(angle), math.sin(angle)
+        ids = []
+        for i, (sx, sy) in enumerate(((-1, -1), (1, -1), (1, 1), (-1, 1))):
+            lx, ly = 0.5 * width * sx, 0.5 * height * sy
+            ids.append(self.add_point_contact(f"{name}/{i}", body,
+                                              (c[0] + ca * lx - sa * ly, c[1] + sa * lx + ca * ly), mu))
+        self.add_shape(self._contacts[ids[0]]["body"], "box", tuple(c), float(width), float(height), float(angle))
+        return ids
+
+    # actuators ------------------------------------------------------------------------------
+    def _act(self, name, kind, bodies=(-1, -1, -1), ref=-1, anchors=None, direction=(0.0, 0.0),
+             limit=(-math.inf, math.inf)):
+        idx = len(self._acts)
+        self._register("actuator", name, idx)
+        lo, hi = float(limit[0]), float(limit[1])
+        if math.isnan(lo) or math.isnan(hi) or lo > hi:
+            raise ModelError(f"actuator {name!r} ({idx}): limit=({lo}, {hi}) must have min <= max")
+        self._acts.append(dict(name=name, kind=kind, bodies=bodies, ref=ref,
+                               anchors=anchors if anchors is not None else (np.zeros(2), np.zeros(2)),
+                               dir=np.asarray(direction, dtype=np.float64), limit=(lo, hi)))
+        return idx
+
+    def add_pin_motor(self, name, pin, limit=(-math.inf, math.inf)) -> int:
+        """Torque [N m] at a pin: +tau on body b, -tau on body a; saturated to limit."""
+        idx = len(self._acts)
+        if isinstance(pin, str):
+            if pin not in self._names["pin"]:
+                raise ModelError(f"actuator {name!r} ({idx}): pin={pin!r} names no pin")
+            pin = self._names["pin"][pin]
+        if not (isinstance(pin, (int, np.integer)) and 0 <= pin < len(self._pins)):
+            raise ModelError(f"actuator {name!r} ({idx}): pin={pin!r} is not a pin id")
+        a, b = self._pins[pin]["body"]
+        return self._act(name, M.ACT_PIN_TORQUE, (a, b, -1), int(pin), limit=limit)
+
+    def add_axial(self, name, body_a, body_b, anchor_a=(0.0, 0.0), anchor_b=(0.0, 0.0),
+                  limit=(-math.inf, math.inf)) -> int:
+        """Force [N] along the line between two anchors; positive pushes them apart (a leg
+        actuator between a hip and a foot point mass)."""
+        idx = len(self._acts)
+        a = self._body_id("actuator", name, idx, "body_a", body_a)
+        b = self._body_id("actuator", name, idx, "body_b", body_b)
+        la, lb = self._anchors("actuator", name, idx, a, b, None, anchor_a, anchor_b)
+        return self._act(name, M.ACT_AXIAL, (a, b, -1), anchors=(la, lb), limit=limit)
+
+    def add_hip_torque(self, name, hip, leg_a, leg_b, limit=(-math.inf, math.inf)) -> int:
+        """Torque [N m] between two massless legs hip->leg_a and hip->leg_b (point masses),
+        realised as forces perpendicular to the legs: +tau turns leg b counter-clockwise
+        relative to leg a; net force and net torque on the system are zero."""
+        idx = len(self._acts)
+        h = self._body_id("actuator", name, idx, "hip", hip)
+        a = self._body_id("actuator", name, idx, "leg_a", leg_a)
+        b = self._body_id("actuator", name, idx, "leg_b", leg_b)
+        return self._act(name, M.ACT_HIP_TORQUE, (a, b, h), limit=limit)
+
+    def add_body_force(self, name, body, direction=(1.0, 0.0), limit=(-math.inf, math.inf)) -> int:
+        """Force [N] at the body's COM along a fixed unit world direction."""
+        idx = len(self._acts)
+        bid = self._body_id("actuator", name, idx, "body", body)
+        d = _vec2("actuator", name, idx, "direction", direction)
+        n = np.hypot(*d)
+        if not n > 0:
+            raise ModelError(f"actuator {name!r} ({idx}): direction={tuple(d)} must be non-zero")
+        return self._act(name, M.ACT_BODY_FORCE, (bid, -1, -1), direction=d / n, limit=limit)
+
+    def add_body_torque(self, name, body, limit=(-math.inf, math.inf)) -> int:
+        """Torque [N m] on one rigid body."""
+        idx = len(self._acts)
+        bid = self._body_id("actuator", name, idx, "body", body)
+        return self._act(name, M.ACT_BODY_TORQUE, (bid, -1, -1), limit=limit)
+
+    # compile --------------------------------------------------------------------------------
+    def compile(self, **meta) -> M.Model:
+        """Validate and freeze into a Model."""
+        dt = _scalar("model", "model", 0, "dt", self.dt)
+        if not dt > 0:
+            raise ModelError(f"model: dt={dt} must be finite and > 0")
+        g = _vec2("model", "model", 0, "gravity", self.gravity)
+        if not isinstance(self.terrain, Terrain):
+            raise ModelError(f"model: terrain={self.terrain!r} must be a planarsim.terrain.Terrain")
+        if not self._bodies:
+            raise ModelError("model: no bodies; add at least one with add_body or add_point_mass")
+        nb, npin, nr, nc, na = (len(x) for x in (self._bodies, self._pins, self._rods, self._contacts, self._acts))
+
+        def ro(a, dtype=np.float64):
+            a = np.ascontiguousarray(np.asarray(a, dtype=dtype))
+            a.setflags(write=False)
+            return a
+
+        mass = np.array([b["mass"] for b in self._bodies])
+        inertia = np.array([b["inertia"] for b in self._bodies])
+        inv_inertia = np.where(inertia > 0, 1.0 / np.where(inertia > 0, inertia, 1.0), 0.0)
+        verts, vadr, vnum = [], [], []
+        for c in self._contacts:
+            vadr.append(len(verts))
+            vnum.append(len(c["verts"]))
+            verts.extend(c["verts"])
+        arrays = M.ModelArrays(
+            dt=dt, gravity=ro(g),
+            body_mass=ro(mass), body_inertia=ro(inertia), body_inv_mass=ro(1.0 / mass),
+            body_inv_inertia=ro(inv_inertia),
+            pin_body=ro([p["body"] for p in self._pins] or np.zeros((0, 2)), np.int64).reshape(npin, 2),
+            pin_anchor=ro([p["anchor"] for p in self._pins] or np.zeros((0, 2, 2))).reshape(npin, 2, 2),
+            pin_ref=ro([p["ref"] for p in self._pins]).reshape(npin),
+            pin_limit=ro([p["limit"] for p in self._pins] or np.zeros((0, 2))).reshape(npin, 2),
+            pin_stiffness=ro([p["k"] for p in self._pins]).reshape(npin),
+            pin_damping=ro([p["c"] for p in self._pins]).reshape(npin),
+            pin_rest=ro([p["rest"] for p in self._pins]).reshape(npin),
+            rod_body=ro([r["body"] for r in self._rods] or np.zeros((0, 2)), np.int64).reshape(nr, 2),
+            rod_anchor=ro([r["anchor"] for r in self._rods] or np.zeros((0, 2, 2))).reshape(nr, 2, 2),
+            rod_length=ro([r["length"] for r in self._rods]).reshape(nr),
+            contact_body=ro([c["body"] for c in self._contacts], np.int64).reshape(nc),
+            contact_kind=ro([c["kind"] for c in self._contacts], np.int64).reshape(nc),
+            contact_local=ro([c["local"] for c in self._contacts] or np.zeros((0, 2))).reshape(nc, 2),
+            contact_radius=ro([c["radius"] for c in self._contacts]).reshape(nc),
+            contact_span=ro([c["span"] for c in self._contacts] or np.zeros((0, 2))).reshape(nc, 2),
+            contact_mu=ro([c["mu"] for c in self._contacts]).reshape(nc),
+            contact_ccd=ro([c["ccd"] for c in self._contacts], np.int64).reshape(nc),
+            contact_vert_adr=ro(vadr, np.int64).reshape(nc),
+            contact_vert_num=ro(vnum, np.int64).reshape(nc),
+            vert_local=ro(verts or np.zeros((0, 2))).reshape(len(verts), 2),
+            act_kind=ro([a["kind"] for a in self._acts], np.int64).reshape(na),
+            act_body=ro([a["bodies"] for a in self._acts] or np.zeros((0, 3)), np.int64).reshape(na, 3),
+            act_ref=ro([a["ref"] for a in self._acts], np.int64).reshape(na),
+            act_anchor=ro([a["anchors"] for a in self._acts] or np.zeros((0, 2, 2))).reshape(na, 2, 2),
+            act_dir=ro([a["dir"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
+            act_range=ro([a["limit"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
+            terrain_coef=ro(self.terrain.coef),
+        )
+        q0 = np.array([b["q"] for b in self._bodies])
+        v0 = np.array([b["v"] for b in self._bodies])
+        for arr in (q0, v0):
+            arr.setflags(write=False)
+        return M.Model(arrays=arrays,
+                       body_names=tuple(b["name"] for b in self._bodies),
+                       pin_names=tuple(p["name"] for p in self._pins),
+                       rod_names=tuple(r["name"] for r in self._rods),
+                       contact_names=tuple(c["name"] for c in self._contacts),
+                       act_names=tuple(a["name"] for a in self._acts),
+                       q0=q0, v0=v0, shapes=tuple(self._shapes), terrain=self.terrain, meta=dict(meta))

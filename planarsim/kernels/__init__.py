@@ -1,0 +1,1 @@
+"""Compiled kernels (numba). Private: use the public wrappers in planarsim."""

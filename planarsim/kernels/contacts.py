@@ -1,0 +1,93 @@
+"""Stage 3: the contact point of every foot, recomputed at the start of each step.
+
+Point contact: the material point itself. Arc contact (curved sole): the circle point closest
+to the ground, c - r n, where n is the ground normal at the ground point closest to the arc
+centre c; used when that direction lies inside the sole's angular span, otherwise the lowest of
+the fallback vertices and the arc's end points (heel, toe). The material point found this way
+(contact_anchor, body frame) is held fixed for the step, so a curved foot rolls.
+"""
+import math
+
+from ._jit import jit
+from .math2d import rotate, world_point
+from .terrain import closest_point
+
+CONTACT_POINT = 0
+CONTACT_ARC = 1
+MODE_FREE = 0
+MODE_PINNED = 1
+MODE_SLIDING = 2
+
+
+@jit
+def _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly):
+    ws.contact_point[i, 0] = px
+    ws.contact_point[i, 1] = py
+    ws.contact_ground[i, 0] = gx
+    ws.contact_ground[i, 1] = gy
+    ws.contact_normal[i, 0] = nx
+    ws.contact_normal[i, 1] = ny
+    ws.contact_gap[i] = gap
+    ws.contact_anchor[i, 0] = lx
+    ws.contact_anchor[i, 1] = ly
+
+
+@jit
+def _try_vertex(m, q, ws, i, b, lx, ly, best):
+    """Use local vertex (lx, ly) for contact i if its gap is below `best`; return the new best."""
+    px, py = world_point(q, b, lx, ly)
+    gx, gy, nx, ny, gap = closest_point(m.terrain_coef, px, py)
+    if gap < best:
+        _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly)
+        return gap
+    return best
+
+
+@jit
+def find_contact(m, q, ws, i):
+    """Contact point, ground point, normal and gap of contact i at configuration q."""
+    b = m.contact_body[i]
+    lx = m.contact_local[i, 0]
+    ly = m.contact_local[i, 1]
+    if m.contact_kind[i] == CONTACT_POINT:
+        _try_vertex(m, q, ws, i, b, lx, ly, math.inf)
+        return
+    # arc: ground point closest to the centre, sole point opposite the normal
+    r = m.contact_radius[i]
+    cx, cy = world_point(q, b, lx, ly)
+    gx, gy, nx, ny, cgap = closest_point(m.terrain_coef, cx, cy)
+    th = q[b, 2]
+    cs = math.cos(th)
+    sn = math.sin(th)
+    # direction -n expressed in the body frame
+    dlx, dly = rotate(cs, -sn, -nx, -ny)
+    a = math.atan2(dly, dlx)
+    a0 = m.contact_span[i, 0]
+    a1 = m.contact_span[i, 1]
+    while a < a0:
+        a += 2.0 * math.pi
+    while a >= a0 + 2.0 * math.pi:
+        a -= 2.0 * math.pi
+    best = math.inf
+    if a <= a1:
+        px = cx - r * nx
+        py = cy - r * ny
+        _store(ws, i, px, py, gx, gy, nx, ny, cgap - r, lx + r * dlx, ly + r * dly)
+        best = cgap - r
+    else:
+        # the sole is turned away from the ground: arc end points and fallback vertices
+        for e in range(2):
+            ang = a0 if e == 0 else a1
+            best = _try_vertex(m, q, ws, i, b, lx + r * math.cos(ang), ly + r * math.sin(ang), best)
+    adr = m.contact_vert_adr[i]
+    for k in range(adr, adr + m.contact_vert_num[i]):
+        best = _try_vertex(m, q, ws, i, b, m.vert_local[k, 0], m.vert_local[k, 1], best)
+
+
+@jit
+def find_contacts(m, s, ws):
+    """Stage 3 for every contact; a disabled contact is forced free."""
+    for i in range(m.contact_body.shape[0]):
+        find_contact(m, s.q, ws, i)
+        if s.contact_enabled[i] == 0:
+            s.contact_mode[i] = MODE_FREE

@@ -1,0 +1,150 @@
+"""Stage 1-2: applied forces (gravity, pin springs, actuators, pushes) and v* = v + h M^-1 f.
+
+Actuator kinds (see planarsim/model.py): pin torque, axial force between anchors, hip torque
+between point-mass legs (as perpendicular forces), body force along a world direction, body
+torque. Commands are saturated to act_range; act_power records the mechanical power [W].
+"""
+import math
+
+from ._jit import jit, jit_inline
+from .math2d import cross2, world_point
+
+ACT_PIN_TORQUE = 0
+ACT_AXIAL = 1
+ACT_HIP_TORQUE = 2
+ACT_BODY_FORCE = 3
+ACT_BODY_TORQUE = 4
+
+
+@jit
+def point_velocity(q, v, body, px, py):
+    """World velocity [m/s] of the world point (px, py) moving with `body` (0 for the world)."""
+    if body < 0:
+        return 0.0, 0.0
+    rx = px - q[body, 0]
+    ry = py - q[body, 1]
+    return v[body, 0] - v[body, 2] * ry, v[body, 1] + v[body, 2] * rx
+
+
+@jit
+def add_point_force(q, f, body, px, py, fx, fy):
+    """Add force (fx, fy) [N] applied at world point (px, py) of `body` (ignored for the world)."""
+    if body < 0:
+        return
+    f[body, 0] += fx
+    f[body, 1] += fy
+    f[body, 2] += cross2(px - q[body, 0], py - q[body, 1], fx, fy)
+
+
+@jit
+def pin_angle_rate(m, q, v, j):
+    """Pin angle theta_b - theta_a - ref [rad] and its rate [rad/s]."""
+    a = m.pin_body[j, 0]
+    b = m.pin_body[j, 1]
+    ang = q[b, 2] - m.pin_ref[j]
+    rate = v[b, 2]
+    if a >= 0:
+        ang -= q[a, 2]
+        rate -= v[a, 2]
+    return ang, rate
+
+
+@jit_inline
+def apply_actuator(m, q, v, f, k, u):
+    """Add actuator k's saturated command u to f; return its mechanical power [W]."""
+    kind = m.act_kind[k]
+    a = m.act_body[k, 0]
+    b = m.act_body[k, 1]
+    if kind == ACT_PIN_TORQUE:
+        j = m.act_ref[k]
+        pa = m.pin_body[j, 0]
+        pb = m.pin_body[j, 1]
+        f[pb, 2] += u
+        if pa >= 0:
+            f[pa, 2] -= u
+        return u * pin_angle_rate(m, q, v, j)[1]
+    if kind == ACT_AXIAL:
+        ax, ay = world_point(q, a, m.act_anchor[k, 0, 0], m.act_anchor[k, 0, 1])
+        bx, by = world_point(q, b, m.act_anchor[k, 1, 0], m.act_anchor[k, 1, 1])
+        dx = bx - ax
+        dy = by - ay
+        L = math.sqrt(dx * dx + dy * dy)
+        if L < 1e-12:
+            return 0.0
+        ex = dx / L
+        ey = dy / L
+        add_point_force(q, f, b, bx, by, u * ex, u * ey)
+        add_point_force(q, f, a, ax, ay, -u * ex, -u * ey)
+        vax, vay = point_velocity(q, v, a, ax, ay)
+        vbx, vby = point_velocity(q, v, b, bx, by)
+        return u * (ex * (vbx - vax) + ey * (vby - vay))
+    if kind == ACT_HIP_TORQUE:
+        h = m.act_body[k, 2]
+        power = 0.0
+        for side in range(2):
+            leg = a if side == 0 else b
+            sign = -1.0 if side == 0 else 1.0
+            dx = q[leg, 0] - q[h, 0]
+            dy = q[leg, 1] - q[h, 1]
+            d2 = dx * dx + dy * dy
+            if d2 < 1e-24:
+                continue
+            # force perpendicular to the leg giving torque sign*u about the hip
+            fx = -sign * u * dy / d2
+            fy = sign * u * dx / d2
+            f[leg, 0] += fx
+            f[leg, 1] += fy
+            f[h, 0] -= fx
+            f[h, 1] -= fy
+            w = cross2(dx, dy, v[leg, 0] - v[h, 0], v[leg, 1] - v[h, 1]) / d2
+            power += sign * u * w
+        return power
+    if kind == ACT_BODY_FORCE:
+        f[a, 0] += u * m.act_dir[k, 0]
+        f[a, 1] += u * m.act_dir[k, 1]
+        return u * (m.act_dir[k, 0] * v[a, 0] + m.act_dir[k, 1] * v[a, 1])
+    # ACT_BODY_TORQUE
+    if m.body_inv_inertia[a] > 0.0:
+        f[a, 2] += u
+    return u * v[a, 2]
+
+
+@jit
+def apply_forces(m, s, ws, u):
+    """f = m g + pushes + pin springs/dampers + saturated actuator commands u."""
+    q = s.q
+    v = s.v
+    f = ws.force
+    for i in range(q.shape[0]):
+        f[i, 0] = m.body_mass[i] * m.gravity[0] + s.ext_force[i, 0]
+        f[i, 1] = m.body_mass[i] * m.gravity[1] + s.ext_force[i, 1]
+        f[i, 2] = s.ext_force[i, 2] if m.body_inv_inertia[i] > 0.0 else 0.0
+    # passive pin springs and dampers
+    for j in range(m.pin_body.shape[0]):
+        k = m.pin_stiffness[j]
+        c = m.pin_damping[j]
+        if k == 0.0 and c == 0.0:
+            continue
+        ang, rate = pin_angle_rate(m, q, v, j)
+        tau = -k * (ang - m.pin_rest[j]) - c * rate
+        f[m.pin_body[j, 1], 2] += tau
+        if m.pin_body[j, 0] >= 0:
+            f[m.pin_body[j, 0], 2] -= tau
+    # actuators, saturated
+    for k in range(m.act_kind.shape[0]):
+        uk = u[k]
+        if uk < m.act_range[k, 0]:
+            uk = m.act_range[k, 0]
+        elif uk > m.act_range[k, 1]:
+            uk = m.act_range[k, 1]
+        ws.act_u[k] = uk
+        ws.act_power[k] = apply_actuator(m, q, v, f, k, uk)
+
+
+@jit
+def predict_velocity(m, s, ws, h):
+    """v* = v + h M^-1 f (point masses keep zero angular velocity)."""
+    for i in range(s.v.shape[0]):
+        ws.v_pred[i, 0] = s.v[i, 0] + h * m.body_inv_mass[i] * ws.force[i, 0]
+        ws.v_pred[i, 1] = s.v[i, 1] + h * m.body_inv_mass[i] * ws.force[i, 1]
+        ws.v_pred[i, 2] = s.v[i, 2] + h * m.body_inv_inertia[i] * ws.force[i, 2]

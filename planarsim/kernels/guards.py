@@ -1,0 +1,27 @@
+"""Stage 9: guards. Every q and v component must be finite and below the magnitude bound."""
+import math
+
+from ._jit import jit
+
+GUARD_OK = 0
+GUARD_NONFINITE = 1
+GUARD_TOO_LARGE = 2
+
+
+@jit
+def check_guards(s, ws, limit):
+    """Return GUARD_*; on failure ws.info[2] = body, ws.info[3] = field 0..5 (x y th vx vy w)."""
+    for i in range(s.q.shape[0]):
+        for f in range(6):
+            x = s.q[i, f] if f < 3 else s.v[i, f - 3]
+            bad = GUARD_OK
+            if not math.isfinite(x):
+                bad = GUARD_NONFINITE
+            elif abs(x) > limit:
+                bad = GUARD_TOO_LARGE
+            if bad != GUARD_OK:
+                ws.info[2] = i
+                ws.info[3] = f
+                ws.guard_value[0] = x
+                return bad
+    return GUARD_OK

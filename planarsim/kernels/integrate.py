@@ -1,0 +1,57 @@
+"""Stages 7 and 7b: integrate positions, then Newton-SHAKE position correction.
+
+integrate:  v = v_new,  q = q + h v  (symplectic Euler).
+correct_positions: the linearised rows leave a residual O(h^2 w^2 r). Newton on the SHAKE
+equation moves q along the START-of-step constraint directions J(q0):
+    (J(q+) W J(q0)^T) mu = -c(q+),   q += W J(q0)^T mu,   v += W J(q0)^T mu / h
+(correcting along J(q+) instead would dissipate energy every step; DESIGN.md section 3.7).
+"""
+from ._jit import jit
+from .rows import eval_row
+from .solve import apply_impulses, assemble, factor_solve
+
+
+@jit
+def integrate_positions(s, vel, h):
+    """v = vel; q += h v."""
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            s.v[i, k] = vel[i, k]
+            s.q[i, k] += h * vel[i, k]
+
+
+@jit
+def max_residual(m, s, ws):
+    """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
+    worst = 0.0
+    for r in range(ws.n_row[0]):
+        c = eval_row(m, s.q, ws, r, ws.row_Jp[r])
+        ws.rhs[r] = -c
+        if abs(c) > worst:
+            worst = abs(c)
+    return worst
+
+
+@jit
+def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
+    """Newton-SHAKE; returns the final max residual [m or rad]."""
+    n = ws.n_row[0]
+    if n == 0:
+        return 0.0
+    worst = max_residual(m, s, ws)
+    for _ in range(iters):
+        if worst <= tol:
+            break
+        assemble(m, ws, ws.row_Jp, ws.row_J, n)
+        factor_solve(ws.A, ws.rhs, ws.lam, n, pivot_tol)
+        # move positions and velocities by the same correction
+        for i in range(ws.v_new.shape[0]):
+            for k in range(3):
+                ws.v_new[i, k] = 0.0
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_new, 1.0)
+        for i in range(s.q.shape[0]):
+            for k in range(3):
+                s.q[i, k] += ws.v_new[i, k]
+                s.v[i, k] += ws.v_new[i, k] / h
+        worst = max_residual(m, s, ws)
+    return worst

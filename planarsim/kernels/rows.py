@@ -1,0 +1,132 @@
+"""Stage 4: constraint rows J (Jacobian blocks on bodies a, b) and position errors c.
+
+Row kinds: pin x / y (p_b - p_a = 0), rod (|p_b - p_a| - L = 0), joint limit (angle - lower
+>= 0, upper - angle >= 0), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0). For a
+point p on a body with COM x, J = (d_x, d_y, (p - x) x d) for a row along unit direction d.
+Sliding contacts keep only the normal row; their impulse direction F = n - mu s t carries the
+Coulomb friction -mu lambda_n s along the tangent t.
+"""
+import math
+
+from ._jit import jit
+from .math2d import cross2, world_point
+from .contacts import MODE_PINNED, MODE_SLIDING
+
+ROW_PIN_X = 0
+ROW_PIN_Y = 1
+ROW_ROD = 2
+ROW_LIMIT_LO = 3
+ROW_LIMIT_HI = 4
+ROW_CONTACT_N = 5
+ROW_CONTACT_T = 6
+
+
+@jit
+def _set_dir(q, body, px, py, dx, dy, sign, out):
+    """out = sign * (dx, dy, (p - x_body) x d)."""
+    if body < 0:
+        out[0] = 0.0
+        out[1] = 0.0
+        out[2] = 0.0
+        return
+    out[0] = sign * dx
+    out[1] = sign * dy
+    out[2] = sign * cross2(px - q[body, 0], py - q[body, 1], dx, dy)
+
+
+@jit
+def eval_row(m, q, ws, r, J):
+    """Jacobian blocks J (2, 3) and error c of row r at configuration q; returns c."""
+    kind = ws.row_kind[r]
+    o = ws.row_owner[r]
+    a = ws.row_body[r, 0]
+    b = ws.row_body[r, 1]
+    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
+        ax, ay = world_point(q, a, m.pin_anchor[o, 0, 0], m.pin_anchor[o, 0, 1])
+        bx, by = world_point(q, b, m.pin_anchor[o, 1, 0], m.pin_anchor[o, 1, 1])
+        dx = 1.0 if kind == ROW_PIN_X else 0.0
+        dy = 1.0 - dx
+        _set_dir(q, a, ax, ay, dx, dy, -1.0, J[0])
+        _set_dir(q, b, bx, by, dx, dy, 1.0, J[1])
+        return (bx - ax) * dx + (by - ay) * dy
+    if kind == ROW_ROD:
+        ax, ay = world_point(q, a, m.rod_anchor[o, 0, 0], m.rod_anchor[o, 0, 1])
+        bx, by = world_point(q, b, m.rod_anchor[o, 1, 0], m.rod_anchor[o, 1, 1])
+        ex = bx - ax
+        ey = by - ay
+        L = math.sqrt(ex * ex + ey * ey)
+        ex /= L
+        ey /= L
+        _set_dir(q, a, ax, ay, ex, ey, -1.0, J[0])
+        _set_dir(q, b, bx, by, ex, ey, 1.0, J[1])
+        return L - m.rod_length[o]
+    if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
+        sign = 1.0 if kind == ROW_LIMIT_LO else -1.0
+        ang = q[b, 2] - m.pin_ref[o]
+        if a >= 0:
+            ang -= q[a, 2]
+        for k in range(3):
+            J[0, k] = 0.0
+            J[1, k] = 0.0
+        if a >= 0:
+            J[0, 2] = -sign
+        J[1, 2] = sign
+        if kind == ROW_LIMIT_LO:
+            return ang - m.pin_limit[o, 0]
+        return m.pin_limit[o, 1] - ang
+    # contact rows: material point vs the ground point found at the start of the step
+    px, py = world_point(q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+    nx = ws.contact_normal[o, 0]
+    ny = ws.contact_normal[o, 1]
+    dx = nx if kind == ROW_CONTACT_N else ny
+    dy = ny if kind == ROW_CONTACT_N else -nx
+    for k in range(3):
+        J[0, k] = 0.0
+    _set_dir(q, b, px, py, dx, dy, 1.0, J[1])
+    return dx * (px - ws.contact_ground[o, 0]) + dy * (py - ws.contact_ground[o, 1])
+
+
+@jit
+def _add_row(ws, n, kind, owner, a, b):
+    ws.row_kind[n] = kind
+    ws.row_owner[n] = owner
+    ws.row_body[n, 0] = a
+    ws.row_body[n, 1] = b
+    return n + 1
+
+
+@jit
+def build_rows(m, s, ws):
+    """Fill the active rows at the current configuration: J, F (impulse directions) and c."""
+    n = 0
+    for j in range(m.pin_body.shape[0]):
+        n = _add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
+        n = _add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
+    for j in range(m.rod_body.shape[0]):
+        n = _add_row(ws, n, ROW_ROD, j, m.rod_body[j, 0], m.rod_body[j, 1])
+    for j in range(m.pin_body.shape[0]):
+        if s.limit_active[j, 0]:
+            n = _add_row(ws, n, ROW_LIMIT_LO, j, m.pin_body[j, 0], m.pin_body[j, 1])
+        if s.limit_active[j, 1]:
+            n = _add_row(ws, n, ROW_LIMIT_HI, j, m.pin_body[j, 0], m.pin_body[j, 1])
+    for i in range(m.contact_body.shape[0]):
+        mode = s.contact_mode[i]
+        if mode == MODE_PINNED or mode == MODE_SLIDING:
+            n = _add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
+        if mode == MODE_PINNED:
+            n = _add_row(ws, n, ROW_CONTACT_T, i, -1, m.contact_body[i])
+    ws.n_row[0] = n
+    for r in range(n):
+        ws.row_c[r] = eval_row(m, s.q, ws, r, ws.row_J[r])
+        for e in range(2):
+            for k in range(3):
+                ws.row_F[r, e, k] = ws.row_J[r, e, k]
+        o = ws.row_owner[r]
+        if ws.row_kind[r] == ROW_CONTACT_N and s.contact_mode[o] == MODE_SLIDING:
+            # impulse lambda_n (n - mu s t): t = (n_y, -n_x)
+            b = ws.row_body[r, 1]
+            nx = ws.contact_normal[o, 0]
+            ny = ws.contact_normal[o, 1]
+            ms = m.contact_mu[o] * s.contact_slip[o]
+            px, py = world_point(s.q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+            _set_dir(s.q, b, px, py, nx - ms * ny, ny + ms * nx, 1.0, ws.row_F[r, 1])

@@ -1,0 +1,126 @@
+"""The compiled step: a table of contents of the stages (DESIGN.md section 3).
+
+step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
+(0 ok, 1 non-finite, 2 too large). A time-of-impact split (CCD) repeats stages 1-6 for the
+remainder of the step with the new contact pinned.
+"""
+from ._jit import jit
+from .ccd import advance_to_impact, time_of_impact
+from .contacts import MODE_PINNED, find_contacts
+from .forces import apply_forces, predict_velocity
+from .guards import check_guards
+from .integrate import correct_positions, integrate_positions
+from .modes import gather_contact_impulses, update_modes
+from .record import record_frame
+from .rows import build_rows
+from .solve import solve_impulses
+
+
+@jit
+def _copy1(src, dst):
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@jit
+def _copy2(src, dst):
+    for i in range(src.shape[0]):
+        for k in range(src.shape[1]):
+            dst[i, k] = src[i, k]
+
+
+@jit
+def copy_state(src, dst):
+    """dst <- src, array by array (dst is a State of the same shapes; no allocation)."""
+    _copy2(src.q, dst.q)
+    _copy2(src.v, dst.v)
+    _copy1(src.time, dst.time)
+    _copy1(src.step, dst.step)
+    _copy1(src.contact_mode, dst.contact_mode)
+    _copy1(src.contact_slip, dst.contact_slip)
+    _copy1(src.contact_enabled, dst.contact_enabled)
+    _copy2(src.limit_active, dst.limit_active)
+    _copy1(src.mode_cursor, dst.mode_cursor)
+    _copy2(src.ext_force, dst.ext_force)
+
+
+@jit
+def solve_modes(m, s, ws, opt, h, include_ccd):
+    """Stages 4-6: build rows, solve, check modes; repeat while modes change (capped)."""
+    rounds = 0
+    changed = 1
+    while changed != 0 and rounds < opt.max_mode_iters:
+        build_rows(m, s, ws)
+        solve_impulses(m, ws, h, opt.pivot_tol)
+        changed = update_modes(m, s, ws, h, opt.mode_strategy, rounds == 0, include_ccd)
+        rounds += 1
+    if changed != 0:
+        # cap reached: solve once more so impulses match the final modes
+        build_rows(m, s, ws)
+        solve_impulses(m, ws, h, opt.pivot_tol)
+        gather_contact_impulses(m, s, ws)
+    ws.info[0] += rounds
+
+
+@jit
+def step(m, s, ws, opt, u):
+    """Advance s by one step of m.dt under actuator commands u; return the guard code."""
+    copy_state(s, ws.prev)
+    ws.info[0] = 0
+    ws.info[1] = 0
+    h = m.dt
+    for split in range(opt.max_ccd_splits + 1):
+        apply_forces(m, s, ws, u)
+        predict_velocity(m, s, ws, h)
+        find_contacts(m, s, ws)
+        ccd_on = split < opt.max_ccd_splits
+        solve_modes(m, s, ws, opt, h, not ccd_on)
+        if ccd_on:
+            tau, hit = time_of_impact(m, s, ws, h)
+            if hit >= 0 and tau >= h * (1.0 - 1e-9):
+                # impact at the very end of the step: finish it, pinned from the next step
+                integrate_positions(s, ws.v_new, h)
+                s.contact_mode[hit] = MODE_PINNED
+                break
+            if hit >= 0:
+                # split the step at the impact and pin the contact for the rest of it
+                advance_to_impact(s, ws, h, tau)
+                s.time[0] += tau
+                h -= tau
+                s.contact_mode[hit] = MODE_PINNED
+                ws.info[1] += 1
+                continue
+        integrate_positions(s, ws.v_new, h)
+        if opt.refine_iters > 0:
+            correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol, opt.pivot_tol)
+        break
+    s.time[0] = ws.prev.time[0] + m.dt
+    s.step[0] += 1
+    if m.contact_body.shape[0] > 0:
+        s.mode_cursor[0] = (s.mode_cursor[0] + 1) % m.contact_body.shape[0]
+    return check_guards(s, ws, opt.guard_limit)
+
+
+@jit
+def run_steps(m, s, ws, opt, u, n):
+    """n steps under constant commands u; returns (guard code, steps completed)."""
+    for k in range(n):
+        code = step(m, s, ws, opt, u)
+        if code != 0:
+            return code, k
+    return 0, n
+
+
+@jit
+def run_recorded(m, s, ws, opt, u, n, every, rec, k0):
+    """n steps under constant u, recording every `every`-th step into rec from frame k0.
+    Returns (guard code, steps completed, next frame index)."""
+    k = k0
+    for i in range(n):
+        code = step(m, s, ws, opt, u)
+        if code != 0:
+            return code, i, k
+        if (s.step[0] % every) == 0 and k < rec.t.shape[0]:
+            record_frame(s, ws, rec, k)
+            k += 1
+    return 0, n, k

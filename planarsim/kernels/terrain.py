@@ -1,0 +1,88 @@
+"""Analytic terrain kernels: h(x) = h0 + s x + sum_k A_k sin(2 pi x / L_k + phi_k).
+
+Coefficient layout (``terrain_coef``): ``[h0, s, K, A_1, L_1, phi_1, ..., A_K, L_K, phi_K]``
+with h0 [m], s [-], A [m], L [m], phi [rad]. Flat ground is ``[0, 0, 0]``.
+"""
+import math
+
+from ._jit import jit
+
+TWO_PI = 2.0 * math.pi
+
+
+@jit
+def height(coef, x):
+    """Ground height h(x) [m]."""
+    h = coef[0] + coef[1] * x
+    for k in range(int(coef[2])):
+        a = coef[3 + 3 * k]
+        w = TWO_PI / coef[4 + 3 * k]
+        h += a * math.sin(w * x + coef[5 + 3 * k])
+    return h
+
+
+@jit
+def height_derivs(coef, x):
+    """(h, h', h'') at x: height [m], slope dh/dx [-], curvature term d2h/dx2 [1/m]."""
+    h = coef[0] + coef[1] * x
+    dh = coef[1]
+    ddh = 0.0
+    for k in range(int(coef[2])):
+        a = coef[3 + 3 * k]
+        w = TWO_PI / coef[4 + 3 * k]
+        arg = w * x + coef[5 + 3 * k]
+        sn = math.sin(arg)
+        cs = math.cos(arg)
+        h += a * sn
+        dh += a * w * cs
+        ddh -= a * w * w * sn
+    return h, dh, ddh
+
+
+@jit
+def normal_at(coef, x):
+    """Unit normal (nx, ny) of the ground at x, pointing up (out of the ground)."""
+    h, dh, ddh = height_derivs(coef, x)
+    inv = 1.0 / math.sqrt(1.0 + dh * dh)
+    return -dh * inv, inv
+
+
+@jit
+def closest_point(coef, px, py):
+    """Closest ground point to (px, py) and the signed gap along its normal.
+
+    Newton on f(x) = (x - px) + (h(x) - py) h'(x) = 0 (stationarity of the squared distance),
+    started at x = px; each step clamped to the vertical distance |py - h(px)|, an upper bound
+    on how far the closest point can lie. Exact (one iteration) for flat and sloped ground.
+
+    Returns (gx, gy, nx, ny, gap): ground point [m], unit normal, gap = n.(p - g) [m]
+    (negative below the ground).
+    """
+    x = px
+    h, dh, ddh = height_derivs(coef, x)
+    bound = abs(py - h) + 1e-12
+    for _ in range(30):
+        f = (x - px) + (h - py) * dh
+        fp = 1.0 + dh * dh + (h - py) * ddh
+        if fp < 1e-3:
+            fp = 1.0 + dh * dh
+        dx = -f / fp
+        if dx > bound:
+            dx = bound
+        elif dx < -bound:
+            dx = -bound
+        x += dx
+        h, dh, ddh = height_derivs(coef, x)
+        if abs(dx) < 1e-14 * (1.0 + abs(x)):
+            break
+    inv = 1.0 / math.sqrt(1.0 + dh * dh)
+    nx = -dh * inv
+    ny = inv
+    gap = nx * (px - x) + ny * (py - h)
+    return x, h, nx, ny, gap
+
+
+@jit
+def gap_of_point(coef, px, py):
+    """Signed distance [m] of (px, py) from the ground (negative below)."""
+    return closest_point(coef, px, py)[4]

@@ -1,0 +1,155 @@
+"""Simulator: a thin Python wrapper over the compiled step.
+
+>>> sim = Simulator(model)            # doctest: +SKIP
+>>> sim.step(u)                       # one step under commands u (n_act,)
+>>> traj = sim.run(1000, u, record_every=10)
+
+The state lives in ``sim.state`` (a State of numpy arrays, mutated in place); ``snapshot()`` and
+``restore()`` copy it. A guard failure raises SimulationDiverged naming step, time, body and
+field, with the state at the start of the failed step.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import SimulationDiverged
+from .kernels.step import run_recorded, run_steps, step as _step
+from .model import Model
+from .options import StepOptions
+from .state import State, make_state, make_workspace
+from .trajectory import Trajectory, make_recorder
+
+FIELD_NAMES = ("x", "y", "theta", "vx", "vy", "omega")
+
+
+class Simulator:
+    """Steps one Model.
+
+    Parameters
+    ----------
+    model : Model
+    options : StepOptions (contact-mode strategy, position refinement, guards)
+    state : State to start from (default: the model's build pose)
+    """
+
+    def __init__(self, model: Model, options: StepOptions | None = None, state: State | None = None):
+        if not isinstance(model, Model):
+            raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
+        self.model = model
+        self.options = options if options is not None else StepOptions()
+        self.state = state.copy() if state is not None else make_state(model)
+        self.ws = make_workspace(model)
+        self._u0 = np.zeros(model.n_act)
+
+    # commands -------------------------------------------------------------------------------
+    def _commands(self, u):
+        if u is None:
+            return self._u0
+        u = np.asarray(u, dtype=np.float64)
+        if u.shape != (self.model.n_act,):
+            raise ValueError(f"commands u must have shape ({self.model.n_act},) "
+                             f"(one per actuator: {list(self.model.act_names)}), got {u.shape}")
+        return u
+
+    def _raise(self, code):
+        ws = self.ws
+        body = int(ws.info[2])
+        field = FIELD_NAMES[int(ws.info[3])]
+        value = float(ws.guard_value[0])
+        step = int(ws.prev.step[0])
+        t = float(ws.prev.time[0])
+        name = self.model.body_names[body]
+        what = "is not finite" if code == 1 else f"exceeds {self.options.guard_limit:g} in magnitude"
+        last = State(*(a.copy() for a in ws.prev))
+        raise SimulationDiverged(f"simulation diverged at step {step} (t={t:.6g} s): body {name!r} "
+                                 f"({body}) {field}={value} {what}", step, t, name, field, value, last)
+
+    # stepping -------------------------------------------------------------------------------
+    def step(self, u=None) -> None:
+        """One step of model.dt under actuator commands u (n_act,) [N or N m]."""
+        code = _step(self.model.arrays, self.state, self.ws, self.options, self._commands(u))
+        if code:
+            self._raise(code)
+
+    def steps(self, n: int, u=None) -> None:
+        """n steps under constant commands, compiled as one loop."""
+        code, done = run_steps(self.model.arrays, self.state, self.ws, self.options,
+                               self._commands(u), int(n))
+        if code:
+            self._raise(code)
+
+    def run(self, duration: float | None = None, u=None, controller=None, n_steps: int | None = None,
+            record_every: int = 1, control_every: int = 1, labels=None) -> Trajectory:
+        """Run for `duration` [s] (or `n_steps`) and return the recorded Trajectory.
+
+        u : constant commands (n_act,), or
+        controller : callable ``controller(sim) -> u`` called every `control_every` steps (the
+            Python path; compiled walkers have their own rollout kernels). Between calls the
+            steps run compiled. Frames are recorded every `record_every` steps.
+        labels : optional callable ``labels(sim) -> dict of scalars`` sampled at each frame
+            (only with a controller), stored in Trajectory.labels.
+        """
+        n = _count_steps(self.model.dt, duration, n_steps)
+        every = int(record_every)
+        if every < 1 or int(control_every) < 1:
+            raise ValueError("record_every and control_every must be >= 1")
+        rec = make_recorder(self.model, n // every + 1)
+        m, s, ws, opt = self.model.arrays, self.state, self.ws, self.options
+        k = 0
+        if controller is None:
+            code, done, k = run_recorded(m, s, ws, opt, self._commands(u), n, every, rec, 0)
+            if code:
+                self._raise(code)
+        else:
+            series = {}
+            done = 0
+            chunk = int(control_every)
+            while done < n:
+                uk = self._commands(controller(self))
+                todo = min(chunk, n - done)
+                k_before = k
+                code, did, k = run_recorded(m, s, ws, opt, uk, todo, every, rec, k)
+                if code:
+                    self._raise(code)
+                done += todo
+                if labels is not None and k > k_before:
+                    for key, val in labels(self).items():
+                        series.setdefault(key, np.zeros(len(rec.t)))[k_before:k] = val
+            labels_out = {key: arr[:k] for key, arr in series.items()}
+            return Trajectory.from_recorder(self.model, rec, k, labels=labels_out,
+                                            info={"dt": self.model.dt})
+        return Trajectory.from_recorder(self.model, rec, k, info={"dt": self.model.dt})
+
+    # state ----------------------------------------------------------------------------------
+    @property
+    def t(self) -> float:
+        return float(self.state.time[0])
+
+    def snapshot(self) -> State:
+        return self.state.copy()
+
+    def restore(self, snap: State) -> None:
+        self.state.restore(snap)
+
+    def set_contact_enabled(self, contact, enabled: bool) -> None:
+        i = self.model.contact(contact) if isinstance(contact, str) else int(contact)
+        self.state.contact_enabled[i] = 1 if enabled else 0
+
+    def contact_impulses(self) -> np.ndarray:
+        """(n_contact, 2) normal and tangential impulse of the last step [N s]."""
+        return self.ws.contact_impulse.copy()
+
+
+def _count_steps(dt, duration, n_steps):
+    if (duration is None) == (n_steps is None):
+        raise ValueError("give exactly one of duration [s] or n_steps")
+    if n_steps is not None:
+        n = int(n_steps)
+    else:
+        duration = float(duration)
+        if not np.isfinite(duration) or duration < 0:
+            raise ValueError(f"duration={duration} must be finite and >= 0 seconds")
+        n = int(round(duration / dt))
+    if n < 0:
+        raise ValueError(f"n_steps={n} must be >= 0")
+    return n

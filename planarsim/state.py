@@ -1,0 +1,121 @@
+"""State (what a run needs to resume bit for bit) and Workspace (what a step recomputes).
+
+Both are NamedTuples of numpy arrays so that compiled kernels take them directly.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .model import Model
+
+
+class State(NamedTuple):
+    """Complete simulation state. Arrays are mutated in place by the kernels.
+
+    q : (n_body, 3) [m, m, rad]          positions and angles of the body COMs
+    v : (n_body, 3) [m/s, m/s, rad/s]    velocities
+    time : (1,) [s]                       simulated time
+    step : (1,) int                       steps taken
+    contact_mode : (n_contact,) int       0 free, 1 pinned, 2 sliding
+    contact_slip : (n_contact,) [-]       slip direction (+-1 along the ground tangent) when sliding
+    contact_enabled : (n_contact,) int    0 disables a contact (it passes through the ground)
+    limit_active : (n_pin, 2) int         lower / upper joint limit rows in use
+    mode_cursor : (1,) int                the contact checked next by the alternating scheme
+    ext_force : (n_body, 3) [N, N, N m]   external force and torque held until changed (pushes)
+    """
+    q: np.ndarray
+    v: np.ndarray
+    time: np.ndarray
+    step: np.ndarray
+    contact_mode: np.ndarray
+    contact_slip: np.ndarray
+    contact_enabled: np.ndarray
+    limit_active: np.ndarray
+    mode_cursor: np.ndarray
+    ext_force: np.ndarray
+
+    @property
+    def t(self) -> float:
+        return float(self.time[0])
+
+    def copy(self) -> "State":
+        return State(*(a.copy() for a in self))
+
+    def restore(self, other: "State") -> None:
+        """Overwrite this state's arrays with `other`'s (bit for bit)."""
+        for a, b in zip(self, other):
+            a[...] = b
+
+    def as_dict(self) -> dict:
+        return {name: getattr(self, name).copy() for name in self._fields}
+
+    @classmethod
+    def from_dict(cls, d) -> "State":
+        return cls(*(np.array(d[name]) for name in cls._fields))
+
+
+def make_state(model: Model, q=None, v=None) -> State:
+    """Initial State of `model` (build pose and velocities unless q, v are given)."""
+    nb, nc, npin = model.n_body, model.n_contact, model.n_pin
+    q = np.array(model.q0 if q is None else q, dtype=np.float64).reshape(nb, 3).copy()
+    v = np.array(model.v0 if v is None else v, dtype=np.float64).reshape(nb, 3).copy()
+    return State(q=q, v=v, time=np.zeros(1), step=np.zeros(1, np.int64),
+                 contact_mode=np.zeros(nc, np.int64), contact_slip=np.ones(nc),
+                 contact_enabled=np.ones(nc, np.int64), limit_active=np.zeros((npin, 2), np.int64),
+                 mode_cursor=np.zeros(1, np.int64), ext_force=np.zeros((nb, 3)))
+
+
+class Workspace(NamedTuple):
+    """Scratch arrays of one step (allocated once by make_workspace; a step never allocates).
+
+    Rows are constraint equations; row r acts on bodies row_body[r] (a, b; -1 = world) with
+    Jacobian blocks row_J[r, 0|1, :] and impulse directions row_F[r, 0|1, :] (they differ only
+    for sliding contacts, whose impulse is lambda_n (n - mu s t)).
+    """
+    force: np.ndarray            # (n_body, 3) applied forces [N, N, N m]
+    v_pred: np.ndarray           # (n_body, 3) unconstrained velocity v + h M^-1 f
+    v_new: np.ndarray            # (n_body, 3) constrained velocity of the current solve
+    q_start: np.ndarray          # (n_body, 3)
+    v_start: np.ndarray          # (n_body, 3)
+    contact_point: np.ndarray    # (n_contact, 2) world contact point [m]
+    contact_ground: np.ndarray   # (n_contact, 2) ground point below it [m]
+    contact_normal: np.ndarray   # (n_contact, 2) unit ground normal
+    contact_gap: np.ndarray      # (n_contact,) signed gap at step start [m]
+    contact_anchor: np.ndarray   # (n_contact, 2) material contact point in the body frame [m]
+    contact_impulse: np.ndarray  # (n_contact, 2) normal, tangential impulse of the step [N s]
+    row_body: np.ndarray         # (R, 2) int
+    row_J: np.ndarray            # (R, 2, 3)
+    row_F: np.ndarray            # (R, 2, 3)
+    row_Jp: np.ndarray           # (R, 2, 3) Jacobian at the end-of-step configuration
+    row_c: np.ndarray            # (R,) position error [m or rad]
+    row_kind: np.ndarray         # (R,) int ROW_*
+    row_owner: np.ndarray        # (R,) int pin / rod / contact index
+    n_row: np.ndarray            # (1,) int rows in use
+    A: np.ndarray                # (R, R) effective-mass matrix J M^-1 F^T
+    rhs: np.ndarray              # (R,)
+    lam: np.ndarray              # (R,) impulses [N s or N m s]
+    act_u: np.ndarray            # (n_act,) applied (saturated) commands
+    act_power: np.ndarray        # (n_act,) mechanical power [W]
+    info: np.ndarray             # (8,) int: mode iterations, ccd splits, guard body, guard field, ...
+    guard_value: np.ndarray      # (1,) offending value when a guard fired
+    prev: State                  # the state at the start of the last step (for guard errors)
+
+
+def max_rows(model: Model) -> int:
+    return max(1, 2 * model.n_pin + model.n_rod + 2 * model.n_pin + 2 * model.n_contact)
+
+
+def make_workspace(model: Model) -> Workspace:
+    nb, nc, na = model.n_body, model.n_contact, model.n_act
+    R = max_rows(model)
+    z = np.zeros
+    return Workspace(force=z((nb, 3)), v_pred=z((nb, 3)), v_new=z((nb, 3)), q_start=z((nb, 3)),
+                     v_start=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
+                     contact_normal=z((nc, 2)), contact_gap=z(nc), contact_anchor=z((nc, 2)),
+                     contact_impulse=z((nc, 2)), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
+                     row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R),
+                     row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
+                     A=z((R, R)), rhs=z(R), lam=z(R), act_u=z(na), act_power=z(na),
+                     info=z(8, np.int64), guard_value=z(1), prev=make_state(model))

@@ -1,0 +1,152 @@
+"""Analytic terrain: flat ground, a constant slope, and sums of sines (hills).
+
+h(x) = h0 + s x + sum_k A_k sin(2 pi x / L_k + phi_k)   [m]
+
+Heights, slopes and normals are exact; the compiled versions live in ``kernels/terrain.py``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ModelError
+
+
+@dataclass(frozen=True)
+class Terrain:
+    """Ground profile. Build with :func:`flat`, :func:`slope`, :func:`hills` or :func:`parse`.
+
+    coef : (3 + 3K,) array  [h0, s, K, A_1, L_1, phi_1, ...]
+    """
+
+    coef: np.ndarray
+    name: str = "terrain"
+
+    def __post_init__(self):
+        coef = np.ascontiguousarray(np.asarray(self.coef, dtype=np.float64))
+        validate_coef(coef)
+        coef.setflags(write=False)
+        object.__setattr__(self, "coef", coef)
+
+    @property
+    def n_sines(self) -> int:
+        return int(self.coef[2])
+
+    def _terms(self):
+        c = self.coef
+        for k in range(self.n_sines):
+            yield c[3 + 3 * k], 2 * math.pi / c[4 + 3 * k], c[5 + 3 * k]
+
+    def height(self, x):
+        """Ground height [m] at x [m] (scalar or array)."""
+        x = np.asarray(x, dtype=np.float64)
+        h = self.coef[0] + self.coef[1] * x
+        for a, w, phi in self._terms():
+            h = h + a * np.sin(w * x + phi)
+        return h
+
+    def slope(self, x):
+        """dh/dx [-] at x (scalar or array)."""
+        x = np.asarray(x, dtype=np.float64)
+        d = self.coef[1] + 0.0 * x
+        for a, w, phi in self._terms():
+            d = d + a * w * np.cos(w * x + phi)
+        return d
+
+    def normal(self, x):
+        """Unit upward normal, shape (..., 2)."""
+        d = self.slope(x)
+        inv = 1.0 / np.sqrt(1.0 + d * d)
+        return np.stack([-d * inv, inv], axis=-1)
+
+    def tangent(self, x):
+        """Unit tangent pointing toward +x, shape (..., 2)."""
+        d = self.slope(x)
+        inv = 1.0 / np.sqrt(1.0 + d * d)
+        return np.stack([inv, d * inv], axis=-1)
+
+
+def validate_coef(coef: np.ndarray) -> None:
+    """Raise ModelError unless coef is a finite, well-formed terrain description."""
+    if coef.ndim != 1 or coef.size < 3:
+        raise ModelError(f"terrain: coef must be a 1-D array [h0, s, K, ...], got shape {coef.shape}")
+    for i, v in enumerate(coef):
+        if not math.isfinite(v):
+            raise ModelError(f"terrain: coef[{i}]={v} must be finite")
+    k = coef[2]
+    if k != int(k) or k < 0 or coef.size != 3 + 3 * int(k):
+        raise ModelError(f"terrain: K=coef[2]={k} must be a whole number with len(coef) == 3 + 3K "
+                         f"(len is {coef.size})")
+    for j in range(int(k)):
+        wavelength = coef[4 + 3 * j]
+        if not wavelength > 0:
+            raise ModelError(f"terrain: sine {j}: wavelength={wavelength} must be > 0")
+
+
+def flat(height: float = 0.0) -> Terrain:
+    """Level ground at `height` [m]."""
+    return Terrain(np.array([height, 0.0, 0.0]), name="flat")
+
+
+def slope(angle_deg: float, height: float = 0.0) -> Terrain:
+    """Constant slope rising toward +x by `angle_deg` degrees (negative: downhill)."""
+    if not math.isfinite(angle_deg) or abs(angle_deg) >= 89.0:
+        raise ModelError(f"terrain: slope angle={angle_deg} deg must be finite and within (-89, 89)")
+    return Terrain(np.array([height, math.tan(math.radians(angle_deg)), 0.0]), name=f"slope:{angle_deg:g}")
+
+
+def hills(amplitudes, wavelengths, phases=None, grade: float = 0.0, height: float = 0.0) -> Terrain:
+    """Sum of sines: amplitudes [m], wavelengths [m], phases [rad], plus a constant grade s [-]."""
+    a = np.atleast_1d(np.asarray(amplitudes, dtype=np.float64))
+    lam = np.atleast_1d(np.asarray(wavelengths, dtype=np.float64))
+    phi = np.zeros_like(a) if phases is None else np.atleast_1d(np.asarray(phases, dtype=np.float64))
+    if not (a.shape == lam.shape == phi.shape):
+        raise ModelError(f"terrain: amplitudes, wavelengths, phases must have one length, got "
+                         f"{a.size}, {lam.size}, {phi.size}")
+    coef = np.concatenate([[height, grade, float(a.size)], np.stack([a, lam, phi], axis=1).ravel()])
+    return Terrain(coef, name="hills")
+
+
+def max_slope_deg(terrain: Terrain, x0: float = -50.0, x1: float = 150.0, n: int = 200001) -> float:
+    """Largest |slope| in degrees over [x0, x1], sampled."""
+    x = np.linspace(x0, x1, n)
+    return float(np.degrees(np.max(np.abs(np.arctan(terrain.slope(x))))))
+
+
+def parse(spec: str) -> Terrain:
+    """Terrain from a command-line spec.
+
+    ``flat`` | ``slope:DEG`` | ``hills`` (default hills) | ``hills:A,L[,PHI][;A,L[,PHI]...]``
+    """
+    spec = spec.strip()
+    kind, _, arg = spec.partition(":")
+    try:
+        if kind == "flat" and not arg:
+            return flat()
+        if kind == "slope":
+            return slope(float(arg))
+        if kind == "hills":
+            if not arg:
+                return default_hills()
+            amps, lams, phis = [], [], []
+            for term in arg.split(";"):
+                parts = [float(p) for p in term.split(",")]
+                if len(parts) not in (2, 3):
+                    raise ValueError(term)
+                amps.append(parts[0])
+                lams.append(parts[1])
+                phis.append(parts[2] if len(parts) == 3 else 0.0)
+            return hills(amps, lams, phis)
+    except ModelError:
+        raise
+    except ValueError:
+        pass
+    raise ModelError(f"terrain spec {spec!r} not understood; use flat, slope:DEG, hills or "
+                     f"hills:A,L[,PHI][;A,L[,PHI]...] (metres, radians)")
+
+
+def default_hills() -> Terrain:
+    """Rolling hills: max slope about 12 deg, peak-to-trough about 0.33 m (the seed's claim)."""
+    return hills([0.12, 0.045], [7.0, 2.9], [0.0, 1.3])

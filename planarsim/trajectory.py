@@ -1,0 +1,172 @@
+"""Trajectory: recorded arrays of a run, with save/load (.npz, atomic) and CSV export.
+
+Frames hold the state AFTER each recorded step. contact_mode is 0 free, 1 pinned, 2 sliding,
+-1 disabled. contact_impulse is (normal, tangential) impulse of the step [N s]; divide by dt
+for a mean force [N]. act_power is the mechanical power of each actuator [W].
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+FORMAT_VERSION = 1
+
+
+class Recorder(NamedTuple):
+    """Preallocated frame arrays filled by kernels.record.record_frame."""
+    t: np.ndarray                # (K,) [s]
+    q: np.ndarray                # (K, n_body, 3)
+    v: np.ndarray                # (K, n_body, 3)
+    contact_mode: np.ndarray     # (K, n_contact) int
+    contact_impulse: np.ndarray  # (K, n_contact, 2) [N s]
+    contact_point: np.ndarray    # (K, n_contact, 2) [m]
+    act_u: np.ndarray            # (K, n_act)
+    act_power: np.ndarray        # (K, n_act) [W]
+
+
+def make_recorder(model, n_frames: int) -> Recorder:
+    nb, nc, na, K = model.n_body, model.n_contact, model.n_act, int(n_frames)
+    z = np.zeros
+    return Recorder(t=z(K), q=z((K, nb, 3)), v=z((K, nb, 3)), contact_mode=z((K, nc), np.int64),
+                    contact_impulse=z((K, nc, 2)), contact_point=z((K, nc, 2)), act_u=z((K, na)),
+                    act_power=z((K, na)))
+
+
+@dataclass
+class Trajectory:
+    """Recorded run. Arrays as in Recorder; `labels` holds extra per-frame series (e.g. the
+    controller's gait/state as ints under 'phase'); `info` holds scalars (walker, dt, ...)."""
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    contact_mode: np.ndarray
+    contact_impulse: np.ndarray
+    contact_point: np.ndarray
+    act_u: np.ndarray
+    act_power: np.ndarray
+    body_names: tuple = ()
+    contact_names: tuple = ()
+    act_names: tuple = ()
+    labels: dict = field(default_factory=dict)
+    info: dict = field(default_factory=dict)
+
+    _ARRAYS = ("t", "q", "v", "contact_mode", "contact_impulse", "contact_point", "act_u", "act_power")
+
+    @classmethod
+    def from_recorder(cls, model, rec: Recorder, n: int | None = None, **kw) -> "Trajectory":
+        n = len(rec.t) if n is None else int(n)
+        arrs = {k: np.array(getattr(rec, k)[:n]) for k in cls._ARRAYS}
+        return cls(**arrs, body_names=model.body_names, contact_names=model.contact_names,
+                   act_names=model.act_names, **kw)
+
+    def __len__(self):
+        return len(self.t)
+
+    def com(self, model) -> np.ndarray:
+        """(K, 2) centre of mass [m]."""
+        m = model.arrays.body_mass
+        return np.einsum("b,kbc->kc", m, self.q[:, :, :2]) / m.sum()
+
+    def com_velocity(self, model) -> np.ndarray:
+        m = model.arrays.body_mass
+        return np.einsum("b,kbc->kc", m, self.v[:, :, :2]) / m.sum()
+
+    def energy(self, model) -> dict:
+        """Kinetic, potential and total energy per frame [J]."""
+        from .energy import kinetic_energy, potential_energy
+        ke = kinetic_energy(model, self.q, self.v)
+        pe = potential_energy(model, self.q)
+        return {"kinetic": ke, "potential": pe, "total": ke + pe}
+
+    # files ------------------------------------------------------------------------------------
+    def save(self, path) -> Path:
+        """Write a .npz atomically (temporary file, then rename) with a format version."""
+        path = Path(path)
+        if path.suffix != ".npz":
+            raise ValueError(f"trajectory file {str(path)!r} must end in .npz")
+        payload = {k: getattr(self, k) for k in self._ARRAYS}
+        payload["format_version"] = np.array(FORMAT_VERSION)
+        payload["body_names"] = np.array(self.body_names, dtype=str)
+        payload["contact_names"] = np.array(self.contact_names, dtype=str)
+        payload["act_names"] = np.array(self.act_names, dtype=str)
+        for k, v in self.labels.items():
+            payload[f"label__{k}"] = np.asarray(v)
+        for k, v in self.info.items():
+            payload[f"info__{k}"] = np.asarray(v)
+        atomic_write(path, lambda f: np.savez_compressed(f, **payload))
+        return path
+
+    @classmethod
+    def load(cls, path) -> "Trajectory":
+        path = Path(path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                data = {k: z[k] for k in z.files}
+        except FileNotFoundError:
+            raise
+        except Exception as e:  # zipfile.BadZipFile, ValueError, EOFError, OSError ...
+            raise ValueError(f"{path}: not a readable planarsim trajectory (truncated or corrupted?): {e}") from None
+        version = int(data.get("format_version", -1))
+        if version != FORMAT_VERSION:
+            raise ValueError(f"{path}: trajectory format version {version}; this planarsim reads "
+                             f"version {FORMAT_VERSION}")
+        missing = [k for k in cls._ARRAYS if k not in data]
+        if missing:
+            raise ValueError(f"{path}: trajectory is missing arrays {missing}")
+        return cls(**{k: data[k] for k in cls._ARRAYS},
+                   body_names=tuple(data["body_names"].tolist()),
+                   contact_names=tuple(data["contact_names"].tolist()),
+                   act_names=tuple(data["act_names"].tolist()),
+                   labels={k[7:]: data[k] for k in data if k.startswith("label__")},
+                   info={k[6:]: data[k].item() if data[k].ndim == 0 else data[k]
+                         for k in data if k.startswith("info__")})
+
+    def to_csv(self, path) -> Path:
+        """One row per frame: t, then x, y, theta, vx, vy, omega of every body, contact modes."""
+        path = Path(path)
+        cols = ["t"]
+        blocks = [self.t[:, None]]
+        for i, name in enumerate(self.body_names or [f"body{i}" for i in range(self.q.shape[1])]):
+            cols += [f"{name}.{c}" for c in ("x", "y", "theta", "vx", "vy", "omega")]
+            blocks += [self.q[:, i, :], self.v[:, i, :]]
+        for i, name in enumerate(self.contact_names):
+            cols.append(f"{name}.mode")
+            blocks.append(self.contact_mode[:, i:i + 1])
+        for k, v in self.labels.items():
+            v = np.asarray(v)
+            if v.ndim == 1 and len(v) == len(self.t):
+                cols.append(k)
+                blocks.append(v[:, None])
+        table = np.hstack([np.asarray(b, dtype=np.float64) for b in blocks])
+        atomic_write(path, lambda f: np.savetxt(f, table, delimiter=",", header=",".join(cols),
+                                                comments="", fmt="%.10g"), binary=False)
+        return path
+
+
+def atomic_write(path, write, binary=True) -> None:
+    """Call write(fileobj) on a temporary file beside `path`, then rename it over `path`.
+
+    An interrupted write (error, Ctrl-C) leaves no file under the final name.
+    """
+    path = Path(path)
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise OSError(f"cannot write {str(path)!r}: folder {str(parent)!r} does not exist")
+    if not os.access(parent, os.W_OK):
+        raise OSError(f"cannot write {str(path)!r}: folder {str(parent)!r} is not writable")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=parent)
+    try:
+        with os.fdopen(fd, "wb" if binary else "w") as f:
+            write(f)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise

@@ -1,0 +1,27 @@
+"""Shared fixtures: tiny canonical models."""
+import math
+
+import numpy as np
+import pytest
+
+import planarsim as ps
+
+
+def make_chain(n_links=4, length=0.5, mass=1.0, dt=1e-3, gravity=(0.0, -9.81), limit=None):
+    """Pendulum chain of thin rods pinned end to end, link 0 pinned to the world at the origin,
+    all links horizontal (along +x) at rest."""
+    b = ps.ModelBuilder(dt=dt, gravity=gravity)
+    prev = None
+    for i in range(n_links):
+        body = b.add_body(f"link{i}", mass=mass, inertia=mass * length ** 2 / 12,
+                          pos=((i + 0.5) * length, 0.0),
+                          shapes=[("capsule", (-length / 2, 0.0), (length / 2, 0.0), 0.02)])
+        b.add_pin(f"pin{i}", prev, body, anchor_world=(i * length, 0.0),
+                  limit=limit if i > 0 else None)
+        prev = body
+    return b.compile()
+
+
+@pytest.fixture
+def chain4():
+    return make_chain(4)
