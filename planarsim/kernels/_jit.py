@@ -22,32 +22,40 @@ jit = njit(**_OPTIONS)
 jit_inline = njit(inline="always", **_OPTIONS)
 
 
-def _drop_stale_caches():
-    here = Path(__file__).resolve().parent
-    roots = [here.parent, here.parent.parent / "walkers"]
-    digest = hashlib.blake2b(digest_size=16)
-    for root in roots:
-        if not root.is_dir():
-            continue
-        for path in sorted(root.rglob("*.py")):
-            digest.update(str(path.relative_to(root)).encode())
-            digest.update(path.read_bytes())
-    stamp = here / "__pycache__" / "kernel_sources.hash"
-    new = digest.hexdigest()
+def _sources_hash(folder: Path, extra: str = "") -> str:
+    digest = hashlib.blake2b(extra.encode(), digest_size=16)
+    for path in sorted(folder.rglob("*.py")):
+        digest.update(str(path.relative_to(folder)).encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+KERNEL_HASH = _sources_hash(Path(__file__).resolve().parent)
+
+
+def drop_stale_caches(folder, clear=None) -> None:
+    """Clear the numba caches below `clear` (default `folder`) when the sources of `folder`
+    or of planarsim's kernels changed since the caches were written.
+
+    Walker packages call this on import with their own folder, since their rollout kernels
+    link the engine's step and their controller files.
+    """
+    folder = Path(folder).resolve()
+    clear = folder if clear is None else Path(clear).resolve()
+    new = _sources_hash(folder, KERNEL_HASH)
+    stamp = folder / "__pycache__" / "numba_sources.hash"
     try:
         if stamp.exists() and stamp.read_text() == new:
             return
-        for root in roots:
-            if root.is_dir():
-                for pattern in ("*.nbi", "*.nbc"):
-                    for f in root.rglob(pattern):
-                        f.unlink(missing_ok=True)
+        for pattern in ("*.nbi", "*.nbc"):
+            for f in clear.rglob(pattern):
+                f.unlink(missing_ok=True)
         stamp.parent.mkdir(exist_ok=True)
         tmp = stamp.with_suffix(f".{os.getpid()}.tmp")
         tmp.write_text(new)
         os.replace(tmp, stamp)
     except OSError:
-        pass  # read-only install: sources cannot change there either
+        pass  # read-only install: its sources cannot change either
 
 
-_drop_stale_caches()
+drop_stale_caches(Path(__file__).resolve().parent, clear=Path(__file__).resolve().parent.parent)
