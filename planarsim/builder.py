@@ -344,10 +344,18 @@ class ModelBuilder:
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:
         """Validate and freeze into a Model."""
-        dt = _scalar("model", "model", 0, "dt", self.dt)
-        if not dt > 0:
+        try:
+            dt = float(self.dt)
+        except (TypeError, ValueError):
+            raise ModelError(f"model: dt={self.dt!r} must be a number") from None
+        if not (math.isfinite(dt) and dt > 0):
             raise ModelError(f"model: dt={dt} must be finite and > 0")
-        g = _vec2("model", "model", 0, "gravity", self.gravity)
+        try:
+            g = np.asarray(self.gravity, dtype=np.float64).reshape(2)
+        except (TypeError, ValueError):
+            raise ModelError(f"model: gravity={self.gravity!r} must be a pair (gx, gy)") from None
+        if not np.all(np.isfinite(g)):
+            raise ModelError(f"model: gravity={tuple(g)} must be finite")
         if not isinstance(self.terrain, Terrain):
             raise ModelError(f"model: terrain={self.terrain!r} must be a planarsim.terrain.Terrain")
         if not self._bodies:

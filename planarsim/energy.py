@@ -4,14 +4,19 @@ from __future__ import annotations
 import numpy as np
 
 
-def kinetic_energy(model, q, v) -> float:
-    """sum 1/2 m |v|^2 + 1/2 I w^2 [J]."""
+def _scalar_or_array(x):
+    return float(x) if np.ndim(x) == 0 else x
+
+
+def kinetic_energy(model, q, v):
+    """sum 1/2 m |v|^2 + 1/2 I w^2 [J]; q, v of shape (..., n_body, 3)."""
     a = model.arrays
     v = np.asarray(v)
-    return float(0.5 * np.sum(a.body_mass * (v[..., 0] ** 2 + v[..., 1] ** 2) + a.body_inertia * v[..., 2] ** 2, axis=-1))
+    ke = 0.5 * np.sum(a.body_mass * (v[..., 0] ** 2 + v[..., 1] ** 2) + a.body_inertia * v[..., 2] ** 2, axis=-1)
+    return _scalar_or_array(ke)
 
 
-def potential_energy(model, q, v=None) -> float:
+def potential_energy(model, q, v=None):
     """-sum m g.x plus pin-spring energy 1/2 k (angle - rest)^2 [J]."""
     a = model.arrays
     q = np.asarray(q)
@@ -22,7 +27,7 @@ def potential_energy(model, q, v=None) -> float:
             ba, bb = a.pin_body[j]
             ang = q[..., bb, 2] - a.pin_ref[j] - (q[..., ba, 2] if ba >= 0 else 0.0)
             pe = pe + 0.5 * k * (ang - a.pin_rest[j]) ** 2
-    return pe
+    return _scalar_or_array(pe)
 
 
 def total_energy(model, q, v):

@@ -100,6 +100,7 @@ class Workspace(NamedTuple):
     act_power: np.ndarray        # (n_act,) mechanical power [W]
     info: np.ndarray             # (8,) int: mode iterations, ccd splits, guard body, guard field, ...
     guard_value: np.ndarray      # (1,) offending value when a guard fired
+    impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)
 
 
@@ -118,4 +119,4 @@ def make_workspace(model: Model) -> Workspace:
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam=z(R), act_u=z(na), act_power=z(na),
-                     info=z(8, np.int64), guard_value=z(1), prev=make_state(model))
+                     info=z(8, np.int64), guard_value=z(1), impact_time=z(1), prev=make_state(model))

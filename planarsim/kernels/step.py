@@ -75,17 +75,18 @@ def step(m, s, ws, opt, u):
         find_contacts(m, s, ws)
         ccd_on = split < opt.max_ccd_splits
         solve_modes(m, s, ws, opt, h, not ccd_on)
+        late_hit = -1
         if ccd_on:
             tau, hit = time_of_impact(m, s, ws, h)
             if hit >= 0 and tau >= h * (1.0 - 1e-9):
                 # impact at the very end of the step: finish it, pinned from the next step
-                integrate_positions(s, ws.v_new, h)
-                s.contact_mode[hit] = MODE_PINNED
-                break
-            if hit >= 0:
+                late_hit = hit
+                ws.impact_time[0] = s.time[0] + h
+            elif hit >= 0:
                 # split the step at the impact and pin the contact for the rest of it
                 advance_to_impact(s, ws, h, tau)
                 s.time[0] += tau
+                ws.impact_time[0] = s.time[0]
                 h -= tau
                 s.contact_mode[hit] = MODE_PINNED
                 ws.info[1] += 1
@@ -93,6 +94,8 @@ def step(m, s, ws, opt, u):
         integrate_positions(s, ws.v_new, h)
         if opt.refine_iters > 0:
             correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol, opt.pivot_tol)
+        if late_hit >= 0:
+            s.contact_mode[late_hit] = MODE_PINNED
         break
     s.time[0] = ws.prev.time[0] + m.dt
     s.step[0] += 1

@@ -48,12 +48,24 @@ def normal_at(coef, x):
 
 
 @jit
+def max_curvature(coef):
+    """Upper bound on |h''| [1/m]: sum_k A_k (2 pi / L_k)^2."""
+    acc = 0.0
+    for k in range(int(coef[2])):
+        w = TWO_PI / coef[4 + 3 * k]
+        acc += abs(coef[3 + 3 * k]) * w * w
+    return acc
+
+
+@jit
 def closest_point(coef, px, py):
     """Closest ground point to (px, py) and the signed gap along its normal.
 
-    Newton on f(x) = (x - px) + (h(x) - py) h'(x) = 0 (stationarity of the squared distance),
-    started at x = px; each step clamped to the vertical distance |py - h(px)|, an upper bound
-    on how far the closest point can lie. Exact (one iteration) for flat and sloped ground.
+    The closest point lies within |py - h(px)| of px horizontally. Where that distance times
+    the largest curvature is small the squared distance has one minimum there and Newton on
+    f(x) = (x - px) + (h(x) - py) h'(x) = 0 started at px finds it; otherwise (far above a
+    tight hill) the interval is sampled first and Newton starts from the nearest sample.
+    Exact (one iteration) for flat and sloped ground.
 
     Returns (gx, gy, nx, ny, gap): ground point [m], unit normal, gap = n.(p - g) [m]
     (negative below the ground).
@@ -61,6 +73,16 @@ def closest_point(coef, px, py):
     x = px
     h, dh, ddh = height_derivs(coef, x)
     bound = abs(py - h) + 1e-12
+    if bound * max_curvature(coef) > 0.5:
+        best = (h - py) * (h - py)
+        for k in range(-16, 17):
+            xs = px + bound * k / 16.0
+            hs = height(coef, xs)
+            d2 = (xs - px) * (xs - px) + (hs - py) * (hs - py)
+            if d2 < best:
+                best = d2
+                x = xs
+        h, dh, ddh = height_derivs(coef, x)
     for _ in range(30):
         f = (x - px) + (h - py) * dh
         fp = 1.0 + dh * dh + (h - py) * ddh

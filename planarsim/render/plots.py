@@ -1,0 +1,234 @@
+"""Plots of a recorded run: joint angles and rates, energy, actuator power and cost of
+transport, contact-mode timeline per contact, phase portraits; saved as PNG, SVG or PDF.
+
+Joint angle of pin j: theta_b - theta_a - ref [rad] (the engine's definition), rate
+omega_b - omega_a [rad/s]. A model without pins (point-mass walkers) shows the angle of each
+rod and axial actuator segment a -> b from the downward vertical instead, with its rate
+(r x (v_b - v_a)) / |r|^2.
+
+Cost of transport (seed 002, eq. 17): CoT = P / (m g v), with P the actuators' positive
+mechanical power sum_i max(P_i, 0) [W] (negative work is not recovered) unless a power series
+is given (e.g. Ranger's electrical power); averaged as the positive work over m g times the
+distance travelled by the COM.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..model import ACT_AXIAL
+from ..trajectory import atomic_write
+
+FIGURE_FORMATS = ("png", "svg", "pdf")
+MODE_COLORS = {-1: "#bbbbbb", 0: "#ffffff", 1: "#2ca02c", 2: "#ff7f0e"}
+MODE_LABELS = {-1: "disabled", 0: "free", 1: "pinned", 2: "sliding"}
+
+
+def new_figure(nrows=1, ncols=1, size=(8.0, 4.0), **kw):
+    """A figure with an Agg canvas (no GUI needed) and its axes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=size, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
+    return fig, axes
+
+
+def save_figure(fig, path, dpi: int = 120) -> Path:
+    """Save `fig` as PNG, SVG or PDF according to the extension of `path`, atomically."""
+    path = Path(path)
+    fmt = path.suffix.lower().lstrip(".")
+    if fmt not in FIGURE_FORMATS:
+        raise ValueError(f"cannot save a figure as {str(path)!r}: extension {path.suffix or '(none)'!r} "
+                         f"unknown; use one of {', '.join('.' + f for f in FIGURE_FORMATS)}")
+    atomic_write(path, lambda f: fig.savefig(f, format=fmt, dpi=dpi))
+    return path
+
+
+# series --------------------------------------------------------------------------------------
+def joint_series(traj, model) -> dict:
+    """{name: (angle (K,) [rad], rate (K,) [rad/s])} for every pin, else for every rod and
+    axial actuator segment (angle from the downward vertical)."""
+    a = model.arrays
+    out = {}
+    q, v = traj.q, traj.v
+    for j, name in enumerate(model.pin_names):
+        ba, bb = a.pin_body[j]
+        th_a = q[:, ba, 2] if ba >= 0 else 0.0
+        w_a = v[:, ba, 2] if ba >= 0 else 0.0
+        out[name] = (q[:, bb, 2] - th_a - a.pin_ref[j], v[:, bb, 2] - w_a)
+    if out:
+        return out
+    segs = [(n, a.rod_body[j], a.rod_anchor[j]) for j, n in enumerate(model.rod_names)]
+    segs += [(model.act_names[j], a.act_body[j, :2], a.act_anchor[j])
+             for j in range(model.n_act) if a.act_kind[j] == ACT_AXIAL]
+    for name, bodies, anchors in segs:
+        p, pv = [], []
+        for side in range(2):
+            b, loc = bodies[side], anchors[side]
+            if b < 0:
+                p.append(np.broadcast_to(loc, (len(q), 2)))
+                pv.append(np.zeros((len(q), 2)))
+                continue
+            c, s = np.cos(q[:, b, 2]), np.sin(q[:, b, 2])
+            r = np.column_stack([c * loc[0] - s * loc[1], s * loc[0] + c * loc[1]])
+            p.append(q[:, b, :2] + r)
+            pv.append(v[:, b, :2] + v[:, b, 2:3] * np.column_stack([-r[:, 1], r[:, 0]]))
+        d, dv = p[1] - p[0], pv[1] - pv[0]
+        ang = np.arctan2(d[:, 0], -d[:, 1])
+        rate = (d[:, 0] * dv[:, 1] - d[:, 1] * dv[:, 0]) / np.maximum((d * d).sum(axis=1), 1e-300)
+        out[name] = (np.unwrap(ang), rate)
+    return out
+
+
+def cost_of_transport(traj, model, power=None):
+    """(instantaneous CoT (K,) [-], averaged CoT [-]) from positive actuator power, or from
+    `power` (K,) [W]. The average is work / (m g |x_end - x_start|) (nan if the COM did not move)."""
+    if power is None:
+        power = np.clip(traj.act_power, 0.0, None).sum(axis=1) if traj.act_power.size else np.zeros(len(traj.t))
+    power = np.asarray(power, float)
+    weight = model.total_mass * float(np.hypot(*model.arrays.gravity))
+    speed = traj.com_velocity(model)[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inst = power / (weight * np.abs(speed))
+    inst[~np.isfinite(inst)] = np.nan
+    com = traj.com(model)
+    dist = abs(com[-1, 0] - com[0, 0]) if len(com) else 0.0
+    work = float(np.trapezoid(power, traj.t)) if len(traj.t) > 1 else 0.0
+    avg = work / (weight * dist) if dist > 1e-12 and weight > 0 else math.nan
+    return inst, avg
+
+
+# single panels -------------------------------------------------------------------------------
+def plot_joint_angles(traj, model, ax=None, rate_ax=None):
+    """Joint angles [deg] on `ax` and rates [deg/s] on `rate_ax` against time."""
+    if ax is None:
+        fig, axes = new_figure(2, 1, size=(8, 5), sharex=True)
+        ax, rate_ax = axes[0, 0], axes[1, 0]
+    for name, (ang, rate) in joint_series(traj, model).items():
+        ax.plot(traj.t, np.degrees(ang), label=name)
+        if rate_ax is not None:
+            rate_ax.plot(traj.t, np.degrees(rate), label=name)
+    ax.set_ylabel("angle [deg]")
+    ax.set_title("joint angles" if model.n_pin else "segment angles (from vertical)")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, ncols=2)
+    if rate_ax is not None:
+        rate_ax.set_ylabel("rate [deg/s]")
+        rate_ax.set_xlabel("time [s]")
+    return ax
+
+
+def plot_energy(traj, model, ax=None):
+    """Kinetic, potential and total mechanical energy [J] against time."""
+    if ax is None:
+        ax = new_figure()[1][0, 0]
+    e = traj.energy(model)
+    for key, style in (("kinetic", "-"), ("potential", "--"), ("total", "-")):
+        ax.plot(traj.t, e[key], style, label=key, lw=2.0 if key == "total" else 1.2)
+    ax.set_ylabel("energy [J]")
+    ax.set_xlabel("time [s]")
+    ax.set_title("mechanical energy")
+    ax.legend(fontsize=7)
+    return ax
+
+
+def plot_power(traj, model, ax=None, cot_ax=None, power=None):
+    """Actuator power [W] per actuator and, on `cot_ax`, the instantaneous cost of transport."""
+    if ax is None:
+        fig, axes = new_figure(2, 1, size=(8, 5), sharex=True)
+        ax, cot_ax = axes[0, 0], axes[1, 0]
+    for j, name in enumerate(model.act_names):
+        ax.plot(traj.t, traj.act_power[:, j], label=name, lw=1.0)
+    ax.set_ylabel("power [W]")
+    ax.set_title("actuator power" if model.n_act else "actuator power (no actuators)")
+    if model.n_act:
+        ax.legend(fontsize=7, ncols=2)
+    if cot_ax is not None:
+        inst, avg = cost_of_transport(traj, model, power)
+        cot_ax.plot(traj.t, inst, lw=1.0, color="k")
+        cot_ax.set_ylabel("CoT [-]")
+        cot_ax.set_xlabel("time [s]")
+        cot_ax.set_title(f"cost of transport (average {avg:.3g})" if math.isfinite(avg)
+                         else "cost of transport (COM did not move)")
+        finite = inst[np.isfinite(inst)]
+        if finite.size:
+            cot_ax.set_ylim(0, max(1e-3, 3 * np.percentile(finite, 90)))
+    return ax
+
+
+def plot_contact_modes(traj, model, ax=None):
+    """One bar per contact coloured by mode (free, pinned, sliding, disabled) against time."""
+    if ax is None:
+        ax = new_figure(size=(8, 0.5 + 0.35 * max(1, model.n_contact)))[1][0, 0]
+    t = traj.t
+    edges = np.r_[t, t[-1] + (t[-1] - t[-2] if len(t) > 1 else model.dt)] if len(t) else np.zeros(1)
+    for i in range(model.n_contact):
+        modes = traj.contact_mode[:, i]
+        change = np.flatnonzero(np.diff(modes)) + 1
+        starts = np.r_[0, change]
+        ends = np.r_[change, len(modes)]
+        for s, e in zip(starts, ends):
+            mode = int(modes[s])
+            if mode == 0:
+                continue
+            ax.broken_barh([(edges[s], edges[e] - edges[s])], (i - 0.4, 0.8),
+                           facecolors=MODE_COLORS.get(mode, "k"))
+    ax.set_yticks(range(model.n_contact), model.contact_names, fontsize=7)
+    ax.set_ylim(-0.6, model.n_contact - 0.4)
+    ax.set_xlim(edges[0], edges[-1])
+    ax.set_xlabel("time [s]")
+    ax.set_title("contact modes")
+    from matplotlib.patches import Patch
+    ax.legend(handles=[Patch(facecolor=MODE_COLORS[m], edgecolor="k", label=MODE_LABELS[m]) for m in (1, 2, -1)],
+              fontsize=7, loc="upper right", ncols=3)
+    return ax
+
+
+def plot_phase_portraits(traj, model, ax=None, names=None):
+    """Rate against angle for each joint (or segment) in `names` (default: all)."""
+    if ax is None:
+        ax = new_figure(size=(5, 5))[1][0, 0]
+    series = joint_series(traj, model)
+    for name in (names or series):
+        if name not in series:
+            raise KeyError(f"phase portrait: no joint or segment named {name!r}; have {list(series)}")
+        ang, rate = series[name]
+        ax.plot(np.degrees(ang), np.degrees(rate), lw=0.9, label=name)
+        if len(ang):
+            ax.plot(np.degrees(ang[:1]), np.degrees(rate[:1]), "o", ms=3, color="k")
+    ax.set_xlabel("angle [deg]")
+    ax.set_ylabel("rate [deg/s]")
+    ax.set_title("phase portraits")
+    if series:
+        ax.legend(fontsize=7)
+    return ax
+
+
+def plot_summary(traj, model, path=None, power=None, size=(11, 12)):
+    """All panels on one figure; saved to `path` (.png/.svg/.pdf) if given. Returns the figure."""
+    if path is not None:
+        _check_figure_path(path)
+    fig, axes = new_figure(4, 2, size=size)
+    ang_ax, rate_ax = axes[0, 0], axes[1, 0]
+    rate_ax.sharex(ang_ax)
+    plot_joint_angles(traj, model, ang_ax, rate_ax)
+    plot_phase_portraits(traj, model, axes[0, 1])
+    plot_energy(traj, model, axes[1, 1])
+    plot_power(traj, model, axes[2, 0], axes[2, 1], power=power)
+    gs = axes[3, 0].get_gridspec()
+    for a in axes[3]:
+        a.remove()
+    plot_contact_modes(traj, model, fig.add_subplot(gs[3, :]))
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def _check_figure_path(path):
+    fmt = Path(path).suffix.lower().lstrip(".")
+    if fmt not in FIGURE_FORMATS:
+        raise ValueError(f"cannot save a figure as {str(path)!r}: extension {Path(path).suffix or '(none)'!r} "
+                         f"unknown; use one of {', '.join('.' + f for f in FIGURE_FORMATS)}")

@@ -1,0 +1,116 @@
+"""Issue 2: analytic pendulum periods, chain pin residuals and energy drift."""
+import math
+
+import numpy as np
+import pytest
+from scipy.special import ellipk
+
+import planarsim as ps
+from tests.conftest import make_chain
+
+G = 9.81
+
+
+def rod_pendulum(theta0, dt, length=1.0, mass=1.0):
+    """Thin rod pinned at one end to the world, released at rest theta0 from hanging down."""
+    b = ps.ModelBuilder(dt=dt)
+    d = length / 2
+    rod = b.add_body("rod", mass=mass, inertia=mass * length ** 2 / 12,
+                     pos=(d * math.sin(theta0), -d * math.cos(theta0)), angle=theta0 - math.pi / 2)
+    b.add_pin("pivot", None, rod, anchor_world=(0.0, 0.0))
+    return b.compile()
+
+
+def measured_period(model, n_periods_time):
+    sim = ps.Simulator(model)
+    traj = sim.run(n_periods_time, record_every=1)
+    angle = traj.q[:, 0, 2] + math.pi / 2  # angle from hanging down
+    t = traj.t
+    # upward zero crossings of the angle, interpolated linearly
+    idx = np.nonzero((angle[:-1] < 0) & (angle[1:] >= 0))[0]
+    crossings = t[idx] + (t[idx + 1] - t[idx]) * (-angle[idx]) / (angle[idx + 1] - angle[idx])
+    assert len(crossings) >= 3
+    return np.mean(np.diff(crossings))
+
+
+def analytic_period(theta0, length=1.0):
+    # compound pendulum: I_pivot = m L^2 / 3, COM at L/2
+    omega0 = math.sqrt(G * (length / 2) / (length ** 2 / 3))
+    k = math.sin(theta0 / 2)
+    return 4.0 / omega0 * ellipk(k * k)
+
+
+def test_small_amplitude_period_within_0p2_percent():
+    theta0 = math.radians(2.0)
+    T = measured_period(rod_pendulum(theta0, 1e-3), 8.0)
+    T0 = 2 * math.pi / math.sqrt(G * 0.5 / (1 / 3))
+    err = abs(T - T0) / T0
+    print(f"small amplitude: T={T:.6f} s, analytic {T0:.6f} s, rel err {err:.2e}")
+    assert err < 2e-3
+
+
+def test_120_degree_period_matches_elliptic_integral_within_0p5_percent():
+    theta0 = math.radians(120.0)
+    T = measured_period(rod_pendulum(theta0, 1e-3), 10.0)
+    Ta = analytic_period(theta0)
+    err = abs(T - Ta) / Ta
+    print(f"120 deg: T={T:.6f} s, elliptic {Ta:.6f} s, rel err {err:.2e}")
+    assert err < 5e-3
+
+
+def pin_residuals(model, q):
+    """(K, n_pin) distance between the two anchors of every pin [m]."""
+    a = model.arrays
+    out = np.zeros((q.shape[0], model.n_pin))
+    for j in range(model.n_pin):
+        pts = []
+        for e in range(2):
+            body = a.pin_body[j, e]
+            lx, ly = a.pin_anchor[j, e]
+            if body < 0:
+                pts.append(np.broadcast_to([lx, ly], (q.shape[0], 2)))
+            else:
+                c, s = np.cos(q[:, body, 2]), np.sin(q[:, body, 2])
+                pts.append(np.stack([q[:, body, 0] + c * lx - s * ly, q[:, body, 1] + s * lx + c * ly], 1))
+        out[:, j] = np.hypot(*(pts[1] - pts[0]).T)
+    return out
+
+
+def chain_run(dt, refine=True, seconds=10.0, n=4):
+    model = make_chain(n, dt=dt)
+    sim = ps.Simulator(model, ps.make_options(refine=refine))
+    e0 = ps.total_energy(model, sim.state.q, sim.state.v)
+    traj = sim.run(seconds, record_every=1)
+    e = traj.energy(model)["total"]
+    scale = 1.0 * G * 0.5 * sum(i + 0.5 for i in range(n))  # PE drop horizontal -> hanging
+    return np.max(pin_residuals(model, traj.q)), np.max(np.abs(e - e0)) / scale
+
+
+def test_chain_pin_residual_below_1e_9_with_refinement():
+    res_on, drift_on = chain_run(1e-3, refine=True)
+    res_off, drift_off = chain_run(1e-3, refine=False)
+    print(f"4-link chain 10 s dt=1ms: residual {res_on:.2e} m (refine on), {res_off:.2e} m (off); "
+          f"energy error {drift_on:.2e} (on), {drift_off:.2e} (off)")
+    assert res_on <= 1e-9
+    assert res_off > res_on
+
+
+def test_chain_energy_error_small_and_first_order_in_dt():
+    errs = [chain_run(dt)[1] for dt in (1e-3, 5e-4, 2.5e-4)]
+    print("energy error / PE drop at dt = 1, 0.5, 0.25 ms:", ", ".join(f"{e:.3e}" for e in errs))
+    assert errs[0] <= 1e-2
+    # at least linear convergence: halving dt at least halves the error (5% slack for noise)
+    assert errs[1] <= 0.5 * errs[0] * 1.05
+    assert errs[2] <= 0.5 * errs[1] * 1.05
+
+
+def test_joint_limit_holds_for_a_chain_falling_against_it():
+    lo, hi = -0.3, 0.3
+    model = make_chain(3, dt=1e-3, limit=(lo, hi))
+    sim = ps.Simulator(model)
+    traj = sim.run(3.0, record_every=1)
+    rel = np.diff(traj.q[:, :, 2], axis=1)  # relative angles of pins 1, 2 (ref angle 0)
+    worst = max(np.max(lo - rel), np.max(rel - hi))
+    print(f"largest limit violation {worst:.2e} rad; reached {rel.min():.4f}..{rel.max():.4f}")
+    assert np.min(rel) < lo + 1e-3 or np.max(rel) > hi - 1e-3  # the limit was actually hit
+    assert worst <= 1e-6

@@ -1,0 +1,76 @@
+"""Terrain: exact heights, slopes and normals; compiled and numpy versions agree."""
+import math
+
+import numpy as np
+from hypothesis import given, settings, strategies as st
+
+from planarsim import terrain
+from planarsim.kernels.terrain import closest_point, height_derivs
+
+amps = st.lists(st.floats(0.0, 0.3), min_size=0, max_size=3)
+
+
+@st.composite
+def terrains(draw):
+    n = draw(st.integers(0, 3))
+    a = [draw(st.floats(0.0, 0.3)) for _ in range(n)]
+    lam = [draw(st.floats(0.5, 10.0)) for _ in range(n)]
+    phi = [draw(st.floats(-math.pi, math.pi)) for _ in range(n)]
+    grade = draw(st.floats(-0.3, 0.3))
+    return terrain.hills(a, lam, phi, grade=grade, height=draw(st.floats(-1, 1)))
+
+
+@settings(max_examples=200, deadline=None)
+@given(terrains(), st.floats(-50, 50))
+def test_normal_is_unit_and_orthogonal_to_tangent(ter, x):
+    n = ter.normal(x)
+    t = ter.tangent(x)
+    assert abs(np.hypot(*n) - 1.0) < 1e-14
+    assert abs(np.dot(n, t)) < 1e-14
+    assert n[1] > 0
+
+
+@settings(max_examples=200, deadline=None)
+@given(terrains(), st.floats(-50, 50))
+def test_slope_matches_central_difference(ter, x):
+    h = 1e-5
+    fd = (ter.height(x + h) - ter.height(x - h)) / (2 * h)
+    assert abs(fd - ter.slope(x)) < 1e-7
+
+
+@settings(max_examples=200, deadline=None)
+@given(terrains(), st.floats(-50, 50))
+def test_compiled_matches_numpy(ter, x):
+    h, dh, ddh = height_derivs(ter.coef, x)
+    assert abs(h - ter.height(x)) < 1e-12
+    assert abs(dh - ter.slope(x)) < 1e-12
+
+
+@settings(max_examples=200, deadline=None)
+@given(terrains(), st.floats(-20, 20), st.floats(-0.2, 0.5))
+def test_closest_point_is_the_nearest_ground_point(ter, px, dy):
+    py = float(ter.height(px)) + dy
+    gx, gy, nx, ny, gap = closest_point(ter.coef, px, py)
+    assert abs(gy - ter.height(gx)) < 1e-12
+    # no sampled ground point is closer than the one found
+    xs = np.linspace(px - 1.0, px + 1.0, 4001)
+    d = np.hypot(xs - px, ter.height(xs) - py)
+    assert abs(gap) <= d.min() + 1e-9
+    # the gap is signed: positive above the ground
+    if abs(dy) > 1e-9:
+        assert np.sign(gap) == np.sign(dy)
+
+
+def test_flat_and_slope_are_exact():
+    t = terrain.slope(10.0)
+    assert abs(t.slope(3.0) - math.tan(math.radians(10))) < 1e-15
+    gx, gy, nx, ny, gap = closest_point(t.coef, 1.0, 2.0)
+    expected = (2.0 - math.tan(math.radians(10))) * math.cos(math.radians(10))
+    assert abs(gap - expected) < 1e-14
+
+
+def test_default_hills_meet_the_seed_claim():
+    t = terrain.default_hills()
+    assert 11.0 < terrain.max_slope_deg(t) <= 12.0
+    x = np.linspace(0, 200, 200001)
+    assert np.ptp(t.height(x)) > 0.3
