@@ -149,9 +149,10 @@ class Scene:
     @property
     def view_height(self) -> float:
         """Height of the view [m], from the axes' aspect on screen."""
-        bbox = self.ax.get_window_extent() if self.ax.figure is not None else None
-        ratio = bbox.height / bbox.width if bbox is not None and bbox.width > 0 else 0.5625
-        return self.view_width * ratio
+        fig = self.ax.figure
+        pos = self.ax.get_position(original=True)   # before the equal-aspect adjustment
+        w_in, h_in = pos.width * fig.get_figwidth(), pos.height * fig.get_figheight()
+        return self.view_width * (h_in / w_in if w_in > 0 else 0.5625)
 
     def _fallback_shapes(self):
         """Rigid bodies without any shape get a disk of their radius of gyration."""

@@ -1,0 +1,323 @@
+"""Interactive viewer: a live Simulator drawn in real time or slow motion.
+
+Seed 002, sections 2.2-2.3: a GUI panel adjusts the gravity vector, the playback speed and the
+controller's gains and shows/hides the contact impulses; playback is held on time by a
+proportional-integral (PI) controller on the pause between frames, because a plain fixed
+pause drifts by the render time and the operating system's sleep error every frame.
+
+``FrameTimer`` (the PI law, with an injectable clock so tests drive it with a fake one):
+after frame k is on screen, its lateness e_k = (wall time - scheduled time k T) [s] gives the
+pause before the next frame
+
+    pause_k = T - kp e_k - ki sum_{i<=k} e_i      (clamped at >= 0; no windup while clamped)
+
+so the integral absorbs the steady render time and oversleep, the proportional term the
+jitter. A frame more than ``max_lag`` late is skipped rather than caught up.
+
+``Viewer`` steps ``sim`` with ``controller(sim) -> u`` (the Python path) by ``speed * T`` of
+simulated time per frame. Keys: space play/pause, right or '.' step one frame, 'i' impulses,
+'c' centre of mass, 'r' reset, and the gait keys (default w walk, s stand, j jump) which call
+``on_gait(name)``. Sliders: gravity [m/s^2], gravity tilt [deg], playback speed and one per
+entry of ``gains = {name: (min, max, getter, setter)}``. It runs headless (Agg canvas, events
+sent by a test) or on screen with :func:`view`.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from .camera import Camera
+from .draw import Scene
+
+DEFAULT_GAIT_KEYS = {"w": "walk", "s": "stand", "j": "jump"}
+
+
+class FrameTimer:
+    """PI-corrected frame timer (see module docstring).
+
+    period : frame interval T [s]; kp, ki : proportional and integral gains [-];
+    clock : callable returning seconds (default time.perf_counter); max_lag : lateness [s]
+    beyond which frames are skipped (default 5 T).
+    """
+
+    def __init__(self, period: float, kp: float = 0.7, ki: float = 0.2, clock=time.perf_counter,
+                 max_lag=None):
+        if not (math.isfinite(period) and period > 0):
+            raise ValueError(f"frame period={period} must be finite and > 0 s")
+        self.period, self.kp, self.ki, self.clock = float(period), float(kp), float(ki), clock
+        self.max_lag = 5.0 * self.period if max_lag is None else float(max_lag)
+        self.start()
+
+    def start(self) -> None:
+        """(Re)start the schedule now: frame 0 is due at once."""
+        self.wall0 = self.clock()
+        self.playback_time = 0.0      # scheduled time of the current frame [s]
+        self.integral = 0.0           # sum of lateness [s]
+        self.last_error = 0.0
+        self.frames = 0
+        self.skipped = 0
+
+    def wall_time(self) -> float:
+        """Seconds of wall time since start()."""
+        return self.clock() - self.wall0
+
+    def frame_done(self) -> float:
+        """Call when the current frame is on screen. Returns the pause [s] before the next frame
+        and advances the schedule by one period (or more, when frames must be skipped)."""
+        e = self.wall_time() - self.playback_time
+        if e > self.max_lag:
+            skip = int(e // self.period)
+            self.playback_time += skip * self.period
+            self.skipped += skip
+            e -= skip * self.period
+        self.last_error = e
+        integral = self.integral + e
+        pause = self.period - self.kp * e - self.ki * integral
+        if pause >= 0.0:
+            self.integral = integral   # no windup while the pause is clamped
+        pause = max(0.0, pause)
+        self.playback_time += self.period
+        self.frames += 1
+        return pause
+
+
+class Viewer:
+    """Live view of a Simulator with play/pause, stepping, sliders and gait keys.
+
+    Parameters
+    ----------
+    sim : Simulator (stepped in place)
+    controller : callable(sim) -> u (n_act,) or None (no commands)
+    fps : frames per second on screen; speed : simulated seconds per wall second
+    control_every : steps between controller calls
+    gains : {name: (min, max, getter, setter)} sliders for controller gains
+    gait_keys : {key: gait name}; on_gait : callable(name) called on those keys
+    labels : callable(sim) -> dict shown in the overlay (e.g. {'gait': 1})
+    fig : a matplotlib Figure to draw into (default: a headless Agg figure)
+    clock : time source for the FrameTimer (tests pass a fake one)
+    scene_kw : options of Scene (view_width, tick_spacing, label_names, style, ...)
+    """
+
+    def __init__(self, sim, controller=None, fps: float = 30.0, speed: float = 1.0, control_every: int = 1,
+                 gains=None, gait_keys=None, on_gait=None, labels=None, fig=None, camera=None,
+                 clock=time.perf_counter, **scene_kw):
+        if control_every < 1:
+            raise ValueError(f"control_every={control_every} must be >= 1 step")
+        self.sim, self.controller, self.labels = sim, controller, labels
+        self.control_every = int(control_every)
+        self.speed = _check_speed(speed)
+        self.gains = dict(gains or {})
+        for name, spec in self.gains.items():
+            if len(spec) != 4 or not (callable(spec[2]) and callable(spec[3])) or not spec[0] < spec[1]:
+                raise ValueError(f"gain {name!r}: expected (min, max, getter, setter) with min < max")
+        self.gait_keys = dict(DEFAULT_GAIT_KEYS if gait_keys is None else gait_keys)
+        self.on_gait = on_gait
+        self.gait = None
+        self.playing = False
+        self.message = ""
+        self.timer = FrameTimer(1.0 / float(fps), clock=clock)
+        self.camera = camera if camera is not None else Camera()
+        self._carry = 0.0
+        self._drawn_t = sim.t
+        self._initial = sim.snapshot()
+        self._model0 = sim.model
+        g = np.asarray(sim.model.arrays.gravity, float)
+        self.gravity = float(np.hypot(*g))
+        self.tilt_deg = float(np.degrees(np.arctan2(g[0], -g[1]))) if self.gravity > 0 else 0.0
+        self.fig = fig if fig is not None else _headless_figure(6.4, 3.6 + 0.3 * (3 + len(self.gains)))
+        self._layout(scene_kw)
+        self.draw()
+
+    # layout -----------------------------------------------------------------------------------
+    def _layout(self, scene_kw):
+        from matplotlib.widgets import Button, Slider
+        fig = self.fig
+        n_sliders = 3 + len(self.gains)
+        h_in = fig.get_figheight()
+        row = 0.3 / h_in                       # slider row height as a figure fraction
+        panel = row * (n_sliders + 1.5)
+        self.ax = fig.add_axes((0.0, panel, 1.0, 1.0 - panel))
+        self.ax.set_axis_off()
+        self.scene = Scene(self.sim.model, self.ax, **scene_kw)
+        self.sliders = {}
+
+        def slider(i, label, lo, hi, val, fn):
+            sax = fig.add_axes((0.25, panel - row * (i + 1.2), 0.6, row * 0.7))
+            s = Slider(sax, label, lo, hi, valinit=val)
+            s.on_changed(fn)
+            self.sliders[label] = s
+            return s
+
+        slider(0, "gravity [m/s2]", 0.0, max(20.0, 1.5 * self.gravity), self.gravity,
+               lambda v: self.set_gravity(v, self.tilt_deg))
+        slider(1, "tilt [deg]", -20.0, 20.0, self.tilt_deg, lambda v: self.set_gravity(self.gravity, v))
+        slider(2, "speed [x]", 0.05, 4.0, self.speed, self.set_speed)
+        for i, (name, (lo, hi, get, set_)) in enumerate(self.gains.items()):
+            slider(3 + i, name, lo, hi, float(get()), set_)
+        y = panel - row * (n_sliders + 1.2)
+        self.buttons = {}
+        for j, (label, fn) in enumerate((("play/pause", self.toggle), ("step", self.step_frame),
+                                         ("impulses", self.toggle_impulses), ("reset", self.reset))):
+            bax = fig.add_axes((0.02 + 0.245 * j, max(0.0, y), 0.225, row * 0.8))
+            b = Button(bax, label)
+            b.on_clicked(lambda event, fn=fn: fn())
+            self.buttons[label] = b
+        self._cid = fig.canvas.mpl_connect("key_press_event", self.on_key)
+
+    # actions ----------------------------------------------------------------------------------
+    def on_key(self, event) -> None:
+        key = event.key
+        if key == " ":
+            self.toggle()
+        elif key in ("right", "."):
+            self.step_frame()
+        elif key == "i":
+            self.toggle_impulses()
+        elif key == "c":
+            self.scene.show_com = not self.scene.show_com
+            self.draw()
+        elif key == "r":
+            self.reset()
+        elif key in self.gait_keys:
+            self.set_gait(self.gait_keys[key])
+
+    def set_gait(self, name: str) -> None:
+        self.gait = name
+        if self.on_gait is not None:
+            self.on_gait(name)
+        self.draw()
+
+    def toggle(self) -> None:
+        self.playing = not self.playing
+        if self.playing:
+            self.timer.start()
+
+    def toggle_impulses(self) -> None:
+        self.scene.show_impulses = not self.scene.show_impulses
+        self.draw()
+
+    def set_speed(self, speed) -> None:
+        self.speed = _check_speed(speed)
+
+    def set_gravity(self, magnitude, tilt_deg=0.0) -> None:
+        """Gravity of `magnitude` [m/s^2] tilted by `tilt_deg` from straight down (+: toward +x)."""
+        self.gravity, self.tilt_deg = float(magnitude), float(tilt_deg)
+        a = math.radians(self.tilt_deg)
+        g = np.array([self.gravity * math.sin(a), -self.gravity * math.cos(a)])
+        g.setflags(write=False)
+        m = self.sim.model
+        self.sim.model = dataclasses.replace(m, arrays=m.arrays._replace(gravity=g))
+
+    def reset(self) -> None:
+        """Back to the state the viewer started from (gravity and sliders kept)."""
+        self.sim.restore(self._initial)
+        self.camera.position = None
+        self._drawn_t = self.sim.t
+        self._carry = 0.0
+        self.message = ""
+        self.draw()
+
+    def step_frame(self) -> None:
+        """Advance one frame (speed x frame period of simulated time) and draw it."""
+        self.advance(self.timer.period * self.speed)
+        self.draw()
+
+    def advance(self, sim_seconds: float) -> int:
+        """Step the simulation by `sim_seconds` [s] (whole steps; the remainder carries over).
+        Returns the number of steps taken. A diverged simulation pauses with a message."""
+        from ..errors import SimulationDiverged
+        dt = self.sim.model.dt
+        want = self._carry + sim_seconds / dt
+        n = int(math.floor(want + 1e-9))
+        self._carry = want - n
+        done = 0
+        try:
+            while done < n:
+                chunk = min(self.control_every, n - done)
+                u = self.controller(self.sim) if self.controller is not None else None
+                if chunk == 1:
+                    self.sim.step(u)
+                else:
+                    self.sim.steps(chunk, u)
+                done += chunk
+        except SimulationDiverged as e:
+            self.playing = False
+            self.message = f"stopped: {e}"
+        return done
+
+    # drawing and the clock --------------------------------------------------------------------
+    def draw(self):
+        sim = self.sim
+        q = sim.state.q
+        com = self.scene.com_of(q)
+        # the camera moves in simulated time, like the exported animations
+        center = self.camera.update(com, max(0.0, sim.t - self._drawn_t))
+        self._drawn_t = sim.t
+        labels = dict(self.labels(sim)) if self.labels is not None else {}
+        if self.gait is not None:
+            labels.setdefault("gait", self.gait)
+        mass = sim.model.arrays.body_mass
+        speed = float(mass @ sim.state.v[:, 0] / mass.sum())
+        arts = self.scene.draw_state(q, center=center, t=sim.t, contact_point=sim.ws.contact_point,
+                                     contact_impulse=sim.ws.contact_impulse, labels=labels, speed=speed)
+        if self.message:
+            self.scene.text.set_text(self.scene.text.get_text() + "\n" + self.message[:120])
+        self.fig.canvas.draw_idle()
+        return arts
+
+    def tick(self) -> float:
+        """One frame of playback: advance (when playing), draw, and return the PI-corrected pause
+        [s] before the next frame."""
+        if self.playing:
+            self.advance(self.timer.period * self.speed)
+        self.draw()
+        return self.timer.frame_done() if self.playing else self.timer.period
+
+    def show(self) -> None:
+        """Run on screen (needs an interactive matplotlib backend; use :func:`view`)."""
+        import matplotlib.pyplot as plt
+        ours = {" ", "right", ".", "i", "c", "r", *self.gait_keys}
+        for key in [k for k in plt.rcParams if k.startswith("keymap.")]:
+            plt.rcParams[key] = [k for k in plt.rcParams[key] if k not in ours]
+        timer = self.fig.canvas.new_timer(interval=int(1000 * self.timer.period))
+        timer.single_shot = True
+
+        def on_timer():
+            pause = self.tick()
+            timer.interval = max(1, int(round(1000 * pause)))
+            timer.start()
+
+        timer.add_callback(on_timer)
+        self._gui_timer = timer
+        self.playing = True
+        self.timer.start()
+        timer.start()
+        plt.show()
+
+
+def view(sim, controller=None, **kw) -> Viewer:
+    """Open the interactive viewer on screen for `sim` driven by `controller(sim) -> u`."""
+    import matplotlib.pyplot as plt
+    n_gains = len(kw.get("gains") or {})
+    fig = plt.figure(figsize=(8.0, 4.5 + 0.35 * (3 + n_gains)))
+    viewer = Viewer(sim, controller, fig=fig, **kw)
+    viewer.show()
+    return viewer
+
+
+def _check_speed(speed) -> float:
+    speed = float(speed)
+    if not (math.isfinite(speed) and speed > 0):
+        raise ValueError(f"playback speed={speed} must be finite and > 0 (1 real time, <1 slow motion)")
+    return speed
+
+
+def _headless_figure(w, h):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(w, h), dpi=100)
+    FigureCanvasAgg(fig)
+    return fig
