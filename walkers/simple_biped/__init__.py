@@ -1,0 +1,20 @@
+"""The Simple Biped (seed 002 sections 3-4): three point masses, STAND / WALK / JUMP.
+
+>>> from walkers import simple_biped as sb              # doctest: +SKIP
+>>> traj, summary, model = sb.simulate(20.0, gait="walk", speed=1.0)
+>>> w = sb.Walker(gait="stand"); w.run(2.0); w.set_gait("jump"); w.run(5.0)
+"""
+from planarsim.kernels._jit import drop_stale_caches
+
+drop_stale_caches(__path__[0])
+
+from .controller import Gait, State  # noqa: E402
+from .model import build  # noqa: E402
+from .params import SimpleBipedParams  # noqa: E402
+from .rollout import Walker, rollout_simple_biped, simulate  # noqa: E402
+
+NAME = "simple-biped"
+GAITS = tuple(g.name.lower() for g in Gait)
+
+__all__ = ["NAME", "GAITS", "Gait", "State", "SimpleBipedParams", "Walker", "build", "simulate",
+           "rollout_simple_biped"]

@@ -1,0 +1,290 @@
+"""The Simple Biped's hierarchical state machine (seed 002 section 4), compiled.
+
+Top level: the gait STAND / WALK / JUMP, requested through ``memory[M_GAIT]`` (settable from
+Python between rollout chunks). Each gait runs its own states:
+
+  STAND        double stance, PD on the hip position (above the middle of the feet)
+  WALK_DOUBLE  eq. 1: PD on the front (stance) leg length; eqs. 2-3: tangential force driving
+               the front leg rate to that of a pendulum with top speed v_top; the desired hip
+               force is split into the two axial leg forces (hip motor off)
+  WALK_SINGLE  phase s = (x_com - x_liftoff) / (x_strike - x_liftoff); the swing foot tracks a
+               4-point rectangle Bezier (top edge 4/3 clearance) through a virtual leg; the
+               stance leg holds its length; gravity compensation everywhere
+  CROUCH, THRUST, FLIGHT, LAND   the jump: crouch, push the hip up, hold the legs in the air,
+               absorb the landing; then crouch again while the gait is JUMP
+Transitions are contact and phase driven. Left/right is data: ``memory[M_STANCE]`` is the
+stance (front) foot index, the swing foot is ``1 - stance``.
+
+Deviations from the seed, stated: eq. 2 is used in its energy-consistent form
+phi_dot_target = -sqrt(v_top^2 + 2 g l (1 - cos phi)) / l (the pendulum passes the top at
+v_top); v_top is adapted once per step by an integral law so the mean speed meets the target;
+the expected strike height continues the slope seen between the feet (slope_trust = 0 gives
+the seed's level-ground guess).
+"""
+import math
+from enum import IntEnum
+
+from planarsim.kernels._jit import jit
+
+from walkers.common.bezier import rectangle_bezier
+from walkers.common.pd import clamp
+from . import params as P
+from .legs import hold_stance, leg_state, push_hip, push_hip_pendulum, track_foot
+
+
+class Gait(IntEnum):
+    STAND = 0
+    WALK = 1
+    JUMP = 2
+
+
+class State(IntEnum):
+    STAND = 0
+    WALK_DOUBLE = 1
+    WALK_SINGLE = 2
+    CROUCH = 3
+    THRUST = 4
+    FLIGHT = 5
+    LAND = 6
+
+
+GAIT_STAND, GAIT_WALK, GAIT_JUMP = 0, 1, 2
+ST_STAND, ST_DOUBLE, ST_SINGLE, ST_CROUCH, ST_THRUST, ST_FLIGHT, ST_LAND = 0, 1, 2, 3, 4, 5, 6
+
+# controller memory layout (float64 vector)
+M_GAIT = 0        # requested gait
+M_STATE = 1       # current state
+M_STANCE = 2      # stance (front) foot index
+M_T_ENTER = 3     # time the state was entered [s]
+M_SPEED = 4       # target speed [m/s] (starts at params.speed; settable at run time)
+M_V_TOP = 5       # pendulum top speed of eq. 2, adapted per step [m/s]
+M_LIFT_X = 6      # COM x at lift-off [m]
+M_STRIKE_X = 7    # expected COM x at the strike [m]
+M_SW_X0 = 8       # swing Bezier: start point, end point, top height [m]
+M_SW_Y0 = 9
+M_SW_X1 = 10
+M_SW_Y1 = 11
+M_SW_TOP = 12
+M_STEPS = 13      # touchdowns in WALK
+M_STEP_T = 14     # time and hip x of the last touchdown
+M_STEP_X = 15
+M_JUMPS = 16      # landings after a flight with both feet off the ground
+M_AIRBORNE = 17   # 1 once both feet left the ground in this flight
+M_PHASE = 18      # last phase variable (single stance)
+M_FALLEN = 19     # set by the rollout's fall monitor
+M_SCUFFS = 20     # swing-foot contacts before touchdown_phase
+M_SW_AIR = 21     # 1 once the swing foot has left the ground in this single stance
+N_MEMORY = 24
+
+
+@jit
+def _enter(mem, state, t):
+    mem[M_STATE] = state
+    mem[M_T_ENTER] = t
+
+
+@jit
+def _com_x(p, q, v):
+    """COM x [m] and x velocity [m/s]."""
+    mh = p[P.I_HIP_MASS]
+    mf = p[P.I_FOOT_MASS]
+    mt = mh + 2.0 * mf
+    return ((mh * q[0, 0] + mf * (q[1, 0] + q[2, 0])) / mt,
+            (mh * v[0, 0] + mf * (v[1, 0] + v[2, 0])) / mt)
+
+
+@jit
+def _start_swing(p, q, v, mem, stance):
+    """Lift-off: the swing Bezier from the swing foot to one step ahead of the stance foot."""
+    l0 = p[P.I_LEG_LENGTH]
+    sw = 1 - stance
+    L = (p[P.I_STEP_LENGTH0] + p[P.I_STEP_LENGTH_PER_SPEED] * mem[M_SPEED]) * l0
+    xs = q[stance + 1, 0]
+    ys = q[stance + 1, 1]
+    dx = xs - q[sw + 1, 0]
+    slope = 0.0
+    if abs(dx) > 0.05 * l0:
+        slope = clamp((ys - q[sw + 1, 1]) / dx, -0.5, 0.5)
+    y_ground = ys + p[P.I_SLOPE_TRUST] * slope * L
+    mem[M_STANCE] = stance
+    mem[M_SW_X0] = q[sw + 1, 0]
+    mem[M_SW_Y0] = q[sw + 1, 1]
+    mem[M_SW_X1] = xs + L
+    mem[M_SW_Y1] = y_ground - p[P.I_STRIKE_PUSH] * l0
+    mem[M_SW_TOP] = max(q[sw + 1, 1], y_ground) + 4.0 / 3.0 * p[P.I_CLEARANCE] * l0
+    mem[M_LIFT_X] = _com_x(p, q, v)[0]
+    mem[M_STRIKE_X] = xs + 0.5 * L
+
+
+@jit
+def _phase(p, q, v, mem):
+    """Phase variable s [-] and its rate [1/s] (linear in the COM x)."""
+    x, vx = _com_x(p, q, v)
+    span = max(mem[M_STRIKE_X] - mem[M_LIFT_X], 0.05 * p[P.I_LEG_LENGTH])
+    return (x - mem[M_LIFT_X]) / span, vx / span
+
+
+@jit
+def _rate_target(v_top, l, phi, g):
+    """Eq. 2 (energy form): leg rate [rad/s] of a pendulum of length l that passes the top at v_top."""
+    return -math.sqrt(v_top * v_top + 2.0 * g * l * (1.0 - math.cos(phi))) / l
+
+
+@jit
+def next_state(p, s, mem, g):
+    """Transitions of the state machine (writes mem); g is the gravity magnitude [m/s^2]."""
+    q = s.q
+    v = s.v
+    t = s.time[0]
+    state = int(mem[M_STATE])
+    gait = int(mem[M_GAIT])
+    t_in = t - mem[M_T_ENTER]
+    c0 = s.contact_mode[0] != 0 and s.contact_enabled[0] != 0
+    c1 = s.contact_mode[1] != 0 and s.contact_enabled[1] != 0
+    if state == ST_STAND:
+        if gait == GAIT_WALK and c0 and c1:
+            mem[M_STANCE] = 0 if q[1, 0] > q[2, 0] else 1
+            mem[M_STEP_T] = t
+            mem[M_STEP_X] = q[0, 0]
+            mem[M_V_TOP] = 0.8 * mem[M_SPEED]
+            _enter(mem, ST_DOUBLE, t)
+        elif gait == GAIT_JUMP and c0 and c1 and t_in > 0.3 and abs(v[0, 0]) + abs(v[0, 1]) < 0.2:
+            _enter(mem, ST_CROUCH, t)
+    elif state == ST_DOUBLE:
+        if gait != GAIT_WALK:
+            _enter(mem, ST_STAND, t)
+            return
+        front = int(mem[M_STANCE])
+        dx, dy, l, ldot, phi, phidot = leg_state(q, v, front)
+        rear_l = leg_state(q, v, 1 - front)[2]
+        # top speed squared the front-leg pendulum will have: (l phi_dot)^2 - 2 g l (1 - cos phi)
+        v_top2 = (l * phidot) ** 2 - 2.0 * g * l * (1.0 - math.cos(phi))
+        err = abs(v_top2 - mem[M_V_TOP] ** 2)
+        if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL] or phi <= 0.0
+                                            or rear_l >= p[P.I_DS_REAR_LENGTH] * p[P.I_LEG_LENGTH]
+                                            or t_in >= p[P.I_DS_TIME_MAX]):
+            _start_swing(p, q, v, mem, front)
+            mem[M_SW_AIR] = 0.0
+            _enter(mem, ST_SINGLE, t)
+    elif state == ST_SINGLE:
+        sw = 1 - int(mem[M_STANCE])
+        if not (c1 if sw == 1 else c0):
+            mem[M_SW_AIR] = 1.0
+        elif mem[M_SW_AIR] > 0.0:
+            ph = _phase(p, q, v, mem)[0]
+            if ph < p[P.I_TOUCHDOWN_PHASE]:
+                mem[M_SCUFFS] += 1
+                mem[M_SW_AIR] = 0.0
+                return
+            # touchdown: the swing foot becomes the front leg; adapt v_top to the step's speed
+            mem[M_STEPS] += 1
+            if mem[M_STEPS] >= 3 and t > mem[M_STEP_T]:
+                v_step = (q[0, 0] - mem[M_STEP_X]) / (t - mem[M_STEP_T])
+                mem[M_V_TOP] = clamp(mem[M_V_TOP] + p[P.I_SPEED_GAIN] * (mem[M_SPEED] - v_step), 0.05, 3.0)
+            mem[M_STEP_T] = t
+            mem[M_STEP_X] = q[0, 0]
+            mem[M_STANCE] = sw
+            _enter(mem, ST_DOUBLE, t)
+    elif state == ST_CROUCH:
+        if gait != GAIT_JUMP:
+            _enter(mem, ST_STAND, t)
+        elif t_in >= p[P.I_CROUCH_TIME]:
+            _enter(mem, ST_THRUST, t)
+    elif state == ST_THRUST:
+        h = q[0, 1] - 0.5 * (q[1, 1] + q[2, 1])
+        if h >= p[P.I_TAKEOFF_HEIGHT] * p[P.I_LEG_LENGTH] or t_in > 0.5:
+            mem[M_AIRBORNE] = 0.0
+            _enter(mem, ST_FLIGHT, t)
+    elif state == ST_FLIGHT:
+        if not c0 and not c1:
+            mem[M_AIRBORNE] = 1.0
+        elif t_in > 0.05:
+            if mem[M_AIRBORNE] > 0.0:
+                mem[M_JUMPS] += 1
+            _enter(mem, ST_LAND, t)
+    elif state == ST_LAND:
+        if t_in >= p[P.I_LAND_TIME]:
+            _enter(mem, ST_CROUCH if gait == GAIT_JUMP else ST_STAND, t)
+
+
+@jit
+def _hold_hip(p, q, v, height, ax_extra, ay_extra, gx, gy, u):
+    """Double stance pose control: PD on the hip toward (mid-feet x, mid-feet y + height)."""
+    mh = p[P.I_HIP_MASS]
+    tx = 0.5 * (q[1, 0] + q[2, 0])
+    ty = 0.5 * (q[1, 1] + q[2, 1]) + height
+    ax = p[P.I_STAND_KP] * (tx - q[0, 0]) - p[P.I_STAND_KD] * v[0, 0] + ax_extra
+    ay = p[P.I_STAND_KP] * (ty - q[0, 1]) - p[P.I_STAND_KD] * v[0, 1] + ay_extra
+    front = 0 if q[1, 0] > q[2, 0] else 1
+    push_hip(q, front, mh * (ax - gx), mh * (ay - gy), 0.0, p[P.I_LEG_FORCE_MAX], u)
+
+
+@jit
+def control(m, s, p, mem, u):
+    """Commands u (n_act = 3: leg0 [N], leg1 [N], hip [N m]) for the current state."""
+    gx = m.gravity[0]
+    gy = m.gravity[1]
+    g = math.sqrt(gx * gx + gy * gy)
+    next_state(p, s, mem, g)
+    q = s.q
+    v = s.v
+    l0 = p[P.I_LEG_LENGTH]
+    mh = p[P.I_HIP_MASS]
+    mf = p[P.I_FOOT_MASS]
+    fmax = p[P.I_LEG_FORCE_MAX]
+    tmax = p[P.I_HIP_TORQUE_MAX]
+    state = int(mem[M_STATE])
+    if state == ST_STAND or state == ST_LAND:
+        _hold_hip(p, q, v, p[P.I_STAND_HEIGHT] * l0, 0.0, 0.0, gx, gy, u)
+    elif state == ST_CROUCH:
+        _hold_hip(p, q, v, p[P.I_CROUCH_HEIGHT] * l0, 0.0, 0.0, gx, gy, u)
+    elif state == ST_THRUST:
+        front = 0 if q[1, 0] > q[2, 0] else 1
+        ax = p[P.I_STAND_KP] * (0.5 * (q[1, 0] + q[2, 0]) - q[0, 0]) - p[P.I_STAND_KD] * v[0, 0]
+        push_hip(q, front, mh * (ax - gx), mh * (p[P.I_THRUST_ACCEL] - gy), 0.0, fmax, u)
+    elif state == ST_FLIGHT:
+        # legs at flight length, feet spread as when standing, in the hip frame (free fall)
+        half = 0.5 * p[P.I_STAND_WIDTH] * l0
+        sign = 1.0 if q[2, 0] >= q[1, 0] else -1.0
+        fl = p[P.I_FLIGHT_LENGTH] * l0
+        track_foot(q, v, 0, q[0, 0] - sign * half, q[0, 1] - fl, v[0, 0], v[0, 1],
+                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, fmax, tmax, u)
+        u_hip0 = u[2]
+        track_foot(q, v, 1, q[0, 0] + sign * half, q[0, 1] - fl, v[0, 0], v[0, 1],
+                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, fmax, tmax, u)
+        u[2] = 0.5 * (u[2] + u_hip0)
+    elif state == ST_DOUBLE:
+        # eq. 1 normal force on the front leg, eqs. 2-3 tangential force, split into the legs
+        front = int(mem[M_STANCE])
+        dx, dy, l, ldot, phi, phidot = leg_state(q, v, front)
+        nx = -dx / l
+        ny = -dy / l
+        a_n = p[P.I_DS_KP] * (p[P.I_WALK_LENGTH] * l0 - l) - p[P.I_DS_KD] * ldot - l * phidot * phidot
+        a_t = p[P.I_ENERGY_GAIN] * l * (_rate_target(mem[M_V_TOP], l, phi, g) - phidot)
+        # tangent t = (-ny, nx): the hip's direction of motion for increasing phi; weight
+        # compensation -mh g split into its n and t parts
+        f_n = mh * (a_n - (gx * nx + gy * ny))
+        f_t = mh * (a_t - (-gx * ny + gy * nx))
+        push_hip_pendulum(q, front, f_n, f_t, fmax, u)
+    else:  # ST_SINGLE
+        stance = int(mem[M_STANCE])
+        sw = 1 - stance
+        ph, ph_dot = _phase(p, q, v, mem)
+        mem[M_PHASE] = ph
+        sb = clamp(ph, 0.0, 1.0)
+        tx, ty, dtx, dty = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1], mem[M_SW_Y1],
+                                            mem[M_SW_TOP], sb)
+        tvx = dtx * ph_dot
+        tvy = dty * ph_dot
+        if ph >= 1.0:
+            # past the expected strike: keep lowering the foot until it finds the ground
+            tvx = 0.0
+            ty -= p[P.I_DESCENT_RATE] * l0 * (ph - 1.0)
+            tvy = -p[P.I_DESCENT_RATE] * l0 * ph_dot
+        elif ph < 0.0:
+            tvx = 0.0
+            tvy = 0.0
+        hold_stance(q, v, stance, p[P.I_WALK_LENGTH] * l0, p[P.I_SS_KP], p[P.I_SS_KD], mh + mf,
+                    gx, gy, fmax, u)
+        track_foot(q, v, sw, tx, ty, tvx, tvy, p[P.I_SWING_KP], p[P.I_SWING_KD], mf, gx, gy,
+                   fmax, tmax, u)
