@@ -4,7 +4,10 @@ Point contact: the material point itself. Arc contact (curved sole): the circle 
 to the ground, c - r n, where n is the ground normal at the ground point closest to the arc
 centre c; used when that direction lies inside the sole's angular span, otherwise the lowest of
 the fallback vertices and the arc's end points (heel, toe). The material point found this way
-(contact_anchor, body frame) is held fixed for the step, so a curved foot rolls.
+(contact_anchor, body frame) is held fixed for the step, so a curved foot rolls. On a sole,
+the normal row constrains the arc centre's distance from the ground (n.(c - g) = r), which a
+rotation leaves unchanged; a fixed material point would rise by r dphi^2 / 2 as the foot rolls
+and let the foot sink by as much every step.
 """
 import math
 
@@ -20,7 +23,8 @@ MODE_SLIDING = 2
 
 
 @jit
-def _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly):
+def _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, on_arc):
+    ws.contact_on_arc[i] = on_arc
     ws.contact_point[i, 0] = px
     ws.contact_point[i, 1] = py
     ws.contact_ground[i, 0] = gx
@@ -38,7 +42,7 @@ def _try_vertex(m, q, ws, i, b, lx, ly, best):
     px, py = world_point(q, b, lx, ly)
     gx, gy, nx, ny, gap = closest_point(m.terrain_coef, px, py)
     if gap < best:
-        _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly)
+        _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, 0)
         return gap
     return best
 
@@ -72,7 +76,7 @@ def find_contact(m, q, ws, i):
     if a <= a1:
         px = cx - r * nx
         py = cy - r * ny
-        _store(ws, i, px, py, gx, gy, nx, ny, cgap - r, lx + r * dlx, ly + r * dly)
+        _store(ws, i, px, py, gx, gy, nx, ny, cgap - r, lx + r * dlx, ly + r * dly, 1)
         best = cgap - r
     else:
         # the sole is turned away from the ground: arc end points and fallback vertices
@@ -85,9 +89,33 @@ def find_contact(m, q, ws, i):
 
 
 @jit
+def engage_contact(s, ws, i, vt):
+    """Bring free contact i into touch: sliding in the direction of its tangential velocity
+    vt [m/s] if it has one, else pinned. A later check turns a sliding contact whose slip
+    reverses into a pinned one, so an impact ends up sticking exactly when Coulomb's law says
+    so, without a pinned impact first stopping a sliding body dead."""
+    if vt > 1e-9:
+        s.contact_mode[i] = MODE_SLIDING
+        s.contact_slip[i] = 1.0
+    elif vt < -1e-9:
+        s.contact_mode[i] = MODE_SLIDING
+        s.contact_slip[i] = -1.0
+    else:
+        s.contact_mode[i] = MODE_PINNED
+    ws.contact_new[i] = 1
+
+
+@jit
 def find_contacts(m, s, ws):
-    """Stage 3 for every contact; a disabled contact is forced free."""
+    """Stage 3 for every contact; a disabled contact is forced free. A contact that a
+    time-of-impact split brought into touch (contact_new == 2) is engaged here, where its
+    ground normal is known."""
     for i in range(m.contact_body.shape[0]):
         find_contact(m, s.q, ws, i)
         if s.contact_enabled[i] == 0:
             s.contact_mode[i] = MODE_FREE
+        elif ws.contact_new[i] == 2:
+            b = m.contact_body[i]
+            vx = s.v[b, 0] - s.v[b, 2] * (ws.contact_point[i, 1] - s.q[b, 1])
+            vy = s.v[b, 1] + s.v[b, 2] * (ws.contact_point[i, 0] - s.q[b, 0])
+            engage_contact(s, ws, i, ws.contact_normal[i, 1] * vx - ws.contact_normal[i, 0] * vy)

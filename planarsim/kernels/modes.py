@@ -5,14 +5,17 @@ Rules (seed 002 section 5 plus the sliding mode of its footnote):
   pinned  -> sliding  if |lambda_t| > mu lambda_n (slip opposite to the friction impulse)
   sliding -> pinned   if the slip velocity at the end of the step has stopped or reversed
   sliding -> free     if lambda_n < 0
-  free    -> pinned   if the contact would end the step below the ground (every step, every
-                      contact: penetration is never tolerated; point masses use CCD instead)
+  free    -> touching if the contact would end the step below the ground (every step, every
+                      contact: penetration is never tolerated; point masses use CCD instead);
+                      sliding if its point moves along the ground, else pinned
 Which pinned/sliding contacts are checked is the strategy: MODES_ALTERNATING checks the one
-under the round-robin cursor, once per step; MODES_ALL checks all of them in every round.
+under the round-robin cursor, once per step, plus any contact engaged during this step (an
+impact must be allowed to slide at once, or a pinned impact would stop a sliding body dead);
+MODES_ALL checks all of them in every round.
 Joint limits engage when the angle would pass the limit and release when their impulse pulls.
 """
 from ._jit import jit
-from .contacts import MODE_FREE, MODE_PINNED, MODE_SLIDING
+from .contacts import MODE_FREE, MODE_PINNED, MODE_SLIDING, engage_contact
 from .forces import point_velocity
 from .math2d import world_point
 from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO
@@ -85,7 +88,7 @@ def engage_contacts(m, s, ws, h, include_ccd):
             continue
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
         if ws.contact_gap[i] + h * vn < 0.0:
-            s.contact_mode[i] = MODE_PINNED
+            engage_contact(s, ws, i, vt)
             changed += 1
     return changed
 
@@ -128,8 +131,11 @@ def update_modes(m, s, ws, h, strategy, first_round, include_ccd):
         for i in range(nc):
             if s.contact_enabled[i]:
                 changed += check_contact(m, s, ws, i)
-    elif first_round:
-        i = s.mode_cursor[0] % nc
-        if s.contact_enabled[i]:
-            changed += check_contact(m, s, ws, i)
+    else:
+        # the contact under the cursor in the first round; contacts engaged during this
+        # step in every round, so an impact can start sliding at once
+        cursor = s.mode_cursor[0] % nc
+        for i in range(nc):
+            if s.contact_enabled[i] and ((first_round and i == cursor) or ws.contact_new[i] == 1):
+                changed += check_contact(m, s, ws, i)
     return changed

@@ -82,6 +82,11 @@ def eval_row(m, q, ws, r, J):
     dy = ny if kind == ROW_CONTACT_N else -nx
     for k in range(3):
         J[0, k] = 0.0
+    if kind == ROW_CONTACT_N and ws.contact_on_arc[o] == 1:
+        # rolling sole: distance of the arc centre from the ground tangent line, minus r
+        cx, cy = world_point(q, b, m.contact_local[o, 0], m.contact_local[o, 1])
+        _set_dir(q, b, cx, cy, dx, dy, 1.0, J[1])
+        return dx * (cx - ws.contact_ground[o, 0]) + dy * (cy - ws.contact_ground[o, 1]) - m.contact_radius[o]
     _set_dir(q, b, px, py, dx, dy, 1.0, J[1])
     return dx * (px - ws.contact_ground[o, 0]) + dy * (py - ws.contact_ground[o, 1])
 

@@ -6,7 +6,7 @@ remainder of the step with the new contact pinned.
 """
 from ._jit import jit
 from .ccd import advance_to_impact, time_of_impact
-from .contacts import MODE_PINNED, find_contacts
+from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import check_guards
 from .integrate import correct_positions, integrate_positions
@@ -68,6 +68,8 @@ def step(m, s, ws, opt, u):
     copy_state(s, ws.prev)
     ws.info[0] = 0
     ws.info[1] = 0
+    for i in range(m.contact_body.shape[0]):
+        ws.contact_new[i] = 0
     h = m.dt
     for split in range(opt.max_ccd_splits + 1):
         apply_forces(m, s, ws, u)
@@ -75,27 +77,21 @@ def step(m, s, ws, opt, u):
         find_contacts(m, s, ws)
         ccd_on = split < opt.max_ccd_splits
         solve_modes(m, s, ws, opt, h, not ccd_on)
-        late_hit = -1
         if ccd_on:
             tau, hit = time_of_impact(m, s, ws, h)
-            if hit >= 0 and tau >= h * (1.0 - 1e-9):
-                # impact at the very end of the step: finish it, pinned from the next step
-                late_hit = hit
-                ws.impact_time[0] = s.time[0] + h
-            elif hit >= 0:
-                # split the step at the impact and pin the contact for the rest of it
+            # an impact at the very end of the step is left to the next step (tau = 0 there)
+            if hit >= 0 and tau < h * (1.0 - 1e-9):
+                # split the step at the impact; the rest of it runs with the contact engaged
                 advance_to_impact(s, ws, h, tau)
                 s.time[0] += tau
                 ws.impact_time[0] = s.time[0]
                 h -= tau
-                s.contact_mode[hit] = MODE_PINNED
+                ws.contact_new[hit] = 2  # engaged by find_contacts of the next sub-step
                 ws.info[1] += 1
                 continue
         integrate_positions(s, ws.v_new, h)
         if opt.refine_iters > 0:
             correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol, opt.pivot_tol)
-        if late_hit >= 0:
-            s.contact_mode[late_hit] = MODE_PINNED
         break
     s.time[0] = ws.prev.time[0] + m.dt
     s.step[0] += 1

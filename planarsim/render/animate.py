@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -215,9 +216,24 @@ def _remove_frames_dir(tmp):
     shutil.rmtree(Path(tmp).with_suffix("").as_posix() + "_frames", ignore_errors=True)
 
 
+# matplotlib's player draws its buttons with Font Awesome icons from a CDN; the page must work
+# offline, so the stylesheet link goes and each icon becomes a plain character
+_ICONS = {"fa-minus": "&minus;", "fa-fast-backward": "|&#9664;&#9664;", "fa-step-backward": "|&#9664;",
+          "fa-play fa-flip-horizontal": "&#9664;", "fa-pause": "&#10074;&#10074;", "fa-play": "&#9654;",
+          "fa-step-forward": "&#9654;|", "fa-fast-forward": "&#9654;&#9654;|", "fa-plus": "+"}
+
+
+def self_contained(fragment: str) -> str:
+    """matplotlib's HTML animation without its external stylesheet (icons as characters)."""
+    fragment = re.sub(r'<link rel="stylesheet"\s+href="[^"]*font-awesome[^"]*">', "", fragment)
+    for cls, text in _ICONS.items():
+        fragment = fragment.replace(f'<i class="fa {cls}"></i>', text)
+    return fragment
+
+
 def _wrap_html_page(tmp, title):
-    """Turn matplotlib's HTML fragment into a complete page (doctype, head, body)."""
-    body = Path(tmp).read_text(encoding="utf-8")
+    """Turn matplotlib's HTML fragment into a complete, offline page (doctype, head, body)."""
+    body = self_contained(Path(tmp).read_text(encoding="utf-8"))
     page = ("<!DOCTYPE html>\n<html>\n<head>\n<meta charset=\"utf-8\">\n"
             f"<title>{title} - planarsim</title>\n</head>\n<body>\n{body}\n</body>\n</html>\n")
     Path(tmp).write_text(page, encoding="utf-8")

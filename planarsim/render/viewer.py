@@ -52,8 +52,8 @@ class FrameTimer:
         self.start()
 
     def start(self) -> None:
-        """(Re)start the schedule now: frame 0 is due at once."""
-        self.wall0 = self.clock()
+        """(Re)start the schedule: playback time 0 is the moment the next frame is on screen."""
+        self.wall0 = None
         self.playback_time = 0.0      # scheduled time of the current frame [s]
         self.integral = 0.0           # sum of lateness [s]
         self.last_error = 0.0
@@ -62,11 +62,13 @@ class FrameTimer:
 
     def wall_time(self) -> float:
         """Seconds of wall time since start()."""
-        return self.clock() - self.wall0
+        return 0.0 if self.wall0 is None else self.clock() - self.wall0
 
     def frame_done(self) -> float:
         """Call when the current frame is on screen. Returns the pause [s] before the next frame
         and advances the schedule by one period (or more, when frames must be skipped)."""
+        if self.wall0 is None:
+            self.wall0 = self.clock()
         e = self.wall_time() - self.playback_time
         if e > self.max_lag:
             skip = int(e // self.period)
@@ -121,6 +123,7 @@ class Viewer:
         self.timer = FrameTimer(1.0 / float(fps), clock=clock)
         self.camera = camera if camera is not None else Camera()
         self._carry = 0.0
+        self._due = self.timer.period
         self._drawn_t = sim.t
         self._initial = sim.snapshot()
         self._model0 = sim.model
@@ -194,6 +197,7 @@ class Viewer:
         self.playing = not self.playing
         if self.playing:
             self.timer.start()
+            self._due = self.timer.period
 
     def toggle_impulses(self) -> None:
         self.scene.show_impulses = not self.scene.show_impulses
@@ -271,10 +275,16 @@ class Viewer:
     def tick(self) -> float:
         """One frame of playback: advance (when playing), draw, and return the PI-corrected pause
         [s] before the next frame."""
-        if self.playing:
-            self.advance(self.timer.period * self.speed)
+        if not self.playing:
+            self.draw()
+            return self.timer.period
+        self.advance(self._due * self.speed)
         self.draw()
-        return self.timer.frame_done() if self.playing else self.timer.period
+        before = self.timer.playback_time
+        pause = self.timer.frame_done()
+        # the next frame shows the simulation one period later (more if the timer skipped frames)
+        self._due = self.timer.playback_time - before
+        return pause
 
     def show(self) -> None:
         """Run on screen (needs an interactive matplotlib backend; use :func:`view`)."""
@@ -292,8 +302,8 @@ class Viewer:
 
         timer.add_callback(on_timer)
         self._gui_timer = timer
-        self.playing = True
-        self.timer.start()
+        if not self.playing:
+            self.toggle()
         timer.start()
         plt.show()
 

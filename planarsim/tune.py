@@ -1,0 +1,210 @@
+"""CMA-ES tuning of a walker's controller parameters (the `cma` package), in parallel.
+
+A walker is tunable when it has an ``objective`` module (``walkers/<name>/objective.py``) with
+``Params`` (a frozen params dataclass offering ``names(True)``, ``bounds(True)``,
+``tunable_array()`` and ``with_tunable(x)``), ``evaluate(params, settings) -> dict(score=...)``
+(higher is better) and ``DEFAULT_SETTINGS``.
+
+Search space: every tunable field scaled to [0, 1] by its bounds (so one step size sigma0 fits
+all), CMA-ES minimising -score with bound handling in [0, 1]. A population is evaluated with
+``executor.map`` in order, so the result depends only on the seed, never on the executor:
+  * default: a local ``ProcessPoolExecutor`` with `workers` processes;
+  * ``scheduler="tcp://host:8786"``: a dask ``distributed.Client(scheduler).get_executor()``
+    (install the extra: ``pip install planarsim[tune]``);
+  * or any ``concurrent.futures``-style executor passed as `executor`.
+After every generation the result (best parameters, per-generation history, settings, seed) is
+written atomically to `out` (JSON), so an interrupted run keeps what was finished;
+:func:`load_result` reads it back.
+
+Command line: ``python -m planarsim.tune simbicon --budget 200 --out tuned.json``.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import math
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .trajectory import atomic_write
+
+FORMAT_VERSION = 1
+
+
+def objective_module(walker: str):
+    """The walker's objective module (walkers/<pkg>/objective.py); clear error if it has none."""
+    from walkers import WALKERS
+    if walker not in WALKERS:
+        raise KeyError(f"unknown walker {walker!r}; known walkers: {sorted(WALKERS)}")
+    try:
+        return importlib.import_module(WALKERS[walker] + ".objective")
+    except ModuleNotFoundError:
+        raise ValueError(f"walker {walker!r} has no tuning objective ({WALKERS[walker]}.objective)") from None
+
+
+def _evaluate(job):
+    """Worker entry point (picklable): (walker, unit vector, base params dict, settings)."""
+    walker, z, base, settings = job
+    mod = objective_module(walker)
+    params = mod.Params(**base)
+    b = params.bounds(True)
+    x = b[:, 0] + np.clip(z, 0.0, 1.0) * (b[:, 1] - b[:, 0])
+    return mod.evaluate(params.with_tunable(x), settings)
+
+
+@dataclass
+class TuneResult:
+    """Best parameters and the history of a tuning run (see :func:`tune`)."""
+    walker: str
+    best_params: dict
+    best_score: float
+    start_score: float
+    history: list = field(default_factory=list)   # per generation: dict(gen, evals, best, median, sigma)
+    settings: dict = field(default_factory=dict)
+    seed: int = 0
+    names: tuple = ()
+    evaluations: int = 0
+
+    def params(self):
+        """The best parameters as the walker's params dataclass."""
+        return objective_module(self.walker).Params(**self.best_params)
+
+    def to_json(self) -> dict:
+        return dict(format_version=FORMAT_VERSION, walker=self.walker, best_params=self.best_params,
+                    best_score=self.best_score, start_score=self.start_score, history=self.history,
+                    settings=self.settings, seed=self.seed, names=list(self.names),
+                    evaluations=self.evaluations)
+
+    def save(self, path) -> Path:
+        path = Path(path)
+        text = json.dumps(self.to_json(), indent=1, default=float)
+        atomic_write(path, lambda f: f.write(text), binary=False)
+        return path
+
+
+def load_result(path) -> TuneResult:
+    """Read a result written by :func:`tune`; a clear ValueError for corrupt/newer files."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not a readable tuning result (truncated or corrupted?): {e}") from None
+    version = data.get("format_version") if isinstance(data, dict) else None
+    if version != FORMAT_VERSION:
+        raise ValueError(f"{path}: tuning-result format version {version}; this planarsim reads "
+                         f"version {FORMAT_VERSION}")
+    data.pop("format_version")
+    data["names"] = tuple(data["names"])
+    return TuneResult(**data)
+
+
+def _make_executor(executor, scheduler, workers):
+    """(executor, closer) from the user's choice."""
+    if executor is not None:
+        return executor, (lambda: None)
+    if scheduler is not None:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise ImportError("a dask scheduler address needs dask.distributed: "
+                              "pip install 'planarsim[tune]'") from None
+        client = Client(scheduler)
+        return client.get_executor(), client.close
+    pool = ProcessPoolExecutor(max_workers=max(1, int(workers)))
+    return pool, (lambda: pool.shutdown(cancel_futures=True))
+
+
+def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | None = None,
+         sigma0: float = 0.1, seed: int = 0, settings: dict | None = None, executor=None,
+         scheduler: str | None = None, workers: int = 2, out=None, progress: bool = True) -> TuneResult:
+    """Tune the walker's controller parameters with CMA-ES; returns a TuneResult.
+
+    x0 : start parameters (a params dataclass; default the walker's defaults)
+    budget : maximum number of objective evaluations (whole generations)
+    popsize : CMA-ES population (default 4 + 3 ln n)
+    sigma0 : initial step size in the unit-scaled space (fraction of each bound's width)
+    seed : CMA-ES random seed (same seed, same settings -> same result)
+    settings : objective settings (see the walker's objective.DEFAULT_SETTINGS)
+    executor / scheduler / workers : where populations run (see the module docstring)
+    out : JSON file written atomically after every generation
+    """
+    import cma
+
+    mod = objective_module(walker)
+    params0 = x0 if x0 is not None else mod.Params()
+    base = params0.as_dict()
+    settings = dict(mod.DEFAULT_SETTINGS, **(settings or {}))
+    b = params0.bounds(True)
+    z0 = (params0.tunable_array() - b[:, 0]) / (b[:, 1] - b[:, 0])
+    opts = {"seed": int(seed) + 1, "bounds": [0.0, 1.0], "verbose": -9, "maxfevals": int(budget)}
+    if popsize:
+        opts["popsize"] = int(popsize)
+    es = cma.CMAEvolutionStrategy(z0.tolist(), float(sigma0), opts)
+    pool, close = _make_executor(executor, scheduler, workers)
+    t_start = time.time()
+    try:
+        start = list(pool.map(_evaluate, [(walker, z0, base, settings)]))[0]["score"]
+        result = TuneResult(walker=walker, best_params=base, best_score=start, start_score=start,
+                            settings=settings, seed=int(seed), names=params0.names(True))
+        while not es.stop() and result.evaluations + es.popsize <= budget:
+            zs = es.ask()
+            scores = [r["score"] for r in pool.map(_evaluate, [(walker, np.asarray(z), base, settings)
+                                                                for z in zs])]
+            es.tell(zs, [-f for f in scores])
+            result.evaluations += len(zs)
+            i = int(np.argmax(scores))
+            if scores[i] > result.best_score:
+                xb = b[:, 0] + np.clip(zs[i], 0, 1) * (b[:, 1] - b[:, 0])
+                result.best_score = float(scores[i])
+                result.best_params = params0.with_tunable(xb).as_dict()
+            result.history.append(dict(gen=len(result.history) + 1, evals=result.evaluations,
+                                       best=float(max(scores)), median=float(np.median(scores)),
+                                       best_so_far=result.best_score, sigma=float(es.sigma)))
+            if out is not None:
+                result.save(out)
+            if progress:
+                h = result.history[-1]
+                print(f"[tune {walker}] gen {h['gen']:3d}  evals {h['evals']:4d}/{budget}  "
+                      f"best {h['best']:9.3f}  median {h['median']:9.3f}  best so far "
+                      f"{h['best_so_far']:9.3f}  sigma {h['sigma']:.3f}  "
+                      f"{time.time() - t_start:6.1f} s", file=sys.stderr, flush=True)
+    finally:
+        close()
+    return result
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="planarsim tune", description="CMA-ES tuning of a walker")
+    ap.add_argument("walker")
+    ap.add_argument("--budget", type=int, default=200, help="objective evaluations")
+    ap.add_argument("--popsize", type=int, default=None)
+    ap.add_argument("--sigma0", type=float, default=0.1)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--workers", type=int, default=2, help="local processes")
+    ap.add_argument("--scheduler", default=None, help="dask scheduler address (tcp://host:port)")
+    ap.add_argument("--start", default=None, help="JSON result to start from (its best params)")
+    ap.add_argument("--duration", type=float, default=None, help="seconds per objective run")
+    ap.add_argument("--out", default="tuned.json")
+    a = ap.parse_args(argv)
+    try:
+        mod = objective_module(a.walker)
+    except (KeyError, ValueError) as e:
+        print(f"planarsim tune: {e}", file=sys.stderr)
+        return 2
+    x0 = load_result(a.start).params() if a.start else None
+    settings = {"duration": a.duration} if a.duration else None
+    r = tune(a.walker, x0=x0, budget=a.budget, popsize=a.popsize, sigma0=a.sigma0, seed=a.seed,
+             workers=a.workers, scheduler=a.scheduler, out=a.out, settings=settings)
+    print(json.dumps(dict(start_score=r.start_score, best_score=r.best_score,
+                          evaluations=r.evaluations, out=a.out)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

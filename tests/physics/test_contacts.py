@@ -1,0 +1,200 @@
+"""Issue 3: contacts on analytic terrain: rod drop, rolling and sliding disk, boxes with
+friction, continuous collision of point masses, sticking and sliding on hills."""
+import math
+
+import numpy as np
+import pytest
+
+import planarsim as ps
+from planarsim import terrain
+
+G = 9.81
+
+
+def corners_y(q, half=0.5, thick=0.025):
+    """(K, 2) heights of the two bottom corners of the dropped rod."""
+    c, s = np.cos(q[:, 0, 2]), np.sin(q[:, 0, 2])
+    return np.stack([q[:, 0, 1] + s * (sx * half) - c * thick for sx in (-1, 1)], axis=1)
+
+
+@pytest.mark.parametrize("strategy", ["alternating", "all"])
+def test_rod_dropped_flat_lands_without_penetration_or_energy_gain(strategy):
+    b = ps.ModelBuilder(dt=1e-3)
+    rod = b.add_body("rod", mass=1.0, inertia=(1.0 + 0.05 ** 2) / 12, pos=(0.0, 0.525))
+    b.add_box_contacts("rod", rod, (0.0, 0.0), 1.0, 0.05, mu=1.0)
+    model = b.compile()
+    sim = ps.Simulator(model, ps.make_options(strategy))
+    traj = sim.run(2.0, record_every=1)
+    low = corners_y(traj.q).min(axis=1)
+    e = traj.energy(model)["total"]
+    impact = int(np.argmax(low < 1e-9))
+    assert impact > 0
+    # both ends strike in the same step
+    assert np.all(corners_y(traj.q)[impact] < 1e-9)
+    speed = np.hypot(traj.v[:, 0, 0], traj.v[:, 0, 1]) + 0.5 * np.abs(traj.v[:, 0, 2])
+    rest = traj.t[np.nonzero(speed > 1e-6)[0].max() + 1]
+    print(f"{strategy}: impact t={traj.t[impact]:.3f} s, max penetration {max(0, -low.min()):.2e} m, "
+          f"energy before {e[impact - 1]:.4f} J after max {e[impact:].max():.4f} J, at rest from t={rest:.3f} s")
+    assert low.min() >= -1e-6
+    assert e[impact:].max() <= e[impact - 1] + 1e-12
+    assert rest - traj.t[impact] <= 1.0
+
+
+def disk_on_slope(mu, angle_deg=10.0, seconds=1.0):
+    r, m = 0.2, 2.0
+    ter = terrain.slope(-angle_deg)  # downhill toward +x
+    a = math.radians(angle_deg)
+    b = ps.ModelBuilder(dt=1e-3, terrain=ter)
+    # centre one radius above the slope, along its normal
+    cx, cy = 0.0, r / math.cos(a)
+    disk = b.add_body("disk", mass=m, inertia=0.5 * m * r * r, pos=(cx, cy))
+    b.add_arc_contact("rim", disk, (0.0, 0.0), r, mu=mu)
+    model = b.compile()
+    sim = ps.Simulator(model)
+    traj = sim.run(seconds, record_every=1)
+    # acceleration along the slope from a quadratic fit of the distance travelled
+    d = traj.q[:, 0, 0] / math.cos(a)
+    t = traj.t
+    keep = t > 0.1
+    acc = 2 * np.polyfit(t[keep], d[keep], 2)[0]
+    gap = np.array([traj.q[k, 0, 1] - (ter.height(traj.q[k, 0, 0]) + r / math.cos(a)) for k in range(len(t))])
+    return acc, traj, gap
+
+
+def test_disk_rolls_down_a_slope_at_two_thirds_g_sin():
+    acc, traj, gap = disk_on_slope(mu=1.0)
+    a = math.radians(10.0)
+    expected = 2.0 / 3.0 * G * math.sin(a)
+    print(f"rolling: a={acc:.5f} m/s^2, expected {expected:.5f}, rel err {abs(acc / expected - 1):.2e}")
+    assert abs(acc / expected - 1) < 0.01
+    assert np.all(traj.contact_mode[200:, 0] == 1)  # pinned (rolling) throughout
+    assert np.abs(gap).max() < 1e-6
+
+
+def test_disk_slides_with_low_friction():
+    acc, traj, gap = disk_on_slope(mu=0.05)
+    a = math.radians(10.0)
+    expected = G * (math.sin(a) - 0.05 * math.cos(a))
+    print(f"sliding: a={acc:.5f} m/s^2, expected {expected:.5f}, rel err {abs(acc / expected - 1):.2e}")
+    assert abs(acc / expected - 1) < 0.01
+    assert np.all(traj.contact_mode[200:, 0] == 2)
+
+
+def box_model(ter, mu, pos, vel=(0.0, 0.0), angle=0.0):
+    b = ps.ModelBuilder(dt=1e-3, terrain=ter)
+    w, h, m = 0.4, 0.2, 3.0
+    box = b.add_body("box", mass=m, inertia=m * (w * w + h * h) / 12, pos=pos, angle=angle, vel=vel)
+    b.add_box_contacts("box", box, (0.0, 0.0), w, h, mu=mu)
+    return b.compile()
+
+
+def test_box_stays_put_on_a_slope_with_enough_friction():
+    deg = 15.0
+    a = math.radians(deg)
+    ter = terrain.slope(deg)
+    # box resting on the slope: centre 0.1 m above the surface along the normal
+    model = box_model(ter, mu=math.tan(a) + 0.1, pos=(-0.1 * math.sin(a), 0.1 * math.cos(a)), angle=a)
+    sim = ps.Simulator(model)
+    sim.steps(50)
+    start = sim.state.q[0, :2].copy()
+    sim.steps(5000)
+    drift = np.hypot(*(sim.state.q[0, :2] - start))
+    print(f"box on 15 deg slope, mu=tan+0.1: drift over 5 s {drift:.2e} m")
+    assert drift < 1e-6
+
+
+def test_box_launched_on_flat_ground_decelerates_at_mu_g():
+    mu, v0 = 0.5, 2.0
+    model = box_model(terrain.flat(), mu=mu, pos=(0.0, 0.1), vel=(v0, 0.0))
+    sim = ps.Simulator(model)
+    traj = sim.run(1.0, record_every=1)
+    vx = traj.v[:, 0, 0]
+    moving = (vx > 0.2) & (vx < 1.8)
+    acc = np.polyfit(traj.t[moving], vx[moving], 1)[0]
+    stop = traj.q[-1, 0, 0]
+    expected_stop = v0 * v0 / (2 * mu * G)
+    print(f"box: deceleration {-acc:.4f} m/s^2 (mu g = {mu * G:.4f}), stopped at {stop:.4f} m "
+          f"(expected {expected_stop:.4f})")
+    assert abs(-acc / (mu * G) - 1) < 0.01
+    assert abs(stop / expected_stop - 1) < 0.01
+    assert abs(traj.v[-1, 0, 0]) < 1e-9
+
+
+def point_drop(h, dt):
+    b = ps.ModelBuilder(dt=dt)
+    p = b.add_point_mass("p", 1.0, pos=(0.0, h))
+    b.add_point_contact("p", p)
+    model = b.compile()
+    sim = ps.Simulator(model)
+    for _ in range(int(2 * math.sqrt(2 * h / G) / dt) + 5):
+        prev = sim.state.copy()
+        sim.step()
+        if sim.state.contact_mode[0] == 1:
+            return sim, prev
+    raise AssertionError("never landed")
+
+
+def test_time_of_impact_is_the_exact_root_of_the_path_model():
+    for dt in (1e-2, 5e-3, 2.5e-3):
+        sim, prev = point_drop(1.0, dt)
+        # path model: y(tau) = y0 + tau vy0 + tau^2 (vy1 - vy0) / dt with vy1 = vy0 - g dt
+        y0, vy0 = prev.q[0, 1], prev.v[0, 1]
+        a = -G
+        tau = (-vy0 - math.sqrt(vy0 * vy0 - 4 * a * y0)) / (2 * a)
+        assert abs(prev.t + tau - sim.ws.impact_time[0]) < 1e-12
+
+
+def test_time_of_impact_converges_to_free_fall_time():
+    h = 1.0
+    exact = math.sqrt(2 * h / G)
+    errs = []
+    for dt in (1e-2, 5e-3, 2.5e-3):
+        sim, _ = point_drop(h, dt)
+        errs.append(abs(sim.ws.impact_time[0] - exact))
+    orders = [math.log2(errs[i] / errs[i + 1]) for i in range(2)]
+    print("impact time errors at dt = 10, 5, 2.5 ms:", ", ".join(f"{e:.2e}" for e in errs),
+          "observed order", ", ".join(f"{o:.2f}" for o in orders))
+    assert errs[0] > errs[1] > errs[2]
+    assert min(orders) > 0.8
+
+
+def test_fast_point_never_tunnels_through_a_hill():
+    ter = terrain.hills([0.3], [2.0], [0.0])
+    b = ps.ModelBuilder(dt=1e-3, terrain=ter)
+    p = b.add_point_mass("p", 1.0, pos=(-3.0, 1.0), vel=(100.0, -20.0))
+    b.add_point_contact("p", p, mu=0.0)
+    model = b.compile()
+    sim = ps.Simulator(model)
+    traj = sim.run(0.3, record_every=1)
+    gap = traj.q[:, 0, 1] - ter.height(traj.q[:, 0, 0])
+    hit = np.nonzero(traj.contact_mode[:, 0] > 0)[0]
+    print(f"fast point: first contact at x={traj.q[hit[0], 0, 0]:.3f} m, min vertical gap {gap.min():.2e} m")
+    assert len(hit) > 0
+    # the first touchdown is where the ballistic path first meets the ground
+    t = np.linspace(0.0, 0.3, 3_000_001)
+    xb, yb = -3.0 + 100.0 * t, 1.0 - 20.0 * t - 0.5 * G * t * t
+    first = xb[np.argmax(yb < ter.height(xb))]
+    print(f"ballistic first crossing at x={first:.4f} m")
+    # the impact happened inside the step that ends with the first contact frame
+    assert traj.q[hit[0] - 1, 0, 0] <= first <= traj.q[hit[0] - 1, 0, 0] + 100.0 * 1e-3 * 1.001
+    assert gap.min() > -1e-6
+
+
+@pytest.mark.parametrize("mu, should_slide", [(0.5, False), (0.2, True)])
+def test_point_on_a_hill_sticks_below_the_friction_angle_and_slides_above(mu, should_slide):
+    ter = terrain.hills([0.2], [4.0], [0.0])
+    # a point where the slope is about 0.3 (17 deg): atan(0.5) = 26.6 deg, atan(0.2) = 11.3 deg
+    x = 4.0 / (2 * math.pi) * math.acos(0.3 / (0.2 * 2 * math.pi / 4.0))
+    b = ps.ModelBuilder(dt=1e-3, terrain=ter)
+    p = b.add_point_mass("p", 1.0, pos=(x, float(ter.height(x)) + 1e-4))
+    b.add_point_contact("p", p, mu=mu)
+    sim = ps.Simulator(b.compile())
+    sim.steps(20)
+    x0 = sim.state.q[0, 0]
+    sim.steps(2000)
+    moved = abs(sim.state.q[0, 0] - x0)
+    print(f"mu={mu}: moved {moved:.3e} m")
+    if should_slide:
+        assert moved > 0.05
+    else:
+        assert moved < 1e-6
