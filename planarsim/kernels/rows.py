@@ -3,6 +3,9 @@
 Row kinds: pin x / y (p_b - p_a = 0), rod (|p_b - p_a| - L = 0), joint limit (angle - lower
 >= 0, upper - angle >= 0), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0). For a
 point p on a body with COM x, J = (d_x, d_y, (p - x) x d) for a row along unit direction d.
+A contact's normal row uses the exact gap (a rolling sole: the gap of its centre minus r, which
+rotation leaves unchanged); its tangent row holds the material point at the ground point found
+at the start of the step (no slip).
 Sliding contacts keep only the normal row; their impulse direction F = n - mu s t carries the
 Coulomb friction -mu lambda_n s along the tangent t.
 """
@@ -11,6 +14,7 @@ import math
 from ._jit import jit
 from .math2d import cross2, world_point
 from .contacts import MODE_PINNED, MODE_SLIDING
+from .terrain import closest_point
 
 ROW_PIN_X = 0
 ROW_PIN_Y = 1
@@ -74,21 +78,28 @@ def eval_row(m, q, ws, r, J):
         if kind == ROW_LIMIT_LO:
             return ang - m.pin_limit[o, 0]
         return m.pin_limit[o, 1] - ang
-    # contact rows: material point vs the ground point found at the start of the step
-    px, py = world_point(q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
-    nx = ws.contact_normal[o, 0]
-    ny = ws.contact_normal[o, 1]
-    dx = nx if kind == ROW_CONTACT_N else ny
-    dy = ny if kind == ROW_CONTACT_N else -nx
+    # contact rows
     for k in range(3):
         J[0, k] = 0.0
-    if kind == ROW_CONTACT_N and ws.contact_on_arc[o] == 1:
-        # rolling sole: distance of the arc centre from the ground tangent line, minus r
-        cx, cy = world_point(q, b, m.contact_local[o, 0], m.contact_local[o, 1])
-        _set_dir(q, b, cx, cy, dx, dy, 1.0, J[1])
-        return dx * (cx - ws.contact_ground[o, 0]) + dy * (cy - ws.contact_ground[o, 1]) - m.contact_radius[o]
-    _set_dir(q, b, px, py, dx, dy, 1.0, J[1])
-    return dx * (px - ws.contact_ground[o, 0]) + dy * (py - ws.contact_ground[o, 1])
+    if kind == ROW_CONTACT_N:
+        # exact gap of the material point (or of the sole's centre, minus r) at q, along the
+        # normal of its closest ground point: the same as the start-of-step values at q0, and
+        # exact on curved ground when the position correction evaluates it at q+
+        if ws.contact_on_arc[o] == 1:
+            px, py = world_point(q, b, m.contact_local[o, 0], m.contact_local[o, 1])
+        else:
+            px, py = world_point(q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+        gx, gy, nx, ny, gap = closest_point(m.terrain_coef, px, py)
+        _set_dir(q, b, px, py, nx, ny, 1.0, J[1])
+        if ws.contact_on_arc[o] == 1:
+            return gap - m.contact_radius[o]
+        return gap
+    # tangent row: the material point stays at the ground point found at the step's start
+    px, py = world_point(q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+    tx = ws.contact_normal[o, 1]
+    ty = -ws.contact_normal[o, 0]
+    _set_dir(q, b, px, py, tx, ty, 1.0, J[1])
+    return tx * (px - ws.contact_ground[o, 0]) + ty * (py - ws.contact_ground[o, 1])
 
 
 @jit
