@@ -74,6 +74,8 @@ M_PHASE = 18      # last phase variable (single stance)
 M_FALLEN = 19     # set by the rollout's fall monitor
 M_SCUFFS = 20     # swing-foot contacts before touchdown_phase
 M_SW_AIR = 21     # 1 once the swing foot has left the ground in this single stance
+M_ABORT = 22      # 1 when the hip rolled back before the top: the swing foot returns behind
+M_RETRIES = 23    # aborted steps
 N_MEMORY = 24
 
 
@@ -160,17 +162,27 @@ def next_state(p, s, mem, g):
         # top speed squared the front-leg pendulum will have: (l phi_dot)^2 - 2 g l (1 - cos phi)
         v_top2 = (l * phidot) ** 2 - 2.0 * g * l * (1.0 - math.cos(phi))
         err = abs(v_top2 - mem[M_V_TOP] ** 2)
-        if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL] or phi <= 0.0
+        if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL]
                                             or rear_l >= p[P.I_DS_REAR_LENGTH] * p[P.I_LEG_LENGTH]
                                             or t_in >= p[P.I_DS_TIME_MAX]):
             _start_swing(p, q, v, mem, front)
             mem[M_SW_AIR] = 0.0
+            mem[M_ABORT] = 0.0
             _enter(mem, ST_SINGLE, t)
     elif state == ST_SINGLE:
         sw = 1 - int(mem[M_STANCE])
-        if not (c1 if sw == 1 else c0):
+        stance = 1 - sw
+        if mem[M_ABORT] == 0.0 and q[0, 0] < q[stance + 1, 0] and _com_x(p, q, v)[1] < 0.0:
+            mem[M_ABORT] = 1.0
+        sw_contact = c1 if sw == 1 else c0
+        if mem[M_ABORT] > 0.0 and sw_contact and (mem[M_SW_AIR] > 0.0 or t_in > 0.05):
+            # the step was abandoned and the foot is back down: push again from the same leg
+            mem[M_RETRIES] += 1
+            _enter(mem, ST_DOUBLE, t)
+            return
+        if not sw_contact:
             mem[M_SW_AIR] = 1.0
-        elif mem[M_SW_AIR] > 0.0:
+        elif mem[M_SW_AIR] > 0.0 and mem[M_ABORT] == 0.0:
             ph = _phase(p, q, v, mem)[0]
             if ph < p[P.I_TOUCHDOWN_PHASE]:
                 mem[M_SCUFFS] += 1
@@ -180,7 +192,8 @@ def next_state(p, s, mem, g):
             mem[M_STEPS] += 1
             if mem[M_STEPS] >= 3 and t > mem[M_STEP_T]:
                 v_step = (q[0, 0] - mem[M_STEP_X]) / (t - mem[M_STEP_T])
-                mem[M_V_TOP] = clamp(mem[M_V_TOP] + p[P.I_SPEED_GAIN] * (mem[M_SPEED] - v_step), 0.05, 3.0)
+                mem[M_V_TOP] = clamp(mem[M_V_TOP] + p[P.I_SPEED_GAIN] * (mem[M_SPEED] - v_step),
+                                     0.05, 1.5 * mem[M_SPEED] + 0.3)
             mem[M_STEP_T] = t
             mem[M_STEP_X] = q[0, 0]
             mem[M_STANCE] = sw
@@ -265,7 +278,9 @@ def control(m, s, p, mem, u):
         # compensation -mh g split into its n and t parts
         f_n = mh * (a_n - (gx * nx + gy * ny))
         f_t = mh * (a_t - (-gx * ny + gy * nx))
-        push_hip_pendulum(q, front, f_n, f_t, fmax, u)
+        if s.contact_mode[front] != 1 and f_t < 0.0:
+            f_t = 0.0  # front foot not stuck (sliding or free): no forward push onto it
+        push_hip_pendulum(q, front, f_n, f_t, p[P.I_DS_FRONT_LOAD] * mh * g, fmax, u)
     else:  # ST_SINGLE
         stance = int(mem[M_STANCE])
         sw = 1 - stance
@@ -282,6 +297,12 @@ def control(m, s, p, mem, u):
             ty -= p[P.I_DESCENT_RATE] * l0 * (ph - 1.0)
             tvy = -p[P.I_DESCENT_RATE] * l0 * ph_dot
         elif ph < 0.0:
+            tvx = 0.0
+            tvy = 0.0
+        if mem[M_ABORT] > 0.0:
+            # rolled back before the top: put the swing foot down where it lifted off
+            tx = mem[M_SW_X0]
+            ty = mem[M_SW_Y0] - p[P.I_STRIKE_PUSH] * l0
             tvx = 0.0
             tvy = 0.0
         hold_stance(q, v, stance, p[P.I_WALK_LENGTH] * l0, p[P.I_SS_KP], p[P.I_SS_KD], mh + mf,

@@ -58,10 +58,11 @@ def push_hip(q, front, fx, fy, fmin, fmax, u):
 
 
 @jit
-def push_hip_pendulum(q, front, f_n, f_t, fmax, u):
+def push_hip_pendulum(q, front, f_n, f_t, f_front_min, fmax, u):
     """Double stance with priority to the front leg's normal force (eq. 1): the hip force
     f_n n + f_t t [N] (n = unit(hip - front foot), t = (-n_y, n_x)) from u_f n + u_r e_r, where
-    the tangential part f_t is saturated so that both legs push within [0, fmax]."""
+    the tangential part f_t is saturated so that the front leg pushes within [f_front_min, fmax]
+    and the rear leg within [0, fmax]."""
     rear = 1 - front
     nx = q[0, 0] - q[front + 1, 0]
     ny = q[0, 1] - q[front + 1, 1]
@@ -80,12 +81,12 @@ def push_hip_pendulum(q, front, f_n, f_t, fmax, u):
         hi = fmax
         if b > 1e-9:
             lo = max(lo, (f_n - fmax) / b)
-            hi = min(hi, f_n / b)
+            hi = min(hi, (f_n - f_front_min) / b)
         elif b < -1e-9:
-            lo = max(lo, f_n / b)
+            lo = max(lo, (f_n - f_front_min) / b)
             hi = min(hi, (f_n - fmax) / b)
         u_r = clamp(u_r, lo, max(lo, hi))
-    u[front] = clamp(f_n - u_r * b, 0.0, fmax)
+    u[front] = clamp(f_n - u_r * b, min(f_front_min, fmax), fmax)
     u[rear] = u_r
     u[ACT_HIP] = 0.0
 

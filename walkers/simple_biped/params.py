@@ -51,11 +51,13 @@ class SimpleBipedParams:
     ds_kp: float = _p(200.0, "1/s^2", "eq. 1: stance leg-length gain (double stance)", 0.0, 1e4)
     ds_kd: float = _p(25.0, "1/s", "eq. 1: stance leg-length rate gain (double stance)", 0.0, 1e3)
     energy_gain: float = _p(10.0, "1/s", "eq. 3: tangential gain on the leg-rate error", 0.0, 1e3)
+    ds_front_load: float = _p(0.3, "-", "least front-leg force in double stance, as a fraction of "
+                              "the hip weight (keeps the new stance foot planted)", 0.0, 1.0)
     ds_time_min: float = _p(0.02, "s", "shortest double stance", 0.0, 1.0)
     ds_time_max: float = _p(0.25, "s", "longest double stance", 0.0, 5.0)
     ds_energy_tol: float = _p(0.02, "m^2/s^2", "double stance ends once the predicted top speed "
                               "squared is this close to v_top^2", 0.0, 10.0)
-    ds_rear_length: float = _p(1.08, "l0", "double stance ends when the rear leg reaches this length", 0.9, 1.3)
+    ds_rear_length: float = _p(1.2, "l0", "double stance ends when the rear leg reaches this length", 0.9, 1.3)
     # walk: single stance ------------------------------------------------------------------
     ss_kp: float = _p(200.0, "1/s^2", "stance leg-length gain (single stance)", 0.0, 1e4)
     ss_kd: float = _p(25.0, "1/s", "stance leg-length rate gain (single stance)", 0.0, 1e3)

@@ -152,7 +152,8 @@ class Walker:
         dist = float(self.state.q[0, 0]) - self.x_start
         return {"time": t, "distance": dist, "mean_speed": dist / t if t > 0 else 0.0,
                 "steps": int(self.memory[C.M_STEPS]), "jumps": int(self.memory[C.M_JUMPS]),
-                "scuffs": int(self.memory[C.M_SCUFFS]), "fell": self.fell, "falls": int(self.fell),
+                "scuffs": int(self.memory[C.M_SCUFFS]),
+                "retries": int(self.memory[C.M_RETRIES]), "fell": self.fell, "falls": int(self.fell),
                 "gait": self.gait, "state": C.State(int(self.memory[C.M_STATE])).name.lower()}
 
 
