@@ -24,6 +24,8 @@ the seed's level-ground guess).
 import math
 from enum import IntEnum
 
+import numpy as np
+
 from planarsim.kernels._jit import jit
 
 from walkers.common.bezier import rectangle_bezier
@@ -127,6 +129,15 @@ def _phase(p, q, v, mem):
 
 
 @jit
+def _v_top(p, mem):
+    """Pendulum top speed [m/s] aimed at: the adapted v_top, or stop_speed when a gait other
+    than WALK waits for the walker to slow down."""
+    if int(mem[M_GAIT]) != GAIT_WALK:
+        return min(mem[M_V_TOP], p[P.I_STOP_SPEED])
+    return mem[M_V_TOP]
+
+
+@jit
 def _rate_target(v_top, l, phi, g):
     """Eq. 2 (energy form): leg rate [rad/s] of a pendulum of length l that passes the top at v_top."""
     return -math.sqrt(v_top * v_top + 2.0 * g * l * (1.0 - math.cos(phi))) / l
@@ -153,7 +164,7 @@ def next_state(p, s, mem, g):
         elif gait == GAIT_JUMP and c0 and c1 and t_in > 0.3 and abs(v[0, 0]) + abs(v[0, 1]) < 0.2:
             _enter(mem, ST_CROUCH, t)
     elif state == ST_DOUBLE:
-        if gait != GAIT_WALK:
+        if gait != GAIT_WALK and abs(v[0, 0]) < p[P.I_STOP_SPEED] + 0.1:
             _enter(mem, ST_STAND, t)
             return
         front = int(mem[M_STANCE])
@@ -161,7 +172,7 @@ def next_state(p, s, mem, g):
         rear_l = leg_state(q, v, 1 - front)[2]
         # top speed squared the front-leg pendulum will have: (l phi_dot)^2 - 2 g l (1 - cos phi)
         v_top2 = (l * phidot) ** 2 - 2.0 * g * l * (1.0 - math.cos(phi))
-        err = abs(v_top2 - mem[M_V_TOP] ** 2)
+        err = abs(v_top2 - _v_top(p, mem) ** 2)
         if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL]
                                             or rear_l >= p[P.I_DS_REAR_LENGTH] * p[P.I_LEG_LENGTH]
                                             or t_in >= p[P.I_DS_TIME_MAX]):
@@ -192,8 +203,9 @@ def next_state(p, s, mem, g):
             mem[M_STEPS] += 1
             if mem[M_STEPS] >= 3 and t > mem[M_STEP_T]:
                 v_step = (q[0, 0] - mem[M_STEP_X]) / (t - mem[M_STEP_T])
-                mem[M_V_TOP] = clamp(mem[M_V_TOP] + p[P.I_SPEED_GAIN] * (mem[M_SPEED] - v_step),
-                                     0.05, 1.5 * mem[M_SPEED] + 0.3)
+                if int(mem[M_GAIT]) == GAIT_WALK:
+                    mem[M_V_TOP] = clamp(mem[M_V_TOP] + p[P.I_SPEED_GAIN] * (mem[M_SPEED] - v_step),
+                                         0.05, 1.5 * mem[M_SPEED] + 0.3)
             mem[M_STEP_T] = t
             mem[M_STEP_X] = q[0, 0]
             mem[M_STANCE] = sw
@@ -228,8 +240,7 @@ def _hold_hip(p, q, v, height, ax_extra, ay_extra, gx, gy, u):
     ty = 0.5 * (q[1, 1] + q[2, 1]) + height
     ax = p[P.I_STAND_KP] * (tx - q[0, 0]) - p[P.I_STAND_KD] * v[0, 0] + ax_extra
     ay = p[P.I_STAND_KP] * (ty - q[0, 1]) - p[P.I_STAND_KD] * v[0, 1] + ay_extra
-    front = 0 if q[1, 0] > q[2, 0] else 1
-    push_hip(q, front, mh * (ax - gx), mh * (ay - gy), 0.0, p[P.I_LEG_FORCE_MAX], u)
+    push_hip(q, mh * (ax - gx), mh * (ay - gy), p[P.I_LEG_FORCE_MAX], u)
 
 
 @jit
@@ -252,9 +263,8 @@ def control(m, s, p, mem, u):
     elif state == ST_CROUCH:
         _hold_hip(p, q, v, p[P.I_CROUCH_HEIGHT] * l0, 0.0, 0.0, gx, gy, u)
     elif state == ST_THRUST:
-        front = 0 if q[1, 0] > q[2, 0] else 1
         ax = p[P.I_STAND_KP] * (0.5 * (q[1, 0] + q[2, 0]) - q[0, 0]) - p[P.I_STAND_KD] * v[0, 0]
-        push_hip(q, front, mh * (ax - gx), mh * (p[P.I_THRUST_ACCEL] - gy), 0.0, fmax, u)
+        push_hip(q, mh * (ax - gx), mh * (p[P.I_THRUST_ACCEL] - gy), fmax, u)
     elif state == ST_FLIGHT:
         # legs at flight length, feet spread as when standing, in the hip frame (free fall)
         half = 0.5 * p[P.I_STAND_WIDTH] * l0
@@ -273,7 +283,7 @@ def control(m, s, p, mem, u):
         nx = -dx / l
         ny = -dy / l
         a_n = p[P.I_DS_KP] * (p[P.I_WALK_LENGTH] * l0 - l) - p[P.I_DS_KD] * ldot - l * phidot * phidot
-        a_t = p[P.I_ENERGY_GAIN] * l * (_rate_target(mem[M_V_TOP], l, phi, g) - phidot)
+        a_t = p[P.I_ENERGY_GAIN] * l * (_rate_target(_v_top(p, mem), l, phi, g) - phidot)
         # tangent t = (-ny, nx): the hip's direction of motion for increasing phi; weight
         # compensation -mh g split into its n and t parts
         f_n = mh * (a_n - (gx * nx + gy * ny))
@@ -309,3 +319,31 @@ def control(m, s, p, mem, u):
                     gx, gy, fmax, u)
         track_foot(q, v, sw, tx, ty, tvx, tvy, p[P.I_SWING_KP], p[P.I_SWING_KD], mf, gx, gy,
                    fmax, tmax, u)
+
+
+class Controller:
+    """Python path: ``Controller(params)(sim) -> u`` runs the same compiled ``control`` once per
+    call (use with ``Simulator.run(controller=..., control_every=1)``); ``gait`` and ``speed``
+    can be changed between calls."""
+
+    def __init__(self, params, gait: int = GAIT_WALK, speed: float | None = None):
+        self.params = params
+        self.p = params.to_array()
+        self.memory = np.zeros(N_MEMORY)
+        self.u = np.zeros(3)
+        self.reset(gait, speed)
+
+    def reset(self, gait: int = GAIT_WALK, speed: float | None = None) -> None:
+        self.memory[:] = 0.0
+        self.memory[M_STATE] = ST_STAND
+        self.memory[M_GAIT] = int(gait)
+        self.memory[M_SPEED] = self.params.speed if speed is None else float(speed)
+
+    def __call__(self, sim) -> np.ndarray:
+        control(sim.model.arrays, sim.state, self.p, self.memory, self.u)
+        return self.u.copy()
+
+    def labels(self, sim) -> dict:
+        """Per-frame labels for ``Simulator.run(labels=...)``."""
+        return {"gait": self.memory[M_GAIT], "state": self.memory[M_STATE],
+                "stance": self.memory[M_STANCE], "phase": self.memory[M_PHASE]}

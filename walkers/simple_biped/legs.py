@@ -29,10 +29,11 @@ def leg_state(q, v, i):
 
 
 @jit
-def push_hip(q, front, fx, fy, fmin, fmax, u):
-    """Double stance: axial forces u[0], u[1] with u_0 e_0 + u_1 e_1 = (fx, fy) on the hip,
-    e_i = unit(hip - foot_i); solved by Cramer's rule, then saturated to [fmin, fmax].
-    If the legs are parallel the front leg carries the force's component along itself."""
+def push_hip(q, fx, fy, fmax, u):
+    """Double stance: axial forces u[0], u[1] >= 0 with u_0 e_0 + u_1 e_1 = (fx, fy) on the hip,
+    e_i = unit(hip - foot_i). Legs only push, so the vertical force has priority: fy is kept
+    (>= 0) and fx is limited to the range that two pushing legs can give with that fy (the
+    cone between the legs), then the 2x2 system is solved by Cramer's rule."""
     ex0 = q[0, 0] - q[1, 0]
     ey0 = q[0, 1] - q[1, 1]
     ex1 = q[0, 0] - q[2, 0]
@@ -43,18 +44,22 @@ def push_hip(q, front, fx, fy, fmin, fmax, u):
     ey0 /= n0
     ex1 /= n1
     ey1 /= n1
-    det = ex0 * ey1 - ey0 * ex1
-    if abs(det) < 1e-3:
-        u[0] = 0.0
-        u[1] = 0.0
-        if front == 0:
-            u[0] = clamp(fx * ex0 + fy * ey0, fmin, fmax)
-        else:
-            u[1] = clamp(fx * ex1 + fy * ey1, fmin, fmax)
-    else:
-        u[0] = clamp((fx * ey1 - fy * ex1) / det, fmin, fmax)
-        u[1] = clamp((ex0 * fy - ey0 * fx) / det, fmin, fmax)
+    u[0] = 0.0
+    u[1] = 0.0
     u[ACT_HIP] = 0.0
+    det = ex0 * ey1 - ey0 * ex1
+    if fy <= 0.0 or ey0 < 1e-6 or ey1 < 1e-6:
+        return
+    # horizontal force with all the load on leg 0 or on leg 1
+    h0 = fy * ex0 / ey0
+    h1 = fy * ex1 / ey1
+    fx = clamp(fx, min(h0, h1), max(h0, h1))
+    if abs(det) < 1e-6:
+        u[0] = clamp(0.5 * fy / ey0, 0.0, fmax)
+        u[1] = clamp(0.5 * fy / ey1, 0.0, fmax)
+        return
+    u[0] = clamp((fx * ey1 - fy * ex1) / det, 0.0, fmax)
+    u[1] = clamp((ex0 * fy - ey0 * fx) / det, 0.0, fmax)
 
 
 @jit

@@ -46,6 +46,7 @@ class SimpleBipedParams:
     descent_rate: float = _p(0.5, "l0", "extra lowering of the swing target per unit phase past 1", 0.0, 5.0)
     speed_gain: float = _p(0.5, "-", "integral gain: energy-target speed change per speed error "
                            "of one step", 0.0, 5.0)
+    stop_speed: float = _p(0.25, "m/s", "pendulum top speed while slowing down to stand", 0.0, 1.0)
     # walk: double stance (eqs. 1-3) -----------------------------------------------------------
     walk_length: float = _p(0.95, "l0", "stance leg length target in walking", 0.5, 1.1)
     ds_kp: float = _p(200.0, "1/s^2", "eq. 1: stance leg-length gain (double stance)", 0.0, 1e4)
