@@ -6,6 +6,7 @@ Each walker module exposes ``NAME``, ``GAITS`` and
 import importlib
 
 WALKERS = {
+    "ranger": "walkers.ranger",
     "simple-biped": "walkers.simple_biped",
 }
 

@@ -1,0 +1,42 @@
+"""Cornell Ranger (seed 002 sections 5-6): four rigid bodies with curved feet, the Ranger motor
+model, FSM WALK / STAND / GUI with a step-to-step push-off feedback, cost of transport.
+
+>>> from walkers import ranger
+>>> traj, summary, model = ranger.simulate(10.0, gait="walk")   # doctest: +SKIP
+"""
+from pathlib import Path as _Path
+
+from planarsim.kernels._jit import drop_stale_caches as _drop
+
+
+def _drop_caches():
+    # our kernels also inline planarsim/actuators.py: fold it into the source hash
+    import hashlib
+    import planarsim
+    here = _Path(__path__[0])
+    act = _Path(planarsim.__file__).resolve().parent / "actuators.py"
+    digest = hashlib.blake2b(act.read_bytes(), digest_size=8).hexdigest()
+    stamp = here / "__pycache__" / "actuators.hash"
+    try:
+        if not stamp.exists() or stamp.read_text() != digest:
+            for pattern in ("*.nbi", "*.nbc"):
+                for f in list(here.rglob(pattern)) + list(act.parent.glob(f"__pycache__/actuators*{pattern[1:]}")):
+                    f.unlink(missing_ok=True)
+            stamp.parent.mkdir(exist_ok=True)
+            stamp.write_text(digest)
+    except OSError:
+        pass
+    _drop(here)
+
+
+_drop_caches()
+
+from .params import RangerParams  # noqa: E402
+from .model import build  # noqa: E402
+from .controller import Controller, Gait, Phase, Program  # noqa: E402
+from .rollout import GAITS, RangerSim, instantaneous_cot, simulate  # noqa: E402
+
+NAME = "ranger"
+
+__all__ = ["NAME", "GAITS", "simulate", "RangerParams", "build", "Controller", "Gait", "Phase",
+           "Program", "RangerSim", "instantaneous_cot"]
