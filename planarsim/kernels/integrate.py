@@ -5,10 +5,18 @@ correct_positions: the linearised rows leave a residual O(h^2 w^2 r). Newton on 
 equation moves q along the START-of-step constraint directions J(q0):
     (J(q+) W J(q0)^T) mu = -c(q+),   q += W J(q0)^T mu,   v += W J(q0)^T mu / h
 (correcting along J(q+) instead would dissipate energy every step; DESIGN.md section 3.7).
+Corrections of unilateral rows (contact normals, joint limits) move positions only: pushing a
+body out of the ground must not give it the velocity overlap / h (energy from nowhere).
 """
 from ._jit import jit
-from .rows import eval_row
+from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_row
 from .solve import apply_impulses, assemble, factor_solve
+
+
+@jit
+def is_unilateral(kind):
+    """Contact normal and joint-limit rows: their corrections remove overlap, not velocity."""
+    return kind == ROW_CONTACT_N or kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI
 
 
 @jit
@@ -44,14 +52,19 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
             break
         assemble(m, ws, ws.row_Jp, ws.row_J, n)
         factor_solve(ws.A, ws.rhs, ws.lam, n, pivot_tol)
-        # move positions and velocities by the same correction
+        # move positions by the correction, velocities by its bilateral part / h
         for i in range(ws.v_new.shape[0]):
             for k in range(3):
                 ws.v_new[i, k] = 0.0
+                ws.v_pred[i, k] = 0.0
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_new, 1.0)
+        for r in range(n):
+            if is_unilateral(ws.row_kind[r]):
+                ws.lam[r] = 0.0
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_pred, 1.0 / h)
         for i in range(s.q.shape[0]):
             for k in range(3):
                 s.q[i, k] += ws.v_new[i, k]
-                s.v[i, k] += ws.v_new[i, k] / h
+                s.v[i, k] += ws.v_pred[i, k]
         worst = max_residual(m, s, ws)
     return worst

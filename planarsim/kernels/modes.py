@@ -11,7 +11,9 @@ Rules (seed 002 section 5 plus the sliding mode of its footnote):
 Which pinned/sliding contacts are checked is the strategy: MODES_ALTERNATING checks the one
 under the round-robin cursor, once per step, plus any contact engaged during this step (an
 impact must be allowed to slide at once, or a pinned impact would stop a sliding body dead);
-MODES_ALL checks all of them in every round.
+and every sliding contact whose friction would reverse its slip sticks at once, in every
+round (an overshooting friction impulse adds energy). MODES_ALL checks every contact in
+every round.
 Joint limits engage when the angle would pass the limit and release when their impulse pulls.
 """
 from ._jit import jit
@@ -133,9 +135,17 @@ def update_modes(m, s, ws, h, strategy, first_round, include_ccd):
                 changed += check_contact(m, s, ws, i)
     else:
         # the contact under the cursor in the first round; contacts engaged during this
-        # step in every round, so an impact can start sliding at once
+        # step in every round, so an impact can start sliding at once; and in every round
+        # any sliding contact whose friction would reverse its slip (that would add energy)
         cursor = s.mode_cursor[0] % nc
         for i in range(nc):
-            if s.contact_enabled[i] and ((first_round and i == cursor) or ws.contact_new[i] == 1):
+            if s.contact_enabled[i] == 0:
+                continue
+            if (first_round and i == cursor) or ws.contact_new[i] == 1:
                 changed += check_contact(m, s, ws, i)
+            elif s.contact_mode[i] == MODE_SLIDING:
+                vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
+                if vt * s.contact_slip[i] <= 0.0:
+                    s.contact_mode[i] = MODE_PINNED
+                    changed += 1
     return changed

@@ -9,6 +9,7 @@ that is a combination of earlier ones; its impulse is zero and the rows it depen
 the load. For consistent constraints this is exact, not a regularisation.
 """
 from ._jit import jit
+from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
 
 
 @jit
@@ -105,7 +106,12 @@ def solve_impulses(m, ws, h, tol):
         return 0
     assemble(m, ws, ws.row_J, ws.row_F, n)
     for r in range(n):
-        ws.rhs[r] = -(ws.row_c[r] / h + row_dot(ws, r, ws.row_J, ws.v_pred))
+        c = ws.row_c[r]
+        if c < 0.0 and ws.row_kind[r] >= ROW_LIMIT_LO and ws.row_kind[r] != ROW_CONTACT_T:
+            # a unilateral row that starts violated only stops approaching; the position
+            # correction removes the overlap without turning it into velocity (energy)
+            c = 0.0
+        ws.rhs[r] = -(c / h + row_dot(ws, r, ws.row_J, ws.v_pred))
     dropped = factor_solve(ws.A, ws.rhs, ws.lam, n, tol)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
     return dropped

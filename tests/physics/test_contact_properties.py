@@ -100,15 +100,17 @@ def test_contact_runs_are_deterministic(scene):
 
 
 def test_energy_oscillation_shrinks_with_dt():
-    scene = (terrain.hills([0.1], [3.0], [0.3]),
-             [dict(kind="box", x=0.0, y=0.6, angle=0.7, vx=2.0, vy=0.0, w=3.0, mu=0.8),
-              dict(kind="disk", x=4.0, y=0.4, angle=0.0, vx=-1.0, vy=0.0, w=0.0, mu=0.3)])
+    # a frictionless point released on a hillside slides to and fro: the integrator's own
+    # energy oscillation is all there is
+    scene = (terrain.hills([0.1], [3.0], [0.0]),
+             [dict(kind="point", x=0.4, y=1e-4, angle=0.0, vx=0.0, vy=0.0, w=0.0, mu=0.0)])
     rises = []
     for dt in (2e-3, 1e-3, 5e-4):
         model = build(scene, dt)
-        traj = run(model, 1.5)
+        traj = run(model, 3.0)
         e0 = energy_above_ground(model, model.q0, model.v0)
         rises.append(max(0.0, (energy_above_ground(model, traj.q, traj.v).max() - e0) / e0))
     print("largest energy rise / E0 at dt = 2, 1, 0.5 ms:", ", ".join(f"{r:.2e}" for r in rises))
     assert rises[0] <= ENERGY_TOL
-    assert rises[2] <= rises[1] <= rises[0]
+    assert rises[0] > 0.0  # the scene does show the oscillation
+    assert rises[2] <= rises[1] < rises[0]
