@@ -2,7 +2,8 @@
 
 Frames are sampled from the trajectory's times: video frame k (k = 0 .. n-1) shows the
 recorded frame nearest to simulated time t_start + k * speed / fps, with
-n = round(duration * fps / speed). So ``speed=1`` is real time, ``speed=0.25`` slow motion
+n = round(duration * fps / speed); a trajectory recorded every h seconds with frames at
+t_1 .. t_K lasts t_K - t_1 + h. So ``speed=1`` is real time, ``speed=0.25`` slow motion
 (4x longer video) and ``speed=4`` four times faster than real time; a 2 s run at 30 fps gives
 60 frames. The camera (camera.py) follows the COM in simulated time, so the picture is the
 same at every playback speed.
@@ -39,8 +40,10 @@ def frame_times(traj, fps: float = 30.0, speed: float = 1.0, start=None, duratio
         raise ValueError(f"speed={speed} must be finite and > 0 (1 real time, <1 slow motion, >1 faster)")
     if len(traj.t) == 0:
         raise ValueError("the trajectory has no frames to animate")
+    # each recorded frame stands for one recording interval h: frames at h, 2h, .. T cover T
+    h = float(np.median(np.diff(traj.t))) if len(traj.t) > 1 else 0.0
     t0 = float(traj.t[0]) if start is None else float(start)
-    t_end = float(traj.t[-1])
+    t_end = float(traj.t[-1]) + h
     if duration is None:
         duration = t_end - t0
     duration = float(duration)
@@ -48,7 +51,7 @@ def frame_times(traj, fps: float = 30.0, speed: float = 1.0, start=None, duratio
         raise ValueError(f"duration={duration} must be finite and >= 0 s")
     if t0 < float(traj.t[0]) - 1e-9 or t0 + duration > t_end + 1e-6 * max(1.0, abs(t_end)):
         raise ValueError(f"start={t0:g} s, duration={duration:g} s lies outside the trajectory "
-                         f"({traj.t[0]:g} .. {t_end:g} s)")
+                         f"({traj.t[0]:g} .. {traj.t[-1]:g} s, recorded every {h:g} s)")
     n = max(1, int(round(duration * fps / speed)))
     return t0 + np.arange(n) * (speed / fps)
 
@@ -125,7 +128,7 @@ def ffmpeg_exe() -> str:
 def _writer(fmt, fps, bitrate=None, embed_limit_mb=200.0):
     from matplotlib import animation
     if fmt == "gif":
-        return animation.PillowWriter(fps=fps)
+        return _GifWriter(fps=fps)
     if fmt == "mp4":
         ffmpeg_exe()
         return animation.FFMpegWriter(fps=fps, codec="libx264", bitrate=bitrate,
@@ -134,6 +137,30 @@ def _writer(fmt, fps, bitrate=None, embed_limit_mb=200.0):
         return animation.HTMLWriter(fps=fps, embed_frames=True, default_mode="loop",
                                     embed_limit=embed_limit_mb)
     raise ValueError(fmt)
+
+
+def _gif_durations(n: int, fps: float) -> list:
+    """Frame delays [ms] in the GIF's 10 ms units whose running sum stays on the fps clock
+    (30 fps: 30, 40, 30, 30, 40, ... ms rather than 30 ms every frame, which runs 11% fast)."""
+    cs = np.round(np.arange(n + 1) * 100.0 / fps)
+    return [int(d) for d in np.maximum(np.diff(cs), 1) * 10]
+
+
+def _make_gif_writer_class():
+    from matplotlib import animation
+
+    class GifWriter(animation.PillowWriter):
+        """matplotlib's PillowWriter with per-frame delays that keep the GIF on time."""
+
+        def finish(self):
+            self._frames[0].save(self.outfile, save_all=True, append_images=self._frames[1:],
+                                 duration=_gif_durations(len(self._frames), self.fps), loop=0)
+
+    return GifWriter
+
+
+def _GifWriter(fps):
+    return _make_gif_writer_class()(fps=fps)
 
 
 # the exporter --------------------------------------------------------------------------------
@@ -148,10 +175,12 @@ class FrameRenderer:
         self.traj, self.model = traj, model
         self.times = frame_times(traj, fps, speed, start, duration)
         self.index = frame_indices(traj, self.times)
-        self.fig, self.ax = make_figure(size, dpi)
+        # even pixel sizes: H.264 with yuv420p needs them
+        w_px, h_px = (max(2, int(round(float(v) * dpi)) // 2 * 2) for v in size)
+        self.fig, self.ax = make_figure((w_px / dpi, h_px / dpi), dpi)
         self.scene = Scene(model, self.ax, **scene_kw)
         cam = camera if camera is not None else Camera()
-        self.centers = cam.track(self.times, traj.com(model)[self.index])
+        self.centers = cam.track(self.times, traj.com(model)[self.index], traj.com_velocity(model)[self.index])
 
     def __len__(self):
         return len(self.times)

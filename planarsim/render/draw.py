@@ -327,7 +327,9 @@ class Scene:
 def make_figure(size=(6.4, 3.6), dpi: int = 100):
     """A figure whose single axes fills it (no margins): the frame of an animation."""
     import matplotlib.figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     fig = matplotlib.figure.Figure(figsize=size, dpi=dpi)
+    FigureCanvasAgg(fig)
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
     ax.set_axis_off()
     ax.patch.set_visible(True)
@@ -337,9 +339,7 @@ def make_figure(size=(6.4, 3.6), dpi: int = 100):
 def render_state(model, q, path=None, size=(6.4, 3.6), dpi=100, center=None, **scene_kw):
     """Draw one state (n_body, 3) on a new Agg figure; save it to `path` if given.
     Returns (fig, scene)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     fig, ax = make_figure(size, dpi)
-    FigureCanvasAgg(fig)
     scene = Scene(model, ax, **scene_kw)
     scene.draw_state(q, center=center)
     if path is not None:

@@ -12,7 +12,7 @@ pause before the next frame
     pause_k = T - kp e_k - ki sum_{i<=k} e_i      (clamped at >= 0; no windup while clamped)
 
 so the integral absorbs the steady render time and oversleep, the proportional term the
-jitter. A frame more than ``max_lag`` late is skipped rather than caught up.
+jitter. The integral starts from the time the first frame took to prepare. A frame more than ``max_lag`` late is skipped rather than caught up.
 
 ``Viewer`` steps ``sim`` with ``controller(sim) -> u`` (the Python path) by ``speed * T`` of
 simulated time per frame. Keys: space play/pause, right or '.' step one frame, 'i' impulses,
@@ -52,8 +52,11 @@ class FrameTimer:
         self.start()
 
     def start(self) -> None:
-        """(Re)start the schedule: playback time 0 is the moment the next frame is on screen."""
+        """(Re)start the schedule: playback time 0 is the moment the next frame is on screen.
+        The time that first frame takes to prepare seeds the integral (warm start), so the
+        first pauses already leave room for the per-frame work."""
         self.wall0 = None
+        self._started = self.clock()
         self.playback_time = 0.0      # scheduled time of the current frame [s]
         self.integral = 0.0           # sum of lateness [s]
         self.last_error = 0.0
@@ -69,6 +72,8 @@ class FrameTimer:
         and advances the schedule by one period (or more, when frames must be skipped)."""
         if self.wall0 is None:
             self.wall0 = self.clock()
+            if self.ki > 0:
+                self.integral = min(self.wall0 - self._started, self.period) / self.ki
         e = self.wall_time() - self.playback_time
         if e > self.max_lag:
             skip = int(e // self.period)
@@ -258,13 +263,14 @@ class Viewer:
         q = sim.state.q
         com = self.scene.com_of(q)
         # the camera moves in simulated time, like the exported animations
-        center = self.camera.update(com, max(0.0, sim.t - self._drawn_t))
+        mass = sim.model.arrays.body_mass
+        com_v = mass @ sim.state.v[:, :2] / mass.sum()
+        center = self.camera.update(com, max(0.0, sim.t - self._drawn_t), com_v)
         self._drawn_t = sim.t
         labels = dict(self.labels(sim)) if self.labels is not None else {}
         if self.gait is not None:
             labels.setdefault("gait", self.gait)
-        mass = sim.model.arrays.body_mass
-        speed = float(mass @ sim.state.v[:, 0] / mass.sum())
+        speed = float(com_v[0])
         arts = self.scene.draw_state(q, center=center, t=sim.t, contact_point=sim.ws.contact_point,
                                      contact_impulse=sim.ws.contact_impulse, labels=labels, speed=speed)
         if self.message:

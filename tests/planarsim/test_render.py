@@ -1,0 +1,737 @@
+"""Rendering, camera, animation export, plots and the interactive viewer (issue 6).
+
+Everything runs headless with Agg; test models are built inline (a box, a pendulum, a point
+mass) so these tests do not depend on any walker package.
+"""
+import math
+import os
+import random
+import shutil
+import subprocess
+from pathlib import Path
+
+import matplotlib
+matplotlib.use("Agg")
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+from matplotlib.backend_bases import KeyEvent, MouseEvent
+
+import planarsim as ps
+from planarsim import terrain
+from planarsim.render import (Camera, FrameTimer, Scene, Style, Viewer, cost_of_transport, export_animation,
+                              frame_indices, frame_times, joint_series, make_figure, plot_summary,
+                              save_figure, show_inline, step_overshoot)
+from planarsim.render.animate import animation_html
+
+RED = (1.0, 0.0, 0.0)
+BLUE = (0.0, 0.0, 1.0)
+
+
+# models ----------------------------------------------------------------------------------------
+def box_model(pos=(0.0, 0.1), vel=(0.0, 0.0), mu=0.8, width=0.8, height=0.2, push=False):
+    b = ps.ModelBuilder(dt=1e-3)
+    box = b.add_body("box", mass=2.0, inertia=2.0 * (width ** 2 + height ** 2) / 12, pos=pos, vel=vel)
+    b.add_box_contacts("corner", box, (0.0, 0.0), width, height, mu=mu)
+    if push:
+        b.add_body_force("push", box, direction=(1.0, 0.0))
+    return b.compile()
+
+
+def pendulum_model(length=1.0, pivot=(0.0, 1.5), motor=True):
+    b = ps.ModelBuilder(dt=1e-3)
+    rod = b.add_body("rod", mass=1.0, inertia=length ** 2 / 12, pos=(pivot[0] + length / 2, pivot[1]),
+                     shapes=[("capsule", (-length / 2, 0.0), (length / 2, 0.0), 0.03)])
+    b.add_pin("pivot", None, rod, anchor_world=pivot)
+    if motor:
+        b.add_pin_motor("motor", "pivot", limit=(-100.0, 100.0))
+    return b.compile()
+
+
+def red_style(**kw):
+    return Style(body_colors=("#ff0000",), edge_color="#ff0000", body_alpha=1.0, tick_color="#0000ff",
+                 terrain_color="#00ff00", ground_fill="#ffffff", **kw)
+
+
+def render(model, q, center, view_width=4.0, size=(6.4, 3.6), dpi=100, **kw):
+    fig, ax = make_figure(size, dpi)
+    scene = Scene(model, ax, view_width=view_width, show_com=False, show_text=False, style=red_style(), **kw)
+    scene.draw_state(q, center=center)
+    fig.canvas.draw()
+    img = np.asarray(fig.canvas.buffer_rgba())[:, :, :3].astype(int)
+    return img, scene
+
+
+def to_pixels(scene, xy):
+    """Data -> image pixel (column, row from the top)."""
+    x0, x1 = scene.ax.get_xlim()
+    y0, y1 = scene.ax.get_ylim()
+    fig = scene.ax.figure
+    w, h = fig.canvas.get_width_height()
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    return np.column_stack([(xy[:, 0] - x0) / (x1 - x0) * w, (y1 - xy[:, 1]) / (y1 - y0) * h])
+
+
+def mask(img, rgb):
+    target = np.array(rgb) * 255
+    return np.all(np.abs(img - target) < 60, axis=2)
+
+
+# camera ---------------------------------------------------------------------------------------
+def analytic_step(t, wn, z, amplitude):
+    wd = wn * math.sqrt(1 - z * z)
+    return amplitude * (1 - np.exp(-z * wn * t) * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t)))
+
+
+@settings(max_examples=40, deadline=None)
+@given(z=st.floats(0.1, 0.95), wn=st.floats(0.5, 20.0), amplitude=st.floats(-5.0, 5.0).filter(lambda a: abs(a) > 1e-3),
+       seed=st.integers(0, 10 ** 6))
+def test_camera_step_response_is_the_damped_oscillator(z, wn, amplitude, seed):
+    """Uneven frame intervals: the camera samples the continuous step response exactly, so its
+    overshoot never exceeds exp(-zeta pi / sqrt(1 - zeta^2)) of the step."""
+    rng = np.random.default_rng(seed)
+    dts = rng.uniform(0.2, 1.0, 400) * min(0.05, 0.5 / wn)
+    times = np.r_[0.0, np.cumsum(dts)]
+    cam = Camera(natural_frequency=wn, damping_ratio=z, position=(0.0, 0.0))
+    path = cam.track(times, np.tile([amplitude, -amplitude], (len(times), 1)))
+    np.testing.assert_allclose(path[:, 0], analytic_step(times, wn, z, amplitude), atol=1e-9 * abs(amplitude))
+    np.testing.assert_allclose(path[:, 1], -path[:, 0], atol=1e-12)
+    overshoot = path[:, 0].max() / amplitude - 1 if amplitude > 0 else path[:, 0].min() / amplitude - 1
+    assert overshoot <= step_overshoot(z) + 1e-9
+
+
+@pytest.mark.parametrize("z", [0.3, 0.7])
+def test_camera_overshoot_is_the_damping_ratio_one_at_fine_frames(z):
+    """At 1000 fps the sampled peak reaches the theory (so the camera really rings as zeta says)."""
+    wn = 4.0
+    times = np.arange(0, 5.0, 1e-3)
+    cam = Camera(wn, z, position=(0.0, 0.0))
+    x = cam.track(times, np.tile([1.0, 0.0], (len(times), 1)))[:, 0]
+    assert x.max() - 1 == pytest.approx(step_overshoot(z), rel=1e-4)
+    t_peak = times[np.argmax(x)]
+    assert t_peak == pytest.approx(math.pi / (wn * math.sqrt(1 - z * z)), abs=1.5e-3)
+
+
+@settings(max_examples=25, deadline=None)
+@given(z=st.floats(1.0, 3.0), wn=st.floats(0.5, 20.0), fps=st.floats(5, 240))
+def test_camera_without_overshoot_when_critically_or_over_damped(z, wn, fps):
+    times = np.arange(0, 20.0 / wn + 1.0, 1.0 / fps)
+    cam = Camera(wn, z, position=(0.0, 0.0))
+    x = cam.track(times, np.tile([2.0, 0.0], (len(times), 1)))[:, 0]
+    assert x.max() <= 2.0 + 1e-12
+    assert np.all(np.diff(x) >= -1e-12)           # monotone approach
+    assert x[-1] > 1.9                             # it does get there
+
+
+def test_camera_is_smoother_than_the_com_it_tracks():
+    """A walking COM whose speed jumps at every heel strike (1 +- 0.3 m/s, twice a second): a
+    camera locked on it would change speed by 0.6 m/s in one frame; the tracking camera's
+    velocity stays continuous, and with the COM velocity fed in it does not lag behind."""
+    fps = 60
+    t = np.arange(0, 6, 1 / fps)
+    v = 1.0 + 0.3 * np.sign(np.sin(2 * np.pi * 2 * t + 0.1))
+    x = np.r_[0.0, np.cumsum(v[:-1]) / fps]
+    com, com_v = np.column_stack([x, np.zeros_like(t)]), np.column_stack([v, np.zeros_like(t)])
+    for cam, max_error in ((Camera(3.0, 0.9), 0.2), (Camera(3.0, 0.9), None)):
+        cx = cam.track(t, com, com_v if max_error else None)[:, 0]
+        cam_dv = np.abs(np.diff(np.gradient(cx, t)[1:-1])).max()
+        assert cam_dv < 0.15 * np.abs(np.diff(v)).max()
+        if max_error:
+            assert np.abs(cx - x).max() < max_error
+        else:   # form (1) lags a ramp by 2 zeta v / wn
+            assert (x - cx)[-fps:].mean() == pytest.approx(2 * 0.9 * 1.0 / 3.0, rel=0.05)
+
+
+def test_camera_rejects_bad_parameters():
+    with pytest.raises(ValueError, match="natural_frequency"):
+        Camera(natural_frequency=0.0)
+    with pytest.raises(ValueError, match="damping_ratio"):
+        Camera(damping_ratio=float("nan"))
+
+
+# drawing --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("angle", [0.0, 0.5])
+def test_box_pixels_are_where_the_geometry_says(angle):
+    model = box_model(width=0.8, height=0.4)
+    q = np.array([[0.3, 0.8, angle]])
+    img, scene = render(model, q, center=(0.0, 0.5))
+    corners = np.array([[-0.4, -0.2], [0.4, -0.2], [0.4, 0.2], [-0.4, 0.2]])
+    c, s = math.cos(angle), math.sin(angle)
+    world = corners @ np.array([[c, -s], [s, c]]).T + q[0, :2]
+    expect = to_pixels(scene, world)
+    rows, cols = np.nonzero(mask(img, RED))
+    assert len(rows) > 1000
+    got = np.array([cols.min(), rows.min(), cols.max() + 1, rows.max() + 1])
+    want = np.array([expect[:, 0].min(), expect[:, 1].min(), expect[:, 0].max(), expect[:, 1].max()])
+    np.testing.assert_allclose(got, want, atol=2.0)   # edge line width and anti-aliasing
+    # the ground line at y = 0 is drawn on the right row
+    g_rows = np.nonzero(mask(img, (0.0, 1.0, 0.0)).any(axis=1))[0]
+    assert abs(g_rows.mean() - to_pixels(scene, [0.0, 0.0])[0, 1]) < 2.0
+
+
+def test_rotation_sense_of_an_asymmetric_shape():
+    """A capsule from the COM to +0.5 m local x, turned +30 deg, points up and to the right."""
+    b = ps.ModelBuilder()
+    b.add_body("arm", mass=1.0, inertia=0.1, pos=(0.0, 1.0), angle=math.radians(30),
+               shapes=[("capsule", (0.0, 0.0), (0.5, 0.0), 0.02)])
+    model = b.compile()
+    img, scene = render(model, model.q0, center=(0.0, 1.0))
+    rows, cols = np.nonzero(mask(img, RED))
+    tip = to_pixels(scene, [0.5 * math.cos(math.radians(30)), 1.0 + 0.5 * math.sin(math.radians(30))])[0]
+    base = to_pixels(scene, [0.0, 1.0])[0]
+    assert abs(cols.max() - tip[0]) < 5 and abs(rows.min() - tip[1]) < 5
+    assert abs(cols.min() - base[0]) < 5 and abs(rows.max() - base[1]) < 5
+
+
+def tick_columns(img, scene):
+    """Pixel columns of the tick marks (blue) found in the image, sorted."""
+    cols = np.nonzero(mask(img, BLUE).any(axis=0))[0]
+    cols = cols[(cols > 2) & (cols < img.shape[1] - 3)]     # ticks cut by the frame edge
+    groups = np.split(cols, np.flatnonzero(np.diff(cols) > 2) + 1)
+    return np.array([g.mean() for g in groups if len(g)])
+
+
+def test_tick_marks_move_in_the_image_when_the_body_moves():
+    """The view follows the COM: the box stays put in the picture, the ticks slide backwards."""
+    model = box_model()
+    spacing = 0.5
+    images = []
+    for x in (0.0, 0.2):
+        q = np.array([[x, 0.1, 0.0]])
+        img, scene = render(model, q, center=None, tick_spacing=spacing)   # centred on the COM
+        images.append((img, scene, x))
+    (img0, sc0, _), (img1, sc1, _) = images
+    t0, t1 = tick_columns(img0, sc0), tick_columns(img1, sc1)
+    px_per_m = img0.shape[1] / 4.0
+    # found ticks are where the spacing puts them
+    x_left = 0.0 - 2.0
+    want0 = (spacing * np.arange(math.ceil(x_left / spacing), math.floor(2.0 / spacing) + 1) - x_left) * px_per_m
+    want0 = want0[(want0 > 3) & (want0 < img0.shape[1] - 3)]
+    np.testing.assert_allclose(t0, want0, atol=1.5)
+    # moved 0.2 m: every tick shifted 0.2 m to the left in the image (mod the spacing)
+    shift = (t1[:, None] - t0[None, :]).ravel()
+    assert np.any(np.abs(shift + 0.2 * px_per_m) < 1.5)
+    assert not np.any(np.abs(shift) < 1.0)        # no tick stayed where it was
+    # while the box itself stayed at the centre of the picture
+    c0 = np.nonzero(mask(img0, RED))[1].mean()
+    c1 = np.nonzero(mask(img1, RED))[1].mean()
+    assert abs(c0 - c1) < 1.0
+
+
+def test_impulse_arrows_follow_the_toggle_and_point_along_the_ground_normal():
+    model = box_model()
+    sim = ps.Simulator(model)
+    sim.run(0.3)
+    q, pts, imp = sim.state.q.copy(), sim.ws.contact_point.copy(), sim.ws.contact_impulse.copy()
+    assert imp[:, 0].sum() > 0
+    fig, ax = make_figure()
+    scene = Scene(model, ax, view_width=3.0, style=red_style(impulse_color="#ff00ff"), show_com=False)
+    scene.draw_state(q, contact_point=pts, contact_impulse=imp)
+    segs = scene.impulses.get_segments()
+    n_loaded = int((np.abs(imp).sum(axis=1) > 0).sum())
+    assert len(segs) == 3 * n_loaded
+    for shaft in segs[::3]:
+        d = shaft[1] - shaft[0]
+        assert d[1] > 0 and abs(d[0]) < 1e-9 * abs(d[1]) + 1e-12   # flat ground, box at rest: straight up
+    # total arrow length is the weight times the scale (the impulses carry the weight)
+    total = sum(np.hypot(*(s[1] - s[0])) for s in segs[::3])
+    assert total == pytest.approx(model.total_mass * 9.81 * scene.impulse_scale, rel=1e-3)
+    scene.show_impulses = False
+    scene.draw_state(q, contact_point=pts, contact_impulse=imp)
+    assert not scene.impulses.get_visible() and len(scene.impulses.get_segments()) == 0
+
+
+def test_every_shape_kind_and_rods_pins_actuators_are_drawn():
+    b = ps.ModelBuilder(terrain=terrain.hills([0.1], [3.0]))
+    hip = b.add_point_mass("hip", mass=5.0, pos=(0.0, 1.0))
+    foot = b.add_point_mass("foot", mass=0.5, pos=(0.0, 0.2))
+    b.add_axial("leg", hip, foot)
+    shin = b.add_body("shin", mass=1.0, inertia=0.05, pos=(0.5, 0.6), shapes=[("box", (0, 0), 0.1, 0.5, 0.2)])
+    b.add_arc_contact("sole", shin, center=(0.0, -0.1), radius=0.2, span=(-2.5, -0.6),
+                      vertices=[(-0.15, -0.25), (0.15, -0.25)])
+    b.add_rod("rod", hip, shin, anchor_a=(0, 0), anchor_b=(0, 0.25))
+    b.add_pin("p", None, shin, anchor_world=(0.5, 0.85))
+    model = b.compile()
+    kinds = sorted(s.kind for s in model.shapes)
+    assert kinds == ["arc", "box", "circle", "circle"]
+    fig, ax = make_figure()
+    scene = Scene(model, ax)
+    scene.draw_state(model.q0)
+    assert len(scene.bodies.get_paths()) == 4
+    assert len(scene.rods.get_segments()) == 1 and len(scene.actuators.get_segments()) == 1
+    np.testing.assert_allclose(scene.pins.get_xydata(), [[0.5, 0.85]], atol=1e-12)
+    np.testing.assert_allclose(scene.rods.get_segments()[0], [[0.0, 1.0], [0.5, 0.85]], atol=1e-12)
+    # the terrain curve is the model's terrain
+    x, y = scene.terrain_line.get_data()
+    np.testing.assert_allclose(y, model.terrain.height(x), atol=1e-12)
+
+
+# export ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def sliding_run():
+    model = box_model(pos=(0.0, 0.1), vel=(1.5, 0.0), mu=0.3)
+    traj = ps.Simulator(model).run(2.0, record_every=10)
+    return model, traj
+
+
+def count_mp4_frames(path):
+    import imageio_ffmpeg
+    gen = imageio_ffmpeg.read_frames(str(path))
+    meta = next(gen)
+    n = sum(1 for _ in gen)
+    return n, meta
+
+
+def test_gif_and_mp4_of_two_seconds_at_30_fps_have_60_frames(sliding_run, tmp_path):
+    from PIL import Image
+    model, traj = sliding_run
+    gif = export_animation(traj, model, tmp_path / "run.gif", fps=30, size=(3.2, 1.8), progress=False)
+    mp4 = export_animation(traj, model, tmp_path / "run.mp4", fps=30, size=(3.2, 1.8), progress=False)
+    with Image.open(gif) as im:
+        assert im.n_frames == 60
+        delays = []
+        for k in range(im.n_frames):
+            im.seek(k)
+            delays.append(im.info["duration"])
+    assert set(delays) <= {30, 40} and sum(delays) == 2000    # GIF counts in 10 ms: kept on time
+    n, meta = count_mp4_frames(mp4)
+    assert n == 60
+    assert meta["fps"] == pytest.approx(30)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.gif", "run.mp4"]   # no leftovers
+
+
+def test_playback_speed_samples_frames_from_the_trajectory_times(sliding_run):
+    model, traj = sliding_run
+    real = frame_times(traj, fps=30, speed=1.0)
+    slow = frame_times(traj, fps=30, speed=0.25)
+    fast = frame_times(traj, fps=30, speed=4.0)
+    assert (len(real), len(slow), len(fast)) == (60, 240, 15)
+    np.testing.assert_allclose(np.diff(slow), 0.25 / 30)
+    np.testing.assert_allclose(np.diff(fast), 4.0 / 30)
+    idx = frame_indices(traj, slow)
+    assert np.abs(traj.t[idx] - slow).max() <= 0.5 * (traj.t[1] - traj.t[0]) + 1e-12
+    window = frame_times(traj, fps=10, speed=0.5, start=0.5, duration=1.0)
+    assert len(window) == 20 and window[0] == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="outside the trajectory"):
+        frame_times(traj, fps=30, start=1.5, duration=2.0)
+    with pytest.raises(ValueError, match="speed"):
+        frame_times(traj, fps=30, speed=0)
+
+
+def test_slow_motion_gif_has_four_times_the_frames(sliding_run, tmp_path):
+    from PIL import Image
+    model, traj = sliding_run
+    out = export_animation(traj, model, tmp_path / "slow.gif", fps=20, speed=0.25, duration=0.5,
+                           size=(1.6, 0.9), dpi=50, progress=False)
+    with Image.open(out) as im:
+        assert im.n_frames == 40
+
+
+def test_unknown_extension_and_unwritable_path_give_clear_errors(sliding_run, tmp_path):
+    model, traj = sliding_run
+    with pytest.raises(ValueError, match=r"'\.avi' unknown.*\.gif.*\.mp4"):
+        export_animation(traj, model, tmp_path / "x.avi", progress=False)
+    with pytest.raises(OSError, match="does not exist"):
+        export_animation(traj, model, tmp_path / "missing" / "x.gif", progress=False)
+    (tmp_path / "adir.gif").mkdir()
+    with pytest.raises(OSError, match="is a folder"):
+        export_animation(traj, model, tmp_path / "adir.gif", progress=False)
+    if os.geteuid() != 0:   # root may write anywhere
+        ro = tmp_path / "ro"
+        ro.mkdir(mode=0o500)
+        with pytest.raises(OSError, match="not writable"):
+            export_animation(traj, model, ro / "x.gif", progress=False)
+    with pytest.raises(ValueError, match="wrong model"):
+        export_animation(traj, _two_body_model(), tmp_path / "y.gif", progress=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["adir.gif"]
+
+
+def _two_body_model():
+    b = ps.ModelBuilder()
+    b.add_point_mass("a", 1.0, pos=(0, 1))
+    b.add_point_mass("b", 1.0, pos=(1, 1))
+    return b.compile()
+
+
+@pytest.mark.parametrize("ext", ["gif", "mp4", "html"])
+def test_interrupted_export_leaves_no_half_written_file(sliding_run, tmp_path, ext):
+    model, traj = sliding_run
+    target = tmp_path / f"run.{ext}"
+    target.write_bytes(b"old contents")
+
+    def interrupt(done, total):
+        if done == 5:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        export_animation(traj, model, target, fps=30, size=(1.6, 0.9), dpi=50, progress=interrupt)
+    assert target.read_bytes() == b"old contents"
+    assert [p.name for p in tmp_path.iterdir()] == [target.name]
+
+
+def test_progress_bar_counts_every_frame(sliding_run, tmp_path, capsys):
+    model, traj = sliding_run
+    seen = []
+    export_animation(traj, model, tmp_path / "a.gif", fps=10, duration=1.0, size=(1.6, 0.9), dpi=50,
+                     progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(k, 10) for k in range(1, 11)]
+    export_animation(traj, model, tmp_path / "b.gif", fps=10, duration=1.0, size=(1.6, 0.9), dpi=50)
+    err = capsys.readouterr().err
+    assert "10/10 frames" in err and "#" * 30 in err
+
+
+# html -----------------------------------------------------------------------------------------
+def test_html_export_is_a_self_contained_player(sliding_run, tmp_path):
+    model, traj = sliding_run
+    out = export_animation(traj, model, tmp_path / "run.html", fps=15, size=(1.6, 0.9), dpi=50, progress=False)
+    page = out.read_text()
+    assert page.startswith("<!DOCTYPE html>") and page.rstrip().endswith("</html>")
+    assert page.count("data:image/png;base64,") == 30          # frames embedded
+    assert "play_animation()" in page and 'type="range"' in page  # play button and frame slider
+    assert "http://" not in page and "https://" not in page      # nothing fetched from the net
+    frag = show_inline(traj, model, fps=15, size=(1.6, 0.9), dpi=50)
+    html = frag.data if hasattr(frag, "data") else frag
+    assert type(frag).__name__ == "HTML" and html.count("data:image/png;base64,") == 30
+    assert "<html>" not in html
+
+
+NODE_DOM_STUB = r"""
+const fs = require('fs'); const vm = require('vm');
+const html = fs.readFileSync(process.argv[2], 'utf8');
+const els = {};
+function el(id) { if (!els[id]) els[id] = {id, value: 0, max: 0, src: '', getAttribute: () => null,
+                                          setAttribute: () => {}}; return els[id]; }
+const sandbox = {navigator: {userAgent: 'node'}, Image: function() { this.src = ''; },
+  setTimeout, setInterval, clearInterval, console,
+  document: {getElementById: el}};
+const form = html.match(/name="(_anim_loop_select\w+)"/)[1];
+sandbox.document[form] = {state: [{value: 'once', checked: false}, {value: 'loop', checked: true},
+                                   {value: 'reflect', checked: false}]};
+vm.createContext(sandbox);
+const scripts = [...html.matchAll(/<script[^>]*>([\s\S]*?)<\/script>/g)].map(m => m[1]);
+for (const s of scripts) vm.runInContext(s, sandbox);
+setTimeout(() => {
+  const play = html.match(/title="Play" aria-label="Play" onclick="([^"]+)"/)[1];
+  const slider = html.match(/id="(_anim_slider\w+)"/)[1];
+  const before = el(slider).value;
+  vm.runInContext(play, sandbox);
+  setTimeout(() => { console.log(JSON.stringify({before, after: el(slider).value, max: el(slider).max}));
+                     process.exit(0); }, 400);
+}, 50);
+"""
+
+
+def test_html_player_script_runs_and_play_advances_the_frame(sliding_run, tmp_path):
+    """The page's own JavaScript run in node (V8) against a minimal DOM: no script error, and the
+    Play button's handler moves the frame slider. (Not a browser: see the chromium test.)"""
+    node = shutil.which("node")
+    if node is None:
+        pytest.skip("node is not installed: cannot run the player's JavaScript")
+    model, traj = sliding_run
+    out = export_animation(traj, model, tmp_path / "run.html", fps=30, size=(1.6, 0.9), dpi=50, progress=False)
+    (tmp_path / "stub.js").write_text(NODE_DOM_STUB)
+    res = subprocess.run([node, str(tmp_path / "stub.js"), str(out)], capture_output=True, text=True, timeout=60)
+    assert res.returncode == 0, res.stderr
+    import json
+    state = json.loads(res.stdout.strip().splitlines()[-1])
+    assert state["before"] == 0 and state["max"] == 59
+    assert 3 <= state["after"] <= 59      # 33 ms per frame for 400 ms: about 12 frames
+
+
+CHROMIUM_PROBE = """<script>
+window.__errors = [];
+window.addEventListener('error', function (e) { window.__errors.push(String(e.message)); });
+</script>"""
+CHROMIUM_DRIVER = """<script>
+setTimeout(function () {
+  var slider = document.querySelector('input.anim-slider');
+  var before = slider.value;
+  document.querySelector('button[title="Play"]').click();
+  setTimeout(function () {
+    var out = document.createElement('pre'); out.id = 'result';
+    out.textContent = 'RESULT ' + before + ' ' + slider.value + ' ERRORS ' + window.__errors.length + ' '
+                      + window.__errors.join('|');
+    document.body.appendChild(out);
+  }, 1000);
+}, 300);
+</script>"""
+
+
+def test_html_export_plays_in_headless_chromium(sliding_run, tmp_path):
+    exe = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome", "chrome")
+                if shutil.which(n)), None)
+    if exe is None:
+        pytest.skip("chromium is not installed (apt-get install chromium): the in-browser check of the "
+                    "HTML export did not run")
+    model, traj = sliding_run
+    out = export_animation(traj, model, tmp_path / "run.html", fps=30, size=(1.6, 0.9), dpi=50, progress=False)
+    page = out.read_text().replace("<head>", "<head>" + CHROMIUM_PROBE, 1).replace("</body>", CHROMIUM_DRIVER + "</body>")
+    out.write_text(page)
+    res = subprocess.run([exe, "--headless", "--disable-gpu", "--no-sandbox", "--virtual-time-budget=5000",
+                          "--dump-dom", out.as_uri()], capture_output=True, text=True, timeout=120)
+    line = next((l for l in res.stdout.splitlines() if "RESULT" in l), None)
+    assert line is not None, res.stderr[-2000:]
+    parts = line.split("RESULT", 1)[1].split()
+    before, after, n_err = int(parts[0]), int(parts[1]), int(parts[3])
+    assert n_err == 0, line
+    assert before == 0 and after > 0
+
+
+# plots ----------------------------------------------------------------------------------------
+def test_joint_rates_are_the_derivative_of_the_angles():
+    model = pendulum_model(motor=False)
+    traj = ps.Simulator(model).run(1.0, record_every=1)
+    (ang, rate), = joint_series(traj, model).values()
+    fd = np.gradient(ang, traj.t)
+    np.testing.assert_allclose(rate[5:-5], fd[5:-5], atol=0.02 * np.abs(rate).max())
+    assert np.ptp(ang) > 1.0   # it swung
+
+    # a point-mass leg (axial actuator): segment angle from the vertical and its rate
+    b = ps.ModelBuilder(gravity=(0.0, 0.0))
+    hip = b.add_point_mass("hip", 1.0, pos=(0.0, 1.0), vel=(1.0, 0.0))
+    foot = b.add_point_mass("foot", 1.0, pos=(0.0, 0.0))
+    b.add_axial("leg", hip, foot)
+    m2 = b.compile()
+    tr2 = ps.Simulator(m2).run(0.5, record_every=1)
+    (ang, rate), = joint_series(tr2, m2).values()
+    # hip moving right over a resting foot: the leg hip->foot turns from straight down to behind
+    d = tr2.q[:, 1, :2] - tr2.q[:, 0, :2]
+    np.testing.assert_allclose(ang, np.arctan2(d[:, 0], -d[:, 1]), atol=1e-12)
+    assert ang[-1] < -0.3
+    np.testing.assert_allclose(rate[2:-2], np.gradient(ang, tr2.t)[2:-2], rtol=1e-3, atol=1e-6)
+
+
+def test_cost_of_transport_of_a_box_dragged_at_constant_speed_is_mu():
+    """Pushing a sliding box with F = mu m g keeps its speed; P = F v, so CoT = mu."""
+    mu = 0.4
+    model = box_model(pos=(0.0, 0.1), vel=(1.0, 0.0), mu=mu, push=True)
+    sim = ps.Simulator(model)
+    force = mu * model.total_mass * 9.81
+    sim.run(0.3, u=np.array([force]))                      # settle the contact modes
+    traj = sim.run(2.0, u=np.array([force]), record_every=5)
+    speed = traj.com_velocity(model)[:, 0]
+    assert np.ptp(speed) < 0.02 and speed.mean() > 0.5   # really dragged at constant speed
+    inst, avg = cost_of_transport(traj, model)
+    assert avg == pytest.approx(mu, rel=0.01)
+    assert np.nanmedian(inst) == pytest.approx(mu, rel=0.01)
+
+
+@pytest.mark.parametrize("ext,magic", [("png", b"\x89PNG"), ("svg", b"<?xml"), ("pdf", b"%PDF")])
+def test_summary_plots_save_by_extension(sliding_run, tmp_path, ext, magic):
+    model, traj = sliding_run
+    out = tmp_path / f"summary.{ext}"
+    fig = plot_summary(traj, model, out)
+    assert out.read_bytes()[:len(magic)] == magic
+    # the energy panel plots the trajectory's own energies
+    energy_ax = next(a for a in fig.axes if a.get_title() == "mechanical energy")
+    total = next(l for l in energy_ax.get_lines() if l.get_label() == "total")
+    np.testing.assert_allclose(total.get_ydata(), traj.energy(model)["total"])
+    # the contact timeline covers exactly the frames in contact
+    modes_ax = next(a for a in fig.axes if a.get_title() == "contact modes")
+    dt_frame = traj.t[1] - traj.t[0]
+    covered = sum(p.get_extents().width for coll in modes_ax.collections for p in coll.get_paths())
+    assert covered == pytest.approx(dt_frame * np.count_nonzero(traj.contact_mode != 0), rel=1e-6)
+
+
+def test_figure_with_unknown_extension_is_refused(sliding_run, tmp_path):
+    model, traj = sliding_run
+    with pytest.raises(ValueError, match=r"'\.jpeg' unknown.*\.png"):
+        plot_summary(traj, model, tmp_path / "x.jpeg")
+    fig = plot_summary(traj, model)
+    with pytest.raises(ValueError, match="unknown"):
+        save_figure(fig, tmp_path / "x")
+    assert list(tmp_path.iterdir()) == []
+
+
+# frame timer ----------------------------------------------------------------------------------
+class FakeClock:
+    """Wall time that only moves when the loop renders or sleeps, with jitter: rendering takes
+    5-9 ms, a sleep is rounded to whole milliseconds (GUI timers) and overshoots by 0-1 ms."""
+
+    def __init__(self, seed=0, render=(0.005, 0.009), oversleep=(0.0, 0.001)):
+        self.t = 1000.0
+        self.rng = random.Random(seed)
+        self.render_range, self.oversleep = render, oversleep
+
+    def __call__(self):
+        return self.t
+
+    def render(self):
+        self.t += self.rng.uniform(*self.render_range)
+
+    def sleep(self, d):
+        self.t += round(max(d, 0.0) * 1000) / 1000 + self.rng.uniform(*self.oversleep)
+
+
+def run_timer(timer, clock, seconds=10.0):
+    errors = []
+    timer.start()
+    while clock() - 1000.0 < seconds:
+        clock.render()
+        pause = timer.frame_done()
+        errors.append(timer.last_error)
+        clock.sleep(pause)
+    return np.array(errors)
+
+
+@pytest.mark.parametrize("fps,seed", [(30, 0), (60, 1), (24, 2)])
+def test_pi_timer_holds_playback_within_5_ms_of_wall_time(fps, seed):
+    clock = FakeClock(seed)
+    errors = run_timer(FrameTimer(1.0 / fps, clock=clock), clock)
+    assert len(errors) >= 0.98 * 10 * fps
+    assert np.abs(errors).max() < 0.005
+    assert abs(errors[len(errors) // 2:].mean()) < 0.001     # no steady lag: the integral took it
+
+
+def test_fixed_pause_timer_drifts_so_the_pi_terms_matter():
+    clock = FakeClock(3)
+    errors = run_timer(FrameTimer(1 / 30, kp=0.0, ki=0.0, max_lag=1e9, clock=clock), clock)
+    assert errors.max() > 1.0      # 7.5 ms late per frame for 10 s
+    clock = FakeClock(3)
+    errors = run_timer(FrameTimer(1 / 30, kp=1.0, ki=0.0, clock=clock), clock)
+    assert abs(errors[30:].mean()) > 0.002   # proportional only: a steady lag (the oversleep)
+
+
+def test_timer_skips_frames_it_cannot_render_in_time():
+    clock = FakeClock(4, render=(0.045, 0.055))    # rendering slower than a 30 fps frame
+    timer = FrameTimer(1 / 30, clock=clock)
+    errors = run_timer(timer, clock, seconds=5.0)
+    assert timer.skipped > 0
+    assert errors.max() <= timer.max_lag + 1e-12
+    assert timer.playback_time == pytest.approx(timer.wall_time(), abs=timer.max_lag + 2 / 30)
+
+
+# viewer ---------------------------------------------------------------------------------------
+def key(viewer, k):
+    c = viewer.fig.canvas
+    c.callbacks.process("key_press_event", KeyEvent("key_press_event", c, k))
+
+
+def click(viewer, ax, fx=0.5, fy=0.5):
+    c = viewer.fig.canvas
+    bb = ax.get_window_extent()
+    x, y = bb.x0 + fx * bb.width, bb.y0 + fy * bb.height
+    for name in ("button_press_event", "button_release_event"):
+        c.callbacks.process(name, MouseEvent(name, c, x, y, button=1))
+
+
+class GaitController:
+    """Holds the pendulum at an angle set by the gait, with a PD gain from a slider."""
+    TARGET = {"stand": 0.0, "walk": -0.5, "jump": 0.5}
+
+    def __init__(self):
+        self.gait, self.kp = "stand", 0.0
+
+    def __call__(self, sim):
+        th, w = sim.state.q[0, 2], sim.state.v[0, 2]
+        return np.array([self.kp * (self.TARGET[self.gait] - th) - 0.2 * self.kp * w])
+
+
+@pytest.fixture
+def live():
+    model = pendulum_model()
+    sim = ps.Simulator(model)
+    ctrl = GaitController()
+    gains = {"kp": (0.0, 200.0, lambda: ctrl.kp, lambda v: setattr(ctrl, "kp", v))}
+    clock = FakeClock(7)
+    viewer = Viewer(sim, ctrl, fps=30, gains=gains, on_gait=lambda g: setattr(ctrl, "gait", g),
+                    labels=lambda s: {"angle": round(float(s.state.q[0, 2]), 3)}, clock=clock)
+    return viewer, sim, ctrl, clock
+
+
+def test_viewer_keys_play_pause_step_and_switch_gaits(live):
+    viewer, sim, ctrl, clock = live
+    assert not viewer.playing
+    viewer.tick()
+    assert sim.t == 0.0                       # paused: nothing moves
+    key(viewer, "right")
+    assert sim.t == pytest.approx(1 / 30, abs=1e-3)
+    key(viewer, " ")
+    assert viewer.playing
+    for _ in range(3):
+        viewer.tick()
+    assert sim.t == pytest.approx(4 / 30, abs=1e-3)
+    key(viewer, " ")
+    t = sim.t
+    viewer.tick()
+    assert sim.t == t and not viewer.playing
+    for k, gait in (("w", "walk"), ("j", "jump"), ("s", "stand")):
+        key(viewer, k)
+        assert ctrl.gait == gait and viewer.gait == gait
+    assert "gait: stand" in viewer.scene.text.get_text() and "angle:" in viewer.scene.text.get_text()
+    key(viewer, "i")
+    assert not viewer.scene.show_impulses
+    click(viewer, viewer.buttons["impulses"].ax)
+    assert viewer.scene.show_impulses
+    key(viewer, "r")
+    assert sim.t == 0.0
+
+
+def test_viewer_gain_slider_and_gait_key_change_the_motion(live):
+    viewer, sim, ctrl, clock = live
+    click(viewer, viewer.sliders["kp"].ax, fx=0.5)
+    assert ctrl.kp == pytest.approx(100.0, abs=2.0)
+    key(viewer, "w")
+    viewer.advance(1.5)                 # 1.5 s with the PD holding -0.5 rad
+    assert sim.state.q[0, 2] == pytest.approx(-0.5 - 9.81 * 0.5 / ctrl.kp, abs=0.05)   # PD + gravity sag
+    key(viewer, "j")
+    viewer.advance(1.5)
+    assert sim.state.q[0, 2] == pytest.approx(0.5 - 9.81 * 0.5 * math.cos(0.5) / ctrl.kp, abs=0.05)
+
+
+def test_viewer_gravity_slider_changes_the_simulation():
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_point_mass("ball", 1.0, pos=(0.0, 5.0))
+    sim = ps.Simulator(b.compile())
+    viewer = Viewer(sim, None, fps=30, clock=FakeClock())
+    slider = viewer.sliders["gravity [m/s2]"]
+    click(viewer, slider.ax, fx=0.0)
+    assert slider.val == pytest.approx(0.0, abs=0.05 * slider.valmax)
+    g = np.hypot(*sim.model.arrays.gravity)
+    assert g == pytest.approx(slider.val)
+    viewer.step_frame()
+    v0 = sim.state.v[0, 1]
+    for _ in range(30):
+        viewer.step_frame()
+    assert sim.state.v[0, 1] - v0 == pytest.approx(-g * 1.0, abs=1e-9)   # falls at the new g
+    click(viewer, viewer.sliders["tilt [deg]"].ax, fx=1.0)
+    click(viewer, slider.ax, fx=0.5)
+    gx, gy = sim.model.arrays.gravity
+    assert math.degrees(math.atan2(gx, -gy)) == pytest.approx(viewer.sliders["tilt [deg]"].val)
+    vx0 = sim.state.v[0, 0]
+    viewer.step_frame()
+    assert sim.state.v[0, 0] > vx0          # tilted gravity pushes along +x
+
+
+def test_viewer_slow_motion_stays_on_time_with_the_pi_timer(live):
+    viewer, sim, ctrl, clock = live
+    click(viewer, viewer.sliders["speed [x]"].ax, fx=(0.25 - 0.05) / (4.0 - 0.05))
+    speed = viewer.speed
+    assert speed == pytest.approx(0.25, abs=0.02)
+    key(viewer, " ")
+    wall, shown = [], []
+    start = None
+    for _ in range(60):                 # 2 s of wall time at 30 fps
+        clock.render()
+        pause = viewer.tick()
+        start = clock() if start is None else start
+        wall.append(clock() - start)
+        shown.append(sim.t)
+        clock.sleep(pause)
+    wall, shown = np.array(wall), np.array(shown)
+    first = shown[0]
+    # simulated time shown = speed x wall time, within the timer's 5 ms (scaled) and one step
+    assert np.abs((shown - first) - speed * wall).max() < speed * 0.005 + sim.model.dt
+
+
+def test_view_opens_and_returns_under_a_non_interactive_backend():
+    """`view` is the on-screen entry point; under Agg plt.show() returns at once, so this checks
+    that the window set-up (figure, GUI timer, key maps) runs without a display."""
+    import matplotlib.pyplot as plt
+    from planarsim.render import view
+    sim = ps.Simulator(pendulum_model())
+    viewer = view(sim, lambda s: np.zeros(1), fps=30)
+    assert viewer.playing and " " not in plt.rcParams["keymap.fullscreen"]
+    assert "s" not in plt.rcParams["keymap.save"]
+    plt.close(viewer.fig)
