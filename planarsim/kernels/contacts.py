@@ -39,7 +39,7 @@ def _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, on_arc):
 @jit
 def _try_vertex(m, q, ws, i, b, lx, ly, best):
     """Use local vertex (lx, ly) for contact i if its gap is below `best`; return the new best."""
-    px, py = world_point(q, b, lx, ly)
+    px, py = world_point(q, ws.body_cs, b, lx, ly)
     gx, gy, nx, ny, gap = closest_point(m.terrain_coef, px, py)
     if gap < best:
         _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, 0)
@@ -58,13 +58,10 @@ def find_contact(m, q, ws, i):
         return
     # arc: ground point closest to the centre, sole point opposite the normal
     r = m.contact_radius[i]
-    cx, cy = world_point(q, b, lx, ly)
+    cx, cy = world_point(q, ws.body_cs, b, lx, ly)
     gx, gy, nx, ny, cgap = closest_point(m.terrain_coef, cx, cy)
-    th = q[b, 2]
-    cs = math.cos(th)
-    sn = math.sin(th)
     # direction -n expressed in the body frame
-    dlx, dly = rotate(cs, -sn, -nx, -ny)
+    dlx, dly = rotate(ws.body_cs[b, 0], -ws.body_cs[b, 1], -nx, -ny)
     a = math.atan2(dly, dlx)
     a0 = m.contact_span[i, 0]
     a1 = m.contact_span[i, 1]

@@ -50,7 +50,7 @@ def pin_angle_rate(m, q, v, j):
 
 
 @jit_inline
-def apply_actuator(m, q, v, f, k, u):
+def apply_actuator(m, q, cs, v, f, k, u):
     """Add actuator k's saturated command u to f; return its mechanical power [W]."""
     kind = m.act_kind[k]
     a = m.act_body[k, 0]
@@ -64,8 +64,8 @@ def apply_actuator(m, q, v, f, k, u):
             f[pa, 2] -= u
         return u * pin_angle_rate(m, q, v, j)[1]
     if kind == ACT_AXIAL:
-        ax, ay = world_point(q, a, m.act_anchor[k, 0, 0], m.act_anchor[k, 0, 1])
-        bx, by = world_point(q, b, m.act_anchor[k, 1, 0], m.act_anchor[k, 1, 1])
+        ax, ay = world_point(q, cs, a, m.act_anchor[k, 0, 0], m.act_anchor[k, 0, 1])
+        bx, by = world_point(q, cs, b, m.act_anchor[k, 1, 0], m.act_anchor[k, 1, 1])
         dx = bx - ax
         dy = by - ay
         L = math.sqrt(dx * dx + dy * dy)
@@ -138,7 +138,7 @@ def apply_forces(m, s, ws, u):
         elif uk > m.act_range[k, 1]:
             uk = m.act_range[k, 1]
         ws.act_u[k] = uk
-        ws.act_power[k] = apply_actuator(m, q, v, f, k, uk)
+        ws.act_power[k] = apply_actuator(m, q, ws.body_cs, v, f, k, uk)
 
 
 @jit

@@ -9,6 +9,7 @@ Corrections of unilateral rows (contact normals, joint limits) move positions on
 body out of the ground must not give it the velocity overlap / h (energy from nowhere).
 """
 from ._jit import jit
+from .math2d import update_trig
 from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_row
 from .solve import apply_impulses, assemble, factor_solve
 
@@ -31,6 +32,7 @@ def integrate_positions(s, vel, h):
 @jit
 def max_residual(m, s, ws):
     """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
+    update_trig(s.q, ws.body_cs)
     worst = 0.0
     for r in range(ws.n_row[0]):
         c = eval_row(m, s.q, ws, r, ws.row_Jp[r])
@@ -51,17 +53,29 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
         if worst <= tol:
             break
         assemble(m, ws, ws.row_Jp, ws.row_J, n)
-        factor_solve(ws.A, ws.rhs, ws.lam, n, pivot_tol)
-        # move positions by the correction, velocities by its bilateral part / h
+        unilateral = 0
+        for r in range(n):
+            ws.row_c[r] = ws.rhs[r]   # -c(q+), kept for the velocity solve (row_c is free now)
+            unilateral += is_unilateral(ws.row_kind[r])
+        factor_solve(ws, ws.rhs, ws.lam, n, pivot_tol)
+        # move positions by the correction
         for i in range(ws.v_new.shape[0]):
             for k in range(3):
                 ws.v_new[i, k] = 0.0
                 ws.v_pred[i, k] = 0.0
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_new, 1.0)
-        for r in range(n):
-            if is_unilateral(ws.row_kind[r]):
-                ws.lam[r] = 0.0
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_pred, 1.0 / h)
+        if unilateral == 0:
+            # velocities by the same correction / h
+            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_pred, 1.0 / h)
+        else:
+            # velocities: bilateral rows change by -c / h, unilateral rows not at all (a
+            # separate solve: zeroing the unilateral impulses of the position solve instead
+            # leaves a pinned foot, held by its contact against a rod, moving at rod-fix / h)
+            assemble(m, ws, ws.row_Jp, ws.row_J, n)
+            for r in range(n):
+                ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
+            factor_solve(ws, ws.rhs, ws.lam, n, pivot_tol)
+            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_pred, 1.0)
         for i in range(s.q.shape[0]):
             for k in range(3):
                 s.q[i, k] += ws.v_new[i, k]

@@ -17,11 +17,18 @@ def rotate(c, s, x, y):
 
 
 @jit
-def world_point(q, body, lx, ly):
-    """World position [m] of the point (lx, ly) fixed in `body`; body < 0 is the world frame."""
+def update_trig(q, cs):
+    """cs[i] = (cos, sin) of body i's angle: computed once per configuration."""
+    for i in range(q.shape[0]):
+        cs[i, 0] = math.cos(q[i, 2])
+        cs[i, 1] = math.sin(q[i, 2])
+
+
+@jit
+def world_point(q, cs, body, lx, ly):
+    """World position [m] of the point (lx, ly) fixed in `body` (cs: cached cos/sin of the
+    body angles at q); body < 0 is the world frame."""
     if body < 0:
         return lx, ly
-    c = math.cos(q[body, 2])
-    s = math.sin(q[body, 2])
-    rx, ry = rotate(c, s, lx, ly)
+    rx, ry = rotate(cs[body, 0], cs[body, 1], lx, ly)
     return q[body, 0] + rx, q[body, 1] + ry

@@ -46,7 +46,7 @@ def gather_contact_impulses(m, s, ws):
 def contact_velocity(m, s, ws, i, vel):
     """Normal and tangential velocity [m/s] of contact i's material point under `vel`."""
     b = m.contact_body[i]
-    px, py = world_point(s.q, b, ws.contact_anchor[i, 0], ws.contact_anchor[i, 1])
+    px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[i, 0], ws.contact_anchor[i, 1])
     vx, vy = point_velocity(s.q, vel, b, px, py)
     nx = ws.contact_normal[i, 0]
     ny = ws.contact_normal[i, 1]

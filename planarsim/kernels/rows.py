@@ -46,16 +46,16 @@ def eval_row(m, q, ws, r, J):
     a = ws.row_body[r, 0]
     b = ws.row_body[r, 1]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-        ax, ay = world_point(q, a, m.pin_anchor[o, 0, 0], m.pin_anchor[o, 0, 1])
-        bx, by = world_point(q, b, m.pin_anchor[o, 1, 0], m.pin_anchor[o, 1, 1])
+        ax, ay = world_point(q, ws.body_cs, a, m.pin_anchor[o, 0, 0], m.pin_anchor[o, 0, 1])
+        bx, by = world_point(q, ws.body_cs, b, m.pin_anchor[o, 1, 0], m.pin_anchor[o, 1, 1])
         dx = 1.0 if kind == ROW_PIN_X else 0.0
         dy = 1.0 - dx
         _set_dir(q, a, ax, ay, dx, dy, -1.0, J[0])
         _set_dir(q, b, bx, by, dx, dy, 1.0, J[1])
         return (bx - ax) * dx + (by - ay) * dy
     if kind == ROW_ROD:
-        ax, ay = world_point(q, a, m.rod_anchor[o, 0, 0], m.rod_anchor[o, 0, 1])
-        bx, by = world_point(q, b, m.rod_anchor[o, 1, 0], m.rod_anchor[o, 1, 1])
+        ax, ay = world_point(q, ws.body_cs, a, m.rod_anchor[o, 0, 0], m.rod_anchor[o, 0, 1])
+        bx, by = world_point(q, ws.body_cs, b, m.rod_anchor[o, 1, 0], m.rod_anchor[o, 1, 1])
         ex = bx - ax
         ey = by - ay
         L = math.sqrt(ex * ex + ey * ey)
@@ -86,16 +86,16 @@ def eval_row(m, q, ws, r, J):
         # normal of its closest ground point: the same as the start-of-step values at q0, and
         # exact on curved ground when the position correction evaluates it at q+
         if ws.contact_on_arc[o] == 1:
-            px, py = world_point(q, b, m.contact_local[o, 0], m.contact_local[o, 1])
+            px, py = world_point(q, ws.body_cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
         else:
-            px, py = world_point(q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+            px, py = world_point(q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
         gx, gy, nx, ny, gap = closest_point(m.terrain_coef, px, py)
         _set_dir(q, b, px, py, nx, ny, 1.0, J[1])
         if ws.contact_on_arc[o] == 1:
             return gap - m.contact_radius[o]
         return gap
     # tangent row: the material point stays at the ground point found at the step's start
-    px, py = world_point(q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+    px, py = world_point(q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
     tx = ws.contact_normal[o, 1]
     ty = -ws.contact_normal[o, 0]
     _set_dir(q, b, px, py, tx, ty, 1.0, J[1])
@@ -144,5 +144,5 @@ def build_rows(m, s, ws):
             nx = ws.contact_normal[o, 0]
             ny = ws.contact_normal[o, 1]
             ms = m.contact_mu[o] * s.contact_slip[o]
-            px, py = world_point(s.q, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+            px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
             _set_dir(s.q, b, px, py, nx - ms * ny, ny + ms * nx, 1.0, ws.row_F[r, 1])

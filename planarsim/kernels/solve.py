@@ -3,6 +3,8 @@
 Impulses lambda make every active row hold at the END of the step (symplectic Euler inside):
     c + h J (v* + W F^T lambda) = 0   =>   (J W F^T) lambda = -(c / h + J v*)
 with W = M^-1 (diagonal: 1/m, 1/m, 1/I per body) and F = J except for sliding contacts.
+The matrix is assembled and eliminated only inside its envelope (rows touch at most two
+bodies, so a chain's matrix is banded): the cost grows linearly with the number of links.
 Closed loops (Ranger in double stance, a box on two corners) make J W F^T singular: Gaussian
 elimination drops a row whose pivot falls below pivot_tol times its own diagonal, i.e. a row
 that is a combination of earlier ones; its impulse is zero and the rows it depends on carry
@@ -13,56 +15,97 @@ from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
 
 
 @jit
-def assemble(m, ws, JL, JR, n):
-    """ws.A[:n, :n] = JL W JR^T over shared bodies (rows touch at most two bodies)."""
-    A = ws.A
+def compute_envelope(ws, n, n_body):
+    """row_first[r]: the first row sharing a body with row r; row_reach[k]: the last row whose
+    envelope reaches column k. Rows touch at most two bodies, so for rows ordered along a
+    chain or tree the envelope is narrow and elimination inside it costs O(n), not O(n^3)."""
+    for b in range(n_body):
+        ws.body_first_row[b] = -1
+    for r in range(n):
+        f = r
+        for e in range(2):
+            b = ws.row_body[r, e]
+            if b < 0:
+                continue
+            if ws.body_first_row[b] < 0:
+                ws.body_first_row[b] = r
+            elif ws.body_first_row[b] < f:
+                f = ws.body_first_row[b]
+        ws.row_first[r] = f
+        ws.row_reach[r] = r
     for i in range(n):
-        for j in range(n):
-            acc = 0.0
-            for ei in range(2):
-                bi = ws.row_body[i, ei]
-                if bi < 0:
-                    continue
-                for ej in range(2):
-                    if ws.row_body[j, ej] != bi:
-                        continue
-                    acc += (JL[i, ei, 0] * JR[j, ej, 0] + JL[i, ei, 1] * JR[j, ej, 1]) * m.body_inv_mass[bi]
-                    acc += JL[i, ei, 2] * JR[j, ej, 2] * m.body_inv_inertia[bi]
-            A[i, j] = acc
+        for k in range(ws.row_first[i], i):
+            ws.row_reach[k] = i
 
 
 @jit
-def factor_solve(A, rhs, x, n, tol):
-    """Solve A x = rhs in place (A, rhs destroyed), dropping dependent rows; returns #dropped."""
+def _entry(m, ws, JL, JR, i, j):
+    """(JL W JR^T)[i, j] over the bodies rows i and j share."""
+    acc = 0.0
+    for ei in range(2):
+        bi = ws.row_body[i, ei]
+        if bi < 0:
+            continue
+        for ej in range(2):
+            if ws.row_body[j, ej] != bi:
+                continue
+            acc += (JL[i, ei, 0] * JR[j, ej, 0] + JL[i, ei, 1] * JR[j, ej, 1]) * m.body_inv_mass[bi]
+            acc += JL[i, ei, 2] * JR[j, ej, 2] * m.body_inv_inertia[bi]
+    return acc
+
+
+@jit
+def assemble(m, ws, JL, JR, n):
+    """ws.A = JL W JR^T inside the envelope (entries outside it are structurally zero)."""
+    A = ws.A
+    for i in range(n):
+        for j in range(ws.row_first[i], i + 1):
+            A[i, j] = _entry(m, ws, JL, JR, i, j)
+            if j != i:
+                A[j, i] = _entry(m, ws, JL, JR, j, i)
+
+
+@jit
+def factor_solve(ws, rhs, x, n, tol):
+    """Solve A x = rhs by Gaussian elimination inside the envelope (A, rhs destroyed).
+
+    A row whose pivot falls below tol times its own diagonal depends on earlier rows (a
+    closed loop, a box on two corners): it is dropped (impulse 0). Returns #dropped.
+    """
+    A = ws.A
+    first = ws.row_first
+    reach = ws.row_reach
     dropped = 0
     for k in range(n):
-        diag = abs(A[k, k])
-        # diagonal before elimination is kept in x[k] as the scale for the pivot test
-        x[k] = diag
+        x[k] = abs(A[k, k])  # scale for the pivot test
     for k in range(n):
         piv = A[k, k]
+        last = reach[k]
         if abs(piv) <= tol * x[k] or x[k] == 0.0:
             dropped += 1
-            for j in range(k, n):
-                A[k, j] = 0.0
-            for i in range(k + 1, n):
-                A[i, k] = 0.0
+            for j in range(k + 1, last + 1):
+                if first[j] <= k:
+                    A[k, j] = 0.0
+                    A[j, k] = 0.0
             A[k, k] = 1.0
             rhs[k] = 0.0
             continue
         inv = 1.0 / piv
-        for i in range(k + 1, n):
+        for i in range(k + 1, last + 1):
+            if first[i] > k:
+                continue
             fct = A[i, k] * inv
             if fct == 0.0:
                 continue
-            for j in range(k + 1, n):
-                A[i, j] -= fct * A[k, j]
-            A[i, k] = 0.0
+            for j in range(k + 1, last + 1):
+                if first[j] <= k:
+                    A[i, j] -= fct * A[k, j]
             rhs[i] -= fct * rhs[k]
     for k in range(n - 1, -1, -1):
         acc = rhs[k]
-        for j in range(k + 1, n):
-            acc -= A[k, j] * x[j]
+        for j in range(k + 1, reach[k] + 1):
+            if first[j] <= k:
+                acc -= A[k, j] * x[j]
         x[k] = acc / A[k, k]
     return dropped
 
@@ -104,6 +147,7 @@ def solve_impulses(m, ws, h, tol):
             ws.v_new[i, k] = ws.v_pred[i, k]
     if n == 0:
         return 0
+    compute_envelope(ws, n, ws.v_new.shape[0])
     assemble(m, ws, ws.row_J, ws.row_F, n)
     for r in range(n):
         c = ws.row_c[r]
@@ -112,6 +156,6 @@ def solve_impulses(m, ws, h, tol):
             # correction removes the overlap without turning it into velocity (energy)
             c = 0.0
         ws.rhs[r] = -(c / h + row_dot(ws, r, ws.row_J, ws.v_pred))
-    dropped = factor_solve(ws.A, ws.rhs, ws.lam, n, tol)
+    dropped = factor_solve(ws, ws.rhs, ws.lam, n, tol)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
     return dropped

@@ -9,6 +9,7 @@ from .ccd import advance_to_impact, time_of_impact
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import check_guards
+from .math2d import update_trig
 from .integrate import correct_positions, integrate_positions
 from .modes import gather_contact_impulses, update_modes
 from .record import record_frame
@@ -72,6 +73,7 @@ def step(m, s, ws, opt, u):
         ws.contact_new[i] = 0
     h = m.dt
     for split in range(opt.max_ccd_splits + 1):
+        update_trig(s.q, ws.body_cs)
         apply_forces(m, s, ws, u)
         predict_velocity(m, s, ws, h)
         find_contacts(m, s, ws)
