@@ -280,7 +280,7 @@ class _Loader:
             self.root_pin = None
         elif kinds == ["hinge"]:
             self.free = ()
-            self.root_pin = joints[0]
+            self.root_pin = self.hinge(joints[0], None, rid)
         else:
             self.fail(node, f"root body joints {kinds} unsupported: use slide x + slide z + hinge y "
                             f"(free in the plane) or one hinge (pinned to the world)")
@@ -378,8 +378,7 @@ class _Loader:
                                         pos=tuple(rb.com), shapes=shapes))
         pins = {}
         if self.root_pin is not None:
-            p = self.hinge(self.root_pin, None, 0)
-            self.pins.insert(0, dict(p, parent=None))
+            self.pins.insert(0, self.root_pin)
         for p in self.pins:
             a = None if p["parent"] is None else ids[p["parent"]]
             pins[p["name"]] = builder.add_pin(p["name"], a, ids[p["child"]], anchor_world=tuple(p["pos"]),
