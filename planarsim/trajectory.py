@@ -163,6 +163,9 @@ def atomic_write(path, write, binary=True) -> None:
     try:
         with os.fdopen(fd, "wb" if binary else "w") as f:
             write(f)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes owner-only files
         os.replace(tmp, path)
     except BaseException:
         try:

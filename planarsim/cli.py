@@ -1,0 +1,261 @@
+"""The `planarsim` command: list, run, view, bench, tune, info.
+
+    planarsim run simple-biped                 # walk, write out/simple-biped.gif + summary
+    planarsim run ranger --duration 20 --out ranger.mp4 --plot ranger.png --json
+    planarsim list
+
+User errors (unknown walker, bad terrain, negative duration, unwritable path) exit with
+code 2 and one line saying what was wrong and what is allowed; no traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+from . import __version__
+
+ANIMATION_EXTS = (".gif", ".mp4", ".html")
+PLOT_EXTS = (".png", ".svg", ".pdf")
+
+
+class UsageError(Exception):
+    """A user mistake: reported in one line, exit code 2."""
+
+
+def _walkers():
+    import walkers
+    return walkers
+
+
+def _load_walker(name):
+    w = _walkers()
+    if name not in w.WALKERS:
+        raise UsageError(f"unknown walker {name!r}; choose one of: {', '.join(sorted(w.WALKERS))}")
+    return w.load(name)
+
+
+def _check_out(path, exts, what):
+    if path is None:
+        return None
+    p = Path(path)
+    if p.suffix.lower() not in exts:
+        raise UsageError(f"{what} {str(p)!r}: extension must be one of {', '.join(exts)}")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"{what} {str(p)!r}: folder {str(parent)!r} does not exist")
+    if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
+        raise UsageError(f"{what} {str(p)!r}: not writable")
+    return p
+
+
+def _positive(text):
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(x) and x > 0):
+        raise argparse.ArgumentTypeError(f"{text} must be a finite number > 0")
+    return x
+
+
+# commands -------------------------------------------------------------------------------------
+def cmd_list(args):
+    from . import terrain
+    w = _walkers()
+    print("walkers (gaits):")
+    for name in sorted(w.WALKERS):
+        try:
+            gaits = ", ".join(w.load(name).GAITS)
+        except Exception as e:  # a broken walker must not hide the others
+            gaits = f"unavailable: {e}"
+        print(f"  {name:16s} {gaits}")
+    print("terrains:")
+    print("  flat             level ground")
+    print("  slope:DEG        constant slope, DEG degrees (negative: downhill toward +x)")
+    print(f"  hills            rolling hills, max slope {terrain.max_slope_deg(terrain.default_hills()):.1f} deg")
+    print("  hills:A,L[,PHI][;A,L[,PHI]...]  sum of sines: amplitude m, wavelength m, phase rad")
+    return 0
+
+
+def cmd_run(args):
+    from . import terrain as T
+    mod = _load_walker(args.walker)
+    if args.gait is not None and args.gait not in mod.GAITS:
+        raise UsageError(f"walker {args.walker!r} has no gait {args.gait!r}; gaits: {', '.join(mod.GAITS)}")
+    try:
+        ter = T.parse(args.terrain) if args.terrain else None
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+    if args.dt is not None and args.dt > 0.01:
+        raise UsageError(f"--dt {args.dt} is too large; use a step of at most 0.01 s (1e-3 is usual)")
+    out = args.out
+    summary_path = None
+    if out is None and not args.no_animation:
+        Path("out").mkdir(exist_ok=True)
+        out = f"out/{args.walker}.gif"
+        summary_path = Path(f"out/{args.walker}_summary.json")
+    out = _check_out(out, ANIMATION_EXTS, "--out")
+    plot = _check_out(args.plot, PLOT_EXTS, "--plot")
+    save = _check_out(args.save, (".npz",), "--save")
+    csv = _check_out(args.csv, (".csv",), "--csv")
+    kw = dict(duration=args.duration, seed=args.seed)
+    if args.gait is not None:
+        kw["gait"] = args.gait
+    if ter is not None:
+        kw["terrain"] = ter
+    if args.dt is not None:
+        kw["dt"] = args.dt
+    t0 = time.perf_counter()
+    if not args.json:
+        print(f"running {args.walker} for {args.duration:g} s ...", file=sys.stderr, flush=True)
+    traj, summary, model = mod.simulate(**kw)
+    wall = time.perf_counter() - t0
+    import inspect
+    default_gait = inspect.signature(mod.simulate).parameters["gait"].default
+    summary = {"walker": args.walker, "gait": args.gait or default_gait,
+               "terrain": args.terrain or "default", "duration_s": args.duration,
+               **{k: _plain(v) for k, v in summary.items()}, "wall_time_s": round(wall, 3)}
+    written = []
+    if save:
+        traj.save(save)
+        written.append(str(save))
+    if csv:
+        traj.to_csv(csv)
+        written.append(str(csv))
+    if plot:
+        from .render import plot_summary
+        plot_summary(traj, model, plot)
+        written.append(str(plot))
+    if out:
+        from .render import export_animation
+        export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=not args.json)
+        written.append(str(out))
+    if summary_path is not None:
+        from .trajectory import atomic_write
+        atomic_write(summary_path, lambda f: f.write(json.dumps(summary, indent=2) + "\n"), binary=False)
+        written.append(str(summary_path))
+    summary["files"] = written
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        for k, v in summary.items():
+            print(f"  {k:22s} {v}")
+    return 0
+
+
+def _plain(v):
+    try:
+        import numpy as np
+        if isinstance(v, np.generic):
+            return v.item()
+        if isinstance(v, np.ndarray):
+            return v.tolist()
+    except ImportError:
+        pass
+    return v
+
+
+def cmd_view(args):
+    mod = _load_walker(args.walker)
+    if not hasattr(mod, "viewer_session"):
+        raise UsageError(f"walker {args.walker!r} has no interactive session yet; use "
+                         f"'planarsim run {args.walker} --out FILE.gif' to watch it")
+    from .render import view
+    sim, controller, kw = mod.viewer_session()
+    view(sim, controller, **kw)
+    return 0
+
+
+def cmd_bench(args):
+    from .bench import main
+    return main(args.rest) or 0
+
+
+def cmd_tune(args):
+    from .tune import main
+    return main(args.rest)
+
+
+def cmd_info(args):
+    import numba
+    import numpy
+    import matplotlib
+    from .kernels import _jit
+    kernels = Path(_jit.__file__).resolve().parent
+    cached = sorted(kernels.glob("__pycache__/*.nbi"))
+    print(f"planarsim {__version__}")
+    print(f"python {sys.version.split()[0]}, numpy {numpy.__version__}, numba {numba.__version__}, "
+          f"matplotlib {matplotlib.__version__}")
+    print(f"numba cache: {len(cached)} kernel index files in {kernels / '__pycache__'}"
+          f"{' (cold: the first run compiles, about a minute)' if not cached else ' (warm)'}")
+    try:
+        from .render import ffmpeg_exe
+        print(f"ffmpeg: {ffmpeg_exe()}")
+    except Exception as e:
+        print(f"ffmpeg: unavailable ({e})")
+    print(f"walkers: {', '.join(sorted(_walkers().WALKERS))}")
+    return 0
+
+
+# parser ---------------------------------------------------------------------------------------
+def make_parser():
+    ap = argparse.ArgumentParser(prog="planarsim", description="Planar physics for walking machines.")
+    ap.add_argument("--version", action="version", version=f"planarsim {__version__}")
+    sub = ap.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    p = sub.add_parser("list", help="walkers, gaits and terrains")
+    p.set_defaults(func=cmd_list)
+    p = sub.add_parser("run", help="simulate a walker; write animation, plots, data, summary")
+    p.add_argument("walker", help="walker name (see 'planarsim list')")
+    p.add_argument("--gait", default=None, help="gait (default: the walker's first)")
+    p.add_argument("--terrain", default=None, help="flat | slope:DEG | hills | hills:A,L[,PHI][;...]")
+    p.add_argument("--duration", type=_positive, default=10.0, help="simulated seconds (default 10)")
+    p.add_argument("--dt", type=_positive, default=None, help="step size [s] (default: walker's)")
+    p.add_argument("--out", default=None, help="animation .gif | .mp4 | .html (default out/WALKER.gif)")
+    p.add_argument("--no-animation", action="store_true", help="skip the default animation")
+    p.add_argument("--fps", type=_positive, default=20.0, help="animation frames per second")
+    p.add_argument("--speed", type=_positive, default=1.0, help="playback speed (0.25 slow motion)")
+    p.add_argument("--plot", default=None, help="summary plot .png | .svg | .pdf")
+    p.add_argument("--save", default=None, help="trajectory .npz")
+    p.add_argument("--csv", default=None, help="trajectory .csv")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    p.set_defaults(func=cmd_run)
+    p = sub.add_parser("view", help="interactive viewer (needs a display)")
+    p.add_argument("walker")
+    p.set_defaults(func=cmd_view)
+    p = sub.add_parser("bench", help="engine benchmarks (planarsim bench --help)", add_help=False)
+    p.add_argument("rest", nargs=argparse.REMAINDER)
+    p.set_defaults(func=cmd_bench)
+    p = sub.add_parser("tune", help="CMA-ES tuning of a walker (planarsim tune --help)", add_help=False)
+    p.add_argument("rest", nargs=argparse.REMAINDER)
+    p.set_defaults(func=cmd_tune)
+    p = sub.add_parser("info", help="versions and numba cache state")
+    p.set_defaults(func=cmd_info)
+    return ap
+
+
+def main(argv=None) -> int:
+    ap = make_parser()
+    args = ap.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except UsageError as e:
+        print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except (OSError, ValueError) as e:
+        # bad input detected deeper down (ModelError is a ValueError): one line, exit 2
+        print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"planarsim {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
