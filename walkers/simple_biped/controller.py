@@ -31,7 +31,7 @@ from planarsim.kernels._jit import jit
 from walkers.common.bezier import rectangle_bezier
 from walkers.common.pd import clamp
 from . import params as P
-from .legs import hold_stance, leg_state, push_hip, push_hip_pendulum, track_foot
+from .legs import hold_stance, leg_state, limit_hip_torque, push_hip, push_hip_pendulum, track_foot
 
 
 class Gait(IntEnum):
@@ -284,6 +284,7 @@ def control(m, s, p, mem, u):
         ny = -dy / l
         a_n = p[P.I_DS_KP] * (p[P.I_WALK_LENGTH] * l0 - l) - p[P.I_DS_KD] * ldot - l * phidot * phidot
         a_t = p[P.I_ENERGY_GAIN] * l * (_rate_target(_v_top(p, mem), l, phi, g) - phidot)
+        a_t = clamp(a_t, -p[P.I_DS_ACCEL_MAX] * g, p[P.I_DS_ACCEL_MAX] * g)
         # tangent t = (-ny, nx): the hip's direction of motion for increasing phi; weight
         # compensation -mh g split into its n and t parts
         f_n = mh * (a_n - (gx * nx + gy * ny))
@@ -319,6 +320,7 @@ def control(m, s, p, mem, u):
                     gx, gy, fmax, u)
         track_foot(q, v, sw, tx, ty, tvx, tvy, p[P.I_SWING_KP], p[P.I_SWING_KD], mf, gx, gy,
                    fmax, tmax, u)
+        limit_hip_torque(q, stance, p[P.I_STANCE_MU], mf * g, u)
 
 
 class Controller:

@@ -79,6 +79,8 @@ def push_hip_pendulum(q, front, f_n, f_t, f_front_min, fmax, u):
     le = math.sqrt(ex * ex + ey * ey)
     a = (-ny * ex + nx * ey) / le   # e_r . t
     b = (nx * ex + ny * ey) / le    # e_r . n
+    # the floor binds only when the front leg is asked to push at least that much
+    f_front_min = min(f_front_min, max(f_n, 0.0))
     u_r = 0.0
     if abs(a) > 1e-3:
         u_r = f_t / a
@@ -133,3 +135,37 @@ def track_foot(q, v, i, tx, ty, tvx, tvy, kp, kd, mass, gx, gy, fmax, tmax, u):
     u[i] = clamp(mass * (kp * (lv - l) + kd * (lv_dot - ldot)) + u_g, -fmax, fmax)
     tau = mass * l * l * (kp * dphi + kd * (phiv_dot - phidot)) + tau_g
     u[ACT_HIP] = clamp((2.0 * i - 1.0) * tau, -tmax, tmax)
+
+
+@jit
+def limit_hip_torque(q, stance, mu, foot_weight, u):
+    """Saturate the hip torque u[2] so that the stance foot is not pushed out of a friction
+    cone of coefficient mu about the world vertical: the force of both actuators on the stance
+    foot, F = u_st (foot - hip)/l + s u_2 (-d_y, d_x)/l^2 (s = +1 on leg 1, -1 on leg 0), must
+    satisfy |F_x| <= mu (-F_y + foot_weight). Both conditions are linear in u_2."""
+    dx = q[stance + 1, 0] - q[0, 0]
+    dy = q[stance + 1, 1] - q[0, 1]
+    l2 = dx * dx + dy * dy
+    l = math.sqrt(l2)
+    s = 2.0 * stance - 1.0
+    ax = u[stance] * dx / l
+    ay = u[stance] * dy / l
+    bx = -s * dy / l2
+    by = s * dx / l2
+    lo = -math.inf
+    hi = math.inf
+    # sign * F_x - mu (-F_y + w) <= 0  ->  c0 + c1 u_2 <= 0
+    for sign in (-1.0, 1.0):
+        c0 = sign * ax + mu * ay - mu * foot_weight
+        c1 = sign * bx + mu * by
+        if c1 > 1e-12:
+            hi = min(hi, -c0 / c1)
+        elif c1 < -1e-12:
+            lo = max(lo, -c0 / c1)
+        elif c0 > 0.0:
+            lo = 0.0
+            hi = 0.0
+    if lo > hi:
+        u[ACT_HIP] = 0.0
+    else:
+        u[ACT_HIP] = clamp(u[ACT_HIP], lo, hi)

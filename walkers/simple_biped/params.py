@@ -54,6 +54,7 @@ class SimpleBipedParams:
     energy_gain: float = _p(10.0, "1/s", "eq. 3: tangential gain on the leg-rate error", 0.0, 1e3)
     ds_front_load: float = _p(0.3, "-", "least front-leg force in double stance, as a fraction of "
                               "the hip weight (keeps the new stance foot planted)", 0.0, 1.0)
+    ds_accel_max: float = _p(1.0, "g", "limit of the tangential hip acceleration of eq. 3", 0.0, 10.0)
     ds_time_min: float = _p(0.02, "s", "shortest double stance", 0.0, 1.0)
     ds_time_max: float = _p(0.25, "s", "longest double stance", 0.0, 5.0)
     ds_energy_tol: float = _p(0.02, "m^2/s^2", "double stance ends once the predicted top speed "
@@ -64,6 +65,8 @@ class SimpleBipedParams:
     ss_kd: float = _p(25.0, "1/s", "stance leg-length rate gain (single stance)", 0.0, 1e3)
     swing_kp: float = _p(900.0, "1/s^2", "virtual swing leg: length and angle gain", 0.0, 1e5)
     swing_kd: float = _p(60.0, "1/s", "virtual swing leg: length and angle rate gain", 0.0, 1e4)
+    stance_mu: float = _p(0.6, "-", "the hip torque may push the stance foot at most this "
+                          "friction ratio (about the vertical) off the ground", 0.0, 5.0)
     touchdown_phase: float = _p(0.5, "-", "a swing-foot contact before this phase is a scuff, not a step", 0.0, 1.0)
     # jump ----------------------------------------------------------------------------------
     crouch_height: float = _p(0.75, "l0", "hip height of the crouch before a jump", 0.4, 1.0)
