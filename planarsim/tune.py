@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import math
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -53,6 +52,8 @@ def _evaluate(job):
     walker, z, base, settings = job
     mod = objective_module(walker)
     params = mod.Params(**base)
+    if z is None:                      # the start point itself, exactly as given
+        return mod.evaluate(params, settings)
     b = params.bounds(True)
     x = b[:, 0] + np.clip(z, 0.0, 1.0) * (b[:, 1] - b[:, 0])
     return mod.evaluate(params.with_tunable(x), settings)
@@ -149,7 +150,7 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
     pool, close = _make_executor(executor, scheduler, workers)
     t_start = time.time()
     try:
-        start = list(pool.map(_evaluate, [(walker, z0, base, settings)]))[0]["score"]
+        start = list(pool.map(_evaluate, [(walker, None, base, settings)]))[0]["score"]
         result = TuneResult(walker=walker, best_params=base, best_score=start, start_score=start,
                             settings=settings, seed=int(seed), names=params0.names(True))
         while not es.stop() and result.evaluations + es.popsize <= budget:

@@ -7,6 +7,7 @@ import importlib
 
 WALKERS = {
     "ranger": "walkers.ranger",
+    "simbicon": "walkers.simbicon",
     "simple-biped": "walkers.simple_biped",
 }
 

@@ -1,0 +1,183 @@
+"""SIMBICON controller (seed 000 sections 2.1-2.3): four-state FSM, PD joints, torso control
+through the stance hip, swing-hip balance feedback. One compiled ``control`` covers every state.
+
+States (Table 1): 0 right swing, timed; 1 right swing, ends at right-foot contact; 2 and 3 the
+mirror for the left leg. So ``swing = phase // 2`` (0 right, 1 left), ``stance = 1 - swing``
+and ``half = phase % 2`` selects the target row: one table for both sides. States 1/3 also end
+after ``contact_timeout`` without contact, so the machine never stalls (the thesis' complaint).
+
+Torques [N m] (motor convention: +tau on the child body, -tau on the parent):
+  knees, ankles: tau = kp (theta_d - theta) - kd theta_dot                       (eq. 1)
+  swing hip:     tau_sw = kp_hip (theta_d - phi_thigh) - kd_hip phi_thigh_dot, with the thigh
+                 angle phi in the WORLD frame (foot placement independent of torso pitch) and
+                 theta_d = theta_d0 + c_d d + c_v v                              (eq. 3)
+                 d = x_torso - x_stance_ankle [m], v = torso forward speed [m/s]; positive
+                 theta is forward, so falling forward lengthens the step
+  torso:         tau_torso = kp_t (theta_torso_d - theta_torso) - kd_t omega_torso
+  stance hip:    tau_st = -tau_torso - tau_sw                                    (eq. 2)
+Note: the thesis' listing adds c_d d + c_v v to the negated (PyBullet-frame) target, i.e. with
+the opposite sign to SIMBICON's eq. 3 in its own frame; we follow eq. 3 as written.
+"""
+from __future__ import annotations
+
+import math
+from enum import IntEnum
+from typing import NamedTuple
+
+import numpy as np
+
+from planarsim.kernels._jit import jit
+
+from .params import SimbiconParams
+
+# target columns
+SWING_HIP, SWING_KNEE, SWING_ANKLE, STANCE_KNEE, STANCE_ANKLE = range(5)
+HIP, KNEE, ANKLE, TORSO = range(4)
+# memory slots
+M_PHASE, M_T0, M_STRIKES, M_TIMEOUTS, M_FELL, M_LAST_STRIKE_T, M_EFFORT, M_MODE_CAP = range(8)
+MEMORY_SIZE = 8
+
+
+class Phase(IntEnum):
+    RIGHT_SWING_UP = 0
+    RIGHT_SWING_DOWN = 1
+    LEFT_SWING_UP = 2
+    LEFT_SWING_DOWN = 3
+
+
+class Tables(NamedTuple):
+    """Everything the compiled controller reads (arrays and scalars only)."""
+    target: np.ndarray        # (2, 5) [half, column] target angles [rad]
+    cd: np.ndarray            # (2,) eq. 3 gains [rad/m]
+    cv: np.ndarray            # (2,) [rad s/m]
+    kp: np.ndarray            # (4,) hip, knee, ankle, torso [N m/rad]
+    kd: np.ndarray            # (4,) [N m s/rad]
+    torso_target: float       # [rad]
+    state_time: float         # [s]
+    contact_timeout: float    # [s]
+    min_contact_time: float   # [s]
+    fall_height: float        # [m]
+    torso: int
+    thigh: np.ndarray         # (2,) body per side
+    pin: np.ndarray           # (2, 3) pin per side and joint
+    act: np.ndarray           # (2, 3) actuator per side and joint
+    contact: np.ndarray       # (2, 4) foot corner contacts per side
+
+
+def make_tables(p: SimbiconParams, model) -> Tables:
+    """Params + the model's index maps -> Tables for the compiled controller."""
+    mt = model.meta
+    f = np.float64
+    return Tables(
+        target=np.array([[p.swing_hip_0, p.swing_knee_0, p.swing_ankle_0, p.stance_knee_0, p.stance_ankle_0],
+                         [p.swing_hip_1, p.swing_knee_1, p.swing_ankle_1, p.stance_knee_1, p.stance_ankle_1]], f),
+        cd=np.array([p.cd_0, p.cd_1], f), cv=np.array([p.cv_0, p.cv_1], f),
+        kp=np.array([p.kp_hip, p.kp_knee, p.kp_ankle, p.kp_torso], f),
+        kd=np.array([p.kd_hip, p.kd_knee, p.kd_ankle, p.kd_torso], f),
+        torso_target=float(p.torso), state_time=float(p.state_time),
+        contact_timeout=float(p.contact_timeout), min_contact_time=float(p.min_contact_time),
+        fall_height=float(p.fall_height), torso=int(mt["torso"]),
+        thigh=np.asarray(mt["thigh"], np.int64), pin=np.asarray(mt["pin"], np.int64),
+        act=np.asarray(mt["act"], np.int64), contact=np.asarray(mt["contact"], np.int64))
+
+
+def make_memory(phase=0, t0=0.0) -> np.ndarray:
+    mem = np.zeros(MEMORY_SIZE)
+    mem[M_PHASE] = phase
+    mem[M_T0] = t0
+    mem[M_LAST_STRIKE_T] = t0
+    return mem
+
+
+@jit
+def pin_angle(m, q, v, j):
+    """Relative angle [rad] and rate [rad/s] of pin j."""
+    a = m.pin_body[j, 0]
+    b = m.pin_body[j, 1]
+    return q[b, 2] - q[a, 2] - m.pin_ref[j], v[b, 2] - v[a, 2]
+
+
+@jit
+def foot_in_contact(s, tab, side):
+    """1 if any corner of `side`'s foot is pinned or sliding."""
+    for c in range(tab.contact.shape[1]):
+        if s.contact_mode[tab.contact[side, c]] != 0:
+            return 1
+    return 0
+
+
+@jit
+def next_phase(s, tab, mem):
+    """Table 1 transitions (plus the contact timeout); updates mem in place."""
+    t = s.time[0]
+    phase = int(mem[M_PHASE])
+    t_in = t - mem[M_T0]
+    if phase % 2 == 0:
+        if t_in >= tab.state_time:
+            mem[M_PHASE] = phase + 1
+            mem[M_T0] = t
+        return
+    contact = foot_in_contact(s, tab, phase // 2) == 1 and t_in >= tab.min_contact_time
+    if contact or t_in >= tab.contact_timeout:
+        mem[M_PHASE] = (phase + 1) % 4
+        mem[M_T0] = t
+        if contact:
+            mem[M_STRIKES] += 1
+            mem[M_LAST_STRIKE_T] = t
+        else:
+            mem[M_TIMEOUTS] += 1
+
+
+@jit
+def control(m, s, ws, tab, mem, u):
+    """Write the six motor torques into u (n_act,) for the current state."""
+    next_phase(s, tab, mem)
+    phase = int(mem[M_PHASE])
+    swing = phase // 2
+    stance = 1 - swing
+    half = phase % 2
+    q = s.q
+    v = s.v
+    tr = tab.torso
+    # eq. 3: swing-hip target from the torso's position over the stance ankle and its speed
+    ankle = tab.pin[stance, ANKLE]
+    foot = m.pin_body[ankle, 1]
+    phi = q[foot, 2]
+    ax = q[foot, 0] + math.cos(phi) * m.pin_anchor[ankle, 1, 0] - math.sin(phi) * m.pin_anchor[ankle, 1, 1]
+    d = q[tr, 0] - ax
+    hip_d = tab.target[half, SWING_HIP] + tab.cd[half] * d + tab.cv[half] * v[tr, 0]
+    th = tab.thigh[swing]
+    tau_swing = tab.kp[HIP] * (hip_d - q[th, 2]) - tab.kd[HIP] * v[th, 2]
+    # eq. 2: the stance hip supplies the torso torque
+    tau_torso = tab.kp[TORSO] * (tab.torso_target - q[tr, 2]) - tab.kd[TORSO] * v[tr, 2]
+    u[tab.act[swing, HIP]] = tau_swing
+    u[tab.act[stance, HIP]] = -tau_torso - tau_swing
+    # eq. 1: knees and ankles
+    for side in range(2):
+        col = SWING_KNEE if side == swing else STANCE_KNEE
+        for jt in range(KNEE, ANKLE + 1):
+            j = tab.pin[side, jt]
+            ang, rate = pin_angle(m, q, v, j)
+            u[tab.act[side, jt]] = tab.kp[jt] * (tab.target[half, col + jt - KNEE] - ang) - tab.kd[jt] * rate
+
+
+class Controller:
+    """Python-path controller: ``u = ctrl(sim)`` calls the same compiled ``control``."""
+
+    def __init__(self, params: SimbiconParams, model):
+        self.params = params
+        self.model = model
+        self.tables = make_tables(params, model)
+        self.reset()
+
+    def reset(self, phase: int = 0, t0: float = 0.0):
+        self.memory = make_memory(phase, t0)
+        self.u = np.zeros(self.model.n_act)
+
+    @property
+    def phase(self) -> Phase:
+        return Phase(int(self.memory[M_PHASE]))
+
+    def __call__(self, sim):
+        control(self.model.arrays, sim.state, sim.ws, self.tables, self.memory, self.u)
+        return self.u
