@@ -122,12 +122,14 @@ class Scene:
     impulse_scale : arrow length per newton [m/N] (default: the total weight draws as 0.3 of
         the view height)
     label_names : {label: {value: name}} to print labels (e.g. gait numbers) as names
+    overlay_labels : labels to print: a list of names, "all", or None for the default
+        (gait and state when present, else the first three)
     style : Style
     """
 
     def __init__(self, model, ax, view_width=None, tick_spacing: float = 0.5, show_impulses=True,
                  show_com=True, impulse_scale=None, label_names=None, style: Style | None = None,
-                 show_text=True):
+                 show_text=True, overlay_labels=None):
         if not (tick_spacing > 0 and math.isfinite(tick_spacing)):
             raise ValueError(f"tick_spacing={tick_spacing} must be a finite distance > 0 m")
         self.model, self.ax = model, ax
@@ -138,8 +140,9 @@ class Scene:
             raise ValueError(f"view_width={view_width} must be a finite width > 0 m")
         self.show_impulses, self.show_com, self.show_text = bool(show_impulses), bool(show_com), bool(show_text)
         self.label_names = label_names or {}
+        self.overlay_labels = overlay_labels
         weight = model.total_mass * float(np.hypot(*model.arrays.gravity)) or model.total_mass * 9.81
-        self.impulse_scale = impulse_scale if impulse_scale else 0.3 * self.view_height / weight
+        self.impulse_scale = impulse_scale if impulse_scale else 0.2 * self.view_height / weight
         self._outlines = [shape_outline(s, self.style.arc_points) for s in model.shapes]
         self._shape_body = [s.body for s in model.shapes]
         self._fallback = self._fallback_shapes()
@@ -259,16 +262,26 @@ class Scene:
         if speed is not None:
             parts.append(f"v = {speed:+.2f} m/s")
         lines = ["   ".join(parts)] if parts else []
-        for key, val in (labels or {}).items():
+        for key, val in self._shown_labels(labels or {}).items():
             names = self.label_names.get(key)
             try:
                 name = names[int(val)] if names is not None else None
             except (KeyError, IndexError, TypeError, ValueError):
                 name = None
-            if name is None:
-                name = f"{val:g}" if isinstance(val, (int, float, np.number)) else str(val)
+            if name is None and isinstance(val, (int, float, np.number)):
+                name = f"{int(val)}" if float(val).is_integer() else f"{float(val):.3g}"
+            elif name is None:
+                name = str(val)
             lines.append(f"{key}: {name}")
         return "\n".join(lines)
+
+    def _shown_labels(self, labels: dict) -> dict:
+        pick = self.overlay_labels
+        if pick == "all":
+            return labels
+        if pick is None:
+            pick = [k for k in ("gait", "state") if k in labels] or list(labels)[:3]
+        return {k: labels[k] for k in pick if k in labels}
 
     # the frame ------------------------------------------------------------------------------
     def set_view(self, center) -> None:

@@ -267,6 +267,19 @@ def test_every_shape_kind_and_rods_pins_actuators_are_drawn():
     np.testing.assert_allclose(y, model.terrain.height(x), atol=1e-12)
 
 
+def test_overlay_text_names_labels_and_picks_the_important_ones():
+    model = box_model()
+    fig, ax = make_figure()
+    scene = Scene(model, ax, label_names={"gait": {0: "STAND", 1: "WALK"}})
+    labels = {"phase": 0.123456, "gait": 1.0, "steps": 4.0, "state": 2.0}
+    text = scene.overlay_text(t=1.5, speed=0.75, labels=labels)
+    assert text.splitlines() == ["t =   1.500 s   v = +0.75 m/s", "gait: WALK", "state: 2"]
+    scene.overlay_labels = "all"
+    assert "phase: 0.123" in scene.overlay_text(labels=labels)
+    scene.overlay_labels = ["steps"]
+    assert scene.overlay_text(labels=labels) == "steps: 4"
+
+
 # export ---------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def sliding_run():
@@ -636,7 +649,8 @@ def live():
     gains = {"kp": (0.0, 200.0, lambda: ctrl.kp, lambda v: setattr(ctrl, "kp", v))}
     clock = FakeClock(7)
     viewer = Viewer(sim, ctrl, fps=30, gains=gains, on_gait=lambda g: setattr(ctrl, "gait", g),
-                    labels=lambda s: {"angle": round(float(s.state.q[0, 2]), 3)}, clock=clock)
+                    labels=lambda s: {"angle": round(float(s.state.q[0, 2]), 3)}, clock=clock,
+                    overlay_labels=["gait", "angle"])
     return viewer, sim, ctrl, clock
 
 
