@@ -291,7 +291,8 @@ def control(m, s, p, mem, u):
         f_t = mh * (a_t - (-gx * ny + gy * nx))
         if s.contact_mode[front] != 1 and f_t < 0.0:
             f_t = 0.0  # front foot not stuck (sliding or free): no forward push onto it
-        push_hip_pendulum(q, front, f_n, f_t, p[P.I_DS_FRONT_LOAD] * mh * g, fmax, u)
+        push_hip_pendulum(q, front, f_n, f_t, p[P.I_DS_FRONT_LOAD] * mh * g,
+                          min(fmax, p[P.I_DS_FORCE_MAX] * (mh + 2.0 * mf) * g), u)
     else:  # ST_SINGLE
         stance = int(mem[M_STANCE])
         sw = 1 - stance

@@ -63,11 +63,12 @@ def push_hip(q, fx, fy, fmax, u):
 
 
 @jit
-def push_hip_pendulum(q, front, f_n, f_t, f_front_min, fmax, u):
+def push_hip_pendulum(q, front, f_n, f_t, f_front_min, f_rear_max, u):
     """Double stance with priority to the front leg's normal force (eq. 1): the hip force
-    f_n n + f_t t [N] (n = unit(hip - front foot), t = (-n_y, n_x)) from u_f n + u_r e_r, where
-    the tangential part f_t is saturated so that the front leg pushes within [f_front_min, fmax]
-    and the rear leg within [0, fmax]."""
+    f_n n + f_t t [N] (n = unit(hip - front foot), t = (-n_y, n_x)) from u_f n + u_r e_r.
+    The rear leg delivers f_t (u_r = f_t / (e_r . t)), limited to [0, f_rear_max] and so that
+    it does not unload the front leg below f_front_min (a floor that binds only when
+    f_n >= f_front_min); the front leg takes the rest of f_n, within [f_front_min, f_rear_max]."""
     rear = 1 - front
     nx = q[0, 0] - q[front + 1, 0]
     ny = q[0, 1] - q[front + 1, 1]
@@ -79,21 +80,14 @@ def push_hip_pendulum(q, front, f_n, f_t, f_front_min, fmax, u):
     le = math.sqrt(ex * ex + ey * ey)
     a = (-ny * ex + nx * ey) / le   # e_r . t
     b = (nx * ex + ny * ey) / le    # e_r . n
-    # the floor binds only when the front leg is asked to push at least that much
     f_front_min = min(f_front_min, max(f_n, 0.0))
     u_r = 0.0
     if abs(a) > 1e-3:
-        u_r = f_t / a
-        lo = 0.0
-        hi = fmax
+        hi = f_rear_max
         if b > 1e-9:
-            lo = max(lo, (f_n - fmax) / b)
             hi = min(hi, (f_n - f_front_min) / b)
-        elif b < -1e-9:
-            lo = max(lo, (f_n - f_front_min) / b)
-            hi = min(hi, (f_n - fmax) / b)
-        u_r = clamp(u_r, lo, max(lo, hi))
-    u[front] = clamp(f_n - u_r * b, min(f_front_min, fmax), fmax)
+        u_r = clamp(f_t / a, 0.0, max(hi, 0.0))
+    u[front] = clamp(f_n - u_r * b, f_front_min, f_rear_max)
     u[rear] = u_r
     u[ACT_HIP] = 0.0
 

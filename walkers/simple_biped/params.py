@@ -55,6 +55,8 @@ class SimpleBipedParams:
     ds_front_load: float = _p(0.3, "-", "least front-leg force in double stance, as a fraction of "
                               "the hip weight (keeps the new stance foot planted)", 0.0, 1.0)
     ds_accel_max: float = _p(1.0, "g", "limit of the tangential hip acceleration of eq. 3", 0.0, 10.0)
+    ds_force_max: float = _p(4.0, "weights", "leg force limit in walking double stance, in "
+                             "units of the total weight", 0.5, 50.0)
     ds_time_min: float = _p(0.02, "s", "shortest double stance", 0.0, 1.0)
     ds_time_max: float = _p(0.25, "s", "longest double stance", 0.0, 5.0)
     ds_energy_tol: float = _p(0.02, "m^2/s^2", "double stance ends once the predicted top speed "
