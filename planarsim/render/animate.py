@@ -191,19 +191,21 @@ class FrameRenderer:
 
 def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, start=None, duration=None,
                      size=(6.4, 3.6), dpi: int = 100, camera: Camera | None = None, progress=True,
-                     bitrate=None, **scene_kw) -> Path:
+                     bitrate=None, embed_limit_mb: float = 200.0, **scene_kw) -> Path:
     """Write an animation of `traj` to `path` (.gif, .mp4 or .html, by extension).
 
     fps : video frames per second; speed : simulated seconds per video second (1 real time,
     0.25 slow motion, 4 faster); start, duration : simulated time window [s] (default: all);
     size : figure size [inch] at `dpi`; camera : a Camera (default Camera()); progress :
-    True for a text bar on stderr, a callable(done, total), or False; scene_kw : options of
+    True for a text bar on stderr, a callable(done, total), or False; bitrate : MP4 bitrate
+    [kbit/s] (None: ffmpeg's default quality); embed_limit_mb : size cap of an HTML page (an
+    error, not silently dropped frames, when exceeded); scene_kw : options of
     Scene (view_width, tick_spacing, show_impulses, show_com, label_names, style, ...).
     Returns the path written.
     """
     path, fmt = check_output_path(path)
     renderer = FrameRenderer(traj, model, fps, speed, start, duration, size, dpi, camera, **scene_kw)
-    writer = _writer(fmt, fps, bitrate)
+    writer = _writer(fmt, fps, bitrate, embed_limit_mb)
     report = _progress(progress, len(renderer), f"frames -> {path.name}")
     suffix = ".html" if fmt == "html" else path.suffix
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".part{suffix}", dir=path.parent)
@@ -213,6 +215,10 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
             for k in range(len(renderer)):
                 renderer.draw(k)
                 writer.grab_frame()
+                if getattr(writer, "_hit_limit", False):   # matplotlib would drop the rest silently
+                    raise ValueError(f"HTML animation {str(path)!r} exceeds the {writer._bytes_limit / 1e6:.0f} MB "
+                                     f"embed limit at frame {k + 1} of {len(renderer)}: lower fps, size or "
+                                     f"dpi, or pass embed_limit_mb")
                 report(k + 1)
         if fmt == "html":
             _wrap_html_page(tmp, title=path.stem)

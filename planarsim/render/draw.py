@@ -22,8 +22,6 @@ from matplotlib.patches import Polygon
 
 from ..model import ACT_AXIAL
 
-MODE_NAMES = {-1: "disabled", 0: "free", 1: "pinned", 2: "sliding"}
-
 
 @dataclass
 class Style:

@@ -131,7 +131,6 @@ class Viewer:
         self._due = self.timer.period
         self._drawn_t = sim.t
         self._initial = sim.snapshot()
-        self._model0 = sim.model
         g = np.asarray(sim.model.arrays.gravity, float)
         self.gravity = float(np.hypot(*g))
         self.tilt_deg = float(np.degrees(np.arctan2(g[0], -g[1]))) if self.gravity > 0 else 0.0

@@ -23,7 +23,6 @@ from planarsim import terrain
 from planarsim.render import (Camera, FrameTimer, Scene, Style, Viewer, cost_of_transport, export_animation,
                               frame_indices, frame_times, joint_series, make_figure, plot_summary,
                               save_figure, show_inline, step_overshoot)
-from planarsim.render.animate import animation_html
 
 RED = (1.0, 0.0, 0.0)
 BLUE = (0.0, 0.0, 1.0)
@@ -407,6 +406,14 @@ def test_html_export_is_a_self_contained_player(sliding_run, tmp_path):
     html = frag.data if hasattr(frag, "data") else frag
     assert type(frag).__name__ == "HTML" and html.count("data:image/png;base64,") == 30
     assert "<html>" not in html
+
+
+def test_html_export_over_its_size_cap_is_an_error_not_a_short_page(sliding_run, tmp_path):
+    model, traj = sliding_run
+    with pytest.raises(ValueError, match="embed limit"):
+        export_animation(traj, model, tmp_path / "big.html", fps=10, size=(1.6, 0.9), dpi=50,
+                         progress=False, embed_limit_mb=0.01)
+    assert list(tmp_path.iterdir()) == []
 
 
 NODE_DOM_STUB = r"""
