@@ -241,8 +241,14 @@ def make_parser():
 
 
 def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # bench and tune own their options (including --help)
+    if argv and argv[0] in ("bench", "tune"):
+        argv = [argv[0], "--", *argv[1:]] if len(argv) > 1 and argv[1].startswith("-") else argv
     ap = make_parser()
     args = ap.parse_args(argv)
+    if getattr(args, "rest", None) and args.rest[:1] == ["--"]:
+        args.rest = args.rest[1:]
     try:
         return int(args.func(args) or 0)
     except UsageError as e:

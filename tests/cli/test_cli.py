@@ -1,0 +1,85 @@
+"""Issue 7: the command line. Runs in-process through planarsim.cli.main."""
+import json
+
+import numpy as np
+import pytest
+
+from planarsim.cli import main
+from planarsim.trajectory import Trajectory
+import walkers
+
+
+def run_cli(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("walker", sorted(walkers.WALKERS))
+def test_run_each_walker_writes_the_files_asked_for(walker, tmp_path, capsys):
+    files = dict(out=tmp_path / "a.gif", plot=tmp_path / "p.png", save=tmp_path / "t.npz",
+                 csv=tmp_path / "t.csv")
+    code, out, err = run_cli(capsys, "run", walker, "--duration", "0.3", "--fps", "10",
+                             "--out", str(files["out"]), "--plot", str(files["plot"]),
+                             "--save", str(files["save"]), "--csv", str(files["csv"]), "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["walker"] == walker
+    for p in files.values():
+        assert p.exists() and p.stat().st_size > 0
+    traj = Trajectory.load(files["save"])
+    assert abs(traj.t[-1] - 0.3) < 0.02
+    assert np.all(np.isfinite(traj.q))
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["run", "no-such-walker"], "unknown walker 'no-such-walker'"),
+    (["run", "simple-biped", "--terrain", "bumpy"], "terrain spec 'bumpy' not understood"),
+    (["run", "simple-biped", "--out", "/no/such/folder/x.gif"], "does not exist"),
+    (["run", "simple-biped", "--out", "x.avi"], "extension must be one of"),
+    (["run", "simple-biped", "--gait", "fly"], "has no gait 'fly'"),
+])
+def test_user_errors_exit_2_with_one_line(argv, fragment, capsys):
+    code, out, err = run_cli(capsys, *argv)
+    assert code == 2
+    assert fragment in err
+    assert len(err.strip().splitlines()) == 1
+    assert "Traceback" not in err
+
+
+def test_negative_duration_is_a_usage_error(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["run", "simple-biped", "--duration", "-1"])
+    assert e.value.code == 2
+    assert "--duration" in capsys.readouterr().err
+
+
+def test_unwritable_output_path(tmp_path, capsys):
+    import os
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        # root may write anywhere except where the kernel says no (/proc/1 on Linux)
+        folder = locked if not os.access(locked, os.W_OK) else "/proc/1"
+        if os.access(folder, os.W_OK):
+            pytest.skip("no unwritable folder available to this user")
+        code, out, err = run_cli(capsys, "run", "simple-biped", "--out", f"{folder}/x.gif")
+        assert code == 2 and "not writable" in err
+    finally:
+        locked.chmod(0o700)
+
+
+@pytest.mark.parametrize("sub", ["list", "run", "view", "bench", "tune", "info"])
+def test_help_of_every_subcommand(sub, capsys):
+    with pytest.raises(SystemExit) as e:
+        main([sub, "--help"])
+    assert e.value.code == 0
+    assert "usage" in capsys.readouterr().out.lower()
+
+
+def test_list_and_info(capsys):
+    code, out, err = run_cli(capsys, "list")
+    assert code == 0 and "simple-biped" in out and "slope:DEG" in out
+    code, out, err = run_cli(capsys, "info")
+    assert code == 0 and "numba" in out
