@@ -12,7 +12,9 @@ pause before the next frame
     pause_k = T - kp e_k - ki sum_{i<=k} e_i      (clamped at >= 0; no windup while clamped)
 
 so the integral absorbs the steady render time and oversleep, the proportional term the
-jitter. The integral starts from the time the first frame took to prepare. A frame more than ``max_lag`` late is skipped rather than caught up.
+jitter. The integral starts from the time the first frame took to prepare. When a frame is
+more than ``max_lag`` late (rendering slower than the frame rate), the schedule skips whole
+frames instead of trying to catch up, and the simulation jumps by the skipped time.
 
 ``Viewer`` steps ``sim`` with ``controller(sim) -> u`` (the Python path) by ``speed * T`` of
 simulated time per frame. Keys: space play/pause, right or '.' step one frame, 'i' impulses,
@@ -40,7 +42,7 @@ class FrameTimer:
 
     period : frame interval T [s]; kp, ki : proportional and integral gains [-];
     clock : callable returning seconds (default time.perf_counter); max_lag : lateness [s]
-    beyond which frames are skipped (default 5 T).
+    beyond which frames are skipped (default 2 T).
     """
 
     def __init__(self, period: float, kp: float = 0.7, ki: float = 0.2, clock=time.perf_counter,
@@ -48,7 +50,7 @@ class FrameTimer:
         if not (math.isfinite(period) and period > 0):
             raise ValueError(f"frame period={period} must be finite and > 0 s")
         self.period, self.kp, self.ki, self.clock = float(period), float(kp), float(ki), clock
-        self.max_lag = 5.0 * self.period if max_lag is None else float(max_lag)
+        self.max_lag = 2.0 * self.period if max_lag is None else float(max_lag)
         self.start()
 
     def start(self) -> None:

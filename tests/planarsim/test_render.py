@@ -101,7 +101,7 @@ def test_camera_step_response_is_the_damped_oscillator(z, wn, amplitude, seed):
 
 
 @pytest.mark.parametrize("z", [0.3, 0.7])
-def test_camera_overshoot_is_the_damping_ratio_one_at_fine_frames(z):
+def test_camera_overshoot_matches_its_damping_ratio_at_fine_frames(z):
     """At 1000 fps the sampled peak reaches the theory (so the camera really rings as zeta says)."""
     wn = 4.0
     times = np.arange(0, 5.0, 1e-3)
@@ -610,7 +610,7 @@ def test_fixed_pause_timer_drifts_so_the_pi_terms_matter():
     assert errors.max() > 1.0      # 7.5 ms late per frame for 10 s
     clock = FakeClock(3)
     errors = run_timer(FrameTimer(1 / 30, kp=1.0, ki=0.0, clock=clock), clock)
-    assert abs(errors[30:].mean()) > 0.002   # proportional only: a steady lag (the oversleep)
+    assert errors[30:].mean() > 0.005   # proportional only: a steady lag (render time + oversleep)
 
 
 def test_timer_skips_frames_it_cannot_render_in_time():
