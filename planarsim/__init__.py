@@ -9,7 +9,10 @@ from .sim import Simulator
 from .state import State, make_state
 from . import terrain
 from .energy import kinetic_energy, potential_energy, total_energy
+from .snapshot import load_snapshot, save_snapshot
+from .trajectory import Trajectory
 
 __all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "Simulator", "State",
            "StepOptions", "ContactMode", "ModeStrategy", "make_options", "make_state", "terrain",
-           "kinetic_energy", "potential_energy", "total_energy", "__version__"]
+           "kinetic_energy", "potential_energy", "total_energy", "save_snapshot", "load_snapshot",
+           "Trajectory", "__version__"]

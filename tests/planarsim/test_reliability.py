@@ -1,0 +1,205 @@
+"""Issue 12: divergence guards, snapshots, damaged files, corrupted models, cache hits."""
+import hashlib
+import math
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import planarsim as ps
+from planarsim import ModelError, SimulationDiverged, terrain
+
+
+def two_link_on_hills():
+    """A box on hills with a pendulum hanging from it: pins, contacts, an actuator."""
+    ter = terrain.hills([0.1], [3.0], [0.4])
+    b = ps.ModelBuilder(dt=1e-3, terrain=ter)
+    box = b.add_body("box", 3.0, 0.05, pos=(0.0, 0.4), vel=(1.0, 0.0), omega=1.0)
+    b.add_box_contacts("box", box, (0.0, 0.0), 0.4, 0.2, mu=0.6)
+    arm = b.add_body("arm", 1.0, 0.02, pos=(0.25, 0.4), angle=0.0)
+    b.add_pin("elbow", box, arm, anchor_world=(0.1, 0.4), limit=(-1.5, 1.5))
+    b.add_arc_contact("hand", arm, (0.15, 0.0), 0.05, mu=0.6)
+    b.add_pin_motor("elbow_motor", "elbow", limit=(-20.0, 20.0))
+    return b.compile()
+
+
+def state_hash(state):
+    h = hashlib.blake2b(digest_size=16)
+    for a in state:
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+def test_nan_torque_fires_at_its_step_with_the_previous_state():
+    model = two_link_on_hills()
+    sim = ps.Simulator(model)
+    u = np.array([3.0])
+    for _ in range(137):
+        sim.step(u)
+    before = sim.snapshot()
+    with pytest.raises(SimulationDiverged) as e:
+        sim.step(np.array([math.nan]))
+    err = e.value
+    assert err.step == 137
+    assert err.body in model.body_names
+    assert f"step 137" in str(err) and repr(err.body) in str(err)
+    assert state_hash(err.last_state) == state_hash(before)
+
+
+def test_huge_velocity_fires_at_its_step():
+    model = two_link_on_hills()
+    sim = ps.Simulator(model)
+    for _ in range(137):
+        sim.step(np.array([3.0]))
+    before = sim.snapshot()
+    sim.state.ext_force[1, 0] = 1e11 * 1.0 / model.dt  # a push giving the arm 1e11 m/s
+    with pytest.raises(SimulationDiverged) as e:
+        sim.step(np.array([3.0]))
+    assert e.value.step == 137
+    assert e.value.body == "arm" or e.value.body == "box"
+    assert abs(e.value.value) > 1e10
+    assert state_hash(e.value.last_state) == state_hash(before._replace(ext_force=e.value.last_state.ext_force))
+
+
+def test_snapshot_restore_continues_bit_for_bit(tmp_path):
+    model = two_link_on_hills()
+    u = np.array([2.0])
+    ref = ps.Simulator(model)
+    ref.steps(500, u)
+    path = ps.save_snapshot(tmp_path / "snap.npz", ref.state, memory={"phase": np.array([3])})
+    hashes = []
+    for _ in range(1000):
+        ref.step(u)
+        hashes.append(state_hash(ref.state))
+    state, memory = ps.load_snapshot(path)
+    assert int(memory["phase"][0]) == 3
+    again = ps.Simulator(model, state=state)
+    for k in range(1000):
+        again.step(u)
+        assert state_hash(again.state) == hashes[k]
+
+
+def test_two_runs_hash_alike_in_process_and_in_a_fresh_process():
+    model = two_link_on_hills()
+
+    def run():
+        sim = ps.Simulator(model)
+        h = hashlib.blake2b(digest_size=16)
+        for _ in range(2000):
+            sim.step(np.array([1.0]))
+            h.update(state_hash(sim.state).encode())
+        return h.hexdigest()
+
+    a, b = run(), run()
+    assert a == b
+    code = textwrap.dedent("""
+        import hashlib, numpy as np, planarsim as ps
+        from tests.planarsim.test_reliability import two_link_on_hills, state_hash
+        sim = ps.Simulator(two_link_on_hills())
+        h = hashlib.blake2b(digest_size=16)
+        for _ in range(2000):
+            sim.step(np.array([1.0]))
+            h.update(state_hash(sim.state).encode())
+        print(h.hexdigest())
+    """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == a
+
+
+def test_a_second_process_loads_the_step_kernel_from_the_cache():
+    ps.Simulator(two_link_on_hills()).step()  # make sure this process compiled (or loaded) it
+    code = textwrap.dedent("""
+        import planarsim as ps
+        from planarsim.kernels.step import step
+        from tests.planarsim.test_reliability import two_link_on_hills
+        ps.Simulator(two_link_on_hills()).step()
+        print(sum(step.stats.cache_hits.values()), sum(step.stats.cache_misses.values()))
+    """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    hits, misses = map(int, out.stdout.split())
+    assert hits >= 1 and misses == 0
+
+
+@pytest.mark.parametrize("damage", ["truncate", "garbage", "newer"])
+def test_damaged_files_give_clear_errors(tmp_path, damage):
+    model = two_link_on_hills()
+    sim = ps.Simulator(model)
+    traj = sim.run(0.05)
+    tpath = traj.save(tmp_path / "t.npz")
+    spath = ps.save_snapshot(tmp_path / "s.npz", sim.state)
+    for path in (tpath, spath):
+        raw = path.read_bytes()
+        if damage == "truncate":
+            path.write_bytes(raw[: len(raw) // 2])
+        elif damage == "garbage":
+            path.write_bytes(b"not a zip at all" + raw[100:200])
+        else:
+            key = "format_version" if path == tpath else "snapshot_version"
+            data = dict(np.load(path))
+            data[key] = np.array(99)
+            np.savez(path, **data)
+    with pytest.raises(ValueError, match="trajectory"):
+        ps.Trajectory.load(tpath)
+    with pytest.raises(ValueError, match="snapshot"):
+        ps.load_snapshot(spath)
+
+
+def test_interrupted_save_leaves_no_file(tmp_path, monkeypatch):
+    traj = ps.Simulator(two_link_on_hills()).run(0.05)
+    target = tmp_path / "t.npz"
+
+    def boom(*a, **k):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(np, "savez_compressed", boom)
+    with pytest.raises(KeyboardInterrupt):
+        traj.save(target)
+    assert list(tmp_path.iterdir()) == []
+
+
+# a valid model description, and one corrupted field at a time --------------------------------
+CORRUPTIONS = [
+    ("body", "mass", -1.0), ("body", "mass", 0.0), ("body", "mass", math.nan),
+    ("body", "inertia", 0.0), ("body", "inertia", -2.0), ("body", "pos", (0.0, math.inf)),
+    ("body", "vel", (math.nan, 0.0)), ("pin", "body_b", "ghost"), ("pin", "name", "hip"),
+    ("pin", "limit", (1.0, -1.0)), ("pin", "anchor_b", (0.0, 0.3)), ("contact", "mu", -0.1),
+    ("contact", "body", 99), ("actuator", "limit", (3.0, -3.0)), ("rod", "length", 0.0),
+    ("model", "dt", 0.0), ("model", "dt", -1e-3), ("model", "gravity", (0.0, math.nan)),
+    ("terrain", "coef", math.nan),
+]
+
+
+def build_described(corrupt=None):
+    kind, field, value = corrupt if corrupt else (None, None, None)
+    def pick(k, f, default):
+        return value if (kind, field) == (k, f) else default
+    ter = terrain.hills([0.1], [3.0]) if kind != "terrain" else None
+    if kind == "terrain":
+        ter = terrain.hills([value], [3.0])
+    b = ps.ModelBuilder(dt=pick("model", "dt", 1e-3), gravity=pick("model", "gravity", (0.0, -9.81)),
+                        terrain=ter)
+    b.add_body("torso", pick("body", "mass", 5.0), pick("body", "inertia", 0.3),
+               pos=pick("body", "pos", (0.0, 1.0)), vel=pick("body", "vel", (0.0, 0.0)))
+    b.add_body("leg", 1.0, 0.1, pos=(0.0, 0.5))
+    b.add_pin("hip", "torso", "leg", anchor_a=(0.0, -0.25), anchor_b=pick("pin", "anchor_b", (0.0, 0.25)),
+              limit=pick("pin", "limit", (-1.0, 1.0)))
+    b.add_pin(pick("pin", "name", "knee_dummy"), None, pick("pin", "body_b", "leg"),
+              anchor_world=(0.0, 0.25))
+    b.add_point_mass("foot", 0.5, pos=(0.0, 0.0))
+    b.add_rod("shank", "leg", "foot", anchor_a=(0.0, -0.25), length=pick("rod", "length", 0.25))
+    b.add_point_contact("toe", pick("contact", "body", "foot"), mu=pick("contact", "mu", 0.8))
+    b.add_pin_motor("hip_motor", "hip", limit=pick("actuator", "limit", (-5.0, 5.0)))
+    return b.compile()
+
+
+def test_the_uncorrupted_description_builds():
+    assert build_described().n_body == 3
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(CORRUPTIONS))
+def test_one_corrupted_field_always_gives_a_model_error(corrupt):
+    with pytest.raises(ModelError):
+        build_described(corrupt)
