@@ -173,7 +173,9 @@ def next_state(p, s, mem, g):
         # top speed squared the front-leg pendulum will have: (l phi_dot)^2 - 2 g l (1 - cos phi)
         v_top2 = (l * phidot) ** 2 - 2.0 * g * l * (1.0 - math.cos(phi))
         err = abs(v_top2 - _v_top(p, mem) ** 2)
-        if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL]
+        # also leave once the hip is over the front foot and still moving on (not a stall)
+        over = phi <= 0.0 and v[0, 0] > p[P.I_STOP_SPEED]
+        if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL] or over
                                             or rear_l >= p[P.I_DS_REAR_LENGTH] * p[P.I_LEG_LENGTH]
                                             or t_in >= p[P.I_DS_TIME_MAX]):
             _start_swing(p, q, v, mem, front)
