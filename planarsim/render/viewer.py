@@ -325,6 +325,33 @@ def view(sim, controller=None, **kw) -> Viewer:
     return viewer
 
 
+def view_walker(module, gait=None, terrain=None, **kw) -> Viewer:
+    """Open the viewer on a walker package that offers the live-view hook
+
+        module.live(gait=..., terrain=...) -> dict(sim=Simulator, controller=callable(sim) -> u,
+            on_gait=callable(name), gains={name: (min, max, getter, setter)},
+            labels=callable(sim) -> dict, label_names={label: {value: name}})
+
+    (only ``sim`` and ``controller`` are required). This is what ``planarsim view WALKER`` runs."""
+    live = getattr(module, "live", None)
+    if live is None:
+        name = getattr(module, "NAME", getattr(module, "__name__", repr(module)))
+        raise NotImplementedError(f"walker {name!r} has no live(gait, terrain) hook for the interactive "
+                                  f"viewer (see planarsim.render.viewer.view_walker)")
+    args = {k: v for k, v in (("gait", gait), ("terrain", terrain)) if v is not None}
+    spec = dict(live(**args))
+    missing = [k for k in ("sim", "controller") if k not in spec]
+    if missing:
+        raise ValueError(f"{module.__name__}.live() must return sim and controller; missing {missing}")
+    sim, controller = spec.pop("sim"), spec.pop("controller")
+    allowed = {"on_gait", "gains", "labels", "label_names", "gait_keys", "control_every"}
+    unknown = sorted(set(spec) - allowed)
+    if unknown:
+        raise ValueError(f"{module.__name__}.live() returned unknown keys {unknown}; allowed: {sorted(allowed)}")
+    spec.update(kw)
+    return view(sim, controller, **spec)
+
+
 def _check_speed(speed) -> float:
     speed = float(speed)
     if not (math.isfinite(speed) and speed > 0):

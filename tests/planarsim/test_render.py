@@ -756,3 +756,24 @@ def test_view_opens_and_returns_under_a_non_interactive_backend():
     assert viewer.playing and " " not in plt.rcParams["keymap.fullscreen"]
     assert "s" not in plt.rcParams["keymap.save"]
     plt.close(viewer.fig)
+
+
+def test_view_walker_uses_the_live_hook_and_names_a_walker_without_one():
+    import types
+    import matplotlib.pyplot as plt
+    from planarsim.render import view_walker
+    ctrl = GaitController()
+
+    def live(gait="stand", terrain=None):
+        ctrl.gait = gait
+        return {"sim": ps.Simulator(pendulum_model()), "controller": ctrl,
+                "on_gait": lambda g: setattr(ctrl, "gait", g)}
+
+    walker = types.SimpleNamespace(__name__="walkers.fake", NAME="fake", live=live)
+    viewer = view_walker(walker, gait="walk")
+    assert ctrl.gait == "walk" and viewer.controller is ctrl
+    key(viewer, "j")
+    assert ctrl.gait == "jump"
+    plt.close(viewer.fig)
+    with pytest.raises(NotImplementedError, match="'fake' has no live"):
+        view_walker(types.SimpleNamespace(__name__="walkers.fake", NAME="fake"))
