@@ -6,6 +6,7 @@ Each walker module exposes ``NAME``, ``GAITS`` and
 import importlib
 
 WALKERS = {
+    "quadruped": "walkers.quadruped",
     "ranger": "walkers.ranger",
     "simbicon": "walkers.simbicon",
     "simple-biped": "walkers.simple_biped",

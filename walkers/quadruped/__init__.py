@@ -1,0 +1,22 @@
+"""The robot dog of seed 003 in the sagittal plane: an A1-like quadruped driven through an
+inverse-kinematics puppet, trotting with diagonal pairs (STAND / PIAFFE / WALK).
+
+>>> from walkers import quadruped as qd                       # doctest: +SKIP
+>>> traj, summary, model = qd.simulate(20.0, gait="walk", speed=0.3)
+>>> dog = qd.Quadruped(gait="piaffe"); dog.run(5.0); dog.set_gait("walk", 0.3); dog.run(10.0)
+"""
+from planarsim.kernels._jit import drop_stale_caches
+
+drop_stale_caches(__path__[0])
+
+from .controller import Controller, FootState, Gait  # noqa: E402
+from .model import LEG_NAMES, PAIR, build  # noqa: E402
+from .params import QuadrupedParams  # noqa: E402
+from .puppet import leg_fk, leg_ik, puppet_pose  # noqa: E402
+from .rollout import GAITS, Quadruped, rollout_quadruped, simulate  # noqa: E402
+
+NAME = "quadruped"
+
+__all__ = ["NAME", "GAITS", "simulate", "Quadruped", "QuadrupedParams", "Controller", "Gait",
+           "FootState", "build", "leg_fk", "leg_ik", "puppet_pose", "rollout_quadruped",
+           "LEG_NAMES", "PAIR"]
