@@ -107,12 +107,14 @@ class Viewer:
     labels : callable(sim) -> dict shown in the overlay (e.g. {'gait': 1})
     fig : a matplotlib Figure to draw into (default: a headless Agg figure)
     clock : time source for the FrameTimer (tests pass a fake one)
+    blit : redraw only the scene over a saved background (default: where the canvas can);
+        a full redraw of the figure with its widgets costs several times more per frame
     scene_kw : options of Scene (view_width, tick_spacing, label_names, style, ...)
     """
 
     def __init__(self, sim, controller=None, fps: float = 30.0, speed: float = 1.0, control_every: int = 1,
                  gains=None, gait_keys=None, on_gait=None, labels=None, fig=None, camera=None,
-                 clock=time.perf_counter, **scene_kw):
+                 clock=time.perf_counter, blit=None, **scene_kw):
         if control_every < 1:
             raise ValueError(f"control_every={control_every} must be >= 1 step")
         self.sim, self.controller, self.labels = sim, controller, labels
@@ -138,6 +140,7 @@ class Viewer:
         self.tilt_deg = float(np.degrees(np.arctan2(g[0], -g[1]))) if self.gravity > 0 else 0.0
         self.fig = fig if fig is not None else _headless_figure(6.4, 3.6 + 0.3 * (3 + len(self.gains)))
         self._layout(scene_kw)
+        self._setup_blit(blit)
         self.draw()
 
     # layout -----------------------------------------------------------------------------------
@@ -276,8 +279,37 @@ class Viewer:
                                      contact_impulse=sim.ws.contact_impulse, labels=labels, speed=speed)
         if self.message:
             self.scene.text.set_text(self.scene.text.get_text() + "\n" + self.message[:120])
-        self.fig.canvas.draw_idle()
+        self._present()
         return arts
+
+    # blitting: the widgets stay in a saved background, only the scene's artists are redrawn
+    def _setup_blit(self, blit):
+        canvas = self.fig.canvas
+        self.blit = bool(canvas.supports_blit) if blit is None else bool(blit)
+        self._background = None
+        if self.blit:
+            for art in self.scene.artists:
+                art.set_animated(True)
+            canvas.mpl_connect("draw_event", self._on_full_draw)
+
+    def _on_full_draw(self, event=None):
+        """After any full redraw (first frame, a slider moved, a resize): keep the background and
+        put the scene on top of it."""
+        self._background = self.fig.canvas.copy_from_bbox(self.ax.bbox)
+        for art in self.scene.artists:
+            self.ax.draw_artist(art)
+
+    def _present(self):
+        canvas = self.fig.canvas
+        if not self.blit:
+            canvas.draw_idle()
+        elif self._background is None:
+            canvas.draw()                      # the draw_event saves the background
+        else:
+            canvas.restore_region(self._background)
+            for art in self.scene.artists:
+                self.ax.draw_artist(art)
+            canvas.blit(self.ax.bbox)
 
     def tick(self) -> float:
         """One frame of playback: advance (when playing), draw, and return the PI-corrected pause

@@ -777,3 +777,25 @@ def test_view_walker_uses_the_live_hook_and_names_a_walker_without_one():
     plt.close(viewer.fig)
     with pytest.raises(NotImplementedError, match="'fake' has no live"):
         view_walker(types.SimpleNamespace(__name__="walkers.fake", NAME="fake"))
+
+
+def test_blitted_frames_equal_full_redraws():
+    """The viewer redraws only the scene over a saved background; the picture must be the one a
+    full redraw of the figure gives."""
+    import copy
+    sim = ps.Simulator(pendulum_model())
+    fast = Viewer(sim, lambda s: np.zeros(1), clock=FakeClock())
+    assert fast.blit
+    key(fast, " ")
+    for _ in range(5):
+        fast.tick()
+    slow = Viewer(sim, lambda s: np.zeros(1), clock=FakeClock(), blit=False)
+    slow.camera = copy.deepcopy(fast.camera)
+    slow._drawn_t = fast._drawn_t
+    slow.draw()
+    fast.draw()
+    a = np.asarray(fast.fig.canvas.buffer_rgba())
+    b = np.asarray(slow.fig.canvas.buffer_rgba())
+    assert a.shape == b.shape
+    assert np.count_nonzero(np.any(a != b, axis=2)) == 0
+    assert np.count_nonzero(np.any(a[:, :, :3] < 200, axis=2)) > 1000    # and it is not blank
