@@ -172,7 +172,9 @@ def next_state(p, s, mem, g):
         rear_l = leg_state(q, v, 1 - front)[2]
         # top speed squared the front-leg pendulum will have: (l phi_dot)^2 - 2 g l (1 - cos phi)
         v_top2 = (l * phidot) ** 2 - 2.0 * g * l * (1.0 - math.cos(phi))
-        err = abs(v_top2 - _v_top(p, mem) ** 2)
+        # the legs cannot brake the pendulum (the rear leg only pushes): leave as soon as the
+        # energy is within tolerance of the target or above it
+        err = _v_top(p, mem) ** 2 - v_top2
         # also leave once the hip is over the front foot and still moving on (not a stall)
         over = phi <= 0.0 and v[0, 0] > p[P.I_STOP_SPEED]
         if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL] or over
@@ -300,14 +302,19 @@ def control(m, s, p, mem, u):
         sw = 1 - stance
         ph, ph_dot = _phase(p, q, v, mem)
         mem[M_PHASE] = ph
+        # height from the Bezier at the phase; the forward coordinate runs ahead (reaches the
+        # strike point at phase swing_lead) so a foot meeting rising ground early lands slowly
         sb = clamp(ph, 0.0, 1.0)
-        tx, ty, dtx, dty = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1], mem[M_SW_Y1],
-                                            mem[M_SW_TOP], sb)
-        tvx = dtx * ph_dot
+        lead = p[P.I_SWING_LEAD]
+        sx = clamp(ph / lead, 0.0, 1.0)
+        tx, ty_x, dtx, dty_x = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1],
+                                                mem[M_SW_Y1], mem[M_SW_TOP], sx)
+        tx_y, ty, dtx_y, dty = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1],
+                                                mem[M_SW_Y1], mem[M_SW_TOP], sb)
+        tvx = dtx * ph_dot / lead if ph < lead else 0.0
         tvy = dty * ph_dot
         if ph >= 1.0:
             # past the expected strike: keep lowering the foot until it finds the ground
-            tvx = 0.0
             ty -= p[P.I_DESCENT_RATE] * l0 * (ph - 1.0)
             tvy = -p[P.I_DESCENT_RATE] * l0 * ph_dot
         elif ph < 0.0:

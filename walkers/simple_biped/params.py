@@ -41,6 +41,8 @@ class SimpleBipedParams:
     clearance: float = _p(0.08, "l0", "swing-foot clearance (Bezier top edge at 4/3 of it)", 0.0, 0.5)
     slope_trust: float = _p(1.0, "-", "fraction of the slope seen between the feet assumed to "
                             "continue under the next step (0: the seed's level-ground guess)", 0.0, 1.0)
+    swing_lead: float = _p(1.0, "-", "phase at which the swing foot's forward coordinate reaches "
+                           "the strike point (1: together with the height, as in the seed)", 0.3, 1.0)
     strike_push: float = _p(0.05, "l0", "Bezier end point below the expected ground, so the foot "
                             "strikes with downward speed", 0.0, 0.3)
     descent_rate: float = _p(0.5, "l0", "extra lowering of the swing target per unit phase past 1", 0.0, 5.0)
@@ -60,7 +62,7 @@ class SimpleBipedParams:
     ds_time_min: float = _p(0.02, "s", "shortest double stance", 0.0, 1.0)
     ds_time_max: float = _p(0.25, "s", "longest double stance", 0.0, 5.0)
     ds_energy_tol: float = _p(0.02, "m^2/s^2", "double stance ends once the predicted top speed "
-                              "squared is this close to v_top^2", 0.0, 10.0)
+                              "squared is above v_top^2 minus this", 0.0, 10.0)
     ds_rear_length: float = _p(1.2, "l0", "double stance ends when the rear leg reaches this length", 0.9, 1.3)
     # walk: single stance ------------------------------------------------------------------
     ss_kp: float = _p(200.0, "1/s^2", "stance leg-length gain (single stance)", 0.0, 1e4)
