@@ -178,8 +178,12 @@ def test_walk_forward_20m():
     assert abs(s["mean_speed"] - 0.3) < 0.2 * 0.3, s
     assert np.degrees(np.abs(traj.q[:, 0, 2])).max() < 10.0
     assert s["steps"] > 100
+    # the "all" contact strategy never lets a pinned foot pull on the ground
+    assert traj.contact_impulse[:, :, 0].min() >= 0.0
+    assert 0.0 < s["cost_of_transport"] < 10.0
     print(f"walk 0.3 m/s: {s['distance']:.2f} m in {s['time']:.0f} s, mean speed "
-          f"{s['mean_speed']:.3f} m/s, steps {s['steps']}, max pitch {s['max_pitch_deg']:.2f} deg")
+          f"{s['mean_speed']:.3f} m/s, steps {s['steps']}, max pitch {s['max_pitch_deg']:.2f} deg, "
+          f"mechanical CoT {s['cost_of_transport']:.2f}")
 
 
 def test_walk_backward():
@@ -210,3 +214,16 @@ def test_gait_switch_at_run_time():
     s = dog.summary()
     assert not s["fell"] and abs(s["distance"] - x) < 0.5
     assert np.all(dog.memory[C.M_STATE:C.M_STATE + 4] == C.F_GROUND)
+
+
+def test_live_hook_for_the_viewer():
+    """The viewer's hook: Python-path controller, gait keys and speed slider act on the run."""
+    spec = qd.live(gait="stand")
+    sim, ctrl = spec["sim"], spec["controller"]
+    sim.run(0.5, controller=ctrl)
+    assert ctrl.memory[C.M_STEP_I] == 0
+    spec["on_gait"](spec["gait_keys"]["w"])
+    spec["gains"]["speed [m/s]"][3](0.3)
+    x0 = float(sim.state.q[0, 0])
+    sim.run(2.0, controller=ctrl)
+    assert ctrl.memory[C.M_STEP_I] >= 3 and sim.state.q[0, 0] - x0 > 0.2

@@ -13,10 +13,10 @@ from .controller import Controller, FootState, Gait  # noqa: E402
 from .model import LEG_NAMES, PAIR, build  # noqa: E402
 from .params import QuadrupedParams  # noqa: E402
 from .puppet import leg_fk, leg_ik, puppet_pose  # noqa: E402
-from .rollout import GAITS, Quadruped, rollout_quadruped, simulate  # noqa: E402
+from .rollout import GAITS, Quadruped, live, rollout_quadruped, simulate  # noqa: E402
 
 NAME = "quadruped"
 
 __all__ = ["NAME", "GAITS", "simulate", "Quadruped", "QuadrupedParams", "Controller", "Gait",
            "FootState", "build", "leg_fk", "leg_ik", "puppet_pose", "rollout_quadruped",
-           "LEG_NAMES", "PAIR"]
+           "LEG_NAMES", "PAIR", "live"]

@@ -71,7 +71,7 @@ F_GROUND, F_LIFT, F_PLANT = 0, 1, 2
 # memory layout mem[...]
 M_GAIT, M_SPEED, M_STEP_I, M_STEPS, M_FELL = 0, 1, 2, 3, 4
 M_T_UPDATE, M_READY_AT, M_X_DESIRED, M_X_PREV, M_V_EST = 5, 6, 7, 8, 9
-M_WEIGHT, M_IK_CLAMPS, M_MAX_PITCH, M_V_RAMP = 10, 11, 12, 13
+M_WEIGHT, M_IK_CLAMPS, M_MAX_PITCH, M_V_RAMP, M_WORK = 10, 11, 12, 13, 14
 M_STATE = 16      # foot state, per leg 16..19
 M_TARGET = 20     # puppet foot target (x, y) world, per leg: 20 + 2i, 21 + 2i
 M_GOAL = 28       # foot goal (x, y) world, per leg: 28 + 2i, 29 + 2i
@@ -268,6 +268,8 @@ def control(m, s, p, mem, u):
             ang, rate = pin_angle_rate(m, s.q, s.v, pin)
             ff = ff_hip if j == 0 else ff_knee
             u[pin] = clamp(kp * (mem[M_QREF + pin] - ang) - kd * rate + ff, -lim, lim)
+            # positive mechanical work of the motors [J] (power at the start of the step)
+            mem[M_WORK] += max(u[pin] * rate, 0.0) * dt
 
 
 def make_memory(model, params: QuadrupedParams, gait: int, speed: float) -> np.ndarray:

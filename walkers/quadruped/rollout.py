@@ -134,13 +134,17 @@ class Quadruped:
 
     def summary(self) -> dict:
         """distance [m] and mean_speed [m/s] of the torso since the start, steps (pair
-        plantings), fell, max_pitch [deg], ik_clamps (control ticks with a clamped leg)."""
+        plantings), fell, max_pitch [deg], ik_clamps (control ticks with a clamped leg),
+        cost_of_transport = positive motor work / (m g |distance|) (NaN below 0.1 m)."""
         t = float(self.state.time[0])
         dist = float(self.state.q[0, 0]) - self.x_start
+        weight = float(self.memory[C.M_WEIGHT])
+        cot = float(self.memory[C.M_WORK]) / (weight * abs(dist)) if abs(dist) >= 0.1 else float("nan")
         return {"time": t, "distance": dist, "mean_speed": dist / t if t > 0 else 0.0,
                 "steps": int(self.memory[C.M_STEPS]), "fell": self.fell, "falls": int(self.fell),
                 "max_pitch_deg": float(np.degrees(self.memory[C.M_MAX_PITCH])),
                 "ik_clamps": int(self.memory[C.M_IK_CLAMPS]),
+                "motor_work_positive": float(self.memory[C.M_WORK]), "cost_of_transport": cot,
                 "gait": C.Gait(int(self.memory[C.M_GAIT])).name.lower(),
                 "speed_command": float(C.command_speed(self.memory))}
 
@@ -152,3 +156,32 @@ def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=0.3, pa
     q = Quadruped(params, terrain, dt, gait, speed, strategy, record_every, seed)
     q.run(duration)
     return q.trajectory(), q.summary(), q.model
+
+
+def live(gait="piaffe", terrain=None, speed=None, params=None, strategy="all") -> dict:
+    """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and
+    the Python-path Controller, keys w / p / s for walk / piaffe / stand, sliders for the
+    commanded speed [m/s] and the servo stiffness kp [N m/rad]."""
+    params = params if params is not None else QuadrupedParams()
+    if isinstance(terrain, str):
+        terrain = ps.terrain.parse(terrain)
+    model = build(params, terrain)
+    sim = ps.Simulator(model, ps.make_options(strategy))
+    ctrl = C.Controller(model, params, gait, speed)
+    mem = ctrl.memory
+
+    def on_gait(name):
+        mem[C.M_GAIT] = C.gait_id(name)
+
+    def set_kp(x):
+        ctrl.p[C.I_KP] = float(x)
+
+    def labels(_sim):
+        return {"gait": mem[C.M_GAIT], "step_i": mem[C.M_STEP_I]}
+
+    return dict(sim=sim, controller=ctrl, on_gait=on_gait,
+                gait_keys={"w": "walk", "p": "piaffe", "s": "stand"},
+                gains={"speed [m/s]": (-0.5, 0.5, lambda: float(mem[C.M_SPEED]),
+                                       lambda x: mem.__setitem__(C.M_SPEED, float(x))),
+                       "kp [N m/rad]": (10.0, 300.0, lambda: float(ctrl.p[C.I_KP]), set_kp)},
+                labels=labels, label_names={"gait": {int(g): g.name.lower() for g in C.Gait}})
