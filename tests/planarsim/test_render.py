@@ -83,7 +83,7 @@ def analytic_step(t, wn, z, amplitude):
     return amplitude * (1 - np.exp(-z * wn * t) * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t)))
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(z=st.floats(0.1, 0.95), wn=st.floats(0.5, 20.0), amplitude=st.floats(-5.0, 5.0).filter(lambda a: abs(a) > 1e-3),
        seed=st.integers(0, 10 ** 6))
 def test_camera_step_response_is_the_damped_oscillator(z, wn, amplitude, seed):
@@ -402,9 +402,9 @@ def test_html_export_is_a_self_contained_player(sliding_run, tmp_path):
     assert page.count("data:image/png;base64,") == 30          # frames embedded
     assert "play_animation()" in page and 'type="range"' in page  # play button and frame slider
     assert "http://" not in page and "https://" not in page      # nothing fetched from the net
-    frag = show_inline(traj, model, fps=15, size=(1.6, 0.9), dpi=50)
+    frag = show_inline(traj, model, fps=5, size=(1.6, 0.9), dpi=50)
     html = frag.data if hasattr(frag, "data") else frag
-    assert type(frag).__name__ == "HTML" and html.count("data:image/png;base64,") == 30
+    assert type(frag).__name__ == "HTML" and html.count("data:image/png;base64,") == 10
     assert "<html>" not in html
 
 
@@ -537,12 +537,12 @@ def test_cost_of_transport_of_a_box_dragged_at_constant_speed_is_mu():
     assert np.nanmedian(inst) == pytest.approx(mu, rel=0.01)
 
 
-@pytest.mark.parametrize("ext,magic", [("png", b"\x89PNG"), ("svg", b"<?xml"), ("pdf", b"%PDF")])
-def test_summary_plots_save_by_extension(sliding_run, tmp_path, ext, magic):
+def test_summary_plots_save_by_extension(sliding_run, tmp_path):
     model, traj = sliding_run
-    out = tmp_path / f"summary.{ext}"
-    fig = plot_summary(traj, model, out)
-    assert out.read_bytes()[:len(magic)] == magic
+    fig = plot_summary(traj, model)
+    for ext, magic in (("png", b"\x89PNG"), ("svg", b"<?xml"), ("pdf", b"%PDF")):
+        out = save_figure(fig, tmp_path / f"summary.{ext}")
+        assert out.read_bytes()[:len(magic)] == magic
     # the energy panel plots the trajectory's own energies
     energy_ax = next(a for a in fig.axes if a.get_title() == "mechanical energy")
     total = next(l for l in energy_ax.get_lines() if l.get_label() == "total")
