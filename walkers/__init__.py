@@ -10,6 +10,9 @@ WALKERS = {
     "ranger": "walkers.ranger",
     "simbicon": "walkers.simbicon",
     "simple-biped": "walkers.simple_biped",
+    "simplest-walker": "walkers.passive.simplest",
+    "compass-gait": "walkers.passive.compass_gait",
+    "rimless-wheel": "walkers.passive.rimless_wheel",
 }
 
 

@@ -1,0 +1,150 @@
+"""Passive walkers against physics: the simplest walking model against an independent scipy
+integration of Garcia et al.'s reduced equations (and their published fixed point), the
+rimless wheel against its closed-form gait, the compass gait's limit cycle.
+
+Tolerances are convergence statements: errors must shrink as dt and the foot mass ratio
+shrink, not merely sit under one bound."""
+import math
+
+import numpy as np
+import pytest
+
+from planarsim.analysis import find_fixed_point
+from walkers.passive import CompassParams, PassiveWalker, RimlessParams, SimplestParams
+from walkers.passive.gait import project_velocities
+from walkers.passive.reference import (GARCIA_THETA, GARCIA_THETA_DOT, simplest_fixed_point,
+                                       simplest_step)
+
+
+@pytest.fixture(scope="module")
+def garcia():
+    return simplest_fixed_point(0.009)
+
+
+def test_reference_reproduces_garcia_fixed_point(garcia):
+    # the independent reference (scipy, rtol 1e-12) lands on the published stable gait
+    x = garcia["x"]
+    assert abs(x[0] - GARCIA_THETA) < 1e-8 and abs(x[1] - GARCIA_THETA_DOT) < 1e-8
+    assert abs(x[2] - 2 * x[0]) < 1e-12                      # on the heel-strike surface
+    lam = garcia["multipliers"]
+    # stable: a complex pair inside the unit circle, the other two ~0 (phi, phi' are slaved)
+    assert abs(lam[0].real + 0.19) < 0.01 and abs(abs(lam[0].imag) - 0.56) < 0.02
+    assert np.all(np.abs(lam[2:]) < 1e-6) and np.all(np.abs(lam) < 1)
+    # one step maps the fixed point onto itself at the reported period
+    xn, period, _ = simplest_step(x, 0.009)
+    assert np.allclose(xn, x, atol=1e-10) and 3.8 < period < 3.95
+
+
+def engine_gait(beta, dt):
+    w = PassiveWalker(SimplestParams(foot_mass_ratio=beta), dt=dt)
+    fp = find_fixed_point(w.step_map(), simplest_fixed_point()["x"], tol=1e-9, eps=1e-4)
+    w.advance(fp.x)
+    return fp, w.last_period * math.sqrt(9.81 / 1.0), w
+
+
+def gait_errors(garcia, beta, dt):
+    """|theta* error|, |theta_dot* error|, |period error| (dimensionless) and the largest
+    distance of the complex multiplier pair from the reference's."""
+    fp, period, w = engine_gait(beta, dt)
+    assert fp.converged, (beta, dt, fp.residual)
+    assert fp.stable
+    assert w.last_release_ok           # the trailing foot left the ground at heel strike
+    dlam = np.max(np.abs(fp.multipliers[:2] - garcia["multipliers"][:2]))
+    return np.array([abs(fp.x[0] - garcia["x"][0]), abs(fp.x[1] - garcia["x"][1]),
+                     abs(period - garcia["period"]), dlam])
+
+
+def test_simplest_walker_fixed_point_converges_with_dt(garcia):
+    errs = np.array([gait_errors(garcia, 1e-5, dt) for dt in (1e-3, 5e-4, 2.5e-4)])
+    print("beta 1e-5, dt 1e-3 / 5e-4 / 2.5e-4: errors theta*, theta_dot*, period, multipliers\n", errs)
+    # first order in dt: each halving shrinks every error by at least 1.6x
+    assert np.all(errs[1] < errs[0] / 1.6) and np.all(errs[2] < errs[1] / 1.6)
+    # finest: theta*, theta_dot* within 1e-3 (dimensionless), period within 0.05%, multipliers 0.01
+    assert errs[2, 0] < 1e-3 and errs[2, 1] < 1e-3
+    assert errs[2, 2] < 5e-4 * garcia["period"] and errs[2, 3] < 1e-2
+
+
+def test_simplest_walker_fixed_point_converges_with_foot_mass_ratio(garcia):
+    errs = np.array([gait_errors(garcia, beta, 2.5e-4) for beta in (1e-2, 1e-3)])
+    print("dt 2.5e-4, beta 1e-2 / 1e-3: errors theta*, theta_dot*, period, multipliers\n", errs)
+    # theta*, period and multipliers move toward the beta -> 0 reference as beta shrinks
+    assert errs[1, 0] < errs[0, 0] / 2 and errs[1, 2] < errs[0, 2] / 2 and errs[1, 3] < errs[0, 3] / 4
+
+
+@pytest.mark.xfail(reason="engine: a heel strike whose new contact engages as sliding "
+                   "(planarsim ec36e0b) can exhaust the CCD splits and mode iterations without "
+                   "resolving the impact; the walker then tips back (see the issue-9 report)",
+                   strict=False)
+def test_simplest_walker_walks_on_the_engines_own_contacts(garcia):
+    # no step map here: the engine finds every heel strike (continuous collision) and the
+    # "all" strategy releases the trailing foot; 30 s of walking from the published gait
+    from walkers.passive.simplest import simulate
+    traj, summary, model = simulate(30.0, dt=2.5e-4, params=SimplestParams(foot_mass_ratio=1e-4))
+    assert not summary["fell"]
+    period = garcia["period"] / math.sqrt(9.81)
+    assert abs(summary["steps"] - 30.0 / period) <= 2
+    assert abs(summary["step_period"] / period - 1) < 0.01
+    assert summary["distance"] > 0
+
+
+def test_velocity_projection_is_minimal_and_consistent():
+    w = PassiveWalker(SimplestParams(foot_mass_ratio=1e-3))
+    q = w.sim.state.q.copy()
+    rng = np.random.default_rng(1)
+    v = rng.normal(size=q.shape)
+    v[:, 2] = 0.0
+    vp = project_velocities(w.model, q, v, [w.feet[0]])
+    assert np.allclose(vp[1, :2], 0.0, atol=1e-12)           # pinned foot at rest
+    for j, (a, b) in enumerate(w.model.arrays.rod_body):      # rods keep their length
+        e = q[b, :2] - q[a, :2]
+        assert abs(e @ (vp[b, :2] - vp[a, :2])) < 1e-12
+    assert np.allclose(project_velocities(w.model, q, vp, [w.feet[0]]), vp, atol=1e-12)
+
+
+# rimless wheel -------------------------------------------------------------------------------
+RIMLESS = [RimlessParams(), RimlessParams(n_spokes=12, slope=0.06, hub_gyration=0.3, spoke_length=0.8)]
+
+
+@pytest.mark.parametrize("p", RIMLESS, ids=["N8-k0.1", "N12-k0.3"])
+def test_rimless_wheel_matches_closed_form(p):
+    from walkers.passive.rimless_wheel import closed_form, simulate
+    cf = closed_form(p)
+    # step map: fixed point, its multiplier eta^2, the steady speed; first order in dt
+    errs = []
+    for dt in (5e-4, 2.5e-4):
+        w = PassiveWalker(p, dt=dt)
+        fp = find_fixed_point(w.step_map(), [-1.2 * cf["omega_after"]], tol=1e-10, eps=1e-4)
+        w.advance(fp.x)
+        assert fp.converged
+        errs.append([abs(fp.x[0] / -cf["omega_after"] - 1), abs(fp.multipliers[0] - cf["eta"] ** 2),
+                     abs(w.last_length / w.last_period / cf["speed"] - 1)])
+    errs = np.array(errs)
+    print("rimless map errors (omega*, multiplier, speed) at dt 5e-4, 2.5e-4:\n", errs)
+    assert np.all(errs[1] < errs[0] / 1.6)
+    assert errs[1, 0] < 3e-3 and errs[1, 1] < 5e-3 and errs[1, 2] < 5e-3
+    # the engine on its own (every spoke enabled, impacts found by the contact solver):
+    # steady speed within 1%, and closer at smaller dt
+    errs = []
+    for dt in (1e-3, 2.5e-4):
+        traj, summary, model = simulate(20.0, params=p, dt=dt)
+        assert not summary["fell"]
+        x = traj.q[:, 0, 0]
+        half = len(x) // 2
+        speed = (x[-1] - x[half]) / (traj.t[-1] - traj.t[half]) / math.cos(p.slope)
+        errs.append(abs(speed / cf["speed"] - 1))
+    print("rimless speed error (dt 1e-3, 2.5e-4):", errs)
+    assert errs[1] < 0.01 and errs[1] < errs[0]
+
+
+# compass gait --------------------------------------------------------------------------------
+def test_compass_gait_has_a_stable_period_one_gait():
+    from walkers.passive.compass_gait import default_start, simulate
+    p = CompassParams()
+    w = PassiveWalker(p, dt=5e-4)
+    fp = find_fixed_point(w.step_map(), default_start(p), tol=1e-9, eps=1e-3)
+    assert fp.converged and fp.stable
+    w.advance(fp.x)
+    assert w.last_release_ok and w.last_length > 0
+    # on the engine's own contacts the walker keeps walking from the fixed point
+    traj, summary, model = simulate(20.0, params=p, dt=5e-4, x0=fp.x)
+    assert not summary["fell"] and abs(summary["step_period"] / w.last_period - 1) < 0.02

@@ -1,0 +1,36 @@
+"""The compass gait (two rigid-body legs pinned at a point-mass hip) as a command-line walker.
+
+Defaults after Goswami, Thuilot and Espiau (1996): hip 10 kg, legs 5 kg with their COM half
+way, slope 3 degrees. The walker starts from `default_start`, a section state near the stable
+period-one gait (found with planarsim.analysis from a rough guess; see the example
+examples/passive_gait.py), and walks passively.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .gait import PassiveWalker, run_gait
+from .params import CompassParams
+from .simplest import slope_from_terrain
+
+NAME = "compass-gait"
+GAITS = ("passive",)
+
+
+def default_start(p: CompassParams | None = None) -> np.ndarray:
+    """A section state (theta, theta_dot [rad/s], phi, phi_dot [rad/s]) near the stable gait
+    of the default compass gait (its fixed point at dt = 2.5e-4 s, found by iterating the step
+    map from (0.22, -1.1, 0.44, -1.4) and then Newton); a rough guess for other parameters."""
+    return np.array([0.27081514, -1.09186744, 0.54163176, -0.71352648])
+
+
+def simulate(duration=10.0, gait="passive", terrain=None, dt=1e-3, seed=0, params=None,
+             x0=None, record_every=10):
+    """Walk down the slope. Returns (Trajectory, summary dict, Model)."""
+    if gait not in GAITS:
+        raise ValueError(f"{NAME}: unknown gait {gait!r}; gaits: {GAITS}")
+    p = params or CompassParams()
+    p = CompassParams(**{**p.as_dict(), "slope": slope_from_terrain(terrain, p.slope)})
+    walker = PassiveWalker(p, dt=dt)
+    traj, summary = run_gait(walker, default_start(p) if x0 is None else x0, duration, record_every)
+    return traj, summary, walker.model

@@ -1,0 +1,348 @@
+"""Passive walkers as simulations with a step-to-step map: set the state from section
+coordinates, run the compiled rollout to the next touchdown, read the coordinates back.
+
+Section coordinates (just after a touchdown, in stance / swing terms, so the left/right
+relabelling is built in and the map of one step is the symmetric reduction):
+- simplest walker and compass gait: x = (theta, theta_dot, phi, phi_dot) in Garcia et al.'s
+  convention: theta = stance-leg angle from the slope normal (counter-clockwise, > 0 leaning
+  back), phi = angle between the legs (swing-leg angle from the downward normal is
+  theta - phi). Rates are in units of sqrt(g / l) for the simplest walker (Garcia's
+  dimensionless time) and in rad/s for the compass gait.
+- rimless wheel: x = (theta_dot,) [rad/s] of the hub (negative rolling downhill); the stance
+  spoke sits at theta = alpha on the section.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import planarsim as ps
+from planarsim.analysis import StepMap, StepMapError
+from planarsim.state import State
+from planarsim.trajectory import Trajectory, make_recorder
+
+from .model import build_compass, build_rimless, build_simplest, leg_up, slope_frame
+from .params import CompassParams, RimlessParams, SimplestParams
+from .rollout import DETECT, ENGINE, FELL, NO_EVENT, TOGGLE, rollout_passive
+
+
+IMPACT_DT = 1e-6   # [s] the step that resolves an impact at the section (refine_touchdown);
+                   # gravity acts 1e-6 s longer, residuals / IMPACT_DT < 1e-6 m/s
+
+
+def _cross(a, b):
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def _dup(theta):
+    """d leg_up / d theta in slope coordinates (t, n): (-cos theta, -sin theta)."""
+    return np.array([-math.cos(theta), -math.sin(theta)])
+
+
+def _point_rows(q, b, local):
+    """World lever arm of a body-fixed point and the (2, 3) rows mapping the body velocity
+    (vx, vy, omega) to the point velocity."""
+    c, sn = math.cos(q[b, 2]), math.sin(q[b, 2])
+    rx, ry = c * local[0] - sn * local[1], sn * local[0] + c * local[1]
+    return np.array([[1.0, 0.0, -ry], [0.0, 1.0, rx]]), np.array([q[b, 0] + rx, q[b, 1] + ry])
+
+
+def project_velocities(model, q, v, pinned=()) -> np.ndarray:
+    """Velocities (n_body, 3) made consistent with the model's rods and pins and with the
+    contacts in `pinned` (their points at rest) at configuration q, by the mass-weighted
+    projection v - W J^T (J W J^T)^+ J v (the smallest kinetic-energy change).
+
+    The engine's position-level step leaves velocities tangent to the constraints of the
+    START of the step, O(dt) off those at its end; a section state, or a shorter step taken
+    from it, needs them consistent with its own configuration."""
+    a = model.arrays
+    nb = model.n_body
+    w = np.repeat(np.c_[a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia], 1, axis=0).ravel()
+    rows = []
+
+    def point(b, local):
+        Jb, p = _point_rows(q, b, local)
+        full = np.zeros((2, 3 * nb))
+        full[:, 3 * b:3 * b + 3] = Jb
+        return full, p
+
+    for j in range(model.n_rod):
+        (ba, bb), (la, lb) = a.rod_body[j], a.rod_anchor[j]
+        Ja, pa = point(ba, la) if ba >= 0 else (np.zeros((2, 3 * nb)), la)
+        Jb, pb = point(bb, lb) if bb >= 0 else (np.zeros((2, 3 * nb)), lb)
+        e = (pb - pa) / np.hypot(*(pb - pa))
+        rows.append(e @ (Jb - Ja))
+    for j in range(model.n_pin):
+        (ba, bb), (la, lb) = a.pin_body[j], a.pin_anchor[j]
+        Ja = point(ba, la)[0] if ba >= 0 else np.zeros((2, 3 * nb))
+        Jb = point(bb, lb)[0] if bb >= 0 else np.zeros((2, 3 * nb))
+        rows.extend(Jb - Ja)
+    for c in pinned:
+        rows.extend(point(a.contact_body[c], a.contact_local[c])[0])
+    if not rows:
+        return v.copy()
+    J = np.array(rows)
+    x = v.ravel()
+    A = (J * w) @ J.T
+    mu = np.linalg.lstsq(A, J @ x, rcond=1e-12)[0]
+    return (x - w * (J.T @ mu)).reshape(nb, 3)
+
+
+class PassiveWalker:
+    """One passive walker, its simulator and its compiled rollout.
+
+    Parameters
+    ----------
+    params : SimplestParams | CompassParams | RimlessParams
+    dt : step size [s]
+    strategy : contact-mode strategy, "all" (default; see DESIGN.md section 8) or "alternating"
+    """
+
+    def __init__(self, params, dt: float = 1e-3, strategy: str = "all", terrain=None):
+        self.params = params
+        self.dt = float(dt)
+        if isinstance(params, SimplestParams):
+            self.kind, self.model = "simplest", build_simplest(params, dt, terrain)
+            self.feet = np.array([self.model.contact("foot_a"), self.model.contact("foot_b")])
+            self.toggle, self.length = TOGGLE, params.leg_length
+            self.rate_scale = math.sqrt(params.gravity / params.leg_length)
+            self.names = ("theta", "theta_dot", "phi", "phi_dot")
+        elif isinstance(params, CompassParams):
+            self.kind, self.model = "compass", build_compass(params, dt, terrain)
+            self.feet = np.array([self.model.contact("foot_a"), self.model.contact("foot_b")])
+            self.toggle, self.length, self.rate_scale = TOGGLE, params.leg_length, 1.0
+            self.names = ("theta", "theta_dot", "phi", "phi_dot")
+        elif isinstance(params, RimlessParams):
+            self.kind, self.model = "rimless", build_rimless(params, dt, terrain)
+            self.feet = np.arange(params.n_spokes)
+            self.toggle, self.length, self.rate_scale = ENGINE, params.spoke_length, 1.0
+            self.names = ("theta_dot",)
+        else:
+            raise TypeError(f"params must be SimplestParams, CompassParams or RimlessParams, got "
+                            f"{type(params).__name__}")
+        self.gamma = params.slope
+        self.t_hat, self.n_hat = slope_frame(self.gamma)
+        self.sim = ps.Simulator(self.model, ps.make_options(strategy))
+        self.memory = np.zeros(2, np.int64)
+        self.hip = self.model.body("hub" if self.kind == "rimless" else "hip")
+        self.fall_height = 0.5 * self.length
+        self.min_ahead = 0.02 * self.length   # [m] see rollout.update_feet
+        self._no_rec = make_recorder(self.model, 0)
+        self.event_time = np.zeros(1)
+        self.event_contact = np.zeros(1, np.int64)
+        self.last_period = math.nan
+        self.last_length = math.nan
+
+    # points ------------------------------------------------------------------------------------
+    def foot_point(self, c, q=None, v=None):
+        """World position and velocity [m, m/s] of contact c's material point."""
+        q = self.sim.state.q if q is None else q
+        v = self.sim.state.v if v is None else v
+        a = self.model.arrays
+        b = a.contact_body[c]
+        th = q[b, 2]
+        lx, ly = a.contact_local[c]
+        r = np.array([math.cos(th) * lx - math.sin(th) * ly, math.sin(th) * lx + math.cos(th) * ly])
+        return q[b, :2] + r, v[b, :2] + v[b, 2] * np.array([-r[1], r[0]])
+
+    # section coordinates -------------------------------------------------------------------------
+    def stance_angle(self, q=None, v=None, stance=None):
+        """Angle theta [rad] of the leg (spoke) from `stance`'s foot to the hip, from the slope
+        normal, and its rate [rad/s]."""
+        q = self.sim.state.q if q is None else q
+        v = self.sim.state.v if v is None else v
+        stance = self.feet[self.memory[0]] if stance is None else int(stance)
+        ps_, vs = self.foot_point(stance, q, v)
+        r, rd = q[self.hip, :2] - ps_, v[self.hip, :2] - vs
+        return math.atan2(-(r @ self.t_hat), r @ self.n_hat), _cross(r, rd) / (r @ r)
+
+    def coords(self, q=None, v=None, stance=None) -> np.ndarray:
+        """Section coordinates of the state (default: the simulator's) with stance contact
+        `stance` (default: the current stance foot)."""
+        q = self.sim.state.q if q is None else q
+        v = self.sim.state.v if v is None else v
+        stance = self.feet[self.memory[0]] if stance is None else int(stance)
+        theta, theta_dot = self.stance_angle(q, v, stance)
+        hp, hv = q[self.hip, :2], v[self.hip, :2]
+        if self.kind == "rimless":
+            return np.array([v[self.hip, 2]])
+        swing = self.feet[1] if stance == self.feet[0] else self.feet[0]
+        pw, vw = self.foot_point(swing, q, v)
+        d, dd = pw - hp, vw - hv
+        psi = math.atan2(d @ self.t_hat, -(d @ self.n_hat))
+        psi_dot = _cross(d, dd) / (d @ d)
+        k = self.rate_scale
+        return np.array([theta, theta_dot / k, theta - psi, (theta_dot - psi_dot) / k])
+
+    def set_coords(self, x) -> None:
+        """Set the simulator's state just after a touchdown: stance foot (foot_a / spoke0)
+        pinned at the origin, the other feet free (swing contact disabled where toggled)."""
+        x = np.asarray(x, dtype=np.float64)
+        s = self.sim.state
+        s.restore(ps.make_state(self.model))
+        t, n = self.t_hat, self.n_hat
+        basis = np.stack([t, n], axis=1)   # slope (t, n) coordinates -> world
+        if self.kind == "rimless":
+            p = self.params
+            alpha = p.half_angle
+            up = leg_up(alpha, self.gamma)
+            s.q[0, :2] = p.spoke_length * up
+            s.q[0, 2] = math.atan2(-up[0], up[1])
+            s.v[0, :2] = p.spoke_length * x[0] * (basis @ _dup(alpha))
+            s.v[0, 2] = x[0]
+        else:
+            k = self.rate_scale
+            th, thd, ph, phd = x[0], x[1] * k, x[2], x[3] * k
+            psi, psid = th - ph, thd - phd
+            l = self.length
+            up_s, up_w = leg_up(th, self.gamma), leg_up(psi, self.gamma)
+            hip = l * up_s
+            vhip = l * thd * (basis @ _dup(th))
+            s.q[self.hip, :2], s.v[self.hip, :2] = hip, vhip
+            if self.kind == "simplest":
+                fb = self.model.body("foot_b")
+                s.q[fb, :2] = hip - l * up_w
+                s.v[fb, :2] = vhip - l * psid * (basis @ _dup(psi))
+            else:
+                a = self.params.com_from_foot
+                for name, up, ang, rate, sgn in (("leg_a", up_s, th, thd, 1.0), ("leg_b", up_w, psi, psid, -1.0)):
+                    b = self.model.body(name)
+                    if sgn > 0:
+                        s.q[b, :2] = a * up
+                        s.v[b, :2] = a * rate * (basis @ _dup(ang))
+                    else:
+                        s.q[b, :2] = hip - (l - a) * up
+                        s.v[b, :2] = vhip - (l - a) * rate * (basis @ _dup(ang))
+                    s.q[b, 2] = math.atan2(-up[0], up[1])
+                    s.v[b, 2] = rate
+        s.contact_mode[self.feet[0]] = 1
+        if self.toggle == TOGGLE:
+            s.contact_enabled[self.feet[1]] = 0
+        self.memory[:] = 0
+
+    # running -----------------------------------------------------------------------------------
+    def rollout(self, n_steps: int, stop_after: int, record_every: int = 0, max_events: int = 0):
+        """Compiled rollout from the current state; returns (code, steps, Trajectory | None)."""
+        rec = make_recorder(self.model, n_steps // record_every + 1) if record_every > 0 else self._no_rec
+        if max_events > self.event_time.size:
+            self.event_time = np.zeros(max_events)
+            self.event_contact = np.zeros(max_events, np.int64)
+        sim = self.sim
+        code, done, k = rollout_passive(self.model.arrays, sim.state, sim.ws, sim.options, sim._u0,
+                                        self.feet, self.memory, self.toggle, self.min_ahead, int(n_steps),
+                                        int(stop_after), self.hip, self.fall_height, rec,
+                                        int(record_every), 0, self.event_time, self.event_contact)
+        if code in (1, 2):
+            sim._raise(code)
+        traj = None
+        if record_every > 0:
+            traj = Trajectory.from_recorder(self.model, rec, k, info={"dt": self.dt, "walker": self.kind})
+        return code, done, traj
+
+    def refine_touchdown(self, old: int) -> float:
+        """Move the state from the end of a DETECT rollout to the touchdown instant itself and
+        resolve the impact there.
+
+        The rollout stopped after the step in which a foot (contact disabled) crossed the
+        ground. This restores the start of that step, finds by root finding the sub-step
+        tau in (0, dt] after which the foot is exactly on the ground, takes it, projects the
+        velocities onto the constraints there (project_velocities), then enables and pins the
+        foot and takes a step of IMPACT_DT, in which the engine resolves the
+        impact and (with the "all" strategy) releases the old stance foot `old`.
+        Returns tau [s]."""
+        from scipy.optimize import brentq
+
+        from planarsim.kernels.step import step as _step
+        from planarsim.kernels.terrain import gap_of_point
+        sim, s, ws = self.sim, self.sim.state, self.sim.ws
+        m = self.model.arrays
+        new = int(self.memory[0])
+        c = int(self.feet[new])
+        prev = State(*(a.copy() for a in ws.prev))
+        # velocities consistent with the start configuration, so that a sub-step shorter
+        # than dt does not read the O(dt) mismatch as the stance foot leaving the ground
+        prev.v[...] = project_velocities(self.model, prev.q, prev.v, [int(self.feet[old])])
+
+        def sub_step(tau):
+            s.restore(prev)
+            if tau > 0.0:
+                code = _step(m._replace(dt=tau), s, ws, sim.options, sim._u0)
+                if code:
+                    sim._raise(code)
+            p = self.foot_point(c)[0]
+            return gap_of_point(m.terrain_coef, p[0], p[1])
+
+        h = m.dt
+        tau = 0.0
+        if sub_step(0.0) > 0.0:
+            tau = brentq(sub_step, 0.0, h, xtol=1e-16, rtol=1e-15, maxiter=200)
+        sub_step(tau)
+        s.v[...] = project_velocities(self.model, s.q, s.v, [int(self.feet[old])])
+        s.contact_enabled[c] = 1
+        s.contact_mode[c] = 1
+        code = _step(m._replace(dt=IMPACT_DT), s, ws, sim.options, sim._u0)
+        if code:
+            sim._raise(code)
+        s.time[0] = prev.time[0] + tau
+        return tau
+
+    def advance(self, x, record_every: int = 0) -> np.ndarray:
+        """The step-to-step map: coordinates just after the next touchdown (StepMapError if
+        the walker falls or takes no step within 20 s). With record_every > 0 the step (up to
+        the end of the sim step containing the touchdown) is kept in self.last_traj."""
+        self.set_coords(x)
+        old = int(self.memory[0])
+        start = self.foot_point(self.feet[old])[0]
+        toggle = self.toggle
+        self.toggle = DETECT
+        try:
+            self.sim.state.contact_enabled[self.feet[1:]] = 0
+            code, done, self.last_traj = self.rollout(int(20.0 / self.dt), 1, record_every)
+        finally:
+            self.toggle = toggle
+        if code == FELL:
+            raise StepMapError(f"{self.kind}: the walker fell from x={x}")
+        if code == NO_EVENT:
+            raise StepMapError(f"{self.kind}: no touchdown within 20 s from x={x}")
+        self.refine_touchdown(old)
+        self.last_release_ok = bool(self.sim.state.contact_mode[self.feet[old]] == 0)
+        self.sim.state.contact_enabled[self.feet[old]] = 0
+        self.last_period = float(self.sim.state.time[0])
+        end = self.foot_point(self.feet[self.memory[0]])[0]
+        self.last_length = float((end - start) @ self.t_hat)
+        return self.coords()
+
+    def step_map(self) -> StepMap:
+        return StepMap(self.advance, dim=len(self.names), names=self.names)
+
+
+def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10):
+    """Walk from section state x0 for `duration` [s] with the compiled rollout, recording every
+    `record_every` steps. Returns (Trajectory, summary dict).
+
+    summary: steps (touchdowns), distance [m] (hip displacement along the slope), mean_speed
+    [m/s], fell (bool), step_period [s] and step_length [m] (means over the last half of the
+    steps), cost_of_transport (gravity work / (weight x distance); tan(gamma)-like for a
+    passive walker on a plane)."""
+    n = int(round(duration / walker.dt))
+    walker.set_coords(x0)
+    hip0 = walker.sim.state.q[walker.hip, :2].copy()
+    max_events = int(duration / 0.05) + 10
+    code, done, traj = walker.rollout(n, 1 << 60, record_every, max_events)
+    n_steps = int(walker.memory[1])
+    hip1 = walker.sim.state.q[walker.hip, :2]
+    distance = float((hip1 - hip0) @ walker.t_hat)
+    t_end = float(walker.sim.state.time[0])
+    ev_t = walker.event_time[:min(n_steps, walker.event_time.size)]
+    late = ev_t[len(ev_t) // 2:]
+    period = float(np.mean(np.diff(late))) if len(late) > 1 else math.nan
+    mass = walker.model.total_mass
+    g = float(np.hypot(*walker.model.arrays.gravity))
+    drop = -float((hip1 - hip0) @ np.array([0.0, 1.0]))
+    summary = dict(walker=walker.kind, steps=n_steps, distance=distance,
+                   mean_speed=distance / t_end if t_end > 0 else 0.0, fell=code == FELL,
+                   step_period=period, step_length=distance / n_steps if n_steps else math.nan,
+                   cost_of_transport=(mass * g * drop) / (mass * g * distance) if distance > 0 else math.nan,
+                   duration=t_end, code=int(code))
+    return traj, summary
