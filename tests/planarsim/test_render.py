@@ -799,3 +799,17 @@ def test_blitted_frames_equal_full_redraws():
     assert a.shape == b.shape
     assert np.count_nonzero(np.any(a != b, axis=2)) == 0
     assert np.count_nonzero(np.any(a[:, :, :3] < 200, axis=2)) > 1000    # and it is not blank
+
+
+def test_viewer_pauses_with_a_message_when_the_simulation_diverges():
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_point_mass("ball", 1.0, pos=(0.0, 0.0))            # no contacts: falls forever
+    sim = ps.Simulator(b.compile(), ps.make_options(guard_limit=5.0))
+    viewer = Viewer(sim, None, clock=FakeClock())
+    key(viewer, " ")
+    viewer.advance(2.0)
+    assert not viewer.playing
+    assert viewer.message.startswith("stopped: simulation diverged")
+    viewer.draw()
+    assert "stopped: simulation diverged" in viewer.scene.text.get_text()
+    assert sim.t < 1.1                                        # |y| passed 5 m after ~1 s
