@@ -1,0 +1,50 @@
+"""Issue 7: every example runs (short durations) and checks its own result."""
+import importlib
+import sys
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def load(name):
+    """Import examples/<name>.py as a module (importable by worker processes too)."""
+    if str(EXAMPLES) not in sys.path:
+        sys.path.insert(0, str(EXAMPLES))
+    return importlib.import_module(name)
+
+
+def test_hopper_hops_forward_without_falling():
+    hopper = load("hopper")
+    traj, summary, model = hopper.run(duration=8.0, speed=0.8)
+    assert summary["hops"] >= 5
+    assert summary["min_hip_height"] > 0.5
+    assert abs(summary["mean_speed"] - 0.8) < 0.25 * 0.8
+
+
+def test_export_animation_and_plots(tmp_path):
+    ex = load("export_animation_and_plots")
+    out, plot = tmp_path / "walk.gif", tmp_path / "walk.png"
+    traj, summary = ex.main(duration=2.0, out=str(out), plot=str(plot), fps=20)
+    with Image.open(out) as gif:
+        assert gif.n_frames == 40
+    assert plot.stat().st_size > 10_000
+    assert (tmp_path / "walk.npz").exists()
+    assert not summary["fell"]
+
+
+def test_parameter_grid_speeds_follow_their_targets():
+    ex = load("parameter_grid")
+    rows = ex.grid(speeds=(0.5, 1.0), amplitudes=(0.0,), duration=10.0, workers=2)
+    achieved = [r[2] for r in rows]
+    assert not any(r[3] for r in rows)
+    assert achieved[1] > achieved[0] + 0.2
+
+
+def test_custom_terrain_walk():
+    ex = load("custom_terrain")
+    summary, climb = ex.main(duration=12.0)
+    assert not summary["fell"]
+    assert summary["distance"] > 6.0
