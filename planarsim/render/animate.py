@@ -23,6 +23,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from matplotlib import animation
 
 from .camera import Camera
 from .draw import Scene, make_figure
@@ -126,7 +127,6 @@ def ffmpeg_exe() -> str:
 
 
 def _writer(fmt, fps, bitrate=None, embed_limit_mb=200.0):
-    from matplotlib import animation
     if fmt == "gif":
         return _GifWriter(fps=fps)
     if fmt == "mp4":
@@ -146,21 +146,12 @@ def _gif_durations(n: int, fps: float) -> list:
     return [int(d) for d in np.maximum(np.diff(cs), 1) * 10]
 
 
-def _make_gif_writer_class():
-    from matplotlib import animation
+class _GifWriter(animation.PillowWriter):
+    """matplotlib's PillowWriter with per-frame delays that keep the GIF on time."""
 
-    class GifWriter(animation.PillowWriter):
-        """matplotlib's PillowWriter with per-frame delays that keep the GIF on time."""
-
-        def finish(self):
-            self._frames[0].save(self.outfile, save_all=True, append_images=self._frames[1:],
-                                 duration=_gif_durations(len(self._frames), self.fps), loop=0)
-
-    return GifWriter
-
-
-def _GifWriter(fps):
-    return _make_gif_writer_class()(fps=fps)
+    def finish(self):
+        self._frames[0].save(self.outfile, save_all=True, append_images=self._frames[1:],
+                             duration=_gif_durations(len(self._frames), self.fps), loop=0)
 
 
 # the exporter --------------------------------------------------------------------------------
@@ -226,8 +217,6 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
         os.replace(tmp, path)
     except BaseException:
         _remove(tmp)
-        if fmt == "html":
-            _remove_frames_dir(tmp)
         raise
     return path
 
@@ -244,11 +233,6 @@ def _remove(p):
         os.unlink(p)
     except OSError:
         pass
-
-
-def _remove_frames_dir(tmp):
-    import shutil
-    shutil.rmtree(Path(tmp).with_suffix("").as_posix() + "_frames", ignore_errors=True)
 
 
 # matplotlib's player draws its buttons with Font Awesome icons from a CDN; the page must work
