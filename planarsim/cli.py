@@ -133,7 +133,9 @@ def cmd_run(args):
         written.append(str(plot))
     if out:
         from .render import export_animation
-        export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=not args.json)
+        from .render.gallery import gait_names
+        export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=not args.json,
+                         label_names=gait_names(mod))
         written.append(str(out))
     if summary_path is not None:
         from .trajectory import atomic_write
