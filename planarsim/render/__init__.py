@@ -1,10 +1,15 @@
 """Pictures of planarsim runs: drawing, tracking camera, animation export, plots, viewer.
 
->>> from planarsim.render import export_animation, plot_summary   # doctest: +SKIP
->>> export_animation(traj, model, "walk.mp4", fps=30, speed=0.5)   # slow motion
->>> plot_summary(traj, model, "walk.png")
+>>> from planarsim.render import export_animation, plot_summary, show_inline, view   # doctest: +SKIP
+>>> export_animation(traj, model, "walk.mp4", fps=30, speed=0.5)   # slow motion; .gif, .html too
+>>> plot_summary(traj, model, "walk.png")                          # .png, .svg or .pdf
+>>> show_inline(traj, model)                                       # in a Jupyter notebook
+>>> view(sim, controller, gains={"kp": (0, 100, get_kp, set_kp)}, on_gait=set_gait)   # live
 
-Nothing here uses numba; matplotlib is imported lazily where a GUI could be involved.
+Modules: draw (Scene: a model drawn from its own shapes), camera (damped second-order
+tracking), animate (GIF/MP4/HTML export), plots, viewer (interactive, PI frame timer),
+gallery (README GIFs: ``python -m planarsim.render.gallery OUTDIR``). No numba here; pyplot is
+imported only by the on-screen viewer.
 """
 from .camera import Camera, step_overshoot
 from .draw import Scene, Style, make_figure, render_state, shape_outline

@@ -117,6 +117,8 @@ class Viewer:
                  clock=time.perf_counter, blit=None, **scene_kw):
         if control_every < 1:
             raise ValueError(f"control_every={control_every} must be >= 1 step")
+        if not (math.isfinite(fps) and fps > 0):
+            raise ValueError(f"fps={fps} must be finite and > 0 frames per second")
         self.sim, self.controller, self.labels = sim, controller, labels
         self.control_every = int(control_every)
         self.speed = _check_speed(speed)
