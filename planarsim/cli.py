@@ -117,9 +117,10 @@ def cmd_run(args):
     wall = time.perf_counter() - t0
     import inspect
     default_gait = inspect.signature(mod.simulate).parameters["gait"].default
-    summary = {"walker": args.walker, "gait": args.gait or default_gait,
-               "terrain": args.terrain or "default", "duration_s": args.duration,
-               **{k: _plain(v) for k, v in summary.items()}, "wall_time_s": round(wall, 3)}
+    own = {"walker": args.walker, "gait": args.gait or default_gait,
+           "terrain": args.terrain or "default", "duration_s": args.duration}
+    summary = {**own, **{k: _plain(v) for k, v in summary.items() if k not in own},
+               "wall_time_s": round(wall, 3)}
     written = []
     if save:
         traj.save(save)
@@ -151,10 +152,13 @@ def cmd_run(args):
 
 
 def _plain(v):
+    """JSON-friendly value: numpy scalars and arrays to Python, NaN and inf to None."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
     try:
         import numpy as np
         if isinstance(v, np.generic):
-            return v.item()
+            return _plain(v.item())
         if isinstance(v, np.ndarray):
             return v.tolist()
     except ImportError:
