@@ -41,13 +41,17 @@ def foot_inertia_com(p: RangerParams) -> float:
     return i_com + p.rotor_on_foot * p.ankle_gear ** 2 * p.rotor_inertia
 
 
-def standing_pose(p: RangerParams, terrain=None):
-    """STAND pose: the end of a double stance. Front (inner) leg at stand_front_angle with its
-    foot level, rear (outer) leg at stand_rear_angle with its foot turned toe down on its sole
-    until it touches the ground. Returns (hip_xy, leg angles (outer, inner), foot angles)."""
+def standing_pose(p: RangerParams, terrain=None, pose: str = "stand"):
+    """A pose at rest with both feet on the ground: front (inner) leg at <pose>_front_angle with
+    its foot level, rear (outer) leg at <pose>_rear_angle with its foot turned toe down on its
+    sole until it touches. pose 'stand': the STAND pose (hip centred between the feet);
+    'walk': the WALK start pose (the end of a double stance, hip just ahead of the front foot).
+    Returns (hip_xy, leg angles (outer, inner), foot angles (outer, inner))."""
     terrain = terrain if terrain is not None else flat()
+    if pose not in ("stand", "walk"):
+        raise ValueError(f"Ranger pose {pose!r} unknown; use 'stand' or 'walk'")
     L, r, d = p.leg_length, p.sole_radius, p.sole_center_height
-    th_front, th_rear = p.stand_front_angle, p.stand_rear_angle
+    th_front, th_rear = getattr(p, f"{pose}_front_angle"), getattr(p, f"{pose}_rear_angle")
     hip_x = -L * math.sin(th_front)                # front ankle at x = 0
     hip_y = float(terrain.height(0.0)) + (r - d) + L * math.cos(th_front)
     x_rear = hip_x + L * math.sin(th_rear)
@@ -55,7 +59,7 @@ def standing_pose(p: RangerParams, terrain=None):
     # lowest sole point of a foot turned by phi (toe down < 0): r - d cos(phi) below the ankle
     c = (r - h_rear) / d
     if not -1.0 < c <= 1.0 or h_rear < r - d - 1e-12:
-        raise ValueError(f"RangerParams: stand_rear_angle={th_rear} and stand_front_angle={th_front} "
+        raise ValueError(f"RangerParams: {pose}_rear_angle={th_rear} and {pose}_front_angle={th_front} "
                          f"put the rear ankle {h_rear:.3f} m above the ground; the foot reaches "
                          f"{r - d:.3f}..{r:.3f} m")
     phi_rear = -math.acos(min(c, 1.0))
@@ -64,15 +68,18 @@ def standing_pose(p: RangerParams, terrain=None):
     return np.array([hip_x, hip_y]), (th_rear, th_front), (phi_rear, 0.0)
 
 
-def build(p: RangerParams | None = None, terrain=None, dt: float = 1e-3, suspended: bool = False) -> ps.Model:
-    """Compile the Ranger model in its standing pose.
+def build(p: RangerParams | None = None, terrain=None, dt: float = 1e-3, suspended: bool = False,
+          pose: str = "stand") -> ps.Model:
+    """Compile the Ranger model in a standing pose ('stand' or 'walk', see standing_pose).
 
-    suspended : pin the hip to the world (the robot on a test stand; used by the GUI test).
+    suspended : lift the robot 0.3 m and pin its hip to the world (a test stand; GUI test).
     """
     p = p if p is not None else RangerParams()
     terrain = terrain if terrain is not None else flat()
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, -9.81), terrain=terrain)
-    hip, angles, foot_angles = standing_pose(p, terrain)
+    hip, angles, foot_angles = standing_pose(p, terrain, pose)
+    if suspended:
+        hip = hip + np.array([0.0, 0.3])       # on the test stand the feet hang 0.3 m up
     L, c = p.leg_length, p.leg_com
     ankles = []
     for s, th in enumerate(angles):

@@ -62,6 +62,8 @@ def rollout_ranger(m, s, ws, opt, k, prog, motor, mem, gui, steplog, u, n, every
 class RangerSim:
     """A Simulator plus the compiled controller; ``run(duration)`` extends the recording.
 
+    The model starts at rest in the WALK start pose for gait 'walk', in the STAND pose otherwise.
+
     >>> rs = RangerSim(gait="stand")          # doctest: +SKIP
     >>> traj = rs.run(5.0); rs.controller.set_gait("walk"); traj2 = rs.run(10.0)
     """
@@ -70,7 +72,8 @@ class RangerSim:
                  gait: str = "walk", strategy: str = "alternating", suspended: bool = False,
                  max_steps: int = 20000):
         self.params = params if params is not None else RangerParams()
-        self.model = build(self.params, terrain, dt=dt, suspended=suspended)
+        pose = "walk" if gait == "walk" else "stand"
+        self.model = build(self.params, terrain, dt=dt, suspended=suspended, pose=pose)
         self.sim = ps.Simulator(self.model, ps.make_options(strategy))
         self.controller = Controller(self.params, dt, max_steps=max_steps)
         self.controller.reset(gait)
@@ -149,7 +152,8 @@ def instantaneous_cot(traj: Trajectory, model, overhead_power: float = 4.5, min_
 
 def simulate(duration: float, gait: str = "walk", terrain=None, dt: float = 1e-3, seed: int = 0,
              params: RangerParams | None = None, strategy: str = "alternating", record_every: int = 10):
-    """Run Ranger from its standing pose. Returns (Trajectory, summary dict, model).
+    """Run Ranger from rest (WALK start pose for 'walk', STAND pose otherwise).
+    Returns (Trajectory, summary dict, model).
 
     gait : 'walk' | 'stand' | 'gui'. The run is deterministic; `seed` is accepted for the
     uniform walker interface (no randomness is used).

@@ -1,0 +1,241 @@
+"""Cornell Ranger walker (issue 5): closed-loop double stance, STAND, WALK from standing for
+1000 steps, GUI tracking against a static-equilibrium calculation, the contact estimator on a
+recorded walk, and the motor model of seed eqs. 13-16.
+
+Figures for the report: ``python benchmarks/ranger.py``.
+"""
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from planarsim.actuators import (MOTOR_GEAR, MOTOR_TORQUE_CONST, make_motor, motor_power,
+                                 motor_torque, saturate_current)
+from walkers import WALKERS
+from walkers import ranger
+from walkers.ranger import RangerParams, RangerSim
+from walkers.ranger import controller as C
+from walkers.ranger.estimator import butterworth2, filter_signal
+from walkers.ranger.model import foot_inertia_com
+
+
+def pin_residuals(model, q):
+    """(K, n_pin) distance between the two anchors of every pin [m] over frames q (K, nb, 3)."""
+    a = model.arrays
+    out = np.zeros((len(q), model.n_pin))
+    for j in range(model.n_pin):
+        pts = []
+        for e in range(2):
+            b = a.pin_body[j, e]
+            lx, ly = a.pin_anchor[j, e]
+            if b < 0:
+                pts.append(np.broadcast_to([lx, ly], (len(q), 2)))
+                continue
+            th = q[:, b, 2]
+            pts.append(np.stack([q[:, b, 0] + np.cos(th) * lx - np.sin(th) * ly,
+                                 q[:, b, 1] + np.sin(th) * lx + np.cos(th) * ly], axis=1))
+        out[:, j] = np.hypot(*(pts[1] - pts[0]).T)
+    return out
+
+
+def hip_height(rs_or_q, p=RangerParams()):
+    q = rs_or_q
+    return q[..., 0, 1] + p.leg_com * np.cos(q[..., 0, 2])
+
+
+def test_registry_and_interface():
+    assert WALKERS["ranger"] == "walkers.ranger"
+    assert ranger.NAME == "ranger" and set(ranger.GAITS) == {"walk", "stand", "gui"}
+    traj, summary, model = ranger.simulate(0.2, gait="stand")
+    assert len(traj.t) > 0 and model.n_body == 4 and model.n_contact == 2
+    assert {"distance", "mean_speed", "steps", "fell", "cost_of_transport"} <= set(summary)
+    with pytest.raises(ValueError, match="gait 'run'"):
+        ranger.simulate(0.1, gait="run")
+    with pytest.raises(ValueError, match="friction"):
+        RangerParams(friction=-1.0)
+
+
+@pytest.mark.parametrize("strategy", ["alternating", "all"])
+def test_double_stance_closed_loop(strategy):
+    """Both soles pinned + hip + two ankles: 10 rows on a loop; the solve drops the redundant
+    row. Pin residuals stay below 1e-9 m and the impulses stay at the size of the weight."""
+    rs = RangerSim(gait="stand", strategy=strategy)
+    traj = rs.run(3.0, record_every=1)
+    assert np.all(traj.contact_mode == 1), "both feet must stay pinned in STAND"
+    res = pin_residuals(rs.model, traj.q)
+    assert res.max() < 1e-9, res.max()
+    weight_impulse = 9.81 * rs.model.arrays.body_mass.sum() * rs.model.dt
+    normal = traj.contact_impulse[:, :, 0]
+    assert np.all(normal >= 0.0)
+    assert np.all(np.abs(normal.sum(axis=1) - weight_impulse) < 0.05 * weight_impulse)
+
+
+def test_stand_holds_30s():
+    rs = RangerSim(gait="stand")
+    h0 = hip_height(rs.sim.state.q)
+    traj = rs.run(30.0, record_every=100)
+    assert not rs.fell and traj.t[-1] >= 30.0 - 1e-9
+    assert np.abs(hip_height(traj.q) - h0).max() < 0.005
+    settled = traj.t > 1.0
+    assert np.abs(traj.v[settled]).max() < 1e-3
+    assert np.all(traj.contact_mode[settled] == 1)
+
+
+@pytest.fixture(scope="module")
+def walk_1000():
+    """WALK from rest in the WALK start pose (both feet down, zero velocity) until 1000 steps
+    (or a fall)."""
+    rs = RangerSim(gait="walk")
+    assert np.all(rs.sim.state.v == 0.0)
+    x0 = rs.hip()[0]
+    while rs.steps < 1000 and not rs.fell and rs.sim.t < 1000.0:
+        rs.run(50.0, record_every=1000)
+    return rs, x0
+
+
+def test_walk_1000_steps_from_rest(walk_1000):
+    rs, x0 = walk_1000
+    s = rs.summary()
+    assert not rs.fell, s
+    assert rs.steps >= 1000
+    assert rs.hip()[0] - x0 > 0.2 * 1000          # really walked forward, > 0.2 m per step
+    assert 0.2 < s["step_length"] < 0.6
+    assert 0.3 < s["step_speed"] < 1.0
+    # the push-off feedback keeps the mid-stance speed near its target over the last steps
+    log = rs.controller.steplog[rs.steps - 200:rs.steps]
+    speed = np.diff(log[:, 1]) / np.diff(log[:, 0])
+    assert np.std(speed) < 0.1 * np.mean(speed)
+    # costs of transport: finite, positive, electrical above mechanical, total above both
+    assert 0 < s["cost_of_transport_mechanical"] < s["cost_of_transport_electrical"] < s["cost_of_transport"]
+
+
+def test_gui_tracks_targets_against_static_equilibrium():
+    """Robot on a test stand (hip pinned to the world), GUI targets and gains set through the
+    Python API. The settled joint angles must match the static equilibrium of PD current
+    torque + parallel springs + gravity, solved here independently by Newton's method."""
+    p = RangerParams()
+    rs = RangerSim(p, gait="gui", suspended=True)
+    c = rs.controller
+    targets = (0.5, 0.3, -0.4)
+    gains = ((15.0, 3.0), (4.0, 0.3), (6.0, 0.3))
+    for j in range(3):
+        c.set_gui(j, targets[j], *gains[j])
+    rs.run(30.0, record_every=1000)
+    q = rs.sim.state.q
+    # the whole assembly swinging on the frictionless stand pin is undamped; what is left of it
+    # is tiny and the joints themselves (damped by the PD) have settled
+    assert np.abs(rs.sim.state.v).max() < 2e-3, "did not settle"
+    g = 9.81
+    gk = (p.hip_gear * p.torque_const, p.ankle_gear * p.torque_const)
+    rest_a = p.ankle_spring_rest - p.ankle_offset
+
+    def torques(x):
+        th_out, th_in, qa_out, qa_in = x
+        hip = th_in - th_out
+        tau_hip = gk[0] * gains[0][0] * (targets[0] - hip) - p.hip_spring * (hip - p.hip_spring_rest)
+        res = []
+        foot_x = []
+        for s, (th, qa) in enumerate(((th_out, qa_out), (th_in, qa_in))):
+            thf = th + qa
+            rx = math.cos(thf) * p.foot_com_x - math.sin(thf) * p.foot_com_y
+            foot_x.append(rx)
+            tau_a = gk[1] * gains[1 + s][0] * (targets[1 + s] - qa) - p.ankle_spring * (qa - rest_a)
+            res.append(tau_a - p.foot_mass * g * rx)                       # foot about its ankle
+        for s, th in enumerate((th_out, th_in)):
+            sign = 1.0 if s == 1 else -1.0
+            grav = -g * (p.leg_mass * p.leg_com * math.sin(th)
+                         + p.foot_mass * (p.leg_length * math.sin(th) + foot_x[s]))
+            res.append(sign * tau_hip + grav)                             # leg + foot about the hip
+        return np.array(res)
+
+    x = np.array([q[0, 2], q[1, 2], q[2, 2] - q[0, 2], q[3, 2] - q[1, 2]]) + 0.05
+    for _ in range(30):
+        f = torques(x)
+        J = np.array([(torques(x + 1e-7 * e) - f) / 1e-7 for e in np.eye(4)]).T
+        x = x - np.linalg.solve(J, f)
+    sim_x = np.array([q[0, 2], q[1, 2], q[2, 2] - q[0, 2], q[3, 2] - q[1, 2]])
+    assert np.abs(torques(x)).max() < 1e-10
+    assert np.abs(sim_x - x).max() < 2e-3, (sim_x, x)
+    # the ankles, whose gains dominate their small loads, sit close to their targets
+    assert abs(sim_x[2] - targets[1]) < 0.02 and abs(sim_x[3] - targets[2]) < 0.02
+
+
+def touchdowns(mode, dt_frame, quiet=0.05):
+    """Frame indices where a foot engages after at least `quiet` seconds free (real touchdowns)."""
+    down = mode > 0
+    out, free_for = ([0] if down[0] else []), 0.0
+    for i in range(1, len(down)):
+        if down[i] and not down[i - 1] and free_for >= quiet:
+            out.append(i)
+        free_for = 0.0 if down[i] else free_for + dt_frame
+    return np.array(out, dtype=int)
+
+
+def test_estimator_switches_once_per_touchdown():
+    """On a recorded walk the filtered estimator turns a foot 'on' at most once between two
+    real touchdowns, and every 'on' follows a real touchdown within 60 ms."""
+    rs = RangerSim(gait="walk")
+    traj = rs.run(30.0, record_every=1)
+    assert not rs.fell and rs.steps > 30
+    dtf = traj.t[1] - traj.t[0]
+    raw_bounces = 0
+    for s, name in enumerate(("contact_outer", "contact_inner")):
+        td = touchdowns(traj.contact_mode[:, s], dtf)
+        est = traj.labels[name]
+        on = np.nonzero((est[1:] > 0.5) & (est[:-1] < 0.5))[0] + 1
+        engaged = np.nonzero((traj.contact_mode[1:, s] > 0) & (traj.contact_mode[:-1, s] == 0))[0]
+        raw_bounces += len(engaged) - len(td)
+        assert len(td) > 10
+        bounds = np.r_[td, len(est)]
+        for k in range(len(td)):
+            n_on = np.count_nonzero((on >= bounds[k]) & (on < bounds[k + 1]))
+            assert n_on <= 1, f"foot {s}: {n_on} estimator touchdowns after real touchdown {k}"
+        for i in on:
+            prior = td[td <= i]
+            assert len(prior) and (i - prior[-1]) * dtf < 0.06, f"foot {s}: 'on' at {traj.t[i]} s"
+    assert raw_bounces >= 0
+
+
+def test_butterworth_gain():
+    dt, fc = 1e-3, 15.0
+    b = butterworth2(fc, dt)
+    z = np.exp(1j * 2 * np.pi * np.array([0.0, fc]) * dt)
+    h = (b[0] + b[1] / z + b[2] / z ** 2) / (1 + b[3] / z + b[4] / z ** 2)
+    assert abs(abs(h[0]) - 1.0) < 1e-12
+    assert abs(abs(h[1]) - 1 / math.sqrt(2)) < 1e-9
+    # a 5 ms bounce of full load barely moves the filtered signal
+    x = np.zeros(200)
+    x[50:55] = 1.0
+    assert filter_signal(x, fc, dt).max() < 0.25
+
+
+MOTOR = make_motor(gear=34, torque_const=0.018, resistance=1.3, contact_voltage=0.7, current_max=6.0,
+                   viscous=0.002, coulomb=0.01, load_friction=0.1, rotor_inertia=1.6e-6)
+
+
+@settings(max_examples=200, deadline=None)
+@given(i=st.floats(-10, 10), w=st.floats(-30, 30))
+def test_motor_model_properties(i, w):
+    gk = MOTOR[MOTOR_GEAR] * MOTOR[MOTOR_TORQUE_CONST]
+    isat = saturate_current(i, MOTOR)
+    assert abs(isat) <= 6.0 and (abs(i) > 6.0 or isat == i)
+    tau = motor_torque(isat, w, MOTOR)
+    # friction opposes the joint rate and never exceeds its bound
+    friction = tau - gk * isat
+    assert friction * w <= 1e-15
+    assert abs(friction) <= 0.002 * abs(w) + 0.01 + 0.1 * gk * abs(isat) + 1e-12
+    # electrical power = shaft power G K w I + losses I^2 R + Vc|I| (losses >= 0)
+    losses = motor_power(isat, w, MOTOR) - gk * w * isat
+    assert losses >= -1e-12
+    assert abs(losses - (isat ** 2 * 1.3 + 0.7 * isat ** 2 / math.sqrt(isat ** 2 + 1e-4))) < 1e-9
+    with pytest.raises(ValueError, match="gear"):
+        make_motor(gear=0.0, torque_const=0.018, resistance=1.3, contact_voltage=0.7, current_max=6)
+
+
+def test_rotor_inertia_on_foot():
+    p = RangerParams()
+    i_with = foot_inertia_com(p)
+    i_without = foot_inertia_com(RangerParams(rotor_on_foot=0.0))
+    assert abs(i_with - i_without - 34 ** 2 * 1.6e-6) < 1e-12
+    assert C.N_PROG == len(C.Program)
