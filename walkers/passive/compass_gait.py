@@ -25,12 +25,13 @@ def default_start(p: CompassParams | None = None) -> np.ndarray:
 
 
 def simulate(duration=10.0, gait="passive", terrain=None, dt=1e-3, seed=0, params=None,
-             x0=None, record_every=10):
-    """Walk down the slope. Returns (Trajectory, summary dict, Model)."""
+             x0=None, record_every=10, impacts="refined"):
+    """Walk down the slope. Returns (Trajectory, summary dict, Model); impacts: see
+    walkers.passive.gait.run_gait ("refined" or "engine")."""
     if gait not in GAITS:
         raise ValueError(f"{NAME}: unknown gait {gait!r}; gaits: {GAITS}")
     p = params or CompassParams()
     p = CompassParams(**{**p.as_dict(), "slope": slope_from_terrain(terrain, p.slope)})
     walker = PassiveWalker(p, dt=dt)
-    traj, summary = run_gait(walker, default_start(p) if x0 is None else x0, duration, record_every)
+    traj, summary = run_gait(walker, default_start(p) if x0 is None else x0, duration, record_every, impacts)
     return traj, summary, walker.model

@@ -317,32 +317,68 @@ class PassiveWalker:
         return StepMap(self.advance, dim=len(self.names), names=self.names)
 
 
-def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10):
+def _concat(trajs):
+    trajs = [t for t in trajs if t is not None and len(t)]
+    first = trajs[0]
+    arrays = {k: np.concatenate([getattr(t, k) for t in trajs]) for k in Trajectory._ARRAYS}
+    return Trajectory(**arrays, body_names=first.body_names, contact_names=first.contact_names,
+                      act_names=first.act_names, info=dict(first.info))
+
+
+def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10,
+             impacts: str = "refined"):
     """Walk from section state x0 for `duration` [s] with the compiled rollout, recording every
     `record_every` steps. Returns (Trajectory, summary dict).
 
+    impacts : "refined" (default): every touchdown is located and resolved as in the step
+        map (refine_touchdown; one Python call per walking step); "engine": the engine's
+        contacts find the touchdowns on their own (continuous collision for point feet, the
+        "all" mode strategy releasing the trailing foot), the end-to-end path.
     summary: steps (touchdowns), distance [m] (hip displacement along the slope), mean_speed
-    [m/s], fell (bool), step_period [s] and step_length [m] (means over the last half of the
-    steps), cost_of_transport (gravity work / (weight x distance); tan(gamma)-like for a
-    passive walker on a plane)."""
+    [m/s], fell (bool), step_period [s] (mean over the last half of the steps), step_length
+    [m], cost_of_transport (gravity work / (weight x distance)), duration [s]."""
+    if impacts not in ("refined", "engine"):
+        raise ValueError(f"impacts={impacts!r} must be 'refined' or 'engine'")
     n = int(round(duration / walker.dt))
     walker.set_coords(x0)
-    hip0 = walker.sim.state.q[walker.hip, :2].copy()
-    max_events = int(duration / 0.05) + 10
-    code, done, traj = walker.rollout(n, 1 << 60, record_every, max_events)
-    n_steps = int(walker.memory[1])
-    hip1 = walker.sim.state.q[walker.hip, :2]
+    s = walker.sim.state
+    hip0 = s.q[walker.hip, :2].copy()
+    if impacts == "engine":
+        max_events = int(duration / 0.05) + 10
+        code, done, traj = walker.rollout(n, 1 << 60, record_every, max_events)
+        events = list(walker.event_time[:min(int(walker.memory[1]), walker.event_time.size)])
+    else:
+        trajs, events, code = [], [], NO_EVENT
+        toggle = walker.toggle
+        walker.toggle = DETECT
+        try:
+            s.contact_enabled[walker.feet] = 0
+            s.contact_enabled[walker.feet[walker.memory[0]]] = 1
+            while s.time[0] < duration - 0.5 * walker.dt:
+                old = int(walker.memory[0])
+                left = int(round((duration - s.time[0]) / walker.dt))
+                code, done, traj = walker.rollout(left, int(walker.memory[1]) + 1, record_every)
+                trajs.append(traj)
+                if code != 0:
+                    break
+                walker.refine_touchdown(old)
+                s.contact_enabled[walker.feet[old]] = 0
+                events.append(float(s.time[0]))
+        finally:
+            walker.toggle = toggle
+        traj = _concat(trajs)
+        if code == NO_EVENT:
+            code = 0
+    n_steps = len(events)
+    hip1 = s.q[walker.hip, :2]
     distance = float((hip1 - hip0) @ walker.t_hat)
-    t_end = float(walker.sim.state.time[0])
-    ev_t = walker.event_time[:min(n_steps, walker.event_time.size)]
-    late = ev_t[len(ev_t) // 2:]
+    t_end = float(s.time[0])
+    late = np.array(events[len(events) // 2:])
     period = float(np.mean(np.diff(late))) if len(late) > 1 else math.nan
-    mass = walker.model.total_mass
-    g = float(np.hypot(*walker.model.arrays.gravity))
-    drop = -float((hip1 - hip0) @ np.array([0.0, 1.0]))
-    summary = dict(walker=walker.kind, steps=n_steps, distance=distance,
+    drop = float(hip0[1] - hip1[1])
+    summary = dict(walker=walker.kind, impacts=impacts, steps=n_steps, distance=distance,
                    mean_speed=distance / t_end if t_end > 0 else 0.0, fell=code == FELL,
                    step_period=period, step_length=distance / n_steps if n_steps else math.nan,
-                   cost_of_transport=(mass * g * drop) / (mass * g * distance) if distance > 0 else math.nan,
+                   cost_of_transport=drop / distance if distance > 0 else math.nan,
                    duration=t_end, code=int(code))
     return traj, summary

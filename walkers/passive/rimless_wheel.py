@@ -19,8 +19,9 @@ def closed_form(p: RimlessParams) -> dict:
 
 
 def simulate(duration=10.0, gait="passive", terrain=None, dt=1e-3, seed=0, params=None,
-             x0=None, record_every=10):
-    """Roll down the slope. Returns (Trajectory, summary dict, Model)."""
+             x0=None, record_every=10, impacts="refined"):
+    """Roll down the slope. Returns (Trajectory, summary dict, Model); impacts: see
+    walkers.passive.gait.run_gait ("refined" or "engine")."""
     if gait not in GAITS:
         raise ValueError(f"{NAME}: unknown gait {gait!r}; gaits: {GAITS}")
     p = params or RimlessParams()
@@ -28,5 +29,5 @@ def simulate(duration=10.0, gait="passive", terrain=None, dt=1e-3, seed=0, param
     walker = PassiveWalker(p, dt=dt)
     if x0 is None:
         x0 = np.array([-closed_form(p)["omega_after"]])
-    traj, summary = run_gait(walker, x0, duration, record_every)
+    traj, summary = run_gait(walker, x0, duration, record_every, impacts)
     return traj, summary, walker.model
