@@ -158,7 +158,7 @@ def test_gui_tracks_targets_against_static_equilibrium():
     assert np.abs(torques(x)).max() < 1e-10
     assert np.abs(sim_x - x).max() < 2e-3, (sim_x, x)
     # the ankles, whose gains dominate their small loads, sit close to their targets
-    assert abs(sim_x[2] - targets[1]) < 0.02 and abs(sim_x[3] - targets[2]) < 0.02
+    assert abs(sim_x[2] - targets[1]) < 0.05 and abs(sim_x[3] - targets[2]) < 0.05
 
 
 def touchdowns(mode, dt_frame, quiet=0.05):
