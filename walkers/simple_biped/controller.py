@@ -178,7 +178,7 @@ def next_state(p, s, mem, g):
         # also leave once the hip is over the front foot and still moving on (not a stall)
         over = phi <= 0.0 and v[0, 0] > p[P.I_STOP_SPEED]
         if t_in >= p[P.I_DS_TIME_MIN] and (err < p[P.I_DS_ENERGY_TOL] or over
-                                            or rear_l >= p[P.I_DS_REAR_LENGTH] * p[P.I_LEG_LENGTH]
+                                            or rear_l >= p[P.I_LEG_LENGTH_MAX] * p[P.I_LEG_LENGTH]
                                             or t_in >= p[P.I_DS_TIME_MAX]):
             _start_swing(p, q, v, mem, front)
             mem[M_SW_AIR] = 0.0
@@ -275,10 +275,12 @@ def control(m, s, p, mem, u):
         sign = 1.0 if q[2, 0] >= q[1, 0] else -1.0
         fl = p[P.I_FLIGHT_LENGTH] * l0
         track_foot(q, v, 0, q[0, 0] - sign * half, q[0, 1] - fl, v[0, 0], v[0, 1],
-                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, fmax, tmax, u)
+                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, p[P.I_LEG_LENGTH_MAX] * l0,
+                   fmax, tmax, u)
         u_hip0 = u[2]
         track_foot(q, v, 1, q[0, 0] + sign * half, q[0, 1] - fl, v[0, 0], v[0, 1],
-                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, fmax, tmax, u)
+                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, p[P.I_LEG_LENGTH_MAX] * l0,
+                   fmax, tmax, u)
         u[2] = 0.5 * (u[2] + u_hip0)
     elif state == ST_DOUBLE:
         # eq. 1 normal force on the front leg, eqs. 2-3 tangential force, split into the legs
@@ -302,19 +304,14 @@ def control(m, s, p, mem, u):
         sw = 1 - stance
         ph, ph_dot = _phase(p, q, v, mem)
         mem[M_PHASE] = ph
-        # height from the Bezier at the phase; the forward coordinate runs ahead (reaches the
-        # strike point at phase swing_lead) so a foot meeting rising ground early lands slowly
         sb = clamp(ph, 0.0, 1.0)
-        lead = p[P.I_SWING_LEAD]
-        sx = clamp(ph / lead, 0.0, 1.0)
-        tx, ty_x, dtx, dty_x = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1],
-                                                mem[M_SW_Y1], mem[M_SW_TOP], sx)
-        tx_y, ty, dtx_y, dty = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1],
-                                                mem[M_SW_Y1], mem[M_SW_TOP], sb)
-        tvx = dtx * ph_dot / lead if ph < lead else 0.0
+        tx, ty, dtx, dty = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1], mem[M_SW_Y1],
+                                            mem[M_SW_TOP], sb)
+        tvx = dtx * ph_dot
         tvy = dty * ph_dot
         if ph >= 1.0:
             # past the expected strike: keep lowering the foot until it finds the ground
+            tvx = 0.0
             ty -= p[P.I_DESCENT_RATE] * l0 * (ph - 1.0)
             tvy = -p[P.I_DESCENT_RATE] * l0 * ph_dot
         elif ph < 0.0:
@@ -329,7 +326,7 @@ def control(m, s, p, mem, u):
         hold_stance(q, v, stance, p[P.I_WALK_LENGTH] * l0, p[P.I_SS_KP], p[P.I_SS_KD], mh + mf,
                     gx, gy, fmax, u)
         track_foot(q, v, sw, tx, ty, tvx, tvy, p[P.I_SWING_KP], p[P.I_SWING_KD], mf, gx, gy,
-                   fmax, tmax, u)
+                   p[P.I_LEG_LENGTH_MAX] * l0, fmax, tmax, u)
         limit_hip_torque(q, stance, p[P.I_STANCE_MU], mf * g, u)
 
 

@@ -104,10 +104,11 @@ def hold_stance(q, v, i, length, kp, kd, mass, gx, gy, fmax, u):
 
 
 @jit
-def track_foot(q, v, i, tx, ty, tvx, tvy, kp, kd, mass, gx, gy, fmax, tmax, u):
+def track_foot(q, v, i, tx, ty, tvx, tvy, kp, kd, mass, gx, gy, lmax, fmax, tmax, u):
     """Virtual leg (seed 002 4.2): PD on leg i's length and angle toward the virtual leg from
     the hip to the target (tx, ty) [m] moving at (tvx, tvy) [m/s], plus the static force that
-    holds the foot's weight (gravity compensation). Writes u[i] and the hip torque u[2]."""
+    holds the foot's weight (gravity compensation). The virtual leg is at most lmax [m] long.
+    Writes u[i] and the hip torque u[2]."""
     dx, dy, l, ldot, phi, phidot = leg_state(q, v, i)
     # virtual leg and its rates relative to the hip
     vx = tx - q[0, 0]
@@ -116,6 +117,9 @@ def track_foot(q, v, i, tx, ty, tvx, tvy, kp, kd, mass, gx, gy, fmax, tmax, u):
     wy = tvy - v[0, 1]
     lv = max(math.sqrt(vx * vx + vy * vy), 1e-6)
     lv_dot = (vx * wx + vy * wy) / lv
+    if lv > lmax:
+        lv = lmax
+        lv_dot = 0.0
     phiv = math.atan2(vx, -vy)
     phiv_dot = (vx * wy - vy * wx) / (lv * lv)
     # foot weight: axial part and moment about the hip of the force -mass g

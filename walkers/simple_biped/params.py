@@ -26,6 +26,8 @@ class SimpleBipedParams:
     hip_mass: float = _p(10.0, "kg", "point mass of the hip (the whole upper body)", 0.1, 1e3)
     foot_mass: float = _p(1.0, "kg", "point mass of each foot (legs themselves are massless)", 0.01, 1e2)
     leg_length: float = _p(1.0, "m", "nominal leg length l0 (the unit of every length below)", 0.1, 10.0)
+    leg_length_max: float = _p(1.2, "l0", "longest leg the controller uses (a double stance ends "
+                               "when the rear leg reaches it; swing targets stay within it)", 0.9, 1.5)
     mu: float = _p(0.9, "-", "Coulomb friction coefficient of the feet", 0.0, 5.0)
     leg_force_max: float = _p(2000.0, "N", "axial leg actuator limit (push and pull)", 1.0, 1e5)
     hip_torque_max: float = _p(250.0, "N m", "hip torque actuator limit", 1.0, 1e4)
@@ -41,8 +43,6 @@ class SimpleBipedParams:
     clearance: float = _p(0.08, "l0", "swing-foot clearance (Bezier top edge at 4/3 of it)", 0.0, 0.5)
     slope_trust: float = _p(1.0, "-", "fraction of the slope seen between the feet assumed to "
                             "continue under the next step (0: the seed's level-ground guess)", 0.0, 1.0)
-    swing_lead: float = _p(1.0, "-", "phase at which the swing foot's forward coordinate reaches "
-                           "the strike point (1: together with the height, as in the seed)", 0.3, 1.0)
     strike_push: float = _p(0.05, "l0", "Bezier end point below the expected ground, so the foot "
                             "strikes with downward speed", 0.0, 0.3)
     descent_rate: float = _p(0.5, "l0", "extra lowering of the swing target per unit phase past 1", 0.0, 5.0)
@@ -63,7 +63,7 @@ class SimpleBipedParams:
     ds_time_max: float = _p(0.25, "s", "longest double stance", 0.0, 5.0)
     ds_energy_tol: float = _p(0.02, "m^2/s^2", "double stance ends once the predicted top speed "
                               "squared is above v_top^2 minus this", 0.0, 10.0)
-    ds_rear_length: float = _p(1.2, "l0", "double stance ends when the rear leg reaches this length", 0.9, 1.3)
+
     # walk: single stance ------------------------------------------------------------------
     ss_kp: float = _p(200.0, "1/s^2", "stance leg-length gain (single stance)", 0.0, 1e4)
     ss_kd: float = _p(25.0, "1/s", "stance leg-length rate gain (single stance)", 0.0, 1e3)
@@ -80,6 +80,8 @@ class SimpleBipedParams:
     flight_length: float = _p(0.9, "l0", "leg length held in flight", 0.4, 1.2)
     land_time: float = _p(0.5, "s", "time spent absorbing a landing before the next crouch", 0.0, 5.0)
     fall_height: float = _p(0.6, "l0", "hip below this height above the ground counts as a fall", 0.0, 1.0)
+    fall_leg_length: float = _p(1.5, "l0", "a leg longer than this counts as a fall (the walker "
+                                "came apart)", 1.0, 10.0)
 
     def __post_init__(self):
         for f in fields(self):

@@ -8,6 +8,8 @@ controller.State), ``stance`` foot, ``phase``, ``steps`` and ``jumps``.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 import planarsim as ps
@@ -21,7 +23,7 @@ from planarsim.trajectory import Trajectory, make_recorder
 
 from . import controller as C
 from .model import build
-from .params import I_FALL_HEIGHT, I_LEG_LENGTH, SimpleBipedParams
+from .params import I_FALL_HEIGHT, I_FALL_LEG_LENGTH, I_LEG_LENGTH, SimpleBipedParams
 
 CODE_FELL = 3
 LABELS = ("gait", "state", "stance", "phase", "steps", "jumps")
@@ -29,9 +31,18 @@ _LABEL_SLOTS = (C.M_GAIT, C.M_STATE, C.M_STANCE, C.M_PHASE, C.M_STEPS, C.M_JUMPS
 
 
 @jit
+def _longest_leg(q):
+    """Longer of the two hip-foot distances [m]."""
+    a = math.hypot(q[1, 0] - q[0, 0], q[1, 1] - q[0, 1])
+    b = math.hypot(q[2, 0] - q[0, 0], q[2, 1] - q[0, 1])
+    return max(a, b)
+
+
+@jit
 def rollout_simple_biped(m, s, ws, opt, p, mem, u, n, every, rec, lab, k0):
     """n steps of control + physics, recording every `every`-th step into rec / lab from frame
-    k0. Stops when the hip falls below fall_height above the ground (code 3, mem[M_FALLEN]=1)
+    k0. Stops on a fall (code 3, mem[M_FALLEN]=1): the hip below fall_height above the ground,
+    or a leg longer than fall_leg_length
     or a guard fires (code 1, 2). Returns (code, steps done, next frame)."""
     k = k0
     for i in range(n):
@@ -48,7 +59,8 @@ def rollout_simple_biped(m, s, ws, opt, p, mem, u, n, every, rec, lab, k0):
             lab[k, 4] = mem[C.M_STEPS]
             lab[k, 5] = mem[C.M_JUMPS]
             k += 1
-        if s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]:
+        if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]
+                or _longest_leg(s.q) > p[I_FALL_LEG_LENGTH] * p[I_LEG_LENGTH]):
             mem[C.M_FALLEN] = 1.0
             return CODE_FELL, i + 1, k
     return 0, n, k
