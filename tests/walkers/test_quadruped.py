@@ -227,3 +227,14 @@ def test_live_hook_for_the_viewer():
     x0 = float(sim.state.q[0, 0])
     sim.run(2.0, controller=ctrl)
     assert ctrl.memory[C.M_STEP_I] >= 3 and sim.state.q[0, 0] - x0 > 0.2
+
+
+@pytest.mark.parametrize("spec", ["hills", "slope:5", "slope:-5"])
+def test_walk_on_uneven_ground(spec):
+    """Foot goals follow the terrain (plant height r / cos(slope) above the ground)."""
+    dog = qd.Quadruped(gait="walk", speed=0.3, terrain=spec, record_every=50)
+    traj = dog.run(15.0)
+    s = dog.summary()
+    assert not s["fell"], s
+    assert abs(s["mean_speed"] - 0.3) < 0.2 * 0.3, s
+    assert np.degrees(np.abs(traj.q[:, 0, 2])).max() < 10.0

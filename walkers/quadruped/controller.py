@@ -39,7 +39,7 @@ import numpy as np
 
 from planarsim.kernels._jit import jit
 from planarsim.kernels.forces import pin_angle_rate
-from planarsim.kernels.terrain import height
+from planarsim.kernels.terrain import height, height_derivs
 
 from walkers.common.pd import clamp
 
@@ -94,6 +94,14 @@ def foot_centre(s, p, i):
 
 
 @jit
+def rest_height(m, p, x):
+    """Height [m] of the centre of a round foot resting on the ground near x (r / cos(slope)
+    above it), lowered by plant_depth."""
+    h, dh, _ = height_derivs(m.terrain_coef, x)
+    return h + p[I_FOOT_RADIUS] * math.sqrt(1.0 + dh * dh) - p[I_PLANT_DEPTH]
+
+
+@jit
 def placement_x(m, s, p, mem, i, t_left):
     """Raibert foot placement for leg i: world x of the landing goal [m]."""
     hx, hy = hip_world(s.q[0, 0], s.q[0, 1], s.q[0, 2], HIP_SIGN[i] * p[I_HIP_X])
@@ -144,19 +152,20 @@ def update_feet(m, s, p, mem):
                 mem[M_STATE + i] = F_LIFT
     # goals of the moving feet follow the body
     foot_speed = p[I_FOOT_STEP] * p[I_UPDATE_RATE]
-    rest = p[I_FOOT_RADIUS] - p[I_PLANT_DEPTH]
     for i in range(N_LEG):
         st = mem[M_STATE + i]
         if st == F_GROUND:
             continue
         tx, ty = mem[M_TARGET + 2 * i], mem[M_TARGET + 2 * i + 1]
-        # time the puppet foot still needs to reach the ground
+        # time the puppet foot still needs to reach the ground (heights above the ground)
         up = ty - height(m.terrain_coef, tx)
+        rest = rest_height(m, p, tx) - height(m.terrain_coef, tx)
         path = (p[I_LIFT_HEIGHT] - up) + (p[I_LIFT_HEIGHT] - rest) if st == F_LIFT else up - rest
         t_left = max(path, 0.0) / foot_speed
         gx = placement_x(m, s, p, mem, i, t_left)
         mem[M_GOAL + 2 * i] = gx
-        mem[M_GOAL + 2 * i + 1] = height(m.terrain_coef, gx) + (p[I_LIFT_HEIGHT] if st == F_LIFT else rest)
+        mem[M_GOAL + 2 * i + 1] = (height(m.terrain_coef, gx) + p[I_LIFT_HEIGHT] if st == F_LIFT
+                                   else rest_height(m, p, gx))
 
 
 @jit

@@ -9,8 +9,8 @@ Contacts: foot i = a full-circle arc contact of radius foot_radius centred at th
           fall_height ends a run as a fall.
 Left and right legs of one end share the hip point and overlap in the plane, like Ranger's
 inner and outer legs; the diagonal pairs are (FL, RR) and (FR, RL) (PAIR below).
-Build pose: standing, torso level at stand_height, every foot straight below its hip, resting
-on the ground (foot centre foot_radius above it).
+Build pose: standing, torso level at stand_height above the mean ground height under the hips,
+every foot straight below its hip, resting on the ground.
 """
 from __future__ import annotations
 
@@ -49,13 +49,21 @@ def _dir(phi):
     return math.sin(phi), -math.cos(phi)
 
 
-def standing_angles(p: QuadrupedParams):
-    """Hip and knee angles [rad] with the foot centre straight below the hip at
-    stand_height - foot_radius."""
-    q1, q2, flag = leg_ik(0.0, -(p.stand_height - p.foot_radius), p.thigh_length, p.calf_length,
+def foot_rest_height(p: QuadrupedParams, terrain: Terrain, x: float) -> float:
+    """Height [m] of the centre of a round foot resting on the terrain near x: r / cos(slope)
+    above the ground (exact on a constant slope)."""
+    return float(terrain.height(x)) + p.foot_radius * math.sqrt(1.0 + float(terrain.slope(x)) ** 2)
+
+
+def standing_angles(p: QuadrupedParams, drop: float | None = None):
+    """Hip and knee angles [rad] with the foot centre straight below the hip, `drop` below it
+    [m] (default stand_height - foot_radius)."""
+    drop = p.stand_height - p.foot_radius if drop is None else drop
+    q1, q2, flag = leg_ik(0.0, -drop, p.thigh_length, p.calf_length,
                           p.hip_lower, p.hip_upper, p.knee_lower, p.knee_upper)
     if flag:
-        raise ValueError(f"QuadrupedParams: standing pose unreachable (IK flag {flag})")
+        raise ValueError(f"QuadrupedParams: standing pose unreachable on this terrain (IK flag {flag}, "
+                         f"hip {drop:.3f} m above the foot centre)")
     return q1, q2
 
 
@@ -64,18 +72,20 @@ def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None,
     """Model of the quadruped standing with its torso COM above x0 [m] on `terrain`."""
     p = params if params is not None else QuadrupedParams()
     terrain = terrain if terrain is not None else flat()
-    ground = max(float(terrain.height(x0 + s * p.hip_x)) for s in (-1, 1))
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, -9.81), terrain=terrain)
-    ty = ground + p.stand_height
+    hips_x = [x0 + HIP_SIGN[i] * p.hip_x for i in range(N_LEG)]
+    ty = 0.5 * (float(terrain.height(hips_x[0])) + float(terrain.height(hips_x[2]))) + p.stand_height
     b.add_body("torso", mass=p.torso_mass, inertia=p.torso_inertia, pos=(x0, ty), angle=0.0,
                shapes=[("box", (0.0, 0.0), p.torso_length, p.torso_height)])
-    q1, q2 = standing_angles(p)
     l1, l2 = p.thigh_length, p.calf_length
     width = (0.018, 0.012)          # drawing: left legs a little thicker than right ones
+    knees = []
     for i, name in enumerate(LEG_NAMES):
-        hx, hy = x0 + HIP_SIGN[i] * p.hip_x, ty
+        hx, hy = hips_x[i], ty
+        q1, q2 = standing_angles(p, hy - foot_rest_height(p, terrain, hx))
         d1, d12 = _dir(q1), _dir(q1 + q2)
         kx, ky = hx + l1 * d1[0], hy + l1 * d1[1]
+        knees.append((kx, ky))
         w = width[i % 2]
         b.add_body(f"{name}_thigh", mass=p.thigh_mass, inertia=p.thigh_inertia + p.armature,
                    pos=(hx + p.thigh_com * d1[0], hy + p.thigh_com * d1[1]), angle=q1,
@@ -84,12 +94,9 @@ def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None,
                    pos=(kx + p.calf_com * d12[0], ky + p.calf_com * d12[1]), angle=q1 + q2,
                    shapes=[("capsule", (0.0, p.calf_com), (0.0, p.calf_com - l2), 0.7 * w)])
     for i, name in enumerate(LEG_NAMES):
-        hx, hy = x0 + HIP_SIGN[i] * p.hip_x, ty
-        d1 = _dir(q1)
-        b.add_pin(f"{name}_hip", BODY_TORSO, thigh_body(i), anchor_world=(hx, hy), ref_angle=0.0,
+        b.add_pin(f"{name}_hip", BODY_TORSO, thigh_body(i), anchor_world=(hips_x[i], ty), ref_angle=0.0,
                   limit=(p.hip_lower, p.hip_upper))
-        b.add_pin(f"{name}_knee", thigh_body(i), calf_body(i),
-                  anchor_world=(hx + l1 * d1[0], hy + l1 * d1[1]), ref_angle=0.0,
+        b.add_pin(f"{name}_knee", thigh_body(i), calf_body(i), anchor_world=knees[i], ref_angle=0.0,
                   limit=(p.knee_lower, p.knee_upper))
     for i, name in enumerate(LEG_NAMES):
         for joint in ("hip", "knee"):
