@@ -129,6 +129,10 @@ def test_simulate_returns_trajectory_summary_and_model():
     traj, summary, model = sb.simulate(5.0, gait="walk", terrain="flat")
     assert summary["distance"] > 1.0 and not summary["fell"]
     assert summary["steps"] > 2
+    # the actuators did at least the work that became kinetic energy of the walking body
+    ke = 0.5 * model.arrays.body_mass @ np.sum(traj.v[-1, :, :2] ** 2, axis=1)
+    assert summary["positive_work"] >= ke
+    assert 0.0 < summary["cost_of_transport"] < 5.0
     assert set(traj.labels) >= {"gait", "state", "stance", "phase"}
     assert len(traj.labels["state"]) == len(traj.t)
     assert model.act_names == ("leg0", "leg1", "hip")

@@ -78,7 +78,8 @@ M_SCUFFS = 20     # swing-foot contacts before touchdown_phase
 M_SW_AIR = 21     # 1 once the swing foot has left the ground in this single stance
 M_ABORT = 22      # 1 when the hip rolled back before the top: the swing foot returns behind
 M_RETRIES = 23    # aborted steps
-N_MEMORY = 24
+M_WORK = 24       # positive mechanical work of all actuators [J] (kept by the rollout)
+N_MEMORY = 28
 
 
 @jit

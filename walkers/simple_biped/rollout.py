@@ -50,6 +50,9 @@ def rollout_simple_biped(m, s, ws, opt, p, mem, u, n, every, rec, lab, k0):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, k
+        for a in range(ws.act_power.shape[0]):
+            if ws.act_power[a] > 0.0:
+                mem[C.M_WORK] += ws.act_power[a] * m.dt
         if s.step[0] % every == 0 and k < rec.t.shape[0]:
             record_frame(s, ws, rec, k)
             lab[k, 0] = mem[C.M_GAIT]
@@ -159,10 +162,15 @@ class Walker:
                           act_names=first.act_names, labels=labels, info=dict(first.info))
 
     def summary(self) -> dict:
-        """distance [m] and mean_speed [m/s] of the hip since the start, steps, jumps, fell, ..."""
+        """distance [m] and mean_speed [m/s] of the hip since the start, positive actuator work
+        [J] and cost of transport (that work per weight and distance [-]), steps, jumps, fell."""
         t = self.state.t
         dist = float(self.state.q[0, 0]) - self.x_start
+        weight = self.model.total_mass * float(np.hypot(*self.model.arrays.gravity))
+        work = float(self.memory[C.M_WORK])
         return {"time": t, "distance": dist, "mean_speed": dist / t if t > 0 else 0.0,
+                "positive_work": work,
+                "cost_of_transport": work / (weight * dist) if dist > 0.1 else float("nan"),
                 "steps": int(self.memory[C.M_STEPS]), "jumps": int(self.memory[C.M_JUMPS]),
                 "scuffs": int(self.memory[C.M_SCUFFS]),
                 "retries": int(self.memory[C.M_RETRIES]), "fell": self.fell, "falls": int(self.fell),
