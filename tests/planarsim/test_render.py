@@ -72,6 +72,12 @@ def to_pixels(scene, xy):
     return np.column_stack([(xy[:, 0] - x0) / (x1 - x0) * w, (y1 - xy[:, 1]) / (y1 - y0) * h])
 
 
+def default_file_mode():
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
 def mask(img, rgb):
     target = np.array(rgb) * 255
     return np.all(np.abs(img - target) < 60, axis=2)
@@ -311,6 +317,7 @@ def test_gif_and_mp4_of_two_seconds_at_30_fps_have_60_frames(sliding_run, tmp_pa
     assert n == 60
     assert meta["fps"] == pytest.approx(30)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.gif", "run.mp4"]   # no leftovers
+    assert gif.stat().st_mode & 0o777 == mp4.stat().st_mode & 0o777 == default_file_mode()
 
 
 def test_playback_speed_samples_frames_from_the_trajectory_times(sliding_run):
@@ -543,6 +550,7 @@ def test_summary_plots_save_by_extension(sliding_run, tmp_path):
     for ext, magic in (("png", b"\x89PNG"), ("svg", b"<?xml"), ("pdf", b"%PDF")):
         out = save_figure(fig, tmp_path / f"summary.{ext}")
         assert out.read_bytes()[:len(magic)] == magic
+        assert out.stat().st_mode & 0o777 == default_file_mode()   # not mkstemp's owner-only mode
     # the energy panel plots the trajectory's own energies
     energy_ax = next(a for a in fig.axes if a.get_title() == "mechanical energy")
     total = next(l for l in energy_ax.get_lines() if l.get_label() == "total")
