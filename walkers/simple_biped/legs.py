@@ -140,7 +140,8 @@ def limit_hip_torque(q, stance, mu, foot_weight, u):
     """Saturate the hip torque u[2] so that the stance foot is not pushed out of a friction
     cone of coefficient mu about the world vertical: the force of both actuators on the stance
     foot, F = u_st (foot - hip)/l + s u_2 (-d_y, d_x)/l^2 (s = +1 on leg 1, -1 on leg 0), must
-    satisfy |F_x| <= mu (-F_y + foot_weight). Both conditions are linear in u_2."""
+    satisfy |F_x| <= mu (-F_y + foot_weight). Both conditions are linear in u_2. The torque is
+    only reduced toward 0, never increased or reversed."""
     dx = q[stance + 1, 0] - q[0, 0]
     dy = q[stance + 1, 1] - q[0, 1]
     l2 = dx * dx + dy * dy
@@ -163,7 +164,9 @@ def limit_hip_torque(q, stance, mu, foot_weight, u):
         elif c0 > 0.0:
             lo = 0.0
             hi = 0.0
+    # saturation only: the result lies between 0 and the asked torque
+    tau = u[ACT_HIP]
     if lo > hi:
         u[ACT_HIP] = 0.0
     else:
-        u[ACT_HIP] = clamp(u[ACT_HIP], lo, hi)
+        u[ACT_HIP] = clamp(clamp(tau, lo, hi), min(tau, 0.0), max(tau, 0.0))
