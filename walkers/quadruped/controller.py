@@ -9,7 +9,11 @@ The seed's step() (run at update_rate = 30 Hz):
   * puppet feet move towards their goals by at most foot_step per update (ours: spread evenly
     over the update period, so the servo targets have no jumps);
   * when both selected feet are within goal_tol of their goals: LIFT -> PLANT (goal on the
-    ground), PLANT -> GROUND.
+    ground), PLANT -> GROUND; ours: PLANT -> GROUND also waits until the real feet touch
+    (the engine's contact mode as a foot contact sensor), at most touch_timeout after the
+    plant began. Without it the puppet "planted" some 10-30 ms before the real feet landed,
+    the weight feed-forward was split onto feet still in the air and the other foot of their
+    end hopped.
 The seed's walker fell when asked to move forward while stepping. Feedback added here (the
 issue asks to say which):
   1. foot placement from body velocity (Raibert): the swing feet's goals are recomputed at every
@@ -48,7 +52,7 @@ from .params import (I_ACCEL, I_CALF_LENGTH, I_FALL_HEIGHT, I_FALL_PITCH, I_FOOT
                      I_GOAL_TOL, I_HIP_LOWER, I_HIP_UPPER, I_HIP_X, I_KD, I_KNEE_LOWER,
                      I_KNEE_UPPER, I_KP, I_LEAD_MAX, I_LIFT_HEIGHT, I_PLACEMENT_GAIN,
                      I_PLANT_DELAY, I_PLANT_DEPTH, I_SETTLE_TIME, I_STAND_HEIGHT, I_STANCE_TIME,
-                     I_THIGH_LENGTH, I_TORQUE_LIMIT, I_TORSO_TRACK_MAX, I_UPDATE_RATE,
+                     I_THIGH_LENGTH, I_TORQUE_LIMIT, I_TOUCH_TIMEOUT, I_TORSO_TRACK_MAX, I_UPDATE_RATE,
                      I_WEIGHT_FF, QuadrupedParams)
 from .puppet import hip_world, leg_angles_for
 
@@ -71,7 +75,7 @@ F_GROUND, F_LIFT, F_PLANT = 0, 1, 2
 # memory layout mem[...]
 M_GAIT, M_SPEED, M_STEP_I, M_STEPS, M_FELL = 0, 1, 2, 3, 4
 M_T_UPDATE, M_READY_AT, M_X_DESIRED, M_X_PREV, M_V_EST = 5, 6, 7, 8, 9
-M_WEIGHT, M_IK_CLAMPS, M_MAX_PITCH, M_V_RAMP, M_WORK = 10, 11, 12, 13, 14
+M_WEIGHT, M_IK_CLAMPS, M_MAX_PITCH, M_V_RAMP, M_WORK, M_PLANT_T = 10, 11, 12, 13, 14, 15
 M_STATE = 16      # foot state, per leg 16..19
 M_TARGET = 20     # puppet foot target (x, y) world, per leg: 20 + 2i, 21 + 2i
 M_GOAL = 28       # foot goal (x, y) world, per leg: 28 + 2i, 29 + 2i
@@ -130,12 +134,15 @@ def update_feet(m, s, p, mem):
         if math.hypot(mem[M_GOAL + 2 * i] - mem[M_TARGET + 2 * i],
                       mem[M_GOAL + 2 * i + 1] - mem[M_TARGET + 2 * i + 1]) >= p[I_GOAL_TOL]:
             reached = False
+        elif st == F_PLANT and s.contact_mode[i] == 0 and t < mem[M_PLANT_T] + p[I_TOUCH_TIMEOUT]:
+            reached = False     # ours: the real foot must touch too (or time out)
     if reached and n_lift + n_plant > 0:
         for i in range(N_LEG):
             if PAIR[i] != pair or mem[M_STATE + i] == F_GROUND:
                 continue
             if n_lift > 0:
                 mem[M_STATE + i] = F_PLANT
+                mem[M_PLANT_T] = t
             else:
                 mem[M_STATE + i] = F_GROUND
                 mem[M_READY_AT] = t + p[I_PLANT_DELAY]

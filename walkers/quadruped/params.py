@@ -75,6 +75,8 @@ class QuadrupedParams:
                             "ground; seed 0.02 m = its foot radius)", 0.0, 0.05)
     plant_delay: float = _p(0.1, "s", "wait after planting before the next pair lifts (the seed's fix "
                             "for bouncing hard feet)", 0.0, 2.0)
+    touch_timeout: float = _p(0.1, "s", "PLANT -> GROUND waits for the real foot's touch at most this "
+                              "long after the plant began (0: the seed's puppet-only switch)", 0.0, 2.0)
     settle_time: float = _p(0.3, "s", "standing still after the start before the first step", 0.0, 5.0)
     goal_tol: float = _p(0.001, "m", "a puppet foot has reached its goal within this distance (seed)", 1e-6, 0.05)
     # feedback the seed lacks ---------------------------------------------------------------------------
