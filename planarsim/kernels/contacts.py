@@ -86,17 +86,15 @@ def find_contact(m, q, ws, i):
 
 
 @jit
-def engage_contact(s, ws, i, vt):
-    """Bring free contact i into touch: sliding in the direction of its tangential velocity
-    vt [m/s] if it has one, else pinned. A later check turns a sliding contact whose slip
-    reverses into a pinned one, so an impact ends up sticking exactly when Coulomb's law says
-    so, without a pinned impact first stopping a sliding body dead."""
-    if vt > 1e-9:
+def engage_contact(m, s, ws, i, vn, vt):
+    """Bring free contact i into touch, approaching at normal velocity vn and tangential vt
+    [m/s]: sliding along vt when |vt| > mu |vn| (an impact's friction impulse, at most mu
+    times its normal impulse, cannot stop that slip), else pinned. The checks after the solve
+    then settle it: a pinned contact outside the friction cone slides, a sliding one whose slip
+    reverses sticks, so an impact ends up sticking exactly when Coulomb's law says so."""
+    if abs(vt) > m.contact_mu[i] * abs(vn) and abs(vt) > 1e-9:
         s.contact_mode[i] = MODE_SLIDING
-        s.contact_slip[i] = 1.0
-    elif vt < -1e-9:
-        s.contact_mode[i] = MODE_SLIDING
-        s.contact_slip[i] = -1.0
+        s.contact_slip[i] = 1.0 if vt > 0.0 else -1.0
     else:
         s.contact_mode[i] = MODE_PINNED
     ws.contact_new[i] = 1
@@ -115,4 +113,6 @@ def find_contacts(m, s, ws):
             b = m.contact_body[i]
             vx = s.v[b, 0] - s.v[b, 2] * (ws.contact_point[i, 1] - s.q[b, 1])
             vy = s.v[b, 1] + s.v[b, 2] * (ws.contact_point[i, 0] - s.q[b, 0])
-            engage_contact(s, ws, i, ws.contact_normal[i, 1] * vx - ws.contact_normal[i, 0] * vy)
+            nx = ws.contact_normal[i, 0]
+            ny = ws.contact_normal[i, 1]
+            engage_contact(m, s, ws, i, nx * vx + ny * vy, ny * vx - nx * vy)

@@ -90,7 +90,7 @@ def engage_contacts(m, s, ws, h, include_ccd):
             continue
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
         if ws.contact_gap[i] + h * vn < 0.0:
-            engage_contact(s, ws, i, vt)
+            engage_contact(m, s, ws, i, vn, vt)
             changed += 1
     return changed
 

@@ -84,11 +84,6 @@ def test_simplest_walker_walks_with_refined_impacts(garcia):
     assert np.min(traj.q[:, 0, 1] - model.terrain.height(traj.q[:, 0, 0])) > 0.95
 
 
-@pytest.mark.xfail(reason="engine: the simplest walker's 3rd heel strike (CCD point foot on a rod) "
-                   "uses up the CCD splits (4) and mode rounds (15) without resolving the impact: "
-                   "the trailing foot stays pinned with a pulling normal impulse, the new foot "
-                   "ends sliding, the hip keeps its pre-impact velocity and tips back",
-                   strict=False)
 def test_simplest_walker_walks_on_the_engines_own_contacts(garcia):
     # no step map here: the engine finds every heel strike (continuous collision) and the
     # "all" strategy releases the trailing foot; 30 s of walking from the published gait
