@@ -168,12 +168,16 @@ def _plain(v):
 
 def cmd_view(args):
     mod = _load_walker(args.walker)
-    if not hasattr(mod, "viewer_session"):
-        raise UsageError(f"walker {args.walker!r} has no interactive session yet; use "
-                         f"'planarsim run {args.walker} --out FILE.gif' to watch it")
-    from .render import view
-    sim, controller, kw = mod.viewer_session()
-    view(sim, controller, **kw)
+    from . import terrain as T
+    from .render.viewer import view_walker
+    try:
+        ter = T.parse(args.terrain) if args.terrain else None
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+    try:
+        view_walker(mod, gait=args.gait, terrain=ter)
+    except NotImplementedError as e:
+        raise UsageError(f"{e}; use 'planarsim run {args.walker} --out FILE.gif' to watch it") from None
     return 0
 
 
@@ -234,6 +238,8 @@ def make_parser():
     p.set_defaults(func=cmd_run)
     p = sub.add_parser("view", help="interactive viewer (needs a display)")
     p.add_argument("walker")
+    p.add_argument("--gait", default=None)
+    p.add_argument("--terrain", default=None, help="flat | slope:DEG | hills | hills:A,L[,PHI][;...]")
     p.set_defaults(func=cmd_view)
     p = sub.add_parser("bench", help="engine benchmarks (planarsim bench --help)", add_help=False)
     p.add_argument("rest", nargs=argparse.REMAINDER)
