@@ -3,6 +3,19 @@ model, FSM WALK / STAND / GUI with a step-to-step push-off feedback, cost of tra
 
 >>> from walkers import ranger
 >>> traj, summary, model = ranger.simulate(10.0, gait="walk")   # doctest: +SKIP
+
+Choices (numbers in params.py, each with its reason):
+- Contact-mode strategy: the seed's "alternating" by default (RangerSim(strategy=...)). Both
+  strategies walk 1000 steps with the shipped parameters; "all" makes the engine engage and
+  release a landing foot about twice as often (bounces) for the same gait, and the seed's
+  scheme is what the controller (estimator thresholds) was tuned with.
+- Rotor inertia: the ankle rotor's G^2 Jm is added to the foot body (armature), and ankle
+  currents on a foot in the air are capped (free_foot_max_accel), see model.py/controller.py.
+- Poses: STAND holds a symmetric pose (hip centred over feet 0.19 m apart); WALK starts at rest
+  from the end-of-double-stance pose (walk_front_angle / walk_rear_angle). Switching a running
+  STAND to WALK does not start a gait (the robot falls after a few steps): the start from the
+  symmetric pose is not solved.
+- Figures: ``python benchmarks/ranger.py --repeats 3 --steps 1000``.
 """
 from pathlib import Path as _Path
 
