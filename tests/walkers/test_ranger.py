@@ -52,6 +52,11 @@ def test_registry_and_interface():
     assert {"distance", "mean_speed", "steps", "fell", "cost_of_transport"} <= set(summary)
     with pytest.raises(ValueError, match="gait 'run'"):
         ranger.simulate(0.1, gait="run")
+    spec = ranger.live(gait="gui")
+    u = spec["controller"](spec["sim"])          # the Python path: one control step
+    assert u.shape == (3,) and np.all(np.isfinite(u))
+    spec["gains"]["GUI hip [rad]"][3](0.4)
+    assert spec["gains"]["GUI hip [rad]"][2]() == 0.4
     with pytest.raises(ValueError, match="friction"):
         RangerParams(friction=-1.0)
 

@@ -47,9 +47,9 @@ _drop_caches()
 from .params import RangerParams  # noqa: E402
 from .model import build  # noqa: E402
 from .controller import Controller, Gait, Phase, Program  # noqa: E402
-from .rollout import GAITS, RangerSim, instantaneous_cot, simulate  # noqa: E402
+from .rollout import GAITS, RangerSim, instantaneous_cot, live, simulate  # noqa: E402
 
 NAME = "ranger"
 
 __all__ = ["NAME", "GAITS", "simulate", "RangerParams", "build", "Controller", "Gait", "Phase",
-           "Program", "RangerSim", "instantaneous_cot"]
+           "Program", "RangerSim", "instantaneous_cot", "live"]

@@ -150,6 +150,30 @@ def instantaneous_cot(traj: Trajectory, model, overhead_power: float = 4.5, min_
     return cot
 
 
+def live(gait: str = "walk", terrain=None, params: RangerParams | None = None,
+         strategy: str = "alternating") -> dict:
+    """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and the
+    Python-path Controller; keys w / s / g for WALK / STAND / GUI; sliders for the GUI joint
+    targets [rad] (seed 6.1: the GUI mode sets joint targets and gains)."""
+    if gait not in GAITS:
+        raise ValueError(f"Ranger gait {gait!r} unknown; use one of {GAITS}")
+    if isinstance(terrain, str):
+        terrain = ps.terrain.parse(terrain)
+    rs = RangerSim(params, terrain, gait=gait, strategy=strategy)
+    ctrl, mem, gui = rs.controller, rs.controller.mem, rs.controller.gui
+
+    def slider(j, lo, hi):
+        return (lo, hi, lambda: float(gui[j, 0]), lambda x: ctrl.set_gui(j, float(x)))
+
+    return dict(sim=rs.sim, controller=ctrl, on_gait=ctrl.set_gait,
+                gait_keys={"w": "walk", "s": "stand", "g": "gui"},
+                gains={"GUI hip [rad]": slider(0, -0.8, 0.8), "GUI outer ankle [rad]": slider(1, -1.5, 1.5),
+                       "GUI inner ankle [rad]": slider(2, -1.5, 1.5)},
+                labels=lambda _sim: {"gait": mem[C.M_GAIT], "phase": mem[C.M_PHASE]},
+                label_names={"gait": {int(g): g.name.lower() for g in C.Gait},
+                             "phase": {int(p): p.name.lower() for p in C.Phase}})
+
+
 def simulate(duration: float, gait: str = "walk", terrain=None, dt: float = 1e-3, seed: int = 0,
              params: RangerParams | None = None, strategy: str = "alternating", record_every: int = 10):
     """Run Ranger from rest (WALK start pose for 'walk', STAND pose otherwise).
