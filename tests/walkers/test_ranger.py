@@ -210,6 +210,15 @@ def test_estimator_switches_once_per_touchdown():
             prior = td[td <= i]
             assert len(prior) and (i - prior[-1]) * dtf < 0.06, f"foot {s}: 'on' at {traj.t[i]} s"
     assert raw_bounces >= 0
+    # eq. 17 frame by frame: positive, and its power-weighted mean is the whole-run figure
+    cot = ranger.instantaneous_cot(traj, rs.model)
+    ok = np.isfinite(cot)
+    assert ok.mean() > 0.9 and np.all(cot[ok] > 0)
+    power = sum(np.maximum(traj.labels[k], 0.0) for k in ("power_hip", "power_outer_ankle", "power_inner_ankle"))
+    weight = 9.81 * rs.model.arrays.body_mass.sum()
+    dist = traj.com(rs.model)[-1, 0] - traj.com(rs.model)[0, 0]
+    whole = (power.sum() * dtf + 4.5 * (traj.t[-1] - traj.t[0])) / (weight * dist)
+    assert 0.2 < whole < 1.0
 
 
 def test_butterworth_gain():
