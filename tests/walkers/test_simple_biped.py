@@ -70,11 +70,12 @@ def test_hills_terrain_is_as_steep_as_the_seed_claims():
     assert np.ptp(terr.height(x)) >= L0 / 3
 
 
+@pytest.mark.parametrize("speed", [0.5, 1.0, 1.5])
 @pytest.mark.parametrize("terrain", [steep_hills(), T.slope(5.0), T.slope(-5.0)],
                          ids=["hills-12deg", "up-5deg", "down-5deg"])
-def test_walks_100m_over_hills_and_slopes_from_rest(terrain):
-    w = sb.Walker(gait="walk", terrain=terrain)
-    traj = walk_until(w, 100.0, t_max=250.0)
+def test_walks_100m_over_hills_and_slopes_from_rest(terrain, speed):
+    w = sb.Walker(gait="walk", terrain=terrain, speed=speed)
+    traj = walk_until(w, 100.0, t_max=100.0 / speed * 2 + 20)
     assert_walked(w, traj, 100.0)
 
 

@@ -53,7 +53,7 @@ class SimpleBipedParams:
     walk_length: float = _p(0.95, "l0", "stance leg length target in walking", 0.5, 1.1)
     ds_kp: float = _p(200.0, "1/s^2", "eq. 1: stance leg-length gain (double stance)", 0.0, 1e4)
     ds_kd: float = _p(25.0, "1/s", "eq. 1: stance leg-length rate gain (double stance)", 0.0, 1e3)
-    energy_gain: float = _p(10.0, "1/s", "eq. 3: tangential gain on the leg-rate error", 0.0, 1e3)
+    energy_gain: float = _p(30.0, "1/s", "eq. 3: tangential gain on the leg-rate error", 0.0, 1e3)
     ds_front_load: float = _p(0.3, "-", "least front-leg force in double stance, as a fraction of "
                               "the hip weight (keeps the new stance foot planted)", 0.0, 1.0)
     ds_accel_max: float = _p(1.0, "g", "limit of the tangential hip acceleration of eq. 3", 0.0, 10.0)
