@@ -15,11 +15,21 @@ Python between rollout chunks). Each gait runs its own states:
 Transitions are contact and phase driven. Left/right is data: ``memory[M_STANCE]`` is the
 stance (front) foot index, the swing foot is ``1 - stance``.
 
-Deviations from the seed, stated: eq. 2 is used in its energy-consistent form
-phi_dot_target = -sqrt(v_top^2 + 2 g l (1 - cos phi)) / l (the pendulum passes the top at
-v_top); v_top is adapted once per step by an integral law so the mean speed meets the target;
-the expected strike height continues the slope seen between the feet (slope_trust = 0 gives
-the seed's level-ground guess).
+Deviations from and additions to the seed, stated:
+- eq. 2 is used in its energy-consistent form phi_dot_target = -sqrt(v_top^2 + 2 g l
+  (1 - cos phi)) / l (the pendulum passes the top at v_top); v_top is adapted once per step by
+  an integral law so that the mean speed over whole steps meets the target speed;
+- the double-stance force split keeps eq. 1's normal force first and saturates eq. 3's
+  tangential force so that the legs only push (legs/push_hip_pendulum); double stance ends when
+  the pendulum energy reaches its target (the legs cannot brake it), the rear leg is at its
+  longest, or the hip has passed over the front foot;
+- the expected strike height continues the slope seen between the feet (slope_trust = 0 gives
+  the seed's level-ground guess);
+- the swing hip torque is saturated so that its reaction does not push the stance foot out of
+  a friction cone (legs/limit_hip_torque);
+- a step whose hip rolls back before passing the stance foot is abandoned: the swing foot
+  goes back down and double stance pushes again (counted as a retry);
+- before STAND the walker slows down (top speed stop_speed) and stops in double stance.
 """
 import math
 from enum import IntEnum
