@@ -1,0 +1,216 @@
+"""Step-to-step map of the walking Ranger (issue 9), for planarsim.analysis.
+
+Section: the controller's own mid-stance event (controller.choose_programs: the stance leg
+passes vertical in single stance, M_MID_DONE 0 -> 1, and the step-to-step feedback sets this
+step's push-off current M_PUSH_I from the hip speed, i.e. the memory that would carry the
+previous step over is rewritten from the state here). The section state is the simulation
+just BEFORE the ``control_ranger`` call that fires the event: State, the last step's contact
+impulses (the estimator's input), and the controller memory before that call (so replaying the
+call runs the estimator filter exactly once). The other memory that carries over is the state of
+the contact estimator's Butterworth filters (2 per foot): part of the section coordinates.
+
+Section coordinates, stance side st (outer legs 0 by default), swing side sw = 1 - st (the
+stance leg angle is the section condition, it stays at its reference value just past 0):
+  x = (stance foot angle, swing leg angle, swing foot angle [rad],
+       stance leg rate, swing leg rate, stance foot rate, swing foot rate [rad/s],
+       filter state z0, z1 of the outer foot, z0, z1 of the inner foot [-])
+The map runs one stride: to the next counted mid-stance of the same stance side. Counted are
+only true crossings (stance leg within CROSS_TOL of vertical): with the shipped controller the
+landing foot bounces, the estimator swaps the stance to the trailing leg for a few ms and the
+mid-stance feedback fires there too, far behind vertical (see the report of issue 9).
+
+Findings (dt = 1 ms, shipped parameters; examples/gait_multipliers.py prints them): the settled
+gait is NOT period-one at this section: successive sections cycle through about five distinct
+states (push currents 1.4-3.1 A), |P(x0) - x0| ~ 0.06-0.25, and the finite-difference Jacobian
+is not reproducible across steps eps (multipliers from O(0.1) to O(100)): the map is
+non-smooth at the scale of dt (contact engagement, estimator hysteresis and program switches
+happen at step boundaries). tests/walkers/test_gait_maps.py asserts the issue's requirement
+and marks it as an expected failure.
+A perturbation rolls the stance foot on its sole (flat ground) and rebuilds every body pose
+and velocity through the pins from it (walkers.common.section), the stance contact point at
+rest, so the perturbed state is consistent with the pins and the pinned stance contact.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from planarsim.analysis import StepMap, StepMapError
+from planarsim.kernels._jit import jit
+from planarsim.kernels.step import step
+
+from walkers.common.section import GaitMapMixin, chain_poses, chain_velocities, copy_tuple, restore_tuple
+
+from . import controller as C
+from .rollout import RangerSim
+
+NAMES = ("stance_foot_angle", "swing_leg_angle", "swing_foot_angle", "stance_leg_rate",
+         "swing_leg_rate", "stance_foot_rate", "swing_foot_rate",
+         "filter_outer_z0", "filter_outer_z1", "filter_inner_z0", "filter_inner_z1")
+CODE_FELL, CODE_NO_EVENT = 3, 4
+DT = 1e-3        # [s] the shipped step (the controller does not walk at dt = 1e-4)
+SETTLE = 20.0    # [s] walking from the start pose before the reference section
+EPS = 1e-3       # finite-difference step [rad, rad/s, -]
+CROSS_TOL = 0.02   # [rad] a counted mid-stance has the stance leg within this of vertical
+
+
+@jit
+def rollout_to_midstance(m, s, ws, opt, k, prog, motor, mem, mem_before, gui, steplog, u,
+                         side, cross_tol, n_events, max_steps):
+    """Control + physics until the controller's mid-stance event has fired n_events times with
+    leg `side` in stance and that leg within cross_tol [rad] of vertical (a true crossing: the
+    event also fires when a landing foot's bounce makes the estimator swap the stance to the
+    trailing leg, far behind vertical; those are not counted). On the last one, mem is put back
+    to its value before that control call and the rollout stops before the physics step (s, ws
+    untouched by it). Returns (code, steps done): 0 ok, 1/2 engine guard, 3 fell, 4 not enough
+    events in max_steps."""
+    count = 0
+    for i in range(max_steps):
+        for j in range(mem.shape[0]):
+            mem_before[j] = mem[j]
+        C.control_ranger(m, s, ws, k, prog, motor, mem, gui, steplog, u)
+        st = int(mem[C.M_STANCE])
+        if (mem_before[C.M_MID_DONE] == 0.0 and mem[C.M_MID_DONE] == 1.0 and st == side
+                and int(mem_before[C.M_STANCE]) == side and s.q[st, 2] > -cross_tol):
+            count += 1
+            if count >= n_events:
+                for j in range(mem.shape[0]):
+                    mem[j] = mem_before[j]
+                return 0, i
+        code = step(m, s, ws, opt, u)
+        if code != 0:
+            return code, i
+        if mem[C.M_FELL] != 0.0:
+            return CODE_FELL, i + 1
+    return CODE_NO_EVENT, max_steps
+
+
+
+class RangerGaitMap(GaitMapMixin):
+    """Section snapshot of a walking Ranger and its stride map (two mid-stances).
+
+    ``RangerGaitMap(settle=20.0, dt=1e-3)`` walks from the WALK start pose for `settle` [s],
+    then on to the next mid-stance on side `stance` (0 outer): that section state is the
+    reference (the converged limit cycle when settle is long enough). ``x0`` its coordinates;
+    ``step_map()`` the StepMap.
+    """
+
+    SECTION = "controller mid-stance (outer stance leg passing vertical), stride map"
+    names = NAMES
+
+    def __init__(self, settle: float = SETTLE, dt: float = DT, params=None, stance: int = 0):
+        self.dt, self.settle = float(dt), float(settle)
+        self.rs = rs = RangerSim(params, dt=dt, gait="walk", max_steps=16)
+        self.model = rs.model
+        self.m = rs.model.arrays
+        c = rs.controller
+        self.tables = (c.k, c.prog, c.motor)
+        self.gui, self.steplog = c.gui, np.zeros((16, C.N_LOG))
+        self.mem_before = np.zeros_like(c.mem)
+        self.max_steps = int(round(3.0 / dt))
+        self.stance = int(stance)
+        if self.stance not in (0, 1):
+            raise ValueError(f"stance={stance} must be 0 (outer legs) or 1 (inner legs)")
+        s, ws = rs.sim.state, rs.sim.ws
+        code, _ = self._rollout(s, ws, c.mem, 10 ** 9, int(round(settle / dt)))
+        if code not in (0, CODE_NO_EVENT):
+            raise StepMapError(f"Ranger failed while settling (code {code})")
+        self._run(s, ws, c.mem, 1)
+        self.state0, self.ws0, self.mem0 = s.copy(), copy_tuple(ws), c.mem.copy()
+        self.x0 = self.coords(self.state0, self.mem0)
+        self.s, self.ws, self.mem = s.copy(), copy_tuple(ws), c.mem.copy()
+        # sole geometry of the stance foot (rolling perturbations) and the reference chain
+        ci = self.stance                      # contact i sits on foot i (model.build order)
+        a = self.m
+        if int(a.contact_body[ci]) != 2 + ci:
+            raise RuntimeError("Ranger model: sole contact order changed; update gait_map")
+        self.sole_center = np.array(a.contact_local[ci], dtype=np.float64)
+        self.sole_radius = float(a.contact_radius[ci])
+
+    def _rollout(self, s, ws, mem, n_events, max_steps):
+        k, prog, motor = self.tables
+        return rollout_to_midstance(self.m, s, ws, self.rs.sim.options, k, prog, motor, mem, self.mem_before,
+                                    self.gui, self.steplog, self.rs.u, self.stance, CROSS_TOL, n_events,
+                                    max_steps)
+
+    def _run(self, s, ws, mem, n_events):
+        code, n = self._rollout(s, ws, mem, n_events, self.max_steps)
+        if code != 0:
+            what = {CODE_FELL: "fell", CODE_NO_EVENT: "no mid-stance"}.get(code, f"engine guard {code}")
+            raise StepMapError(f"Ranger step map: {what} (t={s.time[0]:.3f} s)")
+        return n
+
+    def _step_once(self, s, ws, mem):
+        """Get past a section state (one control + physics step) without stopping at it."""
+        k, prog, motor = self.tables
+        C.control_ranger(self.m, s, ws, k, prog, motor, mem, self.gui, self.steplog, self.rs.u)
+        code = step(self.m, s, ws, self.rs.sim.options, self.rs.u)
+        if code != 0:
+            raise StepMapError(f"Ranger step map: engine guard {code}")
+
+    # coordinates ---------------------------------------------------------------------------------
+    def coords(self, s, mem) -> np.ndarray:
+        st = int(mem[C.M_STANCE])
+        sw = 1 - st
+        q, v = s.q, s.v
+        z = mem[C.M_FILT:C.M_FILT + 4]
+        return np.array([q[2 + st, 2], q[sw, 2], q[2 + sw, 2], v[st, 2], v[sw, 2], v[2 + st, 2],
+                         v[2 + sw, 2], z[0], z[1], z[2], z[3]])
+
+    def _pose(self, q, rates):
+        """Body positions and velocities of the chain rooted at the stance foot rolling on flat
+        ground with its sole centre where q puts it (contact point at rest)."""
+        st = self.stance
+        root = 2 + st
+        th = q[root, 2]
+        c, sn = math.cos(th), math.sin(th)
+        lc = self.sole_center
+        center = q[root, :2] + np.array([c * lc[0] - sn * lc[1], sn * lc[0] + c * lc[1]])
+        pos = chain_poses(self.model, q[:, 2], root, q[root, :2])
+        contact = center - np.array([0.0, self.sole_radius])
+        w = rates[root]
+        r = q[root, :2] - contact
+        vel = chain_velocities(self.model, np.c_[pos, q[:, 2]], rates, root, np.array([-w * r[1], w * r[0]]))
+        return pos, vel, center
+
+    def set_section(self, x) -> None:
+        """Scratch simulation := reference section with coordinates x."""
+        restore_tuple(self.s, self.state0)
+        restore_tuple(self.ws, self.ws0)
+        self.mem[:] = self.mem0
+        d = np.asarray(x, dtype=np.float64) - self.x0
+        st, sw = self.stance, 1 - self.stance
+        q0, v0 = self.state0.q, self.state0.v
+        ang = q0[:, 2].copy()
+        rate = v0[:, 2].copy()
+        ang[2 + st] += d[0]
+        ang[sw] += d[1]
+        ang[2 + sw] += d[2]
+        rate[st] += d[3]
+        rate[sw] += d[4]
+        rate[2 + st] += d[5]
+        rate[2 + sw] += d[6]
+        pos_ref, vel_ref, center = self._pose(q0, v0[:, 2])
+        # the stance foot rolls by d[0] on flat ground: its sole centre moves by -r d[0] along x
+        root = 2 + st
+        lc = self.sole_center
+        c, sn = math.cos(ang[root]), math.sin(ang[root])
+        center_new = center + np.array([-self.sole_radius * d[0], 0.0])
+        q_new = np.c_[np.zeros((self.model.n_body, 2)), ang]
+        q_new[root, :2] = center_new - np.array([c * lc[0] - sn * lc[1], sn * lc[0] + c * lc[1]])
+        pos_new, vel_new, _ = self._pose(q_new, rate)
+        self.s.q[:, :2] += pos_new - pos_ref
+        self.s.q[:, 2] = ang
+        self.s.v[:] += vel_new - vel_ref
+        self.mem[C.M_FILT:C.M_FILT + 4] += d[7:11]
+
+    def advance(self, x) -> np.ndarray:
+        """One stride (two mid-stances) from section coordinates x; the coordinates after it."""
+        self.set_section(x)
+        self._step_once(self.s, self.ws, self.mem)      # leave the section
+        self._run(self.s, self.ws, self.mem, 1)
+        return self.coords(self.s, self.mem)
+
+    def step_map(self) -> StepMap:
+        return StepMap(self.advance, dim=len(NAMES), names=NAMES)
