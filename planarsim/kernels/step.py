@@ -56,7 +56,12 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         changed = update_modes(m, s, ws, h, opt.mode_strategy, rounds == 0, include_ccd)
         rounds += 1
     if changed != 0:
-        # cap reached: solve once more so impulses match the final modes
+        # cap reached: contacts engaged this step must not be left free to penetrate (they
+        # stick), then solve once more so impulses match the final modes
+        for i in range(m.contact_body.shape[0]):
+            if ws.contact_new[i] == 1 and s.contact_mode[i] == 0:
+                s.contact_mode[i] = 1
+        ws.info[4] += 1
         build_rows(m, s, ws)
         solve_impulses(m, ws, h, opt.pivot_tol)
         gather_contact_impulses(m, s, ws)
@@ -67,8 +72,13 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
 def step(m, s, ws, opt, u):
     """Advance s by one step of m.dt under actuator commands u; return the guard code."""
     copy_state(s, ws.prev)
+    # a state handed in from outside (restored, edited) is checked before it is used
+    code = check_guards(s, ws, opt.guard_limit)
+    if code != 0:
+        return code
     ws.info[0] = 0
     ws.info[1] = 0
+    ws.info[4] = 0
     for i in range(m.contact_body.shape[0]):
         ws.contact_new[i] = 0
     h = m.dt
