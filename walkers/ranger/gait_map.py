@@ -21,10 +21,11 @@ mid-stance feedback fires there too, far behind vertical (see the report of issu
 
 Findings (dt = 1 ms, shipped parameters; examples/gait_multipliers.py prints them): the settled
 gait is NOT period-one at this section: successive sections cycle through about five distinct
-states (push currents 1.4-3.1 A), |P(x0) - x0| ~ 0.06-0.25, and the finite-difference Jacobian
-is not reproducible across steps eps (multipliers from O(0.1) to O(100)): the map is
-non-smooth at the scale of dt (contact engagement, estimator hysteresis and program switches
-happen at step boundaries). tests/walkers/test_gait_maps.py asserts the issue's requirement
+states (push currents 1.4-3.1 A), |P(x0) - x0| = 0.16 (swing leg rate [rad/s]), and the
+central-difference Jacobian at x0 depends on the step eps (spectral radius 9.0, 6.7, 2.2 for
+eps = 1e-3, 3e-3, 1e-2; bit for bit reproducible for a given eps): the map is non-smooth at the
+scale of dt (contact engagement, estimator hysteresis and program switches happen at step
+boundaries), and Newton from the mean section state finds no period-one fixed point. tests/walkers/test_gait_maps.py asserts the issue's requirement
 and marks it as an expected failure.
 A perturbation rolls the stance foot on its sole (flat ground) and rebuilds every body pose
 and velocity through the pins from it (walkers.common.section), the stance contact point at
