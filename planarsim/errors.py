@@ -31,3 +31,8 @@ class SimulationDiverged(RuntimeError):
         self.field = field
         self.value = value
         self.last_state = last_state
+
+    def __reduce__(self):
+        # picklable, so that an error raised in a worker process reaches the caller intact
+        return (type(self), (str(self), self.step, self.time, self.body, self.field, self.value,
+                             self.last_state))

@@ -218,3 +218,15 @@ def test_the_uncorrupted_description_builds():
 def test_one_corrupted_field_always_gives_a_model_error(corrupt):
     with pytest.raises(ModelError):
         build_described(corrupt)
+
+
+def test_simulation_diverged_survives_pickling():
+    import pickle
+    model = two_link_on_hills()
+    sim = ps.Simulator(model)
+    sim.state.v[0, 0] = math.nan
+    with pytest.raises(SimulationDiverged) as e:
+        sim.step(np.array([0.0]))
+    back = pickle.loads(pickle.dumps(e.value))
+    assert (back.step, back.body, back.field, str(back)) == (e.value.step, e.value.body, e.value.field, str(e.value))
+    assert np.array_equal(back.last_state.q, e.value.last_state.q)
