@@ -102,7 +102,7 @@ def test_ranger_map_deterministic_and_multipliers_finite(ranger):
 
 
 @pytest.mark.xfail(strict=True, reason="shipped Ranger settles on a gait that is not period-one at "
-                   "mid-stance (~5 distinct section states, |P(x0)-x0| ~ 0.06-0.25); issue 9 report")
+                   "mid-stance (irregular strides, |P(x0)-x0| = 0.16); issue 9 report")
 def test_ranger_gait_is_period_one(ranger):
     assert ranger.residual() <= 1e-3
 

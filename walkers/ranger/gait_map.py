@@ -20,8 +20,10 @@ landing foot bounces, the estimator swaps the stance to the trailing leg for a f
 mid-stance feedback fires there too, far behind vertical (see the report of issue 9).
 
 Findings (dt = 1 ms, shipped parameters; examples/gait_multipliers.py prints them): the settled
-gait is NOT period-one at this section: successive sections cycle through about five distinct
-states (push currents 1.4-3.1 A), |P(x0) - x0| = 0.16 (swing leg rate [rad/s]), and the
+gait is NOT period-one at this section: successive sections wander among several states
+(roughly recurring every 3-5 strides, push currents 1.2-3.2 A) with occasional stumbling
+strides (e.g. one of 2.3 s ending with the stance foot at 0.65 rad), |P(x0) - x0| = 0.16
+(swing leg rate [rad/s]), and the
 central-difference Jacobian at x0 depends on the step eps (spectral radius 9.0, 6.7, 2.2 for
 eps = 1e-3, 3e-3, 1e-2; bit for bit reproducible for a given eps): the map is non-smooth at the
 scale of dt (contact engagement, estimator hysteresis and program switches happen at step
