@@ -30,6 +30,9 @@ class StepOptions(NamedTuple):
     max_ccd_splits : cap on time-of-impact splits of one step
     guard_limit : any |q| or |v| component above this stops the run
     pivot_tol : relative pivot below which a constraint row is treated as redundant (closed loops)
+    cap_policy : when the mode rounds hit max_mode_iters: 1 (default) contacts engaged in this
+        step stick (never left free below the ground); 0 the modes of the last round stand
+        (the seed's tolerance: a cycling contact may be left free and sink for a step)
     """
     mode_strategy: int = MODES_ALTERNATING
     max_mode_iters: int = 8
@@ -38,6 +41,7 @@ class StepOptions(NamedTuple):
     max_ccd_splits: int = 4
     guard_limit: float = 1e10
     pivot_tol: float = 1e-11
+    cap_policy: int = 1
 
 
 def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:

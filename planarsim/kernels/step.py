@@ -58,9 +58,10 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     if changed != 0:
         # cap reached: contacts engaged this step must not be left free to penetrate (they
         # stick), then solve once more so impulses match the final modes
-        for i in range(m.contact_body.shape[0]):
-            if ws.contact_new[i] == 1 and s.contact_mode[i] == 0:
-                s.contact_mode[i] = 1
+        if opt.cap_policy == 1:
+            for i in range(m.contact_body.shape[0]):
+                if ws.contact_new[i] == 1 and s.contact_mode[i] == 0:
+                    s.contact_mode[i] = 1
         ws.info[4] += 1
         build_rows(m, s, ws)
         solve_impulses(m, ws, h, opt.pivot_tol)

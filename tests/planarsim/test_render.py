@@ -411,7 +411,12 @@ def test_html_export_is_a_self_contained_player(sliding_run, tmp_path):
     assert "http://" not in page and "https://" not in page      # nothing fetched from the net
     frag = show_inline(traj, model, fps=5, size=(1.6, 0.9), dpi=50)
     html = frag.data if hasattr(frag, "data") else frag
-    assert type(frag).__name__ == "HTML" and html.count("data:image/png;base64,") == 10
+    try:
+        import IPython  # noqa: F401
+        assert type(frag).__name__ == "HTML"
+    except ImportError:
+        assert isinstance(frag, str)  # without IPython, the HTML string itself
+    assert html.count("data:image/png;base64,") == 10
     assert "<html>" not in html
 
 
