@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .state import State
-from .trajectory import atomic_write
+from .trajectory import atomic_write, read_npz
 
 SNAPSHOT_VERSION = 1
 
@@ -32,13 +32,7 @@ def save_snapshot(path, state: State, memory: dict | None = None) -> Path:
 def load_snapshot(path):
     """Read a snapshot: returns (State, memory dict). Clear errors for damaged files."""
     path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except FileNotFoundError:
-        raise
-    except Exception as e:
-        raise ValueError(f"{path}: not a readable planarsim snapshot (truncated or corrupted?): {e}") from None
+    data = read_npz(path, "snapshot")
     version = int(data.get("snapshot_version", -1))
     if version != SNAPSHOT_VERSION:
         raise ValueError(f"{path}: snapshot format version {version}; this planarsim reads version "

@@ -104,13 +104,7 @@ class Trajectory:
     @classmethod
     def load(cls, path) -> "Trajectory":
         path = Path(path)
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                data = {k: z[k] for k in z.files}
-        except FileNotFoundError:
-            raise
-        except Exception as e:  # zipfile.BadZipFile, ValueError, EOFError, OSError ...
-            raise ValueError(f"{path}: not a readable planarsim trajectory (truncated or corrupted?): {e}") from None
+        data = read_npz(path, "trajectory")
         version = int(data.get("format_version", -1))
         if version != FORMAT_VERSION:
             raise ValueError(f"{path}: trajectory format version {version}; this planarsim reads "
@@ -146,6 +140,17 @@ class Trajectory:
         atomic_write(path, lambda f: np.savetxt(f, table, delimiter=",", header=",".join(cols),
                                                 comments="", fmt="%.10g"), binary=False)
         return path
+
+
+def read_npz(path, what: str) -> dict:
+    """All arrays of a .npz file; a damaged file raises ValueError naming `what` it should be."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise
+    except Exception as e:  # zipfile.BadZipFile, ValueError, EOFError, OSError ...
+        raise ValueError(f"{path}: not a readable planarsim {what} (truncated or corrupted?): {e}") from None
 
 
 def atomic_write(path, write, binary=True) -> None:
