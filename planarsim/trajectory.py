@@ -64,6 +64,22 @@ class Trajectory:
         return cls(**arrs, body_names=model.body_names, contact_names=model.contact_names,
                    act_names=model.act_names, **kw)
 
+    @classmethod
+    def concatenate(cls, chunks) -> "Trajectory":
+        """Join trajectories recorded one after another (chunks of one run) into one; labels
+        are those the chunks share, names and info come from the first chunk."""
+        chunks = list(chunks)
+        if not chunks:
+            raise ValueError("concatenate needs at least one trajectory")
+        if len(chunks) == 1:
+            return chunks[0]
+        first = chunks[0]
+        arrays = {k: np.concatenate([getattr(c, k) for c in chunks]) for k in cls._ARRAYS}
+        shared = [k for k in first.labels if all(k in c.labels for c in chunks)]
+        labels = {k: np.concatenate([np.asarray(c.labels[k]) for c in chunks]) for k in shared}
+        return cls(**arrays, body_names=first.body_names, contact_names=first.contact_names,
+                   act_names=first.act_names, labels=labels, info=dict(first.info))
+
     def __len__(self):
         return len(self.t)
 

@@ -124,15 +124,9 @@ class Quadruped:
 
     def trajectory(self) -> Trajectory:
         """All chunks run so far, joined."""
-        if len(self._chunks) == 1:
-            return self._chunks[0]
         if not self._chunks:
             return Trajectory.from_recorder(self.model, make_recorder(self.model, 0), 0)
-        first = self._chunks[0]
-        arrays = {k: np.concatenate([getattr(c, k) for c in self._chunks]) for k in Trajectory._ARRAYS}
-        labels = {k: np.concatenate([c.labels[k] for c in self._chunks]) for k in LABELS}
-        return Trajectory(**arrays, body_names=first.body_names, contact_names=first.contact_names,
-                          act_names=first.act_names, labels=labels, info=dict(first.info))
+        return Trajectory.concatenate(self._chunks)
 
     def summary(self) -> dict:
         """distance [m] and mean_speed [m/s] of the torso since the start, steps (pair

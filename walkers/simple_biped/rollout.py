@@ -155,11 +155,7 @@ class Walker:
         """All chunks run so far, joined."""
         if not self._chunks:
             return Trajectory.from_recorder(self.model, make_recorder(self.model, 0), 0)
-        first = self._chunks[0]
-        arrays = {k: np.concatenate([getattr(c, k) for c in self._chunks]) for k in Trajectory._ARRAYS}
-        labels = {k: np.concatenate([c.labels[k] for c in self._chunks]) for k in LABELS}
-        return Trajectory(**arrays, body_names=first.body_names, contact_names=first.contact_names,
-                          act_names=first.act_names, labels=labels, info=dict(first.info))
+        return Trajectory.concatenate(self._chunks)
 
     def summary(self) -> dict:
         """distance [m] and mean_speed [m/s] of the hip since the start, positive actuator work
