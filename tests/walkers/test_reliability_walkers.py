@@ -1,5 +1,5 @@
-"""Issue 12 across the shipped walkers: bit-identical runs (in process and in a fresh process
-with a warm cache), and a soak run without divergence (marked slow)."""
+"""Issue 12 across the shipped walkers: bit-identical runs (twice in process, and in a fresh
+process with a cold or warm numba cache), snapshots, and a soak run (marked slow)."""
 import hashlib
 import subprocess
 import sys
@@ -35,13 +35,45 @@ def test_walker_runs_are_bit_identical(name):
     b = run_hashes(name)
     assert len(a) >= 0.9 * SECONDS / 1e-3 or len(a) == len(b)
     assert a == b
-    code = textwrap.dedent(f"""
-        import hashlib
-        from tests.walkers.test_reliability_walkers import run_hashes
-        print(hashlib.blake2b("".join(run_hashes({name!r})).encode()).hexdigest())
+
+
+def all_walker_digests():
+    """{walker: blake2b over the per-step hashes of its 1e4-step run}."""
+    return {name: hashlib.blake2b("".join(run_hashes(name)).encode()).hexdigest()
+            for name in sorted(walkers.WALKERS)}
+
+
+def test_fresh_process_cold_or_warm_cache_gives_the_same_bits(tmp_path):
+    """Every shipped walker, 1e4 steps: the per-step state hashes of this process equal those of
+    a fresh process. One of the two compiled the kernels from an empty numba cache: if this
+    process compiled the step kernel itself (a fresh checkout, as in CI), the subprocess loads
+    the cache it wrote (warm); if this process loaded it from the cache, the subprocess gets an
+    empty cache directory and compiles everything (cold). Either way cold and warm are compared."""
+    import json
+    import os
+    from planarsim.kernels.step import step
+    here = all_walker_digests()
+    compiled_here = bool(step.stats.cache_misses)
+    env = dict(os.environ)
+    if not compiled_here:
+        env["NUMBA_CACHE_DIR"] = str(tmp_path / "cold-cache")
+    code = textwrap.dedent("""
+        import json
+        from planarsim.kernels.step import step
+        from tests.walkers.test_reliability_walkers import all_walker_digests
+        digests = all_walker_digests()
+        print(json.dumps({"digests": digests, "cache_misses": len(step.stats.cache_misses),
+                          "cache_hits": len(step.stats.cache_hits)}))
     """)
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == hashlib.blake2b("".join(a).encode()).hexdigest()
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env=env, timeout=1800)
+    there = json.loads(out.stdout.strip().splitlines()[-1])
+    # the subprocess really was the other kind: cold when this one was warm, and vice versa
+    if compiled_here:
+        assert there["cache_hits"] >= 1, there
+    else:
+        assert there["cache_misses"] >= 1, there
+    assert there["digests"] == here
 
 
 def joint_residuals(model, q):
@@ -98,19 +130,3 @@ def test_walker_snapshot_with_controller_memory_continues_bit_for_bit(tmp_path):
     again.state.restore(state)
     again.memory[:] = memory["controller"]
     assert frame_hashes(again.run(1.0)) == expected
-
-
-def test_cold_cache_process_gives_the_same_bits(tmp_path):
-    """A fresh process that compiles the kernels from scratch (empty numba cache) reproduces
-    the Simple Biped's run bit for bit."""
-    import hashlib as _h
-    import os
-    a = run_hashes("simple-biped", 3.0)
-    code = textwrap.dedent("""
-        import hashlib
-        from tests.walkers.test_reliability_walkers import run_hashes
-        print(hashlib.blake2b("".join(run_hashes("simple-biped", 3.0)).encode()).hexdigest())
-    """)
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cold-cache"))
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
-    assert out.stdout.strip() == _h.blake2b("".join(a).encode()).hexdigest()
