@@ -1,7 +1,8 @@
-"""Engine benchmarks: `python benchmarks/run.py [scenes] [--csv benchmarks/results]`.
+"""Engine benchmarks of issue 8: `python benchmarks/run.py [scenes] [--csv benchmarks/results]`
+(identical to `planarsim bench`; `--help` lists the options).
 
-The scenes and the runner live in planarsim/bench_scenes.py and planarsim/bench.py so that
-`planarsim bench` runs the same thing from an installed package.
+The scenes and the runner live in planarsim/bench*.py so that `planarsim bench` runs the same
+thing from an installed package; the peer comparison needs `pip install planarsim[compare]`.
 """
 import sys
 

@@ -1,87 +1,187 @@
-"""Benchmark runner: steps per second of the named scenes (warm, median of repeats).
+"""Benchmark runner of issue 8: every figure in one run of one command.
 
-    planarsim bench                     # all scenes (same as python benchmarks/run.py)
-    planarsim bench chain4 rod_drop     # some
-    planarsim bench --csv DIR           # also write DIR/<machine>/<scene>.csv
+    planarsim bench                        # everything (same as: python benchmarks/run.py)
+    planarsim bench chain4 rod_drop        # only these scenes (and their peer comparison)
+    planarsim bench --parts scenes,peers   # parts: scenes, peers, walkers, batch, startup
+    planarsim bench --peers pymunk,box2d   # peers to compare (default: all; 'none' skips)
+    planarsim bench --no-cold              # skip the cold-cache start-up (about a minute)
+    planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
 
-Each scene is built, compiled (first-call time printed), warmed up, snapshotted, then timed
-from the snapshot `--repeats` times: compiled multi-step run, and a Python loop of single steps.
+Parts (each warm after compilation; steps/s = median and min-max of --repeats runs):
+- scenes: the named scenes of bench_scenes.md (chains N = 2..64, rod drop, 7-link biped
+  collapse, boxes on hills): first-call time (numba compile or cache load), compiled
+  steps/s, real-time factor, Python single-step loop steps/s; accuracy figures of the peer
+  scenes; log-log slope of the chains' cost per step against N.
+- peers: the chain, biped and rod scenes built natively in MuJoCo (mujoco.rollout, one
+  thread), pymunk and Box2D (Python loops) from the same description (bench_metrics.SceneSpec),
+  timed the same way in the same run: steps/s, ratio planarsim/peer, pin error, energy drift,
+  penetration. Needs `pip install planarsim[compare]`; a missing peer is named and skipped.
+- walkers: every registered walker walking --walker-seconds (60 s) via its simulate().
+- batch: 64 Simple Biped walks on 1 and 2 worker threads (planarsim.batch).
+- startup: import-to-first-step times in fresh subprocesses, warm and cold numba cache
+  (bench_startup.py says how the cache is made cold).
+Then a table of every issue-8 target with the measured figure, met or not met. Targets are
+measured here, never asserted by the tests.
 """
 from __future__ import annotations
 
 import argparse
+import csv
+import math
 import platform
-import statistics
+import re
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-import planarsim as ps
+from .bench_metrics import PEER_SCENES
+from .bench_peers import PEER_MODULES, available_peers, measure_peer, measure_planarsim
+from .bench_report import print_peers, print_scenes, print_startup, print_targets, print_walkers, targets
 from .bench_scenes import SCENES
 
+PARTS = ("scenes", "peers", "walkers", "batch", "startup")
 
-def time_scene(name, build, n_steps, repeats=5, python_steps=2000):
-    model = build()
-    sim = ps.Simulator(model)
-    t0 = time.perf_counter()
-    sim.steps(1)
-    first = time.perf_counter() - t0
-    sim.step()
-    snap = sim.snapshot()
-    compiled = []
-    for _ in range(repeats):
-        sim.restore(snap)
-        t0 = time.perf_counter()
-        sim.steps(n_steps)
-        compiled.append(n_steps / (time.perf_counter() - t0))
-    python = []
-    for _ in range(max(1, repeats // 2)):
-        sim.restore(snap)
-        t0 = time.perf_counter()
-        for _ in range(python_steps):
-            sim.step()
-        python.append(python_steps / (time.perf_counter() - t0))
-    return dict(scene=name, bodies=model.n_body, first_call_s=first,
-                steps_per_s=statistics.median(compiled), spread=(min(compiled), max(compiled)),
-                python_steps_per_s=statistics.median(python))
+
+def machine_name() -> str:
+    """hostname + CPU model, safe as a directory name."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return re.sub(r"[^A-Za-z0-9.+-]+", "-", f"{platform.node()}_{cpu}").strip("-")
+
+
+def chain_slopes(rows):
+    """Log-log slope of cost per step against N over all chains and over N >= 16 (nan when
+    fewer than 2 points)."""
+    chains = sorted((r["bodies"], 1.0 / r["steps_per_s"]) for r in rows if r["scene"].startswith("chain"))
+    out = {}
+    for key, pts in (("all", chains), ("tail", [p for p in chains if p[0] >= 16])):
+        if len(pts) >= 2:
+            n, cost = np.array(pts).T
+            out[key] = (float(np.polyfit(np.log(n), np.log(cost), 1)[0]), [int(x) for x in n])
+        else:
+            out[key] = (math.nan, [int(p[0]) for p in pts])
+    return out
+
+
+def write_csv(results, folder) -> Path:
+    """One CSV per scene (rows: engines / walkers / worker counts) and targets.csv."""
+    out = Path(folder) / machine_name()
+    out.mkdir(parents=True, exist_ok=True)
+    by_scene = {}
+    for row in results["rows"]:
+        by_scene.setdefault(row["scene"], []).append(row)
+    by_scene["targets"] = [dict(target=t, measured=m, status=s) for t, m, s in results["targets"]]
+    for scene, rows in by_scene.items():
+        keys = []
+        for r in rows:
+            keys += [k for k in r if k not in keys]
+        with open(out / f"{scene}.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=keys)
+            w.writeheader()
+            w.writerows(rows)
+    return out
+
+
+def _list(text, known, what):
+    items = [x for x in text.split(",") if x]
+    bad = [x for x in items if x not in known]
+    if bad:
+        raise SystemExit(f"planarsim bench: unknown {what} {bad}; choose from {list(known)}")
+    return items
+
+
+def parse_args(argv):
+    import walkers
+    ap = argparse.ArgumentParser(prog="planarsim bench", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scenes", nargs="*", help=f"scenes (default all): {', '.join(SCENES)}")
+    ap.add_argument("--parts", default=",".join(PARTS), help=f"comma list of {', '.join(PARTS)} (default all)")
+    ap.add_argument("--peers", default=",".join(PEER_MODULES), help="comma list of mujoco, pymunk, box2d, or none")
+    ap.add_argument("--repeats", type=int, default=5, help="timed repeats per figure (default 5)")
+    ap.add_argument("--steps", type=int, default=None, help="timing episode in steps (default: the scene's)")
+    ap.add_argument("--accuracy-seconds", type=float, default=None,
+                    help="accuracy run [s] (default 10 for chains, else the episode)")
+    ap.add_argument("--walkers", default=",".join(walkers.WALKERS), help="comma list of walkers (default all)")
+    ap.add_argument("--walker-seconds", type=float, default=60.0, help="simulated seconds per walk (60)")
+    ap.add_argument("--batch-jobs", type=int, default=64)
+    ap.add_argument("--batch-seconds", type=float, default=10.0, help="simulated seconds per batch job (10)")
+    ap.add_argument("--no-cold", action="store_true", help="skip the cold-cache start-up measurement")
+    ap.add_argument("--csv", metavar="DIR", default=None, help="write DIR/<machine>/<scene>.csv")
+    args = ap.parse_args(argv)
+    if args.repeats < 1:
+        ap.error(f"--repeats {args.repeats} must be >= 1")
+    unknown = [n for n in args.scenes if n not in SCENES]
+    if unknown:
+        ap.error(f"unknown scene(s) {unknown}; choose from {list(SCENES)}")
+    args.scenes = args.scenes or list(SCENES)
+    args.parts = _list(args.parts, PARTS, "part(s)")
+    args.peers = [] if args.peers == "none" else _list(args.peers, PEER_MODULES, "peer(s)")
+    args.walkers = _list(args.walkers, walkers.WALKERS, "walker(s)")
+    return args
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="planarsim bench", description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scenes", nargs="*", help=f"scenes to run (default all): {', '.join(SCENES)}")
-    ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--csv", metavar="DIR", default=None, help="write DIR/<machine>/<scene>.csv")
-    args = ap.parse_args(argv)
-    names = args.scenes or list(SCENES)
-    unknown = [n for n in names if n not in SCENES]
-    if unknown:
-        ap.error(f"unknown scene(s) {unknown}; choose from {list(SCENES)}")
-    print(f"{'scene':16s} {'bodies':>6s} {'first call':>10s} {'steps/s (median, min-max)':>34s} {'python step/s':>14s}")
-    rows = []
-    for name in names:
-        build, n = SCENES[name]
-        r = time_scene(name, build, n, args.repeats)
-        rows.append(r)
-        print(f"{name:16s} {r['bodies']:6d} {r['first_call_s']:9.2f}s {r['steps_per_s']:12,.0f} "
-              f"({r['spread'][0]:,.0f}-{r['spread'][1]:,.0f}) {r['python_steps_per_s']:14,.0f}", flush=True)
-    chains = [r for r in rows if r["scene"].startswith("chain")]
-    if len(chains) >= 3:
-        n = np.array([r["bodies"] for r in chains], float)
-        cost = np.array([1.0 / r["steps_per_s"] for r in chains])
-        slope = np.polyfit(np.log(n), np.log(cost), 1)[0]
-        print(f"chain cost per step ~ N^{slope:.2f} (log-log fit over N = {', '.join(str(int(x)) for x in n)})")
+    args = parse_args(argv)
+    import numba
+    print(f"planarsim bench on {machine_name()}: Python {platform.python_version()}, numpy {np.__version__}, "
+          f"numba {numba.__version__}; {args.repeats} repeats", flush=True)
+    results = {"rows": [], "scenes": {}, "peers": {}, "walkers": {}, "batch": None, "startup": None}
+    rows = results["rows"]
+    parts = set(args.parts)
+    if parts & {"scenes", "peers"}:
+        for name in args.scenes:
+            row = measure_planarsim(name, args.repeats, args.steps, args.accuracy_seconds)
+            results["scenes"][name] = row
+            rows.append(row)
+        results["slopes"] = chain_slopes(list(results["scenes"].values()))
+        print_scenes(results)
+    if "peers" in parts:
+        found, missing = available_peers(args.peers)
+        for msg in missing:
+            print(msg, flush=True)
+        for name in [s for s in args.scenes if s in PEER_SCENES]:
+            results["peers"][name] = []
+            for peer, mod in found.items():
+                row = measure_peer(mod, name, args.repeats, args.steps, args.accuracy_seconds)
+                results["peers"][name].append(row)
+                rows.append(row)
+        if found:
+            print_peers(results)
+        elif args.peers:
+            print("peer comparison skipped: no peer installed (pip install planarsim[compare])")
+    if "walkers" in parts and args.walkers:
+        from .bench_walkers import measure_walker
+        for name in args.walkers:
+            row = measure_walker(name, args.walker_seconds, args.repeats)
+            results["walkers"][name] = row
+            rows.append(row)
+        print_walkers(results)
+    if "batch" in parts:
+        from .bench_walkers import measure_batch
+        batch = measure_batch(args.batch_jobs, args.batch_seconds, max(1, min(args.repeats, 3)))
+        results["batch"] = batch
+        if batch is None:
+            print("batch: planarsim.batch is not available; skipped")
+        else:
+            rows += batch
+            print_walkers(results, batch_only=True)
+    if "startup" in parts:
+        from .bench_startup import measure_startup
+        results["startup"] = measure_startup(cold=not args.no_cold)
+        rows += results["startup"]
+        print_startup(results)
+    results["targets"] = targets(results)
+    print_targets(results)
     if args.csv:
-        out = Path(args.csv) / platform.node()
-        out.mkdir(parents=True, exist_ok=True)
-        for r in rows:
-            (out / f"{r['scene']}.csv").write_text(
-                "scene,bodies,first_call_s,steps_per_s,min,max,python_steps_per_s\n"
-                f"{r['scene']},{r['bodies']},{r['first_call_s']:.3f},{r['steps_per_s']:.0f},"
-                f"{r['spread'][0]:.0f},{r['spread'][1]:.0f},{r['python_steps_per_s']:.0f}\n")
-        print(f"wrote {out}")
+        print(f"wrote {write_csv(results, args.csv)}")
+    return 0
 
 
 if __name__ == "__main__":

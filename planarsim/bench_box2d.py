@@ -1,0 +1,81 @@
+"""Box2D peer of the benchmark scenes: pybox2d, PyPI package `Box2D` (2.3.10 ships manylinux
+wheels for CPython 3.11 on x86_64; `box2d-py` 2.3.8 has no wheel for 3.11 and needs SWIG to
+build). Installed by `pip install planarsim[compare]`.
+
+Bodies from a SceneSpec with the same masses, inertias and start poses: polygon boxes (Box2D's
+skin radius of 1 cm included, as Box2D has it) with groupIndex -1 (no collisions between the
+character's own bodies), then the mass data set explicitly (centre at the body origin); pins
+are revolute joints at the local anchors; the ground is a static edge at y = 0. Friction 1,
+restitution 0, gravity 9.81, dt 1 ms, doSleep False, 8 velocity and 3 position iterations (the
+Box2D manual's recommendation). Timing: a Python loop of world.Step from a freshly built world.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+ENGINE = "box2d"
+PACKAGE = "Box2D"
+VELOCITY_ITERATIONS, POSITION_ITERATIONS = 8, 3
+
+
+def version() -> str:
+    import Box2D
+    return Box2D.__version__
+
+
+class World:
+    """A Box2D world of the scene with run(n) (timed), reset() and record(n)."""
+
+    def __init__(self, spec):
+        import Box2D
+        self.b2, self.spec = Box2D, spec
+        self.reset()
+
+    def reset(self):
+        b2, spec = self.b2, self.spec
+        world = b2.b2World(gravity=(0.0, -9.81), doSleep=False)
+        ground = world.CreateStaticBody(position=(0.0, 0.0))
+        if spec.ground:
+            ground.CreateEdgeFixture(vertices=[(-100.0, 0.0), (100.0, 0.0)], friction=1.0, restitution=0.0)
+        bodies = []
+        for b in range(spec.n_body):
+            body = world.CreateDynamicBody(position=(float(spec.q0[b, 0]), float(spec.q0[b, 1])),
+                                           angle=float(spec.q0[b, 2]))
+            w, h = spec.box[b]
+            if not np.isnan(w):
+                body.CreatePolygonFixture(box=(float(w) / 2, float(h) / 2), density=1.0, friction=1.0,
+                                          restitution=0.0, groupIndex=-1)
+            md = b2.b2MassData()
+            md.mass, md.center, md.I = float(spec.mass[b]), (0.0, 0.0), float(spec.inertia[b])
+            body.massData = md
+            bodies.append(body)
+        for j, (a, b) in enumerate(spec.pin_body):
+            world.CreateRevoluteJoint(bodyA=ground if a < 0 else bodies[a], bodyB=ground if b < 0 else bodies[b],
+                                      localAnchorA=tuple(float(x) for x in spec.pin_anchor[j, 0]),
+                                      localAnchorB=tuple(float(x) for x in spec.pin_anchor[j, 1]),
+                                      collideConnected=False)
+        self.world, self.bodies = world, bodies
+
+    def run(self, n: int):
+        step, dt = self.world.Step, self.spec.dt
+        vi, pi = VELOCITY_ITERATIONS, POSITION_ITERATIONS
+        for _ in range(n):
+            step(dt, vi, pi)
+
+    def pose(self, q, v, k):
+        for b, body in enumerate(self.bodies):
+            p, u = body.position, body.linearVelocity
+            q[k, b] = p[0], p[1], body.angle
+            v[k, b] = u[0], u[1], body.angularVelocity
+
+    def record(self, n: int):
+        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state."""
+        self.reset()
+        q = np.zeros((n + 1, self.spec.n_body, 3))
+        v = np.zeros_like(q)
+        self.pose(q, v, 0)
+        step, dt = self.world.Step, self.spec.dt
+        for k in range(1, n + 1):
+            step(dt, VELOCITY_ITERATIONS, POSITION_ITERATIONS)
+            self.pose(q, v, k)
+        return q, v

@@ -1,0 +1,144 @@
+"""MuJoCo peer of the benchmark scenes (`pip install planarsim[compare]`).
+
+The scene is an MJCF string built from a SceneSpec: the x-z plane is planarsim's x-y plane,
+hinges turn about -y so that positive angles are counter-clockwise as in planarsim. Pinned
+bodies are nested (reduced coordinates: a pin is a hinge at its anchor, so MuJoCo's joint error
+is zero by construction); a body without a parent pin gets slide x, slide z and a hinge. Each
+body frame sits at its centre of mass with an explicit inertia (only the -y component acts).
+Boxes are 3D boxes 0.1 m deep; collisions between the character's own bodies are off
+(contype 2 / conaffinity 1 against a ground plane of contype 1 / conaffinity 2); friction 1;
+MuJoCo's default soft contact (solref 0.02 1, no restitution parameter); Euler integrator,
+timestep 1 ms, gravity 9.81.
+
+Timing: `mujoco.rollout.rollout` with one MjData (one thread), the episode as one call from the
+start state, preallocated output. Recording (accuracy): an mj_step loop reading the body poses
+(xipos, xmat) and COM velocities (mj_objectVelocity).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+ENGINE = "mujoco"
+PACKAGE = "mujoco"
+
+
+def version() -> str:
+    import mujoco
+    return mujoco.__version__
+
+
+def _parents(spec):
+    """parent[b] = (pin index, parent body or -1) for every pinned body; raises if not a tree."""
+    parent = {}
+    for j, (a, b) in enumerate(spec.pin_body):
+        if b < 0 or b in parent:
+            raise ValueError(f"MuJoCo peer: scene {spec.name:.17g} is not a tree of pins (body {b})")
+        parent[int(b)] = (j, int(a))
+    return parent
+
+
+def mjcf(spec) -> str:
+    """The MJCF text of the scene."""
+    parent = _parents(spec)
+    children = {}
+    for b, (j, a) in parent.items():
+        children.setdefault(a, []).append(b)
+    roots = [b for b in range(spec.n_body) if b not in parent]
+
+    def body_xml(b, indent):
+        pad = " " * indent
+        q = spec.q0[b]
+        if b in parent:
+            j, a = parent[b]
+            qa = spec.q0[a] if a >= 0 else np.zeros(3)
+            c, s = np.cos(qa[2]), np.sin(qa[2])
+            dx, dy = q[0] - qa[0], q[1] - qa[1]
+            rel = (c * dx + s * dy, -s * dx + c * dy)
+            ang = q[2] - qa[2]
+            lx, ly = spec.pin_anchor[j, 1]
+            joints = [f'<joint name="pin{j}" type="hinge" axis="0 -1 0" pos="{lx:.17g} 0 {ly:.17g}"/>']
+        else:
+            rel, ang = (q[0], q[1]), q[2]
+            joints = [f'<joint name="b{b}x" type="slide" axis="1 0 0"/>',
+                      f'<joint name="b{b}z" type="slide" axis="0 0 1"/>',
+                      f'<joint name="b{b}r" type="hinge" axis="0 -1 0"/>']
+        inertia = spec.inertia[b]
+        lines = [f'{pad}<body name="b{b}" pos="{rel[0]:.17g} 0 {rel[1]:.17g}" axisangle="0 -1 0 {ang:.17g}">',
+                 f'{pad}  <inertial pos="0 0 0" mass="{spec.mass[b]:.17g}" '
+                 f'diaginertia="{inertia:.17g} {inertia:.17g} {inertia:.17g}"/>']
+        lines += [f"{pad}  {jx}" for jx in joints]
+        w, h = spec.box[b]
+        if not np.isnan(w):
+            lines.append(f'{pad}  <geom type="box" size="{w / 2:.17g} 0.05 {h / 2:.17g}" contype="2" '
+                         'conaffinity="1" friction="1 0.005 0.0001" mass="0"/>')
+        for child in children.get(b, []):
+            lines += body_xml(child, indent + 2)
+        lines.append(f"{pad}</body>")
+        return lines
+
+    world = []
+    if spec.ground:
+        world.append('    <geom type="plane" size="100 1 0.1" contype="1" conaffinity="2" friction="1 0.005 0.0001"/>')
+    for b in roots + children.get(-1, []):
+        world += body_xml(b, 4)
+    return "\n".join([
+        '<mujoco model="planarsim-bench">',
+        '  <compiler angle="radian" inertiafromgeom="false"/>',
+        f'  <option timestep="{spec.dt:.17g}" gravity="0 0 {-9.81:.17g}" integrator="Euler"/>',
+        "  <worldbody>", *world, "  </worldbody>", "</mujoco>"])
+
+
+class World:
+    """A MuJoCo model of the scene with run(n) (timed), reset() and record(n)."""
+
+    def __init__(self, spec):
+        import mujoco
+        from mujoco import rollout
+        self.mj, self._rollout, self.spec = mujoco, rollout, spec
+        self.model = mujoco.MjModel.from_xml_string(mjcf(spec))
+        self.data = mujoco.MjData(self.model)
+        self.kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        self.x0 = np.zeros(mujoco.mj_stateSize(self.model, self.kind))
+        mujoco.mj_getState(self.model, self.data, self.x0, self.kind)
+        self._out = {}
+        self.body_ids = [mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"b{b}")
+                         for b in range(spec.n_body)]
+
+    def reset(self):
+        self.mj.mj_resetData(self.model, self.data)
+
+    def run(self, n: int):
+        """n steps from the start state in one single-threaded rollout call."""
+        if n not in self._out:
+            self._out[n] = np.zeros((1, n, len(self.x0)))
+        self._rollout.rollout(self.model, self.data, self.x0[None, :], nstep=n, state=self._out[n])
+
+    def _kinematics(self):
+        """Poses and COM velocities of the current state (mj_step leaves those of the step's
+        start; this recomputes them without touching the solver's warm start)."""
+        m, d = self.model, self.data
+        self.mj.mj_kinematics(m, d)
+        self.mj.mj_comPos(m, d)
+        self.mj.mj_comVel(m, d)
+
+    def pose(self, q, v, k):
+        d, mj = self.data, self.mj
+        res = np.zeros(6)
+        for b, bid in enumerate(self.body_ids):
+            mat = d.xmat[bid]
+            q[k, b] = d.xipos[bid][0], d.xipos[bid][2], np.arctan2(mat[6], mat[0])
+            mj.mj_objectVelocity(self.model, d, mj.mjtObj.mjOBJ_BODY, bid, res, 0)
+            v[k, b] = res[3], res[5], -res[1]
+
+    def record(self, n: int):
+        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state."""
+        self.reset()
+        self._kinematics()
+        q = np.zeros((n + 1, self.spec.n_body, 3))
+        v = np.zeros_like(q)
+        self.pose(q, v, 0)
+        for k in range(1, n + 1):
+            self.mj.mj_step(self.model, self.data)
+            self._kinematics()
+            self.pose(q, v, k)
+        return q, v

@@ -1,0 +1,87 @@
+"""pymunk peer of the benchmark scenes (`pip install planarsim[compare]`).
+
+Bodies from a SceneSpec with the same masses, inertias and start poses (body origin at the
+centre of mass); pins are PivotJoints at the local anchors; boxes are Poly boxes (radius 0) in
+one ShapeFilter group (no collisions between the character's own bodies); the ground is a
+static Segment at y = 0. Friction 1, elasticity 0, gravity 9.81, dt 1 ms, sleeping off
+(pymunk's default sleep_time_threshold = inf), default 10 solver iterations. pymunk's default
+collision_slop (0.1) is meant for pixel units; for metres it is set to 0.5 mm here.
+Timing: a Python loop of space.step(dt) from a freshly built space (build not timed).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+ENGINE = "pymunk"
+PACKAGE = "pymunk"
+COLLISION_SLOP = 5e-4  # [m]
+
+
+def version() -> str:
+    import pymunk
+    return pymunk.version
+
+
+class World:
+    """A pymunk space of the scene with run(n) (timed), reset() and record(n)."""
+
+    def __init__(self, spec):
+        import pymunk
+        self.pm, self.spec = pymunk, spec
+        self.reset()
+
+    def reset(self):
+        pm, spec = self.pm, self.spec
+        space = pm.Space()
+        space.gravity = (0.0, -9.81)
+        space.collision_slop = COLLISION_SLOP
+        bodies = []
+        group = pm.ShapeFilter(group=1)
+        for b in range(spec.n_body):
+            body = pm.Body(float(spec.mass[b]), float(spec.inertia[b]))
+            body.position = float(spec.q0[b, 0]), float(spec.q0[b, 1])
+            body.angle = float(spec.q0[b, 2])
+            space.add(body)
+            w, h = spec.box[b]
+            if not np.isnan(w):
+                box = pm.Poly.create_box(body, (float(w), float(h)), radius=0.0)
+                box.mass = 0.0  # no mass from the shape: the body's mass and moment stand
+                box.friction, box.elasticity, box.filter = 1.0, 0.0, group
+                space.add(box)
+            bodies.append(body)
+        # the body was created with its mass and moment; a shape with a density would change them
+        for b, body in enumerate(bodies):
+            body.mass, body.moment = float(spec.mass[b]), float(spec.inertia[b])
+        for j, (a, b) in enumerate(spec.pin_body):
+            ba = space.static_body if a < 0 else bodies[a]
+            bb = space.static_body if b < 0 else bodies[b]
+            la, lb = (tuple(float(x) for x in spec.pin_anchor[j, e]) for e in (0, 1))
+            space.add(pm.PivotJoint(ba, bb, la, lb))
+        if spec.ground:
+            ground = pm.Segment(space.static_body, (-100.0, 0.0), (100.0, 0.0), 0.0)
+            ground.friction, ground.elasticity = 1.0, 0.0
+            space.add(ground)
+        self.space, self.bodies = space, bodies
+
+    def run(self, n: int):
+        step, dt = self.space.step, self.spec.dt
+        for _ in range(n):
+            step(dt)
+
+    def pose(self, q, v, k):
+        for b, body in enumerate(self.bodies):
+            p, u = body.position, body.velocity
+            q[k, b] = p.x, p.y, body.angle
+            v[k, b] = u.x, u.y, body.angular_velocity
+
+    def record(self, n: int):
+        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state."""
+        self.reset()
+        q = np.zeros((n + 1, self.spec.n_body, 3))
+        v = np.zeros_like(q)
+        self.pose(q, v, 0)
+        step, dt = self.space.step, self.spec.dt
+        for k in range(1, n + 1):
+            step(dt)
+            self.pose(q, v, k)
+        return q, v

@@ -1,0 +1,157 @@
+"""Printing of the benchmark figures and the table of issue-8 targets (met / not met).
+
+`results` is the dictionary built by bench.main: scenes {name: row}, peers {scene: [rows]},
+walkers {name: row}, batch [rows] or None, startup [rows] or None, slopes.
+"""
+from __future__ import annotations
+
+import math
+
+from .bench_walkers import WALKER_TARGETS
+
+PIN_TOL = 1e-9  # [m] pin residual bound of the targets
+
+
+def _num(x, unit=""):
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    for scale, suffix in ((1e6, "M"), (1e3, "k")):
+        if abs(x) >= scale:
+            return f"{x / scale:.3g}{suffix}{unit}"
+    return f"{x:.3g}{unit}"
+
+
+def _spread(r):
+    return f"{_num(r['steps_per_s'])} ({_num(r['steps_per_s_min'])}-{_num(r['steps_per_s_max'])})"
+
+
+def _len(x):
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    return "0" if x == 0 else f"{x:.2e} m" if abs(x) < 1e-4 else f"{x * 1e3:.3g} mm"
+
+
+def print_scenes(res):
+    print("\nplanarsim scenes (compiled Simulator.steps; Python loop of Simulator.step alongside)")
+    print(f"{'scene':15s} {'bodies':>6s} {'first call':>10s} {'steps/s median (min-max)':>26s} "
+          f"{'x real time':>11s} {'python step/s':>13s}")
+    for r in res["scenes"].values():
+        print(f"{r['scene']:15s} {r['bodies']:6d} {r['first_call_s']:9.2f}s {_spread(r):>26s} "
+              f"{r['rtf']:11,.0f} {_num(r['python_steps_per_s']):>13s}")
+    sl = res.get("slopes", {})
+    for key, label in (("all", "all chains"), ("tail", "N >= 16")):
+        slope, ns = sl.get(key, (math.nan, []))
+        if len(ns) >= 2:
+            print(f"chain cost per step ~ N^{slope:.2f} (log-log fit, {label}: N = {', '.join(map(str, ns))})")
+    print(flush=True)
+
+
+def print_peers(res):
+    print("peer comparison, same run (ratio = planarsim steps/s / peer steps/s; energy drift = "
+          "(E_end - E_0) / scale of bench_scenes.md)")
+    print(f"{'scene':15s} {'engine':9s} {'version':8s} {'steps/s median (min-max)':>26s} {'ratio':>6s} "
+          f"{'pin error':>10s} {'E drift':>8s} {'|dE| max':>8s} {'penetration':>11s} {'rest gap':>9s}")
+    for scene, peers in res["peers"].items():
+        ps_row = res["scenes"][scene]
+        for r in [ps_row] + peers:
+            ratio = "-" if r is ps_row else f"{ps_row['steps_per_s'] / r['steps_per_s']:.2f}x"
+            line = (f"{scene:15s} {r['engine']:9s} {r['version']:8s} {_spread(r):>26s} {ratio:>6s} "
+                    f"{_len(r.get('pin_error_m')):>10s} {100 * r['energy_drift']:7.2f}% "
+                    f"{100 * r['energy_err_max']:7.2f}% {_len(r.get('penetration_m')):>11s} "
+                    f"{_len(r.get('rest_gap_m')):>9s}")
+            if scene == "rod_drop":
+                line += (f"  impact {r['impact_speed']:.3f} m/s, rebound {r['rebound_speed']:.3f} m/s, "
+                         f"at rest after {r['time_to_rest']:.3f} s")
+            print(line)
+    print(flush=True)
+
+
+def print_walkers(res, batch_only=False):
+    if not batch_only:
+        print("walkers (simulate(seconds, gait): compiled rollout + model build + Trajectory)")
+        print(f"{'walker':16s} {'gait':7s} {'first call':>10s} {'steps':>7s} {'steps/s median (min-max)':>26s} "
+              f"{'x real time':>11s} {'fell':>5s} {'distance':>9s}")
+        for r in res["walkers"].values():
+            print(f"{r['walker']:16s} {r['gait']:7s} {r['first_call_s']:9.2f}s {r['steps']:7d} {_spread(r):>26s} "
+                  f"{r['rtf']:11,.0f} {str(r['fell']):>5s} {r['distance_m']:7.1f} m")
+        print(flush=True)
+        return
+    rows = res["batch"]
+    print(f"batch: {rows[0]['jobs']} {rows[0]['walker']} walks of {rows[0]['seconds']:g} s (planarsim.batch.simulate_batch)")
+    for r in rows:
+        print(f"  workers={r['workers']}: {_spread(r)} simulated steps/s, falls {r['falls']}")
+    if len(rows) >= 2:
+        print(f"  {rows[1]['workers']} workers / 1 worker: {rows[1]['steps_per_s'] / rows[0]['steps_per_s']:.2f}x")
+    print(flush=True)
+
+
+def print_startup(res):
+    print("start-up (fresh subprocess; seconds from before `import planarsim`)")
+    for r in res["startup"]:
+        print(f"  {r['cache']:4s} numba cache: import {r['import_s']:.2f} s, first engine step {r['engine_step_s']:.2f} s, "
+              f"first Simple Biped step {r['walker_step_s']:.2f} s (whole process {r['process_s']:.2f} s)")
+    print(flush=True)
+
+
+def _status(ok):
+    return "met" if ok else "NOT MET"
+
+
+def targets(res):
+    """[(target, measured, 'met' | 'NOT MET' | 'not measured')] of every issue-8 target."""
+    out = []
+    scenes, peers = res["scenes"], res["peers"]
+    for scene, label, pins in (("biped_collapse", "7-link biped collapse", True), ("rod_drop", "rod drop", False),
+                               ("chain4", "4-link chain", True), ("chain32", "32-link chain", False)):
+        target = f"{label}: >= 2x fastest peer" + (f", pin residual <= {PIN_TOL:g} m" if pins else "")
+        r, pr = scenes.get(scene), peers.get(scene)
+        if r is None or not pr:
+            out.append((target, "no peer measured" if r else "scene not run", "not measured"))
+            continue
+        best = max(pr, key=lambda p: p["steps_per_s"])
+        ratio = r["steps_per_s"] / best["steps_per_s"]
+        ok = ratio >= 2.0
+        text = f"{ratio:.2f}x {best['engine']} ({_num(r['steps_per_s'])} vs {_num(best['steps_per_s'])} steps/s)"
+        if pins:
+            ok = ok and r["pin_error_m"] <= PIN_TOL
+            text += f", pin residual {r['pin_error_m']:.1e} m"
+        out.append((target, text, _status(ok)))
+    slope, ns = res.get("slopes", {}).get("tail", (math.nan, []))
+    if len(ns) >= 2:
+        out.append(("chains: cost per step linear in N (log-log slope over N >= 16 <= 1.15)",
+                    f"slope {slope:.2f} (all N: {res['slopes']['all'][0]:.2f})", _status(slope <= 1.15)))
+    else:
+        out.append(("chains: cost per step linear in N", "needs chains N >= 16", "not measured"))
+    for name, goal in WALKER_TARGETS.items():
+        r = res["walkers"].get(name)
+        target = f"{name}: >= {_num(goal)} steps/s (one core)"
+        if r is None:
+            out.append((target, "not run", "not measured"))
+        else:
+            out.append((target, f"{_num(r['steps_per_s'])} steps/s" + (", FELL" if r["fell"] else ""),
+                        _status(r["steps_per_s"] >= goal)))
+    batch = res["batch"]
+    target = "batch of 64 on 2 cores: >= 1.8x one core"
+    if not batch or len(batch) < 2:
+        out.append((target, "batch not run", "not measured"))
+    else:
+        ratio = batch[1]["steps_per_s"] / batch[0]["steps_per_s"]
+        out.append((target, f"{ratio:.2f}x ({batch[0]['jobs']} jobs)", _status(ratio >= 1.8 and batch[0]["jobs"] >= 64)))
+    st = {r["cache"]: r for r in res["startup"] or []}
+    for cache, goal in (("cold", 30.0), ("warm", 2.0)):
+        target = f"start-up, {cache} cache: <= {goal:g} s to a walker's first step"
+        r = st.get(cache)
+        if r is None:
+            out.append((target, "not run", "not measured"))
+        else:
+            out.append((target, f"{r['walker_step_s']:.2f} s (engine step {r['engine_step_s']:.2f} s)",
+                        _status(r["walker_step_s"] <= goal)))
+    return out
+
+
+def print_targets(res):
+    print("issue 8 targets (measured in this run)")
+    width = max(len(t) for t, _, _ in res["targets"])
+    for target, measured, status in res["targets"]:
+        print(f"  {target:{width}s}  {measured:52s} {status}")
+    print(flush=True)
