@@ -8,10 +8,10 @@ equation moves q along the START-of-step constraint directions J(q0):
 Corrections of unilateral rows (contact normals, joint limits) move positions only: pushing a
 body out of the ground must not give it the velocity overlap / h (energy from nowhere).
 """
-from ._jit import jit
+from ._jit import jit, jit_inline
 from .math2d import update_trig
 from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_row
-from .solve import apply_impulses, assemble, factor_solve
+from .solve import apply_impulses, assemble, factor_solve, substitute
 
 
 @jit
@@ -42,7 +42,7 @@ def max_residual(m, s, ws):
     return worst
 
 
-@jit
+@jit_inline
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
     """Newton-SHAKE; returns the final max residual [m or rad]."""
     n = ws.n_row[0]
@@ -71,10 +71,10 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
             # velocities: bilateral rows change by -c / h, unilateral rows not at all (a
             # separate solve: zeroing the unilateral impulses of the position solve instead
             # leaves a pinned foot, held by its contact against a rod, moving at rod-fix / h)
-            assemble(m, ws, ws.row_Jp, ws.row_J, n)
+            # (same matrix: its factors are reused)
             for r in range(n):
                 ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
-            factor_solve(ws, ws.rhs, ws.lam, n, pivot_tol)
+            substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
             apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_pred, 1.0)
         for i in range(s.q.shape[0]):
             for k in range(3):

@@ -10,7 +10,7 @@ elimination drops a row whose pivot falls below pivot_tol times its own diagonal
 that is a combination of earlier ones; its impulse is zero and the rows it depends on carry
 the load. For consistent constraints this is exact, not a regularisation.
 """
-from ._jit import jit
+from ._jit import jit, jit_inline
 from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
 
 
@@ -66,47 +66,71 @@ def assemble(m, ws, JL, JR, n):
 
 
 @jit
-def factor_solve(ws, rhs, x, n, tol):
-    """Solve A x = rhs by Gaussian elimination inside the envelope (A, rhs destroyed).
+def factor(A, first, reach, n, tol, scale):
+    """LU factorisation of A in place, inside the envelope given by first / reach (see
+    compute_envelope): U on and above the diagonal, the multipliers L below it. Takes the
+    arrays it needs, not the workspace (a call passing the whole workspace would copy hundreds
+    of array descriptors). `scale` (n,) is scratch.
 
     A row whose pivot falls below tol times its own diagonal depends on earlier rows (a
-    closed loop, a box on two corners): it is dropped (impulse 0). Returns #dropped.
+    closed loop, a box on two corners): it is dropped (impulse 0), marked by a zero pivot.
+    Returns #dropped.
     """
-    A = ws.A
-    first = ws.row_first
-    reach = ws.row_reach
     dropped = 0
     for k in range(n):
-        x[k] = abs(A[k, k])  # scale for the pivot test
+        scale[k] = abs(A[k, k])  # scale for the pivot test
     for k in range(n):
         piv = A[k, k]
         last = reach[k]
-        if abs(piv) <= tol * x[k] or x[k] == 0.0:
+        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
             dropped += 1
             for j in range(k + 1, last + 1):
                 if first[j] <= k:
                     A[k, j] = 0.0
                     A[j, k] = 0.0
-            A[k, k] = 1.0
-            rhs[k] = 0.0
+            A[k, k] = 0.0
             continue
         inv = 1.0 / piv
         for i in range(k + 1, last + 1):
             if first[i] > k:
                 continue
             fct = A[i, k] * inv
+            A[i, k] = fct
             if fct == 0.0:
                 continue
             for j in range(k + 1, last + 1):
                 if first[j] <= k:
                     A[i, j] -= fct * A[k, j]
-            rhs[i] -= fct * rhs[k]
+    return dropped
+
+
+@jit
+def substitute(A, first, reach, rhs, x, n):
+    """x = A^-1 rhs from the factors of `factor` (rhs destroyed); dropped rows get x = 0."""
+    for k in range(n):
+        if A[k, k] == 0.0:
+            rhs[k] = 0.0
+            continue
+        rk = rhs[k]
+        for i in range(k + 1, reach[k] + 1):
+            if first[i] <= k:
+                rhs[i] -= A[i, k] * rk
     for k in range(n - 1, -1, -1):
+        if A[k, k] == 0.0:
+            x[k] = 0.0
+            continue
         acc = rhs[k]
         for j in range(k + 1, reach[k] + 1):
             if first[j] <= k:
                 acc -= A[k, j] * x[j]
         x[k] = acc / A[k, k]
+
+
+@jit_inline
+def factor_solve(ws, rhs, x, n, tol):
+    """Factor ws.A and solve A x = rhs; returns #dropped rows."""
+    dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, x)
+    substitute(ws.A, ws.row_first, ws.row_reach, rhs, x, n)
     return dropped
 
 
@@ -138,7 +162,7 @@ def row_dot(ws, r, J, vel):
     return acc
 
 
-@jit
+@jit_inline
 def solve_impulses(m, ws, h, tol):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows."""
     n = ws.n_row[0]

@@ -4,7 +4,7 @@ step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard cod
 (0 ok, 1 non-finite, 2 too large). A time-of-impact split (CCD) repeats stages 1-6 for the
 remainder of the step with the new contact pinned.
 """
-from ._jit import jit
+from ._jit import jit, jit_inline
 from .ccd import advance_to_impact, time_of_impact
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
@@ -30,7 +30,7 @@ def _copy2(src, dst):
             dst[i, k] = src[i, k]
 
 
-@jit
+@jit_inline
 def copy_state(src, dst):
     """dst <- src, array by array (dst is a State of the same shapes; no allocation)."""
     _copy2(src.q, dst.q)
@@ -45,7 +45,7 @@ def copy_state(src, dst):
     _copy2(src.ext_force, dst.ext_force)
 
 
-@jit
+@jit_inline
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 4-6: build rows, solve, check modes; repeat while modes change (capped)."""
     rounds = 0
@@ -103,7 +103,7 @@ def step(m, s, ws, opt, u):
                 ws.info[1] += 1
                 continue
         integrate_positions(s, ws.v_new, h)
-        if opt.refine_iters > 0:
+        if opt.refine_iters > 0 and ws.n_row[0] > 0:
             correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol, opt.pivot_tol)
         break
     s.time[0] = ws.prev.time[0] + m.dt
