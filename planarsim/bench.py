@@ -28,6 +28,7 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+import os
 import platform
 import re
 import sys
@@ -37,7 +38,8 @@ import numpy as np
 
 from .bench_metrics import PEER_SCENES
 from .bench_peers import PEER_MODULES, available_peers, measure_peer, measure_planarsim
-from .bench_report import print_peers, print_scenes, print_startup, print_targets, print_walkers, targets
+from .bench_report import (plot_chain_scaling, print_peers, print_scenes, print_startup, print_targets,
+                           print_walkers, targets)
 from .bench_scenes import SCENES
 
 PARTS = ("scenes", "peers", "walkers", "batch", "startup")
@@ -71,7 +73,8 @@ def chain_slopes(rows):
 
 
 def write_csv(results, folder) -> Path:
-    """One CSV per scene (rows: engines / walkers / worker counts) and targets.csv."""
+    """One CSV per scene (rows: engines / walkers / worker counts) and targets.csv (plus
+    chain_scaling.png, the log-log plot of the chains, written by main)."""
     out = Path(folder) / machine_name()
     out.mkdir(parents=True, exist_ok=True)
     by_scene = {}
@@ -130,8 +133,9 @@ def parse_args(argv):
 def main(argv=None):
     args = parse_args(argv)
     import numba
-    print(f"planarsim bench on {machine_name()}: Python {platform.python_version()}, numpy {np.__version__}, "
-          f"numba {numba.__version__}; {args.repeats} repeats", flush=True)
+    print(f"planarsim bench on {machine_name()} ({os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}): "
+          f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
+          f"{args.repeats} repeats", flush=True)
     results = {"rows": [], "scenes": {}, "peers": {}, "walkers": {}, "batch": None, "startup": None}
     rows = results["rows"]
     parts = set(args.parts)
@@ -180,7 +184,9 @@ def main(argv=None):
     results["targets"] = targets(results)
     print_targets(results)
     if args.csv:
-        print(f"wrote {write_csv(results, args.csv)}")
+        folder = write_csv(results, args.csv)
+        plot_chain_scaling(results, folder / "chain_scaling.png")
+        print(f"wrote {folder}")
     return 0
 
 

@@ -12,7 +12,8 @@ timestep 1 ms, gravity 9.81.
 
 Timing: `mujoco.rollout.rollout` with one MjData (one thread), the episode as one call from the
 start state, preallocated output. Recording (accuracy): an mj_step loop reading the body poses
-(xipos, xmat) and COM velocities (mj_objectVelocity).
+(xipos, xmat) and COM velocities (mj_objectVelocity); it stops at a MuJoCo warning (the
+figures then cover the run up to it, and the warning is reported).
 """
 from __future__ import annotations
 
@@ -131,14 +132,27 @@ class World:
             v[k, b] = res[3], res[5], -res[1]
 
     def record(self, n: int):
-        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state."""
+        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state. A
+        MuJoCo warning (e.g. unstable QACC, after which MuJoCo resets the state) is kept in
+        `self.warnings` as (step, text) and the frames stop before that step."""
+        mj = self.mj
         self.reset()
         self._kinematics()
         q = np.zeros((n + 1, self.spec.n_body, 3))
         v = np.zeros_like(q)
         self.pose(q, v, 0)
-        for k in range(1, n + 1):
-            self.mj.mj_step(self.model, self.data)
-            self._kinematics()
-            self.pose(q, v, k)
+        self.warnings = []
+        step = [0]
+        previous = mj.get_mju_user_warning()
+        mj.set_mju_user_warning(lambda text: self.warnings.append((step[0], text.strip())))
+        try:
+            for k in range(1, n + 1):
+                step[0] = k
+                mj.mj_step(self.model, self.data)
+                if self.warnings:
+                    return q[:k], v[:k]
+                self._kinematics()
+                self.pose(q, v, k)
+        finally:
+            mj.set_mju_user_warning(previous)
         return q, v

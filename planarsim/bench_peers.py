@@ -116,4 +116,8 @@ def measure_peer(peer, name, repeats=5, n_steps=None, accuracy_seconds=None):
     row.update(_summary(_rates(world.run, world.reset, n, repeats), spec.dt))
     q, v = world.record(k)
     row.update(accuracy(spec, q, v))
+    warnings = getattr(world, "warnings", [])
+    if warnings:
+        step, text = warnings[0]
+        row["warning"] = f"{text} (step {step}); figures up to there"
     return row

@@ -6,6 +6,9 @@ walkers {name: row}, batch [rows] or None, startup [rows] or None, slopes.
 from __future__ import annotations
 
 import math
+import os
+
+import numpy as np
 
 from .bench_walkers import WALKER_TARGETS
 
@@ -31,8 +34,13 @@ def _len(x):
     return "0" if x == 0 else f"{x:.2e} m" if abs(x) < 1e-4 else f"{x * 1e3:.3g} mm"
 
 
+def _pct(x):
+    return f"{100 * x:7.2f}%" if abs(x) < 10 else f"{100 * x:7.1e}%"
+
+
 def print_scenes(res):
-    print("\nplanarsim scenes (compiled Simulator.steps; Python loop of Simulator.step alongside)")
+    print("\nplanarsim scenes (compiled Simulator.steps; Python loop of Simulator.step alongside; the first "
+          "scene's first call loads or compiles the step kernel that all scenes share)")
     print(f"{'scene':15s} {'bodies':>6s} {'first call':>10s} {'steps/s median (min-max)':>26s} "
           f"{'x real time':>11s} {'python step/s':>13s}")
     for r in res["scenes"].values():
@@ -56,14 +64,71 @@ def print_peers(res):
         for r in [ps_row] + peers:
             ratio = "-" if r is ps_row else f"{ps_row['steps_per_s'] / r['steps_per_s']:.2f}x"
             line = (f"{scene:15s} {r['engine']:9s} {r['version']:8s} {_spread(r):>26s} {ratio:>6s} "
-                    f"{_len(r.get('pin_error_m')):>10s} {100 * r['energy_drift']:7.2f}% "
-                    f"{100 * r['energy_err_max']:7.2f}% {_len(r.get('penetration_m')):>11s} "
+                    f"{_len(r.get('pin_error_m')):>10s} {_pct(r['energy_drift'])} "
+                    f"{_pct(r['energy_err_max'])} {_len(r.get('penetration_m')):>11s} "
                     f"{_len(r.get('rest_gap_m')):>9s}")
             if scene == "rod_drop":
                 line += (f"  impact {r['impact_speed']:.3f} m/s, rebound {r['rebound_speed']:.3f} m/s, "
                          f"at rest after {r['time_to_rest']:.3f} s")
+            if r.get("warning"):
+                line += f"  [{r['engine']} warning: {r['warning']}]"
             print(line)
+    slopes = engine_slopes(res)
+    if slopes:
+        print("chain cost per step ~ N^slope (log-log fit over the chains run): "
+              + ", ".join(f"{e} {sl:.2f}" for e, sl in slopes.items()))
     print(flush=True)
+
+
+def _chain_costs(res):
+    """{engine: [(N, seconds per step)]} of the chains in the peer comparison."""
+    out = {}
+    for scene, peers in res["peers"].items():
+        if scene.startswith("chain"):
+            for r in [res["scenes"][scene]] + peers:
+                out.setdefault(r["engine"], []).append((r["bodies"], 1.0 / r["steps_per_s"]))
+    return out
+
+
+def engine_slopes(res):
+    """{engine: log-log slope of cost per step against N} (engines with >= 2 chains)."""
+    out = {}
+    for engine, pts in _chain_costs(res).items():
+        if len(pts) >= 2:
+            n, cost = np.array(sorted(pts)).T
+            out[engine] = float(np.polyfit(np.log(n), np.log(cost), 1)[0])
+    return out
+
+
+def plot_chain_scaling(res, path):
+    """Log-log plot of cost per step against N for every engine, with the fitted slopes."""
+    import matplotlib
+    import matplotlib.ticker
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    costs, slopes = _chain_costs(res), engine_slopes(res)
+    if not slopes:
+        return None
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    for engine, pts in costs.items():
+        if engine in slopes:
+            n, cost = np.array(sorted(pts)).T
+            ax.loglog(n, cost * 1e6, "o-", label=f"{engine} (slope {slopes[engine]:.2f})")
+    ns = sorted({n for pts in costs.values() for n, _ in pts})
+    ax.set_xticks(ns, [str(n) for n in ns])
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.yaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.set_xlabel("links N")
+    ax.set_ylabel("wall time per step [us]")
+    ax.set_title("pendulum chain: cost per step")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
 
 
 def print_walkers(res, batch_only=False):
@@ -81,7 +146,8 @@ def print_walkers(res, batch_only=False):
     for r in rows:
         print(f"  workers={r['workers']}: {_spread(r)} simulated steps/s, falls {r['falls']}")
     if len(rows) >= 2:
-        print(f"  {rows[1]['workers']} workers / 1 worker: {rows[1]['steps_per_s'] / rows[0]['steps_per_s']:.2f}x")
+        print(f"  {rows[1]['workers']} workers / 1 worker: {rows[1]['steps_per_s'] / rows[0]['steps_per_s']:.2f}x "
+              f"(load average now {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores: other processes share them)")
     print(flush=True)
 
 
@@ -118,7 +184,7 @@ def targets(res):
         out.append((target, text, _status(ok)))
     slope, ns = res.get("slopes", {}).get("tail", (math.nan, []))
     if len(ns) >= 2:
-        out.append(("chains: cost per step linear in N (log-log slope over N >= 16 <= 1.15)",
+        out.append(("chains: cost per step linear in N (log-log slope, N >= 16, <= 1.15)",
                     f"slope {slope:.2f} (all N: {res['slopes']['all'][0]:.2f})", _status(slope <= 1.15)))
     else:
         out.append(("chains: cost per step linear in N", "needs chains N >= 16", "not measured"))
