@@ -1,8 +1,11 @@
 """StepOptions: the integer and float switches that choose algorithms inside the step."""
 from __future__ import annotations
 
+import math
 from enum import IntEnum
 from typing import NamedTuple
+
+import numpy as np
 
 MODES_ALTERNATING = 0   # the seed's scheme: check one contact per step, in turn
 MODES_ALL = 1           # check every contact each step, iterate to a consistent set
@@ -54,3 +57,35 @@ def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:
     if not refine:
         kw["refine_iters"] = 0
     return StepOptions(mode_strategy=int(strategy), **kw)
+
+
+_OPTION_RULES = {
+    # field: (type, test, rule)
+    "mode_strategy": (int, lambda x: x in (MODES_ALTERNATING, MODES_ALL), "must be 0 (alternating) or 1 (all)"),
+    "max_mode_iters": (int, lambda x: x >= 1, "must be an integer >= 1"),
+    "refine_iters": (int, lambda x: x >= 0, "must be an integer >= 0"),
+    "refine_tol": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0"),
+    "max_ccd_splits": (int, lambda x: x >= 0, "must be an integer >= 0"),
+    "guard_limit": (float, lambda x: math.isfinite(x) and x > 0.0, "must be finite and > 0"),
+    "pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
+    "cap_policy": (int, lambda x: x in (0, 1), "must be 0 or 1"),
+}
+
+
+def check_options(opt) -> StepOptions:
+    """`opt` as a StepOptions of exactly the field types the compiled step expects (int64 /
+    float64), or a ValueError naming the field, its value and the rule."""
+    if not isinstance(opt, StepOptions):
+        raise TypeError(f"options must be a StepOptions (see make_options), got {type(opt).__name__}")
+    out = {}
+    for name, (kind, test, rule) in _OPTION_RULES.items():
+        value = getattr(opt, name)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise ValueError(f"StepOptions.{name}={value!r} {rule}")
+        if kind is int and float(value) != int(value):
+            raise ValueError(f"StepOptions.{name}={value!r} {rule}")
+        value = kind(value)
+        if not test(value):
+            raise ValueError(f"StepOptions.{name}={value!r} {rule}")
+        out[name] = value
+    return StepOptions(**out)

@@ -15,7 +15,7 @@ import numpy as np
 from .errors import SimulationDiverged
 from .kernels.step import run_recorded, run_steps, step as _step
 from .model import Model
-from .options import StepOptions
+from .options import StepOptions, check_options
 from .state import State, make_state, make_workspace
 from .trajectory import Trajectory, make_recorder
 
@@ -36,15 +36,39 @@ class Simulator:
         if not isinstance(model, Model):
             raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
         self.model = model
-        self.options = options if options is not None else StepOptions()
-        self.state = state.copy() if state is not None else make_state(model)
+        self.options = check_options(options if options is not None else StepOptions())
+        self._state = make_state(model)
+        if state is not None:
+            self.state = state
         self.ws = make_workspace(model)
         self._u0 = np.zeros(model.n_act)
+        self._step_entry = None
+        self._steps_entry = None
+
+    # the state is always this simulator's own arrays (of the types its compiled step expects)
+    @property
+    def state(self) -> State:
+        """The current State (numpy arrays, mutated in place by stepping)."""
+        return self._state
+
+    @state.setter
+    def state(self, value: State) -> None:
+        """Copy `value` into the simulator's own state arrays (shapes must match the model)."""
+        if not isinstance(value, State):
+            raise TypeError(f"state must be a planarsim State, got {type(value).__name__}")
+        for name, mine, theirs in zip(State._fields, self._state, value):
+            theirs = np.asarray(theirs)
+            if theirs.shape != mine.shape:
+                raise ValueError(f"state.{name} has shape {theirs.shape}; this model needs {mine.shape}")
+        self._state.restore(value)
 
     # commands -------------------------------------------------------------------------------
     def _commands(self, u):
         if u is None:
             return self._u0
+        if (type(u) is np.ndarray and u.dtype == np.float64 and u.shape == self._u0.shape
+                and u.flags.c_contiguous):
+            return u
         u = np.asarray(u, dtype=np.float64)
         if u.shape != (self.model.n_act,):
             raise ValueError(f"commands u must have shape ({self.model.n_act},) "
@@ -67,14 +91,30 @@ class Simulator:
     # stepping -------------------------------------------------------------------------------
     def step(self, u=None) -> None:
         """One step of model.dt under actuator commands u (n_act,) [N or N m]."""
-        code = _step(self.model.arrays, self.state, self.ws, self.options, self._commands(u))
+        entry = self._step_entry
+        if entry is None:
+            entry = self._step_entry = self._bind(_step, ())
+        code = entry(self.model.arrays, self._state, self.ws, self.options, self._commands(u))
         if code:
             self._raise(code)
 
+    def _bind(self, kernel, extra):
+        """`kernel` compiled for this simulator's argument types (model, state, workspace,
+        options, commands, *extra), to be called directly: numba's type dispatch would
+        re-derive the types of the ~80 arrays in model, state and workspace on every call
+        (about 15 us); the simulator owns those arrays, so their types cannot change."""
+        args = (self.model.arrays, self._state, self.ws, self.options, self._u0) + tuple(extra)
+        return kernel.compile(tuple(kernel.typeof_pyval(a) for a in args))
+
     def steps(self, n: int, u=None) -> None:
         """n steps under constant commands, compiled as one loop."""
-        code, done = run_steps(self.model.arrays, self.state, self.ws, self.options,
-                               self._commands(u), int(n))
+        n = int(n)
+        if n < 0:
+            raise ValueError(f"n={n} steps must be >= 0")
+        entry = self._steps_entry
+        if entry is None:
+            entry = self._steps_entry = self._bind(run_steps, (n,))
+        code, done = entry(self.model.arrays, self._state, self.ws, self.options, self._commands(u), n)
         if code:
             self._raise(code)
 

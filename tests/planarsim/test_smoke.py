@@ -1,6 +1,14 @@
 import numpy as np
+import pytest
 
 import planarsim as ps
+
+
+def _pendulum():
+    b = ps.ModelBuilder(dt=1e-3)
+    rod = b.add_body("rod", mass=1.0, inertia=1.0 / 12, pos=(0.5, 0.0))
+    b.add_pin("pivot", None, rod, anchor_world=(0.0, 0.0))
+    return b.compile()
 
 
 def test_pendulum_swings_and_keeps_its_pin():
@@ -12,3 +20,44 @@ def test_pendulum_swings_and_keeps_its_pin():
     x, y, th = sim.state.q[0]
     assert y < -0.1  # it fell
     assert abs(np.hypot(x, y) - 0.5) < 1e-9  # the pin held
+
+
+@pytest.mark.parametrize("field, value, rule", [
+    ("max_mode_iters", 0, ">= 1"), ("refine_iters", -1, ">= 0"), ("refine_iters", 1.5, "integer"),
+    ("refine_tol", float("nan"), "finite"), ("pivot_tol", 0.0, r"\(0, 1\)"),
+    ("guard_limit", float("inf"), "finite"), ("mode_strategy", 7, "alternating"),
+    ("cap_policy", 2, "0 or 1"), ("max_ccd_splits", "4", "integer"),
+])
+def test_bad_step_options_are_named(field, value, rule):
+    model = _pendulum()
+    with pytest.raises(ValueError, match=f"StepOptions.{field}=.*{rule}"):
+        ps.Simulator(model, ps.StepOptions(**{field: value}))
+
+
+def test_options_are_normalised_and_python_steps_match_compiled_steps():
+    model = _pendulum()
+    a = ps.Simulator(model, ps.StepOptions(refine_iters=np.int32(2), refine_tol=0))
+    assert type(a.options.refine_iters) is int and type(a.options.refine_tol) is float
+    b = ps.Simulator(model, ps.StepOptions(refine_iters=2, refine_tol=0.0))
+    for _ in range(500):
+        a.step()
+    b.steps(500)
+    assert np.array_equal(a.state.q, b.state.q) and np.array_equal(a.state.v, b.state.v)
+
+
+def test_state_assignment_copies_into_the_simulators_arrays():
+    model = _pendulum()
+    sim = ps.Simulator(model)
+    own = sim.state
+    other = ps.make_state(model)
+    other.q[0, 2] = 0.3
+    sim.state = other
+    assert sim.state is own and sim.state.q[0, 2] == 0.3
+    other.q[0, 2] = 0.5                      # no aliasing
+    assert sim.state.q[0, 2] == 0.3
+    bad = ps.State(*(np.zeros((7,) + a.shape[1:], a.dtype) if k == 0 else a
+                     for k, a in enumerate(other)))
+    with pytest.raises(ValueError, match="state.q has shape"):
+        sim.state = bad
+    with pytest.raises(TypeError, match="State"):
+        sim.state = {"q": 1}
