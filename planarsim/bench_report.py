@@ -133,21 +133,26 @@ def plot_chain_scaling(res, path):
 
 def print_walkers(res, batch_only=False):
     if not batch_only:
-        print("walkers (simulate(seconds, gait): compiled rollout + model build + Trajectory)")
+        print("walkers (simulate(seconds, gait): compiled rollout + model build + Trajectory; overhead = "
+              "a one-step walk, included)")
         print(f"{'walker':16s} {'gait':7s} {'first call':>10s} {'steps':>7s} {'steps/s median (min-max)':>26s} "
-              f"{'x real time':>11s} {'fell':>5s} {'distance':>9s}")
+              f"{'x real time':>11s} {'fell':>5s} {'distance':>9s} {'overhead':>9s}")
         for r in res["walkers"].values():
             print(f"{r['walker']:16s} {r['gait']:7s} {r['first_call_s']:9.2f}s {r['steps']:7d} {_spread(r):>26s} "
-                  f"{r['rtf']:11,.0f} {str(r['fell']):>5s} {r['distance_m']:7.1f} m")
+                  f"{r['rtf']:11,.0f} {str(r['fell']):>5s} {r['distance_m']:7.1f} m {1e3 * r['overhead_s']:6.1f} ms")
         print(flush=True)
         return
     rows = res["batch"]
     print(f"batch: {rows[0]['jobs']} {rows[0]['walker']} walks of {rows[0]['seconds']:g} s (planarsim.batch.simulate_batch)")
     for r in rows:
-        print(f"  workers={r['workers']}: {_spread(r)} simulated steps/s, falls {r['falls']}")
+        print(f"  workers={r['workers']}: {_spread(r)} simulated steps/s, {r['cores_busy']:.2f} cores busy "
+              f"(CPU time / wall), falls {r['falls']}")
     if len(rows) >= 2:
         print(f"  {rows[1]['workers']} workers / 1 worker: {rows[1]['steps_per_s'] / rows[0]['steps_per_s']:.2f}x "
-              f"(load average now {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores: other processes share them)")
+              f"(load average now {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
+        print(f"  machine check: {rows[1]['workers']} independent Python processes ran "
+              f"{rows[0]['machine_capacity']:.2f}x the work of one in the same time "
+              f"({rows[1]['workers']:.1f}x = that many free cores; lower = the machine is shared or oversubscribed)")
     print(flush=True)
 
 
@@ -202,7 +207,8 @@ def targets(res):
         out.append((target, "batch not run", "not measured"))
     else:
         ratio = batch[1]["steps_per_s"] / batch[0]["steps_per_s"]
-        out.append((target, f"{ratio:.2f}x ({batch[0]['jobs']} jobs)", _status(ratio >= 1.8 and batch[0]["jobs"] >= 64)))
+        out.append((target, f"{ratio:.2f}x ({batch[0]['jobs']} jobs; machine check {batch[0]['machine_capacity']:.2f}x)",
+                    _status(ratio >= 1.8 and batch[0]["jobs"] >= 64)))
     st = {r["cache"]: r for r in res["startup"] or []}
     for cache, goal in (("cold", 30.0), ("warm", 2.0)):
         target = f"start-up, {cache} cache: <= {goal:g} s to a walker's first step"
