@@ -21,6 +21,7 @@ import time
 import numpy as np
 
 import planarsim as ps
+from .kernels._jit import jit
 from .bench_metrics import ACCURACY_SECONDS, PEER_SCENES, accuracy, spec_from_model
 from .bench_scenes import SCENES
 
@@ -71,9 +72,30 @@ def accuracy_steps(name, dt, seconds=None):
     return max(1, int(round(seconds / dt)))
 
 
-def measure_planarsim(name, repeats=5, n_steps=None, accuracy_seconds=None, python_steps=2000):
+@jit
+def _empty_kernel():
+    return 0
+
+
+def call_floor_s(calls=20000) -> float:
+    """Wall time of one call of an empty compiled function from Python [s] (median of 5)."""
+    _empty_kernel()
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            _empty_kernel()
+        times.append((time.perf_counter() - t0) / calls)
+    return statistics.median(times)
+
+
+def measure_planarsim(name, repeats=5, n_steps=None, accuracy_seconds=None):
     """Timing (compiled and Python-loop steps/s, first-call time) and, for the peer scenes,
-    the accuracy figures of planarsim on scene `name`."""
+    the accuracy figures of planarsim on scene `name`.
+
+    python_over_floor: wall time of one Simulator.step() in a Python loop over the floor of
+    one compiled call from Python, i.e. the step's own compiled cost (from the compiled
+    multi-step run) plus one call of an empty compiled function (call_floor_s)."""
     build, n_default = SCENES[name]
     n = int(n_steps or n_default)
     model = build()
@@ -85,14 +107,14 @@ def measure_planarsim(name, repeats=5, n_steps=None, accuracy_seconds=None, pyth
     row = dict(scene=name, engine="planarsim", version=getattr(ps, "__version__", ""),
                bodies=model.n_body, first_call_s=first)
     row.update(_summary(_rates(lambda k: sim.steps(k), lambda: sim.restore(start), n, repeats), model.dt))
-    n_py = min(python_steps, n)
-
     def python_loop(k):
         step = sim.step
         for _ in range(k):
             step()
-    py = _rates(python_loop, lambda: sim.restore(start), n_py, max(1, repeats // 2))
+    py = _rates(python_loop, lambda: sim.restore(start), n, repeats)
     row["python_steps_per_s"] = statistics.median(py)
+    row["call_floor_s"] = call_floor_s()
+    row["python_over_floor"] = (1.0 / row["python_steps_per_s"]) / (1.0 / row["steps_per_s"] + row["call_floor_s"])
     if name in PEER_SCENES:
         k = accuracy_steps(name, model.dt, accuracy_seconds)
         spec = spec_from_model(name, model, k * model.dt)

@@ -42,10 +42,14 @@ def print_scenes(res):
     print("\nplanarsim scenes (compiled Simulator.steps; Python loop of Simulator.step alongside; the first "
           "scene's first call loads or compiles the step kernel that all scenes share)")
     print(f"{'scene':15s} {'bodies':>6s} {'first call':>10s} {'steps/s median (min-max)':>26s} "
-          f"{'x real time':>11s} {'python step/s':>13s}")
+          f"{'x real time':>11s} {'python step/s':>13s} {'python/floor':>12s}")
     for r in res["scenes"].values():
         print(f"{r['scene']:15s} {r['bodies']:6d} {r['first_call_s']:9.2f}s {_spread(r):>26s} "
-              f"{r['rtf']:11,.0f} {_num(r['python_steps_per_s']):>13s}")
+              f"{r['rtf']:11,.0f} {_num(r['python_steps_per_s']):>13s} {r['python_over_floor']:11.2f}x")
+    if res["scenes"]:
+        floor = next(iter(res["scenes"].values()))["call_floor_s"]
+        print(f"python/floor = time of one Simulator.step() in a Python loop / (the step's compiled cost "
+              f"+ one empty compiled call from Python, {floor * 1e9:.0f} ns)")
     sl = res.get("slopes", {})
     for key, label in (("all", "all chains"), ("tail", "N >= 16")):
         slope, ns = sl.get(key, (math.nan, []))
@@ -187,6 +191,11 @@ def targets(res):
             ok = ok and r["pin_error_m"] <= PIN_TOL
             text += f", pin residual {r['pin_error_m']:.1e} m"
         out.append((target, text, _status(ok)))
+    if scenes:
+        worst = max(scenes.values(), key=lambda r: r["python_over_floor"])
+        out.append(("Python step() within 2x of one compiled call (floor)",
+                    f"worst {worst['python_over_floor']:.2f}x ({worst['scene']})",
+                    _status(worst["python_over_floor"] <= 2.0)))
     slope, ns = res.get("slopes", {}).get("tail", (math.nan, []))
     if len(ns) >= 2:
         out.append(("chains: cost per step linear in N (log-log slope, N >= 16, <= 1.15)",
