@@ -159,7 +159,7 @@ def main(argv=None):
         if found:
             print_peers(results)
         elif args.peers:
-            print("peer comparison skipped: no peer installed (pip install planarsim[compare])")
+            print("peer comparison skipped: no peer installed (pip install planarsim[compare])\n")
     if "walkers" in parts and args.walkers:
         from .bench_walkers import measure_walker
         for name in args.walkers:
@@ -169,7 +169,7 @@ def main(argv=None):
         print_walkers(results)
     if "batch" in parts:
         from .bench_walkers import measure_batch
-        batch = measure_batch(args.batch_jobs, args.batch_seconds, max(1, min(args.repeats, 3)))
+        batch = measure_batch(args.batch_jobs, args.batch_seconds, args.repeats)
         results["batch"] = batch
         if batch is None:
             print("batch: planarsim.batch is not available; skipped")

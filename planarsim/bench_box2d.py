@@ -29,6 +29,7 @@ class World:
     def __init__(self, spec):
         import Box2D
         self.b2, self.spec = Box2D, spec
+        self.timing = "Python loop of world.Step (8 velocity, 3 position iterations)"
         self.reset()
 
     def reset(self):

@@ -94,8 +94,13 @@ class World:
 
     def __init__(self, spec):
         import mujoco
-        from mujoco import rollout
+        try:
+            from mujoco import rollout
+        except ImportError:  # MuJoCo < 3.1: no rollout module
+            rollout = None
         self.mj, self._rollout, self.spec = mujoco, rollout, spec
+        self.timing = ("mujoco.rollout, one thread" if rollout is not None
+                       else "Python loop of mj_step (this MuJoCo has no rollout module)")
         self.model = mujoco.MjModel.from_xml_string(mjcf(spec))
         self.data = mujoco.MjData(self.model)
         self.kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
@@ -109,7 +114,13 @@ class World:
         self.mj.mj_resetData(self.model, self.data)
 
     def run(self, n: int):
-        """n steps from the start state in one single-threaded rollout call."""
+        """n steps from the start state in one single-threaded rollout call (or an mj_step
+        loop after reset() where mujoco.rollout is missing)."""
+        if self._rollout is None:
+            step, m, d = self.mj.mj_step, self.model, self.data
+            for _ in range(n):
+                step(m, d)
+            return
         if n not in self._out:
             self._out[n] = np.zeros((1, n, len(self.x0)))
         self._rollout.rollout(self.model, self.data, self.x0[None, :], nstep=n, state=self._out[n])

@@ -105,7 +105,7 @@ def measure_planarsim(name, repeats=5, n_steps=None, accuracy_seconds=None):
     sim.steps(1)
     first = time.perf_counter() - t0  # numba compile, or load from the on-disk cache
     row = dict(scene=name, engine="planarsim", version=getattr(ps, "__version__", ""),
-               bodies=model.n_body, first_call_s=first)
+               bodies=model.n_body, timing="compiled Simulator.steps(n)", first_call_s=first)
     row.update(_summary(_rates(lambda k: sim.steps(k), lambda: sim.restore(start), n, repeats), model.dt))
     def python_loop(k):
         step = sim.step
@@ -134,7 +134,7 @@ def measure_peer(peer, name, repeats=5, n_steps=None, accuracy_seconds=None):
     k = accuracy_steps(name, model.dt, accuracy_seconds)
     spec = spec_from_model(name, model, k * model.dt)
     world = peer.World(spec)
-    row = dict(scene=name, engine=peer.ENGINE, version=peer.version(), bodies=spec.n_body)
+    row = dict(scene=name, engine=peer.ENGINE, version=peer.version(), bodies=spec.n_body, timing=world.timing)
     row.update(_summary(_rates(world.run, world.reset, n, repeats), spec.dt))
     q, v = world.record(k)
     row.update(accuracy(spec, q, v))

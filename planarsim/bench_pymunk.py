@@ -28,6 +28,7 @@ class World:
     def __init__(self, spec):
         import pymunk
         self.pm, self.spec = pymunk, spec
+        self.timing = "Python loop of space.step"
         self.reset()
 
     def reset(self):

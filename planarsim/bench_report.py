@@ -61,6 +61,11 @@ def print_scenes(res):
 def print_peers(res):
     print("peer comparison, same run (ratio = planarsim steps/s / peer steps/s; energy drift = "
           "(E_end - E_0) / scale of bench_scenes.md)")
+    timing = {}
+    for scene, peers in res["peers"].items():
+        for r in [res["scenes"][scene]] + peers:
+            timing.setdefault(f"{r['engine']} {r['version']}", r["timing"])
+    print("timed as: " + "; ".join(f"{k}: {v}" for k, v in timing.items()))
     print(f"{'scene':15s} {'engine':9s} {'version':8s} {'steps/s median (min-max)':>26s} {'ratio':>6s} "
           f"{'pin error':>10s} {'E drift':>8s} {'|dE| max':>8s} {'penetration':>11s} {'rest gap':>9s}")
     for scene, peers in res["peers"].items():
