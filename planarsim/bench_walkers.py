@@ -57,8 +57,8 @@ def measure_walker(name, seconds=60.0, repeats=5):
         steps = int(round(simulated / model.dt))
     med = statistics.median(walls)
     return dict(scene=f"walker_{name}", engine="planarsim", walker=name, gait=gait, seconds=seconds,
-                first_call_s=first, overhead_s=statistics.median(fixed), steps=steps, steps_per_s=steps / med, steps_per_s_min=steps / max(walls),
-                steps_per_s_max=steps / min(walls), rtf=steps * model.dt / med, fell=_fell(summary),
+                first_call_s=first, overhead_s=statistics.median(fixed), steps=steps, steps_per_s=steps / med,
+                steps_per_s_min=steps / max(walls), steps_per_s_max=steps / min(walls), rtf=steps * model.dt / med, fell=_fell(summary),
                 distance_m=float(summary.get("distance", float("nan"))))
 
 
