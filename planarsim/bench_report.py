@@ -170,6 +170,9 @@ def print_startup(res):
     for r in res["startup"]:
         print(f"  {r['cache']:4s} numba cache: import {r['import_s']:.2f} s, first engine step {r['engine_step_s']:.2f} s, "
               f"first Simple Biped step {r['walker_step_s']:.2f} s (whole process {r['process_s']:.2f} s)")
+        if r["cache"] == "cold":
+            print(f"       compile times: engine step kernel {r['engine_step_s'] - r['import_s']:.1f} s, "
+                  f"Simple Biped rollout on top {r['walker_step_s'] - r['engine_step_s']:.1f} s")
     print(flush=True)
 
 
