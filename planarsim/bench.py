@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .bench_metrics import PEER_SCENES
-from .bench_peers import PEER_MODULES, available_peers, measure_peer, measure_planarsim
+from .bench_peers import PEER_MODULES, available_peers, measure_scene
 from .bench_report import (plot_chain_scaling, print_peers, print_scenes, print_startup, print_targets,
                            print_walkers, targets)
 from .bench_scenes import SCENES
@@ -139,27 +139,26 @@ def main(argv=None):
     results = {"rows": [], "scenes": {}, "peers": {}, "walkers": {}, "batch": None, "startup": None}
     rows = results["rows"]
     parts = set(args.parts)
-    if parts & {"scenes", "peers"}:
-        for name in args.scenes:
-            row = measure_planarsim(name, args.repeats, args.steps, args.accuracy_seconds)
-            results["scenes"][name] = row
-            rows.append(row)
-        results["slopes"] = chain_slopes(list(results["scenes"].values()))
-        print_scenes(results)
+    found = {}
     if "peers" in parts:
         found, missing = available_peers(args.peers)
         for msg in missing:
             print(msg, flush=True)
-        for name in [s for s in args.scenes if s in PEER_SCENES]:
-            results["peers"][name] = []
-            for peer, mod in found.items():
-                row = measure_peer(mod, name, args.repeats, args.steps, args.accuracy_seconds)
-                results["peers"][name].append(row)
-                rows.append(row)
-        if found:
-            print_peers(results)
-        elif args.peers:
-            print("peer comparison skipped: no peer installed (pip install planarsim[compare])\n")
+    if parts & {"scenes", "peers"}:
+        for name in args.scenes:
+            compare = found if name in PEER_SCENES else {}
+            row, peer_rows = measure_scene(name, compare, args.repeats, args.steps, args.accuracy_seconds)
+            results["scenes"][name] = row
+            rows.append(row)
+            if compare:
+                results["peers"][name] = peer_rows
+                rows += peer_rows
+        results["slopes"] = chain_slopes(list(results["scenes"].values()))
+        print_scenes(results)
+    if found:
+        print_peers(results)
+    elif "peers" in parts and args.peers:
+        print("peer comparison skipped: no peer installed (pip install planarsim[compare])\n")
     if "walkers" in parts and args.walkers:
         from .bench_walkers import measure_walker
         for name in args.walkers:

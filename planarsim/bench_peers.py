@@ -3,8 +3,8 @@ same way in the same run.
 
 Timing: each engine runs the scene's timing episode (bench_scenes.SCENES: 5 s for chains, 3 s
 for the biped collapse, 2 s for the rod drop) from the start state once to warm up, then
-`repeats` times (each from the start state; building the world is not timed); steps/s is the
-median with the min-max spread. planarsim's figure is the compiled multi-step call
+`repeats` times, each from the start state (resetting or rebuilding the world is not timed),
+the repeats going round the engines in turn; steps/s is the median with the min-max spread. planarsim's figure is the compiled multi-step call
 (Simulator.steps); its Python single-step loop is reported next to it.
 Accuracy: one recorded run per engine (10 s for chains, else the episode), judged by
 bench_metrics.accuracy.
@@ -47,16 +47,20 @@ def available_peers(names=None):
     return found, missing
 
 
-def _rates(run, reset, n, repeats):
-    """steps/s of `repeats` timed runs of n steps, each after reset() (not timed)."""
-    reset()
-    run(n)  # warm-up episode
-    rates = []
-    for _ in range(repeats):
+def _rates(engines, n, repeats):
+    """{key: [steps/s of `repeats` timed runs of n steps]} for engines {key: (run, reset)}.
+    Every engine runs one warm-up episode, then the repeats go round the engines in turn (so
+    a slow drift of the machine's load hits all engines alike); reset() is not timed."""
+    for run, reset in engines.values():
         reset()
-        t0 = time.perf_counter()
         run(n)
-        rates.append(n / (time.perf_counter() - t0))
+    rates = {key: [] for key in engines}
+    for _ in range(repeats):
+        for key, (run, reset) in engines.items():
+            reset()
+            t0 = time.perf_counter()
+            run(n)
+            rates[key].append(n / (time.perf_counter() - t0))
     return rates
 
 
@@ -89,13 +93,18 @@ def call_floor_s(calls=20000) -> float:
     return statistics.median(times)
 
 
-def measure_planarsim(name, repeats=5, n_steps=None, accuracy_seconds=None):
-    """Timing (compiled and Python-loop steps/s, first-call time) and, for the peer scenes,
-    the accuracy figures of planarsim on scene `name`.
+def measure_scene(name, peers=None, repeats=5, n_steps=None, accuracy_seconds=None):
+    """(planarsim row, [peer rows]) of scene `name`: timing interleaved over planarsim and
+    the peers {name: module} (bench_mujoco / bench_pymunk / bench_box2d), and for the peer
+    scenes the accuracy figures of each.
 
-    python_over_floor: wall time of one Simulator.step() in a Python loop over the floor of
-    one compiled call from Python, i.e. the step's own compiled cost (from the compiled
-    multi-step run) plus one call of an empty compiled function (call_floor_s)."""
+    planarsim: first_call_s = first Simulator.steps call (numba compile or cache load);
+    steps_per_s = compiled Simulator.steps(n); python_steps_per_s = a Python loop of
+    Simulator.step(); python_over_floor = one step() in that loop over the floor of one
+    compiled call from Python, i.e. the step's own compiled cost plus one call of an empty
+    compiled function (call_floor_s).
+    """
+    peers = peers or {}
     build, n_default = SCENES[name]
     n = int(n_steps or n_default)
     model = build()
@@ -103,43 +112,41 @@ def measure_planarsim(name, repeats=5, n_steps=None, accuracy_seconds=None):
     start = sim.snapshot()
     t0 = time.perf_counter()
     sim.steps(1)
-    first = time.perf_counter() - t0  # numba compile, or load from the on-disk cache
-    row = dict(scene=name, engine="planarsim", version=getattr(ps, "__version__", ""),
-               bodies=model.n_body, timing="compiled Simulator.steps(n)", first_call_s=first)
-    row.update(_summary(_rates(lambda k: sim.steps(k), lambda: sim.restore(start), n, repeats), model.dt))
+    first = time.perf_counter() - t0
+    k = accuracy_steps(name, model.dt, accuracy_seconds)
+    spec = spec_from_model(name, model, k * model.dt) if name in PEER_SCENES else None
+    if peers and spec is None:
+        raise ValueError(f"scene {name!r} has no peer version; peer scenes: {PEER_SCENES}")
+    worlds = {key: mod.World(spec) for key, mod in peers.items()}
+
     def python_loop(k):
         step = sim.step
         for _ in range(k):
             step()
-    py = _rates(python_loop, lambda: sim.restore(start), n, repeats)
-    row["python_steps_per_s"] = statistics.median(py)
+    restore = lambda: sim.restore(start)  # noqa: E731
+    engines = {"planarsim": (sim.steps, restore), "planarsim-python": (python_loop, restore)}
+    engines.update({key: (w.run, w.reset) for key, w in worlds.items()})
+    rates = _rates(engines, n, repeats)
+    row = dict(scene=name, engine="planarsim", version=getattr(ps, "__version__", ""), bodies=model.n_body,
+               timing="compiled Simulator.steps(n)", first_call_s=first)
+    row.update(_summary(rates["planarsim"], model.dt))
+    row["python_steps_per_s"] = statistics.median(rates["planarsim-python"])
     row["call_floor_s"] = call_floor_s()
     row["python_over_floor"] = (1.0 / row["python_steps_per_s"]) / (1.0 / row["steps_per_s"] + row["call_floor_s"])
-    if name in PEER_SCENES:
-        k = accuracy_steps(name, model.dt, accuracy_seconds)
-        spec = spec_from_model(name, model, k * model.dt)
+    if spec is not None:
         sim.restore(start)
         traj = sim.run(n_steps=k, record_every=1)
-        q = np.concatenate([model.q0[None], traj.q])
-        v = np.concatenate([start.v[None], traj.v])
-        row.update(accuracy(spec, q, v))
-    return row
-
-
-def measure_peer(peer, name, repeats=5, n_steps=None, accuracy_seconds=None):
-    """The same figures for a peer module (bench_mujoco / bench_pymunk / bench_box2d)."""
-    build, n_default = SCENES[name]
-    n = int(n_steps or n_default)
-    model = build()
-    k = accuracy_steps(name, model.dt, accuracy_seconds)
-    spec = spec_from_model(name, model, k * model.dt)
-    world = peer.World(spec)
-    row = dict(scene=name, engine=peer.ENGINE, version=peer.version(), bodies=spec.n_body, timing=world.timing)
-    row.update(_summary(_rates(world.run, world.reset, n, repeats), spec.dt))
-    q, v = world.record(k)
-    row.update(accuracy(spec, q, v))
-    warnings = getattr(world, "warnings", [])
-    if warnings:
-        step, text = warnings[0]
-        row["warning"] = f"{text} (step {step}); figures up to there"
-    return row
+        row.update(accuracy(spec, np.concatenate([model.q0[None], traj.q]),
+                            np.concatenate([start.v[None], traj.v])))
+    peer_rows = []
+    for key, world in worlds.items():
+        mod = peers[key]
+        r = dict(scene=name, engine=mod.ENGINE, version=mod.version(), bodies=spec.n_body, timing=world.timing)
+        r.update(_summary(rates[key], spec.dt))
+        r.update(accuracy(spec, *world.record(k)))
+        warnings = getattr(world, "warnings", [])
+        if warnings:
+            step, text = warnings[0]
+            r["warning"] = f"{text} (step {step}); figures up to there"
+        peer_rows.append(r)
+    return row, peer_rows
