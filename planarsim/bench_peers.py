@@ -113,7 +113,7 @@ def measure_scene(name, peers=None, repeats=5, n_steps=None, accuracy_seconds=No
     t0 = time.perf_counter()
     sim.steps(1)
     first = time.perf_counter() - t0
-    k = accuracy_steps(name, model.dt, accuracy_seconds)
+    k = accuracy_steps(name, model.dt, accuracy_seconds) if name in PEER_SCENES else 0
     spec = spec_from_model(name, model, k * model.dt) if name in PEER_SCENES else None
     if peers and spec is None:
         raise ValueError(f"scene {name!r} has no peer version; peer scenes: {PEER_SCENES}")

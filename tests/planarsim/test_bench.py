@@ -57,6 +57,11 @@ def test_walkers_batch_and_warm_startup_parts(capsys):
     assert "warm numba cache" in out and "cold numba cache" not in out
 
 
+def test_scene_without_peer_version_runs_with_its_default_settings(capsys):
+    assert bench.main(["boxes_on_hills", "--parts", "scenes,peers", "--repeats", "1", "--steps", "20"]) == 0
+    assert "boxes_on_hills" in capsys.readouterr().out
+
+
 def test_bad_arguments_name_the_culprit():
     with pytest.raises(SystemExit, match="unknown part"):
         bench.main(["--parts", "scenes,nonsense"])
