@@ -162,7 +162,12 @@ def main(argv=None):
     if "walkers" in parts and args.walkers:
         from .bench_walkers import measure_walker
         for name in args.walkers:
-            row = measure_walker(name, args.walker_seconds, args.repeats)
+            try:
+                row = measure_walker(name, args.walker_seconds, args.repeats)
+            except Exception as exc:  # one broken walker must not hide the other figures
+                print(f"walker {name}: FAILED with {type(exc).__name__}: {exc}", flush=True)
+                results.setdefault("walker_errors", {})[name] = f"{type(exc).__name__}: {exc}"
+                continue
             results["walkers"][name] = row
             rows.append(row)
         print_walkers(results)

@@ -143,7 +143,7 @@ def plot_chain_scaling(res, path):
 def print_walkers(res, batch_only=False):
     if not batch_only:
         print("walkers (simulate(seconds, gait): compiled rollout + model build + Trajectory; overhead = "
-              "a one-step walk, included)")
+              "a 10-step walk, included)")
         print(f"{'walker':16s} {'gait':7s} {'first call':>10s} {'steps':>7s} {'steps/s median (min-max)':>26s} "
               f"{'x real time':>11s} {'fell':>5s} {'distance':>9s} {'overhead':>9s}")
         for r in res["walkers"].values():
@@ -214,7 +214,8 @@ def targets(res):
         r = res["walkers"].get(name)
         target = f"{name}: >= {_num(goal)} steps/s (one core)"
         if r is None:
-            out.append((target, "not run", "not measured"))
+            error = res.get("walker_errors", {}).get(name)
+            out.append((target, f"failed: {error}"[:60] if error else "not run", "not measured"))
         else:
             out.append((target, f"{_num(r['steps_per_s'])} steps/s" + (", FELL" if r["fell"] else ""),
                         _status(r["steps_per_s"] >= goal)))

@@ -6,8 +6,8 @@ recording every 10 steps) plus building the model and assembling the Trajectory,
 what a user's run costs. One short call first (compile or cache load, timed), then `repeats`
 runs from the same start; steps/s = simulated steps / wall time (median and min-max),
 real-time factor = simulated seconds / wall second; `fell` from the walker's summary;
-overhead = wall time of a one-step walk (model build, first step, Trajectory), included in the
-figures.
+overhead = wall time of a 10-step walk (model build, first steps, Trajectory), included in the
+figures. A walker that raises is reported with its error and the others go on.
 
 Batch: planarsim.batch.simulate_batch of `jobs` Simple Biped walks (target speeds spread over
 0.8-1.2 m/s) on 1 and on 2 worker threads (the compiled rollouts release the GIL); throughput
@@ -44,9 +44,9 @@ def measure_walker(name, seconds=60.0, repeats=5):
     module.simulate(0.01, gait=gait)
     first = time.perf_counter() - t0
     fixed = []
-    for _ in range(3):  # warm cost of a one-step walk: build, first step, Trajectory
+    for _ in range(3):  # warm cost of a 10-step walk: build, first steps, Trajectory
         t0 = time.perf_counter()
-        module.simulate(0.001, gait=gait)
+        module.simulate(0.01, gait=gait)
         fixed.append(time.perf_counter() - t0)
     walls, steps, summary = [], 0, {}
     for _ in range(repeats):
