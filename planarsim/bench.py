@@ -1,7 +1,7 @@
 """Benchmark runner of issue 8: every figure in one run of one command.
 
     planarsim bench                        # everything (same as: python benchmarks/run.py)
-    planarsim bench chain4 rod_drop        # only these scenes (and their peer comparison)
+    planarsim bench chain4 rod_drop        # only these scenes and their peer comparison
     planarsim bench --parts scenes,peers   # parts: scenes, peers, walkers, batch, startup
     planarsim bench --peers pymunk,box2d   # peers to compare (default: all; 'none' skips)
     planarsim bench --no-cold              # skip the cold-cache start-up (about a minute)
@@ -105,7 +105,8 @@ def parse_args(argv):
     ap = argparse.ArgumentParser(prog="planarsim bench", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scenes", nargs="*", help=f"scenes (default all): {', '.join(SCENES)}")
-    ap.add_argument("--parts", default=",".join(PARTS), help=f"comma list of {', '.join(PARTS)} (default all)")
+    ap.add_argument("--parts", default=None, help=f"comma list of {', '.join(PARTS)} (default: all; "
+                    "scenes,peers when scenes are named)")
     ap.add_argument("--peers", default=",".join(PEER_MODULES), help="comma list of mujoco, pymunk, box2d, or none")
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per figure (default 5)")
     ap.add_argument("--steps", type=int, default=None, help="timing episode in steps (default: the scene's)")
@@ -123,6 +124,8 @@ def parse_args(argv):
     unknown = [n for n in args.scenes if n not in SCENES]
     if unknown:
         ap.error(f"unknown scene(s) {unknown}; choose from {list(SCENES)}")
+    if args.parts is None:
+        args.parts = "scenes,peers" if args.scenes else ",".join(PARTS)
     args.scenes = args.scenes or list(SCENES)
     args.parts = _list(args.parts, PARTS, "part(s)")
     args.peers = [] if args.peers == "none" else _list(args.peers, PEER_MODULES, "peer(s)")
