@@ -13,10 +13,11 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import SimulationDiverged
-from .kernels.step import run_recorded, run_steps, step as _step
-from .model import Model
+from .kernels.step import run_recorded
+from .model import Model, ModelArrays
 from .options import StepOptions, check_options
-from .state import State, make_state, make_workspace
+from .state import State, Workspace, make_state, make_workspace
+from .tables import pack_tables, set_options
 from .trajectory import Trajectory, make_recorder
 
 FIELD_NAMES = ("x", "y", "theta", "vx", "vy", "omega")
@@ -35,15 +36,49 @@ class Simulator:
     def __init__(self, model: Model, options: StepOptions | None = None, state: State | None = None):
         if not isinstance(model, Model):
             raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
-        self.model = model
-        self.options = check_options(options if options is not None else StepOptions())
+        self._model = model
         self._state = make_state(model)
         if state is not None:
             self.state = state
-        self.ws = make_workspace(model)
+        self._ws = make_workspace(model)
         self._u0 = np.zeros(model.n_act)
-        self._step_entry = None
-        self._steps_entry = None
+        self._recorded_entry = None
+        self._tab, self._flt = pack_tables(model.arrays, self._state, self._ws, StepOptions())
+        self.options = options if options is not None else StepOptions()
+
+    @property
+    def model(self) -> Model:
+        return self._model
+
+    @model.setter
+    def model(self, value: Model) -> None:
+        """Swap in a model with the same bodies, pins, contacts and actuators (new gravity,
+        friction, actuator limits, ...); the state carries over."""
+        if not isinstance(value, Model):
+            raise TypeError(f"model must be a Model, got {type(value).__name__}")
+        old = self._model
+        for name in ModelArrays._fields:
+            a, b = getattr(old.arrays, name), getattr(value.arrays, name)
+            if isinstance(a, np.ndarray) and np.shape(a) != np.shape(b):
+                raise ValueError(f"model.arrays.{name} has shape {np.shape(b)}; this simulator's "
+                                 f"model has {np.shape(a)} (build a new Simulator instead)")
+        self._model = value
+        self._tab, self._flt = pack_tables(value.arrays, self._state, self._ws, self._options)
+        self._recorded_entry = None
+
+    @property
+    def ws(self) -> Workspace:
+        """The step's scratch arrays (contact points, impulses, rows of the last step)."""
+        return self._ws
+
+    @property
+    def options(self) -> StepOptions:
+        return self._options
+
+    @options.setter
+    def options(self, value: StepOptions) -> None:
+        self._options = check_options(value)
+        set_options(self._tab, self._flt, self._options)
 
     # the state is always this simulator's own arrays (of the types its compiled step expects)
     @property
@@ -91,12 +126,17 @@ class Simulator:
     # stepping -------------------------------------------------------------------------------
     def step(self, u=None) -> None:
         """One step of model.dt under actuator commands u (n_act,) [N or N m]."""
-        entry = self._step_entry
-        if entry is None:
-            entry = self._step_entry = self._bind(_step, ())
-        code = entry(self.model.arrays, self._state, self.ws, self.options, self._commands(u))
+        entry = _TABLE_ENTRY or _bind_table_run_steps()
+        code, done = entry(self._tab, self._flt, self._u0 if u is None else self._commands(u), 1)
         if code:
             self._raise(code)
+
+    def _run_recorded(self, u, n, every, rec, k0):
+        """kernels.step.run_recorded on this simulator (bound once: see _bind)."""
+        entry = self._recorded_entry
+        if entry is None:
+            entry = self._recorded_entry = self._bind(run_recorded, (n, every, rec, k0))
+        return entry(self.model.arrays, self._state, self._ws, self._options, u, n, every, rec, k0)
 
     def _bind(self, kernel, extra):
         """`kernel` compiled for this simulator's argument types (model, state, workspace,
@@ -111,10 +151,8 @@ class Simulator:
         n = int(n)
         if n < 0:
             raise ValueError(f"n={n} steps must be >= 0")
-        entry = self._steps_entry
-        if entry is None:
-            entry = self._steps_entry = self._bind(run_steps, (n,))
-        code, done = entry(self.model.arrays, self._state, self.ws, self.options, self._commands(u), n)
+        entry = _TABLE_ENTRY or _bind_table_run_steps()
+        code, done = entry(self._tab, self._flt, self._commands(u), n)
         if code:
             self._raise(code)
 
@@ -134,10 +172,9 @@ class Simulator:
         if every < 1 or int(control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")
         rec = make_recorder(self.model, n // every + 1)
-        m, s, ws, opt = self.model.arrays, self.state, self.ws, self.options
         k = 0
         if controller is None:
-            code, done, k = run_recorded(m, s, ws, opt, self._commands(u), n, every, rec, 0)
+            code, done, k = self._run_recorded(self._commands(u), n, every, rec, 0)
             if code:
                 self._raise(code)
         else:
@@ -148,7 +185,7 @@ class Simulator:
                 uk = self._commands(controller(self))
                 todo = min(chunk, n - done)
                 k_before = k
-                code, did, k = run_recorded(m, s, ws, opt, uk, todo, every, rec, k)
+                code, did, k = self._run_recorded(uk, todo, every, rec, k)
                 if code:
                     self._raise(code)
                 done += todo
@@ -178,6 +215,20 @@ class Simulator:
     def contact_impulses(self) -> np.ndarray:
         """(n_contact, 2) normal and tangential impulse of the last step [N s]."""
         return self.ws.contact_impulse.copy()
+
+
+_TABLE_ENTRY = None
+
+
+def _bind_table_run_steps():
+    """table_run_steps' entry point, compiled (or loaded from the cache) on first use and then
+    called directly: its argument types never change, so numba's type dispatch is not needed."""
+    global _TABLE_ENTRY
+    from numba import float64, int64
+
+    from .kernels.table_step import table_run_steps
+    _TABLE_ENTRY = table_run_steps.compile((int64[::1], float64[::1], float64[::1], int64))
+    return _TABLE_ENTRY
 
 
 def _count_steps(dt, duration, n_steps):

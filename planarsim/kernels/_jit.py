@@ -20,6 +20,9 @@ _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nr
 
 jit = njit(**_OPTIONS)
 jit_inline = njit(inline="always", **_OPTIONS)
+# table_step builds arrays over raw addresses (numba.carray), which numba allows only with its
+# runtime on; those arrays own no memory, so its reference counting has nothing to count
+jit_table = njit(cache=True, fastmath=False, nogil=True, error_model="numpy")
 
 
 def _sources_hash(folder: Path, extra: str = "") -> str:

@@ -29,9 +29,15 @@ def _path_gap(m, s, ws, b, h, tau):
 @jit
 def impact_time(m, s, ws, b, h):
     """First root tau in [0, h] of the path gap of point-mass body b, or inf if none."""
-    g_end = _path_gap(m, s, ws, b, h, h)
     t_lo = 0.0
     g_lo = _path_gap(m, s, ws, b, h, 0.0)
+    # the gap is a distance (1-Lipschitz) and the path stays within h |v0| + h^2 |a| of p0:
+    # a point farther from the ground than that cannot reach it within the step
+    reach = h * math.hypot(s.v[b, 0], s.v[b, 1]) + h * math.hypot(ws.v_new[b, 0] - s.v[b, 0],
+                                                                   ws.v_new[b, 1] - s.v[b, 1])
+    if g_lo > reach + 1e-12:
+        return math.inf
+    g_end = _path_gap(m, s, ws, b, h, h)
     if g_lo <= 0.0:
         return 0.0 if g_end < 0.0 else math.inf
     t_hi = -1.0

@@ -125,17 +125,24 @@ def test_two_runs_hash_alike_in_process_and_in_a_fresh_process():
 
 
 def test_a_second_process_loads_the_step_kernel_from_the_cache():
-    ps.Simulator(two_link_on_hills()).step()  # make sure this process compiled (or loaded) it
+    sim = ps.Simulator(two_link_on_hills())   # make sure this process compiled (or loaded) them
+    sim.step()
+    sim.run(n_steps=2)
     code = textwrap.dedent("""
         import planarsim as ps
-        from planarsim.kernels.step import step
+        from planarsim.kernels.step import run_recorded
+        from planarsim.kernels.table_step import table_run_steps
         from tests.planarsim.test_reliability import two_link_on_hills
-        ps.Simulator(two_link_on_hills()).step()
-        print(sum(step.stats.cache_hits.values()), sum(step.stats.cache_misses.values()))
+        sim = ps.Simulator(two_link_on_hills())
+        sim.step()            # the Python step path (table_run_steps, which links step)
+        sim.run(n_steps=2)    # the recorded path (run_recorded, which links step)
+        for kernel in (table_run_steps, run_recorded):
+            print(sum(kernel.stats.cache_hits.values()), sum(kernel.stats.cache_misses.values()))
     """)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    hits, misses = map(int, out.stdout.split())
-    assert hits >= 1 and misses == 0
+    for line in out.stdout.strip().splitlines():
+        hits, misses = map(int, line.split())
+        assert hits >= 1 and misses == 0, out.stdout
 
 
 @pytest.mark.parametrize("damage", ["truncate", "garbage", "newer"])

@@ -61,3 +61,25 @@ def test_state_assignment_copies_into_the_simulators_arrays():
         sim.state = bad
     with pytest.raises(TypeError, match="State"):
         sim.state = {"q": 1}
+
+
+def test_generated_table_kernel_is_up_to_date():
+    """kernels/table_step.py is generated from the NamedTuples (see kernels/table_gen.py)."""
+    from planarsim.kernels.table_gen import TARGET, render_source
+    assert TARGET.read_text() == render_source(), "run: python -m planarsim.kernels.table_gen"
+
+
+def test_changing_options_reaches_the_python_step():
+    model = _pendulum()
+    a = ps.Simulator(model)
+    a.options = ps.StepOptions(refine_iters=0)
+    b = ps.Simulator(model, ps.StepOptions(refine_iters=0))
+    c = ps.Simulator(model)
+    for _ in range(300):
+        a.step()
+        b.step()
+        c.step()
+    assert np.array_equal(a.state.q, b.state.q)
+    assert not np.array_equal(a.state.q, c.state.q)   # refinement on moves the result
+    with pytest.raises(ValueError, match="refine_iters"):
+        a.options = ps.StepOptions(refine_iters=-2)
