@@ -99,19 +99,26 @@ def test_stand_holds_30s():
 
 @pytest.fixture(scope="module")
 def walk_1000():
-    """WALK from rest in the WALK start pose (both feet down, zero velocity) until 1000 steps
-    (or a fall)."""
-    rs = RangerSim(gait="walk")
-    assert np.all(rs.sim.state.v == 0.0)
+    """STAND for 2 s, then WALK through the Python API (the START phase) until 1000 steps (or a
+    fall)."""
+    rs = RangerSim(gait="stand")
+    stand_q = rs.sim.state.q.copy()
+    rs.run(2.0, record_every=1000)
+    assert not rs.fell and np.abs(rs.sim.state.v).max() < 1e-3 and np.abs(rs.sim.state.q - stand_q).max() < 0.03
+    rs.controller.set_gait("walk")
     x0 = rs.hip()[0]
     while rs.steps < 1000 and not rs.fell and rs.sim.t < 1000.0:
         rs.run(50.0, record_every=1000)
     return rs, x0
 
 
-def test_walk_1000_steps_from_rest(walk_1000):
+def test_walk_1000_steps_from_standing(walk_1000):
     rs, x0 = walk_1000
     s = rs.summary()
+    print(f"\nRanger WALK from STAND: {rs.steps} steps in {s['time']:.1f} s, mean speed "
+          f"{s['mean_speed']:.3f} m/s, whole-step speed {s['step_speed']:.3f} m/s, step length "
+          f"{s['step_length']:.3f} m, CoT total {s['cost_of_transport']:.3f}, electrical "
+          f"{s['cost_of_transport_electrical']:.3f}, mechanical {s['cost_of_transport_mechanical']:.3f}")
     assert not rs.fell, s
     assert rs.steps >= 1000
     assert rs.hip()[0] - x0 > 0.2 * 1000          # really walked forward, > 0.2 m per step
@@ -191,6 +198,9 @@ def test_estimator_switches_once_per_touchdown():
     """On a recorded walk the filtered estimator turns a foot 'on' at most once between two
     real touchdowns, and every 'on' follows a real touchdown within 60 ms."""
     rs = RangerSim(gait="walk")
+    # a fresh WALK run starts at rest in the STAND pose (and gets going through START)
+    assert np.array_equal(rs.sim.state.q, RangerSim(gait="stand").sim.state.q)
+    assert np.all(rs.sim.state.v == 0.0)
     traj = rs.run(30.0, record_every=1)
     assert not rs.fell and rs.steps > 30
     dtf = traj.t[1] - traj.t[0]

@@ -11,10 +11,19 @@ Choices (numbers in params.py, each with its reason):
   scheme is what the controller (estimator thresholds) was tuned with.
 - Rotor inertia: the ankle rotor's G^2 Jm is added to the foot body (armature), and ankle
   currents on a foot in the air are capped (free_foot_max_accel), see model.py/controller.py.
-- Poses: STAND holds a symmetric pose (hip centred over feet 0.19 m apart); WALK starts at rest
-  from the end-of-double-stance pose (walk_front_angle / walk_rear_angle). Switching a running
-  STAND to WALK does not start a gait (the robot falls after a few steps): the start from the
-  symmetric pose is not solved.
+- Poses: every run starts at rest in the STAND pose (hip centred over feet 0.19 m apart). WALK
+  gets going from it through the controller's START phase (a double stance whose rear-foot
+  push uses start_push_current until the front leg is past start_leg_angle), whether WALK is
+  asked for at the start or set on a running STAND (Controller.set_gait).
+- Step options: the engine defaults (cap_policy=1), rollout.step_options(). A landing foot
+  that comes down on its heel (the sole arc's back end, a vertex) while sliding forward is in
+  Painleve's configuration (sliding friction would drive it into the ground: A_nn < mu A_nt;
+  measured A_nn 0.10, A_nt 0.30 [1/kg] at mu 0.8); the engine engages it sliding, the slide
+  pulls (lambda_n < 0), it is released, penetrates, is engaged again, ... until the mode-round
+  cap, where cap_policy=1 sticks it (a tangential impact, the consistent outcome: the sticking
+  impulse lies inside the friction cone). The gait parameters are tuned under that rule (the
+  previous ones relied on cap_policy=0 leaving the heel free to sink for a few ms); the settled
+  gait lands on the arc and meets the cap only in the first steps.
 - Figures: ``python benchmarks/ranger.py --repeats 3 --steps 1000``.
 """
 from pathlib import Path as _Path

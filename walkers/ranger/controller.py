@@ -22,6 +22,8 @@ WALK (stance side s, swing side w = 1 - s, chosen by the contact estimator):
           swing ankle FLIP (toe up, clears the ground) until the legs are land_leg_angle apart
           (swing leg ahead), then LAND
   FLIGHT (no foot down): every joint KEEPs its angle.
+  START (WALK entered at rest, from STAND or the start of a run): DOUBLE's programs with the
+          start-up push current, until the leading leg is start_leg_angle past vertical.
 Step-to-step feedback (seed 6.6, "increase the push-off"): at mid-stance (stance leg passing
 vertical) the hip speed v is measured and the push-off current of that step's push is set to
 I_push = clip(push_current + push_gain (target_speed - v), 0, Imax).
@@ -80,6 +82,9 @@ def choose_programs(m, s, k, mem):
     on the ground again ahead of the stance foot; it becomes the stance foot (a step).
     DOUBLE -> SINGLE when the trailing foot leaves or double stance has lasted ds_time: the
     trailing foot becomes the swing foot. No foot down -> FLIGHT; a foot down -> SINGLE on it.
+    From rest (STANDING, both feet down) -> START: a double stance like DOUBLE (same motor
+    programs) whose trailing push uses start_push_current and which ends when the leading leg
+    has passed start_leg_angle (the hip over the leading foot), not after ds_time.
     """
     c0 = int(mem[M_CONTACT])
     c1 = int(mem[M_CONTACT + 1])
@@ -92,10 +97,15 @@ def choose_programs(m, s, k, mem):
                 mem[M_KEEP + j] = pin_angle_rate(m, s.q, s.v, j)[0]
         phase = PH_FLIGHT
     elif phase == PH_FLIGHT or phase == PH_STANDING:
-        # landing from flight, or starting from standing: the leading foot down is the stance
+        # landing from flight, or starting from standing: the leading foot down is the stance;
+        # from standing, the start-up double stance (PH_START) with its own push current
         if c0 == 1 and c1 == 1:
             st = 1 if s.q[3, 0] > s.q[2, 0] else 0
-            phase = PH_DOUBLE
+            if phase == PH_STANDING:
+                phase = PH_START
+                mem[M_PUSH_I] = k[K_START_I]
+            else:
+                phase = PH_DOUBLE
             mem[M_T_STRIKE] = t
         else:
             st = 0 if c0 == 1 else 1
@@ -118,9 +128,15 @@ def choose_programs(m, s, k, mem):
             mem[M_MID_DONE] = 0
             mem[M_AIRBORNE] = 0
     else:
-        # double stance: the trailing foot pushes off, then swings
+        # double stance: the trailing foot pushes off, then swings; it swings when it has
+        # left, or double stance has lasted ds_time (PH_DOUBLE), or the hip has come over the
+        # leading foot (PH_START)
         sw = 1 - st
-        if mem[M_CONTACT + sw] == 0 or t - mem[M_T_STRIKE] > k[K_DS_TIME]:
+        if phase == PH_START:
+            done = s.q[st, 2] <= k[K_START_LEG]
+        else:
+            done = t - mem[M_T_STRIKE] > k[K_DS_TIME]
+        if mem[M_CONTACT + sw] == 0 or done:
             phase = PH_SINGLE
             mem[M_AIRBORNE] = 1 - mem[M_CONTACT + sw]
     mem[M_PHASE] = phase
@@ -140,7 +156,7 @@ def choose_programs(m, s, k, mem):
         ip = k[K_PUSH_I0] + k[K_PUSH_GAIN] * (k[K_V_TARGET] - vx)
         mem[M_PUSH_I] = min(max(ip, 0.0), k[K_IMAX])
         mem[M_MID_DONE] = 1
-    if phase == PH_DOUBLE:
+    if phase == PH_DOUBLE or phase == PH_START:
         mem[M_PROG] = PR_OFF
         mem[M_PROG + 1 + st] = PR_HOLD
         mem[M_PROG + 1 + sw] = PR_PUSH
@@ -300,6 +316,7 @@ class Controller:
 
     def reset(self, gait: str = "walk") -> None:
         self.mem = make_memory(self._gait_id(gait))
+        set_standing_estimator(self.mem, self.k)      # every run starts standing at rest
         p = self.params
         self.mem[M_PUSH_I] = min(p.push_current + p.push_gain * p.target_speed, p.current_max)
         self.steplog[:] = 0.0

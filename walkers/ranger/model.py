@@ -41,17 +41,16 @@ def foot_inertia_com(p: RangerParams) -> float:
     return i_com + p.rotor_on_foot * p.ankle_gear ** 2 * p.rotor_inertia
 
 
-def standing_pose(p: RangerParams, terrain=None, pose: str = "stand"):
-    """A pose at rest with both feet on the ground: front (inner) leg at <pose>_front_angle with
-    its foot level, rear (outer) leg at <pose>_rear_angle with its foot turned toe down on its
-    sole until it touches. pose 'stand': the STAND pose (hip centred between the feet);
-    'walk': the WALK start pose (the end of a double stance, hip just ahead of the front foot).
+def standing_pose(p: RangerParams, terrain=None):
+    """The STAND pose at rest with both feet on the ground: front (inner) leg at
+    stand_front_angle with its foot level, rear (outer) leg at stand_rear_angle with its foot
+    turned toe down on its sole until it touches. Every gait starts from it (WALK through the
+    controller's START phase).
     Returns (hip_xy, leg angles (outer, inner), foot angles (outer, inner))."""
     terrain = terrain if terrain is not None else flat()
-    if pose not in ("stand", "walk"):
-        raise ValueError(f"Ranger pose {pose!r} unknown; use 'stand' or 'walk'")
+    pose = "stand"
     L, r, d = p.leg_length, p.sole_radius, p.sole_center_height
-    th_front, th_rear = getattr(p, f"{pose}_front_angle"), getattr(p, f"{pose}_rear_angle")
+    th_front, th_rear = p.stand_front_angle, p.stand_rear_angle
     hip_x = -L * math.sin(th_front)                # front ankle at x = 0
     hip_y = float(terrain.height(0.0)) + (r - d) + L * math.cos(th_front)
     x_rear = hip_x + L * math.sin(th_rear)
@@ -68,16 +67,15 @@ def standing_pose(p: RangerParams, terrain=None, pose: str = "stand"):
     return np.array([hip_x, hip_y]), (th_rear, th_front), (phi_rear, 0.0)
 
 
-def build(p: RangerParams | None = None, terrain=None, dt: float = 1e-3, suspended: bool = False,
-          pose: str = "stand") -> ps.Model:
-    """Compile the Ranger model in a standing pose ('stand' or 'walk', see standing_pose).
+def build(p: RangerParams | None = None, terrain=None, dt: float = 1e-3, suspended: bool = False) -> ps.Model:
+    """Compile the Ranger model in the STAND pose (see standing_pose).
 
     suspended : lift the robot 0.3 m and pin its hip to the world (a test stand; GUI test).
     """
     p = p if p is not None else RangerParams()
     terrain = terrain if terrain is not None else flat()
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, -9.81), terrain=terrain)
-    hip, angles, foot_angles = standing_pose(p, terrain, pose)
+    hip, angles, foot_angles = standing_pose(p, terrain)
     if suspended:
         hip = hip + np.array([0.0, 0.3])       # on the test stand the feet hang 0.3 m up
     L, c = p.leg_length, p.leg_com

@@ -59,10 +59,17 @@ def rollout_ranger(m, s, ws, opt, k, prog, motor, mem, gui, steplog, u, n, every
     return 0, n, kf
 
 
+def step_options(strategy: str = "alternating") -> ps.StepOptions:
+    """Ranger's StepOptions: the engine defaults (cap_policy=1: a contact engaged in a step
+    whose mode rounds hit the cap sticks) with the chosen contact-mode strategy."""
+    return ps.make_options(strategy)
+
+
 class RangerSim:
     """A Simulator plus the compiled controller; ``run(duration)`` extends the recording.
 
-    The model starts at rest in the WALK start pose for gait 'walk', in the STAND pose otherwise.
+    The model starts at rest in the STAND pose for every gait; WALK starts from it through the
+    controller's START phase. ``options`` overrides Ranger's StepOptions (step_options()).
 
     >>> rs = RangerSim(gait="stand")          # doctest: +SKIP
     >>> traj = rs.run(5.0); rs.controller.set_gait("walk"); traj2 = rs.run(10.0)
@@ -70,14 +77,10 @@ class RangerSim:
 
     def __init__(self, params: RangerParams | None = None, terrain=None, dt: float = 1e-3,
                  gait: str = "walk", strategy: str = "alternating", suspended: bool = False,
-                 max_steps: int = 20000):
+                 max_steps: int = 20000, options: ps.StepOptions | None = None):
         self.params = params if params is not None else RangerParams()
-        pose = "walk" if gait == "walk" else "stand"
-        self.model = build(self.params, terrain, dt=dt, suspended=suspended, pose=pose)
-        # cap_policy=0: Ranger's gait was tuned against the engine leaving a contact whose mode
-        # cycles free for that step (the seed's tolerance); with the engine's default (stick)
-        # it falls within a few steps. A known limitation, see the issue notes.
-        self.sim = ps.Simulator(self.model, ps.make_options(strategy, cap_policy=0))
+        self.model = build(self.params, terrain, dt=dt, suspended=suspended)
+        self.sim = ps.Simulator(self.model, options if options is not None else step_options(strategy))
         self.controller = Controller(self.params, dt, max_steps=max_steps)
         self.controller.reset(gait)
         self.u = np.zeros(self.model.n_act)
@@ -179,7 +182,7 @@ def live(gait: str = "walk", terrain=None, params: RangerParams | None = None,
 
 def simulate(duration: float, gait: str = "walk", terrain=None, dt: float = 1e-3, seed: int = 0,
              params: RangerParams | None = None, strategy: str = "alternating", record_every: int = 10):
-    """Run Ranger from rest (WALK start pose for 'walk', STAND pose otherwise).
+    """Run Ranger from rest in the STAND pose (WALK starts through the START phase).
     Returns (Trajectory, summary dict, model).
 
     gait : 'walk' | 'stand' | 'gui'. The run is deterministic; `seed` is accepted for the

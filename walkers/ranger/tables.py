@@ -24,6 +24,7 @@ class Phase(IntEnum):
     DOUBLE = 1
     FLIGHT = 2
     STANDING = 3   # STAND and GUI gaits
+    START = 4      # WALK entered from rest: a double stance whose push-off starts the gait
 
 
 class Program(IntEnum):
@@ -39,7 +40,7 @@ class Program(IntEnum):
 
 
 GAIT_WALK, GAIT_STAND, GAIT_GUI = 0, 1, 2
-PH_SINGLE, PH_DOUBLE, PH_FLIGHT, PH_STANDING = 0, 1, 2, 3
+PH_SINGLE, PH_DOUBLE, PH_FLIGHT, PH_STANDING, PH_START = 0, 1, 2, 3, 4
 PR_OFF, PR_HOLD, PR_PUSH, PR_FLIP, PR_SWING, PR_GUI, PR_LAND, PR_KEEP, PR_STAND = 0, 1, 2, 3, 4, 5, 6, 7, 8
 N_PROG = 9
 FR_REL, FR_ABS, FR_SCISSOR, FR_PUSH, FR_NONE = 0, 1, 2, 3, 4
@@ -54,7 +55,8 @@ K_SCISSOR, K_SCISSOR_OFF = 16, 17
 K_LAND_LEG, K_PUSH_LEG = 18, 19
 K_PUSH_I0, K_PUSH_GAIN, K_V_TARGET, K_IMAX = 20, 21, 22, 23
 K_LEG_COM, K_FALL_H, K_GRAV, K_DS_TIME = 24, 25, 26, 27
-N_K = 28
+K_START_I, K_START_LEG = 28, 29
+N_K = 30
 
 # memory mem[...]
 M_GAIT, M_PHASE, M_STANCE = 0, 1, 2
@@ -89,6 +91,7 @@ def make_constants(p: RangerParams, dt: float) -> np.ndarray:
     k[K_PUSH_I0], k[K_PUSH_GAIN], k[K_V_TARGET], k[K_IMAX] = p.push_current, p.push_gain, p.target_speed, p.current_max
     k[K_LEG_COM], k[K_FALL_H], k[K_GRAV] = p.leg_com, p.fall_height, 9.81
     k[K_DS_TIME] = p.ds_time
+    k[K_START_I], k[K_START_LEG] = p.start_push_current, p.start_leg_angle
     return k
 
 
@@ -114,6 +117,20 @@ def make_memory(gait: int = GAIT_WALK) -> np.ndarray:
     mem[M_STANCE] = 1
     mem[M_T_STRIKE] = -1.0
     return mem
+
+
+def set_standing_estimator(mem: np.ndarray, k: np.ndarray) -> None:
+    """Estimator memory of a robot standing at rest on both feet (each foot carrying half the
+    weight, filters at their steady state, both flags on), so a run that starts standing does
+    not begin with a spurious flight."""
+    b0, b1, b2, a1, a2 = k[K_B0:K_B0 + 5]
+    x = 0.5
+    for side in range(2):
+        mem[M_FILT + 2 * side] = x - b0 * x           # y = x at steady state
+        mem[M_FILT + 2 * side + 1] = (b2 - a2) * x
+        mem[M_SIG + side] = x
+        mem[M_RAW + side] = x
+        mem[M_CONTACT + side] = 1
 
 
 def make_gui(p: RangerParams) -> np.ndarray:
