@@ -5,10 +5,11 @@ model, FSM WALK / STAND / GUI with a step-to-step push-off feedback, cost of tra
 >>> traj, summary, model = ranger.simulate(10.0, gait="walk")   # doctest: +SKIP
 
 Choices (numbers in params.py, each with its reason):
-- Contact-mode strategy: the seed's "alternating" by default (RangerSim(strategy=...)). Both
-  strategies walk 1000 steps with the shipped parameters; "all" makes the engine engage and
-  release a landing foot about twice as often (bounces) for the same gait, and the seed's
-  scheme is what the controller (estimator thresholds) was tuned with.
+- Contact-mode strategy: the seed's "alternating" by default (RangerSim(strategy=...)).
+  "all" also walks 1000 steps from a fresh start or after 2 s of STAND, but after 0.3 s of STAND
+  it blew up at t = 23.6 s (measured): a landing foot sliding on its arc in Painleve's
+  configuration is left SLIDING with a pulling normal impulse when the mode rounds hit the
+  cap (cap_policy=1 only sticks contacts left FREE; an engine issue, see the issue-5 report).
 - Rotor inertia: the ankle rotor's G^2 Jm is added to the foot body (armature), and ankle
   currents on a foot in the air are capped (free_foot_max_accel), see model.py/controller.py.
 - Poses: every run starts at rest in the STAND pose (hip centred over feet 0.19 m apart). WALK
