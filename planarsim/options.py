@@ -34,8 +34,9 @@ class StepOptions(NamedTuple):
     guard_limit : any |q| or |v| component above this stops the run
     pivot_tol : relative pivot below which a constraint row is treated as redundant (closed loops)
     cap_policy : when the mode rounds hit max_mode_iters: 1 (default) contacts engaged in this
-        step stick (never left free below the ground); 0 the modes of the last round stand
-        (the seed's tolerance: a cycling contact may be left free and sink for a step)
+        step take a frictionless normal impulse for the step (never left free below the
+        ground, never pulled: no energy gain); 0 the modes of the last round stand (the seed's
+        tolerance: a cycling contact may be left free and sink for a step)
     """
     mode_strategy: int = MODES_ALTERNATING
     max_mode_iters: int = 8

@@ -6,7 +6,7 @@ remainder of the step with the new contact pinned.
 """
 from ._jit import jit, jit_inline
 from .ccd import advance_to_impact, time_of_impact
-from .contacts import find_contacts
+from .contacts import MODE_SLIDING, find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import check_guards
 from .math2d import update_trig
@@ -56,12 +56,17 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         changed = update_modes(m, s, ws, h, opt.mode_strategy, rounds == 0, include_ccd)
         rounds += 1
     if changed != 0:
-        # cap reached: contacts engaged this step must not be left free to penetrate (they
-        # stick), then solve once more so impulses match the final modes
+        # cap reached (the modes of a contact engaged this step cycle: stick violates the
+        # friction cone, sliding reverses, free penetrates): such contacts must neither be left
+        # free to penetrate nor stick with a pulling impulse (that adds energy). They take a
+        # frictionless normal impulse for this step (sliding with slip 0: F = n), which only
+        # removes approach velocity; the next step's checks settle their mode. Then solve once
+        # more so impulses match the final modes.
         if opt.cap_policy == 1:
             for i in range(m.contact_body.shape[0]):
-                if ws.contact_new[i] == 1 and s.contact_mode[i] == 0:
-                    s.contact_mode[i] = 1
+                if ws.contact_new[i] == 1:
+                    s.contact_mode[i] = MODE_SLIDING
+                    s.contact_slip[i] = 0.0
         ws.info[4] += 1
         build_rows(m, s, ws)
         solve_impulses(m, ws, h, opt.pivot_tol)
