@@ -27,10 +27,12 @@ boundaries), so P(x0 + t e_i) jumps by up to 1.6e-2 (rad/s, in the leg rates) be
 perturbations t only 5e-4 apart (median 3e-4..4e-3). A central difference at eps = 1e-3 is
 dominated by those jumps (spectral radius 0.3..12 depending on eps and on the 6th digit of a
 parameter), so the Jacobian here is a least-squares slope over perturbations of +-0.5, 1, 2 eps
-per coordinate, eps = 1e-2 (EPS), whose radius is consistent across eps = 2e-3..2e-2 (0.2..0.6
+per coordinate, eps = 1e-2 (EPS), whose radius is consistent across eps = 2e-3..2e-2 (0.2..0.8
 measured on the shipped and on nearby parameter sets).
-The shipped gait settles on an exactly repeating stride (|P(x0) - x0| = 3e-7: every event falls
-on the same step each stride); nearby parameter sets (1 % changes) mostly wander instead within
+The shipped gait settles on an exactly repeating stride on the engine at c758571
+(|P(x0) - x0| = 3e-7: every event falls on the same step each stride); with the pending
+frictionless cap rule in planarsim/kernels/step.py it wanders within 1.9e-2 (spectral radius
+0.48), and nearby parameter sets (1 % changes) mostly wander as well, within
 ~2e-2 of a mean section state (the jump scale) with multipliers of the same size (4 of 11 sets
 measured return within 1e-3, spectral radius 0.37..0.78).
 A perturbation rolls the stance foot on its sole (flat ground) and rebuilds every body pose
