@@ -5,11 +5,10 @@ model, FSM WALK / STAND / GUI with a step-to-step push-off feedback, cost of tra
 >>> traj, summary, model = ranger.simulate(10.0, gait="walk")   # doctest: +SKIP
 
 Choices (numbers in params.py, each with its reason):
-- Contact-mode strategy: the seed's "alternating" by default (RangerSim(strategy=...)).
-  "all" also walks 1000 steps from a fresh start or after 2 s of STAND, but after 0.3 s of STAND
-  it blew up at t = 23.6 s (measured): a landing foot sliding on its arc in Painleve's
-  configuration is left SLIDING with a pulling normal impulse when the mode rounds hit the
-  cap (cap_policy=1 only sticks contacts left FREE; an engine issue, see the issue-5 report).
+- Contact-mode strategy: the seed's "alternating" by default (RangerSim(strategy=...)); "all"
+  also walks 1000 steps, fresh or after 0.3 s / 2 s of STAND (measured on a6cac2a; on c758571,
+  whose capped rounds could leave a sliding contact with a pulling impulse, one 'all' run
+  after 0.3 s of STAND blew up at t = 23.6 s).
 - Rotor inertia: the ankle rotor's G^2 Jm is added to the foot body (armature), and ankle
   currents on a foot in the air are capped (free_foot_max_accel), see model.py/controller.py.
 - Poses: every run starts at rest in the STAND pose (hip centred over feet 0.19 m apart). WALK
@@ -19,12 +18,12 @@ Choices (numbers in params.py, each with its reason):
 - Step options: the engine defaults (cap_policy=1), rollout.step_options(). A landing foot
   that comes down on its heel (the sole arc's back end, a vertex) while sliding forward is in
   Painleve's configuration (sliding friction would drive it into the ground: A_nn < mu A_nt;
-  measured A_nn 0.10, A_nt 0.30 [1/kg] at mu 0.8); the engine engages it sliding, the slide
-  pulls (lambda_n < 0), it is released, penetrates, is engaged again, ... until the mode-round
-  cap, where cap_policy=1 sticks it (a tangential impact, the consistent outcome: the sticking
-  impulse lies inside the friction cone). The gait parameters are tuned under that rule (the
-  previous ones relied on cap_policy=0 leaving the heel free to sink for a few ms); the settled
-  gait lands on the arc and meets the cap only in the first steps.
+  measured A_nn 0.10, A_nt 0.30 [1/kg] at mu 0.8): engaged sliding it pulls, is released,
+  penetrates, is engaged again, ... until the mode-round cap. cap_policy=0 leaves it free there
+  (the old gait relied on the heel sinking for a few ms); cap_policy=1 gives it a frictionless
+  normal impulse for that step (engine a6cac2a; sticking it before). The gait parameters are
+  tuned under cap_policy=1 (on c758571); the settled gait lands on the arc and meets the cap
+  about once a minute (4 times in 120 s, the first at t = 0).
 - Figures: ``python benchmarks/ranger.py --repeats 3 --steps 1000``.
 """
 from pathlib import Path as _Path
