@@ -23,7 +23,7 @@ Choices (numbers in params.py, each with its reason):
   (the old gait relied on the heel sinking for a few ms); cap_policy=1 gives it a frictionless
   normal impulse for that step (engine a6cac2a; sticking it before). The gait parameters are
   tuned under cap_policy=1 (on c758571); the settled gait lands on the arc and meets the cap
-  about once a minute (4 times in 120 s, the first at t = 0).
+  3 or 4 times in 120 s (the first at t = 0; measured on c758571 and a6cac2a).
 - Figures: ``python benchmarks/ranger.py --repeats 3 --steps 1000``.
 """
 from pathlib import Path as _Path
