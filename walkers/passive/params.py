@@ -8,35 +8,13 @@ Slopes are angles gamma [rad] of a plane falling toward +x; the model builders t
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import dataclass
 
-import numpy as np
-
-
-def _p(default, unit, doc, lo, hi):
-    return field(default=default, metadata=dict(unit=unit, doc=doc, bounds=(lo, hi)))
-
-
-class _Checked:
-    """Bounds check on construction and the array view shared by the three dataclasses."""
-
-    def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            lo, hi = f.metadata["bounds"]
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
-                raise ValueError(f"{type(self).__name__}.{f.name}={value!r} must be a finite number "
-                                 f"in [{lo}, {hi}] ({f.metadata['unit']}: {f.metadata['doc']})")
-
-    def to_array(self) -> np.ndarray:
-        return np.array([float(getattr(self, f.name)) for f in fields(self)])
-
-    def as_dict(self) -> dict:
-        return asdict(self)
+from walkers.common.params import WalkerParams, param as _p
 
 
 @dataclass(frozen=True)
-class SimplestParams(_Checked):
+class SimplestParams(WalkerParams):
     """Garcia, Chatterjee, Ruina and Coleman (1998): point-mass hip, point feet of mass ratio
     beta, massless rigid legs (rods)."""
     slope: float = _p(0.009, "rad", "slope gamma (downhill toward +x)", 0.0, 0.1)
@@ -48,7 +26,7 @@ class SimplestParams(_Checked):
 
 
 @dataclass(frozen=True)
-class CompassParams(_Checked):
+class CompassParams(WalkerParams):
     """Compass gait (Goswami, Thuilot, Espiau 1996) with rigid-body legs pinned at the hip.
     Defaults: hip 10 kg, legs 5 kg with their COM half way (a = b = 0.5 m)."""
     slope: float = _p(0.0524, "rad", "slope gamma (downhill toward +x), 3 degrees", 0.0, 0.3)
@@ -69,7 +47,7 @@ class CompassParams(_Checked):
 
 
 @dataclass(frozen=True)
-class RimlessParams(_Checked):
+class RimlessParams(WalkerParams):
     """Rimless wheel: a rigid hub with n_spokes massless spokes; the feet are point contacts
     at the spoke ends."""
     slope: float = _p(0.1, "rad", "slope gamma (downhill toward +x)", 0.0, 0.5)

@@ -25,17 +25,15 @@ foot, as on the A1). The A1's joint angles map as hip = -thigh_A1, knee = -calf_
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 
-import numpy as np
+from walkers.common.params import WalkerParams, index_constants, param as _p
 
 
-def _p(default, unit, doc, lo, hi):
-    return field(default=default, metadata=dict(unit=unit, doc=doc, bounds=(lo, hi)))
 
 
 @dataclass(frozen=True)
-class QuadrupedParams:
+class QuadrupedParams(WalkerParams):
     # body (A1, Menagerie) ------------------------------------------------------------------------
     torso_mass: float = _p(7.497, "kg", "trunk 4.713 + four hip housings 0.696 (abduction locked)", 0.1, 100.0)
     torso_inertia: float = _p(0.131, "kg m^2", "torso pitch inertia about its COM (trunk + hips at +-0.183 m)", 1e-4, 10.0)
@@ -95,13 +93,7 @@ class QuadrupedParams:
     fall_pitch: float = _p(0.8, "rad", "fallen when |torso pitch| exceeds this", 0.1, 3.1)
 
     def __post_init__(self):
-        for f in fields(self):
-            x = getattr(self, f.name)
-            lo, hi = f.metadata["bounds"]
-            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-                raise ValueError(f"QuadrupedParams.{f.name}={x!r} must be a finite number [{f.metadata['unit']}]")
-            if not lo <= x <= hi:
-                raise ValueError(f"QuadrupedParams.{f.name}={x} outside its bounds [{lo}, {hi}] {f.metadata['unit']}")
+        super().__post_init__()
         if self.knee_lower >= self.knee_upper:
             raise ValueError(f"QuadrupedParams.knee_lower={self.knee_lower} must be below knee_upper={self.knee_upper}")
         lo, hi = leg_reach(self)
@@ -111,19 +103,10 @@ class QuadrupedParams:
                 raise ValueError(f"QuadrupedParams.{name}: hip-to-foot distance {d:.3f} m outside the "
                                  f"leg's reach [{lo:.3f}, {hi:.3f}] m (knee limits)")
 
-    def to_array(self) -> np.ndarray:
-        """Every field as float64, in declaration order (index with I_<FIELD>)."""
-        return np.array([float(getattr(self, f.name)) for f in fields(self)])
-
     @property
     def total_mass(self) -> float:
         """[kg]"""
         return self.torso_mass + 4 * (self.thigh_mass + self.calf_mass)
-
-    @classmethod
-    def describe(cls) -> str:
-        return "\n".join(f"{f.name:18s} {f.default!s:>9} {f.metadata['unit']:8s} {f.metadata['doc']}"
-                         for f in fields(cls))
 
 
 def leg_reach(p: QuadrupedParams):
@@ -135,6 +118,4 @@ def leg_reach(p: QuadrupedParams):
 
 PARAM_NAMES = tuple(f.name for f in fields(QuadrupedParams))
 PARAM_INDEX = {n: i for i, n in enumerate(PARAM_NAMES)}
-for _i, _n in enumerate(PARAM_NAMES):
-    globals()[f"I_{_n.upper()}"] = _i
-N_PARAMS = len(PARAM_NAMES)
+globals().update(index_constants(QuadrupedParams))   # I_<FIELD>, N_PARAMS

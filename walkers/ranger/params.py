@@ -8,18 +8,18 @@ towards +x, so a stance leg goes from positive (foot ahead) to negative (foot be
 """
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 
-import numpy as np
+from walkers.common.params import WalkerParams, param
 
 
 def _p(default, doc, unit, lo, hi):
-    return field(default=default, metadata=dict(doc=doc, unit=unit, bounds=(lo, hi)))
+    """A parameter field (doc before unit, as this file lists them)."""
+    return param(default, unit, doc, lo, hi)
 
 
 @dataclass(frozen=True)
-class RangerParams:
+class RangerParams(WalkerParams):
     # geometry and mass (ranger.md) -------------------------------------------------------------
     leg_length: float = _p(0.96, "hip joint to ankle joint", "m", 0.5, 1.5)
     leg_mass: float = _p(4.96, "mass of each planar leg (outer pair as one, inner pair as one)", "kg", 1.0, 20.0)
@@ -93,26 +93,11 @@ class RangerParams:
     fall_height: float = _p(0.75, "the walker has fallen when the hip drops below this height above ground", "m", 0.1, 1.2)
 
     def __post_init__(self):
-        for f in fields(self):
-            x = getattr(self, f.name)
-            lo, hi = f.metadata["bounds"]
-            if not isinstance(x, (int, float)) or not math.isfinite(x):
-                raise ValueError(f"RangerParams.{f.name}={x!r} must be a finite number [{f.metadata['unit']}]")
-            if not lo <= x <= hi:
-                raise ValueError(f"RangerParams.{f.name}={x} outside its bounds [{lo}, {hi}] {f.metadata['unit']}")
+        super().__post_init__()
         if self.est_off >= self.est_on:
             raise ValueError(f"RangerParams.est_off={self.est_off} must be below est_on={self.est_on}")
         if self.sole_span_front <= self.sole_span_back:
             raise ValueError("RangerParams.sole_span_front must exceed sole_span_back")
-
-    def to_array(self) -> np.ndarray:
-        """Every field as float64, in declaration order (index with PARAM_INDEX[name])."""
-        return np.array([float(getattr(self, f.name)) for f in fields(self)])
-
-    @classmethod
-    def describe(cls) -> str:
-        return "\n".join(f"{f.name:22s} {f.default!s:>9} {f.metadata['unit']:10s} {f.metadata['doc']}"
-                         for f in fields(cls))
 
 
 PARAM_NAMES = tuple(f.name for f in fields(RangerParams))

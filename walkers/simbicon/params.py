@@ -12,18 +12,20 @@ everywhere). The dataclass defaults are the shipped, tuned values: see ``SHIPPED
 """
 from __future__ import annotations
 
-import math
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from walkers.common.params import WalkerParams, param
+
 
 def _p(default, unit, doc, lo, hi, tune=True):
-    return field(default=default, metadata=dict(unit=unit, doc=doc, bounds=(lo, hi), tune=tune))
+    """A parameter field; tune=False keeps it out of the tuner's vector."""
+    return param(default, unit, doc, lo, hi, tune=tune)
 
 
 @dataclass(frozen=True)
-class SimbiconParams:
+class SimbiconParams(WalkerParams):
     # FSM timing ------------------------------------------------------------------------------
     state_time: float = _p(0.2444, "s", "duration of the timed states 0 and 2 (Table 1)", 0.1, 0.6)
     contact_timeout: float = _p(0.6, "s", "states 1 and 3 end after this long even without a "
@@ -68,19 +70,7 @@ class SimbiconParams:
     fall_height: float = _p(0.7, "m", "torso COM below this height above the ground is a fall",
                             0.0, 1.5, tune=False)
 
-    def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            lo, hi = f.metadata["bounds"]
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
-                raise ValueError(f"SimbiconParams.{f.name}={value!r} must be a finite number in "
-                                 f"[{lo}, {hi}] ({f.metadata['unit']}: {f.metadata['doc']})")
-
     # vectors for the tuner and the compiled path ---------------------------------------------
-    def to_array(self) -> np.ndarray:
-        """All fields in declaration order, float64."""
-        return np.array([getattr(self, f.name) for f in fields(self)], dtype=np.float64)
-
     @classmethod
     def names(cls, tunable_only=False) -> tuple:
         return tuple(f.name for f in fields(cls) if f.metadata["tune"] or not tunable_only)
@@ -98,9 +88,6 @@ class SimbiconParams:
         b = self.bounds(True)
         x = np.clip(np.asarray(x, dtype=np.float64), b[:, 0], b[:, 1])
         return replace(self, **{n: float(v) for n, v in zip(self.names(True), x)})
-
-    def as_dict(self) -> dict:
-        return asdict(self)
 
 
 THESIS = SimbiconParams(

@@ -10,18 +10,13 @@ actuator moves. Defaults are the ones every test uses.
 """
 from __future__ import annotations
 
-import math
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import dataclass
 
-import numpy as np
-
-
-def _p(default, unit, doc, lo, hi):
-    return field(default=default, metadata=dict(unit=unit, doc=doc, bounds=(lo, hi)))
+from walkers.common.params import WalkerParams, index_constants, param as _p
 
 
 @dataclass(frozen=True)
-class SimpleBipedParams:
+class SimpleBipedParams(WalkerParams):
     # model ---------------------------------------------------------------------------------
     hip_mass: float = _p(10.0, "kg", "point mass of the hip (the whole upper body)", 0.1, 1e3)
     foot_mass: float = _p(1.0, "kg", "point mass of each foot (legs themselves are massless)", 0.01, 1e2)
@@ -83,32 +78,11 @@ class SimpleBipedParams:
     fall_leg_length: float = _p(1.5, "l0", "a leg longer than this counts as a fall (the walker "
                                 "came apart)", 1.0, 10.0)
 
-    def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            lo, hi = f.metadata["bounds"]
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
-                raise ValueError(f"SimpleBipedParams.{f.name}={value!r} must be a finite number in "
-                                 f"[{lo}, {hi}] ({f.metadata['unit']}: {f.metadata['doc']})")
-
-    def to_array(self) -> np.ndarray:
-        """Float64 vector in field order (indices ``I_<FIELD>``) for the compiled controller."""
-        return np.array([float(getattr(self, f.name)) for f in fields(self)])
-
     def step_length(self, speed: float | None = None) -> float:
         """Step length [m] at `speed` [m/s] (default: the target speed)."""
         v = self.speed if speed is None else speed
         return (self.step_length0 + self.step_length_per_speed * v) * self.leg_length
 
-    def replace(self, **kw) -> "SimpleBipedParams":
-        d = asdict(self)
-        unknown = set(kw) - set(d)
-        if unknown:
-            raise ValueError(f"SimpleBipedParams has no field(s) {sorted(unknown)}")
-        d.update(kw)
-        return SimpleBipedParams(**d)
 
-
-N_PARAMS = len(fields(SimpleBipedParams))
-# I_HIP_MASS = 0, I_FOOT_MASS = 1, ... : compile-time constants for the controller
-globals().update({f"I_{f.name.upper()}": i for i, f in enumerate(fields(SimpleBipedParams))})
+# I_HIP_MASS = 0, I_FOOT_MASS = 1, ..., N_PARAMS: compile-time constants for the controller
+globals().update(index_constants(SimpleBipedParams))
