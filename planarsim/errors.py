@@ -36,3 +36,22 @@ class SimulationDiverged(RuntimeError):
         # picklable, so that an error raised in a worker process reaches the caller intact
         return (type(self), (str(self), self.step, self.time, self.body, self.field, self.value,
                              self.last_state))
+
+
+FIELD_NAMES = ("x", "y", "theta", "vx", "vy", "omega")
+
+
+def diverged(model, ws, code, guard_limit, who="simulation"):
+    """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
+    just failed on workspace ws: step, time, body, field and value from the guard's record,
+    and a copy of the state at the start of that step."""
+    body = int(ws.info[2])
+    field = FIELD_NAMES[int(ws.info[3])]
+    value = float(ws.guard_value[0])
+    step = int(ws.prev.step[0])
+    t = float(ws.prev.time[0])
+    name = model.body_names[body]
+    what = "is not finite" if code == 1 else f"exceeds {guard_limit:g} in magnitude"
+    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    return SimulationDiverged(f"{who} diverged at step {step} (t={t:.6g} s): body {name!r} ({body}) "
+                              f"{field}={value} {what}", step, t, name, field, value, last)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import SimulationDiverged
+from .errors import diverged
 from .kernels.step import run_recorded
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
@@ -20,7 +20,6 @@ from .state import State, Workspace, make_state, make_workspace
 from .tables import pack_tables, set_options
 from .trajectory import Trajectory, make_recorder
 
-FIELD_NAMES = ("x", "y", "theta", "vx", "vy", "omega")
 
 
 class Simulator:
@@ -111,17 +110,7 @@ class Simulator:
         return u
 
     def _raise(self, code):
-        ws = self.ws
-        body = int(ws.info[2])
-        field = FIELD_NAMES[int(ws.info[3])]
-        value = float(ws.guard_value[0])
-        step = int(ws.prev.step[0])
-        t = float(ws.prev.time[0])
-        name = self.model.body_names[body]
-        what = "is not finite" if code == 1 else f"exceeds {self.options.guard_limit:g} in magnitude"
-        last = State(*(a.copy() for a in ws.prev))
-        raise SimulationDiverged(f"simulation diverged at step {step} (t={t:.6g} s): body {name!r} "
-                                 f"({body}) {field}={value} {what}", step, t, name, field, value, last)
+        raise diverged(self.model, self._ws, code, self._options.guard_limit)
 
     # stepping -------------------------------------------------------------------------------
     def step(self, u=None) -> None:

@@ -130,3 +130,17 @@ def test_walker_snapshot_with_controller_memory_continues_bit_for_bit(tmp_path):
     again.state.restore(state)
     again.memory[:] = memory["controller"]
     assert frame_hashes(again.run(1.0)) == expected
+
+
+def test_a_walker_divergence_names_the_body_and_field():
+    """A huge push on the Simple Biped's hip: the walker's own rollout raises the engine's
+    error naming step, body and field, with the state at the start of the failed step."""
+    import planarsim as ps
+    from walkers.simple_biped import Walker
+    w = Walker(record_every=1)
+    w.run(0.2)
+    w.state.ext_force[0, 0] = 1e16     # N: the hip's velocity leaves the guard's bound
+    with pytest.raises(ps.SimulationDiverged, match=r"simple biped diverged at step 200 .*body 'hip' \(0\) vx=") as e:
+        w.run(0.1)
+    assert e.value.step == 200 and e.value.body == "hip" and e.value.field == "vx"
+    assert e.value.last_state.step[0] == 200

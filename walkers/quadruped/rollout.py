@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 import planarsim as ps
-from planarsim.errors import SimulationDiverged
+from planarsim.errors import diverged
 from planarsim.kernels._jit import jit
 from planarsim.kernels.record import record_frame
 from planarsim.kernels.step import step
@@ -112,10 +112,7 @@ class Quadruped:
         code, done, k = rollout_quadruped(self.model.arrays, self.state, self.ws, self.options, self.p,
                                           self.memory, self.u, n, every, rec, lab, LABEL_SLOTS, 0)
         if code in (1, 2):
-            raise SimulationDiverged(f"quadruped diverged near t={float(self.state.time[0]):.4f} s "
-                                     f"(guard code {code})", int(self.ws.prev.step[0]),
-                                     float(self.ws.prev.time[0]), "?", "?",
-                                     float(self.ws.guard_value[0]), self.ws.prev)
+            raise diverged(self.model, self.ws, code, self.options.guard_limit, "quadruped")
         traj = Trajectory.from_recorder(self.model, rec, k,
                                         labels={nm: lab[:k, j].copy() for j, nm in enumerate(LABELS)},
                                         info={"dt": self.model.dt, "walker": "quadruped"})

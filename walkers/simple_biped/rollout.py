@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 import planarsim as ps
-from planarsim.errors import SimulationDiverged
+from planarsim.errors import diverged
 from planarsim.kernels._jit import jit
 from planarsim.kernels.record import record_frame
 from planarsim.kernels.step import step
@@ -142,9 +142,7 @@ class Walker:
         code, done, k = rollout_simple_biped(self.model.arrays, self.state, self.ws, self.options,
                                              self.p, self.memory, self.u, n, every, rec, lab, 0)
         if code in (1, 2):
-            raise SimulationDiverged(f"simple biped diverged near t={self.state.t:.4f} s (guard code {code})",
-                                     int(self.ws.prev.step[0]), float(self.ws.prev.time[0]), "?", "?",
-                                     float(self.ws.guard_value[0]), self.ws.prev)
+            raise diverged(self.model, self.ws, code, self.options.guard_limit, "simple biped")
         traj = Trajectory.from_recorder(self.model, rec, k,
                                         labels={name: lab[:k, j].copy() for j, name in enumerate(LABELS)},
                                         info={"dt": self.model.dt, "walker": "simple-biped"})
