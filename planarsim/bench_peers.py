@@ -4,8 +4,9 @@ same way in the same run.
 Timing: each engine runs the scene's timing episode (bench_scenes.SCENES: 5 s for chains, 3 s
 for the biped collapse, 2 s for the rod drop) from the start state once to warm up, then
 `repeats` times, each from the start state (resetting or rebuilding the world is not timed),
-the repeats going round the engines in turn; steps/s is the median with the min-max spread. planarsim's figure is the compiled multi-step call
-(Simulator.steps); its Python single-step loop is reported next to it.
+the repeats going round the engines in turn; steps/s is the median with the min-max spread.
+planarsim's figure is the compiled multi-step call (Simulator.steps); its Python single-step
+loop is timed alongside.
 Accuracy: one recorded run per engine (10 s for chains, else the episode), judged by
 bench_metrics.accuracy.
 
@@ -21,9 +22,9 @@ import time
 import numpy as np
 
 import planarsim as ps
-from .kernels._jit import jit
 from .bench_metrics import ACCURACY_SECONDS, PEER_SCENES, accuracy, spec_from_model
 from .bench_scenes import SCENES
+from .kernels._jit import jit
 
 #: peer name -> module implementing World(spec) with reset(), run(n), record(n)
 PEER_MODULES = {"mujoco": "planarsim.bench_mujoco", "pymunk": "planarsim.bench_pymunk",
