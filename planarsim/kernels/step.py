@@ -6,7 +6,7 @@ remainder of the step with the new contact pinned.
 """
 from ._jit import jit, jit_inline
 from .ccd import advance_to_impact, time_of_impact
-from .contacts import MODE_SLIDING, find_contacts
+from .contacts import MODE_FREE, MODE_SLIDING, find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import check_guards
 from .math2d import update_trig
@@ -71,6 +71,22 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         build_rows(m, s, ws)
         solve_impulses(m, ws, h, opt.pivot_tol)
         gather_contact_impulses(m, s, ws)
+        if opt.cap_policy == 1:
+            # and no contact may pull: nearly dependent rows (a closed loop through the ground)
+            # can give huge opposite impulses, one pulling. Release the contact that pulls
+            # hardest and solve again, until none pulls (at most one solve per contact).
+            for _ in range(m.contact_body.shape[0]):
+                worst = -1
+                for i in range(m.contact_body.shape[0]):
+                    if s.contact_mode[i] != MODE_FREE and ws.contact_impulse[i, 0] < 0.0:
+                        if worst < 0 or ws.contact_impulse[i, 0] < ws.contact_impulse[worst, 0]:
+                            worst = i
+                if worst < 0:
+                    break
+                s.contact_mode[worst] = MODE_FREE
+                build_rows(m, s, ws)
+                solve_impulses(m, ws, h, opt.pivot_tol)
+                gather_contact_impulses(m, s, ws)
     ws.info[0] += rounds
 
 
