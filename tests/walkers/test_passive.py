@@ -158,3 +158,11 @@ def test_compass_gait_has_a_stable_period_one_gait():
     # on the engine's own contacts the walker keeps walking from the fixed point
     traj, summary, model = simulate(20.0, params=p, dt=5e-4, x0=fp.x, impacts="engine")
     assert not summary["fell"] and abs(summary["step_period"] / w.last_period - 1) < 0.02
+
+
+@pytest.mark.parametrize("name", ["simplest-walker", "compass-gait", "rimless-wheel"])
+def test_runs_shorter_than_one_recording_interval(name):
+    """simulate(0.001) with record_every=10 records nothing but must not fail."""
+    import walkers
+    traj, summary, model = walkers.load(name).simulate(0.001)
+    assert len(traj) <= 1 and summary["steps"] == 0 and not summary["fell"]

@@ -318,11 +318,13 @@ class PassiveWalker:
 
 
 def _concat(trajs):
-    trajs = [t for t in trajs if t is not None and len(t)]
-    first = trajs[0]
-    arrays = {k: np.concatenate([getattr(t, k) for t in trajs]) for k in Trajectory._ARRAYS}
-    return Trajectory(**arrays, body_names=first.body_names, contact_names=first.contact_names,
-                      act_names=first.act_names, info=dict(first.info))
+    """The recorded chunks joined (empty ones dropped; a run shorter than one recording
+    interval gives its empty first chunk; None when nothing was recorded)."""
+    kept = [t for t in trajs if t is not None]
+    if not kept:
+        return None
+    full = [t for t in kept if len(t)]
+    return Trajectory.concatenate(full) if full else kept[0]
 
 
 def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10,
