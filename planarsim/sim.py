@@ -103,7 +103,8 @@ class Simulator:
         if (type(u) is np.ndarray and u.dtype == np.float64 and u.shape == self._u0.shape
                 and u.flags.c_contiguous):
             return u
-        u = np.asarray(u, dtype=np.float64)
+        # contiguous float64: the bound kernels were compiled for exactly that layout
+        u = np.ascontiguousarray(u, dtype=np.float64)
         if u.shape != (self.model.n_act,):
             raise ValueError(f"commands u must have shape ({self.model.n_act},) "
                              f"(one per actuator: {list(self.model.act_names)}), got {u.shape}")

@@ -83,3 +83,29 @@ def test_changing_options_reaches_the_python_step():
     assert not np.array_equal(a.state.q, c.state.q)   # refinement on moves the result
     with pytest.raises(ValueError, match="refine_iters"):
         a.options = ps.StepOptions(refine_iters=-2)
+
+
+def test_commands_of_any_layout_and_type_give_the_same_step():
+    b = ps.ModelBuilder(dt=1e-3)
+    upper = b.add_body("upper", mass=1.0, inertia=1.0 / 12, pos=(0.5, 0.0))
+    lower = b.add_body("lower", mass=1.0, inertia=1.0 / 12, pos=(1.5, 0.0))
+    b.add_pin("shoulder", None, upper, anchor_world=(0.0, 0.0))
+    b.add_pin("elbow", upper, lower, anchor_world=(1.0, 0.0))
+    b.add_pin_motor("m0", "shoulder")
+    b.add_pin_motor("m1", "elbow")
+    model = b.compile()
+    strided = np.array([0.5, 9.0, -0.25, 9.0])[::2]        # a non-contiguous view
+    assert not strided.flags.c_contiguous
+    runs = []
+    # 0.5 and -0.25 are exact in float32 too
+    for u in (np.array([0.5, -0.25]), [0.5, -0.25], np.array([0.5, -0.25], np.float32), strided):
+        sim = ps.Simulator(model)
+        for _ in range(200):
+            sim.step(u)
+        sim.steps(100, u)
+        sim.run(n_steps=50, u=u)
+        runs.append(sim.state.q.copy())
+    for q in runs[1:]:
+        assert np.array_equal(q, runs[0])
+    with pytest.raises(ValueError, match="shape"):
+        ps.Simulator(model).step(np.zeros(3))
