@@ -19,7 +19,13 @@ from numba import njit
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
 
 jit = njit(**_OPTIONS)
-jit_inline = njit(inline="always", **_OPTIONS)
+# kernel: a function called only from other compiled code. numba then builds neither its Python
+# wrapper (which unboxes every array of the model, state and workspace: thousands of lines of
+# LLVM IR per function) nor its C wrapper; this halves the first-ever compile of the step.
+# Anything called from Python (rollouts, run_recorded, step_entry, terrain queries) keeps `jit`.
+kernel = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True, **_OPTIONS)
+kernel_inline = njit(inline="always", no_cpython_wrapper=True, no_cfunc_wrapper=True, **_OPTIONS)
+jit_inline = kernel_inline
 # table_step builds arrays over raw addresses (numba.carray), which numba allows only with its
 # runtime on; those arrays own no memory, so its reference counting has nothing to count
 jit_table = njit(cache=True, fastmath=False, nogil=True, error_model="numpy")

@@ -10,14 +10,14 @@ precision. The step is then split at tau (seed 002 section 3).
 """
 import math
 
-from ._jit import jit
+from ._jit import kernel
 from .contacts import MODE_FREE
 from .terrain import gap_of_point
 
 N_SAMPLES = 8
 
 
-@jit
+@kernel
 def _path_gap(m, s, ws, b, h, tau):
     ax = (ws.v_new[b, 0] - s.v[b, 0]) / h
     ay = (ws.v_new[b, 1] - s.v[b, 1]) / h
@@ -26,7 +26,7 @@ def _path_gap(m, s, ws, b, h, tau):
     return gap_of_point(m.terrain_coef, px, py)
 
 
-@jit
+@kernel
 def impact_time(m, s, ws, b, h):
     """First root tau in [0, h] of the path gap of point-mass body b, or inf if none."""
     t_lo = 0.0
@@ -79,7 +79,7 @@ def impact_time(m, s, ws, b, h):
     return t_hi
 
 
-@jit
+@kernel
 def time_of_impact(m, s, ws, h):
     """Earliest impact (tau, contact) over free, enabled CCD contacts; contact -1 if none."""
     best = math.inf
@@ -94,7 +94,7 @@ def time_of_impact(m, s, ws, h):
     return best, which
 
 
-@jit
+@kernel
 def advance_to_impact(s, ws, h, tau):
     """Move every body along its within-step path to tau: v = v0 + tau a, q += tau v."""
     for i in range(s.q.shape[0]):

@@ -11,7 +11,7 @@ and let the foot sink by as much every step.
 """
 import math
 
-from ._jit import jit
+from ._jit import kernel
 from .math2d import rotate, world_point
 from .terrain import closest_point
 
@@ -22,7 +22,7 @@ MODE_PINNED = 1
 MODE_SLIDING = 2
 
 
-@jit
+@kernel
 def _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, on_arc):
     ws.contact_on_arc[i] = on_arc
     ws.contact_point[i, 0] = px
@@ -36,7 +36,7 @@ def _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, on_arc):
     ws.contact_anchor[i, 1] = ly
 
 
-@jit
+@kernel
 def _try_vertex(m, q, ws, i, b, lx, ly, best):
     """Use local vertex (lx, ly) for contact i if its gap is below `best`; return the new best."""
     px, py = world_point(q, ws.body_cs, b, lx, ly)
@@ -47,7 +47,7 @@ def _try_vertex(m, q, ws, i, b, lx, ly, best):
     return best
 
 
-@jit
+@kernel
 def find_contact(m, q, ws, i):
     """Contact point, ground point, normal and gap of contact i at configuration q."""
     b = m.contact_body[i]
@@ -85,7 +85,7 @@ def find_contact(m, q, ws, i):
         best = _try_vertex(m, q, ws, i, b, m.vert_local[k, 0], m.vert_local[k, 1], best)
 
 
-@jit
+@kernel
 def engage_contact(m, s, ws, i, vn, vt):
     """Bring free contact i into touch, approaching at normal velocity vn and tangential vt
     [m/s]: sliding along vt when |vt| > mu |vn| (an impact's friction impulse, at most mu
@@ -100,7 +100,7 @@ def engage_contact(m, s, ws, i, vn, vt):
     ws.contact_new[i] = 1
 
 
-@jit
+@kernel
 def find_contacts(m, s, ws):
     """Stage 3 for every contact; a disabled contact is forced free. A contact that a
     time-of-impact split brought into touch (contact_new == 2) is engaged here, where its

@@ -6,7 +6,7 @@ torque. Commands are saturated to act_range; act_power records the mechanical po
 """
 import math
 
-from ._jit import jit, jit_inline
+from ._jit import kernel, kernel_inline
 from .math2d import cross2, world_point
 
 ACT_PIN_TORQUE = 0
@@ -16,7 +16,7 @@ ACT_BODY_FORCE = 3
 ACT_BODY_TORQUE = 4
 
 
-@jit
+@kernel
 def point_velocity(q, v, body, px, py):
     """World velocity [m/s] of the world point (px, py) moving with `body` (0 for the world)."""
     if body < 0:
@@ -26,7 +26,7 @@ def point_velocity(q, v, body, px, py):
     return v[body, 0] - v[body, 2] * ry, v[body, 1] + v[body, 2] * rx
 
 
-@jit
+@kernel
 def add_point_force(q, f, body, px, py, fx, fy):
     """Add force (fx, fy) [N] applied at world point (px, py) of `body` (ignored for the world)."""
     if body < 0:
@@ -36,7 +36,7 @@ def add_point_force(q, f, body, px, py, fx, fy):
     f[body, 2] += cross2(px - q[body, 0], py - q[body, 1], fx, fy)
 
 
-@jit
+@kernel
 def pin_angle_rate(m, q, v, j):
     """Pin angle theta_b - theta_a - ref [rad] and its rate [rad/s]."""
     a = m.pin_body[j, 0]
@@ -49,7 +49,7 @@ def pin_angle_rate(m, q, v, j):
     return ang, rate
 
 
-@jit_inline
+@kernel_inline
 def apply_actuator(m, q, cs, v, f, k, u):
     """Add actuator k's saturated command u to f; return its mechanical power [W]."""
     kind = m.act_kind[k]
@@ -109,7 +109,7 @@ def apply_actuator(m, q, cs, v, f, k, u):
     return u * v[a, 2]
 
 
-@jit
+@kernel
 def apply_forces(m, s, ws, u):
     """f = m g + pushes + pin springs/dampers + saturated actuator commands u."""
     q = s.q
@@ -141,7 +141,7 @@ def apply_forces(m, s, ws, u):
         ws.act_power[k] = apply_actuator(m, q, ws.body_cs, v, f, k, uk)
 
 
-@jit
+@kernel
 def predict_velocity(m, s, ws, h):
     """v* = v + h M^-1 f (point masses keep zero angular velocity)."""
     for i in range(s.v.shape[0]):

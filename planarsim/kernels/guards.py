@@ -1,14 +1,14 @@
 """Stage 9: guards. Every q and v component must be finite and below the magnitude bound."""
 import math
 
-from ._jit import jit
+from ._jit import kernel
 
 GUARD_OK = 0
 GUARD_NONFINITE = 1
 GUARD_TOO_LARGE = 2
 
 
-@jit
+@kernel
 def check_guards(s, ws, limit):
     """Return GUARD_*; on failure ws.info[2] = body, ws.info[3] = field 0..5 (x y th vx vy w)."""
     for i in range(s.q.shape[0]):

@@ -8,19 +8,19 @@ equation moves q along the START-of-step constraint directions J(q0):
 Corrections of unilateral rows (contact normals, joint limits) move positions only: pushing a
 body out of the ground must not give it the velocity overlap / h (energy from nowhere).
 """
-from ._jit import jit, jit_inline
+from ._jit import kernel, kernel_inline
 from .math2d import update_trig
 from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_row
 from .solve import apply_impulses, assemble, factor_solve, substitute
 
 
-@jit
+@kernel
 def is_unilateral(kind):
     """Contact normal and joint-limit rows: their corrections remove overlap, not velocity."""
     return kind == ROW_CONTACT_N or kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI
 
 
-@jit
+@kernel
 def integrate_positions(s, vel, h):
     """v = vel; q += h v."""
     for i in range(s.q.shape[0]):
@@ -29,7 +29,7 @@ def integrate_positions(s, vel, h):
             s.q[i, k] += h * vel[i, k]
 
 
-@jit
+@kernel
 def max_residual(m, s, ws):
     """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
     update_trig(s.q, ws.body_cs)
@@ -42,7 +42,7 @@ def max_residual(m, s, ws):
     return worst
 
 
-@jit_inline
+@kernel_inline
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
     """Newton-SHAKE; returns the final max residual [m or rad]."""
     n = ws.n_row[0]

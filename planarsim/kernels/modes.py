@@ -16,7 +16,7 @@ round (an overshooting friction impulse adds energy). MODES_ALL checks every con
 every round.
 Joint limits engage when the angle would pass the limit and release when their impulse pulls.
 """
-from ._jit import jit
+from ._jit import kernel
 from .contacts import MODE_FREE, MODE_PINNED, MODE_SLIDING, engage_contact
 from .forces import point_velocity
 from .math2d import world_point
@@ -26,7 +26,7 @@ MODES_ALTERNATING = 0
 MODES_ALL = 1
 
 
-@jit
+@kernel
 def gather_contact_impulses(m, s, ws):
     """ws.contact_impulse[i] = (lambda_n, lambda_t) from the last solve (zero when free)."""
     for i in range(ws.contact_impulse.shape[0]):
@@ -42,7 +42,7 @@ def gather_contact_impulses(m, s, ws):
             ws.contact_impulse[o, 1] = ws.lam[r]
 
 
-@jit
+@kernel
 def contact_velocity(m, s, ws, i, vel):
     """Normal and tangential velocity [m/s] of contact i's material point under `vel`."""
     b = m.contact_body[i]
@@ -53,7 +53,7 @@ def contact_velocity(m, s, ws, i, vel):
     return nx * vx + ny * vy, ny * vx - nx * vy
 
 
-@jit
+@kernel
 def check_contact(m, s, ws, i):
     """Apply the release / slide / stick rules to contact i; return 1 if its mode changed."""
     mode = s.contact_mode[i]
@@ -78,7 +78,7 @@ def check_contact(m, s, ws, i):
     return 0
 
 
-@jit
+@kernel
 def engage_contacts(m, s, ws, h, include_ccd):
     """Pin every enabled free contact that would end the step below the ground (contacts with
     CCD are left to the time-of-impact split unless include_ccd)."""
@@ -95,7 +95,7 @@ def engage_contacts(m, s, ws, h, include_ccd):
     return changed
 
 
-@jit
+@kernel
 def check_limits(m, s, ws, h):
     """Engage limits the angle would pass; release limits whose impulse pulls."""
     changed = 0
@@ -121,7 +121,7 @@ def check_limits(m, s, ws, h):
     return changed
 
 
-@jit
+@kernel
 def update_modes(m, s, ws, h, strategy, first_round, include_ccd):
     """One round of mode checks after a solve; return the number of changes."""
     gather_contact_impulses(m, s, ws)

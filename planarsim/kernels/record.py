@@ -1,8 +1,8 @@
 """Recording one frame of a run into preallocated arrays (a Recorder NamedTuple)."""
-from ._jit import jit
+from ._jit import kernel
 
 
-@jit
+@kernel
 def record_frame(s, ws, rec, k):
     """Write the state after a step into frame k of rec (see planarsim/trajectory.py)."""
     rec.t[k] = s.time[0]

@@ -11,7 +11,7 @@ Coulomb friction -mu lambda_n s along the tangent t.
 """
 import math
 
-from ._jit import jit
+from ._jit import kernel
 from .math2d import cross2, world_point
 from .contacts import MODE_PINNED, MODE_SLIDING
 from .terrain import closest_point
@@ -25,7 +25,7 @@ ROW_CONTACT_N = 5
 ROW_CONTACT_T = 6
 
 
-@jit
+@kernel
 def _set_dir(q, body, px, py, dx, dy, sign, out):
     """out = sign * (dx, dy, (p - x_body) x d)."""
     if body < 0:
@@ -38,7 +38,7 @@ def _set_dir(q, body, px, py, dx, dy, sign, out):
     out[2] = sign * cross2(px - q[body, 0], py - q[body, 1], dx, dy)
 
 
-@jit
+@kernel
 def eval_row(m, q, ws, r, J):
     """Jacobian blocks J (2, 3) and error c of row r at configuration q; returns c."""
     kind = ws.row_kind[r]
@@ -102,7 +102,7 @@ def eval_row(m, q, ws, r, J):
     return tx * (px - ws.contact_ground[o, 0]) + ty * (py - ws.contact_ground[o, 1])
 
 
-@jit
+@kernel
 def _add_row(ws, n, kind, owner, a, b):
     ws.row_kind[n] = kind
     ws.row_owner[n] = owner
@@ -111,7 +111,7 @@ def _add_row(ws, n, kind, owner, a, b):
     return n + 1
 
 
-@jit
+@kernel
 def build_rows(m, s, ws):
     """Fill the active rows at the current configuration: J, F (impulse directions) and c."""
     n = 0

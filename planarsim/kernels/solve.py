@@ -10,11 +10,11 @@ elimination drops a row whose pivot falls below pivot_tol times its own diagonal
 that is a combination of earlier ones; its impulse is zero and the rows it depends on carry
 the load. For consistent constraints this is exact, not a regularisation.
 """
-from ._jit import jit, jit_inline
+from ._jit import kernel, kernel_inline
 from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
 
 
-@jit
+@kernel
 def compute_envelope(ws, n, n_body):
     """row_first[r]: the first row sharing a body with row r; row_reach[k]: the last row whose
     envelope reaches column k. Rows touch at most two bodies, so for rows ordered along a
@@ -38,7 +38,7 @@ def compute_envelope(ws, n, n_body):
             ws.row_reach[k] = i
 
 
-@jit
+@kernel
 def _entry(m, ws, JL, JR, i, j):
     """(JL W JR^T)[i, j] over the bodies rows i and j share."""
     acc = 0.0
@@ -54,7 +54,7 @@ def _entry(m, ws, JL, JR, i, j):
     return acc
 
 
-@jit
+@kernel
 def assemble(m, ws, JL, JR, n):
     """ws.A = JL W JR^T inside the envelope (entries outside it are structurally zero)."""
     A = ws.A
@@ -65,7 +65,7 @@ def assemble(m, ws, JL, JR, n):
                 A[j, i] = _entry(m, ws, JL, JR, j, i)
 
 
-@jit
+@kernel
 def factor(A, first, reach, n, tol, scale):
     """LU factorisation of A in place, inside the envelope given by first / reach (see
     compute_envelope): U on and above the diagonal, the multipliers L below it. Takes the
@@ -104,7 +104,7 @@ def factor(A, first, reach, n, tol, scale):
     return dropped
 
 
-@jit
+@kernel
 def substitute(A, first, reach, rhs, x, n):
     """x = A^-1 rhs from the factors of `factor` (rhs destroyed); dropped rows get x = 0."""
     for k in range(n):
@@ -126,7 +126,7 @@ def substitute(A, first, reach, rhs, x, n):
         x[k] = acc / A[k, k]
 
 
-@jit_inline
+@kernel_inline
 def factor_solve(ws, rhs, x, n, tol):
     """Factor ws.A and solve A x = rhs; returns #dropped rows."""
     dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, x)
@@ -134,7 +134,7 @@ def factor_solve(ws, rhs, x, n, tol):
     return dropped
 
 
-@jit
+@kernel
 def apply_impulses(m, ws, F, lam, n, vel, scale):
     """vel += scale * W F^T lam (rows 0..n-1)."""
     for r in range(n):
@@ -150,7 +150,7 @@ def apply_impulses(m, ws, F, lam, n, vel, scale):
             vel[b, 2] += m.body_inv_inertia[b] * F[r, e, 2] * l
 
 
-@jit
+@kernel
 def row_dot(ws, r, J, vel):
     """J_r . vel."""
     acc = 0.0
@@ -162,7 +162,7 @@ def row_dot(ws, r, J, vel):
     return acc
 
 
-@jit_inline
+@kernel_inline
 def solve_impulses(m, ws, h, tol):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows."""
     n = ws.n_row[0]

@@ -4,7 +4,7 @@ step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard cod
 (0 ok, 1 non-finite, 2 too large). A time-of-impact split (CCD) repeats stages 1-6 for the
 remainder of the step with the new contact pinned.
 """
-from ._jit import jit, jit_inline
+from ._jit import jit, kernel, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
 from .contacts import MODE_FREE, MODE_SLIDING, find_contacts
 from .forces import apply_forces, predict_velocity
@@ -17,20 +17,20 @@ from .rows import build_rows
 from .solve import solve_impulses
 
 
-@jit
+@kernel
 def _copy1(src, dst):
     for i in range(src.shape[0]):
         dst[i] = src[i]
 
 
-@jit
+@kernel
 def _copy2(src, dst):
     for i in range(src.shape[0]):
         for k in range(src.shape[1]):
             dst[i, k] = src[i, k]
 
 
-@jit_inline
+@kernel_inline
 def copy_state(src, dst):
     """dst <- src, array by array (dst is a State of the same shapes; no allocation)."""
     _copy2(src.q, dst.q)
@@ -45,7 +45,7 @@ def copy_state(src, dst):
     _copy2(src.ext_force, dst.ext_force)
 
 
-@jit_inline
+@kernel_inline
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 4-6: build rows, solve, check modes; repeat while modes change (capped)."""
     rounds = 0
@@ -90,7 +90,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     ws.info[0] += rounds
 
 
-@jit
+@kernel
 def step(m, s, ws, opt, u):
     """Advance s by one step of m.dt under actuator commands u; return the guard code."""
     copy_state(s, ws.prev)
@@ -135,6 +135,12 @@ def step(m, s, ws, opt, u):
 
 
 @jit
+def step_entry(m, s, ws, opt, u):
+    """`step` callable from Python (step itself is a kernel: compiled code calls it directly)."""
+    return step(m, s, ws, opt, u)
+
+
+@kernel
 def run_steps(m, s, ws, opt, u, n):
     """n steps under constant commands u; returns (guard code, steps completed)."""
     for k in range(n):

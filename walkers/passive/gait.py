@@ -253,7 +253,7 @@ class PassiveWalker:
         Returns tau [s]."""
         from scipy.optimize import brentq
 
-        from planarsim.kernels.step import step as _step
+        from planarsim.kernels.step import step_entry as _step
         from planarsim.kernels.terrain import gap_of_point
         sim, s, ws = self.sim, self.sim.state, self.sim.ws
         m = self.model.arrays
