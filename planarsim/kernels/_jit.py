@@ -15,6 +15,7 @@ import os
 from pathlib import Path
 
 from numba import njit
+from numba.core.registry import CPUDispatcher
 
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
 
@@ -23,8 +24,31 @@ jit = njit(**_OPTIONS)
 # wrapper (which unboxes every array of the model, state and workspace: thousands of lines of
 # LLVM IR per function) nor its C wrapper; this halves the first-ever compile of the step.
 # Anything called from Python (rollouts, run_recorded, step_entry, terrain queries) keeps `jit`.
-kernel = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True, **_OPTIONS)
-kernel_inline = njit(inline="always", no_cpython_wrapper=True, no_cfunc_wrapper=True, **_OPTIONS)
+class KernelDispatcher(CPUDispatcher):
+    """Dispatcher of a kernel. Compiled code calls it directly; a call from Python is refused
+    with a clear error (numba would jump into the Python wrapper that was never built)."""
+
+    def __call__(self, *args, **kwargs):
+        name = self.py_func.__qualname__
+        raise TypeError(f"{self.py_func.__module__}.{name} is a compiled kernel: call it from "
+                        "compiled code (a rollout decorated with planarsim.kernels._jit.jit); "
+                        "from Python use Simulator.step / steps or planarsim.kernels.step.step_entry")
+
+
+def _kernel_decorator(**extra):
+    options = dict(_OPTIONS, nopython=True, boundscheck=None, no_cpython_wrapper=True,
+                   no_cfunc_wrapper=True, **extra)
+    options.pop("cache")
+
+    def decorate(fn):
+        disp = KernelDispatcher(py_func=fn, locals={}, targetoptions=dict(options))
+        disp.enable_caching()
+        return disp
+    return decorate
+
+
+kernel = _kernel_decorator()
+kernel_inline = _kernel_decorator(inline="always")
 jit_inline = kernel_inline
 # table_step builds arrays over raw addresses (numba.carray), which numba allows only with its
 # runtime on; those arrays own no memory, so its reference counting has nothing to count

@@ -10,7 +10,7 @@ body out of the ground must not give it the velocity overlap / h (energy from no
 """
 from ._jit import kernel, kernel_inline
 from .math2d import update_trig
-from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_row
+from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_rows
 from .solve import apply_impulses, assemble, factor_solve, substitute
 
 
@@ -33,9 +33,11 @@ def integrate_positions(s, vel, h):
 def max_residual(m, s, ws):
     """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
     update_trig(s.q, ws.body_cs)
+    n = ws.n_row[0]
+    eval_rows(m, s.q, ws, ws.row_Jp, ws.rhs, n)
     worst = 0.0
-    for r in range(ws.n_row[0]):
-        c = eval_row(m, s.q, ws, r, ws.row_Jp[r])
+    for r in range(n):
+        c = ws.rhs[r]
         ws.rhs[r] = -c
         if abs(c) > worst:
             worst = abs(c)
@@ -52,11 +54,11 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
     for _ in range(iters):
         if worst <= tol:
             break
-        assemble(m, ws, ws.row_Jp, ws.row_J, n)
         unilateral = 0
         for r in range(n):
             ws.row_c[r] = ws.rhs[r]   # -c(q+), kept for the velocity solve (row_c is free now)
             unilateral += is_unilateral(ws.row_kind[r])
+        assemble(m, ws, ws.row_Jp, ws.row_J, n)
         factor_solve(ws, ws.rhs, ws.lam, n, pivot_tol)
         # move positions by the correction
         for i in range(ws.v_new.shape[0]):

@@ -103,6 +103,35 @@ def eval_row(m, q, ws, r, J):
 
 
 @kernel
+def _pin_rows(q, cs, anchor, o, a, b, J, c, r):
+    """Rows r (x) and r + 1 (y) of pin o between bodies a and b: both from one evaluation of
+    the two anchor points (the same arithmetic as eval_row, half the work)."""
+    ax, ay = world_point(q, cs, a, anchor[o, 0, 0], anchor[o, 0, 1])
+    bx, by = world_point(q, cs, b, anchor[o, 1, 0], anchor[o, 1, 1])
+    _set_dir(q, a, ax, ay, 1.0, 0.0, -1.0, J[r, 0])
+    _set_dir(q, b, bx, by, 1.0, 0.0, 1.0, J[r, 1])
+    c[r] = (bx - ax) * 1.0 + (by - ay) * 0.0
+    _set_dir(q, a, ax, ay, 0.0, 1.0, -1.0, J[r + 1, 0])
+    _set_dir(q, b, bx, by, 0.0, 1.0, 1.0, J[r + 1, 1])
+    c[r + 1] = (bx - ax) * 0.0 + (by - ay) * 1.0
+
+
+@kernel
+def eval_rows(m, q, ws, J, c, n):
+    """J[r] and c[r] of rows 0..n-1 at configuration q (ws.body_cs holds its cos / sin). A pin's
+    x row is always followed by its y row (build_rows), so both come from one evaluation."""
+    r = 0
+    while r < n:
+        if ws.row_kind[r] == ROW_PIN_X:
+            _pin_rows(q, ws.body_cs, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
+                      ws.row_body[r, 1], J, c, r)
+            r += 2
+        else:
+            c[r] = eval_row(m, q, ws, r, J[r])
+            r += 1
+
+
+@kernel
 def _add_row(ws, n, kind, owner, a, b):
     ws.row_kind[n] = kind
     ws.row_owner[n] = owner
@@ -132,8 +161,8 @@ def build_rows(m, s, ws):
         if mode == MODE_PINNED:
             n = _add_row(ws, n, ROW_CONTACT_T, i, -1, m.contact_body[i])
     ws.n_row[0] = n
+    eval_rows(m, s.q, ws, ws.row_J, ws.row_c, n)
     for r in range(n):
-        ws.row_c[r] = eval_row(m, s.q, ws, r, ws.row_J[r])
         for e in range(2):
             for k in range(3):
                 ws.row_F[r, e, k] = ws.row_J[r, e, k]

@@ -39,30 +39,42 @@ def compute_envelope(ws, n, n_body):
 
 
 @kernel
-def _entry(m, ws, JL, JR, i, j):
-    """(JL W JR^T)[i, j] over the bodies rows i and j share."""
+def _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j):
+    """(JL W JR^T)[i, j] over the bodies rows i and j share (each row touches at most two)."""
     acc = 0.0
+    bj0 = row_body[j, 0]
+    bj1 = row_body[j, 1]
     for ei in range(2):
-        bi = ws.row_body[i, ei]
+        bi = row_body[i, ei]
         if bi < 0:
             continue
-        for ej in range(2):
-            if ws.row_body[j, ej] != bi:
-                continue
-            acc += (JL[i, ei, 0] * JR[j, ej, 0] + JL[i, ei, 1] * JR[j, ej, 1]) * m.body_inv_mass[bi]
-            acc += JL[i, ei, 2] * JR[j, ej, 2] * m.body_inv_inertia[bi]
+        im = inv_mass[bi]
+        ii = inv_inertia[bi]
+        if bj0 == bi:
+            acc += (JL[i, ei, 0] * JR[j, 0, 0] + JL[i, ei, 1] * JR[j, 0, 1]) * im
+            acc += JL[i, ei, 2] * JR[j, 0, 2] * ii
+        if bj1 == bi:
+            acc += (JL[i, ei, 0] * JR[j, 1, 0] + JL[i, ei, 1] * JR[j, 1, 1]) * im
+            acc += JL[i, ei, 2] * JR[j, 1, 2] * ii
     return acc
 
 
 @kernel
-def assemble(m, ws, JL, JR, n):
-    """ws.A = JL W JR^T inside the envelope (entries outside it are structurally zero)."""
-    A = ws.A
+def assemble_rows(JL, JR, row_body, inv_mass, inv_inertia, first, A, n):
+    """A = JL W JR^T inside the envelope (entries outside it are structurally zero). Takes
+    only the arrays it needs: a call that passes the model or workspace NamedTuples copies
+    hundreds of array descriptors and leaves the loop's strides spilled to the stack."""
     for i in range(n):
-        for j in range(ws.row_first[i], i + 1):
-            A[i, j] = _entry(m, ws, JL, JR, i, j)
+        for j in range(first[i], i + 1):
+            A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
             if j != i:
-                A[j, i] = _entry(m, ws, JL, JR, j, i)
+                A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
+
+
+@kernel
+def assemble(m, ws, JL, JR, n):
+    """ws.A = JL W JR^T inside the envelope."""
+    assemble_rows(JL, JR, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.row_first, ws.A, n)
 
 
 @kernel
@@ -135,19 +147,25 @@ def factor_solve(ws, rhs, x, n, tol):
 
 
 @kernel
-def apply_impulses(m, ws, F, lam, n, vel, scale):
+def add_impulses(F, row_body, inv_mass, inv_inertia, lam, n, vel, scale):
     """vel += scale * W F^T lam (rows 0..n-1)."""
     for r in range(n):
         l = lam[r] * scale
         if l == 0.0:
             continue
         for e in range(2):
-            b = ws.row_body[r, e]
+            b = row_body[r, e]
             if b < 0:
                 continue
-            vel[b, 0] += m.body_inv_mass[b] * F[r, e, 0] * l
-            vel[b, 1] += m.body_inv_mass[b] * F[r, e, 1] * l
-            vel[b, 2] += m.body_inv_inertia[b] * F[r, e, 2] * l
+            vel[b, 0] += inv_mass[b] * F[r, e, 0] * l
+            vel[b, 1] += inv_mass[b] * F[r, e, 1] * l
+            vel[b, 2] += inv_inertia[b] * F[r, e, 2] * l
+
+
+@kernel
+def apply_impulses(m, ws, F, lam, n, vel, scale):
+    """vel += scale * W F^T lam (rows 0..n-1)."""
+    add_impulses(F, ws.row_body, m.body_inv_mass, m.body_inv_inertia, lam, n, vel, scale)
 
 
 @kernel

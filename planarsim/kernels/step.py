@@ -140,16 +140,6 @@ def step_entry(m, s, ws, opt, u):
     return step(m, s, ws, opt, u)
 
 
-@kernel
-def run_steps(m, s, ws, opt, u, n):
-    """n steps under constant commands u; returns (guard code, steps completed)."""
-    for k in range(n):
-        code = step(m, s, ws, opt, u)
-        if code != 0:
-            return code, k
-    return 0, n
-
-
 @jit
 def run_recorded(m, s, ws, opt, u, n, every, rec, k0):
     """n steps under constant u, recording every `every`-th step into rec from frame k0.

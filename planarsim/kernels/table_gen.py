@@ -4,7 +4,7 @@ Calling a compiled function from Python costs about 70 ns per array argument for
 unbox it; the model, state and workspace hold about 80 arrays, so a Python ``sim.step()`` paid
 ~6 us before doing any physics. ``table_run_steps(tab, flt, u, n)`` receives instead an int64 table
 with the address and shape of every array (4 slots each) and a float64 table of the scalars,
-rebuilds the NamedTuples inside compiled code (no copy) and calls ``run_steps``. The Simulator owns
+rebuilds the NamedTuples inside compiled code (no copy) and calls ``step`` n times. The Simulator owns
 every array it lists, so the addresses stay valid while it lives.
 
 The kernel is generated from the NamedTuple definitions (80 fields written by hand would be
@@ -35,7 +35,7 @@ from ..options import StepOptions
 from ..state import State, Workspace
 from ._jit import jit_table
 from .pointers import as_float_ptr, as_int_ptr, readonly
-from .step import run_steps
+from .step import step
 '''
 
 
@@ -118,7 +118,14 @@ def render_source() -> str:
             f"# arrays in table order (Workspace.prev expands to the State fields)\nARRAY_ORDER = {order!r}\n\n\n"
             "@jit_table\ndef table_run_steps(tab, flt, u, n):\n"
             '    """n steps; returns (guard code, steps completed) (see kernels/step.py)."""\n'
-            f"{body}\n    return run_steps(m, s, ws, opt, u, n)\n")
+            f"{body}\n"
+            "    # the loop is here rather than in a run_steps kernel: every compiled function that\n"
+            "    # calls another re-optimises all the code below it on its first compile\n"
+            "    for k in range(n):\n"
+            "        code = step(m, s, ws, opt, u)\n"
+            "        if code != 0:\n"
+            "            return code, k\n"
+            "    return 0, n\n")
 
 
 TARGET = Path(__file__).with_name("table_step.py")

@@ -11,7 +11,7 @@ from ..options import StepOptions
 from ..state import State, Workspace
 from ._jit import jit_table
 from .pointers import as_float_ptr, as_int_ptr, readonly
-from .step import run_steps
+from .step import step
 
 N_ARRAY_SLOTS = 340
 N_INT_SCALARS = 5
@@ -128,4 +128,10 @@ def table_run_steps(tab, flt, u, n):
         flt[3],
         tab[N_ARRAY_SLOTS + 4],
     )
-    return run_steps(m, s, ws, opt, u, n)
+    # the loop is here rather than in a run_steps kernel: every compiled function that
+    # calls another re-optimises all the code below it on its first compile
+    for k in range(n):
+        code = step(m, s, ws, opt, u)
+        if code != 0:
+            return code, k
+    return 0, n

@@ -58,6 +58,35 @@ def max_curvature(coef):
 
 
 @jit
+def _closest_on_line(h0, slope, px, py):
+    """closest_point for ground without sines (flat or a slope), inline: the same arithmetic as
+    the general path (Newton from px, exact after one iteration, a second to confirm it)."""
+    x = px
+    h = h0 + slope * x
+    dh = slope
+    bound = abs(py - h) + 1e-12
+    for _ in range(30):
+        f = (x - px) + (h - py) * dh
+        fp = 1.0 + dh * dh + (h - py) * 0.0
+        if fp < 1e-3:
+            fp = 1.0 + dh * dh
+        dx = -f / fp
+        if dx > bound:
+            dx = bound
+        elif dx < -bound:
+            dx = -bound
+        x += dx
+        h = h0 + slope * x
+        if abs(dx) < 1e-14 * (1.0 + abs(x)):
+            break
+    inv = 1.0 / math.sqrt(1.0 + dh * dh)
+    nx = -dh * inv
+    ny = inv
+    gap = nx * (px - x) + ny * (py - h)
+    return x, h, nx, ny, gap
+
+
+@jit
 def closest_point(coef, px, py):
     """Closest ground point to (px, py) and the signed gap along its normal.
 
@@ -70,6 +99,8 @@ def closest_point(coef, px, py):
     Returns (gx, gy, nx, ny, gap): ground point [m], unit normal, gap = n.(p - g) [m]
     (negative below the ground).
     """
+    if coef[2] == 0.0:
+        return _closest_on_line(coef[0], coef[1], px, py)
     x = px
     h, dh, ddh = height_derivs(coef, x)
     bound = abs(py - h) + 1e-12

@@ -47,7 +47,7 @@ import numpy as np
 
 from planarsim.analysis import StepMap, StepMapError
 from planarsim.kernels._jit import jit
-from planarsim.kernels.step import step
+from planarsim.kernels.step import step, step_entry
 
 from walkers.common.section import GaitMapMixin, chain_poses, chain_velocities, copy_tuple, restore_tuple
 
@@ -155,7 +155,7 @@ class RangerGaitMap(GaitMapMixin):
         """Get past a section state (one control + physics step) without stopping at it."""
         k, prog, motor = self.tables
         C.control_ranger(self.m, s, ws, k, prog, motor, mem, self.gui, self.steplog, self.rs.u)
-        code = step(self.m, s, ws, self.rs.sim.options, self.rs.u)
+        code = step_entry(self.m, s, ws, self.rs.sim.options, self.rs.u)
         if code != 0:
             raise StepMapError(f"Ranger step map: engine guard {code}")
 
