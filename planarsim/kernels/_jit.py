@@ -49,7 +49,9 @@ def _kernel_decorator(**extra):
 
 kernel = _kernel_decorator()
 kernel_inline = _kernel_decorator(inline="always")
-jit_inline = kernel_inline
+# callable from Python and inlined into compiled callers (a walker's controller: the Python
+# controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
+jit_inline = njit(inline="always", **_OPTIONS)
 # table_step builds arrays over raw addresses (numba.carray), which numba allows only with its
 # runtime on; those arrays own no memory, so its reference counting has nothing to count
 jit_table = njit(cache=True, fastmath=False, nogil=True, error_model="numpy")

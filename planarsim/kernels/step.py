@@ -1,7 +1,9 @@
 """The compiled step: a table of contents of the stages (DESIGN.md section 3).
 
 step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
-(0 ok, 1 non-finite, 2 too large). A time-of-impact split (CCD) repeats stages 1-6 for the
+(0 ok, 1 non-finite, 2 too large). It is inlined into every compiled caller (a rollout, the
+Simulator's table kernel): a call would pass the ~80 arrays of the model, state and workspace
+one by one, which cost 0.3-0.4 us per step (a third of a rod-drop step). A time-of-impact split (CCD) repeats stages 1-6 for the
 remainder of the step with the new contact pinned.
 """
 from ._jit import jit, kernel, kernel_inline
@@ -90,7 +92,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     ws.info[0] += rounds
 
 
-@kernel
+@kernel_inline
 def step(m, s, ws, opt, u):
     """Advance s by one step of m.dt under actuator commands u; return the guard code."""
     copy_state(s, ws.prev)

@@ -51,19 +51,19 @@ def test_fresh_process_cold_or_warm_cache_gives_the_same_bits(tmp_path):
     empty cache directory and compiles everything (cold). Either way cold and warm are compared."""
     import json
     import os
-    from planarsim.kernels.step import step
+    from walkers.simple_biped.rollout import rollout_simple_biped as rollout   # links step
     here = all_walker_digests()
-    compiled_here = bool(step.stats.cache_misses)
+    compiled_here = bool(rollout.stats.cache_misses)
     env = dict(os.environ)
     if not compiled_here:
         env["NUMBA_CACHE_DIR"] = str(tmp_path / "cold-cache")
     code = textwrap.dedent("""
         import json
-        from planarsim.kernels.step import step
+        from walkers.simple_biped.rollout import rollout_simple_biped as rollout
         from tests.walkers.test_reliability_walkers import all_walker_digests
         digests = all_walker_digests()
-        print(json.dumps({"digests": digests, "cache_misses": len(step.stats.cache_misses),
-                          "cache_hits": len(step.stats.cache_hits)}))
+        print(json.dumps({"digests": digests, "cache_misses": len(rollout.stats.cache_misses),
+                          "cache_hits": len(rollout.stats.cache_hits)}))
     """)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          env=env, timeout=1800)

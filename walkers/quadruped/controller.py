@@ -48,7 +48,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from planarsim.kernels._jit import jit
+from planarsim.kernels._jit import jit, jit_inline
 from planarsim.kernels.forces import pin_angle_rate
 from planarsim.kernels.terrain import height, height_derivs
 
@@ -240,7 +240,7 @@ def stance_forces(s, p, mem, xc):
     return front / nf, (w - front) / nr
 
 
-@jit
+@jit_inline
 def control(m, s, p, mem, u):
     """One control tick: fall monitor, the 30 Hz foot update, puppet feet, puppet pose (IK),
     PD + weight feed-forward into u (n_act,) [N m]. Pin/actuator j = 2 leg + (0 hip, 1 knee)."""

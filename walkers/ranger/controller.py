@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from planarsim.kernels._jit import jit
+from planarsim.kernels._jit import jit, jit_inline
 from planarsim.kernels.forces import pin_angle_rate
 from planarsim.kernels.terrain import height as terrain_height
 
@@ -222,7 +222,7 @@ def air_current(s, k, mp, foot, err, derr):
     return tau / torque_constant(mp)
 
 
-@jit
+@jit_inline
 def control_ranger(m, s, ws, k, prog, motor, mem, gui, steplog, u):
     """One control step: estimator, FSM, motor programs, motor model -> u (torques [N m]).
     Also integrates electrical and mechanical energy and logs each heel strike."""

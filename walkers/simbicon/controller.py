@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planarsim.kernels._jit import jit
+from planarsim.kernels._jit import jit, jit_inline
 
 from .params import SimbiconParams
 
@@ -128,7 +128,7 @@ def next_phase(s, tab, mem):
             mem[M_TIMEOUTS] += 1
 
 
-@jit
+@jit_inline
 def control(m, s, ws, tab, mem, u):
     """Write the six motor torques into u (n_act,) for the current state."""
     next_phase(s, tab, mem)

@@ -36,7 +36,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from planarsim.kernels._jit import jit
+from planarsim.kernels._jit import jit, jit_inline
 
 from walkers.common.bezier import rectangle_bezier
 from walkers.common.pd import clamp
@@ -258,7 +258,7 @@ def _hold_hip(p, q, v, height, ax_extra, ay_extra, gx, gy, u):
     push_hip(q, mh * (ax - gx), mh * (ay - gy), p[P.I_LEG_FORCE_MAX], u)
 
 
-@jit
+@jit_inline
 def control(m, s, p, mem, u):
     """Commands u (n_act = 3: leg0 [N], leg1 [N], hip [N m]) for the current state."""
     gx = m.gravity[0]
