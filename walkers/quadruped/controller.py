@@ -48,7 +48,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline
+from planarsim.kernels._jit import jit, jit_inline, kernel
 from planarsim.kernels.forces import pin_angle_rate
 from planarsim.kernels.terrain import height, height_derivs
 
@@ -91,7 +91,7 @@ M_FLAG = 44       # IK flags per leg 44..47
 N_MEMORY = 48
 
 
-@jit
+@kernel
 def foot_centre(s, p, i):
     """World position of the centre of foot i [m] (calf body 2 + 2i, tip at calf_length)."""
     # hip -> knee along the thigh, knee -> foot along the calf
@@ -104,7 +104,7 @@ def foot_centre(s, p, i):
     return kx + p[I_CALF_LENGTH] * math.sin(th), ky - p[I_CALF_LENGTH] * math.cos(th)
 
 
-@jit
+@kernel
 def rest_height(m, p, x):
     """Height [m] of the centre of a round foot resting on the ground near x (r / cos(slope)
     above it), lowered by plant_depth."""
@@ -112,7 +112,7 @@ def rest_height(m, p, x):
     return h + p[I_FOOT_RADIUS] * math.sqrt(1.0 + dh * dh) - p[I_PLANT_DEPTH]
 
 
-@jit
+@kernel
 def placement_x(m, s, p, mem, i, t_left):
     """Raibert foot placement for leg i: world x of the landing goal [m]."""
     hx, hy = hip_world(s.q[0, 0], s.q[0, 1], s.q[0, 2], HIP_SIGN[i] * p[I_HIP_X])
@@ -182,7 +182,7 @@ def update_feet(m, s, p, mem):
                                    else rest_height(m, p, gx))
 
 
-@jit
+@kernel
 def move_targets(m, s, p, mem):
     """Move each puppet foot towards its goal at foot_step * update_rate [m/s]."""
     dmax = p[I_FOOT_STEP] * p[I_UPDATE_RATE] * m.dt
@@ -203,7 +203,7 @@ def command_speed(mem):
     return mem[M_SPEED] if mem[M_GAIT] == G_WALK else 0.0
 
 
-@jit
+@kernel
 def ramp_speed(m, s, p, mem):
     """The puppet torso's speed [m/s]: 0 until settle_time, then towards the command at accel."""
     if s.time[0] >= p[I_SETTLE_TIME]:
@@ -212,7 +212,7 @@ def ramp_speed(m, s, p, mem):
     return mem[M_V_RAMP]
 
 
-@jit
+@kernel
 def stance_forces(s, p, mem, xc):
     """Vertical ground force per foot on the ground [N], front and rear end (lever rule about
     the torso COM x = xc; all of it on one end when only that end is down)."""

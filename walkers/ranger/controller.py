@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline
+from planarsim.kernels._jit import jit, jit_inline, kernel
 from planarsim.kernels.forces import pin_angle_rate
 from planarsim.kernels.terrain import height as terrain_height
 
@@ -47,7 +47,7 @@ from .tables import *  # noqa: F401,F403  (enums, index layout of k / mem / prog
 
 
 # --------------------------------------------------------------------------------------------
-@jit
+@kernel
 def update_estimator(m, s, ws, k, mem):
     """Filter each foot's load fraction and update its contact flag; count touchdowns."""
     scale = 1.0 / (k[K_DT] * k[K_WEIGHT])
@@ -63,7 +63,7 @@ def update_estimator(m, s, ws, k, mem):
         mem[M_CONTACT + side] = new
 
 
-@jit
+@kernel
 def hip_state(s, k, side):
     """Hip position and velocity [m, m/s] from leg `side` (hip at leg_com above its COM)."""
     th = s.q[side, 2]
@@ -74,7 +74,7 @@ def hip_state(s, k, side):
     return s.q[side, 0] + rx, s.q[side, 1] + ry, s.v[side, 0] - w * ry, s.v[side, 1] + w * rx
 
 
-@jit
+@kernel
 def choose_programs(m, s, k, mem):
     """WALK: phase, stance and the program of each motor (into mem[M_PROG + j]).
 
@@ -166,7 +166,7 @@ def choose_programs(m, s, k, mem):
     mem[M_PROG + 1 + sw] = PR_LAND if th_sw - th_st > k[K_LAND_LEG] else PR_FLIP
 
 
-@jit
+@kernel
 def program_current(m, s, k, prog, gui, mem, motor, j, pr, in_air):
     """Current command [A] of motor j (0 hip, 1 + side ankle) running program pr."""
     frame = int(prog[pr, PC_FRAME])
@@ -207,7 +207,7 @@ def program_current(m, s, k, prog, gui, mem, motor, j, pr, in_air):
     return kp * (target - x) - kd * dx
 
 
-@jit
+@kernel
 def air_current(s, k, mp, foot, err, derr):
     """Section 6.5: model-based swing-foot control, I = tau / (G K) with
     tau = w0^2 I_f err + 2 zeta w0 I_f derr - tau_gravity (gravity's torque on the foot about
@@ -288,7 +288,7 @@ def control_ranger(m, s, ws, k, prog, motor, mem, gui, steplog, u):
             steplog[n, 6] = mem[M_PUSH_I]
 
 
-@jit
+@kernel
 def height_below(m, x):
     """Terrain height [m] at x."""
     return terrain_height(m.terrain_coef, x)

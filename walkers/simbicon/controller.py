@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline
+from planarsim.kernels._jit import jit, jit_inline, kernel
 
 from .params import SimbiconParams
 
@@ -89,7 +89,7 @@ def make_memory(phase=0, t0=0.0) -> np.ndarray:
     return mem
 
 
-@jit
+@kernel
 def pin_angle(m, q, v, j):
     """Relative angle [rad] and rate [rad/s] of pin j."""
     a = m.pin_body[j, 0]
@@ -97,7 +97,7 @@ def pin_angle(m, q, v, j):
     return q[b, 2] - q[a, 2] - m.pin_ref[j], v[b, 2] - v[a, 2]
 
 
-@jit
+@kernel
 def foot_in_contact(s, tab, side):
     """1 if any corner of `side`'s foot is pinned or sliding."""
     for c in range(tab.contact.shape[1]):
@@ -106,7 +106,7 @@ def foot_in_contact(s, tab, side):
     return 0
 
 
-@jit
+@kernel
 def next_phase(s, tab, mem):
     """Table 1 transitions (plus the contact timeout); updates mem in place."""
     t = s.time[0]

@@ -36,7 +36,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline
+from planarsim.kernels._jit import jit, jit_inline, kernel
 
 from walkers.common.bezier import rectangle_bezier
 from walkers.common.pd import clamp
@@ -92,13 +92,13 @@ M_WORK = 24       # positive mechanical work of all actuators [J] (kept by the r
 N_MEMORY = 28
 
 
-@jit
+@kernel
 def _enter(mem, state, t):
     mem[M_STATE] = state
     mem[M_T_ENTER] = t
 
 
-@jit
+@kernel
 def _com_x(p, q, v):
     """COM x [m] and x velocity [m/s]."""
     mh = p[P.I_HIP_MASS]
@@ -108,7 +108,7 @@ def _com_x(p, q, v):
             (mh * v[0, 0] + mf * (v[1, 0] + v[2, 0])) / mt)
 
 
-@jit
+@kernel
 def _start_swing(p, q, v, mem, stance):
     """Lift-off: the swing Bezier from the swing foot to one step ahead of the stance foot."""
     l0 = p[P.I_LEG_LENGTH]
@@ -131,7 +131,7 @@ def _start_swing(p, q, v, mem, stance):
     mem[M_STRIKE_X] = xs + 0.5 * L
 
 
-@jit
+@kernel
 def _phase(p, q, v, mem):
     """Phase variable s [-] and its rate [1/s] (linear in the COM x)."""
     x, vx = _com_x(p, q, v)
@@ -139,7 +139,7 @@ def _phase(p, q, v, mem):
     return (x - mem[M_LIFT_X]) / span, vx / span
 
 
-@jit
+@kernel
 def _v_top(p, mem):
     """Pendulum top speed [m/s] aimed at: the adapted v_top, or stop_speed when a gait other
     than WALK waits for the walker to slow down."""
@@ -148,13 +148,13 @@ def _v_top(p, mem):
     return mem[M_V_TOP]
 
 
-@jit
+@kernel
 def _rate_target(v_top, l, phi, g):
     """Eq. 2 (energy form): leg rate [rad/s] of a pendulum of length l that passes the top at v_top."""
     return -math.sqrt(v_top * v_top + 2.0 * g * l * (1.0 - math.cos(phi))) / l
 
 
-@jit
+@kernel
 def next_state(p, s, mem, g):
     """Transitions of the state machine (writes mem); g is the gravity magnitude [m/s^2]."""
     q = s.q
@@ -247,7 +247,7 @@ def next_state(p, s, mem, g):
             _enter(mem, ST_CROUCH if gait == GAIT_JUMP else ST_STAND, t)
 
 
-@jit
+@kernel
 def _hold_hip(p, q, v, height, ax_extra, ay_extra, gx, gy, u):
     """Double stance pose control: PD on the hip toward (mid-feet x, mid-feet y + height)."""
     mh = p[P.I_HIP_MASS]

@@ -1,0 +1,132 @@
+"""Where a scene's or walker's step time goes, per compiled function (Linux `perf`, sampling).
+
+    python benchmarks/profile_kernels.py chain4                # a bench scene (Simulator.steps)
+    python benchmarks/profile_kernels.py walker:simbicon       # a walker's simulate()
+    python benchmarks/profile_kernels.py biped_collapse --seconds 20
+
+numba's machine code has no symbols that perf can see, so this script writes perf's map file
+(/tmp/perf-<pid>.map: address, size, name of every compiled function the run links), samples
+its own process with `perf record -e cpu-clock` while the kernels run, and prints each
+function's share of the samples. Functions that LLVM inlined are counted in their caller
+(after inlining, `step` is part of the rollout or of the Simulator's table kernel).
+Needs perf (Debian: apt-get install linux-perf); it is not part of the test suite.
+"""
+from __future__ import annotations
+
+import argparse
+import collections
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+
+def _compiled_functions(dispatchers):
+    """{address: symbol} of every function in the libraries of the dispatchers' overloads."""
+    out = {}
+    for disp in dispatchers:
+        for cres in disp.overloads.values():
+            engine = cres.library._codegen._engine
+            seen, todo = set(), [cres.library]
+            while todo:
+                lib = todo.pop()
+                if id(lib) in seen:
+                    continue
+                seen.add(id(lib))
+                for fn in lib.get_defined_functions():
+                    addr = engine.get_function_address(fn.name)
+                    if addr:
+                        out[addr] = fn.name
+                todo.extend(getattr(lib, "_linking_libraries", []))
+    return out
+
+
+def _short(symbol):
+    """planarsim.kernels.solve.factor from numba's mangled _ZN9planarsim7kernels5solve6factor..."""
+    if not symbol.startswith("_ZN"):
+        return symbol
+    rest, names = symbol[3:], []
+    while rest[:1].isdigit():
+        m = re.match(r"\d+", rest)
+        n, k = int(m.group()), m.end()
+        names.append(rest[k:k + n])
+        rest = rest[k + n:]
+    return ".".join(names) or symbol
+
+
+def _workload(target, seconds):
+    """(callable running the workload once, [dispatchers whose code it runs])."""
+    from numba.core.registry import CPUDispatcher
+    if target.startswith("walker:"):
+        import importlib
+        import walkers
+        name = target.split(":", 1)[1]
+        mod = walkers.load(name)
+        mod.simulate(0.05)   # compile or load
+        package = mod.__name__.rsplit(".", 1)[0] if name in ("simplest-walker", "compass-gait",
+                                                              "rimless-wheel") else mod.__name__
+        rollout = importlib.import_module(package + ".rollout")
+        disps = [v for v in vars(rollout).values() if isinstance(v, CPUDispatcher) and v.overloads]
+        return (lambda: mod.simulate(seconds)), disps
+    import planarsim as ps
+    from planarsim.bench_scenes import SCENES
+    from planarsim.kernels.table_step import table_run_steps
+    model = SCENES[target][0]()
+    sim = ps.Simulator(model)
+    sim.steps(10)
+    start = sim.state.copy()
+    n = int(round(seconds / model.dt))
+
+    def run():
+        sim.state = start
+        sim.steps(n)
+    return run, [table_run_steps]
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("target", help="a bench scene (chain4, biped_collapse, ...) or walker:<name>")
+    ap.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--top", type=int, default=20)
+    args = ap.parse_args(argv)
+    if shutil.which("perf") is None:
+        sys.exit("perf is not installed (Debian: apt-get install linux-perf)")
+    run, disps = _workload(args.target, args.seconds)
+    funcs = _compiled_functions(disps)
+    addrs = sorted(funcs)
+    map_path = Path(f"/tmp/perf-{os.getpid()}.map")
+    with map_path.open("w") as fh:
+        for i, a in enumerate(addrs):
+            size = (addrs[i + 1] - a) if i + 1 < len(addrs) else 1 << 16
+            fh.write(f"{a:x} {min(size, 1 << 20):x} {_short(funcs[a])}\n")
+    data = Path(f"/tmp/perf-{os.getpid()}.data")
+    rec = subprocess.Popen(["perf", "record", "-q", "-F", "5000", "-e", "cpu-clock", "-p",
+                            str(os.getpid()), "-o", str(data)],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(1.0)
+    t0 = time.perf_counter()
+    for _ in range(args.runs):
+        run()
+    wall = time.perf_counter() - t0
+    rec.send_signal(2)
+    rec.wait()
+    out = subprocess.run(["perf", "script", "-i", str(data), "-F", "sym"], capture_output=True,
+                         text=True).stdout
+    counts = collections.Counter(line.strip() or "[unknown]" for line in out.splitlines())
+    total = sum(counts.values()) or 1
+    print(f"{args.target}: {args.runs} x {args.seconds:g} s simulated in {wall:.2f} s wall; "
+          f"{total} samples")
+    for sym, c in counts.most_common(args.top):
+        print(f"{100.0 * c / total:6.1f}%  {sym}")
+    data.unlink(missing_ok=True)
+    map_path.unlink(missing_ok=True)
+
+
+if __name__ == "__main__":
+    main()
