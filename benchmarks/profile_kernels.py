@@ -9,7 +9,9 @@ numba's machine code has no symbols that perf can see, so this script writes per
 its own process with `perf record -e cpu-clock` while the kernels run, and prints each
 function's share of the samples. Functions that LLVM inlined are counted in their caller
 (after inlining, `step` is part of the rollout or of the Simulator's table kernel).
-Needs perf (Debian: apt-get install linux-perf); it is not part of the test suite.
+The kernels are compiled afresh into a temporary numba cache (about a minute): code loaded from
+the cache carries no list of its functions. Needs perf (Debian: apt-get install linux-perf);
+it is not part of the test suite.
 """
 from __future__ import annotations
 
@@ -20,8 +22,13 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
+
+if __name__ == "__main__" and "NUMBA_CACHE_DIR" not in os.environ:
+    # before numba is imported: a fresh cache, so every function is compiled here (see above)
+    os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="planarsim-profile-")
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -116,9 +123,10 @@ def main(argv=None):
     wall = time.perf_counter() - t0
     rec.send_signal(2)
     rec.wait()
-    out = subprocess.run(["perf", "script", "-i", str(data), "-F", "sym"], capture_output=True,
+    out = subprocess.run(["perf", "script", "-i", str(data), "-F", "ip,sym"], capture_output=True,
                          text=True).stdout
-    counts = collections.Counter(line.strip() or "[unknown]" for line in out.splitlines())
+    counts = collections.Counter((line.split(None, 1) + ["[unknown]"])[1].strip()
+                                 for line in out.splitlines() if line.strip())
     total = sum(counts.values()) or 1
     print(f"{args.target}: {args.runs} x {args.seconds:g} s simulated in {wall:.2f} s wall; "
           f"{total} samples")
