@@ -75,7 +75,8 @@ class Workspace(NamedTuple):
     for sliding contacts, whose impulse is lambda_n (n - mu s t)).
     """
     force: np.ndarray            # (n_body, 3) applied forces [N, N, N m]
-    body_cs: np.ndarray          # (n_body, 2) cos, sin of the body angles at the current q
+    body_cs: np.ndarray          # (n_body, 3) cos, sin of the body angles at the current q, and
+                                 #   the angles they belong to (NaN: not computed yet)
     body_first_row: np.ndarray   # (n_body,) int first row touching each body (-1: none)
     row_first: np.ndarray        # (R,) int first row sharing a body with row r (envelope)
     row_reach: np.ndarray        # (R,) int last row r' whose envelope starts at or before r
@@ -119,7 +120,7 @@ def make_workspace(model: Model) -> Workspace:
     nb, nc, na = model.n_body, model.n_contact, model.n_act
     R = max_rows(model)
     z = np.zeros
-    return Workspace(force=z((nb, 3)), body_cs=z((nb, 2)), body_first_row=z(nb, np.int64),
+    return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan), body_first_row=z(nb, np.int64),
                      row_first=z(R, np.int64), row_reach=z(R, np.int64), v_pred=z((nb, 3)), v_new=z((nb, 3)), q_start=z((nb, 3)),
                      v_start=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_anchor=z((nc, 2)),

@@ -18,10 +18,16 @@ def rotate(c, s, x, y):
 
 @kernel
 def update_trig(q, cs):
-    """cs[i] = (cos, sin) of body i's angle: computed once per configuration."""
+    """cs[i] = (cos, sin, angle) of body i's angle: computed once per configuration, and only
+    for bodies whose angle changed (the same float, sign of zero included) since the last call:
+    point masses and bodies at rest skip sin and cos."""
     for i in range(q.shape[0]):
-        cs[i, 0] = math.cos(q[i, 2])
-        cs[i, 1] = math.sin(q[i, 2])
+        th = q[i, 2]
+        if th == cs[i, 2] and math.copysign(1.0, th) == math.copysign(1.0, cs[i, 2]):
+            continue
+        cs[i, 0] = math.cos(th)
+        cs[i, 1] = math.sin(th)
+        cs[i, 2] = th
 
 
 @kernel
