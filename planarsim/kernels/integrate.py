@@ -58,7 +58,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
         for r in range(n):
             ws.row_c[r] = ws.rhs[r]   # -c(q+), kept for the velocity solve (row_c is free now)
             unilateral += is_unilateral(ws.row_kind[r])
-        assemble(m, ws, ws.row_Jp, ws.row_J, n)
+        assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
         factor_solve(ws, ws.rhs, ws.lam, n, pivot_tol)
         # move positions by the correction
         for i in range(ws.v_new.shape[0]):

@@ -191,12 +191,14 @@ def build_rows(m, s, ws):
             ic += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws, ws.row_J, ws.row_c, n)
+    sliding = 0
     for r in range(n):
         for e in range(2):
             for k in range(3):
                 ws.row_F[r, e, k] = ws.row_J[r, e, k]
         o = ws.row_owner[r]
         if ws.row_kind[r] == ROW_CONTACT_N and s.contact_mode[o] == MODE_SLIDING:
+            sliding += 1
             # impulse lambda_n (n - mu s t): t = (n_y, -n_x)
             b = ws.row_body[r, 1]
             nx = ws.contact_normal[o, 0]
@@ -204,3 +206,4 @@ def build_rows(m, s, ws):
             ms = m.contact_mu[o] * s.contact_slip[o]
             px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
             _set_dir(s.q, b, px, py, nx - ms * ny, ny + ms * nx, 1.0, ws.row_F[r, 1])
+    ws.info[5] = sliding

@@ -60,21 +60,26 @@ def _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j):
 
 
 @kernel
-def assemble_rows(JL, JR, row_body, inv_mass, inv_inertia, first, A, n):
-    """A = JL W JR^T inside the envelope (entries outside it are structurally zero). Takes
-    only the arrays it needs: a call that passes the model or workspace NamedTuples copies
-    hundreds of array descriptors and leaves the loop's strides spilled to the stack."""
+def assemble_rows(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetric):
+    """A = JL W JR^T inside the envelope (entries outside it are structurally zero); symmetric
+    (JL = JR): the upper triangle is a copy of the lower. Takes only the arrays it needs: a
+    call that passes the model or workspace NamedTuples copies hundreds of array descriptors
+    and leaves the loop's strides spilled to the stack."""
     for i in range(n):
         for j in range(first[i], i + 1):
             A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
             if j != i:
-                A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
+                if symmetric:
+                    A[j, i] = A[i, j]
+                else:
+                    A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
 
 
 @kernel
-def assemble(m, ws, JL, JR, n):
-    """ws.A = JL W JR^T inside the envelope."""
-    assemble_rows(JL, JR, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.row_first, ws.A, n)
+def assemble(m, ws, JL, JR, n, symmetric):
+    """ws.A = JL W JR^T inside the envelope (symmetric: JL = JR)."""
+    assemble_rows(JL, JR, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.row_first, ws.A,
+                  n, symmetric)
 
 
 @kernel
@@ -190,7 +195,8 @@ def solve_impulses(m, ws, h, tol):
     if n == 0:
         return 0
     compute_envelope(ws, n, ws.v_new.shape[0])
-    assemble(m, ws, ws.row_J, ws.row_F, n)
+    # F = J unless a contact slides (build_rows counts those in info[5]): then A is symmetric
+    assemble(m, ws, ws.row_J, ws.row_F, n, ws.info[5] == 0)
     for r in range(n):
         c = ws.row_c[r]
         if c < 0.0 and ws.row_kind[r] >= ROW_LIMIT_LO and ws.row_kind[r] != ROW_CONTACT_T:
