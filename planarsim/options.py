@@ -37,6 +37,10 @@ class StepOptions(NamedTuple):
         step take a frictionless normal impulse for the step (never left free below the
         ground, never pulled: no energy gain); 0 the modes of the last round stand (the seed's
         tolerance: a cycling contact may be left free and sink for a step)
+    refine_pivot_tol : pivot_tol of the position correction. Rows dependent to within it are
+        dropped there: at a fold (a closed loop stretched nearly straight, rows dependent to
+        about 1e-7) the residual grows with the square of the motion and Newton only halves
+        the motion per iteration (residual / 4), where dropping the row converges at once
     """
     mode_strategy: int = MODES_ALTERNATING
     max_mode_iters: int = 8
@@ -46,6 +50,7 @@ class StepOptions(NamedTuple):
     guard_limit: float = 1e10
     pivot_tol: float = 1e-11
     cap_policy: int = 1
+    refine_pivot_tol: float = 1e-7
 
 
 def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:
@@ -70,6 +75,7 @@ _OPTION_RULES = {
     "guard_limit": (float, lambda x: math.isfinite(x) and x > 0.0, "must be finite and > 0"),
     "pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
     "cap_policy": (int, lambda x: x in (0, 1), "must be 0 or 1"),
+    "refine_pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
 }
 
 

@@ -9,6 +9,8 @@ Closed loops (Ranger in double stance, a box on two corners) make J W F^T singul
 elimination drops a row whose pivot falls below pivot_tol times its own diagonal, i.e. a row
 that is a combination of earlier ones; its impulse is zero and the rows it depends on carry
 the load. For consistent constraints this is exact, not a regularisation.
+Without sliding contacts F = J and the matrix is symmetric: it is assembled in its lower
+triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ._jit import kernel, kernel_inline
 from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
@@ -62,22 +64,19 @@ def _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j):
 @kernel
 def assemble_rows(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetric):
     """A = JL W JR^T inside the envelope (entries outside it are structurally zero); symmetric
-    (JL = JR): the upper triangle is a copy of the lower. Takes only the arrays it needs: a
+    (JL = JR): the lower triangle only (all that factor_symmetric reads). Takes only the arrays it needs: a
     call that passes the model or workspace NamedTuples copies hundreds of array descriptors
     and leaves the loop's strides spilled to the stack."""
     for i in range(n):
         for j in range(first[i], i + 1):
             A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
-            if j != i:
-                if symmetric:
-                    A[j, i] = A[i, j]
-                else:
-                    A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
+            if j != i and not symmetric:
+                A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
 
 
 @kernel
 def assemble(m, ws, JL, JR, n, symmetric):
-    """ws.A = JL W JR^T inside the envelope (symmetric: JL = JR)."""
+    """ws.A = JL W JR^T inside the envelope (symmetric: JL = JR, lower triangle only)."""
     assemble_rows(JL, JR, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.row_first, ws.A,
                   n, symmetric)
 
@@ -143,6 +142,64 @@ def substitute(A, first, reach, rhs, x, n):
         x[k] = acc / A[k, k]
 
 
+@kernel
+def factor_symmetric(A, first, reach, n, tol, scale):
+    """As `factor` for a symmetric A, in half the work: A = L D L^T with the multipliers L
+    below the diagonal and D on it; the upper triangle is neither read nor written. The same
+    pivot test drops dependent rows (zero pivot and multipliers). Returns #dropped."""
+    dropped = 0
+    for k in range(n):
+        scale[k] = abs(A[k, k])
+    for k in range(n):
+        piv = A[k, k]
+        last = reach[k]
+        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
+            dropped += 1
+            for i in range(k + 1, last + 1):
+                if first[i] <= k:
+                    A[i, k] = 0.0
+            A[k, k] = 0.0
+            continue
+        inv = 1.0 / piv
+        # rows from the last up: the update of row i reads column k of the rows j <= i, which
+        # must still hold A[j, k] (not yet divided by the pivot)
+        for i in range(last, k, -1):
+            if first[i] > k:
+                continue
+            a_ik = A[i, k]
+            if a_ik == 0.0:
+                continue
+            fct = a_ik * inv
+            for j in range(k + 1, i + 1):
+                if first[j] <= k:
+                    A[i, j] -= fct * A[j, k]
+            A[i, k] = fct
+    return dropped
+
+
+@kernel
+def substitute_symmetric(A, first, reach, rhs, x, n):
+    """x = A^-1 rhs from the factors of `factor_symmetric` (rhs destroyed); dropped rows get
+    x = 0. Back substitution uses U = D L^T: x_k = y_k / d_k - sum_j L_jk x_j."""
+    for k in range(n):
+        if A[k, k] == 0.0:
+            rhs[k] = 0.0
+            continue
+        rk = rhs[k]
+        for i in range(k + 1, reach[k] + 1):
+            if first[i] <= k:
+                rhs[i] -= A[i, k] * rk
+    for k in range(n - 1, -1, -1):
+        if A[k, k] == 0.0:
+            x[k] = 0.0
+            continue
+        acc = rhs[k] / A[k, k]
+        for j in range(k + 1, reach[k] + 1):
+            if first[j] <= k:
+                acc -= A[j, k] * x[j]
+        x[k] = acc
+
+
 @kernel_inline
 def factor_solve(ws, rhs, x, n, tol):
     """Factor ws.A and solve A x = rhs; returns #dropped rows."""
@@ -196,7 +253,8 @@ def solve_impulses(m, ws, h, tol):
         return 0
     compute_envelope(ws, n, ws.v_new.shape[0])
     # F = J unless a contact slides (build_rows counts those in info[5]): then A is symmetric
-    assemble(m, ws, ws.row_J, ws.row_F, n, ws.info[5] == 0)
+    symmetric = ws.info[5] == 0
+    assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     for r in range(n):
         c = ws.row_c[r]
         if c < 0.0 and ws.row_kind[r] >= ROW_LIMIT_LO and ws.row_kind[r] != ROW_CONTACT_T:
@@ -204,6 +262,10 @@ def solve_impulses(m, ws, h, tol):
             # correction removes the overlap without turning it into velocity (energy)
             c = 0.0
         ws.rhs[r] = -(c / h + row_dot(ws, r, ws.row_J, ws.v_pred))
-    dropped = factor_solve(ws, ws.rhs, ws.lam, n, tol)
+    if symmetric:
+        dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
+        substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+    else:
+        dropped = factor_solve(ws, ws.rhs, ws.lam, n, tol)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
     return dropped

@@ -127,7 +127,8 @@ def step(m, s, ws, opt, u):
                 continue
         integrate_positions(s, ws.v_new, h)
         if opt.refine_iters > 0 and ws.n_row[0] > 0:
-            correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol, opt.pivot_tol)
+            correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol,
+                              opt.refine_pivot_tol)
         break
     s.time[0] = ws.prev.time[0] + m.dt
     s.step[0] += 1

@@ -15,7 +15,7 @@ from .step import step
 
 N_ARRAY_SLOTS = 340
 N_INT_SCALARS = 5
-N_FLOATS = 4
+N_FLOATS = 5
 # arrays in table order (Workspace.prev expands to the State fields)
 ARRAY_ORDER = ['ModelArrays.gravity', 'ModelArrays.body_mass', 'ModelArrays.body_inertia', 'ModelArrays.body_inv_mass', 'ModelArrays.body_inv_inertia', 'ModelArrays.pin_body', 'ModelArrays.pin_anchor', 'ModelArrays.pin_ref', 'ModelArrays.pin_limit', 'ModelArrays.pin_stiffness', 'ModelArrays.pin_damping', 'ModelArrays.pin_rest', 'ModelArrays.rod_body', 'ModelArrays.rod_anchor', 'ModelArrays.rod_length', 'ModelArrays.contact_body', 'ModelArrays.contact_kind', 'ModelArrays.contact_local', 'ModelArrays.contact_radius', 'ModelArrays.contact_span', 'ModelArrays.contact_mu', 'ModelArrays.contact_ccd', 'ModelArrays.contact_vert_adr', 'ModelArrays.contact_vert_num', 'ModelArrays.vert_local', 'ModelArrays.act_kind', 'ModelArrays.act_body', 'ModelArrays.act_ref', 'ModelArrays.act_anchor', 'ModelArrays.act_dir', 'ModelArrays.act_range', 'ModelArrays.terrain_coef', 'State.q', 'State.v', 'State.time', 'State.step', 'State.contact_mode', 'State.contact_slip', 'State.contact_enabled', 'State.limit_active', 'State.mode_cursor', 'State.ext_force', 'Workspace.force', 'Workspace.body_cs', 'Workspace.body_first_row', 'Workspace.row_first', 'Workspace.row_reach', 'Workspace.v_pred', 'Workspace.v_new', 'Workspace.q_start', 'Workspace.v_start', 'Workspace.contact_point', 'Workspace.contact_ground', 'Workspace.contact_normal', 'Workspace.contact_gap', 'Workspace.contact_anchor', 'Workspace.contact_impulse', 'Workspace.contact_on_arc', 'Workspace.contact_new', 'Workspace.row_body', 'Workspace.row_J', 'Workspace.row_F', 'Workspace.row_Jp', 'Workspace.row_c', 'Workspace.row_kind', 'Workspace.row_owner', 'Workspace.n_row', 'Workspace.A', 'Workspace.rhs', 'Workspace.lam', 'Workspace.act_u', 'Workspace.act_power', 'Workspace.info', 'Workspace.guard_value', 'Workspace.impact_time', 'Workspace.prev']
 
@@ -127,6 +127,7 @@ def table_run_steps(tab, flt, u, n):
         flt[2],
         flt[3],
         tab[N_ARRAY_SLOTS + 4],
+        flt[4],
     )
     # the loop is here rather than in a run_steps kernel: every compiled function that
     # calls another re-optimises all the code below it on its first compile
