@@ -93,20 +93,27 @@ def measure_batch(jobs=64, seconds=10.0, repeats=3, workers=(1, 2), walker="simp
     job_list = [{"gait": "walk", "speed": s} for s in speeds]
     batch.simulate_batch(walker, job_list[:2], 0.05, workers=1)  # warm-up (cache load)
     capacity = machine_parallel_capacity(max(workers))
-    rows = []
-    for w in workers:
-        rates, cores, steps, out = [], [], 0, []
-        for _ in range(repeats):
+    # repeats interleave the worker counts (1, 2, 1, 2, ...): on a shared machine whose speed
+    # drifts over seconds, each count then sees the same conditions
+    rates = {w: [] for w in workers}
+    cores = {w: [] for w in workers}
+    steps = {w: 0 for w in workers}
+    outs = {w: [] for w in workers}
+    for _ in range(repeats):
+        for w in workers:
             t0, c0 = time.perf_counter(), time.process_time()
             out = batch.simulate_batch(walker, job_list, seconds, workers=w)
             wall = time.perf_counter() - t0
-            cores.append((time.process_time() - c0) / wall)
-            steps = sum(int(round(float(traj.t[-1]) / model.dt)) for traj, _, model in out)
-            rates.append(steps / wall)
+            cores[w].append((time.process_time() - c0) / wall)
+            steps[w] = sum(int(round(float(traj.t[-1]) / model.dt)) for traj, _, model in out)
+            rates[w].append(steps[w] / wall)
+            outs[w] = out
+    rows = []
+    for w in workers:
         rows.append(dict(scene="batch", engine="planarsim", walker=walker, jobs=jobs, seconds=seconds,
                          machine_capacity=capacity,
-                         workers=w, steps=steps, steps_per_s=statistics.median(rates),
-                         steps_per_s_min=min(rates), steps_per_s_max=max(rates),
-                         cores_busy=statistics.median(cores),
-                         falls=sum(_fell(s) for _, s, _ in out)))
+                         workers=w, steps=steps[w], steps_per_s=statistics.median(rates[w]),
+                         steps_per_s_min=min(rates[w]), steps_per_s_max=max(rates[w]),
+                         cores_busy=statistics.median(cores[w]),
+                         falls=sum(_fell(s) for _, s, _ in outs[w])))
     return rows
