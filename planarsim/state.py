@@ -106,8 +106,7 @@ class Workspace(NamedTuple):
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
     act_power: np.ndarray        # (n_act,) mechanical power [W]
     info: np.ndarray             # (8,) int: [0] mode rounds, [1] ccd splits, [2] guard body,
-                                 #   [3] guard field, [4] mode-round cap reached (engaged contacts stuck),
-                                 #   [5] sliding rows among the active rows (0: F = J, A symmetric)
+                                 #   [3] guard field, [4] mode-round cap reached (engaged contacts stuck)
     guard_value: np.ndarray      # (1,) offending value when a guard fired
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)

@@ -141,15 +141,16 @@ def _add_row(ws, n, kind, owner, a, b):
 
 
 @kernel
-def _pin_key(m, j):
-    """Body after which pin j's rows go: the later of its two bodies (a chain or tree built
-    parent first: the child)."""
-    return max(m.pin_body[j, 0], m.pin_body[j, 1])
+def _later_body(bodies, j):
+    """Body after which the rows of joint j (a pin or rod; bodies (n, 2)) go: the later of its
+    two bodies (in a chain or tree built parent first, the child)."""
+    return max(bodies[j, 0], bodies[j, 1])
 
 
 @kernel
 def build_rows(m, s, ws):
-    """Fill the active rows at the current configuration: J, F (impulse directions) and c.
+    """Fill the active rows at the current configuration: J, F (impulse directions) and c;
+    return how many are sliding-contact rows (F != J there; none: J W F^T is symmetric).
 
     Rows go body by body: a pin's (and its limits') and a rod's rows after the later of their
     two bodies, a contact's after its body, pins and rods first (a merge of the three lists in
@@ -166,8 +167,8 @@ def build_rows(m, s, ws):
     jr = 0
     ic = 0
     while jp < n_pin or jr < n_rod or ic < n_con:
-        kp = _pin_key(m, jp) if jp < n_pin else big
-        kr = max(m.rod_body[jr, 0], m.rod_body[jr, 1]) if jr < n_rod else big
+        kp = _later_body(m.pin_body, jp) if jp < n_pin else big
+        kr = _later_body(m.rod_body, jr) if jr < n_rod else big
         kc = m.contact_body[ic] if ic < n_con else big
         if kp <= kr and kp <= kc:
             j = jp
@@ -206,4 +207,4 @@ def build_rows(m, s, ws):
             ms = m.contact_mu[o] * s.contact_slip[o]
             px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
             _set_dir(s.q, b, px, py, nx - ms * ny, ny + ms * nx, 1.0, ws.row_F[r, 1])
-    ws.info[5] = sliding
+    return sliding

@@ -64,9 +64,9 @@ def _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j):
 @kernel
 def assemble_rows(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetric):
     """A = JL W JR^T inside the envelope (entries outside it are structurally zero); symmetric
-    (JL = JR): the lower triangle only (all that factor_symmetric reads). Takes only the arrays it needs: a
-    call that passes the model or workspace NamedTuples copies hundreds of array descriptors
-    and leaves the loop's strides spilled to the stack."""
+    (JL = JR): the lower triangle only (all that factor_symmetric reads). Takes only the
+    arrays it needs: a call that passes the model or workspace NamedTuples copies hundreds of
+    array descriptors and leaves the loop's strides spilled to the stack."""
     for i in range(n):
         for j in range(first[i], i + 1):
             A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
@@ -121,8 +121,9 @@ def factor(A, first, reach, n, tol, scale):
 
 
 @kernel
-def substitute(A, first, reach, rhs, x, n):
-    """x = A^-1 rhs from the factors of `factor` (rhs destroyed); dropped rows get x = 0."""
+def forward_substitute(A, first, reach, rhs, n):
+    """rhs <- L^-1 rhs with the unit lower factor below the diagonal of A (both factorisations
+    store it there); dropped rows (zero pivot) get 0."""
     for k in range(n):
         if A[k, k] == 0.0:
             rhs[k] = 0.0
@@ -131,6 +132,12 @@ def substitute(A, first, reach, rhs, x, n):
         for i in range(k + 1, reach[k] + 1):
             if first[i] <= k:
                 rhs[i] -= A[i, k] * rk
+
+
+@kernel
+def substitute(A, first, reach, rhs, x, n):
+    """x = A^-1 rhs from the factors of `factor` (rhs destroyed); dropped rows get x = 0."""
+    forward_substitute(A, first, reach, rhs, n)
     for k in range(n - 1, -1, -1):
         if A[k, k] == 0.0:
             x[k] = 0.0
@@ -181,14 +188,7 @@ def factor_symmetric(A, first, reach, n, tol, scale):
 def substitute_symmetric(A, first, reach, rhs, x, n):
     """x = A^-1 rhs from the factors of `factor_symmetric` (rhs destroyed); dropped rows get
     x = 0. Back substitution uses U = D L^T: x_k = y_k / d_k - sum_j L_jk x_j."""
-    for k in range(n):
-        if A[k, k] == 0.0:
-            rhs[k] = 0.0
-            continue
-        rk = rhs[k]
-        for i in range(k + 1, reach[k] + 1):
-            if first[i] <= k:
-                rhs[i] -= A[i, k] * rk
+    forward_substitute(A, first, reach, rhs, n)
     for k in range(n - 1, -1, -1):
         if A[k, k] == 0.0:
             x[k] = 0.0
@@ -243,8 +243,9 @@ def row_dot(ws, r, J, vel):
 
 
 @kernel_inline
-def solve_impulses(m, ws, h, tol):
-    """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows."""
+def solve_impulses(m, ws, h, tol, symmetric):
+    """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
+    symmetric: F = J (no sliding contact), so J W F^T is symmetric (L D L^T on its lower half)."""
     n = ws.n_row[0]
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
@@ -252,8 +253,6 @@ def solve_impulses(m, ws, h, tol):
     if n == 0:
         return 0
     compute_envelope(ws, n, ws.v_new.shape[0])
-    # F = J unless a contact slides (build_rows counts those in info[5]): then A is symmetric
-    symmetric = ws.info[5] == 0
     assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     for r in range(n):
         c = ws.row_c[r]

@@ -3,8 +3,8 @@
 step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
 (0 ok, 1 non-finite, 2 too large). It is inlined into every compiled caller (a rollout, the
 Simulator's table kernel): a call would pass the ~80 arrays of the model, state and workspace
-one by one, which cost 0.3-0.4 us per step (a third of a rod-drop step). A time-of-impact split (CCD) repeats stages 1-6 for the
-remainder of the step with the new contact pinned.
+one by one, which cost 0.3-0.4 us per step (a third of a rod-drop step). A time-of-impact
+split (CCD) repeats stages 1-6 for the remainder of the step with the new contact pinned.
 """
 from ._jit import jit, kernel, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
@@ -48,13 +48,19 @@ def copy_state(src, dst):
 
 
 @kernel_inline
+def build_and_solve(m, s, ws, opt, h):
+    """Stages 4-5: the active rows at the current configuration and their impulses."""
+    sliding = build_rows(m, s, ws)
+    solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
+
+
+@kernel_inline
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 4-6: build rows, solve, check modes; repeat while modes change (capped)."""
     rounds = 0
     changed = 1
     while changed != 0 and rounds < opt.max_mode_iters:
-        build_rows(m, s, ws)
-        solve_impulses(m, ws, h, opt.pivot_tol)
+        build_and_solve(m, s, ws, opt, h)
         changed = update_modes(m, s, ws, h, opt.mode_strategy, rounds == 0, include_ccd)
         rounds += 1
     if changed != 0:
@@ -70,8 +76,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
                     s.contact_mode[i] = MODE_SLIDING
                     s.contact_slip[i] = 0.0
         ws.info[4] += 1
-        build_rows(m, s, ws)
-        solve_impulses(m, ws, h, opt.pivot_tol)
+        build_and_solve(m, s, ws, opt, h)
         gather_contact_impulses(m, s, ws)
         if opt.cap_policy == 1:
             # and no contact may pull: nearly dependent rows (a closed loop through the ground)
@@ -86,8 +91,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
                 if worst < 0:
                     break
                 s.contact_mode[worst] = MODE_FREE
-                build_rows(m, s, ws)
-                solve_impulses(m, ws, h, opt.pivot_tol)
+                build_and_solve(m, s, ws, opt, h)
                 gather_contact_impulses(m, s, ws)
     ws.info[0] += rounds
 
