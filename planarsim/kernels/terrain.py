@@ -59,28 +59,13 @@ def max_curvature(coef):
 
 @jit
 def _closest_on_line(h0, slope, px, py):
-    """closest_point for ground without sines (flat or a slope), inline: the same arithmetic as
-    the general path (Newton from px, exact after one iteration, a second to confirm it)."""
-    x = px
+    """closest_point for ground without sines (flat or a slope): the foot of the perpendicular
+    from p to y = h0 + slope x, in closed form."""
+    inv2 = 1.0 / (1.0 + slope * slope)
+    x = (px + slope * (py - h0)) * inv2
     h = h0 + slope * x
-    dh = slope
-    bound = abs(py - h) + 1e-12
-    for _ in range(30):
-        f = (x - px) + (h - py) * dh
-        fp = 1.0 + dh * dh + (h - py) * 0.0
-        if fp < 1e-3:
-            fp = 1.0 + dh * dh
-        dx = -f / fp
-        if dx > bound:
-            dx = bound
-        elif dx < -bound:
-            dx = -bound
-        x += dx
-        h = h0 + slope * x
-        if abs(dx) < 1e-14 * (1.0 + abs(x)):
-            break
-    inv = 1.0 / math.sqrt(1.0 + dh * dh)
-    nx = -dh * inv
+    inv = math.sqrt(inv2)
+    nx = -slope * inv
     ny = inv
     gap = nx * (px - x) + ny * (py - h)
     return x, h, nx, ny, gap
