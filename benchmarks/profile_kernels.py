@@ -8,7 +8,7 @@ numba's machine code has no symbols that perf can see, so this script writes per
 (/tmp/perf-<pid>.map: address, size, name of every compiled function the run links), samples
 its own process with `perf record -e cpu-clock` while the kernels run, and prints each
 function's share of the samples. Functions that LLVM inlined are counted in their caller
-(after inlining, `step` is part of the rollout or of the Simulator's table kernel).
+(those that LLVM kept separate, like `step`, show as their own).
 The kernels are compiled afresh into a temporary numba cache (about a minute): code loaded from
 the cache carries no list of its functions. Needs perf (Debian: apt-get install linux-perf);
 it is not part of the test suite.
@@ -82,7 +82,7 @@ def _workload(target, seconds):
         return (lambda: mod.simulate(seconds)), disps
     import planarsim as ps
     from planarsim.bench_scenes import SCENES
-    from planarsim.kernels.table_step import table_run_steps
+    from planarsim.kernels.step import run_steps
     model = SCENES[target][0]()
     sim = ps.Simulator(model)
     sim.steps(10)
@@ -92,7 +92,7 @@ def _workload(target, seconds):
     def run():
         sim.state = start
         sim.steps(n)
-    return run, [table_run_steps]
+    return run, [run_steps]
 
 
 def main(argv=None):

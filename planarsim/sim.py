@@ -13,11 +13,11 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import diverged
-from .kernels.step import run_recorded
+from .kernels.refs import TableHandle
+from .kernels.step import StepArgs, run_recorded, run_steps
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .state import State, Workspace, make_state, make_workspace
-from .tables import pack_tables, set_options
 from .trajectory import Trajectory, make_recorder
 
 
@@ -42,7 +42,7 @@ class Simulator:
         self._ws = make_workspace(model)
         self._u0 = np.zeros(model.n_act)
         self._recorded_entry = None
-        self._tab, self._flt = pack_tables(model.arrays, self._state, self._ws, StepOptions())
+        self._args = None
         self.options = options if options is not None else StepOptions()
 
     @property
@@ -62,7 +62,7 @@ class Simulator:
                 raise ValueError(f"model.arrays.{name} has shape {np.shape(b)}; this simulator's "
                                  f"model has {np.shape(a)} (build a new Simulator instead)")
         self._model = value
-        self._tab, self._flt = pack_tables(value.arrays, self._state, self._ws, self._options)
+        self._repack()
         self._recorded_entry = None
 
     @property
@@ -77,7 +77,16 @@ class Simulator:
     @options.setter
     def options(self, value: StepOptions) -> None:
         self._options = check_options(value)
-        set_options(self._tab, self._flt, self._options)
+        self._repack()
+
+    def _repack(self):
+        """The table that Simulator.step / steps hand to the compiled run_steps."""
+        args = StepArgs(self._model.arrays, self._state, self._ws, self._options)
+        if self._args is None:
+            self._args = TableHandle(args)
+        else:
+            self._args.repack(args)
+        self._steps_entry = None  # bound on the first step (see _steps_entry)
 
     # the state is always this simulator's own arrays (of the types its compiled step expects)
     @property
@@ -116,10 +125,14 @@ class Simulator:
     # stepping -------------------------------------------------------------------------------
     def step(self, u=None) -> None:
         """One step of model.dt under actuator commands u (n_act,) [N or N m]."""
-        entry = _TABLE_ENTRY or _bind_table_run_steps()
-        code, done = entry(self._tab, self._flt, self._u0 if u is None else self._commands(u), 1)
+        entry = self._steps_entry or self._bind_steps()
+        code, done = entry(self._args, self._u0 if u is None else self._commands(u), 1)
         if code:
             self._raise(code)
+
+    def _bind_steps(self):
+        self._steps_entry = _steps_entry(self._args)
+        return self._steps_entry
 
     def _run_recorded(self, u, n, every, rec, k0):
         """kernels.step.run_recorded on this simulator (bound once: see _bind)."""
@@ -130,9 +143,9 @@ class Simulator:
 
     def _bind(self, kernel, extra):
         """`kernel` compiled for this simulator's argument types (model, state, workspace,
-        options, commands, *extra), to be called directly: numba's type dispatch would
-        re-derive the types of the ~80 arrays in model, state and workspace on every call
-        (about 15 us); the simulator owns those arrays, so their types cannot change."""
+        options, commands, *extra), to be called directly, without numba's type dispatch (the
+        recorder's arrays would be typed again on every call); the simulator owns its arrays,
+        so their types cannot change."""
         args = (self.model.arrays, self._state, self.ws, self.options, self._u0) + tuple(extra)
         return kernel.compile(tuple(kernel.typeof_pyval(a) for a in args))
 
@@ -141,8 +154,8 @@ class Simulator:
         n = int(n)
         if n < 0:
             raise ValueError(f"n={n} steps must be >= 0")
-        entry = _TABLE_ENTRY or _bind_table_run_steps()
-        code, done = entry(self._tab, self._flt, self._commands(u), n)
+        entry = self._steps_entry or self._bind_steps()
+        code, done = entry(self._args, self._commands(u), n)
         if code:
             self._raise(code)
 
@@ -207,18 +220,17 @@ class Simulator:
         return self.ws.contact_impulse.copy()
 
 
-_TABLE_ENTRY = None
+_STEPS_ENTRIES = {}
 
 
-def _bind_table_run_steps():
-    """table_run_steps' entry point, compiled (or loaded from the cache) on first use and then
-    called directly: its argument types never change, so numba's type dispatch is not needed."""
-    global _TABLE_ENTRY
-    from numba import float64, int64
-
-    from .kernels.table_step import table_run_steps
-    _TABLE_ENTRY = table_run_steps.compile((int64[::1], float64[::1], float64[::1], int64))
-    return _TABLE_ENTRY
+def _steps_entry(args):
+    """run_steps compiled (or loaded from the cache) for TableHandle `args` and then called
+    directly: numba's type dispatch is skipped, since a simulator's argument types never change."""
+    entry = _STEPS_ENTRIES.get(args.numba_type)
+    if entry is None:
+        from numba import float64, int64
+        entry = _STEPS_ENTRIES[args.numba_type] = run_steps.compile((args.numba_type, float64[::1], int64))
+    return entry
 
 
 def _count_steps(dt, duration, n_steps):

@@ -20,6 +20,8 @@ from numba.core.registry import CPUDispatcher
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
 
 jit = njit(**_OPTIONS)
+# for numba.cfunc (the step's C entry): as a kernel, without nogil (a C function holds no GIL)
+KERNEL_OPTIONS = dict(fastmath=False, error_model="numpy", _nrt=False)
 # kernel: a function called only from other compiled code. numba then builds neither its Python
 # wrapper (which unboxes every array of the model, state and workspace: thousands of lines of
 # LLVM IR per function) nor its C wrapper; this halves the first-ever compile of the step.
@@ -47,14 +49,14 @@ def _kernel_decorator(**extra):
     return decorate
 
 
-kernel = _kernel_decorator()
+# kernel: inlined by LLVM into its compiled callers (forceinline). A call passes model, state and
+# workspace as three pointers (kernels/refs.py), so LLVM's inliner no longer sees much to gain
+# and left small hot kernels as calls (a fifth slower on the smallest models).
+kernel = _kernel_decorator(forceinline=True)
 kernel_inline = _kernel_decorator(inline="always")
 # callable from Python and inlined into compiled callers (a walker's controller: the Python
 # controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
 jit_inline = njit(inline="always", **_OPTIONS)
-# table_step builds arrays over raw addresses (numba.carray), which numba allows only with its
-# runtime on; those arrays own no memory, so its reference counting has nothing to count
-jit_table = njit(cache=True, fastmath=False, nogil=True, error_model="numpy")
 
 
 def _sources_hash(folder: Path, extra: str = "") -> str:

@@ -1,12 +1,26 @@
 """The compiled step: a table of contents of the stages (DESIGN.md section 3).
 
 step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
-(0 ok, 1 non-finite, 2 too large). It is inlined into every compiled caller (a rollout, the
-Simulator's table kernel): a call would pass the ~80 arrays of the model, state and workspace
-one by one, which cost 0.3-0.4 us per step (a third of a rod-drop step). A time-of-impact
-split (CCD) repeats stages 1-6 for the remainder of the step with the new contact pinned.
+(0 ok, 1 non-finite, 2 too large). Model, state, workspace and options arrive as one pointer
+each (kernels/refs.py), so compiled callers (a walker's rollout, run_steps) call it like any
+function. A time-of-impact split (CCD) repeats stages 1-6 for the remainder of the step with
+the new contact pinned.
 """
-from ._jit import jit, kernel, kernel_inline
+import hashlib
+from typing import NamedTuple
+
+import llvmlite.binding as ll
+from llvmlite import ir
+from numba import cfunc, types
+from numba.core import cgutils
+from numba.core.errors import TypingError
+from numba.extending import intrinsic
+
+from ..model import ModelArrays
+from ..options import StepOptions
+from ..state import State, Workspace
+from . import refs
+from ._jit import KERNEL_OPTIONS, jit, kernel, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
 from .contacts import MODE_FREE, MODE_SLIDING, find_contacts
 from .forces import apply_forces, predict_velocity
@@ -97,7 +111,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
 
 
 @kernel_inline
-def step(m, s, ws, opt, u):
+def _step(m, s, ws, opt, u):
     """Advance s by one step of m.dt under actuator commands u; return the guard code."""
     copy_state(s, ws.prev)
     # a state handed in from outside (restored, edited) is checked before it is used
@@ -139,6 +153,89 @@ def step(m, s, ws, opt, u):
     if m.contact_body.shape[0] > 0:
         s.mode_cursor[0] = (s.mode_cursor[0] + 1) % m.contact_body.shape[0]
     return check_guards(s, ws, opt.guard_limit)
+
+
+# The step is compiled once, as a C function, and called through its address by every compiled
+# caller (run_steps, run_recorded, each walker's rollout). A plain numba call would link the
+# step's code into each caller, where LLVM optimises and compiles it again: that was most of
+# the first-ever start-up (about 15 s per rollout). The address is published to LLVM's symbol
+# table under STEP_SYMBOL; callers loaded from the numba cache publish it first (reload_init).
+_ENGINE = {}
+
+
+def engine_types():
+    """(model, state, workspace, options) numba types the step is compiled for."""
+    if not _ENGINE:
+        from ..builder import ModelBuilder
+        from ..state import make_state, make_workspace
+        b = ModelBuilder()
+        body = b.add_body("b", 1.0, 1.0)
+        b.add_pin("p", None, body, anchor_world=(0.0, 0.0))
+        b.add_point_contact("c", body, (0.0, 0.0))
+        b.add_pin_motor("m", "p")
+        model = b.compile()
+        samples = (model.arrays, make_state(model), make_workspace(model), StepOptions())
+        _ENGINE["types"] = tuple(refs.TableRef(refs.layout_of(x)) for x in samples)
+        text = "|".join(t.name for t in _ENGINE["types"])
+        _ENGINE["symbol"] = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
+    return _ENGINE["types"]
+
+
+def _step_c(m, s, ws, opt, u_data, n_u):
+    return _step(m, s, ws, opt, refs.array_1d(u_data, n_u))
+
+
+def load_step():
+    """Compile the step's C entry (or load it from the cache) and publish its address."""
+    if "cfunc" not in _ENGINE:
+        sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
+        entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
+        ll.add_symbol(_ENGINE["symbol"], entry.address)
+        _ENGINE["cfunc"] = entry
+    return _ENGINE["symbol"]
+
+
+@intrinsic
+def step(typingctx, m, s, ws, opt, u):
+    """step(m, s, ws, opt, u) -> guard code: advance State s by one step of m.dt under actuator
+    commands u (float64, C-contiguous, one per actuator). Callable from compiled code."""
+    expected = engine_types()
+    for name, got, want in zip(("model", "state", "workspace", "options"), (m, s, ws, opt), expected):
+        if got != want:
+            raise TypingError(f"step: {name} is {got}; the step is compiled for {want} "
+                              "(pass model.arrays, a State, a Workspace and StepOptions)")
+    if not (isinstance(u, types.Array) and u.dtype == types.float64 and u.ndim == 1 and u.layout == "C"):
+        raise TypingError(f"step: commands u must be a C-contiguous 1-d float64 array, got {u}")
+    symbol = load_step()
+
+    def codegen(context, builder, signature, args):
+        context.active_code_library._reload_init.add(load_step)
+        i64 = ir.IntType(64)
+        fnty = ir.FunctionType(i64, [cgutils.voidptr_t] * 4 + [ir.DoubleType().as_pointer(), i64])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, symbol)
+        commands = context.make_array(u)(context, builder, args[4])
+        n_u = cgutils.unpack_tuple(builder, commands.shape)[0]
+        return builder.call(fn, list(args[:4]) + [commands.data, n_u])
+    return types.int64(m, s, ws, opt, u), codegen
+
+
+@refs.register
+class StepArgs(NamedTuple):
+    """Everything a step reads and writes but the commands, as one table (Simulator.step)."""
+    m: ModelArrays
+    s: State
+    ws: Workspace
+    opt: StepOptions
+
+
+@jit
+def run_steps(args, u, n):
+    """n steps of StepArgs args under commands u; returns (guard code, steps completed)."""
+    for k in range(n):
+        code = step(args.m, args.s, args.ws, args.opt, u)
+        if code != 0:
+            return code, k
+    return 0, n
 
 
 @jit

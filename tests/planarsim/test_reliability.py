@@ -130,14 +130,15 @@ def test_a_second_process_loads_the_step_kernel_from_the_cache():
     sim.run(n_steps=2)
     code = textwrap.dedent("""
         import planarsim as ps
-        from planarsim.kernels.step import run_recorded
-        from planarsim.kernels.table_step import table_run_steps
+        from planarsim.kernels.step import _ENGINE, run_recorded, run_steps
         from tests.planarsim.test_reliability import two_link_on_hills
         sim = ps.Simulator(two_link_on_hills())
-        sim.step()            # the Python step path (table_run_steps, which links step)
-        sim.run(n_steps=2)    # the recorded path (run_recorded, which links step)
-        for kernel in (table_run_steps, run_recorded):
+        sim.step()            # the Python step path (run_steps, which calls the step)
+        sim.run(n_steps=2)    # the recorded path (run_recorded)
+        for kernel in (run_steps, run_recorded):
             print(sum(kernel.stats.cache_hits.values()), sum(kernel.stats.cache_misses.values()))
+        step = _ENGINE["cfunc"]   # the step itself, a C function every caller calls
+        print(step.cache_hits, 0 if step.cache_hits else 1)
     """)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     for line in out.stdout.strip().splitlines():

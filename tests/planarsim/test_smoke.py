@@ -63,12 +63,6 @@ def test_state_assignment_copies_into_the_simulators_arrays():
         sim.state = {"q": 1}
 
 
-def test_generated_table_kernel_is_up_to_date():
-    """kernels/table_step.py is generated from the NamedTuples (see kernels/table_gen.py)."""
-    from planarsim.kernels.table_gen import TARGET, render_source
-    assert TARGET.read_text() == render_source(), "run: python -m planarsim.kernels.table_gen"
-
-
 def test_changing_options_reaches_the_python_step():
     model = _pendulum()
     a = ps.Simulator(model)

@@ -1,0 +1,132 @@
+"""NamedTuples as one pointer in compiled code (planarsim/kernels/refs.py)."""
+from typing import NamedTuple
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numba import njit
+from numba.core.errors import TypingError
+
+import planarsim as ps
+from planarsim.kernels import refs
+from planarsim.kernels.step import step_entry
+
+
+@refs.register
+class Inner(NamedTuple):
+    a: np.ndarray
+    k: np.ndarray
+
+
+@refs.register
+class Outer(NamedTuple):
+    scale: float
+    count: int
+    grid: np.ndarray
+    inner: Inner
+
+
+@refs.register(readonly=True)
+class Frozen(NamedTuple):
+    x: np.ndarray
+
+
+@njit(_nrt=False)
+def _total(o):
+    """scale * (sum of grid + sum of inner.a) + count + sum of inner.k; bumps inner.k[0]."""
+    t = 0.0
+    for i in range(o.grid.shape[0]):
+        for j in range(o.grid.shape[1]):
+            for k in range(o.grid.shape[2]):
+                t += o.grid[i, j, k]
+    for i in range(o.inner.a.shape[0]):
+        t += o.inner.a[i]
+    t = o.scale * t + o.count
+    for i in range(o.inner.k.shape[0]):
+        t += o.inner.k[i]
+    if o.inner.k.shape[0] > 0:
+        o.inner.k[0] += 1
+    return t
+
+
+@njit(_nrt=False)
+def _first(f):
+    return f.x[0]
+
+
+def _outer(grid_shape, n_a, n_k, seed=0):
+    rng = np.random.default_rng(seed)
+    return Outer(scale=rng.uniform(-2, 2), count=int(rng.integers(-5, 5)),
+                 grid=rng.normal(size=grid_shape), inner=Inner(rng.normal(size=n_a),
+                                                               rng.integers(-9, 9, size=n_k)))
+
+
+def _expected(o):
+    return o.scale * (o.grid.sum() + o.inner.a.sum()) + o.count + o.inner.k.sum()
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.tuples(st.integers(0, 4), st.integers(0, 4), st.integers(0, 4)), st.integers(0, 6),
+       st.integers(0, 3), st.integers(0, 2 ** 31))
+def test_fields_read_and_write_the_numpy_arrays(grid_shape, n_a, n_k, seed):
+    o = _outer(grid_shape, n_a, n_k, seed)
+    want = _expected(o)
+    k0 = o.inner.k.copy()
+    assert _total(o) == pytest.approx(want, rel=1e-12, abs=1e-12)
+    if n_k:
+        assert o.inner.k[0] == k0[0] + 1     # written through to the numpy array
+    # a handle (packed once) reads the same memory
+    h = refs.TableHandle(o)
+    want = _expected(o)
+    assert _total(h) == pytest.approx(want, rel=1e-12, abs=1e-12)
+
+
+def test_a_new_namedtuple_gets_its_own_table():
+    o = _outer((2, 2, 2), 3, 1)
+    first = _total(o)
+    other = o._replace(grid=o.grid * 0.0, inner=Inner(o.inner.a * 0.0, np.zeros(1, np.int64)))
+    assert _total(other) == pytest.approx(other.count)
+    assert _total(o) == pytest.approx(first + 1)    # k[0] was bumped by the first call
+
+
+def test_float_fields_take_ints_and_int_fields_refuse_floats():
+    o = _outer((1, 1, 1), 1, 1)._replace(scale=2)       # an int where a float is declared
+    want = _expected(o)
+    assert _total(o) == pytest.approx(want)
+    with pytest.raises(TypeError, match="Outer.count must be an int"):
+        _total(o._replace(count=1.5))
+
+
+@pytest.mark.parametrize("bad, message", [
+    (lambda o: o._replace(grid=np.zeros((2, 3, 4))[:, ::2]), "Outer.grid must be a C-contiguous"),
+    (lambda o: o._replace(inner=Inner(np.zeros(3, np.float32), o.inner.k)), "Inner.a is a 1-d float32"),
+    (lambda o: o._replace(inner=Inner(np.zeros((1, 1, 1, 1)), o.inner.k)), "Inner.a is a 4-d float64"),
+    (lambda o: o._replace(scale="fast"), "Outer.scale"),
+])
+def test_malformed_fields_are_named(bad, message):
+    o = _outer((2, 3, 2), 3, 2)
+    _total(o)
+    with pytest.raises(TypeError, match=message):
+        _total(bad(o))
+
+
+def test_read_only_arrays_are_refused_where_compiled_code_writes():
+    o = _outer((1, 1, 1), 2, 1)
+    o.inner.k.setflags(write=False)
+    with pytest.raises(TypeError, match="Inner.k is read-only"):
+        _total(o)
+    x = np.arange(3.0)
+    x.setflags(write=False)
+    assert _first(Frozen(x)) == 0.0      # a read-only class takes them
+
+
+def test_the_step_names_what_it_was_given():
+    from tests.planarsim.test_reliability import two_link_on_hills
+    sim = ps.Simulator(two_link_on_hills())
+    m, s, ws = sim.model.arrays, sim.state, sim.ws
+    with pytest.raises(TypingError, match="step: commands u must be a C-contiguous 1-d float64"):
+        step_entry(m, s, ws, sim.options, np.zeros((2, 2)))
+    with pytest.raises(TypingError, match="step: workspace is"):
+        step_entry(m, s, s, sim.options, np.zeros(0))
+    assert step_entry(m, s, ws, sim.options, np.zeros(0)) == 0
