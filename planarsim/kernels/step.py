@@ -7,6 +7,7 @@ function. A time-of-impact split (CCD) repeats stages 1-6 for the remainder of t
 the new contact pinned.
 """
 import hashlib
+import threading
 from typing import NamedTuple
 
 import llvmlite.binding as ll
@@ -161,6 +162,7 @@ def _step(m, s, ws, opt, u):
 # the first-ever start-up (about 15 s per rollout). The address is published to LLVM's symbol
 # table under STEP_SYMBOL; callers loaded from the numba cache publish it first (reload_init).
 _ENGINE = {}
+_LOAD_LOCK = threading.RLock()
 
 
 def engine_types():
@@ -175,9 +177,10 @@ def engine_types():
         b.add_pin_motor("m", "p")
         model = b.compile()
         samples = (model.arrays, make_state(model), make_workspace(model), StepOptions())
-        _ENGINE["types"] = tuple(refs.TableRef(refs.layout_of(x)) for x in samples)
-        text = "|".join(t.name for t in _ENGINE["types"])
+        found = tuple(refs.TableRef(refs.layout_of(x)) for x in samples)
+        text = "|".join(t.name for t in found)
         _ENGINE["symbol"] = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
+        _ENGINE["types"] = found
     return _ENGINE["types"]
 
 
@@ -187,11 +190,12 @@ def _step_c(m, s, ws, opt, u_data, n_u):
 
 def load_step():
     """Compile the step's C entry (or load it from the cache) and publish its address."""
-    if "cfunc" not in _ENGINE:
-        sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
-        entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
-        ll.add_symbol(_ENGINE["symbol"], entry.address)
-        _ENGINE["cfunc"] = entry
+    with _LOAD_LOCK:
+        if "cfunc" not in _ENGINE:
+            sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
+            entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
+            ll.add_symbol(_ENGINE["symbol"], entry.address)
+            _ENGINE["cfunc"] = entry
     return _ENGINE["symbol"]
 
 
