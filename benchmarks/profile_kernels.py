@@ -7,8 +7,9 @@
 numba's machine code has no symbols that perf can see, so this script writes perf's map file
 (/tmp/perf-<pid>.map: address, size, name of every compiled function the run links), samples
 its own process with `perf record -e cpu-clock` while the kernels run, and prints each
-function's share of the samples. Functions that LLVM inlined are counted in their caller
-(those that LLVM kept separate, like `step`, show as their own).
+function's share of the samples. The kernels that are normally inlined into the step are
+compiled as calls here (PLANARSIM_KERNEL_CALLS=1), so each stage shows as its own; the
+figures are therefore of a slightly slower build.
 The kernels are compiled afresh into a temporary numba cache (about a minute): code loaded from
 the cache carries no list of its functions. Needs perf (Debian: apt-get install linux-perf);
 it is not part of the test suite.
@@ -29,17 +30,22 @@ from pathlib import Path
 if __name__ == "__main__" and "NUMBA_CACHE_DIR" not in os.environ:
     # before numba is imported: a fresh cache, so every function is compiled here (see above)
     os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="planarsim-profile-")
+    os.environ["PLANARSIM_KERNEL_CALLS"] = "1"   # stages as calls, not inlined (see _jit.py)
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
 def _compiled_functions(dispatchers):
     """{address: symbol} of every function in the libraries of the dispatchers' overloads."""
+    from planarsim.kernels.step import _ENGINE, load_step
+    load_step()
+    libraries = [cres.library for disp in dispatchers for cres in disp.overloads.values()]
+    libraries.append(_ENGINE["cfunc"]._library)   # the step: called by address, not linked
     out = {}
-    for disp in dispatchers:
-        for cres in disp.overloads.values():
-            engine = cres.library._codegen._engine
-            seen, todo = set(), [cres.library]
+    for library in libraries:
+        if True:
+            engine = library._codegen._engine
+            seen, todo = set(), [library]
             while todo:
                 lib = todo.pop()
                 if id(lib) in seen:

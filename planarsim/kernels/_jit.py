@@ -52,7 +52,9 @@ def _kernel_decorator(**extra):
 # kernel: inlined by LLVM into its compiled callers (forceinline). A call passes model, state and
 # workspace as three pointers (kernels/refs.py), so LLVM's inliner no longer sees much to gain
 # and left small hot kernels as calls (a fifth slower on the smallest models).
-kernel = _kernel_decorator(forceinline=True)
+# PLANARSIM_KERNEL_CALLS=1 keeps them as calls, so that a profiler sees each stage
+# (benchmarks/profile_kernels.py sets it, with a cache of its own)
+kernel = _kernel_decorator(forceinline=os.environ.get("PLANARSIM_KERNEL_CALLS") != "1")
 kernel_inline = _kernel_decorator(inline="always")
 # callable from Python and inlined into compiled callers (a walker's controller: the Python
 # controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
