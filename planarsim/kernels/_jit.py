@@ -69,7 +69,9 @@ def _sources_hash(folder: Path, extra: str = "") -> str:
     return digest.hexdigest()
 
 
-KERNEL_HASH = _sources_hash(Path(__file__).resolve().parent)
+# the kernels compile differently with PLANARSIM_KERNEL_CALLS=1: a switch clears the caches
+KERNEL_HASH = _sources_hash(Path(__file__).resolve().parent,
+                            "calls" if os.environ.get("PLANARSIM_KERNEL_CALLS") == "1" else "")
 
 
 def drop_stale_caches(folder, clear=None) -> None:
