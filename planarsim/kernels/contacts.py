@@ -13,7 +13,7 @@ import math
 
 from ._jit import kernel
 from .math2d import rotate, world_point
-from .terrain import closest_point
+from .terrain import ground_point
 
 CONTACT_POINT = 0
 CONTACT_ARC = 1
@@ -40,7 +40,7 @@ def _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, on_arc):
 def _try_vertex(m, q, ws, i, b, lx, ly, best):
     """Use local vertex (lx, ly) for contact i if its gap is below `best`; return the new best."""
     px, py = world_point(q, ws.body_cs, b, lx, ly)
-    gx, gy, nx, ny, gap = closest_point(m.terrain_coef, px, py)
+    gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
     if gap < best:
         _store(ws, i, px, py, gx, gy, nx, ny, gap, lx, ly, 0)
         return gap
@@ -59,7 +59,7 @@ def find_contact(m, q, ws, i):
     # arc: ground point closest to the centre, sole point opposite the normal
     r = m.contact_radius[i]
     cx, cy = world_point(q, ws.body_cs, b, lx, ly)
-    gx, gy, nx, ny, cgap = closest_point(m.terrain_coef, cx, cy)
+    gx, gy, nx, ny, cgap = ground_point(m.terrain_coef, cx, cy)
     # direction -n expressed in the body frame
     dlx, dly = rotate(ws.body_cs[b, 0], -ws.body_cs[b, 1], -nx, -ny)
     a = math.atan2(dly, dlx)

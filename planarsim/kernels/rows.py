@@ -14,7 +14,7 @@ import math
 from ._jit import kernel
 from .math2d import cross2, world_point
 from .contacts import MODE_PINNED, MODE_SLIDING
-from .terrain import closest_point
+from .terrain import ground_point
 
 ROW_PIN_X = 0
 ROW_PIN_Y = 1
@@ -89,7 +89,7 @@ def eval_row(m, q, ws, r, J):
             px, py = world_point(q, ws.body_cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
         else:
             px, py = world_point(q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
-        gx, gy, nx, ny, gap = closest_point(m.terrain_coef, px, py)
+        gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
         _set_dir(q, b, px, py, nx, ny, 1.0, J[1])
         if ws.contact_on_arc[o] == 1:
             return gap - m.contact_radius[o]

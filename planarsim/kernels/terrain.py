@@ -5,7 +5,7 @@ with h0 [m], s [-], A [m], L [m], phi [rad]. Flat ground is ``[0, 0, 0]``.
 """
 import math
 
-from ._jit import jit
+from ._jit import jit, kernel
 
 TWO_PI = 2.0 * math.pi
 
@@ -57,7 +57,7 @@ def max_curvature(coef):
     return acc
 
 
-@jit
+@kernel
 def _closest_on_line(h0, slope, px, py):
     """closest_point for ground without sines (flat or a slope): the foot of the perpendicular
     from p to y = h0 + slope x, in closed form."""
@@ -118,6 +118,15 @@ def closest_point(coef, px, py):
     ny = inv
     gap = nx * (px - x) + ny * (py - h)
     return x, h, nx, ny, gap
+
+
+@kernel
+def ground_point(coef, px, py):
+    """closest_point with the flat and sloped case inlined into the caller (the general
+    case, hills, stays a call: it is long and its Newton loop dominates anyway)."""
+    if coef[2] == 0.0:
+        return _closest_on_line(coef[0], coef[1], px, py)
+    return closest_point(coef, px, py)
 
 
 @jit
