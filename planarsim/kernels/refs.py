@@ -12,10 +12,12 @@ as ``Workspace.prev``). ``ref.field`` in compiled code reads the table and rebui
 (no copy: the same memory). The table never changes while compiled code runs, so its loads
 carry LLVM's ``invariant.load``: they are hoisted out of loops and shared like local variables.
 
-A NamedTuple passed from Python is packed into a fresh table for the call (about 0.2 us per
-array) and released after it; ``TableHandle`` keeps a packed table for code that calls often
-(the Simulator). Either way the arrays must be C-contiguous with the dtype of the first
-instance typed (float64 or int64), which ``pack`` checks, naming the field.
+A NamedTuple passed from Python is packed on its first call (a few microseconds per array)
+and its table kept, keyed by the object's identity: a NamedTuple cannot change its fields, so
+its table stays right while the cache holds it (the newest _CACHE_SIZE objects). A
+``TableHandle`` is unboxed without any Python call (the Simulator's step). Arrays must be
+C-contiguous float64 or int64 (writeable unless the class is registered read-only), which
+``pack`` checks, naming the field; the dtypes and ndims make the compiled type.
 """
 from __future__ import annotations
 
@@ -166,7 +168,7 @@ def pack(obj, layout=None) -> np.ndarray:
 # alive; the oldest entries are dropped beyond _CACHE_SIZE (a call in progress holds its own
 # reference to its table).
 _CACHE = {}
-_CACHE_SIZE = 256
+_CACHE_SIZE = 128
 
 
 def _entry(obj):

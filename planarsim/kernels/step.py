@@ -2,9 +2,10 @@
 
 step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
 (0 ok, 1 non-finite, 2 too large). Model, state, workspace and options arrive as one pointer
-each (kernels/refs.py), so compiled callers (a walker's rollout, run_steps) call it like any
-function. A time-of-impact split (CCD) repeats stages 1-6 for the remainder of the step with
-the new contact pinned.
+each (kernels/refs.py). The stages are inlined into one C function, compiled once per machine
+and called by address from every compiled caller (a walker's rollout, run_steps; see
+load_step). A time-of-impact split (CCD) repeats stages 1-6 for the remainder of the step
+with the new contact pinned.
 """
 import hashlib
 import threading
