@@ -16,3 +16,13 @@ __all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "Simulat
            "StepOptions", "batch", "ContactMode", "ModeStrategy", "make_options", "make_state", "terrain",
            "kinetic_energy", "potential_energy", "total_energy", "save_snapshot", "load_snapshot",
            "Trajectory", "__version__"]
+
+
+def _publish_cached_step():
+    # a cached compiled function may call the step's C function through another cached one
+    # (kernels/step.py, load_step): publish its address now if the cache holds it
+    from .kernels.step import load_step
+    load_step(compile=False)
+
+
+_publish_cached_step()

@@ -22,6 +22,7 @@ C-contiguous float64 or int64 (writeable unless the class is registered read-onl
 from __future__ import annotations
 
 import hashlib
+import threading
 
 import numpy as np
 from llvmlite import ir
@@ -171,15 +172,19 @@ _CACHE = {}
 _CACHE_SIZE = 128
 
 
+_CACHE_LOCK = threading.Lock()
+
+
 def _entry(obj):
     hit = _CACHE.get(id(obj))
     if hit is not None and hit[0] is obj:
         return hit
     layout = layout_of(obj)
     hit = (obj, TableRef(layout), pack(obj, layout))
-    _CACHE[id(obj)] = hit
-    while len(_CACHE) > _CACHE_SIZE:
-        _CACHE.pop(next(iter(_CACHE)), None)
+    with _CACHE_LOCK:   # batch threads pack concurrently; eviction iterates the dict
+        _CACHE[id(obj)] = hit
+        while len(_CACHE) > _CACHE_SIZE:
+            _CACHE.pop(next(iter(_CACHE)), None)
     return hit
 
 

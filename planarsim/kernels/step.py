@@ -13,7 +13,8 @@ from typing import NamedTuple
 
 import llvmlite.binding as ll
 from llvmlite import ir
-from numba import cfunc, types
+from numba import types
+from numba.core.ccallback import CFunc
 from numba.core import cgutils
 from numba.core.errors import TypingError
 from numba.extending import intrinsic
@@ -189,12 +190,21 @@ def _step_c(m, s, ws, opt, u_data, n_u):
     return _step(m, s, ws, opt, refs.array_1d(u_data, n_u))
 
 
-def load_step():
-    """Compile the step's C entry (or load it from the cache) and publish its address."""
+def load_step(compile=True):
+    """Compile the step's C entry (or load it from the cache) and publish its address; with
+    compile=False only if it is in the cache (returns None otherwise). planarsim's import
+    publishes a cached step at once: a compiled function loaded from the cache that reaches
+    the step only through another cached function has no reload_init of its own."""
     with _LOAD_LOCK:
         if "cfunc" not in _ENGINE:
             sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
-            entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
+            entry = CFunc(_step_c, (sig.args, sig.return_type), locals={},
+                          options=dict(KERNEL_OPTIONS))
+            entry.enable_caching()
+            if not compile and entry._cache.load_overload(
+                    entry._sig, entry._targetdescr.target_context) is None:
+                return None
+            entry.compile()
             ll.add_symbol(_ENGINE["symbol"], entry.address)
             _ENGINE["cfunc"] = entry
     return _ENGINE["symbol"]

@@ -129,4 +129,4 @@ def test_the_step_names_what_it_was_given():
         step_entry(m, s, ws, sim.options, np.zeros((2, 2)))
     with pytest.raises(TypingError, match="step: workspace is"):
         step_entry(m, s, s, sim.options, np.zeros(0))
-    assert step_entry(m, s, ws, sim.options, np.zeros(0)) == 0
+    assert step_entry(m, s, ws, sim.options, np.zeros(sim.model.n_act)) == 0
