@@ -27,7 +27,7 @@ from ._jit import KERNEL_OPTIONS, jit, kernel, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
 from .contacts import MODE_FREE, MODE_SLIDING, find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import check_guards
+from .guards import GUARD_BAD_COMMANDS, check_guards
 from .math2d import update_trig
 from .integrate import correct_positions, integrate_positions
 from .modes import gather_contact_impulses, update_modes
@@ -187,6 +187,9 @@ def engine_types():
 
 
 def _step_c(m, s, ws, opt, u_data, n_u):
+    if n_u != m.act_kind.shape[0]:
+        ws.info[2] = n_u   # nothing is read or changed: the actuators would read past u
+        return GUARD_BAD_COMMANDS
     return _step(m, s, ws, opt, refs.array_1d(u_data, n_u))
 
 
@@ -213,7 +216,9 @@ def load_step(compile=True):
 @intrinsic
 def step(typingctx, m, s, ws, opt, u):
     """step(m, s, ws, opt, u) -> guard code: advance State s by one step of m.dt under actuator
-    commands u (float64, C-contiguous, one per actuator). Callable from compiled code."""
+    commands u (float64, C-contiguous, one per actuator). Callable from compiled code.
+    Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), or -1 when u does not have one
+    entry per actuator (then nothing is changed; planarsim.errors.diverged explains any code)."""
     expected = engine_types()
     for name, got, want in zip(("model", "state", "workspace", "options"), (m, s, ws, opt), expected):
         if got != want:

@@ -130,3 +130,17 @@ def test_the_step_names_what_it_was_given():
     with pytest.raises(TypingError, match="step: workspace is"):
         step_entry(m, s, s, sim.options, np.zeros(0))
     assert step_entry(m, s, ws, sim.options, np.zeros(sim.model.n_act)) == 0
+
+
+def test_commands_of_the_wrong_length_step_nothing_and_are_explained():
+    from planarsim.errors import diverged
+    from tests.planarsim.test_reliability import two_link_on_hills
+    sim = ps.Simulator(two_link_on_hills())
+    m, s, ws = sim.model.arrays, sim.state, sim.ws
+    before = s.copy()
+    for n in (0, sim.model.n_act + 1):
+        code = step_entry(m, s, ws, sim.options, np.zeros(n))
+        assert code == -1
+        assert all(np.array_equal(a, b) for a, b in zip(s, before))
+        err = diverged(sim.model, ws, code, sim.options.guard_limit)
+        assert isinstance(err, ValueError) and f"have {n} entries" in str(err)
