@@ -17,17 +17,3 @@ __all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "Simulat
            "kinetic_energy", "potential_energy", "total_energy", "save_snapshot", "load_snapshot",
            "Trajectory", "__version__"]
 
-
-def _publish_cached_step():
-    # a cached compiled function may call the step's C function through another cached one
-    # (kernels/step.py, load_step): publish its address now if the cache holds it
-    from .kernels.step import load_step
-    try:
-        load_step(compile=False)
-    except Exception as exc:   # a damaged cache must not break the import; the step recompiles
-        import warnings
-        warnings.warn(f"planarsim: could not load the cached step ({exc}); it will be compiled "
-                      "on first use", RuntimeWarning, stacklevel=2)
-
-
-_publish_cached_step()

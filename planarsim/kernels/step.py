@@ -13,8 +13,7 @@ from typing import NamedTuple
 
 import llvmlite.binding as ll
 from llvmlite import ir
-from numba import types
-from numba.core.ccallback import CFunc
+from numba import cfunc, types
 from numba.core import cgutils
 from numba.core.errors import TypingError
 from numba.extending import intrinsic
@@ -193,24 +192,38 @@ def _step_c(m, s, ws, opt, u_data, n_u):
     return _step(m, s, ws, opt, refs.array_1d(u_data, n_u))
 
 
-def load_step(compile=True):
-    """Compile the step's C entry (or load it from the cache) and publish its address; with
-    compile=False only if it is in the cache (returns None otherwise). planarsim's import
-    publishes a cached step at once: a compiled function loaded from the cache that reaches
-    the step only through another cached function has no reload_init of its own."""
+def load_step():
+    """Compile the step's C entry (or load it from the cache) and publish its address."""
     with _LOAD_LOCK:
         if "cfunc" not in _ENGINE:
             sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
-            entry = CFunc(_step_c, (sig.args, sig.return_type), locals={},
-                          options=dict(KERNEL_OPTIONS))
-            entry.enable_caching()
-            if not compile and entry._cache.load_overload(
-                    entry._sig, entry._targetdescr.target_context) is None:
-                return None
-            entry.compile()
+            entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
             ll.add_symbol(_ENGINE["symbol"], entry.address)
             _ENGINE["cfunc"] = entry
     return _ENGINE["symbol"]
+
+
+def _keep_reload_init_of_cached_code():
+    """numba runs a cached function's reload_init when it loads it, but leaves the loaded
+    library's own list empty. A function compiled later that links that library (G calling a
+    cached F that calls the step) then saves no load_step in its cache entry, and a process
+    loading G from the cache would jump to an unpublished symbol. Put the list back on the
+    library, where numba's linking expects it (applied once, before any cache load)."""
+    from numba.core.compiler import CompileResult
+    rebuild = CompileResult.__dict__["_rebuild"].__func__
+    if getattr(rebuild, "keeps_reload_init", False):
+        return
+
+    def _rebuild(cls, *args, **kwargs):
+        result = rebuild(cls, *args, **kwargs)
+        if result.reload_init:
+            result.library._reload_init.update(result.reload_init)
+        return result
+    _rebuild.keeps_reload_init = True
+    CompileResult._rebuild = classmethod(_rebuild)
+
+
+_keep_reload_init_of_cached_code()
 
 
 @intrinsic
