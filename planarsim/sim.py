@@ -86,7 +86,7 @@ class Simulator:
             self._args = TableHandle(args)
         else:
             self._args.repack(args)
-        self._steps_entry = None  # bound on the first step (see _steps_entry)
+        self._steps_entry = None  # bound on the first step (_bind_steps)
 
     # the state is always this simulator's own arrays (of the types its compiled step expects)
     @property
@@ -131,7 +131,10 @@ class Simulator:
             self._raise(code)
 
     def _bind_steps(self):
-        self._steps_entry = _steps_entry(self._args)
+        """run_steps compiled (or loaded from the cache) for this simulator's handle, then
+        called directly: numba's type dispatch is skipped (the handle's type never changes)."""
+        from numba import float64, int64
+        self._steps_entry = run_steps.compile((self._args.numba_type, float64[::1], int64))
         return self._steps_entry
 
     def _run_recorded(self, u, n, every, rec, k0):
@@ -218,19 +221,6 @@ class Simulator:
     def contact_impulses(self) -> np.ndarray:
         """(n_contact, 2) normal and tangential impulse of the last step [N s]."""
         return self.ws.contact_impulse.copy()
-
-
-_STEPS_ENTRIES = {}
-
-
-def _steps_entry(args):
-    """run_steps compiled (or loaded from the cache) for TableHandle `args` and then called
-    directly: numba's type dispatch is skipped, since a simulator's argument types never change."""
-    entry = _STEPS_ENTRIES.get(args.numba_type)
-    if entry is None:
-        from numba import float64, int64
-        entry = _STEPS_ENTRIES[args.numba_type] = run_steps.compile((args.numba_type, float64[::1], int64))
-    return entry
 
 
 def _count_steps(dt, duration, n_steps):

@@ -20,8 +20,11 @@ from numba.core.registry import CPUDispatcher
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
 
 jit = njit(**_OPTIONS)
-# for numba.cfunc (the step's C entry): as a kernel, without nogil (a C function holds no GIL)
-KERNEL_OPTIONS = dict(fastmath=False, error_model="numpy", _nrt=False)
+# for numba.cfunc (the step's C entry, cached by its own argument): a C function holds no GIL
+KERNEL_OPTIONS = {k: v for k, v in _OPTIONS.items() if k not in ("cache", "nogil")}
+# PLANARSIM_KERNEL_CALLS=1 keeps kernels as calls, so that a profiler sees each stage
+# (benchmarks/profile_kernels.py sets it, with a cache of its own)
+_KERNEL_CALLS = os.environ.get("PLANARSIM_KERNEL_CALLS") == "1"
 # kernel: a function called only from other compiled code. numba then builds neither its Python
 # wrapper (which unboxes every array of the model, state and workspace: thousands of lines of
 # LLVM IR per function) nor its C wrapper; this halves the first-ever compile of the step.
@@ -52,9 +55,7 @@ def _kernel_decorator(**extra):
 # kernel: inlined by LLVM into its compiled callers (forceinline). A call passes model, state and
 # workspace as three pointers (kernels/refs.py), so LLVM's inliner no longer sees much to gain
 # and left small hot kernels as calls (a fifth slower on the smallest models).
-# PLANARSIM_KERNEL_CALLS=1 keeps them as calls, so that a profiler sees each stage
-# (benchmarks/profile_kernels.py sets it, with a cache of its own)
-kernel = _kernel_decorator(forceinline=os.environ.get("PLANARSIM_KERNEL_CALLS") != "1")
+kernel = _kernel_decorator(forceinline=not _KERNEL_CALLS)
 kernel_inline = _kernel_decorator(inline="always")
 # callable from Python and inlined into compiled callers (a walker's controller: the Python
 # controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
@@ -70,8 +71,7 @@ def _sources_hash(folder: Path, extra: str = "") -> str:
 
 
 # the kernels compile differently with PLANARSIM_KERNEL_CALLS=1: a switch clears the caches
-KERNEL_HASH = _sources_hash(Path(__file__).resolve().parent,
-                            "calls" if os.environ.get("PLANARSIM_KERNEL_CALLS") == "1" else "")
+KERNEL_HASH = _sources_hash(Path(__file__).resolve().parent, "calls" if _KERNEL_CALLS else "")
 
 
 def drop_stale_caches(folder, clear=None) -> None:

@@ -87,7 +87,6 @@ def _scalar_kind(cls, name, value):
     stays a float, so that the compiled types do not depend on how a value was written)."""
     note = getattr(cls, "__annotations__", {}).get(name, "")
     note = getattr(note, "__name__", str(note))   # the class float, or the string 'float'
-
     if note in ("float", "int"):
         return note
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
@@ -170,8 +169,6 @@ def pack(obj, layout=None) -> np.ndarray:
 # reference to its table).
 _CACHE = {}
 _CACHE_SIZE = 128
-
-
 _CACHE_LOCK = threading.Lock()
 
 
@@ -241,8 +238,9 @@ def _typeof_handle(val, c):
     return val.numba_type
 
 
-def _unbox_table(c, table, release):
-    """NativeValue of the data pointer of int64 array object `table` (NULL: error set)."""
+def _unbox_table(c, table):
+    """NativeValue of the data pointer of int64 array object `table` (a new reference,
+    released after the call; NULL: error set)."""
     failed = cgutils.is_null(c.builder, table)
     ptr = cgutils.alloca_once_value(c.builder, cgutils.voidptr_t(None))
     with c.builder.if_then(c.builder.not_(failed), likely=True):
@@ -252,8 +250,7 @@ def _unbox_table(c, table, release):
         c.builder.store(c.builder.bitcast(ary.data, cgutils.voidptr_t), ptr)
 
     def cleanup():
-        if release:
-            c.pyapi.decref(table)
+        c.pyapi.decref(table)
     return NativeValue(c.builder.load(ptr), is_error=failed, cleanup=cleanup)
 
 
@@ -263,12 +260,12 @@ def _unbox_ref(typ, obj, c):
     fn = c.pyapi.unserialize(c.pyapi.serialize_object(_table_of))
     table = c.pyapi.call_function_objargs(fn, [obj])
     c.pyapi.decref(fn)
-    return _unbox_table(c, table, True)
+    return _unbox_table(c, table)
 
 
 @unbox(HandleType)
 def _unbox_handle(typ, obj, c):
-    return _unbox_table(c, c.pyapi.object_getattr_string(obj, "table"), True)
+    return _unbox_table(c, c.pyapi.object_getattr_string(obj, "table"))
 
 
 @infer_getattr
@@ -282,6 +279,21 @@ class _TableRefAttributes(AttributeTemplate):
 @infer_getattr
 class _HandleAttributes(_TableRefAttributes):
     key = HandleType
+
+
+def _c_array(context, builder, arrty, data, shape):
+    """Array value of C-contiguous type arrty over pointer `data` with the given shape (LLVM
+    i64 values): strides follow from the shape, no memory is owned."""
+    i64 = ir.IntType(64)
+    itemsize = context.get_abi_sizeof(context.get_data_type(arrty.dtype))
+    strides = [ir.Constant(i64, itemsize)]
+    for d in range(len(shape) - 1, 0, -1):
+        strides.insert(0, builder.mul(strides[0], shape[d]))
+    ary = context.make_array(arrty)(context, builder)
+    populate_array(ary, data=data, shape=cgutils.pack_array(builder, shape, i64),
+                   strides=cgutils.pack_array(builder, strides, i64),
+                   itemsize=ir.Constant(i64, itemsize), meminfo=None)
+    return ary._getvalue()
 
 
 def _load_slot(builder, base, k):
@@ -304,18 +316,10 @@ def _getattr(context, builder, typ, value, attr):
     if kind == "ref":
         return builder.bitcast(builder.gep(base, [ir.Constant(i64, offset)]), cgutils.voidptr_t)
     arrty = typ.field_type(attr)
-    item = context.get_data_type(arrty.dtype)
-    itemsize = context.get_abi_sizeof(item)
-    data = builder.inttoptr(_load_slot(builder, base, offset), item.as_pointer())
+    data = builder.inttoptr(_load_slot(builder, base, offset),
+                            context.get_data_type(arrty.dtype).as_pointer())
     shape = [_load_slot(builder, base, offset + 1 + d) for d in range(ndim)]
-    strides = [ir.Constant(i64, itemsize)]
-    for d in range(ndim - 1, 0, -1):
-        strides.insert(0, builder.mul(strides[0], shape[d]))
-    ary = context.make_array(arrty)(context, builder)
-    populate_array(ary, data=data, shape=cgutils.pack_array(builder, shape, i64),
-                   strides=cgutils.pack_array(builder, strides, i64),
-                   itemsize=ir.Constant(i64, itemsize), meminfo=None)
-    return impl_ret_borrowed(context, builder, arrty, ary._getvalue())
+    return impl_ret_borrowed(context, builder, arrty, _c_array(context, builder, arrty, data, shape))
 
 
 def _register_engine_types():
@@ -339,11 +343,5 @@ def array_1d(typingctx, data, n):
     arrty = types.Array(types.float64, 1, "C")
 
     def codegen(context, builder, signature, args):
-        i64 = ir.IntType(64)
-        ary = context.make_array(arrty)(context, builder)
-        itemsize = context.get_abi_sizeof(context.get_data_type(types.float64))
-        populate_array(ary, data=args[0], shape=cgutils.pack_array(builder, [args[1]], i64),
-                       strides=cgutils.pack_array(builder, [ir.Constant(i64, itemsize)], i64),
-                       itemsize=ir.Constant(i64, itemsize), meminfo=None)
-        return ary._getvalue()
+        return _c_array(context, builder, arrty, args[0], [args[1]])
     return arrty(data, n), codegen

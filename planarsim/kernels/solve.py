@@ -82,6 +82,19 @@ def assemble(m, ws, JL, JR, n, symmetric):
 
 
 @kernel
+def diagonal_scale(A, n, scale):
+    """scale[k] = |A[k, k]| before elimination: the yardstick of the pivot test."""
+    for k in range(n):
+        scale[k] = abs(A[k, k])
+
+
+@kernel
+def is_dependent(piv, scale, tol):
+    """A row whose pivot fell below tol times its own diagonal depends on earlier rows."""
+    return abs(piv) <= tol * scale or scale == 0.0
+
+
+@kernel
 def factor(A, first, reach, n, tol, scale):
     """LU factorisation of A in place, inside the envelope given by first / reach (see
     compute_envelope): U on and above the diagonal, the multipliers L below it. Takes the
@@ -93,12 +106,11 @@ def factor(A, first, reach, n, tol, scale):
     Returns #dropped.
     """
     dropped = 0
-    for k in range(n):
-        scale[k] = abs(A[k, k])  # scale for the pivot test
+    diagonal_scale(A, n, scale)
     for k in range(n):
         piv = A[k, k]
         last = reach[k]
-        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
+        if is_dependent(piv, scale[k], tol):
             dropped += 1
             for j in range(k + 1, last + 1):
                 if first[j] <= k:
@@ -155,12 +167,11 @@ def factor_symmetric(A, first, reach, n, tol, scale):
     below the diagonal and D on it; the upper triangle is neither read nor written. The same
     pivot test drops dependent rows (zero pivot and multipliers). Returns #dropped."""
     dropped = 0
-    for k in range(n):
-        scale[k] = abs(A[k, k])
+    diagonal_scale(A, n, scale)
     for k in range(n):
         piv = A[k, k]
         last = reach[k]
-        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
+        if is_dependent(piv, scale[k], tol):
             dropped += 1
             for i in range(k + 1, last + 1):
                 if first[i] <= k:
