@@ -223,3 +223,26 @@ def test_seven_link_biped_collapse_only_loses_energy(strategy):
     assert energy[-1] < 0.5 * energy[0]                     # it did fall
     assert joint_residuals(model, traj.q) <= 1e-9
     assert min(contact_gaps(model, q).min() for q in traj.q) >= -2e-3
+
+
+@pytest.mark.xfail(strict=True, reason="known weakness (issue 8 stop note 18): a corner sinks "
+                   "35 mm while its rows are dropped as dependent on the rest of a closed loop")
+def test_seven_link_biped_collapse_perturbed_by_nanometres_comes_to_rest_above_ground():
+    """The same collapse with the torso's start velocity changed by 3e-9 m/s takes another
+    path through the mode decisions (chaotic, as any collapse) and must end just as clean.
+    It does not yet: a corner of the right foot ends 34.5 mm below the ground and stays
+    there, pinned, because the solve drops its rows as dependent on the loop through the
+    other contacts; once, at rest, a corner switched to sliding and added 0.78 J. Keeping the
+    violated rows instead (deepest contact first) made other paths diverge. The test fails
+    strictly until this is fixed, so a fix shows up."""
+    from planarsim.bench_scenes import biped_collapse
+    from tests.physics.test_contact_properties import contact_gaps
+    model = biped_collapse()
+    sim = ps.Simulator(model)
+    state = sim.state
+    state.v[0, 0] += 3e-9
+    sim.state = state
+    traj = sim.run(3.0, record_every=10)
+    energy = traj.energy(model)["total"]
+    assert np.diff(energy).max() <= 1e-3 * energy[0]
+    assert min(contact_gaps(model, q).min() for q in traj.q) >= -2e-3
