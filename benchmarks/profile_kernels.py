@@ -43,19 +43,18 @@ def _compiled_functions(dispatchers):
     libraries.append(_ENGINE["cfunc"]._library)   # the step: called by address, not linked
     out = {}
     for library in libraries:
-        if True:
-            engine = library._codegen._engine
-            seen, todo = set(), [library]
-            while todo:
-                lib = todo.pop()
-                if id(lib) in seen:
-                    continue
-                seen.add(id(lib))
-                for fn in lib.get_defined_functions():
-                    addr = engine.get_function_address(fn.name)
-                    if addr:
-                        out[addr] = fn.name
-                todo.extend(getattr(lib, "_linking_libraries", []))
+        engine = library._codegen._engine
+        seen, todo = set(), [library]
+        while todo:
+            lib = todo.pop()
+            if id(lib) in seen:
+                continue
+            seen.add(id(lib))
+            for fn in lib.get_defined_functions():
+                addr = engine.get_function_address(fn.name)
+                if addr:
+                    out[addr] = fn.name
+            todo.extend(getattr(lib, "_linking_libraries", []))
     return out
 
 

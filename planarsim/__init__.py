@@ -16,4 +16,3 @@ __all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "Simulat
            "StepOptions", "batch", "ContactMode", "ModeStrategy", "make_options", "make_state", "terrain",
            "kinetic_energy", "potential_energy", "total_energy", "save_snapshot", "load_snapshot",
            "Trajectory", "__version__"]
-

@@ -64,9 +64,8 @@ def _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j):
 @kernel
 def assemble_rows(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetric):
     """A = JL W JR^T inside the envelope (entries outside it are structurally zero); symmetric
-    (JL = JR): the lower triangle only (all that factor_symmetric reads). Takes only the
-    arrays it needs: a call that passes the model or workspace NamedTuples copies hundreds of
-    array descriptors and leaves the loop's strides spilled to the stack."""
+    (JL = JR): the lower triangle only (all that factor_symmetric reads). Takes the arrays
+    it needs as arguments, so the loops index them directly."""
     for i in range(n):
         for j in range(first[i], i + 1):
             A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
@@ -97,9 +96,8 @@ def is_dependent(piv, scale, tol):
 @kernel
 def factor(A, first, reach, n, tol, scale):
     """LU factorisation of A in place, inside the envelope given by first / reach (see
-    compute_envelope): U on and above the diagonal, the multipliers L below it. Takes the
-    arrays it needs, not the workspace (a call passing the whole workspace would copy hundreds
-    of array descriptors). `scale` (n,) is scratch.
+    compute_envelope): U on and above the diagonal, the multipliers L below it. `scale` (n,)
+    is scratch.
 
     A row whose pivot falls below tol times its own diagonal depends on earlier rows (a
     closed loop, a box on two corners): it is dropped (impulse 0), marked by a zero pivot.

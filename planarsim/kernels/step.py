@@ -161,7 +161,7 @@ def _step(m, s, ws, opt, u):
 # caller (run_steps, run_recorded, each walker's rollout). A plain numba call would link the
 # step's code into each caller, where LLVM optimises and compiles it again: that was most of
 # the first-ever start-up (about 15 s per rollout). The address is published to LLVM's symbol
-# table under STEP_SYMBOL; callers loaded from the numba cache publish it first (reload_init).
+# table under the name load_step returns; callers loaded from the numba cache publish it first (reload_init).
 _ENGINE = {}
 _LOAD_LOCK = threading.RLock()
 
@@ -273,7 +273,7 @@ def run_steps(args, u, n):
 
 @jit
 def step_entry(m, s, ws, opt, u):
-    """`step` callable from Python (step itself is a kernel: compiled code calls it directly)."""
+    """`step` callable from Python (step itself is an intrinsic that only compiled code calls)."""
     return step(m, s, ws, opt, u)
 
 
