@@ -82,8 +82,10 @@ class Workspace(NamedTuple):
     row_reach: np.ndarray        # (R,) int last row r' whose envelope starts at or before r
     v_pred: np.ndarray           # (n_body, 3) unconstrained velocity v + h M^-1 f
     v_new: np.ndarray            # (n_body, 3) constrained velocity of the current solve
-    q_start: np.ndarray          # (n_body, 3)
-    v_start: np.ndarray          # (n_body, 3)
+    q_pred: np.ndarray           # (n_body, 3) predicted end-of-step configuration q + h v_pred
+    cs_pred: np.ndarray          # (n_body, 3) cos, sin, angle of q_pred (as body_cs)
+    q_keep: np.ndarray           # (n_body, 3) q and v before a Newton step of the position
+    v_keep: np.ndarray           #   correction (put back if the step does not reduce the error)
     contact_point: np.ndarray    # (n_contact, 2) world contact point [m]
     contact_ground: np.ndarray   # (n_contact, 2) ground point below it [m]
     contact_normal: np.ndarray   # (n_contact, 2) unit ground normal
@@ -97,6 +99,7 @@ class Workspace(NamedTuple):
     row_F: np.ndarray            # (R, 2, 3)
     row_Jp: np.ndarray           # (R, 2, 3) Jacobian at the end-of-step configuration
     row_c: np.ndarray            # (R,) position error [m or rad]
+    row_c_pred: np.ndarray       # (R,) position error at q_pred [m or rad]
     row_kind: np.ndarray         # (R,) int ROW_*
     row_owner: np.ndarray        # (R,) int pin / rod / contact index
     n_row: np.ndarray            # (1,) int rows in use
@@ -106,7 +109,9 @@ class Workspace(NamedTuple):
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
     act_power: np.ndarray        # (n_act,) mechanical power [W]
     info: np.ndarray             # (8,) int: [0] mode rounds, [1] ccd splits, [2] guard body,
-                                 #   [3] guard field, [4] mode-round cap reached (engaged contacts stuck)
+                                 #   [3] guard field, [4] mode-round cap reached (engaged contacts stuck),
+                                 #   [5] Newton steps of the position correction taken back (they
+                                 #   did not reduce the error: rows nearly dependent, inconsistent)
     guard_value: np.ndarray      # (1,) offending value when a guard fired
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)
@@ -121,12 +126,12 @@ def make_workspace(model: Model) -> Workspace:
     R = max_rows(model)
     z = np.zeros
     return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan), body_first_row=z(nb, np.int64),
-                     row_first=z(R, np.int64), row_reach=z(R, np.int64), v_pred=z((nb, 3)), v_new=z((nb, 3)), q_start=z((nb, 3)),
-                     v_start=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
+                     row_first=z(R, np.int64), row_reach=z(R, np.int64), v_pred=z((nb, 3)), v_new=z((nb, 3)), q_pred=z((nb, 3)),
+                     cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)), v_keep=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_anchor=z((nc, 2)),
                      contact_impulse=z((nc, 2)), contact_on_arc=z(nc, np.int64),
                      contact_new=z(nc, np.int64), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
-                     row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R),
+                     row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam=z(R), act_u=z(na), act_power=z(na),
                      info=z(8, np.int64), guard_value=z(1), impact_time=z(1), prev=make_state(model))

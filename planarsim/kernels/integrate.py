@@ -14,6 +14,18 @@ from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_rows
 from .solve import apply_impulses, assemble, factor_solve, substitute
 
 
+# relative pivot below which the position correction drops a row after a Newton step failed to
+# reduce the error: rows within about 1e-2 rad of dependent
+LOOSE_PIVOT_TOL = 1e-4
+# a Newton step that multiplies the largest error by more than this has diverged (near a
+# solution the error falls quadratically; a step may raise it a little where an inconsistent
+# row of a closed loop sets the largest error)
+DIVERGED_GROWTH = 10.0
+# Newton converges quadratically: a step that leaves more than this share of the largest
+# error has stalled
+STALLED_RATIO = 0.5
+
+
 @kernel
 def is_unilateral(kind):
     """Contact normal and joint-limit rows: their corrections remove overlap, not velocity."""
@@ -30,11 +42,23 @@ def integrate_positions(s, vel, h):
 
 
 @kernel
+def predict_configuration(m, s, ws, h):
+    """ws.q_pred = q + h v_pred (the end of the step without constraint impulses) and its
+    cos / sin: the joints' errors there give the velocity solve its second-order term."""
+    if m.pin_body.shape[0] + m.rod_body.shape[0] == 0:
+        return
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            ws.q_pred[i, k] = s.q[i, k] + h * ws.v_pred[i, k]
+    update_trig(ws.q_pred, ws.cs_pred)
+
+
+@kernel
 def max_residual(m, s, ws):
     """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
     update_trig(s.q, ws.body_cs)
     n = ws.n_row[0]
-    eval_rows(m, s.q, ws, ws.row_Jp, ws.rhs, n)
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_Jp, ws.rhs, n)
     worst = 0.0
     for r in range(n):
         c = ws.rhs[r]
@@ -51,15 +75,21 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
     if n == 0:
         return 0.0
     worst = max_residual(m, s, ws)
+    ws.info[5] = 0
+    ptol = pivot_tol
     for _ in range(iters):
         if worst <= tol:
             break
+        for i in range(s.q.shape[0]):
+            for k in range(3):
+                ws.q_keep[i, k] = s.q[i, k]
+                ws.v_keep[i, k] = s.v[i, k]
         unilateral = 0
         for r in range(n):
             ws.row_c[r] = ws.rhs[r]   # -c(q+), kept for the velocity solve (row_c is free now)
             unilateral += is_unilateral(ws.row_kind[r])
         assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
-        factor_solve(ws, ws.rhs, ws.lam, n, pivot_tol)
+        factor_solve(ws, ws.rhs, ws.lam, n, ptol)
         # move positions by the correction
         for i in range(ws.v_new.shape[0]):
             for k in range(3):
@@ -82,5 +112,27 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
             for k in range(3):
                 s.q[i, k] += ws.v_new[i, k]
                 s.v[i, k] += ws.v_pred[i, k]
+        after = max_residual(m, s, ws)
+        if after <= STALLED_RATIO * worst:
+            worst = after
+            continue
+        if after <= DIVERGED_GROWTH * worst:
+            # stalled: the largest error belongs to a row dropped as dependent (a closed loop
+            # through the ground) whose error the others cannot remove; more steps would
+            # only repeat this one
+            worst = after
+            break
+        # Newton diverged: rows nearly dependent (a closed loop through the ground near a
+        # dead point) whose errors disagree give a huge step. Take it back and try once
+        # more with such rows dropped; if that fails too, keep the configuration before it
+        # (the next step's solve sees the rest as c / h).
+        for i in range(s.q.shape[0]):
+            for k in range(3):
+                s.q[i, k] = ws.q_keep[i, k]
+                s.v[i, k] = ws.v_keep[i, k]
         worst = max_residual(m, s, ws)
+        ws.info[5] += 1
+        if ptol >= LOOSE_PIVOT_TOL:
+            break
+        ptol = LOOSE_PIVOT_TOL
     return worst

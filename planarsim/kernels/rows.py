@@ -39,23 +39,24 @@ def _set_dir(q, body, px, py, dx, dy, sign, out):
 
 
 @kernel
-def eval_row(m, q, ws, r, J):
-    """Jacobian blocks J (2, 3) and error c of row r at configuration q; returns c."""
+def eval_row(m, q, cs, ws, r, J):
+    """Jacobian blocks J (2, 3) and error c of row r at configuration q (cs: its cos / sin,
+    math2d.update_trig); returns c."""
     kind = ws.row_kind[r]
     o = ws.row_owner[r]
     a = ws.row_body[r, 0]
     b = ws.row_body[r, 1]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-        ax, ay = world_point(q, ws.body_cs, a, m.pin_anchor[o, 0, 0], m.pin_anchor[o, 0, 1])
-        bx, by = world_point(q, ws.body_cs, b, m.pin_anchor[o, 1, 0], m.pin_anchor[o, 1, 1])
+        ax, ay = world_point(q, cs, a, m.pin_anchor[o, 0, 0], m.pin_anchor[o, 0, 1])
+        bx, by = world_point(q, cs, b, m.pin_anchor[o, 1, 0], m.pin_anchor[o, 1, 1])
         dx = 1.0 if kind == ROW_PIN_X else 0.0
         dy = 1.0 - dx
         _set_dir(q, a, ax, ay, dx, dy, -1.0, J[0])
         _set_dir(q, b, bx, by, dx, dy, 1.0, J[1])
         return (bx - ax) * dx + (by - ay) * dy
     if kind == ROW_ROD:
-        ax, ay = world_point(q, ws.body_cs, a, m.rod_anchor[o, 0, 0], m.rod_anchor[o, 0, 1])
-        bx, by = world_point(q, ws.body_cs, b, m.rod_anchor[o, 1, 0], m.rod_anchor[o, 1, 1])
+        ax, ay = world_point(q, cs, a, m.rod_anchor[o, 0, 0], m.rod_anchor[o, 0, 1])
+        bx, by = world_point(q, cs, b, m.rod_anchor[o, 1, 0], m.rod_anchor[o, 1, 1])
         ex = bx - ax
         ey = by - ay
         L = math.sqrt(ex * ex + ey * ey)
@@ -86,16 +87,16 @@ def eval_row(m, q, ws, r, J):
         # normal of its closest ground point: the same as the start-of-step values at q0, and
         # exact on curved ground when the position correction evaluates it at q+
         if ws.contact_on_arc[o] == 1:
-            px, py = world_point(q, ws.body_cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
+            px, py = world_point(q, cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
         else:
-            px, py = world_point(q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+            px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
         gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
         _set_dir(q, b, px, py, nx, ny, 1.0, J[1])
         if ws.contact_on_arc[o] == 1:
             return gap - m.contact_radius[o]
         return gap
     # tangent row: the material point stays at the ground point found at the step's start
-    px, py = world_point(q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+    px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
     tx = ws.contact_normal[o, 1]
     ty = -ws.contact_normal[o, 0]
     _set_dir(q, b, px, py, tx, ty, 1.0, J[1])
@@ -117,18 +118,35 @@ def _pin_rows(q, cs, anchor, o, a, b, J, c, r):
 
 
 @kernel
-def eval_rows(m, q, ws, J, c, n):
-    """J[r] and c[r] of rows 0..n-1 at configuration q (ws.body_cs holds its cos / sin). A pin's
+def eval_rows(m, q, cs, ws, J, c, n):
+    """J[r] and c[r] of rows 0..n-1 at configuration q (cs holds its cos / sin). A pin's
     x row is always followed by its y row (build_rows), so both come from one evaluation."""
     r = 0
     while r < n:
         if ws.row_kind[r] == ROW_PIN_X:
-            _pin_rows(q, ws.body_cs, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
+            _pin_rows(q, cs, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
                       ws.row_body[r, 1], J, c, r)
             r += 2
         else:
-            c[r] = eval_row(m, q, ws, r, J[r])
+            c[r] = eval_row(m, q, cs, ws, r, J[r])
             r += 1
+
+
+@kernel
+def predict_joint_errors(m, ws, n):
+    """row_c_pred[r] = c(q_pred) of the pin and rod rows (the velocity solve's target);
+    contact and limit rows are left alone (row_Jp is scratch here)."""
+    r = 0
+    while r < n:
+        kind = ws.row_kind[r]
+        if kind == ROW_PIN_X:
+            _pin_rows(ws.q_pred, ws.cs_pred, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
+                      ws.row_body[r, 1], ws.row_Jp, ws.row_c_pred, r)
+            r += 2
+            continue
+        if kind == ROW_ROD:
+            ws.row_c_pred[r] = eval_row(m, ws.q_pred, ws.cs_pred, ws, r, ws.row_Jp[r])
+        r += 1
 
 
 @kernel
@@ -191,7 +209,8 @@ def build_rows(m, s, ws):
                 n = _add_row(ws, n, ROW_CONTACT_T, i, -1, m.contact_body[i])
             ic += 1
     ws.n_row[0] = n
-    eval_rows(m, s.q, ws, ws.row_J, ws.row_c, n)
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n)
+    predict_joint_errors(m, ws, n)
     sliding = 0
     for r in range(n):
         for e in range(2):

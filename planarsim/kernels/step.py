@@ -28,7 +28,7 @@ from .contacts import MODE_FREE, MODE_SLIDING, find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import GUARD_BAD_COMMANDS, check_guards
 from .math2d import update_trig
-from .integrate import correct_positions, integrate_positions
+from .integrate import correct_positions, integrate_positions, predict_configuration
 from .modes import gather_contact_impulses, update_modes
 from .record import record_frame
 from .rows import build_rows
@@ -130,6 +130,7 @@ def _step(m, s, ws, opt, u):
         update_trig(s.q, ws.body_cs)
         apply_forces(m, s, ws, u)
         predict_velocity(m, s, ws, h)
+        predict_configuration(m, s, ws, h)
         find_contacts(m, s, ws)
         ccd_on = split < opt.max_ccd_splits
         solve_modes(m, s, ws, opt, h, not ccd_on)
