@@ -85,7 +85,7 @@ class Workspace(NamedTuple):
     q_pred: np.ndarray           # (n_body, 3) predicted end-of-step configuration q + h v_pred
     cs_pred: np.ndarray          # (n_body, 3) cos, sin, angle of q_pred (as body_cs)
     q_keep: np.ndarray           # (n_body, 3) q and v before a Newton step of the position
-    v_keep: np.ndarray           #   correction (put back if the step does not reduce the error)
+    v_keep: np.ndarray           #   correction (put back if the step diverges)
     contact_point: np.ndarray    # (n_contact, 2) world contact point [m]
     contact_ground: np.ndarray   # (n_contact, 2) ground point below it [m]
     contact_normal: np.ndarray   # (n_contact, 2) unit ground normal
@@ -111,7 +111,7 @@ class Workspace(NamedTuple):
     info: np.ndarray             # (8,) int: [0] mode rounds, [1] ccd splits, [2] guard body,
                                  #   [3] guard field, [4] mode-round cap reached (engaged contacts stuck),
                                  #   [5] Newton steps of the position correction taken back (they
-                                 #   did not reduce the error: rows nearly dependent, inconsistent)
+                                 #   diverged: rows nearly dependent, errors inconsistent)
     guard_value: np.ndarray      # (1,) offending value when a guard fired
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)

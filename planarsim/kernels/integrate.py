@@ -5,6 +5,10 @@ correct_positions: the linearised rows leave a residual O(h^2 w^2 r). Newton on 
 equation moves q along the START-of-step constraint directions J(q0):
     (J(q+) W J(q0)^T) mu = -c(q+),   q += W J(q0)^T mu,   v += W J(q0)^T mu / h
 (correcting along J(q+) instead would dissipate energy every step; DESIGN.md section 3.7).
+Safeguards: a Newton step that raises the largest error tenfold (nearly dependent rows of a
+closed loop through the ground) is taken back and tried once more with such rows dropped;
+one that removes less than half of it has stalled on a row dropped as dependent, and ends
+the correction.
 Corrections of unilateral rows (contact normals, joint limits) move positions only: pushing a
 body out of the ground must not give it the velocity overlap / h (energy from nowhere).
 """
@@ -14,8 +18,8 @@ from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_rows
 from .solve import apply_impulses, assemble, factor_solve, substitute
 
 
-# relative pivot below which the position correction drops a row after a Newton step failed to
-# reduce the error: rows within about 1e-2 rad of dependent
+# relative pivot below which the position correction drops a row after a Newton step diverged:
+# rows within about 1e-2 rad of dependent
 LOOSE_PIVOT_TOL = 1e-4
 # a Newton step that multiplies the largest error by more than this has diverged (near a
 # solution the error falls quadratically; a step may raise it a little where an inconsistent
