@@ -45,8 +45,8 @@ FIELD_NAMES = ("x", "y", "theta", "vx", "vy", "omega")
 def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
-    and a copy of the state at the start of that step. Code GUARD_BAD_COMMANDS (-1: commands of the wrong length,
-    nothing stepped) gives a ValueError instead."""
+    and a copy of the state at the start of that step. Code GUARD_BAD_COMMANDS (-1: commands
+    of the wrong length, nothing stepped) gives a ValueError instead."""
     if code == GUARD_BAD_COMMANDS:
         return ValueError(f"{who}: the commands u have {int(ws.info[2])} entries; the model has "
                           f"{len(model.act_names)} actuators {list(model.act_names)}")

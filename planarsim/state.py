@@ -109,9 +109,10 @@ class Workspace(NamedTuple):
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
     act_power: np.ndarray        # (n_act,) mechanical power [W]
     info: np.ndarray             # (8,) int: [0] mode rounds, [1] ccd splits, [2] guard body,
-                                 #   [3] guard field, [4] mode-round cap reached (engaged contacts stuck),
-                                 #   [5] Newton steps of the position correction taken back (they
-                                 #   diverged: rows nearly dependent, errors inconsistent)
+                                 #   [3] guard field, [4] mode-round cap reached (engaged
+                                 #   contacts stuck), [5] Newton steps of the position
+                                 #   correction taken back (they diverged: rows nearly
+                                 #   dependent, errors inconsistent)
     guard_value: np.ndarray      # (1,) offending value when a guard fired
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)
@@ -125,9 +126,11 @@ def make_workspace(model: Model) -> Workspace:
     nb, nc, na = model.n_body, model.n_contact, model.n_act
     R = max_rows(model)
     z = np.zeros
-    return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan), body_first_row=z(nb, np.int64),
-                     row_first=z(R, np.int64), row_reach=z(R, np.int64), v_pred=z((nb, 3)), v_new=z((nb, 3)), q_pred=z((nb, 3)),
-                     cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)), v_keep=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
+    return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan),
+                     body_first_row=z(nb, np.int64), row_first=z(R, np.int64),
+                     row_reach=z(R, np.int64), v_pred=z((nb, 3)), v_new=z((nb, 3)),
+                     q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
+                     v_keep=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_anchor=z((nc, 2)),
                      contact_impulse=z((nc, 2)), contact_on_arc=z(nc, np.int64),
                      contact_new=z(nc, np.int64), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),

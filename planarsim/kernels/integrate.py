@@ -79,7 +79,6 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
     if n == 0:
         return 0.0
     worst = max_residual(m, s, ws)
-    ws.info[5] = 0
     ptol = pivot_tol
     for _ in range(iters):
         if worst <= tol:

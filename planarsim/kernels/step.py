@@ -123,6 +123,7 @@ def _step(m, s, ws, opt, u):
     ws.info[0] = 0
     ws.info[1] = 0
     ws.info[4] = 0
+    ws.info[5] = 0
     for i in range(m.contact_body.shape[0]):
         ws.contact_new[i] = 0
     h = m.dt

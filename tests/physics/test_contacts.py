@@ -232,9 +232,9 @@ def test_seven_link_biped_collapse_perturbed_by_nanometres_comes_to_rest_above_g
     k = 3 a corner once ended 34.5 mm below the ground, its rows dropped as dependent on the
     loop through the other contacts, and at rest a corner switched to sliding and added
     0.78 J; on another path a Newton step of the position correction near a dead point
-    diverged (+2.7e6 J in one step; such steps are now taken back). Every
-    path must only lose energy (within the correction's m g overlap), never sink a corner
-    more than a capped step does, and come to rest on the ground."""
+    diverged (+2.7e6 J in one step; such steps are now taken back). Every path must only
+    lose energy (within the correction's m g overlap), never sink a corner more than a capped
+    step does, and come to rest on the ground."""
     from planarsim.bench_scenes import biped_collapse
     from tests.physics.test_contact_properties import contact_gaps
     model = biped_collapse()
