@@ -1,6 +1,7 @@
 """The one decorator every kernel uses, and the guard against stale numba caches.
 
-cache=True: compiled once per machine, loaded from disk afterwards.
+cache=True: compiled once per machine, loaded from disk afterwards. Kernels themselves are not
+cached: they are IR linked into their compiled callers (the step, rollouts), which are.
 fastmath=False: fastmath lets LLVM assume no NaNs and would remove the isfinite guards.
 _nrt=False: kernels never allocate; without the runtime's reference counting, passing the
 model/state/workspace NamedTuples (dozens of arrays) between stages costs nothing, where
@@ -15,6 +16,9 @@ import os
 from pathlib import Path
 
 from numba import njit
+from numba.core import compiler
+from numba.core.codegen import JITCodeLibrary
+from numba.core.compiler_lock import require_global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
@@ -40,15 +44,87 @@ class KernelDispatcher(CPUDispatcher):
                         "from Python use Simulator.step / steps or planarsim.kernels.step.step_entry")
 
 
-def _kernel_decorator(**extra):
+class KernelCodeLibrary(JITCodeLibrary):
+    """LLVM IR of a kernel, never compiled to machine code on its own.
+
+    numba finalises every function's library: it links in the libraries of its callees,
+    optimises the whole (O3) and emits machine code. A kernel is only ever linked into a
+    compiled caller (the step, a rollout), where all of it is optimised and emitted again:
+    for the step's nested stages that was each leaf's code optimised once per level it is
+    nested in and emitted as machine code at every level, most of a first-ever start-up's
+    LLVM time. Here finalising only links the callees' IR in (as linkonce_odr, so that
+    copies reaching a caller along several paths merge); the caller optimises and emits
+    everything once."""
+
+    noinline = False   # mark the kernel's function noinline (kernel_call)
+
+    def add_ir_module(self, ir_module):
+        if self.noinline:
+            for fn in ir_module.functions:
+                if not fn.is_declaration and "alwaysinline" not in fn.attributes:
+                    fn.attributes.add("noinline")
+        super().add_ir_module(ir_module)
+
+    def get_pointer_to_function(self, name):
+        return 0   # no entry of its own: compiled code calls a kernel, Python never does
+
+    @property
+    def codegen(self):
+        return _KernelCodegen(self._codegen)
+
+    def finalize(self):
+        require_global_compiler_lock()
+        self._raise_if_finalized()
+        seen = set()
+        for library in self._linking_libraries:
+            if library not in seen:
+                seen.add(library)
+                self._reload_init.update(library._reload_init)
+                self._final_module.link_in(library._get_module_for_linking(), preserve=True)
+        self._final_module.verify()
+        self._finalized = True
+
+
+class _KernelCodegen:
+    """The codegen as a kernel's library shows it: numba's lowering stores the address of the
+    function's environment in the execution engine, where a kernel is never added. Kernels
+    use no environment (nopython, no Python objects), so that store is skipped."""
+
+    def __init__(self, codegen):
+        self._codegen = codegen
+
+    def set_env(self, env_name, env):
+        pass
+
+    def __getattr__(self, name):
+        return getattr(self._codegen, name)
+
+
+class KernelCompiler(compiler.Compiler):
+    """numba's pipeline, lowering a kernel into a KernelCodeLibrary."""
+    noinline = False
+
+    def compile_extra(self, func):
+        if self.state.library is None:
+            codegen = self.state.targetctx.codegen()
+            self.state.library = KernelCodeLibrary(codegen, func.__qualname__)
+            self.state.library.noinline = self.noinline
+        return super().compile_extra(func)
+
+
+class KernelCallCompiler(KernelCompiler):
+    """As KernelCompiler, for a kernel that stays a call (kernel_call)."""
+    noinline = True
+
+
+def _kernel_decorator(pipeline_class=KernelCompiler, **extra):
     options = dict(_OPTIONS, nopython=True, boundscheck=None, no_cpython_wrapper=True,
                    no_cfunc_wrapper=True, **extra)
     options.pop("cache")
 
     def decorate(fn):
-        disp = KernelDispatcher(py_func=fn, locals={}, targetoptions=dict(options))
-        disp.enable_caching()
-        return disp
+        return KernelDispatcher(py_func=fn, locals={}, targetoptions=dict(options),
+                                pipeline_class=pipeline_class)
     return decorate
 
 
@@ -57,9 +133,17 @@ def _kernel_decorator(**extra):
 # and left small hot kernels as calls (a fifth slower on the smallest models).
 kernel = _kernel_decorator(forceinline=not _KERNEL_CALLS)
 kernel_inline = _kernel_decorator(inline="always")
+# kernel_call: never inlined (LLVM's noinline). For long code that runs rarely and would
+# otherwise be copied into every caller (the closest point on hills: a Newton loop of sines),
+# where a copy per call site costs compile time and buys nothing.
+kernel_call = _kernel_decorator(pipeline_class=KernelCallCompiler, forceinline=False)
 # callable from Python and inlined into compiled callers (a walker's controller: the Python
 # controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
 jit_inline = njit(inline="always", **_OPTIONS)
+# callable from Python and always inlined by LLVM into compiled callers (small helpers such as
+# the terrain height, used inside a kernel_call too: numba would otherwise take the caller's
+# inlining setting, and a call per height inside the closest-point loop is a third slower)
+jit_force = njit(forceinline=True, **_OPTIONS)
 
 
 def _sources_hash(folder: Path, extra: str = "") -> str:

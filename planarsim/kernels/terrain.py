@@ -5,12 +5,12 @@ with h0 [m], s [-], A [m], L [m], phi [rad]. Flat ground is ``[0, 0, 0]``.
 """
 import math
 
-from ._jit import jit, kernel
+from ._jit import jit, jit_force, kernel, kernel_call
 
 TWO_PI = 2.0 * math.pi
 
 
-@jit
+@jit_force
 def height(coef, x):
     """Ground height h(x) [m]."""
     h = coef[0] + coef[1] * x
@@ -21,7 +21,7 @@ def height(coef, x):
     return h
 
 
-@jit
+@jit_force
 def height_derivs(coef, x):
     """(h, h', h'') at x: height [m], slope dh/dx [-], curvature term d2h/dx2 [1/m]."""
     h = coef[0] + coef[1] * x
@@ -47,7 +47,7 @@ def normal_at(coef, x):
     return -dh * inv, inv
 
 
-@jit
+@jit_force
 def max_curvature(coef):
     """Upper bound on |h''| [1/m]: sum_k A_k (2 pi / L_k)^2."""
     acc = 0.0
@@ -71,7 +71,7 @@ def _closest_on_line(h0, slope, px, py):
     return x, h, nx, ny, gap
 
 
-@jit
+@jit_force
 def closest_point(coef, px, py):
     """Closest ground point to (px, py) and the signed gap along its normal.
 
@@ -120,13 +120,20 @@ def closest_point(coef, px, py):
     return x, h, nx, ny, gap
 
 
+@kernel_call
+def _closest_on_hills(coef, px, py):
+    """closest_point as one call: LLVM would otherwise copy its loops of sines into every
+    call site in the step (hundreds of copies, seconds of a first-ever compile)."""
+    return closest_point(coef, px, py)
+
+
 @kernel
 def ground_point(coef, px, py):
     """closest_point with the flat and sloped case inlined into the caller (the general
     case, hills, stays a call: it is long and its Newton loop dominates anyway)."""
     if coef[2] == 0.0:
         return _closest_on_line(coef[0], coef[1], px, py)
-    return closest_point(coef, px, py)
+    return _closest_on_hills(coef, px, py)
 
 
 @jit
