@@ -22,7 +22,7 @@ from ..model import ModelArrays
 from ..options import StepOptions
 from ..state import State, Workspace
 from . import refs
-from ._jit import KERNEL_OPTIONS, jit, kernel, kernel_inline
+from ._jit import KERNEL_OPTIONS, jit, kernel, kernel_call, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
 from .contacts import MODE_FREE, MODE_SLIDING, find_contacts
 from .forces import apply_forces, predict_velocity
@@ -70,6 +70,40 @@ def build_and_solve(m, s, ws, opt, h):
     solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
 
 
+@kernel_call
+def settle_capped_modes(m, s, ws, opt, h):
+    """The mode rounds reached their cap: the modes of a contact engaged this step cycle
+    (stick violates the friction cone, sliding reverses, free penetrates). Such contacts
+    must neither be left free to penetrate nor stick with a pulling impulse (that adds
+    energy). They take a frictionless normal impulse for this step (sliding with slip 0:
+    F = n), which only removes approach velocity; the next step's checks settle their mode.
+    Then solve once more so impulses match the final modes. Rare: a call, so that its
+    solves are not copied into the step's hot code."""
+    if opt.cap_policy == 1:
+        for i in range(m.contact_body.shape[0]):
+            if ws.contact_new[i] == 1:
+                s.contact_mode[i] = MODE_SLIDING
+                s.contact_slip[i] = 0.0
+    ws.info[4] += 1
+    build_and_solve(m, s, ws, opt, h)
+    gather_contact_impulses(m, s, ws)
+    if opt.cap_policy == 1:
+        # and no contact may pull: nearly dependent rows (a closed loop through the ground)
+        # can give huge opposite impulses, one pulling. Release the contact that pulls
+        # hardest and solve again, until none pulls (at most one solve per contact).
+        for _ in range(m.contact_body.shape[0]):
+            worst = -1
+            for i in range(m.contact_body.shape[0]):
+                if s.contact_mode[i] != MODE_FREE and ws.contact_impulse[i, 0] < 0.0:
+                    if worst < 0 or ws.contact_impulse[i, 0] < ws.contact_impulse[worst, 0]:
+                        worst = i
+            if worst < 0:
+                break
+            s.contact_mode[worst] = MODE_FREE
+            build_and_solve(m, s, ws, opt, h)
+            gather_contact_impulses(m, s, ws)
+
+
 @kernel_inline
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 4-6: build rows, solve, check modes; repeat while modes change (capped)."""
@@ -80,35 +114,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         changed = update_modes(m, s, ws, h, opt.mode_strategy, rounds == 0, include_ccd)
         rounds += 1
     if changed != 0:
-        # cap reached (the modes of a contact engaged this step cycle: stick violates the
-        # friction cone, sliding reverses, free penetrates): such contacts must neither be left
-        # free to penetrate nor stick with a pulling impulse (that adds energy). They take a
-        # frictionless normal impulse for this step (sliding with slip 0: F = n), which only
-        # removes approach velocity; the next step's checks settle their mode. Then solve once
-        # more so impulses match the final modes.
-        if opt.cap_policy == 1:
-            for i in range(m.contact_body.shape[0]):
-                if ws.contact_new[i] == 1:
-                    s.contact_mode[i] = MODE_SLIDING
-                    s.contact_slip[i] = 0.0
-        ws.info[4] += 1
-        build_and_solve(m, s, ws, opt, h)
-        gather_contact_impulses(m, s, ws)
-        if opt.cap_policy == 1:
-            # and no contact may pull: nearly dependent rows (a closed loop through the ground)
-            # can give huge opposite impulses, one pulling. Release the contact that pulls
-            # hardest and solve again, until none pulls (at most one solve per contact).
-            for _ in range(m.contact_body.shape[0]):
-                worst = -1
-                for i in range(m.contact_body.shape[0]):
-                    if s.contact_mode[i] != MODE_FREE and ws.contact_impulse[i, 0] < 0.0:
-                        if worst < 0 or ws.contact_impulse[i, 0] < ws.contact_impulse[worst, 0]:
-                            worst = i
-                if worst < 0:
-                    break
-                s.contact_mode[worst] = MODE_FREE
-                build_and_solve(m, s, ws, opt, h)
-                gather_contact_impulses(m, s, ws)
+        settle_capped_modes(m, s, ws, opt, h)
     ws.info[0] += rounds
 
 
