@@ -12,7 +12,7 @@ import math
 
 from ._jit import kernel
 from .contacts import MODE_FREE
-from .terrain import ground_point
+from .terrain import ground_point_call
 
 N_SAMPLES = 8
 
@@ -23,7 +23,7 @@ def _path_gap(m, s, ws, b, h, tau):
     ay = (ws.v_new[b, 1] - s.v[b, 1]) / h
     px = s.q[b, 0] + tau * s.v[b, 0] + tau * tau * ax
     py = s.q[b, 1] + tau * s.v[b, 1] + tau * tau * ay
-    return ground_point(m.terrain_coef, px, py)[4]
+    return ground_point_call(m.terrain_coef, px, py)[4]
 
 
 @kernel

@@ -63,9 +63,11 @@ def copy_state(src, dst):
     _copy2(src.ext_force, dst.ext_force)
 
 
-@kernel_inline
+@kernel_call
 def build_and_solve(m, s, ws, opt, h):
-    """Stages 4-5: the active rows at the current configuration and their impulses."""
+    """Stages 4-5: the active rows at the current configuration and their impulses. A call
+    (one copy of its code for the mode rounds and the capped-mode settling): its work is
+    microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
     solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
 

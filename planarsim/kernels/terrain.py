@@ -120,17 +120,26 @@ def closest_point(coef, px, py):
     return x, h, nx, ny, gap
 
 
+@kernel
+def ground_point(coef, px, py):
+    """closest_point inlined into the caller, its flat and sloped case in closed form."""
+    if coef[2] == 0.0:
+        return _closest_on_line(coef[0], coef[1], px, py)
+    return closest_point(coef, px, py)
+
+
 @kernel_call
 def _closest_on_hills(coef, px, py):
-    """closest_point as one call: LLVM would otherwise copy its loops of sines into every
-    call site in the step (hundreds of copies, seconds of a first-ever compile)."""
+    """closest_point as one call (see ground_point_call)."""
     return closest_point(coef, px, py)
 
 
 @kernel
-def ground_point(coef, px, py):
-    """closest_point with the flat and sloped case inlined into the caller (the general
-    case, hills, stays a call: it is long and its Newton loop dominates anyway)."""
+def ground_point_call(coef, px, py):
+    """ground_point whose hills case is one call, for call sites that are many and rarely run
+    (the time-of-impact root search): LLVM would otherwise copy the Newton loop of sines
+    into each of them (once hundreds of copies in the step, seconds of a first-ever
+    compile)."""
     if coef[2] == 0.0:
         return _closest_on_line(coef[0], coef[1], px, py)
     return _closest_on_hills(coef, px, py)
