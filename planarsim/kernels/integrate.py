@@ -11,11 +11,13 @@ one that removes less than half of it has stalled on a row dropped as dependent,
 the correction.
 Corrections of unilateral rows (contact normals, joint limits) move positions only: pushing a
 body out of the ground must not give it the velocity overlap / h (energy from nowhere).
+rows_hold_within proves, from the rows the solve already built, when the correction would
+find nothing to do (bodies at rest or translating), so the step skips it exactly.
 """
-from ._jit import kernel, kernel_inline
+from ._jit import kernel, kernel_call, kernel_inline
 from .math2d import update_trig
-from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, eval_rows
-from .solve import apply_impulses, assemble, factor_solve, substitute
+from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, eval_rows
+from .solve import apply_impulses, assemble, factor_solve, row_dot, substitute
 
 
 # relative pivot below which the position correction drops a row after a Newton step diverged:
@@ -55,6 +57,54 @@ def predict_configuration(m, s, ws, h):
         for k in range(3):
             ws.q_pred[i, k] = s.q[i, k] + h * ws.v_pred[i, k]
     update_trig(ws.q_pred, ws.cs_pred)
+
+
+@kernel
+def _lever(m, ws, r, e):
+    """An upper bound |x| + |y| [m] on the distance from its body's COM of the point whose
+    motion row r constrains on body slot e (a pin's anchor, a contact's material point or its
+    sole's centre); no square root."""
+    o = ws.row_owner[r]
+    kind = ws.row_kind[r]
+    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
+        return abs(m.pin_anchor[o, e, 0]) + abs(m.pin_anchor[o, e, 1])
+    if kind == ROW_CONTACT_N and ws.contact_on_arc[o] == 1:
+        return abs(m.contact_local[o, 0]) + abs(m.contact_local[o, 1])
+    return abs(ws.contact_anchor[o, 0]) + abs(ws.contact_anchor[o, 1])
+
+
+@kernel_call
+def rows_hold_within(m, s, ws, h, limit):
+    """True if every row's error after integrating is provably at most `limit` [m or rad],
+    without evaluating the rows again: the error predicted to first order, c + h J v (rows
+    and J at the step's start, v the new velocity), plus the second-order motion of each
+    row's point on a body turning by d = h w, at most (d^2 / 2 + |d|^3 / 6) times its
+    distance from the COM (bounded by _lever). A bound for pins, joint limits and contacts
+    on flat or sloped ground (their errors are linear in the points); never claimed where
+    curvature enters otherwise (rods, hills). Stops at the first row that may exceed the
+    limit, the first-order errors of all rows checked first (they are cheaper)."""
+    if m.terrain_coef[2] != 0.0 or m.rod_body.shape[0] > 0:
+        return False
+    n = ws.n_row[0]
+    for r in range(n):
+        ws.rhs[r] = abs(ws.row_c[r] + h * row_dot(ws, r, ws.row_J, s.v))
+        if ws.rhs[r] > limit:
+            return False
+    for r in range(n):
+        err = ws.rhs[r]
+        kind = ws.row_kind[r]
+        if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
+            continue
+        for e in range(2):
+            b = ws.row_body[r, e]
+            if b < 0:
+                continue
+            d = abs(h * s.v[b, 2])
+            if d > 0.0:
+                err += (0.5 * d * d + d * d * d / 6.0) * _lever(m, ws, r, e)
+        if err > limit:
+            return False
+    return True
 
 
 @kernel
