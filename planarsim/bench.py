@@ -4,7 +4,7 @@
     planarsim bench chain4 rod_drop        # only these scenes and their peer comparison
     planarsim bench --parts scenes,peers   # parts: scenes, peers, walkers, batch, startup
     planarsim bench --peers pymunk,box2d   # peers to compare (default: all; 'none' skips)
-    planarsim bench --no-cold              # skip the cold-cache start-up (about a minute)
+    planarsim bench --no-cold              # skip the cold-cache start-up (about half a minute)
     planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
 
 Parts (each warm after compilation; steps/s = median and min-max of --repeats runs):

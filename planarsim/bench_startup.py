@@ -10,10 +10,10 @@ the whole child process (interpreter start included) is reported too.
   user's own NUMBA_CACHE_DIR if set), which the parent has just filled by running the same
   script once (not timed).
 - cold: the child gets ``NUMBA_CACHE_DIR`` pointing at a new, empty temporary directory.
-  numba then looks up and writes every cached kernel there only (its user-provided cache
-  locator comes first), so every kernel of the engine and the walker is compiled from scratch,
-  exactly as on a first-ever run; the directory is deleted afterwards. This takes about a
-  minute of one core.
+  numba then looks up and writes every cached function there only (its user-provided cache
+  locator comes first), so the engine's step and the walker's rollout are compiled from
+  scratch, exactly as on a first-ever run; the directory is deleted afterwards. This takes
+  about half a minute of one core.
 """
 from __future__ import annotations
 

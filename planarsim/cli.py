@@ -202,7 +202,7 @@ def cmd_info(args):
     print(f"python {sys.version.split()[0]}, numpy {numpy.__version__}, numba {numba.__version__}, "
           f"matplotlib {matplotlib.__version__}")
     print(f"numba cache: {len(cached)} kernel index files in {kernels / '__pycache__'}"
-          f"{' (cold: the first run compiles, about a minute)' if not cached else ' (warm)'}")
+          f"{' (cold: the first run compiles, about half a minute)' if not cached else ' (warm)'}")
     try:
         from .render import ffmpeg_exe
         print(f"ffmpeg: {ffmpeg_exe()}")

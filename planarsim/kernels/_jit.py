@@ -1,4 +1,4 @@
-"""The one decorator every kernel uses, and the guard against stale numba caches.
+"""The decorators of every compiled function, and the guard against stale numba caches.
 
 cache=True: compiled once per machine, loaded from disk afterwards. Kernels themselves are not
 cached: they are IR linked into their compiled callers (the step, rollouts), which are.
@@ -88,7 +88,9 @@ class KernelCodeLibrary(JITCodeLibrary):
 class _KernelCodegen:
     """The codegen as a kernel's library shows it: numba's lowering stores the address of the
     function's environment in the execution engine, where a kernel is never added. Kernels
-    use no environment (nopython, no Python objects), so that store is skipped."""
+    use no environment (nopython, no Python objects), so that store is skipped. Hence a kernel
+    must not print, raise or use objmode: those read the environment, which a freshly compiled
+    caller would then lack."""
 
     def __init__(self, codegen):
         self._codegen = codegen
@@ -140,9 +142,11 @@ kernel_call = _kernel_decorator(pipeline_class=KernelCallCompiler, forceinline=F
 # callable from Python and inlined into compiled callers (a walker's controller: the Python
 # controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
 jit_inline = njit(inline="always", **_OPTIONS)
-# callable from Python and always inlined by LLVM into compiled callers (small helpers such as
-# the terrain height, used inside a kernel_call too: numba would otherwise take the caller's
-# inlining setting, and a call per height inside the closest-point loop is a third slower)
+# callable from Python and always inlined by LLVM into compiled callers (the terrain's height
+# and closest point). A plain `jit` function takes the inlining setting of the caller that
+# compiles it first (numba's flag inheritance: forced inline under a kernel, not under a
+# kernel_call, and the cache keeps that choice); where that matters for speed, say it here.
+# Inside kernel_call's closest point a call per height was a third slower.
 jit_force = njit(forceinline=True, **_OPTIONS)
 
 

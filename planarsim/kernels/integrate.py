@@ -14,9 +14,12 @@ body out of the ground must not give it the velocity overlap / h (energy from no
 rows_hold_within proves, from the rows the solve already built, when the correction would
 find nothing to do (bodies at rest or translating), so the step skips it exactly.
 """
+import math
+
 from ._jit import kernel, kernel_call, kernel_inline
 from .math2d import update_trig
-from .rows import ROW_CONTACT_N, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, eval_rows
+from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
+                   ROW_PIN_Y, eval_rows)
 from .solve import apply_impulses, assemble, factor_solve, row_dot, substitute
 
 
@@ -59,18 +62,25 @@ def predict_configuration(m, s, ws, h):
     update_trig(ws.q_pred, ws.cs_pred)
 
 
+# relative rounding of a row evaluated at coordinates of size x: about eps x per operation;
+# a few operations, with margin
+ROUNDING = 16 * 2.220446049250313e-16
+
+
 @kernel
 def _lever(m, ws, r, e):
     """An upper bound |x| + |y| [m] on the distance from its body's COM of the point whose
     motion row r constrains on body slot e (a pin's anchor, a contact's material point or its
-    sole's centre); no square root."""
+    sole's centre); no square root. inf for rows it does not know."""
     o = ws.row_owner[r]
     kind = ws.row_kind[r]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
         return abs(m.pin_anchor[o, e, 0]) + abs(m.pin_anchor[o, e, 1])
     if kind == ROW_CONTACT_N and ws.contact_on_arc[o] == 1:
         return abs(m.contact_local[o, 0]) + abs(m.contact_local[o, 1])
-    return abs(ws.contact_anchor[o, 0]) + abs(ws.contact_anchor[o, 1])
+    if kind == ROW_CONTACT_N or kind == ROW_CONTACT_T:
+        return abs(ws.contact_anchor[o, 0]) + abs(ws.contact_anchor[o, 1])
+    return math.inf
 
 
 @kernel_call
@@ -79,10 +89,11 @@ def rows_hold_within(m, s, ws, h, limit):
     without evaluating the rows again: the error predicted to first order, c + h J v (rows
     and J at the step's start, v the new velocity), plus the second-order motion of each
     row's point on a body turning by d = h w, at most (d^2 / 2 + |d|^3 / 6) times its
-    distance from the COM (bounded by _lever). A bound for pins, joint limits and contacts
-    on flat or sloped ground (their errors are linear in the points); never claimed where
-    curvature enters otherwise (rods, hills). Stops at the first row that may exceed the
-    limit, the first-order errors of all rows checked first (they are cheaper)."""
+    distance from the COM (bounded by _lever), plus the rounding of evaluating the row at
+    the body's coordinates. A bound for pins, joint limits and contacts on flat or sloped
+    ground (their errors are linear in the points); never claimed where curvature enters
+    otherwise (rods, hills). Stops at the first row that may exceed the limit, the
+    first-order errors of all rows checked first (they are cheaper)."""
     if m.terrain_coef[2] != 0.0 or m.rod_body.shape[0] > 0:
         return False
     n = ws.n_row[0]
@@ -92,16 +103,18 @@ def rows_hold_within(m, s, ws, h, limit):
             return False
     for r in range(n):
         err = ws.rhs[r]
-        kind = ws.row_kind[r]
-        if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
-            continue
+        angular = ws.row_kind[r] == ROW_LIMIT_LO or ws.row_kind[r] == ROW_LIMIT_HI
         for e in range(2):
             b = ws.row_body[r, e]
             if b < 0:
                 continue
+            if angular:
+                err += ROUNDING * (1.0 + abs(s.q[b, 2]))
+                continue
+            lever = _lever(m, ws, r, e)
             d = abs(h * s.v[b, 2])
-            if d > 0.0:
-                err += (0.5 * d * d + d * d * d / 6.0) * _lever(m, ws, r, e)
+            err += (0.5 * d * d + d * d * d / 6.0) * lever
+            err += ROUNDING * (1.0 + abs(s.q[b, 0]) + abs(s.q[b, 1]) + lever)
         if err > limit:
             return False
     return True

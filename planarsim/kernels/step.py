@@ -2,9 +2,10 @@
 
 step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
 (0 ok, 1 non-finite, 2 too large). Model, state, workspace and options arrive as one pointer
-each (kernels/refs.py). The stages are inlined into one C function, compiled once per machine
-and called by address from every compiled caller (a walker's rollout, run_steps; see
-load_step). A time-of-impact split (CCD) repeats stages 1-6 for the remainder of the step
+each (kernels/refs.py). The stages are compiled into one C function (inlined, but for a few
+long or rarely run parts kept as calls: build_and_solve, the capped-mode settling, the skip
+test of the correction), compiled once per machine and called by address from every compiled
+caller (a walker's rollout, run_steps; see load_step). A time-of-impact split (CCD) repeats stages 1-6 for the remainder of the step
 with the new contact pinned.
 """
 import hashlib

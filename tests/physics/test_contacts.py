@@ -251,8 +251,9 @@ def test_seven_link_biped_collapse_perturbed_by_nanometres_comes_to_rest_above_g
     assert np.abs(traj.v[-1]).max() < 1e-3
 
 
-@pytest.mark.xfail(strict=True, reason="known weakness: at a fold the position correction's "
-                   "retry with nearly dependent rows dropped turns a large move into velocity")
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="known weakness: at a fold the position correction's retry with "
+                          "nearly dependent rows dropped turns a large move into velocity")
 def test_position_correction_retry_at_a_fold_adds_no_energy():
     """A state of the 7-link collapse (reached on the path of a faster velocity solve that was
     not kept) where the legs' closed loop through the ground is at a fold: the position
@@ -269,6 +270,7 @@ def test_position_correction_retry_at_a_fold_adds_no_energy():
     sim = ps.Simulator(model, state=State(**{k: data[k] for k in State._fields}))
     e0 = total_energy(model, sim.state.q, sim.state.v)
     sim.step()
-    assert sim.ws.info[5] >= 1          # the fold was met: a diverged correction taken back
+    if sim.ws.info[5] < 1:   # not an assertion: the xfail expects only the energy checks to fail
+        pytest.fail("the saved state no longer meets the fold (no diverged correction step)")
     assert total_energy(model, sim.state.q, sim.state.v) <= e0
     assert np.abs(sim.state.v).max() < 1.0
