@@ -112,6 +112,8 @@ def rows_hold_within(m, s, ws, h, limit):
                 err += ROUNDING * (1.0 + abs(s.q[b, 2]))
                 continue
             lever = _lever(m, ws, r, e)
+            if lever == math.inf:
+                return False   # (0 * inf would give NaN, which compares as within the limit)
             d = abs(h * s.v[b, 2])
             err += (0.5 * d * d + d * d * d / 6.0) * lever
             err += ROUNDING * (1.0 + abs(s.q[b, 0]) + abs(s.q[b, 1]) + lever)

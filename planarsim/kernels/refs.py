@@ -319,7 +319,8 @@ def _getattr(context, builder, typ, value, attr):
     data = builder.inttoptr(_load_slot(builder, base, offset),
                             context.get_data_type(arrty.dtype).as_pointer())
     shape = [_load_slot(builder, base, offset + 1 + d) for d in range(ndim)]
-    return impl_ret_borrowed(context, builder, arrty, _c_array(context, builder, arrty, data, shape))
+    ary = _c_array(context, builder, arrty, data, shape)
+    return impl_ret_borrowed(context, builder, arrty, ary)
 
 
 def _register_engine_types():

@@ -5,8 +5,8 @@ step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard cod
 each (kernels/refs.py). The stages are compiled into one C function (inlined, but for a few
 long or rarely run parts kept as calls: build_and_solve, the capped-mode settling, the skip
 test of the correction), compiled once per machine and called by address from every compiled
-caller (a walker's rollout, run_steps; see load_step). A time-of-impact split (CCD) repeats stages 1-6 for the remainder of the step
-with the new contact pinned.
+caller (a walker's rollout, run_steps; see load_step). A time-of-impact split (CCD) repeats
+stages 1-6 for the remainder of the step with the new contact pinned.
 """
 import hashlib
 import threading
@@ -89,23 +89,23 @@ def settle_capped_modes(m, s, ws, opt, h):
                 s.contact_mode[i] = MODE_SLIDING
                 s.contact_slip[i] = 0.0
     ws.info[4] += 1
-    build_and_solve(m, s, ws, opt, h)
-    gather_contact_impulses(m, s, ws)
-    if opt.cap_policy == 1:
+    n_contact = m.contact_body.shape[0]
+    for release in range(n_contact + 1):
+        build_and_solve(m, s, ws, opt, h)
+        gather_contact_impulses(m, s, ws)
+        if opt.cap_policy != 1 or release == n_contact:
+            break
         # and no contact may pull: nearly dependent rows (a closed loop through the ground)
         # can give huge opposite impulses, one pulling. Release the contact that pulls
         # hardest and solve again, until none pulls (at most one solve per contact).
-        for _ in range(m.contact_body.shape[0]):
-            worst = -1
-            for i in range(m.contact_body.shape[0]):
-                if s.contact_mode[i] != MODE_FREE and ws.contact_impulse[i, 0] < 0.0:
-                    if worst < 0 or ws.contact_impulse[i, 0] < ws.contact_impulse[worst, 0]:
-                        worst = i
-            if worst < 0:
-                break
-            s.contact_mode[worst] = MODE_FREE
-            build_and_solve(m, s, ws, opt, h)
-            gather_contact_impulses(m, s, ws)
+        worst = -1
+        for i in range(n_contact):
+            if s.contact_mode[i] != MODE_FREE and ws.contact_impulse[i, 0] < 0.0:
+                if worst < 0 or ws.contact_impulse[i, 0] < ws.contact_impulse[worst, 0]:
+                    worst = i
+        if worst < 0:
+            break
+        s.contact_mode[worst] = MODE_FREE
 
 
 @kernel_inline
@@ -177,7 +177,8 @@ def _step(m, s, ws, opt, u):
 # caller (run_steps, run_recorded, each walker's rollout). A plain numba call would link the
 # step's code into each caller, where LLVM optimises and compiles it again: that was most of
 # the first-ever start-up (about 15 s per rollout). The address is published to LLVM's symbol
-# table under the name load_step returns; callers loaded from the numba cache publish it first (reload_init).
+# table under the name load_step returns; callers loaded from the numba cache publish it
+# first (reload_init).
 _ENGINE = {}
 _LOAD_LOCK = threading.RLock()
 
