@@ -10,13 +10,12 @@ closed to 1e-9 m, no corner deeper than 2 mm at any time nor 1 um at the end. A 
 flagged BAD when any of these fails. The tests assert a subset on a few paths
 (tests/physics/test_contacts.py); this prints the whole picture, for a change to the solver
 or the contact modes to be judged on many paths rather than the one the bench runs. Takes
-about 20 s. On 27bb09a: 12 of 32 paths BAD (pin gaps up to 6.5e-6 m, one corner 14 um deep
+about 3 s. On 27bb09a: 12 of 32 paths BAD (pin gaps up to 6.5e-6 m, one corner 14 um deep
 at rest), none above its start energy.
 """
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
@@ -25,45 +24,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
+from planarsim.bench_metrics import lowest_point, pin_separation, spec_from_model  # noqa: E402
 from planarsim.bench_scenes import biped_collapse  # noqa: E402
-from planarsim.kernels.terrain import closest_point  # noqa: E402
-
-
-def _points(model, q, bodies, anchors):
-    """World points (K, 2) of local anchors on bodies (-1: the world) over frames q."""
-    out = []
-    for body, (lx, ly) in zip(bodies, anchors):
-        if body < 0:
-            out.append(np.broadcast_to([lx, ly], (q.shape[0], 2)))
-        else:
-            c, s = np.cos(q[:, body, 2]), np.sin(q[:, body, 2])
-            x = q[:, body, 0] + c * lx - s * ly
-            y = q[:, body, 1] + s * lx + c * ly
-            out.append(np.stack([x, y], 1))
-    return out
-
-
-def pin_gap(model, q):
-    """Largest pin gap [m] over frames q (K, n_body, 3)."""
-    a = model.arrays
-    worst = 0.0
-    for j in range(model.n_pin):
-        pa, pb = _points(model, q, a.pin_body[j], a.pin_anchor[j])
-        worst = max(worst, float(np.hypot(*(pb - pa).T).max()))
-    return worst
-
-
-def contact_gap(model, q):
-    """Smallest gap [m] of any contact at configuration q (n_body, 3)."""
-    a = model.arrays
-    gaps = []
-    for i in range(model.n_contact):
-        b = a.contact_body[i]
-        c, s = math.cos(q[b, 2]), math.sin(q[b, 2])
-        lx, ly = a.contact_local[i]
-        px, py = q[b, 0] + c * lx - s * ly, q[b, 1] + s * lx + c * ly
-        gaps.append(closest_point(a.terrain_coef, px, py)[4] - a.contact_radius[i])
-    return min(gaps)
 
 
 def main(argv=None) -> int:
@@ -72,6 +34,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seconds", type=float, default=3.0, help="simulated time per path [s]")
     args = ap.parse_args(argv)
     model = biped_collapse()
+    spec = spec_from_model("biped_collapse", model, args.seconds)   # boxes on flat ground y = 0
     bad = 0
     for strategy in ("alternating", "all"):
         for k in range(args.paths):
@@ -83,9 +46,9 @@ def main(argv=None) -> int:
             energy = traj.energy(model)["total"]
             rise = float(np.diff(energy).max())
             above = float(energy.max() - energy[0])
-            pins = pin_gap(model, traj.q)
-            deepest = min(contact_gap(model, q) for q in traj.q[::10])
-            end = contact_gap(model, traj.q[-1])
+            pins = pin_separation(spec, traj.q)
+            corners = lowest_point(spec, traj.q)
+            deepest, end = float(corners.min()), float(corners[-1])
             flag = (above > 0 or rise > 1e-3 * energy[0] or pins > 1e-9 or deepest < -2e-3
                     or end < -1e-6)
             bad += flag
