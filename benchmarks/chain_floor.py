@@ -1,0 +1,282 @@
+"""How fast the engine's algorithm can run the pendulum chains at all (not a test).
+
+    python benchmarks/chain_floor.py                 # N = 4 and 32, median of 5 runs each
+    python benchmarks/chain_floor.py --links 4 8 16 32 64
+
+Times the engine on the bench chains (bench_scenes.chain: 0.5 m, 1 kg thin rods, horizontal
+at rest, dt = 1 ms) next to two dedicated chain steps written for this one model, in the
+same process:
+
+- "dedicated": the engine's algorithm with nothing general left. Gravity, a velocity solve
+  of the pins aimed at their errors at q + h v* (Jacobian at the step's start), symplectic
+  Euler, then Newton-SHAKE corrections along the start-of-step directions until every pin
+  holds to 1e-12 m (at most 4). Fixed row layout (pin k: rows 2k, 2k+1 on links k-1, k),
+  one banded LU (bandwidth 3) for both solves (the engine factors the symmetric velocity
+  solve as L D L^T, half the work), no row kinds, contacts, modes, guards or state copies.
+- "light": the scheme the issue's throwaway prototype describes: the velocity solve
+  linearised at q + h v* (a first Newton-SHAKE step) and one correction, with no residual
+  checks at all.
+
+The first shows what the engine's generality costs; the second what a lighter scheme gains
+and what it gives up (its residual and energy columns). All three are judged alike: the
+largest pin gap over a 10 s run (sampled every 0.1 s), and the energy change over it as a
+share of the bench's scale m g L sum(i + 1/2).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import planarsim as ps  # noqa: E402
+from planarsim.bench_scenes import G, chain  # noqa: E402
+
+# the engine's compile flags, with numba's runtime (run_chain allocates its scratch arrays)
+jit = njit(cache=True, fastmath=False, error_model="numpy")
+
+LENGTH = 0.5       # [m] link length (bench_scenes.chain)
+MASS = 1.0         # [kg]
+INERTIA = MASS * LENGTH ** 2 / 12   # [kg m^2] thin rod about its centre
+INV_MASS = 1.0 / MASS
+INV_INERTIA = 1.0 / INERTIA
+DT = 1e-3          # [s]
+TOL = 1e-12        # [m] the engine's refine_tol
+MAX_ITERS = 4      # the engine's refine_iters
+BAND = 3           # rows of pin k couple to those of pins k - 1 and k + 1
+
+
+@jit
+def _trig(q, cs):
+    for k in range(q.shape[0]):
+        cs[k, 0] = math.cos(q[k, 2])
+        cs[k, 1] = math.sin(q[k, 2])
+
+
+@jit
+def _pins(q, cs, J, c):
+    """Pin k joins the right end of link k - 1 (the world origin for k = 0) to the left end
+    of link k: rows 2k (x) and 2k + 1 (y); J[r, 0:3] on link k - 1, J[r, 3:6] on link k."""
+    half = 0.5 * LENGTH
+    for k in range(q.shape[0]):
+        rbx = -half * cs[k, 0]
+        rby = -half * cs[k, 1]
+        rax = 0.0
+        ray = 0.0
+        ax = 0.0
+        ay = 0.0
+        if k > 0:
+            rax = half * cs[k - 1, 0]
+            ray = half * cs[k - 1, 1]
+            ax = q[k - 1, 0] + rax
+            ay = q[k - 1, 1] + ray
+        x = 2 * k
+        J[x, 0] = -1.0
+        J[x, 1] = 0.0
+        J[x, 2] = ray
+        J[x, 3] = 1.0
+        J[x, 4] = 0.0
+        J[x, 5] = -rby
+        J[x + 1, 0] = 0.0
+        J[x + 1, 1] = -1.0
+        J[x + 1, 2] = -rax
+        J[x + 1, 3] = 0.0
+        J[x + 1, 4] = 1.0
+        J[x + 1, 5] = rbx
+        c[x] = q[k, 0] + rbx - ax
+        c[x + 1] = q[k, 1] + rby - ay
+
+
+@jit
+def _dot(JL, i, si, JR, j, sj):
+    """The mass-weighted product of row i's block on slot si (0: link k - 1, 1: link k) with
+    row j's block on slot sj: J W J^T of one shared link."""
+    a = 3 * si
+    b = 3 * sj
+    return ((JL[i, a] * JR[j, b] + JL[i, a + 1] * JR[j, b + 1]) * INV_MASS
+            + JL[i, a + 2] * JR[j, b + 2] * INV_INERTIA)
+
+
+@jit
+def _solve(JL, JR, A, rhs, x):
+    """x = (JL W JR^T)^-1 rhs by a banded LU (rhs destroyed). Rows of pin k touch links k - 1
+    and k, so A couples them to pins k - 1 and k + 1 only: a band of 3 on either side."""
+    n = rhs.shape[0]
+    for i in range(n):
+        pin = i // 2
+        for j in range(2 * pin, i + 1):             # rows of the same pin: links pin - 1, pin
+            A[i, j] = _dot(JL, i, 1, JR, j, 1)
+            if pin > 0:
+                A[i, j] += _dot(JL, i, 0, JR, j, 0)
+            if j != i:
+                A[j, i] = _dot(JL, j, 1, JR, i, 1)
+                if pin > 0:
+                    A[j, i] += _dot(JL, j, 0, JR, i, 0)
+        if pin > 0:
+            for j in range(2 * pin - 2, 2 * pin):   # rows of the pin before: link pin - 1
+                A[i, j] = _dot(JL, i, 0, JR, j, 1)
+                A[j, i] = _dot(JL, j, 1, JR, i, 0)
+    for k in range(n):
+        inv = 1.0 / A[k, k]
+        last = min(n, k + BAND + 1)
+        for i in range(k + 1, last):
+            f = A[i, k] * inv
+            A[i, k] = f
+            for j in range(k + 1, last):
+                A[i, j] -= f * A[k, j]
+            rhs[i] -= f * rhs[k]
+    for k in range(n - 1, -1, -1):
+        acc = rhs[k]
+        for j in range(k + 1, min(n, k + BAND + 1)):
+            acc -= A[k, j] * x[j]
+        x[k] = acc / A[k, k]
+
+
+@jit
+def _apply(J, lam, dv, scale):
+    """dv += scale W J^T lam."""
+    for k in range(dv.shape[0]):
+        for r in (2 * k, 2 * k + 1):
+            l = lam[r] * scale
+            if k > 0:
+                dv[k - 1, 0] += J[r, 0] * l * INV_MASS
+                dv[k - 1, 1] += J[r, 1] * l * INV_MASS
+                dv[k - 1, 2] += J[r, 2] * l * INV_INERTIA
+            dv[k, 0] += J[r, 3] * l * INV_MASS
+            dv[k, 1] += J[r, 4] * l * INV_MASS
+            dv[k, 2] += J[r, 5] * l * INV_INERTIA
+
+
+@jit
+def run_chain(q, v, n_steps, light):
+    """n_steps of the dedicated chain step (light: see the module docstring) on q, v
+    (N, 3) in place; returns the largest pin gap [m] after any step (0 when light: it
+    checks nothing)."""
+    N = q.shape[0]
+    n = 2 * N
+    J0 = np.zeros((n, 6))
+    J1 = np.zeros((n, 6))
+    c = np.zeros(n)
+    A = np.zeros((n, n))
+    rhs = np.zeros(n)
+    lam = np.zeros(n)
+    cs = np.zeros((N, 2))
+    dv = np.zeros((N, 3))
+    qp = np.zeros((N, 3))
+    worst_all = 0.0
+    for _ in range(n_steps):
+        _trig(q, cs)
+        _pins(q, cs, J0, c)
+        for k in range(N):
+            v[k, 1] -= G * DT
+            for d in range(3):
+                qp[k, d] = q[k, d] + DT * v[k, d]
+        _trig(qp, cs)
+        _pins(qp, cs, J1, rhs)
+        for r in range(n):
+            rhs[r] = -rhs[r] / DT
+        _solve(J1 if light else J0, J0, A, rhs, lam)
+        _apply(J0, lam, v, 1.0)
+        for k in range(N):
+            for d in range(3):
+                q[k, d] += DT * v[k, d]
+        worst = 0.0
+        for it in range(1 if light else MAX_ITERS + 1):
+            _trig(q, cs)
+            _pins(q, cs, J1, c)
+            worst = 0.0
+            for r in range(n):
+                worst = max(worst, abs(c[r]))
+                rhs[r] = -c[r]
+            if not light and (worst <= TOL or it == MAX_ITERS):
+                break
+            _solve(J1, J0, A, rhs, lam)
+            dv[:] = 0.0
+            _apply(J0, lam, dv, 1.0)
+            for k in range(N):
+                for d in range(3):
+                    q[k, d] += dv[k, d]
+                    v[k, d] += dv[k, d] / DT
+        if not light:
+            worst_all = max(worst_all, worst)
+    return worst_all
+
+
+def _start(n_links):
+    q = np.zeros((n_links, 3))
+    q[:, 0] = (np.arange(n_links) + 0.5) * LENGTH
+    return q, np.zeros((n_links, 3))
+
+
+def _energy(q, v):
+    return float((0.5 * MASS * (v[:, 0] ** 2 + v[:, 1] ** 2) + 0.5 * INERTIA * v[:, 2] ** 2
+                  + MASS * G * q[:, 1]).sum())
+
+
+def _largest_gap(q):
+    """Largest pin gap [m] of chain poses q (N, 3)."""
+    left = q[:, :2] - 0.5 * LENGTH * np.c_[np.cos(q[:, 2]), np.sin(q[:, 2])]
+    right = q[:, :2] + 0.5 * LENGTH * np.c_[np.cos(q[:, 2]), np.sin(q[:, 2])]
+    ends = np.vstack([[0.0, 0.0], right[:-1]])
+    return float(np.abs(left - ends).max())
+
+
+def _median_rate(run, n_steps, repeats):
+    rates = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        run()
+        rates.append(n_steps / (time.perf_counter() - t))
+    return statistics.median(rates)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--links", type=int, nargs="+", default=[4, 32])
+    ap.add_argument("--repeats", type=int, default=5)
+    args = ap.parse_args(argv)
+    if any(n < 1 for n in args.links):
+        ap.error("--links: every chain needs at least one link")
+    n_steps, n_accuracy = 5000, 10000      # 5 s timing episode, 10 s accuracy run (the bench's)
+    print(f"{'N':>3s}  {'runner':10s} {'steps/s':>9s}  {'x engine':>8s}  {'largest pin gap':>15s}  "
+          f"{'energy change / scale':>21s}")
+    for n_links in args.links:
+        scale = MASS * G * LENGTH * sum(i + 0.5 for i in range(n_links))
+        model = chain(n_links)
+        ps.Simulator(model).steps(10)     # compiled / loaded before timing
+        engine = _median_rate(lambda: ps.Simulator(model).steps(n_steps), n_steps, args.repeats)
+        sim = ps.Simulator(model)
+        e0 = _energy(sim.state.q, sim.state.v)
+        gap = 0.0
+        for _ in range(n_accuracy // 100):
+            sim.steps(100)
+            gap = max(gap, _largest_gap(sim.state.q))
+        drift = (_energy(sim.state.q, sim.state.v) - e0) / scale
+        print(f"{n_links:3d}  {'engine':10s} {engine / 1e3:8.0f}k  {1.0:8.2f}  {gap:15.1e}  "
+              f"{drift:+21.2%}")
+        for name, light in (("dedicated", False), ("light", True)):
+            run_chain(*_start(n_links), 10, light)
+
+            def timed(light=light):
+                run_chain(*_start(n_links), n_steps, light)
+            rate = _median_rate(timed, n_steps, args.repeats)
+            q, v = _start(n_links)
+            gap = 0.0
+            for _ in range(n_accuracy // 100):
+                run_chain(q, v, 100, light)
+                gap = max(gap, _largest_gap(q))
+            drift = (_energy(q, v) - e0) / scale
+            print(f"{n_links:3d}  {name:10s} {rate / 1e3:8.0f}k  {rate / engine:8.2f}  {gap:15.1e}  "
+                  f"{drift:+21.2%}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
