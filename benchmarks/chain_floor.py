@@ -29,6 +29,7 @@ import math
 import statistics
 import sys
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -157,8 +158,7 @@ def _apply(J, lam, dv, scale):
 @jit
 def run_chain(q, v, n_steps, light):
     """n_steps of the dedicated chain step (light: see the module docstring) on q, v
-    (N, 3) in place; returns the largest pin gap [m] after any step (0 when light: it
-    checks nothing)."""
+    (N, 3) in place."""
     N = q.shape[0]
     n = 2 * N
     J0 = np.zeros((n, 6))
@@ -170,7 +170,6 @@ def run_chain(q, v, n_steps, light):
     cs = np.zeros((N, 2))
     dv = np.zeros((N, 3))
     qp = np.zeros((N, 3))
-    worst_all = 0.0
     for _ in range(n_steps):
         _trig(q, cs)
         _pins(q, cs, J0, c)
@@ -187,7 +186,6 @@ def run_chain(q, v, n_steps, light):
         for k in range(N):
             for d in range(3):
                 q[k, d] += DT * v[k, d]
-        worst = 0.0
         for it in range(1 if light else MAX_ITERS + 1):
             _trig(q, cs)
             _pins(q, cs, J1, c)
@@ -204,9 +202,6 @@ def run_chain(q, v, n_steps, light):
                 for d in range(3):
                     q[k, d] += dv[k, d]
                     v[k, d] += dv[k, d] / DT
-        if not light:
-            worst_all = max(worst_all, worst)
-    return worst_all
 
 
 def _start(n_links):
@@ -228,9 +223,11 @@ def _largest_gap(q):
     return float(np.abs(left - ends).max())
 
 
-def _median_rate(run, n_steps, repeats):
+def _median_rate(make_run, n_steps, repeats):
+    """Median steps/s of `repeats` runs of n_steps; make_run() sets one up (not timed)."""
     rates = []
     for _ in range(repeats):
+        run = make_run()
         t = time.perf_counter()
         run()
         rates.append(n_steps / (time.perf_counter() - t))
@@ -251,7 +248,8 @@ def main(argv=None) -> int:
         scale = MASS * G * LENGTH * sum(i + 0.5 for i in range(n_links))
         model = chain(n_links)
         ps.Simulator(model).steps(10)     # compiled / loaded before timing
-        engine = _median_rate(lambda: ps.Simulator(model).steps(n_steps), n_steps, args.repeats)
+        engine = _median_rate(lambda: partial(ps.Simulator(model).steps, n_steps), n_steps,
+                              args.repeats)
         sim = ps.Simulator(model)
         e0 = _energy(sim.state.q, sim.state.v)
         gap = 0.0
@@ -262,11 +260,9 @@ def main(argv=None) -> int:
         print(f"{n_links:3d}  {'engine':10s} {engine / 1e3:8.0f}k  {1.0:8.2f}  {gap:15.1e}  "
               f"{drift:+21.2%}")
         for name, light in (("dedicated", False), ("light", True)):
-            run_chain(*_start(n_links), 10, light)
-
-            def timed(light=light):
-                run_chain(*_start(n_links), n_steps, light)
-            rate = _median_rate(timed, n_steps, args.repeats)
+            run_chain(*_start(n_links), 10, light)     # compiled / loaded before timing
+            rate = _median_rate(lambda light=light: partial(run_chain, *_start(n_links), n_steps,
+                                                            light), n_steps, args.repeats)
             q, v = _start(n_links)
             gap = 0.0
             for _ in range(n_accuracy // 100):
