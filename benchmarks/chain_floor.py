@@ -28,8 +28,6 @@ import argparse
 import math
 import statistics
 import sys
-import time
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +36,8 @@ from numba import njit
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
+from planarsim.bench_metrics import energy, pin_separation, spec_from_model  # noqa: E402
+from planarsim.bench_peers import _rates  # noqa: E402
 from planarsim.bench_scenes import G, chain  # noqa: E402
 
 # the engine's compile flags, with numba's runtime (run_chain allocates its scratch arrays)
@@ -49,8 +49,8 @@ INERTIA = MASS * LENGTH ** 2 / 12   # [kg m^2] thin rod about its centre
 INV_MASS = 1.0 / MASS
 INV_INERTIA = 1.0 / INERTIA
 DT = 1e-3          # [s]
-TOL = 1e-12        # [m] the engine's refine_tol
-MAX_ITERS = 4      # the engine's refine_iters
+TOL = ps.StepOptions().refine_tol          # [m] the engine's default
+MAX_ITERS = ps.StepOptions().refine_iters  # the engine's default
 BAND = 3           # rows of pin k couple to those of pins k - 1 and k + 1
 
 
@@ -204,36 +204,6 @@ def run_chain(q, v, n_steps, light):
                     v[k, d] += dv[k, d] / DT
 
 
-def _start(n_links):
-    q = np.zeros((n_links, 3))
-    q[:, 0] = (np.arange(n_links) + 0.5) * LENGTH
-    return q, np.zeros((n_links, 3))
-
-
-def _energy(q, v):
-    return float((0.5 * MASS * (v[:, 0] ** 2 + v[:, 1] ** 2) + 0.5 * INERTIA * v[:, 2] ** 2
-                  + MASS * G * q[:, 1]).sum())
-
-
-def _largest_gap(q):
-    """Largest pin gap [m] of chain poses q (N, 3)."""
-    left = q[:, :2] - 0.5 * LENGTH * np.c_[np.cos(q[:, 2]), np.sin(q[:, 2])]
-    right = q[:, :2] + 0.5 * LENGTH * np.c_[np.cos(q[:, 2]), np.sin(q[:, 2])]
-    ends = np.vstack([[0.0, 0.0], right[:-1]])
-    return float(np.abs(left - ends).max())
-
-
-def _median_rate(make_run, n_steps, repeats):
-    """Median steps/s of `repeats` runs of n_steps; make_run() sets one up (not timed)."""
-    rates = []
-    for _ in range(repeats):
-        run = make_run()
-        t = time.perf_counter()
-        run()
-        rates.append(n_steps / (time.perf_counter() - t))
-    return statistics.median(rates)
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--links", type=int, nargs="+", default=[4, 32])
@@ -245,32 +215,39 @@ def main(argv=None) -> int:
     print(f"{'N':>3s}  {'runner':10s} {'steps/s':>9s}  {'x engine':>8s}  {'largest pin gap':>15s}  "
           f"{'energy change / scale':>21s}")
     for n_links in args.links:
-        scale = MASS * G * LENGTH * sum(i + 0.5 for i in range(n_links))
-        model = chain(n_links)
-        ps.Simulator(model).steps(10)     # compiled / loaded before timing
-        engine = _median_rate(lambda: partial(ps.Simulator(model).steps, n_steps), n_steps,
-                              args.repeats)
-        sim = ps.Simulator(model)
-        e0 = _energy(sim.state.q, sim.state.v)
-        gap = 0.0
-        for _ in range(n_accuracy // 100):
-            sim.steps(100)
-            gap = max(gap, _largest_gap(sim.state.q))
-        drift = (_energy(sim.state.q, sim.state.v) - e0) / scale
-        print(f"{n_links:3d}  {'engine':10s} {engine / 1e3:8.0f}k  {1.0:8.2f}  {gap:15.1e}  "
-              f"{drift:+21.2%}")
-        for name, light in (("dedicated", False), ("light", True)):
-            run_chain(*_start(n_links), 10, light)     # compiled / loaded before timing
-            rate = _median_rate(lambda light=light: partial(run_chain, *_start(n_links), n_steps,
-                                                            light), n_steps, args.repeats)
-            q, v = _start(n_links)
-            gap = 0.0
+        model = chain(n_links, dt=DT, length=LENGTH, mass=MASS)
+        spec = spec_from_model(f"chain{n_links}", model, n_accuracy * DT)
+        box = {}
+
+        def reset_engine():
+            box["sim"] = ps.Simulator(model)
+
+        def reset_dedicated():
+            box["q"], box["v"] = model.q0.copy(), np.zeros((n_links, 3))
+        # runner: (run n steps, reset to the start (not timed), current (q, v))
+        runners = {
+            "engine": (lambda n: box["sim"].steps(n), reset_engine,
+                       lambda: (box["sim"].state.q, box["sim"].state.v)),
+            "dedicated": (lambda n: run_chain(box["q"], box["v"], n, False), reset_dedicated,
+                          lambda: (box["q"], box["v"])),
+            "light": (lambda n: run_chain(box["q"], box["v"], n, True), reset_dedicated,
+                      lambda: (box["q"], box["v"])),
+        }
+        timed = _rates({key: r[:2] for key, r in runners.items()}, n_steps, args.repeats)
+        rates = {key: statistics.median(r) for key, r in timed.items()}
+        for key, (run, reset, pose) in runners.items():
+            # accuracy: poses sampled every 100 steps (0.1 s) over the 10 s run
+            reset()
+            q0, v0 = (x.copy() for x in pose())
+            poses = [q0]
             for _ in range(n_accuracy // 100):
-                run_chain(q, v, 100, light)
-                gap = max(gap, _largest_gap(q))
-            drift = (_energy(q, v) - e0) / scale
-            print(f"{n_links:3d}  {name:10s} {rate / 1e3:8.0f}k  {rate / engine:8.2f}  {gap:15.1e}  "
-                  f"{drift:+21.2%}")
+                run(100)
+                poses.append(pose()[0].copy())
+            q1, v1 = pose()
+            drift = (energy(spec, q1, v1) - energy(spec, q0, v0)) / spec.energy_scale
+            print(f"{n_links:3d}  {key:10s} {rates[key] / 1e3:8.0f}k  "
+                  f"{rates[key] / rates['engine']:8.2f}  "
+                  f"{pin_separation(spec, np.array(poses)):15.1e}  {drift:+21.2%}")
     return 0
 
 
