@@ -3,8 +3,11 @@
 ``ModelError`` is raised while building a model; its message names the element kind, name,
 index, field, value and the rule broken. ``SimulationDiverged`` is raised when a guard in the
 compiled step fires (non-finite or huge state); it carries the last finite state.
+``AuditViolation`` is raised, with StepOptions.audit_raise = 1, when a step breaks a rule of
+its own audit (kernels/audit.py); it names the step, time, rule, contact or pin and body.
 """
-from .kernels.guards import GUARD_BAD_COMMANDS
+from .kernels.audit import AUDIT_DEPTH, AUDIT_NAMES, AUDIT_PIN_GAP
+from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS
 
 
 class ModelError(ValueError):
@@ -42,11 +45,63 @@ class SimulationDiverged(RuntimeError):
 FIELD_NAMES = ("x", "y", "theta", "vx", "vy", "omega")
 
 
+class AuditViolation(SimulationDiverged):
+    """A step broke a rule of its own audit (StepOptions.audit_raise = 1).
+
+    Attributes as SimulationDiverged, plus rule : str (pull, cone, work, pin_gap, depth,
+    fallback, unsolved) and element : str (the contact or pin named)."""
+
+    def __init__(self, message, step, time, body, field, value, last_state, rule="", element=""):
+        super().__init__(message, step, time, body, field, value, last_state)
+        self.rule = rule
+        self.element = element
+
+    def __reduce__(self):
+        return (type(self), (str(self), self.step, self.time, self.body, self.field, self.value,
+                             self.last_state, self.rule, self.element))
+
+
+_AUDIT_TEXT = {
+    "pull": "a contact impulse pulls (lambda_n = {v:.3g} N s)",
+    "cone": "friction outside its cone by {v:.3g} N s",
+    "work": "a contact impulse does positive work ({v:.3g} J)",
+    "pin_gap": "a pin is open by {v:.3g} m",
+    "depth": "a contact is {v:.3g} m below the ground",
+    "fallback": "the contact solve with friction found no answer: solved without friction",
+    "unsolved": "the contact solve found no consistent answer",
+}
+
+
+def audit_violation(model, ws, who="simulation"):
+    """The AuditViolation of the step that just broke a rule of its audit (ws.audit_last)."""
+    step, kind, element, body = (int(x) for x in ws.audit_last)
+    rule = AUDIT_NAMES[kind]
+    value = float(ws.audit_value[0])
+    if kind == AUDIT_PIN_GAP and element < len(model.pin_names):
+        element_name = f"pin {model.pin_names[element]!r} ({element})"
+    elif kind == AUDIT_PIN_GAP:
+        rod = element - len(model.pin_names)
+        element_name = f"rod {model.rod_names[rod]!r} ({rod})"
+    elif kind <= AUDIT_DEPTH:
+        element_name = f"contact {model.contact_names[element]!r} ({element})"
+    else:
+        element_name = "contacts"
+    body_name = model.body_names[body] if 0 <= body < len(model.body_names) else "-"
+    t = float(ws.prev.time[0])
+    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    return AuditViolation(f"{who}: audit at step {step} (t={t:.6g} s): "
+                          f"{_AUDIT_TEXT[rule].format(v=value)}; {element_name} on body "
+                          f"{body_name!r} ({body}); all counts {dict(zip(AUDIT_NAMES, ws.audit.tolist()))}",
+                          step, t, body_name, rule, value, last, rule, element_name)
+
+
 def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
     and a copy of the state at the start of that step. Code GUARD_BAD_COMMANDS (-1: commands
     of the wrong length, nothing stepped) gives a ValueError instead."""
+    if code == GUARD_AUDIT:
+        return audit_violation(model, ws, who)
     if code == GUARD_BAD_COMMANDS:
         return ValueError(f"{who}: the commands u have {int(ws.info[2])} entries; the model has "
                           f"{len(model.act_names)} actuators {list(model.act_names)}")

@@ -26,31 +26,33 @@ class ContactMode(IntEnum):
 class StepOptions(NamedTuple):
     """Algorithm switches passed to the compiled step.
 
-    mode_strategy : MODES_ALTERNATING (default) or MODES_ALL
-    max_mode_iters : cap on solve / mode-check rounds within one step
+    mode_strategy : MODES_ALTERNATING (default) or MODES_ALL: how the modes carried over
+        from the last step are re-examined before the complementarity solve (both end at a
+        consistent answer; see kernels/step.py solve_modes)
     refine_iters : Newton-SHAKE position corrections after integrating (0: off)
     refine_tol : stop refining when every constraint residual is below this [m or rad]
     max_ccd_splits : cap on time-of-impact splits of one step
     guard_limit : any |q| or |v| component above this stops the run
-    pivot_tol : relative pivot below which a constraint row is treated as redundant (closed loops)
-    cap_policy : when the mode rounds hit max_mode_iters: 1 (default) contacts engaged in this
-        step take a frictionless normal impulse for the step (never left free below the
-        ground, never pulled: no energy gain); 0 the modes of the last round stand (the seed's
-        tolerance: a cycling contact may be left free and sink for a step)
+    pivot_tol : relative pivot below which the guess solve treats a row as redundant (its
+        answer is checked against every rule; one that breaks a rule goes to the
+        complementarity solve, which uses no such threshold)
     refine_pivot_tol : pivot_tol of the position correction. Rows dependent to within it are
         dropped there: at a fold (a closed loop stretched nearly straight, rows dependent to
         about 1e-7) the residual grows with the square of the motion and Newton only halves
         the motion per iteration (residual / 4), where dropping the row converges at once
+    audit_raise : 1 turns a violation of the step's audit (a pulling contact, friction outside
+        its cone, positive contact work, a pin open by more than 1e-9 m, a contact deeper than
+        1e-8 m, a solve that fell back; kernels/audit.py) into an error naming the step, time,
+        contact or pin and body; 0 (default) only counts them in Workspace.audit
     """
     mode_strategy: int = MODES_ALTERNATING
-    max_mode_iters: int = 8
     refine_iters: int = 4
     refine_tol: float = 1e-12
     max_ccd_splits: int = 4
     guard_limit: float = 1e10
     pivot_tol: float = 1e-11
-    cap_policy: int = 1
     refine_pivot_tol: float = 1e-7
+    audit_raise: int = 0
 
 
 def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:
@@ -68,14 +70,13 @@ def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:
 _OPTION_RULES = {
     # field: (type, test, rule)
     "mode_strategy": (int, lambda x: x in (MODES_ALTERNATING, MODES_ALL), "must be 0 (alternating) or 1 (all)"),
-    "max_mode_iters": (int, lambda x: x >= 1, "must be an integer >= 1"),
     "refine_iters": (int, lambda x: x >= 0, "must be an integer >= 0"),
     "refine_tol": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0"),
     "max_ccd_splits": (int, lambda x: x >= 0, "must be an integer >= 0"),
     "guard_limit": (float, lambda x: math.isfinite(x) and x > 0.0, "must be finite and > 0"),
     "pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
-    "cap_policy": (int, lambda x: x in (0, 1), "must be 0 or 1"),
     "refine_pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
+    "audit_raise": (int, lambda x: x in (0, 1), "must be 0 or 1"),
 }
 
 

@@ -108,12 +108,32 @@ class Workspace(NamedTuple):
     lam: np.ndarray              # (R,) impulses [N s or N m s]
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
     act_power: np.ndarray        # (n_act,) mechanical power [W]
-    info: np.ndarray             # (8,) int: [0] mode rounds, [1] ccd splits, [2] guard body,
-                                 #   [3] guard field, [4] mode-round cap reached (engaged
-                                 #   contacts stuck), [5] Newton steps of the position
-                                 #   correction taken back (they diverged: rows nearly
-                                 #   dependent, errors inconsistent)
+    info: np.ndarray             # (8,) int: [0] linear solves of the velocity stage, [1] ccd
+                                 #   splits, [2] guard body, [3] guard field, [4] complementarity
+                                 #   (Lemke) solves, [5] Newton steps of the position correction
+                                 #   taken back (diverged), [6] Lemke pivots, [7] projections
+                                 #   of the positions by the complementarity solve
     guard_value: np.ndarray      # (1,) offending value when a guard fired
+    row_b: np.ndarray            # (R,) residual of each row without impulses: w = A lam + b
+                                 #   [m/s] (velocity stage) or [m, rad] (position projection)
+    contact_candidate: np.ndarray  # (n_contact,) int 1: in the complementarity problem
+    limit_candidate: np.ndarray  # (n_pin, 2) int 1: in the complementarity problem
+    lcp_rows: np.ndarray         # (R,) int rows: joints first, then the others
+    lcp_var: np.ndarray          # (R,) int row -> first LCP variable (tangent rows: 3)
+    lcp_pos: np.ndarray          # (R,) int non-joint row k -> its first LCP variable
+    lcp_B: np.ndarray            # (R, R) joint block A_bb, factored
+    lcp_G: np.ndarray            # (R, R + 1) A_bb^-1 [A_bx, b_b]
+    lcp_S: np.ndarray            # (R, R + 1) Schur complement [S, s]
+    lcp_M: np.ndarray            # (L, L) the LCP matrix (L: unilateral + 3 per friction row)
+    lcp_q: np.ndarray            # (L,)
+    lcp_z: np.ndarray            # (L,) its solution
+    lcp_scale: np.ndarray        # (L,) diagonal scaling of the variables
+    lcp_T: np.ndarray            # (L, 2L + 2) Lemke's tableau
+    lcp_basis: np.ndarray        # (L,) int
+    audit: np.ndarray            # (N_AUDIT,) int violations counted since the workspace was
+                                 #   made (kernels/audit.py: AUDIT_NAMES)
+    audit_last: np.ndarray       # (4,) int the last violation: step, kind, contact or pin, body
+    audit_value: np.ndarray      # (1,) its size (impulse [N s], work [J], gap or depth [m])
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)
 
@@ -122,9 +142,17 @@ def max_rows(model: Model) -> int:
     return max(1, 2 * model.n_pin + model.n_rod + 2 * model.n_pin + 2 * model.n_contact)
 
 
+def max_lcp(model: Model) -> int:
+    """Variables of the largest complementarity problem: joint limits and contact normals one
+    each, a contact's friction three (beta+, beta-, gamma)."""
+    return max(1, 2 * model.n_pin + 4 * model.n_contact)
+
+
 def make_workspace(model: Model) -> Workspace:
+    from .kernels.audit import N_AUDIT
     nb, nc, na = model.n_body, model.n_contact, model.n_act
     R = max_rows(model)
+    L = max_lcp(model)
     z = np.zeros
     return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan),
                      body_first_row=z(nb, np.int64), row_first=z(R, np.int64),
@@ -137,4 +165,11 @@ def make_workspace(model: Model) -> Workspace:
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam=z(R), act_u=z(na), act_power=z(na),
-                     info=z(8, np.int64), guard_value=z(1), impact_time=z(1), prev=make_state(model))
+                     info=z(8, np.int64), guard_value=z(1), row_b=z(R),
+                     contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
+                     lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),
+                     lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),
+                     lcp_q=z(L), lcp_z=z(L), lcp_scale=z(L), lcp_T=z((L, 2 * L + 2)),
+                     lcp_basis=z(L, np.int64), audit=z(N_AUDIT, np.int64),
+                     audit_last=z(4, np.int64), audit_value=z(1),
+                     impact_time=z(1), prev=make_state(model))

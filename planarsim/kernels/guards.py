@@ -6,6 +6,7 @@ from ._jit import kernel
 GUARD_OK = 0
 GUARD_NONFINITE = 1
 GUARD_TOO_LARGE = 2
+GUARD_AUDIT = 3           # the step broke a rule of its own audit (StepOptions.audit_raise = 1)
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[2]:
                           # its length); negative, so that no walker's own return code clashes
 

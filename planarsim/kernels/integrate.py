@@ -42,6 +42,35 @@ def is_unilateral(kind):
 
 
 @kernel
+def keep_correction_rows(s, ws):
+    """Keep the rows the Newton correction holds: joints, active limits, the normal row of
+    every touching contact and the tangent row of every sticking one (a sticking foot does
+    not creep along the ground while the correction closes the joints). Rows of contacts the
+    solve set free, and the tangent rows of sliding ones, are dropped."""
+    k = 0
+    for r in range(ws.n_row[0]):
+        kind = ws.row_kind[r]
+        o = ws.row_owner[r]
+        if kind == ROW_CONTACT_T and s.contact_mode[o] != 1:
+            continue
+        if kind == ROW_CONTACT_N and s.contact_mode[o] == 0:
+            continue
+        if (kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI) and s.limit_active[o, kind - ROW_LIMIT_LO] == 0:
+            continue
+        if k != r:
+            ws.row_kind[k] = kind
+            ws.row_owner[k] = o
+            ws.row_body[k, 0] = ws.row_body[r, 0]
+            ws.row_body[k, 1] = ws.row_body[r, 1]
+            ws.row_c[k] = ws.row_c[r]
+            for e in range(2):
+                for c in range(3):
+                    ws.row_J[k, e, c] = ws.row_J[r, e, c]
+        k += 1
+    ws.n_row[0] = k
+
+
+@kernel
 def integrate_positions(s, vel, h):
     """v = vel; q += h v."""
     for i in range(s.q.shape[0]):

@@ -1,29 +1,31 @@
-"""Stage 6: contact-mode and joint-limit checks after a solve.
+"""Stage 5: the rules of contacts and limits, and the checks of a solve's answer against them.
 
-Rules (seed 002 section 5 plus the sliding mode of its footnote):
-  pinned  -> free     if the normal impulse pulls (lambda_n < 0)
-  pinned  -> sliding  if |lambda_t| > mu lambda_n (slip opposite to the friction impulse)
-  sliding -> pinned   if the slip velocity at the end of the step has stopped or reversed
-  sliding -> free     if lambda_n < 0
-  free    -> touching if the contact would end the step below the ground (every step, every
-                      contact: penetration is never tolerated; point masses use CCD instead);
-                      sliding if its point moves along the ground, else pinned
-Which pinned/sliding contacts are checked is the strategy: MODES_ALTERNATING checks the one
-under the round-robin cursor, once per step, plus any contact engaged during this step (an
-impact must be allowed to slide at once, or a pinned impact would stop a sliding body dead);
-and every sliding contact whose friction would reverse its slip sticks at once, in every
-round (an overshooting friction impulse adds energy). MODES_ALL checks every contact in
-every round.
-Joint limits engage when the angle would pass the limit and release when their impulse pulls.
+Rules (seed 002 section 5 plus the sliding mode of its footnote), which a consistent answer
+meets for every contact and limit at once:
+  pinned   its normal impulse pushes (lambda_n >= 0) and friction is inside the cone
+           (|lambda_t| <= mu lambda_n); the point does not move along the ground
+  sliding  it pushes; friction -mu lambda_n s at the cone's edge, opposite the slip s, and the
+           slip does not reverse within the step
+  free     no impulse, and the point does not end the step below the ground
+  limits   a limit's impulse pushes; an inactive limit is not passed
+rule_breaks checks a guess's answer (the modes carried over); engage_* bring contacts and
+limits the motion would push through into the problem; seed_rule is the alternating
+strategy's one-contact re-examination (release if it pulls, slide outside the cone, stick on
+reversal); modes_from_solution reads the modes off a complementarity solution.
 """
 from ._jit import kernel
 from .contacts import MODE_FREE, MODE_PINNED, MODE_SLIDING, engage_contact
 from .forces import point_velocity
 from .math2d import world_point
+from .mixed_lcp import is_sliding_solution
 from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO
+from .solve import row_dot
 
 MODES_ALTERNATING = 0
 MODES_ALL = 1
+# a solve's answer breaks a rule when it misses it by more than this share of its own scale
+SOLVE_REL_TOL = 1e-9
+SLIP_ROUNDING = 1e-12
 
 
 @kernel
@@ -79,16 +81,19 @@ def check_contact(m, s, ws, i):
 
 
 @kernel
-def engage_contacts(m, s, ws, h, include_ccd):
-    """Pin every enabled free contact that would end the step below the ground (contacts with
-    CCD are left to the time-of-impact split unless include_ccd)."""
+def engage_contacts(m, s, ws, h, include_ccd, vel):
+    """Bring into touch every enabled free contact, not yet in the complementarity problem,
+    that would end the step below the ground under velocity vel (contacts with CCD are left to
+    the time-of-impact split unless include_ccd). Returns how many."""
     changed = 0
     for i in range(m.contact_body.shape[0]):
         if s.contact_mode[i] != MODE_FREE or s.contact_enabled[i] == 0:
             continue
+        if ws.contact_candidate[i] == 1:
+            continue
         if m.contact_ccd[i] == 1 and not include_ccd:
             continue
-        vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
+        vn, vt = contact_velocity(m, s, ws, i, vel)
         if ws.contact_gap[i] + h * vn < 0.0:
             engage_contact(m, s, ws, i, vn, vt)
             changed += 1
@@ -96,56 +101,102 @@ def engage_contacts(m, s, ws, h, include_ccd):
 
 
 @kernel
-def check_limits(m, s, ws, h):
-    """Engage limits the angle would pass; release limits whose impulse pulls."""
+def engage_limits(m, s, ws, h, vel):
+    """Engage every joint limit, not yet in the complementarity problem, that the angle would
+    pass under velocity vel. Returns how many."""
     changed = 0
-    for r in range(ws.n_row[0]):
-        kind = ws.row_kind[r]
-        if (kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI) and ws.lam[r] < 0.0:
-            s.limit_active[ws.row_owner[r], kind - ROW_LIMIT_LO] = 0
-            changed += 1
     for j in range(m.pin_body.shape[0]):
         lo = m.pin_limit[j, 0]
         hi = m.pin_limit[j, 1]
         a = m.pin_body[j, 0]
         b = m.pin_body[j, 1]
-        ang = s.q[b, 2] - m.pin_ref[j] + h * ws.v_new[b, 2]
+        ang = s.q[b, 2] - m.pin_ref[j] + h * vel[b, 2]
         if a >= 0:
-            ang -= s.q[a, 2] + h * ws.v_new[a, 2]
-        if s.limit_active[j, 0] == 0 and ang < lo:
+            ang -= s.q[a, 2] + h * vel[a, 2]
+        if s.limit_active[j, 0] == 0 and ws.limit_candidate[j, 0] == 0 and ang < lo:
             s.limit_active[j, 0] = 1
             changed += 1
-        if s.limit_active[j, 1] == 0 and ang > hi:
+        if s.limit_active[j, 1] == 0 and ws.limit_candidate[j, 1] == 0 and ang > hi:
             s.limit_active[j, 1] = 1
             changed += 1
     return changed
 
 
 @kernel
-def update_modes(m, s, ws, h, strategy, first_round, include_ccd):
-    """One round of mode checks after a solve; return the number of changes."""
+def rule_breaks(m, s, ws, h):
+    """How many rows of the last solve break a rule of contact and limits (the solve took the
+    modes as given; this checks its answer): an equality row not met (a dependent row dropped
+    whose residual the others do not remove), a normal or limit impulse that pulls, friction
+    outside its cone, a sliding contact whose slip reversed. Tolerances are relative to the
+    impulses' and velocities' own size (rounding, not physics)."""
+    n = ws.n_row[0]
+    big_lam = 0.0
+    big_b = 0.0
+    for r in range(n):
+        big_lam = max(big_lam, abs(ws.lam[r]))
+        big_b = max(big_b, abs(ws.row_b[r]))
+    tol_lam = SOLVE_REL_TOL * big_lam
+    tol_w = SOLVE_REL_TOL * (big_b + 1.0)
+    breaks = 0
+    for r in range(n):
+        kind = ws.row_kind[r]
+        o = ws.row_owner[r]
+        # residual w = J (v_new - v*) + b of the row as solved (an equality here)
+        w = row_dot(ws, r, ws.row_J, ws.v_new) - row_dot(ws, r, ws.row_J, ws.v_pred) + ws.row_b[r]
+        if abs(w) > tol_w:
+            breaks += 1
+        if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
+            if ws.lam[r] < -tol_lam:
+                breaks += 1
+        elif kind == ROW_CONTACT_N:
+            if ws.lam[r] < -tol_lam:
+                breaks += 1
+            if s.contact_mode[o] == MODE_SLIDING:
+                vn, vt = contact_velocity(m, s, ws, o, ws.v_new)
+                vn_free, vt_free = contact_velocity(m, s, ws, o, ws.v_pred)
+                # friction along a reversed slip would add energy: only a reversal at the
+                # rounding level of the contact's free motion passes
+                if vt * s.contact_slip[o] < -SLIP_ROUNDING * (abs(vn_free) + abs(vt_free)):
+                    breaks += 1
+        elif kind == ROW_CONTACT_T:
+            if abs(ws.lam[r]) > m.contact_mu[o] * ws.lam[r - 1] + tol_lam:
+                breaks += 1
+    return breaks
+
+
+@kernel
+def seed_rule(m, s, ws, i):
+    """The seed's alternating check of one contact: release it if it pulls, let it slide if
+    its friction leaves the cone, stick it if its slip reversed. Returns 1 if it changed."""
     gather_contact_impulses(m, s, ws)
-    changed = engage_contacts(m, s, ws, h, include_ccd) + check_limits(m, s, ws, h)
-    nc = m.contact_body.shape[0]
-    if nc == 0:
-        return changed
-    if strategy == MODES_ALL:
-        for i in range(nc):
-            if s.contact_enabled[i]:
-                changed += check_contact(m, s, ws, i)
-    else:
-        # the contact under the cursor in the first round; contacts engaged during this
-        # step in every round, so an impact can start sliding at once; and in every round
-        # any sliding contact whose friction would reverse its slip (that would add energy)
-        cursor = s.mode_cursor[0] % nc
-        for i in range(nc):
-            if s.contact_enabled[i] == 0:
-                continue
-            if (first_round and i == cursor) or ws.contact_new[i] == 1:
-                changed += check_contact(m, s, ws, i)
-            elif s.contact_mode[i] == MODE_SLIDING:
-                vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
-                if vt * s.contact_slip[i] <= 0.0:
-                    s.contact_mode[i] = MODE_PINNED
-                    changed += 1
-    return changed
+    return check_contact(m, s, ws, i)
+
+
+@kernel
+def modes_from_solution(m, s, ws):
+    """Contact modes and limits from a complementarity solution over rows 0..n-1 (every
+    candidate contact had its normal and tangent rows): free where the normal impulse is 0,
+    sliding where the slip speed is positive (friction at the cone's edge, slip s opposite to
+    it), pinned otherwise; a limit whose impulse is 0 is released."""
+    n = ws.n_row[0]
+    for r in range(n):
+        kind = ws.row_kind[r]
+        o = ws.row_owner[r]
+        if kind == ROW_CONTACT_N and (r + 1 == n or ws.row_kind[r + 1] != ROW_CONTACT_T):
+            # solved without friction (the frictionless rule): F = n, a slip of 0
+            if ws.lam[r] <= 0.0:
+                s.contact_mode[o] = MODE_FREE
+            else:
+                s.contact_mode[o] = MODE_SLIDING
+                s.contact_slip[o] = 0.0
+        elif kind == ROW_CONTACT_T:
+            if ws.lam[r - 1] <= 0.0:
+                s.contact_mode[o] = MODE_FREE
+            elif is_sliding_solution(m, ws, r) and ws.lam[r] != 0.0:
+                s.contact_mode[o] = MODE_SLIDING
+                s.contact_slip[o] = -1.0 if ws.lam[r] > 0.0 else 1.0
+            else:
+                s.contact_mode[o] = MODE_PINNED
+        elif kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
+            if ws.lam[r] <= 0.0:
+                s.limit_active[o, kind - ROW_LIMIT_LO] = 0

@@ -11,7 +11,9 @@ bodies, so a chain's matrix is banded): the cost grows linearly with the number 
 Closed loops (Ranger in double stance, a box on two corners) make J W F^T singular: Gaussian
 elimination drops a row whose pivot falls below pivot_tol times its own diagonal, i.e. a row
 that is a combination of earlier ones; its impulse is zero and the rows it depends on carry
-the load. For consistent constraints this is exact, not a regularisation.
+the load. This is the guess solve: which rows carry the load is arbitrary here, so its answer
+is checked (modes.rule_breaks) and one that pulls or misses a row goes to the
+complementarity solve (complementarity.py), which needs no threshold.
 Without sliding contacts F = J and the matrix is symmetric: it is assembled in its lower
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
@@ -254,6 +256,24 @@ def row_dot(ws, r, J, vel):
     return acc
 
 
+@kernel
+def fill_row_b(ws, h, n):
+    """ws.row_b: each row's end-of-step residual without impulses [m/s], w = A lam + b."""
+    for r in range(n):
+        if ws.row_kind[r] < ROW_LIMIT_LO:
+            # a joint's error at the end of the step without impulses, c(q + h v*): c + h J v*
+            # plus the second-order drift of its rotating anchors, which the position
+            # correction would otherwise remove (one Newton iteration fewer)
+            ws.row_b[r] = ws.row_c_pred[r] / h
+            continue
+        c = ws.row_c[r]
+        if c < 0.0 and ws.row_kind[r] != ROW_CONTACT_T:
+            # a unilateral row that starts violated only stops approaching; the position
+            # correction removes the overlap without turning it into velocity (energy)
+            c = 0.0
+        ws.row_b[r] = c / h + row_dot(ws, r, ws.row_J, ws.v_pred)
+
+
 @kernel_inline
 def solve_impulses(m, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
@@ -266,19 +286,9 @@ def solve_impulses(m, ws, h, tol, symmetric):
         return 0
     compute_envelope(ws, n, ws.v_new.shape[0])
     assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
+    fill_row_b(ws, h, n)
     for r in range(n):
-        if ws.row_kind[r] < ROW_LIMIT_LO:
-            # a joint's error at the end of the step without impulses, c(q + h v*): c + h J v*
-            # plus the second-order drift of its rotating anchors, which the position
-            # correction would otherwise remove (one Newton iteration fewer)
-            ws.rhs[r] = -ws.row_c_pred[r] / h
-            continue
-        c = ws.row_c[r]
-        if c < 0.0 and ws.row_kind[r] != ROW_CONTACT_T:
-            # a unilateral row that starts violated only stops approaching; the position
-            # correction removes the overlap without turning it into velocity (energy)
-            c = 0.0
-        ws.rhs[r] = -(c / h + row_dot(ws, r, ws.row_J, ws.v_pred))
+        ws.rhs[r] = -ws.row_b[r]
     if symmetric:
         dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
         substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)

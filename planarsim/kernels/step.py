@@ -25,13 +25,17 @@ from ..state import State, Workspace
 from . import refs
 from ._jit import KERNEL_OPTIONS, jit, kernel, kernel_call, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
-from .contacts import MODE_FREE, MODE_SLIDING, find_contacts
+from .audit import (DEPTH_TOL, PIN_GAP_TOL, audit_impulses, audit_positions, audit_total,
+                    worst_violation)
+from .complementarity import project_positions, solve_contacts
+from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import GUARD_BAD_COMMANDS, check_guards
+from .guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, check_guards
 from .math2d import update_trig
-from .integrate import (correct_positions, integrate_positions, predict_configuration,
-                        rows_hold_within)
-from .modes import gather_contact_impulses, update_modes
+from .integrate import (correct_positions, integrate_positions, keep_correction_rows,
+                        predict_configuration, rows_hold_within)
+from .modes import (MODES_ALTERNATING, engage_contacts, engage_limits, gather_contact_impulses,
+                    rule_breaks, seed_rule)
 from .record import record_frame
 from .rows import build_rows
 from .solve import solve_impulses
@@ -65,61 +69,66 @@ def copy_state(src, dst):
     _copy2(src.ext_force, dst.ext_force)
 
 
+# Newton iterations of the complementarity projection of the positions (quadratic)
+PROJECTION_ITERS = 8
+
+
 @kernel_call
 def build_and_solve(m, s, ws, opt, h):
-    """Stages 4-5: the active rows at the current configuration and their impulses. A call
-    (one copy of its code for the mode rounds and the capped-mode settling): its work is
-    microseconds, the call a few nanoseconds."""
+    """Stages 4-5: the active rows at the current configuration and their impulses under the
+    modes as they stand. A call (one copy of its code for both solves of solve_modes): its
+    work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
     solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
 
 
-@kernel_call
-def settle_capped_modes(m, s, ws, opt, h):
-    """The mode rounds reached their cap: the modes of a contact engaged this step cycle
-    (stick violates the friction cone, sliding reverses, free penetrates). Such contacts
-    must neither be left free to penetrate nor stick with a pulling impulse (that adds
-    energy). They take a frictionless normal impulse for this step (sliding with slip 0:
-    F = n), which only removes approach velocity; the next step's checks settle their mode.
-    Then solve once more so impulses match the final modes. Rare: a call, so that its
-    solves are not copied into the step's hot code."""
-    if opt.cap_policy == 1:
-        for i in range(m.contact_body.shape[0]):
-            if ws.contact_new[i] == 1:
-                s.contact_mode[i] = MODE_SLIDING
-                s.contact_slip[i] = 0.0
-    ws.info[4] += 1
-    n_contact = m.contact_body.shape[0]
-    for release in range(n_contact + 1):
-        build_and_solve(m, s, ws, opt, h)
-        gather_contact_impulses(m, s, ws)
-        if opt.cap_policy != 1 or release == n_contact:
-            break
-        # and no contact may pull: nearly dependent rows (a closed loop through the ground)
-        # can give huge opposite impulses, one pulling. Release the contact that pulls
-        # hardest and solve again, until none pulls (at most one solve per contact).
-        worst = -1
-        for i in range(n_contact):
-            if s.contact_mode[i] != MODE_FREE and ws.contact_impulse[i, 0] < 0.0:
-                if worst < 0 or ws.contact_impulse[i, 0] < ws.contact_impulse[worst, 0]:
-                    worst = i
-        if worst < 0:
-            break
-        s.contact_mode[worst] = MODE_FREE
-
-
 @kernel_inline
 def solve_modes(m, s, ws, opt, h, include_ccd):
-    """Stages 4-6: build rows, solve, check modes; repeat while modes change (capped)."""
-    rounds = 0
-    changed = 1
-    while changed != 0 and rounds < opt.max_mode_iters:
+    """Stages 4-6: impulses and contact modes that meet every rule (modes.rule_breaks).
+
+    The modes carried over from the last step (plus contacts and limits the free motion would
+    push into the ground or past their limit) are a guess: one linear solve, then its answer
+    is checked against every rule. Alternating strategy: if it breaks one, the contact under
+    the cursor is re-examined by the seed's rule and solved once more. An answer that still
+    breaks a rule goes to the complementarity solve, which ends at a consistent answer
+    (complementarity.solve_contacts). No rounds, no cap."""
+    engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
+    engage_limits(m, s, ws, h, ws.v_pred)
+    build_and_solve(m, s, ws, opt, h)
+    rounds = 1
+    ok = rule_breaks(m, s, ws, h) == 0
+    ok = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
+        m, s, ws, h, ws.v_new) == 0 and ok
+    nc = m.contact_body.shape[0]
+    if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
+        seed_rule(m, s, ws, s.mode_cursor[0] % nc)
         build_and_solve(m, s, ws, opt, h)
-        changed = update_modes(m, s, ws, h, opt.mode_strategy, rounds == 0, include_ccd)
         rounds += 1
-    if changed != 0:
-        settle_capped_modes(m, s, ws, opt, h)
+        ok = rule_breaks(m, s, ws, h) == 0
+        ok = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
+            m, s, ws, h, ws.v_new) == 0 and ok
+    if ok:
+        gather_contact_impulses(m, s, ws)
+    else:
+        solve_contacts(m, s, ws, h, include_ccd)
     ws.info[0] += rounds
+
+
+@kernel_call
+def settle_positions(m, s, ws, h, opt):
+    """After the Newton correction: the end-of-step pin gaps and contact depths; where one is
+    above a tenth of its audit tolerance, the complementarity projection (it also catches a
+    free contact whose turning body dipped it below the ground). Returns the violations the
+    audit counts at the configuration the step ends at."""
+    update_trig(s.q, ws.body_cs)
+    gap, depth = worst_violation(m, s, ws)
+    if gap > 0.1 * PIN_GAP_TOL or depth > 0.1 * DEPTH_TOL:
+        project_positions(m, s, ws, h, PROJECTION_ITERS, opt.refine_tol)
+        update_trig(s.q, ws.body_cs)
+        gap, depth = worst_violation(m, s, ws)
+    if gap > PIN_GAP_TOL or depth > DEPTH_TOL:
+        return audit_positions(m, s, ws, s.step[0])
+    return 0
 
 
 @kernel_inline
@@ -130,10 +139,9 @@ def _step(m, s, ws, opt, u):
     code = check_guards(s, ws, opt.guard_limit)
     if code != 0:
         return code
-    ws.info[0] = 0
-    ws.info[1] = 0
-    ws.info[4] = 0
-    ws.info[5] = 0
+    for k in (0, 1, 4, 5, 6, 7):
+        ws.info[k] = 0
+    audited = audit_total(ws)
     for i in range(m.contact_body.shape[0]):
         ws.contact_new[i] = 0
     h = m.dt
@@ -157,7 +165,9 @@ def _step(m, s, ws, opt, u):
                 ws.contact_new[hit] = 2  # engaged by find_contacts of the next sub-step
                 ws.info[1] += 1
                 continue
+        audit_impulses(m, s, ws)
         integrate_positions(s, ws.v_new, h)
+        keep_correction_rows(s, ws)
         # the correction only when the rows may be off by more than refine_tol: a bound of
         # half of it (far above rounding) proves the correction would find nothing to do
         # (bodies at rest, translating), at a few flops per row instead of re-evaluating them
@@ -165,12 +175,17 @@ def _step(m, s, ws, opt, u):
                 opt.refine_tol > 0.0 and rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol)):
             correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol,
                               opt.refine_pivot_tol)
+        if opt.refine_iters > 0:
+            settle_positions(m, s, ws, h, opt)
         break
     s.time[0] = ws.prev.time[0] + m.dt
     s.step[0] += 1
     if m.contact_body.shape[0] > 0:
         s.mode_cursor[0] = (s.mode_cursor[0] + 1) % m.contact_body.shape[0]
-    return check_guards(s, ws, opt.guard_limit)
+    code = check_guards(s, ws, opt.guard_limit)
+    if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
+        return GUARD_AUDIT
+    return code
 
 
 # The step is compiled once, as a C function, and called through its address by every compiled

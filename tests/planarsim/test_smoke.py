@@ -23,10 +23,10 @@ def test_pendulum_swings_and_keeps_its_pin():
 
 
 @pytest.mark.parametrize("field, value, rule", [
-    ("max_mode_iters", 0, ">= 1"), ("refine_iters", -1, ">= 0"), ("refine_iters", 1.5, "integer"),
+    ("refine_iters", -1, ">= 0"), ("refine_iters", 1.5, "integer"),
     ("refine_tol", float("nan"), "finite"), ("pivot_tol", 0.0, r"\(0, 1\)"),
     ("guard_limit", float("inf"), "finite"), ("mode_strategy", 7, "alternating"),
-    ("cap_policy", 2, "0 or 1"), ("max_ccd_splits", "4", "integer"),
+    ("audit_raise", 2, "0 or 1"), ("max_ccd_splits", "4", "integer"),
 ])
 def test_bad_step_options_are_named(field, value, rule):
     model = _pendulum()

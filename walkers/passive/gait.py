@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from planarsim.kernels.audit import audit_counts
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
 from planarsim.state import State
@@ -382,5 +383,5 @@ def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10,
                    mean_speed=distance / t_end if t_end > 0 else 0.0, fell=code == FELL,
                    step_period=period, step_length=distance / n_steps if n_steps else math.nan,
                    cost_of_transport=drop / distance if distance > 0 else math.nan,
-                   duration=t_end, code=int(code))
+                   duration=t_end, code=int(code), audit=audit_counts(walker.sim.ws))
     return traj, summary

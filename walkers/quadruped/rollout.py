@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from planarsim.kernels.audit import audit_counts
 import planarsim as ps
 from planarsim.errors import diverged
 from planarsim.kernels._jit import jit
@@ -139,7 +140,8 @@ class Quadruped:
                 "ik_clamps": int(self.memory[C.M_IK_CLAMPS]),
                 "motor_work_positive": float(self.memory[C.M_WORK]), "cost_of_transport": cot,
                 "gait": C.Gait(int(self.memory[C.M_GAIT])).name.lower(),
-                "speed_command": float(C.command_speed(self.memory))}
+                "speed_command": float(C.command_speed(self.memory)),
+                "audit": audit_counts(self.ws)}
 
 
 def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=0.3, params=None,

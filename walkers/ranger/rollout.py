@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from planarsim.kernels.audit import audit_counts
 import planarsim as ps
 from planarsim.kernels._jit import jit
 from planarsim.kernels.record import record_frame
@@ -114,7 +115,8 @@ class RangerSim:
         return np.array([q[0, 0] - p.leg_com * np.sin(q[0, 2]), q[0, 1] + p.leg_com * np.cos(q[0, 2])])
 
     def summary(self) -> dict:
-        return summarize(self.controller, self.model, self.sim.state, self.params)
+        return {**summarize(self.controller, self.model, self.sim.state, self.params),
+                "audit": audit_counts(self.sim.ws)}
 
 
 def summarize(ctrl: Controller, model, state, p: RangerParams) -> dict:

@@ -16,7 +16,8 @@ from planarsim.kernels.step import step
 from planarsim.kernels.terrain import height
 from planarsim.trajectory import Trajectory, make_recorder
 
-from .controller import M_EFFORT, M_FELL, M_MODE_CAP, M_PHASE, M_STRIKES, M_TIMEOUTS, control, make_memory, make_tables
+from planarsim.kernels.audit import audit_counts
+from .controller import M_EFFORT, M_FELL, M_PHASE, M_STRIKES, M_TIMEOUTS, control, make_memory, make_tables
 from .model import build, non_foot_clearance, start_state
 from .params import SimbiconParams
 
@@ -45,8 +46,6 @@ def rollout_simbicon(m, s, ws, opt, tab, mem, u, n, every, rec, k0, push):
             return code, i, k
         for a in range(u.shape[0]):
             mem[M_EFFORT] += ws.act_u[a] * ws.act_u[a] * m.dt
-        if ws.info[0] >= opt.max_mode_iters:
-            mem[M_MODE_CAP] += 1.0   # contact modes did not settle within the cap this step
         jump = max(abs(s.q[tr, 0] - x_before), abs(s.q[tr, 1] - y_before)) / m.dt
         if (abs(s.v[tr, 0]) > GLITCH_SPEED or abs(s.v[tr, 1]) > GLITCH_SPEED
                 or abs(s.v[tr, 2]) > GLITCH_SPIN or jump > GLITCH_SPEED):
@@ -111,7 +110,7 @@ def run(params: SimbiconParams, duration: float, terrain=None, dt=1e-3, push=Non
     summary = dict(distance=float(sim.state.q[tab.torso, 0] - x0), time=t,
                    steps=int(mem[M_STRIKES]), timeouts=int(mem[M_TIMEOUTS]),
                    fell=bool(code in (FELL, GLITCH)), glitch=bool(code == GLITCH),
-                   mode_cap_steps=int(mem[M_MODE_CAP]), phase=int(mem[M_PHASE]),
+                   phase=int(mem[M_PHASE]), audit=audit_counts(sim.ws),
                    effort=float(mem[M_EFFORT]))
     summary["speed"] = summary["distance"] / t if t > 0 else 0.0
     traj = None

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from planarsim.kernels.audit import audit_counts
 import planarsim as ps
 from planarsim.errors import diverged
 from planarsim.kernels._jit import jit
@@ -168,7 +169,8 @@ class Walker:
                 "steps": int(self.memory[C.M_STEPS]), "jumps": int(self.memory[C.M_JUMPS]),
                 "scuffs": int(self.memory[C.M_SCUFFS]),
                 "retries": int(self.memory[C.M_RETRIES]), "fell": self.fell, "falls": int(self.fell),
-                "gait": self.gait, "state": C.State(int(self.memory[C.M_STATE])).name.lower()}
+                "gait": self.gait, "state": C.State(int(self.memory[C.M_STATE])).name.lower(),
+                "audit": audit_counts(self.ws)}
 
 
 def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=None, params=None,

@@ -1,0 +1,208 @@
+"""The step audits its own answer and counts what breaks the rules (ws.audit).
+
+After the velocity stage (impulses as applied):
+  pull      a contact's normal impulse pulls (lambda_n < 0)
+  cone      friction outside its cone (|lambda_t| > mu lambda_n)
+  work      a contact's impulse does positive work at the step's end velocity
+            (lambda_n v_n + lambda_t v_t > 0: it would add energy)
+After the position stage (the configuration the step ends at):
+  pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
+  depth     a contact point below the ground by more than DEPTH_TOL
+And of the solver itself:
+  fallback  the complementarity solve with friction found no answer and the frictionless
+            rule was used (it can only remove energy)
+  unsolved  no consistent answer at all (impulses left as the last solve gave them)
+Each count is cumulative over the workspace's life; ws.audit_last holds the step, kind, the
+contact or pin, and the body of the last violation, ws.audit_value its size. With
+StepOptions.audit_raise = 1 a violation ends the step with GUARD_AUDIT, which
+planarsim.errors.diverged turns into an AuditViolation naming all of it.
+"""
+import math
+
+from ._jit import kernel
+from .math2d import world_point
+from .terrain import ground_point
+
+AUDIT_PULL = 0
+AUDIT_CONE = 1
+AUDIT_WORK = 2
+AUDIT_PIN_GAP = 3
+AUDIT_DEPTH = 4
+AUDIT_FALLBACK = 5
+AUDIT_UNSOLVED = 6
+N_AUDIT = 7
+AUDIT_NAMES = ("pull", "cone", "work", "pin_gap", "depth", "fallback", "unsolved")
+
+PIN_GAP_TOL = 1e-9       # [m]
+DEPTH_TOL = 1e-8         # [m]
+# impulses and work are judged relative to their own size (rounding of the solve)
+IMPULSE_REL_TOL = 1e-8
+WORK_REL_TOL = 1e-8
+
+
+@kernel
+def audit_total(ws):
+    """All violations counted so far."""
+    total = 0
+    for k in range(ws.audit.shape[0]):
+        total += ws.audit[k]
+    return total
+
+
+@kernel
+def note(ws, step, kind, who, body, value):
+    """Count one violation of `kind` and remember it."""
+    ws.audit[kind] += 1
+    ws.audit_last[0] = step
+    ws.audit_last[1] = kind
+    ws.audit_last[2] = who
+    ws.audit_last[3] = body
+    ws.audit_value[0] = value
+
+
+@kernel
+def contact_power_terms(m, q, cs, vel, ws, i):
+    """Normal and tangential velocity [m/s] of contact i's material point under vel."""
+    b = m.contact_body[i]
+    px, py = world_point(q, cs, b, ws.contact_anchor[i, 0], ws.contact_anchor[i, 1])
+    vx = vel[b, 0] - vel[b, 2] * (py - q[b, 1])
+    vy = vel[b, 1] + vel[b, 2] * (px - q[b, 0])
+    nx = ws.contact_normal[i, 0]
+    ny = ws.contact_normal[i, 1]
+    return nx * vx + ny * vy, ny * vx - nx * vy
+
+
+@kernel
+def audit_impulses(m, s, ws):
+    """Pulling contacts, friction outside its cone and positive contact work, from
+    ws.contact_impulse and the constrained velocity ws.v_new. Returns the violations found."""
+    found = 0
+    step = s.step[0]
+    for i in range(m.contact_body.shape[0]):
+        ln = ws.contact_impulse[i, 0]
+        lt = ws.contact_impulse[i, 1]
+        if ln == 0.0 and lt == 0.0:
+            continue
+        size = abs(ln) + abs(lt)
+        b = m.contact_body[i]
+        if ln < -IMPULSE_REL_TOL * size:
+            note(ws, step, AUDIT_PULL, i, b, ln)
+            found += 1
+        if abs(lt) > m.contact_mu[i] * ln + IMPULSE_REL_TOL * size:
+            note(ws, step, AUDIT_CONE, i, b, abs(lt) - m.contact_mu[i] * ln)
+            found += 1
+        vn, vt = contact_power_terms(m, s.q, ws.body_cs, ws.v_new, ws, i)
+        vp_n, vp_t = contact_power_terms(m, s.q, ws.body_cs, ws.v_pred, ws, i)
+        work = ln * vn + lt * vt
+        scale = size * (abs(vn) + abs(vt) + abs(vp_n) + abs(vp_t))
+        if work > WORK_REL_TOL * scale + 1e-300:
+            note(ws, step, AUDIT_WORK, i, b, work)
+            found += 1
+    return found
+
+
+@kernel
+def pin_gap(m, q, cs, j):
+    """Distance [m] between the two anchors of pin j at configuration q."""
+    a = m.pin_body[j, 0]
+    b = m.pin_body[j, 1]
+    ax, ay = world_point(q, cs, a, m.pin_anchor[j, 0, 0], m.pin_anchor[j, 0, 1])
+    bx, by = world_point(q, cs, b, m.pin_anchor[j, 1, 0], m.pin_anchor[j, 1, 1])
+    return math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+
+
+@kernel
+def rod_error(m, q, cs, j):
+    """|distance - length| [m] of rod j's anchors at configuration q."""
+    a = m.rod_body[j, 0]
+    b = m.rod_body[j, 1]
+    ax, ay = world_point(q, cs, a, m.rod_anchor[j, 0, 0], m.rod_anchor[j, 0, 1])
+    bx, by = world_point(q, cs, b, m.rod_anchor[j, 1, 0], m.rod_anchor[j, 1, 1])
+    return abs(math.sqrt((bx - ax) ** 2 + (by - ay) ** 2) - m.rod_length[j])
+
+
+@kernel
+def point_gap(m, q, cs, b, lx, ly):
+    px, py = world_point(q, cs, b, lx, ly)
+    gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
+    return gap
+
+
+@kernel
+def contact_gap(m, q, cs, i):
+    """Signed gap [m] of contact i at configuration q: its point (a point contact), or the
+    lowest of its sole, arc ends and fallback vertices (an arc contact)."""
+    b = m.contact_body[i]
+    lx = m.contact_local[i, 0]
+    ly = m.contact_local[i, 1]
+    if m.contact_kind[i] == 0:
+        return point_gap(m, q, cs, b, lx, ly)
+    r = m.contact_radius[i]
+    cx, cy = world_point(q, cs, b, lx, ly)
+    gx, gy, nx, ny, cgap = ground_point(m.terrain_coef, cx, cy)
+    # the sole's lowest point when the ground normal points into its span
+    dlx = cs[b, 0] * (-nx) + cs[b, 1] * (-ny)
+    dly = -cs[b, 1] * (-nx) + cs[b, 0] * (-ny)
+    a = math.atan2(dly, dlx)
+    a0 = m.contact_span[i, 0]
+    a1 = m.contact_span[i, 1]
+    while a < a0:
+        a += 2.0 * math.pi
+    while a >= a0 + 2.0 * math.pi:
+        a -= 2.0 * math.pi
+    best = cgap - r if a <= a1 else math.inf
+    for e in range(2):
+        ang = a0 if e == 0 else a1
+        best = min(best, point_gap(m, q, cs, b, lx + r * math.cos(ang), ly + r * math.sin(ang)))
+    adr = m.contact_vert_adr[i]
+    for k in range(adr, adr + m.contact_vert_num[i]):
+        best = min(best, point_gap(m, q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1]))
+    return best
+
+
+@kernel
+def worst_violation(m, s, ws):
+    """Largest pin gap and largest depth below the ground [m] of enabled contacts at the
+    current configuration (ws.body_cs must match s.q)."""
+    gap = 0.0
+    for j in range(m.pin_body.shape[0]):
+        gap = max(gap, pin_gap(m, s.q, ws.body_cs, j))
+    for j in range(m.rod_body.shape[0]):
+        gap = max(gap, rod_error(m, s.q, ws.body_cs, j))
+    depth = 0.0
+    for i in range(m.contact_body.shape[0]):
+        if s.contact_enabled[i] == 0:
+            continue
+        depth = max(depth, -contact_gap(m, s.q, ws.body_cs, i))
+    return gap, depth
+
+
+@kernel
+def audit_positions(m, s, ws, step):
+    """Pins open by more than PIN_GAP_TOL and contacts deeper than DEPTH_TOL at the current
+    configuration; returns the violations found."""
+    found = 0
+    for j in range(m.pin_body.shape[0]):
+        g = pin_gap(m, s.q, ws.body_cs, j)
+        if g > PIN_GAP_TOL:
+            note(ws, step, AUDIT_PIN_GAP, j, m.pin_body[j, 1], g)
+            found += 1
+    n_pin = m.pin_body.shape[0]
+    for j in range(m.rod_body.shape[0]):
+        g = rod_error(m, s.q, ws.body_cs, j)
+        if g > PIN_GAP_TOL:
+            note(ws, step, AUDIT_PIN_GAP, n_pin + j, m.rod_body[j, 1], g)
+            found += 1
+    for i in range(m.contact_body.shape[0]):
+        if s.contact_enabled[i] == 0:
+            continue
+        d = -contact_gap(m, s.q, ws.body_cs, i)
+        if d > DEPTH_TOL:
+            note(ws, step, AUDIT_DEPTH, i, m.contact_body[i], d)
+            found += 1
+    return found
+
+
+def audit_counts(ws) -> dict:
+    """{rule: violations counted} of a workspace (Python side; for summaries)."""
+    return {name: int(ws.audit[k]) for k, name in enumerate(AUDIT_NAMES)}

@@ -1,0 +1,189 @@
+"""The guaranteed solves: contact modes and impulses as one complementarity problem.
+
+Velocity stage (solve_contacts): every candidate contact (touching, or one the motion would
+push into the ground) enters with its normal and tangent rows, every candidate limit with its
+row; solve_mixed_lcp finds impulses that push, friction inside its cone and opposing any slip,
+joints held; the modes are read off the answer. A contact outside the problem that the new
+velocity would still push into the ground joins it and the problem is solved again (at most
+once per contact: a finite loop, no cap to reach). If the problem with friction has no answer
+on Lemke's path (Painleve-type configurations; rounding), the rule is: solve it without
+friction (a positive semidefinite problem, always solvable here, whose inelastic impulses can
+only remove energy), and count it in the audit.
+
+Position stage (project_positions): the configuration after integrating, projected onto
+closed joints and contacts on or above the ground: the smallest mass-weighted move
+dq = W J^T mu with joint errors 0 and gaps >= 0 (mu >= 0 on contacts and limits), a
+complementarity problem without friction, linearised at the current configuration and
+repeated until every error is below tolerance. Joint corrections also change the velocity by
+dq / h (as the Newton correction does); contact corrections move positions only.
+"""
+from ._jit import kernel, kernel_call
+from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note, pin_gap
+from .contacts import MODE_FREE, MODE_PINNED, find_contact
+from .lcp import LCP_SOLVED
+from .math2d import update_trig
+from .mixed_lcp import assemble_dense, is_joint_row, solve_mixed_lcp
+from .modes import engage_contacts, engage_limits, gather_contact_impulses, modes_from_solution
+from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
+                   ROW_PIN_Y, ROW_ROD, _add_row, build_rows, eval_rows)
+from .solve import apply_impulses, fill_row_b
+
+# Lemke's path is finite; the cap only stops a path that rounding has sent astray
+PIVOTS_PER_VARIABLE = 20
+
+
+@kernel
+def _drop_tangent_rows(ws):
+    """Remove the friction rows (the frictionless rule); returns the rows left."""
+    k = 0
+    for r in range(ws.n_row[0]):
+        if ws.row_kind[r] == ROW_CONTACT_T:
+            continue
+        if k != r:
+            ws.row_kind[k] = ws.row_kind[r]
+            ws.row_owner[k] = ws.row_owner[r]
+            ws.row_body[k, 0] = ws.row_body[r, 0]
+            ws.row_body[k, 1] = ws.row_body[r, 1]
+            ws.row_c[k] = ws.row_c[r]
+            ws.row_c_pred[k] = ws.row_c_pred[r]
+            ws.row_b[k] = ws.row_b[r]
+            for e in range(2):
+                for c in range(3):
+                    ws.row_J[k, e, c] = ws.row_J[r, e, c]
+                    ws.row_F[k, e, c] = ws.row_J[r, e, c]
+        k += 1
+    ws.n_row[0] = k
+    return k
+
+
+@kernel
+def _lcp_once(m, s, ws, h):
+    """Build the rows of every candidate (contacts pinned: normal and tangent rows) and solve
+    the complementarity problem; v_new from its impulses. Returns True if solved."""
+    for i in range(m.contact_body.shape[0]):
+        ws.contact_candidate[i] = 0
+        if s.contact_mode[i] != MODE_FREE:
+            s.contact_mode[i] = MODE_PINNED
+            ws.contact_candidate[i] = 1
+    for j in range(m.pin_body.shape[0]):
+        ws.limit_candidate[j, 0] = s.limit_active[j, 0]
+        ws.limit_candidate[j, 1] = s.limit_active[j, 1]
+    build_rows(m, s, ws)
+    n = ws.n_row[0]
+    fill_row_b(ws, h, n)
+    assemble_dense(m, ws, n)
+    cap = PIVOTS_PER_VARIABLE * (4 * n + 10)
+    status, pivots = solve_mixed_lcp(m, ws, n, cap)
+    ws.info[4] += 1
+    ws.info[6] += pivots
+    if status != LCP_SOLVED:
+        # no answer with friction on Lemke's path: the frictionless rule
+        n = _drop_tangent_rows(ws)
+        assemble_dense(m, ws, n)
+        status, pivots = solve_mixed_lcp(m, ws, n, cap)
+        ws.info[6] += pivots
+        body = m.contact_body[0] if m.contact_body.shape[0] > 0 else -1
+        if status == LCP_SOLVED:
+            note(ws, s.step[0], AUDIT_FALLBACK, 0, body, 0.0)
+        else:
+            note(ws, s.step[0], AUDIT_UNSOLVED, 0, body, 0.0)
+    for i in range(ws.v_new.shape[0]):
+        for k in range(3):
+            ws.v_new[i, k] = ws.v_pred[i, k]
+    apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_new, 1.0)
+    return status == LCP_SOLVED
+
+
+@kernel_call
+def solve_contacts(m, s, ws, h, include_ccd):
+    """The velocity stage as one complementarity problem (see the module's docstring)."""
+    for attempt in range(m.contact_body.shape[0] + 2 * m.pin_body.shape[0] + 1):
+        _lcp_once(m, s, ws, h)
+        modes_from_solution(m, s, ws)
+        if engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
+                m, s, ws, h, ws.v_new) == 0:
+            break
+    gather_contact_impulses(m, s, ws)
+    for i in range(m.contact_body.shape[0]):
+        ws.contact_candidate[i] = 0
+    for j in range(m.pin_body.shape[0]):
+        ws.limit_candidate[j, 0] = 0
+        ws.limit_candidate[j, 1] = 0
+
+
+# contacts within this gap [m] of the ground take part in the position projection (their
+# row may become active as others move)
+PROJECTION_MARGIN = 1e-6
+
+
+@kernel
+def _projection_rows(m, s, ws):
+    """Rows at the current configuration for the position projection: every joint, active
+    limits, the normal row of every enabled contact closer to the ground than the margin
+    (contact points found again here). Returns the number of rows."""
+    update_trig(s.q, ws.body_cs)
+    n = 0
+    for j in range(m.pin_body.shape[0]):
+        n = _add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
+        n = _add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
+        for e in range(2):
+            if s.limit_active[j, e]:
+                n = _add_row(ws, n, ROW_LIMIT_LO + e, j, m.pin_body[j, 0], m.pin_body[j, 1])
+    for j in range(m.rod_body.shape[0]):
+        n = _add_row(ws, n, ROW_ROD, j, m.rod_body[j, 0], m.rod_body[j, 1])
+    for i in range(m.contact_body.shape[0]):
+        if s.contact_enabled[i] == 0:
+            continue
+        find_contact(m, s.q, ws, i)
+        if ws.contact_gap[i] < PROJECTION_MARGIN:
+            n = _add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
+    ws.n_row[0] = n
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n)
+    return n
+
+
+@kernel
+def _largest_error(ws, n):
+    worst = 0.0
+    for r in range(n):
+        c = ws.row_c[r]
+        if is_joint_row(ws.row_kind[r]):
+            worst = max(worst, abs(c))
+        else:
+            worst = max(worst, -c)
+    return worst
+
+
+@kernel_call
+def project_positions(m, s, ws, h, iters, tol):
+    """Project the configuration onto closed joints and contacts not below the ground (see
+    the module's docstring). Returns the largest remaining error [m or rad]."""
+    worst = 0.0
+    for it in range(iters + 1):
+        n = _projection_rows(m, s, ws)
+        worst = _largest_error(ws, n)
+        if worst <= tol or it == iters:
+            break
+        for r in range(n):
+            ws.row_b[r] = ws.row_c[r]
+        assemble_dense(m, ws, n)
+        status, pivots = solve_mixed_lcp(m, ws, n, PIVOTS_PER_VARIABLE * (n + 10))
+        ws.info[6] += pivots
+        ws.info[7] += 1
+        if status != LCP_SOLVED:
+            break
+        for i in range(s.q.shape[0]):
+            for k in range(3):
+                ws.q_keep[i, k] = 0.0
+                ws.v_keep[i, k] = 0.0
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.q_keep, 1.0)
+        # joint corrections change the velocity too (dq / h), contact corrections do not
+        for r in range(n):
+            if not is_joint_row(ws.row_kind[r]):
+                ws.lam[r] = 0.0
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_keep, 1.0 / h)
+        for i in range(s.q.shape[0]):
+            for k in range(3):
+                s.q[i, k] += ws.q_keep[i, k]
+                s.v[i, k] += ws.v_keep[i, k]
+    return worst

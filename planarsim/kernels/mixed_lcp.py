@@ -1,0 +1,229 @@
+"""The rows of a step as one mixed complementarity problem, solved by Lemke's method (lcp.py).
+
+Rows r with impulses x_r and residuals w = A x + b (A = J W J^T, dense here, b = ws.row_b):
+  joints (pins x / y, rods):   x free,  w = 0
+  unilateral (contact normals, joint limits):   x >= 0, w >= 0, x w = 0
+  friction (a contact's tangent row t, after its normal row n):   |x_t| <= mu x_n, and
+      w_t = 0 inside the cone (sticking) or x_t = -mu x_n sign(w_t) (sliding)
+The joints are eliminated first (Schur complement: x_b = -A_bb^-1 (b_b + A_bx x_x); the joint
+rows of a tree are independent, so A_bb is positive definite; a row of a joint-only loop that
+depends exactly on others is consistent and is left out there, impulse 0). Friction takes the
+form of Stewart and Trinkle (1996): x_t = beta+ - beta-, with a slip speed gamma,
+  beta+ >= 0  _|_  w_t + gamma >= 0,   beta- >= 0  _|_  -w_t + gamma >= 0,
+  gamma >= 0  _|_  mu x_n - beta+ - beta- >= 0,
+which in the plane is Coulomb's law exactly (the cone has two edges). Variables are scaled to
+unit diagonal before pivoting (masses 1:1000 apart give a well-scaled tableau).
+The velocity stage calls this with b = c / h + J v*; the position projection with b = c.
+"""
+import math
+
+from ._jit import kernel, kernel_call
+from .lcp import LCP_SOLVED, lemke
+from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_LO, ROW_ROD
+from .solve import _entry
+
+# a joint-only loop: a joint row whose pivot falls to this share of its diagonal is an exact
+# combination of the others (consistent joints), left out with impulse 0
+JOINT_LOOP_TOL = 1e-12
+# friction within this share of mu lambda_n is at the cone's edge; a slip speed below this
+# share of the contact's free-motion speed is rounding
+CONE_EDGE_TOL = 1e-9
+# diagonal terms (scaled units) tried in turn when Lemke's path ends on a ray
+REGULARISATION = (1e-12, 1e-10, 1e-8)
+
+
+@kernel
+def assemble_dense(m, ws, n):
+    """ws.A[:n, :n] = J W J^T in full (rows touching no common body give 0)."""
+    for i in range(n):
+        for j in range(i + 1):
+            a = _entry(ws.row_J, ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, i, j)
+            ws.A[i, j] = a
+            ws.A[j, i] = a
+
+
+@kernel
+def is_joint_row(kind):
+    return kind <= ROW_ROD
+
+
+@kernel
+def _factor_joints(B, nb):
+    """B = L D L^T in place (dense, lower triangle and diagonal); rows of a joint-only loop
+    that are exact combinations of earlier ones get a zero pivot."""
+    for k in range(nb):
+        scale = abs(B[k, k])
+        for j in range(k):
+            B[k, k] -= B[k, j] * B[k, j] * B[j, j]
+        if abs(B[k, k]) <= JOINT_LOOP_TOL * scale or scale == 0.0:
+            B[k, k] = 0.0
+        for i in range(k + 1, nb):
+            acc = B[i, k]
+            for j in range(k):
+                acc -= B[i, j] * B[k, j] * B[j, j]
+            B[i, k] = acc / B[k, k] if B[k, k] != 0.0 else 0.0
+
+
+@kernel
+def _solve_joints(B, nb, G, col):
+    """G[:nb, col] <- (L D L^T)^-1 G[:nb, col] (a zero pivot gives 0)."""
+    for i in range(nb):
+        acc = G[i, col]
+        for j in range(i):
+            acc -= B[i, j] * G[j, col]
+        G[i, col] = acc
+    for i in range(nb):
+        G[i, col] = G[i, col] / B[i, i] if B[i, i] != 0.0 else 0.0
+    for i in range(nb - 1, -1, -1):
+        acc = G[i, col]
+        for j in range(i + 1, nb):
+            acc -= B[j, i] * G[j, col]
+        G[i, col] = acc
+
+
+@kernel_call
+def solve_mixed_lcp(m, ws, n, max_pivots):
+    """Impulses ws.lam[:n] of rows 0..n-1 (ws.A dense from assemble_dense, ws.row_b) that meet
+    the complementarity rules above. ws.lcp_var[r] gives row r's first LCP variable (a
+    tangent row: beta+, beta-, gamma at var, var + 1, var + 2); ws.lcp_z their values.
+    Returns (status lcp.LCP_*, pivots); impulses are left at 0 unless solved."""
+    nb = 0
+    nx = 0
+    for r in range(n):
+        ws.lam[r] = 0.0
+        if is_joint_row(ws.row_kind[r]):
+            ws.lcp_rows[nb] = r
+            nb += 1
+    for r in range(n):
+        if not is_joint_row(ws.row_kind[r]):
+            ws.lcp_rows[nb + nx] = r
+            nx += 1
+    # joints: B = A_bb factored; G = A_bb^-1 [A_bx, b_b]
+    B = ws.lcp_B
+    G = ws.lcp_G
+    for i in range(nb):
+        for j in range(nb):
+            B[i, j] = ws.A[ws.lcp_rows[i], ws.lcp_rows[j]]
+    _factor_joints(B, nb)
+    for j in range(nx + 1):
+        for i in range(nb):
+            ri = ws.lcp_rows[i]
+            G[i, j] = ws.A[ri, ws.lcp_rows[nb + j]] if j < nx else ws.row_b[ri]
+        _solve_joints(B, nb, G, j)
+    # Schur complement S = A_xx - A_xb G_x, s = b_x - A_xb G_b (S in lcp_S)
+    S = ws.lcp_S
+    for i in range(nx):
+        ri = ws.lcp_rows[nb + i]
+        for j in range(nx + 1):
+            acc = ws.A[ri, ws.lcp_rows[nb + j]] if j < nx else ws.row_b[ri]
+            for k in range(nb):
+                acc -= ws.A[ri, ws.lcp_rows[k]] * G[k, j]
+            S[i, j] = acc
+    # variables: a unilateral row one (x >= 0), a tangent row three (beta+, beta-, gamma)
+    nv = 0
+    for i in range(nx):
+        r = ws.lcp_rows[nb + i]
+        ws.lcp_var[r] = nv
+        ws.lcp_pos[i] = nv
+        nv += 3 if ws.row_kind[r] == ROW_CONTACT_T else 1
+    Mx = ws.lcp_M
+    qx = ws.lcp_q
+    d = ws.lcp_scale
+    for i in range(nv):
+        qx[i] = 0.0
+        for j in range(nv):
+            Mx[i, j] = 0.0
+    # scaling: unit diagonal for x and beta (1 / sqrt(S_ii)), gamma by sqrt(S_tt) so that its
+    # couplings to beta stay 1
+    for i in range(nx):
+        r = ws.lcp_rows[nb + i]
+        p = ws.lcp_pos[i]
+        sii = S[i, i]
+        sc = 1.0 / math.sqrt(sii) if sii > 0.0 else 1.0
+        d[p] = sc
+        if ws.row_kind[r] == ROW_CONTACT_T:
+            d[p + 1] = sc
+            d[p + 2] = 1.0 / sc
+    for i in range(nx):
+        ri = ws.lcp_rows[nb + i]
+        pi = ws.lcp_pos[i]
+        ti = ws.row_kind[ri] == ROW_CONTACT_T
+        for j in range(nx):
+            rj = ws.lcp_rows[nb + j]
+            pj = ws.lcp_pos[j]
+            sij = S[i, j]
+            if ws.row_kind[rj] == ROW_CONTACT_T:
+                Mx[pi, pj] = sij
+                Mx[pi, pj + 1] = -sij
+                if ti:
+                    Mx[pi + 1, pj] = -sij
+                    Mx[pi + 1, pj + 1] = sij
+            else:
+                Mx[pi, pj] = sij
+                if ti:
+                    Mx[pi + 1, pj] = -sij
+        qx[pi] = S[i, nx]
+        if ti:
+            qx[pi + 1] = -S[i, nx]
+            Mx[pi, pi + 2] = 1.0
+            Mx[pi + 1, pi + 2] = 1.0
+            # gamma's row: mu x_n - beta+ - beta-, x_n the normal row just before this one
+            o = ws.row_owner[ri]
+            pn = ws.lcp_var[ri - 1]
+            Mx[pi + 2, pn] = m.contact_mu[o]
+            Mx[pi + 2, pi] = -1.0
+            Mx[pi + 2, pi + 1] = -1.0
+    for i in range(nv):
+        qx[i] *= d[i]
+        for j in range(nv):
+            Mx[i, j] *= d[i] * d[j]
+    status, pivots = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots)
+    # Lemke's path can end on a ray of a solvable problem when M is only copositive (friction
+    # makes it so). M + eps I is strictly copositive, for which the path always ends at a
+    # solution; its answer misses the rules of M by eps z (scaled units: a relative error of
+    # eps), far below the audit's tolerances. The smallest eps that rounding lets through.
+    eps = 0.0
+    for attempt in range(len(REGULARISATION)):
+        if status == LCP_SOLVED:
+            break
+        step = REGULARISATION[attempt] - eps
+        eps = REGULARISATION[attempt]
+        for i in range(nv):
+            Mx[i, i] += step
+        status, more = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots)
+        pivots += more
+    if status != LCP_SOLVED:
+        return status, pivots
+    for i in range(nv):
+        ws.lcp_z[i] *= d[i]
+    for i in range(nx):
+        r = ws.lcp_rows[nb + i]
+        p = ws.lcp_pos[i]
+        if ws.row_kind[r] == ROW_CONTACT_T:
+            ws.lam[r] = ws.lcp_z[p] - ws.lcp_z[p + 1]
+            # rounding may leave |x_t| a hair above mu x_n: clip to the cone
+            bound = m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1]
+            if ws.lam[r] > bound:
+                ws.lam[r] = bound
+            elif ws.lam[r] < -bound:
+                ws.lam[r] = -bound
+        else:
+            ws.lam[r] = ws.lcp_z[p]
+    # joint impulses: x_b = -(G_b + G_x x_x)
+    for k in range(nb):
+        acc = G[k, nx]
+        for j in range(nx):
+            acc += G[k, j] * ws.lam[ws.lcp_rows[nb + j]]
+        ws.lam[ws.lcp_rows[k]] = -acc
+    return status, pivots
+
+
+@kernel
+def is_sliding_solution(m, ws, r):
+    """After solve_mixed_lcp: does the contact of tangent row r slide (slip speed gamma > 0
+    and its friction at the cone's edge; a gamma of rounding size on a contact well inside
+    its cone is not a slip)?"""
+    p = ws.lcp_var[r]
+    edge = m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1]
+    slip_floor = CONE_EDGE_TOL * (abs(ws.row_b[r]) + abs(ws.row_b[r - 1]))
+    return ws.lcp_z[p + 2] > slip_floor and abs(ws.lam[r]) >= edge * (1.0 - CONE_EDGE_TOL)
