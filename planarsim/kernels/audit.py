@@ -20,7 +20,9 @@ planarsim.errors.diverged turns into an AuditViolation naming all of it.
 import math
 
 from ._jit import kernel
+from .contacts import sole_facing
 from .math2d import world_point
+from .modes import contact_velocity
 from .terrain import ground_point
 
 AUDIT_PULL = 0
@@ -61,18 +63,6 @@ def note(ws, step, kind, who, body, value):
 
 
 @kernel
-def contact_power_terms(m, q, cs, vel, ws, i):
-    """Normal and tangential velocity [m/s] of contact i's material point under vel."""
-    b = m.contact_body[i]
-    px, py = world_point(q, cs, b, ws.contact_anchor[i, 0], ws.contact_anchor[i, 1])
-    vx = vel[b, 0] - vel[b, 2] * (py - q[b, 1])
-    vy = vel[b, 1] + vel[b, 2] * (px - q[b, 0])
-    nx = ws.contact_normal[i, 0]
-    ny = ws.contact_normal[i, 1]
-    return nx * vx + ny * vy, ny * vx - nx * vy
-
-
-@kernel
 def audit_impulses(m, s, ws):
     """Pulling contacts, friction outside its cone and positive contact work, from
     ws.contact_impulse and the constrained velocity ws.v_new. Returns the violations found."""
@@ -91,8 +81,8 @@ def audit_impulses(m, s, ws):
         if abs(lt) > m.contact_mu[i] * ln + IMPULSE_REL_TOL * size:
             note(ws, step, AUDIT_CONE, i, b, abs(lt) - m.contact_mu[i] * ln)
             found += 1
-        vn, vt = contact_power_terms(m, s.q, ws.body_cs, ws.v_new, ws, i)
-        vp_n, vp_t = contact_power_terms(m, s.q, ws.body_cs, ws.v_pred, ws, i)
+        vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
+        vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
         work = ln * vn + lt * vt
         scale = size * (abs(vn) + abs(vt) + abs(vp_n) + abs(vp_t))
         if work > WORK_REL_TOL * scale + 1e-300:
@@ -102,23 +92,24 @@ def audit_impulses(m, s, ws):
 
 
 @kernel
+def anchor_distance(q, cs, bodies, anchors, j):
+    """Distance [m] between the two anchors of joint j (bodies (n, 2), anchors (n, 2, 2) in
+    the bodies' frames) at configuration q."""
+    ax, ay = world_point(q, cs, bodies[j, 0], anchors[j, 0, 0], anchors[j, 0, 1])
+    bx, by = world_point(q, cs, bodies[j, 1], anchors[j, 1, 0], anchors[j, 1, 1])
+    return math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+
+
+@kernel
 def pin_gap(m, q, cs, j):
     """Distance [m] between the two anchors of pin j at configuration q."""
-    a = m.pin_body[j, 0]
-    b = m.pin_body[j, 1]
-    ax, ay = world_point(q, cs, a, m.pin_anchor[j, 0, 0], m.pin_anchor[j, 0, 1])
-    bx, by = world_point(q, cs, b, m.pin_anchor[j, 1, 0], m.pin_anchor[j, 1, 1])
-    return math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+    return anchor_distance(q, cs, m.pin_body, m.pin_anchor, j)
 
 
 @kernel
 def rod_error(m, q, cs, j):
     """|distance - length| [m] of rod j's anchors at configuration q."""
-    a = m.rod_body[j, 0]
-    b = m.rod_body[j, 1]
-    ax, ay = world_point(q, cs, a, m.rod_anchor[j, 0, 0], m.rod_anchor[j, 0, 1])
-    bx, by = world_point(q, cs, b, m.rod_anchor[j, 1, 0], m.rod_anchor[j, 1, 1])
-    return abs(math.sqrt((bx - ax) ** 2 + (by - ay) ** 2) - m.rod_length[j])
+    return abs(anchor_distance(q, cs, m.rod_body, m.rod_anchor, j) - m.rod_length[j])
 
 
 @kernel
@@ -140,19 +131,10 @@ def contact_gap(m, q, cs, i):
     r = m.contact_radius[i]
     cx, cy = world_point(q, cs, b, lx, ly)
     gx, gy, nx, ny, cgap = ground_point(m.terrain_coef, cx, cy)
-    # the sole's lowest point when the ground normal points into its span
-    dlx = cs[b, 0] * (-nx) + cs[b, 1] * (-ny)
-    dly = -cs[b, 1] * (-nx) + cs[b, 0] * (-ny)
-    a = math.atan2(dly, dlx)
-    a0 = m.contact_span[i, 0]
-    a1 = m.contact_span[i, 1]
-    while a < a0:
-        a += 2.0 * math.pi
-    while a >= a0 + 2.0 * math.pi:
-        a -= 2.0 * math.pi
-    best = cgap - r if a <= a1 else math.inf
+    in_span, dlx, dly = sole_facing(m, cs, b, i, nx, ny)
+    best = cgap - r if in_span else math.inf
     for e in range(2):
-        ang = a0 if e == 0 else a1
+        ang = m.contact_span[i, e]
         best = min(best, point_gap(m, q, cs, b, lx + r * math.cos(ang), ly + r * math.sin(ang)))
     adr = m.contact_vert_adr[i]
     for k in range(adr, adr + m.contact_vert_num[i]):

@@ -18,14 +18,14 @@ repeated until every error is below tolerance. Joint corrections also change the
 dq / h (as the Newton correction does); contact corrections move positions only.
 """
 from ._jit import kernel, kernel_call
-from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note, pin_gap
+from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .contacts import MODE_FREE, MODE_PINNED, find_contact
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, is_joint_row, solve_mixed_lcp
 from .modes import engage_contacts, engage_limits, gather_contact_impulses, modes_from_solution
-from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
-                   ROW_PIN_Y, ROW_ROD, _add_row, build_rows, eval_rows)
+from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
+                   add_row, build_rows, eval_rows, move_row)
 from .solve import apply_impulses, fill_row_b
 
 # Lemke's path is finite; the cap only stops a path that rounding has sent astray
@@ -40,17 +40,7 @@ def _drop_tangent_rows(ws):
         if ws.row_kind[r] == ROW_CONTACT_T:
             continue
         if k != r:
-            ws.row_kind[k] = ws.row_kind[r]
-            ws.row_owner[k] = ws.row_owner[r]
-            ws.row_body[k, 0] = ws.row_body[r, 0]
-            ws.row_body[k, 1] = ws.row_body[r, 1]
-            ws.row_c[k] = ws.row_c[r]
-            ws.row_c_pred[k] = ws.row_c_pred[r]
-            ws.row_b[k] = ws.row_b[r]
-            for e in range(2):
-                for c in range(3):
-                    ws.row_J[k, e, c] = ws.row_J[r, e, c]
-                    ws.row_F[k, e, c] = ws.row_J[r, e, c]
+            move_row(ws, k, r)
         k += 1
     ws.n_row[0] = k
     return k
@@ -124,19 +114,19 @@ def _projection_rows(m, s, ws):
     update_trig(s.q, ws.body_cs)
     n = 0
     for j in range(m.pin_body.shape[0]):
-        n = _add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
-        n = _add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
+        n = add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
+        n = add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
         for e in range(2):
             if s.limit_active[j, e]:
-                n = _add_row(ws, n, ROW_LIMIT_LO + e, j, m.pin_body[j, 0], m.pin_body[j, 1])
+                n = add_row(ws, n, ROW_LIMIT_LO + e, j, m.pin_body[j, 0], m.pin_body[j, 1])
     for j in range(m.rod_body.shape[0]):
-        n = _add_row(ws, n, ROW_ROD, j, m.rod_body[j, 0], m.rod_body[j, 1])
+        n = add_row(ws, n, ROW_ROD, j, m.rod_body[j, 0], m.rod_body[j, 1])
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:
             continue
         find_contact(m, s.q, ws, i)
         if ws.contact_gap[i] < PROJECTION_MARGIN:
-            n = _add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
+            n = add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n)
     return n

@@ -48,6 +48,21 @@ def _try_vertex(m, q, ws, i, b, lx, ly, best):
 
 
 @kernel
+def sole_facing(m, cs, b, i, nx, ny):
+    """(in_span, dlx, dly): the direction -n (ground normal n) in body b's frame, and whether
+    it points into arc contact i's angular span (then the sole's point closest to the ground
+    is the centre plus r times it)."""
+    dlx, dly = rotate(cs[b, 0], -cs[b, 1], -nx, -ny)
+    a = math.atan2(dly, dlx)
+    a0 = m.contact_span[i, 0]
+    while a < a0:
+        a += 2.0 * math.pi
+    while a >= a0 + 2.0 * math.pi:
+        a -= 2.0 * math.pi
+    return a <= m.contact_span[i, 1], dlx, dly
+
+
+@kernel
 def find_contact(m, q, ws, i):
     """Contact point, ground point, normal and gap of contact i at configuration q."""
     b = m.contact_body[i]
@@ -60,17 +75,11 @@ def find_contact(m, q, ws, i):
     r = m.contact_radius[i]
     cx, cy = world_point(q, ws.body_cs, b, lx, ly)
     gx, gy, nx, ny, cgap = ground_point(m.terrain_coef, cx, cy)
-    # direction -n expressed in the body frame
-    dlx, dly = rotate(ws.body_cs[b, 0], -ws.body_cs[b, 1], -nx, -ny)
-    a = math.atan2(dly, dlx)
+    in_span, dlx, dly = sole_facing(m, ws.body_cs, b, i, nx, ny)
     a0 = m.contact_span[i, 0]
     a1 = m.contact_span[i, 1]
-    while a < a0:
-        a += 2.0 * math.pi
-    while a >= a0 + 2.0 * math.pi:
-        a -= 2.0 * math.pi
     best = math.inf
-    if a <= a1:
+    if in_span:
         px = cx - r * nx
         py = cy - r * ny
         _store(ws, i, px, py, gx, gy, nx, ny, cgap - r, lx + r * dlx, ly + r * dly, 1)

@@ -19,7 +19,7 @@ import math
 from ._jit import kernel, kernel_call, kernel_inline
 from .math2d import update_trig
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
-                   ROW_PIN_Y, eval_rows)
+                   ROW_PIN_Y, eval_rows, move_row)
 from .solve import apply_impulses, assemble, factor_solve, row_dot, substitute
 
 
@@ -58,14 +58,7 @@ def keep_correction_rows(s, ws):
         if (kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI) and s.limit_active[o, kind - ROW_LIMIT_LO] == 0:
             continue
         if k != r:
-            ws.row_kind[k] = kind
-            ws.row_owner[k] = o
-            ws.row_body[k, 0] = ws.row_body[r, 0]
-            ws.row_body[k, 1] = ws.row_body[r, 1]
-            ws.row_c[k] = ws.row_c[r]
-            for e in range(2):
-                for c in range(3):
-                    ws.row_J[k, e, c] = ws.row_J[r, e, c]
+            move_row(ws, k, r)
         k += 1
     ws.n_row[0] = k
 

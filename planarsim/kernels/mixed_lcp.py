@@ -19,7 +19,7 @@ import math
 
 from ._jit import kernel, kernel_call
 from .lcp import LCP_SOLVED, lemke
-from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_LO, ROW_ROD
+from .rows import ROW_CONTACT_T, ROW_ROD
 from .solve import _entry
 
 # a joint-only loop: a joint row whose pivot falls to this share of its diagonal is an exact

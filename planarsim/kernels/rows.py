@@ -150,7 +150,24 @@ def predict_joint_errors(m, ws, n):
 
 
 @kernel
-def _add_row(ws, n, kind, owner, a, b):
+def move_row(ws, k, r):
+    """Row r's kind, owner, bodies, error, Jacobian and impulse direction into slot k <= r
+    (compacting the row list in place)."""
+    ws.row_kind[k] = ws.row_kind[r]
+    ws.row_owner[k] = ws.row_owner[r]
+    ws.row_body[k, 0] = ws.row_body[r, 0]
+    ws.row_body[k, 1] = ws.row_body[r, 1]
+    ws.row_c[k] = ws.row_c[r]
+    ws.row_c_pred[k] = ws.row_c_pred[r]
+    ws.row_b[k] = ws.row_b[r]
+    for e in range(2):
+        for c in range(3):
+            ws.row_J[k, e, c] = ws.row_J[r, e, c]
+            ws.row_F[k, e, c] = ws.row_F[r, e, c]
+
+
+@kernel
+def add_row(ws, n, kind, owner, a, b):
     ws.row_kind[n] = kind
     ws.row_owner[n] = owner
     ws.row_body[n, 0] = a
@@ -190,23 +207,23 @@ def build_rows(m, s, ws):
         kc = m.contact_body[ic] if ic < n_con else big
         if kp <= kr and kp <= kc:
             j = jp
-            n = _add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
-            n = _add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
+            n = add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
+            n = add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
             if s.limit_active[j, 0]:
-                n = _add_row(ws, n, ROW_LIMIT_LO, j, m.pin_body[j, 0], m.pin_body[j, 1])
+                n = add_row(ws, n, ROW_LIMIT_LO, j, m.pin_body[j, 0], m.pin_body[j, 1])
             if s.limit_active[j, 1]:
-                n = _add_row(ws, n, ROW_LIMIT_HI, j, m.pin_body[j, 0], m.pin_body[j, 1])
+                n = add_row(ws, n, ROW_LIMIT_HI, j, m.pin_body[j, 0], m.pin_body[j, 1])
             jp += 1
         elif kr <= kc:
-            n = _add_row(ws, n, ROW_ROD, jr, m.rod_body[jr, 0], m.rod_body[jr, 1])
+            n = add_row(ws, n, ROW_ROD, jr, m.rod_body[jr, 0], m.rod_body[jr, 1])
             jr += 1
         else:
             i = ic
             mode = s.contact_mode[i]
             if mode == MODE_PINNED or mode == MODE_SLIDING:
-                n = _add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
+                n = add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
             if mode == MODE_PINNED:
-                n = _add_row(ws, n, ROW_CONTACT_T, i, -1, m.contact_body[i])
+                n = add_row(ws, n, ROW_CONTACT_T, i, -1, m.contact_body[i])
             ic += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n)
