@@ -4,7 +4,8 @@ After the velocity stage (impulses as applied):
   pull      a contact's normal impulse pulls (lambda_n < 0)
   cone      friction outside its cone (|lambda_t| > mu lambda_n)
   work      a contact's impulse does positive work at the step's end velocity
-            (lambda_n v_n + lambda_t v_t > 0: it would add energy)
+            (lambda_n v_n + lambda_t v_t > 0: it would add energy) beyond rounding: more
+            than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR)
 After the position stage (the configuration the step ends at):
   pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
   depth     a contact point below the ground by more than DEPTH_TOL
@@ -39,7 +40,10 @@ PIN_GAP_TOL = 1e-9       # [m]
 DEPTH_TOL = 1e-8         # [m]
 # impulses and work are judged relative to their own size (rounding of the solve)
 IMPULSE_REL_TOL = 1e-8
-WORK_REL_TOL = 1e-8
+WORK_REL_TOL = 1e-7      # the accuracy the complementarity solve accepts (lcp.ANSWER_TOL)
+# [m/s] a contact velocity this small is the solve's rounding, not motion (the mode rules
+# accept row residuals of 1e-9 (max |b| + 1) as well): it moves a point 1e-9 h m per step
+VELOCITY_FLOOR = 1e-9
 
 
 @kernel
@@ -84,8 +88,8 @@ def audit_impulses(m, s, ws):
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
         vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
         work = ln * vn + lt * vt
-        scale = size * (abs(vn) + abs(vt) + abs(vp_n) + abs(vp_t))
-        if work > WORK_REL_TOL * scale + 1e-300:
+        scale = WORK_REL_TOL * (abs(vn) + abs(vt) + abs(vp_n) + abs(vp_t)) + VELOCITY_FLOOR
+        if work > size * scale:
             note(ws, step, AUDIT_WORK, i, b, work)
             found += 1
     return found

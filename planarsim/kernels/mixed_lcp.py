@@ -18,7 +18,7 @@ The velocity stage calls this with b = c / h + J v*; the position projection wit
 import math
 
 from ._jit import kernel, kernel_call
-from .lcp import LCP_SOLVED, lemke
+from .lcp import LCP_RAY, LCP_SOLVED, lemke
 from .rows import ROW_CONTACT_T, ROW_ROD
 from .solve import _entry
 
@@ -177,21 +177,27 @@ def solve_mixed_lcp(m, ws, n, max_pivots):
         qx[i] *= d[i]
         for j in range(nv):
             Mx[i, j] *= d[i] * d[j]
-    status, pivots = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots)
     # Lemke's path can end on a ray of a solvable problem when M is only copositive (friction
-    # makes it so). M + eps I is strictly copositive, for which the path always ends at a
-    # solution; its answer misses the rules of M by eps z (scaled units: a relative error of
-    # eps), far below the audit's tolerances. The smallest eps that rounding lets through.
+    # makes it so), or rounding can send it astray in a degenerate problem (the answer check
+    # in lcp.py catches that). M + eps I is strictly copositive, for which the path always
+    # ends at a solution; its answer misses the rules of M by eps z (scaled units: a relative
+    # error of eps), far below the audit's tolerances. Each eps in turn, on the covering
+    # vector's path, then on a second covering vector's.
+    status = LCP_RAY
+    pivots = 0
     eps = 0.0
-    for attempt in range(len(REGULARISATION)):
+    for cover in range(2):
+        for attempt in range(len(REGULARISATION) + 1):
+            target = 0.0 if attempt == 0 else REGULARISATION[attempt - 1]
+            for i in range(nv):
+                Mx[i, i] += target - eps
+            eps = target
+            status, more = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots, cover)
+            pivots += more
+            if status == LCP_SOLVED:
+                break
         if status == LCP_SOLVED:
             break
-        step = REGULARISATION[attempt] - eps
-        eps = REGULARISATION[attempt]
-        for i in range(nv):
-            Mx[i, i] += step
-        status, more = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots)
-        pivots += more
     if status != LCP_SOLVED:
         return status, pivots
     for i in range(nv):

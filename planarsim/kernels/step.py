@@ -32,8 +32,8 @@ from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, check_guards
 from .math2d import update_trig
-from .integrate import (correct_positions, integrate_positions, keep_correction_rows,
-                        predict_configuration, rows_hold_within)
+from .integrate import (bound_correction_work, correct_positions, integrate_positions,
+                        keep_correction_rows, predict_configuration, rows_hold_within)
 from .modes import (MODES_ALTERNATING, engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .record import record_frame
@@ -166,7 +166,7 @@ def _step(m, s, ws, opt, u):
                 ws.info[1] += 1
                 continue
         audit_impulses(m, s, ws)
-        integrate_positions(s, ws.v_new, h)
+        integrate_positions(s, ws, ws.v_new, h)
         keep_correction_rows(s, ws)
         # the correction only when the rows may be off by more than refine_tol: a bound of
         # half of it (far above rounding) proves the correction would find nothing to do
@@ -177,6 +177,7 @@ def _step(m, s, ws, opt, u):
                               opt.refine_pivot_tol)
         if opt.refine_iters > 0:
             settle_positions(m, s, ws, h, opt)
+            bound_correction_work(m, s, ws)
         break
     s.time[0] = ws.prev.time[0] + m.dt
     s.step[0] += 1
