@@ -136,6 +136,8 @@ class Workspace(NamedTuple):
                                  #   made (kernels/audit.py: AUDIT_NAMES)
     audit_last: np.ndarray       # (4,) int the last violation: step, kind, contact or pin, body
     audit_value: np.ndarray      # (1,) its size (impulse [N s], work [J], gap or depth [m])
+    lcp_eps: np.ndarray          # (1,) largest diagonal term the complementarity solves of
+                                 #   this step added (mixed_lcp.REGULARISATION; scaled units)
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)
 
@@ -173,5 +175,5 @@ def make_workspace(model: Model) -> Workspace:
                      lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),
                      lcp_q=z(L), lcp_z=z(L), lcp_scale=z(L), lcp_T=z((L, 2 * L + 2)),
                      lcp_basis=z(L, np.int64), audit=z(N_AUDIT, np.int64),
-                     audit_last=z(4, np.int64), audit_value=z(1),
+                     audit_last=z(4, np.int64), audit_value=z(1), lcp_eps=z(1),
                      impact_time=z(1), prev=make_state(model))

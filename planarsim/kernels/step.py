@@ -141,6 +141,7 @@ def _step(m, s, ws, opt, u):
         return code
     for k in (0, 1, 4, 5, 6, 7):
         ws.info[k] = 0
+    ws.lcp_eps[0] = 0.0
     audited = audit_total(ws)
     for i in range(m.contact_body.shape[0]):
         ws.contact_new[i] = 0

@@ -16,7 +16,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from benchmarks.contact_stress import corpus, run_case  # noqa: E402
 
 
-@pytest.mark.xfail(strict=False, reason="contact solve being rewritten")
 @pytest.mark.parametrize("family,seed,strategy", corpus(quick=True))
 def test_contact_stress_case_meets_targets(family, seed, strategy):
     r = run_case(family, seed, strategy)
