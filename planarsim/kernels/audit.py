@@ -23,7 +23,7 @@ import math
 
 from ._jit import kernel
 from .contacts import sole_facing
-from .math2d import world_point
+from .math2d import cross2, world_point
 from .modes import contact_velocity
 from .terrain import ground_point
 
@@ -85,8 +85,8 @@ def regularised_work(m, s, ws, i, ln, lt):
     ry = py - s.q[b, 1]
     nx = ws.contact_normal[i, 0]
     ny = ws.contact_normal[i, 1]
-    arm_n = rx * ny - ry * nx           # r x n
-    arm_t = rx * (-nx) - ry * ny        # r x t, t = (ny, -nx)
+    arm_n = cross2(rx, ry, nx, ny)
+    arm_t = cross2(rx, ry, ny, -nx)     # t = (ny, -nx), as contact_velocity
     k_n = m.body_inv_mass[b] + m.body_inv_inertia[b] * arm_n * arm_n
     k_t = m.body_inv_mass[b] + m.body_inv_inertia[b] * arm_t * arm_t
     return 2.0 * eps * (ln * ln * k_n + lt * lt * k_t)

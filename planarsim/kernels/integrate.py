@@ -17,6 +17,7 @@ find nothing to do (bodies at rest or translating), so the step skips it exactly
 import math
 
 from ._jit import kernel, kernel_call, kernel_inline
+from .contacts import MODE_FREE, MODE_PINNED
 from .math2d import update_trig
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
                    ROW_PIN_Y, eval_rows, move_row)
@@ -55,9 +56,9 @@ def keep_correction_rows(s, ws):
     for r in range(ws.n_row[0]):
         kind = ws.row_kind[r]
         o = ws.row_owner[r]
-        if kind == ROW_CONTACT_T and s.contact_mode[o] != 1:
+        if kind == ROW_CONTACT_T and s.contact_mode[o] != MODE_PINNED:
             continue
-        if kind == ROW_CONTACT_N and s.contact_mode[o] == 0:
+        if kind == ROW_CONTACT_N and s.contact_mode[o] == MODE_FREE:
             continue
         if (kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI) and s.limit_active[o, kind - ROW_LIMIT_LO] == 0:
             continue

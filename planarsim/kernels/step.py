@@ -82,6 +82,16 @@ def build_and_solve(m, s, ws, opt, h):
     solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
 
 
+@kernel
+def answer_holds(m, s, ws, h, include_ccd):
+    """The last solve's answer breaks no rule (modes.rule_breaks) and leaves no contact or
+    limit outside the problem that its velocity would push through (those are engaged)."""
+    ok = rule_breaks(m, s, ws, h) == 0
+    engaged = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
+        m, s, ws, h, ws.v_new)
+    return ok and engaged == 0
+
+
 @kernel_inline
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 4-6: impulses and contact modes that meet every rule (modes.rule_breaks).
@@ -96,17 +106,13 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     engage_limits(m, s, ws, h, ws.v_pred)
     build_and_solve(m, s, ws, opt, h)
     rounds = 1
-    ok = rule_breaks(m, s, ws, h) == 0
-    ok = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
-        m, s, ws, h, ws.v_new) == 0 and ok
+    ok = answer_holds(m, s, ws, h, include_ccd)
     nc = m.contact_body.shape[0]
     if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
         seed_rule(m, s, ws, s.mode_cursor[0] % nc)
         build_and_solve(m, s, ws, opt, h)
         rounds += 1
-        ok = rule_breaks(m, s, ws, h) == 0
-        ok = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
-            m, s, ws, h, ws.v_new) == 0 and ok
+        ok = answer_holds(m, s, ws, h, include_ccd)
     if ok:
         gather_contact_impulses(m, s, ws)
     else:
