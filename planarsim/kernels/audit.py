@@ -5,8 +5,7 @@ After the velocity stage (impulses as applied):
   cone      friction outside its cone (|lambda_t| > mu lambda_n)
   work      a contact's impulse does positive work at the step's end velocity
             (lambda_n v_n + lambda_t v_t > 0: it would add energy) beyond rounding: more
-            than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR), plus what the step's
-            regularisation allows (regularised_work)
+            than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR)
 After the position stage (the configuration the step ends at):
   pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
   depth     a contact point below the ground by more than DEPTH_TOL
@@ -23,7 +22,7 @@ import math
 
 from ._jit import kernel
 from .contacts import sole_facing
-from .math2d import cross2, world_point
+from .math2d import world_point
 from .modes import contact_velocity
 from .terrain import ground_point
 
@@ -70,29 +69,6 @@ def note(ws, step, kind, who, body, value):
 
 
 @kernel
-def regularised_work(m, s, ws, i, ln, lt):
-    """[J] The work contact i's impulse (ln, lt) [N s] may do by the step's regularisation:
-    a solve of M + eps I (scaled units, ws.lcp_eps) leaves each row's velocity off by
-    eps lambda k (k its inverse effective mass, at most the bare one of its body,
-    1/m + (r x e)^2 / I), so the impulse's work is off by up to eps lambda^2 k per row;
-    twice that (the friction rows share their velocity between beta+ and beta-)."""
-    eps = ws.lcp_eps[0]
-    if eps == 0.0:
-        return 0.0
-    b = m.contact_body[i]
-    px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[i, 0], ws.contact_anchor[i, 1])
-    rx = px - s.q[b, 0]
-    ry = py - s.q[b, 1]
-    nx = ws.contact_normal[i, 0]
-    ny = ws.contact_normal[i, 1]
-    arm_n = cross2(rx, ry, nx, ny)
-    arm_t = cross2(rx, ry, ny, -nx)     # t = (ny, -nx), as contact_velocity
-    k_n = m.body_inv_mass[b] + m.body_inv_inertia[b] * arm_n * arm_n
-    k_t = m.body_inv_mass[b] + m.body_inv_inertia[b] * arm_t * arm_t
-    return 2.0 * eps * (ln * ln * k_n + lt * lt * k_t)
-
-
-@kernel
 def audit_impulses(m, s, ws):
     """Pulling contacts, friction outside its cone and positive contact work, from
     ws.contact_impulse and the constrained velocity ws.v_new. Returns the violations found."""
@@ -115,7 +91,7 @@ def audit_impulses(m, s, ws):
         vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
         work = ln * vn + lt * vt
         scale = WORK_REL_TOL * (abs(vn) + abs(vt) + abs(vp_n) + abs(vp_t)) + VELOCITY_FLOOR
-        if work > size * scale + regularised_work(m, s, ws, i, ln, lt):
+        if work > size * scale:
             note(ws, step, AUDIT_WORK, i, b, work)
             found += 1
     return found

@@ -1,0 +1,90 @@
+"""Lemke's method and the polish of a regularised answer, on random complementarity problems
+of contact shape: M = J J^T with more rows than degrees of freedom (redundant contacts
+sharing a load, so M and the answer's basis are singular) and q built around a known
+answer, so that every problem has one."""
+import numpy as np
+from hypothesis import given, settings, strategies as st
+
+from numba import njit
+
+from planarsim.kernels._jit import _OPTIONS
+from planarsim.kernels.lcp import LCP_SOLVED, lemke, polish
+
+# not cached: numba checks a cached function against its own file only, and this wrapper
+# must follow the kernels it calls
+jit = njit(**dict(_OPTIONS, cache=False))
+
+
+@jit
+def _solve_in(M, q, eps, z_reg, z, T, basis):
+    m = q.shape[0]
+    for i in range(m):
+        M[i, i] += eps
+    status, pivots = lemke(M, q, m, T, basis, z, 40 * m + 10, 0)
+    for i in range(m):
+        M[i, i] -= eps
+    for i in range(m):
+        z_reg[i] = z[i]
+    if status != LCP_SOLVED:
+        return status, -1
+    return status, polish(M, q, m, T, basis, z)
+
+
+def _solve(M, q, eps, z_reg, z):
+    """lemke on M + eps I into z_reg, then polish for M into z: (lemke's, polish's status)."""
+    m = len(q)
+    return _solve_in(M, q, eps, z_reg, z, np.zeros((m, 2 * m + 2)), np.zeros(m, np.int64))
+
+
+def _miss(M, q, z):
+    """Largest breach of z >= 0, w >= 0, z w = 0 (w = M z + q), relative to max |q|."""
+    w = M @ z + q
+    scale = np.abs(q).max()
+    return max(-z.min(), -w.min(), np.abs(z * w).max() / scale) / scale
+
+
+@st.composite
+def redundant_contacts(draw):
+    """(M, q): k contact rows on d < k degrees of freedom, half of them loaded in the answer."""
+    d = draw(st.integers(2, 6))
+    k = draw(st.integers(d + 1, 2 * d + 2))
+    seed = draw(st.integers(0, 2**31 - 1))
+    rng = np.random.default_rng(seed)
+    J = rng.normal(size=(k, d))
+    M = J @ J.T
+    loaded = rng.random(k) < 0.5
+    z_star = np.where(loaded, rng.uniform(0.1, 1.0, k), 0.0)
+    w_star = np.where(loaded, 0.0, rng.uniform(0.0, 1.0, k))
+    return M, w_star - M @ z_star
+
+
+@settings(max_examples=150, deadline=None)
+@given(redundant_contacts())
+def test_polish_turns_a_regularised_answer_into_an_exact_one(problem):
+    M, q = problem
+    if q.min() >= 0.0:          # nothing pushes: z = 0, no path, nothing to polish
+        return
+    z_reg = np.zeros(len(q))
+    z = np.zeros(len(q))
+    status, polished = _solve(M.copy(), q, 1e-6, z_reg, z)
+    assert status == LCP_SOLVED
+    assert polished == LCP_SOLVED
+    assert _miss(M, q, z) < 1e-9
+    # the regularised answer itself misses by about eps z: polish did the work
+    assert _miss(M, q, z_reg) > 10 * _miss(M, q, z) or _miss(M, q, z_reg) < 1e-9
+
+
+def test_polish_shares_a_redundant_load_without_drifting():
+    """Two identical contacts under one load (a singular basis): the regularised answer
+    splits it evenly; polish makes the total exact and keeps the split to rounding (the
+    regularised tableau amplifies rounding by 1 / eps along the null space: 1e-10 here),
+    rather than moving the load from one contact to the other."""
+    M = np.array([[1.0, 1.0], [1.0, 1.0]])
+    q = np.array([-1.0, -1.0])
+    z_reg = np.zeros(2)
+    z = np.zeros(2)
+    status, polished = _solve(M.copy(), q, 1e-6, z_reg, z)
+    assert (status, polished) == (LCP_SOLVED, LCP_SOLVED)
+    assert abs(z_reg.sum() - 1.0) > 1e-7
+    assert abs(z.sum() - 1.0) < 1e-14
+    assert abs(z[0] - z[1]) < 1e-8
