@@ -13,7 +13,7 @@ import numpy as np
 from .state import State
 from .trajectory import atomic_write, read_npz
 
-SNAPSHOT_VERSION = 1
+SNAPSHOT_VERSION = 2   # 2: the State holds the last step's impulses
 
 
 def save_snapshot(path, state: State, memory: dict | None = None) -> Path:

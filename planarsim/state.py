@@ -24,6 +24,11 @@ class State(NamedTuple):
     limit_active : (n_pin, 2) int         lower / upper joint limit rows in use
     mode_cursor : (1,) int                the contact checked next by the alternating scheme
     ext_force : (n_body, 3) [N, N, N m]   external force and torque held until changed (pushes)
+    last_contact_impulse : (n_contact, 2) [N s]   normal, tangential impulse of the last step
+    last_pin_impulse : (n_pin, 4) [N s, N s, N m s, N m s]   x, y, lower, upper limit impulse
+    last_rod_impulse : (n_rod,) [N s]     of the last step; the next step's solve starts from
+                                          them (kernels/warm_start.py): a closed loop whose
+                                          load split is not unique keeps the last one
     """
     q: np.ndarray
     v: np.ndarray
@@ -35,6 +40,9 @@ class State(NamedTuple):
     limit_active: np.ndarray
     mode_cursor: np.ndarray
     ext_force: np.ndarray
+    last_contact_impulse: np.ndarray
+    last_pin_impulse: np.ndarray
+    last_rod_impulse: np.ndarray
 
     @property
     def t(self) -> float:
@@ -64,7 +72,9 @@ def make_state(model: Model, q=None, v=None) -> State:
     return State(q=q, v=v, time=np.zeros(1), step=np.zeros(1, np.int64),
                  contact_mode=np.zeros(nc, np.int64), contact_slip=np.ones(nc),
                  contact_enabled=np.ones(nc, np.int64), limit_active=np.zeros((npin, 2), np.int64),
-                 mode_cursor=np.zeros(1, np.int64), ext_force=np.zeros((nb, 3)))
+                 mode_cursor=np.zeros(1, np.int64), ext_force=np.zeros((nb, 3)),
+                 last_contact_impulse=np.zeros((nc, 2)), last_pin_impulse=np.zeros((npin, 4)),
+                 last_rod_impulse=np.zeros(model.n_rod))
 
 
 class Workspace(NamedTuple):
@@ -107,6 +117,7 @@ class Workspace(NamedTuple):
     n_row: np.ndarray            # (1,) int rows in use
     A: np.ndarray                # (R, R) effective-mass matrix J M^-1 F^T
     rhs: np.ndarray              # (R,)
+    lam_start: np.ndarray        # (R,) impulses the solve starts from (the last step's)
     lam: np.ndarray              # (R,) impulses [N s or N m s]
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
     act_power: np.ndarray        # (n_act,) mechanical power [W]
@@ -168,7 +179,7 @@ def make_workspace(model: Model) -> Workspace:
                      contact_new=z(nc, np.int64), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
-                     A=z((R, R)), rhs=z(R), lam=z(R), act_u=z(na), act_power=z(na),
+                     A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R), act_u=z(na), act_power=z(na),
                      info=z(8, np.int64), guard_value=z(1), row_b=z(R),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
                      lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),

@@ -123,12 +123,22 @@ def engage_limits(m, s, ws, h, vel):
 
 
 @kernel
+def _contact_size(m, s, ws, r):
+    """|lambda_n| + |lambda_t| [N s] of the contact whose normal row is r (its tangent row
+    follows it; a sliding contact has none, its friction is mu lambda_n)."""
+    if r + 1 < ws.n_row[0] and ws.row_kind[r + 1] == ROW_CONTACT_T:
+        return abs(ws.lam[r]) + abs(ws.lam[r + 1])
+    return abs(ws.lam[r]) * (1.0 + m.contact_mu[ws.row_owner[r]])
+
+
+@kernel
 def rule_breaks(m, s, ws, h):
     """How many rows of the last solve break a rule of contact and limits (the solve took the
     modes as given; this checks its answer): an equality row not met (a dependent row dropped
     whose residual the others do not remove), a normal or limit impulse that pulls, friction
     outside its cone, a sliding contact whose slip reversed. Tolerances are relative to the
-    impulses' and velocities' own size (rounding, not physics)."""
+    impulses' and velocities' own size (rounding, not physics): a contact's own impulse for
+    its pull and cone rules (an answer that passes here passes the audit's)."""
     n = ws.n_row[0]
     big_lam = 0.0
     big_b = 0.0
@@ -149,7 +159,8 @@ def rule_breaks(m, s, ws, h):
             if ws.lam[r] < -tol_lam:
                 breaks += 1
         elif kind == ROW_CONTACT_N:
-            if ws.lam[r] < -tol_lam:
+            # a contact's rules are judged against its own impulse (as the audit judges them)
+            if ws.lam[r] < -SOLVE_REL_TOL * _contact_size(m, s, ws, r):
                 breaks += 1
             if s.contact_mode[o] == MODE_SLIDING:
                 vn, vt = contact_velocity(m, s, ws, o, ws.v_new)
@@ -159,7 +170,8 @@ def rule_breaks(m, s, ws, h):
                 if vt * s.contact_slip[o] < -SLIP_ROUNDING * (abs(vn_free) + abs(vt_free)):
                     breaks += 1
         elif kind == ROW_CONTACT_T:
-            if abs(ws.lam[r]) > m.contact_mu[o] * ws.lam[r - 1] + tol_lam:
+            size = abs(ws.lam[r]) + abs(ws.lam[r - 1])
+            if abs(ws.lam[r]) > m.contact_mu[o] * ws.lam[r - 1] + SOLVE_REL_TOL * size:
                 breaks += 1
     return breaks
 

@@ -39,6 +39,7 @@ from .modes import (MODES_ALTERNATING, engage_contacts, engage_limits, gather_co
 from .record import record_frame
 from .rows import build_rows
 from .solve import solve_impulses
+from .warm_start import remember_impulses, start_impulses
 
 
 @kernel
@@ -67,6 +68,9 @@ def copy_state(src, dst):
     _copy2(src.limit_active, dst.limit_active)
     _copy1(src.mode_cursor, dst.mode_cursor)
     _copy2(src.ext_force, dst.ext_force)
+    _copy2(src.last_contact_impulse, dst.last_contact_impulse)
+    _copy2(src.last_pin_impulse, dst.last_pin_impulse)
+    _copy1(src.last_rod_impulse, dst.last_rod_impulse)
 
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
@@ -79,6 +83,7 @@ def build_and_solve(m, s, ws, opt, h):
     modes as they stand. A call (one copy of its code for both solves of solve_modes): its
     work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
+    start_impulses(s, ws, ws.n_row[0])
     solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
 
 
@@ -117,6 +122,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         gather_contact_impulses(m, s, ws)
     else:
         solve_contacts(m, s, ws, h, include_ccd)
+    remember_impulses(s, ws)
     ws.info[0] += rounds
 
 
