@@ -104,6 +104,7 @@ class Workspace(NamedTuple):
     contact_gap: np.ndarray      # (n_contact,) signed gap at step start [m]
     contact_anchor: np.ndarray   # (n_contact, 2) material contact point in the body frame [m]
     contact_impulse: np.ndarray  # (n_contact, 2) normal, tangential impulse of the step [N s]
+    contact_held: np.ndarray     # (n_contact,) int 1 if the position correction held its normal row
     contact_on_arc: np.ndarray   # (n_contact,) int 1: the contact lies on a circular sole
     contact_new: np.ndarray      # (n_contact,) int 1: engaged during this step
     row_body: np.ndarray         # (R, 2) int
@@ -175,7 +176,7 @@ def make_workspace(model: Model) -> Workspace:
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), v_solved=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_anchor=z((nc, 2)),
-                     contact_impulse=z((nc, 2)), contact_on_arc=z(nc, np.int64),
+                     contact_impulse=z((nc, 2)), contact_held=z(nc, np.int64), contact_on_arc=z(nc, np.int64),
                      contact_new=z(nc, np.int64), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),

@@ -21,9 +21,10 @@ planarsim.errors.diverged turns into an AuditViolation naming all of it.
 import math
 
 from ._jit import kernel
-from .contacts import sole_facing
+from .contacts import CONTACT_POINT, sole_facing
 from .math2d import world_point
 from .modes import contact_velocity
+from .rows import ROW_CONTACT_N
 from .terrain import ground_point
 
 AUDIT_PULL = 0
@@ -88,12 +89,14 @@ def audit_impulses(m, s, ws):
             note(ws, step, AUDIT_CONE, i, b, abs(lt) - m.contact_mu[i] * ln)
             found += 1
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
-        vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
         work = ln * vn + lt * vt
-        scale = WORK_REL_TOL * (abs(vn) + abs(vt) + abs(vp_n) + abs(vp_t)) + VELOCITY_FLOOR
+        scale = WORK_REL_TOL * (abs(vn) + abs(vt)) + VELOCITY_FLOOR
         if work > size * scale:
-            note(ws, step, AUDIT_WORK, i, b, work)
-            found += 1
+            # the tolerance also scales with the free motion's speed (computed only here)
+            vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
+            if work > size * (scale + WORK_REL_TOL * (abs(vp_n) + abs(vp_t))):
+                note(ws, step, AUDIT_WORK, i, b, work)
+                found += 1
     return found
 
 
@@ -132,7 +135,7 @@ def contact_gap(m, q, cs, i):
     b = m.contact_body[i]
     lx = m.contact_local[i, 0]
     ly = m.contact_local[i, 1]
-    if m.contact_kind[i] == 0:
+    if m.contact_kind[i] == CONTACT_POINT:
         return point_gap(m, q, cs, b, lx, ly)
     r = m.contact_radius[i]
     cx, cy = world_point(q, cs, b, lx, ly)
@@ -149,20 +152,55 @@ def contact_gap(m, q, cs, i):
 
 
 @kernel
-def worst_violation(m, s, ws):
+def surely_clear(m, s, ws, i):
+    """Point contact i cannot be below the ground at s.q: its gap at the start of the step
+    (ws.contact_gap, found at ws.prev.q; no time-of-impact split) exceeds how far the point
+    can have moved since, |dx| + |dtheta| r (the signed distance to the ground changes by at
+    most the point's move). Saves the ground query of contacts well clear of it."""
+    if m.contact_kind[i] != CONTACT_POINT or ws.info[1] != 0:
+        return False
+    b = m.contact_body[i]
+    lx = m.contact_local[i, 0]
+    ly = m.contact_local[i, 1]
+    reach = (abs(s.q[b, 0] - ws.prev.q[b, 0]) + abs(s.q[b, 1] - ws.prev.q[b, 1])
+             + abs(s.q[b, 2] - ws.prev.q[b, 2]) * math.sqrt(lx * lx + ly * ly))
+    return ws.contact_gap[i] > reach
+
+
+@kernel
+def worst_violation(m, s, ws, bounded, rows_held):
     """Largest pin gap and largest depth below the ground [m] of enabled contacts at the
-    current configuration (ws.body_cs must match s.q)."""
+    current configuration (ws.body_cs must match s.q). bounded: skip point contacts that
+    are surely clear (valid while ws.contact_gap is the start of the step's). rows_held: the
+    position correction proved every row it kept within PIN_GAP_TOL / 10 (flat or sloped
+    ground, where a point contact's row is its exact gap): skip the joints, and the point
+    contacts whose normal row it kept (ws.contact_held)."""
     gap = 0.0
-    for j in range(m.pin_body.shape[0]):
-        gap = max(gap, pin_gap(m, s.q, ws.body_cs, j))
-    for j in range(m.rod_body.shape[0]):
-        gap = max(gap, rod_error(m, s.q, ws.body_cs, j))
+    if not rows_held:
+        for j in range(m.pin_body.shape[0]):
+            gap = max(gap, pin_gap(m, s.q, ws.body_cs, j))
+        for j in range(m.rod_body.shape[0]):
+            gap = max(gap, rod_error(m, s.q, ws.body_cs, j))
     depth = 0.0
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:
             continue
+        if rows_held and ws.contact_held[i] == 1 and m.contact_kind[i] == CONTACT_POINT:
+            continue
+        if bounded and surely_clear(m, s, ws, i):
+            continue
         depth = max(depth, -contact_gap(m, s.q, ws.body_cs, i))
     return gap, depth
+
+
+@kernel
+def mark_held_contacts(m, ws):
+    """ws.contact_held[i] = 1 if contact i's normal row is among the rows 0..n_row-1."""
+    for i in range(ws.contact_held.shape[0]):
+        ws.contact_held[i] = 0
+    for r in range(ws.n_row[0]):
+        if ws.row_kind[r] == ROW_CONTACT_N:
+            ws.contact_held[ws.row_owner[r]] = 1
 
 
 @kernel

@@ -13,6 +13,8 @@ limits the motion would push through into the problem; seed_rule is the alternat
 strategy's one-contact re-examination (release if it pulls, slide outside the cone, stick on
 reversal); modes_from_solution reads the modes off a complementarity solution.
 """
+import math
+
 from ._jit import kernel
 from .contacts import MODE_FREE, MODE_PINNED, MODE_SLIDING, engage_contact
 from .forces import point_velocity
@@ -93,11 +95,25 @@ def engage_contacts(m, s, ws, h, include_ccd, vel):
             continue
         if m.contact_ccd[i] == 1 and not include_ccd:
             continue
+        if not may_reach_ground(m, ws, i, h, vel):
+            continue
         vn, vt = contact_velocity(m, s, ws, i, vel)
         if ws.contact_gap[i] + h * vn < 0.0:
             engage_contact(m, s, ws, i, vn, vt)
             changed += 1
     return changed
+
+
+@kernel
+def may_reach_ground(m, ws, i, h, vel):
+    """False when contact i's point surely stays above the ground for a step of h under
+    vel: its gap exceeds h (|v_x| + |v_y| + |omega| r), r its distance from the COM (a
+    bound on its speed; no trigonometry)."""
+    b = m.contact_body[i]
+    ax = ws.contact_anchor[i, 0]
+    ay = ws.contact_anchor[i, 1]
+    speed = abs(vel[b, 0]) + abs(vel[b, 1]) + abs(vel[b, 2]) * math.sqrt(ax * ax + ay * ay)
+    return ws.contact_gap[i] <= h * speed
 
 
 @kernel
@@ -132,13 +148,15 @@ def _contact_size(m, s, ws, r):
 
 
 @kernel
-def rule_breaks(m, s, ws, h):
+def rule_breaks(m, s, ws, h, equalities):
     """How many rows of the last solve break a rule of contact and limits (the solve took the
     modes as given; this checks its answer): an equality row not met (a dependent row dropped
     whose residual the others do not remove), a normal or limit impulse that pulls, friction
     outside its cone, a sliding contact whose slip reversed. Tolerances are relative to the
     impulses' and velocities' own size (rounding, not physics): a contact's own impulse for
-    its pull and cone rules (an answer that passes here passes the audit's)."""
+    its pull and cone rules (an answer that passes here passes the audit's). equalities: also
+    check every row's equation (needed where the solve dropped a dependent row or had no
+    symmetric factorisation; a backward-stable L D L^T of all rows meets them to rounding)."""
     n = ws.n_row[0]
     big_lam = 0.0
     big_b = 0.0
@@ -152,9 +170,11 @@ def rule_breaks(m, s, ws, h):
         kind = ws.row_kind[r]
         o = ws.row_owner[r]
         # residual w = J (v_new - v*) + b of the row as solved (an equality here)
-        w = row_dot(ws, r, ws.row_J, ws.v_new) - row_dot(ws, r, ws.row_J, ws.v_pred) + ws.row_b[r]
-        if abs(w) > tol_w:
-            breaks += 1
+        if equalities:
+            w = (row_dot(ws, r, ws.row_J, ws.v_new) - row_dot(ws, r, ws.row_J, ws.v_pred)
+                 + ws.row_b[r])
+            if abs(w) > tol_w:
+                breaks += 1
         if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
             if ws.lam[r] < -tol_lam:
                 breaks += 1

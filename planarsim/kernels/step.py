@@ -26,7 +26,7 @@ from . import refs
 from ._jit import KERNEL_OPTIONS, jit, kernel, kernel_call, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
 from .audit import (DEPTH_TOL, PIN_GAP_TOL, audit_impulses, audit_positions, audit_total,
-                    worst_violation)
+                    mark_held_contacts, worst_violation)
 from .complementarity import project_positions, solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
@@ -75,23 +75,29 @@ def copy_state(src, dst):
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
 PROJECTION_ITERS = 8
+# rows held to refine_tol count as within the audit's tolerances when refine_tol is at most
+# this share of them (a pin's gap is at most sqrt(2) times its rows' errors; the settling
+# threshold is a tenth of the tolerance)
+ROWS_HELD_SHARE = 0.05
 
 
 @kernel_call
 def build_and_solve(m, s, ws, opt, h):
     """Stages 4-5: the active rows at the current configuration and their impulses under the
-    modes as they stand. A call (one copy of its code for both solves of solve_modes): its
+    modes as they stand. Returns True if the answer's equations need checking (a dependent
+    row was dropped, or the system was not symmetric). A call (one copy of its code for both solves of solve_modes): its
     work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
     start_impulses(s, ws, ws.n_row[0])
-    solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
+    dropped = solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
+    return dropped > 0 or sliding > 0
 
 
 @kernel
-def answer_holds(m, s, ws, h, include_ccd):
+def answer_holds(m, s, ws, h, include_ccd, equalities):
     """The last solve's answer breaks no rule (modes.rule_breaks) and leaves no contact or
     limit outside the problem that its velocity would push through (those are engaged)."""
-    ok = rule_breaks(m, s, ws, h) == 0
+    ok = rule_breaks(m, s, ws, h, equalities) == 0
     engaged = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
         m, s, ws, h, ws.v_new)
     return ok and engaged == 0
@@ -109,15 +115,15 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     (complementarity.solve_contacts). No rounds, no cap."""
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
-    build_and_solve(m, s, ws, opt, h)
+    equalities = build_and_solve(m, s, ws, opt, h)
     rounds = 1
-    ok = answer_holds(m, s, ws, h, include_ccd)
+    ok = answer_holds(m, s, ws, h, include_ccd, equalities)
     nc = m.contact_body.shape[0]
     if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
         seed_rule(m, s, ws, s.mode_cursor[0] % nc)
-        build_and_solve(m, s, ws, opt, h)
+        equalities = build_and_solve(m, s, ws, opt, h)
         rounds += 1
-        ok = answer_holds(m, s, ws, h, include_ccd)
+        ok = answer_holds(m, s, ws, h, include_ccd, equalities)
     if ok:
         gather_contact_impulses(m, s, ws)
     else:
@@ -127,17 +133,20 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
 
 
 @kernel_call
-def settle_positions(m, s, ws, h, opt):
+def settle_positions(m, s, ws, h, opt, rows_held):
     """After the Newton correction: the end-of-step pin gaps and contact depths; where one is
     above a tenth of its audit tolerance, the complementarity projection (it also catches a
-    free contact whose turning body dipped it below the ground). Returns the violations the
-    audit counts at the configuration the step ends at."""
+    free contact whose turning body dipped it below the ground). rows_held: the correction
+    proved its rows within a tenth of the tolerances (audit.worst_violation then skips
+    them). Returns the violations the audit counts at the configuration the step ends at."""
     update_trig(s.q, ws.body_cs)
-    gap, depth = worst_violation(m, s, ws)
+    if rows_held:
+        mark_held_contacts(m, ws)
+    gap, depth = worst_violation(m, s, ws, True, rows_held)
     if gap > 0.1 * PIN_GAP_TOL or depth > 0.1 * DEPTH_TOL:
         project_positions(m, s, ws, h, PROJECTION_ITERS, opt.refine_tol)
         update_trig(s.q, ws.body_cs)
-        gap, depth = worst_violation(m, s, ws)
+        gap, depth = worst_violation(m, s, ws, False, False)
     if gap > PIN_GAP_TOL or depth > DEPTH_TOL:
         return audit_positions(m, s, ws, s.step[0])
     return 0
@@ -184,12 +193,17 @@ def _step(m, s, ws, opt, u):
         # the correction only when the rows may be off by more than refine_tol: a bound of
         # half of it (far above rounding) proves the correction would find nothing to do
         # (bodies at rest, translating), at a few flops per row instead of re-evaluating them
+        held = True
         if opt.refine_iters > 0 and ws.n_row[0] > 0 and not (
                 opt.refine_tol > 0.0 and rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol)):
-            correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol,
-                              opt.refine_pivot_tol)
+            held = correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol,
+                                     opt.refine_pivot_tol) <= opt.refine_tol
         if opt.refine_iters > 0:
-            settle_positions(m, s, ws, h, opt)
+            # rows held to refine_tol are within the audit's tolerances where a point
+            # contact's row is its exact gap (flat or sloped ground; pin rows are exact)
+            held = (held and m.terrain_coef[2] == 0.0
+                    and opt.refine_tol <= ROWS_HELD_SHARE * min(PIN_GAP_TOL, DEPTH_TOL))
+            settle_positions(m, s, ws, h, opt, held)
             bound_correction_work(m, s, ws)
         break
     s.time[0] = ws.prev.time[0] + m.dt
