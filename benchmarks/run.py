@@ -1,4 +1,4 @@
-"""Engine benchmarks of issue 8: `python benchmarks/run.py [scenes] [--csv benchmarks/results]`
+"""Engine benchmarks: `python benchmarks/run.py [scenes] [--csv benchmarks/results]`
 (identical to `planarsim bench`; `--help` lists the options).
 
 The scenes and the runner live in planarsim/bench*.py so that `planarsim bench` runs the same

@@ -1,4 +1,4 @@
-"""Floquet multipliers of the actuated walkers' gaits (issue 9): the Simple Biped and Ranger.
+"""Floquet multipliers of the actuated walkers' gaits: the Simple Biped and Ranger.
 
 Each walker walks from rest until its gait has converged; the section state there (controller
 touchdown for the Simple Biped, controller mid-stance for Ranger; see walkers/*/gait_map.py) is

@@ -1,4 +1,4 @@
-"""Benchmark runner of issue 8: every figure in one run of one command.
+"""Benchmark runner: every benchmark figure in one run of one command.
 
     planarsim bench                        # everything (same as: python benchmarks/run.py)
     planarsim bench chain4 rod_drop        # only these scenes and their peer comparison
@@ -8,7 +8,7 @@
     planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
 
 Parts (each warm after compilation; steps/s = median and min-max of --repeats runs):
-- scenes: the named scenes of bench_scenes.md (chains N = 2..64, rod drop, 7-link biped
+- scenes: the named scenes of bench_scenes.py (chains N = 2..64, rod drop, 7-link biped
   collapse, boxes on hills): first-call time (numba compile or cache load), compiled
   steps/s, real-time factor, Python single-step loop steps/s; accuracy figures of the peer
   scenes; log-log slope of the chains' cost per step against N.
@@ -20,7 +20,7 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
 - batch: 64 Simple Biped walks on 1 and 2 worker threads (planarsim.batch).
 - startup: import-to-first-step times in fresh subprocesses, warm and cold numba cache
   (bench_startup.py says how the cache is made cold).
-Then a table of every issue-8 target with the measured figure, met or not met. Targets are
+Then a table of every benchmark target with the measured figure, met or not met. Targets are
 measured here, never asserted by the tests.
 """
 from __future__ import annotations

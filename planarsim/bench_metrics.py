@@ -19,7 +19,7 @@ import numpy as np
 
 from .bench_scenes import G
 
-#: episode of the timing runs and of the accuracy runs per scene kind [s] (bench_scenes.md)
+#: episode of the timing runs and of the accuracy runs per scene kind [s] (bench_scenes.py)
 ACCURACY_SECONDS = {"chain": 10.0, "biped_collapse": 3.0, "rod_drop": 2.0}
 #: scenes that the peers build (the chains N = 2..64, the biped collapse, the rod drop)
 PEER_SCENES = ("chain2", "chain4", "chain8", "chain16", "chain32", "chain64", "biped_collapse", "rod_drop")
@@ -59,7 +59,7 @@ class SceneSpec:
 
 def spec_from_model(name: str, model, seconds: float) -> SceneSpec:
     """Read a SceneSpec off a planarsim Model built by bench_scenes (boxes from the corner
-    contacts of each body; energy scale of bench_scenes.md for chains, else the potential
+    contacts of each body; energy scale of the bench scenes for chains, else the potential
     energy of the start pose above the lowest body point)."""
     a = model.arrays
     nb = model.n_body
@@ -127,7 +127,7 @@ def accuracy(spec: SceneSpec, q, v) -> dict:
     """Accuracy figures of a recorded run (frame 0 = start, frames every dt).
 
     pin_error_m: largest pin separation; energy_drift: (E_end - E_0) / scale (signed) and
-    energy_err_max: max |E - E_0| / scale (scale of bench_scenes.md); penetration_m: largest
+    energy_err_max: max |E - E_0| / scale (the scene's energy scale); penetration_m: largest
     depth of a box corner below the ground; rest_gap_m: lowest corner height at the end
     (positive: the body hovers). Rod drop adds impact_speed, rebound_speed [m/s] and
     time_to_rest [s] (all speeds of any point below 1 cm/s from then on; nan if never).

@@ -1,4 +1,4 @@
-"""Printing of the benchmark figures and the table of issue-8 targets (met / not met).
+"""Printing of the benchmark figures and the table of benchmark targets (met / not met).
 
 `results` is the dictionary built by bench.main: scenes {name: row}, peers {scene: [rows]},
 walkers {name: row}, batch [rows] or None, startup [rows] or None, slopes.
@@ -60,7 +60,7 @@ def print_scenes(res):
 
 def print_peers(res):
     print("peer comparison, same run (ratio = planarsim steps/s / peer steps/s; energy drift = "
-          "(E_end - E_0) / scale of bench_scenes.md)")
+          "(E_end - E_0) / the scene's energy scale)")
     timing = {}
     for scene, peers in res["peers"].items():
         for r in [res["scenes"][scene]] + peers:
@@ -181,7 +181,7 @@ def _status(ok):
 
 
 def targets(res):
-    """[(target, measured, 'met' | 'NOT MET' | 'not measured')] of every issue-8 target."""
+    """[(target, measured, 'met' | 'NOT MET' | 'not measured')] of every benchmark target."""
     out = []
     scenes, peers = res["scenes"], res["peers"]
     for scene, label, pins in (("biped_collapse", "7-link biped collapse", True), ("rod_drop", "rod drop", False),
@@ -240,7 +240,7 @@ def targets(res):
 
 
 def print_targets(res):
-    print("issue 8 targets (measured in this run)")
+    print("benchmark targets (measured in this run)")
     width = max(len(t) for t, _, _ in res["targets"])
     for target, measured, status in res["targets"]:
         print(f"  {target:{width}s}  {measured:52s} {status}")

@@ -1,4 +1,4 @@
-"""Named benchmark scenes (see ../shared/reference/bench_scenes.md), shared with tests/examples."""
+"""Named benchmark scenes (each peer engine builds the same ones), shared with tests and examples."""
 from __future__ import annotations
 
 import math
@@ -44,7 +44,7 @@ def boxes_on_hills(n=10, dt=1e-3):
 
 
 def biped_collapse(dt=1e-3):
-    """The planar 7-link biped of bench_scenes.md collapsing onto flat ground (no actuators)."""
+    """The planar 7-link biped collapsing onto flat ground (no actuators)."""
     b = ps.ModelBuilder(dt=dt)
     def box_inertia(m, w, h):
         return m * (w * w + h * h) / 12

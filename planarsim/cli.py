@@ -166,8 +166,22 @@ def _plain(v):
     return v
 
 
+def _has_display() -> bool:
+    """Whether an interactive window can open: on Linux a DISPLAY or WAYLAND_DISPLAY, and a
+    matplotlib backend that is not a file-only one (MPLBACKEND=Agg, say)."""
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                 or os.environ.get("WAYLAND_DISPLAY")):
+        return False
+    backend = os.environ.get("MPLBACKEND", "").lower()
+    return backend not in ("agg", "pdf", "ps", "svg", "pgf", "cairo", "template")
+
+
 def cmd_view(args):
     mod = _load_walker(args.walker)
+    if not _has_display():
+        raise UsageError(f"no display to open the viewer on (no DISPLAY, or a file-only "
+                         f"matplotlib backend); use 'planarsim run {args.walker} --out "
+                         f"{args.walker}.gif' to watch it")
     from . import terrain as T
     from .render.viewer import view_walker
     try:
@@ -213,10 +227,18 @@ def cmd_info(args):
 
 
 # parser ---------------------------------------------------------------------------------------
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a bad argument is one line and a pointer to --help (exit 2), not the whole
+    usage first."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
 def make_parser():
-    ap = argparse.ArgumentParser(prog="planarsim", description="Planar physics for walking machines.")
+    ap = _Parser(prog="planarsim", description="Planar physics for walking machines.")
     ap.add_argument("--version", action="version", version=f"planarsim {__version__}")
-    sub = ap.add_subparsers(dest="command", metavar="COMMAND")
+    sub = ap.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     p = sub.add_parser("list", help="walkers, gaits and terrains")
     p.set_defaults(func=cmd_list)

@@ -7,7 +7,7 @@ compiled step fires (non-finite or huge state); it carries the last finite state
 its own audit (kernels/audit.py); it names the step, time, rule, contact or pin and body.
 """
 from .kernels.audit import AUDIT_DEPTH, AUDIT_NAMES, AUDIT_PIN_GAP
-from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS
+from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE_COMMAND
 
 
 class ModelError(ValueError):
@@ -99,12 +99,18 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
     and a copy of the state at the start of that step. Code GUARD_BAD_COMMANDS (-1: commands
-    of the wrong length, nothing stepped) gives a ValueError instead."""
+    of the wrong length) and GUARD_NONFINITE_COMMAND (-2: a NaN or infinite command), where
+    nothing was stepped, give a ValueError instead."""
     if code == GUARD_AUDIT:
         return audit_violation(model, ws, who)
     if code == GUARD_BAD_COMMANDS:
         return ValueError(f"{who}: the commands u have {int(ws.info[2])} entries; the model has "
                           f"{len(model.act_names)} actuators {list(model.act_names)}")
+    if code == GUARD_NONFINITE_COMMAND:
+        k = int(ws.info[2])
+        return ValueError(f"{who}: command u[{k}] for actuator {model.act_names[k]!r} is "
+                          f"{float(ws.guard_value[0])}; commands must be finite (N or N m); "
+                          f"nothing was stepped")
     body = int(ws.info[2])
     field = FIELD_NAMES[int(ws.info[3])]
     value = float(ws.guard_value[0])

@@ -188,7 +188,14 @@ class Simulator:
             done = 0
             chunk = int(control_every)
             while done < n:
-                uk = self._commands(controller(self))
+                uk = controller(self)
+                if uk is None:
+                    raise TypeError(
+                        f"controller {getattr(controller, '__name__', controller)!r} returned None "
+                        f"at t={self.t:.6g} s; it must return the commands u, shape "
+                        f"({self.model.n_act},), one per actuator {list(self.model.act_names)} "
+                        "(did it forget `return`?)")
+                uk = self._commands(uk)
                 todo = min(chunk, n - done)
                 k_before = k
                 code, did, k = self._run_recorded(uk, todo, every, rec, k)

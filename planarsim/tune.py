@@ -147,6 +147,10 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
     if popsize:
         opts["popsize"] = int(popsize)
     es = cma.CMAEvolutionStrategy(z0.tolist(), float(sigma0), opts)
+    if int(budget) < es.popsize:
+        raise ValueError(f"budget {int(budget)} is smaller than one generation of {walker}'s "
+                         f"tuning ({es.popsize} evaluations): nothing would be tuned; give "
+                         f"--budget >= {es.popsize} (or a smaller --popsize)")
     pool, close = _make_executor(executor, scheduler, workers)
     t_start = time.time()
     try:
@@ -194,14 +198,19 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="tuned.json")
     a = ap.parse_args(argv)
     try:
-        mod = objective_module(a.walker)
+        objective_module(a.walker)
     except (KeyError, ValueError) as e:
         print(f"planarsim tune: {e}", file=sys.stderr)
         return 2
     x0 = load_result(a.start).params() if a.start else None
     settings = {"duration": a.duration} if a.duration else None
-    r = tune(a.walker, x0=x0, budget=a.budget, popsize=a.popsize, sigma0=a.sigma0, seed=a.seed,
-             workers=a.workers, scheduler=a.scheduler, out=a.out, settings=settings)
+    try:
+        r = tune(a.walker, x0=x0, budget=a.budget, popsize=a.popsize, sigma0=a.sigma0,
+                 seed=a.seed, workers=a.workers, scheduler=a.scheduler, out=a.out,
+                 settings=settings)
+    except ValueError as e:
+        print(f"planarsim tune: {e}", file=sys.stderr)
+        return 2
     print(json.dumps(dict(start_score=r.start_score, best_score=r.best_score,
                           evaluations=r.evaluations, out=a.out)))
     return 0

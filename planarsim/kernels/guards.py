@@ -9,6 +9,8 @@ GUARD_TOO_LARGE = 2
 GUARD_AUDIT = 3           # the step broke a rule of its own audit (StepOptions.audit_raise = 1)
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[2]:
                           # its length); negative, so that no walker's own return code clashes
+GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[2]: its index,
+                               # ws.guard_value: the value); nothing is stepped
 
 
 @kernel
@@ -27,4 +29,16 @@ def check_guards(s, ws, limit):
                 ws.info[3] = f
                 ws.guard_value[0] = x
                 return bad
+    return GUARD_OK
+
+
+@kernel
+def check_commands(u, ws):
+    """GUARD_NONFINITE_COMMAND if some command u[k] is NaN or infinite (recorded in ws.info[2]
+    and ws.guard_value), else GUARD_OK."""
+    for k in range(u.shape[0]):
+        if not math.isfinite(u[k]):
+            ws.info[2] = k
+            ws.guard_value[0] = u[k]
+            return GUARD_NONFINITE_COMMAND
     return GUARD_OK

@@ -30,7 +30,7 @@ from .audit import (DEPTH_TOL, PIN_GAP_TOL, audit_impulses, audit_positions, aud
 from .complementarity import project_positions, solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, check_guards
+from .guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, check_commands, check_guards
 from .math2d import update_trig
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, predict_configuration, rows_hold_within)
@@ -249,7 +249,11 @@ def _step_c(m, s, ws, opt, u_data, n_u):
     if n_u != m.act_kind.shape[0]:
         ws.info[2] = n_u   # nothing is read or changed: the actuators would read past u
         return GUARD_BAD_COMMANDS
-    return _step(m, s, ws, opt, refs.array_1d(u_data, n_u))
+    u = refs.array_1d(u_data, n_u)
+    code = check_commands(u, ws)
+    if code != 0:
+        return code
+    return _step(m, s, ws, opt, u)
 
 
 def load_step():
@@ -290,8 +294,9 @@ _keep_reload_init_of_cached_code()
 def step(typingctx, m, s, ws, opt, u):
     """step(m, s, ws, opt, u) -> guard code: advance State s by one step of m.dt under actuator
     commands u (float64, C-contiguous, one per actuator). Callable from compiled code.
-    Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), or -1 when u does not have one
-    entry per actuator (then nothing is changed; planarsim.errors.diverged explains any code)."""
+    Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), -1 when u does not have one
+    entry per actuator, -2 when a command is NaN or infinite (for both nothing is changed;
+    planarsim.errors.diverged explains any code)."""
     expected = engine_types()
     for name, got, want in zip(("model", "state", "workspace", "options"), (m, s, ws, opt), expected):
         if got != want:

@@ -51,7 +51,26 @@ def test_negative_duration_is_a_usage_error(capsys):
     with pytest.raises(SystemExit) as e:
         main(["run", "simple-biped", "--duration", "-1"])
     assert e.value.code == 2
-    assert "--duration" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "--duration" in err
+    assert len(err.strip().splitlines()) == 1, err    # one line, not the usage first
+
+
+def test_view_without_a_display_says_so_and_exits_2(monkeypatch, capsys):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    code, out, err = run_cli(capsys, "view", "ranger")
+    assert code == 2
+    assert "no display" in err and "planarsim run ranger" in err
+
+
+def test_tune_refuses_a_budget_below_one_generation(tmp_path, capsys):
+    out = tmp_path / "tuned.json"
+    code, _, err = run_cli(capsys, "tune", "simbicon", "--budget", "3", "--out", str(out))
+    assert code == 2
+    assert "budget 3 is smaller than one generation" in err
+    assert not out.exists()
 
 
 def test_unwritable_output_path(tmp_path, capsys):

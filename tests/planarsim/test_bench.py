@@ -22,7 +22,7 @@ TINY = ["--repeats", "1", "--steps", "20", "--accuracy-seconds", "0.05"]
 def test_scenes_and_peers_print_figures_and_write_csv(tmp_path, capsys):
     assert bench.main(["chain2", "rod_drop", "--parts", "scenes,peers", "--csv", str(tmp_path), *TINY]) == 0
     out = capsys.readouterr().out
-    assert "planarsim scenes" in out and "issue 8 targets" in out
+    assert "planarsim scenes" in out and "benchmark targets" in out
     found, missing = available_peers()
     assert len(found) + len(missing) == len(PEER_MODULES)
     for name in found:
@@ -73,7 +73,7 @@ def test_benchmarks_run_py_is_the_same_command():
     proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "run.py"), "chain2", "--parts", "scenes",
                            "--peers", "none", *TINY], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
-    assert "chain2" in proc.stdout and "issue 8 targets" in proc.stdout
+    assert "chain2" in proc.stdout and "benchmark targets" in proc.stdout
 
 
 @pytest.mark.parametrize("peer", sorted(PEER_MODULES))

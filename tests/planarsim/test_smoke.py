@@ -103,3 +103,31 @@ def test_commands_of_any_layout_and_type_give_the_same_step():
         assert np.array_equal(q, runs[0])
     with pytest.raises(ValueError, match="shape"):
         ps.Simulator(model).step(np.zeros(3))
+
+
+def test_a_controller_that_returns_nothing_is_named():
+    """A Python controller that forgets `return` would run with zero commands: an error."""
+    b = ps.ModelBuilder(dt=1e-3)
+    body = b.add_body("arm", 1.0, 0.1, pos=(0.0, -0.5))
+    b.add_pin("shoulder", None, body, anchor_world=(0.0, 0.0))
+    b.add_pin_motor("motor", "shoulder")
+    sim = ps.Simulator(b.compile())
+
+    def hold(sim):
+        0.0 * sim.t
+    with pytest.raises(TypeError, match="'hold' returned None.*forget `return`"):
+        sim.run(0.01, controller=hold)
+
+
+def test_a_nan_command_is_named_as_a_command_and_nothing_steps():
+    b = ps.ModelBuilder(dt=1e-3)
+    body = b.add_body("arm", 1.0, 0.1, pos=(0.0, -0.5))
+    b.add_pin("shoulder", None, body, anchor_world=(0.0, 0.0))
+    b.add_pin_motor("motor", "shoulder")
+    sim = ps.Simulator(b.compile())
+    before = sim.snapshot()
+    for call in (lambda: sim.step([np.nan]), lambda: sim.steps(3, [np.inf]),
+                 lambda: sim.run(0.01, controller=lambda s: [np.nan])):
+        with pytest.raises(ValueError, match=r"command u\[0\] for actuator 'motor' is (nan|inf)"):
+            call()
+        assert np.array_equal(sim.state.q, before.q) and sim.state.step[0] == before.step[0]

@@ -14,8 +14,7 @@ The seed's step() (run at update_rate = 30 Hz):
     plant began. Without it the puppet "planted" some 10-30 ms before the real feet landed,
     the weight feed-forward was split onto feet still in the air and the other foot of their
     end hopped.
-The seed's walker fell when asked to move forward while stepping. Feedback added here (the
-issue asks to say which):
+The seed's walker fell when asked to move forward while stepping. Feedback added here:
   1. foot placement from body velocity (Raibert): the swing feet's goals are recomputed at every
      update at x_hip + v_cmd t_left + v T_st / 2 + k_v (v - v_cmd), limited to +-lead_max
      around the hip; v is the torso speed measured over the last update period and t_left the

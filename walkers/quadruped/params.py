@@ -1,4 +1,4 @@
-"""Parameters of the planar quadruped (issue 11, seed 003): an A1-like robot dog in the sagittal
+"""Parameters of the planar quadruped: an A1-like robot dog in the sagittal
 plane, its puppet (IK) and its trot controller.
 
 One frozen dataclass; every field carries doc, unit and bounds in its metadata. ``to_array()``
@@ -7,7 +7,7 @@ gives the float64 vector the compiled controller reads through the module-level 
 
 Sources of the robot numbers: the Unitree A1 model of MuJoCo Menagerie
 (google-deepmind/mujoco_menagerie, unitree_a1/a1.xml, derived from Unitree's URDF), and the
-issue's trunk size 0.267 x 0.194 x 0.114 m:
+A1's published trunk size 0.267 x 0.194 x 0.114 m:
   trunk 4.713 kg, I_yy 0.0378 kg m^2; four hip (abduction) housings 0.696 kg each at
   x = +-0.183 m (hip-to-hip 0.366 m); thigh 1.013 kg, COM 0.027 m below the hip,
   I_yy 0.00514 kg m^2, length 0.2 m; calf + foot 0.226 kg, COM 0.132 m below the knee,

@@ -1,4 +1,4 @@
-"""Step-to-step map of the walking Ranger (issue 9), for planarsim.analysis.
+"""Step-to-step map of the walking Ranger, for planarsim.analysis.
 
 Section: the controller's own mid-stance event (controller.choose_programs: the stance leg
 passes vertical in single stance, M_MID_DONE 0 -> 1, and the step-to-step feedback sets this
@@ -17,7 +17,7 @@ stance leg angle is the section condition, it stays at its reference value just 
 The map runs one stride: to the next counted mid-stance of the same stance side. Counted are
 only true crossings (stance leg within CROSS_TOL of vertical): with the shipped controller the
 landing foot bounces, the estimator swaps the stance to the trailing leg for a few ms and the
-mid-stance feedback fires there too, far behind vertical (see the report of issue 9).
+mid-stance feedback fires there too, far behind vertical.
 
 Findings (dt = 1 ms, shipped parameters, engine default StepOptions (cap_policy=1); figures
 from ``python -c "from walkers.ranger.gait_map import RangerGaitMap; ..."``, see the test file):

@@ -1,6 +1,6 @@
 """The SIMBICON character (seed 000, Table 2 / appendix A.1) loaded from its MJCF file.
 
-``legs.xml`` (a copy of ../shared/reference/legs.xml) goes through planarsim.mjcf: 7 rigid
+``legs.xml`` (the thesis' MJCF character, shipped beside this file) goes through planarsim.mjcf: 7 rigid
 bodies (torso with the hip spheres welded on; thigh + knee sphere; shin + ankle sphere; foot,
 per side), 6 pins with the MJCF limits and passive stiffness/damping 5 N m/rad / 5 N m s/rad.
 This module adds, with the public builder only:

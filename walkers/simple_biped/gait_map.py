@@ -1,4 +1,4 @@
-"""Step-to-step map of the walking Simple Biped (issue 9), for planarsim.analysis.
+"""Step-to-step map of the walking Simple Biped, for planarsim.analysis.
 
 Section: the controller's own touchdown (controller.next_state: WALK_SINGLE -> WALK_DOUBLE,
 M_STEPS += 1), taken just after ``control`` made that switch and before the physics step, so
