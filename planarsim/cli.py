@@ -10,6 +10,7 @@ code 2 and one line saying what was wrong and what is allowed; no traceback.
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import math
 import os
@@ -70,7 +71,9 @@ def cmd_list(args):
     print("walkers (gaits):")
     for name in sorted(w.WALKERS):
         try:
-            gaits = ", ".join(w.load(name).GAITS)
+            mod = w.load(name)
+            default = inspect.signature(mod.simulate).parameters["gait"].default
+            gaits = ", ".join(f"{g} (default)" if g == default else g for g in mod.GAITS)
         except Exception as e:  # a broken walker must not hide the others
             gaits = f"unavailable: {e}"
         print(f"  {name:16s} {gaits}")
@@ -95,7 +98,8 @@ def cmd_run(args):
         raise UsageError(f"--dt {args.dt} is too large; use a step of at most 0.01 s (1e-3 is usual)")
     out = args.out
     summary_path = None
-    if out is None and not args.no_animation:
+    # --json alone is for scripts: the summary, nothing rendered (ask with --out for a file)
+    if out is None and not args.no_animation and not args.json:
         Path("out").mkdir(exist_ok=True)
         out = f"out/{args.walker}.gif"
         summary_path = Path(f"out/{args.walker}_summary.json")
@@ -115,7 +119,6 @@ def cmd_run(args):
         print(f"running {args.walker} for {args.duration:g} s ...", file=sys.stderr, flush=True)
     traj, summary, model = mod.simulate(**kw)
     wall = time.perf_counter() - t0
-    import inspect
     default_gait = inspect.signature(mod.simulate).parameters["gait"].default
     own = {"walker": args.walker, "gait": args.gait or default_gait,
            "terrain": args.terrain or "default", "duration_s": args.duration}
@@ -244,12 +247,14 @@ def make_parser():
     p.set_defaults(func=cmd_list)
     p = sub.add_parser("run", help="simulate a walker; write animation, plots, data, summary")
     p.add_argument("walker", help="walker name (see 'planarsim list')")
-    p.add_argument("--gait", default=None, help="gait (default: the walker's first)")
+    p.add_argument("--gait", default=None,
+                   help="gait (default: the walker's default, marked in 'planarsim list')")
     p.add_argument("--terrain", default=None, help="flat | slope:DEG | hills | hills:A,L[,PHI][;...]")
     p.add_argument("--duration", type=_positive, default=10.0, help="simulated seconds (default 10)")
     p.add_argument("--dt", type=_positive, default=None, help="step size [s] (default: walker's)")
     p.add_argument("--out", default=None, help="animation .gif | .mp4 | .html (default out/WALKER.gif)")
-    p.add_argument("--no-animation", action="store_true", help="skip the default animation")
+    p.add_argument("--no-animation", action="store_true",
+                   help="skip the default animation (out/WALKER.gif; --json alone skips it too)")
     p.add_argument("--fps", type=_positive, default=20.0, help="animation frames per second")
     p.add_argument("--speed", type=_positive, default=1.0, help="playback speed (0.25 slow motion)")
     p.add_argument("--plot", default=None, help="summary plot .png | .svg | .pdf")

@@ -102,3 +102,18 @@ def test_list_and_info(capsys):
     assert code == 0 and "simple-biped" in out and "slope:DEG" in out
     code, out, err = run_cli(capsys, "info")
     assert code == 0 and "numba" in out
+
+
+def test_json_alone_renders_nothing(tmp_path, monkeypatch, capsys):
+    """--json without --out is for scripts: the summary only, no default animation written."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, "run", "simple-biped", "--duration", "0.2", "--json")
+    assert code == 0, err
+    assert json.loads(out)["files"] == []
+    assert not (tmp_path / "out").exists()
+
+
+def test_list_marks_each_walkers_default_gait(capsys):
+    code, out, _ = run_cli(capsys, "list")
+    assert code == 0
+    assert "stand, walk (default), jump" in out      # the Simple Biped walks by default
