@@ -24,10 +24,15 @@ from .terrain import Terrain, flat
 PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
 
 
+def _who(kind, name, idx):
+    """How errors name an element: "pin 'knee' (2)", or "box shape (3)" for unnamed ones."""
+    return f"{kind} ({idx})" if name is None else f"{kind} {name!r} ({idx})"
+
+
 def _finite(kind, name, idx, fieldname, value):
     arr = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(arr)):
-        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={value} must be finite")
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value} must be finite")
     return arr
 
 
@@ -35,7 +40,7 @@ def _vec2(kind, name, idx, fieldname, value):
     try:
         arr = np.asarray(value, dtype=np.float64).reshape(2)
     except (TypeError, ValueError):
-        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={value!r} must be a pair (x, y)") from None
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value!r} must be a pair (x, y)") from None
     return _finite(kind, name, idx, fieldname, arr)
 
 
@@ -43,10 +48,38 @@ def _scalar(kind, name, idx, fieldname, value):
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={value!r} must be a number") from None
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value!r} must be a number") from None
     if not math.isfinite(x):
-        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={x} must be finite")
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={x} must be finite")
     return x
+
+
+def _length(kind, name, idx, fieldname, value, zero_ok=False):
+    """A size [m]: finite and > 0 (>= 0 if zero_ok)."""
+    x = _scalar(kind, name, idx, fieldname, value)
+    if x < 0 or (x == 0 and not zero_ok):
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={x} must be {'>= 0' if zero_ok else '> 0'}")
+    return x
+
+
+SHAPE_PARAMS = {"capsule": ("p0", "p1", "radius"), "circle": ("center", "radius"),
+                "box": ("center", "width", "height", "angle")}  # box: angle optional
+
+
+def _check_shape(kind, idx, params):
+    """Parameters of a drawing shape: points (x, y) [m], radius [m] >= 0, box width and
+    height [m] > 0, angle [rad]; all finite."""
+    fields = SHAPE_PARAMS[kind]
+    what = f"{kind} shape"
+    if not (len(fields) - (kind == "box") <= len(params) <= len(fields)):
+        raise ModelError(f"{_who(what, None, idx)}: params={params!r} must be ({', '.join(fields)})")
+    for f, p in zip(fields, params):
+        if f in ("p0", "p1", "center"):
+            _vec2(what, None, idx, f, p)
+        elif f == "angle":
+            _scalar(what, None, idx, f, p)
+        else:
+            _length(what, None, idx, f, p, zero_ok=f == "radius")
 
 
 class ModelBuilder:
@@ -81,13 +114,13 @@ class ModelBuilder:
             return -1
         if isinstance(body, str):
             if body not in self._names["body"]:
-                raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={body!r} names no body")
+                raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={body!r} names no body")
             return self._names["body"][body]
         if isinstance(body, (int, np.integer)) and 0 <= body < len(self._bodies):
             return int(body)
         if isinstance(body, (int, np.integer)) and body == -1 and allow_world:
             return -1
-        raise ModelError(f"{kind} {name!r} ({idx}): {fieldname}={body!r} is not a body id "
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={body!r} is not a body id "
                          f"(0..{len(self._bodies) - 1}){' or None for the world' if allow_world else ''}")
 
     # bodies ---------------------------------------------------------------------------------
@@ -111,25 +144,31 @@ class ModelBuilder:
         return idx
 
     def add_point_mass(self, name, mass, pos=(0.0, 0.0), vel=(0.0, 0.0), radius=None) -> int:
-        """Point mass [kg] > 0 at pos [m]: no rotational degree of freedom, takes no torque."""
+        """Point mass [kg] > 0 at pos [m]: no rotational degree of freedom, takes no torque.
+        radius [m] >= 0 is only drawn (default: grows with the cube root of the mass)."""
         idx = len(self._bodies)
         self._register("body", name, idx)
         mass = _scalar("body", name, idx, "mass", mass)
         if not mass > 0:
             raise ModelError(f"body {name!r} ({idx}): mass={mass} must be finite and > 0")
+        r = (0.04 * (mass / 1.0) ** (1 / 3) if radius is None
+             else _length("body", name, idx, "radius", radius, zero_ok=True))
         q = np.r_[_vec2("body", name, idx, "pos", pos), 0.0]
         v = np.r_[_vec2("body", name, idx, "vel", vel), 0.0]
         self._bodies.append(dict(name=name, mass=mass, inertia=0.0, q=q, v=v, point=True))
-        r = radius if radius is not None else 0.04 * (mass / 1.0) ** (1 / 3)
-        self._shapes.append(M.Shape(idx, "circle", ((0.0, 0.0), float(r))))
+        self._shapes.append(M.Shape(idx, "circle", ((0.0, 0.0), r)))
         return idx
 
     def add_shape(self, body, kind, *params):
         """Drawing shape on a body: ('capsule', p0, p1, radius) | ('box', center, w, h[, angle])
-        | ('circle', center, radius); local frame, metres. Shapes do not collide."""
-        if kind not in ("capsule", "box", "circle"):
+        | ('circle', center, radius); local frame, metres. Shapes do not collide. `body` is a
+        body id or name; radii must be >= 0, box sides > 0 (SHAPE_PARAMS, _check_shape)."""
+        if kind not in SHAPE_PARAMS:
             raise ModelError(f"shape on body {body}: kind={kind!r} must be capsule, box or circle")
-        self._shapes.append(M.Shape(int(body), kind, tuple(params)))
+        idx = len(self._shapes)
+        bid = self._body_id(f"{kind} shape", None, idx, "body", body)
+        _check_shape(kind, idx, params)
+        self._shapes.append(M.Shape(bid, kind, tuple(params)))
 
     # world <-> local ------------------------------------------------------------------------
     def _local(self, body, p_world):
@@ -269,15 +308,20 @@ class ModelBuilder:
 
     def add_box_contacts(self, name, body, center, width, height, mu=1.0, angle=0.0) -> list:
         """Four corner point contacts of a box (local centre [m], width x height [m]).
-        Returns the four contact ids, named ``name/0..3``; also draws the box."""
-        c = np.asarray(center, dtype=np.float64)
+        Returns the four contact ids, named ``name/0..3``; also draws the box. width and
+        height must be > 0."""
+        idx = len(self._contacts)
+        c = _vec2("box", name, idx, "center", center)
+        width = _length("box", name, idx, "width", width)
+        height = _length("box", name, idx, "height", height)
+        angle = _scalar("box", name, idx, "angle", angle)
         ca, sa = math.cos(angle), math.sin(angle)
         ids = []
         for i, (sx, sy) in enumerate(((-1, -1), (1, -1), (1, 1), (-1, 1))):
             lx, ly = 0.5 * width * sx, 0.5 * height * sy
             ids.append(self.add_point_contact(f"{name}/{i}", body,
                                               (c[0] + ca * lx - sa * ly, c[1] + sa * lx + ca * ly), mu))
-        self.add_shape(self._contacts[ids[0]]["body"], "box", tuple(c), float(width), float(height), float(angle))
+        self.add_shape(self._contacts[ids[0]]["body"], "box", tuple(c), width, height, angle)
         return ids
 
     # actuators ------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from .kernels.refs import TableHandle
 from .kernels.step import StepArgs, run_recorded, run_steps
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
-from .state import State, Workspace, make_state, make_workspace
+from .state import State, Workspace, check_state, make_state, make_workspace
 from .trajectory import Trajectory, make_recorder
 
 
@@ -96,13 +96,11 @@ class Simulator:
 
     @state.setter
     def state(self, value: State) -> None:
-        """Copy `value` into the simulator's own state arrays (shapes must match the model)."""
+        """Copy `value` into the simulator's own state arrays; a state that does not fit the
+        model (state.check_state: shapes, finite numbers, codes in range) raises ValueError."""
         if not isinstance(value, State):
             raise TypeError(f"state must be a planarsim State, got {type(value).__name__}")
-        for name, mine, theirs in zip(State._fields, self._state, value):
-            theirs = np.asarray(theirs)
-            if theirs.shape != mine.shape:
-                raise ValueError(f"state.{name} has shape {theirs.shape}; this model needs {mine.shape}")
+        check_state(value, self._model)
         self._state.restore(value)
 
     # commands -------------------------------------------------------------------------------
@@ -219,7 +217,8 @@ class Simulator:
         return self.state.copy()
 
     def restore(self, snap: State) -> None:
-        self.state.restore(snap)
+        """Continue from `snap` (checked as the `state` setter checks it)."""
+        self.state = snap
 
     def set_contact_enabled(self, contact, enabled: bool) -> None:
         i = self.model.contact(contact) if isinstance(contact, str) else int(contact)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .state import State
+from .state import State, check_state
 from .trajectory import atomic_write, read_npz
 
 SNAPSHOT_VERSION = 2   # 2: the State holds the last step's impulses
@@ -29,8 +29,11 @@ def save_snapshot(path, state: State, memory: dict | None = None) -> Path:
     return path
 
 
-def load_snapshot(path):
-    """Read a snapshot: returns (State, memory dict). Clear errors for damaged files."""
+def load_snapshot(path, model=None):
+    """Read a snapshot: returns (State, memory dict). Clear errors for damaged files; a state
+    whose arrays disagree in shape (or, given `model`, do not fit it), hold NaN or infinite
+    numbers or codes out of range raises ValueError naming the file and the field
+    (state.check_state)."""
     path = Path(path)
     data = read_npz(path, "snapshot")
     version = int(data.get("snapshot_version", -1))
@@ -41,5 +44,6 @@ def load_snapshot(path):
     if missing:
         raise ValueError(f"{path}: snapshot is missing state arrays {missing}")
     state = State(*(np.array(data[f"state__{k}"]) for k in State._fields))
+    check_state(state, model, what=f"{path}: snapshot state")
     memory = {k[8:]: v for k, v in data.items() if k.startswith("memory__")}
     return state, memory

@@ -64,6 +64,79 @@ class State(NamedTuple):
         return cls(*(np.array(d[name]) for name in cls._fields))
 
 
+STATE_DIMS = dict(  # shape of each State array; strings are the model's sizes
+    q=("n_body", 3), v=("n_body", 3), time=(1,), step=(1,), contact_mode=("n_contact",),
+    contact_slip=("n_contact",), contact_enabled=("n_contact",), limit_active=("n_pin", 2),
+    mode_cursor=(1,), ext_force=("n_body", 3), last_contact_impulse=("n_contact", 2),
+    last_pin_impulse=("n_pin", 4), last_rod_impulse=("n_rod",))
+
+# fields holding codes, not quantities: the values each may take and the rule's words
+_STATE_CODES = dict(
+    contact_mode=((0, 1, 2), "must be 0 (free), 1 (pinned) or 2 (sliding)"),
+    contact_enabled=((0, 1), "must be 0 or 1"),
+    limit_active=((0, 1), "must be 0 or 1"),
+    contact_slip=((-1, 0, 1), "must be -1 or +1 (0: sliding solved without friction)"))
+
+# the element that index 0 of a field counts (named in errors when the model is known)
+_STATE_ELEMENT = dict(q="body", v="body", ext_force="body", contact_mode="contact",
+                      contact_slip="contact", contact_enabled="contact",
+                      last_contact_impulse="contact", limit_active="pin", last_pin_impulse="pin",
+                      last_rod_impulse="rod")
+
+
+def check_shapes(arrays, dims, what, sizes=None) -> dict:
+    """Raise ValueError unless each arrays[name] has the shape dims[name] (ints: fixed sizes,
+    strings: sizes shared by the arrays, taken from `sizes`, else from the first array that
+    has them). The message names `what`.name, its shape and the one wanted. Returns the sizes."""
+    sizes = dict(sizes or {})
+    for name, want in dims.items():
+        shape = np.shape(arrays[name])
+        known = dict(sizes)
+        if len(shape) == len(want):
+            for d, n in zip(want, shape):
+                if isinstance(d, str):
+                    sizes.setdefault(d, n)
+        if len(shape) != len(want) or any(sizes.get(d, d) != n for d, n in zip(want, shape)):
+            spec = ", ".join(f"{d}={known[d]}" if d in known else str(d) for d in want)
+            spec += "," if len(want) == 1 else ""
+            raise ValueError(f"{what}.{name} has shape {shape}; it must be ({spec})")
+    return sizes
+
+
+def check_state(state, model: Model | None = None, what: str = "state") -> None:
+    """Raise ValueError naming the field, index and value (and the body, contact, pin or rod
+    when `model` is given) unless `state` is one the step can take: shapes as STATE_DIMS (the
+    model's sizes, or sizes the arrays agree on), finite numbers [SI units], codes as
+    _STATE_CODES, step an integer >= 0, mode_cursor in 0..n_contact-1 (0 without contacts),
+    and, with a model, no active limit on a side where the pin has none."""
+    arrays = dict(zip(State._fields, state))
+    sizes = None if model is None else dict(n_body=model.n_body, n_contact=model.n_contact,
+                                            n_pin=model.n_pin, n_rod=model.n_rod)
+    sizes = check_shapes(arrays, STATE_DIMS, what, sizes)
+    nc = sizes["n_contact"]
+    rules = {name: (lambda a, v=values: np.isin(a, v), words)
+             for name, (values, words) in _STATE_CODES.items()}
+    rules["step"] = (lambda a: (a >= 0) & (a == np.floor(a)), "must be an integer >= 0")
+    rules["mode_cursor"] = (lambda a: (a >= 0) & (a < max(nc, 1)) & (a == np.floor(a)),
+                            f"must be in 0..{nc - 1}" if nc else "must be 0 (no contacts)")
+    for name, a in arrays.items():
+        a = np.asarray(a)
+        if a.dtype.kind not in "biuf":
+            raise ValueError(f"{what}.{name} has dtype {a.dtype}; it must hold numbers")
+        test, words = rules.get(name, (np.isfinite, "must be finite"))
+        ok = test(a)
+        if name == "limit_active" and model is not None and np.all(ok):
+            ok = (a == 0) | np.isfinite(model.arrays.pin_limit)
+            words = "must be 0: the pin has no limit on that side"
+        if not np.all(ok):
+            i = tuple(int(k) for k in np.argwhere(~ok)[0])
+            who = ""
+            if model is not None and name in _STATE_ELEMENT:
+                kind = _STATE_ELEMENT[name]
+                who = f" ({kind} {getattr(model, kind + '_names')[i[0]]!r})"
+            raise ValueError(f"{what}.{name}[{', '.join(map(str, i))}]={a[i].item()}{who} {words}")
+
+
 def make_state(model: Model, q=None, v=None) -> State:
     """Initial State of `model` (build pose and velocities unless q, v are given)."""
     nb, nc, npin = model.n_body, model.n_contact, model.n_pin

@@ -14,7 +14,14 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .state import check_shapes
+
 FORMAT_VERSION = 1
+
+FRAME_DIMS = dict(  # shape of each per-frame array of a Trajectory (K frames)
+    t=("K",), q=("K", "n_body", 3), v=("K", "n_body", 3), contact_mode=("K", "n_contact"),
+    contact_impulse=("K", "n_contact", 2), contact_point=("K", "n_contact", 2),
+    act_u=("K", "n_act"), act_power=("K", "n_act"))
 
 
 class Recorder(NamedTuple):
@@ -119,6 +126,8 @@ class Trajectory:
 
     @classmethod
     def load(cls, path) -> "Trajectory":
+        """Read a .npz written by save. ValueError naming the file for a damaged file, another
+        format version, missing arrays, or arrays whose shapes disagree (FRAME_DIMS)."""
         path = Path(path)
         data = read_npz(path, "trajectory")
         version = int(data.get("format_version", -1))
@@ -128,6 +137,7 @@ class Trajectory:
         missing = [k for k in cls._ARRAYS if k not in data]
         if missing:
             raise ValueError(f"{path}: trajectory is missing arrays {missing}")
+        check_shapes(data, FRAME_DIMS, f"{path}: trajectory")
         return cls(**{k: data[k] for k in cls._ARRAYS},
                    body_names=tuple(data["body_names"].tolist()),
                    contact_names=tuple(data["contact_names"].tolist()),

@@ -1,0 +1,204 @@
+"""Inputs that were accepted silently now raise an error naming the culprit: ModelError for
+model-building mistakes, ValueError for data files and states."""
+import math
+
+import numpy as np
+import pytest
+
+import planarsim as ps
+from planarsim import ModelError
+
+NAN = float("nan")
+
+
+def base():
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_body("torso", mass=10.0, inertia=1.0, pos=(0.0, 1.0))
+    return b
+
+
+def resting_rod():
+    """A 1 m rod lying on flat ground on two end contacts, with an arm pinned to it (a lower
+    limit, no upper one) and a point mass held by a rod on the arm: the State has contacts,
+    a pin and a rod."""
+    b = ps.ModelBuilder(dt=1e-3)
+    rod = b.add_body("rod", 1.0, 1.0 / 12, pos=(0.0, 0.0))
+    b.add_point_contact("left", rod, (-0.5, 0.0))
+    b.add_point_contact("right", rod, (0.5, 0.0))
+    arm = b.add_body("arm", 0.1, 0.01, pos=(0.0, 0.3))
+    b.add_pin("hinge", rod, arm, anchor_world=(0.0, 0.1), limit=(-1.0, math.inf))
+    bob = b.add_point_mass("bob", 0.1, pos=(0.0, 0.6))
+    b.add_rod("link", arm, bob, anchor_a=(0.0, 0.2))
+    return b.compile()
+
+
+# 1. point-mass and shape radii ----------------------------------------------------------------
+@pytest.mark.parametrize("radius", [-0.05, NAN])
+@pytest.mark.parametrize("where", ["point_mass", "circle", "capsule"])
+def test_negative_or_nan_radius(where, radius):
+    b = base()
+    with pytest.raises(ModelError, match=r"radius=(-0\.05|nan) must be") as e:
+        if where == "point_mass":
+            b.add_point_mass("foot", 1.0, radius=radius)
+        elif where == "circle":
+            b.add_shape("torso", "circle", (0.0, 0.0), radius)
+        else:
+            b.add_shape(0, "capsule", (0.0, 0.0), (0.0, -0.5), radius)
+    assert ("'foot'" if where == "point_mass" else f"{where} shape") in str(e.value)
+
+
+# 2. box sizes ---------------------------------------------------------------------------------
+@pytest.mark.parametrize("width, height, bad", [(0.0, 0.2, "width=0.0"), (-0.4, 0.2, "width=-0.4"),
+                                                (0.4, 0.0, "height=0.0"), (0.4, NAN, "height=nan")])
+@pytest.mark.parametrize("where", ["contacts", "shape"])
+def test_box_of_zero_negative_or_nan_size(where, width, height, bad):
+    b = base()
+    if where == "contacts":
+        with pytest.raises(ModelError, match=rf"box 'feet' \(0\): {bad} must be"):
+            b.add_box_contacts("feet", "torso", (0.0, -0.5), width, height)
+        assert b._contacts == [], "no corner contact may be left behind"
+    else:
+        with pytest.raises(ModelError, match=rf"box shape .*: {bad} must be"):
+            b.add_body("leg", 1.0, 0.1, shapes=[("box", (0.0, 0.0), width, height)])
+
+
+# 3. shapes on missing bodies ------------------------------------------------------------------
+@pytest.mark.parametrize("body, pattern", [(7, r"body=7 is not a body id \(0\.\.0\)"),
+                                           (-1, r"body=-1 is not a body id"),
+                                           ("shin", r"body='shin' names no body")])
+def test_shape_on_a_missing_body(body, pattern):
+    b = base()
+    with pytest.raises(ModelError, match=r"circle shape \(0\): " + pattern):
+        b.add_shape(body, "circle", (0.0, 0.0), 0.1)
+    assert b.compile().shapes == ()
+
+
+# 4. trajectory files --------------------------------------------------------------------------
+@pytest.mark.parametrize("damage, pattern", [
+    (lambda d: d.update(q=d["q"][:, :, 0]), r"trajectory\.q has shape \(\d+, 2\); it must be \(K=\d+, n_body, 3\)"),
+    (lambda d: d.update(q=d["q"].reshape(-1)), r"trajectory\.q has shape \(\d+,\); it must be"),
+    (lambda d: d.update(v=d["v"][:-1]), r"trajectory\.v has shape \((\d+), 2, 3\); it must be \(K=(?!\1)\d+, n_body=2, 3\)"),
+    (lambda d: d.update(t=d["t"][:-2]), r"trajectory\.q has shape .*; it must be \(K=\d+, n_body, 3\)"),
+    (lambda d: d.update(act_u=d["act_u"][:3]), r"trajectory\.act_u has shape \(3, 1\)"),
+])
+def test_trajectory_file_with_bad_shapes(tmp_path, damage, pattern):
+    b = base()
+    b.add_body("leg", 1.0, 0.1, pos=(0.0, 0.5))
+    b.add_pin("hip", "torso", "leg", anchor_world=(0.0, 0.75))
+    b.add_pin_motor("hip_motor", "hip")
+    traj = ps.Simulator(b.compile()).run(0.01, u=[0.0])
+    path = traj.save(tmp_path / "t.npz")
+    data = dict(np.load(path))
+    damage(data)
+    np.savez(path, **data)
+    with pytest.raises(ValueError, match=r"t\.npz: " + pattern):
+        ps.Trajectory.load(path)
+
+
+# 5. states handed in by a user ----------------------------------------------------------------
+def _reshape(a):
+    return np.zeros((a.shape[0] + 1,) + a.shape[1:], a.dtype)
+
+
+BAD_VALUES = [  # (field, change, the words of the error)
+    ("contact_mode", lambda a: a.__setitem__(1, 7), r"contact_mode\[1\]=7 .*must be 0 \(free\), 1 \(pinned\) or 2"),
+    ("contact_mode", lambda a: a.__setitem__(0, -1), r"contact_mode\[0\]=-1 "),
+    ("contact_enabled", lambda a: a.__setitem__(0, 2), r"contact_enabled\[0\]=2 .*must be 0 or 1"),
+    ("limit_active", lambda a: a.__setitem__((0, 1), 5), r"limit_active\[0, 1\]=5 .*must be 0 or 1"),
+    ("limit_active", lambda a: a.__setitem__((0, 1), 1),
+     r"limit_active\[0, 1\]=1 \(pin 'hinge'\) must be 0: the pin has no limit on that side"),
+    ("contact_slip", lambda a: a.__setitem__(1, 0.5), r"contact_slip\[1\]=0.5 .*must be -1 or \+1"),
+    ("mode_cursor", lambda a: a.__setitem__(0, 2), r"mode_cursor\[0\]=2 must be in 0\.\.1"),
+    ("mode_cursor", lambda a: a.__setitem__(0, -1), r"mode_cursor\[0\]=-1 must be in 0\.\.1"),
+    ("step", lambda a: a.__setitem__(0, -3), r"step\[0\]=-3 must be an integer >= 0"),
+    ("q", lambda a: a.__setitem__((1, 2), np.nan), r"q\[1, 2\]=nan .*must be finite"),
+    ("v", lambda a: a.__setitem__((0, 0), np.inf), r"v\[0, 0\]=inf .*must be finite"),
+    ("time", lambda a: a.__setitem__(0, np.nan), r"time\[0\]=nan must be finite"),
+    ("ext_force", lambda a: a.__setitem__((2, 1), -np.inf), r"ext_force\[2, 1\]=-inf .*must be finite"),
+    ("last_contact_impulse", lambda a: a.__setitem__((0, 0), np.nan), r"last_contact_impulse\[0, 0\]=nan"),
+    ("last_pin_impulse", lambda a: a.__setitem__((0, 3), np.inf), r"last_pin_impulse\[0, 3\]=inf"),
+    ("last_rod_impulse", lambda a: a.__setitem__(0, np.nan), r"last_rod_impulse\[0\]=nan"),
+]
+# Simulator(state=) and the setter checked shapes already; restore and snapshots did not
+BAD_SHAPES = [
+    ("q", _reshape, r"q has shape \(4, 3\)"),
+    ("contact_mode", lambda a: a[:1], r"contact_mode has shape \(1,\)"),
+    ("last_contact_impulse", lambda a: a[:, :1], r"last_contact_impulse has shape \(2, 1\)"),
+    ("last_pin_impulse", lambda a: a[:, :2], r"last_pin_impulse has shape \(1, 2\)"),
+    ("last_rod_impulse", _reshape, r"last_rod_impulse has shape \(2,\)"),
+]
+
+
+def _bad_state(model, field, change):
+    sim = ps.Simulator(model)
+    sim.run(0.05)
+    state = sim.snapshot()
+    arr = getattr(state, field)
+    out = change(arr)
+    return state._replace(**{field: out}) if out is not None else state
+
+
+CASES = ([(entry, *case) for entry in ("init", "setter", "restore", "load_snapshot")
+          for case in BAD_VALUES]
+         + [(entry, *case) for entry in ("restore", "load_snapshot") for case in BAD_SHAPES])
+
+
+@pytest.mark.parametrize("entry, field, change, pattern", CASES,
+                         ids=[f"{e}-{f}-{i}" for i, (e, f, _, _) in enumerate(CASES)])
+def test_bad_state_is_refused(tmp_path, entry, field, change, pattern):
+    model = resting_rod()
+    bad = _bad_state(model, field, change)
+    sim = ps.Simulator(model)
+    before = sim.snapshot()
+    with pytest.raises(ValueError, match=r"state\." + pattern):
+        if entry == "init":
+            ps.Simulator(model, state=bad)
+        elif entry == "setter":
+            sim.state = bad
+        elif entry == "restore":
+            sim.restore(bad)
+        else:
+            ps.load_snapshot(ps.save_snapshot(tmp_path / "s.npz", bad), model)
+    for a, b in zip(sim.state, before):   # a refused state leaves the simulator unchanged
+        assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("field, change, pattern", [
+    ("contact_mode", lambda a: a.__setitem__(1, 7), r"s\.npz: snapshot state\.contact_mode\[1\]=7 must be"),
+    ("mode_cursor", lambda a: a.__setitem__(0, 2), r"s\.npz: snapshot state\.mode_cursor\[0\]=2 must be in 0\.\.1"),
+    ("contact_slip", lambda a: a[:1], r"s\.npz: snapshot state\.contact_slip has shape \(1,\); it must be \(n_contact=2,\)"),
+])
+def test_snapshot_without_a_model_checks_itself(tmp_path, field, change, pattern):
+    """Without a model, a snapshot's arrays must agree with each other (sizes from the first
+    array that has them: q, contact_mode, limit_active, last_rod_impulse)."""
+    bad = _bad_state(resting_rod(), field, change)
+    with pytest.raises(ValueError, match=pattern):
+        ps.load_snapshot(ps.save_snapshot(tmp_path / "s.npz", bad))
+
+
+def test_bad_state_names_the_contact():
+    model = resting_rod()
+    bad = _bad_state(model, "contact_mode", lambda a: a.__setitem__(1, 7))
+    with pytest.raises(ValueError, match=r"state\.contact_mode\[1\]=7 \(contact 'right'\)"):
+        ps.Simulator(model).state = bad
+
+
+def test_valid_states_still_pass(tmp_path):
+    """Legal states (every mode, disabled contacts, active limits, slip 0 of the frictionless
+    rule, a cursor on the last contact) are taken as before, from a file too."""
+    model = resting_rod()
+    sim = ps.Simulator(model)
+    sim.run(0.05)
+    state = sim.snapshot()
+    state.contact_mode[:] = (2, 0)
+    state.contact_slip[:] = (0.0, -1.0)
+    state.contact_enabled[:] = (0, 1)
+    state.limit_active[0] = (1, 0)
+    state.mode_cursor[0] = 1
+    loaded, _ = ps.load_snapshot(ps.save_snapshot(tmp_path / "s.npz", state))
+    sim.restore(loaded)
+    sim.state = state
+    ps.Simulator(model, state=state).steps(10)
+    free = ps.ModelBuilder()
+    free.add_point_mass("ball", 1.0, radius=0.0)   # a radius of 0 only draws nothing
+    assert ps.Simulator(free.compile()).state.mode_cursor[0] == 0
