@@ -21,7 +21,7 @@ from .contacts import MODE_FREE, MODE_PINNED
 from .math2d import update_trig
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
                    ROW_PIN_Y, eval_rows, move_row)
-from .solve import apply_impulses, assemble, factor_solve, row_dot, substitute
+from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 
 
 # SHAKE's regime: the correction's velocity change dv is at most this share of the velocity
@@ -207,6 +207,9 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
     n = ws.n_row[0]
     if n == 0:
         return 0.0
+    # the envelope of the rows as they are now (keep_correction_rows compacted them; after a
+    # complementarity solve they are not the rows the guess's solve had)
+    compute_envelope(ws, n, s.q.shape[0])
     worst = max_residual(m, s, ws)
     ptol = pivot_tol
     for _ in range(iters):

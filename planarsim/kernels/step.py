@@ -74,7 +74,7 @@ def copy_state(src, dst):
 
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
-PROJECTION_ITERS = 8
+PROJECTION_ITERS = 20
 # rows held to refine_tol count as within the audit's tolerances when refine_tol is at most
 # this share of them (a pin's gap is at most sqrt(2) times its rows' errors; the settling
 # threshold is a tenth of the tolerance)
