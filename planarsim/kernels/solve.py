@@ -275,10 +275,10 @@ def fill_row_b(ws, h, n):
 
 
 @kernel_inline
-def solve_impulses(m, ws, h, tol, symmetric):
+def solve_impulses(m, ws, h, tol, symmetric, warm):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
-    The solve starts from ws.lam_start (warm_start.py): it finds the change from there, so a
-    dependent row (dropped) keeps its starting impulse.
+    With warm, the solve starts from ws.lam_start (warm_start.py): it finds the change from
+    there, so a dependent row (dropped) keeps its starting impulse.
     symmetric: F = J (no sliding contact), so J W F^T is symmetric (L D L^T on its lower half)."""
     n = ws.n_row[0]
     for i in range(ws.v_new.shape[0]):
@@ -289,17 +289,22 @@ def solve_impulses(m, ws, h, tol, symmetric):
     compute_envelope(ws, n, ws.v_new.shape[0])
     assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     fill_row_b(ws, h, n)
-    apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
-    for r in range(n):
-        # w = A lam + b at the start: b + J (v_new - v*)
-        ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
-                      - row_dot(ws, r, ws.row_J, ws.v_pred))
+    if warm:
+        apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
+        for r in range(n):
+            # w = A lam + b at the start: b + J (v_new - v*)
+            ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
+                          - row_dot(ws, r, ws.row_J, ws.v_pred))
+    else:
+        for r in range(n):
+            ws.rhs[r] = -ws.row_b[r]
     if symmetric:
         dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
         substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
     else:
         dropped = factor_solve(ws, ws.rhs, ws.lam, n, tol)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
-    for r in range(n):
-        ws.lam[r] += ws.lam_start[r]
+    if warm:
+        for r in range(n):
+            ws.lam[r] += ws.lam_start[r]
     return dropped

@@ -88,8 +88,8 @@ def build_and_solve(m, s, ws, opt, h):
     row was dropped, or the system was not symmetric). A call (one copy of its code for both solves of solve_modes): its
     work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
-    start_impulses(s, ws, ws.n_row[0])
-    dropped = solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0)
+    warm = start_impulses(s, ws, ws.n_row[0])
+    dropped = solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0, warm)
     return dropped > 0 or sliding > 0
 
 
@@ -139,6 +139,8 @@ def settle_positions(m, s, ws, h, opt, rows_held):
     free contact whose turning body dipped it below the ground). rows_held: the correction
     proved its rows within a tenth of the tolerances (audit.worst_violation then skips
     them). Returns the violations the audit counts at the configuration the step ends at."""
+    if rows_held and m.contact_body.shape[0] == 0:
+        return 0        # joints held, nothing else to check
     update_trig(s.q, ws.body_cs)
     if rows_held:
         mark_held_contacts(m, ws)

@@ -16,7 +16,16 @@ from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW
 @kernel
 def start_impulses(s, ws, n):
     """ws.lam_start[:n]: each row's impulse in the last step (0 where it had none). A sliding
-    contact's single row (impulse lambda_n along n - mu s t) starts at lambda_n."""
+    contact's single row (impulse lambda_n along n - mu s t) starts at lambda_n. Returns
+    False (and starts nothing) when no row is a contact or limit: joint rows alone have one
+    answer, so where the solve starts cannot matter."""
+    unilateral = False
+    for r in range(n):
+        if ws.row_kind[r] >= ROW_LIMIT_LO:
+            unilateral = True
+            break
+    if not unilateral:
+        return False
     for r in range(n):
         o = ws.row_owner[r]
         kind = ws.row_kind[r]
@@ -32,6 +41,7 @@ def start_impulses(s, ws, n):
         elif kind == ROW_ROD:
             x = s.last_rod_impulse[o]
         ws.lam_start[r] = x
+    return True
 
 
 @kernel
