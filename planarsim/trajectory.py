@@ -7,13 +7,13 @@ for a mean force [N]. act_power is the mechanical power of each actuator [W].
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
+from .files import discard, publish, staging_file
 from .state import check_shapes
 
 FORMAT_VERSION = 1
@@ -180,9 +180,9 @@ def read_npz(path, what: str) -> dict:
 
 
 def atomic_write(path, write, binary=True) -> None:
-    """Call write(fileobj) on a temporary file beside `path`, then rename it over `path`.
-
-    An interrupted write (error, Ctrl-C) leaves no file under the final name.
+    """Call write(fileobj) on a temporary file, then move it onto `path` in one step
+    (planarsim.files): an interrupted write (error, Ctrl-C, SIGKILL) leaves no file under
+    the final name and none beside it.
     """
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
@@ -190,17 +190,11 @@ def atomic_write(path, write, binary=True) -> None:
         raise OSError(f"cannot write {str(path)!r}: folder {str(parent)!r} does not exist")
     if not os.access(parent, os.W_OK):
         raise OSError(f"cannot write {str(path)!r}: folder {str(parent)!r} is not writable")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=parent)
+    tmp = staging_file(path)
     try:
-        with os.fdopen(fd, "wb" if binary else "w") as f:
+        with open(tmp, "wb" if binary else "w") as f:
             write(f)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes owner-only files
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        discard(tmp)
         raise

@@ -9,9 +9,9 @@ t_1 .. t_K lasts t_K - t_1 + h. So ``speed=1`` is real time, ``speed=0.25`` slow
 same at every playback speed.
 
 MP4 uses the ffmpeg binary shipped by the ``imageio-ffmpeg`` wheel (a dependency of
-planarsim; no system install). Every file is written to a temporary file beside the target
-and renamed over it at the end (``os.replace``): an error or Ctrl-C leaves no half-written
-file. Unknown extensions and unwritable folders are rejected before any frame is drawn.
+planarsim; no system install). Every file is written to a temporary file and moved onto
+the target at the end (planarsim.files): an error, Ctrl-C or SIGKILL leaves no half-written
+file at or beside the target. Unknown extensions and unwritable folders are rejected before any frame is drawn.
 """
 from __future__ import annotations
 
@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib import animation
 
+from ..files import discard, publish, staging_file
 from .camera import Camera
 from .draw import Scene, make_figure
 
@@ -199,8 +200,7 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
     writer = _writer(fmt, fps, bitrate, embed_limit_mb)
     report = _progress(progress, len(renderer), f"frames -> {path.name}")
     suffix = ".html" if fmt == "html" else path.suffix
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".part{suffix}", dir=path.parent)
-    os.close(fd)
+    tmp = staging_file(path, suffix)
     try:
         with writer.saving(renderer.fig, tmp, dpi):
             for k in range(len(renderer)):
@@ -213,26 +213,11 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
                 report(k + 1)
         if fmt == "html":
             _wrap_html_page(tmp, title=path.stem)
-        os.chmod(tmp, _file_mode())
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
-        _remove(tmp)
+        discard(tmp)
         raise
     return path
-
-
-def _file_mode() -> int:
-    """rw for everyone the umask allows (mkstemp creates files readable by the owner only)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
-
-
-def _remove(p):
-    try:
-        os.unlink(p)
-    except OSError:
-        pass
 
 
 # matplotlib's player draws its buttons with Font Awesome icons from a CDN; the page must work

@@ -14,7 +14,6 @@ distance travelled by the COM.
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 import numpy as np
@@ -45,8 +44,6 @@ def save_figure(fig, path, dpi: int = 120) -> Path:
         raise ValueError(f"cannot save a figure as {str(path)!r}: extension {path.suffix or '(none)'!r} "
                          f"unknown; use one of {', '.join('.' + f for f in FIGURE_FORMATS)}")
     atomic_write(path, lambda f: fig.savefig(f, format=fmt, dpi=dpi))
-    from .animate import _file_mode
-    os.chmod(path, _file_mode())      # atomic_write's temporary file is owner-only (mkstemp)
     return path
 
 

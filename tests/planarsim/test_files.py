@@ -1,0 +1,66 @@
+"""Output files: an interrupted write (even SIGKILL) leaves nothing at or beside the target,
+and temporary files of dead processes are removed by the next write."""
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+
+import pytest
+
+from planarsim.files import remove_stale
+from planarsim.trajectory import atomic_write
+
+SLOW_WRITER = """
+import sys, time
+from planarsim.trajectory import atomic_write
+def write(f):
+    f.write(b"x" * 1000)
+    f.flush()
+    print("writing", flush=True)
+    time.sleep(60)
+atomic_write(sys.argv[1], write)
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
+def test_sigkill_during_a_save_leaves_no_file_at_or_beside_the_target(tmp_path):
+    target = tmp_path / "run.npz"
+    proc = subprocess.Popen([sys.executable, "-c", SLOW_WRITER, str(target)],
+                            stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "writing"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert os.listdir(tmp_path) == []
+    # the next write removes what the killed process left in the temporary folder
+    atomic_write(target, lambda f: f.write(b"ok"))
+    assert target.read_bytes() == b"ok"
+    left = [n for n in os.listdir(tempfile.gettempdir()) if n.startswith(f"planarsim-{proc.pid}-")]
+    assert left == []
+
+
+def test_stale_parts_of_dead_processes_beside_the_target_are_removed(tmp_path):
+    target = tmp_path / "walk.gif"
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    stale = tmp_path / f".walk.gif.{dead.pid}.abc123.part.gif"
+    stale.write_bytes(b"half")
+    mine = tmp_path / f".walk.gif.{os.getpid()}.def456.part.gif"     # a live writer's: kept
+    mine.write_bytes(b"busy")
+    other = tmp_path / f".other.gif.{dead.pid}.abc.part"                # another target's: kept
+    other.write_bytes(b"x")
+    remove_stale(target)
+    assert not stale.exists() and mine.exists() and other.exists()
+
+
+def test_a_failed_write_leaves_nothing(tmp_path):
+    target = tmp_path / "summary.json"
+
+    def fail(f):
+        f.write("{")
+        raise RuntimeError("disk full")
+    with pytest.raises(RuntimeError):
+        atomic_write(target, fail, binary=False)
+    assert os.listdir(tmp_path) == []
+    assert not [n for n in os.listdir(tempfile.gettempdir())
+                if n.startswith(f"planarsim-{os.getpid()}-")]
