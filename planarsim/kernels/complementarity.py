@@ -128,7 +128,7 @@ def _projection_rows(m, s, ws):
         if ws.contact_gap[i] < PROJECTION_MARGIN:
             n = add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
     ws.n_row[0] = n
-    eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n)
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     return n
 
 

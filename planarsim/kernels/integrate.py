@@ -191,7 +191,7 @@ def max_residual(m, s, ws):
     """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
     update_trig(s.q, ws.body_cs)
     n = ws.n_row[0]
-    eval_rows(m, s.q, ws.body_cs, ws, ws.row_Jp, ws.rhs, n)
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_Jp, ws.rhs, n, False)
     worst = 0.0
     for r in range(n):
         c = ws.rhs[r]

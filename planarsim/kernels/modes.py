@@ -199,9 +199,16 @@ def rule_breaks(m, s, ws, h, equalities):
 @kernel
 def seed_rule(m, s, ws, i):
     """The seed's alternating check of one contact: release it if it pulls, let it slide if
-    its friction leaves the cone, stick it if its slip reversed. Returns 1 if it changed."""
+    its friction leaves the cone, stick it if its slip reversed. The same check goes to every
+    contact engaged during this step by the free motion's prediction (ws.contact_new == 1):
+    the free motion pushes a point resting a hair above the ground into it every step, while
+    the impulses of the other contacts may hold it clear. Returns how many changed."""
     gather_contact_impulses(m, s, ws)
-    return check_contact(m, s, ws, i)
+    changed = check_contact(m, s, ws, i)
+    for k in range(m.contact_body.shape[0]):
+        if k != i and ws.contact_new[k] == 1:
+            changed += check_contact(m, s, ws, k)
+    return changed
 
 
 @kernel

@@ -39,9 +39,11 @@ def _set_dir(q, body, px, py, dx, dy, sign, out):
 
 
 @kernel
-def eval_row(m, q, cs, ws, r, J):
+def eval_row(m, q, cs, ws, r, J, found):
     """Jacobian blocks J (2, 3) and error c of row r at configuration q (cs: its cos / sin,
-    math2d.update_trig); returns c."""
+    math2d.update_trig); returns c. found: the contacts' ground points, normals and gaps in ws
+    were found at this q (stage 3), so a normal row reuses them instead of asking the
+    terrain again (the same numbers)."""
     kind = ws.row_kind[r]
     o = ws.row_owner[r]
     a = ws.row_body[r, 0]
@@ -90,6 +92,10 @@ def eval_row(m, q, cs, ws, r, J):
             px, py = world_point(q, cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
         else:
             px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+        if found:
+            # find_contact's query at this q: its gap is already the sole's (centre's - r)
+            _set_dir(q, b, px, py, ws.contact_normal[o, 0], ws.contact_normal[o, 1], 1.0, J[1])
+            return ws.contact_gap[o]
         gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
         _set_dir(q, b, px, py, nx, ny, 1.0, J[1])
         if ws.contact_on_arc[o] == 1:
@@ -118,9 +124,10 @@ def _pin_rows(q, cs, anchor, o, a, b, J, c, r):
 
 
 @kernel
-def eval_rows(m, q, cs, ws, J, c, n):
-    """J[r] and c[r] of rows 0..n-1 at configuration q (cs holds its cos / sin). A pin's
-    x row is always followed by its y row (build_rows), so both come from one evaluation."""
+def eval_rows(m, q, cs, ws, J, c, n, found):
+    """J[r] and c[r] of rows 0..n-1 at configuration q (cs holds its cos / sin; found: see
+    eval_row). A pin's x row is always followed by its y row (build_rows), so both come from
+    one evaluation."""
     r = 0
     while r < n:
         if ws.row_kind[r] == ROW_PIN_X:
@@ -128,7 +135,7 @@ def eval_rows(m, q, cs, ws, J, c, n):
                       ws.row_body[r, 1], J, c, r)
             r += 2
         else:
-            c[r] = eval_row(m, q, cs, ws, r, J[r])
+            c[r] = eval_row(m, q, cs, ws, r, J[r], found)
             r += 1
 
 
@@ -145,7 +152,7 @@ def predict_joint_errors(m, ws, n):
             r += 2
             continue
         if kind == ROW_ROD:
-            ws.row_c_pred[r] = eval_row(m, ws.q_pred, ws.cs_pred, ws, r, ws.row_Jp[r])
+            ws.row_c_pred[r] = eval_row(m, ws.q_pred, ws.cs_pred, ws, r, ws.row_Jp[r], False)
         r += 1
 
 
@@ -226,7 +233,7 @@ def build_rows(m, s, ws):
                 n = add_row(ws, n, ROW_CONTACT_T, i, -1, m.contact_body[i])
             ic += 1
     ws.n_row[0] = n
-    eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n)
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     predict_joint_errors(m, ws, n)
     sliding = 0
     for r in range(n):

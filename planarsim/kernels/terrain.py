@@ -8,6 +8,9 @@ import math
 from ._jit import jit, jit_force, kernel, kernel_call
 
 TWO_PI = 2.0 * math.pi
+# a Newton step of the closest-point search this small [m per m of |x|] is its last: the error
+# left is of order K dx^2 (K = |f''/2f'|, bounded by the terrain's derivatives), below rounding
+NEWTON_LAST_STEP = 1e-10
 
 
 @jit_force
@@ -102,17 +105,23 @@ def closest_point(coef, px, py):
     for _ in range(30):
         f = (x - px) + (h - py) * dh
         fp = 1.0 + dh * dh + (h - py) * ddh
-        if fp < 1e-3:
+        newton = fp >= 1e-3
+        if not newton:
             fp = 1.0 + dh * dh
         dx = -f / fp
         if dx > bound:
             dx = bound
         elif dx < -bound:
             dx = -bound
+        if newton and abs(dx) < NEWTON_LAST_STEP * (1.0 + abs(x)):
+            # converging quadratically: the step after this one would be ~ dx^2 (rounding),
+            # and h, h' at x + dx follow from their Taylor series to O(dx^2) (no new sines)
+            x += dx
+            h += dh * dx
+            dh += ddh * dx
+            break
         x += dx
         h, dh, ddh = height_derivs(coef, x)
-        if abs(dx) < 1e-14 * (1.0 + abs(x)):
-            break
     inv = 1.0 / math.sqrt(1.0 + dh * dh)
     nx = -dh * inv
     ny = inv
