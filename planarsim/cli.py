@@ -76,7 +76,12 @@ def cmd_list(args):
             gaits = ", ".join(f"{g} (default)" if g == default else g for g in mod.GAITS)
         except Exception as e:  # a broken walker must not hide the others
             gaits = f"unavailable: {e}"
-        print(f"  {name:16s} {gaits}")
+        try:
+            tunable = w.objective(name) is not None
+        except Exception:
+            tunable = False
+        print(f"  {name:16s} {gaits}{'   [tunable]' if tunable else ''}")
+    print("  (planarsim params WALKER lists a walker's parameters; [tunable]: planarsim tune WALKER)")
     print("terrains:")
     print("  flat             level ground")
     print("  slope:DEG        constant slope, DEG degrees (negative: downhill toward +x)")
@@ -108,6 +113,9 @@ def cmd_run(args):
     save = _check_out(args.save, (".npz",), "--save")
     csv = _check_out(args.csv, (".csv",), "--csv")
     kw = dict(duration=args.duration, seed=args.seed)
+    changed = _walker_params(mod, args)
+    if changed:
+        kw["params"] = mod.Params(**{**mod.Params().as_dict(), **changed})
     if args.gait is not None:
         kw["gait"] = args.gait
     if ter is not None:
@@ -121,7 +129,8 @@ def cmd_run(args):
     wall = time.perf_counter() - t0
     default_gait = inspect.signature(mod.simulate).parameters["gait"].default
     own = {"walker": args.walker, "gait": args.gait or default_gait,
-           "terrain": args.terrain or "default", "duration_s": args.duration}
+           "terrain": args.terrain or "default", "duration_s": args.duration,
+           "params_changed": changed}
     summary = {**own, **{k: _plain(v) for k, v in summary.items() if k not in own},
                "wall_time_s": round(wall, 3)}
     written = []
@@ -151,6 +160,35 @@ def cmd_run(args):
     else:
         for k, v in summary.items():
             print(f"  {k:22s} {v}")
+    return 0
+
+
+def _walker_params(mod, args) -> dict:
+    """{name: value} of the walker's parameters changed by --params FILE, then --set NAME=VALUE
+    (later wins); ValueError naming the culprit (the CLI prints it and exits 2)."""
+    from walkers.common.params import load_values, parse_assignments
+    changed = {}
+    if args.params:
+        changed.update(load_values(args.params, mod.Params))
+    changed.update(parse_assignments(args.set or (), mod.Params))
+    defaults = mod.Params().as_dict()
+    return {k: v for k, v in changed.items() if v != defaults[k]}
+
+
+def cmd_params(args):
+    mod = _load_walker(args.walker)
+    rows = mod.Params.table()
+    if args.json:
+        print(json.dumps(rows))
+        return 0
+    print(f"{args.walker} parameters ({mod.Params.__name__}); change with "
+          f"'planarsim run {args.walker} --set NAME=VALUE' or '--params FILE.json'; "
+          "* = varied by planarsim tune")
+    width = max(len(r["name"]) for r in rows)
+    for r in rows:
+        bounds = f"[{r['lower']:g}, {r['upper']:g}]"
+        print(f"  {'*' if r['tunable'] else ' '} {r['name']:{width}s} {r['default']!s:>10} "
+              f"{r['unit']:10s} {bounds:20s} {r['doc']}")
     return 0
 
 
@@ -262,7 +300,16 @@ def make_parser():
     p.add_argument("--csv", default=None, help="trajectory .csv")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="change a walker parameter (repeatable; see 'planarsim params WALKER')")
+    p.add_argument("--params", default=None, metavar="FILE.json",
+                   help="walker parameters from a file: a 'planarsim tune' result or "
+                        "{\"name\": value, ...} (--set wins over it)")
     p.set_defaults(func=cmd_run)
+    p = sub.add_parser("params", help="a walker's parameters: units, bounds, defaults")
+    p.add_argument("walker", help="walker name (see 'planarsim list')")
+    p.add_argument("--json", action="store_true", help="as one JSON list")
+    p.set_defaults(func=cmd_params)
     p = sub.add_parser("view", help="interactive viewer (needs a display)")
     p.add_argument("walker")
     p.add_argument("--gait", default=None)
@@ -297,6 +344,10 @@ def main(argv=None) -> int:
         # bad input detected deeper down (ModelError is a ValueError): one line, exit 2
         print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # the reader went away (planarsim params W | head): not an error of ours
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except KeyboardInterrupt:
         print(f"planarsim {args.command}: interrupted", file=sys.stderr)
         return 130

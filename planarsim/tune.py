@@ -21,7 +21,6 @@ Command line: ``python -m planarsim.tune simbicon --budget 200 --out tuned.json`
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import sys
 import time
@@ -38,13 +37,15 @@ FORMAT_VERSION = 1
 
 def objective_module(walker: str):
     """The walker's objective module (walkers/<pkg>/objective.py); clear error if it has none."""
-    from walkers import WALKERS
-    if walker not in WALKERS:
-        raise KeyError(f"unknown walker {walker!r}; known walkers: {sorted(WALKERS)}")
-    try:
-        return importlib.import_module(WALKERS[walker] + ".objective")
-    except ModuleNotFoundError:
-        raise ValueError(f"walker {walker!r} has no tuning objective ({WALKERS[walker]}.objective)") from None
+    import walkers
+    if walker not in walkers.WALKERS:
+        raise KeyError(f"unknown walker {walker!r}; known walkers: {sorted(walkers.WALKERS)}")
+    mod = walkers.objective(walker)
+    if mod is None:
+        tunable = sorted(n for n in walkers.WALKERS if walkers.objective(n) is not None)
+        raise ValueError(f"walker {walker!r} has no tuning objective (nothing to tune); "
+                         f"tunable walkers: {', '.join(tunable)}")
+    return mod
 
 
 def _evaluate(job):

@@ -1,7 +1,9 @@
 """Walker packages. ``WALKERS`` maps command-line names to module paths (used by the CLI).
 
-Each walker module exposes ``NAME``, ``GAITS`` and
-``simulate(duration, gait=..., terrain=None, dt=1e-3, seed=0, ...) -> (Trajectory, summary, model)``.
+Each walker module exposes ``NAME``, ``GAITS``, ``Params`` (its parameter dataclass, see
+walkers.common.params) and
+``simulate(duration, gait=..., terrain=None, dt=1e-3, seed=0, params=None, ...) -> (Trajectory, summary, model)``.
+A walker is tunable (planarsim tune) when its package has an ``objective`` module.
 """
 import importlib
 
@@ -21,3 +23,18 @@ def load(name: str):
     if name not in WALKERS:
         raise KeyError(f"unknown walker {name!r}; known walkers: {sorted(WALKERS)}")
     return importlib.import_module(WALKERS[name])
+
+
+def objective(name: str):
+    """The tuning objective module of walker `name` (``<package>.objective``), or None if the
+    walker has none (the passive walkers: nothing to tune)."""
+    mod = load(name)
+    package = mod.__name__ if hasattr(mod, "__path__") else None
+    if package is None:
+        return None
+    try:
+        return importlib.import_module(package + ".objective")
+    except ModuleNotFoundError as e:
+        if e.name != package + ".objective":
+            raise
+        return None

@@ -14,6 +14,7 @@ from .params import CompassParams
 from .simplest import slope_from_terrain
 
 NAME = "compass-gait"
+Params = CompassParams   # the walker's parameters (planarsim params compass-gait)
 GAITS = ("passive",)
 
 

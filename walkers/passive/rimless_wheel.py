@@ -9,6 +9,7 @@ from .reference import rimless_fixed_point
 from .simplest import slope_from_terrain
 
 NAME = "rimless-wheel"
+Params = RimlessParams   # the walker's parameters (planarsim params rimless-wheel)
 GAITS = ("passive",)
 
 

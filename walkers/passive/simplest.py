@@ -11,6 +11,7 @@ from .params import SimplestParams
 from .reference import GARCIA_THETA, GARCIA_THETA_DOT, simplest_heel_strike
 
 NAME = "simplest-walker"
+Params = SimplestParams   # the walker's parameters (planarsim params simplest-walker)
 GAITS = ("passive",)
 
 

@@ -16,6 +16,7 @@ from .puppet import leg_fk, leg_ik, puppet_pose  # noqa: E402
 from .rollout import GAITS, Quadruped, live, rollout_quadruped, simulate  # noqa: E402
 
 NAME = "quadruped"
+Params = QuadrupedParams   # the walker's parameters (planarsim params quadruped)
 
 __all__ = ["NAME", "GAITS", "simulate", "Quadruped", "QuadrupedParams", "Controller", "Gait",
            "FootState", "build", "leg_fk", "leg_ik", "puppet_pose", "rollout_quadruped",

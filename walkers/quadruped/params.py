@@ -34,6 +34,10 @@ from walkers.common.params import WalkerParams, index_constants, param as _p
 
 @dataclass(frozen=True)
 class QuadrupedParams(WalkerParams):
+    # fields planarsim tune varies (the controller's gains and settings; the model stays)
+    TUNABLE = ("kp", "kd", "weight_ff", "foot_step", "lift_height", "plant_delay", "placement_gain",
+               "stance_time", "torso_track_max")
+
     # body (A1, Menagerie) ------------------------------------------------------------------------
     torso_mass: float = _p(7.497, "kg", "trunk 4.713 + four hip housings 0.696 (abduction locked)", 0.1, 100.0)
     torso_inertia: float = _p(0.131, "kg m^2", "torso pitch inertia about its COM (trunk + hips at +-0.183 m)", 1e-4, 10.0)

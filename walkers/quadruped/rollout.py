@@ -144,10 +144,11 @@ class Quadruped:
                 "audit": audit_counts(self.ws)}
 
 
-def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=0.3, params=None,
+def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=None, params=None,
              strategy="all", record_every=10):
     """Run the quadruped from standing for `duration` [s] in `gait` ("stand" | "piaffe" | "walk")
-    at the commanded `speed` [m/s] (walk only). Returns (Trajectory, summary dict, Model)."""
+    at the commanded `speed` [m/s] (walk only; default params.speed, 0.3). Returns
+    (Trajectory, summary dict, Model)."""
     q = Quadruped(params, terrain, dt, gait, speed, strategy, record_every, seed)
     q.run(duration)
     return q.trajectory(), q.summary(), q.model

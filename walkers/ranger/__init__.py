@@ -59,6 +59,7 @@ from .controller import Controller, Gait, Phase, Program  # noqa: E402
 from .rollout import GAITS, RangerSim, instantaneous_cot, live, simulate  # noqa: E402
 
 NAME = "ranger"
+Params = RangerParams   # the walker's parameters (planarsim params ranger)
 
 __all__ = ["NAME", "GAITS", "simulate", "RangerParams", "build", "Controller", "Gait", "Phase",
            "Program", "RangerSim", "instantaneous_cot", "live"]

@@ -1,7 +1,8 @@
 """Ranger parameters: one frozen dataclass, every number with doc, unit, default and bounds.
 
-Sources (see /work/shared/reference/ranger.md): the seed 002 (sections 5-6) and M. P. Kelly's
-public Ranger simulator. Values marked CHOSEN are ours, with the reason in their doc.
+Sources: Ranger's published numbers (Bhounsule et al., "Low-bandwidth reflex-based control for
+lower power walking: 65 km on a single battery charge", IJRR 2014) and M. P. Kelly's public
+Ranger simulator. Values marked CHOSEN are ours, with the reason in their doc.
 Angles: body angles are counter-clockwise from the build pose, a leg at 0 is vertical (hip
 above ankle), a foot at 0 is level (sole bottom directly below the ankle). The robot walks
 towards +x, so a stance leg goes from positive (foot ahead) to negative (foot behind).
@@ -20,6 +21,11 @@ def _p(default, doc, unit, lo, hi):
 
 @dataclass(frozen=True)
 class RangerParams(WalkerParams):
+    # fields planarsim tune varies (the controller's gains and settings; the model stays)
+    TUNABLE = ("hold_kp", "hold_kd", "hip_kp", "hip_kd", "scissor_gain", "scissor_offset", "land_angle",
+               "land_leg_angle", "push_leg_angle", "push_current", "push_gain",
+               "target_speed", "air_omega", "air_zeta")
+
     # geometry and mass (ranger.md) -------------------------------------------------------------
     leg_length: float = _p(0.96, "hip joint to ankle joint", "m", 0.5, 1.5)
     leg_mass: float = _p(4.96, "mass of each planar leg (outer pair as one, inner pair as one)", "kg", 1.0, 20.0)

@@ -11,6 +11,7 @@ from .controller import Controller, Phase  # noqa: E402
 from .rollout import run, simulate  # noqa: E402
 
 NAME = "simbicon"
+Params = SimbiconParams   # the walker's parameters (planarsim params simbicon)
 GAITS = ("walk",)
 
 __all__ = ["NAME", "GAITS", "simulate", "run", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]

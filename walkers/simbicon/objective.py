@@ -10,8 +10,6 @@ Everything is deterministic: the same parameters give the same score in any proc
 """
 from __future__ import annotations
 
-import numpy as np
-
 from .params import SimbiconParams
 from .rollout import run
 

@@ -12,9 +12,7 @@ everywhere). The dataclass defaults are the shipped, tuned values: see ``SHIPPED
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
-
-import numpy as np
+from dataclasses import dataclass
 
 from walkers.common.params import WalkerParams, param
 
@@ -69,25 +67,6 @@ class SimbiconParams(WalkerParams):
                             0.0, 2.0, tune=False)
     fall_height: float = _p(0.7, "m", "torso COM below this height above the ground is a fall",
                             0.0, 1.5, tune=False)
-
-    # vectors for the tuner and the compiled path ---------------------------------------------
-    @classmethod
-    def names(cls, tunable_only=False) -> tuple:
-        return tuple(f.name for f in fields(cls) if f.metadata["tune"] or not tunable_only)
-
-    @classmethod
-    def bounds(cls, tunable_only=False) -> np.ndarray:
-        """(n, 2) lower/upper bounds of the (tunable) fields."""
-        return np.array([f.metadata["bounds"] for f in fields(cls) if f.metadata["tune"] or not tunable_only])
-
-    def tunable_array(self) -> np.ndarray:
-        return np.array([getattr(self, n) for n in self.names(True)], dtype=np.float64)
-
-    def with_tunable(self, x) -> "SimbiconParams":
-        """A copy with the tunable fields set from vector x (clipped to the bounds)."""
-        b = self.bounds(True)
-        x = np.clip(np.asarray(x, dtype=np.float64), b[:, 0], b[:, 1])
-        return replace(self, **{n: float(v) for n, v in zip(self.names(True), x)})
 
 
 THESIS = SimbiconParams(

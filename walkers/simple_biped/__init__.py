@@ -14,6 +14,7 @@ from .params import SimpleBipedParams  # noqa: E402
 from .rollout import Walker, rollout_simple_biped, simulate  # noqa: E402
 
 NAME = "simple-biped"
+Params = SimpleBipedParams   # the walker's parameters (planarsim params simple-biped)
 GAITS = tuple(g.name.lower() for g in Gait)
 
 __all__ = ["NAME", "GAITS", "Gait", "State", "SimpleBipedParams", "Walker", "build", "simulate",

@@ -17,6 +17,11 @@ from walkers.common.params import WalkerParams, index_constants, param as _p
 
 @dataclass(frozen=True)
 class SimpleBipedParams(WalkerParams):
+    # fields planarsim tune varies (the controller's gains and settings; the model stays)
+    TUNABLE = ("step_length0", "step_length_per_speed", "clearance", "strike_push", "speed_gain",
+               "walk_length", "ds_kp", "ds_kd", "energy_gain", "ds_front_load", "ss_kp",
+               "ss_kd", "swing_kp", "swing_kd")
+
     # model ---------------------------------------------------------------------------------
     hip_mass: float = _p(10.0, "kg", "point mass of the hip (the whole upper body)", 0.1, 1e3)
     foot_mass: float = _p(1.0, "kg", "point mass of each foot (legs themselves are massless)", 0.01, 1e2)
