@@ -7,7 +7,7 @@ With the control points at the corners of a rectangle of height H (P1, P2 direct
 P3), the curve's top is at (3/4) H: a top edge at (4/3) c gives a clearance c (seed 002 4.2).
 Points are given as scalars [m]; s is dimensionless.
 """
-from planarsim.kernels._jit import jit
+from planarsim.compiled import jit
 
 
 @jit

@@ -4,7 +4,7 @@ pd(kp, kd, target, value, target_rate, rate) = kp (target - value) + kd (target_
 Gains are per unit of whatever the caller multiplies by (e.g. [1/s^2] and [1/s] when the result
 is an acceleration that the caller multiplies by a mass).
 """
-from planarsim.kernels._jit import jit
+from planarsim.compiled import jit
 
 
 @jit

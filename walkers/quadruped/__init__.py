@@ -5,7 +5,7 @@ inverse-kinematics puppet, trotting with diagonal pairs (STAND / PIAFFE / WALK).
 >>> traj, summary, model = qd.simulate(20.0, gait="walk", speed=0.3)
 >>> dog = qd.Quadruped(gait="piaffe"); dog.run(5.0); dog.set_gait("walk", 0.3); dog.run(10.0)
 """
-from planarsim.kernels._jit import drop_stale_caches
+from planarsim.compiled import drop_stale_caches
 
 drop_stale_caches(__path__[0])
 

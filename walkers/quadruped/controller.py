@@ -47,9 +47,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline, kernel
-from planarsim.kernels.forces import pin_angle_rate
-from planarsim.kernels.terrain import height, height_derivs
+from planarsim.compiled import jit, jit_inline, kernel, pin_angle_rate, height, height_derivs
 
 from walkers.common.pd import clamp
 

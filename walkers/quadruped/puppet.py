@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from planarsim.kernels._jit import jit
+from planarsim.compiled import jit
 
 IK_OK, IK_FAR, IK_NEAR, IK_HIP_LIMIT, IK_NOT_FINITE = 0, 1, 2, 4, 8
 REACH_TOL = 1e-12   # [m]

@@ -16,20 +16,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from planarsim.kernels.audit import audit_counts
+from planarsim.compiled import (RUN_FELL, audit_counts, check_run, jit, record_frame, step,
+                                make_recorder)
 import planarsim as ps
-from planarsim.errors import diverged
-from planarsim.kernels._jit import jit
-from planarsim.kernels.record import record_frame
-from planarsim.kernels.step import step
 from planarsim.state import make_workspace
-from planarsim.trajectory import Trajectory, make_recorder
+from planarsim.trajectory import Trajectory
 
 from . import controller as C
 from .model import build
 from .params import QuadrupedParams
 
-CODE_FELL = 3
 LABELS = ("gait", "step_i", "state_FL", "state_FR", "state_RL", "state_RR", "speed_estimate",
           "x_desired")
 LABEL_SLOTS = np.array([C.M_GAIT, C.M_STEP_I, C.M_STATE, C.M_STATE + 1, C.M_STATE + 2,
@@ -40,12 +36,12 @@ GAITS = tuple(g.name.lower() for g in C.Gait)
 @jit
 def rollout_quadruped(m, s, ws, opt, p, mem, u, n, every, rec, lab, slots, k0):
     """n steps of control + physics, recording every `every`-th step into rec / lab from frame
-    k0. Returns (code, steps done, next frame): 0 ok, 1/2 guard, 3 fell."""
+    k0. Returns (run code, steps done, next frame): RUN_OK, an engine failure or RUN_FELL."""
     k = k0
     for i in range(n):
         C.control(m, s, p, mem, u)
         if mem[C.M_FELL] != 0.0:
-            return CODE_FELL, i, k
+            return RUN_FELL, i, k
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, k
@@ -112,8 +108,7 @@ class Quadruped:
         lab = np.zeros((n // every + 1, len(LABELS)))
         code, done, k = rollout_quadruped(self.model.arrays, self.state, self.ws, self.options, self.p,
                                           self.memory, self.u, n, every, rec, lab, LABEL_SLOTS, 0)
-        if code in (1, 2):
-            raise diverged(self.model, self.ws, code, self.options.guard_limit, "quadruped")
+        check_run(code, self.model, self.ws, self.options, "quadruped")
         traj = Trajectory.from_recorder(self.model, rec, k,
                                         labels={nm: lab[:k, j].copy() for j, nm in enumerate(LABELS)},
                                         info={"dt": self.model.dt, "walker": "quadruped"})

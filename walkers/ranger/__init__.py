@@ -28,7 +28,7 @@ Choices (numbers in params.py, each with its reason):
 """
 from pathlib import Path as _Path
 
-from planarsim.kernels._jit import drop_stale_caches as _drop
+from planarsim.compiled import drop_stale_caches as _drop
 
 
 def _drop_caches():

@@ -34,9 +34,7 @@ import math
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline, kernel
-from planarsim.kernels.forces import pin_angle_rate
-from planarsim.kernels.terrain import height as terrain_height
+from planarsim.compiled import jit_inline, kernel, pin_angle_rate, height as terrain_height
 
 from .estimator import filter_step, hysteresis
 from .motor import drive_motor, motor_table, torque_constant

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from planarsim.kernels._jit import jit
+from planarsim.compiled import jit
 
 
 def butterworth2(cutoff_hz: float, dt: float) -> np.ndarray:

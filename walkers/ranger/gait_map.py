@@ -46,8 +46,7 @@ import math
 import numpy as np
 
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.kernels._jit import jit
-from planarsim.kernels.step import step, step_entry
+from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, jit, step, step_from_python as step_entry
 
 from walkers.common.section import GaitMapMixin, chain_poses, chain_velocities, copy_tuple, restore_tuple
 
@@ -57,7 +56,6 @@ from .rollout import RangerSim
 NAMES = ("stance_foot_angle", "swing_leg_angle", "swing_foot_angle", "stance_leg_rate",
          "swing_leg_rate", "stance_foot_rate", "swing_foot_rate",
          "filter_outer_z0", "filter_outer_z1", "filter_inner_z0", "filter_inner_z1")
-CODE_FELL, CODE_NO_EVENT = 3, 4
 DT = 1e-3        # [s] the shipped step (the controller does not walk at dt = 1e-4)
 SETTLE = 20.0    # [s] walking from the start pose before the reference section
 EPS = 1e-2       # perturbation scale of the least-squares Jacobian [rad, rad/s, -]
@@ -92,8 +90,8 @@ def rollout_to_midstance(m, s, ws, opt, k, prog, motor, mem, mem_before, gui, st
         if code != 0:
             return code, i
         if mem[C.M_FELL] != 0.0:
-            return CODE_FELL, i + 1
-    return CODE_NO_EVENT, max_steps
+            return RUN_FELL, i + 1
+    return RUN_NO_EVENT, max_steps
 
 
 
@@ -124,7 +122,7 @@ class RangerGaitMap(GaitMapMixin):
             raise ValueError(f"stance={stance} must be 0 (outer legs) or 1 (inner legs)")
         s, ws = rs.sim.state, rs.sim.ws
         code, _ = self._rollout(s, ws, c.mem, 10 ** 9, int(round(settle / dt)))
-        if code not in (0, CODE_NO_EVENT):
+        if code not in (RUN_OK, RUN_NO_EVENT):
             raise StepMapError(f"Ranger failed while settling (code {code})")
         self._run(s, ws, c.mem, 1)
         self.state0, self.ws0, self.mem0 = s.copy(), copy_tuple(ws), c.mem.copy()
@@ -147,7 +145,7 @@ class RangerGaitMap(GaitMapMixin):
     def _run(self, s, ws, mem, n_events):
         code, n = self._rollout(s, ws, mem, n_events, self.max_steps)
         if code != 0:
-            what = {CODE_FELL: "fell", CODE_NO_EVENT: "no mid-stance"}.get(code, f"engine guard {code}")
+            what = {RUN_FELL: "fell", RUN_NO_EVENT: "no mid-stance"}.get(code, f"engine guard {code}")
             raise StepMapError(f"Ranger step map: {what} (t={s.time[0]:.3f} s)")
         return n
 

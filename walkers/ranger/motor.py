@@ -8,7 +8,7 @@ import numpy as np
 
 from planarsim.actuators import (MOTOR_GEAR, MOTOR_NPARAM, MOTOR_TORQUE_CONST, make_motor,
                                  motor_power, motor_torque, saturate_current)
-from planarsim.kernels._jit import jit
+from planarsim.compiled import jit
 
 from .params import RangerParams
 

@@ -14,13 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from planarsim.kernels.audit import audit_counts
+from planarsim.compiled import audit_counts, check_run, jit, record_frame, step, make_recorder
 import planarsim as ps
-from planarsim.kernels._jit import jit
-from planarsim.kernels.record import record_frame
-from planarsim.kernels.step import step
-from planarsim.state import make_state, make_workspace
-from planarsim.trajectory import Trajectory, make_recorder
+from planarsim.trajectory import Trajectory
 
 from . import controller as C
 from .controller import Controller, control_ranger
@@ -94,8 +90,7 @@ class RangerSim:
         c = self.controller
         code, done, kf = rollout_ranger(m, s, ws, opt, c.k, c.prog, c.motor, c.mem, c.gui, c.steplog,
                                         self.u, n, int(record_every), rec, lab, LABEL_INDEX, 0)
-        if code:
-            self.sim._raise(code)
+        check_run(code, self.model, ws, opt, "ranger")
         labels = {name: lab[:kf, i] for i, name in enumerate(LABELS)}
         return Trajectory.from_recorder(self.model, rec, kf, labels=labels,
                                         info={"dt": m.dt, "walker": "ranger"})

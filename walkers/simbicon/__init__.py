@@ -1,7 +1,7 @@
 """SIMBICON biped (seed 000): the MJCF character of the thesis, its four-state FSM with PD
 joints, torso control through the stance hip and swing-hip balance feedback; tuned by
 planarsim.tune (CMA-ES)."""
-from planarsim.kernels._jit import drop_stale_caches
+from planarsim.compiled import drop_stale_caches
 
 drop_stale_caches(__path__[0])
 

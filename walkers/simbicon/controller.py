@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline, kernel
+from planarsim.compiled import jit_inline, kernel
 
 from .params import SimbiconParams
 

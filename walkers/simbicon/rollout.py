@@ -10,19 +10,16 @@ from __future__ import annotations
 import numpy as np
 
 from planarsim import Simulator, make_options
-from planarsim.kernels._jit import jit
-from planarsim.kernels.record import record_frame
-from planarsim.kernels.step import step
-from planarsim.kernels.terrain import height
-from planarsim.trajectory import Trajectory, make_recorder
+from planarsim.compiled import (RUN_FELL, RUN_WALKER, audit_counts, check_run, engine_failed,
+                                jit, record_frame, step, height, make_recorder)
+from planarsim.trajectory import Trajectory
 
-from planarsim.kernels.audit import audit_counts
 from .controller import M_EFFORT, M_FELL, M_PHASE, M_STRIKES, M_TIMEOUTS, control, make_memory, make_tables
 from .model import build, non_foot_clearance, start_state
 from .params import SimbiconParams
 
-FELL = 100   # rollout return code: the torso came down
-GLITCH = 101  # rollout return code: the torso moved faster than a walker can (solver blow-up)
+FELL = RUN_FELL   # rollout return code: the torso came down
+GLITCH = RUN_WALKER + 2  # rollout return code: the torso moved faster than a walker can (solver blow-up)
 STRATEGY = "all"   # engine contact-mode strategy (see the report: "alternating" hits its cap often with box feet)
 GLITCH_SPEED = 10.0   # [m/s] torso COM speed taken as a solver glitch
 GLITCH_SPIN = 30.0    # [rad/s] torso angular speed taken as a solver glitch
@@ -101,9 +98,9 @@ def run(params: SimbiconParams, duration: float, terrain=None, dt=1e-3, push=Non
     x0 = float(sim.state.q[tab.torso, 0])
     code, done, k = rollout_simbicon(model.arrays, sim.state, sim.ws, sim.options, tab, mem, u, n,
                                      every, rec, 0, _push_array(push))
-    if code not in (0, FELL, GLITCH):
+    if engine_failed(code):
         if not glitch_ok:
-            sim._raise(code)
+            check_run(code, model, sim.ws, sim.options, "simbicon")
         code = GLITCH      # the engine's guard fired (non-finite or huge state)
         sim.state.restore(sim.ws.prev)
     t = float(sim.state.time[0])

@@ -4,7 +4,7 @@
 >>> traj, summary, model = sb.simulate(20.0, gait="walk", speed=1.0)
 >>> w = sb.Walker(gait="stand"); w.run(2.0); w.set_gait("jump"); w.run(5.0)
 """
-from planarsim.kernels._jit import drop_stale_caches
+from planarsim.compiled import drop_stale_caches
 
 drop_stale_caches(__path__[0])
 

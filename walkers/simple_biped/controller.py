@@ -36,7 +36,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from planarsim.kernels._jit import jit, jit_inline, kernel
+from planarsim.compiled import jit_inline, kernel
 
 from walkers.common.bezier import rectangle_bezier
 from walkers.common.pd import clamp

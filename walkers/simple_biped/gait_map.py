@@ -21,18 +21,15 @@ from __future__ import annotations
 import numpy as np
 
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.kernels._jit import jit
-from planarsim.kernels.step import step
-from planarsim.kernels.terrain import height
+from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, jit, step, height
 
 from walkers.common.section import GaitMapMixin, copy_tuple, restore_tuple
 
 from . import controller as C
 from .params import I_FALL_HEIGHT, I_FALL_LEG_LENGTH, I_LEG_LENGTH
-from .rollout import CODE_FELL, Walker, _longest_leg
+from .rollout import Walker, _longest_leg
 
 NAMES = ("hip_dx", "hip_dy", "hip_vx", "hip_vy", "rear_dx", "v_top")
-CODE_NO_EVENT = 4
 DT = 1e-4       # [s] analysis step: the controller switches at step boundaries, which makes the
                 # map jump by O(dt) (about 2e-3 m/s in hip vx at dt = 1 ms, 1e-4 at 0.1 ms);
                 # finite differences need steps well above those jumps
@@ -56,8 +53,8 @@ def rollout_to_touchdown(m, s, ws, opt, p, mem, u, n_events, max_steps):
         if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]
                 or _longest_leg(s.q) > p[I_FALL_LEG_LENGTH] * p[I_LEG_LENGTH]):
             mem[C.M_FALLEN] = 1.0
-            return CODE_FELL, i + 1
-    return CODE_NO_EVENT, max_steps
+            return RUN_FELL, i + 1
+    return RUN_NO_EVENT, max_steps
 
 
 class SimpleBipedGaitMap(GaitMapMixin):
@@ -78,7 +75,7 @@ class SimpleBipedGaitMap(GaitMapMixin):
         self.max_steps = int(round(4.0 / dt))
         code, _ = rollout_to_touchdown(self.m, w.state, w.ws, w.options, w.p, w.memory, w.u, 10 ** 9,
                                        int(round(settle / dt)))
-        if code not in (0, CODE_NO_EVENT) or w.fell:
+        if code not in (RUN_OK, RUN_NO_EVENT) or w.fell:
             raise StepMapError(f"the Simple Biped failed while settling (code {code})")
         for _ in range(3):   # to a touchdown of the requested foot
             self._run(w.state, w.ws, w.memory, 1)
@@ -100,7 +97,7 @@ class SimpleBipedGaitMap(GaitMapMixin):
         w = self.walker
         code, n = rollout_to_touchdown(self.m, s, ws, w.options, w.p, mem, w.u, n_events, self.max_steps)
         if code != 0:
-            what = {CODE_FELL: "fell", CODE_NO_EVENT: "no touchdown"}.get(code, f"engine guard {code}")
+            what = {RUN_FELL: "fell", RUN_NO_EVENT: "no touchdown"}.get(code, f"engine guard {code}")
             raise StepMapError(f"Simple Biped step map: {what} (t={s.time[0]:.3f} s)")
         return n
 

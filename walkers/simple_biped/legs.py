@@ -8,7 +8,7 @@ leg i is u_2 = (2 i - 1) tau: left/right symmetry is this sign, not a second cop
 """
 import math
 
-from planarsim.kernels._jit import jit
+from planarsim.compiled import jit
 
 from walkers.common.pd import clamp
 

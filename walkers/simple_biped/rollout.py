@@ -12,21 +12,16 @@ import math
 
 import numpy as np
 
-from planarsim.kernels.audit import audit_counts
+from planarsim.compiled import (RUN_FELL, audit_counts, check_run, jit, record_frame, step, height,
+                                make_recorder)
 import planarsim as ps
-from planarsim.errors import diverged
-from planarsim.kernels._jit import jit
-from planarsim.kernels.record import record_frame
-from planarsim.kernels.step import step
-from planarsim.kernels.terrain import height
 from planarsim.state import make_workspace
-from planarsim.trajectory import Trajectory, make_recorder
+from planarsim.trajectory import Trajectory
 
 from . import controller as C
 from .model import build
 from .params import I_FALL_HEIGHT, I_FALL_LEG_LENGTH, I_LEG_LENGTH, SimpleBipedParams
 
-CODE_FELL = 3
 LABELS = ("gait", "state", "stance", "phase", "steps", "jumps")
 _LABEL_SLOTS = (C.M_GAIT, C.M_STATE, C.M_STANCE, C.M_PHASE, C.M_STEPS, C.M_JUMPS)
 
@@ -42,9 +37,9 @@ def _longest_leg(q):
 @jit
 def rollout_simple_biped(m, s, ws, opt, p, mem, u, n, every, rec, lab, k0):
     """n steps of control + physics, recording every `every`-th step into rec / lab from frame
-    k0. Stops on a fall (code 3, mem[M_FALLEN]=1): the hip below fall_height above the ground,
+    k0. Stops on a fall (RUN_FELL, mem[M_FALLEN]=1): the hip below fall_height above the ground,
     or a leg longer than fall_leg_length
-    or a guard fires (code 1, 2). Returns (code, steps done, next frame)."""
+    or an engine failure (planarsim.compiled run codes). Returns (code, steps done, next frame)."""
     k = k0
     for i in range(n):
         C.control(m, s, p, mem, u)
@@ -66,7 +61,7 @@ def rollout_simple_biped(m, s, ws, opt, p, mem, u, n, every, rec, lab, k0):
         if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]
                 or _longest_leg(s.q) > p[I_FALL_LEG_LENGTH] * p[I_LEG_LENGTH]):
             mem[C.M_FALLEN] = 1.0
-            return CODE_FELL, i + 1, k
+            return RUN_FELL, i + 1, k
     return 0, n, k
 
 
@@ -142,8 +137,7 @@ class Walker:
         lab = np.zeros((n // every + 1, len(LABELS)))
         code, done, k = rollout_simple_biped(self.model.arrays, self.state, self.ws, self.options,
                                              self.p, self.memory, self.u, n, every, rec, lab, 0)
-        if code in (1, 2):
-            raise diverged(self.model, self.ws, code, self.options.guard_limit, "simple biped")
+        check_run(code, self.model, self.ws, self.options, "simple biped")
         traj = Trajectory.from_recorder(self.model, rec, k,
                                         labels={name: lab[:k, j].copy() for j, name in enumerate(LABELS)},
                                         info={"dt": self.model.dt, "walker": "simple-biped"})

@@ -1,0 +1,70 @@
+"""What compiled code uses from the engine: a walker's controller and rollout, or your own.
+
+Decorators (the three you need; all cache their machine code on disk, never allocate, and
+keep the NaN checks that fastmath would drop):
+    jit          compiled, callable from Python and from compiled code (a rollout)
+    jit_inline   the same, inlined into its compiled callers (a controller run every step)
+    kernel       compiled code only, inlined (small helpers; no Python entry)
+
+Engine, from compiled code:
+    step(m, s, ws, opt, u) -> run code      advance State s by one step of m.dt
+    record_frame(s, ws, rec, k)              write frame k of a Recorder (make_recorder)
+    height(coef, x), height_derivs(coef, x)  the ground h(x) [m] and (h, h', h'')
+    closest_point(coef, px, py)              (gx, gy, nx, ny, gap) of the nearest ground point
+    pin_angle_rate(m, q, v, j)               pin j's angle [rad] and rate [rad/s]
+From Python:
+    step_from_python(m, s, ws, opt, u)       the same step (about 12 us a call: prefer
+                                             Simulator.step / steps, or a compiled rollout)
+    check_run(code, model, ws, options, who) raise for an engine failure, else return code
+    audit_counts(ws)                         the step audit's counts by rule
+    drop_stale_caches(folder)                call on import of a package with compiled code
+
+Run codes. step returns RUN_OK or an engine failure: RUN_NONFINITE / RUN_TOO_LARGE (the state
+blew up), RUN_AUDIT (StepOptions.audit_raise and a rule broken), RUN_BAD_COMMANDS /
+RUN_NONFINITE_COMMAND (nothing stepped). A rollout adds its own reasons to stop from
+RUN_WALKER up (RUN_FELL, RUN_NO_EVENT, or more of its own), so that one test,
+``engine_failed(code)``, tells the two apart everywhere.
+"""
+from .errors import diverged
+from .kernels._jit import drop_stale_caches, jit, jit_inline, kernel
+from .kernels.audit import audit_counts
+from .kernels.forces import pin_angle_rate
+from .kernels.guards import (GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE,
+                             GUARD_NONFINITE_COMMAND, GUARD_OK, GUARD_TOO_LARGE)
+from .kernels.record import record_frame
+from .kernels.step import step, step_entry as step_from_python
+from .kernels.terrain import closest_point, gap_of_point, height, height_derivs
+from .trajectory import make_recorder
+
+RUN_OK = GUARD_OK
+RUN_NONFINITE = GUARD_NONFINITE
+RUN_TOO_LARGE = GUARD_TOO_LARGE
+RUN_AUDIT = GUARD_AUDIT
+RUN_BAD_COMMANDS = GUARD_BAD_COMMANDS
+RUN_NONFINITE_COMMAND = GUARD_NONFINITE_COMMAND
+RUN_WALKER = 100        # codes from here up are a rollout's own reasons to stop
+RUN_FELL = 100          # the walker fell (its own test: hip too low, torso down, ...)
+RUN_NO_EVENT = 101      # a step map found no section event (touchdown, mid-stance) in time
+
+
+def engine_failed(code) -> bool:
+    """True for the engine's failure codes (the state blew up, an audit rule broke, bad
+    commands), False for RUN_OK and a rollout's own codes (RUN_WALKER and up)."""
+    return code != RUN_OK and code < RUN_WALKER
+
+
+def check_run(code, model, ws, options, who="simulation") -> int:
+    """Raise the engine's error for a failure code (planarsim.errors.diverged: a
+    SimulationDiverged naming step, time, body and value; an AuditViolation; a ValueError for
+    bad commands); return any other code unchanged."""
+    code = int(code)
+    if engine_failed(code):
+        raise diverged(model, ws, code, options.guard_limit, who)
+    return code
+
+
+__all__ = ["jit", "jit_inline", "kernel", "step", "step_from_python", "record_frame",
+           "make_recorder", "height", "height_derivs", "closest_point", "gap_of_point",
+           "pin_angle_rate", "audit_counts", "drop_stale_caches", "check_run", "engine_failed",
+           "RUN_OK", "RUN_NONFINITE", "RUN_TOO_LARGE", "RUN_AUDIT", "RUN_BAD_COMMANDS",
+           "RUN_NONFINITE_COMMAND", "RUN_WALKER", "RUN_FELL", "RUN_NO_EVENT"]
