@@ -17,6 +17,7 @@ From Python:
                                              Simulator.step / steps, or a compiled rollout)
     check_run(code, model, ws, options, who) raise for an engine failure, else return code
     audit_counts(ws)                         the step audit's counts by rule
+    step_info(ws)                            what the last step did (solves, splits, pivots)
     drop_stale_caches(folder)                call on import of a package with compiled code
 
 Run codes. step returns RUN_OK or an engine failure: RUN_NONFINITE / RUN_TOO_LARGE (the state
@@ -29,6 +30,7 @@ from .errors import diverged
 from .kernels._jit import drop_stale_caches, jit, jit_inline, kernel
 from .kernels.audit import audit_counts
 from .kernels.forces import pin_angle_rate
+from .kernels.info import step_info
 from .kernels.guards import (GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE,
                              GUARD_NONFINITE_COMMAND, GUARD_OK, GUARD_TOO_LARGE)
 from .kernels.record import record_frame
@@ -65,6 +67,6 @@ def check_run(code, model, ws, options, who="simulation") -> int:
 
 __all__ = ["jit", "jit_inline", "kernel", "step", "step_from_python", "record_frame",
            "make_recorder", "height", "height_derivs", "closest_point", "gap_of_point",
-           "pin_angle_rate", "audit_counts", "drop_stale_caches", "check_run", "engine_failed",
+           "pin_angle_rate", "audit_counts", "step_info", "drop_stale_caches", "check_run", "engine_failed",
            "RUN_OK", "RUN_NONFINITE", "RUN_TOO_LARGE", "RUN_AUDIT", "RUN_BAD_COMMANDS",
            "RUN_NONFINITE_COMMAND", "RUN_WALKER", "RUN_FELL", "RUN_NO_EVENT"]

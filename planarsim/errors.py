@@ -7,6 +7,7 @@ compiled step fires (non-finite or huge state); it carries the last finite state
 its own audit (kernels/audit.py); it names the step, time, rule, contact or pin and body.
 """
 from .kernels.audit import AUDIT_DEPTH, AUDIT_NAMES, AUDIT_PIN_GAP
+from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE_COMMAND
 
 
@@ -104,15 +105,15 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
     if code == GUARD_AUDIT:
         return audit_violation(model, ws, who)
     if code == GUARD_BAD_COMMANDS:
-        return ValueError(f"{who}: the commands u have {int(ws.info[2])} entries; the model has "
+        return ValueError(f"{who}: the commands u have {int(ws.info[INFO_COMMAND])} entries; the model has "
                           f"{len(model.act_names)} actuators {list(model.act_names)}")
     if code == GUARD_NONFINITE_COMMAND:
-        k = int(ws.info[2])
+        k = int(ws.info[INFO_COMMAND])
         return ValueError(f"{who}: command u[{k}] for actuator {model.act_names[k]!r} is "
                           f"{float(ws.guard_value[0])}; commands must be finite (N or N m); "
                           f"nothing was stepped")
-    body = int(ws.info[2])
-    field = FIELD_NAMES[int(ws.info[3])]
+    body = int(ws.info[INFO_GUARD_BODY])
+    field = FIELD_NAMES[int(ws.info[INFO_GUARD_FIELD])]
     value = float(ws.guard_value[0])
     step = int(ws.prev.step[0])
     t = float(ws.prev.time[0])

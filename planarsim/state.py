@@ -8,6 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .kernels.info import N_INFO
 from .model import Model
 
 
@@ -195,11 +196,8 @@ class Workspace(NamedTuple):
     lam: np.ndarray              # (R,) impulses [N s or N m s]
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
     act_power: np.ndarray        # (n_act,) mechanical power [W]
-    info: np.ndarray             # (8,) int: [0] linear solves of the velocity stage, [1] ccd
-                                 #   splits, [2] guard body, [3] guard field, [4] complementarity
-                                 #   (Lemke) solves, [5] Newton steps of the position correction
-                                 #   taken back (diverged), [6] Lemke pivots, [7] projections
-                                 #   of the positions by the complementarity solve
+    info: np.ndarray             # (N_INFO,) int: what the last step did, slots named in
+                                 #   kernels/info.py (INFO_*; step_info(ws) by name)
     guard_value: np.ndarray      # (1,) offending value when a guard fired
     row_b: np.ndarray            # (R,) residual of each row without impulses: w = A lam + b
                                  #   [m/s] (velocity stage) or [m, rad] (position projection)
@@ -254,7 +252,7 @@ def make_workspace(model: Model) -> Workspace:
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R), act_u=z(na), act_power=z(na),
-                     info=z(8, np.int64), guard_value=z(1), row_b=z(R),
+                     info=z(N_INFO, np.int64), guard_value=z(1), row_b=z(R),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
                      lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),
                      lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),

@@ -21,6 +21,7 @@ planarsim.errors.diverged turns into an AuditViolation naming all of it.
 import math
 
 from ._jit import kernel
+from .info import INFO_CCD_SPLITS
 from .contacts import CONTACT_POINT, sole_facing
 from .math2d import world_point
 from .modes import contact_velocity
@@ -157,7 +158,7 @@ def surely_clear(m, s, ws, i):
     (ws.contact_gap, found at ws.prev.q; no time-of-impact split) exceeds how far the point
     can have moved since, |dx| + |dtheta| r (the signed distance to the ground changes by at
     most the point's move). Saves the ground query of contacts well clear of it."""
-    if m.contact_kind[i] != CONTACT_POINT or ws.info[1] != 0:
+    if m.contact_kind[i] != CONTACT_POINT or ws.info[INFO_CCD_SPLITS] != 0:
         return False
     b = m.contact_body[i]
     lx = m.contact_local[i, 0]

@@ -19,6 +19,7 @@ dq / h (as the Newton correction does); contact corrections move positions only.
 """
 from ._jit import kernel, kernel_call
 from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
+from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
 from .contacts import MODE_FREE, MODE_PINNED, find_contact
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
@@ -64,14 +65,14 @@ def _lcp_once(m, s, ws, h):
     assemble_dense(m, ws, n)
     cap = PIVOTS_PER_VARIABLE * (4 * n + 10)
     status, pivots = solve_mixed_lcp(m, ws, n, cap)
-    ws.info[4] += 1
-    ws.info[6] += pivots
+    ws.info[INFO_LCP_SOLVES] += 1
+    ws.info[INFO_LCP_PIVOTS] += pivots
     if status != LCP_SOLVED:
         # no answer with friction on Lemke's path: the frictionless rule
         n = _drop_tangent_rows(ws)
         assemble_dense(m, ws, n)
         status, pivots = solve_mixed_lcp(m, ws, n, cap)
-        ws.info[6] += pivots
+        ws.info[INFO_LCP_PIVOTS] += pivots
         body = m.contact_body[0] if m.contact_body.shape[0] > 0 else -1
         if status == LCP_SOLVED:
             note(ws, s.step[0], AUDIT_FALLBACK, 0, body, 0.0)
@@ -158,8 +159,8 @@ def project_positions(m, s, ws, h, iters, tol):
             ws.row_b[r] = ws.row_c[r]
         assemble_dense(m, ws, n)
         status, pivots = solve_mixed_lcp(m, ws, n, PIVOTS_PER_VARIABLE * (n + 10))
-        ws.info[6] += pivots
-        ws.info[7] += 1
+        ws.info[INFO_LCP_PIVOTS] += pivots
+        ws.info[INFO_PROJECTIONS] += 1
         if status != LCP_SOLVED:
             break
         for i in range(s.q.shape[0]):

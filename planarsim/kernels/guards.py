@@ -2,20 +2,22 @@
 import math
 
 from ._jit import kernel
+from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 
 GUARD_OK = 0
 GUARD_NONFINITE = 1
 GUARD_TOO_LARGE = 2
 GUARD_AUDIT = 3           # the step broke a rule of its own audit (StepOptions.audit_raise = 1)
-GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[2]:
+GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[INFO_COMMAND]:
                           # its length); negative, so that no walker's own return code clashes
-GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[2]: its index,
+GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[INFO_COMMAND]: its index,
                                # ws.guard_value: the value); nothing is stepped
 
 
 @kernel
 def check_guards(s, ws, limit):
-    """Return GUARD_*; on failure ws.info[2] = body, ws.info[3] = field 0..5 (x y th vx vy w)."""
+    """Return GUARD_*; on failure ws.info[INFO_GUARD_BODY] = body,
+    ws.info[INFO_GUARD_FIELD] = field 0..5 (x y th vx vy w)."""
     for i in range(s.q.shape[0]):
         for f in range(6):
             x = s.q[i, f] if f < 3 else s.v[i, f - 3]
@@ -25,8 +27,8 @@ def check_guards(s, ws, limit):
             elif abs(x) > limit:
                 bad = GUARD_TOO_LARGE
             if bad != GUARD_OK:
-                ws.info[2] = i
-                ws.info[3] = f
+                ws.info[INFO_GUARD_BODY] = i
+                ws.info[INFO_GUARD_FIELD] = f
                 ws.guard_value[0] = x
                 return bad
     return GUARD_OK
@@ -34,11 +36,11 @@ def check_guards(s, ws, limit):
 
 @kernel
 def check_commands(u, ws):
-    """GUARD_NONFINITE_COMMAND if some command u[k] is NaN or infinite (recorded in ws.info[2]
-    and ws.guard_value), else GUARD_OK."""
+    """GUARD_NONFINITE_COMMAND if some command u[k] is NaN or infinite (recorded in
+    ws.info[INFO_COMMAND] and ws.guard_value), else GUARD_OK."""
     for k in range(u.shape[0]):
         if not math.isfinite(u[k]):
-            ws.info[2] = k
+            ws.info[INFO_COMMAND] = k
             ws.guard_value[0] = u[k]
             return GUARD_NONFINITE_COMMAND
     return GUARD_OK

@@ -18,6 +18,7 @@ import math
 
 from ._jit import kernel, kernel_call, kernel_inline
 from .contacts import MODE_FREE, MODE_PINNED
+from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
                    ROW_PIN_Y, eval_rows, move_row)
@@ -266,7 +267,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
                 s.q[i, k] = ws.q_keep[i, k]
                 s.v[i, k] = ws.v_keep[i, k]
         worst = max_residual(m, s, ws)
-        ws.info[5] += 1
+        ws.info[INFO_NEWTON_TAKEN_BACK] += 1
         if ptol >= LOOSE_PIVOT_TOL:
             break
         ptol = LOOSE_PIVOT_TOL

@@ -32,6 +32,7 @@ from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, check_commands, check_guards
 from .math2d import update_trig
+from .info import INFO_CCD_SPLITS, INFO_COMMAND, INFO_SOLVES, STEP_COUNTS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, predict_configuration, rows_hold_within)
 from .modes import (MODES_ALTERNATING, engage_contacts, engage_limits, gather_contact_impulses,
@@ -129,7 +130,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     else:
         solve_contacts(m, s, ws, h, include_ccd)
     remember_impulses(s, ws)
-    ws.info[0] += rounds
+    ws.info[INFO_SOLVES] += rounds
 
 
 @kernel_call
@@ -162,7 +163,7 @@ def _step(m, s, ws, opt, u):
     code = check_guards(s, ws, opt.guard_limit)
     if code != 0:
         return code
-    for k in (0, 1, 4, 5, 6, 7):
+    for k in STEP_COUNTS:
         ws.info[k] = 0
     ws.lcp_eps[0] = 0.0
     audited = audit_total(ws)
@@ -187,7 +188,7 @@ def _step(m, s, ws, opt, u):
                 ws.impact_time[0] = s.time[0]
                 h -= tau
                 ws.contact_new[hit] = 2  # engaged by find_contacts of the next sub-step
-                ws.info[1] += 1
+                ws.info[INFO_CCD_SPLITS] += 1
                 continue
         audit_impulses(m, s, ws)
         integrate_positions(s, ws, ws.v_new, h)
@@ -249,7 +250,7 @@ def engine_types():
 
 def _step_c(m, s, ws, opt, u_data, n_u):
     if n_u != m.act_kind.shape[0]:
-        ws.info[2] = n_u   # nothing is read or changed: the actuators would read past u
+        ws.info[INFO_COMMAND] = n_u   # nothing is read or changed: the actuators would read past u
         return GUARD_BAD_COMMANDS
     u = refs.array_1d(u_data, n_u)
     code = check_commands(u, ws)

@@ -7,6 +7,7 @@ import pytest
 
 import planarsim as ps
 from planarsim import terrain
+from planarsim.kernels.info import INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK
 
 G = 9.81
 
@@ -273,7 +274,7 @@ def test_position_correction_at_a_fold_adds_no_energy():
     sim = ps.Simulator(model, state=state)
     e0 = total_energy(model, sim.state.q, sim.state.v)
     sim.step()
-    assert sim.ws.info[5] >= 1, "the saved state no longer meets the fold"
+    assert sim.ws.info[INFO_NEWTON_TAKEN_BACK] >= 1, "the saved state no longer meets the fold"
     assert total_energy(model, sim.state.q, sim.state.v) <= e0
     assert joint_residuals(model, sim.state.q[None]) <= 1e-9
     assert sum(sim.ws.audit) == 0, dict(zip(AUDIT_NAMES, sim.ws.audit))
@@ -292,7 +293,7 @@ def test_resting_closed_loop_keeps_its_load_split_and_skips_the_complementarity_
     solves = 0
     for _ in range(200):
         sim.step()
-        solves += int(sim.ws.info[4])
+        solves += int(sim.ws.info[INFO_LCP_SOLVES])
     assert np.abs(sim.state.v).max() < 1e-6, "the biped is not at rest"
     assert solves == 0
     assert sum(sim.ws.audit) == 0

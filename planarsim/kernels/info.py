@@ -1,0 +1,24 @@
+"""Slots of ws.info: what the last step did (counts reset at its start) and what its guard
+found. Read them by name from Python with step_info(ws)."""
+INFO_SOLVES = 0            # linear solves of the velocity stage (guess, retry)
+INFO_CCD_SPLITS = 1        # time-of-impact splits of the step
+INFO_GUARD_BODY = 2        # the guard's body (GUARD_NONFINITE, GUARD_TOO_LARGE)
+INFO_GUARD_FIELD = 3       # the guard's field 0..5 of that body: x y theta vx vy omega
+INFO_LCP_SOLVES = 4        # complementarity (Lemke) solves of the velocity stage
+INFO_NEWTON_TAKEN_BACK = 5  # Newton steps of the position correction taken back (diverged)
+INFO_LCP_PIVOTS = 6        # Lemke pivots, velocity stage and projections
+INFO_PROJECTIONS = 7       # complementarity projections of the positions
+INFO_COMMAND = 8           # the command the guard names: index of a NaN / inf one
+                           # (GUARD_NONFINITE_COMMAND), or how many were given (GUARD_BAD_COMMANDS)
+N_INFO = 9
+
+INFO_NAMES = ("solves", "ccd_splits", "guard_body", "guard_field", "lcp_solves",
+              "newton_taken_back", "lcp_pivots", "projections", "command")
+# counted afresh by every step (the guard slots keep the last failure)
+STEP_COUNTS = (INFO_SOLVES, INFO_CCD_SPLITS, INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK,
+               INFO_LCP_PIVOTS, INFO_PROJECTIONS)
+
+
+def step_info(ws) -> dict:
+    """{name: value} of ws.info (Python side)."""
+    return {name: int(ws.info[k]) for k, name in enumerate(INFO_NAMES)}
