@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from . import model as M
+from .kernels.codes import CONTACT_ARC, CONTACT_POINT
 from .errors import ModelError
 from .terrain import Terrain, flat
 
@@ -274,7 +275,7 @@ class ModelBuilder:
         local = _vec2("contact", name, idx, "local", local)
         verts = [_vec2("contact", name, idx, f"vertex[{i}]", v) for i, v in enumerate(verts)]
         point = self._bodies[bid]["point"]
-        if point and (kind != M.CONTACT_POINT or np.hypot(*local) > 1e-12):
+        if point and (kind != CONTACT_POINT or np.hypot(*local) > 1e-12):
             raise ModelError(f"contact {name!r} ({idx}): a point mass can only carry a point contact at (0, 0)")
         self._contacts.append(dict(name=name, body=bid, kind=kind, local=local, radius=radius,
                                    span=span, mu=mu, verts=verts,
@@ -284,7 +285,7 @@ class ModelBuilder:
     def add_point_contact(self, name, body, local=(0.0, 0.0), mu=1.0) -> int:
         """A point of `body` (local [m]) that touches the ground; on a point mass it uses
         continuous collision detection."""
-        return self._contact(name, body, M.CONTACT_POINT, local, 0.0, (0.0, 0.0), mu, [])
+        return self._contact(name, body, CONTACT_POINT, local, 0.0, (0.0, 0.0), mu, [])
 
     def add_arc_contact(self, name, body, center, radius, span=(-math.pi, math.pi), vertices=(),
                         mu=1.0) -> int:
@@ -300,7 +301,7 @@ class ModelBuilder:
         a1 = _scalar("contact", name, idx, "span[1]", span[1])
         if not a1 > a0:
             raise ModelError(f"contact {name!r} ({idx}): span=({a0}, {a1}) must have span[1] > span[0]")
-        cid = self._contact(name, body, M.CONTACT_ARC, center, r, (a0, a1), mu, list(vertices))
+        cid = self._contact(name, body, CONTACT_ARC, center, r, (a0, a1), mu, list(vertices))
         b = self._contacts[cid]["body"]
         self._shapes.append(M.Shape(b, "arc", (tuple(self._contacts[cid]["local"]), r, (a0, a1),
                                                 tuple(tuple(v) for v in self._contacts[cid]["verts"]))))

@@ -12,10 +12,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-# contact geometry kinds
-CONTACT_POINT = 0
-CONTACT_ARC = 1
-
 # actuator kinds
 ACT_PIN_TORQUE = 0   # torque tau on body b, -tau on body a, at a pin [N m]
 ACT_AXIAL = 1        # force along the line a->b between two anchors, + pushes apart [N]

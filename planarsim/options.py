@@ -7,9 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-MODES_ALTERNATING = 0   # the seed's scheme: check one contact per step, in turn
-MODES_ALL = 1           # check every contact each step, iterate to a consistent set
-MODES_COUNT = 2
+from .kernels.codes import MODE_FREE, MODE_PINNED, MODE_SLIDING, MODES_ALL, MODES_ALTERNATING
 
 
 class ModeStrategy(IntEnum):
@@ -18,9 +16,9 @@ class ModeStrategy(IntEnum):
 
 
 class ContactMode(IntEnum):
-    FREE = 0
-    PINNED = 1
-    SLIDING = 2
+    FREE = MODE_FREE
+    PINNED = MODE_PINNED
+    SLIDING = MODE_SLIDING
 
 
 class StepOptions(NamedTuple):

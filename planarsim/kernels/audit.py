@@ -22,7 +22,8 @@ import math
 
 from ._jit import kernel
 from .info import INFO_CCD_SPLITS
-from .contacts import CONTACT_POINT, sole_facing
+from .codes import CONTACT_POINT
+from .contacts import sole_facing
 from .math2d import world_point
 from .modes import contact_velocity
 from .rows import ROW_CONTACT_N

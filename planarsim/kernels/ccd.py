@@ -11,7 +11,7 @@ precision. The step is then split at tau (seed 002 section 3).
 import math
 
 from ._jit import kernel
-from .contacts import MODE_FREE
+from .codes import MODE_FREE
 from .terrain import ground_point_call
 
 N_SAMPLES = 8

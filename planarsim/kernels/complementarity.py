@@ -20,7 +20,8 @@ dq / h (as the Newton correction does); contact corrections move positions only.
 from ._jit import kernel, kernel_call
 from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
-from .contacts import MODE_FREE, MODE_PINNED, find_contact
+from .codes import MODE_FREE, MODE_PINNED
+from .contacts import find_contact
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, is_joint_row, solve_mixed_lcp

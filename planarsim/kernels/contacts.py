@@ -15,11 +15,7 @@ from ._jit import kernel
 from .math2d import rotate, world_point
 from .terrain import ground_point
 
-CONTACT_POINT = 0
-CONTACT_ARC = 1
-MODE_FREE = 0
-MODE_PINNED = 1
-MODE_SLIDING = 2
+from .codes import CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
 
 
 @kernel

@@ -17,7 +17,7 @@ find nothing to do (bodies at rest or translating), so the step skips it exactly
 import math
 
 from ._jit import kernel, kernel_call, kernel_inline
-from .contacts import MODE_FREE, MODE_PINNED
+from .codes import MODE_FREE, MODE_PINNED
 from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,

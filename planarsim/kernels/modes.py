@@ -16,15 +16,14 @@ reversal); modes_from_solution reads the modes off a complementarity solution.
 import math
 
 from ._jit import kernel
-from .contacts import MODE_FREE, MODE_PINNED, MODE_SLIDING, engage_contact
+from .codes import MODE_FREE, MODE_PINNED, MODE_SLIDING
+from .contacts import engage_contact
 from .forces import point_velocity
 from .math2d import world_point
 from .mixed_lcp import is_sliding_solution
 from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO
 from .solve import row_dot
 
-MODES_ALTERNATING = 0
-MODES_ALL = 1
 # a solve's answer breaks a rule when it misses it by more than this share of its own scale
 SOLVE_REL_TOL = 1e-9
 SLIP_ROUNDING = 1e-12

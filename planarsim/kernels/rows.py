@@ -13,7 +13,7 @@ import math
 
 from ._jit import kernel
 from .math2d import cross2, world_point
-from .contacts import MODE_PINNED, MODE_SLIDING
+from .codes import MODE_PINNED, MODE_SLIDING
 from .terrain import ground_point
 
 ROW_PIN_X = 0

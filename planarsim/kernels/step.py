@@ -35,7 +35,8 @@ from .math2d import update_trig
 from .info import INFO_CCD_SPLITS, INFO_COMMAND, INFO_SOLVES, STEP_COUNTS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, predict_configuration, rows_hold_within)
-from .modes import (MODES_ALTERNATING, engage_contacts, engage_limits, gather_contact_impulses,
+from .codes import MODES_ALTERNATING
+from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .record import record_frame
 from .rows import build_rows

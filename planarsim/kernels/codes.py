@@ -1,0 +1,11 @@
+"""Integer codes shared by the kernels and the Python side, defined once."""
+# contact kinds (model.contact_kind)
+CONTACT_POINT = 0      # a material point (a point mass, a box corner)
+CONTACT_ARC = 1        # a circular-arc sole that rolls
+# contact modes (state.contact_mode)
+MODE_FREE = 0
+MODE_PINNED = 1        # no slip along the ground
+MODE_SLIDING = 2       # slipping, Coulomb friction at the cone's edge
+# how the modes carried over from the last step are checked (StepOptions.mode_strategy)
+MODES_ALTERNATING = 0  # one contact re-examined per step, in turn, before the guaranteed solve
+MODES_ALL = 1          # straight to the guaranteed (complementarity) solve when the guess fails
