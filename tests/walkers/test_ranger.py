@@ -15,7 +15,7 @@ from planarsim.actuators import (MOTOR_GEAR, MOTOR_TORQUE_CONST, make_motor, mot
 from walkers import WALKERS
 from walkers import ranger
 from walkers.ranger import RangerParams, RangerSim
-from walkers.ranger import controller as C
+from walkers.ranger import tables as T
 from walkers.ranger.estimator import butterworth2, filter_signal
 from walkers.ranger.model import foot_inertia_com
 
@@ -272,4 +272,4 @@ def test_rotor_inertia_on_foot():
     i_with = foot_inertia_com(p)
     i_without = foot_inertia_com(RangerParams(rotor_on_foot=0.0))
     assert abs(i_with - i_without - 34 ** 2 * 1.6e-6) < 1e-12
-    assert C.N_PROG == len(C.Program)
+    assert T.N_PROG == len(T.Program)

@@ -1,11 +1,11 @@
 """What every walker's parameter dataclass shares: fields with unit, doc and bounds, the
 bounds check on construction, the float64 vector the compiled controller reads, and the
-``I_<FIELD>`` index constants generated from the field order.
+``I_<FIELD>`` index constants (written out in each params.py; index_constants checks them).
 
 >>> @dataclass(frozen=True)                                          # doctest: +SKIP
 ... class MyParams(WalkerParams):
 ...     hip_mass: float = param(10.0, "kg", "hip point mass", 0.1, 1e3)
->>> globals().update(index_constants(MyParams))   # I_HIP_MASS = 0, N_PARAMS = 1
+>>> I_HIP_MASS, N_PARAMS = 0, 1    # written out; index_constants(MyParams) checks them in a test
 """
 from __future__ import annotations
 
@@ -97,8 +97,8 @@ class WalkerParams:
 
 
 def index_constants(cls) -> dict:
-    """{"I_<FIELD>": index, ..., "N_PARAMS": count} for a module's globals: compile-time
-    constants for the controller, generated from the field order so the two never disagree."""
+    """{"I_<FIELD>": index, ..., "N_PARAMS": count}: what a params module's written-out
+    compile-time constants must be (tests/walkers/test_param_indices.py checks them)."""
     names = [f.name for f in fields(cls)]
     out = {f"I_{name.upper()}": i for i, name in enumerate(names)}
     out["N_PARAMS"] = len(names)

@@ -55,7 +55,8 @@ _drop_caches()
 
 from .params import RangerParams  # noqa: E402
 from .model import build  # noqa: E402
-from .controller import Controller, Gait, Phase, Program  # noqa: E402
+from .controller import Controller  # noqa: E402
+from .tables import Gait, Phase, Program  # noqa: E402
 from .rollout import GAITS, RangerSim, instantaneous_cot, live, simulate  # noqa: E402
 
 NAME = "ranger"

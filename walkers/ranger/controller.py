@@ -41,7 +41,17 @@ from .motor import drive_motor, motor_table, torque_constant
 from .params import RangerParams
 
 
-from .tables import *  # noqa: F401,F403  (enums, index layout of k / mem / prog, table makers)
+# the tables' enums, index layout of k / mem / prog, and table makers (named, not starred)
+from .tables import (
+    FR_ABS, FR_NONE, FR_PUSH, FR_SCISSOR, GAIT_GUI, GAIT_STAND, GAIT_WALK, Gait, K_AIR_ACC,
+    K_AIR_W, K_AIR_Z, K_B0, K_DS_TIME, K_DT, K_EST_OFF, K_EST_ON, K_FALL_H, K_FOOT_CX,
+    K_FOOT_CY, K_FOOT_I, K_FOOT_M, K_GRAV, K_IMAX, K_LAND_LEG, K_LEG_COM, K_PUSH_GAIN,
+    K_PUSH_I0, K_PUSH_LEG, K_SCISSOR, K_START_I, K_START_LEG, K_V_TARGET, K_WEIGHT, M_AIRBORNE,
+    M_CONTACT, M_CUR, M_E, M_FELL, M_FILT, M_GAIT, M_KEEP, M_MID_DONE, M_PEL, M_PHASE, M_PROG,
+    M_PUSH_I, M_RAW, M_SIG, M_STANCE, M_STEPS, M_TOUCH, M_T_STRIKE, M_V_MID, N_LOG,
+    PC_FRAME, PC_IFF, PC_KD, PC_KP, PC_TARGET, PH_DOUBLE, PH_FLIGHT, PH_SINGLE, PH_STANDING,
+    PH_START, PR_FLIP, PR_GUI, PR_HOLD, PR_KEEP, PR_LAND, PR_OFF, PR_PUSH, PR_STAND, PR_SWING,
+    make_constants, make_gui, make_memory, make_programs, set_standing_estimator)
 
 
 # --------------------------------------------------------------------------------------------

@@ -19,6 +19,7 @@ import planarsim as ps
 from planarsim.trajectory import Trajectory
 
 from . import controller as C
+from . import tables as T
 from .controller import Controller, control_ranger
 from .model import build
 from .params import RangerParams
@@ -174,7 +175,7 @@ def live(gait: str = "walk", terrain=None, params: RangerParams | None = None,
                        "GUI inner ankle [rad]": slider(2, -1.5, 1.5)},
                 labels=lambda _sim: {"gait": mem[C.M_GAIT], "phase": mem[C.M_PHASE]},
                 label_names={"gait": {int(g): g.name.lower() for g in C.Gait},
-                             "phase": {int(p): p.name.lower() for p in C.Phase}})
+                             "phase": {int(p): p.name.lower() for p in T.Phase}})
 
 
 def simulate(duration: float, gait: str = "walk", terrain=None, dt: float = 1e-3, seed: int = 0,
