@@ -3,7 +3,7 @@
     python benchmarks/chain_floor.py                 # N = 4 and 32, median of 5 runs each
     python benchmarks/chain_floor.py --links 4 8 16 32 64
 
-Times the engine on the bench chains (bench_scenes.chain: 0.5 m, 1 kg thin rods, horizontal
+Times the engine on the bench chains (scenes.chain: 0.5 m, 1 kg thin rods, horizontal
 at rest, dt = 1 ms) next to two dedicated chain steps written for this one model, in the
 same process:
 
@@ -36,14 +36,14 @@ from numba import njit
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
-from planarsim.bench_metrics import energy, pin_separation, spec_from_model  # noqa: E402
-from planarsim.bench_peers import _rates  # noqa: E402
-from planarsim.bench_scenes import G, chain  # noqa: E402
+from benchmarks.metrics import energy, pin_separation, spec_from_model  # noqa: E402
+from benchmarks.peers import _rates  # noqa: E402
+from benchmarks.scenes import G, chain  # noqa: E402
 
 # the engine's compile flags, with numba's runtime (run_chain allocates its scratch arrays)
 jit = njit(cache=True, fastmath=False, error_model="numpy")
 
-LENGTH = 0.5       # [m] link length (bench_scenes.chain)
+LENGTH = 0.5       # [m] link length (scenes.chain)
 MASS = 1.0         # [kg]
 INERTIA = MASS * LENGTH ** 2 / 12   # [kg m^2] thin rod about its centre
 INV_MASS = 1.0 / MASS

@@ -26,8 +26,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
-from planarsim.bench_metrics import lowest_point, pin_separation, spec_from_model  # noqa: E402
-from planarsim.bench_scenes import biped_collapse  # noqa: E402
+from benchmarks.metrics import lowest_point, pin_separation, spec_from_model  # noqa: E402
+from benchmarks.scenes import biped_collapse  # noqa: E402
 
 
 def main(argv=None) -> int:

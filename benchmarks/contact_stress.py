@@ -11,7 +11,7 @@ Families (every scene drawn from numpy.random.default_rng(seed); friction mu in 
   bodies), both feet flat on flat ground (a closed loop through the ground), then random
   joint-angle offsets (sd 0.03 rad), joint rates (sd 0.3 rad/s) and a small torso velocity;
   the lowest corner starts 0 to 1 mm above the ground. No actuators, so it collapses.
-- biped_collapse: the 7-link bench_scenes.biped_collapse (feet are bodies too), perturbed
+- biped_collapse: the 7-link scenes.biped_collapse (feet are bodies too), perturbed
   the same way.
 - chain_hills: 16 boxes pinned end to end (0.2-0.35 m long, 0.5-2 kg each), bent at random
   (sd 0.15 rad per pin) and tilted (+-0.4 rad), moving (up to 1 m/s sideways and 2 m/s down,
@@ -25,11 +25,11 @@ MAX_STEPS steps, so runs at small dt cover less time. Every run is recorded at e
 judged on each end-of-step state (and the start):
 
 - energy gained: max over the run of E(t) - E0, E = kinetic + gravitational potential
-  (bench_metrics.energy) [J], against the bound E_tol of energy_bound (the integrator's own
+  (metrics.energy) [J], against the bound E_tol of energy_bound (the integrator's own
   O(dt) oscillation; see there);
-- pin gap: bench_metrics.pin_separation, target PIN_TOL = 1e-9 m;
+- pin gap: metrics.pin_separation, target PIN_TOL = 1e-9 m;
 - depth: the deepest box corner below the ground, target DEPTH_TOL = 1e-8 m (flat ground:
-  bench_metrics.lowest_point; hills: see clearance);
+  metrics.lowest_point; hills: see clearance);
 - divergence: planarsim.SimulationDiverged, or a non-finite state;
 - audit: the engine's own violation counters sim.ws.audit (n/a where the engine has none).
 
@@ -51,9 +51,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
 from planarsim import terrain  # noqa: E402
-from planarsim.bench_metrics import (energy, lowest_point, pin_separation,  # noqa: E402
+from benchmarks.metrics import (energy, lowest_point, pin_separation,  # noqa: E402
                                      spec_from_model, world_points)
-from planarsim.bench_scenes import G, biped_collapse  # noqa: E402
+from benchmarks.scenes import G, biped_collapse  # noqa: E402
 
 FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio")
 STRATEGIES = ("alternating", "all")
@@ -111,7 +111,7 @@ def joint_pose(model, dangle, rates, root_v):
 
 def clearance(spec, ground, q):
     """(K,) smallest height of any box corner above the ground over frames q (K, n_body, 3) [m]
-    (negative: below). Level ground at y = 0 is bench_metrics.lowest_point; elsewhere the
+    (negative: below). Level ground at y = 0 is metrics.lowest_point; elsewhere the
     vertical height over the terrain times cos(slope), the distance along the ground normal to
     first order (exact on a line; off by about d^2 x curvature, far below 1e-8 m here)."""
     c = ground.coef

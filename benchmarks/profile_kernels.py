@@ -86,7 +86,7 @@ def _workload(target, seconds):
         disps = [v for v in vars(rollout).values() if isinstance(v, CPUDispatcher) and v.overloads]
         return (lambda: mod.simulate(seconds)), disps
     import planarsim as ps
-    from planarsim.bench_scenes import SCENES
+    from benchmarks.scenes import SCENES
     from planarsim.kernels.step import run_steps
     model = SCENES[target][0]()
     sim = ps.Simulator(model)

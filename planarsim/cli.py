@@ -237,7 +237,7 @@ def cmd_view(args):
 
 
 def cmd_bench(args):
-    from .bench import main
+    from benchmarks.runner import main
     return main(args.rest) or 0
 
 

@@ -210,7 +210,7 @@ def test_seven_link_biped_collapse_only_loses_energy(strategy):
     pulling contacts are released: energy never exceeds its start, pins stay closed, and a
     corner ends a capped step at most about a millimetre deep (removed by the next step's
     correction)."""
-    from planarsim.bench_scenes import biped_collapse
+    from benchmarks.scenes import biped_collapse
     from tests.physics.test_contact_properties import contact_gaps
     from tests.walkers.test_reliability_walkers import joint_residuals
     model = biped_collapse()
@@ -236,7 +236,7 @@ def test_seven_link_biped_collapse_perturbed_by_nanometres_comes_to_rest_above_g
     diverged (+2.7e6 J in one step; such steps are now taken back). Every path must only
     lose energy (within the correction's m g overlap), never sink a corner more than a capped
     step does, and come to rest on the ground."""
-    from planarsim.bench_scenes import biped_collapse
+    from benchmarks.scenes import biped_collapse
     from tests.physics.test_contact_properties import contact_gaps
     model = biped_collapse()
     sim = ps.Simulator(model)
@@ -286,7 +286,7 @@ def test_resting_closed_loop_keeps_its_load_split_and_skips_the_complementarity_
     impulses (held in the State), so the split the complementarity solve found is kept:
     resting steps pass the guess's checks (no complementarity solve) and the audit, and a
     run restored from a snapshot continues bit for bit."""
-    from planarsim.bench_scenes import biped_collapse
+    from benchmarks.scenes import biped_collapse
     model = biped_collapse()
     sim = ps.Simulator(model)
     sim.run(2.0)

@@ -4,7 +4,7 @@ import pytest
 
 import planarsim as ps
 from planarsim.batch import run_parallel, simulate_batch, steps_batch
-from planarsim.bench_scenes import chain
+from benchmarks.scenes import chain
 
 
 def test_steps_batch_equals_serial_bit_for_bit():

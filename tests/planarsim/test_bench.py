@@ -1,4 +1,4 @@
-"""The benchmark runner (issue 8) on tiny settings, so that `planarsim bench` cannot silently
+"""The benchmark runner on tiny settings, so that `planarsim bench` cannot silently
 break; no timing is asserted. The peer checks run only for the peers that are installed
 (`pip install planarsim[compare]`); the runner itself must work without them."""
 import csv
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import planarsim as ps
-from planarsim import bench
-from planarsim.bench_metrics import accuracy, spec_from_model
-from planarsim.bench_peers import PEER_MODULES, available_peers
-from planarsim.bench_scenes import biped_collapse, chain
+from benchmarks import runner as bench
+from benchmarks.metrics import accuracy, spec_from_model
+from benchmarks.peers import PEER_MODULES, available_peers
+from benchmarks.scenes import biped_collapse, chain
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = ["--repeats", "1", "--steps", "20", "--accuracy-seconds", "0.05"]

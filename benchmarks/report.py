@@ -10,7 +10,7 @@ import os
 
 import numpy as np
 
-from .bench_walkers import WALKER_TARGETS
+from benchmarks.walker_runs import WALKER_TARGETS
 
 PIN_TOL = 1e-9  # [m] pin residual bound of the targets
 

@@ -1,14 +1,14 @@
 """Scene timing and accuracy for planarsim and its peers (MuJoCo, pymunk, Box2D), measured the
 same way in the same run.
 
-Timing: each engine runs the scene's timing episode (bench_scenes.SCENES: 5 s for chains, 3 s
+Timing: each engine runs the scene's timing episode (scenes.SCENES: 5 s for chains, 3 s
 for the biped collapse, 2 s for the rod drop) from the start state once to warm up, then
 `repeats` times, each from the start state (resetting or rebuilding the world is not timed),
 the repeats going round the engines in turn; steps/s is the median with the min-max spread.
 planarsim's figure is the compiled multi-step call (Simulator.steps); its Python single-step
 loop is timed alongside.
 Accuracy: one recorded run per engine (10 s for chains, else the episode), judged by
-bench_metrics.accuracy.
+metrics.accuracy.
 
 The peers are optional (`pip install planarsim[compare]`); `available_peers` says which are
 importable and why the others are not.
@@ -22,13 +22,13 @@ import time
 import numpy as np
 
 import planarsim as ps
-from .bench_metrics import ACCURACY_SECONDS, PEER_SCENES, accuracy, spec_from_model
-from .bench_scenes import SCENES
-from .kernels._jit import jit
+from benchmarks.metrics import ACCURACY_SECONDS, PEER_SCENES, accuracy, spec_from_model
+from benchmarks.scenes import SCENES
+from planarsim.compiled import jit
 
 #: peer name -> module implementing World(spec) with reset(), run(n), record(n)
-PEER_MODULES = {"mujoco": "planarsim.bench_mujoco", "pymunk": "planarsim.bench_pymunk",
-                "box2d": "planarsim.bench_box2d"}
+PEER_MODULES = {"mujoco": "benchmarks.peers.mujoco_peer", "pymunk": "benchmarks.peers.pymunk_peer",
+                "box2d": "benchmarks.peers.box2d_peer"}
 
 
 def available_peers(names=None):
@@ -96,7 +96,7 @@ def call_floor_s(calls=20000) -> float:
 
 def measure_scene(name, peers=None, repeats=5, n_steps=None, accuracy_seconds=None):
     """(planarsim row, [peer rows]) of scene `name`: timing interleaved over planarsim and
-    the peers {name: module} (bench_mujoco / bench_pymunk / bench_box2d), and for the peer
+    the peers {name: module} (peers/mujoco_peer, pymunk_peer, box2d_peer), and for the peer
     scenes the accuracy figures of each.
 
     planarsim: first_call_s = first Simulator.steps call (numba compile or cache load);

@@ -1,10 +1,10 @@
 """Engine-neutral description of a benchmark scene, and the accuracy figures computed from
 recorded poses so that every engine (planarsim and its peers) is judged by the same code.
 
-A `SceneSpec` is read off the planarsim model of the scene (bench_scenes.py): body masses,
+A `SceneSpec` is read off the planarsim model of the scene (scenes.py): body masses,
 inertias and start poses, the boxes given by each body's four corner contacts, and the pins
-with their local anchors. Peers build their native scene from it (bench_mujoco.py,
-bench_pymunk.py, bench_box2d.py), so the initial conditions are identical by construction.
+with their local anchors. Peers build their native scene from it (peers/mujoco_peer.py,
+peers/pymunk_peer.py, peers/box2d_peer.py), so the initial conditions are identical by construction.
 
 Recorded runs are arrays in planarsim's conventions: q (K, n_body, 3) = centre of mass x, y [m]
 and angle theta [rad, counter-clockwise]; v (K, n_body, 3) = COM velocity [m/s] and angular
@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bench_scenes import G
+from benchmarks.scenes import G
 
-#: episode of the timing runs and of the accuracy runs per scene kind [s] (bench_scenes.py)
+#: episode of the timing runs and of the accuracy runs per scene kind [s] (scenes.py)
 ACCURACY_SECONDS = {"chain": 10.0, "biped_collapse": 3.0, "rod_drop": 2.0}
 #: scenes that the peers build (the chains N = 2..64, the biped collapse, the rod drop)
 PEER_SCENES = ("chain2", "chain4", "chain8", "chain16", "chain32", "chain64", "biped_collapse", "rod_drop")
@@ -58,7 +58,7 @@ class SceneSpec:
 
 
 def spec_from_model(name: str, model, seconds: float) -> SceneSpec:
-    """Read a SceneSpec off a planarsim Model built by bench_scenes (boxes from the corner
+    """Read a SceneSpec off a planarsim Model built by scenes.py (boxes from the corner
     contacts of each body; energy scale of the bench scenes for chains, else the potential
     energy of the start pose above the lowest body point)."""
     a = model.arrays

@@ -30,7 +30,7 @@ import json, time
 t0 = time.perf_counter()
 import planarsim as ps
 t_import = time.perf_counter() - t0
-from planarsim.bench_scenes import chain
+from benchmarks.scenes import chain
 sim = ps.Simulator(chain(2))
 sim.step()
 t_engine = time.perf_counter() - t0

@@ -86,7 +86,7 @@ def measure_batch(jobs=64, seconds=10.0, repeats=3, workers=(1, 2), walker="simp
     """Throughput of a batch of `jobs` walks on each worker count; None if planarsim.batch is
     missing."""
     try:
-        from . import batch
+        from planarsim import batch
     except ImportError:
         return None
     speeds = [0.8 + 0.4 * i / max(1, jobs - 1) for i in range(jobs)]

@@ -8,18 +8,18 @@
     planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
 
 Parts (each warm after compilation; steps/s = median and min-max of --repeats runs):
-- scenes: the named scenes of bench_scenes.py (chains N = 2..64, rod drop, 7-link biped
+- scenes: the named scenes of scenes.py (chains N = 2..64, rod drop, 7-link biped
   collapse, boxes on hills): first-call time (numba compile or cache load), compiled
   steps/s, real-time factor, Python single-step loop steps/s; accuracy figures of the peer
   scenes; log-log slope of the chains' cost per step against N.
 - peers: the chain, biped and rod scenes built natively in MuJoCo (mujoco.rollout, one
-  thread), pymunk and Box2D (Python loops) from the same description (bench_metrics.SceneSpec),
+  thread), pymunk and Box2D (Python loops) from the same description (metrics.SceneSpec),
   timed the same way in the same run: steps/s, ratio planarsim/peer, pin error, energy drift,
   penetration. Needs `pip install planarsim[compare]`; a missing peer is named and skipped.
 - walkers: every registered walker walking --walker-seconds (60 s) via its simulate().
 - batch: 64 Simple Biped walks on 1 and 2 worker threads (planarsim.batch).
 - startup: import-to-first-step times in fresh subprocesses, warm and cold numba cache
-  (bench_startup.py says how the cache is made cold).
+  (startup.py says how the cache is made cold).
 Then a table of every benchmark target with the measured figure, met or not met. Targets are
 measured here, never asserted by the tests.
 """
@@ -36,11 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .bench_metrics import PEER_SCENES
-from .bench_peers import PEER_MODULES, available_peers, measure_scene
-from .bench_report import (plot_chain_scaling, print_peers, print_scenes, print_startup, print_targets,
+from benchmarks.metrics import PEER_SCENES
+from benchmarks.peers import PEER_MODULES, available_peers, measure_scene
+from benchmarks.report import (plot_chain_scaling, print_peers, print_scenes, print_startup, print_targets,
                            print_walkers, targets)
-from .bench_scenes import SCENES
+from benchmarks.scenes import SCENES
 
 PARTS = ("scenes", "peers", "walkers", "batch", "startup")
 
@@ -163,7 +163,7 @@ def main(argv=None):
     elif "peers" in parts and args.peers:
         print("peer comparison skipped: no peer installed (pip install planarsim[compare])\n")
     if "walkers" in parts and args.walkers:
-        from .bench_walkers import measure_walker
+        from benchmarks.walker_runs import measure_walker
         for name in args.walkers:
             try:
                 row = measure_walker(name, args.walker_seconds, args.repeats)
@@ -175,7 +175,7 @@ def main(argv=None):
             rows.append(row)
         print_walkers(results)
     if "batch" in parts:
-        from .bench_walkers import measure_batch
+        from benchmarks.walker_runs import measure_batch
         batch = measure_batch(args.batch_jobs, args.batch_seconds, args.repeats)
         results["batch"] = batch
         if batch is None:
@@ -184,7 +184,7 @@ def main(argv=None):
             rows += batch
             print_walkers(results, batch_only=True)
     if "startup" in parts:
-        from .bench_startup import measure_startup
+        from benchmarks.startup import measure_startup
         results["startup"] = measure_startup(cold=not args.no_cold)
         rows += results["startup"]
         print_startup(results)
