@@ -22,7 +22,7 @@ import time
 
 import walkers
 
-#: the issue-8 steps/s targets of walkers (one core)
+#: the steps/s targets of walkers (one core)
 WALKER_TARGETS = {"simple-biped": 1e6, "ranger": 5e5, "simbicon": 3e5}
 
 

@@ -1,4 +1,4 @@
-"""DC motor + gearbox model (seed 002 eqs. 13-16, reference/ranger.md), as compiled pure functions.
+"""DC motor + gearbox model (Kelly 2014, eqs. 13-16, with Ranger's published motor constants), as compiled pure functions.
 
 A motor is one row of a float array laid out by the MOTOR_* indices below (build it with
 ``make_motor``). The command is the armature current I [A]; w [rad/s] is the joint rate
@@ -7,7 +7,7 @@ A motor is one row of a float array laid out by the MOTOR_* indices below (build
     T = G K I - c1 w - c0 sgn(w) - mu G K |I| sgn(w)                      [N m]
     P = I^2 R + Vc |I| + G K w I                                           [W]
 
-``sgn`` and ``|.|`` are smoothed (seed eq. 15): sgn(w) ~ w / sqrt(w^2 + w0^2),
+``sgn`` and ``|.|`` are smoothed (Kelly 2014, eq. 15): sgn(w) ~ w / sqrt(w^2 + w0^2),
 |I| ~ I^2 / sqrt(I^2 + I0^2), so the friction is a continuous, bounded-slope function of the
 rate (a discontinuous Coulomb term chatters under an explicit step on a light body).
 The rotor inertia (reflected G^2 Jm) is NOT part of the torque here: it is a body property

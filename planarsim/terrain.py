@@ -148,5 +148,5 @@ def parse(spec: str) -> Terrain:
 
 
 def default_hills() -> Terrain:
-    """Rolling hills: max slope about 12 deg, peak-to-trough about 0.33 m (the seed's claim)."""
+    """Rolling hills: max slope about 12 deg, peak-to-trough about 0.33 m (Kelly 2014's figure)."""
     return hills([0.12, 0.045], [7.0, 2.9], [0.0, 1.3])

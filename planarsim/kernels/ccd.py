@@ -6,7 +6,7 @@ with the step's constrained average acceleration a = (v1 - v0) / h):
 so p(h) = p0 + h v1 is exactly where the full step would end. The time of impact is the first
 root of the analytic gap g(tau) = gap(p(tau)): bracketed by sampling (so a fast point cannot
 cross a crest and out again unseen), then refined by the Illinois regula falsi to machine
-precision. The step is then split at tau (seed 002 section 3).
+precision. The step is then split at tau (Kelly 2014, section 3).
 """
 import math
 

@@ -1,6 +1,6 @@
 """Stage 5: the rules of contacts and limits, and the checks of a solve's answer against them.
 
-Rules (seed 002 section 5 plus the sliding mode of its footnote), which a consistent answer
+Rules (Kelly 2014, section 5 plus the sliding mode of its footnote), which a consistent answer
 meets for every contact and limit at once:
   pinned   its normal impulse pushes (lambda_n >= 0) and friction is inside the cone
            (|lambda_t| <= mu lambda_n); the point does not move along the ground
@@ -197,7 +197,7 @@ def rule_breaks(m, s, ws, h, equalities):
 
 @kernel
 def seed_rule(m, s, ws, i):
-    """The seed's alternating check of one contact: release it if it pulls, let it slide if
+    """The alternating check (Kelly 2014) of one contact: release it if it pulls, let it slide if
     its friction leaves the cone, stick it if its slip reversed. The same check goes to every
     contact engaged during this step by the free motion's prediction (ws.contact_new == 1):
     the free motion pushes a point resting a hair above the ground into it every step, while

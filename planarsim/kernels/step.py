@@ -112,7 +112,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     The modes carried over from the last step (plus contacts and limits the free motion would
     push into the ground or past their limit) are a guess: one linear solve, then its answer
     is checked against every rule. Alternating strategy: if it breaks one, the contact under
-    the cursor is re-examined by the seed's rule and solved once more. An answer that still
+    the cursor is re-examined by the alternating rule and solved once more. An answer that still
     breaks a rule goes to the complementarity solve, which ends at a consistent answer
     (complementarity.solve_contacts). No rounds, no cap."""
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)

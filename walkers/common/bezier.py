@@ -4,7 +4,7 @@ B(s) = (1-s)^3 P0 + 3 (1-s)^2 s P1 + 3 (1-s) s^2 P2 + s^3 P3,   0 <= s <= 1
 dB/ds = 3 (1-s)^2 (P1-P0) + 6 (1-s) s (P2-P1) + 3 s^2 (P3-P2)
 
 With the control points at the corners of a rectangle of height H (P1, P2 directly above P0,
-P3), the curve's top is at (3/4) H: a top edge at (4/3) c gives a clearance c (seed 002 4.2).
+P3), the curve's top is at (3/4) H: a top edge at (4/3) c gives a clearance c (Kelly 2014, 4.2).
 Points are given as scalars [m]; s is dimensionless.
 """
 from planarsim.compiled import jit

@@ -1,4 +1,4 @@
-"""The robot dog of seed 003 in the sagittal plane: an A1-like quadruped driven through an
+"""The robot dog of the 2023 robot-dog post in the sagittal plane: an A1-like quadruped driven through an
 inverse-kinematics puppet, trotting with diagonal pairs (STAND / PIAFFE / WALK).
 
 >>> from walkers import quadruped as qd                       # doctest: +SKIP

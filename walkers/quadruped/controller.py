@@ -1,10 +1,10 @@
-"""Trot controller of the planar quadruped (seed 003): a per-foot state machine
+"""Trot controller of the planar quadruped (after the 2023 robot-dog post): a per-foot state machine
 GROUND -> LIFT -> PLANT -> GROUND on diagonal pairs, a kinematic puppet posed by IK, and PD
 tracking of the puppet's joint angles by the motors (compiled).
 
-The seed's step() (run at update_rate = 30 Hz):
+The post's step() (run at update_rate = 30 Hz):
   * the next step starts only when all four feet are GROUND (and, ours, plant_delay seconds
-    after the last plant: the seed's delay for hard, bouncing feet); it selects the pair
+    after the last plant: the post's delay for hard, bouncing feet); it selects the pair
     step_i % 2 (even: FL + RR) and puts both feet in LIFT with a goal lift_height above ground;
   * puppet feet move towards their goals by at most foot_step per update (ours: spread evenly
     over the update period, so the servo targets have no jumps);
@@ -14,7 +14,7 @@ The seed's step() (run at update_rate = 30 Hz):
     plant began. Without it the puppet "planted" some 10-30 ms before the real feet landed,
     the weight feed-forward was split onto feet still in the air and the other foot of their
     end hopped.
-The seed's walker fell when asked to move forward while stepping. Feedback added here:
+The post's walker fell when asked to move forward while stepping. Feedback added here:
   1. foot placement from body velocity (Raibert): the swing feet's goals are recomputed at every
      update at x_hip + v_cmd t_left + v T_st / 2 + k_v (v - v_cmd), limited to +-lead_max
      around the hip; v is the torso speed measured over the last update period and t_left the
@@ -31,11 +31,11 @@ The seed's walker fell when asked to move forward while stepping. Feedback added
      feet on the ground (front/rear split by the lever rule about the torso COM).
 No COM shift is used. What each feedback buys (python benchmarks/quadruped.py --ablation):
 in the sagittal plane a diagonal pair is one front and one rear foot, so the trunk always
-stands on a support interval, and the seed's failure (tilt and fall when moving forward) did
-not appear at 0.3 m/s even "seed-like" (placement off: feet planted under the hips; torso tie
-loosened to 0.5 m). It appears at 0.5 m/s (seed-like fell after 4.7 s; shipped walks), and
+stands on a support interval, and the post's failure (tilt and fall when moving forward) did
+not appear at 0.3 m/s even "post-like" (placement off: feet planted under the hips; torso tie
+loosened to 0.5 m). It appears at 0.5 m/s (post-like fell after 4.7 s; shipped walks), and
 under pushes: the largest 0.2 s push at the torso survived while walking at 0.3 m/s was
-forward/backward 100/140 N shipped, 60/100 N without placement, 60/60 N seed-like.
+forward/backward 100/140 N shipped, 60/100 N without placement, 60/60 N post-like.
 Motor command per joint:
     u = kp (q_puppet - q) - kd dq/dt + tau_ff,   |u| <= torque_limit
 Gaits: STAND (no stepping), PIAFFE (trot in place: v_cmd = 0), WALK (v_cmd = speed).
@@ -120,7 +120,7 @@ def placement_x(m, s, p, mem, i, t_left):
 
 @jit
 def update_feet(m, s, p, mem):
-    """The seed's step(): switch LIFT -> PLANT -> GROUND when the moving pair's puppet feet have
+    """The post's step(): switch LIFT -> PLANT -> GROUND when the moving pair's puppet feet have
     reached their goals, start the next step when all four are down (and the plant delay has
     passed), then refresh the goals of the moving feet (placement from the body velocity)."""
     t = s.time[0]
@@ -247,7 +247,7 @@ def control(m, s, p, mem, u):
     if ty - height(m.terrain_coef, tx) < p[I_FALL_HEIGHT] or abs(th) > p[I_FALL_PITCH]:
         mem[M_FELL] = 1.0
     mem[M_MAX_PITCH] = max(mem[M_MAX_PITCH], abs(th))
-    # the seed's step() at update_rate, with the torso speed over the last period
+    # the post's step() at update_rate, with the torso speed over the last period
     if t >= mem[M_T_UPDATE] - 1e-9:
         period = 1.0 / p[I_UPDATE_RATE]
         mem[M_V_EST] = (tx - mem[M_X_PREV]) / period

@@ -66,22 +66,22 @@ class QuadrupedParams(WalkerParams):
     kp: float = _p(100.0, "N m/rad", "PD stiffness tracking the puppet's joint angles (Menagerie 100)", 0.0, 1e4)
     kd: float = _p(2.0, "N m s/rad", "PD damping on the joint rate (Menagerie joint damping 2)", 0.0, 100.0)
     weight_ff: float = _p(1.0, "-", "fraction of the weight fed forward as J^T F on the legs whose "
-                          "feet are on the ground (0: pure PD, as in the seed)", 0.0, 2.0)
-    # puppet and stepping (seed 003) -----------------------------------------------------------------
+                          "feet are on the ground (0: pure PD, as in the post)", 0.0, 2.0)
+    # puppet and stepping (the 2023 robot-dog post) ---------------------------------------------------
     stand_height: float = _p(0.27, "m", "torso COM height above the ground (Menagerie home pose)", 0.1, 0.4)
-    update_rate: float = _p(30.0, "Hz", "rate of the foot state machine update (the seed's step())", 1.0, 1000.0)
+    update_rate: float = _p(30.0, "Hz", "rate of the foot state machine update (the post's step())", 1.0, 1000.0)
     foot_step: float = _p(0.05, "m", "largest move of a puppet foot towards its goal per update "
-                          "(seed 0.05 m; spread evenly over the update period)", 0.001, 1.0)
-    lift_height: float = _p(0.1, "m", "foot centre height of the lift goal above the ground (seed 0.1)", 0.03, 0.2)
+                          "(the post: 0.05 m; spread evenly over the update period)", 0.001, 1.0)
+    lift_height: float = _p(0.1, "m", "foot centre height of the lift goal above the ground (the post: 0.1)", 0.03, 0.2)
     plant_depth: float = _p(0.0, "m", "plant goal below the resting foot centre (foot radius above "
                             "ground; seed 0.02 m = its foot radius)", 0.0, 0.05)
-    plant_delay: float = _p(0.1, "s", "wait after planting before the next pair lifts (the seed's fix "
+    plant_delay: float = _p(0.1, "s", "wait after planting before the next pair lifts (the post's fix "
                             "for bouncing hard feet)", 0.0, 2.0)
     touch_timeout: float = _p(0.1, "s", "PLANT -> GROUND waits for the real foot's touch at most this "
-                              "long after the plant began (0: the seed's puppet-only switch)", 0.0, 2.0)
+                              "long after the plant began (0: the post's puppet-only switch)", 0.0, 2.0)
     settle_time: float = _p(0.3, "s", "standing still after the start before the first step", 0.0, 5.0)
-    goal_tol: float = _p(0.001, "m", "a puppet foot has reached its goal within this distance (seed)", 1e-6, 0.05)
-    # feedback the seed lacks ---------------------------------------------------------------------------
+    goal_tol: float = _p(0.001, "m", "a puppet foot has reached its goal within this distance (the post)", 1e-6, 0.05)
+    # feedback the post lacks ---------------------------------------------------------------------------
     speed: float = _p(0.3, "m/s", "commanded forward speed in WALK (negative: backward)", -1.0, 1.0)
     accel: float = _p(0.5, "m/s^2", "the puppet torso's speed ramps towards the command at this rate, "
                       "starting after settle_time", 0.01, 10.0)

@@ -1,4 +1,4 @@
-"""The kinematic puppet of seed 003: analytic two-link inverse kinematics of a leg and the
+"""The kinematic puppet of the 2023 robot-dog post: analytic two-link inverse kinematics of a leg and the
 puppet's joint angles from foot targets and a torso pose (compiled).
 
 Leg geometry (params.py convention): a segment at absolute angle phi points along

@@ -6,7 +6,7 @@ beyond fall_pitch). Per recorded frame, ``Trajectory.labels`` holds the controll
 step counter, the four foot states (0 ground, 1 lift, 2 plant) and the measured torso speed.
 
 Contact-mode strategy: "all" by default (every foot checked every step). With four feet the
-seed's alternating check visits a given foot only every fourth step, so a foot being lifted
+the alternating strategy's check visits a given foot only every fourth step, so a foot being lifted
 stays pinned and pulls on the ground until its turn: on a 30 s walk at 0.3 m/s the alternating
 scheme recorded normal impulses down to -0.025 N s in one 1 ms step (a 25 N pull), the "all"
 scheme none below 0; gait, distance and pitch were otherwise the same (benchmarks/quadruped.py

@@ -1,11 +1,11 @@
-"""Cornell Ranger (seed 002 sections 5-6): four rigid bodies with curved feet, the Ranger motor
+"""Cornell Ranger (Kelly 2014, sections 5-6): four rigid bodies with curved feet, the Ranger motor
 model, FSM WALK / STAND / GUI with a step-to-step push-off feedback, cost of transport.
 
 >>> from walkers import ranger
 >>> traj, summary, model = ranger.simulate(10.0, gait="walk")   # doctest: +SKIP
 
 Choices (numbers in params.py, each with its reason):
-- Contact-mode strategy: the seed's "alternating" by default (RangerSim(strategy=...)); "all"
+- Contact-mode strategy: Kelly's "alternating" by default (RangerSim(strategy=...)); "all"
   also walks 1000 steps, fresh or after 0.3 s / 2 s of STAND (measured on a6cac2a; on c758571,
   whose capped rounds could leave a sliding contact with a pulling impulse, one 'all' run
   after 0.3 s of STAND blew up at t = 23.6 s).

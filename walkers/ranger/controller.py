@@ -1,4 +1,4 @@
-"""Ranger controller (seed 002 section 6): FSM WALK / STAND / GUI over motor programs.
+"""Ranger controller (Kelly 2014, section 6): FSM WALK / STAND / GUI over motor programs.
 
 Motor programs are rows of a table ``prog[program] = (frame, target, kp, kd, current_ff)``,
 a PD on the motor current (eq. 18) ``I = I_ff + kp (target - x) + kd (0 - dx)``, where the frame
@@ -8,13 +8,13 @@ says what x is:
   SCISSOR  hip only: x = theta_swing + c theta_stance (the swing leg mirrors the stance leg)
   PUSH     ankle: constant current I_ff (toe down) until the foot reaches the target, then PD
   NONE     zero current (OFF)
-Programs OFF, HOLD, PUSH, FLIP, SWING, GUI are the seed's; LAND (HOLD with the landing target)
+Programs OFF, HOLD, PUSH, FLIP, SWING, GUI are Kelly's; LAND (HOLD with the landing target)
 and KEEP (hold the joint angles captured when flight began) are two more rows of data.
 An ankle whose foot the estimator puts in the air runs the model-based controller of section
 6.5 instead of the current PD: a spring-mass-damper of natural frequency w0 and damping ratio
-zeta on the foot inertia (kp = w0^2 I, kd = 2 zeta w0 I; the seed's kd = 2 zeta w0^2 I is not
+zeta on the foot inertia (kp = w0^2 I, kd = 2 zeta w0 I; Kelly's kd = 2 zeta w0^2 I is not
 dimensionally a damping) plus cancellation of gravity's torque on the foot, and its current is
-saturated to I_foot * free_foot_max_accel / (G K) (the seed's light-foot torque limit).
+saturated to I_foot * free_foot_max_accel / (G K) (Kelly's light-foot torque limit).
 
 WALK (stance side s, swing side w = 1 - s, chosen by the contact estimator):
   DOUBLE (both feet down): stance = the foot that landed (leading) HOLD, trailing PUSH, hip OFF
@@ -24,7 +24,7 @@ WALK (stance side s, swing side w = 1 - s, chosen by the contact estimator):
   FLIGHT (no foot down): every joint KEEPs its angle.
   START (WALK entered at rest, from STAND or the start of a run): DOUBLE's programs with the
           start-up push current, until the leading leg is start_leg_angle past vertical.
-Step-to-step feedback (seed 6.6, "increase the push-off"): at mid-stance (stance leg passing
+Step-to-step feedback (Kelly 2014, 6.6, "increase the push-off"): at mid-stance (stance leg passing
 vertical) the hip speed v is measured and the push-off current of that step's push is set to
 I_push = clip(push_current + push_gain (target_speed - v), 0, Imax).
 """

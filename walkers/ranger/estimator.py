@@ -1,4 +1,4 @@
-"""Contact estimator (seed 002 section 6.3): a second-order Butterworth low-pass filter on each
+"""Contact estimator (Kelly 2014, section 6.3): a second-order Butterworth low-pass filter on each
 foot's contact signal, then a two-threshold (hysteresis) switch, so a foot that bounces off
 the ground for a few milliseconds does not flip the stance/swing selection.
 

@@ -1,4 +1,4 @@
-"""Ranger as four rigid bodies on the public builder (seed 002 section 5).
+"""Ranger as four rigid bodies on the public builder (Kelly 2014, section 5).
 
 Bodies: 0 outer leg, 1 inner leg, 2 outer foot, 3 inner foot (side s: leg s, foot 2 + s).
 Pins:   0 hip (outer -> inner: angle = theta_inner - theta_outer), 1 + s ankle of side s

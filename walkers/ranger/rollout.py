@@ -158,7 +158,7 @@ def live(gait: str = "walk", terrain=None, params: RangerParams | None = None,
          strategy: str = "alternating") -> dict:
     """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and the
     Python-path Controller; keys w / s / g for WALK / STAND / GUI; sliders for the GUI joint
-    targets [rad] (seed 6.1: the GUI mode sets joint targets and gains)."""
+    targets [rad] (Kelly 2014, 6.1: the GUI mode sets joint targets and gains)."""
     if gait not in GAITS:
         raise ValueError(f"Ranger gait {gait!r} unknown; use one of {GAITS}")
     if isinstance(terrain, str):

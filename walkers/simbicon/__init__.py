@@ -1,4 +1,4 @@
-"""SIMBICON biped (seed 000): the MJCF character of the thesis, its four-state FSM with PD
+"""SIMBICON biped (Thachuk 2018): the MJCF character of the thesis, its four-state FSM with PD
 joints, torso control through the stance hip and swing-hip balance feedback; tuned by
 planarsim.tune (CMA-ES)."""
 from planarsim.compiled import drop_stale_caches

@@ -1,4 +1,4 @@
-"""SIMBICON controller (seed 000 sections 2.1-2.3): four-state FSM, PD joints, torso control
+"""SIMBICON controller (Thachuk 2018 sections 2.1-2.3): four-state FSM, PD joints, torso control
 through the stance hip, swing-hip balance feedback. One compiled ``control`` covers every state.
 
 States (Table 1): 0 right swing, timed; 1 right swing, ends at right-foot contact; 2 and 3 the

@@ -1,4 +1,4 @@
-"""The SIMBICON character (seed 000, Table 2 / appendix A.1) loaded from its MJCF file.
+"""The SIMBICON character (Thachuk 2018, Table 2 / appendix A.1) loaded from its MJCF file.
 
 ``legs.xml`` (the thesis' MJCF character, shipped beside this file) goes through planarsim.mjcf: 7 rigid
 bodies (torso with the hip spheres welded on; thigh + knee sphere; shin + ankle sphere; foot,

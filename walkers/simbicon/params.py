@@ -1,4 +1,4 @@
-"""Parameters of the 2D SIMBICON biped (seed 000: Tables 3 and 4, eqs. 1-3).
+"""Parameters of the 2D SIMBICON biped (Thachuk 2018: Tables 3 and 4, eqs. 1-3).
 
 One frozen dataclass; each field carries doc, unit, bounds and whether the tuner may change it
 (``tune``) in its metadata. Angles follow the thesis' Table 3 sign convention, which is also

@@ -1,4 +1,4 @@
-"""The Simple Biped (seed 002 sections 3-4): three point masses, STAND / WALK / JUMP.
+"""The Simple Biped (Kelly 2014, sections 3-4): three point masses, STAND / WALK / JUMP.
 
 >>> from walkers import simple_biped as sb              # doctest: +SKIP
 >>> traj, summary, model = sb.simulate(20.0, gait="walk", speed=1.0)

@@ -1,4 +1,4 @@
-"""The Simple Biped's hierarchical state machine (seed 002 section 4), compiled.
+"""The Simple Biped's hierarchical state machine (Kelly 2014, section 4), compiled.
 
 Top level: the gait STAND / WALK / JUMP, requested through ``memory[M_GAIT]`` (settable from
 Python between rollout chunks). Each gait runs its own states:
@@ -15,7 +15,7 @@ Python between rollout chunks). Each gait runs its own states:
 Transitions are contact and phase driven. Left/right is data: ``memory[M_STANCE]`` is the
 stance (front) foot index, the swing foot is ``1 - stance``.
 
-Deviations from and additions to the seed, stated:
+Deviations from and additions to Kelly's controller, stated:
 - eq. 2 is used in its energy-consistent form phi_dot_target = -sqrt(v_top^2 + 2 g l
   (1 - cos phi)) / l (the pendulum passes the top at v_top); v_top is adapted once per step by
   an integral law so that the mean speed over whole steps meets the target speed;
@@ -24,7 +24,7 @@ Deviations from and additions to the seed, stated:
   the pendulum energy reaches its target (the legs cannot brake it), the rear leg is at its
   longest, or the hip has passed over the front foot;
 - the expected strike height continues the slope seen between the feet (slope_trust = 0 gives
-  the seed's level-ground guess);
+  Kelly's level-ground guess);
 - the swing hip torque is saturated so that its reaction does not push the stance foot out of
   a friction cone (legs/limit_hip_torque);
 - a step whose hip rolls back before passing the stance foot is abandoned: the swing foot

@@ -105,7 +105,7 @@ def hold_stance(q, v, i, length, kp, kd, mass, gx, gy, fmax, u):
 
 @jit
 def track_foot(q, v, i, tx, ty, tvx, tvy, kp, kd, mass, gx, gy, lmax, fmax, tmax, u):
-    """Virtual leg (seed 002 4.2): PD on leg i's length and angle toward the virtual leg from
+    """Virtual leg (Kelly 2014, 4.2): PD on leg i's length and angle toward the virtual leg from
     the hip to the target (tx, ty) [m] moving at (tvx, tvy) [m/s], plus the static force that
     holds the foot's weight (gravity compensation). The virtual leg is at most lmax [m] long.
     Writes u[i] and the hip torque u[2]."""

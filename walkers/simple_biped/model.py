@@ -1,4 +1,4 @@
-"""The Simple Biped model (seed 002 section 3): three point masses joined by actuators.
+"""The Simple Biped model (Kelly 2014, section 3): three point masses joined by actuators.
 
 Bodies: ``hip`` (hip_mass) and ``foot0``, ``foot1`` (foot_mass each); the legs are massless.
 Actuators (index order is used by the controller):

@@ -1,4 +1,4 @@
-"""Parameters of the Simple Biped (seed 002 sections 3-4): model, actuator limits and gains.
+"""Parameters of the Simple Biped (Kelly 2014, sections 3-4): model, actuator limits and gains.
 
 One frozen dataclass; every field carries doc, unit and bounds in its metadata. ``to_array()``
 gives the float64 vector the compiled controller reads through the module-level indices
@@ -42,7 +42,7 @@ class SimpleBipedParams(WalkerParams):
     step_length_per_speed: float = _p(0.3, "l0 s/m", "step length increase per unit speed", 0.0, 1.0)
     clearance: float = _p(0.08, "l0", "swing-foot clearance (Bezier top edge at 4/3 of it)", 0.0, 0.5)
     slope_trust: float = _p(1.0, "-", "fraction of the slope seen between the feet assumed to "
-                            "continue under the next step (0: the seed's level-ground guess)", 0.0, 1.0)
+                            "continue under the next step (0: Kelly's level-ground guess)", 0.0, 1.0)
     strike_push: float = _p(0.05, "l0", "Bezier end point below the expected ground, so the foot "
                             "strikes with downward speed", 0.0, 0.3)
     descent_rate: float = _p(0.5, "l0", "extra lowering of the swing target per unit phase past 1", 0.0, 5.0)
