@@ -4,7 +4,7 @@ integrate:  v = v_new,  q = q + h v  (symplectic Euler).
 correct_positions: the linearised rows leave a residual O(h^2 w^2 r). Newton on the SHAKE
 equation moves q along the START-of-step constraint directions J(q0):
     (J(q+) W J(q0)^T) mu = -c(q+),   q += W J(q0)^T mu,   v += W J(q0)^T mu / h
-(correcting along J(q+) instead would dissipate energy every step; DESIGN.md section 3.7).
+(correcting along J(q+) instead would dissipate energy every step).
 Safeguards: a Newton step that raises the largest error tenfold (nearly dependent rows of a
 closed loop through the ground) is taken back and tried once more with such rows dropped;
 one that removes less than half of it has stalled on a row dropped as dependent, and ends

@@ -1,4 +1,4 @@
-"""The compiled step: a table of contents of the stages (DESIGN.md section 3).
+"""The compiled step: a table of contents of the stages (README, "How the engine works").
 
 step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
 (0 ok, 1 non-finite, 2 too large). Model, state, workspace and options arrive as one pointer

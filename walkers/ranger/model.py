@@ -9,7 +9,7 @@ Feet:   circular-arc soles (radius 0.2 m, centre 0.14 m above the ankle on a lev
         are the heel and the toe. contact s is the sole of foot s.
 Motors: 0 hip, 1 + s ankle of side s: pin torques [N m], saturated at the peak torques.
 Springs: the parallel springs of ranger.md are passive pin springs.
-Rotor inertia (DESIGN.md 8, light feet behind heavy legs): with rotor_on_foot = 1 the ankle
+Rotor inertia (light feet behind heavy legs): with rotor_on_foot = 1 the ankle
 rotor's reflected inertia G^2 Jm (0.00185 kg m^2, as large as the foot's own 0.002) is added to
 the foot body as an armature. Exact for the foot's rotation relative to a leg that does not
 rotate; the error is the leg's angular velocity times G^2 Jm, against the leg's 0.45 kg m^2

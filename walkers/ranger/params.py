@@ -68,7 +68,7 @@ class RangerParams(WalkerParams):
     ankle_torque_peak: float = _p(4.8, "ankle torque saturation (peak; 3.6 continuous)", "N m", 0.1, 50.0)
     overhead_power: float = _p(4.5, "electrical power of computers and sensors", "W", 0.0, 50.0)
     rotor_on_foot: float = _p(1.0, "CHOSEN: 1 adds the ankle rotor's G^2 Jm to the foot inertia (armature), 0 leaves it out", "-", 0.0, 1.0)
-    # light-foot guard (DESIGN.md 8) -------------------------------------------------------------
+    # light-foot guard (a light foot behind a heavy leg) -------------------------------------------------------------
     free_foot_max_accel: float = _p(2000.0, "CHOSEN: ankle torque on a foot in the air is saturated to I_foot times this", "rad/s^2", 10.0, 1e6)
     # contact estimator --------------------------------------------------------------------------
     est_cutoff: float = _p(15.0, "CHOSEN: Butterworth low-pass cutoff of the contact signal", "Hz", 0.5, 200.0)
