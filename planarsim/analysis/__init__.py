@@ -1,0 +1,24 @@
+"""Gait analysis: step events, Poincare sections, step-to-step maps, fixed points, Floquet
+multipliers with error estimates, continuation of gaits in a parameter with bifurcation
+detection, brute-force bifurcation diagrams, basins of attraction, step-level summaries,
+and their plots.
+
+Modules: events (touchdowns, sections), stepmap (StepMap, Jacobians, fixed points,
+multipliers), parallel (MapPool: map evaluations on every core), continuation, bifurcation,
+basin, summary (whole-step cost of transport, step length, speed), plots.
+"""
+from .events import IN_CONTACT, StepEvents, poincare_section, step_events, touchdowns
+from .stepmap import (EPS_LADDER, FixedPoint, MultiplierWarning, Multipliers, StepMap, StepMapError,
+                      central_jacobian, central_points, find_fixed_point, floquet_multipliers,
+                      jacobian, match_distance, multipliers_with_error, serial_evaluator,
+                      sort_multipliers)
+from .parallel import MapPool, compose
+from .plots import plot_limit_cycle, plot_multipliers
+
+__all__ = [
+    "IN_CONTACT", "StepEvents", "poincare_section", "step_events", "touchdowns",
+    "EPS_LADDER", "FixedPoint", "MultiplierWarning", "Multipliers", "StepMap", "StepMapError",
+    "central_jacobian", "central_points", "find_fixed_point", "floquet_multipliers", "jacobian",
+    "match_distance", "multipliers_with_error", "serial_evaluator", "sort_multipliers",
+    "MapPool", "compose", "plot_limit_cycle", "plot_multipliers",
+]
