@@ -12,6 +12,8 @@ from .stepmap import (EPS_LADDER, FixedPoint, MultiplierWarning, Multipliers, St
                       central_jacobian, central_points, find_fixed_point, floquet_multipliers,
                       jacobian, match_distance, multipliers_with_error, serial_evaluator,
                       sort_multipliers)
+from .continuation import (Bifurcation, Branch, BranchPoint, continue_branch, newton_fixed_point,
+                           period_doubling_branch, test_functions, write_csv)
 from .parallel import MapPool, compose
 from .plots import plot_limit_cycle, plot_multipliers
 
@@ -20,5 +22,6 @@ __all__ = [
     "EPS_LADDER", "FixedPoint", "MultiplierWarning", "Multipliers", "StepMap", "StepMapError",
     "central_jacobian", "central_points", "find_fixed_point", "floquet_multipliers", "jacobian",
     "match_distance", "multipliers_with_error", "serial_evaluator", "sort_multipliers",
-    "MapPool", "compose", "plot_limit_cycle", "plot_multipliers",
+    "Bifurcation", "Branch", "BranchPoint", "continue_branch", "newton_fixed_point",
+    "period_doubling_branch", "test_functions", "write_csv", "MapPool", "compose", "plot_limit_cycle", "plot_multipliers",
 ]
