@@ -12,10 +12,13 @@ from .stepmap import (EPS_LADDER, FixedPoint, MultiplierWarning, Multipliers, St
                       central_jacobian, central_points, find_fixed_point, floquet_multipliers,
                       jacobian, match_distance, multipliers_with_error, serial_evaluator,
                       sort_multipliers)
+from .bifurcation import Basin, Diagram, basin_of_attraction, bifurcation_diagram
 from .continuation import (Bifurcation, Branch, BranchPoint, continue_branch, newton_fixed_point,
-                           period_doubling_branch, test_functions, write_csv)
+                           period_doubling_branch, bifurcation_tests, write_csv)
 from .parallel import MapPool, compose
-from .plots import plot_limit_cycle, plot_multipliers
+from .summary import frame_from_state, step_summary
+from .plots import (plot_basin, plot_bifurcation_diagram, plot_branch_multipliers, plot_limit_cycle,
+                    plot_multipliers)
 
 __all__ = [
     "IN_CONTACT", "StepEvents", "poincare_section", "step_events", "touchdowns",
@@ -23,5 +26,7 @@ __all__ = [
     "central_jacobian", "central_points", "find_fixed_point", "floquet_multipliers", "jacobian",
     "match_distance", "multipliers_with_error", "serial_evaluator", "sort_multipliers",
     "Bifurcation", "Branch", "BranchPoint", "continue_branch", "newton_fixed_point",
-    "period_doubling_branch", "test_functions", "write_csv", "MapPool", "compose", "plot_limit_cycle", "plot_multipliers",
+    "period_doubling_branch", "bifurcation_tests", "write_csv", "MapPool", "compose",
+    "frame_from_state", "step_summary", "Basin", "Diagram", "basin_of_attraction",
+    "bifurcation_diagram", "plot_basin", "plot_bifurcation_diagram", "plot_branch_multipliers", "plot_limit_cycle", "plot_multipliers",
 ]

@@ -120,7 +120,7 @@ def write_csv(path, rows):
 
 
 # test functions ------------------------------------------------------------------------------
-def test_functions(lam) -> dict:
+def bifurcation_tests(lam) -> dict:
     """det(J + I), det(J - I) (real, from the multipliers) and the number of complex
     multipliers outside the unit circle."""
     lam = np.asarray(lam, complex)
@@ -173,8 +173,8 @@ def _point(pool, p, x, period, residual, mult_tol):
 
 def _locate(pool, a: BranchPoint, b: BranchPoint, kind, tol, p_tol, mult_tol, max_iter=12):
     """Regula falsi (Illinois) on the test function of `kind` between a and b."""
-    fa = test_functions(a.multipliers)[kind]
-    fb = test_functions(b.multipliers)[kind]
+    fa = bifurcation_tests(a.multipliers)[kind]
+    fb = bifurcation_tests(b.multipliers)[kind]
     pa, pb, xa, xb = a.p, b.p, a.x, b.x
     best = a if abs(fa) < abs(fb) else b
     side = 0
@@ -187,7 +187,7 @@ def _locate(pool, a: BranchPoint, b: BranchPoint, kind, tol, p_tol, mult_tol, ma
         if not conv:
             break
         c = _point(pool, pc, x, a.period, r, mult_tol)
-        fc = test_functions(c.multipliers)[kind]
+        fc = bifurcation_tests(c.multipliers)[kind]
         best = c
         if np.sign(fc) == np.sign(fa):
             pa, xa, fa = pc, x, fc
@@ -199,7 +199,7 @@ def _locate(pool, a: BranchPoint, b: BranchPoint, kind, tol, p_tol, mult_tol, ma
             if side == 1:
                 fa *= 0.5
             side = 1
-    located = abs(pb - pa) <= p_tol or abs(test_functions(best.multipliers)[kind]) < 1e-9
+    located = abs(pb - pa) <= p_tol or abs(bifurcation_tests(best.multipliers)[kind]) < 1e-9
     return Bifurcation(kind, best.p, best.x, best.multipliers, a.period, located, abs(pb - pa))
 
 
@@ -209,7 +209,7 @@ def _interpolated(a, b, kind):
         rb = np.max(np.abs(b.multipliers[np.abs(b.multipliers.imag) > 0] if np.any(b.multipliers.imag) else b.multipliers))
         fa, fb = ra - 1.0, rb - 1.0
     else:
-        fa, fb = test_functions(a.multipliers)[kind], test_functions(b.multipliers)[kind]
+        fa, fb = bifurcation_tests(a.multipliers)[kind], bifurcation_tests(b.multipliers)[kind]
     w = fa / (fa - fb) if fa != fb else 0.5
     w = min(max(w, 0.0), 1.0)
     return Bifurcation(kind, a.p + w * (b.p - a.p), a.x + w * (b.x - a.x),
@@ -218,7 +218,7 @@ def _interpolated(a, b, kind):
 
 
 def _detect(pool, a, b, locate, tol, p_tol, mult_tol, folded=False):
-    ta, tb = test_functions(a.multipliers), test_functions(b.multipliers)
+    ta, tb = bifurcation_tests(a.multipliers), bifurcation_tests(b.multipliers)
     found = []
     if np.sign(ta["period-doubling"]) != np.sign(tb["period-doubling"]):
         found.append(_locate(pool, a, b, "period-doubling", tol, p_tol, mult_tol) if locate
@@ -234,7 +234,8 @@ def _detect(pool, a, b, locate, tol, p_tol, mult_tol, folded=False):
 def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
                     method: str = "natural", period: int = 1, tol: float = 1e-9,
                     locate: bool = True, p_tol: float | None = None, mult_tol: float = 3e-3,
-                    param: str = "p", progress=None, max_points: int | None = None) -> Branch:
+                    param: str = "p", progress=None, max_points: int | None = None,
+                    subperiod: int | None = None) -> Branch:
     """Follow the fixed point of P^period(x; p) near x0 from p0 toward p1.
 
     method "natural": `points` equally spaced values of p (a failed Newton halves the step,
@@ -243,7 +244,8 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
     Bifurcations between neighbouring points are detected and, with locate, period
     doublings located to p_tol (default 1e-5 of |p1 - p0|; Bifurcation.bracket is the
     bracket reached: the map's noise can stop it earlier). progress(done, total) is called
-    after each point. Returns a Branch.
+    after each point. subperiod: reject solutions that are fixed points of P^subperiod (the
+    period-n orbit a period-2n branch was born from; natural continuation). Returns a Branch.
     """
     if method not in ("natural", "arclength"):
         raise ValueError(f"method={method!r} must be 'natural' or 'arclength'")
@@ -264,14 +266,16 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
     if progress:
         progress(1, total)
     if method == "natural":
-        _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total)
+        _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total,
+                 subperiod)
     else:
         _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total)
     branch.evaluations = pool.evaluations - ev0
     return branch
 
 
-def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total):
+def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total,
+             subperiod=None):
     p = p0
     halvings = 0
     while (p1 - p) * np.sign(h) > 1e-12 * abs(p1 - p0):
@@ -282,6 +286,9 @@ def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, prog
         pts = branch.points
         guess = pts[-1].x if len(pts) < 2 else pts[-1].x + (pts[-1].x - pts[-2].x) * (pn - p) / (pts[-1].p - pts[-2].p)
         x, r, conv, _ = newton_fixed_point(pool, pn, guess, period, tol)
+        if conv and subperiod:
+            y, ok = pool.evaluate(x[None, :], pn, subperiod)
+            conv = bool(ok[0]) and np.max(np.abs(y[0] - x)) > max(1e3 * tol, 1e-8)
         if not conv:
             halvings += 1
             if halvings > 4:
@@ -335,8 +342,15 @@ def _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, pr
         r = float(np.max(np.abs(pool.evaluate(xn[None, :], pn, period)[0][0] - xn)))
         b = _point(pool, pn, xn, period, r, mult_tol)
         folded = len(branch.points) >= 2 and (pn - a.p) * (a.p - branch.points[-2].p) < 0
-        branch.bifurcations += _detect(pool, a, b, locate and not folded, tol, p_tol, mult_tol,
-                                       folded=False)
+        found = _detect(pool, a, b, locate and not folded, tol, p_tol, mult_tol)
+        for bf in found:
+            if bf.kind == "fold" and len(branch.points) >= 2:
+                # p is quadratic in the fold's test function near the fold: fit three points
+                pts3 = [branch.points[-2], a, b]
+                tau = [bifurcation_tests(q.multipliers)["fold"] for q in pts3]
+                if len(set(tau)) == 3:
+                    bf.p = float(np.polyval(np.polyfit(tau, [q.p for q in pts3], 2), 0.0))
+        branch.bifurcations += found
         branch.points.append(b)
         if progress:
             progress(len(branch.points), total)
@@ -393,5 +407,6 @@ def period_doubling_branch(pool: MapPool, bif: Bifurcation, p1: float, points: i
             x, r, conv, _ = newton_fixed_point(pool, pstart, base + s * a * v, 2 * n, tol)
             if conv and np.max(np.abs(x - base)) > 100 * tol and \
                     np.max(np.abs(pool.evaluate(x[None, :], pstart, n)[0][0] - x)) > 100 * tol:
-                return continue_branch(pool, x, pstart, p1, points, period=2 * n, tol=tol, **kw)
+                return continue_branch(pool, x, pstart, p1, points, period=2 * n, tol=tol,
+                                       subperiod=n, **kw)
     raise StepMapError(f"no period-{2 * n} orbit found next to the period doubling at {bif.p:g}")
