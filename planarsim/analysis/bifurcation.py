@@ -65,6 +65,7 @@ def bifurcation_diagram(pool: MapPool, p_values, x0, transient: int = 200, keep:
     n = int(transient) + int(keep)
     items = [(float(p), x0f(p), n, int(keep), None, 0.0) for p in ps]
     res = pool.run(iterate_task, items, progress)
+    pool.evaluations += int(sum(r[1] + r[2] for r in res))
     return Diagram(param, ps, [r[0] for r in res], np.array([r[1] for r in res]),
                    np.array([r[2] for r in res], bool), int(transient), int(keep))
 
@@ -109,6 +110,7 @@ def basin_of_attraction(pool: MapPool, p: float, a_values, b_values, state, attr
     items = [(float(p), np.asarray(state(a, b), dtype=np.float64), int(n_steps), 0, target, float(tol))
              for a in A for b in B]
     res = pool.run(iterate_task, items, progress)
+    pool.evaluations += int(sum(r[1] + r[2] for r in res))
     shape = (len(A), len(B))
     steps = np.array([r[1] for r in res]).reshape(shape)
     fell = np.array([r[2] for r in res], bool).reshape(shape)

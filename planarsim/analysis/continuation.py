@@ -131,9 +131,11 @@ def bifurcation_tests(lam) -> dict:
 
 
 # Newton --------------------------------------------------------------------------------------
-def newton_fixed_point(pool: MapPool, p, x0, period=1, tol=1e-9, max_iter=12, eps=1e-5,
+def newton_fixed_point(pool: MapPool, p, x0, period=1, tol=1e-9, max_iter=20, eps=1e-4,
                        max_halvings=8):
-    """Newton on P^period(x; p) - x with the Jacobian's columns evaluated in one batch.
+    """Newton on P^period(x; p) - x with the Jacobian's columns (central differences, step
+    eps: a simulated map is piecewise smooth below ~1e-5, see multipliers_with_error)
+    evaluated in one batch.
     Returns (x, residual, converged, J at the last iterate)."""
     x = np.asarray(x0, dtype=np.float64).copy()
     d = x.size
@@ -383,20 +385,18 @@ def _arclength_newton(pool, yp, t, period, tol, dp_fd, max_iter=10):
 
 
 def period_doubling_branch(pool: MapPool, bif: Bifurcation, p1: float, points: int = 20,
-                           tol: float = 1e-9, amplitudes=(1e-3, 3e-3, 1e-2, 3e-2), **kw) -> Branch:
+                           tol: float = 1e-6, amplitudes=(1e-3, 3e-3, 1e-2, 3e-2, 0.1), **kw) -> Branch:
     """The period-2n orbit born at period doubling `bif` (of the period-n orbit), continued
     from just past bif.p toward p1 (the side where it exists: where the period-n gait lost
     stability). Starts Newton on P^2n from x* +- a v (v: eigenvector of the multiplier
     nearest -1) for the amplitudes a in turn and takes the first solution that is not the
-    period-n point. Raises StepMapError when none is found."""
+    period-n point. Raises StepMapError when none is found. tol: Newton's residual on
+    P^2n (a simulated map's noise, ~1e-7 for the passive walkers, compounds over 2n steps)."""
     n = bif.period
     d = bif.x.size
     dp = (p1 - bif.p) / max(int(points) - 1, 1)
-    pstart = bif.p + 0.25 * dp
-    Y, ok = pool.evaluate(central_points(bif.x, 1e-5), pstart, n)
-    if not ok.all():
-        raise StepMapError(f"the map fails next to the period doubling at {bif.p:g}")
-    J = central_jacobian(Y, 1e-5)
+    pstart = bif.p + 0.5 * dp
+    J = multipliers_with_error(None, bif.x, evaluate=pool.evaluator(pstart, n), warn=False).jacobian
     lam, V = np.linalg.eig(J)
     v = np.real(V[:, np.argmin(np.abs(lam + 1.0))])
     v /= np.max(np.abs(v))
