@@ -219,13 +219,20 @@ def _interpolated(a, b, kind):
                        abs(b.p - a.p))
 
 
+def _resolved(a, b, critical):
+    """Whether the multiplier nearest `critical` (+1 or -1) is farther from it than its error
+    estimate at both points (else a sign change of the test function may be noise: just past
+    a period doubling the new orbit's multiplier sits at +1)."""
+    return all(np.min(np.abs(q.multipliers - critical)) > q.error for q in (a, b))
+
+
 def _detect(pool, a, b, locate, tol, p_tol, mult_tol, folded=False):
     ta, tb = bifurcation_tests(a.multipliers), bifurcation_tests(b.multipliers)
     found = []
-    if np.sign(ta["period-doubling"]) != np.sign(tb["period-doubling"]):
+    if np.sign(ta["period-doubling"]) != np.sign(tb["period-doubling"]) and _resolved(a, b, -1.0):
         found.append(_locate(pool, a, b, "period-doubling", tol, p_tol, mult_tol) if locate
                      else _interpolated(a, b, "period-doubling"))
-    if folded or np.sign(ta["fold"]) != np.sign(tb["fold"]):
+    if folded or (np.sign(ta["fold"]) != np.sign(tb["fold"]) and _resolved(a, b, 1.0)):
         found.append(_interpolated(a, b, "fold"))
     if ta["neimark-sacker"] != tb["neimark-sacker"]:
         found.append(_interpolated(a, b, "neimark-sacker"))

@@ -69,7 +69,7 @@ def plot_bifurcation_diagram(diagram, coordinate: int = 0, path=None, ax=None, b
     if diagram is not None:
         for p, orb in zip(diagram.p, diagram.orbits):
             if len(orb):
-                ax.plot(np.full(len(orb), p), orb[:, coordinate], ",", color="k", alpha=0.6)
+                ax.plot(np.full(len(orb), p), orb[:, coordinate], ".", ms=1.5, color="k")
         onset = diagram.fall_onset()
         if onset is not None:
             ax.axvline(onset, color="C3", lw=1.0, ls=":", label=f"falls from {onset:.5g}")
@@ -83,9 +83,10 @@ def plot_bifurcation_diagram(diagram, coordinate: int = 0, path=None, ax=None, b
             ax.plot(p, y, ls, color=f"C{i % 10}", lw=1.2,
                     label=f"period {br.period}" + (" (stable)" if ls == "-" else " (unstable)"))
     for bf in bifurcations:
+        short = {"period-doubling": "PD", "fold": "F", "neimark-sacker": "NS"}.get(bf.kind, bf.kind)
         ax.plot(bf.p, bf.x[coordinate], "o", mfc="none", color="C3", ms=7)
-        ax.annotate(f"{bf.kind} {bf.p:.5g}", (bf.p, bf.x[coordinate]), fontsize=7,
-                    xytext=(4, 6), textcoords="offset points")
+        ax.annotate(f"{short} {bf.p:.5f}", (bf.p, bf.x[coordinate]), fontsize=7, rotation=90,
+                    xytext=(-3, -48), textcoords="offset points")
     ax.set_xlabel(getattr(diagram, "param", None) or (branches[0].param if branches else "p"))
     ax.set_ylabel(label or f"x[{coordinate}] at touchdown")
     ax.set_title(title)
