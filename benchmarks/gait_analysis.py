@@ -45,6 +45,18 @@ def speedup():
             times[workers] = time.perf_counter() - t0
             print(f"  {workers} worker(s): {times[workers]:6.1f} s, {br.evaluations} evaluations, {br.end}")
     print(f"  speed-up on 2 cores: {times[1] / times[2]:.2f}x")
+    # how many cores the machine really gives now: one batch of 128 independent evaluations
+    from planarsim.analysis import central_points
+    X = np.concatenate([central_points(fam.guess(0.009), h) for h in 1e-4 * 0.5 ** np.arange(16)])
+    raw = {}
+    for workers in (1, 2):
+        with MapPool(fam, workers=workers) as pool:
+            pool.evaluate(X[:3], 0.009)
+            t0 = time.perf_counter()
+            pool.evaluate(X, 0.009)
+            raw[workers] = time.perf_counter() - t0
+    print(f"  one batch of {len(X)} evaluations: {raw[1]:.2f} s on 1 worker, {raw[2]:.2f} s on 2 "
+          f"({raw[1] / raw[2]:.2f}x; near 1x means the second core is busy with other work)")
 
 
 def multipliers():

@@ -162,16 +162,18 @@ class MapPool:
     def run(self, task: Callable, items: Sequence, progress: Callable | None = None) -> list:
         """[task(maps, item) for item in items] on the workers, in order; task must be a
         module-level function (it is sent to the workers by name). progress(done, total) is
-        called as results arrive. The first item runs here first, so that a cold numba cache
-        compiles once (and forked workers inherit the compiled code)."""
+        called as results arrive. Until the workers start, the first item runs here first, so
+        that a cold numba cache compiles once (and forked workers inherit the compiled code)."""
         items = list(items)
         n = len(items)
         if not n:
             return []
-        out = [task(self._local, items[0])]
-        if progress:
-            progress(1, n)
-        rest = items[1:]
+        out = []
+        if self.backend == "serial" or self._pool is None or n == 1:
+            out.append(task(self._local, items[0]))   # warms the numba cache before forking
+            if progress:
+                progress(1, n)
+        rest = items[len(out):]
         if not rest:
             return out
         if self.backend == "serial":
@@ -181,7 +183,8 @@ class MapPool:
                     progress(i + 2, n)
             return out
         pool = self._ensure()
-        chunk = max(1, len(rest) // (4 * self.workers))
+        chunk = max(1, len(rest) // (2 * self.workers))
+        k0 = len(out)
         if self.backend == "process":
             it = pool.imap(_process_run, [(task, r) for r in rest], chunksize=chunk)
         else:
@@ -189,7 +192,7 @@ class MapPool:
         for i, r in enumerate(it):
             out.append(r)
             if progress:
-                progress(i + 2, n)
+                progress(k0 + i + 1, n)
         return out
 
     def evaluate(self, X, p, period: int = 1):
