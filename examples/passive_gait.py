@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from planarsim.analysis import StepMapError, find_fixed_point, plot_limit_cycle, plot_multipliers
+from planarsim.analysis import (StepMapError, find_fixed_point, multipliers_with_error, plot_limit_cycle,
+                                plot_multipliers)
 from walkers.passive import CompassParams, PassiveWalker, RimlessParams, SimplestParams
 
 WALKERS = ("simplest-walker", "compass-gait", "rimless-wheel")
@@ -30,7 +31,7 @@ def initial_guess(name, params):
     return default_start(params)
 
 
-def analyse(name, slope, dt=1e-3, beta=1e-3, out=None, eps=1e-3, quiet=False):
+def analyse(name, slope, dt=1e-3, beta=1e-3, out=None, eps="auto", quiet=False):
     """Find the period-one gait; print and return a dict; save plots into `out` if given."""
     if name == "simplest-walker":
         params = SimplestParams(slope=slope, foot_mass_ratio=beta)
@@ -42,11 +43,14 @@ def analyse(name, slope, dt=1e-3, beta=1e-3, out=None, eps=1e-3, quiet=False):
         raise ValueError(f"unknown passive walker {name!r}; choose from {WALKERS}")
     walker = PassiveWalker(params, dt=dt)
     step_map = walker.step_map()
-    fp = find_fixed_point(step_map, initial_guess(name, params), tol=1e-9, eps=eps)
+    fp = find_fixed_point(step_map, initial_guess(name, params), tol=1e-9, eps=1e-4)
+    mult = multipliers_with_error(step_map, fp.x, eps)   # the step chosen from the map's noise
+    fp.multipliers = mult.values
     walker.advance(fp.x)
     result = dict(walker=name, slope=slope, dt=dt, fixed_point=dict(zip(walker.names, fp.x.tolist())),
                   converged=fp.converged, residual=fp.residual, step_period=walker.last_period,
                   step_length=walker.last_length, multipliers=fp.multipliers, stable=fp.stable,
+                  multiplier_error=mult.error, multiplier_eps=mult.eps,
                   evaluations=fp.evaluations)
     if not quiet:
         print(f"{name} on slope {slope} rad, dt = {dt} s" + (f", beta = {beta}" if name == "simplest-walker" else ""))
@@ -55,7 +59,8 @@ def analyse(name, slope, dt=1e-3, beta=1e-3, out=None, eps=1e-3, quiet=False):
         for k, v in result["fixed_point"].items():
             print(f"    {k:10s} = {v:+.8f}")
         print(f"  step period = {walker.last_period:.6f} s, step length = {walker.last_length:.6f} m")
-        print("  Floquet multipliers: " + ", ".join(f"{m.real:+.4f}{m.imag:+.4f}j (|{abs(m):.4f}|)" for m in fp.multipliers))
+        print("  Floquet multipliers: " + ", ".join(f"{m.real:+.4f}{m.imag:+.4f}j (|{abs(m):.4f}|)" for m in fp.multipliers)
+              + f"  (estimated error {mult.error:.1e}, eps {mult.eps:.2g})")
         print(f"  {'stable' if fp.stable else 'UNSTABLE'} (spectral radius {fp.spectral_radius:.4f})")
     if out is not None:
         out = Path(out)

@@ -1,8 +1,9 @@
-"""The `planarsim` command: list, run, view, bench, tune, info.
+"""The `planarsim` command: list, run, view, bench, tune, analyze, info.
 
     planarsim run simple-biped                 # walk, write out/simple-biped.gif + summary
     planarsim run ranger --duration 20 --out ranger.mp4 --plot ranger.png --json
     planarsim list
+    planarsim analyze simplest-walker --param slope --range 0.009:0.019 --csv gaits.csv
 
 User errors (unknown walker, bad terrain, negative duration, unwritable path) exit with
 code 2 and one line saying what was wrong and what is allowed; no traceback.
@@ -267,6 +268,99 @@ def cmd_info(args):
     return 0
 
 
+# analyze ---------------------------------------------------------------------------------------
+def _analysis_family(args):
+    """The walker's step-map family in --param (one-line UsageError on bad input)."""
+    w = _walkers()
+    if args.walker not in w.WALKERS:
+        raise UsageError(f"unknown walker {args.walker!r}; choose one of: {', '.join(sorted(w.WALKERS))}")
+    from walkers.passive import family as fam
+    if args.walker not in fam.PARAMS:
+        raise UsageError(f"walker {args.walker!r} has no step-to-step map family for analysis; "
+                         f"walkers with one: {', '.join(sorted(fam.PARAMS))}")
+    if args.param not in fam.param_names(args.walker):
+        raise UsageError(f"{args.walker} has no parameter {args.param!r}; parameters: "
+                         f"{', '.join(fam.param_names(args.walker))}")
+    try:
+        a, b = (float(v) for v in args.range.split(":"))
+    except ValueError:
+        raise UsageError(f"--range {args.range!r} must be A:B, two numbers (e.g. 0.009:0.019)") from None
+    lo, hi = fam.param_bounds(args.walker, args.param)
+    if not (math.isfinite(a) and math.isfinite(b)) or a == b:
+        raise UsageError(f"--range {args.range!r} must be two different finite numbers")
+    if not (lo <= min(a, b) and max(a, b) <= hi):
+        raise UsageError(f"--range {args.range!r} leaves the bounds of {args.param}: [{lo}, {hi}]")
+    if args.dt is not None and args.dt > 0.01:
+        raise UsageError(f"--dt {args.dt} is too large; use a step of at most 0.01 s (1e-3 is usual)")
+    return fam.WalkerFamily(args.walker, args.param, dt=args.dt or 1e-3), a, b
+
+
+def cmd_analyze(args):
+    """Continuation of the period-one gait in one parameter (multipliers, bifurcations,
+    period-2 after a doubling) or a brute-force bifurcation diagram; CSV and plot."""
+    import numpy as np
+    from .analysis import (MapPool, StepMapError, bifurcation_diagram, continue_branch,
+                           period_doubling_branch, plot_bifurcation_diagram, plot_branch_multipliers)
+    from .render.animate import TextProgress
+    family, a, b = _analysis_family(args)
+    if args.points < 2:
+        raise UsageError(f"--points {args.points} must be at least 2")
+    csv = _check_out(args.csv, (".csv",), "--csv")
+    plot = _check_out(args.plot, PLOT_EXTS, "--plot")
+    bar = TextProgress(args.points, "points")
+    progress = None if args.quiet else (lambda done, total: bar(min(done, bar.total)))
+    x0 = family.guess(a)
+    t0 = time.perf_counter()
+    with MapPool(family, workers=args.workers) as pool:
+        if args.diagram:
+            d = bifurcation_diagram(pool, np.linspace(a, b, args.points), x0, args.transient,
+                                    args.keep, param=args.param, progress=progress)
+            periods = d.periods()
+            for p, k, fell in zip(d.p, periods, d.fell):
+                print(f"  {args.param} = {p:.6g}: " + ("fell" if fell else
+                      f"period {k}" if k > 0 else f"no period up to {args.keep // 2} (chaos?)"))
+            onset = d.fall_onset()
+            print(f"falls from {args.param} = {onset:.6g}" if onset is not None else "no falls in the range")
+            if csv:
+                d.to_csv(csv, 0, family.names[0])
+            if plot:
+                plot_bifurcation_diagram(d, 0, plot, label=f"{family.names[0]} at touchdown",
+                                         title=f"{args.walker}: bifurcation diagram")
+        else:
+            try:
+                br = continue_branch(pool, x0, a, b, args.points, method=args.method,
+                                     param=args.param, progress=progress)
+            except StepMapError as e:
+                raise UsageError(f"no gait to continue: {e}") from None
+            branches = [br]
+            pd = br.first("period-doubling")
+            if pd is not None and args.follow:
+                try:
+                    branches.append(period_doubling_branch(pool, pd, b, max(4, args.points // 2),
+                                                           param=args.param))
+                except StepMapError as e:
+                    print(f"  period-2 orbit not followed: {e}", file=sys.stderr)
+            for k in branches:
+                print(f"period-{k.period} branch: {len(k.points)} points, {k.end}")
+                for bf in k.bifurcations:
+                    print(f"  {bf.kind} at {args.param} = {bf.p:.7g}"
+                          f"{'' if bf.located else f' (within {bf.bracket:.2g})'}")
+            if csv:
+                from .analysis import write_csv
+                write_csv(csv, [r for k in branches for r in k.rows(family.names)])
+            if plot:
+                if plot.with_suffix("").name.endswith("_multipliers"):
+                    plot_branch_multipliers(br, plot)
+                else:
+                    allb = [bf for k in branches for bf in k.bifurcations]
+                    plot_bifurcation_diagram(None, 0, plot, branches=branches, bifurcations=allb,
+                                             label=f"{family.names[0]} at touchdown",
+                                             title=f"{args.walker}: gaits along {args.param}")
+    print(f"({time.perf_counter() - t0:.1f} s, {pool.evaluations} step-map evaluations on "
+          f"{pool.workers} workers)" + (f"; wrote {', '.join(str(p) for p in (csv, plot) if p)}" if csv or plot else ""))
+    return 0
+
+
 # parser ---------------------------------------------------------------------------------------
 class _Parser(argparse.ArgumentParser):
     """argparse, but a bad argument is one line and a pointer to --help (exit 2), not the whole
@@ -321,6 +415,26 @@ def make_parser():
     p = sub.add_parser("tune", help="CMA-ES tuning of a walker (planarsim tune --help)", add_help=False)
     p.add_argument("rest", nargs=argparse.REMAINDER)
     p.set_defaults(func=cmd_tune)
+    p = sub.add_parser("analyze", help="gaits along a parameter: continuation, bifurcations, diagram")
+    p.add_argument("walker", help="walker with a step-to-step map (the passive walkers)")
+    p.add_argument("--param", required=True, help="parameter to vary (e.g. slope)")
+    p.add_argument("--range", required=True, help="A:B, the parameter's range")
+    p.add_argument("--points", type=int, default=20, help="points along the range (default 20)")
+    p.add_argument("--method", choices=("natural", "arclength"), default="natural",
+                   help="continuation method (arclength passes folds)")
+    p.add_argument("--diagram", action="store_true",
+                   help="brute-force bifurcation diagram instead (iterate, keep the last values)")
+    p.add_argument("--transient", type=int, default=200, help="--diagram: steps dropped")
+    p.add_argument("--keep", type=int, default=32, help="--diagram: section values kept")
+    p.add_argument("--no-follow", dest="follow", action="store_false",
+                   help="do not follow the period-2 orbit after a period doubling")
+    p.add_argument("--dt", type=_positive, default=None, help="step size [s] (default 1e-3)")
+    p.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    p.add_argument("--csv", default=None, help="results .csv")
+    p.add_argument("--plot", default=None,
+                   help="plot .png | .svg | .pdf (a name ending in _multipliers: the multipliers)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_analyze)
     p = sub.add_parser("info", help="versions and numba cache state")
     p.set_defaults(func=cmd_info)
     return ap

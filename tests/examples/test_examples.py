@@ -48,3 +48,14 @@ def test_custom_terrain_walk():
     summary, climb = ex.main(duration=12.0)
     assert not summary["fell"]
     assert summary["distance"] > 6.0
+
+
+def test_period_doubling_example_runs_small(tmp_path, capsys):
+    ex = load("period_doubling")
+    ex.main(["--range", "0.009:0.011", "--points", "3", "--slopes", "2", "--transient", "3",
+             "--keep", "2", "--dt", "2e-3", "--out", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert "period-1 gait: 3 points" in out and "no falls in the range" in out
+    for name in ("simplest_period_doubling.png", "simplest_multipliers_branch.png",
+                 "simplest_diagram.csv", "simplest_branches.csv"):
+        assert (tmp_path / name).stat().st_size > 100

@@ -19,7 +19,7 @@ import numpy as np
 
 from planarsim.kernels.audit import audit_counts
 import planarsim as ps
-from planarsim.analysis import StepMap, StepMapError
+from planarsim.analysis import StepMap, StepMapError, frame_from_state, step_summary
 from planarsim.state import State
 from planarsim.trajectory import Trajectory, make_recorder
 
@@ -225,7 +225,8 @@ class PassiveWalker:
     # running -----------------------------------------------------------------------------------
     def rollout(self, n_steps: int, stop_after: int, record_every: int = 0, max_events: int = 0):
         """Compiled rollout from the current state; returns (code, steps, Trajectory | None)."""
-        rec = make_recorder(self.model, n_steps // record_every + 1) if record_every > 0 else self._no_rec
+        extra = max_events if self.toggle != DETECT else 0   # touchdown frames
+        rec = make_recorder(self.model, n_steps // record_every + 1 + extra) if record_every > 0 else self._no_rec
         if max_events > self.event_time.size:
             self.event_time = np.zeros(max_events)
             self.event_contact = np.zeros(max_events, np.int64)
@@ -338,8 +339,11 @@ def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10,
         contacts find the touchdowns on their own (continuous collision for point feet, the
         "all" mode strategy releasing the trailing foot), the end-to-end path.
     summary: steps (touchdowns), distance [m] (hip displacement along the slope), mean_speed
-    [m/s], fell (bool), step_period [s] (mean over the last half of the steps), step_length
-    [m], cost_of_transport (gravity work / (weight x distance)), duration [s]."""
+    [m/s] (distance / duration), fell (bool), duration [s], and over whole steps, first to
+    last touchdown (planarsim.analysis.step_summary of the recorded touchdowns; NaN without
+    recording or with fewer than two touchdowns): whole_steps, step_period [s], step_length
+    [m] and speed [m/s] (centre of mass along the slope), cost_of_transport (energy lost per
+    weight and distance along the slope: sin(slope) on a steady gait)."""
     if impacts not in ("refined", "engine"):
         raise ValueError(f"impacts={impacts!r} must be 'refined' or 'engine'")
     n = int(round(duration / walker.dt))
@@ -367,6 +371,8 @@ def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10,
                 walker.refine_touchdown(old)
                 s.contact_enabled[walker.feet[old]] = 0
                 events.append(float(s.time[0]))
+                if record_every > 0:   # the touchdown itself, for the whole-step summary
+                    trajs.append(frame_from_state(walker.model, s, walker.sim.ws))
         finally:
             walker.toggle = toggle
         traj = _concat(trajs)
@@ -376,12 +382,12 @@ def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10,
     hip1 = s.q[walker.hip, :2]
     distance = float((hip1 - hip0) @ walker.t_hat)
     t_end = float(s.time[0])
-    late = np.array(events[len(events) // 2:])
-    period = float(np.mean(np.diff(late))) if len(late) > 1 else math.nan
-    drop = float(hip0[1] - hip1[1])
+    whole = dict(whole_steps=0, step_period=math.nan, step_length=math.nan, speed=math.nan,
+                 cost_of_transport=math.nan)
+    if traj is not None and len(traj):
+        ws = step_summary(traj, walker.model, walker.feet, direction=walker.t_hat)
+        whole = {k: ws[k] for k in whole}
     summary = dict(walker=walker.kind, impacts=impacts, steps=n_steps, distance=distance,
                    mean_speed=distance / t_end if t_end > 0 else 0.0, fell=code == FELL,
-                   step_period=period, step_length=distance / n_steps if n_steps else math.nan,
-                   cost_of_transport=drop / distance if distance > 0 else math.nan,
-                   duration=t_end, code=int(code), audit=audit_counts(walker.sim.ws))
+                   **whole, duration=t_end, code=int(code), audit=audit_counts(walker.sim.ws))
     return traj, summary

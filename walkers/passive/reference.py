@@ -63,6 +63,19 @@ def simplest_step(x, gamma, rtol=1e-12, atol=1e-13, t_max=10.0):
     raise RuntimeError(f"simplest walker: no heel strike within {t_max} from x={x}")
 
 
+def simplest_map(gamma):
+    """The reduced model's step map x -> next x at slope gamma [rad], for planarsim.analysis
+    (a step without heel strike, a fall, raises StepMapError)."""
+    from planarsim.analysis import StepMapError
+
+    def f(x):
+        try:
+            return simplest_step(x, gamma)[0]
+        except RuntimeError as e:
+            raise StepMapError(str(e)) from None
+    return f
+
+
 def simplest_fixed_point(gamma=GARCIA_GAMMA, x0=None, tol=1e-12):
     """Newton fixed point of the reduced model's stride map.
 

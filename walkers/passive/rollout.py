@@ -106,7 +106,10 @@ def rollout_passive(m, s, ws, opt, u, feet, memory, toggle, min_ahead, n, stop_a
             if e < event_time.shape[0]:
                 event_time[e] = s.time[0]
                 event_contact[e] = feet[hit]
-        if every > 0 and s.step[0] % every == 0 and k < rec.t.shape[0]:
+        # touchdowns are recorded too (whole-step summaries start and end on them), except
+        # DETECT's, which the step map still has to locate and resolve
+        if every > 0 and (s.step[0] % every == 0 or (hit >= 0 and toggle != DETECT)) \
+                and k < rec.t.shape[0]:
             record_frame(s, ws, rec, k)
             k += 1
         if hit >= 0 and memory[1] >= stop_after:

@@ -19,99 +19,17 @@ S = identity. ``StepMap(advance, symmetry=S)`` applies it.
 Fixed points: Newton on F(x) = P(x) - x with a finite-difference Jacobian (central by
 default), solving (J - I) dx = -F, with step halving when |F| does not decrease or the
 walker fails (falls) during an evaluation.
-
-Step events from a recorded run: the touchdown of a contact is a frame whose contact mode is
-in contact (pinned or sliding) after a frame where it was not (free, or disabled: -1).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from typing import Callable
 
 import numpy as np
-
-IN_CONTACT = (1, 2)   # contact modes that touch the ground: pinned, sliding
 
 
 class StepMapError(RuntimeError):
     """A step-map evaluation failed (the walker fell, or no touchdown happened)."""
-
-
-# step events ---------------------------------------------------------------------------------
-def touchdowns(contact_mode: np.ndarray) -> np.ndarray:
-    """Frames at which a contact touches down.
-
-    contact_mode : (K,) modes of one contact per recorded frame (0 free, 1 pinned, 2 sliding,
-        -1 disabled).
-    Returns the frame indices k >= 1 with mode[k] in contact and mode[k-1] not.
-    """
-    mode = np.asarray(contact_mode)
-    if mode.ndim != 1:
-        raise ValueError(f"contact_mode must be 1-D (frames of one contact), got shape {mode.shape}")
-    on = np.isin(mode, IN_CONTACT)
-    return np.flatnonzero(on[1:] & ~on[:-1]) + 1
-
-
-@dataclass(frozen=True)
-class StepEvents:
-    """Touchdowns of several contacts, in time order.
-
-    frame : (n,) int   recorded frame just after the touchdown
-    time : (n,) [s]
-    contact : (n,) int contact index that touched down
-    """
-    frame: np.ndarray
-    time: np.ndarray
-    contact: np.ndarray
-
-    def __len__(self):
-        return len(self.frame)
-
-    @property
-    def periods(self) -> np.ndarray:
-        """(n - 1,) time between consecutive touchdowns [s]."""
-        return np.diff(self.time)
-
-
-def _contact_index(traj, contact) -> int:
-    if isinstance(contact, str):
-        names = list(traj.contact_names)
-        if contact not in names:
-            raise KeyError(f"no contact named {contact!r} in the trajectory; have {names}")
-        return names.index(contact)
-    c = int(contact)
-    if not 0 <= c < traj.contact_mode.shape[1]:
-        raise IndexError(f"contact index {c} out of range 0..{traj.contact_mode.shape[1] - 1}")
-    return c
-
-
-def step_events(traj, contacts: Sequence | None = None) -> StepEvents:
-    """Touchdown events of `contacts` (names or indices; default all) in a Trajectory."""
-    if contacts is None:
-        contacts = range(traj.contact_mode.shape[1])
-    frames, which = [], []
-    for c in contacts:
-        ci = _contact_index(traj, c)
-        f = touchdowns(traj.contact_mode[:, ci])
-        frames.append(f)
-        which.append(np.full(len(f), ci))
-    frame = np.concatenate(frames) if frames else np.zeros(0, int)
-    contact = np.concatenate(which) if which else np.zeros(0, int)
-    order = np.argsort(frame, kind="stable")
-    frame, contact = frame[order], contact[order]
-    return StepEvents(frame=frame, time=np.asarray(traj.t)[frame], contact=contact)
-
-
-def poincare_section(traj, coords: Callable, contacts: Sequence | None = None):
-    """Section points at touchdown: X[i] = coords(q, v, contact) at each event frame.
-
-    coords(q (n_body, 3), v (n_body, 3), contact) -> (d,) section coordinates of the state
-    whose new stance contact is `contact`. Returns (StepEvents, X (n, d)).
-    """
-    ev = step_events(traj, contacts)
-    X = np.array([np.asarray(coords(traj.q[f], traj.v[f], c), dtype=np.float64)
-                  for f, c in zip(ev.frame, ev.contact)])
-    return ev, X.reshape(len(ev), -1)
 
 
 # the step-to-step map ------------------------------------------------------------------------
@@ -270,57 +188,147 @@ def find_fixed_point(f: Callable, x0, tol: float = 1e-10, max_iter: int = 30, ep
                       evaluations=count[0], history=history)
 
 
-# plots ---------------------------------------------------------------------------------------
-def _axes(ax, figsize=(4.5, 4.5)):
-    import matplotlib
-    if ax is not None:
-        return ax.figure, ax
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=figsize)
-    return fig, ax
+# multipliers with an error estimate ----------------------------------------------------------
+class MultiplierWarning(UserWarning):
+    """The finite-difference multipliers did not settle: their error estimate exceeds tol."""
 
 
-def _finish(fig, path):
-    if path is not None:
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        import matplotlib.pyplot as plt
-        plt.close(fig)
-    return fig
+# steps of the eps ladder (absolute, in the section coordinates' units): 1e-2 / 4^k
+EPS_LADDER = tuple(1e-2 / 4.0 ** k for k in range(7))
 
 
-def plot_multipliers(multipliers, path=None, ax=None, title="Floquet multipliers", label=None):
-    """Multipliers in the complex plane against the unit circle; saved to `path` if given."""
-    lam = np.asarray(multipliers, dtype=complex)
-    fig, ax = _axes(ax)
-    th = np.linspace(0.0, 2.0 * np.pi, 361)
-    ax.plot(np.cos(th), np.sin(th), color="0.5", lw=1.0, label="unit circle")
-    ax.axhline(0.0, color="0.85", lw=0.8)
-    ax.axvline(0.0, color="0.85", lw=0.8)
-    ax.plot(lam.real, lam.imag, "x", ms=9, mew=2, color="C3", label=label or "multipliers")
-    lim = max(1.2, 1.1 * float(np.max(np.abs(lam))) if lam.size else 1.2)
-    ax.set_xlim(-lim, lim)
-    ax.set_ylim(-lim, lim)
-    ax.set_aspect("equal")
-    ax.set_xlabel("Re")
-    ax.set_ylabel("Im")
-    ax.set_title(title)
-    ax.legend(loc="upper right", fontsize=8)
-    return _finish(fig, path)
+def serial_evaluator(f: Callable):
+    """evaluate(X (n, d)) -> (Y (n, d), ok (n,)) calling f on each row; a StepMapError (the
+    walker fell) gives ok False and a NaN row."""
+    def evaluate(X):
+        X = np.atleast_2d(np.asarray(X, dtype=np.float64))
+        Y = np.full(X.shape, np.nan)
+        ok = np.zeros(len(X), bool)
+        for i, x in enumerate(X):
+            try:
+                Y[i] = f(x)
+                ok[i] = True
+            except StepMapError:
+                pass
+        return Y, ok
+    return evaluate
 
 
-def plot_limit_cycle(angle, rate, path=None, ax=None, section=None, labels=("angle [rad]", "rate [rad/s]"),
-                     title="limit cycle", **style):
-    """Phase portrait (angle vs rate) of a recorded gait; `section` (n, 2) marks the
-    Poincare-section points (touchdowns). Saved to `path` if given."""
-    fig, ax = _axes(ax, figsize=(5.5, 4.2))
-    ax.plot(np.asarray(angle), np.asarray(rate), lw=1.0, **style)
-    if section is not None and len(section):
-        sec = np.asarray(section)
-        ax.plot(sec[:, 0], sec[:, 1], "o", ms=4, color="C3", label="touchdown section")
-        ax.legend(fontsize=8)
-    ax.set_xlabel(labels[0])
-    ax.set_ylabel(labels[1])
-    ax.set_title(title)
-    return _finish(fig, path)
+def central_points(x, eps) -> np.ndarray:
+    """(2d, d) stencil x + eps_i e_i, x - eps_i e_i (i = 0..d-1, interleaved)."""
+    x = np.asarray(x, dtype=np.float64)
+    d = x.size
+    h = np.broadcast_to(np.asarray(eps, dtype=np.float64), (d,))
+    P = np.repeat(x[None, :], 2 * d, axis=0)
+    for i in range(d):
+        P[2 * i, i] += h[i]
+        P[2 * i + 1, i] -= h[i]
+    return P
+
+
+def central_jacobian(Y, eps) -> np.ndarray:
+    """Jacobian (d, d) from the map's values Y (2d, d) on central_points(x, eps)."""
+    Y = np.asarray(Y)
+    d = Y.shape[1]
+    h = np.broadcast_to(np.asarray(eps, dtype=np.float64), (d,))
+    return ((Y[0::2] - Y[1::2]) / (2.0 * h)).T
+
+
+def match_distance(a, b) -> float:
+    """Largest |a_i - b_pi(i)| under the pairing pi of two multiplier sets that minimises the
+    total distance (so that a reordering by modulus does not count as a change)."""
+    from scipy.optimize import linear_sum_assignment
+    a, b = np.asarray(a, complex), np.asarray(b, complex)
+    C = np.abs(a[:, None] - b[None, :])
+    r, c = linear_sum_assignment(C)
+    return float(np.max(C[r, c])) if len(r) else 0.0
+
+
+@dataclass
+class Multipliers:
+    """Floquet multipliers with an error estimate (multipliers_with_error).
+
+    values : (d,) largest modulus first;  error : estimated largest error of a multiplier;
+    eps : finite-difference step that gave `values` (absolute, units of x);
+    noise : estimated noise level of the map (units of x; NaN when not seen);
+    converged : error <= tol;  jacobian : (d, d) at eps;  ladder : [(eps, values), ...] tried;
+    evaluations : map evaluations used
+    """
+    values: np.ndarray
+    error: float
+    eps: float
+    noise: float
+    converged: bool
+    jacobian: np.ndarray
+    ladder: list = field(default_factory=list)
+    evaluations: int = 0
+
+    @property
+    def spectral_radius(self) -> float:
+        return float(np.max(np.abs(self.values)))
+
+    @property
+    def stable(self) -> bool:
+        return bool(np.all(np.abs(self.values) < 1.0))
+
+
+def multipliers_with_error(f: Callable | None, x, eps="auto", tol: float = 3e-3, evaluate=None,
+                           warn: bool = True) -> Multipliers:
+    """Multipliers of the step map f at x (a fixed point) with an error estimate.
+
+    eps="auto": central differences on the ladder EPS_LADDER (1e-2 / 4^k, coarse to fine).
+    Going down the ladder the truncation error shrinks as eps^2 until the map's own noise
+    takes over: a simulated map is smooth only down to some scale (touchdown-time root
+    finding, solver tolerances, the step in which an impact falls), below which it is
+    piecewise smooth with jumps, and differences grow as noise / eps or settle on the slope of
+    one smooth piece. The first (coarsest) pair of neighbouring rungs whose multipliers agree
+    within tol is taken (none: the pair that agrees best), and the next pairs too while their
+change keeps falling by more than 4x (truncation regime): the finer rung gives the values and
+    eps, their change the error estimate; the changes further down, times their eps, give
+    the noise level. A number eps: central differences at 2 eps and eps, the change between
+    them as the error estimate.
+    Rungs at which the map fails (the walker falls) are skipped. A MultiplierWarning is issued
+    (if warn) when the error exceeds tol. evaluate(X) -> (Y, ok) evaluates many points at once
+    (a MapPool's, to use every core); default: f one point after another.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    evaluate = evaluate or serial_evaluator(f)
+    if isinstance(eps, str):
+        if eps != "auto":
+            raise ValueError(f"eps={eps!r} must be 'auto' or a positive number")
+        steps = list(EPS_LADDER)
+    else:
+        e = float(eps)
+        if not (e > 0 and np.isfinite(e)):
+            raise ValueError(f"finite-difference step eps={eps} must be > 0")
+        steps = [2.0 * e, e]
+    pts = np.concatenate([central_points(x, h) for h in steps])
+    Y, ok = evaluate(pts)
+    n = 2 * x.size
+    rungs = []
+    for k, h in enumerate(steps):
+        if ok[k * n:(k + 1) * n].all():
+            J = central_jacobian(Y[k * n:(k + 1) * n], h)
+            rungs.append((h, J, sort_multipliers(np.linalg.eigvals(J))))
+    if not rungs:
+        raise StepMapError(f"the step map fails at every finite-difference step around x={x}")
+    if len(rungs) == 1:
+        h, J, lam = rungs[0]
+        res = Multipliers(lam, np.inf, h, np.nan, False, J, [(h, lam)], len(pts))
+    else:
+        diffs = [match_distance(rungs[k][2], rungs[k + 1][2]) for k in range(len(rungs) - 1)]
+        agree = [j for j, dj in enumerate(diffs) if dj <= tol]
+        k = agree[0] if agree else int(np.argmin(diffs))
+        while k + 1 < len(diffs) and diffs[k + 1] < diffs[k] / 4.0:
+            k += 1   # still in the truncation regime (changes fall as eps^2: 16x a rung)
+        h, J, lam = rungs[k + 1]
+        finer = [diffs[j] * rungs[j + 1][0] for j in range(k + 1, len(diffs))]
+        noise = float(np.max(finer)) if finer else np.nan
+        res = Multipliers(lam, float(diffs[k]), h, noise, bool(diffs[k] <= tol), J,
+                          [(r[0], r[2]) for r in rungs], len(pts))
+    if warn and not res.converged:
+        import warnings
+        warnings.warn(f"Floquet multipliers not converged in the finite-difference step: estimated "
+                      f"error {res.error:.2g} > tol {tol:g} (eps {res.eps:.2g})", MultiplierWarning,
+                      stacklevel=2)
+    return res

@@ -1,0 +1,88 @@
+"""Step events from a recorded run: the touchdown of a contact is a frame whose contact mode is
+in contact (pinned or sliding) after a frame where it was not (free, or disabled: -1);
+Poincare-section points at those frames."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+IN_CONTACT = (1, 2)   # contact modes that touch the ground: pinned, sliding
+
+
+# step events ---------------------------------------------------------------------------------
+def touchdowns(contact_mode: np.ndarray) -> np.ndarray:
+    """Frames at which a contact touches down.
+
+    contact_mode : (K,) modes of one contact per recorded frame (0 free, 1 pinned, 2 sliding,
+        -1 disabled).
+    Returns the frame indices k >= 1 with mode[k] in contact and mode[k-1] not.
+    """
+    mode = np.asarray(contact_mode)
+    if mode.ndim != 1:
+        raise ValueError(f"contact_mode must be 1-D (frames of one contact), got shape {mode.shape}")
+    on = np.isin(mode, IN_CONTACT)
+    return np.flatnonzero(on[1:] & ~on[:-1]) + 1
+
+
+@dataclass(frozen=True)
+class StepEvents:
+    """Touchdowns of several contacts, in time order.
+
+    frame : (n,) int   recorded frame just after the touchdown
+    time : (n,) [s]
+    contact : (n,) int contact index that touched down
+    """
+    frame: np.ndarray
+    time: np.ndarray
+    contact: np.ndarray
+
+    def __len__(self):
+        return len(self.frame)
+
+    @property
+    def periods(self) -> np.ndarray:
+        """(n - 1,) time between consecutive touchdowns [s]."""
+        return np.diff(self.time)
+
+
+def _contact_index(traj, contact) -> int:
+    if isinstance(contact, str):
+        names = list(traj.contact_names)
+        if contact not in names:
+            raise KeyError(f"no contact named {contact!r} in the trajectory; have {names}")
+        return names.index(contact)
+    c = int(contact)
+    if not 0 <= c < traj.contact_mode.shape[1]:
+        raise IndexError(f"contact index {c} out of range 0..{traj.contact_mode.shape[1] - 1}")
+    return c
+
+
+def step_events(traj, contacts: Sequence | None = None) -> StepEvents:
+    """Touchdown events of `contacts` (names or indices; default all) in a Trajectory."""
+    if contacts is None:
+        contacts = range(traj.contact_mode.shape[1])
+    frames, which = [], []
+    for c in contacts:
+        ci = _contact_index(traj, c)
+        f = touchdowns(traj.contact_mode[:, ci])
+        frames.append(f)
+        which.append(np.full(len(f), ci))
+    frame = np.concatenate(frames) if frames else np.zeros(0, int)
+    contact = np.concatenate(which) if which else np.zeros(0, int)
+    order = np.argsort(frame, kind="stable")
+    frame, contact = frame[order], contact[order]
+    return StepEvents(frame=frame, time=np.asarray(traj.t)[frame], contact=contact)
+
+
+def poincare_section(traj, coords: Callable, contacts: Sequence | None = None):
+    """Section points at touchdown: X[i] = coords(q, v, contact) at each event frame.
+
+    coords(q (n_body, 3), v (n_body, 3), contact) -> (d,) section coordinates of the state
+    whose new stance contact is `contact`. Returns (StepEvents, X (n, d)).
+    """
+    ev = step_events(traj, contacts)
+    X = np.array([np.asarray(coords(traj.q[f], traj.v[f], c), dtype=np.float64)
+                  for f, c in zip(ev.frame, ev.contact)])
+    return ev, X.reshape(len(ev), -1)

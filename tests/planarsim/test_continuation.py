@@ -1,0 +1,192 @@
+"""Continuation, bifurcation detection, brute-force diagrams, basins and multiplier error
+estimates on maps with known answers (logistic map: period doubling at r = 3 and
+1 + sqrt(6), chaos, escape past r = 4; a fold x -> x + p - x^2 at p = 0; a rotation-dilation
+with a Neimark-Sacker point at modulus 1)."""
+import math
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from planarsim.analysis import (MapPool, MultiplierWarning, StepMapError, basin_of_attraction,
+                                bifurcation_diagram, continue_branch, multipliers_with_error,
+                                period_doubling_branch, plot_basin, plot_bifurcation_diagram,
+                                plot_branch_multipliers, bifurcation_tests)
+
+
+def logistic(r):
+    def f(x):
+        y = r * x * (1.0 - x)
+        if not 0.0 <= y[0] <= 1.0:
+            raise StepMapError("left [0, 1]")
+        return y
+    return f
+
+
+def fold_family(p):
+    return lambda x: x + p - x * x
+
+
+def ns_family(p, theta=0.7):
+    c, s = math.cos(theta), math.sin(theta)
+
+    def f(x):
+        r2 = x @ x
+        return p * np.array([c * x[0] - s * x[1], s * x[0] + c * x[1]]) * (1.0 - r2)
+    return f
+
+
+def test_logistic_period_doublings_located_and_followed():
+    with MapPool(logistic, backend="serial") as pool:
+        br = continue_branch(pool, [0.6], 2.65, 3.35, points=8, param="r", tol=1e-12)
+        assert br.end.startswith("reached") and len(br.points) == 8
+        for b in br.points:   # x* = 1 - 1/r, multiplier 2 - r
+            assert abs(b.x[0] - (1 - 1 / b.p)) < 1e-10 and abs(b.multipliers[0] - (2 - b.p)) < 1e-6
+            assert b.stable == (b.p < 3.0)
+        pd = br.first("period-doubling")
+        assert pd is not None and pd.located and abs(pd.p - 3.0) < 1e-6
+        assert br.first("fold") is None and br.first("neimark-sacker") is None
+        br2 = period_doubling_branch(pool, pd, 3.5, points=8, param="r", tol=1e-12)
+        assert br2.period == 2 and br2.points[0].stable
+        pd2 = br2.first("period-doubling")
+        assert pd2 is not None and abs(pd2.p - (1 + math.sqrt(6))) < 1e-5
+        rows = br2.rows(["x"])
+        assert rows[0]["period"] == 2 and "mult0_re" in rows[0]
+
+
+def test_fold_found_by_arclength_which_turns_back():
+    # fixed points x = +-sqrt(p) for p > 0; multiplier 1 - 2x: the stable upper branch meets
+    # the unstable lower one at the fold p = 0
+    with MapPool(fold_family, backend="serial") as pool:
+        nat = continue_branch(pool, [1.0], 1.0, -0.5, points=7, tol=1e-12)
+        assert not nat.end.startswith("reached")     # no fixed point past the fold
+        arc = continue_branch(pool, [1.0], 1.0, -0.5, points=7, method="arclength", tol=1e-12,
+                              max_points=40)
+        folds = [b for b in arc.bifurcations if b.kind == "fold"]
+        assert len(folds) == 1 and abs(folds[0].p) < 0.05
+        assert arc.points[-1].x[0] < 0                # came back along the lower branch
+        assert min(arc.p) > -0.05
+
+
+def test_neimark_sacker_detected():
+    with MapPool(ns_family, backend="serial") as pool:
+        br = continue_branch(pool, [0.0, 0.0], 0.8, 1.2, points=5, tol=1e-12)
+        ns = br.first("neimark-sacker")
+        assert ns is not None and abs(ns.p - 1.0) < 0.02
+        assert br.first("period-doubling") is None and br.first("fold") is None
+
+
+def test_bifurcation_test_function_signs():
+    t = bifurcation_tests([-1.2, 0.3])
+    assert t["period-doubling"] < 0 and t["fold"] > 0 and t["neimark-sacker"] == 0
+    assert bifurcation_tests([1.1 + 0.2j, 1.1 - 0.2j])["neimark-sacker"] == 2
+
+
+def test_brute_force_diagram_periods_chaos_and_escape():
+    rs = np.array([2.8, 3.2, 3.5, 3.9, 4.05])
+    with MapPool(logistic, backend="serial") as pool:
+        d = bifurcation_diagram(pool, rs, [0.3], transient=400, keep=32, param="r")
+    assert d.periods(1e-6).tolist()[:3] == [1, 2, 4]
+    assert d.periods(1e-6)[3] == 0                 # chaos: no period up to 16
+    assert d.fell.tolist() == [False] * 4 + [True] and d.fall_onset() == 4.05
+    assert len(d.orbits[0]) == 32 and len(d.orbits[4]) == 0
+    assert len(d.rows()) == 4 * 32 + 1
+
+
+def pair(p):
+    g = logistic(p)
+    return lambda x: np.array([g(x[:1])[0], 0.5 * x[1]])
+
+
+def test_basin_of_a_decoupled_map():
+    a = np.linspace(-0.15, 1.15, 8)
+    b = np.linspace(-1.0, 1.0, 3)
+    xs = 1 - 1 / 2.8
+    with MapPool(pair, backend="serial") as pool:
+        bs = basin_of_attraction(pool, 2.8, a, b, lambda u, v: [u, v], [xs, 0.0], n_steps=200,
+                                 tol=1e-8, names=("x", "y"))
+    inside = (a > 0) & (a < 1)
+    assert np.array_equal(bs.reached, np.repeat(inside[:, None], 3, axis=1))
+    assert np.array_equal(bs.fell, ~bs.reached)
+    assert abs(bs.fraction - inside.mean()) < 1e-12 and len(bs.rows()) == 24
+
+
+@pytest.mark.parametrize("backend", ["thread", "process"])
+def test_pool_backends_agree_with_serial(backend):
+    X = np.linspace(0.05, 0.95, 23)[:, None]
+    done = []
+    with MapPool(logistic, backend="serial") as s, MapPool(logistic, workers=2, backend=backend) as pool:
+        Y0, ok0 = s.evaluate(X, 3.7, period=3)
+        Y1, ok1 = pool.evaluate(X, 3.7, period=3)
+        d = pool.run(__import__("planarsim.analysis.parallel", fromlist=["x"]).evaluate_task,
+                     [(4.2, [0.5], 1)], progress=lambda k, n: done.append((k, n)))
+    assert np.array_equal(Y0, Y1) and np.array_equal(ok0, ok1) and ok0.all()
+    assert d == [None] and done == [(1, 1)]        # 4.2 * 0.25 > 1: escaped
+
+
+def smooth(x):
+    return np.array([math.sin(x[0]) + 0.5 * x[1], 0.3 * math.tanh(x[0]) + 0.1 * math.exp(x[1])])
+
+
+def test_multipliers_with_error_on_a_smooth_map():
+    x = np.array([0.4, -0.2])
+    J = np.array([[math.cos(0.4), 0.5], [0.3 / math.cosh(0.4) ** 2, 0.1 * math.exp(-0.2)]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = multipliers_with_error(smooth, x)
+    assert m.converged and m.error < 1e-6
+    assert np.allclose(np.sort(m.values.real), np.sort(np.linalg.eigvals(J).real), atol=1e-8)
+    assert m.eps < 1e-4            # a smooth map goes down the ladder
+    two = multipliers_with_error(smooth, x, eps=1e-3)
+    assert two.eps == 1e-3 and len(two.ladder) == 2 and 1e-9 < two.error < 1e-5
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.floats(1e-9, 1e-6), st.integers(0, 1000))
+def test_multiplier_error_covers_noise(noise, seed):
+    # a linear map with a rough (piecewise-constant) perturbation of amplitude `noise`
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(3, 3)) * 0.4
+
+    def f(x):
+        return A @ x + noise * np.sin(np.floor(x * 1e6))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MultiplierWarning)
+        m = multipliers_with_error(f, np.zeros(3))
+    from planarsim.analysis import match_distance
+    err = match_distance(m.values, np.linalg.eigvals(A))
+    assert err <= 2 * m.error + 1e-9     # the estimate bounds the true error (up to 2x)
+
+
+def test_unconverged_multipliers_warn():
+    def f(x):
+        return np.array([0.5 * x[0] + 1e-3 * np.sign(np.sin(1e7 * x[0]))])
+    with pytest.warns(MultiplierWarning, match="not converged"):
+        m = multipliers_with_error(f, [0.1234567], tol=1e-6)
+    assert not m.converged
+    with pytest.raises(ValueError, match="eps"):
+        multipliers_with_error(f, [0.0], eps="fine")
+
+
+def test_plots_of_branch_diagram_and_basin(tmp_path):
+    import matplotlib.image as mpimg
+    with MapPool(logistic, backend="serial") as pool:
+        br = continue_branch(pool, [0.6], 2.6, 3.3, points=5, tol=1e-12)
+        d = bifurcation_diagram(pool, np.linspace(2.8, 4.0, 6), [0.3], transient=50, keep=8)
+    with MapPool(pair, backend="serial") as pool:
+        bs = basin_of_attraction(pool, 2.8, np.linspace(-0.1, 1.1, 5), [0.0, 1.0],
+                                 lambda u, v: [u, v], [1 - 1 / 2.8, 0.0], n_steps=100, tol=1e-6)
+    paths = [tmp_path / n for n in ("d.png", "m.png", "b.png")]
+    plot_bifurcation_diagram(d, 0, paths[0], branches=[br], bifurcations=br.bifurcations)
+    plot_branch_multipliers(br, paths[1])
+    plot_basin(bs, paths[2], attractor=[1 - 1 / 2.8, 0.0])
+    for p in paths:
+        img = mpimg.imread(p)
+        assert img.shape[0] > 200 and img[..., :3].std() > 0.05
+    br.to_csv(tmp_path / "b.csv")
+    d.to_csv(tmp_path / "d.csv")
+    bs.to_csv(tmp_path / "s.csv")
+    assert (tmp_path / "b.csv").read_text().splitlines()[0].startswith("p,period,x0")
+    assert len((tmp_path / "d.csv").read_text().splitlines()) > 6
