@@ -6,7 +6,7 @@ The command-line names are the submodules ``walkers.passive.simplest``,
 ``walkers.passive.compass_gait`` and ``walkers.passive.rimless_wheel`` (each exposing NAME,
 GAITS and simulate(...)).
 """
-from planarsim.kernels._jit import drop_stale_caches
+from planarsim.compiled import drop_stale_caches
 
 drop_stale_caches(__path__[0])
 

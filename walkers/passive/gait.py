@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from planarsim.kernels.audit import audit_counts
+from planarsim.compiled import audit_counts, check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError, frame_from_state, step_summary
 from planarsim.state import State
@@ -97,7 +97,7 @@ class PassiveWalker:
     ----------
     params : SimplestParams | CompassParams | RimlessParams
     dt : step size [s]
-    strategy : contact-mode strategy, "all" (default; see DESIGN.md section 8) or "alternating"
+    strategy : contact-mode strategy, "all" (default: the old stance foot must leave the ground in the heel-strike step) or "alternating"
     """
 
     def __init__(self, params, dt: float = 1e-3, strategy: str = "all", terrain=None):
@@ -125,6 +125,7 @@ class PassiveWalker:
         self.gamma = params.slope
         self.t_hat, self.n_hat = slope_frame(self.gamma)
         self.sim = ps.Simulator(self.model, ps.make_options(strategy))
+        self.u0 = np.zeros(self.model.n_act)   # passive: no actuator commands
         self.memory = np.zeros(2, np.int64)
         self.hip = self.model.body("hub" if self.kind == "rimless" else "hip")
         self.fall_height = 0.5 * self.length
@@ -231,12 +232,11 @@ class PassiveWalker:
             self.event_time = np.zeros(max_events)
             self.event_contact = np.zeros(max_events, np.int64)
         sim = self.sim
-        code, done, k = rollout_passive(self.model.arrays, sim.state, sim.ws, sim.options, sim._u0,
+        code, done, k = rollout_passive(self.model.arrays, sim.state, sim.ws, sim.options, self.u0,
                                         self.feet, self.memory, self.toggle, self.min_ahead, int(n_steps),
                                         int(stop_after), self.hip, self.fall_height, rec,
                                         int(record_every), 0, self.event_time, self.event_contact)
-        if code in (1, 2):
-            sim._raise(code)
+        check_run(code, self.model, sim.ws, sim.options, self.kind)
         traj = None
         if record_every > 0:
             traj = Trajectory.from_recorder(self.model, rec, k, info={"dt": self.dt, "walker": self.kind})
@@ -255,8 +255,6 @@ class PassiveWalker:
         Returns tau [s]."""
         from scipy.optimize import brentq
 
-        from planarsim.kernels.step import step_entry as _step
-        from planarsim.kernels.terrain import gap_of_point
         sim, s, ws = self.sim, self.sim.state, self.sim.ws
         m = self.model.arrays
         new = int(self.memory[0])
@@ -269,9 +267,8 @@ class PassiveWalker:
         def sub_step(tau):
             s.restore(prev)
             if tau > 0.0:
-                code = _step(m._replace(dt=tau), s, ws, sim.options, sim._u0)
-                if code:
-                    sim._raise(code)
+                check_run(step_from_python(m._replace(dt=tau), s, ws, sim.options, self.u0),
+                          self.model, ws, sim.options, self.kind)
             p = self.foot_point(c)[0]
             return gap_of_point(m.terrain_coef, p[0], p[1])
 
@@ -283,9 +280,8 @@ class PassiveWalker:
         s.v[...] = project_velocities(self.model, s.q, s.v, [int(self.feet[old])])
         s.contact_enabled[c] = 1
         s.contact_mode[c] = 1
-        code = _step(m._replace(dt=IMPACT_DT), s, ws, sim.options, sim._u0)
-        if code:
-            sim._raise(code)
+        check_run(step_from_python(m._replace(dt=IMPACT_DT), s, ws, sim.options, self.u0),
+                  self.model, ws, sim.options, self.kind)
         s.time[0] = prev.time[0] + tau
         return tau
 

@@ -13,20 +13,18 @@ Foot bookkeeping (``update_feet``), after every step:
   step; the touched foot becomes the stance foot and, with ``toggle``, the old stance foot's
   contact is disabled (it becomes the swing foot).
 The old stance foot must leave the ground in the heel-strike step itself: that needs the
-``all`` contact-mode strategy (DESIGN.md section 8); with ``alternating`` the walker can lock.
+``all`` contact-mode strategy; with ``alternating`` the walker can lock.
 
 memory (int64): [stance index into `feet`, touchdowns so far].
 """
 import math
 
-from planarsim.kernels._jit import jit
-from planarsim.kernels.record import record_frame
-from planarsim.kernels.step import step
-from planarsim.kernels.terrain import closest_point, gap_of_point
+from planarsim.compiled import (RUN_FELL, RUN_NO_EVENT, closest_point, gap_of_point, jit,
+                                record_frame, step)
 
 MODE_FREE = 0
-FELL = 10          # return code: the watched body came closer to the ground than fall_height
-NO_EVENT = 11      # return code: n steps done without reaching stop_after touchdowns
+FELL = RUN_FELL          # return code: the watched body came closer to the ground than fall_height
+NO_EVENT = RUN_NO_EVENT  # return code: n steps done without reaching stop_after touchdowns
 ENGINE = 0         # toggle: every foot contact stays enabled; the engine finds the touchdowns
 TOGGLE = 1         # toggle: swing contact disabled until past the stance foot and above ground
 DETECT = 2         # toggle: non-stance contacts stay disabled; a touchdown is a non-stance foot
