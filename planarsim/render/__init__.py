@@ -8,8 +8,10 @@
 
 Modules: draw (Scene: a model drawn from its own shapes), camera (damped second-order
 tracking), animate (GIF/MP4/HTML export), plots, viewer (interactive, PI frame timer),
-gallery (README GIFs: ``python -m planarsim.render.gallery OUTDIR``). No numba here; pyplot is
-imported only by the on-screen viewer.
+gallery (README GIFs: ``python -m planarsim.render.gallery OUTDIR``); helpers: frames (sampling,
+per-frame pixels, worker processes), writers, gif, html, stamps (cached text bitmaps), sides
+(which leg a part belongs to), legend. No numba here; pyplot is imported only by the
+on-screen viewer.
 """
 from .camera import Camera, step_overshoot
 from .draw import Scene, Style, make_figure, render_state, shape_outline

@@ -56,7 +56,9 @@ def red_style(**kw):
 
 def render(model, q, center, view_width=4.0, size=(6.4, 3.6), dpi=100, **kw):
     fig, ax = make_figure(size, dpi)
-    scene = Scene(model, ax, view_width=view_width, show_com=False, show_text=False, style=red_style(), **kw)
+    # geometry only: the legend's force arrow is red too
+    scene = Scene(model, ax, view_width=view_width, show_com=False, show_text=False, show_legend=False,
+                  style=red_style(), **kw)
     scene.draw_state(q, center=center)
     fig.canvas.draw()
     img = np.asarray(fig.canvas.buffer_rgba())[:, :, :3].astype(int)
@@ -445,19 +447,26 @@ vm.createContext(sandbox);
 const scripts = [...html.matchAll(/<script[^>]*>([\s\S]*?)<\/script>/g)].map(m => m[1]);
 for (const s of scripts) vm.runInContext(s, sandbox);
 setTimeout(() => {
-  const play = html.match(/title="Play" aria-label="Play" onclick="([^"]+)"/)[1];
   const slider = html.match(/id="(_anim_slider\w+)"/)[1];
-  const before = el(slider).value;
-  vm.runInContext(play, sandbox);
-  setTimeout(() => { console.log(JSON.stringify({before, after: el(slider).value, max: el(slider).max}));
-                     process.exit(0); }, 400);
-}, 50);
+  const button = (title) => html.match(new RegExp(`title="${title}" aria-label="${title}" onclick="([^"]+)"`))[1];
+  const autoplayed = el(slider).value;                 // nobody pressed Play: the page plays by itself
+  vm.runInContext(button('Pause'), sandbox);
+  const paused = el(slider).value;
+  setTimeout(() => {
+    const still = el(slider).value;
+    vm.runInContext(button('Play'), sandbox);
+    setTimeout(() => { console.log(JSON.stringify({autoplayed, paused, still, after: el(slider).value,
+                                                   max: el(slider).max}));
+                       process.exit(0); }, 300);
+  }, 200);
+}, 400);
 """
 
 
-def test_html_player_script_runs_and_play_advances_the_frame(sliding_run, tmp_path):
-    """The page's own JavaScript run in node (V8) against a minimal DOM: no script error, and the
-    Play button's handler moves the frame slider. (Not a browser: see the chromium test.)"""
+def test_html_player_script_runs_plays_by_itself_and_pauses(sliding_run, tmp_path):
+    """The page's own JavaScript run in node (V8) against a minimal DOM: no script error, the
+    page starts playing on its own, Pause holds the frame and Play moves it on. (Not a browser:
+    see the chromium test.)"""
     node = shutil.which("node")
     if node is None:
         pytest.skip("node is not installed: cannot run the player's JavaScript")
@@ -468,8 +477,10 @@ def test_html_player_script_runs_and_play_advances_the_frame(sliding_run, tmp_pa
     assert res.returncode == 0, res.stderr
     import json
     state = json.loads(res.stdout.strip().splitlines()[-1])
-    assert state["before"] == 0 and state["max"] == 59
-    assert 3 <= state["after"] <= 59      # 33 ms per frame for 400 ms: about 12 frames
+    assert state["max"] == 59
+    assert 3 <= state["autoplayed"] <= 59      # 33 ms per frame for 400 ms: about 12 frames
+    assert state["still"] == state["paused"]
+    assert state["after"] != state["paused"]
 
 
 CHROMIUM_PROBE = """<script>
@@ -480,7 +491,7 @@ CHROMIUM_DRIVER = """<script>
 setTimeout(function () {
   var slider = document.querySelector('input.anim-slider');
   var before = slider.value;
-  document.querySelector('button[title="Play"]').click();
+  document.querySelector('button[title="Pause"]').click();
   setTimeout(function () {
     var out = document.createElement('pre'); out.id = 'result';
     out.textContent = 'RESULT ' + before + ' ' + slider.value + ' ERRORS ' + window.__errors.length + ' '
@@ -527,7 +538,8 @@ def chromium_or_skip():
 
 def test_html_export_plays_in_headless_chromium(sliding_run, tmp_path):
     """The exported page in a real browser (Debian's chromium, headless): it loads without a
-    script error, and pressing Play advances the frame slider."""
+    script error, plays by itself (the frame slider has moved before anyone presses a button)
+    and Pause holds the frame."""
     exe = chromium_or_skip()
     model, traj = sliding_run
     out = export_animation(traj, model, tmp_path / "run.html", fps=30, size=(1.6, 0.9), dpi=50, progress=False)
@@ -540,7 +552,7 @@ def test_html_export_plays_in_headless_chromium(sliding_run, tmp_path):
     assert found is not None, (res.stdout[-1000:], res.stderr[-2000:])
     before, after, n_err = int(found[1]), int(found[2]), int(found[3])
     assert n_err == 0, found[4]
-    assert before == 0 and after > 0
+    assert before > 0 and after == before
 
 
 # plots ----------------------------------------------------------------------------------------
