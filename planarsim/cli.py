@@ -114,10 +114,13 @@ def cmd_run(args):
         kw["terrain"] = ter
     if args.dt is not None:
         kw["dt"] = args.dt
+    from .progress import Elapsed, stderr_is_terminal
+    bars = not args.json and stderr_is_terminal()      # progress only where someone watches
     t0 = time.perf_counter()
     if not args.json:
-        print(f"running {args.walker} for {args.duration:g} s ...", file=sys.stderr, flush=True)
-    traj, summary, model = mod.simulate(**kw)
+        print(f"running {args.walker} for {args.duration:g} s", file=sys.stderr, flush=True)
+    with Elapsed(f"simulating {args.duration:g} s", enabled=bars):
+        traj, summary, model = mod.simulate(**kw)
     wall = time.perf_counter() - t0
     default_gait = inspect.signature(mod.simulate).parameters["gait"].default
     own = {"walker": args.walker, "gait": args.gait or default_gait,
@@ -129,7 +132,7 @@ def cmd_run(args):
         traj.save(save)
         written.append(str(save))
     if csv:
-        traj.to_csv(csv)
+        traj.to_csv(csv, model)
         written.append(str(csv))
     if plot:
         from .render import plot_summary
@@ -138,8 +141,9 @@ def cmd_run(args):
     if out:
         from .render import export_animation
         from .render.gallery import gait_names
-        export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=not args.json,
-                         label_names=gait_names(mod))
+        export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=bars,
+                         label_names=gait_names(mod), summary=summary,
+                         title=f"{args.walker}: {own['gait']} gait, {own['terrain']} terrain")
         written.append(str(out))
     if summary_path is not None:
         from .trajectory import atomic_write
