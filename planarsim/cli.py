@@ -127,6 +127,7 @@ def cmd_run(args):
            "terrain": args.terrain or "default", "duration_s": args.duration}
     summary = {**own, **{k: _plain(v) for k, v in summary.items() if k not in own},
                "wall_time_s": round(wall, 3)}
+    title = f"{args.walker} ({own['gait']} gait) on {getattr(model.terrain, 'name', 'its')} terrain"
     written = []
     if save:
         traj.save(save)
@@ -136,14 +137,13 @@ def cmd_run(args):
         written.append(str(csv))
     if plot:
         from .render import plot_summary
-        plot_summary(traj, model, plot)
+        plot_summary(traj, model, plot, title=title)
         written.append(str(plot))
     if out:
         from .render import export_animation
         from .render.gallery import gait_names
         export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=bars,
-                         label_names=gait_names(mod), summary=summary,
-                         title=f"{args.walker}: {own['gait']} gait, {own['terrain']} terrain")
+                         label_names=gait_names(mod), summary=summary, title=title)
         written.append(str(out))
     if summary_path is not None:
         from .trajectory import atomic_write

@@ -18,10 +18,11 @@ from .draw import Scene, Style, make_figure, render_state, shape_outline
 from .animate import (animation_html, export_animation, ffmpeg_exe, frame_indices, frame_times,
                       show_inline)
 from .plots import (cost_of_transport, joint_series, plot_contact_modes, plot_energy,
-                    plot_joint_angles, plot_phase_portraits, plot_power, plot_summary, save_figure)
+                    plot_joint_angles, plot_phase_portraits, plot_position, plot_power, plot_speed,
+                    plot_summary, save_figure)
 from .viewer import FrameTimer, Viewer, view, view_walker
 
 __all__ = ["Camera", "step_overshoot", "Scene", "Style", "make_figure", "render_state", "shape_outline",
            "animation_html", "export_animation", "ffmpeg_exe", "frame_indices", "frame_times", "show_inline",
            "cost_of_transport", "joint_series", "plot_contact_modes", "plot_energy", "plot_joint_angles",
-           "plot_phase_portraits", "plot_power", "plot_summary", "save_figure", "FrameTimer", "Viewer", "view", "view_walker"]
+           "plot_phase_portraits", "plot_position", "plot_power", "plot_speed", "plot_summary", "save_figure", "FrameTimer", "Viewer", "view", "view_walker"]

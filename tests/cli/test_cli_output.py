@@ -80,8 +80,8 @@ def test_html_page_is_titled_with_the_walker_and_holds_the_summary(tmp_path, cap
                            "--out", str(out), "--terrain", "flat")
     assert code == 0, err
     page = out.read_text()
-    assert "<title>simple-biped: walk gait, flat terrain - planarsim</title>" in page
-    assert "<h1>simple-biped: walk gait, flat terrain</h1>" in page
+    assert "<title>simple-biped (walk gait) on flat terrain - planarsim</title>" in page
+    assert "<h1>simple-biped (walk gait) on flat terrain</h1>" in page
     assert '<table class="planarsim-summary">' in page and "<th>mean_speed</th>" in page
     assert "play_animation(); }" in page              # plays when opened
 
@@ -115,3 +115,21 @@ def test_csv_names_axial_efforts_as_forces_and_without_a_model_as_u(tmp_path):
     np.testing.assert_allclose(table[:, col], traj.contact_impulse[:, 0, 0], rtol=1e-9)   # 10 digits
     with pytest.raises(ValueError, match="wrong model"):
         traj.to_csv(tmp_path / "c.csv", walkers.load("ranger").simulate(duration=0.02)[2])
+
+
+def test_plot_is_titled_with_walker_gait_and_terrain(tmp_path, capsys, monkeypatch):
+    import planarsim.render.plots as plots
+    seen = {}
+    real = plots.plot_summary
+
+    def spy(traj, model, path=None, **kw):
+        seen["fig"] = real(traj, model, path, **kw)
+        return seen["fig"]
+
+    monkeypatch.setattr(plots, "plot_summary", spy)
+    import planarsim.render
+    monkeypatch.setattr(planarsim.render, "plot_summary", spy)
+    code, _, err = run_cli(capsys, "run", "ranger", "--duration", "0.3", "--plot", str(tmp_path / "p.png"),
+                           "--terrain", "flat", "--json")
+    assert code == 0, err
+    assert seen["fig"]._suptitle.get_text() == "ranger (walk gait) on flat terrain"
