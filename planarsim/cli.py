@@ -289,7 +289,7 @@ def make_parser():
     p.add_argument("--speed", type=_positive, default=1.0, help="playback speed (0.25 slow motion)")
     p.add_argument("--plot", default=None, help="summary plot .png | .svg | .pdf")
     p.add_argument("--save", default=None, help="trajectory .npz")
-    p.add_argument("--csv", default=None, help="trajectory .csv")
+    p.add_argument("--csv", default=None, help="trajectory .csv (SI units in the column names)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.set_defaults(func=cmd_run)

@@ -299,9 +299,12 @@ class Scene:
         tip = base - length[:, None] * ter.normal(xt).reshape(-1, 2)
         return line, np.stack([base, tip], axis=1), major
 
-    def _place_tick_labels(self, ticks, major):
+    def _place_tick_labels(self, ticks, major, center_x):
+        """Labels under the labelled ticks inside the view (none cut by its edge)."""
         tips = ticks[major, 1]
         xs = ticks[major, 0, 0]
+        keep = np.abs(xs - center_x) <= 0.45 * self.view_width
+        tips, xs = tips[keep], xs[keep]
         gap = 0.3 * self.style.tick_length
         for i, lab in enumerate(self.tick_labels):
             if i < len(xs):
@@ -391,7 +394,7 @@ class Scene:
         bottom = center[1] - 2.0 * self.view_height - abs(line[:, 1]).max()
         self.ground_fill.set_xy(np.vstack([line, [[x1, bottom], [x0, bottom]]]))
         self.ticks.set_segments(list(ticks))
-        self._place_tick_labels(ticks, major)
+        self._place_tick_labels(ticks, major, center[0])
         self.bodies.set_verts(self.body_polygons(q))
         self.rods.set_segments(self._segments(q, a.rod_body, a.rod_anchor))
         axial = self._axial

@@ -18,16 +18,17 @@ def legend_bitmap(entries, dpi: float, style) -> np.ndarray | None:
     handles = []
     for label, kind, color in entries:
         if kind == "side":
-            handles.append(Patch(facecolor=color, edgecolor=style.edge_color, lw=0.8, label=label))
+            handles.append(Patch(facecolor=color, edgecolor=style.edge_color, lw=0.8))
         elif kind == "arrow":
-            handles.append(Line2D([], [], color=color, lw=1.6, marker=">", ms=5, markevery=[1], label=label))
-        else:
-            handles.append(Line2D([], [], ls="none", marker="o", ms=7, mfc="white", mec=color, mew=1.2,
-                                  label=label))
+            handles.append(Line2D([], [], color=color, lw=1.6, marker=">", ms=5, markevery=[1]))
+        else:   # the scene's mark: a ring with a cross, drawn over each other
+            handles.append((Line2D([], [], ls="none", marker="o", ms=8, mfc="white", mec=color, mew=1.2),
+                            Line2D([], [], ls="none", marker="+", ms=8, color=color, mew=1.2)))
+    labels = [label for label, _, _ in entries]
     fig = matplotlib.figure.Figure(figsize=(4, 2), dpi=dpi)
     canvas = FigureCanvasAgg(fig)
     fig.patch.set_alpha(0.0)
-    leg = fig.legend(handles=handles, loc="upper right", fontsize=0.85 * style.font_size, frameon=True,
+    leg = fig.legend(handles, labels, loc="upper right", fontsize=0.85 * style.font_size, frameon=True,
                      framealpha=0.85, edgecolor="#cccccc", handlelength=1.4, borderpad=0.4, labelspacing=0.3)
     canvas.draw()
     img = np.asarray(canvas.buffer_rgba())
