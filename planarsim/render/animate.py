@@ -122,20 +122,18 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
 
 
 def animation_html(traj, model, fps: float = 30.0, speed: float = 1.0, progress=False, autoplay=False,
-                   **kw) -> str:
+                   start=None, duration=None, size=(6.4, 3.6), dpi: int = 100, camera: Camera | None = None,
+                   workers=None, colors: int = 128, **scene_kw) -> str:
     """The animation as an HTML fragment (frames embedded as base64 PNG, with play/pause and a
-    frame slider): what a Jupyter notebook shows inline."""
+    frame slider): what a Jupyter notebook shows inline. Arguments as export_animation."""
     import tempfile
 
     from .writers import HtmlWriter
-    kw.setdefault("size", (6.4, 3.6))
-    scene_kw = {k: v for k, v in kw.items() if k not in ("size", "dpi", "camera", "start", "duration", "workers")}
-    renderer = FrameRenderer(traj, model, fps, speed, kw.get("start"), kw.get("duration"), kw["size"],
-                             kw.get("dpi", 100), kw.get("camera"), **scene_kw)
+    renderer = FrameRenderer(traj, model, fps, speed, start, duration, size, dpi, camera, **scene_kw)
     report = progress_for(progress, len(renderer), "frames")
     with tempfile.TemporaryDirectory() as d:
-        writer = HtmlWriter(Path(d) / "unused.html", fps, _samples(renderer))
-        _pump(renderer, writer, kw.get("workers") or _default_workers(len(renderer)), report)
+        writer = HtmlWriter(Path(d) / "unused.html", fps, _samples(renderer), colors)
+        _pump(renderer, writer, _default_workers(len(renderer)) if workers is None else workers, report)
     return player_fragment(writer.frames, fps, autoplay=autoplay)
 
 

@@ -17,16 +17,34 @@ import numpy as np
 from PIL import Image
 
 
-def palette_from(samples, colors: int = 64) -> bytes:
-    """RGB bytes of a palette of `colors` entries fitted to RGB arrays (H, W, 3); the last
-    entry is left free (transparency)."""
+def palette_from(samples, colors: int = 64, exact: int = 8) -> bytes:
+    """RGB bytes of a palette of `colors` entries fitted to RGB arrays (H, W, 3): median cut,
+    then the `exact` most frequent colours (background, ground, ...) put in exactly, in place
+    of their nearest entries (a median-cut box averages white with the light edges around
+    it) and of every entry within 4 levels of them (Pillow maps a colour to the entry nearest
+    to its 4-level box, so white would still come out as 253); the last entry is left free
+    (transparency)."""
     if not 3 <= int(colors) <= 256:
         raise ValueError(f"colors={colors} must be between 3 and 256")
     strip = np.concatenate([np.asarray(s, np.uint8)[:, :, :3] for s in samples], axis=0)
-    fitted = Image.fromarray(strip, "RGB").quantize(int(colors) - 1, method=Image.Quantize.MEDIANCUT)
+    fitted = Image.fromarray(np.ascontiguousarray(strip), "RGB").quantize(int(colors) - 1,
+                                                                          method=Image.Quantize.MEDIANCUT)
     used = int(np.asarray(fitted).max()) + 1
-    rgb = bytes(fitted.getpalette()[:3 * used])
-    return rgb + bytes(3 * (int(colors) - used))
+    pal = np.array(fitted.getpalette()[:3 * used], dtype=np.int64).reshape(-1, 3)
+    packed = strip.reshape(-1, 3).astype(np.int64) @ np.array([65536, 256, 1])
+    values, counts = np.unique(packed, return_counts=True)
+    taken = set()
+    for v in values[np.argsort(counts)[::-1][:exact]]:
+        rgb = np.array([v >> 16, (v >> 8) & 255, v & 255])
+        order = np.argsort(((pal - rgb) ** 2).sum(axis=1))
+        slot = next((int(i) for i in order if int(i) not in taken), None)
+        if slot is not None:
+            near = np.flatnonzero(np.abs(pal - rgb).max(axis=1) <= 4)
+            pal[near] = rgb
+            pal[slot] = rgb
+            taken.update(int(i) for i in near)
+            taken.add(slot)
+    return bytes(pal.astype(np.uint8).ravel()) + bytes(3 * (int(colors) - used))
 
 
 def _palette_image(palette: bytes, used: int) -> Image.Image:

@@ -8,7 +8,6 @@ from the net) become plain characters, so the page works offline.
 from __future__ import annotations
 
 import html
-import json
 import re
 import uuid
 
@@ -20,8 +19,10 @@ _ICONS = {"fa-minus": "&minus;", "fa-fast-backward": "|&#9664;&#9664;", "fa-step
 _PAGE_STYLE = """<style>
 body { font-family: sans-serif; margin: 1.5em; color: #222; }
 h1 { text-align: center; font-size: 1.4em; font-weight: normal; }
-.planarsim-run { display: flex; flex-wrap: wrap; justify-content: center; align-items: flex-start; gap: 2em; }
-.planarsim-summary { border-collapse: collapse; font-size: 0.9em; }
+.planarsim-run { display: flex; justify-content: center; align-items: flex-start; gap: 2em; }
+@media (max-width: 60em) { .planarsim-run { flex-wrap: wrap; } }
+.planarsim-summary { border-collapse: collapse; font-size: 0.9em; max-width: 24em; }
+.planarsim-summary td { overflow-wrap: anywhere; }
 .planarsim-summary th { text-align: left; padding: 2px 1em 2px 0; font-weight: normal; color: #555; }
 .planarsim-summary td { text-align: right; padding: 2px 0; font-family: monospace; }
 </style>"""
@@ -56,8 +57,10 @@ def summary_table(summary: dict) -> str:
     for key, val in summary.items():
         if isinstance(val, float):
             text = f"{val:.4g}"
-        elif isinstance(val, (dict, list, tuple)):
-            text = json.dumps(val)
+        elif isinstance(val, dict):
+            text = ", ".join(f"{k} {v}" for k, v in val.items())
+        elif isinstance(val, (list, tuple)):
+            text = ", ".join(str(v) for v in val)
         else:
             text = str(val)
         rows.append(f"<tr><th>{html.escape(str(key))}</th><td>{html.escape(text)}</td></tr>")
