@@ -242,8 +242,8 @@ class Scene:
         self.pins, = ax.plot([], [], "o", ms=4.5, mfc=st.pin_color, mec=st.edge_color, mew=0.8, zorder=5)
         self.impulses = LineCollection([], colors=st.impulse_color, linewidths=1.6, zorder=6)
         ax.add_collection(self.impulses)
-        self.com, = ax.plot([], [], "o", ms=8, mfc="white", mec=st.com_color, mew=1.2, zorder=7)
-        self.com_cross, = ax.plot([], [], "+", ms=8, color=st.com_color, mew=1.2, zorder=8)
+        self.com, = ax.plot([], [], ls="none", marker=com_marker(), ms=8, mfc="white", mec=st.com_color,
+                            mew=1.2, zorder=7)
         self.text = TextStamp(0.01, 0.98, "", transform=ax.transAxes, ha="left", va="top",
                               fontsize=st.font_size, color=st.text_color, zorder=9)
         ax.add_artist(self.text)
@@ -289,7 +289,7 @@ class Scene:
 
     def _terrain(self, x0, x1):
         ter = self.model.terrain
-        xs = np.linspace(x0, x1, 300)
+        xs = np.linspace(x0, x1, 121)      # 5 cm apart on a 5 m view: smooth for hills of 1 m and more
         line = np.column_stack([xs, ter.height(xs)])
         s = self.tick_spacing
         xt = s * np.arange(math.ceil(x0 / s), math.floor(x1 / s) + 1)
@@ -406,9 +406,8 @@ class Scene:
         self.impulses.set_segments(self.impulse_segments(np.asarray(contact_point), np.asarray(contact_impulse))
                                    if show_imp else [])
         self.impulses.set_visible(show_imp)
-        for art in (self.com, self.com_cross):
-            art.set_data([com[0]], [com[1]])
-            art.set_visible(self.show_com)
+        self.com.set_data([com[0]], [com[1]])
+        self.com.set_visible(self.show_com)
         self.text.set_text(self.overlay_text(t, speed, labels) if self.show_text else "")
         self.legend.set_visible(self.show_legend)
         return self.artists
@@ -416,7 +415,7 @@ class Scene:
     @property
     def artists(self) -> list:
         return [self.ground_fill, self.terrain_line, self.ticks, *self.tick_labels, self.rods, self.actuators,
-                self.bodies, self.pins, self.impulses, self.com, self.com_cross, self.text, self.legend]
+                self.bodies, self.pins, self.impulses, self.com, self.text, self.legend]
 
     def draw_frame(self, traj, k: int, center=None, t=None) -> list:
         """Draw recorded frame k of a Trajectory; t [s] is the time shown (default: its own)."""
@@ -426,6 +425,13 @@ class Scene:
         return self.draw_state(traj.q[k], center=center, t=float(traj.t[k]) if t is None else float(t),
                                contact_point=traj.contact_point[k], contact_impulse=traj.contact_impulse[k],
                                labels=labels, speed=speed)
+
+
+def com_marker():
+    """The centre-of-mass mark: a ring with a cross through it (one marker path)."""
+    from matplotlib.path import Path
+    cross = Path([(-1, 0), (1, 0), (0, -1), (0, 1)], [Path.MOVETO, Path.LINETO, Path.MOVETO, Path.LINETO])
+    return Path.make_compound_path(Path.unit_circle(), cross)
 
 
 def distance_label(x: float) -> str:

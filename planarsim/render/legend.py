@@ -21,9 +21,9 @@ def legend_bitmap(entries, dpi: float, style) -> np.ndarray | None:
             handles.append(Patch(facecolor=color, edgecolor=style.edge_color, lw=0.8))
         elif kind == "arrow":
             handles.append(Line2D([], [], color=color, lw=1.6, marker=">", ms=5, markevery=[1]))
-        else:   # the scene's mark: a ring with a cross, drawn over each other
-            handles.append((Line2D([], [], ls="none", marker="o", ms=8, mfc="white", mec=color, mew=1.2),
-                            Line2D([], [], ls="none", marker="+", ms=8, color=color, mew=1.2)))
+        else:   # the scene's mark: a ring with a cross
+            from .draw import com_marker
+            handles.append(Line2D([], [], ls="none", marker=com_marker(), ms=8, mfc="white", mec=color, mew=1.2))
     labels = [label for label, _, _ in entries]
     fig = matplotlib.figure.Figure(figsize=(4, 2), dpi=dpi)
     canvas = FigureCanvasAgg(fig)

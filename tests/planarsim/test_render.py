@@ -1073,3 +1073,17 @@ def test_summary_plot_has_title_position_and_speed(sliding_run):
     # slid from 1.5 m/s to rest at mu g: v^2 / (2 mu g) = 0.38 m, less the first recorded step
     assert dist[0] == 0.0 and dist[-1] == pytest.approx(1.5 ** 2 / (2 * 0.3 * 9.81) - 1.5 * 0.01, abs=0.01)
     assert "slope:3" in plot_summary(traj, model, title="box on slope:3 terrain")._suptitle.get_text()
+
+
+def test_gif_keeps_the_background_and_ground_colours_exact(sliding_run, tmp_path):
+    from PIL import Image
+    model, traj = sliding_run
+    out = export_animation(traj, model, tmp_path / "run.gif", fps=10, size=(3.2, 1.8), progress=False)
+    style = Style()
+    with Image.open(out) as im:
+        im.seek(5)
+        rgb = np.asarray(im.convert("RGB"))
+    colours = {tuple(int(c) for c in px) for px in rgb.reshape(-1, 3)}
+    assert (255, 255, 255) in colours                                     # white stays white
+    ground = tuple(int(style.ground_fill[i:i + 2], 16) for i in (1, 3, 5))
+    assert ground in colours
