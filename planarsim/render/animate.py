@@ -76,7 +76,12 @@ def _make_writer(fmt, tmp, renderer, fps, bitrate, embed_limit_mb, colors, page)
 
 
 def _default_workers(n_frames: int) -> int:
-    return min(2, usable_cores()) if n_frames >= PARALLEL_MIN_FRAMES else 1
+    """2 on a machine with 2 or more usable cores for 40 frames or more; 1 where threads other
+    than this one run (a notebook kernel's, say): forking a threaded process is unsafe."""
+    import threading
+    if n_frames < PARALLEL_MIN_FRAMES or threading.active_count() > 1:
+        return 1
+    return min(2, usable_cores())
 
 
 def _pump(renderer, writer, workers, report) -> None:

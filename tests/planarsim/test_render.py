@@ -1087,3 +1087,63 @@ def test_gif_keeps_the_background_and_ground_colours_exact(sliding_run, tmp_path
     assert (255, 255, 255) in colours                                     # white stays white
     ground = tuple(int(style.ground_fill[i:i + 2], 16) for i in (1, 3, 5))
     assert ground in colours
+
+
+KILLED_EXPORTER = """
+import multiprocessing, sys
+import numpy as np
+import planarsim as ps
+from planarsim.render import export_animation
+b = ps.ModelBuilder(dt=1e-3)
+box = b.add_body("box", mass=2.0, inertia=0.1, pos=(0.0, 0.1), vel=(1.0, 0.0))
+b.add_box_contacts("corner", box, (0.0, 0.0), 0.8, 0.2, mu=0.3)
+model = b.compile()
+traj = ps.Simulator(model).run(2.0, record_every=10)
+
+def progress(done, total):
+    if done == 5:
+        pids = [p.pid for p in multiprocessing.active_children()]
+        print("exporting", *pids, flush=True)
+        import time
+        time.sleep(60)
+
+export_animation(traj, model, sys.argv[1], fps=100, progress=progress, workers=2)
+"""
+
+
+def _gone(pid):
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return "\nState:\tZ" in f.read()      # a zombie has ended
+    except FileNotFoundError:
+        return True
+
+
+@pytest.mark.skipif(not hasattr(os, "fork") or not Path("/proc").is_dir(), reason="fork, /proc")
+def test_sigkill_mid_export_leaves_nothing_and_no_drawing_processes(tmp_path):
+    import signal
+    import sys
+    import tempfile
+    import time
+    target = tmp_path / "run.gif"
+    proc = subprocess.Popen([sys.executable, "-c", KILLED_EXPORTER, str(target)], stdout=subprocess.PIPE, text=True)
+    words = proc.stdout.readline().split()
+    assert words[:1] == ["exporting"], words
+    workers = [int(w) for w in words[1:]]
+    assert len(workers) == 2
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert os.listdir(tmp_path) == []
+    deadline = time.monotonic() + 20
+    while not all(_gone(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert all(_gone(pid) for pid in workers)        # the workers ended with their parent
+    traj, model = _tiny_run()
+    export_animation(traj, model, target, fps=5, progress=False)       # the next write cleans up
+    left = [n for n in os.listdir(tempfile.gettempdir()) if n.startswith(f"planarsim-{proc.pid}-")]
+    assert left == [] and sorted(os.listdir(tmp_path)) == ["run.gif"]
+
+
+def _tiny_run():
+    model = box_model()
+    return ps.Simulator(model).run(0.5, record_every=10), model
