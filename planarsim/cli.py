@@ -136,11 +136,13 @@ def cmd_run(args):
         traj.save(save)
         written.append(str(save))
     if csv:
-        traj.to_csv(csv, model)
+        with Elapsed(f"writing {csv.name}", enabled=bars):
+            traj.to_csv(csv, model)
         written.append(str(csv))
     if plot:
         from .render import plot_summary
-        plot_summary(traj, model, plot, title=title)
+        with Elapsed(f"plotting {plot.name}", enabled=bars):
+            plot_summary(traj, model, plot, title=title)
         written.append(str(plot))
     if out:
         from .render import export_animation
