@@ -86,8 +86,12 @@ def _default_workers(n_frames: int) -> int:
 
 def _pump(renderer, writer, workers, report) -> None:
     """Draw every frame (on `workers` processes), encode it and add it to `writer` in order."""
-    for encoded in map_frames(lambda k: writer.encode(renderer.image(k)), len(renderer), workers, report):
-        writer.add(encoded)
+    frames = map_frames(lambda k: writer.encode(renderer.image(k)), len(renderer), workers, report)
+    try:
+        for encoded in frames:
+            writer.add(encoded)
+    finally:
+        frames.close()          # ends the drawing processes now, not when the traceback goes
 
 
 def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, start=None, duration=None,

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import os
+import pickle
 
 import numpy as np
 
@@ -182,7 +183,7 @@ def _serve(work, frames, send, others):
                 item = (False, e)
             try:
                 send.send(item)
-            except (TypeError, AttributeError, ValueError) as e:     # an error that does not pickle
+            except (pickle.PicklingError, TypeError, AttributeError, ValueError) as e:   # does not pickle
                 item = (False, RuntimeError(f"drawing frame {k} failed: {item[1]!r} ({e})"))
                 send.send(item)
             if not item[0]:

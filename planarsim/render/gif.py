@@ -126,7 +126,7 @@ def gif_delays(n: int, fps: float) -> list:
 
 
 class GifStream:
-    """Writes encoded frames (encode_frame) to a binary file, looping forever."""
+    """Writes frames encoded by FrameEncoder to a binary file, in order; the GIF loops forever."""
 
     def __init__(self, fileobj, n_frames: int, fps: float):
         self.f, self.delays, self.k = fileobj, gif_delays(n_frames, fps), 0

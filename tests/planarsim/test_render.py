@@ -1147,3 +1147,14 @@ def test_sigkill_mid_export_leaves_nothing_and_no_drawing_processes(tmp_path):
 def _tiny_run():
     model = box_model()
     return ps.Simulator(model).run(0.5, record_every=10), model
+
+
+def test_an_error_while_writing_ends_the_drawing_processes_at_once(sliding_run, tmp_path):
+    import multiprocessing
+    model, traj = sliding_run
+    with pytest.raises(ValueError, match="embed limit") as caught:
+        export_animation(traj, model, tmp_path / "big.html", fps=30, size=(1.6, 0.9), dpi=50,
+                         progress=False, embed_limit_mb=0.01, workers=2)
+    assert caught.value is not None                    # the traceback is still held here
+    assert multiprocessing.active_children() == []
+    assert list(tmp_path.iterdir()) == []
