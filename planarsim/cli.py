@@ -119,12 +119,9 @@ def cmd_run(args):
     t0 = time.perf_counter()
     if not args.json:
         print(f"running {args.walker} for {args.duration:g} s", file=sys.stderr, flush=True)
-    preload = _Preload() if (out or plot) else None
     with Elapsed(f"simulating {args.duration:g} s", enabled=bars):
         traj, summary, model = mod.simulate(**kw)
     wall = time.perf_counter() - t0
-    if preload is not None:
-        preload.join()
     default_gait = inspect.signature(mod.simulate).parameters["gait"].default
     own = {"walker": args.walker, "gait": args.gait or default_gait,
            "terrain": args.terrain or "default", "duration_s": args.duration}
@@ -161,29 +158,6 @@ def cmd_run(args):
         for k, v in summary.items():
             print(f"  {k:22s} {v}")
     return 0
-
-
-class _Preload:
-    """Imports the drawing modules (matplotlib, Pillow, the fonts) on a thread while the
-    simulation runs: its compiled kernels release the GIL, so about 0.2 s of imports leave
-    the critical path. Any failure is left for the real import to report."""
-
-    def __init__(self):
-        import threading
-        self._thread = threading.Thread(target=self._run, name="planarsim-preload", daemon=True)
-        self._thread.start()
-
-    @staticmethod
-    def _run():
-        try:
-            from .render import frames, writers  # noqa: F401
-            from .render.stamps import _font
-            _font("monospace", 12)
-        except Exception:   # pragma: no cover - imported again, with its error, where needed
-            pass
-
-    def join(self):
-        self._thread.join()
 
 
 def _plain(v):
