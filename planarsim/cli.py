@@ -123,10 +123,13 @@ def cmd_run(args):
         kw["terrain"] = ter
     if args.dt is not None:
         kw["dt"] = args.dt
+    from .progress import Elapsed, stderr_is_terminal
+    bars = not args.json and stderr_is_terminal()      # progress only where someone watches
     t0 = time.perf_counter()
     if not args.json:
-        print(f"running {args.walker} for {args.duration:g} s ...", file=sys.stderr, flush=True)
-    traj, summary, model = mod.simulate(**kw)
+        print(f"running {args.walker} for {args.duration:g} s", file=sys.stderr, flush=True)
+    with Elapsed(f"simulating {args.duration:g} s", enabled=bars):
+        traj, summary, model = mod.simulate(**kw)
     wall = time.perf_counter() - t0
     default_gait = inspect.signature(mod.simulate).parameters["gait"].default
     own = {"walker": args.walker, "gait": args.gait or default_gait,
@@ -134,22 +137,25 @@ def cmd_run(args):
            "params_changed": changed}
     summary = {**own, **{k: _plain(v) for k, v in summary.items() if k not in own},
                "wall_time_s": round(wall, 3)}
+    title = f"{args.walker} ({own['gait']} gait) on {getattr(model.terrain, 'name', 'its')} terrain"
     written = []
     if save:
         traj.save(save)
         written.append(str(save))
     if csv:
-        traj.to_csv(csv)
+        with Elapsed(f"writing {csv.name}", enabled=bars):
+            traj.to_csv(csv, model)
         written.append(str(csv))
     if plot:
         from .render import plot_summary
-        plot_summary(traj, model, plot)
+        with Elapsed(f"plotting {plot.name}", enabled=bars):
+            plot_summary(traj, model, plot, title=title)
         written.append(str(plot))
     if out:
         from .render import export_animation
         from .render.gallery import gait_names
-        export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=not args.json,
-                         label_names=gait_names(mod))
+        export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=bars,
+                         label_names=gait_names(mod), summary=summary, title=title)
         written.append(str(out))
     if summary_path is not None:
         from .trajectory import atomic_write
@@ -391,7 +397,7 @@ def make_parser():
     p.add_argument("--speed", type=_positive, default=1.0, help="playback speed (0.25 slow motion)")
     p.add_argument("--plot", default=None, help="summary plot .png | .svg | .pdf")
     p.add_argument("--save", default=None, help="trajectory .npz")
-    p.add_argument("--csv", default=None, help="trajectory .csv")
+    p.add_argument("--csv", default=None, help="trajectory .csv (SI units in the column names)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--set", action="append", metavar="NAME=VALUE",
@@ -440,8 +446,29 @@ def make_parser():
     return ap
 
 
+# commands that leave no thread, process or buffered file behind: as a program of their own they
+# end without the interpreter's teardown (freeing numba's compiled code and matplotlib takes
+# about 0.35 s, longer than the Simple Biped's whole simulation)
+QUICK_EXIT = ("run", "list", "info")
+
+
 def main(argv=None) -> int:
+    """The command line; `argv` None reads sys.argv (and, as the program itself, ends the
+    process for the QUICK_EXIT commands once their output is flushed)."""
+    program = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
+    code = _main(argv)
+    if program and argv and argv[0] in QUICK_EXIT:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):    # a closed pipe (planarsim list | head)
+                pass
+        os._exit(code)
+    return code
+
+
+def _main(argv) -> int:
     # bench and tune own their options (including --help)
     if argv and argv[0] in ("bench", "tune"):
         argv = [argv[0], "--", *argv[1:]] if len(argv) > 1 and argv[1].startswith("-") else argv

@@ -146,26 +146,58 @@ class Trajectory:
                    info={k[6:]: data[k].item() if data[k].ndim == 0 else data[k]
                          for k in data if k.startswith("info__")})
 
-    def to_csv(self, path) -> Path:
-        """One row per frame: t, then x, y, theta, vx, vy, omega of every body, contact modes."""
+    def to_csv(self, path, model=None) -> Path:
+        """One row per frame, SI units in every column name (csv_columns); with the model, each
+        actuator's applied effort is named torque_Nm or force_N by its kind."""
         path = Path(path)
-        cols = ["t"]
-        blocks = [self.t[:, None]]
-        for i, name in enumerate(self.body_names or [f"body{i}" for i in range(self.q.shape[1])]):
-            cols += [f"{name}.{c}" for c in ("x", "y", "theta", "vx", "vy", "omega")]
-            blocks += [self.q[:, i, :], self.v[:, i, :]]
-        for i, name in enumerate(self.contact_names):
-            cols.append(f"{name}.mode")
-            blocks.append(self.contact_mode[:, i:i + 1])
-        for k, v in self.labels.items():
-            v = np.asarray(v)
-            if v.ndim == 1 and len(v) == len(self.t):
-                cols.append(k)
-                blocks.append(v[:, None])
-        table = np.hstack([np.asarray(b, dtype=np.float64) for b in blocks])
+        cols, blocks = csv_columns(self, model)
+        table = np.hstack([np.asarray(b, dtype=np.float64).reshape(len(self.t), -1) for b in blocks])
         atomic_write(path, lambda f: np.savetxt(f, table, delimiter=",", header=",".join(cols),
                                                 comments="", fmt="%.10g"), binary=False)
         return path
+
+
+# per-column unit suffixes of the CSV
+_BODY_COLS = ("x_m", "y_m", "theta_rad", "vx_m_per_s", "vy_m_per_s", "omega_rad_per_s")
+# actuator kinds (model.ACT_*): what their command is, once saturated
+_EFFORT = {0: "torque_Nm", 1: "force_N", 2: "torque_Nm", 3: "force_N", 4: "torque_Nm"}
+
+
+def csv_columns(traj, model=None) -> tuple:
+    """(column names, per-frame blocks) of Trajectory.to_csv:
+
+    t_s; per body NAME.x_m, .y_m, .theta_rad, .vx_m_per_s, .vy_m_per_s, .omega_rad_per_s;
+    per contact NAME.mode (0 free, 1 pinned, 2 sliding, -1 disabled), .impulse_n_Ns and
+    .impulse_t_Ns (normal and tangential impulse of the step; / dt for a mean force),
+    .point_x_m, .point_y_m; per actuator its applied (saturated) command NAME.torque_Nm or
+    NAME.force_N (NAME.u, in N or N m, without the model) and NAME.power_W; then the labels
+    (controller gait/state codes, ...).
+    """
+    K = len(traj.t)
+    cols, blocks = ["t_s"], [traj.t]
+    bodies = traj.body_names or [f"body{i}" for i in range(traj.q.shape[1])]
+    for i, name in enumerate(bodies):
+        cols += [f"{name}.{c}" for c in _BODY_COLS]
+        blocks += [traj.q[:, i, :], traj.v[:, i, :]]
+    contacts = traj.contact_names or [f"contact{i}" for i in range(traj.contact_mode.shape[1])]
+    for i, name in enumerate(contacts):
+        cols += [f"{name}.mode", f"{name}.impulse_n_Ns", f"{name}.impulse_t_Ns",
+                 f"{name}.point_x_m", f"{name}.point_y_m"]
+        blocks += [traj.contact_mode[:, i], traj.contact_impulse[:, i, :], traj.contact_point[:, i, :]]
+    acts = traj.act_names or [f"act{i}" for i in range(traj.act_u.shape[1])]
+    kinds = list(model.arrays.act_kind) if model is not None else [None] * len(acts)
+    if model is not None and tuple(model.act_names) != tuple(acts):
+        raise ValueError(f"the model's actuators {list(model.act_names)} are not the trajectory's "
+                         f"{list(acts)}: wrong model for this trajectory?")
+    for i, (name, kind) in enumerate(zip(acts, kinds)):
+        cols += [f"{name}.{_EFFORT.get(int(kind), 'u') if kind is not None else 'u'}", f"{name}.power_W"]
+        blocks += [traj.act_u[:, i], traj.act_power[:, i]]
+    for k, v in traj.labels.items():
+        v = np.asarray(v)
+        if v.ndim == 1 and len(v) == K:
+            cols.append(k)
+            blocks.append(v)
+    return cols, blocks
 
 
 def read_npz(path, what: str) -> dict:

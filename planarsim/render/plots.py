@@ -1,5 +1,6 @@
-"""Plots of a recorded run: joint angles and rates, energy, actuator power and cost of
-transport, contact-mode timeline per contact, phase portraits; saved as PNG, SVG or PDF.
+"""Plots of a recorded run: position and speed of the centre of mass, joint angles and rates,
+energy, actuator power and cost of transport, contact-mode timeline per contact, phase
+portraits; saved as PNG, SVG or PDF. The summary figure is titled with walker and terrain.
 
 Joint angle of pin j: theta_b - theta_a - ref [rad] (the engine's definition), rate
 omega_b - omega_a [rad/s]. A model without pins (point-mass walkers) shows the angle of each
@@ -102,6 +103,39 @@ def cost_of_transport(traj, model, power=None):
 
 
 # single panels -------------------------------------------------------------------------------
+def plot_position(traj, model, ax=None):
+    """Distance travelled x - x(0) and height y of the centre of mass [m] against time."""
+    if ax is None:
+        ax = new_figure()[1][0, 0]
+    com = traj.com(model)
+    if len(com):
+        ax.plot(traj.t, com[:, 0] - com[0, 0], label="distance x - x(0)")
+        ax.plot(traj.t, com[:, 1], "--", label="height y")
+    ax.set_ylabel("position [m]")
+    ax.set_xlabel("time [s]")
+    ax.set_title("centre of mass: position")
+    ax.legend(fontsize=7)
+    return ax
+
+
+def plot_speed(traj, model, ax=None):
+    """Forward speed of the centre of mass [m/s] against time, with its mean over the run."""
+    if ax is None:
+        ax = new_figure()[1][0, 0]
+    vx = traj.com_velocity(model)[:, 0]
+    ax.plot(traj.t, vx, lw=1.0, label="forward speed")
+    if len(vx):
+        com = traj.com(model)
+        span = traj.t[-1] - traj.t[0]
+        mean = (com[-1, 0] - com[0, 0]) / span if span > 0 else float(vx.mean())
+        ax.axhline(mean, color="k", lw=0.8, ls=":", label=f"mean {mean:.2f} m/s")
+    ax.set_ylabel("speed [m/s]")
+    ax.set_xlabel("time [s]")
+    ax.set_title("centre of mass: forward speed")
+    ax.legend(fontsize=7)
+    return ax
+
+
 def plot_joint_angles(traj, model, ax=None, rate_ax=None):
     """Joint angles [deg] on `ax` and rates [deg/s] on `rate_ax` against time."""
     if ax is None:
@@ -207,21 +241,32 @@ def plot_phase_portraits(traj, model, ax=None, names=None):
     return ax
 
 
-def plot_summary(traj, model, path=None, power=None, size=(11, 12)):
-    """All panels on one figure; saved to `path` (.png/.svg/.pdf) if given. Returns the figure."""
+def summary_title(traj, model) -> str:
+    """'<walker> on <terrain> terrain' from the trajectory's info and the model's terrain."""
+    walker = str(traj.info.get("walker", "")) or "run"
+    return f"{walker} on {getattr(model.terrain, 'name', 'terrain')} terrain"
+
+
+def plot_summary(traj, model, path=None, power=None, size=(11, 14), title=None):
+    """All panels on one figure titled `title` (default summary_title); saved to `path`
+    (.png/.svg/.pdf) if given. Returns the figure."""
     if path is not None:
         _check_figure_path(path)
-    fig, axes = new_figure(4, 2, size=size)
-    ang_ax, rate_ax = axes[0, 0], axes[1, 0]
+    fig, axes = new_figure(5, 2, size=size)
+    fig.suptitle(title or summary_title(traj, model))
+    plot_position(traj, model, axes[0, 0])
+    plot_speed(traj, model, axes[0, 1])
+    axes[0, 1].sharex(axes[0, 0])
+    ang_ax, rate_ax = axes[1, 0], axes[2, 0]
     rate_ax.sharex(ang_ax)
     plot_joint_angles(traj, model, ang_ax, rate_ax)
-    plot_phase_portraits(traj, model, axes[0, 1])
-    plot_energy(traj, model, axes[1, 1])
-    plot_power(traj, model, axes[2, 0], axes[2, 1], power=power)
-    gs = axes[3, 0].get_gridspec()
-    for a in axes[3]:
+    plot_phase_portraits(traj, model, axes[1, 1])
+    plot_energy(traj, model, axes[2, 1])
+    plot_power(traj, model, axes[3, 0], axes[3, 1], power=power)
+    gs = axes[4, 0].get_gridspec()
+    for a in axes[4]:
         a.remove()
-    plot_contact_modes(traj, model, fig.add_subplot(gs[3, :]))
+    plot_contact_modes(traj, model, fig.add_subplot(gs[4, :]))
     if path is not None:
         save_figure(fig, path)
     return fig

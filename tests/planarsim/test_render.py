@@ -56,7 +56,9 @@ def red_style(**kw):
 
 def render(model, q, center, view_width=4.0, size=(6.4, 3.6), dpi=100, **kw):
     fig, ax = make_figure(size, dpi)
-    scene = Scene(model, ax, view_width=view_width, show_com=False, show_text=False, style=red_style(), **kw)
+    # geometry only: the legend's force arrow is red too
+    scene = Scene(model, ax, view_width=view_width, show_com=False, show_text=False, show_legend=False,
+                  style=red_style(), **kw)
     scene.draw_state(q, center=center)
     fig.canvas.draw()
     img = np.asarray(fig.canvas.buffer_rgba())[:, :, :3].astype(int)
@@ -445,19 +447,26 @@ vm.createContext(sandbox);
 const scripts = [...html.matchAll(/<script[^>]*>([\s\S]*?)<\/script>/g)].map(m => m[1]);
 for (const s of scripts) vm.runInContext(s, sandbox);
 setTimeout(() => {
-  const play = html.match(/title="Play" aria-label="Play" onclick="([^"]+)"/)[1];
   const slider = html.match(/id="(_anim_slider\w+)"/)[1];
-  const before = el(slider).value;
-  vm.runInContext(play, sandbox);
-  setTimeout(() => { console.log(JSON.stringify({before, after: el(slider).value, max: el(slider).max}));
-                     process.exit(0); }, 400);
-}, 50);
+  const button = (title) => html.match(new RegExp(`title="${title}" aria-label="${title}" onclick="([^"]+)"`))[1];
+  const autoplayed = el(slider).value;                 // nobody pressed Play: the page plays by itself
+  vm.runInContext(button('Pause'), sandbox);
+  const paused = el(slider).value;
+  setTimeout(() => {
+    const still = el(slider).value;
+    vm.runInContext(button('Play'), sandbox);
+    setTimeout(() => { console.log(JSON.stringify({autoplayed, paused, still, after: el(slider).value,
+                                                   max: el(slider).max}));
+                       process.exit(0); }, 300);
+  }, 200);
+}, 400);
 """
 
 
-def test_html_player_script_runs_and_play_advances_the_frame(sliding_run, tmp_path):
-    """The page's own JavaScript run in node (V8) against a minimal DOM: no script error, and the
-    Play button's handler moves the frame slider. (Not a browser: see the chromium test.)"""
+def test_html_player_script_runs_plays_by_itself_and_pauses(sliding_run, tmp_path):
+    """The page's own JavaScript run in node (V8) against a minimal DOM: no script error, the
+    page starts playing on its own, Pause holds the frame and Play moves it on. (Not a browser:
+    see the chromium test.)"""
     node = shutil.which("node")
     if node is None:
         pytest.skip("node is not installed: cannot run the player's JavaScript")
@@ -468,8 +477,10 @@ def test_html_player_script_runs_and_play_advances_the_frame(sliding_run, tmp_pa
     assert res.returncode == 0, res.stderr
     import json
     state = json.loads(res.stdout.strip().splitlines()[-1])
-    assert state["before"] == 0 and state["max"] == 59
-    assert 3 <= state["after"] <= 59      # 33 ms per frame for 400 ms: about 12 frames
+    assert state["max"] == 59
+    assert 3 <= state["autoplayed"] <= 59      # 33 ms per frame for 400 ms: about 12 frames
+    assert state["still"] == state["paused"]
+    assert state["after"] != state["paused"]
 
 
 CHROMIUM_PROBE = """<script>
@@ -480,7 +491,7 @@ CHROMIUM_DRIVER = """<script>
 setTimeout(function () {
   var slider = document.querySelector('input.anim-slider');
   var before = slider.value;
-  document.querySelector('button[title="Play"]').click();
+  document.querySelector('button[title="Pause"]').click();
   setTimeout(function () {
     var out = document.createElement('pre'); out.id = 'result';
     out.textContent = 'RESULT ' + before + ' ' + slider.value + ' ERRORS ' + window.__errors.length + ' '
@@ -527,7 +538,8 @@ def chromium_or_skip():
 
 def test_html_export_plays_in_headless_chromium(sliding_run, tmp_path):
     """The exported page in a real browser (Debian's chromium, headless): it loads without a
-    script error, and pressing Play advances the frame slider."""
+    script error, plays by itself (the frame slider has moved before anyone presses a button)
+    and Pause holds the frame."""
     exe = chromium_or_skip()
     model, traj = sliding_run
     out = export_animation(traj, model, tmp_path / "run.html", fps=30, size=(1.6, 0.9), dpi=50, progress=False)
@@ -540,7 +552,7 @@ def test_html_export_plays_in_headless_chromium(sliding_run, tmp_path):
     assert found is not None, (res.stdout[-1000:], res.stderr[-2000:])
     before, after, n_err = int(found[1]), int(found[2]), int(found[3])
     assert n_err == 0, found[4]
-    assert before == 0 and after > 0
+    assert before > 0 and after == before
 
 
 # plots ----------------------------------------------------------------------------------------
@@ -859,3 +871,290 @@ def test_viewer_pauses_with_a_message_when_the_simulation_diverges():
     viewer.draw()
     assert "stopped: simulation diverged" in viewer.scene.text.get_text()
     assert sim.t < 1.1                                        # |y| passed 5 m after ~1 s
+
+
+# reading at a glance ---------------------------------------------------------------------------
+from planarsim.render.sides import model_sides, side_of   # noqa: E402
+from planarsim.render.stamps import TextStamp              # noqa: E402
+
+
+@pytest.mark.parametrize("name, side", [
+    ("left_thigh", "left"), ("right_shin", "right"), ("l_foot", "left"), ("r_knee", "right"),
+    ("FL_calf", "left"), ("RR_thigh", "right"), ("HL_hip_motor", "left"), ("outer_leg", "outer"),
+    ("inner_foot", "inner"), ("foot0", "leg 0"), ("leg1", "leg 1"), ("foot_a", "leg a"), ("leg_b", "leg b"),
+    ("right_sole/2", "right"), ("hip", None), ("torso", None), ("base", None), ("spoke3", None),
+    ("hub", None), ("hip_motor", None)])
+def test_side_of_reads_the_leg_from_the_name(name, side):
+    assert side_of(name) == side
+
+
+def test_every_walker_has_its_two_legs_on_two_sides():
+    import walkers
+    for name in walkers.WALKERS:
+        _, _, model = walkers.load(name).simulate(0.02)
+        sides = {s for group in model_sides(model).values() for s in group} - {None}
+        if name == "rimless-wheel":
+            assert sides == set()                 # one rigid body: no legs to tell apart
+        else:
+            assert len(sides) == 2, (name, sides)
+
+
+def _legged_model():
+    b = ps.ModelBuilder(dt=1e-3)
+    hip = b.add_point_mass("hip", 5.0, pos=(0.0, 1.0), radius=0.05)
+    f0 = b.add_point_mass("foot_left", 0.5, pos=(-0.2, 0.05), radius=0.04)
+    f1 = b.add_point_mass("foot_right", 0.5, pos=(0.2, 0.05), radius=0.04)
+    b.add_axial("leg_left", hip, f0)
+    b.add_axial("leg_right", hip, f1)
+    return b.compile()
+
+
+def test_left_and_right_legs_are_drawn_in_the_two_side_colours():
+    model = _legged_model()
+    fig, ax = make_figure()
+    style = Style(side_colors=("#0000ff", "#ff0000"), trunk_color="#00ff00")
+    scene = Scene(model, ax, view_width=2.0, style=style, show_legend=False, show_text=False, show_com=False)
+    scene.draw_state(model.q0, center=(0.0, 0.5))
+    fig.canvas.draw()
+    img = np.asarray(fig.canvas.buffer_rgba())[:, :, :3].astype(int)
+    blue, red = np.nonzero(mask(img, BLUE)), np.nonzero(mask(img, RED))
+    mid = to_pixels(scene, [0.0, 0.5])[0, 0]
+    assert len(blue[1]) > 100 and len(red[1]) > 100
+    assert np.median(blue[1]) < mid < np.median(red[1])    # the left leg left, the right one right
+    hip = to_pixels(scene, [0.0, 1.0])[0].round().astype(int)
+    assert mask(img, (0.0, 1.0, 0.0))[hip[1], hip[0]]       # the trunk in the trunk colour
+    # the override: both legs one side
+    scene2 = Scene(model, make_figure()[1], sides={"foot_right": "left", "leg_right": "left"})
+    assert scene2.sides["body"] == [None, "left", "left"] and scene2.side_labels == ["left"]
+    with pytest.raises(ValueError, match="sides=.*'up'"):
+        Scene(model, make_figure()[1], sides={"hip": "up"})
+
+
+def test_ground_ticks_carry_distance_labels_at_their_places(sliding_run):
+    model, traj = sliding_run
+    fig, ax = make_figure()
+    scene = Scene(model, ax, view_width=4.0, tick_spacing=0.5)
+    assert scene.label_spacing == 1.0
+    scene.draw_state(traj.q[0], center=(0.3, 0.5))
+    shown = [lab for lab in scene.tick_labels if lab.get_visible()]
+    texts = [lab.get_text() for lab in shown]
+    assert texts == ["-1 m", "0 m", "1 m", "2 m"]      # view -1.7 .. 2.3 m; none cut by its edge
+    for lab in shown:
+        x = float(lab.get_text().split()[0])
+        assert lab.get_position()[0] == pytest.approx(x) and lab.get_position()[1] < 0   # under the ground
+    fig.canvas.draw()
+    for lab in shown:                        # each label whole on the picture
+        x0, y0, w, h = lab.window_box(fig.dpi)
+        assert 0 <= x0 and x0 + w <= fig.canvas.get_width_height()[0] and y0 >= 0
+
+
+def test_legend_names_sides_force_and_com_and_is_on_every_frame(tmp_path):
+    model = _legged_model()
+    traj = ps.Simulator(model).run(0.5, record_every=10)
+    fig, ax = make_figure()
+    scene = Scene(model, ax)
+    assert [e[0] for e in scene.legend_entries()] == ["left leg", "right leg", "centre of mass"]
+    from planarsim.render.animate import FrameRenderer
+    r = FrameRenderer(traj, model, fps=20, size=(4.0, 2.25))
+    box = None
+    for k in range(len(r)):
+        img = r.rgb(k).astype(int)
+        x0, y0, w, h = r.scene.legend.window_box(r.fig.dpi)
+        assert r.scene.legend.get_visible()
+        height = img.shape[0]
+        patch = img[height - (y0 + h):height - y0, x0:x0 + w]
+        side0 = np.array(tuple(int(Style().side_colors[0][i:i + 2], 16) for i in (1, 3, 5)))
+        assert np.any(np.all(np.abs(patch - side0) < 8, axis=2))          # the legend's left-leg patch
+        assert box is None or box == (x0, y0, w, h)                        # in the same place
+        box = (x0, y0, w, h)
+        assert r.scene.text.get_text().startswith(f"t = {r.shown_times[k]:7.3f} s")
+    assert r.shown_times[0] == 0.0
+
+
+def test_artists_are_reused_from_frame_to_frame(sliding_run):
+    model, traj = sliding_run
+    from planarsim.render.animate import FrameRenderer
+    from matplotlib.artist import Artist
+    made = []
+    real_init = Artist.__init__
+
+    def counting_init(self, *a, **kw):
+        made.append(type(self).__name__)
+        real_init(self, *a, **kw)
+
+    r = FrameRenderer(traj, model, fps=30)
+    r.rgb(0)
+    children = list(r.ax.get_children())
+    Artist.__init__ = counting_init
+    try:
+        for k in range(1, len(r)):
+            r.rgb(k)
+    finally:
+        Artist.__init__ = real_init
+    assert made == [] and len(r) == 60
+    assert r.ax.get_children() == children
+
+
+def test_text_stamp_draws_the_text_where_it_says():
+    fig, ax = make_figure((3.0, 1.0), 100)
+    stamp = TextStamp(0.5, 0.5, "Hi there", transform=ax.transAxes, ha="center", va="center", fontsize=14,
+                      color="#ff0000")
+    ax.add_artist(stamp)
+    fig.canvas.draw()
+    img = np.asarray(fig.canvas.buffer_rgba())[:, :, :3].astype(int)
+    rows, cols = np.nonzero(mask(img, RED))
+    assert len(rows) > 50
+    assert abs(cols.mean() - 150) < 8 and abs(rows.mean() - 50) < 8
+    x0, y0, w, h = stamp.window_box(fig.dpi)
+    assert x0 <= cols.min() and cols.max() < x0 + w and 100 - (y0 + h) <= rows.min()
+    stamp.set_text("")
+    fig.canvas.draw()
+    assert not mask(np.asarray(fig.canvas.buffer_rgba())[:, :, :3].astype(int), RED).any()
+
+
+def test_ten_second_walk_gif_is_at_most_one_megabyte(tmp_path):
+    """The command line's default animation (640x360, 20 fps) of a 10 s Simple Biped walk."""
+    import walkers
+    from PIL import Image
+    from planarsim.render.gallery import gait_names
+    mod = walkers.load("simple-biped")
+    traj, _, model = mod.simulate(duration=10.0)
+    out = export_animation(traj, model, tmp_path / "walk.gif", fps=20, progress=False,
+                           label_names=gait_names(mod))
+    assert out.stat().st_size <= 1_000_000
+    with Image.open(out) as im:
+        assert im.n_frames == 200 and im.size == (640, 360)
+        im.seek(150)
+        frame = np.asarray(im.convert("RGB")).astype(int)
+    assert np.count_nonzero(np.any(frame < 200, axis=2)) > 2000        # a picture, not a blank
+
+
+def test_frames_drawn_on_two_processes_equal_those_drawn_on_one(sliding_run, tmp_path):
+    from PIL import Image
+    model, traj = sliding_run
+    one = export_animation(traj, model, tmp_path / "one.gif", fps=30, size=(3.2, 1.8), progress=False, workers=1)
+    two = export_animation(traj, model, tmp_path / "two.gif", fps=30, size=(3.2, 1.8), progress=False, workers=2)
+    with Image.open(one) as a, Image.open(two) as b:
+        assert a.n_frames == b.n_frames == 60
+        for k in range(60):
+            a.seek(k)
+            b.seek(k)
+            assert np.array_equal(np.asarray(a.convert("RGB")), np.asarray(b.convert("RGB"))), k
+
+
+def test_a_frame_error_in_a_worker_reaches_the_caller_and_leaves_nothing(sliding_run, tmp_path, monkeypatch):
+    from planarsim.render import frames
+    model, traj = sliding_run
+    real = frames.FrameRenderer.draw
+
+    def broken(self, k):
+        if k == 50:
+            raise ValueError("frame 50 is broken")
+        return real(self, k)
+
+    monkeypatch.setattr(frames.FrameRenderer, "draw", broken)
+    with pytest.raises(ValueError, match="frame 50 is broken"):
+        export_animation(traj, model, tmp_path / "x.gif", fps=30, size=(1.6, 0.9), dpi=50, progress=False,
+                         workers=2)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_summary_plot_has_title_position_and_speed(sliding_run):
+    import dataclasses
+    model, traj = sliding_run
+    traj = dataclasses.replace(traj, info={**traj.info, "walker": "box"})
+    fig = plot_summary(traj, model)
+    assert fig._suptitle.get_text() == "box on flat terrain"
+    speed_ax = next(a for a in fig.axes if a.get_title() == "centre of mass: forward speed")
+    line = speed_ax.get_lines()[0]
+    np.testing.assert_allclose(line.get_ydata(), traj.com_velocity(model)[:, 0])
+    pos_ax = next(a for a in fig.axes if a.get_title() == "centre of mass: position")
+    dist = pos_ax.get_lines()[0].get_ydata()
+    # slid from 1.5 m/s to rest at mu g: v^2 / (2 mu g) = 0.38 m, less the first recorded step
+    assert dist[0] == 0.0 and dist[-1] == pytest.approx(1.5 ** 2 / (2 * 0.3 * 9.81) - 1.5 * 0.01, abs=0.01)
+    assert "slope:3" in plot_summary(traj, model, title="box on slope:3 terrain")._suptitle.get_text()
+
+
+def test_gif_keeps_the_background_and_ground_colours_exact(sliding_run, tmp_path):
+    from PIL import Image
+    model, traj = sliding_run
+    out = export_animation(traj, model, tmp_path / "run.gif", fps=10, size=(3.2, 1.8), progress=False)
+    style = Style()
+    with Image.open(out) as im:
+        im.seek(5)
+        rgb = np.asarray(im.convert("RGB"))
+    colours = {tuple(int(c) for c in px) for px in rgb.reshape(-1, 3)}
+    assert (255, 255, 255) in colours                                     # white stays white
+    ground = tuple(int(style.ground_fill[i:i + 2], 16) for i in (1, 3, 5))
+    assert ground in colours
+
+
+KILLED_EXPORTER = """
+import multiprocessing, sys
+import numpy as np
+import planarsim as ps
+from planarsim.render import export_animation
+b = ps.ModelBuilder(dt=1e-3)
+box = b.add_body("box", mass=2.0, inertia=0.1, pos=(0.0, 0.1), vel=(1.0, 0.0))
+b.add_box_contacts("corner", box, (0.0, 0.0), 0.8, 0.2, mu=0.3)
+model = b.compile()
+traj = ps.Simulator(model).run(2.0, record_every=10)
+
+def progress(done, total):
+    if done == 5:
+        pids = [p.pid for p in multiprocessing.active_children()]
+        print("exporting", *pids, flush=True)
+        import time
+        time.sleep(60)
+
+export_animation(traj, model, sys.argv[1], fps=100, progress=progress, workers=2)
+"""
+
+
+def _gone(pid):
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return "\nState:\tZ" in f.read()      # a zombie has ended
+    except FileNotFoundError:
+        return True
+
+
+@pytest.mark.skipif(not hasattr(os, "fork") or not Path("/proc").is_dir(), reason="fork, /proc")
+def test_sigkill_mid_export_leaves_nothing_and_no_drawing_processes(tmp_path):
+    import signal
+    import sys
+    import tempfile
+    import time
+    target = tmp_path / "run.gif"
+    proc = subprocess.Popen([sys.executable, "-c", KILLED_EXPORTER, str(target)], stdout=subprocess.PIPE, text=True)
+    words = proc.stdout.readline().split()
+    assert words[:1] == ["exporting"], words
+    workers = [int(w) for w in words[1:]]
+    assert len(workers) == 2
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert os.listdir(tmp_path) == []
+    deadline = time.monotonic() + 20
+    while not all(_gone(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert all(_gone(pid) for pid in workers)        # the workers ended with their parent
+    traj, model = _tiny_run()
+    export_animation(traj, model, target, fps=5, progress=False)       # the next write cleans up
+    left = [n for n in os.listdir(tempfile.gettempdir()) if n.startswith(f"planarsim-{proc.pid}-")]
+    assert left == [] and sorted(os.listdir(tmp_path)) == ["run.gif"]
+
+
+def _tiny_run():
+    model = box_model()
+    return ps.Simulator(model).run(0.5, record_every=10), model
+
+
+def test_an_error_while_writing_ends_the_drawing_processes_at_once(sliding_run, tmp_path):
+    import multiprocessing
+    model, traj = sliding_run
+    with pytest.raises(ValueError, match="embed limit") as caught:
+        export_animation(traj, model, tmp_path / "big.html", fps=30, size=(1.6, 0.9), dpi=50,
+                         progress=False, embed_limit_mb=0.01, workers=2)
+    assert caught.value is not None                    # the traceback is still held here
+    assert multiprocessing.active_children() == []
+    assert list(tmp_path.iterdir()) == []
