@@ -15,7 +15,7 @@ from pathlib import Path
 
 import walkers
 from planarsim.render import export_animation
-from planarsim.render.gallery import gait_names
+from walkers.gallery import gait_names
 
 
 def measure(traj, model, names, out, workers, repeats):

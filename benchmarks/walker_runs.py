@@ -9,7 +9,7 @@ real-time factor = simulated seconds / wall second; `fell` from the walker's sum
 overhead = wall time of a 10-step walk (model build, first steps, Trajectory), included in the
 figures. A walker that raises is reported with its error and the others go on.
 
-Batch: planarsim.batch.simulate_batch of `jobs` Simple Biped walks (target speeds spread over
+Batch: walkers.batch.simulate_batch of `jobs` Simple Biped walks (target speeds spread over
 0.8-1.2 m/s) on 1 and on 2 worker threads (the compiled rollouts release the GIL); throughput
 = simulated steps of all jobs / wall time, median (min-max) of `repeats` batches after a
 warm-up batch; cores busy = CPU time of this process / wall time (2.0 when both threads really
@@ -86,7 +86,7 @@ def measure_batch(jobs=64, seconds=10.0, repeats=3, workers=(1, 2), walker="simp
     """Throughput of a batch of `jobs` walks on each worker count; None if planarsim.batch is
     missing."""
     try:
-        from planarsim import batch
+        from walkers import batch
     except ImportError:
         return None
     speeds = [0.8 + 0.4 * i / max(1, jobs - 1) for i in range(jobs)]

@@ -10,7 +10,7 @@ and cost nothing to start.
 >>> import planarsim as ps
 >>> sims = [ps.Simulator(model) for _ in range(64)]            # doctest: +SKIP
 >>> ps.batch.steps_batch(sims, 10_000)                           # doctest: +SKIP
->>> out = ps.batch.simulate_batch("simple-biped", [{"speed": s} for s in speeds], 10.0)  # doctest: +SKIP
+>>> # many runs of a registered walker: walkers.batch.simulate_batch
 """
 from __future__ import annotations
 
@@ -71,14 +71,3 @@ def steps_batch(sims, n: int, u=None, workers: int | None = None) -> None:
         if len(us) != len(sims):
             raise ValueError(f"{len(us)} command arrays for {len(sims)} simulators")
     run_parallel([(lambda s=s, uk=uk: s.steps(n, uk)) for s, uk in zip(sims, us)], workers)
-
-
-def simulate_batch(walker: str, jobs: Sequence[dict], duration: float, workers: int | None = None) -> list:
-    """Run the registered walker's ``simulate(duration, **job)`` for every job (keyword
-    dictionaries: gait, seed, params, terrain, ...) in parallel; returns the list of
-    (Trajectory, summary, Model) in job order."""
-    from walkers import load
-
-    module = load(walker)
-    jobs = [dict(job) for job in jobs]
-    return run_parallel([(lambda job=job: module.simulate(duration, **job)) for job in jobs], workers)

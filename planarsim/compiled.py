@@ -19,6 +19,7 @@ From Python:
     audit_counts(ws)                         the step audit's counts by rule
     step_info(ws)                            what the last step did (solves, splits, pivots)
     drop_stale_caches(folder)                call on import of a package with compiled code
+    kernel_cache()                           (folder, index files) of the engine's numba cache
 
 Run codes. step returns RUN_OK or an engine failure: RUN_NONFINITE / RUN_TOO_LARGE (the state
 blew up), RUN_AUDIT (StepOptions.audit_raise and a rule broken), RUN_BAD_COMMANDS /
@@ -49,6 +50,16 @@ RUN_FELL = 100          # the walker fell (its own test: hip too low, torso down
 RUN_NO_EVENT = 101      # a step map found no section event (touchdown, mid-stance) in time
 
 
+def kernel_cache():
+    """(folder, sorted index files) of the engine kernels' numba cache: no files means the next
+    run compiles (about half a minute)."""
+    from pathlib import Path
+
+    from .kernels import _jit
+    folder = Path(_jit.__file__).resolve().parent / "__pycache__"
+    return folder, sorted(folder.glob("*.nbi"))
+
+
 def engine_failed(code) -> bool:
     """True for the engine's failure codes (the state blew up, an audit rule broke, bad
     commands), False for RUN_OK and a rollout's own codes (RUN_WALKER and up)."""
@@ -67,6 +78,7 @@ def check_run(code, model, ws, options, who="simulation") -> int:
 
 __all__ = ["jit", "jit_inline", "kernel", "step", "step_from_python", "record_frame",
            "make_recorder", "height", "height_derivs", "closest_point", "gap_of_point",
-           "pin_angle_rate", "audit_counts", "step_info", "drop_stale_caches", "check_run", "engine_failed",
+           "pin_angle_rate", "audit_counts", "step_info", "drop_stale_caches", "kernel_cache",
+           "check_run", "engine_failed",
            "RUN_OK", "RUN_NONFINITE", "RUN_TOO_LARGE", "RUN_AUDIT", "RUN_BAD_COMMANDS",
            "RUN_NONFINITE_COMMAND", "RUN_WALKER", "RUN_FELL", "RUN_NO_EVENT"]

@@ -8,7 +8,7 @@
 
 Modules: draw (Scene: a model drawn from its own shapes), camera (damped second-order
 tracking), animate (GIF/MP4/HTML export), plots, viewer (interactive, PI frame timer),
-gallery (README GIFs: ``python -m planarsim.render.gallery OUTDIR``); helpers: frames (sampling,
+gallery (README GIFs: ``python -m walkers.gallery OUTDIR``); helpers: frames (sampling,
 per-frame pixels, worker processes), writers, gif, html, stamps (cached text bitmaps), sides
 (which leg a part belongs to), legend. No numba here; pyplot is imported only by the
 on-screen viewer.

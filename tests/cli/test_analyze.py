@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from planarsim.cli import main
+from walkers.cli import main
 
 
 @pytest.mark.parametrize("argv, text", [

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from planarsim.cli import main
+from walkers.cli import main
 from planarsim.trajectory import Trajectory
 import walkers
 
@@ -117,3 +117,23 @@ def test_list_marks_each_walkers_default_gait(capsys):
     code, out, _ = run_cli(capsys, "list")
     assert code == 0
     assert "stand, walk (default), jump" in out      # the Simple Biped walks by default
+
+
+def test_a_reader_that_stops_early_is_not_an_error(tmp_path, monkeypatch, capsys):
+    """planarsim params ranger | head -1: the closed pipe is the reader's choice, exit 0 and
+    no message (an OSError handler used to catch it first: exit 2, 'Broken pipe')."""
+    sink = open(tmp_path / "sink", "w")
+
+    class ClosedPipe:
+        def write(self, text):
+            raise BrokenPipeError(32, "Broken pipe")
+
+        def flush(self):
+            pass
+
+        def fileno(self):
+            return sink.fileno()
+    monkeypatch.setattr("sys.stdout", ClosedPipe())
+    code = main(["params", "ranger"])
+    err = capsys.readouterr().err
+    assert code == 0 and "Broken pipe" not in err, err

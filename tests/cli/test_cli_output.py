@@ -7,7 +7,7 @@ import re
 import pytest
 
 import planarsim.progress as progress
-from planarsim.cli import main
+from walkers.cli import main
 from planarsim.progress import Elapsed, TextProgress
 
 

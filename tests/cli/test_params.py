@@ -6,7 +6,7 @@ from dataclasses import fields
 import pytest
 
 import walkers
-from planarsim.cli import main
+from walkers.cli import main
 
 TUNABLE = ("quadruped", "ranger", "simbicon", "simple-biped")
 

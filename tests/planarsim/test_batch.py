@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 import planarsim as ps
-from planarsim.batch import run_parallel, simulate_batch, steps_batch
+from planarsim.batch import run_parallel, steps_batch
+from walkers.batch import simulate_batch
 from benchmarks.scenes import chain
 
 

@@ -41,7 +41,17 @@ def test_users_of_the_engine_stay_on_its_public_side(folder):
                 continue
             if module.startswith("planarsim.kernels") or any(p.startswith("_") for p in module.split(".")):
                 bad.append(f"{path.relative_to(ROOT)}: import from {module}")
-            elif name is not None and name.startswith("_"):
+            elif name is not None and name.startswith("_") and not name.startswith("__"):
                 bad.append(f"{path.relative_to(ROOT)}: {module}.{name}")
         bad += [f"{path.relative_to(ROOT)}: {a}" for a in _private_attributes(path)]
+    assert not bad, "\n".join(bad)
+
+
+def test_the_engine_never_imports_walkers_or_benchmarks():
+    bad = []
+    for path in sorted((ROOT / "planarsim").rglob("*.py")):
+        for module, name in _imports(path):
+            top = module.split(".")[0]
+            if top in ("walkers", "benchmarks"):
+                bad.append(f"{path.relative_to(ROOT)}: import {module}")
     assert not bad, "\n".join(bad)

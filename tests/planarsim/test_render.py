@@ -1016,7 +1016,7 @@ def test_ten_second_walk_gif_is_at_most_one_megabyte(tmp_path):
     """The command line's default animation (640x360, 20 fps) of a 10 s Simple Biped walk."""
     import walkers
     from PIL import Image
-    from planarsim.render.gallery import gait_names
+    from walkers.gallery import gait_names
     mod = walkers.load("simple-biped")
     traj, _, model = mod.simulate(duration=10.0)
     out = export_animation(traj, model, tmp_path / "walk.gif", fps=20, progress=False,

@@ -8,7 +8,7 @@ import pytest
 
 pytest.importorskip("cma", reason="planarsim.tune needs the 'cma' package (pip install cma)")
 
-from planarsim.tune import load_result, tune  # noqa: E402
+from walkers.tune import load_result, tune  # noqa: E402
 from walkers.simbicon.params import THESIS  # noqa: E402
 
 # short runs keep the test cheap: 3 s walks, no pushes, 2 generations of 6

@@ -19,7 +19,7 @@ import sys
 import time
 from pathlib import Path
 
-from . import __version__
+from planarsim import __version__
 
 ANIMATION_EXTS = (".gif", ".mp4", ".html")
 PLOT_EXTS = (".png", ".svg", ".pdf")
@@ -67,7 +67,7 @@ def _positive(text):
 
 # commands -------------------------------------------------------------------------------------
 def cmd_list(args):
-    from . import terrain
+    from planarsim import terrain
     w = _walkers()
     print("walkers (gaits):")
     for name in sorted(w.WALKERS):
@@ -92,7 +92,7 @@ def cmd_list(args):
 
 
 def cmd_run(args):
-    from . import terrain as T
+    from planarsim import terrain as T
     mod = _load_walker(args.walker)
     if args.gait is not None and args.gait not in mod.GAITS:
         raise UsageError(f"walker {args.walker!r} has no gait {args.gait!r}; gaits: {', '.join(mod.GAITS)}")
@@ -123,7 +123,7 @@ def cmd_run(args):
         kw["terrain"] = ter
     if args.dt is not None:
         kw["dt"] = args.dt
-    from .progress import Elapsed, stderr_is_terminal
+    from planarsim.progress import Elapsed, stderr_is_terminal
     bars = not args.json and stderr_is_terminal()      # progress only where someone watches
     t0 = time.perf_counter()
     if not args.json:
@@ -147,18 +147,18 @@ def cmd_run(args):
             traj.to_csv(csv, model)
         written.append(str(csv))
     if plot:
-        from .render import plot_summary
+        from planarsim.render import plot_summary
         with Elapsed(f"plotting {plot.name}", enabled=bars):
             plot_summary(traj, model, plot, title=title)
         written.append(str(plot))
     if out:
-        from .render import export_animation
-        from .render.gallery import gait_names
+        from planarsim.render import export_animation
+        from walkers.gallery import gait_names
         export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=bars,
                          label_names=gait_names(mod), summary=summary, title=title)
         written.append(str(out))
     if summary_path is not None:
-        from .trajectory import atomic_write
+        from planarsim.trajectory import atomic_write
         atomic_write(summary_path, lambda f: f.write(json.dumps(summary, indent=2) + "\n"), binary=False)
         written.append(str(summary_path))
     summary["files"] = written
@@ -230,8 +230,8 @@ def cmd_view(args):
         raise UsageError(f"no display to open the viewer on (no DISPLAY, or a file-only "
                          f"matplotlib backend); use 'planarsim run {args.walker} --out "
                          f"{args.walker}.gif' to watch it")
-    from . import terrain as T
-    from .render.viewer import view_walker
+    from planarsim import terrain as T
+    from planarsim.render.viewer import view_walker
     try:
         ter = T.parse(args.terrain) if args.terrain else None
     except ValueError as e:
@@ -249,7 +249,7 @@ def cmd_bench(args):
 
 
 def cmd_tune(args):
-    from .tune import main
+    from walkers.tune import main
     return main(args.rest)
 
 
@@ -257,16 +257,15 @@ def cmd_info(args):
     import numba
     import numpy
     import matplotlib
-    from .kernels import _jit
-    kernels = Path(_jit.__file__).resolve().parent
-    cached = sorted(kernels.glob("__pycache__/*.nbi"))
+    from planarsim.compiled import kernel_cache
+    folder, cached = kernel_cache()
     print(f"planarsim {__version__}")
     print(f"python {sys.version.split()[0]}, numpy {numpy.__version__}, numba {numba.__version__}, "
           f"matplotlib {matplotlib.__version__}")
-    print(f"numba cache: {len(cached)} kernel index files in {kernels / '__pycache__'}"
+    print(f"numba cache: {len(cached)} kernel index files in {folder}"
           f"{' (cold: the first run compiles, about half a minute)' if not cached else ' (warm)'}")
     try:
-        from .render import ffmpeg_exe
+        from planarsim.render import ffmpeg_exe
         print(f"ffmpeg: {ffmpeg_exe()}")
     except Exception as e:
         print(f"ffmpeg: unavailable ({e})")
@@ -305,9 +304,9 @@ def cmd_analyze(args):
     """Continuation of the period-one gait in one parameter (multipliers, bifurcations,
     period-2 after a doubling) or a brute-force bifurcation diagram; CSV and plot."""
     import numpy as np
-    from .analysis import (MapPool, StepMapError, bifurcation_diagram, continue_branch,
+    from planarsim.analysis import (MapPool, StepMapError, bifurcation_diagram, continue_branch,
                            period_doubling_branch, plot_bifurcation_diagram, plot_branch_multipliers)
-    from .render.animate import TextProgress
+    from planarsim.render.animate import TextProgress
     family, a, b = _analysis_family(args)
     if args.points < 2:
         raise UsageError(f"--points {args.points} must be at least 2")
@@ -352,7 +351,7 @@ def cmd_analyze(args):
                     print(f"  {bf.kind} at {args.param} = {bf.p:.7g}"
                           f"{'' if bf.located else f' (within {bf.bracket:.2g})'}")
             if csv:
-                from .analysis import write_csv
+                from planarsim.analysis import write_csv
                 write_csv(csv, [r for k in branches for r in k.rows(family.names)])
             if plot:
                 if plot.with_suffix("").name.endswith("_multipliers"):
@@ -481,14 +480,14 @@ def _main(argv) -> int:
     except UsageError as e:
         print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
         return 2
-    except (OSError, ValueError) as e:
-        # bad input detected deeper down (ModelError is a ValueError): one line, exit 2
-        print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
-        return 2
     except BrokenPipeError:
         # the reader went away (planarsim params W | head): not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except (OSError, ValueError) as e:
+        # bad input detected deeper down (ModelError is a ValueError): one line, exit 2
+        print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(f"planarsim {args.command}: interrupted", file=sys.stderr)
         return 130

@@ -1,6 +1,6 @@
 """Make one small GIF per registered walker (for the README), with the walkers' own simulate().
 
-    python -m planarsim.render.gallery docs/gifs --duration 6 --fps 15 --width 480
+    python -m walkers.gallery docs/gifs --duration 6 --fps 15 --width 480
 
 Each walker package registered in ``walkers.WALKERS`` is run with its first gait that walks
 (``walk`` if it has one) on flat ground and rendered with the tracking camera. The files are
@@ -12,7 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .animate import export_animation
+from planarsim.render.animate import export_animation
 
 
 def gait_names(module) -> dict:
@@ -45,7 +45,7 @@ def make_gif(name, out_dir, duration=6.0, fps=15.0, width_px=480, speed=1.0, pro
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m planarsim.render.gallery", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m walkers.gallery", description=__doc__.splitlines()[0])
     ap.add_argument("out_dir", type=Path)
     ap.add_argument("--duration", type=float, default=6.0, help="simulated seconds per walker")
     ap.add_argument("--fps", type=float, default=15.0)

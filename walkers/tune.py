@@ -16,7 +16,7 @@ After every generation the result (best parameters, per-generation history, sett
 written atomically to `out` (JSON), so an interrupted run keeps what was finished;
 :func:`load_result` reads it back.
 
-Command line: ``python -m planarsim.tune simbicon --budget 200 --out tuned.json``.
+Command line: ``planarsim tune simbicon --budget 200 --out tuned.json`` (or ``python -m walkers.tune``).
 """
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .trajectory import atomic_write
+from planarsim.trajectory import atomic_write
 
 FORMAT_VERSION = 1
 
