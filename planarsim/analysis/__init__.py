@@ -7,7 +7,7 @@ Modules: events (touchdowns, sections), stepmap (StepMap, Jacobians, fixed point
 multipliers), parallel (MapPool: map evaluations on every core), continuation, bifurcation,
 basin, summary (whole-step cost of transport, step length, speed), plots.
 """
-from .events import IN_CONTACT, StepEvents, poincare_section, step_events, touchdowns
+from .events import IN_CONTACT, StepEvents, foot_groups, poincare_section, step_events, touchdowns
 from .stepmap import (EPS_LADDER, FixedPoint, MultiplierWarning, Multipliers, StepMap, StepMapError,
                       central_jacobian, central_points, find_fixed_point, floquet_multipliers,
                       jacobian, match_distance, multipliers_with_error, serial_evaluator,
@@ -21,7 +21,7 @@ from .plots import (plot_basin, plot_bifurcation_diagram, plot_branch_multiplier
                     plot_multipliers)
 
 __all__ = [
-    "IN_CONTACT", "StepEvents", "poincare_section", "step_events", "touchdowns",
+    "IN_CONTACT", "StepEvents", "foot_groups", "poincare_section", "step_events", "touchdowns",
     "EPS_LADDER", "FixedPoint", "MultiplierWarning", "Multipliers", "StepMap", "StepMapError",
     "central_jacobian", "central_points", "find_fixed_point", "floquet_multipliers", "jacobian",
     "match_distance", "multipliers_with_error", "serial_evaluator", "sort_multipliers",

@@ -59,8 +59,48 @@ def _contact_index(traj, contact) -> int:
     return c
 
 
-def step_events(traj, contacts: Sequence | None = None) -> StepEvents:
-    """Touchdown events of `contacts` (names or indices; default all) in a Trajectory."""
+def foot_groups(contact_names) -> list:
+    """Contacts grouped into feet by name: 'left_sole/0' .. 'left_sole/3' (the corners of one
+    box foot, as add_box_contacts names them) are one foot; any other contact is a foot of
+    its own. Returns a list of lists of contact indices."""
+    groups = {}
+    for i, name in enumerate(contact_names):
+        groups.setdefault(str(name).split("/")[0], []).append(i)
+    return list(groups.values())
+
+
+def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = None,
+                min_air: float = 0.0) -> StepEvents:
+    """Touchdown events of `contacts` (names or indices; default all) in a Trajectory.
+
+    feet : groups of contacts (names or indices) that touch down as one: a foot touches down at
+        the frame where one of its contacts is in contact and none was the frame before (a box
+        foot landing heel then toe is one event); the event names the group's first contact.
+        Overrides `contacts`.
+    min_air : [s] with feet, a touchdown counts only after the foot was off the ground this
+        long (a foot that bounces or chatters for a few frames at landing lands once).
+    """
+    if feet is not None:
+        frames, which = [], []
+        for group in feet:
+            idx = [_contact_index(traj, c) for c in group]
+            on = np.isin(traj.contact_mode[:, idx], IN_CONTACT).any(axis=1)
+            f = np.flatnonzero(on[1:] & ~on[:-1]) + 1
+            if min_air > 0.0 and len(f):
+                t = np.asarray(traj.t)
+                lift = np.flatnonzero(~on[1:] & on[:-1]) + 1      # frames the foot left
+                keep = []
+                for k in f:
+                    left = lift[lift < k]
+                    keep.append(len(left) == 0 or t[k] - t[left[-1]] >= min_air)
+                f = f[np.array(keep, dtype=bool)]
+            frames.append(f)
+            which.append(np.full(len(f), idx[0]))
+        frame = np.concatenate(frames) if frames else np.zeros(0, int)
+        contact = np.concatenate(which) if which else np.zeros(0, int)
+        order = np.argsort(frame, kind="stable")
+        frame, contact = frame[order], contact[order]
+        return StepEvents(frame=frame, time=np.asarray(traj.t)[frame], contact=contact)
     if contacts is None:
         contacts = range(traj.contact_mode.shape[1])
     frames, which = [], []

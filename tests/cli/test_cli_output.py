@@ -82,7 +82,7 @@ def test_html_page_is_titled_with_the_walker_and_holds_the_summary(tmp_path, cap
     page = out.read_text()
     assert "<title>simple-biped (walk gait) on flat terrain - planarsim</title>" in page
     assert "<h1>simple-biped (walk gait) on flat terrain</h1>" in page
-    assert '<table class="planarsim-summary">' in page and "<th>mean_speed</th>" in page
+    assert '<table class="planarsim-summary">' in page and "<th>mean_speed_m_per_s</th>" in page
     assert "play_animation(); }" in page              # plays when opened
 
 

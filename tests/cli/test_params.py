@@ -46,7 +46,7 @@ def test_set_changes_the_physics_and_is_reported(capsys):
     heavy = json.loads(out)
     assert heavy["params_changed"] == {"hip_mass": 14.0}    # mu=0.9 is the default
     assert base["params_changed"] == {}
-    assert heavy["positive_work"] != base["positive_work"]
+    assert heavy["extras"]["positive_work_J"] != base["extras"]["positive_work_J"]
 
 
 def test_params_file_then_set_later_wins(tmp_path, capsys):

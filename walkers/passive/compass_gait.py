@@ -14,6 +14,11 @@ from .params import CompassParams
 from .simplest import slope_from_terrain
 
 NAME = "compass-gait"
+SUMMARY_EXTRAS = {
+    "cost_of_transport": ("cost_of_transport", "mechanical energy lost per weight and distance along the slope over whole steps: sin(slope) on a steady gait"),
+    "impacts": ("impacts", "how touchdowns were resolved: refined (located and resolved exactly) or engine"),
+    "steps": ("controller_steps", "touchdowns the rollout recorded"),
+}
 Params = CompassParams   # the walker's parameters (planarsim params compass-gait)
 GAITS = ("passive",)
 

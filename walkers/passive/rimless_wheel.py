@@ -9,6 +9,11 @@ from .reference import rimless_fixed_point
 from .simplest import slope_from_terrain
 
 NAME = "rimless-wheel"
+SUMMARY_EXTRAS = {
+    "cost_of_transport": ("cost_of_transport", "mechanical energy lost per weight and distance along the slope over whole steps: sin(slope) on a steady gait"),
+    "impacts": ("impacts", "how touchdowns were resolved: refined (located and resolved exactly) or engine"),
+    "steps": ("controller_steps", "touchdowns the rollout recorded"),
+}
 Params = RimlessParams   # the walker's parameters (planarsim params rimless-wheel)
 GAITS = ("passive",)
 

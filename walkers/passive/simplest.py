@@ -11,6 +11,11 @@ from .params import SimplestParams
 from .reference import GARCIA_THETA, GARCIA_THETA_DOT, simplest_heel_strike
 
 NAME = "simplest-walker"
+SUMMARY_EXTRAS = {
+    "cost_of_transport": ("cost_of_transport", "mechanical energy lost per weight and distance along the slope over whole steps: sin(slope) on a steady gait"),
+    "impacts": ("impacts", "how touchdowns were resolved: refined (located and resolved exactly) or engine"),
+    "steps": ("controller_steps", "touchdowns the rollout recorded"),
+}
 Params = SimplestParams   # the walker's parameters (planarsim params simplest-walker)
 GAITS = ("passive",)
 

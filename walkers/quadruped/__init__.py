@@ -16,6 +16,15 @@ from .puppet import leg_fk, leg_ik, puppet_pose  # noqa: E402
 from .rollout import GAITS, Quadruped, live, rollout_quadruped, simulate  # noqa: E402
 
 NAME = "quadruped"
+FEET = (("FL_foot", "RR_foot"), ("FR_foot", "RL_foot"))   # a trot: diagonal pairs land together
+SUMMARY_EXTRAS = {
+    "motor_work_positive": ("motor_work_positive_J", "positive work of the joint motors over the run"),
+    "cost_of_transport": ("cost_of_transport", "positive motor work per weight and distance, over the run"),
+    "max_pitch_deg": ("max_pitch_deg", "largest torso pitch"),
+    "ik_clamps": ("ik_clamps", "foot targets out of the legs' reach, clamped by the puppet"),
+    "speed_command": ("speed_command_m_per_s", "commanded forward speed"),
+    "steps": ("controller_steps", "pair lifts counted by the stepping state machine"),
+}
 Params = QuadrupedParams   # the walker's parameters (planarsim params quadruped)
 
 __all__ = ["NAME", "GAITS", "simulate", "Quadruped", "QuadrupedParams", "Controller", "Gait",

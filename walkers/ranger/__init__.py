@@ -60,6 +60,15 @@ from .tables import Gait, Phase, Program  # noqa: E402
 from .rollout import GAITS, RangerSim, instantaneous_cot, live, simulate  # noqa: E402
 
 NAME = "ranger"
+SUMMARY_EXTRAS = {
+    "cost_of_transport": ("cost_of_transport", "electrical energy plus the computers' 4.5 W, per weight and distance, over whole steps (Ranger's figure of merit)"),
+    "cost_of_transport_electrical": ("cost_of_transport_electrical", "positive electrical motor energy per weight and distance, whole steps"),
+    "cost_of_transport_electrical_net": ("cost_of_transport_electrical_net", "net electrical motor energy per weight and distance, whole steps"),
+    "cost_of_transport_mechanical": ("cost_of_transport_mechanical", "positive motor shaft work per weight and distance, whole steps"),
+    "cost_of_transport_mechanical_net": ("cost_of_transport_mechanical_net", "net motor shaft work per weight and distance, whole steps"),
+    "push_current_mean": ("push_current_mean_A", "mean push-off current of the ankle motors"),
+    "steps": ("controller_steps", "heel strikes counted by the controller"),
+}
 Params = RangerParams   # the walker's parameters (planarsim params ranger)
 
 __all__ = ["NAME", "GAITS", "simulate", "RangerParams", "build", "Controller", "Gait", "Phase",

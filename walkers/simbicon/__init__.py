@@ -11,6 +11,14 @@ from .controller import Controller, Phase  # noqa: E402
 from .rollout import run, simulate  # noqa: E402
 
 NAME = "simbicon"
+SUMMARY_EXTRAS = {
+    "effort": ("effort_N2m2s", "time integral of the sum of squared joint torques"),
+    "glitch": ("glitch", "the run was stopped because the torso moved faster than a walker can"),
+    "min_clearance": ("min_clearance_m", "lowest height of a part other than the feet above the ground"),
+    "phase": ("final_phase", "state of the four-state machine at the end"),
+    "timeouts": ("timeouts", "states ended by their timeout rather than a foot strike"),
+    "steps": ("controller_steps", "swing-foot strikes counted by the controller"),
+}
 Params = SimbiconParams   # the walker's parameters (planarsim params simbicon)
 GAITS = ("walk",)
 

@@ -14,6 +14,15 @@ from .params import SimpleBipedParams  # noqa: E402
 from .rollout import Walker, rollout_simple_biped, simulate  # noqa: E402
 
 NAME = "simple-biped"
+SUMMARY_EXTRAS = {
+    "positive_work": ("positive_work_J", "positive work of the actuators over the run"),
+    "cost_of_transport": ("cost_of_transport", "positive actuator work per weight and distance, over the run"),
+    "steps": ("controller_steps", "steps counted by the state machine"),
+    "jumps": ("jumps", "jumps completed"),
+    "scuffs": ("scuffs", "swing-foot contacts early in the swing, not counted as steps"),
+    "retries": ("retries", "steps the state machine aborted and began again"),
+    "state": ("final_state", "state machine state at the end"),
+}
 Params = SimpleBipedParams   # the walker's parameters (planarsim params simple-biped)
 GAITS = tuple(g.name.lower() for g in Gait)
 
