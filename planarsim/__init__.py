@@ -7,12 +7,12 @@ from .model import Model
 from .options import ContactMode, ModeStrategy, StepOptions, make_options
 from .sim import Simulator
 from .state import State, make_state
-from . import batch, terrain
+from . import batch, measure, terrain
 from .energy import kinetic_energy, potential_energy, total_energy
 from .snapshot import load_snapshot, save_snapshot
 from .trajectory import Trajectory
 
 __all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "Simulator", "State",
-           "StepOptions", "batch", "ContactMode", "ModeStrategy", "make_options", "make_state", "terrain",
+           "StepOptions", "batch", "measure", "ContactMode", "ModeStrategy", "make_options", "make_state", "terrain",
            "kinetic_energy", "potential_energy", "total_energy", "save_snapshot", "load_snapshot",
            "Trajectory", "__version__"]

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model import ACT_AXIAL
+from ..measure import cost_of_transport, joint_angles as joint_series  # noqa: F401
 from ..trajectory import atomic_write
 
 FIGURE_FORMATS = ("png", "svg", "pdf")
@@ -48,58 +48,7 @@ def save_figure(fig, path, dpi: int = 120) -> Path:
     return path
 
 
-# series --------------------------------------------------------------------------------------
-def joint_series(traj, model) -> dict:
-    """{name: (angle (K,) [rad], rate (K,) [rad/s])} for every pin, else for every rod and
-    axial actuator segment (angle from the downward vertical)."""
-    a = model.arrays
-    out = {}
-    q, v = traj.q, traj.v
-    for j, name in enumerate(model.pin_names):
-        ba, bb = a.pin_body[j]
-        th_a = q[:, ba, 2] if ba >= 0 else 0.0
-        w_a = v[:, ba, 2] if ba >= 0 else 0.0
-        out[name] = (q[:, bb, 2] - th_a - a.pin_ref[j], v[:, bb, 2] - w_a)
-    if out:
-        return out
-    segs = [(n, a.rod_body[j], a.rod_anchor[j]) for j, n in enumerate(model.rod_names)]
-    segs += [(model.act_names[j], a.act_body[j, :2], a.act_anchor[j])
-             for j in range(model.n_act) if a.act_kind[j] == ACT_AXIAL]
-    for name, bodies, anchors in segs:
-        p, pv = [], []
-        for side in range(2):
-            b, loc = bodies[side], anchors[side]
-            if b < 0:
-                p.append(np.broadcast_to(loc, (len(q), 2)))
-                pv.append(np.zeros((len(q), 2)))
-                continue
-            c, s = np.cos(q[:, b, 2]), np.sin(q[:, b, 2])
-            r = np.column_stack([c * loc[0] - s * loc[1], s * loc[0] + c * loc[1]])
-            p.append(q[:, b, :2] + r)
-            pv.append(v[:, b, :2] + v[:, b, 2:3] * np.column_stack([-r[:, 1], r[:, 0]]))
-        d, dv = p[1] - p[0], pv[1] - pv[0]
-        ang = np.arctan2(d[:, 0], -d[:, 1])
-        rate = (d[:, 0] * dv[:, 1] - d[:, 1] * dv[:, 0]) / np.maximum((d * d).sum(axis=1), 1e-300)
-        out[name] = (np.unwrap(ang), rate)
-    return out
-
-
-def cost_of_transport(traj, model, power=None):
-    """(instantaneous CoT (K,) [-], averaged CoT [-]) from positive actuator power, or from
-    `power` (K,) [W]. The average is work / (m g |x_end - x_start|) (nan if the COM did not move)."""
-    if power is None:
-        power = np.clip(traj.act_power, 0.0, None).sum(axis=1) if traj.act_power.size else np.zeros(len(traj.t))
-    power = np.asarray(power, float)
-    weight = model.total_mass * float(np.hypot(*model.arrays.gravity))
-    speed = traj.com_velocity(model)[:, 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inst = power / (weight * np.abs(speed))
-    inst[~np.isfinite(inst)] = np.nan
-    com = traj.com(model)
-    dist = abs(com[-1, 0] - com[0, 0]) if len(com) else 0.0
-    work = float(np.trapezoid(power, traj.t)) if len(traj.t) > 1 else 0.0
-    avg = work / (weight * dist) if dist > 1e-12 and weight > 0 else math.nan
-    return inst, avg
+# series: planarsim.measure (joint_series is joint_angles, kept under its old name here)
 
 
 # single panels -------------------------------------------------------------------------------

@@ -1,0 +1,123 @@
+"""Measurements of a recorded run (a Trajectory) of any model: joint angles and rates, centre of
+mass, energy, cost of transport, step events and whole-step summaries, in one place.
+
+    from planarsim import measure
+    angles = measure.joint_angles(traj, model)        # {pin name: (angle [rad], rate [rad/s])}
+    x_com = measure.centre_of_mass(traj, model)        # (K, 2) [m]
+    e = measure.energy(traj, model)["total"]           # (K,) [J]
+    inst, avg = measure.cost_of_transport(traj, model) # positive actuator work per weight and distance
+    s = measure.summary(traj, model)                   # whole steps: period, length, speed, CoT
+
+For a controller (one state, not a recording): measure.pin_angle_rate(model, q, v, "hip"), or
+planarsim.compiled.pin_angle_rate in compiled code.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .analysis import StepEvents, step_events, step_summary
+from .model import ACT_AXIAL
+
+__all__ = ["centre_of_mass", "centre_of_mass_velocity", "energy", "pin_angle_rate", "summary",
+           "joint_angles", "cost_of_transport", "step_events", "step_summary", "StepEvents"]
+
+
+def centre_of_mass(traj, model) -> np.ndarray:
+    """(K, 2) centre of mass [m] per frame."""
+    return traj.com(model)
+
+
+def centre_of_mass_velocity(traj, model) -> np.ndarray:
+    """(K, 2) centre-of-mass velocity [m/s] per frame."""
+    return traj.com_velocity(model)
+
+
+def energy(traj, model) -> dict:
+    """{"kinetic", "potential", "total"}: (K,) [J] per frame."""
+    return traj.energy(model)
+
+
+def pin_angle_rate(model, q, v, pin) -> tuple:
+    """Angle theta_b - theta_a - ref [rad] and rate [rad/s] of pin `pin` (name or index) at one
+    state (q, v: (n_body, 3), e.g. sim.state.q, sim.state.v)."""
+    names = list(model.pin_names)
+    if isinstance(pin, str):
+        if pin not in names:
+            raise KeyError(f"no pin named {pin!r}; pins: {names}")
+        pin = names.index(pin)
+    a = model.arrays
+    ba, bb = a.pin_body[pin]
+    ang = q[bb, 2] - a.pin_ref[pin] - (q[ba, 2] if ba >= 0 else 0.0)
+    rate = v[bb, 2] - (v[ba, 2] if ba >= 0 else 0.0)
+    return float(ang), float(rate)
+
+
+def summary(traj, model, feet=None, min_air=0.05) -> dict:
+    """Whole-step summary of any recorded run (planarsim.analysis.step_summary): feet default
+    to the contacts grouped by name (a box foot's corners are one foot), a landing counts after
+    min_air [s] off the ground. Adds distance [m] and mean_speed [m/s] of the centre of mass
+    over the whole recording."""
+    from .analysis import foot_groups
+    feet = foot_groups(traj.contact_names) if feet is None else feet
+    out = step_summary(traj, model, feet=feet, min_air=min_air)
+    com = traj.com(model)
+    t = np.asarray(traj.t)
+    dist = float(com[-1, 0] - com[0, 0]) if len(com) else 0.0
+    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    out.update(distance=dist, mean_speed=dist / span if span > 0 else math.nan)
+    return out
+
+
+def joint_angles(traj, model) -> dict:
+    """{name: (angle (K,) [rad], rate (K,) [rad/s])} for every pin, else for every rod and
+    axial actuator segment (angle from the downward vertical)."""
+    a = model.arrays
+    out = {}
+    q, v = traj.q, traj.v
+    for j, name in enumerate(model.pin_names):
+        ba, bb = a.pin_body[j]
+        th_a = q[:, ba, 2] if ba >= 0 else 0.0
+        w_a = v[:, ba, 2] if ba >= 0 else 0.0
+        out[name] = (q[:, bb, 2] - th_a - a.pin_ref[j], v[:, bb, 2] - w_a)
+    if out:
+        return out
+    segs = [(n, a.rod_body[j], a.rod_anchor[j]) for j, n in enumerate(model.rod_names)]
+    segs += [(model.act_names[j], a.act_body[j, :2], a.act_anchor[j])
+             for j in range(model.n_act) if a.act_kind[j] == ACT_AXIAL]
+    for name, bodies, anchors in segs:
+        p, pv = [], []
+        for side in range(2):
+            b, loc = bodies[side], anchors[side]
+            if b < 0:
+                p.append(np.broadcast_to(loc, (len(q), 2)))
+                pv.append(np.zeros((len(q), 2)))
+                continue
+            c, s = np.cos(q[:, b, 2]), np.sin(q[:, b, 2])
+            r = np.column_stack([c * loc[0] - s * loc[1], s * loc[0] + c * loc[1]])
+            p.append(q[:, b, :2] + r)
+            pv.append(v[:, b, :2] + v[:, b, 2:3] * np.column_stack([-r[:, 1], r[:, 0]]))
+        d, dv = p[1] - p[0], pv[1] - pv[0]
+        ang = np.arctan2(d[:, 0], -d[:, 1])
+        rate = (d[:, 0] * dv[:, 1] - d[:, 1] * dv[:, 0]) / np.maximum((d * d).sum(axis=1), 1e-300)
+        out[name] = (np.unwrap(ang), rate)
+    return out
+
+
+def cost_of_transport(traj, model, power=None):
+    """(instantaneous CoT (K,) [-], averaged CoT [-]) from positive actuator power, or from
+    `power` (K,) [W]. The average is work / (m g |x_end - x_start|) (nan if the COM did not move)."""
+    if power is None:
+        power = np.clip(traj.act_power, 0.0, None).sum(axis=1) if traj.act_power.size else np.zeros(len(traj.t))
+    power = np.asarray(power, float)
+    weight = model.total_mass * float(np.hypot(*model.arrays.gravity))
+    speed = traj.com_velocity(model)[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inst = power / (weight * np.abs(speed))
+    inst[~np.isfinite(inst)] = np.nan
+    com = traj.com(model)
+    dist = abs(com[-1, 0] - com[0, 0]) if len(com) else 0.0
+    work = float(np.trapezoid(power, traj.t)) if len(traj.t) > 1 else 0.0
+    avg = work / (weight * dist) if dist > 1e-12 and weight > 0 else math.nan
+    return inst, avg
