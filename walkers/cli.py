@@ -163,7 +163,7 @@ def cmd_run(args):
         export_animation(traj, model, out, fps=args.fps, speed=args.speed, progress=bars,
                          label_names=gait_names(mod), summary=summary, title=title)
         written.append(str(out))
-    wall["output"] = round(time.perf_counter() - t2, 3)
+    summary["wall_time_s"]["output"] = round(time.perf_counter() - t2, 3)
     if summary_path is not None:
         from planarsim.trajectory import atomic_write
         atomic_write(summary_path, lambda f: f.write(json.dumps(summary, indent=2) + "\n"), binary=False)
