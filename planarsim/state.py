@@ -170,6 +170,8 @@ class Workspace(NamedTuple):
     cs_pred: np.ndarray          # (n_body, 3) cos, sin, angle of q_pred (as body_cs)
     q_keep: np.ndarray           # (n_body, 3) q and v before a Newton step of the position
     v_keep: np.ndarray           #   correction (put back if the step diverges)
+    dq_correction: np.ndarray    # (n_body, 3) a position correction's move [m, rad] (Newton, projection)
+    dv_correction: np.ndarray    # (n_body, 3) its change of velocity [m/s, rad/s] (joints: move / h)
     v_solved: np.ndarray         # (n_body, 3) velocity the contact solve ended at, before the
                                  #   position correction changed it (bound_correction_work)
     contact_point: np.ndarray    # (n_contact, 2) world contact point [m]
@@ -245,7 +247,8 @@ def make_workspace(model: Model) -> Workspace:
                      body_first_row=z(nb, np.int64), row_first=z(R, np.int64),
                      row_reach=z(R, np.int64), v_pred=z((nb, 3)), v_new=z((nb, 3)),
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
-                     v_keep=z((nb, 3)), v_solved=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
+                     v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),
+                     v_solved=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_anchor=z((nc, 2)),
                      contact_impulse=z((nc, 2)), contact_held=z(nc, np.int64), contact_on_arc=z(nc, np.int64),
                      contact_new=z(nc, np.int64), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),

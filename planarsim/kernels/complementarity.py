@@ -166,16 +166,16 @@ def project_positions(m, s, ws, h, iters, tol):
             break
         for i in range(s.q.shape[0]):
             for k in range(3):
-                ws.q_keep[i, k] = 0.0
-                ws.v_keep[i, k] = 0.0
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.q_keep, 1.0)
+                ws.dq_correction[i, k] = 0.0
+                ws.dv_correction[i, k] = 0.0
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
         # joint corrections change the velocity too (dq / h), contact corrections do not
         for r in range(n):
             if not is_joint_row(ws.row_kind[r]):
                 ws.lam[r] = 0.0
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_keep, 1.0 / h)
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
         for i in range(s.q.shape[0]):
             for k in range(3):
-                s.q[i, k] += ws.q_keep[i, k]
-                s.v[i, k] += ws.v_keep[i, k]
+                s.q[i, k] += ws.dq_correction[i, k]
+                s.v[i, k] += ws.dv_correction[i, k]
     return worst

@@ -227,14 +227,14 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
         assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
         factor_solve(ws, ws.rhs, ws.lam, n, ptol)
         # move positions by the correction
-        for i in range(ws.v_new.shape[0]):
+        for i in range(ws.dq_correction.shape[0]):
             for k in range(3):
-                ws.v_new[i, k] = 0.0
-                ws.v_pred[i, k] = 0.0
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_new, 1.0)
+                ws.dq_correction[i, k] = 0.0
+                ws.dv_correction[i, k] = 0.0
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
         if unilateral == 0:
             # velocities by the same correction / h
-            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_pred, 1.0 / h)
+            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
         else:
             # velocities: bilateral rows change by -c / h, unilateral rows not at all (a
             # separate solve: zeroing the unilateral impulses of the position solve instead
@@ -243,11 +243,11 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
             for r in range(n):
                 ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
             substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
-            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_pred, 1.0)
+            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
         for i in range(s.q.shape[0]):
             for k in range(3):
-                s.q[i, k] += ws.v_new[i, k]
-                s.v[i, k] += ws.v_pred[i, k]
+                s.q[i, k] += ws.dq_correction[i, k]
+                s.v[i, k] += ws.dv_correction[i, k]
         after = max_residual(m, s, ws)
         if after <= STALLED_RATIO * worst:
             worst = after
