@@ -8,7 +8,7 @@ drop_stale_caches(__path__[0])
 from .params import SimbiconParams, THESIS  # noqa: E402
 from .model import build  # noqa: E402
 from .controller import Controller, Phase  # noqa: E402
-from .rollout import run, simulate  # noqa: E402
+from .rollout import live, run, simulate  # noqa: E402
 
 NAME = "simbicon"
 SUMMARY_EXTRAS = {
@@ -22,4 +22,4 @@ SUMMARY_EXTRAS = {
 Params = SimbiconParams   # the walker's parameters (planarsim params simbicon)
 GAITS = ("walk",)
 
-__all__ = ["NAME", "GAITS", "simulate", "run", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]
+__all__ = ["NAME", "GAITS", "simulate", "run", "live", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]

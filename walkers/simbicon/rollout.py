@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import numpy as np
 
+import planarsim as ps
 from planarsim import Simulator, make_options
 from planarsim.compiled import (RUN_FELL, RUN_WALKER, audit_counts, check_run, engine_failed,
                                 jit, record_frame, step, height, make_recorder)
 from planarsim.trajectory import Trajectory
 
-from .controller import M_EFFORT, M_FELL, M_PHASE, M_STRIKES, M_TIMEOUTS, control, make_memory, make_tables
+from .controller import (M_EFFORT, M_FELL, M_PHASE, M_STRIKES, M_TIMEOUTS, Phase, control, make_memory,
+                         make_tables)
 from .model import build, non_foot_clearance, start_state
 from .params import SimbiconParams
 
@@ -130,3 +132,32 @@ def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, push=None, pa
                                record_every=record_every)
     traj.info["seed"] = seed
     return traj, summary, model
+
+
+def live(gait="walk", terrain=None, params=None) -> dict:
+    """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator from
+    the standing start and the compiled controller called from Python each step; a slider
+    pushes the torso [N] (hold it to push)."""
+    if gait != "walk":
+        raise ValueError(f"simbicon gait {gait!r} unknown; gaits: ('walk',)")
+    params = params if params is not None else SimbiconParams()
+    if isinstance(terrain, str):
+        terrain = ps.terrain.parse(terrain)
+    model = build(params, terrain)
+    sim = Simulator(model, make_options(STRATEGY),
+                    state=start_state(model, params.start_lean, params.start_speed))
+    tab, mem, u = make_tables(params, model), make_memory(), np.zeros(model.n_act)
+    push = [0.0]
+
+    def controller(sim):
+        sim.state.ext_force[tab.torso, 0] = push[0]
+        control(model.arrays, sim.state, sim.ws, tab, mem, u)
+        return u
+
+    def set_push(x):
+        push[0] = float(x)
+
+    return dict(sim=sim, controller=controller,
+                gains={"push [N]": (-150.0, 150.0, lambda: push[0], set_push)},
+                labels=lambda _sim: {"phase": mem[M_PHASE]},
+                label_names={"phase": {int(p): p.name.lower() for p in Phase}})

@@ -178,3 +178,25 @@ def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=None, p
     w = Walker(params, terrain, dt, gait, speed, record_every, seed)
     w.run(duration)
     return w.trajectory(), w.summary(), w.model
+
+
+def live(gait="walk", terrain=None, params=None, speed=None) -> dict:
+    """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and the
+    compiled controller called from Python each step; keys s / w / j for STAND / WALK / JUMP,
+    a slider for the target walking speed [m/s]."""
+    if isinstance(terrain, str):
+        terrain = ps.terrain.parse(terrain)
+    w = Walker(params, terrain, gait=gait, speed=speed)
+    sim = ps.Simulator(w.model, w.options, w.state)
+    m, p, mem, u = w.model.arrays, w.p, w.memory, w.u
+
+    def controller(sim):
+        C.control(m, sim.state, p, mem, u)
+        return u
+
+    return dict(sim=sim, controller=controller, on_gait=w.set_gait,
+                gait_keys={"s": "stand", "w": "walk", "j": "jump"},
+                gains={"speed [m/s]": (0.0, 2.0, lambda: float(mem[C.M_SPEED]), w.set_speed)},
+                labels=lambda _sim: {"gait": mem[C.M_GAIT], "state": mem[C.M_STATE]},
+                label_names={"gait": {int(g): g.name.lower() for g in C.Gait},
+                             "state": {int(s): s.name.lower() for s in C.State}})
