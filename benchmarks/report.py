@@ -152,7 +152,7 @@ def print_walkers(res, batch_only=False):
         print(flush=True)
         return
     rows = res["batch"]
-    print(f"batch: {rows[0]['jobs']} {rows[0]['walker']} walks of {rows[0]['seconds']:g} s (planarsim.batch.simulate_batch)")
+    print(f"batch: {rows[0]['jobs']} {rows[0]['walker']} walks of {rows[0]['seconds']:g} s (walkers.batch.simulate_batch)")
     for r in rows:
         print(f"  workers={r['workers']}: {_spread(r)} simulated steps/s, {r['cores_busy']:.2f} cores busy "
               f"(CPU time / wall), falls {r['falls']}")

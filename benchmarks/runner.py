@@ -17,7 +17,7 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
   timed the same way in the same run: steps/s, ratio planarsim/peer, pin error, energy drift,
   penetration. Needs `pip install planarsim[compare]`; a missing peer is named and skipped.
 - walkers: every registered walker walking --walker-seconds (60 s) via its simulate().
-- batch: 64 Simple Biped walks on 1 and 2 worker threads (planarsim.batch).
+- batch: 64 Simple Biped walks on 1 and 2 worker threads (walkers.batch).
 - startup: import-to-first-step times in fresh subprocesses, warm and cold numba cache
   (startup.py says how the cache is made cold).
 Then a table of every benchmark target with the measured figure, met or not met. Targets are
@@ -179,7 +179,7 @@ def main(argv=None):
         batch = measure_batch(args.batch_jobs, args.batch_seconds, args.repeats)
         results["batch"] = batch
         if batch is None:
-            print("batch: planarsim.batch is not available; skipped")
+            print("batch: walkers.batch is not available; skipped")
         else:
             rows += batch
             print_walkers(results, batch_only=True)

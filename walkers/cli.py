@@ -102,6 +102,9 @@ def cmd_run(args):
         raise UsageError(str(e)) from None
     if args.dt is not None and args.dt > 0.01:
         raise UsageError(f"--dt {args.dt} is too large; use a step of at most 0.01 s (1e-3 is usual)")
+    changed = _walker_params(mod, args)     # bad parameters are refused before anything is made
+    if "slope" in changed and args.terrain:
+        raise UsageError("--set slope and --terrain both set the slope; give one of them")
     out = args.out
     summary_path = None
     # --json alone is for scripts: the summary, nothing rendered (ask with --out for a file)
@@ -114,7 +117,6 @@ def cmd_run(args):
     save = _check_out(args.save, (".npz",), "--save")
     csv = _check_out(args.csv, (".csv",), "--csv")
     kw = dict(duration=args.duration, seed=args.seed)
-    changed = _walker_params(mod, args)
     if changed:
         kw["params"] = mod.Params(**{**mod.Params().as_dict(), **changed})
     if args.gait is not None:
@@ -468,18 +470,56 @@ def make_parser():
 QUICK_EXIT = ("run", "list", "info")
 
 
+class _ReaderMayLeave:
+    """stdout whose reader may stop reading (planarsim analyze ... | head): the text it no
+    longer wants is dropped and the command carries on, so the files it was asked for are
+    still written. Any other write error is raised."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self.reader_left = False
+
+    def write(self, text):
+        if not self.reader_left:
+            try:
+                return self._stream.write(text)
+            except BrokenPipeError:
+                self.reader_left = True
+        return len(text)
+
+    def flush(self):
+        if not self.reader_left:
+            try:
+                self._stream.flush()
+            except BrokenPipeError:
+                self.reader_left = True
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
     """The command line; `argv` None reads sys.argv (and, as the program itself, ends the
     process for the QUICK_EXIT commands once their output is flushed)."""
     program = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
-    code = _main(argv)
+    stdout = sys.stdout
+    sys.stdout = _ReaderMayLeave(stdout)
+    code = 1
+    try:
+        code = _main(argv)
+        sys.stdout.flush()
+    except OSError as e:      # stdout itself failed (a full disk under > file): not silent
+        print(f"planarsim: error: cannot write the output: {e}", file=sys.stderr)
+        code = code if code else 1
+    finally:
+        left = sys.stdout.reader_left
+        sys.stdout = stdout
+    if left:
+        # nothing more may reach the closed pipe, not even at the interpreter's exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), stdout.fileno())
     if program and argv and argv[0] in QUICK_EXIT:
-        for stream in (sys.stdout, sys.stderr):
-            try:
-                stream.flush()
-            except (OSError, ValueError):    # a closed pipe (planarsim list | head)
-                pass
+        sys.stderr.flush()
         os._exit(code)
     return code
 
@@ -497,10 +537,6 @@ def _main(argv) -> int:
     except UsageError as e:
         print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
         return 2
-    except BrokenPipeError:
-        # the reader went away (planarsim params W | head): not an error of ours
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
     except (OSError, ValueError) as e:
         # bad input detected deeper down (ModelError is a ValueError): one line, exit 2
         print(f"planarsim {args.command}: error: {e}", file=sys.stderr)

@@ -90,7 +90,8 @@ def plot_bifurcation_diagram(diagram, coordinate: int = 0, path=None, ax=None, b
     ax.set_xlabel(getattr(diagram, "param", None) or (branches[0].param if branches else "p"))
     ax.set_ylabel(label or f"x[{coordinate}] at touchdown")
     ax.set_title(title)
-    ax.legend(fontsize=7, loc="best")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="best")
     return _finish(fig, path)
 
 

@@ -8,8 +8,8 @@ import math
 from ._jit import jit, jit_force, kernel, kernel_call
 
 TWO_PI = 2.0 * math.pi
-# a Newton step of the closest-point search this small [m per m of |x|] is its last: the error
-# left is of order K dx^2 (K = |f''/2f'|, bounded by the terrain's derivatives), below rounding
+# a Newton step of the closest-point search this small [m] (plus the rounding of x) is its last:
+# the error left is of order K dx^2 (K = |f''/2f'|, bounded by the terrain's derivatives)
 NEWTON_LAST_STEP = 1e-10
 
 
@@ -113,7 +113,7 @@ def closest_point(coef, px, py):
             dx = bound
         elif dx < -bound:
             dx = -bound
-        if newton and abs(dx) < NEWTON_LAST_STEP * (1.0 + abs(x)):
+        if newton and abs(dx) < NEWTON_LAST_STEP + 1e-14 * abs(x):
             # converging quadratically: the step after this one would be ~ dx^2 (rounding),
             # and h, h' at x + dx follow from their Taylor series to O(dx^2) (no new sines)
             x += dx

@@ -1,4 +1,4 @@
-"""Issue 7: the command line. Runs in-process through planarsim.cli.main."""
+"""The command line (planarsim = walkers.cli.main). Runs in-process through main."""
 import json
 
 import numpy as np
@@ -137,3 +137,26 @@ def test_a_reader_that_stops_early_is_not_an_error(tmp_path, monkeypatch, capsys
     code = main(["params", "ranger"])
     err = capsys.readouterr().err
     assert code == 0 and "Broken pipe" not in err, err
+
+
+def test_a_reader_that_leaves_does_not_stop_the_files(tmp_path, monkeypatch, capsys):
+    """planarsim analyze ... --csv d.csv --plot d.png | head -1: the printing stops, the command
+    goes on and writes what it was asked for."""
+    sink = open(tmp_path / "sink", "w")
+
+    class ClosedPipe:
+        def write(self, text):
+            raise BrokenPipeError(32, "Broken pipe")
+
+        def flush(self):
+            pass
+
+        def fileno(self):
+            return sink.fileno()
+    monkeypatch.setattr("sys.stdout", ClosedPipe())
+    csv_path, png = tmp_path / "d.csv", tmp_path / "d.png"
+    code = main(["analyze", "simplest-walker", "--param", "slope", "--range", "0.009:0.010",
+                 "--points", "6", "--diagram", "--transient", "1", "--keep", "2", "--csv",
+                 str(csv_path), "--plot", str(png), "--workers", "1"])
+    assert code == 0, capsys.readouterr().err
+    assert csv_path.stat().st_size > 0 and png.stat().st_size > 0

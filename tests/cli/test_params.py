@@ -104,3 +104,24 @@ def test_tune_then_run_with_the_result(walker, tmp_path, capsys):
     changed = json.loads(text)["params_changed"]
     defaults = objective.Params().as_dict()
     assert changed == {k: v for k, v in result["best_params"].items() if v != defaults[k]}
+
+
+def test_a_count_takes_whole_numbers(capsys):
+    code, out, err = run_cli(capsys, "run", "rimless-wheel", "--duration", "1", "--json",
+                             "--set", "n_spokes=10")
+    assert code == 0, err
+    assert json.loads(out)["params_changed"] == {"n_spokes": 10}
+    code, out, err = run_cli(capsys, "run", "rimless-wheel", "--json", "--set", "n_spokes=7.5")
+    assert code == 2 and "must be a whole number" in err and len(err.strip().splitlines()) == 1
+
+
+def test_slope_set_twice_is_refused(capsys):
+    code, _, err = run_cli(capsys, "run", "simplest-walker", "--json", "--set", "slope=0.01",
+                           "--terrain", "slope:-1")
+    assert code == 2 and "--set slope and --terrain" in err
+
+
+def test_bad_parameters_make_no_output_folder(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    code, _, _ = run_cli(capsys, "run", "simple-biped", "--set", "bogus=1")
+    assert code == 2 and not (tmp_path / "out").exists()

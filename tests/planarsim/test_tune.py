@@ -1,4 +1,4 @@
-"""CMA-ES tuning (planarsim.tune) on the SIMBICON biped: a small budget started from the thesis'
+"""CMA-ES tuning (walkers.tune) on the SIMBICON biped: a small budget started from the thesis'
 Table 3/4 parameters improves the objective, the same seed gives the same result on a local
 process pool and on a dask LocalCluster with 2 workers, results reload, bad files are refused."""
 import json
@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-pytest.importorskip("cma", reason="planarsim.tune needs the 'cma' package (pip install cma)")
+pytest.importorskip("cma", reason="walkers.tune needs the 'cma' package (pip install cma)")
 
 from walkers.tune import load_result, tune  # noqa: E402
 from walkers.simbicon.params import THESIS  # noqa: E402

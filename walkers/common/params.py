@@ -37,6 +37,11 @@ class WalkerParams:
             if not lo <= value <= hi:
                 raise ValueError(f"{cls}.{f.name}={value!r} outside its bounds [{lo}, {hi}] "
                                  f"({f.metadata['unit']}: {f.metadata['doc']})")
+            if _is_int_field(f) and value != int(value):
+                raise ValueError(f"{cls}.{f.name}={value!r} must be a whole number "
+                                 f"({f.metadata['unit']}: {f.metadata['doc']})")
+            if _is_int_field(f) and not isinstance(value, int):
+                object.__setattr__(self, f.name, int(value))
 
     def to_array(self) -> np.ndarray:
         """Every field as float64 in declaration order (index with the I_<FIELD> constants)."""
@@ -105,6 +110,21 @@ def index_constants(cls) -> dict:
     return out
 
 
+def _is_int_field(f) -> bool:
+    """A field declared `int` (a count, say the rimless wheel's spokes)."""
+    return f.type in (int, "int")
+
+
+def _typed(cls, name, value):
+    """value as the field's type: an int field takes whole numbers only."""
+    f = next(f for f in fields(cls) if f.name == name)
+    if _is_int_field(f):
+        if value != int(value):
+            raise ValueError(f"{name}={value!r} must be a whole number ({f.metadata['doc']})")
+        return int(value)
+    return float(value)
+
+
 def parse_assignments(items, cls) -> dict:
     """{name: value} from command-line items "name=value" for params class `cls` (an unknown
     name or a value that is not a number is a ValueError naming it and the known names)."""
@@ -119,9 +139,15 @@ def parse_assignments(items, cls) -> dict:
             raise ValueError(f"--set {item!r}: {cls.__name__} has no parameter {name!r} "
                              f"(see 'planarsim params WALKER' for the {len(known)} names)")
         try:
-            out[name] = float(text)
+            value = float(text)
         except ValueError:
             raise ValueError(f"--set {item!r}: {text!r} is not a number") from None
+        if not math.isfinite(value):
+            raise ValueError(f"--set {item!r}: {text!r} is not a finite number")
+        try:
+            out[name] = _typed(cls, name, value)
+        except ValueError as e:
+            raise ValueError(f"--set {item!r}: {e}") from None
     return out
 
 
@@ -149,4 +175,7 @@ def load_values(path, cls) -> dict:
     for name, value in data.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueError(f"--params {path}: {name}={value!r} is not a number")
-    return {k: float(v) for k, v in data.items()}
+    try:
+        return {k: _typed(cls, k, v) for k, v in data.items()}
+    except (ValueError, OverflowError) as e:
+        raise ValueError(f"--params {path}: {e}") from None

@@ -46,7 +46,8 @@ import math
 import numpy as np
 
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, jit, step, step_from_python as step_entry
+from planarsim.compiled import (RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, step,
+                                step_from_python as step_entry)
 
 from walkers.common.section import GaitMapMixin, chain_poses, chain_velocities, copy_tuple, restore_tuple
 
@@ -144,8 +145,10 @@ class RangerGaitMap(GaitMapMixin):
 
     def _run(self, s, ws, mem, n_events):
         code, n = self._rollout(s, ws, mem, n_events, self.max_steps)
+        # an engine failure raises (it is not a fall of the walker)
+        check_run(code, self.rs.model, ws, self.rs.sim.options, "Ranger step map")
         if code != 0:
-            what = {RUN_FELL: "fell", RUN_NO_EVENT: "no mid-stance"}.get(code, f"engine guard {code}")
+            what = {RUN_FELL: "fell", RUN_NO_EVENT: "no mid-stance"}[code]
             raise StepMapError(f"Ranger step map: {what} (t={s.time[0]:.3f} s)")
         return n
 
@@ -153,9 +156,8 @@ class RangerGaitMap(GaitMapMixin):
         """Get past a section state (one control + physics step) without stopping at it."""
         k, prog, motor = self.tables
         C.control_ranger(self.m, s, ws, k, prog, motor, mem, self.gui, self.steplog, self.rs.u)
-        code = step_entry(self.m, s, ws, self.rs.sim.options, self.rs.u)
-        if code != 0:
-            raise StepMapError(f"Ranger step map: engine guard {code}")
+        check_run(step_entry(self.m, s, ws, self.rs.sim.options, self.rs.u), self.rs.model, ws,
+                  self.rs.sim.options, "Ranger step map")
 
     # coordinates ---------------------------------------------------------------------------------
     def coords(self, s, mem) -> np.ndarray:

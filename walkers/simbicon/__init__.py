@@ -1,6 +1,6 @@
 """SIMBICON biped (Thachuk 2018): the MJCF character of the thesis, its four-state FSM with PD
 joints, torso control through the stance hip and swing-hip balance feedback; tuned by
-planarsim.tune (CMA-ES)."""
+walkers.tune (planarsim tune, CMA-ES)."""
 from planarsim.compiled import drop_stale_caches
 
 drop_stale_caches(__path__[0])

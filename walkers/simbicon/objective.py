@@ -1,4 +1,4 @@
-"""Tuning objective of the SIMBICON biped (used by planarsim.tune), and the push test.
+"""Tuning objective of the SIMBICON biped (used by planarsim tune), and the push test.
 
 score = distance [m] walked in an unpushed run of `duration`
         + push_bonus * (number of push runs survived) + sum of their distances / n_push

@@ -79,7 +79,7 @@ THESIS = SimbiconParams(
 """Tables 3 and 4 of the thesis, unchanged (one kp/kd pair for every joint)."""
 
 SHIPPED_NOTE = (
-    "The dataclass defaults are the thesis' Tables 3/4 after three CMA-ES stages (planarsim.tune) "
+    "The dataclass defaults are the thesis' Tables 3/4 after three CMA-ES stages (planarsim tune) "
     "in this engine: (1) from SIMBICON-like targets (swing hip 0.5/-0.1, knee -1.1/-0.05, stance "
     "ankle 0, ankle gains 300/30), 1584 evaluations of 10 s walks (seed 3); (2) 640 evaluations "
     "of 20 s walks with +-60 N pushes (seed 5); (3) from (2), 20 s walks with +-60/80/100 N "

@@ -11,7 +11,8 @@ import numpy as np
 
 import planarsim as ps
 from planarsim import Simulator, make_options
-from planarsim.compiled import (RUN_FELL, RUN_WALKER, audit_counts, check_run, engine_failed,
+from planarsim.compiled import (RUN_FELL, RUN_NONFINITE, RUN_TOO_LARGE, RUN_WALKER, audit_counts,
+                                check_run,
                                 jit, record_frame, step, height, make_recorder)
 from planarsim.trajectory import Trajectory
 
@@ -100,11 +101,11 @@ def run(params: SimbiconParams, duration: float, terrain=None, dt=1e-3, push=Non
     x0 = float(sim.state.q[tab.torso, 0])
     code, done, k = rollout_simbicon(model.arrays, sim.state, sim.ws, sim.options, tab, mem, u, n,
                                      every, rec, 0, _push_array(push))
-    if engine_failed(code):
-        if not glitch_ok:
-            check_run(code, model, sim.ws, sim.options, "simbicon")
-        code = GLITCH      # the engine's guard fired (non-finite or huge state)
+    if code in (RUN_NONFINITE, RUN_TOO_LARGE) and glitch_ok:
+        # the state blew up in the last step: a solver glitch (for tuning, a lost run)
+        code = GLITCH
         sim.state.restore(sim.ws.prev)
+    check_run(code, model, sim.ws, sim.options, "simbicon")   # any other engine failure raises
     t = float(sim.state.time[0])
     summary = dict(distance=float(sim.state.q[tab.torso, 0] - x0), time=t,
                    steps=int(mem[M_STRIKES]), timeouts=int(mem[M_TIMEOUTS]),

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, jit, step, height
+from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, step, height
 
 from walkers.common.section import GaitMapMixin, copy_tuple, restore_tuple
 
@@ -96,8 +96,11 @@ class SimpleBipedGaitMap(GaitMapMixin):
     def _run(self, s, ws, mem, n_events):
         w = self.walker
         code, n = rollout_to_touchdown(self.m, s, ws, w.options, w.p, mem, w.u, n_events, self.max_steps)
+        # an engine failure raises (it is not a fall of the walker); a fall or no touchdown
+        # is the map's own failure
+        check_run(code, w.model, ws, w.options, "Simple Biped step map")
         if code != 0:
-            what = {RUN_FELL: "fell", RUN_NO_EVENT: "no touchdown"}.get(code, f"engine guard {code}")
+            what = {RUN_FELL: "fell", RUN_NO_EVENT: "no touchdown"}[code]
             raise StepMapError(f"Simple Biped step map: {what} (t={s.time[0]:.3f} s)")
         return n
 
