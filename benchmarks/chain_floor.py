@@ -13,7 +13,7 @@ same process:
   holds to 1e-12 m (at most 4). Fixed row layout (pin k: rows 2k, 2k+1 on links k-1, k),
   one banded LU (bandwidth 3) for both solves (the engine factors the symmetric velocity
   solve as L D L^T, half the work), no row kinds, contacts, modes, guards or state copies.
-- "light": the scheme the issue's throwaway prototype describes: the velocity solve
+- "light": the scheme of a throwaway prototype: the velocity solve
   linearised at q + h v* (a first Newton-SHAKE step) and one correction, with no residual
   checks at all.
 

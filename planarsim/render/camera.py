@@ -1,6 +1,6 @@
 """Tracking camera: a damped second-order system that follows the centre of mass.
 
-Seed 002, section 2.1: a camera locked on the COM makes the picture jerk (every heel strike
+Kelly 2014, section 2.1: a camera locked on the COM makes the picture jerk (every heel strike
 kicks the view); a camera modelled as a dynamical system tracking the COM moves smoothly.
 Each coordinate c of the camera centre obeys
 

@@ -7,7 +7,7 @@ omega_b - omega_a [rad/s]. A model without pins (point-mass walkers) shows the a
 rod and axial actuator segment a -> b from the downward vertical instead, with its rate
 (r x (v_b - v_a)) / |r|^2.
 
-Cost of transport (seed 002, eq. 17): CoT = P / (m g v), with P the actuators' positive
+Cost of transport (Kelly 2014, eq. 17): CoT = P / (m g v), with P the actuators' positive
 mechanical power sum_i max(P_i, 0) [W] (negative work is not recovered) unless a power series
 is given (e.g. Ranger's electrical power); averaged as the positive work over m g times the
 distance travelled by the COM.

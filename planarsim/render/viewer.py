@@ -1,6 +1,6 @@
 """Interactive viewer: a live Simulator drawn in real time or slow motion.
 
-Seed 002, sections 2.2-2.3: a GUI panel adjusts the gravity vector, the playback speed and the
+Kelly 2014, sections 2.2-2.3: a GUI panel adjusts the gravity vector, the playback speed and the
 controller's gains and shows/hides the contact impulses; playback is held on time by a
 proportional-integral (PI) controller on the pause between frames, because a plain fixed
 pause drifts by the render time and the operating system's sleep error every frame.

@@ -1,4 +1,4 @@
-"""Issue 7: every example runs (short durations) and checks its own result."""
+"""Every example runs (short durations) and checks its own result."""
 import importlib
 import sys
 from pathlib import Path

@@ -1,4 +1,4 @@
-"""Issue 3: property tests. Random bodies dropped with random velocities on random
+"""Property tests. Random bodies dropped with random velocities on random
 sum-of-sines terrain never gain energy beyond the integrator's O(dt) oscillation, never end a
 step more than 1e-6 m below the ground, and run deterministically."""
 import math

@@ -1,4 +1,4 @@
-"""Issue 3: contacts on analytic terrain: rod drop, rolling and sliding disk, boxes with
+"""Contacts on analytic terrain: rod drop, rolling and sliding disk, boxes with
 friction, continuous collision of point masses, sticking and sliding on hills."""
 import math
 

@@ -1,4 +1,4 @@
-"""Issue 2: conservation, invariance and determinism on random free-floating assemblies."""
+"""Conservation, invariance and determinism on random free-floating assemblies."""
 import math
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Issue 2: analytic pendulum periods, chain pin residuals and energy drift."""
+"""Analytic pendulum periods, chain pin residuals and energy drift."""
 import math
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Issue 2 / 12: the builder rejects bad models with a ModelError naming the culprit."""
+"""The builder rejects bad models with a ModelError naming the culprit."""
 import math
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Issue 12: divergence guards, snapshots, damaged files, corrupted models, cache hits."""
+"""Divergence guards, snapshots, damaged files, corrupted models, cache hits."""
 import hashlib
 import math
 import subprocess

@@ -1,4 +1,4 @@
-"""Rendering, camera, animation export, plots and the interactive viewer (issue 6).
+"""Rendering, camera, animation export, plots and the interactive viewer.
 
 Everything runs headless with Agg; test models are built inline (a box, a pendulum, a point
 mass) so these tests do not depend on any walker package.

@@ -1,4 +1,4 @@
-"""Issue 9 on the actuated walkers: step-to-step maps of the Simple Biped and Ranger at a
+"""On the actuated walkers: step-to-step maps of the Simple Biped and Ranger at a
 section where the controller resets its memory, their fixed points (the settled gait) and
 Floquet multipliers (central finite differences).
 
@@ -8,7 +8,7 @@ Bounds, stated:
   of the map's jumps from the controller switching at step boundaries); multipliers bit for bit
   reproducible, inside the unit circle at eps = 3e-3 and 1e-2, and a 1e-2 perturbation decays.
 - Ranger (dt = 1 ms, section: controller mid-stance, stride map, 11 coordinates), with the
-  engine's default StepOptions that Ranger runs with (cap_policy=1): the issue asks for a
+  engine's default StepOptions that Ranger runs with (cap_policy=1): the acceptance asks for a
   period-one gait with all multipliers inside the unit circle. The controller acts at 1 ms
   steps, so the map jumps by up to ~1.6e-2 (rad/s) between nearby points (see
   walkers/ranger/gait_map.py) and a settled gait either repeats exactly (every event on the

@@ -1,4 +1,4 @@
-"""Planar quadruped (issue 11, seed 003): IK puppet, stepping in place, walking forward and
+"""Planar quadruped (the 2023 robot-dog post): IK puppet, stepping in place, walking forward and
 backward through the compiled rollout, and the Python controller path.
 
 Figures for the report: ``python benchmarks/quadruped.py``.

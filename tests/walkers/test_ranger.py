@@ -1,4 +1,4 @@
-"""Cornell Ranger walker (issue 5): closed-loop double stance, STAND, WALK from standing for
+"""Cornell Ranger walker: closed-loop double stance, STAND, WALK from standing for
 1000 steps, GUI tracking against a static-equilibrium calculation, the contact estimator on a
 recorded walk, and the motor model of seed eqs. 13-16.
 

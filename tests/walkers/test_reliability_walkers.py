@@ -1,4 +1,4 @@
-"""Issue 12 across the shipped walkers: bit-identical runs (twice in process, and in a fresh
+"""Across the shipped walkers: bit-identical runs (twice in process, and in a fresh
 process with a cold or warm numba cache), snapshots, and a soak run (marked slow)."""
 import hashlib
 import subprocess

@@ -1,4 +1,4 @@
-"""Issue 4 acceptance: the Simple Biped walks, stands and jumps in simulation.
+"""The Simple Biped walks, stands and jumps in simulation.
 
 Every test uses the shipped default parameters (``SimpleBipedParams()``); only the commanded
 gait, the target speed and the terrain differ. The walker always starts at rest, standing.
