@@ -1,6 +1,7 @@
 """Passive walkers against physics: the simplest walking model against an independent scipy
 integration of Garcia et al.'s reduced equations (and their published fixed point), the
-rimless wheel against its closed-form gait, the compass gait's limit cycle.
+rimless wheel against its closed-form gait, the compass gait against an independent scipy
+integration of Goswami et al.'s model (its limit cycle and Floquet multipliers).
 
 Tolerances are convergence statements: errors must shrink as dt and the foot mass ratio
 shrink, not merely sit under one bound."""
@@ -12,8 +13,9 @@ import pytest
 from planarsim.analysis import find_fixed_point
 from walkers.passive import CompassParams, PassiveWalker, RimlessParams, SimplestParams
 from walkers.passive.gait import project_velocities
-from walkers.passive.reference import (GARCIA_THETA, GARCIA_THETA_DOT, simplest_fixed_point,
-                                       simplest_step)
+from walkers.passive.reference import (GARCIA_THETA, GARCIA_THETA_DOT, compass_fixed_point,
+                                       compass_heel_strike, compass_momenta, compass_step,
+                                       simplest_fixed_point, simplest_step)
 
 
 @pytest.fixture(scope="module")
@@ -158,6 +160,77 @@ def test_compass_gait_has_a_stable_period_one_gait():
     # on the engine's own contacts the walker keeps walking from the fixed point
     traj, summary, model = simulate(20.0, params=p, dt=5e-4, x0=fp.x, impacts="engine")
     assert not summary["fell"] and abs(summary["step_period"] / w.last_period - 1) < 0.02
+
+
+@pytest.fixture(scope="module")
+def compass_ref():
+    return compass_fixed_point(CompassParams())
+
+
+def test_compass_reference_conserves_what_it_should(compass_ref):
+    from walkers.passive.reference import _compass_consts, compass_energy
+    p = CompassParams()
+    c = _compass_consts(p)
+    x = compass_ref["x"]
+    xn, period, step, y = compass_step(x, p)
+    assert np.allclose(xn, x, atol=1e-10)                   # a fixed point
+    # swing phase: the ODE (M, C, G) conserves the energy computed from the kinematics alone
+    E = [compass_energy(y(t), c) for t in np.linspace(0.0, period, 101)]
+    assert np.ptp(E) < 1e-9 * abs(E[0])
+    # heel strike: the foot is on the slope, ahead; both angular momenta are conserved
+    ye = y(period)
+    foot = p.leg_length * np.array([math.sin(ye[1]) - math.sin(ye[0]), math.cos(ye[0]) - math.cos(ye[1])])
+    assert abs(foot[1]) < 1e-12 and abs(foot[0] - step) < 1e-12 and step > 0
+    yp = compass_heel_strike(ye, c)
+    H_minus = compass_momenta(ye, c, foot)
+    H_total_plus = compass_momenta(yp, c, np.zeros(2))[0]
+    assert abs(H_total_plus - H_minus[0]) < 1e-12 * abs(H_minus[0])
+    # old stance leg about the hip, by hand (I = m r^2): before (I - m a b) th1', after (the
+    # new swing leg) (m b^2 + I) th2' - m l b cos(th1 - th2) th1'
+    mH, m, l, a, b, I = c[:6]
+    H_leg_minus = (I - m * a * b) * ye[2]
+    H_leg_plus = (m * b * b + I) * yp[3] - m * l * b * math.cos(yp[0] - yp[1]) * yp[2]
+    assert abs(H_minus[1] - H_leg_minus) < 1e-12 * abs(H_leg_minus)
+    assert abs(H_leg_plus - H_leg_minus) < 1e-12 * abs(H_leg_minus)
+    # the impact agrees with Goswami et al.'s closed form (point-mass legs: no leg inertia)
+    c0 = c[:5] + (0.0,) + c[6:]
+    c2 = math.cos(ye[1] - ye[0])                             # cos(2 alpha)
+    Qm = np.array([[-m * a * b, -m * a * b + (mH * l * l + 2 * m * a * l) * c2], [0.0, -m * a * b]])
+    Qp = np.array([[m * b * (b - l * c2), m * l * (l - b * c2) + m * a * a + mH * l * l],
+                   [m * b * b, -m * b * l * c2]])
+    w_ns, w_s = np.linalg.solve(Qp, Qm @ [ye[3], ye[2]])    # (non-stance, stance) after
+    yp0 = compass_heel_strike(ye, c0)
+    assert abs(yp0[2] - w_s) < 1e-12 and abs(yp0[3] - w_ns) < 1e-12
+    # a stable period-one gait: a complex pair, one real multiplier, one zero (phi+ = 2 theta+)
+    lam = compass_ref["multipliers"]
+    assert np.all(np.abs(lam) < 1) and abs(lam[0].imag) > 0.1 and abs(lam[3]) < 1e-6
+
+
+def test_compass_reference_gait_matches_the_engines_walk(compass_ref):
+    from walkers.passive.compass_gait import simulate
+    traj, summary, model = simulate(10.0)
+    assert not summary["fell"]
+    for key in ("step_period", "step_length", "speed"):
+        assert abs(summary[key] / compass_ref[key.replace("step_period", "period")] - 1) < 0.01, key
+
+
+def test_compass_gait_multipliers_converge_to_the_reference(compass_ref):
+    """Engine multipliers (eps 'auto') against the scipy reference's. The error is first order
+    in dt, about 3 dt (benchmarks/gait_analysis.py --only multipliers: 3.0e-3, 1.0e-3,
+    7.5e-4, 3.3e-4 at dt 1e-3 ... 1.25e-4, 9x over three halvings; the engine's own
+    finite-difference error estimate is 2e-4), so at dt 5e-4 it must be under 4 dt = 2e-3
+    and at least 1.6x smaller than at 1e-3."""
+    from planarsim.analysis import match_distance, multipliers_with_error
+    from walkers.passive.compass_gait import default_start
+    errs = []
+    for dt in (1e-3, 5e-4):
+        w = PassiveWalker(CompassParams(), dt=dt)
+        fp = find_fixed_point(w.step_map(), default_start(), tol=1e-10, eps=1e-4)
+        assert fp.converged
+        m = multipliers_with_error(w.step_map(), fp.x)
+        errs.append(match_distance(m.values, compass_ref["multipliers"]))
+    print("compass multiplier errors at dt 1e-3, 5e-4:", errs)
+    assert errs[1] < 2e-3 and errs[1] < errs[0] / 1.6
 
 
 @pytest.mark.parametrize("name", ["simplest-walker", "compass-gait", "rimless-wheel"])

@@ -1,5 +1,6 @@
 """Independent references for the passive walkers (no planarsim inside): the reduced ODEs of
-the simplest walking model integrated with scipy, and the rimless wheel in closed form.
+the simplest walking model and Goswami et al.'s compass gait integrated with scipy, and the
+rimless wheel in closed form. (The compass gait's equations are given with its code below.)
 
 Simplest walking model (Garcia, Chatterjee, Ruina, Coleman 1998, beta -> 0), dimensionless
 time t sqrt(g / l):
@@ -117,3 +118,181 @@ def rimless_fixed_point(slope, n_spokes, spoke_length=1.0, hub_mass=1.0, hub_ine
     step = 2 * l * math.sin(alpha)
     return dict(omega_after=w_after, omega_before=w_before, eta=eta, period=period,
                 speed=step / period, step_length=step)
+
+
+# compass gait --------------------------------------------------------------------------------
+# Goswami, Thuilot & Espiau (1998): point-mass hip mH, two legs of mass m (COM at a from the
+# foot, b = l - a from the hip, inertia m r^2 about the COM), slope gamma. Absolute leg angles
+# from the slope normal (counter-clockwise, > 0 leaning back): stance th1, swing th2; the unit
+# vector from foot to hip is up(th) = -sin(th) t + cos(th) n. Stance foot at the origin:
+#     stance COM a up(th1), hip l up(th1), swing COM l up(th1) - b up(th2).
+# Lagrangian (D = th1 - th2, I = m r^2):
+#     T = 1/2 [m a^2 + (mH + m) l^2 + I] th1'^2 + 1/2 (m b^2 + I) th2'^2 - m l b cos(D) th1' th2'
+#     V = g [(m a + (mH + m) l) cos(th1 - gamma) - m b cos(th2 - gamma)]
+# Swing phase, M(q) q'' + C(q, q') q' + G(q) = 0:
+#     M = [[m a^2 + (mH + m) l^2 + I, -m l b cos D], [-m l b cos D, m b^2 + I]]
+#     C q' = [-m l b sin(D) th2'^2, m l b sin(D) th1'^2]
+#     G = [-(m a + (mH + m) l) g sin(th1 - gamma), m b g sin(th2 - gamma)]
+# Heel strike: the swing foot's height along n, l (cos th1 - cos th2), reaches 0 going down
+# with the swing foot ahead of the stance foot (th2 > th1); the crossing at mid-stance (the
+# scuff) is ignored, as in the engine. Impact (plastic, no slip, the trailing foot leaves
+# without impulse): the angular momentum of the whole walker about the new stance foot and
+# that of the old stance leg about the hip are conserved; then the legs swap labels.
+# Section coordinates as the engine's (walkers.passive.gait): just after heel strike,
+# x = (theta = th1, theta_dot [rad/s], phi = th1 - th2, phi_dot [rad/s]).
+
+def _compass_consts(p):
+    r = p.leg_gyration if p.leg_gyration > 0 else 1e-3     # as walkers.passive.model.build_compass
+    return (p.hip_mass, p.leg_mass, p.leg_length, p.com_from_foot,
+            p.leg_length - p.com_from_foot, p.leg_mass * r * r, p.gravity, p.slope)
+
+
+def compass_rhs(t, y, c):
+    """Swing-phase ODE: y = (th1, th2, th1' , th2') [rad, rad/s] -> y' (c: _compass_consts)."""
+    mH, m, l, a, b, I, g, gam = c
+    th1, th2, w1, w2 = y
+    D = th1 - th2
+    cD, sD = math.cos(D), math.sin(D)
+    M11, M12, M22 = m * a * a + (mH + m) * l * l + I, -m * l * b * cD, m * b * b + I
+    r1 = m * l * b * sD * w2 * w2 + (m * a + (mH + m) * l) * g * math.sin(th1 - gam)
+    r2 = -m * l * b * sD * w1 * w1 - m * b * g * math.sin(th2 - gam)
+    det = M11 * M22 - M12 * M12
+    return [w1, w2, (M22 * r1 - M12 * r2) / det, (M11 * r2 - M12 * r1) / det]
+
+
+def _up(th):
+    """Foot-to-hip unit vector in slope (t, n) coordinates, and its derivative in th."""
+    return np.array([-math.sin(th), math.cos(th)]), np.array([-math.cos(th), -math.sin(th)])
+
+
+def compass_parts(y, c):
+    """The walker's masses from kinematics alone, stance foot at the origin, slope (t, n)
+    coordinates: list of (mass [kg], inertia [kg m^2], position [m], velocity [m/s],
+    angular rate [rad/s]) for the stance leg, the hip and the swing leg."""
+    mH, m, l, a, b, I, g, gam = c
+    th1, th2, w1, w2 = y
+    u1, du1 = _up(th1)
+    u2, du2 = _up(th2)
+    return [(m, I, a * u1, a * w1 * du1, w1),
+            (mH, 0.0, l * u1, l * w1 * du1, 0.0),
+            (m, I, l * u1 - b * u2, l * w1 * du1 - b * w2 * du2, w2)]
+
+
+def compass_energy(y, c):
+    """Mechanical energy [J] computed from compass_parts (independent of the ODE's M, C, G)."""
+    g, gam = c[6], c[7]
+    gvec = g * np.array([math.sin(gam), -math.cos(gam)])   # gravity in slope coordinates
+    return sum(0.5 * mi * (v @ v) + 0.5 * Ii * w * w - mi * (gvec @ r) for mi, Ii, r, v, w in
+               compass_parts(y, c))
+
+
+def _cross2(a, b):
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def compass_momenta(y, c, point):
+    """(angular momentum of the whole walker about `point`, of the stance leg about the hip)
+    [kg m^2/s], from compass_parts."""
+    parts = compass_parts(y, c)
+    hip = parts[1][2]
+    H = sum(mi * _cross2(r - point, v) + Ii * w for mi, Ii, r, v, w in parts)
+    mi, Ii, r, v, w = parts[0]
+    return H, mi * _cross2(r - hip, v) + Ii * w
+
+
+def compass_heel_strike(y, c):
+    """Impact and relabelling: y = (th1, th2, th1', th2') just before heel strike -> just
+    after (new stance = old swing leg). Solves the two momentum balances, linear in the new
+    rates, by evaluating them at unit rates."""
+    th1, th2 = y[0], y[1]
+    foot = compass_parts([th1, th2, 0.0, 0.0], c)[1][2] - c[2] * _up(th2)[0]   # new stance foot
+    H_total_minus, H_leg_minus = compass_momenta(y, c, foot)
+    # after: new stance foot at the origin, new labels (th2, th1); momenta linear in the rates
+    A = np.empty((2, 2))
+    for j in range(2):
+        e = [th2, th1, float(j == 0), float(j == 1)]
+        Ht, _ = compass_momenta(e, c, np.zeros(2))
+        parts = compass_parts(e, c)
+        mi, Ii, r, v, w = parts[2]                     # new swing leg = old stance leg
+        A[0, j], A[1, j] = Ht, mi * _cross2(r - parts[1][2], v) + Ii * w
+    w = np.linalg.solve(A, [H_total_minus, H_leg_minus])
+    return np.array([th2, th1, w[0], w[1]])
+
+
+def _to_section(y):
+    return np.array([y[0], y[2], y[0] - y[1], y[2] - y[3]])
+
+
+def _from_section(x):
+    return np.array([x[0], x[0] - x[2], x[1], x[1] - x[3]])
+
+
+def compass_step(x, p, rtol=1e-12, atol=1e-13, t_max=10.0):
+    """One step of the compass gait: section state x (theta, theta_dot [rad/s], phi,
+    phi_dot [rad/s]) just after heel strike -> (next x, step period [s], step length [m],
+    y(t) -> (th1, th2, th1', th2') over the step). p: CompassParams.
+
+    The strike event is terminal; at a crossing that is not a heel strike (the scuff at
+    mid-stance) the integration restarts from the crossing."""
+    from scipy.integrate import solve_ivp
+    c = _compass_consts(p)
+
+    def strike(t, y, c):
+        return math.cos(y[0]) - math.cos(y[1])          # swing-foot height / l
+    strike.direction = -1.0
+    strike.terminal = True
+    t0, y0, segs = 0.0, _from_section(x), []
+    while t0 < t_max:
+        sol = solve_ivp(compass_rhs, (t0, t_max), y0, args=(c,), events=strike, rtol=rtol,
+                        atol=atol, dense_output=True, method="DOP853")
+        segs.append((sol.t[-1], sol.sol))
+        if sol.status != 1:
+            break
+        te, ye = float(sol.t_events[0][-1]), sol.y_events[0][-1]
+        if ye[1] > ye[0] and te > 0.0:
+            step = c[2] * (math.sin(ye[1]) - math.sin(ye[0]))
+
+            def y_of_t(t):
+                return next(s for t_end, s in segs if t <= t_end)(t)
+            return _to_section(compass_heel_strike(ye, c)), te, step, y_of_t
+        # restart 1 us past the crossing (integrated without events) so that it is not
+        # found again
+        past = solve_ivp(compass_rhs, (te, te + 1e-6), ye, args=(c,), rtol=rtol, atol=atol,
+                         dense_output=True, method="DOP853")
+        segs.append((past.t[-1], past.sol))
+        t0, y0 = float(past.t[-1]), past.y[:, -1]
+    raise RuntimeError(f"compass gait: no heel strike within {t_max} s from x={x}")
+
+
+def compass_map(p):
+    """The reference compass gait's step map x -> next x (a fall raises StepMapError)."""
+    from planarsim.analysis import StepMapError
+
+    def f(x):
+        try:
+            return compass_step(x, p)[0]
+        except RuntimeError as e:
+            raise StepMapError(str(e)) from None
+    return f
+
+
+def compass_fixed_point(p=None, x0=None, tol=1e-12, eps=1e-6):
+    """Newton fixed point of the reference compass gait's step map (p: CompassParams, default
+    the defaults; x0: section state, default walkers.passive.compass_gait.default_start).
+    Multipliers by central differences of step eps.
+
+    Returns dict(x (4,), period [s], step_length [m], speed [m/s], multipliers (4,) largest
+    modulus first, jacobian)."""
+    from planarsim.analysis import find_fixed_point, floquet_multipliers
+    from .params import CompassParams
+    p = CompassParams() if p is None else p
+    if x0 is None:
+        from .compass_gait import default_start
+        x0 = default_start(p)
+    f = compass_map(p)
+    fp = find_fixed_point(f, x0, tol=tol, eps=eps)
+    if not fp.converged:
+        raise RuntimeError(f"compass reference fixed point did not converge: residual {fp.residual:g}")
+    _, period, step, _ = compass_step(fp.x, p)
+    return dict(x=fp.x, period=period, step_length=step, speed=step / period,
+                multipliers=floquet_multipliers(f, fp.x, eps=eps), jacobian=fp.jacobian)
