@@ -226,13 +226,16 @@ def _resolved(a, b, critical):
     return all(np.min(np.abs(q.multipliers - critical)) > q.error for q in (a, b))
 
 
-def _detect(pool, a, b, locate, tol, p_tol, mult_tol, folded=False):
+def _detect(pool, a, b, locate, tol, p_tol, mult_tol, folded=False, born=False):
+    """Bifurcations between branch points a and b. born: a is the first point of a period-2n
+    branch, half a step past the doubling where it was born: there its multiplier passes +1
+    by construction (P^2n's pitchfork), so a +1 crossing next to it is the birth, not a fold."""
     ta, tb = bifurcation_tests(a.multipliers), bifurcation_tests(b.multipliers)
     found = []
     if np.sign(ta["period-doubling"]) != np.sign(tb["period-doubling"]) and _resolved(a, b, -1.0):
         found.append(_locate(pool, a, b, "period-doubling", tol, p_tol, mult_tol) if locate
                      else _interpolated(a, b, "period-doubling"))
-    if folded or (np.sign(ta["fold"]) != np.sign(tb["fold"]) and _resolved(a, b, 1.0)):
+    if folded or (not born and np.sign(ta["fold"]) != np.sign(tb["fold"]) and _resolved(a, b, 1.0)):
         found.append(_interpolated(a, b, "fold"))
     if ta["neimark-sacker"] != tb["neimark-sacker"]:
         found.append(_interpolated(a, b, "neimark-sacker"))
@@ -306,7 +309,8 @@ def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, prog
             continue
         halvings = max(0, halvings - 1)
         b = _point(pool, pn, x, period, r, mult_tol)
-        branch.bifurcations += _detect(pool, pts[-1], b, locate, tol, p_tol, mult_tol)
+        branch.bifurcations += _detect(pool, pts[-1], b, locate, tol, p_tol, mult_tol,
+                                       born=bool(subperiod) and len(pts) == 1)
         pts.append(b)
         p = pn
         if progress:

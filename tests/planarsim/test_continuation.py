@@ -190,3 +190,15 @@ def test_plots_of_branch_diagram_and_basin(tmp_path):
     bs.to_csv(tmp_path / "s.csv")
     assert (tmp_path / "b.csv").read_text().splitlines()[0].startswith("p,period,x0")
     assert len((tmp_path / "d.csv").read_text().splitlines()) > 6
+
+
+def test_the_birth_of_a_period_two_orbit_is_not_a_fold():
+    """Half a step past a doubling the period-2 orbit's multiplier is near +1 (the pitchfork of
+    P^2); the simplest walker's map, noisy at 1e-5, estimated it at 1.13 +- 0.04 there and 0.72
+    at the next point, and a fold was reported where the orbit is born. Between a branch's
+    first point and the next (born=True) that crossing is not a fold; anywhere else it is."""
+    from planarsim.analysis.continuation import BranchPoint, _detect
+    a = BranchPoint(0.015144, np.zeros(2), np.array([1.1322, 0.0102]), 0.041, 1e-7, 2)
+    b = BranchPoint(0.015540, np.zeros(2), np.array([0.7212, 0.0386]), 0.037, 1e-7, 2)
+    assert [f.kind for f in _detect(None, a, b, False, 1e-6, 1e-6, 3e-3)] == ["fold"]
+    assert _detect(None, a, b, False, 1e-6, 1e-6, 3e-3, born=True) == []
