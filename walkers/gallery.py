@@ -12,6 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from planarsim.progress import stderr_is_terminal
 from planarsim.render.animate import export_animation
 
 
@@ -62,7 +63,8 @@ def main(argv=None) -> int:
     failed = 0
     for name in names:
         try:
-            out = make_gif(name, args.out_dir, args.duration, args.fps, args.width)
+            out = make_gif(name, args.out_dir, args.duration, args.fps, args.width,
+                           progress=stderr_is_terminal())
             print(f"{name}: {out} ({out.stat().st_size / 1024:.0f} KiB)")
         except Exception as e:  # one broken walker should not stop the others
             failed += 1
