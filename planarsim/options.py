@@ -38,6 +38,9 @@ class StepOptions(NamedTuple):
         dropped there: at a fold (a closed loop stretched nearly straight, rows dependent to
         about 1e-7) the residual grows with the square of the motion and Newton only halves
         the motion per iteration (residual / 4), where dropping the row converges at once
+    dt : [s] length of the steps taken with these options; 0 (default): the model's dt. A
+        sub-step (a touchdown located inside a step, say) is options._replace(dt=tau): the
+        model stays as it is
     audit_raise : 1 turns a violation of the step's audit (a pulling contact, friction outside
         its cone, positive contact work, a pin open by more than 1e-9 m, a contact deeper than
         1e-8 m, a solve that fell back; kernels/audit.py) into an error naming the step, time,
@@ -51,6 +54,7 @@ class StepOptions(NamedTuple):
     pivot_tol: float = 1e-11
     refine_pivot_tol: float = 1e-7
     audit_raise: int = 0
+    dt: float = 0.0
 
 
 def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:
@@ -75,6 +79,7 @@ _OPTION_RULES = {
     "pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
     "refine_pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
     "audit_raise": (int, lambda x: x in (0, 1), "must be 0 or 1"),
+    "dt": (float, lambda x: math.isfinite(x) and 0.0 <= x <= 1.0, "must be 0 (the model's dt) or a step in (0, 1] s"),
 }
 
 

@@ -1,7 +1,7 @@
 """The compiled step: a table of contents of the stages (README, "How the engine works").
 
-step(m, s, ws, opt, u) advances State s by m.dt in place and returns a guard code
-(0 ok, 1 non-finite, 2 too large). Model, state, workspace and options arrive as one pointer
+step(m, s, ws, opt, u) advances State s in place by one step of opt.dt (0: the model's m.dt)
+and returns a guard code (0 ok, 1 non-finite, 2 too large). Model, state, workspace and options arrive as one pointer
 each (kernels/refs.py). The stages are compiled into one C function (inlined, but for a few
 long or rarely run parts kept as calls: build_and_solve, the capped-mode settling, the skip
 test of the correction), compiled once per machine and called by address from every compiled
@@ -158,7 +158,8 @@ def settle_positions(m, s, ws, h, opt, rows_held):
 
 @kernel_inline
 def _step(m, s, ws, opt, u):
-    """Advance s by one step of m.dt under actuator commands u; return the guard code."""
+    """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u;
+    return the guard code."""
     copy_state(s, ws.prev)
     # a state handed in from outside (restored, edited) is checked before it is used
     code = check_guards(s, ws, opt.guard_limit)
@@ -170,7 +171,8 @@ def _step(m, s, ws, opt, u):
     audited = audit_total(ws)
     for i in range(m.contact_body.shape[0]):
         ws.contact_new[i] = 0
-    h = m.dt
+    step_length = opt.dt if opt.dt > 0.0 else m.dt
+    h = step_length
     for split in range(opt.max_ccd_splits + 1):
         update_trig(s.q, ws.body_cs)
         apply_forces(m, s, ws, u)
@@ -210,7 +212,7 @@ def _step(m, s, ws, opt, u):
             settle_positions(m, s, ws, h, opt, held)
             bound_correction_work(m, s, ws)
         break
-    s.time[0] = ws.prev.time[0] + m.dt
+    s.time[0] = ws.prev.time[0] + step_length
     s.step[0] += 1
     if m.contact_body.shape[0] > 0:
         s.mode_cursor[0] = (s.mode_cursor[0] + 1) % m.contact_body.shape[0]
@@ -296,8 +298,8 @@ _keep_reload_init_of_cached_code()
 
 @intrinsic
 def step(typingctx, m, s, ws, opt, u):
-    """step(m, s, ws, opt, u) -> guard code: advance State s by one step of m.dt under actuator
-    commands u (float64, C-contiguous, one per actuator). Callable from compiled code.
+    """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0: m.dt)
+    under actuator commands u (float64, C-contiguous, one per actuator). Callable from compiled code.
     Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), -1 when u does not have one
     entry per actuator, -2 when a command is NaN or infinite (for both nothing is changed;
     planarsim.errors.diverged explains any code)."""

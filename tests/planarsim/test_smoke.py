@@ -131,3 +131,22 @@ def test_a_nan_command_is_named_as_a_command_and_nothing_steps():
         with pytest.raises(ValueError, match=r"command u\[0\] for actuator 'motor' is (nan|inf)"):
             call()
         assert np.array_equal(sim.state.q, before.q) and sim.state.step[0] == before.step[0]
+
+
+def test_a_step_of_another_length_needs_no_new_model():
+    """StepOptions.dt: a step of tau with the model as it is equals a step of a model built
+    with dt = tau, bit for bit; time advances by tau; 0 means the model's dt."""
+    from benchmarks.scenes import biped_collapse
+    tau = 3.7e-4
+    a = ps.Simulator(biped_collapse(dt=1e-3), ps.make_options(dt=tau))
+    b = ps.Simulator(biped_collapse(dt=tau))
+    for _ in range(300):
+        a.step()
+        b.step()
+    assert np.array_equal(a.state.q, b.state.q) and np.array_equal(a.state.v, b.state.v)
+    assert a.state.time[0] == b.state.time[0] and abs(a.state.time[0] - 300 * tau) < 1e-12
+    c = ps.Simulator(biped_collapse(dt=1e-3), ps.make_options(dt=0.0))
+    c.step()
+    assert c.state.time[0] == 1e-3
+    with pytest.raises(ValueError, match="StepOptions.dt"):
+        ps.Simulator(biped_collapse(), ps.make_options(dt=-1e-3))

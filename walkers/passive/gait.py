@@ -267,7 +267,7 @@ class PassiveWalker:
         def sub_step(tau):
             s.restore(prev)
             if tau > 0.0:
-                check_run(step_from_python(m._replace(dt=tau), s, ws, sim.options, self.u0),
+                check_run(step_from_python(m, s, ws, sim.options._replace(dt=tau), self.u0),
                           self.model, ws, sim.options, self.kind)
             p = self.foot_point(c)[0]
             return gap_of_point(m.terrain_coef, p[0], p[1])
@@ -280,7 +280,7 @@ class PassiveWalker:
         s.v[...] = project_velocities(self.model, s.q, s.v, [int(self.feet[old])])
         s.contact_enabled[c] = 1
         s.contact_mode[c] = 1
-        check_run(step_from_python(m._replace(dt=IMPACT_DT), s, ws, sim.options, self.u0),
+        check_run(step_from_python(m, s, ws, sim.options._replace(dt=IMPACT_DT), self.u0),
                   self.model, ws, sim.options, self.kind)
         s.time[0] = prev.time[0] + tau
         return tau
