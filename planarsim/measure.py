@@ -47,6 +47,8 @@ def pin_angle_rate(model, q, v, pin) -> tuple:
         if pin not in names:
             raise KeyError(f"no pin named {pin!r}; pins: {names}")
         pin = names.index(pin)
+    elif not 0 <= int(pin) < len(names):
+        raise IndexError(f"pin index {pin} out of range 0..{len(names) - 1}; pins: {names}")
     a = model.arrays
     ba, bb = a.pin_body[pin]
     ang = q[bb, 2] - a.pin_ref[pin] - (q[ba, 2] if ba >= 0 else 0.0)

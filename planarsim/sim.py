@@ -71,6 +71,12 @@ class Simulator:
         return self._ws
 
     @property
+    def dt(self) -> float:
+        """[s] the length of this simulator's steps: StepOptions.dt, or the model's dt when
+        that is 0."""
+        return float(self._options.dt) if self._options.dt > 0.0 else float(self.model.dt)
+
+    @property
     def options(self) -> StepOptions:
         return self._options
 
@@ -122,7 +128,8 @@ class Simulator:
 
     # stepping -------------------------------------------------------------------------------
     def step(self, u=None) -> None:
-        """One step of model.dt under actuator commands u (n_act,) [N or N m]."""
+        """One step of `dt` (the options' dt, else the model's) under actuator commands u
+        (n_act,) [N or N m]."""
         entry = self._steps_entry or self._bind_steps()
         code, done = entry(self._args, self._u0 if u is None else self._commands(u), 1)
         if code:
@@ -171,7 +178,7 @@ class Simulator:
         labels : optional callable ``labels(sim) -> dict of scalars`` sampled at each frame
             (only with a controller), stored in Trajectory.labels.
         """
-        n = _count_steps(self.model.dt, duration, n_steps)
+        n = _count_steps(self.dt, duration, n_steps)
         every = int(record_every)
         if every < 1 or int(control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")
@@ -205,8 +212,8 @@ class Simulator:
                         series.setdefault(key, np.zeros(len(rec.t)))[k_before:k] = val
             labels_out = {key: arr[:k] for key, arr in series.items()}
             return Trajectory.from_recorder(self.model, rec, k, labels=labels_out,
-                                            info={"dt": self.model.dt})
-        return Trajectory.from_recorder(self.model, rec, k, info={"dt": self.model.dt})
+                                            info={"dt": self.dt})
+        return Trajectory.from_recorder(self.model, rec, k, info={"dt": self.dt})
 
     # state ----------------------------------------------------------------------------------
     @property

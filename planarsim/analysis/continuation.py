@@ -247,7 +247,7 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
                     method: str = "natural", period: int = 1, tol: float = 1e-9,
                     locate: bool = True, p_tol: float | None = None, mult_tol: float = 3e-3,
                     param: str = "p", progress=None, max_points: int | None = None,
-                    subperiod: int | None = None) -> Branch:
+                    subperiod: int | None = None, born_at_doubling: bool = False) -> Branch:
     """Follow the fixed point of P^period(x; p) near x0 from p0 toward p1.
 
     method "natural": `points` equally spaced values of p (a failed Newton halves the step,
@@ -257,7 +257,9 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
     doublings located to p_tol (default 1e-5 of |p1 - p0|; Bifurcation.bracket is the
     bracket reached: the map's noise can stop it earlier). progress(done, total) is called
     after each point. subperiod: reject solutions that are fixed points of P^subperiod (the
-    period-n orbit a period-2n branch was born from; natural continuation). Returns a Branch.
+    period-n orbit a period-2n branch was born from; natural continuation). born_at_doubling:
+    x0 lies half a step past the doubling the branch was born at (period_doubling_branch), so
+    a +1 crossing in the first interval is that birth, not a fold. Returns a Branch.
     """
     if method not in ("natural", "arclength"):
         raise ValueError(f"method={method!r} must be 'natural' or 'arclength'")
@@ -279,15 +281,16 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
         progress(1, total)
     if method == "natural":
         _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total,
-                 subperiod)
+                 subperiod, born_at_doubling)
     else:
-        _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total)
+        _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total,
+                   born_at_doubling)
     branch.evaluations = pool.evaluations - ev0
     return branch
 
 
 def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total,
-             subperiod=None):
+             subperiod=None, born_at_doubling=False):
     p = p0
     halvings = 0
     while (p1 - p) * np.sign(h) > 1e-12 * abs(p1 - p0):
@@ -310,7 +313,7 @@ def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, prog
         halvings = max(0, halvings - 1)
         b = _point(pool, pn, x, period, r, mult_tol)
         branch.bifurcations += _detect(pool, pts[-1], b, locate, tol, p_tol, mult_tol,
-                                       born=bool(subperiod) and len(pts) == 1)
+                                       born=born_at_doubling and len(pts) == 1)
         pts.append(b)
         p = pn
         if progress:
@@ -318,7 +321,8 @@ def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, prog
     branch.end = f"reached {branch.param}={p1:g}"
 
 
-def _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total):
+def _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total,
+               born_at_doubling=False):
     d = branch.points[0].x.size
     lo, hi = min(p0, p1), max(p0, p1)
     ds = abs(h)
@@ -355,7 +359,8 @@ def _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, pr
         r = float(np.max(np.abs(pool.evaluate(xn[None, :], pn, period)[0][0] - xn)))
         b = _point(pool, pn, xn, period, r, mult_tol)
         folded = len(branch.points) >= 2 and (pn - a.p) * (a.p - branch.points[-2].p) < 0
-        found = _detect(pool, a, b, locate and not folded, tol, p_tol, mult_tol)
+        found = _detect(pool, a, b, locate and not folded, tol, p_tol, mult_tol,
+                        born=born_at_doubling and len(branch.points) == 1)
         for bf in found:
             if bf.kind == "fold" and len(branch.points) >= 2:
                 # p is quadratic in the fold's test function near the fold: fit three points
@@ -419,5 +424,5 @@ def period_doubling_branch(pool: MapPool, bif: Bifurcation, p1: float, points: i
             if conv and np.max(np.abs(x - base)) > 100 * tol and \
                     np.max(np.abs(pool.evaluate(x[None, :], pstart, n)[0][0] - x)) > 100 * tol:
                 return continue_branch(pool, x, pstart, p1, points, period=2 * n, tol=tol,
-                                       subperiod=n, **kw)
+                                       subperiod=n, born_at_doubling=True, **kw)
     raise StepMapError(f"no period-{2 * n} orbit found next to the period doubling at {bif.p:g}")

@@ -84,6 +84,8 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
         frames, which = [], []
         for group in feet:
             idx = [_contact_index(traj, c) for c in group]
+            if not idx:
+                raise ValueError(f"feet={feet!r}: a foot needs at least one contact")
             on = np.isin(traj.contact_mode[:, idx], IN_CONTACT).any(axis=1)
             f = np.flatnonzero(on[1:] & ~on[:-1]) + 1
             if min_air > 0.0 and len(f):

@@ -244,7 +244,7 @@ class Viewer:
         """Step the simulation by `sim_seconds` [s] (whole steps; the remainder carries over).
         Returns the number of steps taken. A diverged simulation pauses with a message."""
         from ..errors import SimulationDiverged
-        dt = self.sim.model.dt
+        dt = self.sim.dt
         want = self._carry + sim_seconds / dt
         n = int(math.floor(want + 1e-9))
         self._carry = want - n

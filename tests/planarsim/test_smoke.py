@@ -150,3 +150,12 @@ def test_a_step_of_another_length_needs_no_new_model():
     assert c.state.time[0] == 1e-3
     with pytest.raises(ValueError, match="StepOptions.dt"):
         ps.Simulator(biped_collapse(), ps.make_options(dt=-1e-3))
+
+
+def test_a_simulator_runs_its_duration_with_the_options_step_length():
+    from benchmarks.scenes import chain
+    sim = ps.Simulator(chain(2), ps.make_options(dt=5e-4))
+    assert sim.dt == 5e-4
+    traj = sim.run(1.0, record_every=1)
+    assert abs(sim.state.time[0] - 1.0) < 1e-9 and len(traj.t) == 2000
+    assert traj.info["dt"] == 5e-4

@@ -16,7 +16,7 @@ Common keys, the same for every walker, units in their names:
   wall_time_s       {"compile": numba compile or cache load and model build, "run": the
                     simulation, "output": files written}
   extras            the walker's own numbers, named with units in its module's SUMMARY_EXTRAS
-                    (planarsim run --help lists them)
+                    (README lists them)
 """
 from __future__ import annotations
 
@@ -83,17 +83,3 @@ def walker_summary(mod, traj, model, raw: dict, *, walker, gait, terrain, durati
            "extras": {extras_spec[k][0]: raw[k] for k in raw
                       if k in extras_spec and extras_spec[k] is not None}}
     return _plain(out)
-
-
-def extras_help(walkers_module) -> str:
-    """Every walker's extra summary keys with their explanations (for planarsim run --help)."""
-    lines = []
-    for name in sorted(walkers_module.WALKERS):
-        try:
-            spec = getattr(walkers_module.load(name), "SUMMARY_EXTRAS", {})
-        except Exception:        # a broken walker must not break --help
-            continue
-        items = [f"{key} ({doc})" for key, doc in (v for v in spec.values() if v is not None)]
-        if items:
-            lines.append(f"  {name}: " + "; ".join(items))
-    return "\n".join(lines)
