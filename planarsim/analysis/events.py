@@ -70,7 +70,7 @@ def foot_groups(contact_names) -> list:
 
 
 def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = None,
-                min_air: float = 0.0) -> StepEvents:
+                min_air: float = 0.0, together: float = 0.0) -> StepEvents:
     """Touchdown events of `contacts` (names or indices; default all) in a Trajectory.
 
     feet : groups of contacts (names or indices) that touch down as one: a foot touches down at
@@ -79,6 +79,8 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
         Overrides `contacts`.
     min_air : [s] with feet, a touchdown counts only after the foot was off the ground this
         long (a foot that bounces or chatters for a few frames at landing lands once).
+    together : [s] with feet, touchdowns of several feet within this time of the first of
+        them are one landing (a jump landing on both feet; the event names the first foot).
     """
     if feet is not None:
         frames, which = [], []
@@ -102,7 +104,17 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
         contact = np.concatenate(which) if which else np.zeros(0, int)
         order = np.argsort(frame, kind="stable")
         frame, contact = frame[order], contact[order]
-        return StepEvents(frame=frame, time=np.asarray(traj.t)[frame], contact=contact)
+        time = np.asarray(traj.t)[frame]
+        if together > 0.0 and len(frame):
+            keep = np.ones(len(frame), dtype=bool)
+            start = time[0]
+            for k in range(1, len(frame)):
+                if time[k] - start < together:
+                    keep[k] = False
+                else:
+                    start = time[k]
+            frame, contact, time = frame[keep], contact[keep], time[keep]
+        return StepEvents(frame=frame, time=time, contact=contact)
     if contacts is None:
         contacts = range(traj.contact_mode.shape[1])
     frames, which = [], []

@@ -143,6 +143,7 @@ class Scene:
         if not (tick_spacing > 0 and math.isfinite(tick_spacing)):
             raise ValueError(f"tick_spacing={tick_spacing} must be a finite distance > 0 m")
         self.model, self.ax = model, ax
+        self.step_length = model.dt   # [s] turns an impulse into a mean force (draw_frame: the recording's)
         self.style = style or Style()
         self.tick_spacing = float(tick_spacing)
         self.view_width = float(view_width) if view_width else max(2.0, 4.0 * model_extent(model))
@@ -318,7 +319,7 @@ class Scene:
         """Arrow segments (shaft and two head strokes) for contact impulses (n_contact, 2)
         (normal, tangential) [N s] at points (n_contact, 2), drawn as mean force x impulse_scale."""
         segs = []
-        dt = self.model.dt
+        dt = self.step_length
         ter = self.model.terrain
         for i in range(len(points)):
             ln, lt = impulses[i]
@@ -422,6 +423,7 @@ class Scene:
         labels = {key: np.asarray(v)[k] for key, v in traj.labels.items()
                   if np.ndim(v) == 1 and len(v) == len(traj.t)}
         speed = float(self.model.arrays.body_mass @ traj.v[k, :, 0] / self.model.total_mass)
+        self.step_length = float(traj.info.get("dt", self.model.dt))
         return self.draw_state(traj.q[k], center=center, t=float(traj.t[k]) if t is None else float(t),
                                contact_point=traj.contact_point[k], contact_impulse=traj.contact_impulse[k],
                                labels=labels, speed=speed)

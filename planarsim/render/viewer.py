@@ -156,6 +156,7 @@ class Viewer:
         self.ax = fig.add_axes((0.0, panel, 1.0, 1.0 - panel))
         self.ax.set_axis_off()
         self.scene = Scene(self.sim.model, self.ax, **scene_kw)
+        self.scene.step_length = self.sim.dt
         self.sliders = {}
 
         def slider(i, label, lo, hi, val, fn):

@@ -62,3 +62,10 @@ def test_readme_explains_every_walker_extra():
                for key, _ in (v for v in walkers.load(name).SUMMARY_EXTRAS.values() if v is not None)
                if f"`{key}`" not in readme]
     assert not missing
+
+
+def test_a_jump_is_one_landing(capsys):
+    """Both feet of a jump land within MIN_AIR_S: the summary counts the walker's own jumps."""
+    assert main(["run", "simple-biped", "--gait", "jump", "--duration", "6", "--json", "--no-animation"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["extras"]["jumps"] >= 2 and s["steps"] == s["extras"]["jumps"]

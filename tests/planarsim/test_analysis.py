@@ -38,6 +38,18 @@ def test_step_events_merge_contacts_in_time_order_and_section():
         step_events(traj, ["middle"])
 
 
+def test_feet_landing_together_land_once():
+    # both feet leave at frame 2 and land at frames 5 and 6 (0.01 s apart), then walk: the
+    # right foot lifts at 8 and lands alone at 10
+    modes = np.array([[1, 1], [1, 1], [0, 0], [0, 0], [0, 0], [1, 0], [1, 1], [1, 1], [1, 0],
+                      [1, 0], [1, 1]])
+    traj = SimpleNamespace(contact_mode=modes, contact_names=("left", "right"), t=np.arange(11) * 0.01)
+    feet = [["left"], ["right"]]
+    assert step_events(traj, feet=feet).frame.tolist() == [5, 6, 10]
+    assert step_events(traj, feet=feet, together=0.02).frame.tolist() == [5, 10]
+    assert step_events(traj, feet=feet, together=0.06).frame.tolist() == [5]
+
+
 # fixed points and multipliers ----------------------------------------------------------------
 def henon(a=1.4, b=0.3):
     return lambda x: np.array([1.0 - a * x[0] ** 2 + x[1], b * x[0]])

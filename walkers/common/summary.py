@@ -4,11 +4,13 @@ Common keys, the same for every walker, units in their names:
   walker, gait, terrain, duration_s, params_changed
   time_s            simulated time reached [s] (less than duration_s after a fall)
   fell              the walker's own fall test fired (or the engine stopped it)
-  distance_m        horizontal displacement of the centre of mass [m]
-  mean_speed_m_per_s  distance_m / time_s
+  distance_m        horizontal displacement of the centre of mass [m] from the first
+                    recorded frame (one recording interval after the start) to the last
+  mean_speed_m_per_s  distance_m over the time between those frames [m/s]
   steps             foot touchdowns over the run (from the recorded contact modes; a foot
                     is its contacts together, FEET of the walker; a landing counts after
-                    at least MIN_AIR_S in the air, so a bounce lands once)
+                    at least MIN_AIR_S in the air, so a bounce lands once, and feet landing
+                    within MIN_AIR_S of each other land once: a jump is one landing)
   whole_steps, step_period_s, step_length_m, step_speed_m_per_s
                     over whole steps, first to last touchdown (planarsim.analysis.step_summary):
                     they do not depend on where in a step the run ends; NaN before two touchdowns
@@ -69,13 +71,14 @@ def walker_summary(mod, traj, model, raw: dict, *, walker, gait, terrain, durati
     t = float(raw.get("time", raw.get("duration", traj.t[-1] if len(traj.t) else 0.0)))
     com = traj.com(model)
     dist = float(com[-1, 0] - com[0, 0]) if len(com) else 0.0
+    span = float(traj.t[-1] - traj.t[0]) if len(traj.t) > 1 else 0.0
     feet = feet_of(mod, model)
-    ss = step_summary(traj, model, feet=feet, min_air=MIN_AIR_S)
-    touchdowns = len(step_events(traj, feet=feet, min_air=MIN_AIR_S))
+    ss = step_summary(traj, model, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S)
+    touchdowns = len(step_events(traj, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S))
     out = {"walker": walker, "gait": gait, "terrain": terrain, "duration_s": float(duration),
            "params_changed": params_changed or {},
            "time_s": t, "fell": bool(raw.get("fell", False)), "distance_m": dist,
-           "mean_speed_m_per_s": dist / t if t > 0 else 0.0,
+           "mean_speed_m_per_s": dist / span if span > 0 else 0.0,
            "steps": int(touchdowns), "whole_steps": int(ss["whole_steps"]),
            "step_period_s": ss["step_period"], "step_length_m": ss["step_length"],
            "step_speed_m_per_s": ss["speed"], "audit": raw.get("audit", {}),

@@ -41,6 +41,17 @@ def foot_inertia_com(p: RangerParams) -> float:
     return i_com + p.rotor_on_foot * p.ankle_gear ** 2 * p.rotor_inertia
 
 
+def _pose_misfit(terrain, hip_x: float, x_rear: float, what: str) -> str:
+    """The error text of a standing pose that does not fit: on flat ground the parameters are
+    to blame, elsewhere the terrain's rise between the feet [m] is named too."""
+    if not np.any(terrain.coef[2:]) and terrain.coef[1] == 0.0:
+        return f"RangerParams: {what}"
+    rise = float(terrain.height(0.0)) - float(terrain.height(x_rear))
+    return (f"Ranger cannot stand at x = 0 on terrain {terrain.name!r}: the ground rises {rise:+.3f} m "
+            f"from the rear foot to the front foot, and {what}. Ranger walks on flat ground "
+            "(its controller has no terrain estimate)")
+
+
 def standing_pose(p: RangerParams, terrain=None):
     """The STAND pose at rest with both feet on the ground: front (inner) leg at
     stand_front_angle with its foot level, rear (outer) leg at stand_rear_angle with its foot
@@ -58,12 +69,14 @@ def standing_pose(p: RangerParams, terrain=None):
     # lowest sole point of a foot turned by phi (toe down < 0): r - d cos(phi) below the ankle
     c = (r - h_rear) / d
     if not -1.0 < c <= 1.0 or h_rear < r - d - 1e-12:
-        raise ValueError(f"RangerParams: {pose}_rear_angle={th_rear} and {pose}_front_angle={th_front} "
-                         f"put the rear ankle {h_rear:.3f} m above the ground; the foot reaches "
-                         f"{r - d:.3f}..{r:.3f} m")
+        raise ValueError(_pose_misfit(terrain, hip_x, x_rear,
+                                      f"{pose}_rear_angle={th_rear} and {pose}_front_angle={th_front} "
+                                      f"put the rear ankle {h_rear:.3f} m above the ground; the foot "
+                                      f"reaches {r - d:.3f}..{r:.3f} m"))
     phi_rear = -math.acos(min(c, 1.0))
     if -math.pi / 2 - phi_rear > p.sole_span_front:
-        raise ValueError(f"RangerParams: the rear foot would need {phi_rear:.3f} rad toe down, past its toe")
+        raise ValueError(_pose_misfit(terrain, hip_x, x_rear,
+                                      f"the rear foot would need {phi_rear:.3f} rad toe down, past its toe"))
     return np.array([hip_x, hip_y]), (th_rear, th_front), (phi_rear, 0.0)
 
 
