@@ -39,19 +39,21 @@ def _number(x) -> str:
     return repr(x)
 
 
-def runs():
-    """(walker name, gait, keywords, label) of every run digested."""
-    for name in sorted(walkers.WALKERS):
+def runs(names=()):
+    """(walker name, gait, keywords, label) of every run digested (of walkers `names`, or all)."""
+    names = names or sorted(walkers.WALKERS)
+    for name in names:
         for gait in walkers.load(name).GAITS:
             yield name, gait, {}, gait
-    yield from EXTRA_RUNS
+    yield from (r for r in EXTRA_RUNS if r[0] in names)
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=5.0, help="simulated time per run [s]")
+    ap.add_argument("names", nargs="*", help="walkers to digest (default: all)")
     a = ap.parse_args(argv)
-    for name, gait, kw, label in runs():
+    for name, gait, kw, label in runs(a.names):
         traj, summary, _ = walkers.load(name).simulate(a.seconds, gait=gait, **kw)
         print(f"{name:16s} {label:7s} traj {digest(traj.q, traj.v, traj.t)} frames {len(traj.t)}")
         print(f"{'':24s} summary {_number(summary)}")
