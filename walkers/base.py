@@ -153,22 +153,22 @@ class WalkerRun:
 
 def simulation(run_class):
     """The module-level ``simulate(duration, **keywords)`` of a walker: a `run_class` built with
-    the keywords (its __init__'s) runs `duration` [s] from its start; returns (Trajectory of
+    the keywords (its __init__'s, keyword-only here) runs `duration` [s] from its start; returns (Trajectory of
     the run, summary dict, Model). The Trajectory's info records the gait and seed."""
     init = inspect.signature(run_class.__init__)
-    rest = list(init.parameters.values())[1:]
+    keywords = [prm.replace(kind=inspect.Parameter.KEYWORD_ONLY) for prm in list(init.parameters.values())[1:]]
 
-    def simulate(duration, *args, **kwargs):
-        bound = init.bind(None, *args, **kwargs)
+    def simulate(duration, **kwargs):
+        bound = init.bind(None, **kwargs)
         bound.apply_defaults()
-        run = run_class(*args, **kwargs)
+        run = run_class(**kwargs)
         run.run(duration)
         traj = run.trajectory()
         traj.info.update({k: bound.arguments[k] for k in ("gait", "seed") if k in bound.arguments})
         return traj, run.summary(), run.model
 
     duration = inspect.Parameter("duration", inspect.Parameter.POSITIONAL_OR_KEYWORD)
-    simulate.__signature__ = inspect.Signature([duration] + rest)
+    simulate.__signature__ = inspect.Signature([duration] + keywords)
     simulate.__module__ = run_class.__module__
     simulate.__qualname__ = simulate.__name__ = "simulate"
     simulate.__doc__ = (f"Run {run_class.NAME} from its start for `duration` [s]; returns (Trajectory, "
