@@ -12,8 +12,10 @@ Python between rollout chunks). Each gait runs its own states:
                stance leg holds its length; gravity compensation everywhere
   CROUCH, THRUST, FLIGHT, LAND   the jump: crouch, push the hip up, hold the legs in the air,
                absorb the landing; then crouch again while the gait is JUMP
-Transitions are contact and phase driven. Left/right is data: ``memory[M_STANCE]`` is the
-stance (front) foot index, the swing foot is ``1 - stance``.
+Transitions are contact and phase driven (next_state). What a state commands is data: its row
+of the state table (make_tables: control law, target, PD gains, feed-forward), so STAND, LAND,
+CROUCH and THRUST are one law with different rows. Left/right is data too: ``memory[M_STANCE]``
+is the stance (front) foot index, the swing foot is ``1 - stance``.
 
 Deviations from and additions to Kelly's controller, stated:
 - eq. 2 is used in its energy-consistent form phi_dot_target = -sqrt(v_top^2 + 2 g l
@@ -127,7 +129,7 @@ def make_tables(params) -> Tables:
     kp, kd = p[P.I_STAND_KP], p[P.I_STAND_KD]
     swing = (p[P.I_SWING_KP], p[P.I_SWING_KD])
     row = np.zeros((len(State), N_ROW))
-    #                  law          length                        kp            kd            kp_y kd_y accel_y               swing
+    # columns: law, length, kp, kd, kp_y, kd_y, accel_y, swing kp, swing kd
     row[ST_STAND] = (LAW_HIP, p[P.I_STAND_HEIGHT] * l0, kp, kd, kp, kd, 0.0, 0.0, 0.0)
     row[ST_LAND] = row[ST_STAND]
     row[ST_CROUCH] = (LAW_HIP, p[P.I_CROUCH_HEIGHT] * l0, kp, kd, kp, kd, 0.0, 0.0, 0.0)
