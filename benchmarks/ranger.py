@@ -21,9 +21,9 @@ from walkers.ranger import RangerSim  # noqa: E402
 
 
 def one_run(seconds, strategy, record_every=10):
-    rs = RangerSim(gait="walk", strategy=strategy)
+    rs = RangerSim(gait="walk", strategy=strategy, record_every=record_every)
     t0 = time.perf_counter()
-    rs.run(seconds, record_every=record_every)
+    rs.run(seconds)
     return time.perf_counter() - t0, rs
 
 
@@ -53,16 +53,16 @@ def main(argv=None):
             wall, rs = one_run(args.seconds, strategy)
             walls.append(wall)
         w = np.median(walls)
-        n = int(rs.sim.state.step[0])
+        n = int(rs.state.step[0])
         print(f"[{strategy}] {args.seconds:.0f} s walk: real-time factor {args.seconds / w:.1f} "
               f"(median of {args.repeats}, spread {args.seconds / max(walls):.1f}..{args.seconds / min(walls):.1f}), "
               f"{n / w:,.0f} steps/s")
         print("   ", figures(rs))
         if args.steps:
-            rs = RangerSim(gait="walk", strategy=strategy)
+            rs = RangerSim(gait="walk", strategy=strategy, record_every=1000)
             t1 = time.perf_counter()
-            while rs.steps < args.steps and not rs.fell and rs.sim.t < 10.0 * args.steps:
-                rs.run(50.0, record_every=1000)
+            while rs.steps < args.steps and not rs.fell and rs.time < 10.0 * args.steps:
+                rs.run(50.0)
             print(f"[{strategy}] walk to {args.steps} steps ({time.perf_counter() - t1:.1f} s wall):")
             print("   ", figures(rs))
 

@@ -1,8 +1,9 @@
 """Walker packages. ``WALKERS`` maps command-line names to module paths (used by the CLI).
 
 Each walker module exposes ``NAME``, ``GAITS``, ``Params`` (its parameter dataclass, see
-walkers.common.params) and
-``simulate(duration, gait=..., terrain=None, dt=1e-3, seed=0, params=None, ...) -> (Trajectory, summary, model)``.
+walkers.common.params), ``Run`` (its run class, a walkers.base.WalkerRun) and
+``simulate(duration, gait=..., terrain=None, dt=1e-3, seed=0, params=None, ...) -> (Trajectory, summary, model)``
+(walkers/base.py has the whole contract).
 A walker is tunable (planarsim tune) when its package has an ``objective`` module.
 """
 import importlib

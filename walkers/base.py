@@ -10,23 +10,177 @@ A walker module has
   SUMMARY_EXTRAS  {raw summary key: (name with unit, meaning) or None}: its own numbers beyond
                   the common summary (walkers.common.summary)
   FEET            optional: groups of contact names that are one foot each (default: by name)
+  Run             its run class, a WalkerRun (below)
   simulate(duration, gait=..., terrain=None, dt=1e-3, seed=0, params=None, record_every=10, ...)
-                  -> (Trajectory, summary dict, Model); the summary has at least `fell`,
-                  `audit` and `time` (or `duration`) and otherwise only keys its
-                  SUMMARY_EXTRAS or walkers.common.summary.REPLACED declare
+                  -> (Trajectory, summary dict, Model): ``simulation(Run)``, a Run from the
+                  start for duration [s]; the summary has at least `fell`, `audit` and `time`
+                  (or `duration`) and otherwise only keys its SUMMARY_EXTRAS or
+                  walkers.common.summary.REPLACED declare
   live(gait=..., terrain=None, ...)
                   optional: the interactive viewer's hook (planarsim.render.viewer.view_walker)
 and, to be tunable, a sibling module `objective` (Params, DEFAULT_SETTINGS,
 evaluate(params, settings) -> {"score": ...}).
-Its compiled rollout stops with planarsim.compiled's run codes: RUN_OK, an engine failure
-(raised with check_run), or its own reasons from RUN_WALKER up (RUN_FELL).
+
+A run (WalkerRun) holds the model, State, Workspace, StepOptions, parameters, controller table
+and memory of one walker in the world; ``run(seconds)`` advances it with the walker's compiled
+rollout and returns that chunk's Trajectory, so running a then b seconds ends bit for bit where
+running a + b seconds does. A subclass supplies only what differs: it builds model, table and
+memory in its __init__, names its LABELS (per-frame copies of memory slots) and FELL_SLOT, and
+implements ``advance`` (one call of its rollout) and ``numbers`` (its raw summary numbers).
+
+An actuated walker's compiled controller is ``control(m, s, ws, tab, mem, u)``: model arrays,
+State, Workspace, the walker's read-only table of parameters and constants (a NamedTuple of
+arrays, or the float parameter array itself; Ranger's also carries the heel-strike log its
+controller writes), its float64 memory vector (read and written) and the command vector u
+(written, n_act). Its compiled rollout stops with planarsim.compiled's run
+codes: RUN_OK, an engine failure (raised with check_run), or its own reasons from RUN_WALKER up
+(RUN_FELL).
 """
 from __future__ import annotations
 
 import inspect
+import math
+
+import numpy as np
 
 SIMULATE_KEYWORDS = ("gait", "terrain", "dt", "seed", "params", "record_every")
-REQUIRED = ("NAME", "GAITS", "Params", "SUMMARY_EXTRAS", "simulate")
+REQUIRED = ("NAME", "GAITS", "Params", "SUMMARY_EXTRAS", "Run", "simulate")
+
+
+class WalkerRun:
+    """One walker in the world, run in chunks by its compiled rollout.
+
+    Attributes: model, state (State), ws (Workspace), options (StepOptions), params (the
+    walker's Params), tables (its controller table), memory (its controller memory), u
+    (commands, n_act), record_every (steps between recorded frames; 0 records none), chunks
+    (the Trajectory of every run() so far).
+    """
+
+    NAME = "walker"    # recorded in Trajectory.info["walker"] and named by engine errors
+    LABELS = ()        # per-frame labels: the columns advance() writes into `lab`
+    FELL_SLOT = -1     # memory slot the rollout sets non-zero when the walker falls
+
+    def __init__(self, model, params, tables, memory, *, state=None, ws=None, options=None,
+                 record_every=10):
+        import planarsim as ps
+        from planarsim.state import make_workspace
+        if not (isinstance(record_every, (int, np.integer)) and record_every >= 0):
+            raise ValueError(f"record_every={record_every!r} must be an integer >= 0 (steps between frames)")
+        self.model = model
+        self.params = params
+        self.tables = tables
+        self.memory = memory
+        self.state = state if state is not None else ps.make_state(model)
+        self.ws = ws if ws is not None else make_workspace(model)
+        self.options = options if options is not None else ps.StepOptions()
+        self.u = np.zeros(model.n_act)
+        self.record_every = int(record_every)
+        self.chunks = []
+
+    # what a walker supplies -----------------------------------------------------------------
+    def advance(self, n: int, every: int, rec, lab):
+        """Run the compiled rollout n steps, recording every `every`-th step into rec / lab
+        from frame 0; return (run code, frames recorded)."""
+        raise NotImplementedError
+
+    def numbers(self) -> dict:
+        """The walker's raw summary numbers (its summary without `audit`)."""
+        raise NotImplementedError
+
+    def frames(self, n: int) -> int:
+        """Recorder frames a chunk of n steps needs."""
+        return n // self.record_every + 1 if self.record_every else 0
+
+    def stopped(self, code: int) -> int:
+        """The run code of a chunk, before engine failures are raised (a walker may take some
+        of them as its own outcome)."""
+        return code
+
+    # the contract ---------------------------------------------------------------------------
+    @property
+    def dt(self) -> float:
+        """The step length actually used [s]: options.dt, or the model's dt where it is 0."""
+        return self.options.dt if self.options.dt else self.model.dt
+
+    @property
+    def time(self) -> float:
+        """Simulated time [s]."""
+        return float(self.state.time[0])
+
+    @property
+    def fell(self) -> bool:
+        return bool(self.memory[self.FELL_SLOT])
+
+    def run(self, seconds: float):
+        """Advance `seconds` [s] (rounded to whole steps; stops early on a fall) and return
+        this chunk's Trajectory. Engine failures raise (planarsim.compiled.check_run)."""
+        from planarsim.compiled import check_run, make_recorder
+        from planarsim.trajectory import Trajectory
+        try:
+            seconds = float(seconds)
+        except (TypeError, ValueError):
+            raise ValueError(f"seconds={seconds!r} must be a number of seconds") from None
+        if not (math.isfinite(seconds) and seconds >= 0.0):
+            raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
+        n = int(round(seconds / self.dt))
+        frames = self.frames(n)
+        rec = make_recorder(self.model, frames)
+        lab = np.zeros((frames, len(self.LABELS)))
+        code, k = self.advance(n, max(self.record_every, 1), rec, lab)
+        check_run(self.stopped(int(code)), self.model, self.ws, self.options, self.NAME)
+        traj = Trajectory.from_recorder(self.model, rec, k,
+                                        labels={name: lab[:k, j].copy() for j, name in enumerate(self.LABELS)},
+                                        info={"dt": self.dt, "walker": self.NAME})
+        self.chunks.append(traj)
+        return traj
+
+    def trajectory(self):
+        """All chunks run so far, joined (empty ones left out)."""
+        from planarsim.compiled import make_recorder
+        from planarsim.trajectory import Trajectory
+        full = [c for c in self.chunks if len(c)]
+        if full:
+            return Trajectory.concatenate(full)
+        if self.chunks:
+            return self.chunks[0]
+        return Trajectory.from_recorder(self.model, make_recorder(self.model, 0), 0,
+                                        info={"dt": self.dt, "walker": self.NAME})
+
+    def summary(self) -> dict:
+        """The walker's numbers (numbers()) and `audit`, the engine's audit counts."""
+        from planarsim.compiled import audit_counts
+        return {**self.numbers(), "audit": audit_counts(self.ws)}
+
+
+def simulation(run_class):
+    """The module-level ``simulate(duration, **keywords)`` of a walker: a `run_class` built with
+    the keywords (its __init__'s, keyword-only here) runs `duration` [s] from its start; returns (Trajectory of
+    the run, summary dict, Model). The Trajectory's info records the gait and seed."""
+    init = inspect.signature(run_class.__init__)
+    keywords = [prm.replace(kind=inspect.Parameter.KEYWORD_ONLY) for prm in list(init.parameters.values())[1:]]
+
+    def simulate(duration, **kwargs):
+        bound = init.bind(None, **kwargs)
+        bound.apply_defaults()
+        run = run_class(**kwargs)
+        run.run(duration)
+        traj = run.trajectory()
+        traj.info.update({k: bound.arguments[k] for k in ("gait", "seed") if k in bound.arguments})
+        return traj, run.summary(), run.model
+
+    duration = inspect.Parameter("duration", inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    simulate.__signature__ = inspect.Signature([duration] + keywords)
+    simulate.__module__ = run_class.__module__
+    simulate.__qualname__ = simulate.__name__ = "simulate"
+    simulate.__doc__ = (f"Run {run_class.NAME} from its start for `duration` [s]; returns (Trajectory, "
+                        f"summary dict, Model). Keywords: those of {run_class.__name__}.")
+    return simulate
+
+
+def terrain_of(terrain):
+    """A Terrain from a Terrain, a spec string (planarsim.terrain.parse) or None (flat)."""
+    import planarsim as ps
+    return ps.terrain.parse(terrain) if isinstance(terrain, str) else terrain
 
 
 def contract_problems(name: str, module) -> list:
@@ -43,6 +197,8 @@ def contract_problems(name: str, module) -> list:
     elif sig.parameters["gait"].default not in module.GAITS:
         problems.append(f"simulate()'s default gait {sig.parameters['gait'].default!r} is not in GAITS")
     from walkers.common.params import WalkerParams
+    if not (isinstance(module.Run, type) and issubclass(module.Run, WalkerRun)):
+        problems.append("Run is not a WalkerRun subclass")
     if not (isinstance(module.Params, type) and issubclass(module.Params, WalkerParams)):
         problems.append("Params is not a WalkerParams dataclass")
     for key, spec in module.SUMMARY_EXTRAS.items():

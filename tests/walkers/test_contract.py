@@ -1,10 +1,21 @@
 """Every shipped walker meets the walker contract (walkers/base.py): the same module attributes,
-the same simulate() keywords, a summary the common summary can read."""
+a run class on WalkerRun, the same simulate() keywords, a summary the common summary can read,
+and chunked runs that end bit for bit where one run of the same length does."""
+import math
+
+import numpy as np
 import pytest
 
 import walkers
-from walkers.base import contract_problems
-from walkers.common.summary import REPLACED
+from walkers.base import WalkerRun, contract_problems
+from walkers.common.summary import REPLACED, walker_summary
+
+# the keys `planarsim run W --json` prints for every walker W
+COMMON_KEYS = {"walker", "gait", "terrain", "duration_s", "params_changed", "time_s", "fell",
+               "distance_m", "mean_speed_m_per_s", "steps", "whole_steps", "step_period_s",
+               "step_length_m", "step_speed_m_per_s", "audit", "wall_time_s", "extras"}
+# run keywords for the chunk test: SIMBICON pushed across the chunk boundary
+CHUNK_KEYWORDS = {"simbicon": {"push": dict(force=60.0, start=0.8, duration=0.3)}}
 
 
 @pytest.mark.parametrize("name", sorted(walkers.WALKERS))
@@ -16,14 +27,64 @@ def test_every_walker_meets_the_contract(name):
     undeclared = [k for k in summary if k not in REPLACED and k not in mod.SUMMARY_EXTRAS]
     assert not undeclared
     assert len(traj.t) > 0 and model.n_body > 0
+    common = walker_summary(mod, traj, model, summary, walker=name, gait=mod.GAITS[0],
+                            terrain="flat", duration=0.2)
+    assert set(common) == COMMON_KEYS
+
+
+@pytest.mark.parametrize("name", sorted(walkers.WALKERS))
+def test_chunked_run_ends_where_one_run_does(name):
+    """Run(...).run(a); .run(b) ends bit for bit in the state of Run(...).run(a + b)."""
+    mod = walkers.load(name)
+    kw = CHUNK_KEYWORDS.get(name, {})
+    whole = mod.Run(**kw)
+    whole.run(2.5)
+    chunked = mod.Run(**kw)
+    first = chunked.run(1.0)
+    second = chunked.run(1.5)
+    for field in ("q", "v", "time", "step", "contact_mode", "contact_enabled"):
+        assert np.array_equal(getattr(chunked.state, field), getattr(whole.state, field)), field
+    assert np.array_equal(chunked.memory, whole.memory)
+    joined = chunked.trajectory()
+    assert len(joined) == len(first) + len(second)
+    assert np.array_equal(joined.q, whole.trajectory().q)
+    assert chunked.summary()["fell"] == whole.summary()["fell"]
+
+
+@pytest.mark.parametrize("name", sorted(walkers.WALKERS))
+def test_feet_and_extras_names(name):
+    """FEET (where given) names real contacts, each once; SUMMARY_EXTRAS names are unique."""
+    mod = walkers.load(name)
+    model = mod.Run().model
+    feet = getattr(mod, "FEET", None)
+    if feet is not None:
+        flat = [c for group in feet for c in group]
+        assert set(flat) <= set(model.contact_names), set(flat) - set(model.contact_names)
+        assert len(flat) == len(set(flat))
+    names = [spec[0] for spec in mod.SUMMARY_EXTRAS.values() if spec is not None]
+    assert len(names) == len(set(names)), names
+
+
+@pytest.mark.parametrize("seconds", [-1.0, math.nan, math.inf, "long"])
+def test_run_rejects_bad_seconds(seconds):
+    run = walkers.load("simple-biped").Run()
+    with pytest.raises(ValueError, match="seconds"):
+        run.run(seconds)
+
+
+def test_run_rejects_bad_record_every():
+    with pytest.raises(ValueError, match="record_every"):
+        walkers.load("quadruped").Run(record_every=-1)
 
 
 def test_the_contract_check_names_what_is_missing():
     import types
     fake = types.SimpleNamespace(NAME="other", GAITS=("walk",), Params=object, SUMMARY_EXTRAS={"x": ("x_m",)},
-                                 simulate=lambda duration, gait="run": None)
+                                 Run=object, simulate=lambda duration, gait="run": None)
     problems = contract_problems("fake", fake)
     assert any("registered as 'fake'" in p for p in problems)
     assert any("lacks the keywords" in p for p in problems)
     assert any("WalkerParams" in p for p in problems)
+    assert any("WalkerRun" in p for p in problems)
     assert any("SUMMARY_EXTRAS['x']" in p for p in problems)
+    assert issubclass(walkers.load("ranger").Run, WalkerRun)

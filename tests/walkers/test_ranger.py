@@ -67,9 +67,9 @@ def test_double_stance_closed_loop(strategy):
     foot-ground. Pin residuals stay below 1e-9 m and the impulses carry exactly the weight.
     (With rolling arc soles the 10 rows are independent, rank 10 of 12 coordinates: each foot
     can still rock about its contact; the solver's dropped-row path is not needed here.)"""
-    rs = RangerSim(gait="stand", strategy=strategy)
-    traj = rs.run(3.0, record_every=1)
-    ws = rs.sim.ws
+    rs = RangerSim(gait="stand", strategy=strategy, record_every=1)
+    traj = rs.run(3.0)
+    ws = rs.ws
     J = np.zeros((ws.n_row[0], 3 * rs.model.n_body))
     for r in range(ws.n_row[0]):
         for e in range(2):
@@ -87,9 +87,9 @@ def test_double_stance_closed_loop(strategy):
 
 
 def test_stand_holds_30s():
-    rs = RangerSim(gait="stand")
-    h0 = hip_height(rs.sim.state.q)
-    traj = rs.run(30.0, record_every=100)
+    rs = RangerSim(gait="stand", record_every=100)
+    h0 = hip_height(rs.state.q)
+    traj = rs.run(30.0)
     assert not rs.fell and traj.t[-1] >= 30.0 - 1e-9
     assert np.abs(hip_height(traj.q) - h0).max() < 0.005
     settled = traj.t > 1.0
@@ -101,14 +101,14 @@ def test_stand_holds_30s():
 def walk_1000():
     """STAND for 2 s, then WALK through the Python API (the START phase) until 1000 steps (or a
     fall)."""
-    rs = RangerSim(gait="stand")
-    stand_q = rs.sim.state.q.copy()
-    rs.run(2.0, record_every=1000)
-    assert not rs.fell and np.abs(rs.sim.state.v).max() < 1e-3 and np.abs(rs.sim.state.q - stand_q).max() < 0.03
-    rs.controller.set_gait("walk")
+    rs = RangerSim(gait="stand", record_every=1000)
+    stand_q = rs.state.q.copy()
+    rs.run(2.0)
+    assert not rs.fell and np.abs(rs.state.v).max() < 1e-3 and np.abs(rs.state.q - stand_q).max() < 0.03
+    rs.set_gait("walk")
     x0 = rs.hip()[0]
-    while rs.steps < 1000 and not rs.fell and rs.sim.t < 1000.0:
-        rs.run(50.0, record_every=1000)
+    while rs.steps < 1000 and not rs.fell and rs.time < 1000.0:
+        rs.run(50.0)
     return rs, x0
 
 
@@ -125,7 +125,7 @@ def test_walk_1000_steps_from_standing(walk_1000):
     assert 0.2 < s["step_length"] < 0.6
     assert 0.3 < s["step_speed"] < 1.0
     # the push-off feedback keeps the mid-stance speed near its target over the last steps
-    log = rs.controller.steplog[rs.steps - 200:rs.steps]
+    log = rs.tables.steplog[rs.steps - 200:rs.steps]
     speed = np.diff(log[:, 1]) / np.diff(log[:, 0])
     assert np.std(speed) < 0.1 * np.mean(speed)
     # costs of transport: finite, positive, electrical above mechanical, total above both
@@ -137,17 +137,17 @@ def test_gui_tracks_targets_against_static_equilibrium():
     Python API. The settled joint angles must match the static equilibrium of PD current
     torque + parallel springs + gravity, solved here independently by Newton's method."""
     p = RangerParams()
-    rs = RangerSim(p, gait="gui", suspended=True)
+    rs = RangerSim(p, gait="gui", suspended=True, record_every=1000)
     c = rs.controller
     targets = (0.5, 0.3, -0.4)
     gains = ((15.0, 3.0), (4.0, 0.3), (6.0, 0.3))
     for j in range(3):
         c.set_gui(j, targets[j], *gains[j])
-    rs.run(30.0, record_every=1000)
-    q = rs.sim.state.q
+    rs.run(30.0)
+    q = rs.state.q
     # the whole assembly swinging on the frictionless stand pin is undamped; what is left of it
     # is tiny and the joints themselves (damped by the PD) have settled
-    assert np.abs(rs.sim.state.v).max() < 2e-3, "did not settle"
+    assert np.abs(rs.state.v).max() < 2e-3, "did not settle"
     g = 9.81
     gk = (p.hip_gear * p.torque_const, p.ankle_gear * p.torque_const)
     rest_a = p.ankle_spring_rest - p.ankle_offset
@@ -197,11 +197,11 @@ def touchdowns(mode, dt_frame, quiet=0.05):
 def test_estimator_switches_once_per_touchdown():
     """On a recorded walk the filtered estimator turns a foot 'on' at most once between two
     real touchdowns, and every 'on' follows a real touchdown within 60 ms."""
-    rs = RangerSim(gait="walk")
+    rs = RangerSim(gait="walk", record_every=1)
     # a fresh WALK run starts at rest in the STAND pose (and gets going through START)
-    assert np.array_equal(rs.sim.state.q, RangerSim(gait="stand").sim.state.q)
-    assert np.all(rs.sim.state.v == 0.0)
-    traj = rs.run(30.0, record_every=1)
+    assert np.array_equal(rs.state.q, RangerSim(gait="stand").state.q)
+    assert np.all(rs.state.v == 0.0)
+    traj = rs.run(30.0)
     assert not rs.fell and rs.steps > 30
     dtf = traj.t[1] - traj.t[0]
     raw_bounces = 0

@@ -140,7 +140,7 @@ def test_a_walker_divergence_names_the_body_and_field():
     w = Walker(record_every=1)
     w.run(0.2)
     w.state.ext_force[0, 0] = 1e16     # N: the hip's velocity leaves the guard's bound
-    with pytest.raises(ps.SimulationDiverged, match=r"simple biped diverged at step 200 .*body 'hip' \(0\) vx=") as e:
+    with pytest.raises(ps.SimulationDiverged, match=r"simple-biped diverged at step 200 .*body 'hip' \(0\) vx=") as e:
         w.run(0.1)
     assert e.value.step == 200 and e.value.body == "hip" and e.value.field == "vx"
     assert e.value.last_state.step[0] == 200

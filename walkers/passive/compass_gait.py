@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .gait import PassiveWalker, run_gait
+from walkers.base import simulation
+
 from .params import CompassParams
-from .simplest import slope_from_terrain
+from .run import GAITS, PassiveRun  # noqa: F401
 
 NAME = "compass-gait"
 SUMMARY_EXTRAS = {
@@ -20,7 +21,6 @@ SUMMARY_EXTRAS = {
     "steps": ("controller_steps", "touchdowns the rollout recorded"),
 }
 Params = CompassParams   # the walker's parameters (planarsim params compass-gait)
-GAITS = ("passive",)
 
 
 def default_start(p: CompassParams | None = None) -> np.ndarray:
@@ -30,14 +30,13 @@ def default_start(p: CompassParams | None = None) -> np.ndarray:
     return np.array([0.27081514, -1.09186744, 0.54163176, -0.71352648])
 
 
-def simulate(duration=10.0, gait="passive", terrain=None, dt=1e-3, seed=0, params=None,
-             x0=None, record_every=10, impacts="refined"):
-    """Walk down the slope. Returns (Trajectory, summary dict, Model); impacts: see
-    walkers.passive.gait.run_gait ("refined" or "engine")."""
-    if gait not in GAITS:
-        raise ValueError(f"{NAME}: unknown gait {gait!r}; gaits: {GAITS}")
-    p = params or CompassParams()
-    p = CompassParams(**{**p.as_dict(), "slope": slope_from_terrain(terrain, p.slope)})
-    walker = PassiveWalker(p, dt=dt)
-    traj, summary = run_gait(walker, default_start(p) if x0 is None else x0, duration, record_every, impacts)
-    return traj, summary, walker.model
+class Run(PassiveRun):
+    """The compass gait walking down its slope (walkers.passive.run.PassiveRun)."""
+    NAME = NAME
+    Params = CompassParams
+
+    def start(self, params):
+        return default_start(params)
+
+
+simulate = simulation(Run)

@@ -17,9 +17,9 @@ import math
 
 import numpy as np
 
-from planarsim.compiled import audit_counts, check_run, gap_of_point, step_from_python
+from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
-from planarsim.analysis import StepMap, StepMapError, frame_from_state, step_summary
+from planarsim.analysis import StepMap, StepMapError
 from planarsim.state import State
 from planarsim.trajectory import Trajectory, make_recorder
 
@@ -313,77 +313,3 @@ class PassiveWalker:
 
     def step_map(self) -> StepMap:
         return StepMap(self.advance, dim=len(self.names), names=self.names)
-
-
-def _concat(trajs):
-    """The recorded chunks joined (empty ones dropped; a run shorter than one recording
-    interval gives its empty first chunk; None when nothing was recorded)."""
-    kept = [t for t in trajs if t is not None]
-    if not kept:
-        return None
-    full = [t for t in kept if len(t)]
-    return Trajectory.concatenate(full) if full else kept[0]
-
-
-def run_gait(walker: PassiveWalker, x0, duration: float, record_every: int = 10,
-             impacts: str = "refined"):
-    """Walk from section state x0 for `duration` [s] with the compiled rollout, recording every
-    `record_every` steps. Returns (Trajectory, summary dict).
-
-    impacts : "refined" (default): every touchdown is located and resolved as in the step
-        map (refine_touchdown; one Python call per walking step); "engine": the engine's
-        contacts find the touchdowns on their own (continuous collision for point feet, the
-        "all" mode strategy releasing the trailing foot), the end-to-end path.
-    summary: steps (touchdowns), distance [m] (hip displacement along the slope), mean_speed
-    [m/s] (distance / duration), fell (bool), duration [s], and over whole steps, first to
-    last touchdown (planarsim.analysis.step_summary of the recorded touchdowns; NaN without
-    recording or with fewer than two touchdowns): whole_steps, step_period [s], step_length
-    [m] and speed [m/s] (centre of mass along the slope), cost_of_transport (energy lost per
-    weight and distance along the slope: sin(slope) on a steady gait)."""
-    if impacts not in ("refined", "engine"):
-        raise ValueError(f"impacts={impacts!r} must be 'refined' or 'engine'")
-    n = int(round(duration / walker.dt))
-    walker.set_coords(x0)
-    s = walker.sim.state
-    hip0 = s.q[walker.hip, :2].copy()
-    if impacts == "engine":
-        max_events = int(duration / 0.05) + 10
-        code, done, traj = walker.rollout(n, 1 << 60, record_every, max_events)
-        events = list(walker.event_time[:min(int(walker.memory[1]), walker.event_time.size)])
-    else:
-        trajs, events, code = [], [], NO_EVENT
-        toggle = walker.toggle
-        walker.toggle = DETECT
-        try:
-            s.contact_enabled[walker.feet] = 0
-            s.contact_enabled[walker.feet[walker.memory[0]]] = 1
-            while s.time[0] < duration - 0.5 * walker.dt:
-                old = int(walker.memory[0])
-                left = int(round((duration - s.time[0]) / walker.dt))
-                code, done, traj = walker.rollout(left, int(walker.memory[1]) + 1, record_every)
-                trajs.append(traj)
-                if code != 0:
-                    break
-                walker.refine_touchdown(old)
-                s.contact_enabled[walker.feet[old]] = 0
-                events.append(float(s.time[0]))
-                if record_every > 0:   # the touchdown itself, for the whole-step summary
-                    trajs.append(frame_from_state(walker.model, s, walker.sim.ws))
-        finally:
-            walker.toggle = toggle
-        traj = _concat(trajs)
-        if code == NO_EVENT:
-            code = 0
-    n_steps = len(events)
-    hip1 = s.q[walker.hip, :2]
-    distance = float((hip1 - hip0) @ walker.t_hat)
-    t_end = float(s.time[0])
-    whole = dict(whole_steps=0, step_period=math.nan, step_length=math.nan, speed=math.nan,
-                 cost_of_transport=math.nan)
-    if traj is not None and len(traj):
-        ws = step_summary(traj, walker.model, walker.feet, direction=walker.t_hat)
-        whole = {k: ws[k] for k in whole}
-    summary = dict(walker=walker.kind, impacts=impacts, steps=n_steps, distance=distance,
-                   mean_speed=distance / t_end if t_end > 0 else 0.0, fell=code == FELL,
-                   **whole, duration=t_end, code=int(code), audit=audit_counts(walker.sim.ws))
-    return traj, summary

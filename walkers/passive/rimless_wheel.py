@@ -3,10 +3,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .gait import PassiveWalker, run_gait
+from walkers.base import simulation
+
 from .params import RimlessParams
 from .reference import rimless_fixed_point
-from .simplest import slope_from_terrain
+from .run import GAITS, PassiveRun  # noqa: F401
 
 NAME = "rimless-wheel"
 SUMMARY_EXTRAS = {
@@ -15,7 +16,6 @@ SUMMARY_EXTRAS = {
     "steps": ("controller_steps", "touchdowns the rollout recorded"),
 }
 Params = RimlessParams   # the walker's parameters (planarsim params rimless-wheel)
-GAITS = ("passive",)
 
 
 def closed_form(p: RimlessParams) -> dict:
@@ -24,16 +24,13 @@ def closed_form(p: RimlessParams) -> dict:
                                p.hub_mass * p.hub_gyration ** 2, p.gravity)
 
 
-def simulate(duration=10.0, gait="passive", terrain=None, dt=1e-3, seed=0, params=None,
-             x0=None, record_every=10, impacts="refined"):
-    """Roll down the slope. Returns (Trajectory, summary dict, Model); impacts: see
-    walkers.passive.gait.run_gait ("refined" or "engine")."""
-    if gait not in GAITS:
-        raise ValueError(f"{NAME}: unknown gait {gait!r}; gaits: {GAITS}")
-    p = params or RimlessParams()
-    p = RimlessParams(**{**p.as_dict(), "slope": slope_from_terrain(terrain, p.slope)})
-    walker = PassiveWalker(p, dt=dt)
-    if x0 is None:
-        x0 = np.array([-closed_form(p)["omega_after"]])
-    traj, summary = run_gait(walker, x0, duration, record_every, impacts)
-    return traj, summary, walker.model
+class Run(PassiveRun):
+    """The rimless wheel rolling down its slope (walkers.passive.run.PassiveRun)."""
+    NAME = NAME
+    Params = RimlessParams
+
+    def start(self, params):
+        return np.array([-closed_form(params)["omega_after"]])
+
+
+simulate = simulation(Run)

@@ -13,7 +13,7 @@ from .controller import Controller, FootState, Gait  # noqa: E402
 from .model import LEG_NAMES, PAIR, build  # noqa: E402
 from .params import QuadrupedParams  # noqa: E402
 from .puppet import leg_fk, leg_ik, puppet_pose  # noqa: E402
-from .rollout import GAITS, Quadruped, live, rollout_quadruped, simulate  # noqa: E402
+from .rollout import GAITS, Quadruped, Run, live, rollout_quadruped, simulate  # noqa: E402
 
 NAME = "quadruped"
 FEET = (("FL_foot", "RR_foot"), ("FR_foot", "RL_foot"))   # a trot: diagonal pairs land together
@@ -27,6 +27,6 @@ SUMMARY_EXTRAS = {
 }
 Params = QuadrupedParams   # the walker's parameters (planarsim params quadruped)
 
-__all__ = ["NAME", "GAITS", "simulate", "Quadruped", "QuadrupedParams", "Controller", "Gait",
+__all__ = ["NAME", "GAITS", "simulate", "Run", "Quadruped", "QuadrupedParams", "Controller", "Gait",
            "FootState", "build", "leg_fk", "leg_ik", "puppet_pose", "rollout_quadruped",
            "LEG_NAMES", "PAIR", "live"]

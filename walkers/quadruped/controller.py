@@ -238,8 +238,8 @@ def stance_forces(s, p, mem, xc):
 
 
 @jit_inline
-def control(m, s, p, mem, u):
-    """One control tick: fall monitor, the 30 Hz foot update, puppet feet, puppet pose (IK),
+def control(m, s, ws, p, mem, u):
+    """One control tick (p: the parameter vector, the quadruped's table): fall monitor, the 30 Hz foot update, puppet feet, puppet pose (IK),
     PD + weight feed-forward into u (n_act,) [N m]. Pin/actuator j = 2 leg + (0 hip, 1 knee)."""
     t, dt = s.time[0], m.dt
     tx, ty, th = s.q[0, 0], s.q[0, 1], s.q[0, 2]
@@ -330,7 +330,7 @@ class Controller:
                                   self.params.speed if speed is None else float(speed))
 
     def __call__(self, sim):
-        control(self.model.arrays, sim.state, self.p, self.memory, self.u)
+        control(self.model.arrays, sim.state, sim.ws, self.p, self.memory, self.u)
         return self.u
 
 

@@ -1,4 +1,5 @@
-"""Compiled rollout of the quadruped and its Python front end (``Quadruped``, ``simulate``).
+"""Compiled rollout of the quadruped and its run class (``Quadruped``, a walkers.base.WalkerRun;
+``simulate``).
 
 ``rollout_quadruped`` runs physics + controller + recording + fall monitor without returning
 to Python; it stops after the step where the robot fell (torso below fall_height or pitched
@@ -16,11 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from planarsim.compiled import (RUN_FELL, audit_counts, check_run, jit, record_frame, step,
-                                make_recorder)
+from planarsim.compiled import RUN_FELL, jit, record_frame, step
 import planarsim as ps
-from planarsim.state import make_workspace
-from planarsim.trajectory import Trajectory
+
+from walkers.base import WalkerRun, simulation, terrain_of
 
 from . import controller as C
 from .model import build
@@ -39,7 +39,7 @@ def rollout_quadruped(m, s, ws, opt, p, mem, u, n, every, rec, lab, slots, k0):
     k0. Returns (run code, steps done, next frame): RUN_OK, an engine failure or RUN_FELL."""
     k = k0
     for i in range(n):
-        C.control(m, s, p, mem, u)
+        C.control(m, s, ws, p, mem, u)
         if mem[C.M_FELL] != 0.0:
             return RUN_FELL, i, k
         code = step(m, s, ws, opt, u)
@@ -53,8 +53,9 @@ def rollout_quadruped(m, s, ws, opt, p, mem, u, n, every, rec, lab, slots, k0):
     return 0, n, k
 
 
-class Quadruped:
-    """The robot dog in the world: model, state, controller memory, recorded history.
+class Quadruped(WalkerRun):
+    """The robot dog in the world (a WalkerRun): model, state, controller memory, chunks. Its
+    controller table is the parameter vector (params.to_array(), indices I_<FIELD>).
 
     Parameters
     ----------
@@ -67,26 +68,23 @@ class Quadruped:
     seed : 0 starts from the exact standing pose; others shift the torso height by < 5 mm
     """
 
+    NAME = "quadruped"
+    LABELS = LABELS
+    FELL_SLOT = C.M_FELL
+
     def __init__(self, params=None, terrain=None, dt=1e-3, gait="walk", speed=None,
                  strategy="all", record_every=10, seed=0):
-        self.params = params if params is not None else QuadrupedParams()
-        if isinstance(terrain, str):
-            terrain = ps.terrain.parse(terrain)
-        self.model = build(self.params, terrain, dt)
-        self.state = ps.make_state(self.model)
+        params = params if params is not None else QuadrupedParams()
+        model = build(params, terrain_of(terrain), dt)
+        state = ps.make_state(model)
         if seed:
-            lift = 0.005 * np.random.default_rng(seed).uniform()
-            self.state.q[:, 1] += lift
-        self.ws = make_workspace(self.model)
-        self.options = ps.make_options(strategy)
-        self.p = self.params.to_array()
-        self.memory = C.make_memory(self.model, self.params, C.gait_id(gait),
-                                    self.params.speed if speed is None else float(speed))
-        self.memory[C.M_TARGET + 1:C.M_TARGET + 8:2] += self.state.q[0, 1] - self.model.q0[0, 1]
-        self.u = np.zeros(self.model.n_act)
-        self.record_every = int(record_every)
+            state.q[:, 1] += 0.005 * np.random.default_rng(seed).uniform()
+        memory = C.make_memory(model, params, C.gait_id(gait),
+                               params.speed if speed is None else float(speed))
+        memory[C.M_TARGET + 1:C.M_TARGET + 8:2] += state.q[0, 1] - model.q0[0, 1]
+        super().__init__(model, params, params.to_array(), memory, state=state,
+                         options=ps.make_options(strategy), record_every=record_every)
         self.x_start = float(self.state.q[0, 0])
-        self._chunks = []
 
     def set_gait(self, gait, speed=None) -> None:
         """Switch gait ("stand" | "piaffe" | "walk") and optionally the speed [m/s] at run time."""
@@ -95,37 +93,21 @@ class Quadruped:
             self.memory[C.M_SPEED] = float(speed)
 
     @property
-    def fell(self) -> bool:
-        return bool(self.memory[C.M_FELL])
+    def p(self) -> np.ndarray:
+        """The parameter vector the controller reads (its table)."""
+        return self.tables
 
-    def run(self, seconds: float) -> Trajectory:
-        """Advance `seconds` [s] (stops early on a fall); return this chunk's Trajectory."""
-        if not seconds >= 0:
-            raise ValueError(f"seconds={seconds} must be >= 0")
-        n = int(round(float(seconds) / self.model.dt))
-        every = self.record_every
-        rec = make_recorder(self.model, n // every + 1)
-        lab = np.zeros((n // every + 1, len(LABELS)))
-        code, done, k = rollout_quadruped(self.model.arrays, self.state, self.ws, self.options, self.p,
-                                          self.memory, self.u, n, every, rec, lab, LABEL_SLOTS, 0)
-        check_run(code, self.model, self.ws, self.options, "quadruped")
-        traj = Trajectory.from_recorder(self.model, rec, k,
-                                        labels={nm: lab[:k, j].copy() for j, nm in enumerate(LABELS)},
-                                        info={"dt": self.model.dt, "walker": "quadruped"})
-        self._chunks.append(traj)
-        return traj
+    def advance(self, n, every, rec, lab):
+        code, done, k = rollout_quadruped(self.model.arrays, self.state, self.ws, self.options,
+                                          self.tables, self.memory, self.u, n, every, rec, lab,
+                                          LABEL_SLOTS, 0)
+        return code, k
 
-    def trajectory(self) -> Trajectory:
-        """All chunks run so far, joined."""
-        if not self._chunks:
-            return Trajectory.from_recorder(self.model, make_recorder(self.model, 0), 0)
-        return Trajectory.concatenate(self._chunks)
-
-    def summary(self) -> dict:
+    def numbers(self) -> dict:
         """distance [m] and mean_speed [m/s] of the torso since the start, steps (pair
         plantings), fell, max_pitch [deg], ik_clamps (control ticks with a clamped leg),
         cost_of_transport = positive motor work / (m g |distance|) (NaN below 0.1 m)."""
-        t = float(self.state.time[0])
+        t = self.time
         dist = float(self.state.q[0, 0]) - self.x_start
         weight = float(self.memory[C.M_WEIGHT])
         cot = float(self.memory[C.M_WORK]) / (weight * abs(dist)) if abs(dist) >= 0.1 else float("nan")
@@ -135,18 +117,11 @@ class Quadruped:
                 "ik_clamps": int(self.memory[C.M_IK_CLAMPS]),
                 "motor_work_positive": float(self.memory[C.M_WORK]), "cost_of_transport": cot,
                 "gait": C.Gait(int(self.memory[C.M_GAIT])).name.lower(),
-                "speed_command": float(C.command_speed(self.memory)),
-                "audit": audit_counts(self.ws)}
+                "speed_command": float(C.command_speed(self.memory))}
 
 
-def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=None, params=None,
-             strategy="all", record_every=10):
-    """Run the quadruped from standing for `duration` [s] in `gait` ("stand" | "piaffe" | "walk")
-    at the commanded `speed` [m/s] (walk only; default params.speed, 0.3). Returns
-    (Trajectory, summary dict, Model)."""
-    q = Quadruped(params, terrain, dt, gait, speed, strategy, record_every, seed)
-    q.run(duration)
-    return q.trajectory(), q.summary(), q.model
+Run = Quadruped
+simulate = simulation(Quadruped)
 
 
 def live(gait="piaffe", terrain=None, speed=None, params=None, strategy="all") -> dict:
@@ -154,9 +129,7 @@ def live(gait="piaffe", terrain=None, speed=None, params=None, strategy="all") -
     the Python-path Controller, keys w / p / s for walk / piaffe / stand, sliders for the
     commanded speed [m/s] and the servo stiffness kp [N m/rad]."""
     params = params if params is not None else QuadrupedParams()
-    if isinstance(terrain, str):
-        terrain = ps.terrain.parse(terrain)
-    model = build(params, terrain)
+    model = build(params, terrain_of(terrain))
     sim = ps.Simulator(model, ps.make_options(strategy))
     ctrl = C.Controller(model, params, gait, speed)
     mem = ctrl.memory

@@ -56,8 +56,8 @@ _drop_caches()
 from .params import RangerParams  # noqa: E402
 from .model import build  # noqa: E402
 from .controller import Controller  # noqa: E402
-from .tables import Gait, Phase, Program  # noqa: E402
-from .rollout import GAITS, RangerSim, instantaneous_cot, live, simulate  # noqa: E402
+from .tables import Gait, Phase, Program, Tables, make_tables  # noqa: E402
+from .rollout import GAITS, RangerSim, Run, instantaneous_cot, live, simulate  # noqa: E402
 
 NAME = "ranger"
 SUMMARY_EXTRAS = {
@@ -71,5 +71,5 @@ SUMMARY_EXTRAS = {
 }
 Params = RangerParams   # the walker's parameters (planarsim params ranger)
 
-__all__ = ["NAME", "GAITS", "simulate", "RangerParams", "build", "Controller", "Gait", "Phase",
+__all__ = ["NAME", "GAITS", "simulate", "Run", "RangerParams", "build", "Controller", "Tables", "make_tables", "Gait", "Phase",
            "Program", "RangerSim", "instantaneous_cot", "live"]

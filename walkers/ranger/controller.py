@@ -37,7 +37,7 @@ import numpy as np
 from planarsim.compiled import jit_inline, kernel, pin_angle_rate, height as terrain_height
 
 from .estimator import filter_step, hysteresis
-from .motor import drive_motor, motor_table, torque_constant
+from .motor import drive_motor, torque_constant
 from .params import RangerParams
 
 
@@ -51,7 +51,7 @@ from .tables import (
     M_PUSH_I, M_RAW, M_SIG, M_STANCE, M_STEPS, M_TOUCH, M_T_STRIKE, M_V_MID, N_LOG,
     PC_FRAME, PC_IFF, PC_KD, PC_KP, PC_TARGET, PH_DOUBLE, PH_FLIGHT, PH_SINGLE, PH_STANDING,
     PH_START, PR_FLIP, PR_GUI, PR_HOLD, PR_KEEP, PR_LAND, PR_OFF, PR_PUSH, PR_STAND, PR_SWING,
-    make_constants, make_gui, make_memory, make_programs, set_standing_estimator)
+    make_memory, make_tables, set_standing_estimator)
 
 
 # --------------------------------------------------------------------------------------------
@@ -231,9 +231,14 @@ def air_current(s, k, mp, foot, err, derr):
 
 
 @jit_inline
-def control_ranger(m, s, ws, k, prog, motor, mem, gui, steplog, u):
+def control(m, s, ws, tab, mem, u):
     """One control step: estimator, FSM, motor programs, motor model -> u (torques [N m]).
-    Also integrates electrical and mechanical energy and logs each heel strike."""
+    Also integrates electrical and mechanical energy and logs each heel strike (tab.steplog)."""
+    k = tab.k
+    prog = tab.prog
+    motor = tab.motor
+    gui = tab.gui
+    steplog = tab.steplog
     update_estimator(m, s, ws, k, mem)
     gait = int(mem[M_GAIT])
     steps_before = mem[M_STEPS]
@@ -309,25 +314,23 @@ class Controller:
     ``Controller(params, dt)``; ``set_gait("walk"|"stand"|"gui")``; ``set_gui(joint, target,
     kp, kd)`` (joint 0 hip, 1 outer ankle, 2 inner ankle; REL pin angles [rad], gains [A/rad],
     [A s/rad]); ``__call__(sim) -> u`` runs one control step on a Simulator (the Python path).
+    ``reset`` refills the memory in place (a run holding it sees the new values).
     """
 
     GAITS = {"walk": GAIT_WALK, "stand": GAIT_STAND, "gui": GAIT_GUI}
 
     def __init__(self, params: RangerParams | None = None, dt: float = 1e-3, max_steps: int = 20000):
         self.params = params if params is not None else RangerParams()
-        self.k = make_constants(self.params, dt)
-        self.prog = make_programs(self.params)
-        self.motor = motor_table(self.params)
-        self.gui = make_gui(self.params)
-        self.steplog = np.zeros((max_steps, N_LOG))
+        self.tables = make_tables(self.params, dt, max_steps)
+        self.mem = make_memory()
         self.reset()
 
     def reset(self, gait: str = "walk") -> None:
-        self.mem = make_memory(self._gait_id(gait))
-        set_standing_estimator(self.mem, self.k)      # every run starts standing at rest
+        self.mem[:] = make_memory(self._gait_id(gait))
+        set_standing_estimator(self.mem, self.tables.k)      # every run starts standing at rest
         p = self.params
         self.mem[M_PUSH_I] = min(p.push_current + p.push_gain * p.target_speed, p.current_max)
-        self.steplog[:] = 0.0
+        self.tables.steplog[:] = 0.0
 
     def _gait_id(self, gait) -> int:
         if isinstance(gait, str):
@@ -342,14 +345,14 @@ class Controller:
     def set_gui(self, joint: int, target: float, kp: float | None = None, kd: float | None = None) -> None:
         if joint not in (0, 1, 2):
             raise ValueError(f"GUI joint {joint!r} must be 0 (hip), 1 (outer ankle) or 2 (inner ankle)")
-        self.gui[joint, 0] = float(target)
+        gui = self.tables.gui
+        gui[joint, 0] = float(target)
         if kp is not None:
-            self.gui[joint, 1] = float(kp)
+            gui[joint, 1] = float(kp)
         if kd is not None:
-            self.gui[joint, 2] = float(kd)
+            gui[joint, 2] = float(kd)
 
     def __call__(self, sim) -> np.ndarray:
         u = np.zeros(3)
-        control_ranger(sim.model.arrays, sim.state, sim.ws, self.k, self.prog, self.motor, self.mem,
-                       self.gui, self.steplog, u)
+        control(sim.model.arrays, sim.state, sim.ws, self.tables, self.mem, u)
         return u

@@ -4,7 +4,7 @@ Section: the controller's own mid-stance event (controller.choose_programs: the 
 passes vertical in single stance, M_MID_DONE 0 -> 1, and the step-to-step feedback sets this
 step's push-off current M_PUSH_I from the hip speed, i.e. the memory that would carry the
 previous step over is rewritten from the state here). The section state is the simulation
-just BEFORE the ``control_ranger`` call that fires the event: State, the last step's contact
+just BEFORE the ``control`` call that fires the event: State, the last step's contact
 impulses (the estimator's input), and the controller memory before that call (so replaying the
 call runs the estimator filter exactly once). The other memory that carries over is the state of
 the contact estimator's Butterworth filters (2 per foot): part of the section coordinates.
@@ -65,8 +65,8 @@ CROSS_TOL = 0.02   # [rad] a counted mid-stance has the stance leg within this o
 
 
 @jit
-def rollout_to_midstance(m, s, ws, opt, k, prog, motor, mem, mem_before, gui, steplog, u,
-                         side, cross_tol, n_events, max_steps):
+def rollout_to_midstance(m, s, ws, opt, tab, mem, mem_before, u, side, cross_tol, n_events,
+                         max_steps):
     """Control + physics until the controller's mid-stance event has fired n_events times with
     leg `side` in stance and that leg within cross_tol [rad] of vertical (a true crossing: the
     event also fires when a landing foot's bounce makes the estimator swap the stance to the
@@ -78,7 +78,7 @@ def rollout_to_midstance(m, s, ws, opt, k, prog, motor, mem, mem_before, gui, st
     for i in range(max_steps):
         for j in range(mem.shape[0]):
             mem_before[j] = mem[j]
-        C.control_ranger(m, s, ws, k, prog, motor, mem, gui, steplog, u)
+        C.control(m, s, ws, tab, mem, u)
         st = int(mem[C.M_STANCE])
         if (mem_before[C.M_MID_DONE] == 0.0 and mem[C.M_MID_DONE] == 1.0 and st == side
                 and int(mem_before[C.M_STANCE]) == side and s.q[st, 2] > -cross_tol):
@@ -113,22 +113,20 @@ class RangerGaitMap(GaitMapMixin):
         self.rs = rs = RangerSim(params, dt=dt, gait="walk", max_steps=16)
         self.model = rs.model
         self.m = rs.model.arrays
-        c = rs.controller
-        self.tables = (c.k, c.prog, c.motor)
-        self.gui, self.steplog = c.gui, np.zeros((16, C.N_LOG))
-        self.mem_before = np.zeros_like(c.mem)
+        self.tables = rs.tables._replace(steplog=np.zeros((16, C.N_LOG)))
+        self.mem_before = np.zeros_like(rs.memory)
         self.max_steps = int(round(3.0 / dt))
         self.stance = int(stance)
         if self.stance not in (0, 1):
             raise ValueError(f"stance={stance} must be 0 (outer legs) or 1 (inner legs)")
-        s, ws = rs.sim.state, rs.sim.ws
-        code, _ = self._rollout(s, ws, c.mem, 10 ** 9, int(round(settle / dt)))
+        s, ws, mem = rs.state, rs.ws, rs.memory
+        code, _ = self._rollout(s, ws, mem, 10 ** 9, int(round(settle / dt)))
         if code not in (RUN_OK, RUN_NO_EVENT):
             raise StepMapError(f"Ranger failed while settling (code {code})")
-        self._run(s, ws, c.mem, 1)
-        self.state0, self.ws0, self.mem0 = s.copy(), copy_tuple(ws), c.mem.copy()
+        self._run(s, ws, mem, 1)
+        self.state0, self.ws0, self.mem0 = s.copy(), copy_tuple(ws), mem.copy()
         self.x0 = self.coords(self.state0, self.mem0)
-        self.s, self.ws, self.mem = s.copy(), copy_tuple(ws), c.mem.copy()
+        self.s, self.ws, self.mem = s.copy(), copy_tuple(ws), mem.copy()
         # sole geometry of the stance foot (rolling perturbations) and the reference chain
         ci = self.stance                      # contact i sits on foot i (model.build order)
         a = self.m
@@ -138,15 +136,13 @@ class RangerGaitMap(GaitMapMixin):
         self.sole_radius = float(a.contact_radius[ci])
 
     def _rollout(self, s, ws, mem, n_events, max_steps):
-        k, prog, motor = self.tables
-        return rollout_to_midstance(self.m, s, ws, self.rs.sim.options, k, prog, motor, mem, self.mem_before,
-                                    self.gui, self.steplog, self.rs.u, self.stance, CROSS_TOL, n_events,
-                                    max_steps)
+        return rollout_to_midstance(self.m, s, ws, self.rs.options, self.tables, mem, self.mem_before,
+                                    self.rs.u, self.stance, CROSS_TOL, n_events, max_steps)
 
     def _run(self, s, ws, mem, n_events):
         code, n = self._rollout(s, ws, mem, n_events, self.max_steps)
         # an engine failure raises (it is not a fall of the walker)
-        check_run(code, self.rs.model, ws, self.rs.sim.options, "Ranger step map")
+        check_run(code, self.rs.model, ws, self.rs.options, "Ranger step map")
         if code != 0:
             what = {RUN_FELL: "fell", RUN_NO_EVENT: "no mid-stance"}[code]
             raise StepMapError(f"Ranger step map: {what} (t={s.time[0]:.3f} s)")
@@ -154,10 +150,9 @@ class RangerGaitMap(GaitMapMixin):
 
     def _step_once(self, s, ws, mem):
         """Get past a section state (one control + physics step) without stopping at it."""
-        k, prog, motor = self.tables
-        C.control_ranger(self.m, s, ws, k, prog, motor, mem, self.gui, self.steplog, self.rs.u)
-        check_run(step_entry(self.m, s, ws, self.rs.sim.options, self.rs.u), self.rs.model, ws,
-                  self.rs.sim.options, "Ranger step map")
+        C.control(self.m, s, ws, self.tables, mem, self.rs.u)
+        check_run(step_entry(self.m, s, ws, self.rs.options, self.rs.u), self.rs.model, ws,
+                  self.rs.options, "Ranger step map")
 
     # coordinates ---------------------------------------------------------------------------------
     def coords(self, s, mem) -> np.ndarray:

@@ -1,15 +1,18 @@
 """Ranger controller data: FSM enums, the index layout of the constant vector k, of the
 controller memory mem and of the motor-program table, and the functions that fill them from
-RangerParams. The compiled controller (controller.py) reads these module-level integers.
+RangerParams (make_tables: all of them as one Tables). The compiled controller (controller.py)
+reads these module-level integers.
 """
 from __future__ import annotations
 
 from enum import IntEnum
+from typing import NamedTuple
 
 import numpy as np
 
 from .estimator import butterworth2
 from .model import foot_inertia_com
+from .motor import motor_table
 from .params import RangerParams
 
 
@@ -142,3 +145,18 @@ def make_gui(p: RangerParams) -> np.ndarray:
     g[1, 0] = -p.stand_rear_angle
     g[2, 0] = -p.stand_front_angle
     return g
+
+
+class Tables(NamedTuple):
+    """What the compiled controller reads, as one argument (and the step log it writes)."""
+    k: np.ndarray         # (N_K,) constants, indices K_*
+    prog: np.ndarray      # (N_PROG, 5) motor programs, columns PC_*
+    motor: np.ndarray     # (3, MOTOR_NPARAM) motor rows: hip, outer ankle, inner ankle
+    gui: np.ndarray       # (3, 3) GUI joint target [rad], kp [A/rad], kd [A s/rad] (set at run time)
+    steplog: np.ndarray   # (max_steps, N_LOG) one row per heel strike, written by the controller
+
+
+def make_tables(p: RangerParams, dt: float, max_steps: int = 20000) -> Tables:
+    """RangerParams and the step length dt [s] -> Tables, with room to log max_steps steps."""
+    return Tables(k=make_constants(p, dt), prog=make_programs(p), motor=motor_table(p),
+                  gui=make_gui(p), steplog=np.zeros((int(max_steps), N_LOG)))

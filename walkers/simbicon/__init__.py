@@ -8,7 +8,7 @@ drop_stale_caches(__path__[0])
 from .params import SimbiconParams, THESIS  # noqa: E402
 from .model import build  # noqa: E402
 from .controller import Controller, Phase  # noqa: E402
-from .rollout import live, run, simulate  # noqa: E402
+from .rollout import GAITS, Run, SimbiconRun, live, run, simulate  # noqa: E402
 
 NAME = "simbicon"
 SUMMARY_EXTRAS = {
@@ -20,6 +20,5 @@ SUMMARY_EXTRAS = {
     "steps": ("controller_steps", "swing-foot strikes counted by the controller"),
 }
 Params = SimbiconParams   # the walker's parameters (planarsim params simbicon)
-GAITS = ("walk",)
 
-__all__ = ["NAME", "GAITS", "simulate", "run", "live", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]
+__all__ = ["NAME", "GAITS", "simulate", "Run", "SimbiconRun", "run", "live", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]

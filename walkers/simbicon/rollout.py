@@ -1,4 +1,5 @@
-"""Compiled rollout of the SIMBICON biped and the Python ``simulate`` entry point.
+"""Compiled rollout of the SIMBICON biped, its run class (``SimbiconRun``, a
+walkers.base.WalkerRun), ``simulate`` and the tuning entry point ``run``.
 
 ``rollout_simbicon`` runs physics + controller + recording + a torso push without returning to
 Python. A push is (fx [N], fy [N], start [s], duration [s]) applied at the torso COM through
@@ -9,15 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
-import planarsim as ps
 from planarsim import Simulator, make_options
-from planarsim.compiled import (RUN_FELL, RUN_NONFINITE, RUN_TOO_LARGE, RUN_WALKER, audit_counts,
-                                check_run,
-                                jit, record_frame, step, height, make_recorder)
-from planarsim.trajectory import Trajectory
+from planarsim.compiled import (RUN_FELL, RUN_NONFINITE, RUN_TOO_LARGE, RUN_WALKER, jit, record_frame,
+                                step, height)
 
-from .controller import (M_EFFORT, M_FELL, M_PHASE, M_STRIKES, M_TIMEOUTS, Phase, control, make_memory,
-                         make_tables)
+from walkers.base import WalkerRun, simulation, terrain_of
+
+from .controller import (M_EFFORT, M_FELL, M_GLITCH, M_PHASE, M_STRIKES, M_TIMEOUTS, Phase, control,
+                         make_memory, make_tables)
 from .model import build, non_foot_clearance, start_state
 from .params import SimbiconParams
 
@@ -26,6 +26,7 @@ GLITCH = RUN_WALKER + 2  # rollout return code: the torso moved faster than a wa
 STRATEGY = "all"   # engine contact-mode strategy (see the report: "alternating" hits its cap often with box feet)
 GLITCH_SPEED = 10.0   # [m/s] torso COM speed taken as a solver glitch
 GLITCH_SPIN = 30.0    # [rad/s] torso angular speed taken as a solver glitch
+GAITS = ("walk",)
 
 
 @jit
@@ -77,74 +78,100 @@ def _push_array(push):
     return arr
 
 
+class SimbiconRun(WalkerRun):
+    """The SIMBICON biped in the world (a WalkerRun), from the standing start pose.
+
+    Parameters
+    ----------
+    params : SimbiconParams (defaults if None)
+    terrain : planarsim.terrain.Terrain or spec string (flat if None)
+    dt : step size [s]
+    gait : "walk" (its only gait)
+    push : None | (fx [N], start [s], duration [s]) | dict(force=fx or (fx, fy), start=, duration=):
+           a push at the torso COM, by absolute time (chunked runs push at the same instant)
+    seed : accepted for the common interface (the walker is deterministic)
+    record_every : steps between recorded frames (0: none, and no min_clearance)
+    strategy : engine contact-mode strategy
+    glitch_ok : an engine divergence ends the run as a glitch (a fall) instead of raising
+    model : a model built already (build(params, terrain, dt)), to skip the build
+    """
+
+    NAME = "simbicon"
+    FELL_SLOT = M_FELL
+
+    def __init__(self, params: SimbiconParams | None = None, terrain=None, dt=1e-3, gait="walk",
+                 push=None, seed=0, record_every=10, strategy: str = STRATEGY, glitch_ok: bool = True,
+                 model=None):
+        if gait not in GAITS:
+            raise ValueError(f"simbicon gait {gait!r} unknown; gaits: {GAITS}")
+        params = params if params is not None else SimbiconParams()
+        model = model if model is not None else build(params, terrain_of(terrain), dt)
+        super().__init__(model, params, make_tables(params, model), make_memory(),
+                         state=start_state(model, params.start_lean, params.start_speed),
+                         options=make_options(strategy), record_every=record_every)
+        self.push = _push_array(push)
+        self.glitch_ok = bool(glitch_ok)
+        self.x_start = float(self.state.q[self.tables.torso, 0])
+
+    def advance(self, n, every, rec, lab):
+        code, done, k = rollout_simbicon(self.model.arrays, self.state, self.ws, self.options, self.tables,
+                                         self.memory, self.u, n, every, rec, 0, self.push)
+        return code, k
+
+    def stopped(self, code: int) -> int:
+        """A state that blew up in the last step is a solver glitch when glitch_ok (for tuning,
+        a lost run): the state before that step is kept. A glitch is a fall."""
+        if code in (RUN_NONFINITE, RUN_TOO_LARGE) and self.glitch_ok:
+            code = GLITCH
+            self.state.restore(self.ws.prev)
+        if code == GLITCH:
+            self.memory[M_FELL] = 1.0
+            self.memory[M_GLITCH] = 1.0
+        return code
+
+    def numbers(self) -> dict:
+        """distance [m] (torso x), speed [m/s] (distance / simulated time), steps (swing-foot
+        strikes), timeouts (states ended by the timeout), fell (torso came down, a glitch, or a
+        non-foot part touched the ground), time [s] simulated, effort [N^2 m^2 s] (integral of
+        the sum of squared applied torques), min_clearance [m] (lowest non-foot part above the
+        ground, when recorded)."""
+        mem = self.memory
+        t = self.time
+        out = dict(distance=float(self.state.q[self.tables.torso, 0] - self.x_start), time=t,
+                   steps=int(mem[M_STRIKES]), timeouts=int(mem[M_TIMEOUTS]), fell=self.fell,
+                   glitch=bool(mem[M_GLITCH]), phase=int(mem[M_PHASE]), effort=float(mem[M_EFFORT]))
+        out["speed"] = out["distance"] / t if t > 0 else 0.0
+        if self.record_every:
+            traj = self.trajectory()
+            clearance = float(non_foot_clearance(self.model, traj.q).min()) if len(traj) else np.inf
+            out["min_clearance"] = clearance
+            out["fell"] = out["fell"] or clearance < 0.0
+        return out
+
+
+Run = SimbiconRun
+simulate = simulation(SimbiconRun)
+
+
 def run(params: SimbiconParams, duration: float, terrain=None, dt=1e-3, push=None,
         record_every: int = 10, model=None, record: bool = True, strategy: str = STRATEGY,
         glitch_ok: bool = True):
-    """Compiled rollout from the standing start pose. With glitch_ok (default) an engine
-    divergence (SimulationDiverged) ends the run as a glitch instead of raising.
-
-    Returns (Trajectory or None, summary dict, model). summary: distance [m] (torso x), speed
-    [m/s] (distance / simulated time), steps (swing-foot strikes), timeouts (contact states
-    ended by the timeout), fell (torso came down or a non-foot part touched the ground),
-    time [s] simulated, effort [N^2 m^2 s] (integral of the sum of squared applied torques),
-    min_clearance [m] (lowest non-foot part above the ground, when recorded).
-    """
-    model = model if model is not None else build(params, terrain, dt)
-    sim = Simulator(model, make_options(strategy), state=start_state(model, params.start_lean,
-                                                                             params.start_speed))
-    tab = make_tables(params, model)
-    mem = make_memory()
-    u = np.zeros(model.n_act)
-    n = int(round(duration / model.dt))
-    every = int(record_every) if record else n + 1
-    rec = make_recorder(model, n // every + 1 if record else 0)
-    x0 = float(sim.state.q[tab.torso, 0])
-    code, done, k = rollout_simbicon(model.arrays, sim.state, sim.ws, sim.options, tab, mem, u, n,
-                                     every, rec, 0, _push_array(push))
-    if code in (RUN_NONFINITE, RUN_TOO_LARGE) and glitch_ok:
-        # the state blew up in the last step: a solver glitch (for tuning, a lost run)
-        code = GLITCH
-        sim.state.restore(sim.ws.prev)
-    check_run(code, model, sim.ws, sim.options, "simbicon")   # any other engine failure raises
-    t = float(sim.state.time[0])
-    summary = dict(distance=float(sim.state.q[tab.torso, 0] - x0), time=t,
-                   steps=int(mem[M_STRIKES]), timeouts=int(mem[M_TIMEOUTS]),
-                   fell=bool(code in (FELL, GLITCH)), glitch=bool(code == GLITCH),
-                   phase=int(mem[M_PHASE]), audit=audit_counts(sim.ws),
-                   effort=float(mem[M_EFFORT]))
-    summary["speed"] = summary["distance"] / t if t > 0 else 0.0
-    traj = None
-    if record:
-        traj = Trajectory.from_recorder(model, rec, k, info={"dt": model.dt, "walker": "simbicon"})
-        clearance = float(non_foot_clearance(model, traj.q).min()) if k else np.inf
-        summary["min_clearance"] = clearance
-        summary["fell"] = summary["fell"] or clearance < 0.0
-    return traj, summary, model
-
-
-def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, push=None, params=None,
-             record_every=10):
-    """Uniform walker entry point: (Trajectory, summary, model). The walker is deterministic;
-    `seed` is accepted for the common interface and recorded in the trajectory info."""
-    if gait != "walk":
-        raise ValueError(f"simbicon gait {gait!r} unknown; gaits: ('walk',)")
-    params = params if params is not None else SimbiconParams()
-    traj, summary, model = run(params, duration, terrain=terrain, dt=dt, push=push,
-                               record_every=record_every)
-    traj.info["seed"] = seed
-    return traj, summary, model
+    """A SimbiconRun of `duration` [s] (tuning's entry point; record=False records nothing).
+    Returns (Trajectory or None, summary dict, model); see SimbiconRun.numbers for the keys."""
+    r = SimbiconRun(params, terrain, dt, push=push, record_every=record_every if record else 0,
+                    strategy=strategy, glitch_ok=glitch_ok, model=model)
+    r.run(duration)
+    return (r.trajectory() if record else None), r.summary(), r.model
 
 
 def live(gait="walk", terrain=None, params=None) -> dict:
     """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator from
     the standing start and the compiled controller called from Python each step; a slider
     pushes the torso [N] (hold it to push)."""
-    if gait != "walk":
-        raise ValueError(f"simbicon gait {gait!r} unknown; gaits: ('walk',)")
+    if gait not in GAITS:
+        raise ValueError(f"simbicon gait {gait!r} unknown; gaits: {GAITS}")
     params = params if params is not None else SimbiconParams()
-    if isinstance(terrain, str):
-        terrain = ps.terrain.parse(terrain)
-    model = build(params, terrain)
+    model = build(params, terrain_of(terrain))
     sim = Simulator(model, make_options(STRATEGY),
                     state=start_state(model, params.start_lean, params.start_speed))
     tab, mem, u = make_tables(params, model), make_memory(), np.zeros(model.n_act)

@@ -8,10 +8,10 @@ from planarsim.compiled import drop_stale_caches
 
 drop_stale_caches(__path__[0])
 
-from .controller import Gait, State  # noqa: E402
+from .controller import Gait, State, Tables, make_tables  # noqa: E402
 from .model import build  # noqa: E402
 from .params import SimpleBipedParams  # noqa: E402
-from .rollout import Walker, live, rollout_simple_biped, simulate  # noqa: E402
+from .rollout import Run, Walker, live, rollout_simple_biped, simulate  # noqa: E402
 
 NAME = "simple-biped"
 SUMMARY_EXTRAS = {
@@ -26,5 +26,5 @@ SUMMARY_EXTRAS = {
 Params = SimpleBipedParams   # the walker's parameters (planarsim params simple-biped)
 GAITS = tuple(g.name.lower() for g in Gait)
 
-__all__ = ["NAME", "GAITS", "Gait", "State", "SimpleBipedParams", "Walker", "build", "simulate", "live",
+__all__ = ["NAME", "GAITS", "Gait", "State", "Tables", "make_tables", "SimpleBipedParams", "Run", "Walker", "build", "simulate", "live",
            "rollout_simple_biped"]

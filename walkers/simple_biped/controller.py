@@ -12,8 +12,10 @@ Python between rollout chunks). Each gait runs its own states:
                stance leg holds its length; gravity compensation everywhere
   CROUCH, THRUST, FLIGHT, LAND   the jump: crouch, push the hip up, hold the legs in the air,
                absorb the landing; then crouch again while the gait is JUMP
-Transitions are contact and phase driven. Left/right is data: ``memory[M_STANCE]`` is the
-stance (front) foot index, the swing foot is ``1 - stance``.
+Transitions are contact and phase driven (next_state). What a state commands is data: its row
+of the state table (make_tables: control law, target, PD gains, feed-forward), so STAND, LAND,
+CROUCH and THRUST are one law with different rows. Left/right is data too: ``memory[M_STANCE]``
+is the stance (front) foot index, the swing foot is ``1 - stance``.
 
 Deviations from and additions to Kelly's controller, stated:
 - eq. 2 is used in its energy-consistent form phi_dot_target = -sqrt(v_top^2 + 2 g l
@@ -33,6 +35,7 @@ Deviations from and additions to Kelly's controller, stated:
 """
 import math
 from enum import IntEnum
+from typing import NamedTuple
 
 import numpy as np
 
@@ -90,6 +93,51 @@ M_ABORT = 22      # 1 when the hip rolled back before the top: the swing foot re
 M_RETRIES = 23    # aborted steps
 M_WORK = 24       # positive mechanical work of all actuators [J] (kept by the rollout)
 N_MEMORY = 28
+
+# control laws, chosen per state by the state table
+LAW_HIP = 0       # PD on the hip over the middle of the feet, both legs pushing (push_hip)
+LAW_FLIGHT = 1    # both feet held below the hip at a leg length, spread as when standing
+LAW_DOUBLE = 2    # walking double stance: eqs. 1-3 on the front leg, split into both legs
+LAW_SINGLE = 3    # walking single stance: stance leg holds its length, swing foot tracks the Bezier
+
+# columns of the state table Tables.row[state]
+R_LAW = 0         # control law (LAW_*)
+R_LENGTH = 1      # target [m]: hip height above the mid-feet (LAW_HIP) or leg length (the others)
+R_KP = 2          # gain on that target [1/s^2] (LAW_HIP: hip x; LAW_DOUBLE, LAW_SINGLE: stance leg)
+R_KD = 3          # its rate gain [1/s]
+R_KP_Y = 4        # LAW_HIP: hip height gain [1/s^2]
+R_KD_Y = 5        # LAW_HIP: hip vertical rate gain [1/s]
+R_ACCEL_Y = 6     # LAW_HIP: vertical hip acceleration added [m/s^2]
+R_SWING_KP = 7    # swing / flight foot gains (virtual leg) [1/s^2]
+R_SWING_KD = 8    # [1/s]
+N_ROW = 9
+
+
+class Tables(NamedTuple):
+    """What the compiled controller reads: the parameter vector and one row per state."""
+    p: np.ndarray      # (N_PARAMS,) SimpleBipedParams.to_array(), indices params.I_<FIELD>
+    row: np.ndarray    # (len(State), N_ROW) control data per state, columns R_*
+
+
+def make_tables(params) -> Tables:
+    """Params -> Tables. Per state: STAND and LAND hold the hip at stand_height, CROUCH at
+    crouch_height (stand gains); THRUST keeps the hip over the feet and accelerates it up at
+    thrust_accel; FLIGHT holds flight_length legs; WALK_DOUBLE / WALK_SINGLE hold walk_length
+    on the stance leg with the ds / ss gains."""
+    p = params.to_array()
+    l0 = p[P.I_LEG_LENGTH]
+    kp, kd = p[P.I_STAND_KP], p[P.I_STAND_KD]
+    swing = (p[P.I_SWING_KP], p[P.I_SWING_KD])
+    row = np.zeros((len(State), N_ROW))
+    # columns: law, length, kp, kd, kp_y, kd_y, accel_y, swing kp, swing kd
+    row[ST_STAND] = (LAW_HIP, p[P.I_STAND_HEIGHT] * l0, kp, kd, kp, kd, 0.0, 0.0, 0.0)
+    row[ST_LAND] = row[ST_STAND]
+    row[ST_CROUCH] = (LAW_HIP, p[P.I_CROUCH_HEIGHT] * l0, kp, kd, kp, kd, 0.0, 0.0, 0.0)
+    row[ST_THRUST] = (LAW_HIP, 0.0, kp, kd, 0.0, 0.0, p[P.I_THRUST_ACCEL], 0.0, 0.0)
+    row[ST_FLIGHT] = (LAW_FLIGHT, p[P.I_FLIGHT_LENGTH] * l0, 0.0, 0.0, 0.0, 0.0, 0.0, *swing)
+    row[ST_DOUBLE] = (LAW_DOUBLE, p[P.I_WALK_LENGTH] * l0, p[P.I_DS_KP], p[P.I_DS_KD], 0.0, 0.0, 0.0, 0.0, 0.0)
+    row[ST_SINGLE] = (LAW_SINGLE, p[P.I_WALK_LENGTH] * l0, p[P.I_SS_KP], p[P.I_SS_KD], 0.0, 0.0, 0.0, *swing)
+    return Tables(p=p, row=row)
 
 
 @kernel
@@ -248,97 +296,113 @@ def next_state(p, s, mem, g):
 
 
 @kernel
-def _hold_hip(p, q, v, height, ax_extra, ay_extra, gx, gy, u):
-    """Double stance pose control: PD on the hip toward (mid-feet x, mid-feet y + height)."""
+def _hold_hip(p, r, q, v, gx, gy, u):
+    """Hip PD toward (mid-feet x, mid-feet y + r[R_LENGTH]) plus r[R_ACCEL_Y] upward, both legs
+    pushing (state row r)."""
     mh = p[P.I_HIP_MASS]
     tx = 0.5 * (q[1, 0] + q[2, 0])
-    ty = 0.5 * (q[1, 1] + q[2, 1]) + height
-    ax = p[P.I_STAND_KP] * (tx - q[0, 0]) - p[P.I_STAND_KD] * v[0, 0] + ax_extra
-    ay = p[P.I_STAND_KP] * (ty - q[0, 1]) - p[P.I_STAND_KD] * v[0, 1] + ay_extra
+    ty = 0.5 * (q[1, 1] + q[2, 1]) + r[R_LENGTH]
+    ax = r[R_KP] * (tx - q[0, 0]) - r[R_KD] * v[0, 0]
+    ay = r[R_KP_Y] * (ty - q[0, 1]) - r[R_KD_Y] * v[0, 1] + r[R_ACCEL_Y]
     push_hip(q, mh * (ax - gx), mh * (ay - gy), p[P.I_LEG_FORCE_MAX], u)
 
 
+@kernel
+def _flight(p, r, q, v, u):
+    """Legs at r[R_LENGTH], feet spread as when standing, in the hip frame (free fall); the hip
+    torque is the mean of the two feet's."""
+    l0 = p[P.I_LEG_LENGTH]
+    half = 0.5 * p[P.I_STAND_WIDTH] * l0
+    sign = 1.0 if q[2, 0] >= q[1, 0] else -1.0
+    u_hip0 = 0.0
+    for f in range(2):
+        side = -sign if f == 0 else sign
+        track_foot(q, v, f, q[0, 0] + side * half, q[0, 1] - r[R_LENGTH], v[0, 0], v[0, 1],
+                   r[R_SWING_KP], r[R_SWING_KD], p[P.I_FOOT_MASS], 0.0, 0.0,
+                   p[P.I_LEG_LENGTH_MAX] * l0, p[P.I_LEG_FORCE_MAX], p[P.I_HIP_TORQUE_MAX], u)
+        if f == 0:
+            u_hip0 = u[2]
+    u[2] = 0.5 * (u[2] + u_hip0)
+
+
+@kernel
+def _double_stance(p, r, s, mem, gx, gy, g, u):
+    """Eq. 1 normal force on the front leg toward r[R_LENGTH], eqs. 2-3 tangential force, split
+    into the two legs."""
+    q = s.q
+    v = s.v
+    mh = p[P.I_HIP_MASS]
+    front = int(mem[M_STANCE])
+    dx, dy, l, ldot, phi, phidot = leg_state(q, v, front)
+    nx = -dx / l
+    ny = -dy / l
+    a_n = r[R_KP] * (r[R_LENGTH] - l) - r[R_KD] * ldot - l * phidot * phidot
+    a_t = p[P.I_ENERGY_GAIN] * l * (_rate_target(_v_top(p, mem), l, phi, g) - phidot)
+    a_t = clamp(a_t, -p[P.I_DS_ACCEL_MAX] * g, p[P.I_DS_ACCEL_MAX] * g)
+    # tangent t = (-ny, nx): the hip's direction of motion for increasing phi; weight
+    # compensation -mh g split into its n and t parts
+    f_n = mh * (a_n - (gx * nx + gy * ny))
+    f_t = mh * (a_t - (-gx * ny + gy * nx))
+    if s.contact_mode[front] != 1 and f_t < 0.0:
+        f_t = 0.0  # front foot not stuck (sliding or free): no forward push onto it
+    push_hip_pendulum(q, front, f_n, f_t, p[P.I_DS_FRONT_LOAD] * mh * g,
+                      min(p[P.I_LEG_FORCE_MAX], p[P.I_DS_FORCE_MAX] * (mh + 2.0 * p[P.I_FOOT_MASS]) * g), u)
+
+
+@kernel
+def _single_stance(p, r, q, v, mem, gx, gy, g, u):
+    """The stance leg holds r[R_LENGTH]; the swing foot tracks the swing Bezier at the phase."""
+    l0 = p[P.I_LEG_LENGTH]
+    mh = p[P.I_HIP_MASS]
+    mf = p[P.I_FOOT_MASS]
+    stance = int(mem[M_STANCE])
+    sw = 1 - stance
+    ph, ph_dot = _phase(p, q, v, mem)
+    mem[M_PHASE] = ph
+    sb = clamp(ph, 0.0, 1.0)
+    tx, ty, dtx, dty = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1], mem[M_SW_Y1],
+                                        mem[M_SW_TOP], sb)
+    tvx = dtx * ph_dot
+    tvy = dty * ph_dot
+    if ph >= 1.0:
+        # past the expected strike: keep lowering the foot until it finds the ground
+        tvx = 0.0
+        ty -= p[P.I_DESCENT_RATE] * l0 * (ph - 1.0)
+        tvy = -p[P.I_DESCENT_RATE] * l0 * ph_dot
+    elif ph < 0.0:
+        tvx = 0.0
+        tvy = 0.0
+    if mem[M_ABORT] > 0.0:
+        # rolled back before the top: put the swing foot down where it lifted off
+        tx = mem[M_SW_X0]
+        ty = mem[M_SW_Y0] - p[P.I_STRIKE_PUSH] * l0
+        tvx = 0.0
+        tvy = 0.0
+    hold_stance(q, v, stance, r[R_LENGTH], r[R_KP], r[R_KD], mh + mf, gx, gy, p[P.I_LEG_FORCE_MAX], u)
+    track_foot(q, v, sw, tx, ty, tvx, tvy, r[R_SWING_KP], r[R_SWING_KD], mf, gx, gy,
+               p[P.I_LEG_LENGTH_MAX] * l0, p[P.I_LEG_FORCE_MAX], p[P.I_HIP_TORQUE_MAX], u)
+    limit_hip_torque(q, stance, p[P.I_STANCE_MU], mf * g, u)
+
+
 @jit_inline
-def control(m, s, p, mem, u):
-    """Commands u (n_act = 3: leg0 [N], leg1 [N], hip [N m]) for the current state."""
+def control(m, s, ws, tab, mem, u):
+    """Commands u (n_act = 3: leg0 [N], leg1 [N], hip [N m]): the state machine's transition,
+    then the control law of the state's row in tab.row."""
+    p = tab.p
     gx = m.gravity[0]
     gy = m.gravity[1]
     g = math.sqrt(gx * gx + gy * gy)
     next_state(p, s, mem, g)
-    q = s.q
-    v = s.v
-    l0 = p[P.I_LEG_LENGTH]
-    mh = p[P.I_HIP_MASS]
-    mf = p[P.I_FOOT_MASS]
-    fmax = p[P.I_LEG_FORCE_MAX]
-    tmax = p[P.I_HIP_TORQUE_MAX]
-    state = int(mem[M_STATE])
-    if state == ST_STAND or state == ST_LAND:
-        _hold_hip(p, q, v, p[P.I_STAND_HEIGHT] * l0, 0.0, 0.0, gx, gy, u)
-    elif state == ST_CROUCH:
-        _hold_hip(p, q, v, p[P.I_CROUCH_HEIGHT] * l0, 0.0, 0.0, gx, gy, u)
-    elif state == ST_THRUST:
-        ax = p[P.I_STAND_KP] * (0.5 * (q[1, 0] + q[2, 0]) - q[0, 0]) - p[P.I_STAND_KD] * v[0, 0]
-        push_hip(q, mh * (ax - gx), mh * (p[P.I_THRUST_ACCEL] - gy), fmax, u)
-    elif state == ST_FLIGHT:
-        # legs at flight length, feet spread as when standing, in the hip frame (free fall)
-        half = 0.5 * p[P.I_STAND_WIDTH] * l0
-        sign = 1.0 if q[2, 0] >= q[1, 0] else -1.0
-        fl = p[P.I_FLIGHT_LENGTH] * l0
-        track_foot(q, v, 0, q[0, 0] - sign * half, q[0, 1] - fl, v[0, 0], v[0, 1],
-                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, p[P.I_LEG_LENGTH_MAX] * l0,
-                   fmax, tmax, u)
-        u_hip0 = u[2]
-        track_foot(q, v, 1, q[0, 0] + sign * half, q[0, 1] - fl, v[0, 0], v[0, 1],
-                   p[P.I_SWING_KP], p[P.I_SWING_KD], mf, 0.0, 0.0, p[P.I_LEG_LENGTH_MAX] * l0,
-                   fmax, tmax, u)
-        u[2] = 0.5 * (u[2] + u_hip0)
-    elif state == ST_DOUBLE:
-        # eq. 1 normal force on the front leg, eqs. 2-3 tangential force, split into the legs
-        front = int(mem[M_STANCE])
-        dx, dy, l, ldot, phi, phidot = leg_state(q, v, front)
-        nx = -dx / l
-        ny = -dy / l
-        a_n = p[P.I_DS_KP] * (p[P.I_WALK_LENGTH] * l0 - l) - p[P.I_DS_KD] * ldot - l * phidot * phidot
-        a_t = p[P.I_ENERGY_GAIN] * l * (_rate_target(_v_top(p, mem), l, phi, g) - phidot)
-        a_t = clamp(a_t, -p[P.I_DS_ACCEL_MAX] * g, p[P.I_DS_ACCEL_MAX] * g)
-        # tangent t = (-ny, nx): the hip's direction of motion for increasing phi; weight
-        # compensation -mh g split into its n and t parts
-        f_n = mh * (a_n - (gx * nx + gy * ny))
-        f_t = mh * (a_t - (-gx * ny + gy * nx))
-        if s.contact_mode[front] != 1 and f_t < 0.0:
-            f_t = 0.0  # front foot not stuck (sliding or free): no forward push onto it
-        push_hip_pendulum(q, front, f_n, f_t, p[P.I_DS_FRONT_LOAD] * mh * g,
-                          min(fmax, p[P.I_DS_FORCE_MAX] * (mh + 2.0 * mf) * g), u)
-    else:  # ST_SINGLE
-        stance = int(mem[M_STANCE])
-        sw = 1 - stance
-        ph, ph_dot = _phase(p, q, v, mem)
-        mem[M_PHASE] = ph
-        sb = clamp(ph, 0.0, 1.0)
-        tx, ty, dtx, dty = rectangle_bezier(mem[M_SW_X0], mem[M_SW_Y0], mem[M_SW_X1], mem[M_SW_Y1],
-                                            mem[M_SW_TOP], sb)
-        tvx = dtx * ph_dot
-        tvy = dty * ph_dot
-        if ph >= 1.0:
-            # past the expected strike: keep lowering the foot until it finds the ground
-            tvx = 0.0
-            ty -= p[P.I_DESCENT_RATE] * l0 * (ph - 1.0)
-            tvy = -p[P.I_DESCENT_RATE] * l0 * ph_dot
-        elif ph < 0.0:
-            tvx = 0.0
-            tvy = 0.0
-        if mem[M_ABORT] > 0.0:
-            # rolled back before the top: put the swing foot down where it lifted off
-            tx = mem[M_SW_X0]
-            ty = mem[M_SW_Y0] - p[P.I_STRIKE_PUSH] * l0
-            tvx = 0.0
-            tvy = 0.0
-        hold_stance(q, v, stance, p[P.I_WALK_LENGTH] * l0, p[P.I_SS_KP], p[P.I_SS_KD], mh + mf,
-                    gx, gy, fmax, u)
-        track_foot(q, v, sw, tx, ty, tvx, tvy, p[P.I_SWING_KP], p[P.I_SWING_KD], mf, gx, gy,
-                   p[P.I_LEG_LENGTH_MAX] * l0, fmax, tmax, u)
-        limit_hip_torque(q, stance, p[P.I_STANCE_MU], mf * g, u)
+    r = tab.row[int(mem[M_STATE])]
+    law = int(r[R_LAW])
+    if law == LAW_HIP:
+        _hold_hip(p, r, s.q, s.v, gx, gy, u)
+    elif law == LAW_FLIGHT:
+        _flight(p, r, s.q, s.v, u)
+    elif law == LAW_DOUBLE:
+        _double_stance(p, r, s, mem, gx, gy, g, u)
+    else:
+        _single_stance(p, r, s.q, s.v, mem, gx, gy, g, u)
 
 
 class Controller:
@@ -348,7 +412,7 @@ class Controller:
 
     def __init__(self, params, gait: int = GAIT_WALK, speed: float | None = None):
         self.params = params
-        self.p = params.to_array()
+        self.tables = make_tables(params)
         self.memory = np.zeros(N_MEMORY)
         self.u = np.zeros(3)
         self.reset(gait, speed)
@@ -360,7 +424,7 @@ class Controller:
         self.memory[M_SPEED] = self.params.speed if speed is None else float(speed)
 
     def __call__(self, sim) -> np.ndarray:
-        control(sim.model.arrays, sim.state, self.p, self.memory, self.u)
+        control(sim.model.arrays, sim.state, sim.ws, self.tables, self.memory, self.u)
         return self.u.copy()
 
     def labels(self, sim) -> dict:

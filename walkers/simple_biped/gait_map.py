@@ -38,13 +38,14 @@ EPS = 3e-3      # finite-difference step [m, m/s]
 
 
 @jit
-def rollout_to_touchdown(m, s, ws, opt, p, mem, u, n_events, max_steps):
+def rollout_to_touchdown(m, s, ws, opt, tab, mem, u, n_events, max_steps):
     """Control + physics until the controller has counted n_events more touchdowns; stops right
     after the ``control`` call that counted the last one (before its physics step).
     Returns (code, steps done): 0 ok, 1/2 engine guard, 3 fell, 4 no touchdown in max_steps."""
+    p = tab.p
     start = mem[C.M_STEPS]
     for i in range(max_steps):
-        C.control(m, s, p, mem, u)
+        C.control(m, s, ws, tab, mem, u)
         if mem[C.M_STEPS] - start >= n_events:
             return 0, i
         code = step(m, s, ws, opt, u)
@@ -73,7 +74,7 @@ class SimpleBipedGaitMap(GaitMapMixin):
         self.walker = w = Walker(params, dt=dt, gait="walk", speed=speed, record_every=10 ** 9)
         self.m = w.model.arrays
         self.max_steps = int(round(4.0 / dt))
-        code, _ = rollout_to_touchdown(self.m, w.state, w.ws, w.options, w.p, w.memory, w.u, 10 ** 9,
+        code, _ = rollout_to_touchdown(self.m, w.state, w.ws, w.options, w.tables, w.memory, w.u, 10 ** 9,
                                        int(round(settle / dt)))
         if code not in (RUN_OK, RUN_NO_EVENT) or w.fell:
             raise StepMapError(f"the Simple Biped failed while settling (code {code})")
@@ -95,7 +96,7 @@ class SimpleBipedGaitMap(GaitMapMixin):
 
     def _run(self, s, ws, mem, n_events):
         w = self.walker
-        code, n = rollout_to_touchdown(self.m, s, ws, w.options, w.p, mem, w.u, n_events, self.max_steps)
+        code, n = rollout_to_touchdown(self.m, s, ws, w.options, w.tables, mem, w.u, n_events, self.max_steps)
         # an engine failure raises (it is not a fall of the walker); a fall or no touchdown
         # is the map's own failure
         check_run(code, w.model, ws, w.options, "Simple Biped step map")

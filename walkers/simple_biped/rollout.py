@@ -1,4 +1,5 @@
-"""Compiled rollout of the Simple Biped and its Python front end (``Walker``, ``simulate``).
+"""Compiled rollout of the Simple Biped and its run class (``Walker``, a walkers.base.WalkerRun;
+``simulate``).
 
 ``rollout_simple_biped`` runs physics + controller + recording + fall monitor without returning
 to Python. ``Walker`` keeps model, state and controller memory between chunks, so the gait (and
@@ -12,18 +13,17 @@ import math
 
 import numpy as np
 
-from planarsim.compiled import (RUN_FELL, audit_counts, check_run, jit, record_frame, step, height,
-                                make_recorder)
+from planarsim.compiled import RUN_FELL, jit, record_frame, step, height
 import planarsim as ps
-from planarsim.state import make_workspace
-from planarsim.trajectory import Trajectory
+
+from walkers.base import WalkerRun, simulation, terrain_of
 
 from . import controller as C
 from .model import build
 from .params import I_FALL_HEIGHT, I_FALL_LEG_LENGTH, I_LEG_LENGTH, SimpleBipedParams
 
 LABELS = ("gait", "state", "stance", "phase", "steps", "jumps")
-_LABEL_SLOTS = (C.M_GAIT, C.M_STATE, C.M_STANCE, C.M_PHASE, C.M_STEPS, C.M_JUMPS)
+LABEL_SLOTS = np.array([C.M_GAIT, C.M_STATE, C.M_STANCE, C.M_PHASE, C.M_STEPS, C.M_JUMPS], dtype=np.int64)
 
 
 @jit
@@ -35,14 +35,15 @@ def _longest_leg(q):
 
 
 @jit
-def rollout_simple_biped(m, s, ws, opt, p, mem, u, n, every, rec, lab, k0):
-    """n steps of control + physics, recording every `every`-th step into rec / lab from frame
-    k0. Stops on a fall (RUN_FELL, mem[M_FALLEN]=1): the hip below fall_height above the ground,
-    or a leg longer than fall_leg_length
-    or an engine failure (planarsim.compiled run codes). Returns (code, steps done, next frame)."""
+def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, k0):
+    """n steps of control + physics, recording every `every`-th step into rec / lab (memory
+    slots `slots`) from frame k0. Stops on a fall (RUN_FELL, mem[M_FALLEN]=1): the hip below
+    fall_height above the ground, or a leg longer than fall_leg_length; or on an engine failure
+    (planarsim.compiled run codes). Returns (code, steps done, next frame)."""
+    p = tab.p
     k = k0
     for i in range(n):
-        C.control(m, s, p, mem, u)
+        C.control(m, s, ws, tab, mem, u)
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, k
@@ -51,12 +52,8 @@ def rollout_simple_biped(m, s, ws, opt, p, mem, u, n, every, rec, lab, k0):
                 mem[C.M_WORK] += ws.act_power[a] * m.dt
         if s.step[0] % every == 0 and k < rec.t.shape[0]:
             record_frame(s, ws, rec, k)
-            lab[k, 0] = mem[C.M_GAIT]
-            lab[k, 1] = mem[C.M_STATE]
-            lab[k, 2] = mem[C.M_STANCE]
-            lab[k, 3] = mem[C.M_PHASE]
-            lab[k, 4] = mem[C.M_STEPS]
-            lab[k, 5] = mem[C.M_JUMPS]
+            for c in range(slots.shape[0]):
+                lab[k, c] = mem[slots[c]]
             k += 1
         if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]
                 or _longest_leg(s.q) > p[I_FALL_LEG_LENGTH] * p[I_LEG_LENGTH]):
@@ -74,38 +71,38 @@ def _gait_id(gait) -> int:
     return int(C.Gait(gait))
 
 
-class Walker:
-    """A Simple Biped in the world: model, state, controller memory, recorded history.
+class Walker(WalkerRun):
+    """A Simple Biped in the world (a WalkerRun): model, state, controller memory, chunks.
 
     Parameters
     ----------
     params : SimpleBipedParams (default values if None)
-    terrain : planarsim.terrain.Terrain (flat if None)
+    terrain : planarsim.terrain.Terrain or spec string (flat if None)
     dt : step size [s]
     gait : initial gait, "stand" | "walk" | "jump"
     speed : target walking speed [m/s] (params.speed if None)
     record_every : steps between recorded frames
     seed : 0 starts from the exact standing pose; other seeds shift the hip by up to 1 cm in x
+    options : StepOptions (the engine defaults if None)
     """
+
+    NAME = "simple-biped"
+    LABELS = LABELS
+    FELL_SLOT = C.M_FALLEN
 
     def __init__(self, params=None, terrain=None, dt=1e-3, gait="walk", speed=None,
                  record_every=10, seed=0, options=None):
-        self.params = params if params is not None else SimpleBipedParams()
-        self.model = build(self.params, terrain, dt)
-        self.state = ps.make_state(self.model)
+        params = params if params is not None else SimpleBipedParams()
+        model = build(params, terrain_of(terrain), dt)
+        memory = np.zeros(C.N_MEMORY)
+        memory[C.M_STATE] = C.ST_STAND
+        memory[C.M_SPEED] = params.speed if speed is None else float(speed)
+        memory[C.M_GAIT] = _gait_id(gait)
+        super().__init__(model, params, C.make_tables(params), memory, options=options,
+                         record_every=record_every)
         if seed:
-            self.state.q[0, 0] += 0.01 * self.params.leg_length * np.random.default_rng(seed).uniform(-1, 1)
-        self.ws = make_workspace(self.model)
-        self.options = options if options is not None else ps.StepOptions()
-        self.p = self.params.to_array()
-        self.memory = np.zeros(C.N_MEMORY)
-        self.memory[C.M_STATE] = C.ST_STAND
-        self.memory[C.M_SPEED] = self.params.speed if speed is None else float(speed)
-        self.memory[C.M_GAIT] = _gait_id(gait)
-        self.u = np.zeros(self.model.n_act)
-        self.record_every = int(record_every)
+            self.state.q[0, 0] += 0.01 * params.leg_length * np.random.default_rng(seed).uniform(-1, 1)
         self.x_start = float(self.state.q[0, 0])
-        self._chunks = []
 
     # run-time switches ------------------------------------------------------------------------
     def set_gait(self, gait) -> None:
@@ -122,38 +119,17 @@ class Walker:
     def gait(self) -> str:
         return C.Gait(int(self.memory[C.M_GAIT])).name.lower()
 
-    @property
-    def fell(self) -> bool:
-        return bool(self.memory[C.M_FALLEN])
-
-    # running ------------------------------------------------------------------------------------
-    def run(self, seconds: float) -> Trajectory:
-        """Advance `seconds` [s] (stops early on a fall); return this chunk's Trajectory."""
-        n = int(round(float(seconds) / self.model.dt))
-        if n < 0:
-            raise ValueError(f"seconds={seconds} must be >= 0")
-        every = self.record_every
-        rec = make_recorder(self.model, n // every + 1)
-        lab = np.zeros((n // every + 1, len(LABELS)))
+    # the contract -----------------------------------------------------------------------------
+    def advance(self, n, every, rec, lab):
         code, done, k = rollout_simple_biped(self.model.arrays, self.state, self.ws, self.options,
-                                             self.p, self.memory, self.u, n, every, rec, lab, 0)
-        check_run(code, self.model, self.ws, self.options, "simple biped")
-        traj = Trajectory.from_recorder(self.model, rec, k,
-                                        labels={name: lab[:k, j].copy() for j, name in enumerate(LABELS)},
-                                        info={"dt": self.model.dt, "walker": "simple-biped"})
-        self._chunks.append(traj)
-        return traj
+                                             self.tables, self.memory, self.u, n, every, rec, lab,
+                                             LABEL_SLOTS, 0)
+        return code, k
 
-    def trajectory(self) -> Trajectory:
-        """All chunks run so far, joined."""
-        if not self._chunks:
-            return Trajectory.from_recorder(self.model, make_recorder(self.model, 0), 0)
-        return Trajectory.concatenate(self._chunks)
-
-    def summary(self) -> dict:
+    def numbers(self) -> dict:
         """distance [m] and mean_speed [m/s] of the hip since the start, positive actuator work
         [J] and cost of transport (that work per weight and distance [-]), steps, jumps, fell."""
-        t = self.state.t
+        t = self.time
         dist = float(self.state.q[0, 0]) - self.x_start
         weight = self.model.total_mass * float(np.hypot(*self.model.arrays.gravity))
         work = float(self.memory[C.M_WORK])
@@ -163,35 +139,23 @@ class Walker:
                 "steps": int(self.memory[C.M_STEPS]), "jumps": int(self.memory[C.M_JUMPS]),
                 "scuffs": int(self.memory[C.M_SCUFFS]),
                 "retries": int(self.memory[C.M_RETRIES]), "fell": self.fell, "falls": int(self.fell),
-                "gait": self.gait, "state": C.State(int(self.memory[C.M_STATE])).name.lower(),
-                "audit": audit_counts(self.ws)}
+                "gait": self.gait, "state": C.State(int(self.memory[C.M_STATE])).name.lower()}
 
 
-def simulate(duration, gait="walk", terrain=None, dt=1e-3, seed=0, speed=None, params=None,
-             record_every=10):
-    """Run the Simple Biped from rest for `duration` [s] in `gait`.
-
-    Returns (Trajectory, summary dict, Model); see Walker.summary for the keys.
-    """
-    if isinstance(terrain, str):
-        terrain = ps.terrain.parse(terrain)
-    w = Walker(params, terrain, dt, gait, speed, record_every, seed)
-    w.run(duration)
-    return w.trajectory(), w.summary(), w.model
+Run = Walker
+simulate = simulation(Walker)
 
 
 def live(gait="walk", terrain=None, params=None, speed=None) -> dict:
     """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and the
     compiled controller called from Python each step; keys s / w / j for STAND / WALK / JUMP,
     a slider for the target walking speed [m/s]."""
-    if isinstance(terrain, str):
-        terrain = ps.terrain.parse(terrain)
     w = Walker(params, terrain, gait=gait, speed=speed)
     sim = ps.Simulator(w.model, w.options, w.state)
-    m, p, mem, u = w.model.arrays, w.p, w.memory, w.u
+    m, tab, mem, u = w.model.arrays, w.tables, w.memory, w.u
 
     def controller(sim):
-        C.control(m, sim.state, p, mem, u)
+        C.control(m, sim.state, sim.ws, tab, mem, u)
         return u
 
     return dict(sim=sim, controller=controller, on_gait=w.set_gait,

@@ -1,0 +1,180 @@
+"""The passive walkers' run class (a walkers.base.WalkerRun): walk down the slope from a
+section state with the compiled rollout (walkers.passive.rollout).
+
+Touchdowns, ``impacts``:
+  "refined" (default): every touchdown is located and resolved as in the step map
+      (PassiveWalker.refine_touchdown; one Python call per walking step, none per sim step);
+  "engine": the engine's contacts find the touchdowns on their own (continuous collision for
+      point feet, the "all" mode strategy releasing the trailing foot), the end-to-end path.
+Either way a recorded run also holds a frame at each touchdown (whole-step summaries start
+and end on them). Chunks end where one run of their total length would be: run(a); run(b)
+walks to step round(a / dt) + round(b / dt) like run(a + b).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from planarsim.analysis import step_summary
+
+from walkers.base import WalkerRun, terrain_of
+
+from .gait import PassiveWalker
+from .rollout import DETECT, FELL, NO_EVENT, rollout_passive
+
+GAITS = ("passive",)
+IMPACTS = ("refined", "engine")
+MIN_STEP_PERIOD = 0.05   # [s] touchdowns assumed at most this often (room for event frames)
+
+
+def slope_from_terrain(terrain, default):
+    """Slope gamma [rad] of a constant-slope terrain (falling toward +x), or `default`."""
+    if terrain is None:
+        return default
+    coef = np.asarray(terrain.coef)
+    if coef[2] != 0:
+        raise ValueError(f"passive walkers need a constant slope (terrain 'slope:DEG' with DEG < 0 "
+                         f"for downhill), got {getattr(terrain, 'name', 'terrain')!r}")
+    gamma = -math.atan(coef[1])
+    if gamma < 0:
+        raise ValueError(f"passive walkers walk downhill toward +x: use a negative slope angle, "
+                         f"got {math.degrees(-gamma):g} deg")
+    return gamma
+
+
+def record_state(rec, k, s, ws) -> None:
+    """Write State s (and ws's contact and actuator data) into frame k of rec, as record_frame
+    does (disabled contacts get mode -1)."""
+    rec.t[k] = s.time[0]
+    rec.q[k] = s.q
+    rec.v[k] = s.v
+    rec.contact_mode[k] = np.where(np.asarray(s.contact_enabled) != 0, s.contact_mode, -1)
+    rec.contact_impulse[k] = ws.contact_impulse
+    rec.contact_point[k] = ws.contact_point
+    rec.act_u[k] = ws.act_u
+    rec.act_power[k] = ws.act_power
+
+
+class PassiveRun(WalkerRun):
+    """A passive walker walking down its slope. A walker module subclasses it with NAME, Params
+    (its parameter class) and ``start(params)`` (the default section state).
+
+    Parameters
+    ----------
+    params : the walker's Params (defaults if None); its slope is taken from `terrain` if given
+    terrain : a constant downhill slope (planarsim.terrain spec 'slope:DEG', DEG < 0) or None
+    dt : step size [s]
+    gait : "passive"
+    seed : accepted for the common interface (the walker is deterministic)
+    x0 : section state to start from (PassiveWalker.coords; default start(params))
+    record_every : steps between recorded frames (0: none)
+    impacts : "refined" | "engine" (module doc)
+    """
+
+    Params = None
+
+    def __init__(self, params=None, terrain=None, dt=1e-3, gait="passive", seed=0, x0=None,
+                 record_every=10, impacts="refined"):
+        if gait not in GAITS:
+            raise ValueError(f"{self.NAME}: unknown gait {gait!r}; gaits: {GAITS}")
+        if impacts not in IMPACTS:
+            raise ValueError(f"impacts={impacts!r} must be 'refined' or 'engine'")
+        terrain = terrain_of(terrain)
+        p = params or self.Params()
+        p = self.Params(**{**p.as_dict(), "slope": slope_from_terrain(terrain, p.slope)})
+        self.walker = w = PassiveWalker(p, dt=dt)
+        w.set_coords(self.start(p) if x0 is None else x0)
+        super().__init__(w.model, p, None, w.memory, state=w.sim.state, ws=w.sim.ws,
+                         options=w.sim.options, record_every=record_every)
+        self.impacts = impacts
+        self.hip0 = self.state.q[w.hip, :2].copy()
+        self.steps_asked = 0      # steps asked for by all runs so far
+        self.code = 0             # run code of the last chunk (0, or FELL)
+        self.fallen = False
+
+    def start(self, params) -> np.ndarray:
+        """Default section state for `params`."""
+        raise NotImplementedError
+
+    @property
+    def fell(self) -> bool:
+        return self.fallen
+
+    def max_touchdowns(self, n: int) -> int:
+        return int(n * self.dt / MIN_STEP_PERIOD) + 10
+
+    def frames(self, n: int) -> int:
+        # sim-step frames, one more per touchdown (its frame; a refined touchdown also takes
+        # one sim step more)
+        return n // self.record_every + 2 + 2 * self.max_touchdowns(n) if self.record_every else 0
+
+    def advance(self, n, every, rec, lab):
+        self.steps_asked += n
+        code, k = (self._engine if self.impacts == "engine" else self._refined)(n, rec)
+        self.code = int(code)
+        self.fallen = self.fallen or code == FELL
+        return code, k
+
+    def _rollout(self, n, stop_after, rec, k0):
+        w, s = self.walker, self.state
+        return rollout_passive(self.model.arrays, s, self.ws, self.options, w.u0, w.feet, w.memory, w.toggle,
+                               w.min_ahead, int(n), int(stop_after), w.hip, w.fall_height, rec,
+                               self.record_every, k0, w.event_time, w.event_contact)
+
+    def _engine(self, n, rec):
+        """The engine finds the touchdowns (events logged in walker.event_time / event_contact)."""
+        w = self.walker
+        need = int(w.memory[1]) + self.max_touchdowns(n)
+        if need > w.event_time.size:
+            w.event_time = np.concatenate([w.event_time, np.zeros(need - w.event_time.size)])
+            w.event_contact = np.concatenate([w.event_contact,
+                                              np.zeros(need - w.event_contact.size, np.int64)])
+        code, done, k = self._rollout(n, 1 << 60, rec, 0)
+        return code, k
+
+    def _refined(self, n, rec):
+        """Rollouts from touchdown to touchdown, each touchdown refined, up to step steps_asked."""
+        w, s = self.walker, self.state
+        end = self.steps_asked * self.dt
+        k, code = 0, NO_EVENT
+        toggle = w.toggle
+        w.toggle = DETECT
+        try:
+            s.contact_enabled[w.feet] = 0
+            s.contact_enabled[w.feet[w.memory[0]]] = 1
+            while s.time[0] < end - 0.5 * self.dt:
+                old = int(w.memory[0])
+                left = int(round((end - s.time[0]) / self.dt))
+                code, done, k = self._rollout(left, int(w.memory[1]) + 1, rec, k)
+                if code != 0:
+                    break
+                w.refine_touchdown(old)
+                s.contact_enabled[w.feet[old]] = 0
+                if self.record_every and k < rec.t.shape[0]:
+                    record_state(rec, k, s, self.ws)
+                    k += 1
+        finally:
+            w.toggle = toggle
+        return (0 if code == NO_EVENT else code), k
+
+    def numbers(self) -> dict:
+        """steps (touchdowns), distance [m] (hip displacement along the slope), mean_speed [m/s]
+        (distance / duration), fell, duration [s], code (the last chunk's run code), and over
+        whole steps, first to last touchdown (planarsim.analysis.step_summary of the recorded
+        touchdowns; NaN without recording or with fewer than two touchdowns): whole_steps,
+        step_period [s], step_length [m] and speed [m/s] (centre of mass along the slope),
+        cost_of_transport (energy lost per weight and distance along the slope: sin(slope) on
+        a steady gait)."""
+        w = self.walker
+        distance = float((self.state.q[w.hip, :2] - self.hip0) @ w.t_hat)
+        t_end = self.time
+        whole = dict(whole_steps=0, step_period=math.nan, step_length=math.nan, speed=math.nan,
+                     cost_of_transport=math.nan)
+        traj = self.trajectory()
+        if len(traj):
+            ws = step_summary(traj, self.model, w.feet, direction=w.t_hat)
+            whole = {k: ws[k] for k in whole}
+        return dict(walker=w.kind, impacts=self.impacts, steps=int(w.memory[1]), distance=distance,
+                    mean_speed=distance / t_end if t_end > 0 else 0.0, fell=self.fell,
+                    **whole, duration=t_end, code=self.code)
