@@ -124,7 +124,7 @@ Run = Quadruped
 simulate = simulation(Quadruped)
 
 
-def live(gait="piaffe", terrain=None, speed=None, params=None, strategy="all") -> dict:
+def live(gait="walk", terrain=None, speed=None, params=None, strategy="all") -> dict:
     """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and
     the Python-path Controller, keys w / p / s for walk / piaffe / stand, sliders for the
     commanded speed [m/s] and the servo stiffness kp [N m/rad]."""
