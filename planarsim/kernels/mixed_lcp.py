@@ -18,7 +18,7 @@ The velocity stage calls this with b = c / h + J v*; the position projection wit
 import math
 
 from ._jit import kernel, kernel_call
-from .lcp import LCP_RAY, LCP_SOLVED, lemke, polish
+from .lcp import ANSWER_TOL, LCP_INACCURATE, LCP_RAY, LCP_SOLVED, lemke, polish
 from .rows import ROW_CONTACT_T, ROW_ROD
 from .solve import _entry
 
@@ -210,6 +210,17 @@ def solve_mixed_lcp(m, ws, n, max_pivots):
             Mx[i, i] -= eps
         if polish(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z) == LCP_SOLVED:
             eps = 0.0
+        else:
+            # the nearby problem's answer misses the rules of M by eps z (scaled units): kept
+            # only where that is within what an exact answer may miss (lcp.ANSWER_TOL of
+            # max -q); a large z (a load that redundant rows share without bound) is no answer
+            z_max = 0.0
+            q_neg = 0.0
+            for i in range(nv):
+                z_max = max(z_max, ws.lcp_z[i])
+                q_neg = max(q_neg, -qx[i])
+            if eps * z_max > ANSWER_TOL * q_neg:
+                return LCP_INACCURATE, pivots
     ws.lcp_eps[0] = max(ws.lcp_eps[0], eps)
     for i in range(nv):
         ws.lcp_z[i] *= d[i]
