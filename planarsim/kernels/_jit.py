@@ -7,6 +7,11 @@ _nrt=False: kernels never allocate; without the runtime's reference counting, pa
 model/state/workspace NamedTuples (dozens of arrays) between stages costs nothing, where
 with it every call increments and decrements every array (about 1 us per call).
 
+The kernels' code library and pipeline use numba internals (numba_check.py checks them on
+import). Measured with numba 0.68.1: plain `njit` kernels with numba's own library (each
+kernel optimised and emitted as machine code at every nesting level) took a cold start to a
+walker's first step from 37-42 s to 59-65 s on the same machine and load.
+
 Numba checks a cached function against its own file only; a kernel that calls into another
 file would keep stale machine code after that file changes. ``_drop_stale_caches`` hashes all
 kernel sources and clears the numba caches of planarsim and walkers when the hash changes.
@@ -40,8 +45,8 @@ class KernelDispatcher(CPUDispatcher):
     def __call__(self, *args, **kwargs):
         name = self.py_func.__qualname__
         raise TypeError(f"{self.py_func.__module__}.{name} is a compiled kernel: call it from "
-                        "compiled code (a rollout decorated with planarsim.kernels._jit.jit); "
-                        "from Python use Simulator.step / steps or planarsim.kernels.step.step_entry")
+                        "compiled code (a rollout decorated with planarsim.compiled.jit); from "
+                        "Python use Simulator.step / steps or planarsim.compiled.step_from_python")
 
 
 class KernelCodeLibrary(JITCodeLibrary):
