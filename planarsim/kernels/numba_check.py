@@ -37,7 +37,7 @@ NEEDED = (
     "numba.core.cgutils:voidptr_t",
 )
 # fields of a code library that KernelCodeLibrary.finalize reads and sets
-LIBRARY_FIELDS = ("_linking_libraries", "_final_module", "_reload_init", "_finalized", "_codegen")
+LIBRARY_FIELDS = ("_linking_libraries", "_final_module", "_finalized", "_codegen")
 # keyword arguments of the dispatcher's constructor that _jit passes
 DISPATCHER_ARGS = ("py_func", "locals", "targetoptions", "pipeline_class")
 
