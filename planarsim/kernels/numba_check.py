@@ -14,28 +14,21 @@ import numba
 
 CHECKED = "0.59-0.68"
 
-# "module:attribute.path" of every internal used
-NEEDED = (
-    "numba.core.codegen:JITCodeLibrary.add_ir_module",
-    "numba.core.codegen:JITCodeLibrary.finalize",
-    "numba.core.codegen:JITCodeLibrary.get_pointer_to_function",
-    "numba.core.codegen:JITCodeLibrary.codegen",
-    "numba.core.codegen:JITCodeLibrary._raise_if_finalized",
-    "numba.core.codegen:JITCodeLibrary._get_module_for_linking",
-    "numba.core.codegen:JITCPUCodegen.set_env",
-    "numba.core.compiler:Compiler.compile_extra",
-    "numba.core.compiler_lock:require_global_compiler_lock",
-    "numba.core.registry:CPUDispatcher",
-    "numba.core.imputils:impl_ret_borrowed",
-    "numba.core.typing.templates:AttributeTemplate",
-    "numba.np.arrayobj:populate_array",
-    "numba.core.cgutils:alloca_once_value",
-    "numba.core.cgutils:get_or_insert_function",
-    "numba.core.cgutils:is_null",
-    "numba.core.cgutils:pack_array",
-    "numba.core.cgutils:unpack_tuple",
-    "numba.core.cgutils:voidptr_t",
-)
+# module: attributes (dotted below a class) of every internal used
+NEEDED = {
+    "numba.core.codegen": "JITCodeLibrary.add_ir_module JITCodeLibrary.finalize "
+                          "JITCodeLibrary.get_pointer_to_function JITCodeLibrary.codegen "
+                          "JITCodeLibrary._raise_if_finalized JITCodeLibrary._get_module_for_linking "
+                          "JITCPUCodegen.set_env",
+    "numba.core.compiler": "Compiler.compile_extra",
+    "numba.core.compiler_lock": "require_global_compiler_lock",
+    "numba.core.registry": "CPUDispatcher",
+    "numba.core.imputils": "impl_ret_borrowed",
+    "numba.core.typing.templates": "AttributeTemplate",
+    "numba.np.arrayobj": "populate_array",
+    "numba.core.cgutils": "alloca_once_value get_or_insert_function is_null pack_array "
+                          "unpack_tuple voidptr_t",
+}
 # fields of a code library that KernelCodeLibrary.finalize reads and sets
 LIBRARY_FIELDS = ("_linking_libraries", "_final_module", "_finalized", "_codegen")
 # keyword arguments of the dispatcher's constructor that _jit passes
@@ -46,27 +39,25 @@ class NumbaChanged(ImportError):
     """The installed numba lacks an internal that planarsim's compiled layer uses."""
 
 
-def _lookup(spec):
-    module, path = spec.split(":")
-    obj = importlib.import_module(module)
-    for part in path.split("."):
-        obj = getattr(obj, part)
-    return obj
+def _has(module, path):
+    try:
+        obj = importlib.import_module(module)
+        for part in path.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError):
+        return False
+    return True
 
 
 def changed_internals():
     """The internals (as 'module.attribute' text) missing from the installed numba."""
-    missing = []
-    for spec in NEEDED:
-        try:
-            _lookup(spec)
-        except (ImportError, AttributeError):
-            missing.append(spec.replace(":", "."))
+    missing = [f"{module}.{path}" for module, paths in NEEDED.items() for path in paths.split()
+               if not _has(module, path)]
     try:
-        params = inspect.signature(_lookup("numba.core.registry:CPUDispatcher").__init__).parameters
+        from numba.core.registry import CPUDispatcher, cpu_target
+        params = inspect.signature(CPUDispatcher.__init__).parameters
         missing += [f"numba.core.registry.CPUDispatcher(..., {a}=)" for a in DISPATCHER_ARGS
                     if a not in params]
-        from numba.core.registry import cpu_target
         library = cpu_target.target_context.codegen().create_library("planarsim_check")
         missing += [f"numba.core.codegen.JITCodeLibrary().{f}" for f in LIBRARY_FIELDS
                     if not hasattr(library, f)]
