@@ -1,13 +1,19 @@
 """What compiled code uses from the engine: a walker's controller and rollout, or your own.
 
-Decorators (the three you need; all cache their machine code on disk, never allocate, and
-keep the NaN checks that fastmath would drop):
+Decorators (the three you need; all never allocate and keep the NaN checks that fastmath
+would drop; jit and jit_inline cache their machine code on disk, a kernel is cached inside
+its compiled callers):
     jit          compiled, callable from Python and from compiled code (a rollout)
     jit_inline   the same, inlined into its compiled callers (a controller run every step)
-    kernel       compiled code only, inlined (small helpers; no Python entry)
+    kernel       compiled code only, inlined (small helpers; calling one from Python raises
+                 a TypeError that says so)
 
 Engine, from compiled code:
-    step(m, s, ws, opt, u) -> run code      advance State s by one step of m.dt
+    step(m, s, ws, opt, u) -> run code      advance State s by one step of opt.dt (0: m.dt).
+                                             The step is one C function, compiled once per
+                                             machine and loaded when this module is imported;
+                                             every caller calls it by address (the linkage is
+                                             all in planarsim/kernels/link.py)
     record_frame(s, ws, rec, k)              write frame k of a Recorder (make_recorder)
     height(coef, x), height_derivs(coef, x)  the ground h(x) [m] and (h, h', h'')
     closest_point(coef, px, py)              (gx, gy, nx, ny, gap) of the nearest ground point
@@ -35,7 +41,7 @@ from .kernels.info import step_info
 from .kernels.guards import (GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE,
                              GUARD_NONFINITE_COMMAND, GUARD_OK, GUARD_TOO_LARGE)
 from .kernels.record import record_frame
-from .kernels.step import step, step_entry as step_from_python
+from .kernels.link import step, step_entry as step_from_python
 from .kernels.terrain import closest_point, gap_of_point, height, height_derivs
 from .trajectory import make_recorder
 

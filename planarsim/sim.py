@@ -14,12 +14,18 @@ import numpy as np
 
 from .errors import diverged
 from .kernels.refs import TableHandle
-from .kernels.step import StepArgs, run_recorded, run_steps
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .state import State, Workspace, check_state, make_state, make_workspace
 from .trajectory import Trajectory, make_recorder
 
+
+
+def _link():
+    """kernels.link, imported with the first Simulator: importing it loads the compiled step
+    (from the numba cache, or its first-ever compile), which `import planarsim` does not need."""
+    from .kernels import link
+    return link
 
 
 class Simulator:
@@ -87,7 +93,7 @@ class Simulator:
 
     def _repack(self):
         """The table that Simulator.step / steps hand to the compiled run_steps."""
-        args = StepArgs(self._model.arrays, self._state, self._ws, self._options)
+        args = _link().StepArgs(self._model.arrays, self._state, self._ws, self._options)
         if self._args is None:
             self._args = TableHandle(args)
         else:
@@ -139,14 +145,14 @@ class Simulator:
         """run_steps compiled (or loaded from the cache) for this simulator's handle, then
         called directly: numba's type dispatch is skipped (the handle's type never changes)."""
         from numba import float64, int64
-        self._steps_entry = run_steps.compile((self._args.numba_type, float64[::1], int64))
+        self._steps_entry = _link().run_steps.compile((self._args.numba_type, float64[::1], int64))
         return self._steps_entry
 
     def _run_recorded(self, u, n, every, rec, k0):
-        """kernels.step.run_recorded on this simulator (bound once: see _bind)."""
+        """kernels.link.run_recorded on this simulator (bound once: see _bind)."""
         entry = self._recorded_entry
         if entry is None:
-            entry = self._recorded_entry = self._bind(run_recorded, (n, every, rec, k0))
+            entry = self._recorded_entry = self._bind(_link().run_recorded, (n, every, rec, k0))
         return entry(self.model.arrays, self._state, self._ws, self._options, u, n, every, rec, k0)
 
     def _bind(self, kernel, extra):

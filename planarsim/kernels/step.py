@@ -5,40 +5,24 @@ and returns a guard code (0 ok, 1 non-finite, 2 too large). Model, state, worksp
 each (kernels/refs.py). The stages are compiled into one C function (inlined, but for a few
 long or rarely run parts kept as calls: build_and_solve, the capped-mode settling, the skip
 test of the correction), compiled once per machine and called by address from every compiled
-caller (a walker's rollout, run_steps; see load_step). A time-of-impact split (CCD) repeats
+caller (a walker's rollout, run_steps; kernels/link.py). A time-of-impact split (CCD) repeats
 stages 1-6 for the remainder of the step with the new contact pinned.
 """
-import hashlib
-import threading
-from typing import NamedTuple
-
-import llvmlite.binding as ll
-from llvmlite import ir
-from numba import cfunc, types
-from numba.core import cgutils
-from numba.core.errors import TypingError
-from numba.extending import intrinsic
-
-from ..model import ModelArrays
-from ..options import StepOptions
-from ..state import State, Workspace
-from . import refs
-from ._jit import KERNEL_OPTIONS, jit, kernel, kernel_call, kernel_inline
+from ._jit import kernel, kernel_call, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
 from .audit import (DEPTH_TOL, PIN_GAP_TOL, audit_impulses, audit_positions, audit_total,
                     mark_held_contacts, worst_violation)
 from .complementarity import project_positions, solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, check_commands, check_guards
+from .guards import GUARD_AUDIT, check_guards
 from .math2d import update_trig
-from .info import INFO_CCD_SPLITS, INFO_COMMAND, INFO_SOLVES, STEP_COUNTS
+from .info import INFO_CCD_SPLITS, INFO_SOLVES, STEP_COUNTS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, predict_configuration, rows_hold_within)
 from .codes import MODES_ALTERNATING
 from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
-from .record import record_frame
 from .rows import build_rows
 from .solve import solve_impulses
 from .warm_start import remember_impulses, start_impulses
@@ -220,144 +204,3 @@ def _step(m, s, ws, opt, u):
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
     return code
-
-
-# The step is compiled once, as a C function, and called through its address by every compiled
-# caller (run_steps, run_recorded, each walker's rollout). A plain numba call would link the
-# step's code into each caller, where LLVM optimises and compiles it again: that was most of
-# the first-ever start-up (about 15 s per rollout). The address is published to LLVM's symbol
-# table under the name load_step returns; callers loaded from the numba cache publish it
-# first (reload_init).
-_ENGINE = {}
-_LOAD_LOCK = threading.RLock()
-
-
-def engine_types():
-    """(model, state, workspace, options) numba types the step is compiled for."""
-    if not _ENGINE:
-        from ..builder import ModelBuilder
-        from ..state import make_state, make_workspace
-        b = ModelBuilder()
-        body = b.add_body("b", 1.0, 1.0)
-        b.add_pin("p", None, body, anchor_world=(0.0, 0.0))
-        b.add_point_contact("c", body, (0.0, 0.0))
-        b.add_pin_motor("m", "p")
-        model = b.compile()
-        samples = (model.arrays, make_state(model), make_workspace(model), StepOptions())
-        found = tuple(refs.TableRef(refs.layout_of(x)) for x in samples)
-        text = "|".join(t.name for t in found)
-        _ENGINE["symbol"] = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
-        _ENGINE["types"] = found
-    return _ENGINE["types"]
-
-
-def _step_c(m, s, ws, opt, u_data, n_u):
-    if n_u != m.act_kind.shape[0]:
-        ws.info[INFO_COMMAND] = n_u   # nothing is read or changed: the actuators would read past u
-        return GUARD_BAD_COMMANDS
-    u = refs.array_1d(u_data, n_u)
-    code = check_commands(u, ws)
-    if code != 0:
-        return code
-    return _step(m, s, ws, opt, u)
-
-
-def load_step():
-    """Compile the step's C entry (or load it from the cache) and publish its address."""
-    with _LOAD_LOCK:
-        if "cfunc" not in _ENGINE:
-            sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
-            entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
-            ll.add_symbol(_ENGINE["symbol"], entry.address)
-            _ENGINE["cfunc"] = entry
-    return _ENGINE["symbol"]
-
-
-def _keep_reload_init_of_cached_code():
-    """numba runs a cached function's reload_init when it loads it, but leaves the loaded
-    library's own list empty. A function compiled later that links that library (G calling a
-    cached F that calls the step) then saves no load_step in its cache entry, and a process
-    loading G from the cache would jump to an unpublished symbol. Put the list back on the
-    library, where numba's linking expects it (applied once, before any cache load)."""
-    from numba.core.compiler import CompileResult
-    rebuild = CompileResult.__dict__["_rebuild"].__func__
-    if getattr(rebuild, "keeps_reload_init", False):
-        return
-
-    def _rebuild(cls, *args, **kwargs):
-        result = rebuild(cls, *args, **kwargs)
-        if result.reload_init:
-            result.library._reload_init.update(result.reload_init)
-        return result
-    _rebuild.keeps_reload_init = True
-    CompileResult._rebuild = classmethod(_rebuild)
-
-
-_keep_reload_init_of_cached_code()
-
-
-@intrinsic
-def step(typingctx, m, s, ws, opt, u):
-    """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0: m.dt)
-    under actuator commands u (float64, C-contiguous, one per actuator). Callable from compiled code.
-    Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), -1 when u does not have one
-    entry per actuator, -2 when a command is NaN or infinite (for both nothing is changed;
-    planarsim.errors.diverged explains any code)."""
-    expected = engine_types()
-    for name, got, want in zip(("model", "state", "workspace", "options"), (m, s, ws, opt), expected):
-        if got != want:
-            raise TypingError(f"step: {name} is {got}; the step is compiled for {want} "
-                              "(pass model.arrays, a State, a Workspace and StepOptions)")
-    if not (isinstance(u, types.Array) and u.dtype == types.float64 and u.ndim == 1 and u.layout == "C"):
-        raise TypingError(f"step: commands u must be a C-contiguous 1-d float64 array, got {u}")
-    symbol = load_step()
-
-    def codegen(context, builder, signature, args):
-        context.active_code_library._reload_init.add(load_step)
-        i64 = ir.IntType(64)
-        fnty = ir.FunctionType(i64, [cgutils.voidptr_t] * 4 + [ir.DoubleType().as_pointer(), i64])
-        fn = cgutils.get_or_insert_function(builder.module, fnty, symbol)
-        commands = context.make_array(u)(context, builder, args[4])
-        n_u = cgutils.unpack_tuple(builder, commands.shape)[0]
-        return builder.call(fn, list(args[:4]) + [commands.data, n_u])
-    return types.int64(m, s, ws, opt, u), codegen
-
-
-@refs.register
-class StepArgs(NamedTuple):
-    """Everything a step reads and writes but the commands, as one table (Simulator.step)."""
-    m: ModelArrays
-    s: State
-    ws: Workspace
-    opt: StepOptions
-
-
-@jit
-def run_steps(args, u, n):
-    """n steps of StepArgs args under commands u; returns (guard code, steps completed)."""
-    for k in range(n):
-        code = step(args.m, args.s, args.ws, args.opt, u)
-        if code != 0:
-            return code, k
-    return 0, n
-
-
-@jit
-def step_entry(m, s, ws, opt, u):
-    """`step` callable from Python (step itself is an intrinsic that only compiled code calls)."""
-    return step(m, s, ws, opt, u)
-
-
-@jit
-def run_recorded(m, s, ws, opt, u, n, every, rec, k0):
-    """n steps under constant u, recording every `every`-th step into rec from frame k0.
-    Returns (guard code, steps completed, next frame index)."""
-    k = k0
-    for i in range(n):
-        code = step(m, s, ws, opt, u)
-        if code != 0:
-            return code, i, k
-        if (s.step[0] % every) == 0 and k < rec.t.shape[0]:
-            record_frame(s, ws, rec, k)
-            k += 1
-    return 0, n, k

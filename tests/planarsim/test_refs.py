@@ -10,7 +10,7 @@ from numba.core.errors import TypingError
 
 import planarsim as ps
 from planarsim.kernels import refs
-from planarsim.kernels.step import step_entry
+from planarsim.kernels.link import step_entry
 
 
 @refs.register

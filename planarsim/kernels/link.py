@@ -1,0 +1,150 @@
+"""The step's linkage: one C function, published once per process, that all code calls.
+
+The step (kernels/step.py) is compiled once, as a C function (a numba cfunc, cached on disk),
+and every compiled caller (run_steps, run_recorded, step_entry, each walker's rollout, your
+own) calls it by address through the intrinsic ``step``. A plain numba call would link the
+step's code into each caller, where LLVM optimises and compiles it again: that was most of
+the first-ever start-up (about 15 s per rollout).
+
+A caller's machine code names the step by a symbol (``planarsim_step_<hash of the engine
+types>``) that LLVM resolves when the caller is compiled or loaded from the numba cache. The
+symbol is therefore published when this module is imported, before any caller can exist:
+everything that calls the step imports ``step`` from here (or from planarsim.compiled), so
+importing it loads the C function (about 0.1 s from the cache, plus numba's own set-up on
+the first compile of a process; the first-ever compile takes most of the cold start).
+planarsim itself imports this module only when a Simulator is made.
+"""
+import hashlib
+import threading
+from typing import NamedTuple
+
+import llvmlite.binding as ll
+from llvmlite import ir
+from numba import cfunc, types
+from numba.core import cgutils
+from numba.core.errors import TypingError
+from numba.extending import intrinsic
+
+from ..model import ModelArrays
+from ..options import StepOptions
+from ..state import State, Workspace
+from . import refs
+from ._jit import KERNEL_OPTIONS, jit
+from .guards import GUARD_BAD_COMMANDS, check_commands
+from .info import INFO_COMMAND
+from .record import record_frame
+from .step import _step
+
+_ENGINE = {}
+_LOAD_LOCK = threading.RLock()
+
+
+def engine_types():
+    """(model, state, workspace, options) numba types the step is compiled for."""
+    if not _ENGINE:
+        from ..builder import ModelBuilder
+        from ..state import make_state, make_workspace
+        b = ModelBuilder()
+        body = b.add_body("b", 1.0, 1.0)
+        b.add_pin("p", None, body, anchor_world=(0.0, 0.0))
+        b.add_point_contact("c", body, (0.0, 0.0))
+        b.add_pin_motor("m", "p")
+        model = b.compile()
+        samples = (model.arrays, make_state(model), make_workspace(model), StepOptions())
+        found = tuple(refs.TableRef(refs.layout_of(x)) for x in samples)
+        text = "|".join(t.name for t in found)
+        _ENGINE["symbol"] = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
+        _ENGINE["types"] = found
+    return _ENGINE["types"]
+
+
+def _step_c(m, s, ws, opt, u_data, n_u):
+    if n_u != m.act_kind.shape[0]:
+        ws.info[INFO_COMMAND] = n_u   # nothing is read or changed: the actuators would read past u
+        return GUARD_BAD_COMMANDS
+    u = refs.array_1d(u_data, n_u)
+    code = check_commands(u, ws)
+    if code != 0:
+        return code
+    return _step(m, s, ws, opt, u)
+
+
+def load_step():
+    """Compile the step's C function (or load it from the cache) and publish its address
+    under the symbol returned (once per process; this module's import does it)."""
+    with _LOAD_LOCK:
+        if "cfunc" not in _ENGINE:
+            sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
+            entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
+            ll.add_symbol(_ENGINE["symbol"], entry.address)
+            _ENGINE["cfunc"] = entry
+    return _ENGINE["symbol"]
+
+
+load_step()
+
+
+@intrinsic
+def step(typingctx, m, s, ws, opt, u):
+    """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0: m.dt)
+    under actuator commands u (float64, C-contiguous, one per actuator). Callable from compiled code.
+    Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), -1 when u does not have one
+    entry per actuator, -2 when a command is NaN or infinite (for both nothing is changed;
+    planarsim.errors.diverged explains any code)."""
+    expected = engine_types()
+    for name, got, want in zip(("model", "state", "workspace", "options"), (m, s, ws, opt), expected):
+        if got != want:
+            raise TypingError(f"step: {name} is {got}; the step is compiled for {want} "
+                              "(pass model.arrays, a State, a Workspace and StepOptions)")
+    if not (isinstance(u, types.Array) and u.dtype == types.float64 and u.ndim == 1 and u.layout == "C"):
+        raise TypingError(f"step: commands u must be a C-contiguous 1-d float64 array, got {u}")
+    symbol = load_step()
+
+    def codegen(context, builder, signature, args):
+        i64 = ir.IntType(64)
+        fnty = ir.FunctionType(i64, [cgutils.voidptr_t] * 4 + [ir.DoubleType().as_pointer(), i64])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, symbol)
+        commands = context.make_array(u)(context, builder, args[4])
+        n_u = cgutils.unpack_tuple(builder, commands.shape)[0]
+        return builder.call(fn, list(args[:4]) + [commands.data, n_u])
+    return types.int64(m, s, ws, opt, u), codegen
+
+
+@refs.register
+class StepArgs(NamedTuple):
+    """Everything a step reads and writes but the commands, as one table (Simulator.step)."""
+    m: ModelArrays
+    s: State
+    ws: Workspace
+    opt: StepOptions
+
+
+@jit
+def run_steps(args, u, n):
+    """n steps of StepArgs args under commands u; returns (guard code, steps completed)."""
+    for k in range(n):
+        code = step(args.m, args.s, args.ws, args.opt, u)
+        if code != 0:
+            return code, k
+    return 0, n
+
+
+@jit
+def step_entry(m, s, ws, opt, u):
+    """`step` callable from Python (step itself is an intrinsic that only compiled code calls)."""
+    return step(m, s, ws, opt, u)
+
+
+@jit
+def run_recorded(m, s, ws, opt, u, n, every, rec, k0):
+    """n steps under constant u, recording every `every`-th step into rec from frame k0.
+    Returns (guard code, steps completed, next frame index)."""
+    k = k0
+    for i in range(n):
+        code = step(m, s, ws, opt, u)
+        if code != 0:
+            return code, i, k
+        if (s.step[0] % every) == 0 and k < rec.t.shape[0]:
+            record_frame(s, ws, rec, k)
+            k += 1
+    return 0, n, k

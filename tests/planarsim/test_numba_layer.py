@@ -1,0 +1,115 @@
+"""The numba layer: its check of numba's internals, kernels' own code library, the step's
+linkage across processes and the cache invalidation after a kernel's source changes."""
+import os
+import subprocess
+import sys
+import textwrap
+
+import numba
+import numpy as np
+import pytest
+
+import planarsim as ps
+from planarsim.kernels import _jit, numba_check
+
+
+def _run(code, *args, path=(), cwd=None):
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([*map(str, path), os.getcwd()]))
+    out = subprocess.run([sys.executable, "-c", textwrap.dedent(code), *args], capture_output=True,
+                         text=True, env=env, cwd=cwd or os.getcwd())
+    assert out.returncode == 0, (args, out.returncode, out.stderr[-2000:])
+    return out.stdout.split()
+
+
+def test_installed_numba_has_every_internal_the_layer_uses():
+    assert numba_check.changed_internals() == []
+
+
+def test_a_changed_internal_fails_loudly_naming_it_and_the_numba_version(monkeypatch):
+    from numba.core import cgutils
+    monkeypatch.delattr(cgutils, "unpack_tuple")
+    with pytest.raises(ImportError) as err:
+        numba_check.check_numba()
+    text = str(err.value)
+    assert f"numba {numba.__version__}" in text
+    assert "numba.core.cgutils.unpack_tuple" in text and "numba<0.69" in text
+
+
+def test_kernels_lower_into_the_kernel_library_and_refuse_python_calls():
+    @_jit.kernel
+    def twice(x):
+        return 2.0 * x
+
+    @numba.njit
+    def caller(x):
+        return twice(x) + 1.0
+
+    assert caller(1.5) == 4.0
+    (cres,) = twice.overloads.values()
+    assert type(cres.library) is _jit.KernelCodeLibrary   # not numba's own (slow cold start)
+    with pytest.raises(TypeError, match="compiled kernel"):
+        twice(1.5)
+
+
+def test_cached_code_reaching_the_step_through_other_cached_code_loads(tmp_path):
+    """F calls the step, G calls F, all cached. Process 1 compiles F; process 2 loads F from
+    the cache and compiles G; process 3 loads G alone from the cache. In each, importing the
+    caller's module (which imports `step`) must have published the step's address before its
+    cached machine code is loaded (else the process dies jumping to an unresolved symbol)."""
+    (tmp_path / "fmod.py").write_text(textwrap.dedent("""
+        from planarsim.compiled import jit, step
+
+        @jit
+        def F(m, s, ws, opt, u):
+            return step(m, s, ws, opt, u)
+    """))
+    (tmp_path / "gmod.py").write_text(textwrap.dedent("""
+        from planarsim.compiled import jit
+        from fmod import F
+
+        @jit
+        def G(m, s, ws, opt, u):
+            return F(m, s, ws, opt, u) + 10
+    """))
+    run = """
+        import sys
+        mod = __import__(sys.argv[1])   # first: nothing else has loaded the step
+        import numpy as np
+        from planarsim.model import Model
+        from planarsim.options import StepOptions
+        from planarsim.state import make_state, make_workspace
+        from tests.planarsim.test_reliability import two_link_on_hills
+        model = two_link_on_hills()
+        s, ws = make_state(model), make_workspace(model)
+        fn = getattr(mod, sys.argv[2])
+        print(fn(model.arrays, s, ws, StepOptions(), np.zeros(model.n_act)), s.step[0],
+              sum(fn.stats.cache_hits.values()))
+    """
+    outs = [_run(run, mod, fn, path=[tmp_path]) for mod, fn in (("fmod", "F"), ("gmod", "G"), ("gmod", "G"))]
+    assert outs[0] == ["0", "1", "0"]      # F compiled, one step taken
+    assert outs[1] == ["10", "1", "0"]     # G compiled (F from the cache)
+    assert outs[2] == ["10", "1", "1"]     # G from the cache, and the step ran
+
+
+def test_editing_a_kernel_recompiles_its_cached_callers(tmp_path):
+    """numba checks a cached function against its own file only: b.run calls kernel a.value,
+    and after a.py changes, drop_stale_caches (on the package's import) must clear b's cache."""
+    pkg = tmp_path / "kpkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("from planarsim.compiled import drop_stale_caches\n"
+                                     "drop_stale_caches(__path__[0])\n")
+    (pkg / "b.py").write_text(textwrap.dedent("""
+        from planarsim.compiled import jit
+        from .a import value
+
+        @jit
+        def run(x):
+            return value(x)
+    """))
+    code = "from kpkg.b import run; print(run(1.0), sum(run.stats.cache_hits.values()))"
+    outs = []
+    for k in (1, 1, 2):
+        (pkg / "a.py").write_text(f"from planarsim.compiled import kernel\n\n@kernel\n"
+                                  f"def value(x):\n    return x + {k}\n")
+        outs.append(_run(code, path=[tmp_path]))
+    assert outs == [["2.0", "0"], ["2.0", "1"], ["3.0", "0"]]
