@@ -20,7 +20,7 @@ import hashlib
 import os
 from pathlib import Path
 
-from numba import njit
+from numba import njit, types
 from numba.core import compiler
 from numba.core.codegen import JITCodeLibrary
 from numba.core.compiler_lock import require_global_compiler_lock
@@ -47,6 +47,13 @@ class KernelDispatcher(CPUDispatcher):
         raise TypeError(f"{self.py_func.__module__}.{name} is a compiled kernel: call it from "
                         "compiled code (a rollout decorated with planarsim.compiled.jit); from "
                         "Python use Simulator.step / steps or planarsim.compiled.step_from_python")
+
+    def get_call_template(self, args, kws):
+        """Compile for the arguments' plain types: a constant argument (a row kind, an audit
+        rule) would otherwise make one more compilation of the kernel per value."""
+        args = tuple(types.unliteral(a) for a in args)
+        kws = {k: types.unliteral(v) for k, v in kws.items()}
+        return super().get_call_template(args, kws)
 
 
 class KernelCodeLibrary(JITCodeLibrary):

@@ -51,6 +51,21 @@ def test_kernels_lower_into_the_kernel_library_and_refuse_python_calls():
         twice(1.5)
 
 
+def test_a_kernel_compiles_once_for_all_constant_arguments():
+    """numba would compile a kernel once per constant value passed to it (a row kind, an audit
+    rule): 177 compilations of the step's kernels instead of 122, 8 s of a cold start."""
+    @_jit.kernel
+    def scaled(x, k):
+        return k * x
+
+    @numba.njit
+    def caller(x):
+        return scaled(x, 1) + scaled(x, 2) + scaled(x, 3)
+
+    assert caller(1.5) == 9.0
+    assert len(scaled.overloads) == 1
+
+
 def test_cached_code_reaching_the_step_through_other_cached_code_loads(tmp_path):
     """F calls the step, G calls F, all cached. Process 1 compiles F; process 2 loads F from
     the cache and compiles G; process 3 loads G alone from the cache. In each, importing the
