@@ -46,9 +46,17 @@ def _load_walker(name):
     w = _walkers()
     if name not in w.WALKERS:
         raise UsageError(f"unknown walker {name!r}; choose one of: {', '.join(sorted(w.WALKERS))}")
-    if not _engine_cache_files()[1] and "NUMBA_CACHE_DIR" not in os.environ:
-        print("compiling the engine (first run only, about half a minute)", file=sys.stderr, flush=True)
+    _say_if_compiling()
     return w.load(name)
+
+
+def _say_if_compiling():
+    """Before the first import of a walker on a cold cache: a note on stderr (the import
+    compiles the step, about half a minute once)."""
+    if "planarsim.kernels.link" in sys.modules or "NUMBA_CACHE_DIR" in os.environ:
+        return
+    if not _engine_cache_files()[1]:
+        print("compiling the engine (first run only, about half a minute)", file=sys.stderr, flush=True)
 
 
 def _check_out(path, exts, what):
@@ -79,6 +87,7 @@ def _positive(text):
 def cmd_list(args):
     from planarsim import terrain
     w = _walkers()
+    _say_if_compiling()
     print("walkers (gaits):")
     for name in sorted(w.WALKERS):
         try:
