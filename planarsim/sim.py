@@ -22,8 +22,8 @@ from .trajectory import Trajectory, make_recorder
 
 
 def _link():
-    """kernels.link, imported with the first Simulator: importing it loads the compiled step
-    (from the numba cache, or its first-ever compile), which `import planarsim` does not need."""
+    """kernels.link, imported with the first Simulator (its compiled functions publish the
+    step before their first call: from the numba cache, or its first-ever compile)."""
     from .kernels import link
     return link
 

@@ -20,7 +20,7 @@ import hashlib
 import os
 from pathlib import Path
 
-from numba import njit, types
+from numba import types
 from numba.core import compiler
 from numba.core.codegen import JITCodeLibrary
 from numba.core.compiler_lock import require_global_compiler_lock
@@ -28,7 +28,48 @@ from numba.core.registry import CPUDispatcher
 
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
 
-jit = njit(**_OPTIONS)
+
+
+class CallerDispatcher(CPUDispatcher):
+    """Dispatcher of a `jit` function. Its machine code may call the compiled step by a
+    symbol that LLVM resolves when the code is compiled or loaded from the cache; so before
+    either, the step is published (kernels/link.py: loaded from the cache, or compiled the
+    first time ever). Importing a module of compiled code therefore compiles nothing: a
+    command that only lists walkers or parameters never waits for the step."""
+
+    def compile(self, sig):
+        link_step()
+        return super().compile(sig)
+
+
+_LINKING = []
+
+
+def link_step():
+    """Publish the compiled step's symbol (kernels/link.py load_step, once per process)."""
+    if not _LINKING:
+        _LINKING.append(True)      # the step's own compile calls jit functions (terrain)
+        try:
+            from .link import load_step
+            load_step()
+        except BaseException:
+            _LINKING.clear()
+            raise
+
+
+def _caller_decorator(**extra):
+    options = dict(_OPTIONS, nopython=True, boundscheck=None, **extra)
+    cache = options.pop("cache")
+
+    def decorate(fn):
+        dispatcher = CallerDispatcher(py_func=fn, locals={}, targetoptions=dict(options))
+        if cache:
+            dispatcher.enable_caching()
+        return dispatcher
+    return decorate
+
+
+jit = _caller_decorator()
 # for numba.cfunc (the step's C entry, cached by its own argument): a C function holds no GIL
 KERNEL_OPTIONS = {k: v for k, v in _OPTIONS.items() if k not in ("cache", "nogil")}
 # PLANARSIM_KERNEL_CALLS=1 keeps kernels as calls, so that a profiler sees each stage
@@ -152,13 +193,13 @@ kernel_inline = _kernel_decorator(inline="always")
 kernel_call = _kernel_decorator(pipeline_class=KernelCallCompiler, forceinline=False)
 # callable from Python and inlined into compiled callers (a walker's controller: the Python
 # controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
-jit_inline = njit(inline="always", **_OPTIONS)
+jit_inline = _caller_decorator(inline="always")
 # callable from Python and always inlined by LLVM into compiled callers (the terrain's height
 # and closest point). A plain `jit` function takes the inlining setting of the caller that
 # compiles it first (numba's flag inheritance: forced inline under a kernel, not under a
 # kernel_call, and the cache keeps that choice); where that matters for speed, say it here.
 # Inside kernel_call's closest point a call per height was a third slower.
-jit_force = njit(forceinline=True, **_OPTIONS)
+jit_force = _caller_decorator(forceinline=True)
 
 
 def _sources_hash(folder: Path, extra: str = "") -> str:

@@ -8,11 +8,14 @@ the first-ever start-up (about 15 s per rollout).
 
 A caller's machine code names the step by a symbol (``planarsim_step_<hash of the engine
 types>``) that LLVM resolves when the caller is compiled or loaded from the numba cache. The
-symbol is therefore published when this module is imported, before any caller can exist:
-everything that calls the step imports ``step`` from here (or from planarsim.compiled), so
-importing it loads the C function (about 0.1 s from the cache, plus numba's own set-up on
-the first compile of a process; the first-ever compile takes most of the cold start).
-planarsim itself imports this module only when a Simulator is made.
+symbol is therefore published (load_step) before any such code exists in a process: by the
+dispatcher of every `jit` function before it compiles or loads code (_jit.CallerDispatcher),
+and by the intrinsic when a caller is typed. Loading takes about 0.1 s from the cache plus
+numba's own set-up on the first compile of a process; the first-ever compile takes most of
+the cold start. Importing this module compiles nothing, so a command that only imports
+walkers (to list them, say) is quick. Decorate your own code that calls ``step`` with
+planarsim.compiled.jit: a plain numba.njit(cache=True) function loaded from the cache in a
+new process would name a symbol nothing has published yet.
 """
 import hashlib
 import threading
@@ -71,7 +74,7 @@ def _step_c(m, s, ws, opt, u_data, n_u):
 
 def load_step():
     """Compile the step's C function (or load it from the cache) and publish its address
-    under the symbol returned (once per process; this module's import does it)."""
+    under the symbol returned (once per process; see the module's docstring)."""
     with _LOAD_LOCK:
         if "cfunc" not in _ENGINE:
             sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
@@ -80,8 +83,6 @@ def load_step():
             _ENGINE["cfunc"] = entry
     return _ENGINE["symbol"]
 
-
-load_step()
 
 
 @intrinsic
