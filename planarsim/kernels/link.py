@@ -22,6 +22,7 @@ import threading
 from typing import NamedTuple
 
 import llvmlite.binding as ll
+import numpy as np
 from llvmlite import ir
 from numba import cfunc, types
 from numba.core import cgutils
@@ -134,6 +135,40 @@ def run_steps(args, u, n):
 def step_entry(m, s, ws, opt, u):
     """`step` callable from Python (step itself is an intrinsic that only compiled code calls)."""
     return step(m, s, ws, opt, u)
+
+
+# step_from_python's bound entries, by the identity of (model arrays, state, workspace):
+# NamedTuples cannot change, so a handle packed once stays right while it is held; a new
+# StepOptions (options._replace(dt=...), say) only rewrites the options' few slots
+_BOUND = {}
+_BOUND_SIZE = 32
+_BOUND_LOCK = threading.Lock()
+
+
+def step_from_python(m, s, ws, opt, u):
+    """One step of `step` from Python for a model's arrays, State, Workspace and StepOptions of
+    your own; returns the guard code (0 ok; planarsim.errors.diverged explains any other).
+    The four are packed into one handle on their first call and the compiled loop is called
+    without numba's type dispatch (about 1 us a call on top of the step, like Simulator.step)."""
+    key = (id(m), id(s), id(ws))
+    hit = _BOUND.get(key)
+    if hit is None or hit[0][0] is not m or hit[0][1] is not s or hit[0][2] is not ws:
+        handle = refs.TableHandle(StepArgs(m, s, ws, opt))
+        entry = run_steps.compile((handle.numba_type, types.float64[::1], types.int64))
+        hit = [(m, s, ws), handle, entry, opt]
+        with _BOUND_LOCK:
+            _BOUND[key] = hit
+            while len(_BOUND) > _BOUND_SIZE:
+                _BOUND.pop(next(iter(_BOUND)), None)
+    elif hit[3] is not opt:
+        field = hit[1].layout.by_name["opt"]
+        if refs.layout_of(opt) is not field[6]:
+            raise TypeError(f"step_from_python: options of another layout ({type(opt).__name__})")
+        refs.fill(opt, field[6], hit[1].table, field[5])
+        hit[3] = opt
+    if not (type(u) is np.ndarray and u.dtype == np.float64 and u.ndim == 1 and u.flags.c_contiguous):
+        u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
+    return hit[2](hit[1], u, 1)[0]
 
 
 @jit

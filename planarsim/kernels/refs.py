@@ -124,7 +124,8 @@ def layout_of(obj) -> Layout:
     return layout
 
 
-def _fill(obj, layout, table, base):
+def fill(obj, layout, table, base):
+    """Write NamedTuple `obj`'s fields into `table` from slot `base` (its layout's order)."""
     for name, kind, dtype, ndim, readonly, offset, sub in layout.fields:
         value = getattr(obj, name)
         k = base + offset
@@ -138,7 +139,7 @@ def _fill(obj, layout, table, base):
             table[k] = value.ctypes.data
             table[k + 1:k + 1 + ndim] = value.shape
         elif kind == "ref":
-            _fill(value, sub, table, k)
+            fill(value, sub, table, k)
         elif kind == "float":
             if not isinstance(value, (int, float, np.integer, np.floating)):
                 raise TypeError(f"{type(obj).__name__}.{name} must be a float, got {value!r}")
@@ -159,7 +160,7 @@ def pack(obj, layout=None) -> np.ndarray:
     """The int64 table of registered NamedTuple `obj` (valid while its arrays live)."""
     layout = layout_of(obj) if layout is None else layout
     table = np.zeros(max(layout.size, 1), np.int64)
-    _fill(obj, layout, table, 0)
+    fill(obj, layout, table, 0)
     return table
 
 

@@ -144,3 +144,38 @@ def test_commands_of_the_wrong_length_step_nothing_and_are_explained():
         assert all(np.array_equal(a, b) for a, b in zip(s, before))
         err = diverged(sim.model, ws, code, sim.options.guard_limit)
         assert isinstance(err, ValueError) and f"have {n} entries" in str(err)
+
+
+def test_step_from_python_steps_as_the_simulator_does():
+    """planarsim.compiled.step_from_python on a model's own State and Workspace gives the
+    Simulator's step bit for bit, and refuses commands of the wrong length with its code."""
+    from planarsim.compiled import RUN_BAD_COMMANDS, step_from_python
+    from planarsim.state import make_workspace
+    from conftest import make_chain
+    model = make_chain(3)
+    sim = ps.Simulator(model)
+    s, ws, opt = ps.make_state(model), make_workspace(model), ps.StepOptions()
+    u = np.zeros(model.n_act)
+    for _ in range(200):
+        sim.step()
+        assert step_from_python(model.arrays, s, ws, opt, u) == 0
+    assert np.array_equal(s.q, sim.state.q) and np.array_equal(s.v, sim.state.v)
+    assert step_from_python(model.arrays, s, ws, opt, np.zeros(model.n_act + 1)) == RUN_BAD_COMMANDS
+
+
+def test_step_from_python_follows_new_options_on_the_same_state():
+    """A new StepOptions each call (a sub-step of another length) takes effect at once."""
+    from planarsim.compiled import step_from_python
+    from planarsim.state import make_workspace
+    from conftest import make_chain
+    model = make_chain(2)
+    sim = ps.Simulator(model, ps.StepOptions(dt=2.5e-4))
+    s, ws = ps.make_state(model), make_workspace(model)
+    u = np.zeros(model.n_act)
+    for k in range(100):
+        assert step_from_python(model.arrays, s, ws, ps.StepOptions(dt=1e-3), u) == 0
+        s.time[0] -= 1e-3
+        s.q[:], s.v[:] = ws.prev.q, ws.prev.v       # undo it: the next call's options count
+        assert step_from_python(model.arrays, s, ws, ps.StepOptions(dt=2.5e-4), u) == 0
+        sim.step()
+    assert np.array_equal(s.q, sim.state.q) and np.array_equal(s.v, sim.state.v)
