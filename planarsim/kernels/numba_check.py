@@ -21,8 +21,9 @@ NEEDED = {
                           "JITCodeLibrary._raise_if_finalized JITCodeLibrary._get_module_for_linking "
                           "JITCPUCodegen.set_env",
     "numba.core.compiler": "Compiler.compile_extra",
-    "numba.core.compiler_lock": "require_global_compiler_lock",
-    "numba.core.registry": "CPUDispatcher",
+    "numba.core.compiler_lock": "require_global_compiler_lock global_compiler_lock",
+    "numba.core.registry": "CPUDispatcher CPUDispatcher.compile CPUDispatcher.enable_caching "
+                           "CPUDispatcher.get_call_template",
     "numba.core.imputils": "impl_ret_borrowed",
     "numba.core.typing.templates": "AttributeTemplate",
     "numba.np.arrayobj": "populate_array",

@@ -68,9 +68,9 @@ def test_a_kernel_compiles_once_for_all_constant_arguments():
 
 def test_cached_code_reaching_the_step_through_other_cached_code_loads(tmp_path):
     """F calls the step, G calls F, all cached. Process 1 compiles F; process 2 loads F from
-    the cache and compiles G; process 3 loads G alone from the cache. In each, importing the
-    caller's module (which imports `step`) must have published the step's address before its
-    cached machine code is loaded (else the process dies jumping to an unresolved symbol)."""
+    the cache and compiles G; process 3 loads G alone from the cache. In each, the jit
+    dispatcher must have published the step's address before its cached machine code is
+    loaded (else the process dies jumping to an unresolved symbol)."""
     (tmp_path / "fmod.py").write_text(textwrap.dedent("""
         from planarsim.compiled import jit, step
 
@@ -104,6 +104,30 @@ def test_cached_code_reaching_the_step_through_other_cached_code_loads(tmp_path)
     assert outs[0] == ["0", "1", "0"]      # F compiled, one step taken
     assert outs[1] == ["10", "1", "0"]     # G compiled (F from the cache)
     assert outs[2] == ["10", "1", "1"]     # G from the cache, and the step ran
+
+
+def test_threads_first_calling_cached_rollouts_wait_for_the_step():
+    """A fresh process whose first compiled calls are two walkers' cached rollouts, started
+    at once from two threads: one publishes the step, the other waits for it (a thread that
+    went on would load code naming a symbol not yet published)."""
+    import walkers
+    for name in ("simple-biped", "rimless-wheel"):
+        walkers.load(name).simulate(0.01)          # the caches are warm
+    code = textwrap.dedent("""
+        import threading, walkers
+        out = {}
+        def go(name):
+            out[name] = walkers.load(name).simulate(0.2)[1]["fell"]
+        names = ("simple-biped", "rimless-wheel")
+        mods = [walkers.load(n) for n in names]
+        threads = [threading.Thread(target=go, args=(n,)) for n in names]
+        for t in threads: t.start()
+        for t in threads: t.join()
+        print(sorted(out.items()))
+    """)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "('rimless-wheel', False), ('simple-biped', False)" in done.stdout
 
 
 def test_editing_a_kernel_recompiles_its_cached_callers(tmp_path):
