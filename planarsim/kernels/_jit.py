@@ -23,7 +23,7 @@ from pathlib import Path
 from numba import types
 from numba.core import compiler
 from numba.core.codegen import JITCodeLibrary
-from numba.core.compiler_lock import global_compiler_lock, require_global_compiler_lock
+from numba.core.compiler_lock import require_global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
@@ -43,25 +43,17 @@ class CallerDispatcher(CPUDispatcher):
 
 
 _LINKED = []     # the step is published in this process
-_LINKING = []    # it is being published (the step's own compile calls jit functions: terrain)
 
 
 def link_step():
-    """Publish the compiled step's symbol (kernels/link.py load_step, once per process).
-    Under numba's compiler lock: another thread's compile waits until the symbol exists, and
-    one lock cannot deadlock with a compile already holding it."""
+    """Publish the compiled step's symbol (kernels/link.py load_step, which waits under
+    numba's compiler lock while another thread publishes it), once per process."""
     if _LINKED:
         return
-    with global_compiler_lock:
-        if _LINKED or _LINKING:
-            return
-        _LINKING.append(True)
-        try:
-            from .link import load_step
-            load_step()
-            _LINKED.append(True)
-        finally:
-            _LINKING.clear()
+    from . import link
+    link.load_step()
+    if "cfunc" in link._ENGINE:
+        _LINKED.append(True)
 
 
 def _caller_decorator(**extra):

@@ -26,6 +26,7 @@ import numpy as np
 from llvmlite import ir
 from numba import cfunc, types
 from numba.core import cgutils
+from numba.core.compiler_lock import global_compiler_lock
 from numba.core.errors import TypingError
 from numba.extending import intrinsic
 
@@ -40,7 +41,7 @@ from .record import record_frame
 from .step import _step
 
 _ENGINE = {}
-_LOAD_LOCK = threading.RLock()
+_LOADING = []     # this thread is compiling the step (see load_step)
 
 
 def engine_types():
@@ -75,13 +76,23 @@ def _step_c(m, s, ws, opt, u_data, n_u):
 
 def load_step():
     """Compile the step's C function (or load it from the cache) and publish its address
-    under the symbol returned (once per process; see the module's docstring)."""
-    with _LOAD_LOCK:
-        if "cfunc" not in _ENGINE:
-            sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
-            entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
-            ll.add_symbol(_ENGINE["symbol"], entry.address)
-            _ENGINE["cfunc"] = entry
+    under the symbol returned (once per process; see the module's docstring). Under numba's
+    compiler lock, so that another thread's compile waits for the symbol; a call from inside
+    the step's own compile (it compiles jit functions, whose dispatchers come here) returns
+    at once: that code does not call the step."""
+    if "cfunc" in _ENGINE:
+        return _ENGINE["symbol"]
+    with global_compiler_lock:
+        if "cfunc" not in _ENGINE and not _LOADING:
+            _LOADING.append(True)
+            try:
+                sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
+                entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
+                ll.add_symbol(_ENGINE["symbol"], entry.address)
+                _ENGINE["cfunc"] = entry
+            finally:
+                _LOADING.clear()
+    engine_types()
     return _ENGINE["symbol"]
 
 
