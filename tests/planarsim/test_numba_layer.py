@@ -130,6 +130,34 @@ def test_threads_first_calling_cached_rollouts_wait_for_the_step():
     assert "('rimless-wheel', False), ('simple-biped', False)" in done.stdout
 
 
+def test_a_cold_cache_compiles_the_step_for_a_plain_njit_caller_first(tmp_path):
+    """A first-ever process (an empty numba cache) whose first compiled code is a plain
+    numba.njit function calling the step: typing it compiles and publishes the step, whose
+    own compile goes through jit dispatchers (terrain) that must not start it again. A
+    walker's rollout then runs in the same process. About half a minute: a full compile."""
+    code = textwrap.dedent("""
+        import numpy as np
+        from numba import njit
+        import planarsim as ps, walkers
+        from planarsim.compiled import step
+        from planarsim.state import make_workspace
+        @njit
+        def one(m, s, ws, opt, u):
+            return step(m, s, ws, opt, u)
+        b = ps.ModelBuilder()
+        body = b.add_body("b", 1.0, 0.1, pos=(0.5, 0.0))
+        b.add_pin("p", None, body, anchor_world=(0.0, 0.0))
+        model = b.compile()
+        s, ws = ps.make_state(model), make_workspace(model)
+        print("step", one(model.arrays, s, ws, ps.StepOptions(), np.zeros(0)))
+        print("fell", walkers.load("rimless-wheel").simulate(0.5)[1]["fell"])
+    """)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, env=env)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "step 0" in done.stdout and "fell False" in done.stdout
+
+
 def test_editing_a_kernel_recompiles_its_cached_callers(tmp_path):
     """numba checks a cached function against its own file only: b.run calls kernel a.value,
     and after a.py changes, drop_stale_caches (on the package's import) must clear b's cache."""
