@@ -11,9 +11,10 @@ its compiled callers):
 Engine, from compiled code:
     step(m, s, ws, opt, u) -> run code      advance State s by one step of opt.dt (0: m.dt).
                                              The step is one C function, compiled once per
-                                             machine and loaded when this module is imported;
-                                             every caller calls it by address (the linkage is
-                                             all in planarsim/kernels/link.py)
+                                             machine and loaded before the first jit function
+                                             runs; every caller calls it by address (the
+                                             linkage is all in planarsim/kernels/link.py).
+                                             Decorate callers with jit, not numba.njit
     record_frame(s, ws, rec, k)              write frame k of a Recorder (make_recorder)
     height(coef, x), height_derivs(coef, x)  the ground h(x) [m] and (h, h', h'')
     closest_point(coef, px, py)              (gx, gy, nx, ny, gap) of the nearest ground point

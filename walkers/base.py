@@ -58,11 +58,12 @@ class WalkerRun:
 
     NAME = "walker"    # recorded in Trajectory.info["walker"] and named by engine errors
     LABELS = ()        # per-frame labels: the columns advance() writes into `lab`
-    FELL_SLOT = -1     # memory slot the rollout sets non-zero when the walker falls
+    FELL_SLOT = None   # memory slot the rollout sets non-zero when the walker falls (required)
 
     def __init__(self, model, params, tables, memory, *, state=None, ws=None, options=None,
                  record_every=10):
         import planarsim as ps
+        from planarsim.options import check_options
         from planarsim.state import make_workspace
         if not (isinstance(record_every, (int, np.integer)) and record_every >= 0):
             raise ValueError(f"record_every={record_every!r} must be an integer >= 0 (steps between frames)")
@@ -72,7 +73,11 @@ class WalkerRun:
         self.memory = memory
         self.state = state if state is not None else ps.make_state(model)
         self.ws = ws if ws is not None else make_workspace(model)
-        self.options = options if options is not None else ps.StepOptions()
+        self.options = ps.StepOptions() if options is None else check_options(options)
+        if self.options.dt not in (0.0, model.dt):
+            # the controllers integrate (work, effort, motor currents, ramps) with the model's dt
+            raise ValueError(f"{self.NAME}: options.dt={self.options.dt} s differs from the model's "
+                             f"dt={model.dt} s; build the walker with dt={self.options.dt} instead")
         self.u = np.zeros(model.n_act)
         self.record_every = int(record_every)
         self.chunks = []
@@ -109,6 +114,8 @@ class WalkerRun:
 
     @property
     def fell(self) -> bool:
+        if self.FELL_SLOT is None:
+            raise NotImplementedError(f"{type(self).__name__} sets no FELL_SLOT (or overrides fell)")
         return bool(self.memory[self.FELL_SLOT])
 
     def run(self, seconds: float):
@@ -122,7 +129,8 @@ class WalkerRun:
             raise ValueError(f"seconds={seconds!r} must be a number of seconds") from None
         if not (math.isfinite(seconds) and seconds >= 0.0):
             raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
-        n = int(round(seconds / self.dt))
+        # a walker that fell stays where it fell: its rollout would otherwise take one more step
+        n = 0 if self.fell else int(round(seconds / self.dt))
         frames = self.frames(n)
         rec = make_recorder(self.model, frames)
         lab = np.zeros((frames, len(self.LABELS)))

@@ -31,7 +31,7 @@ from numba.core.errors import TypingError
 from numba.extending import intrinsic
 
 from ..model import ModelArrays
-from ..options import StepOptions
+from ..options import StepOptions, check_options
 from ..state import State, Workspace
 from . import refs
 from ._jit import KERNEL_OPTIONS, jit
@@ -163,22 +163,25 @@ def step_from_python(m, s, ws, opt, u):
     without numba's type dispatch (about 1 us a call on top of the step, like Simulator.step)."""
     key = (id(m), id(s), id(ws))
     hit = _BOUND.get(key)
+    given = opt
+    if hit is None or hit[3] is not given:
+        opt = check_options(given)       # a NaN or negative dt, say, named here
     if hit is None or hit[0][0] is not m or hit[0][1] is not s or hit[0][2] is not ws:
         handle = refs.TableHandle(StepArgs(m, s, ws, opt))
         entry = run_steps.compile((handle.numba_type, types.float64[::1], types.int64))
-        hit = [(m, s, ws), handle, entry, opt]
+        hit = [(m, s, ws), handle, entry, given]
         with _BOUND_LOCK:
             _BOUND[key] = hit
             while len(_BOUND) > _BOUND_SIZE:
                 _BOUND.pop(next(iter(_BOUND)), None)
     elif hit[3] is not opt:
         field = hit[1].layout.by_name["opt"]
-        if refs.layout_of(opt) is not field[6]:
-            raise TypeError(f"step_from_python: options of another layout ({type(opt).__name__})")
         refs.fill(opt, field[6], hit[1].table, field[5])
-        hit[3] = opt
+        hit[3] = given
     if not (type(u) is np.ndarray and u.dtype == np.float64 and u.ndim == 1 and u.flags.c_contiguous):
-        u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        if u.ndim != 1:
+            raise ValueError(f"step_from_python: commands u must be 1-d (one per actuator), got shape {u.shape}")
     return hit[2](hit[1], u, 1)[0]
 
 

@@ -179,3 +179,19 @@ def test_step_from_python_follows_new_options_on_the_same_state():
         assert step_from_python(model.arrays, s, ws, ps.StepOptions(dt=2.5e-4), u) == 0
         sim.step()
     assert np.array_equal(s.q, sim.state.q) and np.array_equal(s.v, sim.state.v)
+
+
+def test_step_from_python_names_bad_options_and_commands():
+    from planarsim.compiled import step_from_python
+    from planarsim.state import make_workspace
+    from conftest import make_chain
+    model = make_chain(2)
+    s, ws = ps.make_state(model), make_workspace(model)
+    u = np.zeros(model.n_act)
+    with pytest.raises(ValueError, match="dt"):
+        step_from_python(model.arrays, s, ws, ps.StepOptions(dt=float("nan")), u)
+    assert step_from_python(model.arrays, s, ws, ps.StepOptions(), u) == 0
+    with pytest.raises(ValueError, match="dt"):
+        step_from_python(model.arrays, s, ws, ps.StepOptions(dt=-1e-3), u)
+    with pytest.raises(ValueError, match="1-d"):
+        step_from_python(model.arrays, s, ws, ps.StepOptions(), np.zeros((1, model.n_act)))

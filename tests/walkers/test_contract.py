@@ -51,6 +51,34 @@ def test_chunked_run_ends_where_one_run_does(name):
     assert chunked.summary()["fell"] == whole.summary()["fell"]
 
 
+# a start or terrain each walker falls on within 6 s
+FALLS = {"simple-biped": dict(terrain="hills:0.15,1.0"), "simbicon": dict(terrain="hills:0.1,1.5"),
+         "compass-gait": dict(terrain="slope:-8")}
+
+
+@pytest.mark.parametrize("name", sorted(FALLS))
+def test_a_walker_that_fell_stays_where_it_fell(name):
+    """A chunk after the fall adds nothing: chunked runs end where one run does after a fall too."""
+    mod = walkers.load(name)
+    whole = mod.Run(**FALLS[name])
+    whole.run(6.0)
+    assert whole.fell
+    chunked = mod.Run(**FALLS[name])
+    chunked.run(whole.time + 0.5)
+    assert len(chunked.run(1.0)) == 0
+    assert chunked.time == whole.time and np.array_equal(chunked.state.q, whole.state.q)
+    assert len(chunked.trajectory()) == len(whole.trajectory())
+
+
+def test_options_with_another_step_length_are_refused():
+    """The controllers integrate with the model's dt: options.dt must be 0 or that dt."""
+    import planarsim as ps
+    with pytest.raises(ValueError, match="options.dt"):
+        walkers.load("simple-biped").Run(options=ps.StepOptions(dt=2e-3))
+    with pytest.raises(ValueError, match="dt"):
+        walkers.load("simple-biped").Run(options=ps.StepOptions(dt=math.nan))
+
+
 @pytest.mark.parametrize("name", sorted(walkers.WALKERS))
 def test_feet_and_extras_names(name):
     """FEET (where given) names real contacts, each once; SUMMARY_EXTRAS names are unique."""

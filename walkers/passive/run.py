@@ -110,6 +110,8 @@ class PassiveRun(WalkerRun):
         return n // self.record_every + 2 + 2 * self.max_touchdowns(n) if self.record_every else 0
 
     def advance(self, n, every, rec, lab):
+        if self.fallen:
+            return FELL, 0        # it stays where it fell (the refined rollout walks to a total)
         self.steps_asked += n
         code, k = (self._engine if self.impacts == "engine" else self._refined)(n, rec)
         self.code = int(code)
