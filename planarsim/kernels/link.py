@@ -46,7 +46,7 @@ _LOADING = []     # this thread is compiling the step (see load_step)
 
 def engine_types():
     """(model, state, workspace, options) numba types the step is compiled for."""
-    if not _ENGINE:
+    if "types" not in _ENGINE:
         from ..builder import ModelBuilder
         from ..state import make_state, make_workspace
         b = ModelBuilder()
@@ -58,8 +58,8 @@ def engine_types():
         samples = (model.arrays, make_state(model), make_workspace(model), StepOptions())
         found = tuple(refs.TableRef(refs.layout_of(x)) for x in samples)
         text = "|".join(t.name for t in found)
-        _ENGINE["symbol"] = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
-        _ENGINE["types"] = found
+        symbol = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
+        _ENGINE.update(symbol=symbol, types=found)     # one update: another thread sees both or none
     return _ENGINE["types"]
 
 
