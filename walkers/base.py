@@ -25,8 +25,10 @@ A run (WalkerRun) holds the model, State, Workspace, StepOptions, parameters, co
 and memory of one walker in the world; ``run(seconds)`` advances it with the walker's compiled
 rollout and returns that chunk's Trajectory, so running a then b seconds ends bit for bit where
 running a + b seconds does. A subclass supplies only what differs: it builds model, table and
-memory in its __init__, names its LABELS (per-frame copies of memory slots) and FELL_SLOT, and
-implements ``advance`` (one call of its rollout) and ``numbers`` (its raw summary numbers).
+memory in its __init__, names its LABELS (per-frame copies of memory slots LABEL_SLOTS),
+FELL_SLOT and ROLLOUT (its compiled rollout; advance() calls it, or a walker whose rollout takes
+more overrides advance) and implements ``numbers`` (its raw summary numbers). A rollout records
+through walkers.common.record.record_labelled.
 
 An actuated walker's compiled controller is ``control(m, s, ws, tab, mem, u)``: model arrays,
 State, Workspace, the walker's read-only table of parameters and constants (a NamedTuple of
@@ -59,6 +61,11 @@ class WalkerRun:
     NAME = "walker"    # recorded in Trajectory.info["walker"] and named by engine errors
     LABELS = ()        # per-frame labels: the columns advance() writes into `lab`
     FELL_SLOT = None   # memory slot the rollout sets non-zero when the walker falls (required)
+    # the compiled rollout advance() calls, as staticmethod(f) with f(m, s, ws, opt, tab, mem,
+    # u, n, every, rec, lab, LABEL_SLOTS, k0) -> (run code, steps done, next frame); a walker
+    # whose rollout takes more overrides advance()
+    ROLLOUT = None
+    LABEL_SLOTS = None  # int64 memory slots recorded per frame, one per LABELS name
 
     def __init__(self, model, params, tables, memory, *, state=None, ws=None, options=None,
                  record_every=10):
@@ -86,7 +93,11 @@ class WalkerRun:
     def advance(self, n: int, every: int, rec, lab):
         """Run the compiled rollout n steps, recording every `every`-th step into rec / lab
         from frame 0; return (run code, frames recorded)."""
-        raise NotImplementedError
+        if self.ROLLOUT is None:
+            raise NotImplementedError(f"{type(self).__name__} sets no ROLLOUT (or overrides advance)")
+        code, done, k = self.ROLLOUT(self.model.arrays, self.state, self.ws, self.options, self.tables,
+                                     self.memory, self.u, n, every, rec, lab, self.LABEL_SLOTS, 0)
+        return code, k
 
     def numbers(self) -> dict:
         """The walker's raw summary numbers (its summary without `audit`)."""

@@ -17,10 +17,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from planarsim.compiled import RUN_FELL, jit, record_frame, step
+from planarsim.compiled import RUN_FELL, jit, step
 import planarsim as ps
 
 from walkers.base import WalkerRun, simulation, terrain_of
+from walkers.common.record import record_labelled
 
 from . import controller as C
 from .model import build
@@ -45,11 +46,7 @@ def rollout_quadruped(m, s, ws, opt, p, mem, u, n, every, rec, lab, slots, k0):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, k
-        if s.step[0] % every == 0 and k < rec.t.shape[0]:
-            record_frame(s, ws, rec, k)
-            for c in range(slots.shape[0]):
-                lab[k, c] = mem[slots[c]]
-            k += 1
+        k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
     return 0, n, k
 
 
@@ -71,6 +68,8 @@ class Quadruped(WalkerRun):
     NAME = "quadruped"
     LABELS = LABELS
     FELL_SLOT = C.M_FELL
+    ROLLOUT = staticmethod(rollout_quadruped)
+    LABEL_SLOTS = LABEL_SLOTS
 
     def __init__(self, params=None, terrain=None, dt=1e-3, gait="walk", speed=None,
                  strategy="all", record_every=10, seed=0):
@@ -96,12 +95,6 @@ class Quadruped(WalkerRun):
     def p(self) -> np.ndarray:
         """The parameter vector the controller reads (its table)."""
         return self.tables
-
-    def advance(self, n, every, rec, lab):
-        code, done, k = rollout_quadruped(self.model.arrays, self.state, self.ws, self.options,
-                                          self.tables, self.memory, self.u, n, every, rec, lab,
-                                          LABEL_SLOTS, 0)
-        return code, k
 
     def numbers(self) -> dict:
         """distance [m] and mean_speed [m/s] of the torso since the start, steps (pair

@@ -15,11 +15,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from planarsim.compiled import jit, record_frame, step
+from planarsim.compiled import jit, step
 import planarsim as ps
 from planarsim.trajectory import Trajectory
 
 from walkers.base import WalkerRun, simulation, terrain_of
+from walkers.common.record import record_labelled
 
 from . import controller as C
 from . import tables as T
@@ -50,11 +51,7 @@ def rollout_ranger(m, s, ws, opt, tab, mem, u, n, every, rec, lab, lab_idx, k0):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, kf
-        if (s.step[0] % every) == 0 and kf < rec.t.shape[0]:
-            record_frame(s, ws, rec, kf)
-            for c in range(lab_idx.shape[0]):
-                lab[kf, c] = mem[lab_idx[c]]
-            kf += 1
+        kf = record_labelled(s, ws, rec, lab, mem, lab_idx, every, kf)
         if mem[C.M_FELL] != 0.0:
             return 0, i + 1, kf
     return 0, n, kf
@@ -79,6 +76,8 @@ class RangerSim(WalkerRun):
     NAME = "ranger"
     LABELS = tuple(LABELS)
     FELL_SLOT = C.M_FELL
+    ROLLOUT = staticmethod(rollout_ranger)
+    LABEL_SLOTS = LABEL_INDEX
 
     def __init__(self, params: RangerParams | None = None, terrain=None, dt: float = 1e-3,
                  gait: str = "walk", strategy: str = "alternating", suspended: bool = False,
@@ -107,11 +106,6 @@ class RangerSim(WalkerRun):
         q = self.state.q
         p = self.params
         return np.array([q[0, 0] - p.leg_com * np.sin(q[0, 2]), q[0, 1] + p.leg_com * np.cos(q[0, 2])])
-
-    def advance(self, n, every, rec, lab):
-        code, done, kf = rollout_ranger(self.model.arrays, self.state, self.ws, self.options, self.tables,
-                                        self.memory, self.u, n, every, rec, lab, LABEL_INDEX, 0)
-        return code, kf
 
     def numbers(self) -> dict:
         """Distance, speed, steps and whole-step costs of transport from the step log (see the

@@ -13,10 +13,11 @@ import math
 
 import numpy as np
 
-from planarsim.compiled import RUN_FELL, jit, record_frame, step, height
+from planarsim.compiled import RUN_FELL, jit, step, height
 import planarsim as ps
 
 from walkers.base import WalkerRun, simulation, terrain_of
+from walkers.common.record import record_labelled
 
 from . import controller as C
 from .model import build
@@ -50,11 +51,7 @@ def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, 
         for a in range(ws.act_power.shape[0]):
             if ws.act_power[a] > 0.0:
                 mem[C.M_WORK] += ws.act_power[a] * m.dt
-        if s.step[0] % every == 0 and k < rec.t.shape[0]:
-            record_frame(s, ws, rec, k)
-            for c in range(slots.shape[0]):
-                lab[k, c] = mem[slots[c]]
-            k += 1
+        k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
         if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]
                 or _longest_leg(s.q) > p[I_FALL_LEG_LENGTH] * p[I_LEG_LENGTH]):
             mem[C.M_FALLEN] = 1.0
@@ -89,6 +86,8 @@ class Walker(WalkerRun):
     NAME = "simple-biped"
     LABELS = LABELS
     FELL_SLOT = C.M_FALLEN
+    ROLLOUT = staticmethod(rollout_simple_biped)
+    LABEL_SLOTS = LABEL_SLOTS
 
     def __init__(self, params=None, terrain=None, dt=1e-3, gait="walk", speed=None,
                  record_every=10, seed=0, options=None):
@@ -120,12 +119,6 @@ class Walker(WalkerRun):
         return C.Gait(int(self.memory[C.M_GAIT])).name.lower()
 
     # the contract -----------------------------------------------------------------------------
-    def advance(self, n, every, rec, lab):
-        code, done, k = rollout_simple_biped(self.model.arrays, self.state, self.ws, self.options,
-                                             self.tables, self.memory, self.u, n, every, rec, lab,
-                                             LABEL_SLOTS, 0)
-        return code, k
-
     def numbers(self) -> dict:
         """distance [m] and mean_speed [m/s] of the hip since the start, positive actuator work
         [J] and cost of transport (that work per weight and distance [-]), steps, jumps, fell."""
