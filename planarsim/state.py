@@ -177,7 +177,13 @@ class Workspace(NamedTuple):
     contact_point: np.ndarray    # (n_contact, 2) world contact point [m]
     contact_ground: np.ndarray   # (n_contact, 2) ground point below it [m]
     contact_normal: np.ndarray   # (n_contact, 2) unit ground normal
-    contact_gap: np.ndarray      # (n_contact,) signed gap at step start [m]
+    contact_gap: np.ndarray      # (n_contact,) signed gap at step start [m]; of a contact
+                                 #   left unqueried (contact_stale) a lower bound of it
+    contact_stale: np.ndarray    # (n_contact,) int 1: a free point contact surely clear of the
+                                 #   ground, not queried this step (its ground point and normal
+                                 #   are an earlier step's; kernels/contacts.py)
+    contact_found: np.ndarray    # (n_contact, 4) its body's pose (x, y, theta) and its gap
+                                 #   where it was last queried (gap -inf: never)
     contact_anchor: np.ndarray   # (n_contact, 2) material contact point in the body frame [m]
     contact_impulse: np.ndarray  # (n_contact, 2) normal, tangential impulse of the step [N s]
     contact_held: np.ndarray     # (n_contact,) int 1 if the position correction held its normal row
@@ -249,7 +255,8 @@ def make_workspace(model: Model) -> Workspace:
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),
                      v_solved=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
-                     contact_normal=z((nc, 2)), contact_gap=z(nc), contact_anchor=z((nc, 2)),
+                     contact_normal=z((nc, 2)), contact_gap=z(nc), contact_stale=z(nc, np.int64),
+                     contact_found=np.full((nc, 4), -np.inf), contact_anchor=z((nc, 2)),
                      contact_impulse=z((nc, 2)), contact_held=z(nc, np.int64), contact_on_arc=z(nc, np.int64),
                      contact_new=z(nc, np.int64), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),

@@ -8,10 +8,16 @@ the fallback vertices and the arc's end points (heel, toe). The material point f
 the normal row constrains the arc centre's distance from the ground (n.(c - g) = r), which a
 rotation leaves unchanged; a fixed material point would rise by r dphi^2 / 2 as the foot rolls
 and let the foot sink by as much every step.
+On hills, a free point contact whose last ground query proves it still clear (its gap then, minus how
+far its point can have moved since) is not queried again: its material point is placed (cheap),
+its gap is kept as that lower bound and it is marked stale. Whoever needs its ground point or
+normal (modes.engage_contacts, when the bound no longer proves it clear) queries it first
+(refresh_contact), at the same configuration, so the step's numbers are those of querying
+every contact every step.
 """
 import math
 
-from ._jit import kernel
+from ._jit import kernel, kernel_call
 from .math2d import rotate, world_point
 from .terrain import ground_point
 
@@ -90,6 +96,62 @@ def find_contact(m, q, ws, i):
         best = _try_vertex(m, q, ws, i, b, m.vert_local[k, 0], m.vert_local[k, 1], best)
 
 
+# a free point contact is left unqueried while its proven gap is above this share of the gap
+# it was last queried at (the bound loosens as the body moves; a loose bound would only make
+# the engage test query it anyway)
+CLEAR_SHARE = 0.5
+
+
+@kernel
+def _query(m, q, ws, i):
+    """find_contact, and where and at what gap it was done (the bound's reference)."""
+    find_contact(m, q, ws, i)
+    b = m.contact_body[i]
+    ws.contact_found[i, 0] = q[b, 0]
+    ws.contact_found[i, 1] = q[b, 1]
+    ws.contact_found[i, 2] = q[b, 2]
+    ws.contact_found[i, 3] = ws.contact_gap[i]
+    ws.contact_stale[i] = 0
+
+
+@kernel_call
+def _stays_clear(m, q, ws, i):
+    """Point contact i is surely above the ground at q: its gap when last queried minus how far
+    its point can have moved since (|dx| + |dy| + |dtheta| (|lx| + |ly|); the signed distance to
+    the ground changes by at most the point's move) is above CLEAR_SHARE of that gap. Places
+    its material point and keeps that bound as its gap (stale)."""
+    if m.contact_kind[i] != CONTACT_POINT:
+        return False
+    gap0 = ws.contact_found[i, 3]
+    if not gap0 > 0.0:
+        return False
+    b = m.contact_body[i]
+    lx = m.contact_local[i, 0]
+    ly = m.contact_local[i, 1]
+    reach = (abs(q[b, 0] - ws.contact_found[i, 0]) + abs(q[b, 1] - ws.contact_found[i, 1])
+             + abs(q[b, 2] - ws.contact_found[i, 2]) * (abs(lx) + abs(ly)))
+    bound = gap0 - reach
+    if not bound > CLEAR_SHARE * gap0:
+        return False
+    px, py = world_point(q, ws.body_cs, b, lx, ly)
+    ws.contact_point[i, 0] = px
+    ws.contact_point[i, 1] = py
+    ws.contact_anchor[i, 0] = lx
+    ws.contact_anchor[i, 1] = ly
+    ws.contact_on_arc[i] = 0
+    ws.contact_gap[i] = bound
+    ws.contact_stale[i] = 1
+    return True
+
+
+@kernel
+def refresh_contact(m, s, ws, i):
+    """Query contact i's ground point now if find_contacts left it stale (same configuration,
+    same numbers as querying it there)."""
+    if ws.contact_stale[i] == 1:
+        _query(m, s.q, ws, i)
+
+
 @kernel
 def engage_contact(m, s, ws, i, vn, vt):
     """Bring free contact i into touch, approaching at normal velocity vn and tangential vt
@@ -107,11 +169,17 @@ def engage_contact(m, s, ws, i, vn, vt):
 
 @kernel
 def find_contacts(m, s, ws):
-    """Stage 3 for every contact; a disabled contact is forced free. A contact that a
+    """Stage 3 for every contact (a free point contact surely clear of the ground is left
+    unqueried: see the module's docstring); a disabled contact is forced free. A contact that a
     time-of-impact split brought into touch (contact_new == 2) is engaged here, where its
     ground normal is known."""
+    # on flat or sloped ground a query costs no more than the bound that would spare it
+    lazy = m.terrain_coef[2] != 0.0
     for i in range(m.contact_body.shape[0]):
-        find_contact(m, s.q, ws, i)
+        if (lazy and s.contact_mode[i] == MODE_FREE and s.contact_enabled[i] == 1
+                and ws.contact_new[i] == 0 and _stays_clear(m, s.q, ws, i)):
+            continue
+        _query(m, s.q, ws, i)
         if s.contact_enabled[i] == 0:
             s.contact_mode[i] = MODE_FREE
         elif ws.contact_new[i] == 2:

@@ -17,7 +17,7 @@ import math
 
 from ._jit import kernel
 from .codes import MODE_FREE, MODE_PINNED, MODE_SLIDING
-from .contacts import engage_contact
+from .contacts import engage_contact, refresh_contact
 from .forces import point_velocity
 from .math2d import world_point
 from .mixed_lcp import is_sliding_solution
@@ -96,6 +96,11 @@ def engage_contacts(m, s, ws, h, include_ccd, vel):
             continue
         if not may_reach_ground(m, ws, i, h, vel):
             continue
+        if ws.contact_stale[i] == 1:
+            # its gap was a lower bound: query it, and test it again with its real gap
+            refresh_contact(m, s, ws, i)
+            if not may_reach_ground(m, ws, i, h, vel):
+                continue
         vn, vt = contact_velocity(m, s, ws, i, vel)
         if ws.contact_gap[i] + h * vn < 0.0:
             engage_contact(m, s, ws, i, vn, vt)
