@@ -1,0 +1,73 @@
+"""Each step of a bench scene timed alone: how the steps that need the complementarity solve
+compare with the others (not a test).
+
+    python benchmarks/step_times.py biped_collapse
+    python benchmarks/step_times.py boxes_on_hills --repeats 25 --strategy all
+
+Every step of the scene's bench run is timed on its own (Simulator.steps(1), best of
+--repeats runs from the same start), less the cost of an empty call. Prints the total, the
+steps that ran the complementarity (Lemke) solve and their mean, the other steps' mean, and
+the share of the run the complementarity steps take.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import planarsim as ps  # noqa: E402
+from benchmarks.scenes import SCENES  # noqa: E402
+from planarsim.compiled import step_info  # noqa: E402
+
+
+def step_times(name, repeats=15, strategy="alternating"):
+    """(best time of each step [ns], bool array: the step ran the complementarity solve)."""
+    if name not in SCENES:
+        raise SystemExit(f"unknown scene {name!r}; scenes: {', '.join(SCENES)}")
+    build, n = SCENES[name]
+    model = build()
+    options = ps.StepOptions(mode_strategy={"alternating": 0, "all": 1}[strategy])
+    best = np.full(n, np.inf)
+    lcp = np.zeros(n, bool)
+    clock = time.perf_counter_ns
+    for _ in range(repeats):
+        sim = ps.Simulator(model, options=options)
+        for k in range(n):
+            t0 = clock()
+            sim.steps(1)
+            best[k] = min(best[k], clock() - t0)
+            lcp[k] = step_info(sim.ws)["lcp_solves"] > 0
+    sim = ps.Simulator(model, options=options)
+    empty = np.inf
+    for _ in range(2000):
+        t0 = clock()
+        sim.steps(0)
+        empty = min(empty, clock() - t0)
+    return best - empty, lcp
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scene", help=", ".join(SCENES))
+    ap.add_argument("--repeats", type=int, default=15)
+    ap.add_argument("--strategy", choices=("alternating", "all"), default="alternating")
+    args = ap.parse_args(argv)
+    t, lcp = step_times(args.scene, args.repeats, args.strategy)
+    us = t / 1e3
+    print(f"{args.scene}: {len(t)} steps, {us.sum() / 1e3:.2f} ms in all")
+    if lcp.any():
+        print(f"  {lcp.sum()} steps with the complementarity solve: {us[lcp].mean():.2f} us "
+              f"each, {us[lcp].sum() / us.sum():.0%} of the run")
+    else:
+        print("  no step needed the complementarity solve")
+    if (~lcp).any():
+        print(f"  {(~lcp).sum()} other steps: {us[~lcp].mean():.2f} us each")
+
+
+if __name__ == "__main__":
+    main()
