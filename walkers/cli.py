@@ -34,14 +34,6 @@ def _walkers():
     return walkers
 
 
-def _engine_cache_files():
-    """(folder, index files) of the engine kernels' numba cache, found without importing the
-    compiled step (importing a walker loads it, and compiles it on a first-ever run)."""
-    import importlib.util
-    folder = Path(importlib.util.find_spec("planarsim.kernels").origin).parent / "__pycache__"
-    return folder, sorted(folder.glob("*.nbi"))
-
-
 def _load_walker(name):
     w = _walkers()
     if name not in w.WALKERS:
@@ -54,7 +46,8 @@ def _say_if_compiling():
     about half a minute once)."""
     if "NUMBA_CACHE_DIR" in os.environ:
         return
-    if not _engine_cache_files()[1]:
+    from planarsim.compiled import kernel_cache
+    if not kernel_cache()[1]:
         print("compiling the engine (first run only, about half a minute)", file=sys.stderr, flush=True)
 
 
@@ -296,7 +289,8 @@ def cmd_info(args):
     import numba
     import numpy
     import matplotlib
-    folder, cached = _engine_cache_files()
+    from planarsim.compiled import kernel_cache
+    folder, cached = kernel_cache()
     print(f"planarsim {__version__}")
     print(f"python {sys.version.split()[0]}, numpy {numpy.__version__}, numba {numba.__version__}, "
           f"matplotlib {matplotlib.__version__}")

@@ -1,5 +1,5 @@
 """A rollout's recording: the frame and the controller's labels of the steps it records."""
-from planarsim.compiled import kernel, record_frame
+from planarsim.compiled import jit, kernel, record_frame
 
 
 @kernel
@@ -12,3 +12,9 @@ def record_labelled(s, ws, rec, lab, mem, slots, every, k):
             lab[k, c] = mem[slots[c]]
         return k + 1
     return k
+
+
+@jit
+def record_one(s, ws, rec, k):
+    """Frame k of rec from State s and Workspace ws, from Python (record_frame is a kernel)."""
+    record_frame(s, ws, rec, k)

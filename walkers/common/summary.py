@@ -26,7 +26,8 @@ import math
 
 import numpy as np
 
-from planarsim.analysis import foot_groups, step_events, step_summary
+from planarsim.analysis import foot_groups, step_events
+from planarsim.measure import summary as measure_summary
 
 MIN_AIR_S = 0.05     # [s] a foot must be off the ground this long for its next landing to count
 # the walkers' own keys that the common part replaces (the same quantity, measured one way)
@@ -69,16 +70,14 @@ def walker_summary(mod, traj, model, raw: dict, *, walker, gait, terrain, durati
         raise KeyError(f"walker {walker!r} reports {unknown} without declaring them in "
                        f"{mod.__name__}.SUMMARY_EXTRAS (name with unit, explanation)")
     t = float(raw.get("time", raw.get("duration", traj.t[-1] if len(traj.t) else 0.0)))
-    com = traj.com(model)
-    dist = float(com[-1, 0] - com[0, 0]) if len(com) else 0.0
-    span = float(traj.t[-1] - traj.t[0]) if len(traj.t) > 1 else 0.0
     feet = feet_of(mod, model)
-    ss = step_summary(traj, model, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S)
+    ss = measure_summary(traj, model, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S)
+    dist = ss["distance"]
     touchdowns = len(step_events(traj, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S))
     out = {"walker": walker, "gait": gait, "terrain": terrain, "duration_s": float(duration),
            "params_changed": params_changed or {},
            "time_s": t, "fell": bool(raw.get("fell", False)), "distance_m": dist,
-           "mean_speed_m_per_s": dist / span if span > 0 else 0.0,
+           "mean_speed_m_per_s": ss["mean_speed"] if math.isfinite(ss["mean_speed"]) else 0.0,
            "steps": int(touchdowns), "whole_steps": int(ss["whole_steps"]),
            "step_period_s": ss["step_period"], "step_length_m": ss["step_length"],
            "step_speed_m_per_s": ss["speed"], "audit": raw.get("audit", {}),

@@ -232,15 +232,21 @@ class PassiveWalker:
             self.event_time = np.zeros(max_events)
             self.event_contact = np.zeros(max_events, np.int64)
         sim = self.sim
-        code, done, k = rollout_passive(self.model.arrays, sim.state, sim.ws, sim.options, self.u0,
-                                        self.feet, self.memory, self.toggle, self.min_ahead, int(n_steps),
-                                        int(stop_after), self.hip, self.fall_height, rec,
-                                        int(record_every), 0, self.event_time, self.event_contact)
+        code, done, k = self.run_compiled(n_steps, stop_after, rec, record_every, 0)
         check_run(code, self.model, sim.ws, sim.options, self.kind)
         traj = None
         if record_every > 0:
             traj = Trajectory.from_recorder(self.model, rec, k, info={"dt": self.dt, "walker": self.kind})
         return code, done, traj
+
+    def run_compiled(self, n_steps: int, stop_after: int, rec, record_every: int, k0: int):
+        """The compiled rollout (rollout_passive) from the current state into rec from frame k0,
+        touchdowns logged in event_time / event_contact; returns (code, steps done, next frame)."""
+        sim = self.sim
+        return rollout_passive(self.model.arrays, sim.state, sim.ws, sim.options, self.u0, self.feet,
+                               self.memory, self.toggle, self.min_ahead, int(n_steps), int(stop_after),
+                               self.hip, self.fall_height, rec, int(record_every), int(k0),
+                               self.event_time, self.event_contact)
 
     def refine_touchdown(self, old: int) -> float:
         """Move the state from the end of a DETECT rollout to the touchdown instant itself and

@@ -19,9 +19,10 @@ import numpy as np
 from planarsim.analysis import step_summary
 
 from walkers.base import WalkerRun, terrain_of
+from walkers.common.record import record_one
 
 from .gait import PassiveWalker
-from .rollout import DETECT, FELL, NO_EVENT, rollout_passive
+from .rollout import DETECT, FELL, NO_EVENT
 
 GAITS = ("passive",)
 IMPACTS = ("refined", "engine")
@@ -41,19 +42,6 @@ def slope_from_terrain(terrain, default):
         raise ValueError(f"passive walkers walk downhill toward +x: use a negative slope angle, "
                          f"got {math.degrees(-gamma):g} deg")
     return gamma
-
-
-def record_state(rec, k, s, ws) -> None:
-    """Write State s (and ws's contact and actuator data) into frame k of rec, as record_frame
-    does (disabled contacts get mode -1)."""
-    rec.t[k] = s.time[0]
-    rec.q[k] = s.q
-    rec.v[k] = s.v
-    rec.contact_mode[k] = np.where(np.asarray(s.contact_enabled) != 0, s.contact_mode, -1)
-    rec.contact_impulse[k] = ws.contact_impulse
-    rec.contact_point[k] = ws.contact_point
-    rec.act_u[k] = ws.act_u
-    rec.act_power[k] = ws.act_power
 
 
 class PassiveRun(WalkerRun):
@@ -90,8 +78,7 @@ class PassiveRun(WalkerRun):
         self.impacts = impacts
         self.hip0 = self.state.q[w.hip, :2].copy()
         self.steps_asked = 0      # steps asked for by all runs so far
-        self.code = 0             # run code of the last chunk (0, or FELL)
-        self.fallen = False
+        self.code = 0             # run code of the last chunk (0, or FELL; FELL stays)
 
     def start(self, params) -> np.ndarray:
         """Default section state for `params`."""
@@ -99,7 +86,7 @@ class PassiveRun(WalkerRun):
 
     @property
     def fell(self) -> bool:
-        return self.fallen
+        return self.code == FELL
 
     def max_touchdowns(self, n: int) -> int:
         return int(n * self.dt / MIN_STEP_PERIOD) + 10
@@ -110,19 +97,13 @@ class PassiveRun(WalkerRun):
         return n // self.record_every + 2 + 2 * self.max_touchdowns(n) if self.record_every else 0
 
     def advance(self, n, every, rec, lab):
-        if self.fallen:
+        if self.fell:
             return FELL, 0        # it stays where it fell (the refined rollout walks to a total)
         self.steps_asked += n
         code, k = (self._engine if self.impacts == "engine" else self._refined)(n, rec)
         self.code = int(code)
-        self.fallen = self.fallen or code == FELL
         return code, k
 
-    def _rollout(self, n, stop_after, rec, k0):
-        w, s = self.walker, self.state
-        return rollout_passive(self.model.arrays, s, self.ws, self.options, w.u0, w.feet, w.memory, w.toggle,
-                               w.min_ahead, int(n), int(stop_after), w.hip, w.fall_height, rec,
-                               self.record_every, k0, w.event_time, w.event_contact)
 
     def _engine(self, n, rec):
         """The engine finds the touchdowns (events logged in walker.event_time / event_contact)."""
@@ -132,7 +113,7 @@ class PassiveRun(WalkerRun):
             w.event_time = np.concatenate([w.event_time, np.zeros(need - w.event_time.size)])
             w.event_contact = np.concatenate([w.event_contact,
                                               np.zeros(need - w.event_contact.size, np.int64)])
-        code, done, k = self._rollout(n, 1 << 60, rec, 0)
+        code, done, k = self.walker.run_compiled(n, 1 << 60, rec, self.record_every, 0)
         return code, k
 
     def _refined(self, n, rec):
@@ -148,13 +129,13 @@ class PassiveRun(WalkerRun):
             while s.time[0] < end - 0.5 * self.dt:
                 old = int(w.memory[0])
                 left = int(round((end - s.time[0]) / self.dt))
-                code, done, k = self._rollout(left, int(w.memory[1]) + 1, rec, k)
+                code, done, k = w.run_compiled(left, int(w.memory[1]) + 1, rec, self.record_every, k)
                 if code != 0:
                     break
                 w.refine_touchdown(old)
                 s.contact_enabled[w.feet[old]] = 0
                 if self.record_every and k < rec.t.shape[0]:
-                    record_state(rec, k, s, self.ws)
+                    record_one(s, self.ws, rec, k)
                     k += 1
         finally:
             w.toggle = toggle

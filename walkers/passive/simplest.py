@@ -8,7 +8,7 @@ from walkers.base import simulation
 
 from .params import SimplestParams
 from .reference import GARCIA_THETA, GARCIA_THETA_DOT, simplest_heel_strike
-from .run import GAITS, PassiveRun, slope_from_terrain  # noqa: F401  (slope_from_terrain: public here too)
+from .run import GAITS, PassiveRun  # noqa: F401
 
 NAME = "simplest-walker"
 SUMMARY_EXTRAS = {

@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 
 from planarsim import Simulator, make_options
-from planarsim.compiled import (RUN_FELL, RUN_NONFINITE, RUN_TOO_LARGE, RUN_WALKER, jit, record_frame,
-                                step, height)
+from planarsim.compiled import RUN_FELL, RUN_NONFINITE, RUN_TOO_LARGE, RUN_WALKER, jit, step, height
 
 from walkers.base import WalkerRun, simulation, terrain_of
+from walkers.common.record import record_labelled
 
 from .controller import (M_EFFORT, M_FELL, M_GLITCH, M_PHASE, M_STRIKES, M_TIMEOUTS, Phase, control,
                          make_memory, make_tables)
@@ -30,8 +30,9 @@ GAITS = ("walk",)
 
 
 @jit
-def rollout_simbicon(m, s, ws, opt, tab, mem, u, n, every, rec, k0, push):
-    """n steps; returns (code, steps done, frames recorded). code: 0 ok, guard code, or FELL."""
+def rollout_simbicon(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, k0, push):
+    """n steps (WalkerRun.ROLLOUT's arguments, then the push); returns (code, steps done,
+    frames recorded). code: 0 ok, guard code, or FELL."""
     k = k0
     tr = tab.torso
     for i in range(n):
@@ -52,9 +53,7 @@ def rollout_simbicon(m, s, ws, opt, tab, mem, u, n, every, rec, k0, push):
                 or abs(s.v[tr, 2]) > GLITCH_SPIN or jump > GLITCH_SPEED):
             mem[M_FELL] = 1.0
             return GLITCH, i + 1, k
-        if (s.step[0] % every) == 0 and k < rec.t.shape[0]:
-            record_frame(s, ws, rec, k)
-            k += 1
+        k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
         if s.q[tr, 1] - height(m.terrain_coef, s.q[tr, 0]) < tab.fall_height:
             mem[M_FELL] = 1.0
             return FELL, i + 1, k
@@ -98,6 +97,7 @@ class SimbiconRun(WalkerRun):
 
     NAME = "simbicon"
     FELL_SLOT = M_FELL
+    LABEL_SLOTS = np.zeros(0, np.int64)   # no per-frame labels
 
     def __init__(self, params: SimbiconParams | None = None, terrain=None, dt=1e-3, gait="walk",
                  push=None, seed=0, record_every=10, strategy: str = STRATEGY, glitch_ok: bool = True,
@@ -115,7 +115,8 @@ class SimbiconRun(WalkerRun):
 
     def advance(self, n, every, rec, lab):
         code, done, k = rollout_simbicon(self.model.arrays, self.state, self.ws, self.options, self.tables,
-                                         self.memory, self.u, n, every, rec, 0, self.push)
+                                         self.memory, self.u, n, every, rec, lab, self.LABEL_SLOTS, 0,
+                                         self.push)
         return code, k
 
     def stopped(self, code: int) -> int:
