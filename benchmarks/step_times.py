@@ -31,7 +31,7 @@ def step_times(name, repeats=15, strategy="alternating"):
         raise SystemExit(f"unknown scene {name!r}; scenes: {', '.join(SCENES)}")
     build, n = SCENES[name]
     model = build()
-    options = ps.StepOptions(mode_strategy={"alternating": 0, "all": 1}[strategy])
+    options = ps.make_options(strategy)
     best = np.full(n, np.inf)
     lcp = np.zeros(n, bool)
     clock = time.perf_counter_ns

@@ -16,7 +16,7 @@ from .errors import diverged
 from .kernels.refs import TableHandle
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
-from .state import State, Workspace, check_state, make_state, make_workspace
+from .state import State, Workspace, check_state, forget_ground_queries, make_state, make_workspace
 from .trajectory import Trajectory, make_recorder
 
 
@@ -68,6 +68,8 @@ class Simulator:
                 raise ValueError(f"model.arrays.{name} has shape {np.shape(b)}; this simulator's "
                                  f"model has {np.shape(a)} (build a new Simulator instead)")
         self._model = value
+        # the ground queries' references belong to the old terrain and contact points
+        forget_ground_queries(self._ws)
         self._repack()
         self._recorded_entry = None
 

@@ -157,6 +157,8 @@ class Workspace(NamedTuple):
     Rows are constraint equations; row r acts on bodies row_body[r] (a, b; -1 = world) with
     Jacobian blocks row_J[r, 0|1, :] and impulse directions row_F[r, 0|1, :] (they differ only
     for sliding contacts, whose impulse is lambda_n (n - mu s t)).
+    A workspace belongs to one model: its contacts' last ground queries (contact_found) are of
+    that model's terrain and contact points (forget_ground_queries when either changes).
     """
     force: np.ndarray            # (n_body, 3) applied forces [N, N, N m]
     body_cs: np.ndarray          # (n_body, 3) cos, sin of the body angles at the current q, and
@@ -231,6 +233,13 @@ class Workspace(NamedTuple):
                                  #   this step added (mixed_lcp.REGULARISATION; scaled units)
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
     prev: State                  # the state at the start of the last step (for guard errors)
+
+
+def forget_ground_queries(ws: Workspace) -> None:
+    """Drop the contacts' last ground queries (the next step queries every contact): for a
+    workspace kept across a change of terrain or contact points."""
+    ws.contact_found[:] = -np.inf
+    ws.contact_stale[:] = 0
 
 
 def max_rows(model: Model) -> int:

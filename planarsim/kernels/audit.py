@@ -23,7 +23,7 @@ import math
 from ._jit import kernel
 from .info import INFO_CCD_SPLITS
 from .codes import CONTACT_POINT
-from .contacts import sole_facing
+from .contacts import point_reach, sole_facing
 from .math2d import world_point
 from .modes import contact_velocity
 from .rows import ROW_CONTACT_N
@@ -156,16 +156,15 @@ def contact_gap(m, q, cs, i):
 @kernel
 def surely_clear(m, s, ws, i):
     """Point contact i cannot be below the ground at s.q: its gap at the start of the step
-    (ws.contact_gap, found at ws.prev.q; no time-of-impact split) exceeds how far the point
-    can have moved since, |dx| + |dtheta| r (the signed distance to the ground changes by at
-    most the point's move). Saves the ground query of contacts well clear of it."""
+    (ws.contact_gap, found at ws.prev.q or a lower bound of it; no time-of-impact split)
+    exceeds how far the point can have moved since (contacts.point_reach; the signed distance
+    to the ground changes by at most the point's move). Saves the ground query of contacts
+    well clear of it."""
     if m.contact_kind[i] != CONTACT_POINT or ws.info[INFO_CCD_SPLITS] != 0:
         return False
     b = m.contact_body[i]
-    lx = m.contact_local[i, 0]
-    ly = m.contact_local[i, 1]
-    reach = (abs(s.q[b, 0] - ws.prev.q[b, 0]) + abs(s.q[b, 1] - ws.prev.q[b, 1])
-             + abs(s.q[b, 2] - ws.prev.q[b, 2]) * math.sqrt(lx * lx + ly * ly))
+    reach = point_reach(s.q, b, ws.prev.q[b, 0], ws.prev.q[b, 1], ws.prev.q[b, 2],
+                        m.contact_local[i, 0], m.contact_local[i, 1])
     return ws.contact_gap[i] > reach
 
 

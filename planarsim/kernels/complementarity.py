@@ -21,7 +21,7 @@ from ._jit import kernel, kernel_call
 from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
 from .codes import MODE_FREE, MODE_PINNED
-from .contacts import find_contact
+from .contacts import query_contact
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, is_joint_row, solve_mixed_lcp
@@ -126,7 +126,7 @@ def _projection_rows(m, s, ws):
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:
             continue
-        find_contact(m, s.q, ws, i)
+        query_contact(m, s.q, ws, i)
         if ws.contact_gap[i] < PROJECTION_MARGIN:
             n = add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
     ws.n_row[0] = n

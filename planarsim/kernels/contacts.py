@@ -103,8 +103,17 @@ CLEAR_SHARE = 0.5
 
 
 @kernel
-def _query(m, q, ws, i):
-    """find_contact, and where and at what gap it was done (the bound's reference)."""
+def point_reach(q, b, x0, y0, th0, lx, ly):
+    """A bound [m] on how far the point (lx, ly) of body b has moved between the pose
+    (x0, y0, th0) and q: |dx| + |dy| + |dtheta| r, r its distance from the COM."""
+    return (abs(q[b, 0] - x0) + abs(q[b, 1] - y0)
+            + abs(q[b, 2] - th0) * math.sqrt(lx * lx + ly * ly))
+
+
+@kernel
+def query_contact(m, q, ws, i):
+    """find_contact, and the pose and gap it was done at (the reference of _stays_clear's
+    bound)."""
     find_contact(m, q, ws, i)
     b = m.contact_body[i]
     ws.contact_found[i, 0] = q[b, 0]
@@ -117,8 +126,8 @@ def _query(m, q, ws, i):
 @kernel_call
 def _stays_clear(m, q, ws, i):
     """Point contact i is surely above the ground at q: its gap when last queried minus how far
-    its point can have moved since (|dx| + |dy| + |dtheta| (|lx| + |ly|); the signed distance to
-    the ground changes by at most the point's move) is above CLEAR_SHARE of that gap. Places
+    its point can have moved since (point_reach; the signed distance to the ground changes by at
+    most the point's move) is above CLEAR_SHARE of that gap. Places
     its material point and keeps that bound as its gap (stale)."""
     if m.contact_kind[i] != CONTACT_POINT:
         return False
@@ -128,9 +137,8 @@ def _stays_clear(m, q, ws, i):
     b = m.contact_body[i]
     lx = m.contact_local[i, 0]
     ly = m.contact_local[i, 1]
-    reach = (abs(q[b, 0] - ws.contact_found[i, 0]) + abs(q[b, 1] - ws.contact_found[i, 1])
-             + abs(q[b, 2] - ws.contact_found[i, 2]) * (abs(lx) + abs(ly)))
-    bound = gap0 - reach
+    bound = gap0 - point_reach(q, b, ws.contact_found[i, 0], ws.contact_found[i, 1],
+                               ws.contact_found[i, 2], lx, ly)
     if not bound > CLEAR_SHARE * gap0:
         return False
     px, py = world_point(q, ws.body_cs, b, lx, ly)
@@ -149,7 +157,7 @@ def refresh_contact(m, s, ws, i):
     """Query contact i's ground point now if find_contacts left it stale (same configuration,
     same numbers as querying it there)."""
     if ws.contact_stale[i] == 1:
-        _query(m, s.q, ws, i)
+        query_contact(m, s.q, ws, i)
 
 
 @kernel
@@ -179,7 +187,7 @@ def find_contacts(m, s, ws):
         if (lazy and s.contact_mode[i] == MODE_FREE and s.contact_enabled[i] == 1
                 and ws.contact_new[i] == 0 and _stays_clear(m, s.q, ws, i)):
             continue
-        _query(m, s.q, ws, i)
+        query_contact(m, s.q, ws, i)
         if s.contact_enabled[i] == 0:
             s.contact_mode[i] = MODE_FREE
         elif ws.contact_new[i] == 2:

@@ -32,7 +32,7 @@ from numba.extending import intrinsic
 
 from ..model import ModelArrays
 from ..options import StepOptions, check_options
-from ..state import State, Workspace
+from ..state import State, Workspace, forget_ground_queries
 from . import refs
 from ._jit import KERNEL_OPTIONS, jit
 from .guards import GUARD_BAD_COMMANDS, check_commands
@@ -152,6 +152,7 @@ def step_entry(m, s, ws, opt, u):
 # NamedTuples cannot change, so a handle packed once stays right while it is held; a new
 # StepOptions (options._replace(dt=...), say) only rewrites the options' few slots
 _BOUND = {}
+_WS_MODEL = {}   # workspace (its contact_found array) -> the model arrays it last stepped
 _BOUND_SIZE = 32
 _BOUND_LOCK = threading.Lock()
 
@@ -167,6 +168,14 @@ def step_from_python(m, s, ws, opt, u):
     if hit is None or hit[3] is not given:
         opt = check_options(given)       # a NaN or negative dt, say, named here
     if hit is None or hit[0][0] is not m or hit[0][1] is not s or hit[0][2] is not ws:
+        with _BOUND_LOCK:
+            last = _WS_MODEL.get(id(ws.contact_found))
+            if last is not None and last is not m:
+                # a workspace stepped with another model: its ground queries were of that one
+                forget_ground_queries(ws)
+            _WS_MODEL[id(ws.contact_found)] = m
+            while len(_WS_MODEL) > _BOUND_SIZE:
+                _WS_MODEL.pop(next(iter(_WS_MODEL)), None)
         handle = refs.TableHandle(StepArgs(m, s, ws, opt))
         entry = run_steps.compile((handle.numba_type, types.float64[::1], types.int64))
         hit = [(m, s, ws), handle, entry, given]

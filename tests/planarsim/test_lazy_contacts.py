@@ -105,3 +105,43 @@ def test_engage_queries_a_skipped_contact_before_judging_it():
         assert state.contact_mode[i] == 0
         assert ws.contact_stale[i] == 0
         assert ws.contact_gap[i] > h * 20.0        # its real gap, queried at s.q
+
+
+def test_a_new_model_forgets_the_ground_queries_of_the_old():
+    """Simulator.model = another terrain: the kept gaps were of the old ground, so the next
+    step queries every contact again. Hills raised 1 m under falling boxes bury every corner,
+    which the old bounds call clear; kept, the corners stay unqueried and sink unseen."""
+    ter = terrain.hills([0.08], [2.5])
+    sim = ps.Simulator(_boxes(ter, 2.0))
+    sim.steps(30)          # every box in the air, every contact clear and unqueried
+    assert sim.ws.contact_stale.all() and (sim.state.contact_mode == 0).all()
+    sim.model = _boxes(terrain.hills([0.08], [2.5], height=1.0), 2.0)
+    sim.steps(1)
+    assert sim.ws.contact_stale.sum() == 0
+    # every corner the raised ground buried was found and lifted onto it in that step
+    m = sim.model.arrays
+    coef = np.asarray(m.terrain_coef)
+    q = sim.state.q
+    gaps = []
+    for i in range(m.contact_body.shape[0]):
+        b = m.contact_body[i]
+        c, s = np.cos(q[b, 2]), np.sin(q[b, 2])
+        lx, ly = m.contact_local[i]
+        gaps.append(closest_point.py_func(coef, q[b, 0] + c * lx - s * ly, q[b, 1] + s * lx + c * ly)[4])
+    assert min(gaps) >= -1e-8
+
+
+def test_step_from_python_forgets_the_ground_queries_of_another_model():
+    """The same Workspace stepped by step_from_python with another model's arrays: the next
+    step queries every contact again (the kept gaps were of the other ground)."""
+    from planarsim.compiled import step_from_python
+    low = _boxes(terrain.hills([0.08], [2.5]), 2.0)
+    high = _boxes(terrain.hills([0.08], [2.5], height=1.0), 2.0)
+    sim = ps.Simulator(low)
+    state, ws, opt = sim.state, sim.ws, sim.options
+    u = np.zeros(0)
+    for _ in range(30):
+        assert step_from_python(low.arrays, state, ws, opt, u) == 0
+    assert ws.contact_stale.all()
+    step_from_python(high.arrays, state, ws, opt, u)
+    assert ws.contact_stale.sum() == 0
