@@ -66,10 +66,11 @@ def leg_ik(x, y, l1, l2, hip_lo, hip_hi, knee_lo, knee_hi):
     q2 = min(max(q2, knee_lo), knee_hi)   # rounding only: d is inside the reach
     s2 = math.sin(q2)
     q1 = math.atan2(x, -y) - math.atan2(l2 * s2, l1 + l2 * math.cos(q2))
-    # the same direction may come out one turn off the limits' branch
-    if q1 > hip_hi and q1 - 2.0 * math.pi >= hip_lo:
+    # the same direction may come out one turn off the limits' branch (a hip angle at a limit
+    # may land a rounding error beyond it after the turn: ANGLE_TOL, as below)
+    if q1 > hip_hi and q1 - 2.0 * math.pi >= hip_lo - ANGLE_TOL:
         q1 -= 2.0 * math.pi
-    elif q1 < hip_lo and q1 + 2.0 * math.pi <= hip_hi:
+    elif q1 < hip_lo and q1 + 2.0 * math.pi <= hip_hi + ANGLE_TOL:
         q1 += 2.0 * math.pi
     if q1 > hip_hi:
         if q1 > hip_hi + ANGLE_TOL:
