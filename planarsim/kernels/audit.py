@@ -169,6 +169,21 @@ def surely_clear(m, s, ws, i):
 
 
 @kernel
+def needs_ground_query(m, s, ws):
+    """Some enabled contact is neither a point contact whose normal row the position
+    correction held (ws.contact_held, marked) nor surely clear of the ground: only a ground
+    query can tell its depth (worst_violation with rows_held skips exactly these)."""
+    for i in range(m.contact_body.shape[0]):
+        if s.contact_enabled[i] == 0:
+            continue
+        if ws.contact_held[i] == 1 and m.contact_kind[i] == CONTACT_POINT:
+            continue
+        if not surely_clear(m, s, ws, i):
+            return True
+    return False
+
+
+@kernel
 def worst_violation(m, s, ws, bounded, rows_held):
     """Largest pin gap and largest depth below the ground [m] of enabled contacts at the
     current configuration (ws.body_cs must match s.q). bounded: skip point contacts that

@@ -11,7 +11,7 @@ stages 1-6 for the remainder of the step with the new contact pinned.
 from ._jit import kernel, kernel_call, kernel_inline
 from .ccd import advance_to_impact, time_of_impact
 from .audit import (DEPTH_TOL, PIN_GAP_TOL, audit_impulses, audit_positions, audit_total,
-                    mark_held_contacts, worst_violation)
+                    mark_held_contacts, needs_ground_query, worst_violation)
 from .complementarity import project_positions, solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
@@ -118,18 +118,28 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     ws.info[INFO_SOLVES] += rounds
 
 
-@kernel_call
+@kernel
 def settle_positions(m, s, ws, h, opt, rows_held):
     """After the Newton correction: the end-of-step pin gaps and contact depths; where one is
     above a tenth of its audit tolerance, the complementarity projection (it also catches a
     free contact whose turning body dipped it below the ground). rows_held: the correction
     proved its rows within a tenth of the tolerances (audit.worst_violation then skips
-    them). Returns the violations the audit counts at the configuration the step ends at."""
-    if rows_held and m.contact_body.shape[0] == 0:
-        return 0        # joints held, nothing else to check
-    update_trig(s.q, ws.body_cs)
+    them). Returns the violations the audit counts at the configuration the step ends at.
+    Where the rows are held and every other contact is surely clear (a body at rest on the
+    ground) that is known without a ground query; the rest is one call (_settle_measured)."""
     if rows_held:
+        if m.contact_body.shape[0] == 0:
+            return 0        # joints held, nothing else to check
         mark_held_contacts(m, ws)
+        if not needs_ground_query(m, s, ws):
+            return 0        # joints and touching contacts held, the others surely clear
+    return _settle_measured(m, s, ws, h, opt, rows_held)
+
+
+@kernel_call
+def _settle_measured(m, s, ws, h, opt, rows_held):
+    """settle_positions where the ground must be asked (rows_held: contact_held is marked)."""
+    update_trig(s.q, ws.body_cs)
     gap, depth = worst_violation(m, s, ws, True, rows_held)
     if gap > 0.1 * PIN_GAP_TOL or depth > 0.1 * DEPTH_TOL:
         project_positions(m, s, ws, h, PROJECTION_ITERS, opt.refine_tol)
