@@ -169,16 +169,24 @@ def surely_clear(m, s, ws, i):
 
 
 @kernel
+def depth_known(m, s, ws, i, bounded, rows_held):
+    """Contact i's depth needs no ground query: it is disabled, or (rows_held) a point contact
+    whose normal row the position correction held (ws.contact_held), or (bounded) surely
+    clear of the ground."""
+    if s.contact_enabled[i] == 0:
+        return True
+    if rows_held and ws.contact_held[i] == 1 and m.contact_kind[i] == CONTACT_POINT:
+        return True
+    return bounded and surely_clear(m, s, ws, i)
+
+
+@kernel
 def needs_ground_query(m, s, ws):
-    """Some enabled contact is neither a point contact whose normal row the position
-    correction held (ws.contact_held, marked) nor surely clear of the ground: only a ground
-    query can tell its depth (worst_violation with rows_held skips exactly these)."""
+    """Some contact's depth needs a ground query after a correction that held its rows
+    (depth_known, bounded; ws.contact_held marked): otherwise worst_violation would find
+    nothing."""
     for i in range(m.contact_body.shape[0]):
-        if s.contact_enabled[i] == 0:
-            continue
-        if ws.contact_held[i] == 1 and m.contact_kind[i] == CONTACT_POINT:
-            continue
-        if not surely_clear(m, s, ws, i):
+        if not depth_known(m, s, ws, i, True, True):
             return True
     return False
 
@@ -199,13 +207,8 @@ def worst_violation(m, s, ws, bounded, rows_held):
             gap = max(gap, rod_error(m, s.q, ws.body_cs, j))
     depth = 0.0
     for i in range(m.contact_body.shape[0]):
-        if s.contact_enabled[i] == 0:
-            continue
-        if rows_held and ws.contact_held[i] == 1 and m.contact_kind[i] == CONTACT_POINT:
-            continue
-        if bounded and surely_clear(m, s, ws, i):
-            continue
-        depth = max(depth, -contact_gap(m, s.q, ws.body_cs, i))
+        if not depth_known(m, s, ws, i, bounded, rows_held):
+            depth = max(depth, -contact_gap(m, s.q, ws.body_cs, i))
     return gap, depth
 
 
