@@ -169,13 +169,41 @@ def surely_clear(m, s, ws, i):
 
 
 @kernel
+def vertices_within_arc(m, i):
+    """Every fallback vertex of arc contact i lies inside its circle (with a margin far above
+    rounding): then on flat or sloped ground no part of the foot is lower than the circle's
+    lowest point (the arc's ends lie on the circle)."""
+    r = m.contact_radius[i]
+    cx = m.contact_local[i, 0]
+    cy = m.contact_local[i, 1]
+    adr = m.contact_vert_adr[i]
+    for k in range(adr, adr + m.contact_vert_num[i]):
+        dx = m.vert_local[k, 0] - cx
+        dy = m.vert_local[k, 1] - cy
+        if dx * dx + dy * dy > (1.0 - 1e-9) * r * r:
+            return False
+    return True
+
+
+@kernel
+def held_row_is_depth(m, ws, i):
+    """Contact i's normal row bounds its depth when held: a point contact's row is its
+    point's gap; an arc contact's row on the sole is the circle's gap (centre's gap - r), a
+    bound on the whole foot's when its vertices lie inside the circle (vertices_within_arc).
+    Flat or sloped ground (rows_held implies it)."""
+    if m.contact_kind[i] == CONTACT_POINT:
+        return True
+    return ws.contact_on_arc[i] == 1 and vertices_within_arc(m, i)
+
+
+@kernel
 def depth_known(m, s, ws, i, bounded, rows_held):
-    """Contact i's depth needs no ground query: it is disabled, or (rows_held) a point contact
-    whose normal row the position correction held (ws.contact_held), or (bounded) surely
-    clear of the ground."""
+    """Contact i's depth needs no ground query: it is disabled, or (rows_held) its normal row
+    was held by the position correction (ws.contact_held) and bounds its depth
+    (held_row_is_depth), or (bounded) it is surely clear of the ground."""
     if s.contact_enabled[i] == 0:
         return True
-    if rows_held and ws.contact_held[i] == 1 and m.contact_kind[i] == CONTACT_POINT:
+    if rows_held and ws.contact_held[i] == 1 and held_row_is_depth(m, ws, i):
         return True
     return bounded and surely_clear(m, s, ws, i)
 
@@ -197,8 +225,8 @@ def worst_violation(m, s, ws, bounded, rows_held):
     current configuration (ws.body_cs must match s.q). bounded: skip point contacts that
     are surely clear (valid while ws.contact_gap is the start of the step's). rows_held: the
     position correction proved every row it kept within PIN_GAP_TOL / 10 (flat or sloped
-    ground, where a point contact's row is its exact gap): skip the joints, and the point
-    contacts whose normal row it kept (ws.contact_held)."""
+    ground, where a point contact's row is its exact gap): skip the joints, and the contacts
+    whose normal row it kept (ws.contact_held) where that row bounds the depth."""
     gap = 0.0
     if not rows_held:
         for j in range(m.pin_body.shape[0]):
