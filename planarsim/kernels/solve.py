@@ -19,6 +19,7 @@ triangle only and factored as L D L^T (half the work of LU, the same pivot test)
 """
 from ._jit import kernel, kernel_inline
 from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
+from .warm_start import start_dropped_rows
 
 
 @kernel
@@ -275,10 +276,10 @@ def fill_row_b(ws, h, n):
 
 
 @kernel_inline
-def solve_impulses(m, ws, h, tol, symmetric, warm):
+def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
-    With warm, the solve starts from ws.lam_start (warm_start.py): it finds the change from
-    there, so a dependent row (dropped) keeps its starting impulse.
+    A row dropped as dependent keeps the impulse it had in the last step (ws.lam_start;
+    warm_start.py) and the others are solved given it.
     symmetric: F = J (no sliding contact), so J W F^T is symmetric (L D L^T on its lower half)."""
     n = ws.n_row[0]
     for i in range(ws.v_new.shape[0]):
@@ -289,20 +290,24 @@ def solve_impulses(m, ws, h, tol, symmetric, warm):
     compute_envelope(ws, n, ws.v_new.shape[0])
     assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     fill_row_b(ws, h, n)
+    if symmetric:
+        dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
+    else:
+        dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
+    warm = start_dropped_rows(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
         for r in range(n):
-            # w = A lam + b at the start: b + J (v_new - v*)
+            # w = A lam + b with the dropped rows at their start: b + J (v_new - v*)
             ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
                           - row_dot(ws, r, ws.row_J, ws.v_pred))
     else:
         for r in range(n):
             ws.rhs[r] = -ws.row_b[r]
     if symmetric:
-        dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
         substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
     else:
-        dropped = factor_solve(ws, ws.rhs, ws.lam, n, tol)
+        substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
     if warm:
         for r in range(n):

@@ -25,7 +25,7 @@ from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .rows import build_rows
 from .solve import solve_impulses
-from .warm_start import remember_impulses, start_impulses
+from .warm_start import remember_impulses
 
 
 @kernel
@@ -74,8 +74,7 @@ def build_and_solve(m, s, ws, opt, h):
     row was dropped, or the system was not symmetric). A call (one copy of its code for both solves of solve_modes): its
     work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
-    warm = start_impulses(s, ws, ws.n_row[0])
-    dropped = solve_impulses(m, ws, h, opt.pivot_tol, sliding == 0, warm)
+    dropped = solve_impulses(m, s, ws, h, opt.pivot_tol, sliding == 0)
     return dropped > 0 or sliding > 0
 
 

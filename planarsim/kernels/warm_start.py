@@ -1,11 +1,13 @@
-"""The last step's impulses as the start of the next step's solve.
+"""The last step's impulses as the start of the next step's solve, where it matters.
 
 Where the rows of a step are independent the solve's answer does not depend on where it
 starts (up to rounding). Where they are not (a closed loop through the ground: a box on two
-corners, two feet in double stance), the answer is a load split out of many, and the linear
-solve of the guess leaves a dependent row at its starting impulse. Starting from zero, that
+corners, two feet in double stance), the answer is a load split out of many: the linear
+solve drops a dependent row, and the impulse that row keeps decides the split. At zero, that
 split pulls or leaves friction outside its cone at rest, and every resting step went to the
-complementarity solve; starting from the last step's answer, a resting loop keeps its split.
+complementarity solve; at the last step's impulse, a resting loop keeps its split. So the
+dropped rows keep their last impulses and the others are solved given them (solve.py), the
+same answer as solving for the change from the last step's impulses of every row.
 The impulses live in the State (last_*_impulse), so a restored run continues bit for bit.
 """
 from ._jit import kernel
@@ -14,11 +16,32 @@ from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW
 
 
 @kernel
-def start_impulses(s, ws, n):
-    """ws.lam_start[:n]: each row's impulse in the last step (0 where it had none). A sliding
-    contact's single row (impulse lambda_n along n - mu s t) starts at lambda_n. Returns
-    False (and starts nothing) when no row is a contact or limit: joint rows alone have one
-    answer, so where the solve starts cannot matter."""
+def last_impulse(s, ws, r):
+    """Row r's impulse in the last step (0 where it had none). A sliding contact's single row
+    (impulse lambda_n along n - mu s t) starts at lambda_n."""
+    o = ws.row_owner[r]
+    kind = ws.row_kind[r]
+    if kind == ROW_CONTACT_N:
+        return s.last_contact_impulse[o, 0]
+    if kind == ROW_CONTACT_T:
+        return s.last_contact_impulse[o, 1]
+    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
+        return s.last_pin_impulse[o, kind - ROW_PIN_X]
+    if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
+        return s.last_pin_impulse[o, 2 + kind - ROW_LIMIT_LO]
+    if kind == ROW_ROD:
+        return s.last_rod_impulse[o]
+    return 0.0
+
+
+@kernel
+def start_dropped_rows(s, ws, n, dropped):
+    """ws.lam_start[:n]: the last step's impulse of each row the factorisation dropped as
+    dependent (marked by a zero pivot in ws.A), 0 for the others. Returns False (and starts
+    nothing) when no row was dropped, or no row is a contact or limit: joint rows alone have
+    one answer, so where the solve starts cannot matter."""
+    if dropped == 0:
+        return False
     unilateral = False
     for r in range(n):
         if ws.row_kind[r] >= ROW_LIMIT_LO:
@@ -27,20 +50,7 @@ def start_impulses(s, ws, n):
     if not unilateral:
         return False
     for r in range(n):
-        o = ws.row_owner[r]
-        kind = ws.row_kind[r]
-        x = 0.0
-        if kind == ROW_CONTACT_N:
-            x = s.last_contact_impulse[o, 0]
-        elif kind == ROW_CONTACT_T:
-            x = s.last_contact_impulse[o, 1]
-        elif kind == ROW_PIN_X or kind == ROW_PIN_Y:
-            x = s.last_pin_impulse[o, kind - ROW_PIN_X]
-        elif kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
-            x = s.last_pin_impulse[o, 2 + kind - ROW_LIMIT_LO]
-        elif kind == ROW_ROD:
-            x = s.last_rod_impulse[o]
-        ws.lam_start[r] = x
+        ws.lam_start[r] = last_impulse(s, ws, r) if ws.A[r, r] == 0.0 else 0.0
     return True
 
 
