@@ -19,7 +19,7 @@ triangle only and factored as L D L^T (half the work of LU, the same pivot test)
 """
 from ._jit import kernel, kernel_inline
 from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
-from .warm_start import start_dropped_rows
+from .warm_start import start_impulses
 
 
 @kernel
@@ -278,8 +278,8 @@ def fill_row_b(ws, h, n):
 @kernel_inline
 def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
-    A row dropped as dependent keeps the impulse it had in the last step (ws.lam_start;
-    warm_start.py) and the others are solved given it.
+    Where a row is dropped as dependent, the solve finds the change from the last step's
+    impulses (ws.lam_start; warm_start.py), so the dropped row keeps its impulse.
     symmetric: F = J (no sliding contact), so J W F^T is symmetric (L D L^T on its lower half)."""
     n = ws.n_row[0]
     for i in range(ws.v_new.shape[0]):
@@ -294,11 +294,11 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
         dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
     else:
         dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
-    warm = start_dropped_rows(s, ws, n, dropped)
+    warm = start_impulses(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
         for r in range(n):
-            # w = A lam + b with the dropped rows at their start: b + J (v_new - v*)
+            # w = A lam + b at the start: b + J (v_new - v*)
             ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
                           - row_dot(ws, r, ws.row_J, ws.v_pred))
     else:

@@ -1,13 +1,13 @@
 """The last step's impulses as the start of the next step's solve, where it matters.
 
 Where the rows of a step are independent the solve's answer does not depend on where it
-starts (up to rounding). Where they are not (a closed loop through the ground: a box on two
-corners, two feet in double stance), the answer is a load split out of many: the linear
-solve drops a dependent row, and the impulse that row keeps decides the split. At zero, that
-split pulls or leaves friction outside its cone at rest, and every resting step went to the
-complementarity solve; at the last step's impulse, a resting loop keeps its split. So the
-dropped rows keep their last impulses and the others are solved given them (solve.py), the
-same answer as solving for the change from the last step's impulses of every row.
+starts (up to rounding): it starts from zero. Where they are not (a closed loop through the
+ground: a box on two corners, two feet in double stance), the answer is a load split out of
+many: the linear solve drops a dependent row, and the impulse that row keeps decides the
+split. At zero, that split pulls or leaves friction outside its cone at rest, and every
+resting step went to the complementarity solve. So where the factorisation dropped a row,
+the solve starts from the last step's impulses and finds the change from them: the dropped
+rows keep theirs, and a resting loop, whose change is then zero, keeps its split bit for bit.
 The impulses live in the State (last_*_impulse), so a restored run continues bit for bit.
 """
 from ._jit import kernel
@@ -35,11 +35,11 @@ def last_impulse(s, ws, r):
 
 
 @kernel
-def start_dropped_rows(s, ws, n, dropped):
-    """ws.lam_start[:n]: the last step's impulse of each row the factorisation dropped as
-    dependent (marked by a zero pivot in ws.A), 0 for the others. Returns False (and starts
-    nothing) when no row was dropped, or no row is a contact or limit: joint rows alone have
-    one answer, so where the solve starts cannot matter."""
+def start_impulses(s, ws, n, dropped):
+    """ws.lam_start[:n]: each row's impulse in the last step, where the factorisation dropped
+    a row as dependent (dropped > 0). Returns False (and starts nothing) when none was
+    dropped, or no row is a contact or limit: joint rows alone have one answer, so where the
+    solve starts cannot matter."""
     if dropped == 0:
         return False
     unilateral = False
@@ -50,7 +50,7 @@ def start_dropped_rows(s, ws, n, dropped):
     if not unilateral:
         return False
     for r in range(n):
-        ws.lam_start[r] = last_impulse(s, ws, r) if ws.A[r, r] == 0.0 else 0.0
+        ws.lam_start[r] = last_impulse(s, ws, r)
     return True
 
 
