@@ -17,7 +17,7 @@ from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import GUARD_AUDIT, check_guards
 from .math2d import update_trig
-from .info import INFO_CCD_SPLITS, INFO_SOLVES, STEP_COUNTS
+from .info import INFO_CCD_SPLITS, INFO_PROJECTIONS, INFO_SOLVES, STEP_COUNTS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, predict_configuration, rows_hold_within)
 from .codes import MODES_ALTERNATING
@@ -193,17 +193,21 @@ def _step(m, s, ws, opt, u):
         # half of it (far above rounding) proves the correction would find nothing to do
         # (bodies at rest, translating), at a few flops per row instead of re-evaluating them
         held = True
+        corrected = False
         if opt.refine_iters > 0 and ws.n_row[0] > 0 and not (
                 opt.refine_tol > 0.0 and rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol)):
             held = correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol,
                                      opt.refine_pivot_tol) <= opt.refine_tol
+            corrected = True
         if opt.refine_iters > 0:
             # rows held to refine_tol are within the audit's tolerances where a point
             # contact's row is its exact gap (flat or sloped ground; pin rows are exact)
             held = (held and m.terrain_coef[2] == 0.0
                     and opt.refine_tol <= ROWS_HELD_SHARE * min(PIN_GAP_TOL, DEPTH_TOL))
             settle_positions(m, s, ws, h, opt, held)
-            bound_correction_work(m, s, ws)
+            if corrected or ws.info[INFO_PROJECTIONS] > 0:
+                # only a correction or a projection changes the velocity the solve gave
+                bound_correction_work(m, s, ws)
         break
     s.time[0] = ws.prev.time[0] + step_length
     s.step[0] += 1
