@@ -21,7 +21,7 @@ from .contacts import engage_contact, refresh_contact
 from .forces import point_velocity
 from .math2d import world_point
 from .mixed_lcp import is_sliding_solution
-from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO
+from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, has_mode_rows
 from .solve import row_dot
 
 # a solve's answer breaks a rule when it misses it by more than this share of its own scale
@@ -162,6 +162,8 @@ def rule_breaks(m, s, ws, h, equalities):
     check every row's equation (needed where the solve dropped a dependent row or had no
     symmetric factorisation; a backward-stable L D L^T of all rows meets them to rounding)."""
     n = ws.n_row[0]
+    if not equalities and not has_mode_rows(ws, n):
+        return 0        # joints only, their equations met by the solve: no rule to break
     big_lam = 0.0
     big_b = 0.0
     for r in range(n):

@@ -26,6 +26,16 @@ ROW_CONTACT_T = 6
 
 
 @kernel
+def has_mode_rows(ws, n):
+    """Some row among 0..n-1 belongs to a contact or a joint limit (whose rule a solve can
+    break); otherwise the rows are joints only."""
+    for r in range(n):
+        if ws.row_kind[r] >= ROW_LIMIT_LO:
+            return True
+    return False
+
+
+@kernel
 def _set_dir(q, body, px, py, dx, dy, sign, out):
     """out = sign * (dx, dy, (p - x_body) x d)."""
     if body < 0:

@@ -12,7 +12,7 @@ The impulses live in the State (last_*_impulse), so a restored run continues bit
 """
 from ._jit import kernel
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
-                   ROW_PIN_Y, ROW_ROD)
+                   ROW_PIN_Y, ROW_ROD, has_mode_rows)
 
 
 @kernel
@@ -42,12 +42,7 @@ def start_impulses(s, ws, n, dropped):
     solve starts cannot matter."""
     if dropped == 0:
         return False
-    unilateral = False
-    for r in range(n):
-        if ws.row_kind[r] >= ROW_LIMIT_LO:
-            unilateral = True
-            break
-    if not unilateral:
+    if not has_mode_rows(ws, n):
         return False
     for r in range(n):
         ws.lam_start[r] = last_impulse(s, ws, r)
