@@ -20,7 +20,6 @@ from .state import State, Workspace, check_state, forget_ground_queries, make_st
 from .trajectory import Trajectory, make_recorder
 
 
-
 def _link():
     """kernels.link, imported with the first Simulator (its compiled functions publish the
     step before their first call: from the numba cache, or its first-ever compile)."""

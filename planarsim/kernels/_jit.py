@@ -29,7 +29,6 @@ from numba.core.registry import CPUDispatcher
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
 
 
-
 class CallerDispatcher(CPUDispatcher):
     """Dispatcher of a `jit` function. Its machine code may call the compiled step by a
     symbol that LLVM resolves when the code is compiled or loaded from the cache; so before

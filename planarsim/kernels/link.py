@@ -96,7 +96,6 @@ def load_step():
     return _ENGINE["symbol"]
 
 
-
 @intrinsic
 def step(typingctx, m, s, ws, opt, u):
     """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0: m.dt)
@@ -190,7 +189,8 @@ def step_from_python(m, s, ws, opt, u):
     if not (type(u) is np.ndarray and u.dtype == np.float64 and u.ndim == 1 and u.flags.c_contiguous):
         u = np.ascontiguousarray(u, dtype=np.float64)
         if u.ndim != 1:
-            raise ValueError(f"step_from_python: commands u must be 1-d (one per actuator), got shape {u.shape}")
+            raise ValueError("step_from_python: commands u must be 1-d (one per actuator), "
+                             f"got shape {u.shape}")
     return hit[2](hit[1], u, 1)[0]
 
 

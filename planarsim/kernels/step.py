@@ -1,11 +1,12 @@
 """The compiled step: a table of contents of the stages (README, "How the engine works").
 
 step(m, s, ws, opt, u) advances State s in place by one step of opt.dt (0: the model's m.dt)
-and returns a guard code (0 ok, 1 non-finite, 2 too large). Model, state, workspace and options arrive as one pointer
-each (kernels/refs.py). The stages are compiled into one C function (inlined, but for a few
-long or rarely run parts kept as calls: build_and_solve, the capped-mode settling, the skip
-test of the correction), compiled once per machine and called by address from every compiled
-caller (a walker's rollout, run_steps; kernels/link.py). A time-of-impact split (CCD) repeats
+and returns a guard code (0 ok, 1 non-finite, 2 too large). Model, state, workspace and
+options arrive as one pointer each (kernels/refs.py). The stages are compiled into one C
+function (inlined, but for a few long or rarely run parts kept as calls: build_and_solve, the
+complementarity solve, the skip test of the correction, the measured end-of-step audit),
+compiled once per machine and called by address from every compiled caller (a walker's
+rollout, run_steps; kernels/link.py). A time-of-impact split (CCD) repeats
 stages 1-6 for the remainder of the step with the new contact pinned.
 """
 from ._jit import kernel, kernel_call, kernel_inline
@@ -71,8 +72,8 @@ ROWS_HELD_SHARE = 0.05
 def build_and_solve(m, s, ws, opt, h):
     """Stages 4-5: the active rows at the current configuration and their impulses under the
     modes as they stand. Returns True if the answer's equations need checking (a dependent
-    row was dropped, or the system was not symmetric). A call (one copy of its code for both solves of solve_modes): its
-    work is microseconds, the call a few nanoseconds."""
+    row was dropped, or the system was not symmetric). A call (one copy of its code for both
+    solves of solve_modes): its work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
     dropped = solve_impulses(m, s, ws, h, opt.pivot_tol, sliding == 0)
     return dropped > 0 or sliding > 0
