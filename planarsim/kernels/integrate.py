@@ -52,7 +52,8 @@ def keep_correction_rows(s, ws):
     """Keep the rows the Newton correction holds: joints, active limits, the normal row of
     every touching contact and the tangent row of every sticking one (a sticking foot does
     not creep along the ground while the correction closes the joints). Rows of contacts the
-    solve set free, and the tangent rows of sliding ones, are dropped."""
+    solve set free, and the tangent rows of sliding ones, are dropped. Returns how many were
+    dropped."""
     k = 0
     for r in range(ws.n_row[0]):
         kind = ws.row_kind[r]
@@ -66,7 +67,9 @@ def keep_correction_rows(s, ws):
         if k != r:
             move_row(ws, k, r)
         k += 1
+    dropped = ws.n_row[0] - k
     ws.n_row[0] = k
+    return dropped
 
 
 @kernel
@@ -203,14 +206,17 @@ def max_residual(m, s, ws):
 
 
 @kernel_inline
-def correct_positions(m, s, ws, h, iters, tol, pivot_tol):
-    """Newton-SHAKE; returns the final max residual [m or rad]."""
+def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
+    """Newton-SHAKE; returns the final max residual [m or rad]. envelope_ready: the rows are
+    those of the velocity solve's envelope (ws.row_first / row_reach): none was dropped since
+    and no complementarity solve changed them."""
     n = ws.n_row[0]
     if n == 0:
         return 0.0
-    # the envelope of the rows as they are now (keep_correction_rows compacted them; after a
-    # complementarity solve they are not the rows the guess's solve had)
-    compute_envelope(ws, n, s.q.shape[0])
+    if not envelope_ready:
+        # the envelope of the rows as they are now (keep_correction_rows compacted them;
+        # after a complementarity solve they are not the rows the guess's solve had)
+        compute_envelope(ws, n, s.q.shape[0])
     worst = max_residual(m, s, ws)
     ptol = pivot_tol
     for _ in range(iters):

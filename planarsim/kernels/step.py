@@ -98,7 +98,9 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     is checked against every rule. Alternating strategy: if it breaks one, the contact under
     the cursor is re-examined by the alternating rule and solved once more. An answer that still
     breaks a rule goes to the complementarity solve, which ends at a consistent answer
-    (complementarity.solve_contacts). No rounds, no cap."""
+    (complementarity.solve_contacts). No rounds, no cap. Returns True if a linear solve's
+    answer stood (its rows and their envelope are in ws), False if the complementarity solve
+    replaced it."""
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
     equalities = build_and_solve(m, s, ws, opt, h)
@@ -116,6 +118,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         solve_contacts(m, s, ws, h, include_ccd)
     remember_impulses(s, ws)
     ws.info[INFO_SOLVES] += rounds
+    return ok
 
 
 @kernel
@@ -174,7 +177,7 @@ def _step(m, s, ws, opt, u):
         predict_configuration(m, s, ws, h)
         find_contacts(m, s, ws)
         ccd_on = split < opt.max_ccd_splits
-        solve_modes(m, s, ws, opt, h, not ccd_on)
+        answered = solve_modes(m, s, ws, opt, h, not ccd_on)
         if ccd_on:
             tau, hit = time_of_impact(m, s, ws, h)
             # an impact at the very end of the step is left to the next step (tau = 0 there)
@@ -189,7 +192,9 @@ def _step(m, s, ws, opt, u):
                 continue
         audit_impulses(m, s, ws)
         integrate_positions(s, ws, ws.v_new, h)
-        keep_correction_rows(s, ws)
+        kept_all = keep_correction_rows(s, ws) == 0
+        # the solve's envelope stands where its rows all stay (no need to compute it again)
+        envelope_ready = answered and kept_all
         # the correction only when the rows may be off by more than refine_tol: a bound of
         # half of it (far above rounding) proves the correction would find nothing to do
         # (bodies at rest, translating), at a few flops per row instead of re-evaluating them
@@ -198,7 +203,7 @@ def _step(m, s, ws, opt, u):
         if opt.refine_iters > 0 and ws.n_row[0] > 0 and not (
                 opt.refine_tol > 0.0 and rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol)):
             held = correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol,
-                                     opt.refine_pivot_tol) <= opt.refine_tol
+                                     opt.refine_pivot_tol, envelope_ready) <= opt.refine_tol
             corrected = True
         if opt.refine_iters > 0:
             # rows held to refine_tol are within the audit's tolerances where a point
