@@ -16,17 +16,51 @@ Numba checks a cached function against its own file only; a kernel that calls in
 file would keep stale machine code after that file changes. ``_drop_stale_caches`` hashes all
 kernel sources and clears the numba caches of planarsim and walkers when the hash changes.
 """
+import contextlib
 import hashlib
 import os
 from pathlib import Path
 
+import llvmlite.binding as llvm
 from numba import types
 from numba.core import compiler
 from numba.core.codegen import JITCodeLibrary
-from numba.core.compiler_lock import require_global_compiler_lock
+from numba.core.compiler_lock import global_compiler_lock, require_global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
+
+
+# LLVM's code layout while planarsim's machine code is emitted: every function and every block
+# not entered by falling through from the one before starts on a 64-byte line (padding only:
+# the same instructions, the same numbers). Without it, where a hot loop's blocks fall
+# relative to the 64-byte lines the CPU fetches and caches decoded code by depends on the size
+# of all the code before it, so an edit anywhere in the step moved small scenes by 5-10%
+# either way (with it, by 2-4%). Measured with it (numba 0.68.1, AMD EPYC): 2-11% more
+# steps/s on the bench scenes and walkers, none slower. LLVM keeps such options
+# process-wide, so they are set only while planarsim compiles (under numba's compiler lock)
+# and put back to LLVM's defaults after: other numba code in the process is compiled as it
+# would be without planarsim.
+CODE_LAYOUT = ("-align-all-functions=6", "-align-all-nofallthru-blocks=6")
+LLVM_LAYOUT_DEFAULTS = ("-align-all-functions=0", "-align-all-nofallthru-blocks=0")
+_LAYOUT_DEPTH = [0]
+
+
+@contextlib.contextmanager
+def code_layout():
+    """Compile planarsim's machine code inside this block (reentrant; see CODE_LAYOUT)."""
+    with global_compiler_lock:
+        if _LAYOUT_DEPTH[0] == 0:
+            for option in CODE_LAYOUT:
+                llvm.set_option("planarsim", option)
+        _LAYOUT_DEPTH[0] += 1
+        try:
+            yield
+        finally:
+            _LAYOUT_DEPTH[0] -= 1
+            if _LAYOUT_DEPTH[0] == 0:
+                for option in LLVM_LAYOUT_DEFAULTS:
+                    llvm.set_option("planarsim", option)
 
 
 class CallerDispatcher(CPUDispatcher):
@@ -38,7 +72,8 @@ class CallerDispatcher(CPUDispatcher):
 
     def compile(self, sig):
         link_step()
-        return super().compile(sig)
+        with code_layout():
+            return super().compile(sig)
 
 
 _LINKED = []     # the step is published in this process

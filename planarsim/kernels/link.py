@@ -34,7 +34,7 @@ from ..model import ModelArrays
 from ..options import StepOptions, check_options
 from ..state import State, Workspace, forget_ground_queries
 from . import refs
-from ._jit import KERNEL_OPTIONS, jit
+from ._jit import KERNEL_OPTIONS, code_layout, jit
 from .guards import GUARD_BAD_COMMANDS, check_commands
 from .info import INFO_COMMAND
 from .record import record_frame
@@ -87,7 +87,8 @@ def load_step():
             _LOADING.append(True)
             try:
                 sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
-                entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
+                with code_layout():
+                    entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
                 ll.add_symbol(_ENGINE["symbol"], entry.address)
                 _ENGINE["cfunc"] = entry
             finally:

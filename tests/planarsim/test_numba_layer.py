@@ -180,3 +180,51 @@ def test_editing_a_kernel_recompiles_its_cached_callers(tmp_path):
                                   f"def value(x):\n    return x + {k}\n")
         outs.append(_run(code, path=[tmp_path]))
     assert outs == [["2.0", "0"], ["2.0", "1"], ["3.0", "0"]]
+
+
+_BRANCHY_IR = r'''
+declare double @g(double)
+define double @f(double %x, double %y) {
+entry:
+  %c = fcmp olt double %x, %y
+  br i1 %c, label %a, label %b
+a:
+  %r1 = call double @g(double %x)
+  br label %m
+b:
+  %r2 = call double @g(double %y)
+  %r3 = fadd double %r2, 1.0
+  br label %m
+m:
+  %r = phi double [%r1, %a], [%r3, %b]
+  %c2 = fcmp olt double %r, 0.0
+  br i1 %c2, label %a2, label %e
+a2:
+  %r4 = call double @g(double %r)
+  ret double %r4
+e:
+  ret double %r
+}
+'''
+
+
+def _alignments():
+    """How many alignment directives LLVM emits for a small function with branches now."""
+    import llvmlite.binding as llvm
+    llvm.initialize_native_target()
+    llvm.initialize_native_asmprinter()
+    machine = llvm.Target.from_default_triple().create_target_machine(opt=3)
+    return machine.emit_assembly(llvm.parse_assembly(_BRANCHY_IR)).count(".p2align")
+
+
+def test_code_layout_aligns_blocks_while_planarsim_compiles_and_leaves_others_alone():
+    from planarsim.kernels._jit import code_layout
+    from planarsim.kernels.link import load_step
+    load_step()     # the step compiled (or loaded) under code_layout; options restored after
+    plain = _alignments()
+    with code_layout():
+        with code_layout():      # reentrant: the inner exit keeps the layout
+            pass
+        aligned = _alignments()
+    assert aligned > plain, "the layout options did not reach LLVM's code generation"
+    assert _alignments() == plain, "the layout options leaked into code compiled after"
