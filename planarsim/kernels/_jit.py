@@ -36,7 +36,7 @@ _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nr
 # the same instructions, the same numbers). Without it, where a hot loop's blocks fall
 # relative to the 64-byte lines the CPU fetches and caches decoded code by depends on the size
 # of all the code before it, so an edit anywhere in the step moved small scenes by 5-10%
-# either way (with it, by 2-4%). Measured with it (numba 0.68.1, AMD EPYC): 2-11% more
+# either way (with it, by 2-7%). Measured with it (numba 0.68.1, AMD EPYC): 2-11% more
 # steps/s on the bench scenes and walkers, none slower. LLVM keeps such options
 # process-wide, so they are set only while planarsim compiles (under numba's compiler lock)
 # and put back to LLVM's defaults after: other numba code in the process is compiled as it
