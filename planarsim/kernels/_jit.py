@@ -36,11 +36,13 @@ _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nr
 # the same instructions, the same numbers). Without it, where a hot loop's blocks fall
 # relative to the 64-byte lines the CPU fetches and caches decoded code by depends on the size
 # of all the code before it, so an edit anywhere in the step moved small scenes by 5-10%
-# either way (with it, by 2-7%). Measured with it (numba 0.68.1, AMD EPYC): 2-11% more
+# either way (with it, by 2-7%). Measured with it (numba 0.68.1, AMD EPYC): 2-12% more
 # steps/s on the bench scenes and walkers, none slower. LLVM keeps such options
 # process-wide, so they are set only while planarsim compiles (under numba's compiler lock)
-# and put back to LLVM's defaults after: other numba code in the process is compiled as it
-# would be without planarsim.
+# and then set to LLVM's defaults (0): numba code compiled outside planarsim's compiles is
+# laid out as without planarsim (a plain numba function compiled as part of a planarsim
+# caller gets the layout; a user's own setting of these two options is not kept). numba's
+# cache does not record the options: code cached before them runs unaligned (only slower).
 CODE_LAYOUT = ("-align-all-functions=6", "-align-all-nofallthru-blocks=6")
 LLVM_LAYOUT_DEFAULTS = ("-align-all-functions=0", "-align-all-nofallthru-blocks=0")
 _LAYOUT_DEPTH = [0]

@@ -99,8 +99,8 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     the cursor is re-examined by the alternating rule and solved once more. An answer that still
     breaks a rule goes to the complementarity solve, which ends at a consistent answer
     (complementarity.solve_contacts). No rounds, no cap. Returns True if a linear solve's
-    answer stood (its rows and their envelope are in ws), False if the complementarity solve
-    replaced it."""
+    answer stood (its rows, and their envelope where there are rows, are in ws), False if
+    the complementarity solve replaced it."""
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
     equalities = build_and_solve(m, s, ws, opt, h)

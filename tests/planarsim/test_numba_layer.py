@@ -209,22 +209,49 @@ e:
 
 
 def _alignments():
-    """How many alignment directives LLVM emits for a small function with branches now."""
+    """(alignment directives, 64-byte ones) LLVM emits now for a small function with branches."""
     import llvmlite.binding as llvm
     llvm.initialize_native_target()
     llvm.initialize_native_asmprinter()
     machine = llvm.Target.from_default_triple().create_target_machine(opt=3)
-    return machine.emit_assembly(llvm.parse_assembly(_BRANCHY_IR)).count(".p2align")
+    text = machine.emit_assembly(llvm.parse_assembly(_BRANCHY_IR))
+    return text.count(".p2align"), text.count(".p2align\t6") + text.count(".p2align 6")
 
 
-def test_code_layout_aligns_blocks_while_planarsim_compiles_and_leaves_others_alone():
+def test_code_layout_aligns_functions_and_blocks_inside_and_nothing_after():
     from planarsim.kernels._jit import code_layout
-    from planarsim.kernels.link import load_step
-    load_step()     # the step compiled (or loaded) under code_layout; options restored after
     plain = _alignments()
     with code_layout():
         with code_layout():      # reentrant: the inner exit keeps the layout
             pass
         aligned = _alignments()
-    assert aligned > plain, "the layout options did not reach LLVM's code generation"
-    assert _alignments() == plain, "the layout options leaked into code compiled after"
+    assert aligned[0] > plain[0], "no block alignment inside code_layout (-align-all-nofallthru-blocks)"
+    assert aligned[1] > plain[1], "no 64-byte alignment inside code_layout (-align-all-functions)"
+    assert _alignments() == plain, "the layout options stayed set after code_layout"
+
+
+def test_planarsim_compiles_its_step_and_callers_under_code_layout():
+    """The step's C function and every planarsim jit caller are compiled (or loaded) with the
+    layout options set, and LLVM's defaults are back after each (fresh process: the step is
+    loaded there)."""
+    out = _run("""
+        import llvmlite.binding as llvm
+        calls = []
+        real = llvm.set_option
+        llvm.set_option = lambda name, option: (calls.append(option), real(name, option))[1]
+        from planarsim.kernels._jit import CODE_LAYOUT, LLVM_LAYOUT_DEFAULTS
+        from planarsim.kernels.link import load_step
+        load_step()
+        step_calls = list(calls)
+        del calls[:]
+        from planarsim.kernels import _jit
+
+        @_jit._caller_decorator(cache=False)     # planarsim's jit, uncached (no source file)
+        def twice(x):
+            return 2.0 * x
+        twice(1.5)
+        ok_step = step_calls == list(CODE_LAYOUT) + list(LLVM_LAYOUT_DEFAULTS)
+        ok_jit = calls == list(CODE_LAYOUT) + list(LLVM_LAYOUT_DEFAULTS)
+        print(ok_step, ok_jit)
+    """)
+    assert out == ["True", "True"], out
