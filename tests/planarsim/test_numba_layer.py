@@ -6,10 +6,8 @@ import sys
 import textwrap
 
 import numba
-import numpy as np
 import pytest
 
-import planarsim as ps
 from planarsim.kernels import _jit, numba_check
 
 

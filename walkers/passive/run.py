@@ -104,7 +104,6 @@ class PassiveRun(WalkerRun):
         self.code = int(code)
         return code, k
 
-
     def _engine(self, n, rec):
         """The engine finds the touchdowns (events logged in walker.event_time / event_contact)."""
         w = self.walker
