@@ -20,6 +20,15 @@ Families (every scene drawn from numpy.random.default_rng(seed); friction mu in 
 - mass_ratio: two pinned boxes with a mass ratio of 1 to 1000 at most, hitting flat ground at
   10-100 m/s within 60 deg of straight down, tumbling at up to 10 rad/s.
 
+- shape_pile: 4-8 colliding shapes (boxes, capsules, circles, convex polygons of 3-6
+  vertices; 2-40 cm) with masses 10^U(-1.5, 1.5) kg (ratios to 1:1000), stacked loosely with
+  random offsets and tilts and thrown down at 1-30 m/s (and up to 10 rad/s) onto each other
+  and flat ground.
+- shape_hills: the same onto sine hills (slopes up to about 30 deg).
+  Depth there is the deepest overlap of any two shapes (the narrow phase, kernels/collide.py,
+  tested against an independent reference in tests/physics/test_collide.py) and of any shape
+  below the ground (corners and edges sampled every 5 mm, circles by their centre's gap).
+
 Seed k runs at dt = DTS[k % 5] (1e-4 ... 1e-2 s). A run simulates SECONDS[family] (or --seconds) but at most
 MAX_STEPS steps, so runs at small dt cover less time. Every run is recorded at every step and
 judged on each end-of-step state (and the start):
@@ -55,10 +64,13 @@ from benchmarks.metrics import (energy, lowest_point, pin_separation,  # noqa: E
                                      spec_from_model, world_points)
 from benchmarks.scenes import G, biped_collapse  # noqa: E402
 
-FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio")
+FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio", "shape_pile",
+            "shape_hills")
+SHAPE_FAMILIES = ("shape_pile", "shape_hills")   # bodies touching bodies (colliding shapes)
 STRATEGIES = ("alternating", "all")
 DTS = (1e-4, 3e-4, 1e-3, 3e-3, 1e-2)      # [s] step sizes; seed k runs at DTS[k % 5]
-SECONDS = {"biped_stance": 2.0, "biped_collapse": 2.0, "chain_hills": 3.0, "mass_ratio": 1.0}  # [s]
+SECONDS = {"biped_stance": 2.0, "biped_collapse": 2.0, "chain_hills": 3.0, "mass_ratio": 1.0,
+           "shape_pile": 2.0, "shape_hills": 2.0}  # [s]
 MAX_STEPS = 3000          # cap on steps per run (dt = 1e-4 s: 0.3 s simulated)
 RUNS_PER_FAMILY = 40      # seeds per family of the default corpus
 QUICK_RUNS = 5            # seeds per family with --quick (one strategy each, in turn)
@@ -208,6 +220,76 @@ def mass_ratio(rng, dt):
     return b.compile()
 
 
+def random_shape(rng):
+    """(kind, params, mass [kg], inertia [kg m^2]) of a random colliding shape centred on its
+    body's COM (uniform density; a polygon's vertices about its centroid)."""
+    kind = ("box", "capsule", "circle", "polygon")[int(rng.integers(4))]
+    mass = 10.0 ** rng.uniform(-1.5, 1.5)
+    if kind == "box":
+        w, h = rng.uniform(0.02, 0.4, size=2)
+        return kind, ((0.0, 0.0), w, h), mass, mass * (w * w + h * h) / 12
+    if kind == "circle":
+        r = rng.uniform(0.02, 0.2)
+        return kind, ((0.0, 0.0), r), mass, 0.5 * mass * r * r
+    if kind == "capsule":
+        half, r = rng.uniform(0.02, 0.2), rng.uniform(0.01, 0.08)
+        return (kind, ((-half, 0.0), (half, 0.0), r), mass,
+                mass * ((2 * half) ** 2 / 12 + r * r / 2))
+    n = int(rng.integers(3, 7))
+    ang = np.sort(rng.uniform(0, 2 * math.pi, size=n))
+    rad = rng.uniform(0.05, 0.2, size=n)
+    pts = np.stack([rad * np.cos(ang), rad * np.sin(ang)], axis=1)
+    # keep the convex hull (Andrew's monotone chain), then centre it on its centroid
+    pts = pts[np.lexsort((pts[:, 1], pts[:, 0]))]
+    def half_hull(points):
+        out = []
+        for p in points:
+            while len(out) >= 2 and np.cross(out[-1] - out[-2], p - out[-2]) <= 1e-9:
+                out.pop()
+            out.append(p)
+        return out
+    hull = np.array(half_hull(pts)[:-1] + half_hull(pts[::-1])[:-1])
+    if len(hull) < 3:
+        w = rng.uniform(0.05, 0.3)
+        return "box", ((0.0, 0.0), w, w), mass, mass * w * w / 6
+    x, y = hull[:, 0], hull[:, 1]
+    cross = x * np.roll(y, -1) - np.roll(x, -1) * y
+    area = cross.sum() / 2
+    cx = ((x + np.roll(x, -1)) * cross).sum() / (6 * area)
+    cy = ((y + np.roll(y, -1)) * cross).sum() / (6 * area)
+    hull = hull - (cx, cy)
+    x, y = hull[:, 0], hull[:, 1]
+    second = (x * x + x * np.roll(x, -1) + np.roll(x, -1) ** 2
+              + y * y + y * np.roll(y, -1) + np.roll(y, -1) ** 2)
+    inertia = mass * (cross * second).sum() / (12 * area)
+    return kind, ([tuple(p) for p in hull],), mass, inertia
+
+
+def shape_scene(rng, dt, hills):
+    """4-8 random shapes in a loose column over flat ground or sine hills; returns the model
+    and the start velocities (n_body, 3)."""
+    if hills:
+        n_sines = int(rng.integers(1, 3))
+        lam = rng.uniform(2.0, 6.0, size=n_sines)
+        amp = rng.uniform(0.2, 1.0, size=n_sines) * 0.09 * lam / n_sines
+        ground = terrain.hills(amp, lam, rng.uniform(0, 2 * math.pi, size=n_sines))
+    else:
+        ground = terrain.flat()
+    b = ps.ModelBuilder(dt=dt, terrain=ground)
+    mu = rng.uniform(0.2, 1.2)
+    x0 = rng.uniform(-2.0, 2.0)
+    y = ground.height(x0) + 0.45
+    v = []
+    for k in range(int(rng.integers(4, 9))):
+        kind, params, mass, inertia = random_shape(rng)
+        b.add_body(f"s{k}", mass, inertia, pos=(x0 + rng.uniform(-0.15, 0.15), y),
+                   angle=rng.uniform(-math.pi, math.pi), shapes=[(kind, *params, {"mu": mu})])
+        y += 0.45
+        speed, heading = rng.uniform(1.0, 30.0), rng.uniform(-math.pi / 4, math.pi / 4)
+        v.append((speed * math.sin(heading), -speed * math.cos(heading), rng.uniform(-10, 10)))
+    return b.compile(), np.array(v)
+
+
 def build(family, seed):
     """(model, ground, q0, v0) of one corpus case; q0, v0 the start state [m, rad, m/s, rad/s]."""
     rng = np.random.default_rng(seed)
@@ -222,6 +304,9 @@ def build(family, seed):
         root_v = (rng.uniform(-1, 1), rng.uniform(-2, 0), rng.normal(0, 0.5))
         q, v = joint_pose(model, rng.normal(0, 0.15, model.n_pin), rng.normal(0, 0.5, model.n_pin), root_v)
         gap = rng.uniform(0.05, 1.0)
+    elif family in SHAPE_FAMILIES:
+        model, v = shape_scene(rng, dt, family == "shape_hills")
+        return model, model.terrain, model.q0.copy(), v
     elif family == "mass_ratio":
         model = mass_ratio(rng, dt)
         speed, heading = rng.uniform(10, 100), rng.uniform(-math.pi / 3, math.pi / 3)
@@ -235,6 +320,86 @@ def build(family, seed):
 
 
 # --- judging -----------------------------------------------------------------------------------
+def shape_spec(name, model, seconds):
+    """The SceneSpec of a shape scene (masses, inertias; no boxes for the peers)."""
+    from benchmarks.metrics import SceneSpec
+    a = model.arrays
+    nb = model.n_body
+    return SceneSpec(name=name, dt=float(a.dt), mass=a.body_mass.copy(),
+                     inertia=a.body_inertia.copy(), q0=model.q0.copy(),
+                     box=np.full((nb, 2), np.nan), pin_body=a.pin_body.copy(),
+                     pin_anchor=a.pin_anchor.copy(), ground=True, seconds=seconds,
+                     energy_scale=1.0)
+
+
+_OVERLAP = None
+
+
+def _overlap_kernel():
+    """A compiled loop over frames and shape pairs: the deepest overlap [m] per frame."""
+    global _OVERLAP
+    if _OVERLAP is None:
+        from numba import njit
+        from planarsim.kernels._jit import _OPTIONS
+        from planarsim.kernels.collide import collide
+
+        @njit(**dict(_OPTIONS, cache=False))
+        def overlap(vert, norm, adr, num, rad, body, pairs, q, out, scratch):
+            for k in range(q.shape[0]):
+                worst = 0.0
+                for p in range(pairs.shape[0]):
+                    sa = pairs[p, 0]
+                    sb = pairs[p, 1]
+                    ba = body[sa]
+                    bb = body[sb]
+                    xa, ya, ca, sna = 0.0, 0.0, 1.0, 0.0
+                    xb, yb, cb, snb = 0.0, 0.0, 1.0, 0.0
+                    if ba >= 0:
+                        xa, ya = q[k, ba, 0], q[k, ba, 1]
+                        ca, sna = np.cos(q[k, ba, 2]), np.sin(q[k, ba, 2])
+                    if bb >= 0:
+                        xb, yb = q[k, bb, 0], q[k, bb, 1]
+                        cb, snb = np.cos(q[k, bb, 2]), np.sin(q[k, bb, 2])
+                    n = collide(vert, norm, adr[sa], num[sa], rad[sa], xa, ya, ca, sna,
+                                adr[sb], num[sb], rad[sb], xb, yb, cb, snb, 0.0, scratch)
+                    for j in range(n):
+                        worst = max(worst, -scratch[j, 8])
+                out[k] = worst
+        _OVERLAP = overlap
+    return _OVERLAP
+
+
+def shape_clearance(model, q):
+    """(K,) smallest clearance [m] over frames q of a shape scene (negative: overlap): every
+    pair of shapes that may touch (the narrow phase at each frame) and every shape against
+    the ground (polygon and capsule edges sampled every 5 mm, a circle or capsule by the
+    distance of its core from the ground minus its radius, to first order in the slope)."""
+    a = model.arrays
+    ground = model.terrain
+    pairs = a.contact_pair[(a.contact_kind == 2) & (a.contact_pair[:, 2] == 0), :2].copy()
+    worst = np.zeros(q.shape[0])
+    if len(pairs):
+        _overlap_kernel()(a.core_vert, a.core_norm, a.shape_vert_adr, a.shape_vert_num,
+                          a.shape_radius, a.shape_body, np.ascontiguousarray(pairs),
+                          np.ascontiguousarray(q), worst, np.zeros((2, 10)))
+    low = -worst
+    for s in range(len(a.shape_body)):
+        body = a.shape_body[s]
+        if body < 0:
+            continue
+        core = a.core_vert[a.shape_vert_adr[s]:a.shape_vert_adr[s] + a.shape_vert_num[s]]
+        edges = [(core[k], core[(k + 1) % len(core)]) for k in range(len(core))]
+        pts = [core[0]] if len(core) == 1 else []
+        for p0, p1 in edges:
+            n = max(2, int(np.hypot(*(p1 - p0)) / 0.005) + 1)
+            pts.extend(p0 + (p1 - p0) * u for u in np.linspace(0.0, 1.0, n))
+        for p in pts:
+            x, y = world_points(q, body, p).T
+            gap = (y - ground.height(x)) / np.sqrt(1.0 + ground.slope(x) ** 2) - a.shape_radius[s]
+            low = np.minimum(low, gap)
+    return low
+
+
 def energy_bound(spec, ground, q0, v0):
     """E_tol [J]: how far symplectic Euler's own energy error may take a dissipative run above E0.
 
@@ -281,7 +446,8 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
     model, ground, q0, v0 = build(family, seed)
     dt = model.dt
     steps = min(int(round((SECONDS[family] if seconds is None else seconds) / dt)), max_steps)
-    spec = spec_from_model(family, model, steps * dt)
+    spec = (shape_spec(family, model, steps * dt) if family in SHAPE_FAMILIES
+            else spec_from_model(family, model, steps * dt))
     sim = ps.Simulator(model, ps.make_options(strategy), ps.make_state(model, q0, v0))
     out = dict(family=family, seed=seed, strategy=strategy, dt=dt, steps=steps,
                e0=float(energy(spec, q0[None], v0[None])[0]), e_tol=energy_bound(spec, ground, q0, v0),
@@ -295,7 +461,9 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
         else:
             out["gain"] = float(np.max(energy(spec, q, v) - out["e0"]))
             out["pin"] = pin_separation(spec, q)
-            out["depth"] = max(0.0, -float(np.min(clearance(spec, ground, q))))
+            low = (shape_clearance(model, q) if family in SHAPE_FAMILIES
+                   else clearance(spec, ground, q))
+            out["depth"] = max(0.0, -float(np.min(low)))
     except ps.SimulationDiverged as exc:
         out["diverged"] = str(exc).splitlines()[0][:160]
     counts = getattr(sim.ws, "audit", None)

@@ -7,6 +7,8 @@ import planarsim as ps
 from planarsim import terrain
 
 G = 9.81
+# the shapes only draw these scenes: their contacts are added one by one
+DRAWN = {"collide": False}
 
 
 def chain(n_links=4, dt=1e-3, length=0.5, mass=1.0):
@@ -17,7 +19,7 @@ def chain(n_links=4, dt=1e-3, length=0.5, mass=1.0):
     for i in range(n_links):
         body = b.add_body(f"link{i}", mass=mass, inertia=mass * length ** 2 / 12,
                           pos=((i + 0.5) * length, 0.0),
-                          shapes=[("capsule", (-length / 2, 0.0), (length / 2, 0.0), 0.02)])
+                          shapes=[("capsule", (-length / 2, 0.0), (length / 2, 0.0), 0.02, DRAWN)])
         b.add_pin(f"pin{i}", prev, body, anchor_world=(i * length, 0.0))
         prev = body
     return b.compile()
@@ -70,18 +72,18 @@ def biped_collapse(dt=1e-3):
         poses[side] = (th_thigh, th_shin, th_foot, hip, knee, ankle, foot_c)
     lift = 0.001 - lowest
     torso = b.add_body("torso", 15.0, box_inertia(15.0, 0.2, 0.8), pos=(0.0, lift + 0.4),
-                       shapes=[("box", (0.0, 0.0), 0.2, 0.8, 0.0)])
+                       shapes=[("box", (0.0, 0.0), 0.2, 0.8, 0.0, DRAWN)])
     b.add_box_contacts("torso_c", torso, (0.0, 0.0), 0.2, 0.8)
     for side, (tt, ts, tf, hip, knee, ankle, foot_c) in poses.items():
         def mid(p, q):
             return ((p[0] + q[0]) / 2, (p[1] + q[1]) / 2 + lift)
         thigh = b.add_body(f"thigh_{side}", 7.0, box_inertia(7.0, 0.08, 0.45), pos=mid(hip, knee), angle=tt,
-                           shapes=[("box", (0.0, 0.0), 0.08, 0.45, 0.0)])
+                           shapes=[("box", (0.0, 0.0), 0.08, 0.45, 0.0, DRAWN)])
         shin = b.add_body(f"shin_{side}", 5.0, box_inertia(5.0, 0.08, 0.45), pos=mid(knee, ankle), angle=ts,
-                          shapes=[("box", (0.0, 0.0), 0.08, 0.45, 0.0)])
+                          shapes=[("box", (0.0, 0.0), 0.08, 0.45, 0.0, DRAWN)])
         foot = b.add_body(f"foot_{side}", 1.0, box_inertia(1.0, 0.2, 0.05),
                           pos=(foot_c[0], foot_c[1] + lift), angle=tf,
-                          shapes=[("box", (0.0, 0.0), 0.2, 0.05, 0.0)])
+                          shapes=[("box", (0.0, 0.0), 0.2, 0.05, 0.0, DRAWN)])
         b.add_pin(f"hip_{side}", torso, thigh, anchor_world=(hip[0], hip[1] + lift))
         b.add_pin(f"knee_{side}", thigh, shin, anchor_world=(knee[0], knee[1] + lift))
         b.add_pin(f"ankle_{side}", shin, foot, anchor_world=(ankle[0], ankle[1] + lift))
@@ -101,3 +103,60 @@ SCENES = {
     "boxes_on_hills": (boxes_on_hills, 2000),
     "biped_collapse": (biped_collapse, 3000),
 }
+
+
+# ---- shapes that collide -------------------------------------------------------------------
+BOX_W, BOX_H = 0.4, 0.2     # [m]
+
+
+def _box(b, name, x, y, mass=1.0, mu=0.6, angle=0.0):
+    return b.add_body(name, mass, mass * (BOX_W ** 2 + BOX_H ** 2) / 12, pos=(x, y), angle=angle,
+                      shapes=[("box", (0.0, 0.0), BOX_W, BOX_H, {"mu": mu})])
+
+
+def box_column(n=10, dt=1e-3):
+    """N boxes 0.4 x 0.2 m, 1 kg, stacked at rest on flat ground."""
+    b = ps.ModelBuilder(dt=dt)
+    for k in range(n):
+        _box(b, f"box{k}", 0.0, BOX_H / 2 + k * BOX_H)
+    return b.compile()
+
+
+def box_pyramid(dt=1e-3):
+    """20 boxes in rows of 6, 5, 4, 3, 2, at rest on flat ground (2 cm between neighbours)."""
+    b = ps.ModelBuilder(dt=dt)
+    k = 0
+    for level, n in enumerate((6, 5, 4, 3, 2)):
+        for j in range(n):
+            _box(b, f"box{k}", (j - (n - 1) / 2) * (BOX_W + 0.02), BOX_H / 2 + level * BOX_H)
+            k += 1
+    return b.compile()
+
+
+def box_piles(piles=5, n=10, dt=1e-3):
+    """`piles` separate columns of n boxes, 1 m apart (separate islands)."""
+    b = ps.ModelBuilder(dt=dt)
+    for p in range(piles):
+        for k in range(n):
+            _box(b, f"box{p}_{k}", 1.0 * p, BOX_H / 2 + k * BOX_H)
+    return b.compile()
+
+
+def box_drop(dt=1e-3):
+    """Ten boxes dropped from 0.5-2.75 m, tilted and offset, onto each other and the ground."""
+    b = ps.ModelBuilder(dt=dt)
+    for k in range(10):
+        _box(b, f"box{k}", 0.07 * ((k * 37) % 7 - 3), 0.5 + 0.25 * k,
+             angle=0.3 * ((k * 53) % 5 - 2))
+    return b.compile()
+
+
+SCENES.update({
+    "box_column5": (lambda: box_column(5), 2000),
+    "box_column10": (lambda: box_column(10), 2000),
+    "box_column20": (lambda: box_column(20), 1000),
+    "box_column40": (lambda: box_column(40), 500),
+    "box_pyramid": (box_pyramid, 1000),
+    "box_piles": (box_piles, 1000),
+    "box_drop": (box_drop, 2000),
+})

@@ -18,8 +18,10 @@ import math
 import numpy as np
 
 from . import model as M
-from .kernels.codes import CONTACT_ARC, CONTACT_POINT
+from .kernels.codes import CONTACT_ARC, CONTACT_PAIR, CONTACT_POINT
 from .errors import ModelError
+from .kernels.collide import core_normals
+from .shapes import bounding_circle, collision_core, collision_pairs
 from .terrain import Terrain, flat
 
 PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
@@ -64,7 +66,10 @@ def _length(kind, name, idx, fieldname, value, zero_ok=False):
 
 
 SHAPE_PARAMS = {"capsule": ("p0", "p1", "radius"), "circle": ("center", "radius"),
-                "box": ("center", "width", "height", "angle")}  # box: angle optional
+                "box": ("center", "width", "height", "angle"),  # box: angle optional
+                "polygon": ("vertices",)}
+# what a colliding shape takes unless told: friction coefficient, restitution, filter bits
+SHAPE_DEFAULTS = dict(collide=True, mu=1.0, restitution=0.0, category=1, mask=0xFFFF, name=None)
 
 
 def _check_shape(kind, idx, params):
@@ -75,7 +80,15 @@ def _check_shape(kind, idx, params):
     if not (len(fields) - (kind == "box") <= len(params) <= len(fields)):
         raise ModelError(f"{_who(what, None, idx)}: params={params!r} must be ({', '.join(fields)})")
     for f, p in zip(fields, params):
-        if f in ("p0", "p1", "center"):
+        if f == "vertices":
+            try:
+                n = len(p)
+            except TypeError:
+                raise ModelError(f"{_who(what, None, idx)}: vertices={p!r} must be a list of "
+                                 "(x, y) pairs") from None
+            for k in range(n):
+                _vec2(what, None, idx, f"vertices[{k}]", p[k])
+        elif f in ("p0", "p1", "center"):
             _vec2(what, None, idx, f, p)
         elif f == "angle":
             _scalar(what, None, idx, f, p)
@@ -99,6 +112,8 @@ class ModelBuilder:
         self.terrain = terrain if terrain is not None else flat()
         self._bodies, self._pins, self._rods, self._contacts, self._acts = [], [], [], [], []
         self._shapes = []
+        self._collide = []          # colliding shapes: dicts (shape, body, core, radius, ...)
+        self._enabled_pairs = set()
         self._names = {"body": {}, "pin": {}, "rod": {}, "contact": {}, "actuator": {}}
 
     # naming ---------------------------------------------------------------------------------
@@ -127,7 +142,10 @@ class ModelBuilder:
     # bodies ---------------------------------------------------------------------------------
     def add_body(self, name, mass, inertia, pos=(0.0, 0.0), angle=0.0, vel=(0.0, 0.0), omega=0.0,
                  shapes=()) -> int:
-        """Rigid body: mass [kg] > 0, inertia about its COM [kg m^2] > 0, pose of its COM."""
+        """Rigid body: mass [kg] > 0, inertia about its COM [kg m^2] > 0, pose of its COM.
+        shapes: tuples (kind, *params) as add_shape takes them, each optionally ending with a
+        dict of add_shape's keywords, e.g. ``("box", (0, 0), 0.2, 0.1, {"mu": 0.5})``; they
+        collide unless that dict says ``"collide": False``."""
         idx = len(self._bodies)
         self._register("body", name, idx)
         mass = _scalar("body", name, idx, "mass", mass)
@@ -141,7 +159,9 @@ class ModelBuilder:
         v = np.r_[_vec2("body", name, idx, "vel", vel), _scalar("body", name, idx, "omega", omega)]
         self._bodies.append(dict(name=name, mass=mass, inertia=inertia, q=q, v=v, point=False))
         for s in shapes:
-            self.add_shape(idx, *s)
+            s = tuple(s)
+            options = s[-1] if s and isinstance(s[-1], dict) else {}
+            self.add_shape(idx, *(s[:-1] if options else s), **options)
         return idx
 
     def add_point_mass(self, name, mass, pos=(0.0, 0.0), vel=(0.0, 0.0), radius=None) -> int:
@@ -160,16 +180,68 @@ class ModelBuilder:
         self._shapes.append(M.Shape(idx, "circle", ((0.0, 0.0), r)))
         return idx
 
-    def add_shape(self, body, kind, *params):
-        """Drawing shape on a body: ('capsule', p0, p1, radius) | ('box', center, w, h[, angle])
-        | ('circle', center, radius); local frame, metres. Shapes do not collide. `body` is a
-        body id or name; radii must be >= 0, box sides > 0 (SHAPE_PARAMS, _check_shape)."""
+    def add_shape(self, body, kind, *params, collide=True, mu=1.0, restitution=0.0, category=1,
+                  mask=0xFFFF, name=None) -> int:
+        """A shape on a body (local frame [m]), or fixed in the world (body None: world
+        coordinates; steps, kerbs, walls): ('circle', center, radius) | ('capsule', p0, p1,
+        radius) | ('box', center, width, height[, angle]) | ('polygon', [(x, y), ...]) (convex,
+        either winding). Returns the shape's id.
+
+        It collides with the ground and with other bodies' shapes unless collide=False (then
+        it is only drawn). mu: its friction coefficient (a pair uses sqrt(mu_a mu_b), the
+        ground the shape's mu); restitution in [0, 1] (a pair uses the larger, default 0: a
+        plastic impact; a disk dropped with e rebounds to e^2 of its height). category and
+        mask: filter bits (a pair collides when each one's category meets the other's mask).
+        Bodies of one mechanism (linked by pins or rods) do not collide with each other
+        unless enable_collision names the pair."""
         if kind not in SHAPE_PARAMS:
-            raise ModelError(f"shape on body {body}: kind={kind!r} must be capsule, box or circle")
+            raise ModelError(f"shape on body {body}: kind={kind!r} must be one of "
+                             f"{', '.join(SHAPE_PARAMS)}")
         idx = len(self._shapes)
-        bid = self._body_id(f"{kind} shape", None, idx, "body", body)
+        what = f"{kind} shape" if name is None else f"{kind} shape {name!r}"
+        bid = self._body_id(what, None, idx, "body", body, allow_world=body is None)
         _check_shape(kind, idx, params)
+        if not isinstance(collide, (bool, np.bool_)):
+            raise ModelError(f"{_who(what, None, idx)}: collide={collide!r} must be True or False")
+        if bid < 0 and not collide:
+            raise ModelError(f"{_who(what, None, idx)}: a world shape (body None) must collide")
+        if collide:
+            self._collide.append(self._collision_shape(idx, what, bid, kind, params, mu,
+                                                       restitution, category, mask, name))
         self._shapes.append(M.Shape(bid, kind, tuple(params)))
+        return idx
+
+    def _collision_shape(self, idx, what, bid, kind, params, mu, restitution, category, mask, name):
+        """The record compile() turns into shape_* arrays and contacts (validated here)."""
+        if name is not None and (not isinstance(name, str) or not name):
+            raise ModelError(f"{_who(what, None, idx)}: name={name!r} must be a non-empty string")
+        if bid >= 0 and self._bodies[bid]["point"]:
+            raise ModelError(f"{_who(what, None, idx)}: body {self._bodies[bid]['name']!r} is a point "
+                             "mass; give a colliding shape a rigid body (add_body), or use "
+                             "add_point_contact")
+        mu = _scalar(what, None, idx, "mu", mu)
+        if mu < 0:
+            raise ModelError(f"{_who(what, None, idx)}: mu={mu} must be >= 0")
+        e = _scalar(what, None, idx, "restitution", restitution)
+        if not 0.0 <= e <= 1.0:
+            raise ModelError(f"{_who(what, None, idx)}: restitution={e} must be in [0, 1]")
+        for field, bits in (("category", category), ("mask", mask)):
+            if isinstance(bits, (bool, np.bool_)) or not isinstance(bits, (int, np.integer)) or bits < 0:
+                raise ModelError(f"{_who(what, None, idx)}: {field}={bits!r} must be a non-negative "
+                                 "integer (bits)")
+        core, radius = collision_core(kind, params, idx, name)
+        label = name or f"{self._bodies[bid]['name'] if bid >= 0 else 'world'}.{kind}{idx}"
+        return dict(shape=idx, body=bid, kind=kind, core=core, radius=radius, mu=mu,
+                    restitution=e, category=int(category), mask=int(mask), label=label)
+
+    def enable_collision(self, body_a, body_b):
+        """Let two bodies of one mechanism (linked by pins or rods, which keeps them apart by
+        default) collide: their colliding shapes then touch each other."""
+        a = self._body_id("collision pair", None, 0, "body_a", body_a)
+        b = self._body_id("collision pair", None, 0, "body_b", body_b)
+        if a == b:
+            raise ModelError(f"collision pair: body_a and body_b are the same ({a})")
+        self._enabled_pairs.add(frozenset((a, b)))
 
     # world <-> local ------------------------------------------------------------------------
     def _local(self, body, p_world):
@@ -279,7 +351,8 @@ class ModelBuilder:
             raise ModelError(f"contact {name!r} ({idx}): a point mass can only carry a point contact at (0, 0)")
         self._contacts.append(dict(name=name, body=bid, kind=kind, local=local, radius=radius,
                                    span=span, mu=mu, verts=verts,
-                                   ccd=1 if point else 0))
+                                   ccd=1 if point else 0, other=-1, pair=(-1, -1, -1),
+                                   restitution=0.0))
         return idx
 
     def add_point_contact(self, name, body, local=(0.0, 0.0), mu=1.0) -> int:
@@ -322,7 +395,8 @@ class ModelBuilder:
             lx, ly = 0.5 * width * sx, 0.5 * height * sy
             ids.append(self.add_point_contact(f"{name}/{i}", body,
                                               (c[0] + ca * lx - sa * ly, c[1] + sa * lx + ca * ly), mu))
-        self.add_shape(self._contacts[ids[0]]["body"], "box", tuple(c), width, height, angle)
+        self.add_shape(self._contacts[ids[0]]["body"], "box", tuple(c), width, height, angle,
+                       collide=False)   # drawn: its corners are the contacts
         return ids
 
     # actuators ------------------------------------------------------------------------------
@@ -386,6 +460,69 @@ class ModelBuilder:
         bid = self._body_id("actuator", name, idx, "body", body)
         return self._act(name, M.ACT_BODY_TORQUE, (bid, -1, -1), limit=limit)
 
+    # colliding shapes -> contacts ------------------------------------------------------------
+    def _shape_contacts(self):
+        """The contacts of the colliding shapes (compile adds them after the user's): a
+        polygon's corners and a circle's or capsule's end circles against the ground, and two
+        slots (a face on a face touches at two points) for every pair of shapes that may touch
+        (shapes.collision_pairs), ordered by the later of their bodies (the rows' order)."""
+        out = []
+
+        def contact(name, body, kind, local=(0.0, 0.0), radius=0.0, span=(0.0, 0.0), mu=1.0,
+                    other=-1, pair=(-1, -1, -1), restitution=0.0):
+            return dict(name=name, body=body, kind=kind, local=np.asarray(local, float),
+                        radius=radius, span=span, mu=mu, verts=[], ccd=0, other=other, pair=pair,
+                        restitution=restitution)
+
+        for sh in self._collide:
+            if sh["body"] < 0:
+                continue        # world shapes meet bodies, not the ground
+            common = dict(mu=sh["mu"], restitution=sh["restitution"])
+            if sh["kind"] in ("box", "polygon"):
+                for k, v in enumerate(sh["core"]):
+                    out.append(contact(f"{sh['label']}/ground{k}", sh["body"], CONTACT_POINT, v,
+                                       **common))
+            else:
+                for k, v in enumerate(sh["core"]):
+                    out.append(contact(f"{sh['label']}/ground{k}", sh["body"], CONTACT_ARC, v,
+                                       sh["radius"], (-math.pi, math.pi), **common))
+        joints = [p["body"] for p in self._pins] + [r["body"] for r in self._rods]
+        for i, j in collision_pairs(self._collide, len(self._bodies), joints, self._enabled_pairs):
+            if self._collide[i]["body"] < 0:
+                i, j = j, i     # the world's shape second: contact_body is always a body
+            a, b = self._collide[i], self._collide[j]
+            for k in range(2):
+                out.append(contact(f"{a['label']}|{b['label']}/{k}", a["body"], CONTACT_PAIR,
+                                   radius=a["radius"] + b["radius"],
+                                   mu=math.sqrt(a["mu"] * b["mu"]), other=b["body"],
+                                   pair=(i, j, k),
+                                   restitution=max(a["restitution"], b["restitution"])))
+        out.sort(key=lambda c: max(c["body"], c["other"]))   # stable: a pair's slots stay together
+        names = {c["name"] for c in self._contacts}
+        for c in out:
+            if c["name"] in names:
+                raise ModelError(f"contact {c['name']!r}: a shape's contact has the name of a "
+                                 "contact added before; rename the shape (name=...)")
+            names.add(c["name"])
+        return out
+
+    def _shape_arrays(self, ro):
+        """shape_* arrays of the colliding shapes (kernels/collide.py: a core and a radius)."""
+        cores = [sh["core"] for sh in self._collide]
+        adr = np.cumsum([0] + [len(c) for c in cores])[:-1]
+        core = np.concatenate(cores) if cores else np.zeros((0, 2))
+        norm = np.concatenate([core_normals(c) for c in cores]) if cores else np.zeros((0, 2))
+        ns = len(cores)
+        return dict(
+            shape_body=ro([sh["body"] for sh in self._collide], np.int64).reshape(ns),
+            shape_vert_adr=ro(adr, np.int64).reshape(ns),
+            shape_vert_num=ro([len(c) for c in cores], np.int64).reshape(ns),
+            shape_radius=ro([sh["radius"] for sh in self._collide]).reshape(ns),
+            shape_bound=ro([bounding_circle(sh["core"], sh["radius"]) for sh in self._collide]
+                           or np.zeros((0, 3))).reshape(ns, 3),
+            core_vert=ro(core).reshape(len(core), 2),
+            core_norm=ro(norm).reshape(len(core), 2))
+
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:
         """Validate and freeze into a Model."""
@@ -405,7 +542,8 @@ class ModelBuilder:
             raise ModelError(f"model: terrain={self.terrain!r} must be a planarsim.terrain.Terrain")
         if not self._bodies:
             raise ModelError("model: no bodies; add at least one with add_body or add_point_mass")
-        nb, npin, nr, nc, na = (len(x) for x in (self._bodies, self._pins, self._rods, self._contacts, self._acts))
+        contacts = self._contacts + self._shape_contacts()
+        nb, npin, nr, nc, na = (len(x) for x in (self._bodies, self._pins, self._rods, contacts, self._acts))
 
         def ro(a, dtype=np.float64):
             a = np.ascontiguousarray(np.asarray(a, dtype=dtype))
@@ -416,7 +554,7 @@ class ModelBuilder:
         inertia = np.array([b["inertia"] for b in self._bodies])
         inv_inertia = np.where(inertia > 0, 1.0 / np.where(inertia > 0, inertia, 1.0), 0.0)
         verts, vadr, vnum = [], [], []
-        for c in self._contacts:
+        for c in contacts:
             vadr.append(len(verts))
             vnum.append(len(c["verts"]))
             verts.extend(c["verts"])
@@ -434,15 +572,18 @@ class ModelBuilder:
             rod_body=ro([r["body"] for r in self._rods] or np.zeros((0, 2)), np.int64).reshape(nr, 2),
             rod_anchor=ro([r["anchor"] for r in self._rods] or np.zeros((0, 2, 2))).reshape(nr, 2, 2),
             rod_length=ro([r["length"] for r in self._rods]).reshape(nr),
-            contact_body=ro([c["body"] for c in self._contacts], np.int64).reshape(nc),
-            contact_kind=ro([c["kind"] for c in self._contacts], np.int64).reshape(nc),
-            contact_local=ro([c["local"] for c in self._contacts] or np.zeros((0, 2))).reshape(nc, 2),
-            contact_radius=ro([c["radius"] for c in self._contacts]).reshape(nc),
-            contact_span=ro([c["span"] for c in self._contacts] or np.zeros((0, 2))).reshape(nc, 2),
-            contact_mu=ro([c["mu"] for c in self._contacts]).reshape(nc),
-            contact_ccd=ro([c["ccd"] for c in self._contacts], np.int64).reshape(nc),
+            contact_body=ro([c["body"] for c in contacts], np.int64).reshape(nc),
+            contact_kind=ro([c["kind"] for c in contacts], np.int64).reshape(nc),
+            contact_local=ro([c["local"] for c in contacts] or np.zeros((0, 2))).reshape(nc, 2),
+            contact_radius=ro([c["radius"] for c in contacts]).reshape(nc),
+            contact_span=ro([c["span"] for c in contacts] or np.zeros((0, 2))).reshape(nc, 2),
+            contact_mu=ro([c["mu"] for c in contacts]).reshape(nc),
+            contact_ccd=ro([c["ccd"] for c in contacts], np.int64).reshape(nc),
             contact_vert_adr=ro(vadr, np.int64).reshape(nc),
             contact_vert_num=ro(vnum, np.int64).reshape(nc),
+            contact_other=ro([c["other"] for c in contacts], np.int64).reshape(nc),
+            contact_pair=ro([c["pair"] for c in contacts] or np.zeros((0, 3)), np.int64).reshape(nc, 3),
+            contact_restitution=ro([c["restitution"] for c in contacts]).reshape(nc),
             vert_local=ro(verts or np.zeros((0, 2))).reshape(len(verts), 2),
             act_kind=ro([a["kind"] for a in self._acts], np.int64).reshape(na),
             act_body=ro([a["bodies"] for a in self._acts] or np.zeros((0, 3)), np.int64).reshape(na, 3),
@@ -451,6 +592,7 @@ class ModelBuilder:
             act_dir=ro([a["dir"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
             act_range=ro([a["limit"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
             terrain_coef=ro(self.terrain.coef),
+            **self._shape_arrays(ro),
         )
         q0 = np.array([b["q"] for b in self._bodies])
         v0 = np.array([b["v"] for b in self._bodies])
@@ -460,6 +602,6 @@ class ModelBuilder:
                        body_names=tuple(b["name"] for b in self._bodies),
                        pin_names=tuple(p["name"] for p in self._pins),
                        rod_names=tuple(r["name"] for r in self._rods),
-                       contact_names=tuple(c["name"] for c in self._contacts),
+                       contact_names=tuple(c["name"] for c in contacts),
                        act_names=tuple(a["name"] for a in self._acts),
                        q0=q0, v0=v0, shapes=tuple(self._shapes), terrain=self.terrain, meta=dict(meta))

@@ -58,6 +58,7 @@ _CHILDREN = {
     "geom": set(),
 }
 DEFAULT_DENSITY = 1000.0  # [kg/m^3] MuJoCo's default geom density
+DRAWN = {"collide": False}  # add_shape's options for a geom that is only drawn
 
 
 @dataclass
@@ -368,12 +369,14 @@ class _Loader:
             rb.inertia = float(sum(p[2] for p in rb.parts) + (m * d2).sum())
             shapes = []
             for _, c, _, s in rb.parts:
+                # drawn only: the model touches the ground through its own contact points
                 if s[0] == "circle":
-                    shapes.append(("circle", tuple(c - rb.com), s[1]))
+                    shapes.append(("circle", tuple(c - rb.com), s[1], DRAWN))
                 elif s[0] == "box":
-                    shapes.append(("box", tuple(c - rb.com), s[1], s[2]))
+                    shapes.append(("box", tuple(c - rb.com), s[1], s[2], DRAWN))
                 else:
-                    shapes.append(("capsule", tuple(s[1] - rb.com), tuple(s[2] - rb.com), s[3]))
+                    shapes.append(("capsule", tuple(s[1] - rb.com), tuple(s[2] - rb.com), s[3],
+                                   DRAWN))
             ids.append(builder.add_body(rb.name, mass=rb.mass, inertia=rb.inertia,
                                         pos=tuple(rb.com), shapes=shapes))
         pins = {}

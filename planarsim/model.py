@@ -48,6 +48,11 @@ class ModelArrays(NamedTuple):
     contact_ccd: np.ndarray         # (n_contact,) 1: continuous collision (point on point mass)
     contact_vert_adr: np.ndarray    # (n_contact,) first fallback vertex (heel, toe, ...)
     contact_vert_num: np.ndarray    # (n_contact,) number of fallback vertices
+    contact_other: np.ndarray       # (n_contact,) int the second body of a shape pair (-1: the
+                                    #   world's shape; -1 for every contact with the ground)
+    contact_pair: np.ndarray        # (n_contact, 3) int a pair's shapes (a on contact_body, b on
+                                    #   contact_other) and its slot 0 | 1; -1 for ground contacts
+    contact_restitution: np.ndarray  # (n_contact,) coefficient of restitution [-] (0: plastic)
     vert_local: np.ndarray          # (n_vert, 2) fallback vertices in the body frame [m]
     act_kind: np.ndarray            # (n_act,) ACT_* kind
     act_body: np.ndarray            # (n_act, 3) int bodies (a, b, c) as the kind needs; -1 unused
@@ -56,11 +61,19 @@ class ModelArrays(NamedTuple):
     act_dir: np.ndarray             # (n_act, 2) world direction for ACT_BODY_FORCE
     act_range: np.ndarray           # (n_act, 2) saturation [min, max] [N or N m]
     terrain_coef: np.ndarray        # (3 + 3K,) see kernels/terrain.py
+    shape_body: np.ndarray          # (n_shape,) int body of each colliding shape (-1: the world)
+    shape_vert_adr: np.ndarray      # (n_shape,) int first core vertex (planarsim/shapes.py)
+    shape_vert_num: np.ndarray      # (n_shape,) int core vertices: 1 circle, 2 capsule, >= 3 polygon
+    shape_radius: np.ndarray        # (n_shape,) radius around the core [m]
+    shape_bound: np.ndarray         # (n_shape, 3) bounding circle: centre (local) and radius [m]
+    core_vert: np.ndarray           # (n_core, 2) core vertices in the shape's frame [m]
+    core_norm: np.ndarray           # (n_core, 2) outward unit normal of the edge from each vertex
 
 
 @dataclass(frozen=True)
 class Shape:
-    """Drawing geometry fixed to a body (local frame, metres). kind: capsule | box | circle | arc."""
+    """Drawing geometry fixed to a body (local frame, metres; body -1: the world, world
+    coordinates). kind: capsule | box | circle | polygon | arc."""
     body: int
     kind: str
     params: tuple
@@ -92,6 +105,8 @@ class Model:
     def n_contact(self): return len(self.contact_names)
     @property
     def n_act(self): return len(self.act_names)
+    @property
+    def n_shape(self): return int(self.arrays.shape_body.shape[0])
     @property
     def dt(self): return self.arrays.dt
     @property

@@ -30,6 +30,9 @@ class State(NamedTuple):
     last_rod_impulse : (n_rod,) [N s]     of the last step; the next step's solve starts from
                                           them (kernels/warm_start.py): a closed loop whose
                                           load split is not unique keeps the last one
+    contact_feature : (n_contact,) int    the features a shape pair's slot touched with in the
+                                          last step (-1: none; kernels/pair.py): a slot keeps its
+                                          mode and impulse while they stay the same
     """
     q: np.ndarray
     v: np.ndarray
@@ -44,6 +47,7 @@ class State(NamedTuple):
     last_contact_impulse: np.ndarray
     last_pin_impulse: np.ndarray
     last_rod_impulse: np.ndarray
+    contact_feature: np.ndarray
 
     @property
     def t(self) -> float:
@@ -69,7 +73,7 @@ STATE_DIMS = dict(  # shape of each State array; strings are the model's sizes
     q=("n_body", 3), v=("n_body", 3), time=(1,), step=(1,), contact_mode=("n_contact",),
     contact_slip=("n_contact",), contact_enabled=("n_contact",), limit_active=("n_pin", 2),
     mode_cursor=(1,), ext_force=("n_body", 3), last_contact_impulse=("n_contact", 2),
-    last_pin_impulse=("n_pin", 4), last_rod_impulse=("n_rod",))
+    last_pin_impulse=("n_pin", 4), last_rod_impulse=("n_rod",), contact_feature=("n_contact",))
 
 # fields holding codes, not quantities: the values each may take and the rule's words
 _STATE_CODES = dict(
@@ -82,7 +86,7 @@ _STATE_CODES = dict(
 _STATE_ELEMENT = dict(q="body", v="body", ext_force="body", contact_mode="contact",
                       contact_slip="contact", contact_enabled="contact",
                       last_contact_impulse="contact", limit_active="pin", last_pin_impulse="pin",
-                      last_rod_impulse="rod")
+                      last_rod_impulse="rod", contact_feature="contact")
 
 
 def check_shapes(arrays, dims, what, sizes=None) -> dict:
@@ -118,6 +122,8 @@ def check_state(state, model: Model | None = None, what: str = "state") -> None:
     rules = {name: (lambda a, v=values: np.isin(a, v), words)
              for name, (values, words) in _STATE_CODES.items()}
     rules["step"] = (lambda a: (a >= 0) & (a == np.floor(a)), "must be an integer >= 0")
+    rules["contact_feature"] = (lambda a: (a >= -1) & (a == np.floor(a)),
+                                "must be an integer >= -1")
     rules["mode_cursor"] = (lambda a: (a >= 0) & (a < max(nc, 1)) & (a == np.floor(a)),
                             f"must be in 0..{nc - 1}" if nc else "must be 0 (no contacts)")
     for name, a in arrays.items():
@@ -148,7 +154,8 @@ def make_state(model: Model, q=None, v=None) -> State:
                  contact_enabled=np.ones(nc, np.int64), limit_active=np.zeros((npin, 2), np.int64),
                  mode_cursor=np.zeros(1, np.int64), ext_force=np.zeros((nb, 3)),
                  last_contact_impulse=np.zeros((nc, 2)), last_pin_impulse=np.zeros((npin, 4)),
-                 last_rod_impulse=np.zeros(model.n_rod))
+                 last_rod_impulse=np.zeros(model.n_rod),
+                 contact_feature=np.full(nc, -1, np.int64))
 
 
 class Workspace(NamedTuple):
@@ -191,6 +198,19 @@ class Workspace(NamedTuple):
     contact_held: np.ndarray     # (n_contact,) int 1 if the position correction held its normal row
     contact_on_arc: np.ndarray   # (n_contact,) int 1: the contact lies on a circular sole
     contact_new: np.ndarray      # (n_contact,) int 1: engaged during this step
+    contact_bodies: np.ndarray   # (n_contact, 2) int the contact's reference body (-1: the
+                                 #   ground or the world) and the body carrying its material
+                                 #   point (a shape pair's roles change with its features)
+    contact_dist: np.ndarray     # (n_contact,) int 1: a shape pair's gap is a distance between
+                                 #   two core points (vertex on vertex), 0: from a face
+    contact_face: np.ndarray     # (n_contact, 4) a pair's reference face in its body's frame:
+                                 #   unit normal, and a point on the face's core line (or the
+                                 #   core vertex where contact_dist) [m]
+    contact_refpt: np.ndarray    # (n_contact, 2) the reference body's material point where the
+                                 #   contact touched at the step's start (its frame) [m]
+    contact_radii: np.ndarray    # (n_contact, 2) radius of the reference and the other shape [m]
+    contact_bounce: np.ndarray   # (n_contact,) normal velocity restitution asks for [m/s]
+    manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/collide.py)
     row_body: np.ndarray         # (R, 2) int
     row_J: np.ndarray            # (R, 2, 3)
     row_F: np.ndarray            # (R, 2, 3)
@@ -267,7 +287,14 @@ def make_workspace(model: Model) -> Workspace:
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_stale=z(nc, np.int64),
                      contact_found=np.full((nc, 4), -np.inf), contact_anchor=z((nc, 2)),
                      contact_impulse=z((nc, 2)), contact_held=z(nc, np.int64), contact_on_arc=z(nc, np.int64),
-                     contact_new=z(nc, np.int64), row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
+                     contact_new=z(nc, np.int64),
+                     contact_bodies=np.stack([np.full(nc, -1, np.int64),
+                                              np.asarray(model.arrays.contact_body, np.int64)],
+                                             axis=1).reshape(nc, 2).copy(),
+                     contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
+                     contact_refpt=z((nc, 2)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
+                     manifold=z((2, 10)),
+                     row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R), act_u=z(na), act_power=z(na),

@@ -15,7 +15,7 @@ def make_chain(n_links=4, length=0.5, mass=1.0, dt=1e-3, gravity=(0.0, -9.81), l
     for i in range(n_links):
         body = b.add_body(f"link{i}", mass=mass, inertia=mass * length ** 2 / 12,
                           pos=((i + 0.5) * length, 0.0),
-                          shapes=[("capsule", (-length / 2, 0.0), (length / 2, 0.0), 0.02)])
+                          shapes=[("capsule", (-length / 2, 0.0), (length / 2, 0.0), 0.02, {"collide": False})])
         b.add_pin(f"pin{i}", prev, body, anchor_world=(i * length, 0.0),
                   limit=limit if i > 0 else None)
         prev = body

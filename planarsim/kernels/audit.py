@@ -3,12 +3,15 @@
 After the velocity stage (impulses as applied):
   pull      a contact's normal impulse pulls (lambda_n < 0)
   cone      friction outside its cone (|lambda_t| > mu lambda_n)
+            (both beyond rounding: IMPULSE_REL_TOL of the contact's own impulse plus
+            IMPULSE_FLOOR of the step's largest)
   work      a contact's impulse does positive work at the step's end velocity
             (lambda_n v_n + lambda_t v_t > 0: it would add energy) beyond rounding: more
             than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR)
 After the position stage (the configuration the step ends at):
   pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
-  depth     a contact point below the ground by more than DEPTH_TOL
+  depth     a contact point below the ground, or two shapes overlapping, by more than
+            DEPTH_TOL
 And of the solver itself:
   fallback  the complementarity solve with friction found no answer and the frictionless
             rule was used (it can only remove energy)
@@ -22,10 +25,10 @@ import math
 
 from ._jit import kernel
 from .info import INFO_CCD_SPLITS
-from .codes import CONTACT_POINT
-from .contacts import point_reach, sole_facing
+from .codes import CONTACT_PAIR, CONTACT_POINT
+from .contacts import contact_velocity, point_reach, sole_facing
 from .math2d import world_point
-from .modes import contact_velocity
+from .pair import pair_gap_now
 from .rows import ROW_CONTACT_N
 from .terrain import ground_point
 
@@ -43,6 +46,10 @@ PIN_GAP_TOL = 1e-9       # [m]
 DEPTH_TOL = 1e-8         # [m]
 # impulses and work are judged relative to their own size (rounding of the solve)
 IMPULSE_REL_TOL = 1e-8
+# ... and an impulse below this share of the step's largest contact impulse is rounding: a
+# statically indeterminate contact (a box resting on two boxes) carries none, and the solve
+# leaves it about 1e-16 of the load, of either sign
+IMPULSE_FLOOR = 1e-10
 WORK_REL_TOL = 1e-7      # the accuracy the complementarity solve accepts (lcp.ANSWER_TOL)
 # [m/s] a contact velocity this small is the solve's rounding, not motion: it moves a point by
 # 1e-8 h m in a step, a hundredth of DEPTH_TOL or less (h <= 1e-2 s), below what the position
@@ -77,6 +84,10 @@ def audit_impulses(m, s, ws):
     ws.contact_impulse and the constrained velocity ws.v_new. Returns the violations found."""
     found = 0
     step = s.step[0]
+    largest = 0.0
+    for i in range(m.contact_body.shape[0]):
+        largest = max(largest, abs(ws.contact_impulse[i, 0]))
+    floor = IMPULSE_FLOOR * largest
     for i in range(m.contact_body.shape[0]):
         ln = ws.contact_impulse[i, 0]
         lt = ws.contact_impulse[i, 1]
@@ -84,14 +95,15 @@ def audit_impulses(m, s, ws):
             continue
         size = abs(ln) + abs(lt)
         b = m.contact_body[i]
-        if ln < -IMPULSE_REL_TOL * size:
+        if ln < -(IMPULSE_REL_TOL * size + floor):
             note(ws, step, AUDIT_PULL, i, b, ln)
             found += 1
-        if abs(lt) > m.contact_mu[i] * ln + IMPULSE_REL_TOL * size:
+        if abs(lt) > m.contact_mu[i] * ln + IMPULSE_REL_TOL * size + floor:
             note(ws, step, AUDIT_CONE, i, b, abs(lt) - m.contact_mu[i] * ln)
             found += 1
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
-        work = ln * vn + lt * vt
+        # restitution's rebound (at most e times the approach speed) is work it may do
+        work = ln * (vn - ws.contact_bounce[i]) + lt * vt
         scale = WORK_REL_TOL * (abs(vn) + abs(vt)) + VELOCITY_FLOOR
         if work > size * scale:
             # the tolerance also scales with the free motion's speed (computed only here)
@@ -154,6 +166,15 @@ def contact_gap(m, q, cs, i):
 
 
 @kernel
+def contact_depth(m, s, ws, i):
+    """How far [m] contact i is below the ground, or a shape pair's shapes overlap, at s.q
+    (ws.body_cs current); negative: clear by that much."""
+    if m.contact_kind[i] == CONTACT_PAIR:
+        return -pair_gap_now(m, s.q, ws.body_cs, ws, i)
+    return -contact_gap(m, s.q, ws.body_cs, i)
+
+
+@kernel
 def surely_clear(m, s, ws, i):
     """Point contact i cannot be below the ground at s.q: its gap at the start of the step
     (ws.contact_gap, found at ws.prev.q or a lower bound of it; no time-of-impact split)
@@ -193,6 +214,8 @@ def held_row_is_depth(m, ws, i):
     Flat or sloped ground (rows_held implies it)."""
     if m.contact_kind[i] == CONTACT_POINT:
         return True
+    if m.contact_kind[i] == CONTACT_PAIR:
+        return False    # other features of the pair may touch: measured afresh
     return ws.contact_on_arc[i] == 1 and vertices_within_arc(m, i)
 
 
@@ -236,7 +259,7 @@ def worst_violation(m, s, ws, bounded, rows_held):
     depth = 0.0
     for i in range(m.contact_body.shape[0]):
         if not depth_known(m, s, ws, i, bounded, rows_held):
-            depth = max(depth, -contact_gap(m, s.q, ws.body_cs, i))
+            depth = max(depth, contact_depth(m, s, ws, i))
     return gap, depth
 
 
@@ -269,7 +292,7 @@ def audit_positions(m, s, ws, step):
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:
             continue
-        d = -contact_gap(m, s.q, ws.body_cs, i)
+        d = contact_depth(m, s, ws, i)
         if d > DEPTH_TOL:
             note(ws, step, AUDIT_DEPTH, i, m.contact_body[i], d)
             found += 1

@@ -20,8 +20,9 @@ dq / h (as the Newton correction does); contact corrections move positions only.
 from ._jit import kernel, kernel_call
 from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
-from .codes import MODE_FREE, MODE_PINNED
+from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
 from .contacts import query_contact
+from .pair import find_pair
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, is_joint_row, solve_mixed_lcp
@@ -109,7 +110,7 @@ PROJECTION_MARGIN = 1e-6
 
 
 @kernel
-def _projection_rows(m, s, ws):
+def _projection_rows(m, s, ws, h):
     """Rows at the current configuration for the position projection: every joint, active
     limits, the normal row of every enabled contact closer to the ground than the margin
     (contact points found again here). Returns the number of rows."""
@@ -126,9 +127,14 @@ def _projection_rows(m, s, ws):
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:
             continue
-        query_contact(m, s.q, ws, i)
+        if m.contact_kind[i] == CONTACT_PAIR:
+            if m.contact_pair[i, 2] == 0:
+                # the features touching now (modes left as they are)
+                find_pair(m, s, ws, i, h, PROJECTION_MARGIN, True)
+        else:
+            query_contact(m, s.q, ws, i)
         if ws.contact_gap[i] < PROJECTION_MARGIN:
-            n = add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
+            n = add_row(ws, n, ROW_CONTACT_N, i, ws.contact_bodies[i, 0], ws.contact_bodies[i, 1])
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     return n
@@ -152,7 +158,7 @@ def project_positions(m, s, ws, h, iters, tol):
     the module's docstring). Returns the largest remaining error [m or rad]."""
     worst = 0.0
     for it in range(iters + 1):
-        n = _projection_rows(m, s, ws)
+        n = _projection_rows(m, s, ws, h)
         worst = _largest_error(ws, n)
         if worst <= tol or it == iters:
             break

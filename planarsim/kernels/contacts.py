@@ -21,7 +21,9 @@ from ._jit import kernel, kernel_call
 from .math2d import rotate, world_point
 from .terrain import ground_point
 
-from .codes import CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
+from .codes import CONTACT_PAIR, CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
+from .forces import point_velocity
+from .pair import find_pair
 
 
 @kernel
@@ -173,17 +175,74 @@ def engage_contact(m, s, ws, i, vn, vt):
     else:
         s.contact_mode[i] = MODE_PINNED
     ws.contact_new[i] = 1
+    ws.contact_bounce[i] = bounce_of(m, s, ws, i)
+
+
+# [m/s] restitution acts on impacts faster than this (slower ones are plastic: a body coming
+# to rest does not bounce forever in ever smaller hops)
+BOUNCE_SPEED = 1e-3
 
 
 @kernel
-def find_contacts(m, s, ws):
+def contact_velocity(m, s, ws, i, vel):
+    """Normal and tangential velocity [m/s] of contact i's material point under `vel`
+    (relative to the other body's coincident point for a shape pair)."""
+    a = ws.contact_bodies[i, 0]
+    b = ws.contact_bodies[i, 1]
+    if m.contact_kind[i] == CONTACT_PAIR:
+        px = ws.contact_point[i, 0]
+        py = ws.contact_point[i, 1]
+    else:
+        px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[i, 0], ws.contact_anchor[i, 1])
+    vx, vy = point_velocity(s.q, vel, b, px, py)
+    ux, uy = point_velocity(s.q, vel, a, px, py)
+    vx -= ux
+    vy -= uy
+    nx = ws.contact_normal[i, 0]
+    ny = ws.contact_normal[i, 1]
+    return nx * vx + ny * vy, ny * vx - nx * vy
+
+
+@kernel
+def pair_motion_scale(s, ws, i, vel):
+    """|v_b(p)| + |v_a(p)| (L1) [m/s] of a pair contact's two bodies at its point under vel:
+    the scale of the rounding in its relative velocity (both bodies may move together, their
+    relative motion then being rounding alone)."""
+    px = ws.contact_point[i, 0]
+    py = ws.contact_point[i, 1]
+    vx, vy = point_velocity(s.q, vel, ws.contact_bodies[i, 1], px, py)
+    ux, uy = point_velocity(s.q, vel, ws.contact_bodies[i, 0], px, py)
+    return abs(vx) + abs(vy) + abs(ux) + abs(uy)
+
+
+@kernel
+def bounce_of(m, s, ws, i):
+    """The normal velocity [m/s] restitution asks of contact i after an impact: e times its
+    approach speed at the step's start, 0 below BOUNCE_SPEED."""
+    e = m.contact_restitution[i]
+    if e == 0.0:
+        return 0.0
+    vn, vt = contact_velocity(m, s, ws, i, s.v)
+    return e * -vn if -vn > BOUNCE_SPEED else 0.0
+
+
+@kernel
+def find_contacts(m, s, ws, h):
     """Stage 3 for every contact (a free point contact surely clear of the ground is left
-    unqueried: see the module's docstring); a disabled contact is forced free. A contact that a
-    time-of-impact split brought into touch (contact_new == 2) is engaged here, where its
-    ground normal is known."""
+    unqueried: see the module's docstring; a shape pair's two slots by kernels/pair.py); a
+    disabled contact is forced free. A contact that a time-of-impact split brought into touch
+    (contact_new == 2) is engaged here, where its ground normal is known."""
     # on flat or sloped ground a query costs no more than the bound that would spare it
     lazy = m.terrain_coef[2] != 0.0
     for i in range(m.contact_body.shape[0]):
+        if m.contact_kind[i] == CONTACT_PAIR:
+            if m.contact_pair[i, 2] == 0:
+                find_pair(m, s, ws, i, h, 0.0, False)
+            if s.contact_enabled[i] == 0:
+                s.contact_mode[i] = MODE_FREE
+            else:
+                ws.contact_bounce[i] = bounce_of(m, s, ws, i)
+            continue
         if (lazy and s.contact_mode[i] == MODE_FREE and s.contact_enabled[i] == 1
                 and ws.contact_new[i] == 0 and _stays_clear(m, s.q, ws, i)):
             continue
@@ -197,3 +256,5 @@ def find_contacts(m, s, ws):
             nx = ws.contact_normal[i, 0]
             ny = ws.contact_normal[i, 1]
             engage_contact(m, s, ws, i, nx * vx + ny * vy, ny * vx - nx * vy)
+        else:
+            ws.contact_bounce[i] = bounce_of(m, s, ws, i)

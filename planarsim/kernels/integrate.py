@@ -17,7 +17,7 @@ find nothing to do (bodies at rest or translating), so the step skips it exactly
 import math
 
 from ._jit import kernel, kernel_call, kernel_inline
-from .codes import MODE_FREE, MODE_PINNED
+from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
 from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
@@ -52,7 +52,8 @@ def keep_correction_rows(s, ws):
     """Keep the rows the Newton correction holds: joints, active limits, the normal row of
     every touching contact and the tangent row of every sticking one (a sticking foot does
     not creep along the ground while the correction closes the joints). Rows of contacts the
-    solve set free, and the tangent rows of sliding ones, are dropped. Returns how many were
+    solve set free or that rebound (restitution), and the tangent rows of sliding ones, are
+    dropped. Returns how many were
     dropped."""
     k = 0
     for r in range(ws.n_row[0]):
@@ -62,6 +63,8 @@ def keep_correction_rows(s, ws):
             continue
         if kind == ROW_CONTACT_N and s.contact_mode[o] == MODE_FREE:
             continue
+        if (kind == ROW_CONTACT_N or kind == ROW_CONTACT_T) and ws.contact_bounce[o] > 0.0:
+            continue    # rebounding (restitution): it leaves the surface, not held to it
         if (kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI) and s.limit_active[o, kind - ROW_LIMIT_LO] == 0:
             continue
         if k != r:
@@ -144,6 +147,8 @@ def _lever(m, ws, r, e):
     kind = ws.row_kind[r]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
         return abs(m.pin_anchor[o, e, 0]) + abs(m.pin_anchor[o, e, 1])
+    if (kind == ROW_CONTACT_N or kind == ROW_CONTACT_T) and m.contact_kind[o] == CONTACT_PAIR:
+        return math.inf     # a face turning with its body: not linear in the points
     if kind == ROW_CONTACT_N and ws.contact_on_arc[o] == 1:
         return abs(m.contact_local[o, 0]) + abs(m.contact_local[o, 1])
     if kind == ROW_CONTACT_N or kind == ROW_CONTACT_T:

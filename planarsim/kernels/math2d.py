@@ -38,3 +38,17 @@ def world_point(q, cs, body, lx, ly):
         return lx, ly
     rx, ry = rotate(cs[body, 0], cs[body, 1], lx, ly)
     return q[body, 0] + rx, q[body, 1] + ry
+
+
+@kernel
+def set_dir(q, body, px, py, dx, dy, sign, out):
+    """out = sign * (dx, dy, (p - x_body) x d): the Jacobian block of a row along the unit
+    direction d at world point p of `body` (zeros for the world, body < 0)."""
+    if body < 0:
+        out[0] = 0.0
+        out[1] = 0.0
+        out[2] = 0.0
+        return
+    out[0] = sign * dx
+    out[1] = sign * dy
+    out[2] = sign * cross2(px - q[body, 0], py - q[body, 1], dx, dy)

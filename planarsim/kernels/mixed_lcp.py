@@ -19,6 +19,8 @@ import math
 
 from ._jit import kernel, kernel_call
 from .lcp import ANSWER_TOL, LCP_INACCURATE, LCP_RAY, LCP_SOLVED, lemke, polish
+from .codes import CONTACT_PAIR
+from .contacts import pair_motion_scale
 from .rows import ROW_CONTACT_T, ROW_ROD
 from .solve import _entry
 
@@ -249,11 +251,15 @@ def solve_mixed_lcp(m, ws, n, max_pivots):
 
 
 @kernel
-def is_sliding_solution(m, ws, r):
+def is_sliding_solution(m, s, ws, r):
     """After solve_mixed_lcp: does the contact of tangent row r slide (slip speed gamma > 0
     and its friction at the cone's edge; a gamma of rounding size on a contact well inside
-    its cone is not a slip)?"""
+    its cone is not a slip; of a shape pair, rounding of both bodies' motion)?"""
     p = ws.lcp_var[r]
-    edge = m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1]
-    slip_floor = CONE_EDGE_TOL * (abs(ws.row_b[r]) + abs(ws.row_b[r - 1]))
+    o = ws.row_owner[r]
+    edge = m.contact_mu[o] * ws.lam[r - 1]
+    scale = abs(ws.row_b[r]) + abs(ws.row_b[r - 1])
+    if m.contact_kind[o] == CONTACT_PAIR:
+        scale += pair_motion_scale(s, ws, o, ws.v_pred)
+    slip_floor = CONE_EDGE_TOL * scale
     return ws.lcp_z[p + 2] > slip_floor and abs(ws.lam[r]) >= edge * (1.0 - CONE_EDGE_TOL)

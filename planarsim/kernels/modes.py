@@ -16,10 +16,10 @@ reversal); modes_from_solution reads the modes off a complementarity solution.
 import math
 
 from ._jit import kernel
-from .codes import MODE_FREE, MODE_PINNED, MODE_SLIDING
-from .contacts import engage_contact, refresh_contact
-from .forces import point_velocity
-from .math2d import world_point
+from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED, MODE_SLIDING
+from .contacts import contact_velocity, engage_contact, pair_motion_scale, refresh_contact
+from .pair import PAIR_ENGAGE_SLACK, pair_speed
+from .audit import IMPULSE_FLOOR
 from .mixed_lcp import is_sliding_solution
 from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, has_mode_rows
 from .solve import row_dot
@@ -43,17 +43,6 @@ def gather_contact_impulses(m, s, ws):
                 ws.contact_impulse[o, 1] = -m.contact_mu[o] * s.contact_slip[o] * ws.lam[r]
         elif ws.row_kind[r] == ROW_CONTACT_T:
             ws.contact_impulse[o, 1] = ws.lam[r]
-
-
-@kernel
-def contact_velocity(m, s, ws, i, vel):
-    """Normal and tangential velocity [m/s] of contact i's material point under `vel`."""
-    b = m.contact_body[i]
-    px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[i, 0], ws.contact_anchor[i, 1])
-    vx, vy = point_velocity(s.q, vel, b, px, py)
-    nx = ws.contact_normal[i, 0]
-    ny = ws.contact_normal[i, 1]
-    return nx * vx + ny * vy, ny * vx - nx * vy
 
 
 @kernel
@@ -102,7 +91,11 @@ def engage_contacts(m, s, ws, h, include_ccd, vel):
             if not may_reach_ground(m, ws, i, h, vel):
                 continue
         vn, vt = contact_velocity(m, s, ws, i, vel)
-        if ws.contact_gap[i] + h * vn < 0.0:
+        # a shape pair touching at rest sees its relative velocity as rounding of either
+        # sign (both bodies move alike): it engages when pushed in beyond PAIR_ENGAGE_SLACK,
+        # else a contact carrying no load would be released and engaged again without end
+        slack = PAIR_ENGAGE_SLACK if m.contact_kind[i] == CONTACT_PAIR else 0.0
+        if ws.contact_gap[i] + h * vn < -slack:
             engage_contact(m, s, ws, i, vn, vt)
             changed += 1
     return changed
@@ -113,6 +106,8 @@ def may_reach_ground(m, ws, i, h, vel):
     """False when contact i's point surely stays above the ground for a step of h under
     vel: its gap exceeds h (|v_x| + |v_y| + |omega| r), r its distance from the COM (a
     bound on its speed; no trigonometry)."""
+    if m.contact_kind[i] == CONTACT_PAIR:
+        return ws.contact_gap[i] <= h * pair_speed(m, ws, i, vel)
     b = m.contact_body[i]
     ax = ws.contact_anchor[i, 0]
     ay = ws.contact_anchor[i, 1]
@@ -166,10 +161,15 @@ def rule_breaks(m, s, ws, h, equalities):
         return 0        # joints only, their equations met by the solve: no rule to break
     big_lam = 0.0
     big_b = 0.0
+    big_normal = 0.0
     for r in range(n):
         big_lam = max(big_lam, abs(ws.lam[r]))
         big_b = max(big_b, abs(ws.row_b[r]))
+        if ws.row_kind[r] == ROW_CONTACT_N:
+            big_normal = max(big_normal, abs(ws.lam[r]))
     tol_lam = SOLVE_REL_TOL * big_lam
+    # rounding of a contact that carries no load (statically indeterminate: a box on two)
+    floor = IMPULSE_FLOOR * big_normal
     tol_w = SOLVE_REL_TOL * (big_b + 1.0)
     breaks = 0
     for r in range(n):
@@ -186,18 +186,22 @@ def rule_breaks(m, s, ws, h, equalities):
                 breaks += 1
         elif kind == ROW_CONTACT_N:
             # a contact's rules are judged against its own impulse (as the audit judges them)
-            if ws.lam[r] < -SOLVE_REL_TOL * _contact_size(m, s, ws, r):
+            if ws.lam[r] < -(SOLVE_REL_TOL * _contact_size(m, s, ws, r) + floor):
                 breaks += 1
             if s.contact_mode[o] == MODE_SLIDING:
                 vn, vt = contact_velocity(m, s, ws, o, ws.v_new)
                 vn_free, vt_free = contact_velocity(m, s, ws, o, ws.v_pred)
                 # friction along a reversed slip would add energy: only a reversal at the
-                # rounding level of the contact's free motion passes
-                if vt * s.contact_slip[o] < -SLIP_ROUNDING * (abs(vn_free) + abs(vt_free)):
+                # rounding level of the contact's free motion passes (of a shape pair, of
+                # both bodies' motion: falling together, their relative motion is rounding)
+                scale = abs(vn_free) + abs(vt_free)
+                if m.contact_kind[o] == CONTACT_PAIR:
+                    scale += pair_motion_scale(s, ws, o, ws.v_pred)
+                if vt * s.contact_slip[o] < -SLIP_ROUNDING * scale:
                     breaks += 1
         elif kind == ROW_CONTACT_T:
             size = abs(ws.lam[r]) + abs(ws.lam[r - 1])
-            if abs(ws.lam[r]) > m.contact_mu[o] * ws.lam[r - 1] + SOLVE_REL_TOL * size:
+            if abs(ws.lam[r]) > m.contact_mu[o] * ws.lam[r - 1] + SOLVE_REL_TOL * size + floor:
                 breaks += 1
     return breaks
 
@@ -237,7 +241,7 @@ def modes_from_solution(m, s, ws):
         elif kind == ROW_CONTACT_T:
             if ws.lam[r - 1] <= 0.0:
                 s.contact_mode[o] = MODE_FREE
-            elif is_sliding_solution(m, ws, r) and ws.lam[r] != 0.0:
+            elif is_sliding_solution(m, s, ws, r) and ws.lam[r] != 0.0:
                 s.contact_mode[o] = MODE_SLIDING
                 s.contact_slip[o] = -1.0 if ws.lam[r] > 0.0 else 1.0
             else:

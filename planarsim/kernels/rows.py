@@ -1,7 +1,8 @@
 """Stage 4: constraint rows J (Jacobian blocks on bodies a, b) and position errors c.
 
 Row kinds: pin x / y (p_b - p_a = 0), rod (|p_b - p_a| - L = 0), joint limit (angle - lower
->= 0, upper - angle >= 0), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0). For a
+>= 0, upper - angle >= 0), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0); a shape
+pair's contact rows act on both its bodies (kernels/pair.py). For a
 point p on a body with COM x, J = (d_x, d_y, (p - x) x d) for a row along unit direction d.
 A contact's normal row uses the exact gap (a rolling sole: the gap of its centre minus r, which
 rotation leaves unchanged); its tangent row holds the material point at the ground point found
@@ -12,8 +13,9 @@ Coulomb friction -mu lambda_n s along the tangent t.
 import math
 
 from ._jit import kernel
-from .math2d import cross2, world_point
-from .codes import MODE_PINNED, MODE_SLIDING
+from .math2d import set_dir, world_point
+from .codes import CONTACT_PAIR, MODE_PINNED, MODE_SLIDING
+from .pair import pair_row
 from .terrain import ground_point
 
 ROW_PIN_X = 0
@@ -36,19 +38,6 @@ def has_mode_rows(ws, n):
 
 
 @kernel
-def _set_dir(q, body, px, py, dx, dy, sign, out):
-    """out = sign * (dx, dy, (p - x_body) x d)."""
-    if body < 0:
-        out[0] = 0.0
-        out[1] = 0.0
-        out[2] = 0.0
-        return
-    out[0] = sign * dx
-    out[1] = sign * dy
-    out[2] = sign * cross2(px - q[body, 0], py - q[body, 1], dx, dy)
-
-
-@kernel
 def eval_row(m, q, cs, ws, r, J, found):
     """Jacobian blocks J (2, 3) and error c of row r at configuration q (cs: its cos / sin,
     math2d.update_trig); returns c. found: the contacts' ground points, normals and gaps in ws
@@ -63,8 +52,8 @@ def eval_row(m, q, cs, ws, r, J, found):
         bx, by = world_point(q, cs, b, m.pin_anchor[o, 1, 0], m.pin_anchor[o, 1, 1])
         dx = 1.0 if kind == ROW_PIN_X else 0.0
         dy = 1.0 - dx
-        _set_dir(q, a, ax, ay, dx, dy, -1.0, J[0])
-        _set_dir(q, b, bx, by, dx, dy, 1.0, J[1])
+        set_dir(q, a, ax, ay, dx, dy, -1.0, J[0])
+        set_dir(q, b, bx, by, dx, dy, 1.0, J[1])
         return (bx - ax) * dx + (by - ay) * dy
     if kind == ROW_ROD:
         ax, ay = world_point(q, cs, a, m.rod_anchor[o, 0, 0], m.rod_anchor[o, 0, 1])
@@ -74,8 +63,8 @@ def eval_row(m, q, cs, ws, r, J, found):
         L = math.sqrt(ex * ex + ey * ey)
         ex /= L
         ey /= L
-        _set_dir(q, a, ax, ay, ex, ey, -1.0, J[0])
-        _set_dir(q, b, bx, by, ex, ey, 1.0, J[1])
+        set_dir(q, a, ax, ay, ex, ey, -1.0, J[0])
+        set_dir(q, b, bx, by, ex, ey, 1.0, J[1])
         return L - m.rod_length[o]
     if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
         sign = 1.0 if kind == ROW_LIMIT_LO else -1.0
@@ -92,6 +81,8 @@ def eval_row(m, q, cs, ws, r, J, found):
             return ang - m.pin_limit[o, 0]
         return m.pin_limit[o, 1] - ang
     # contact rows
+    if m.contact_kind[o] == CONTACT_PAIR:
+        return pair_row(q, cs, ws, o, J, kind == ROW_CONTACT_T)
     for k in range(3):
         J[0, k] = 0.0
     if kind == ROW_CONTACT_N:
@@ -104,10 +95,10 @@ def eval_row(m, q, cs, ws, r, J, found):
             px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
         if found:
             # find_contact's query at this q: its gap is already the sole's (centre's - r)
-            _set_dir(q, b, px, py, ws.contact_normal[o, 0], ws.contact_normal[o, 1], 1.0, J[1])
+            set_dir(q, b, px, py, ws.contact_normal[o, 0], ws.contact_normal[o, 1], 1.0, J[1])
             return ws.contact_gap[o]
         gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
-        _set_dir(q, b, px, py, nx, ny, 1.0, J[1])
+        set_dir(q, b, px, py, nx, ny, 1.0, J[1])
         if ws.contact_on_arc[o] == 1:
             return gap - m.contact_radius[o]
         return gap
@@ -115,7 +106,7 @@ def eval_row(m, q, cs, ws, r, J, found):
     px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
     tx = ws.contact_normal[o, 1]
     ty = -ws.contact_normal[o, 0]
-    _set_dir(q, b, px, py, tx, ty, 1.0, J[1])
+    set_dir(q, b, px, py, tx, ty, 1.0, J[1])
     return tx * (px - ws.contact_ground[o, 0]) + ty * (py - ws.contact_ground[o, 1])
 
 
@@ -125,11 +116,11 @@ def _pin_rows(q, cs, anchor, o, a, b, J, c, r):
     the two anchor points (the same arithmetic as eval_row, half the work)."""
     ax, ay = world_point(q, cs, a, anchor[o, 0, 0], anchor[o, 0, 1])
     bx, by = world_point(q, cs, b, anchor[o, 1, 0], anchor[o, 1, 1])
-    _set_dir(q, a, ax, ay, 1.0, 0.0, -1.0, J[r, 0])
-    _set_dir(q, b, bx, by, 1.0, 0.0, 1.0, J[r, 1])
+    set_dir(q, a, ax, ay, 1.0, 0.0, -1.0, J[r, 0])
+    set_dir(q, b, bx, by, 1.0, 0.0, 1.0, J[r, 1])
     c[r] = (bx - ax) * 1.0 + (by - ay) * 0.0
-    _set_dir(q, a, ax, ay, 0.0, 1.0, -1.0, J[r + 1, 0])
-    _set_dir(q, b, bx, by, 0.0, 1.0, 1.0, J[r + 1, 1])
+    set_dir(q, a, ax, ay, 0.0, 1.0, -1.0, J[r + 1, 0])
+    set_dir(q, b, bx, by, 0.0, 1.0, 1.0, J[r + 1, 1])
     c[r + 1] = (bx - ax) * 0.0 + (by - ay) * 1.0
 
 
@@ -221,7 +212,7 @@ def build_rows(m, s, ws):
     while jp < n_pin or jr < n_rod or ic < n_con:
         kp = _later_body(m.pin_body, jp) if jp < n_pin else big
         kr = _later_body(m.rod_body, jr) if jr < n_rod else big
-        kc = m.contact_body[ic] if ic < n_con else big
+        kc = max(m.contact_body[ic], m.contact_other[ic]) if ic < n_con else big
         if kp <= kr and kp <= kc:
             j = jp
             n = add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
@@ -237,10 +228,12 @@ def build_rows(m, s, ws):
         else:
             i = ic
             mode = s.contact_mode[i]
+            a = ws.contact_bodies[i, 0]
+            b = ws.contact_bodies[i, 1]
             if mode == MODE_PINNED or mode == MODE_SLIDING:
-                n = add_row(ws, n, ROW_CONTACT_N, i, -1, m.contact_body[i])
+                n = add_row(ws, n, ROW_CONTACT_N, i, a, b)
             if mode == MODE_PINNED:
-                n = add_row(ws, n, ROW_CONTACT_T, i, -1, m.contact_body[i])
+                n = add_row(ws, n, ROW_CONTACT_T, i, a, b)
             ic += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
@@ -258,6 +251,14 @@ def build_rows(m, s, ws):
             nx = ws.contact_normal[o, 0]
             ny = ws.contact_normal[o, 1]
             ms = m.contact_mu[o] * s.contact_slip[o]
-            px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
-            _set_dir(s.q, b, px, py, nx - ms * ny, ny + ms * nx, 1.0, ws.row_F[r, 1])
+            if m.contact_kind[o] == CONTACT_PAIR:
+                # at the surface point found at this q; equal and opposite on the reference body
+                px = ws.contact_point[o, 0]
+                py = ws.contact_point[o, 1]
+                set_dir(s.q, ws.row_body[r, 0], px, py, nx - ms * ny, ny + ms * nx, -1.0,
+                        ws.row_F[r, 0])
+            else:
+                px, py = world_point(s.q, ws.body_cs, b, ws.contact_anchor[o, 0],
+                                     ws.contact_anchor[o, 1])
+            set_dir(s.q, b, px, py, nx - ms * ny, ny + ms * nx, 1.0, ws.row_F[r, 1])
     return sliding

@@ -18,7 +18,7 @@ Without sliding contacts F = J and the matrix is symmetric: it is assembled in i
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ._jit import kernel, kernel_inline
-from .rows import ROW_CONTACT_T, ROW_LIMIT_LO
+from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_LO
 from .warm_start import start_impulses
 
 
@@ -272,7 +272,14 @@ def fill_row_b(ws, h, n):
             # a unilateral row that starts violated only stops approaching; the position
             # correction removes the overlap without turning it into velocity (energy)
             c = 0.0
-        ws.row_b[r] = c / h + row_dot(ws, r, ws.row_J, ws.v_pred)
+        bounce = 0.0
+        if ws.row_kind[r] == ROW_CONTACT_N:
+            bounce = ws.contact_bounce[ws.row_owner[r]]
+            if bounce > 0.0:
+                # an impact with restitution: the rebound e v_approach, from the surface (the
+                # gap left at the step's start, at most h v_approach, is not waited for)
+                c = 0.0
+        ws.row_b[r] = c / h + row_dot(ws, r, ws.row_J, ws.v_pred) - bounce
 
 
 @kernel_inline

@@ -58,6 +58,7 @@ def copy_state(src, dst):
     _copy2(src.last_contact_impulse, dst.last_contact_impulse)
     _copy2(src.last_pin_impulse, dst.last_pin_impulse)
     _copy1(src.last_rod_impulse, dst.last_rod_impulse)
+    _copy1(src.contact_feature, dst.contact_feature)
 
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
@@ -175,7 +176,7 @@ def _step(m, s, ws, opt, u):
         apply_forces(m, s, ws, u)
         predict_velocity(m, s, ws, h)
         predict_configuration(m, s, ws, h)
-        find_contacts(m, s, ws)
+        find_contacts(m, s, ws, h)
         ccd_on = split < opt.max_ccd_splits
         answered = solve_modes(m, s, ws, opt, h, not ccd_on)
         if ccd_on:

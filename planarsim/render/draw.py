@@ -84,6 +84,8 @@ def shape_outline(shape, n: int = 24) -> np.ndarray:
         angle = float(p[3]) if len(p) > 3 else 0.0
         corners = np.array([[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]])
         return corners @ _rot(angle).T + center
+    if kind == "polygon":
+        return np.asarray(p[0], float).reshape(-1, 2).copy()
     if kind == "arc":
         center, r, (a0, a1) = np.asarray(p[0], float), float(p[1]), p[2]
         verts = np.asarray(p[3], float).reshape(-1, 2) if len(p) > 3 and len(p[3]) else np.zeros((0, 2))
@@ -94,7 +96,7 @@ def shape_outline(shape, n: int = 24) -> np.ndarray:
         ang = np.arctan2(verts[:, 1] - center[1], verts[:, 0] - center[0])
         ang = a1 + np.mod(ang - a1, 2 * math.pi)
         return np.vstack([sole, verts[np.argsort(ang)]])
-    raise ValueError(f"shape on body {shape.body}: unknown kind {kind!r} (capsule, box, circle, arc)")
+    raise ValueError(f"shape on body {shape.body}: unknown kind {kind!r} (capsule, box, circle, polygon, arc)")
 
 
 def model_extent(model) -> float:
@@ -200,6 +202,8 @@ class Scene:
 
     def _body_color(self, b):
         st = self.style
+        if b < 0:
+            return st.terrain_color     # a world shape (a step, a wall): part of the ground
         if not self.side_labels:
             return st.body_colors[b % len(st.body_colors)]
         i = side_index(self.sides["body"][b])

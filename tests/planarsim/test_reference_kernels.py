@@ -31,7 +31,7 @@ def _rows_at(m, s, ws):
         for k in range(3):
             ws.q_pred[i, k] = s.q[i, k]
     update_trig(ws.q_pred, ws.cs_pred)
-    find_contacts(m, s, ws)
+    find_contacts(m, s, ws, m.dt)
     build_rows(m, s, ws)
     n = ws.n_row[0]
     assemble_dense(m, ws, n)

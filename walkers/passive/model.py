@@ -26,6 +26,9 @@ from planarsim import terrain as ps_terrain
 
 from .params import CompassParams, RimlessParams, SimplestParams
 
+# the shapes only draw the walker: its feet are its contacts
+DRAWN = {"collide": False}
+
 FEET = ("foot_a", "foot_b")
 
 
@@ -81,7 +84,7 @@ def build_compass(p: CompassParams = CompassParams(), dt: float = 1e-3, terrain=
         angle = math.atan2(-up[0], up[1])
         com = hip - bl * up
         leg = b.add_body(name, p.leg_mass, p.leg_mass * k * k, pos=com, angle=angle,
-                         shapes=[("capsule", (0.0, -a), (0.0, bl), 0.02 * l)])
+                         shapes=[("capsule", (0.0, -a), (0.0, bl), 0.02 * l, DRAWN)])
         b.add_pin(f"hip_{name}", h, leg, anchor_world=hip)
         b.add_point_contact(foot, leg, local=(0.0, -a), mu=p.mu)
     return b.compile(walker="compass-gait", slope=p.slope)
@@ -98,12 +101,12 @@ def build_rimless(p: RimlessParams = RimlessParams(), dt: float = 1e-3, terrain=
     up = leg_up(alpha, p.slope)
     hub_angle = math.atan2(-up[0], up[1])
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, -p.gravity), terrain=terrain)
-    shapes = [("circle", (0.0, 0.0), 0.08 * l)]
+    shapes = [("circle", (0.0, 0.0), 0.08 * l, DRAWN)]
     feet = []
     for i in range(n_sp):
         ang = 2.0 * math.pi * i / n_sp
         foot = (l * math.sin(ang), -l * math.cos(ang))
-        shapes.append(("capsule", (0.0, 0.0), foot, 0.01 * l))
+        shapes.append(("capsule", (0.0, 0.0), foot, 0.01 * l, DRAWN))
         feet.append(foot)
     hub = b.add_body("hub", p.hub_mass, p.hub_mass * p.hub_gyration ** 2, pos=centre, angle=hub_angle,
                      shapes=shapes)

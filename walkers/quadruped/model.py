@@ -22,6 +22,9 @@ from planarsim.terrain import Terrain, flat
 from .params import QuadrupedParams
 from .puppet import leg_ik
 
+# the shapes only draw the walker: its feet are its contacts
+DRAWN = {"collide": False}
+
 LEG_NAMES = ("FL", "FR", "RL", "RR")
 N_LEG = 4
 HIP_SIGN = (1, 1, -1, -1)        # hip at x = HIP_SIGN[i] * hip_x in the torso frame
@@ -76,7 +79,7 @@ def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None,
     hips_x = [x0 + HIP_SIGN[i] * p.hip_x for i in range(N_LEG)]
     ty = 0.5 * (float(terrain.height(hips_x[0])) + float(terrain.height(hips_x[2]))) + p.stand_height
     b.add_body("torso", mass=p.torso_mass, inertia=p.torso_inertia, pos=(x0, ty), angle=0.0,
-               shapes=[("box", (0.0, 0.0), p.torso_length, p.torso_height)])
+               shapes=[("box", (0.0, 0.0), p.torso_length, p.torso_height, DRAWN)])
     l1, l2 = p.thigh_length, p.calf_length
     width = (0.018, 0.012)          # drawing: left legs a little thicker than right ones
     knees = []
@@ -89,10 +92,10 @@ def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None,
         w = width[i % 2]
         b.add_body(f"{name}_thigh", mass=p.thigh_mass, inertia=p.thigh_inertia + p.armature,
                    pos=(hx + p.thigh_com * d1[0], hy + p.thigh_com * d1[1]), angle=q1,
-                   shapes=[("capsule", (0.0, p.thigh_com), (0.0, p.thigh_com - l1), w)])
+                   shapes=[("capsule", (0.0, p.thigh_com), (0.0, p.thigh_com - l1), w, DRAWN)])
         b.add_body(f"{name}_calf", mass=p.calf_mass, inertia=p.calf_inertia + p.armature,
                    pos=(kx + p.calf_com * d12[0], ky + p.calf_com * d12[1]), angle=q1 + q2,
-                   shapes=[("capsule", (0.0, p.calf_com), (0.0, p.calf_com - l2), 0.7 * w)])
+                   shapes=[("capsule", (0.0, p.calf_com), (0.0, p.calf_com - l2), 0.7 * w, DRAWN)])
     for i, name in enumerate(LEG_NAMES):
         b.add_pin(f"{name}_hip", BODY_TORSO, thigh_body(i), anchor_world=(hips_x[i], ty), ref_angle=0.0,
                   limit=(p.hip_lower, p.hip_upper))

@@ -26,6 +26,9 @@ from planarsim.terrain import flat
 
 from .params import RangerParams
 
+# the shapes only draw the walker: its feet are its contacts
+DRAWN = {"collide": False}
+
 OUTER, INNER = 0, 1
 LEG = (0, 1)             # body of the leg of side s
 FOOT = (2, 3)            # body of the foot of side s
@@ -98,7 +101,7 @@ def build(p: RangerParams | None = None, terrain=None, dt: float = 1e-3, suspend
         com = hip + c * d
         b.add_body(("outer_leg", "inner_leg")[s], mass=p.leg_mass, inertia=p.leg_inertia,
                    pos=tuple(com), angle=th,
-                   shapes=[("capsule", (0.0, c), (0.0, c - L), 0.025 if s == 0 else 0.018)])
+                   shapes=[("capsule", (0.0, c), (0.0, c - L), 0.025 if s == 0 else 0.018, DRAWN)])
         ankles.append(hip + L * d)
     fx, fy = p.foot_com_x, p.foot_com_y
     i_foot = foot_inertia_com(p)

@@ -1,0 +1,151 @@
+"""Collision shapes as the kernels see them: a convex core and a radius.
+
+Every shape is a convex core plus a radius r >= 0 (its points within r of the core):
+  circle    one core vertex (the centre), r > 0
+  capsule   two core vertices (the segment's ends), r > 0
+  box       four core vertices (counter-clockwise), r = 0
+  polygon   n >= 3 core vertices (convex, counter-clockwise), r = 0
+so one manifold routine (kernels/collide.py) serves every pair. Coordinates are the body's
+local frame [m] (the world's for a static shape, body -1).
+
+Which pairs of shapes can touch is decided once, here, when the model is compiled
+(``collision_pairs``): two shapes collide when they lie on different bodies (not both the
+world), their category and mask bits accept each other (``cat_a & mask_b`` and
+``cat_b & mask_a`` non-zero, as Box2D and MuJoCo's contype/conaffinity), and their bodies are
+not parts of one mechanism (bodies linked by pins or rods, directly or through others, do
+not collide with each other unless the pair is enabled by ``ModelBuilder.enable_collision``).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import ModelError
+
+SHAPE_KINDS = ("circle", "capsule", "box", "polygon")
+# two core vertices closer than this are one point [m]; a polygon's turn at a vertex below
+# this share of its edges' lengths is no turn (collinear)
+CORE_TOL = 1e-12
+
+
+def _who(idx, kind, name):
+    return f"{kind} shape {name!r} ({idx})" if name else f"{kind} shape ({idx})"
+
+
+def box_vertices(center, width, height, angle=0.0):
+    """The four corners (4, 2) [m] of a box, counter-clockwise from (-w/2, -h/2)."""
+    ca, sa = math.cos(angle), math.sin(angle)
+    out = []
+    for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+        lx, ly = 0.5 * width * sx, 0.5 * height * sy
+        out.append((center[0] + ca * lx - sa * ly, center[1] + sa * lx + ca * ly))
+    return np.array(out, dtype=np.float64)
+
+
+def convex_ccw(vertices, who):
+    """The vertices (n, 2) of a convex polygon in counter-clockwise order (a clockwise one is
+    reversed). ModelError naming `who` when there are fewer than 3, two coincide, three are
+    collinear, or the polygon is not convex (or winds around more than once)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] != 2:
+        raise ModelError(f"{who}: vertices must be a list of (x, y) pairs, got shape {v.shape}")
+    if v.shape[0] < 3:
+        raise ModelError(f"{who}: a polygon needs at least 3 vertices, got {v.shape[0]}")
+    if not np.all(np.isfinite(v)):
+        raise ModelError(f"{who}: vertices must be finite")
+    edges = np.roll(v, -1, axis=0) - v
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    scale = float(np.max(np.abs(v))) + 1.0
+    if np.any(lengths <= CORE_TOL * scale):
+        k = int(np.argmin(lengths))
+        raise ModelError(f"{who}: vertices {k} and {(k + 1) % len(v)} coincide")
+    turns = edges[:, 0] * np.roll(edges[:, 1], -1) - edges[:, 1] * np.roll(edges[:, 0], -1)
+    area2 = float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
+    sign = 1.0 if area2 > 0 else -1.0
+    flat = np.abs(turns) <= CORE_TOL * lengths * np.roll(lengths, -1)
+    if np.any(flat):
+        k = int(np.argmax(flat))
+        raise ModelError(f"{who}: vertex {(k + 1) % len(v)} lies on the line of its neighbours "
+                         "(drop it)")
+    if np.any(turns * sign < 0):
+        k = int(np.argmax(turns * sign < 0))
+        raise ModelError(f"{who}: the polygon is not convex (it turns the other way at vertex "
+                         f"{(k + 1) % len(v)}); split it into convex pieces")
+    # convex turns all one way but winding twice (a star drawn in one stroke)
+    angles = np.arctan2(edges[:, 1], edges[:, 0])
+    total = np.sum(np.angle(np.exp(1j * (np.roll(angles, -1) - angles))))
+    if abs(abs(total) - 2 * math.pi) > 1e-6:
+        raise ModelError(f"{who}: the polygon winds around {abs(total) / (2 * math.pi):.0f} times; "
+                         "give its vertices once, in order")
+    return v if sign > 0 else v[::-1].copy()
+
+
+def collision_core(kind, params, idx, name=None):
+    """(core (n, 2), radius) of a colliding shape's parameters, validated: radii > 0, box
+    sides > 0, a capsule's ends apart, a polygon convex with at least 3 distinct vertices."""
+    who = _who(idx, kind, name)
+    if kind == "circle":
+        center, radius = params[0], float(params[1])
+        if not radius > 0:
+            raise ModelError(f"{who}: radius={radius} must be > 0 for a shape that collides")
+        return np.array([center], dtype=np.float64), radius
+    if kind == "capsule":
+        p0, p1, radius = np.asarray(params[0], float), np.asarray(params[1], float), float(params[2])
+        if not radius > 0:
+            raise ModelError(f"{who}: radius={radius} must be > 0 for a shape that collides")
+        if math.hypot(*(p1 - p0)) <= CORE_TOL * (1.0 + np.max(np.abs(np.r_[p0, p1]))):
+            raise ModelError(f"{who}: p0 and p1 coincide; use a circle")
+        return np.array([p0, p1], dtype=np.float64), radius
+    if kind == "box":
+        angle = float(params[3]) if len(params) > 3 else 0.0
+        return box_vertices(params[0], float(params[1]), float(params[2]), angle), 0.0
+    if kind == "polygon":
+        return convex_ccw(params[0], who), 0.0
+    raise ModelError(f"{who}: kind must be one of {', '.join(SHAPE_KINDS)}")
+
+
+def bounding_circle(core, radius):
+    """(cx, cy, R): a circle [m] in the shape's frame holding the whole shape (centre: the
+    middle of the core's bounding box)."""
+    lo = core.min(axis=0)
+    hi = core.max(axis=0)
+    c = 0.5 * (lo + hi)
+    return float(c[0]), float(c[1]), float(np.max(np.hypot(*(core - c).T))) + radius
+
+
+def mechanism_of(n_body, joints):
+    """Component label (n_body,) of the graph whose edges are `joints` (pairs of body ids,
+    -1 = the world, which joins nothing): bodies with one label form one mechanism."""
+    parent = list(range(n_body))
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b in joints:
+        if a >= 0 and b >= 0:
+            parent[root(a)] = root(b)
+    return [root(i) for i in range(n_body)]
+
+
+def collision_pairs(shapes, n_body, joints, enabled):
+    """Pairs (i, j), i < j, of colliding shapes that may touch (see the module's docstring).
+    shapes: dicts with body, category, mask; joints: (a, b) body pairs of pins and rods;
+    enabled: set of frozenset({body_a, body_b}) enabled although in one mechanism."""
+    label = mechanism_of(n_body, joints)
+    pairs = []
+    for i, si in enumerate(shapes):
+        for j in range(i + 1, len(shapes)):
+            sj = shapes[j]
+            a, b = si["body"], sj["body"]
+            if a == b:
+                continue        # one body (or both static)
+            if not (si["category"] & sj["mask"]) or not (sj["category"] & si["mask"]):
+                continue
+            if a >= 0 and b >= 0 and label[a] == label[b] and frozenset((a, b)) not in enabled:
+                continue
+            pairs.append((i, j))
+    return pairs

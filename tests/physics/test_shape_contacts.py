@@ -1,0 +1,218 @@
+"""Shapes that collide: stacks held exactly, impacts, restitution, no tunnelling, filtering,
+and the builder's checks of shapes."""
+import math
+
+import numpy as np
+import pytest
+
+import planarsim as ps
+from planarsim.compiled import audit_counts
+from planarsim.errors import ModelError
+
+W, H = 0.4, 0.2     # box width, height [m]
+
+
+def box_inertia(mass, w, h):
+    return mass * (w * w + h * h) / 12.0
+
+
+def column(masses, dt=1e-3, gap=0.0, mu=0.6, x_offsets=None):
+    """Boxes W x H stacked on flat ground, bottom first, `gap` [m] apart."""
+    b = ps.ModelBuilder(dt=dt)
+    for k, mass in enumerate(masses):
+        x = 0.0 if x_offsets is None else x_offsets[k]
+        b.add_body(f"box{k}", mass, box_inertia(mass, W, H), pos=(x, H / 2 + k * (H + gap)),
+                   shapes=[("box", (0.0, 0.0), W, H, {"mu": mu})])
+    return b.compile()
+
+
+def run(model, seconds, strategy="alternating"):
+    sim = ps.Simulator(model, ps.make_options(strategy))
+    worst_depth = 0.0
+    steps = int(round(seconds / model.dt))
+    for _ in range(steps // 100):
+        sim.steps(100)
+    sim.steps(steps % 100)
+    return sim
+
+
+def assert_clean(sim):
+    counts = audit_counts(sim.ws)
+    assert all(v == 0 for v in counts.values()), counts
+
+
+@pytest.mark.parametrize("masses", [[1.0] * 10, [1.0, 100.0] * 5, [1.0] * 9 + [100.0]],
+                         ids=["equal", "alternating_1_100", "heavy_on_top"])
+def test_column_of_ten_boxes_stands_exactly(masses):
+    model = column(masses)
+    sim = ps.Simulator(model)
+    q0 = sim.state.q.copy()
+    sim.steps(10000)     # 10 s
+    assert_clean(sim)    # no overlap deeper than 1e-8 m at the end of any step, no pull, no work
+    drift = np.abs(sim.state.q - q0).max()
+    assert drift <= 1e-9, drift
+    # every box rests on the one below: tops at (k + 1) H
+    tops = sim.state.q[:, 1] + H / 2
+    np.testing.assert_allclose(tops, H * np.arange(1, len(masses) + 1), atol=1e-9)
+
+
+def test_pyramid_of_twenty_boxes_stands():
+    b = ps.ModelBuilder(dt=1e-3)
+    rows = [6, 5, 4, 3, 2]
+    k = 0
+    for level, n in enumerate(rows):
+        for j in range(n):
+            x = (j - (n - 1) / 2) * (W + 0.02)
+            b.add_body(f"box{k}", 1.0, box_inertia(1.0, W, H), pos=(x, H / 2 + level * H),
+                       shapes=[("box", (0.0, 0.0), W, H)])
+            k += 1
+    model = b.compile()
+    assert model.n_body == 20
+    sim = ps.Simulator(model)
+    q0 = sim.state.q.copy()
+    sim.steps(10000)
+    assert_clean(sim)
+    assert np.abs(sim.state.q - q0).max() <= 1e-9
+
+
+@pytest.mark.parametrize("strategy", ["alternating", "all"])
+def test_two_boxes_dropped_stack_at_the_right_height(strategy):
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_body("low", 2.0, box_inertia(2.0, W, H), pos=(0.0, 0.5), shapes=[("box", (0, 0), W, H)])
+    b.add_body("high", 1.0, box_inertia(1.0, 0.2, 0.1), pos=(0.05, 1.2),
+               shapes=[("box", (0, 0), 0.2, 0.1)])
+    sim = ps.Simulator(b.compile(), ps.make_options(strategy))
+    sim.steps(3000)
+    assert_clean(sim)
+    q = sim.state.q
+    assert abs(q[0, 1] - H / 2) < 1e-8
+    assert abs(q[1, 1] - (H + 0.05)) < 1e-8
+    assert abs(q[0, 2]) < 1e-6 and abs(q[1, 2]) < 1e-6
+    assert np.abs(sim.state.v).max() < 1e-6
+
+
+def test_box_sliding_down_a_tilted_plank_stops_against_a_box():
+    slope = math.radians(25.0)
+    L, T = 4.0, 0.1                      # a static plank, tilted down to the right
+    origin = np.array([0.0, 1.0])
+    t = np.array([math.cos(slope), -math.sin(slope)])     # down the plank
+    n = np.array([math.sin(slope), math.cos(slope)])      # its upper face's normal
+
+    def on_plank(u, half_height):
+        return tuple(origin + u * t + (T / 2 + half_height) * n)
+
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_shape(None, "box", tuple(origin), L, T, -slope, mu=1.0)
+    # the stop holds by friction (pair mu 1 > tan 25 deg); the slider slides (0.2 < 0.47)
+    b.add_body("stop", 50.0, box_inertia(50.0, 0.3, 0.5), pos=on_plank(1.0, 0.25),
+               angle=-slope, shapes=[("box", (0, 0), 0.3, 0.5, {"mu": 1.0})])
+    b.add_body("slider", 1.0, box_inertia(1.0, 0.2, 0.2), pos=on_plank(-1.0, 0.1),
+               angle=-slope, shapes=[("box", (0, 0), 0.2, 0.2, {"mu": 0.04})])
+    model = b.compile()
+    sim = ps.Simulator(model)
+    sim.steps(4000)
+    assert_clean(sim)
+    assert np.abs(sim.state.v).max() < 1e-6        # everything at rest
+    slider = sim.state.q[model.body("slider"), :2]
+    stop = sim.state.q[model.body("stop"), :2]
+    # the slider rests against the stop's uphill face: centres 0.15 + 0.1 m apart along t
+    assert abs((stop - slider) @ t - 0.25) < 1e-8
+    assert abs((slider - origin) @ n - (T / 2 + 0.1)) < 1e-8     # on the plank, not in it
+
+
+@pytest.mark.parametrize("e", [0.3, 0.5, 0.8])
+def test_disk_rebounds_to_e_squared_of_its_height(e):
+    h0 = 1.0
+    r = 0.1
+    b = ps.ModelBuilder(dt=1e-4)
+    b.add_body("disk", 1.0, 0.5 * r * r, pos=(0.0, r + h0),
+               shapes=[("circle", (0, 0), r, {"restitution": e})])
+    sim = ps.Simulator(b.compile())
+    t_fall = math.sqrt(2 * h0 / 9.81)
+    sim.steps(int(t_fall / 1e-4) + 50)
+    assert sim.state.v[0, 1] > 0          # on its way up
+    best = 0.0
+    for _ in range(int(1.5 * t_fall / 1e-4)):
+        sim.step()
+        best = max(best, sim.state.q[0, 1] - r)
+    assert abs(best - e * e * h0) <= 0.01 * e * e * h0, best
+    assert_clean(sim)
+
+
+def test_fast_box_does_not_pass_through_a_thin_plank():
+    b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, 0.0))
+    b.add_shape(None, "box", (0.0, 0.0), 1.0, 0.05)
+    b.add_body("box", 1.0, box_inertia(1.0, 0.1, 0.1), pos=(0.0, 0.5), vel=(0.0, -20.0),
+               shapes=[("box", (0, 0), 0.1, 0.1)])
+    sim = ps.Simulator(b.compile())
+    sim.steps(200)
+    assert_clean(sim)
+    assert sim.state.q[0, 1] >= 0.025 + 0.05 - 1e-8
+
+
+def test_pinned_bodies_do_not_collide_unless_enabled():
+    def build(enable):
+        b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, 0.0))
+        a = b.add_body("a", 1.0, 0.1, pos=(0.0, 1.0), shapes=[("box", (0, 0), 0.4, 0.4)])
+        c = b.add_body("c", 1.0, 0.1, pos=(0.3, 1.0), shapes=[("box", (0, 0), 0.4, 0.4)])
+        b.add_pin("p", a, c, anchor_world=(0.15, 1.0))
+        if enable:
+            b.enable_collision("a", "c")
+        return b.compile()
+    assert not any("|" in n for n in build(False).contact_names)
+    assert sum("|" in n for n in build(True).contact_names) == 2
+
+
+def test_category_and_mask_filter_pairs():
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_body("a", 1.0, 0.1, pos=(0.0, 1.0), shapes=[("circle", (0, 0), 0.1, {"category": 2})])
+    b.add_body("c", 1.0, 0.1, pos=(0.0, 2.0), shapes=[("circle", (0, 0), 0.1, {"mask": 1})])
+    b.add_body("d", 1.0, 0.1, pos=(0.0, 3.0), shapes=[("circle", (0, 0), 0.1)])
+    names = b.compile().contact_names
+    pairs = {n.split("/")[0] for n in names if "|" in n}
+    assert pairs == {"a.circle0|d.circle2", "c.circle1|d.circle2"}
+
+
+def test_shape_drawn_only_has_no_contacts():
+    b = ps.ModelBuilder()
+    b.add_body("a", 1.0, 0.1, shapes=[("box", (0, 0), 0.4, 0.4, {"collide": False})])
+    assert b.compile().n_contact == 0
+
+
+@pytest.mark.parametrize("kind,params,words", [
+    ("box", ((0, 0), 0.0, 1.0), "width=0.0 must be > 0"),
+    ("box", ((0, 0), 1.0, -1.0), "height=-1.0 must be > 0"),
+    ("circle", ((0, 0), 0.0), "radius=0.0 must be > 0"),
+    ("capsule", ((0, 0), (1, 0), -0.1), "radius=-0.1 must be >= 0"),
+    ("polygon", ([(0, 0), (1, 0)],), "at least 3 vertices"),
+    ("polygon", ([(0, 0), (2, 0), (1, 0.2), (1, 1)],), "not convex"),
+    ("polygon", ([(0, 0), (1, 0), (2, 0), (1, 1)],), "on the line"),
+])
+def test_bad_shapes_are_model_errors(kind, params, words):
+    b = ps.ModelBuilder()
+    b.add_body("a", 1.0, 0.1)
+    with pytest.raises(ModelError, match=words):
+        b.add_shape("a", kind, *params)
+
+
+def test_shape_on_a_missing_body_and_bad_mask():
+    b = ps.ModelBuilder()
+    b.add_body("a", 1.0, 0.1)
+    with pytest.raises(ModelError, match="names no body"):
+        b.add_shape("nobody", "circle", (0, 0), 0.1)
+    with pytest.raises(ModelError, match="not a body id"):
+        b.add_shape(7, "circle", (0, 0), 0.1)
+    with pytest.raises(ModelError, match="mask=1.5 must be a non-negative integer"):
+        b.add_shape("a", "circle", (0, 0), 0.1, mask=1.5)
+    with pytest.raises(ModelError, match="restitution=2.0"):
+        b.add_shape("a", "circle", (0, 0), 0.1, restitution=2.0)
+
+
+def test_clockwise_polygon_is_accepted_and_collides():
+    b = ps.ModelBuilder(dt=1e-3)
+    tri = [(-0.2, -0.1), (0.0, 0.2), (0.2, -0.1)]     # clockwise
+    b.add_body("tri", 1.0, 0.01, pos=(0.0, 0.5), shapes=[("polygon", tri)])
+    sim = ps.Simulator(b.compile())
+    sim.steps(2000)
+    assert_clean(sim)
+    assert abs(sim.state.q[0, 1] - 0.1) < 1e-8       # rests on its flat side
