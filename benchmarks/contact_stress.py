@@ -220,6 +220,10 @@ def mass_ratio(rng, dt):
     return b.compile()
 
 
+def _cross2(a, b):
+    return a[0] * b[1] - a[1] * b[0]
+
+
 def random_shape(rng):
     """(kind, params, mass [kg], inertia [kg m^2]) of a random colliding shape centred on its
     body's COM (uniform density; a polygon's vertices about its centroid)."""
@@ -244,7 +248,7 @@ def random_shape(rng):
     def half_hull(points):
         out = []
         for p in points:
-            while len(out) >= 2 and np.cross(out[-1] - out[-2], p - out[-2]) <= 1e-9:
+            while len(out) >= 2 and _cross2(out[-1] - out[-2], p - out[-2]) <= 1e-9:
                 out.pop()
             out.append(p)
         return out
@@ -395,9 +399,26 @@ def shape_clearance(model, q):
             pts.extend(p0 + (p1 - p0) * u for u in np.linspace(0.0, 1.0, n))
         for p in pts:
             x, y = world_points(q, body, p).T
-            gap = (y - ground.height(x)) / np.sqrt(1.0 + ground.slope(x) ** 2) - a.shape_radius[s]
-            low = np.minimum(low, gap)
+            low = np.minimum(low, ground_distance(ground, x, y) - a.shape_radius[s])
     return low
+
+
+def ground_distance(ground, x, y, iters=12):
+    """Signed distance [m] of the points (x, y) from the ground curve (negative: below),
+    by Newton on the foot point x' (d/dx' of |(x', h(x')) - (x, y)|^2 / 2 = 0), from x' = x;
+    exact for points within a fraction of the curvature radius (all that depth needs)."""
+    xs = np.array(x, dtype=float)
+    c = ground.coef
+    for _ in range(iters):
+        h, dh, ddh = ground.height(xs), ground.slope(xs), 0.0 * xs
+        for k in range(int(c[2])):
+            a, w, phi = c[3 + 3 * k], 2 * math.pi / c[4 + 3 * k], c[5 + 3 * k]
+            ddh = ddh - a * w * w * np.sin(w * xs + phi)
+        f = (xs - x) + (h - y) * dh
+        df = 1.0 + dh * dh + (h - y) * ddh
+        xs = xs - f / np.where(np.abs(df) > 1e-12, df, 1e-12)
+    d = np.hypot(xs - x, ground.height(xs) - y)
+    return np.where(y >= ground.height(x), d, -d)
 
 
 def energy_bound(spec, ground, q0, v0):

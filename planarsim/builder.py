@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from . import model as M
-from .kernels.codes import CONTACT_ARC, CONTACT_PAIR, CONTACT_POINT
+from .kernels.codes import CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
 from .errors import ModelError
 from .kernels.collide import core_normals
 from .shapes import bounding_circle, collision_core, collision_pairs
@@ -68,8 +68,6 @@ def _length(kind, name, idx, fieldname, value, zero_ok=False):
 SHAPE_PARAMS = {"capsule": ("p0", "p1", "radius"), "circle": ("center", "radius"),
                 "box": ("center", "width", "height", "angle"),  # box: angle optional
                 "polygon": ("vertices",)}
-# what a colliding shape takes unless told: friction coefficient, restitution, filter bits
-SHAPE_DEFAULTS = dict(collide=True, mu=1.0, restitution=0.0, category=1, mask=0xFFFF, name=None)
 
 
 def _check_shape(kind, idx, params):
@@ -181,7 +179,7 @@ class ModelBuilder:
         return idx
 
     def add_shape(self, body, kind, *params, collide=True, mu=1.0, restitution=0.0, category=1,
-                  mask=0xFFFF, name=None) -> int:
+                  mask=0xFFFF, ground=True, name=None) -> int:
         """A shape on a body (local frame [m]), or fixed in the world (body None: world
         coordinates; steps, kerbs, walls): ('circle', center, radius) | ('capsule', p0, p1,
         radius) | ('box', center, width, height[, angle]) | ('polygon', [(x, y), ...]) (convex,
@@ -191,7 +189,9 @@ class ModelBuilder:
         it is only drawn). mu: its friction coefficient (a pair uses sqrt(mu_a mu_b), the
         ground the shape's mu); restitution in [0, 1] (a pair uses the larger, default 0: a
         plastic impact; a disk dropped with e rebounds to e^2 of its height). category and
-        mask: filter bits (a pair collides when each one's category meets the other's mask).
+        mask: filter bits (a pair collides when each one's category meets the other's mask);
+        ground=False: it touches other shapes but not the analytic ground (a foot whose own
+        contacts already touch it).
         Bodies of one mechanism (linked by pins or rods) do not collide with each other
         unless enable_collision names the pair."""
         if kind not in SHAPE_PARAMS:
@@ -208,6 +208,9 @@ class ModelBuilder:
         if collide:
             self._collide.append(self._collision_shape(idx, what, bid, kind, params, mu,
                                                        restitution, category, mask, name))
+            if not isinstance(ground, (bool, np.bool_)):
+                raise ModelError(f"{_who(what, None, idx)}: ground={ground!r} must be True or False")
+            self._collide[-1]["ground"] = bool(ground)
         self._shapes.append(M.Shape(bid, kind, tuple(params)))
         return idx
 
@@ -215,10 +218,6 @@ class ModelBuilder:
         """The record compile() turns into shape_* arrays and contacts (validated here)."""
         if name is not None and (not isinstance(name, str) or not name):
             raise ModelError(f"{_who(what, None, idx)}: name={name!r} must be a non-empty string")
-        if bid >= 0 and self._bodies[bid]["point"]:
-            raise ModelError(f"{_who(what, None, idx)}: body {self._bodies[bid]['name']!r} is a point "
-                             "mass; give a colliding shape a rigid body (add_body), or use "
-                             "add_point_contact")
         mu = _scalar(what, None, idx, "mu", mu)
         if mu < 0:
             raise ModelError(f"{_who(what, None, idx)}: mu={mu} must be >= 0")
@@ -474,18 +473,27 @@ class ModelBuilder:
                         radius=radius, span=span, mu=mu, verts=[], ccd=0, other=other, pair=pair,
                         restitution=restitution)
 
+        curved = self.terrain.coef[2] != 0      # hills: a straight side can touch a crest
         for sh in self._collide:
-            if sh["body"] < 0:
+            if sh["body"] < 0 or not sh["ground"]:
                 continue        # world shapes meet bodies, not the ground
             common = dict(mu=sh["mu"], restitution=sh["restitution"])
+            core = sh["core"]
             if sh["kind"] in ("box", "polygon"):
-                for k, v in enumerate(sh["core"]):
+                for k, v in enumerate(core):
                     out.append(contact(f"{sh['label']}/ground{k}", sh["body"], CONTACT_POINT, v,
                                        **common))
             else:
-                for k, v in enumerate(sh["core"]):
+                for k, v in enumerate(core):
                     out.append(contact(f"{sh['label']}/ground{k}", sh["body"], CONTACT_ARC, v,
                                        sh["radius"], (-math.pi, math.pi), **common))
+            if curved and len(core) >= 2:
+                # each straight side: its point nearest the ground where that is not an end
+                for k in range(len(core) if len(core) > 2 else 1):
+                    c = contact(f"{sh['label']}/edge{k}", sh["body"], CONTACT_EDGE, core[k],
+                                sh["radius"], **common)
+                    c["verts"] = [np.asarray(core[(k + 1) % len(core)], float)]
+                    out.append(c)
         joints = [p["body"] for p in self._pins] + [r["body"] for r in self._rods]
         for i, j in collision_pairs(self._collide, len(self._bodies), joints, self._enabled_pairs):
             if self._collide[i]["body"] < 0:

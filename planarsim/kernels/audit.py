@@ -25,8 +25,8 @@ import math
 
 from ._jit import kernel
 from .info import INFO_CCD_SPLITS
-from .codes import CONTACT_PAIR, CONTACT_POINT
-from .contacts import contact_velocity, point_reach, sole_facing
+from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
+from .contacts import contact_velocity, edge_deepest, point_reach, sole_facing
 from .math2d import world_point
 from .pair import pair_gap_now
 from .rows import ROW_CONTACT_N
@@ -105,10 +105,12 @@ def audit_impulses(m, s, ws):
         # restitution's rebound (at most e times the approach speed) is work it may do
         work = ln * (vn - ws.contact_bounce[i]) + lt * vt
         scale = WORK_REL_TOL * (abs(vn) + abs(vt)) + VELOCITY_FLOOR
-        if work > size * scale:
+        # an impulse of rounding size (below the floor) does rounding work at any speed
+        if work > size * scale + floor * (abs(vn) + abs(vt)):
             # the tolerance also scales with the free motion's speed (computed only here)
             vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
-            if work > size * (scale + WORK_REL_TOL * (abs(vp_n) + abs(vp_t))):
+            if work > (size * (scale + WORK_REL_TOL * (abs(vp_n) + abs(vp_t)))
+                       + floor * (abs(vn) + abs(vt))):
                 note(ws, step, AUDIT_WORK, i, b, work)
                 found += 1
     return found
@@ -151,6 +153,12 @@ def contact_gap(m, q, cs, i):
     ly = m.contact_local[i, 1]
     if m.contact_kind[i] == CONTACT_POINT:
         return point_gap(m, q, cs, b, lx, ly)
+    if m.contact_kind[i] == CONTACT_EDGE:
+        inside, px, py = edge_deepest(m, q, cs, i)
+        if not inside:
+            return math.inf     # the ends are lowest: their own contacts are measured
+        gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
+        return gap - m.contact_radius[i]
     r = m.contact_radius[i]
     cx, cy = world_point(q, cs, b, lx, ly)
     gx, gy, nx, ny, cgap = ground_point(m.terrain_coef, cx, cy)
@@ -214,8 +222,8 @@ def held_row_is_depth(m, ws, i):
     Flat or sloped ground (rows_held implies it)."""
     if m.contact_kind[i] == CONTACT_POINT:
         return True
-    if m.contact_kind[i] == CONTACT_PAIR:
-        return False    # other features of the pair may touch: measured afresh
+    if m.contact_kind[i] == CONTACT_PAIR or m.contact_kind[i] == CONTACT_EDGE:
+        return False    # other features, or another point of the edge, may touch
     return ws.contact_on_arc[i] == 1 and vertices_within_arc(m, i)
 
 

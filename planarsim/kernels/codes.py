@@ -3,6 +3,7 @@
 CONTACT_POINT = 0      # a material point (a point mass, a box corner)
 CONTACT_ARC = 1        # a circular-arc sole that rolls
 CONTACT_PAIR = 2       # one of two slots of a pair of colliding shapes (kernels/pair.py)
+CONTACT_EDGE = 3       # a shape's straight edge over curved ground: its deepest point (hills)
 # contact modes (state.contact_mode)
 MODE_FREE = 0
 MODE_PINNED = 1        # no slip along the ground

@@ -19,9 +19,9 @@ import math
 
 from ._jit import kernel, kernel_call
 from .math2d import rotate, world_point
-from .terrain import ground_point
+from .terrain import ground_point, height_derivs
 
-from .codes import CONTACT_PAIR, CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
+from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
 from .forces import point_velocity
 from .pair import find_pair
 
@@ -66,6 +66,121 @@ def sole_facing(m, cs, b, i, nx, ny):
     return a <= m.contact_span[i, 1], dlx, dly
 
 
+# bisection steps of an edge's deepest point (the interval shrinks below rounding of u)
+EDGE_BISECTIONS = 60
+# an edge is searched in pieces at most this share of the ground's shortest wavelength long
+# (within a piece the slope h' is monotone: a sine's slope turns every half wavelength)
+EDGE_PIECE = 0.125
+
+
+@kernel
+def _edge_rate(coef, x0, y0, dx, dy, u, rounded):
+    """The sign of d/du of the ground clearance of p(u) = p0 + u (dx, dy): of its height above
+    the ground, dy - h' dx, or (rounded: a capsule's side, whose distance along the normal
+    counts) of its distance from the ground, n.(dx, dy) with n the normal at its foot."""
+    if rounded:
+        gx, gy, nx, ny, gap = ground_point(coef, x0 + u * dx, y0 + u * dy)
+        return nx * dx + ny * dy
+    return dy - height_derivs(coef, x0 + u * dx)[1] * dx
+
+
+@kernel
+def _edge_minimum(coef, x0, y0, dx, dy, u0, u1, rounded):
+    """(u, f): the local minimum of the clearance f(u) of p(u) = p0 + u (dx, dy) on [u0, u1]
+    (_edge_rate) where its rate is monotone there and turns from negative to positive
+    (bisection); f = inf when it does not."""
+    if not (_edge_rate(coef, x0, y0, dx, dy, u0, rounded) < 0.0
+            <= _edge_rate(coef, x0, y0, dx, dy, u1, rounded)):
+        return u0, math.inf
+    lo = u0
+    hi = u1
+    for _ in range(EDGE_BISECTIONS):
+        u = 0.5 * (lo + hi)
+        if _edge_rate(coef, x0, y0, dx, dy, u, rounded) < 0.0:
+            lo = u
+        else:
+            hi = u
+    u = 0.5 * (lo + hi)
+    if rounded:
+        return u, ground_point(coef, x0 + u * dx, y0 + u * dy)[4]
+    return u, y0 + u * dy - height_derivs(coef, x0 + u * dx)[0]
+
+
+@kernel
+def edge_deepest(m, q, cs, i):
+    """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
+    fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
+    the segment (else the segment's ends, the shape's corners or end circles, are lowest).
+    Along the segment the height above the ground f(u) = y(u) - h(x(u)) has the rate
+    f' = dy - h' dx, monotone between the ground's inflections (h'' = 0): the segment is cut
+    in pieces of EDGE_PIECE of the shortest wavelength, each at its inflection if it holds
+    one, and where f' turns from negative to positive on a monotone part the local minimum
+    is found by bisection; the lowest of them is returned. For a capsule's side (radius > 0)
+    the distance along the ground's normal is minimised instead (its surface lies r along
+    the normal from the deepest point of its core)."""
+    coef = m.terrain_coef
+    b = m.contact_body[i]
+    k = m.contact_vert_adr[i]
+    x0, y0 = world_point(q, cs, b, m.contact_local[i, 0], m.contact_local[i, 1])
+    x1, y1 = world_point(q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1])
+    dx = x1 - x0
+    dy = y1 - y0
+    rounded = m.contact_radius[i] > 0.0
+    shortest = math.inf
+    for j in range(int(coef[2])):
+        shortest = min(shortest, coef[4 + 3 * j])
+    pieces = 1 if shortest == math.inf else int(math.ceil(abs(dx) / (EDGE_PIECE * shortest))) + 1
+    best = math.inf
+    best_u = 0.0
+    for piece in range(pieces):
+        ua = piece / pieces
+        ub = (piece + 1) / pieces
+        ca = height_derivs(coef, x0 + ua * dx)[2]
+        cb = height_derivs(coef, x0 + ub * dx)[2]
+        ue = ub
+        if ca * cb < 0.0:
+            # an inflection: f' turns back there; the two sides are monotone
+            lo = ua
+            hi = ub
+            for _ in range(EDGE_BISECTIONS):
+                u = 0.5 * (lo + hi)
+                if height_derivs(coef, x0 + u * dx)[2] * ca > 0.0:
+                    lo = u
+                else:
+                    hi = u
+            ue = 0.5 * (lo + hi)
+            u, f = _edge_minimum(coef, x0, y0, dx, dy, ua, ue, rounded)
+            if f < best:
+                best = f
+                best_u = u
+            ua = ue
+        u, f = _edge_minimum(coef, x0, y0, dx, dy, ua, ub, rounded)
+        if f < best:
+            best = f
+            best_u = u
+    inside = best < math.inf and 0.0 < best_u < 1.0
+    return inside, x0 + best_u * dx, y0 + best_u * dy
+
+
+@kernel
+def find_edge(m, q, ws, i):
+    """Edge contact i at q: its deepest core point, pushed out by the shape's radius along the
+    ground normal (a capsule's side), as a material point held for the step; gap inf where the
+    segment's ends are its lowest points (their own contacts hold them)."""
+    inside, px, py = edge_deepest(m, q, ws.body_cs, i)
+    if not inside:
+        ws.contact_gap[i] = math.inf
+        ws.contact_on_arc[i] = 0
+        return
+    r = m.contact_radius[i]
+    gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
+    sx = px - r * nx
+    sy = py - r * ny
+    b = m.contact_body[i]
+    lx, ly = rotate(ws.body_cs[b, 0], -ws.body_cs[b, 1], sx - q[b, 0], sy - q[b, 1])
+    _store(ws, i, sx, sy, gx, gy, nx, ny, gap - r, lx, ly, 0)
+
+
 @kernel
 def find_contact(m, q, ws, i):
     """Contact point, ground point, normal and gap of contact i at configuration q."""
@@ -74,6 +189,9 @@ def find_contact(m, q, ws, i):
     ly = m.contact_local[i, 1]
     if m.contact_kind[i] == CONTACT_POINT:
         _try_vertex(m, q, ws, i, b, lx, ly, math.inf)
+        return
+    if m.contact_kind[i] == CONTACT_EDGE:
+        find_edge(m, q, ws, i)
         return
     # arc: ground point closest to the centre, sole point opposite the normal
     r = m.contact_radius[i]
@@ -247,8 +365,8 @@ def find_contacts(m, s, ws, h):
                 and ws.contact_new[i] == 0 and _stays_clear(m, s.q, ws, i)):
             continue
         query_contact(m, s.q, ws, i)
-        if s.contact_enabled[i] == 0:
-            s.contact_mode[i] = MODE_FREE
+        if s.contact_enabled[i] == 0 or ws.contact_gap[i] == math.inf:
+            s.contact_mode[i] = MODE_FREE     # disabled, or an edge whose ends are lowest
         elif ws.contact_new[i] == 2:
             b = m.contact_body[i]
             vx = s.v[b, 0] - s.v[b, 2] * (ws.contact_point[i, 1] - s.q[b, 1])

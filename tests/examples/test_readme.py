@@ -1,5 +1,6 @@
 """README's Python code runs as written (the tour, then the compiled controller, which reuses
 the tour's model), in a temporary folder."""
+import math
 import re
 import runpy
 from pathlib import Path
@@ -18,3 +19,15 @@ def test_readme_python_blocks_run_in_order(tmp_path, monkeypatch):
     assert (tmp_path / "tour.gif").stat().st_size > 0
     assert (tmp_path / "tour.png").stat().st_size > 0
     assert namespace["code"] == 0 and namespace["traj"].t.shape[0] == namespace["k"]
+    # the tour's torso and leg are shapes that collide: whatever the controller does, no corner
+    # of the torso's box ends up inside the hill (it used to fall 0.5 m into it)
+    model, traj = namespace["model"], namespace["traj"]
+    ground = model.terrain
+    torso = model.body("torso")
+    for frame in traj.q:
+        x, y, th = frame[torso]
+        for dx in (-0.1, 0.1):
+            for dy in (-0.25, 0.25):
+                px = x + math.cos(th) * dx - math.sin(th) * dy
+                py = y + math.sin(th) * dx + math.cos(th) * dy
+                assert py - ground.height(px) > -1e-6

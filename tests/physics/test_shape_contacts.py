@@ -216,3 +216,29 @@ def test_clockwise_polygon_is_accepted_and_collides():
     sim.steps(2000)
     assert_clean(sim)
     assert abs(sim.state.q[0, 1] - 0.1) < 1e-8       # rests on its flat side
+
+
+@pytest.mark.parametrize("kind,params", [("box", ((0, 0), 1.0, 0.1)),
+                                         ("capsule", ((-0.5, 0), (0.5, 0), 0.05))])
+def test_long_shape_rests_on_a_crest_without_sinking_into_it(kind, params):
+    """A 1 m long box or capsule dropped flat onto the crest of a hill (radius of curvature
+    1.3 m): its corners or end circles hang in the air, the middle of its lower side carries it."""
+    from planarsim import terrain
+    from planarsim.kernels.audit import DEPTH_TOL
+    ground = terrain.hills([0.3], [4.0], [math.pi / 2])      # crest at x = 0, height 0.3
+    b = ps.ModelBuilder(dt=1e-3, terrain=ground)
+    b.add_body("plank", 2.0, 2.0 / 12, pos=(0.0, 0.42), shapes=[(kind, *params)])
+    model = b.compile()
+    sim = ps.Simulator(model)
+    sim.steps(3000)
+    assert_clean(sim)
+    x, y, th = sim.state.q[0]
+    # the lowest point of the lower side over the crest is 0.05 m below the body's centre
+    xs = np.linspace(-0.5, 0.5, 2001)
+    c, s = math.cos(th), math.sin(th)
+    px = x + c * xs + s * 0.05
+    py = y + s * xs - c * 0.05
+    clearance = py - np.array([ground.height(v) for v in px])
+    assert clearance.min() > -DEPTH_TOL            # nowhere inside the hill
+    assert clearance.min() < 1e-6                   # resting on it, not hovering
+    assert abs(x) < 0.05 and abs(th) < 0.05         # balanced on the crest

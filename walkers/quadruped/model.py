@@ -71,15 +71,18 @@ def standing_angles(p: QuadrupedParams, drop: float | None = None):
 
 
 def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None, dt: float = 1e-3,
-          x0: float = 0.0) -> ps.Model:
-    """Model of the quadruped standing with its torso COM above x0 [m] on `terrain`."""
+          x0: float = 0.0, extras=None) -> ps.Model:
+    """Model of the quadruped standing with its torso COM above x0 [m] on `terrain`.
+    extras(builder), if given, adds bodies and shapes after the walker's own (a box to push,
+    an obstacle): the torso's box collides with their shapes (not with the ground: the feet
+    are the dog's contacts), the legs are drawn only."""
     p = params if params is not None else QuadrupedParams()
     terrain = terrain if terrain is not None else flat()
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, -9.81), terrain=terrain)
     hips_x = [x0 + HIP_SIGN[i] * p.hip_x for i in range(N_LEG)]
     ty = 0.5 * (float(terrain.height(hips_x[0])) + float(terrain.height(hips_x[2]))) + p.stand_height
     b.add_body("torso", mass=p.torso_mass, inertia=p.torso_inertia, pos=(x0, ty), angle=0.0,
-               shapes=[("box", (0.0, 0.0), p.torso_length, p.torso_height, DRAWN)])
+               shapes=[("box", (0.0, 0.0), p.torso_length, p.torso_height, {"ground": False})])
     l1, l2 = p.thigh_length, p.calf_length
     width = (0.018, 0.012)          # drawing: left legs a little thicker than right ones
     knees = []
@@ -108,4 +111,6 @@ def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None,
     for i, name in enumerate(LEG_NAMES):
         b.add_arc_contact(f"{name}_foot", calf_body(i), center=(0.0, p.calf_com - l2),
                           radius=p.foot_radius, mu=p.friction)
+    if extras is not None:
+        extras(b)
     return b.compile(walker="quadruped")

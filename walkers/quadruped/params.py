@@ -41,7 +41,7 @@ class QuadrupedParams(WalkerParams):
     # body (A1, Menagerie) ------------------------------------------------------------------------
     torso_mass: float = _p(7.497, "kg", "trunk 4.713 + four hip housings 0.696 (abduction locked)", 0.1, 100.0)
     torso_inertia: float = _p(0.131, "kg m^2", "torso pitch inertia about its COM (trunk + hips at +-0.183 m)", 1e-4, 10.0)
-    torso_length: float = _p(0.267, "m", "trunk length (drawing only)", 0.01, 2.0)
+    torso_length: float = _p(0.267, "m", "trunk length (its box touches only bodies a scene adds)", 0.01, 2.0)
     torso_height: float = _p(0.114, "m", "trunk height (drawing only)", 0.01, 1.0)
     hip_x: float = _p(0.183, "m", "hip pins at x = +-hip_x from the torso COM (hip-to-hip 0.366 m)", 0.01, 1.0)
     thigh_length: float = _p(0.2, "m", "hip pin to knee pin", 0.01, 1.0)

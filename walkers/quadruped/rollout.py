@@ -63,6 +63,7 @@ class Quadruped(WalkerRun):
     speed : commanded walking speed [m/s] (params.speed if None; negative walks backward)
     strategy : contact-mode strategy, "all" (default) or "alternating"
     seed : 0 starts from the exact standing pose; others shift the torso height by < 5 mm
+    extras : extras(builder) adds bodies and shapes to the scene (model.build)
     """
 
     NAME = "quadruped"
@@ -72,9 +73,9 @@ class Quadruped(WalkerRun):
     LABEL_SLOTS = LABEL_SLOTS
 
     def __init__(self, params=None, terrain=None, dt=1e-3, gait="walk", speed=None,
-                 strategy="all", record_every=10, seed=0):
+                 strategy="all", record_every=10, seed=0, extras=None):
         params = params if params is not None else QuadrupedParams()
-        model = build(params, terrain_of(terrain), dt)
+        model = build(params, terrain_of(terrain), dt, extras=extras)
         state = ps.make_state(model)
         if seed:
             state.q[:, 1] += 0.005 * np.random.default_rng(seed).uniform()
