@@ -59,3 +59,11 @@ def test_period_doubling_example_runs_small(tmp_path, capsys):
     for name in ("simplest_period_doubling.png", "simplest_multipliers_branch.png",
                  "simplest_diagram.csv", "simplest_branches.csv"):
         assert (tmp_path / name).stat().st_size > 100
+
+
+def test_the_dog_pushes_a_box_two_metres():
+    ex = load("push_box")
+    travel, summary = ex.main(duration=12.0)
+    assert not summary["fell"]
+    assert travel >= 2.0
+    assert all(v == 0 for v in summary["audit"].values()), summary["audit"]

@@ -22,8 +22,9 @@ from planarsim.terrain import Terrain, flat
 from .params import QuadrupedParams
 from .puppet import leg_ik
 
-# the shapes only draw the walker: its feet are its contacts
-DRAWN = {"collide": False}
+# the walker's shapes touch what a scene adds (extras), not the ground: its feet are its
+# contacts; its own parts never collide with each other (one mechanism)
+OFF_GROUND = {"ground": False}
 
 LEG_NAMES = ("FL", "FR", "RL", "RR")
 N_LEG = 4
@@ -74,15 +75,15 @@ def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None,
           x0: float = 0.0, extras=None) -> ps.Model:
     """Model of the quadruped standing with its torso COM above x0 [m] on `terrain`.
     extras(builder), if given, adds bodies and shapes after the walker's own (a box to push,
-    an obstacle): the torso's box collides with their shapes (not with the ground: the feet
-    are the dog's contacts), the legs are drawn only."""
+    an obstacle): the torso's box and the legs' capsules collide with their shapes (not with
+    the ground: the feet are the dog's contacts)."""
     p = params if params is not None else QuadrupedParams()
     terrain = terrain if terrain is not None else flat()
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, -9.81), terrain=terrain)
     hips_x = [x0 + HIP_SIGN[i] * p.hip_x for i in range(N_LEG)]
     ty = 0.5 * (float(terrain.height(hips_x[0])) + float(terrain.height(hips_x[2]))) + p.stand_height
     b.add_body("torso", mass=p.torso_mass, inertia=p.torso_inertia, pos=(x0, ty), angle=0.0,
-               shapes=[("box", (0.0, 0.0), p.torso_length, p.torso_height, {"ground": False})])
+               shapes=[("box", (0.0, 0.0), p.torso_length, p.torso_height, OFF_GROUND)])
     l1, l2 = p.thigh_length, p.calf_length
     width = (0.018, 0.012)          # drawing: left legs a little thicker than right ones
     knees = []
@@ -95,10 +96,10 @@ def build(params: QuadrupedParams | None = None, terrain: Terrain | None = None,
         w = width[i % 2]
         b.add_body(f"{name}_thigh", mass=p.thigh_mass, inertia=p.thigh_inertia + p.armature,
                    pos=(hx + p.thigh_com * d1[0], hy + p.thigh_com * d1[1]), angle=q1,
-                   shapes=[("capsule", (0.0, p.thigh_com), (0.0, p.thigh_com - l1), w, DRAWN)])
+                   shapes=[("capsule", (0.0, p.thigh_com), (0.0, p.thigh_com - l1), w, OFF_GROUND)])
         b.add_body(f"{name}_calf", mass=p.calf_mass, inertia=p.calf_inertia + p.armature,
                    pos=(kx + p.calf_com * d12[0], ky + p.calf_com * d12[1]), angle=q1 + q2,
-                   shapes=[("capsule", (0.0, p.calf_com), (0.0, p.calf_com - l2), 0.7 * w, DRAWN)])
+                   shapes=[("capsule", (0.0, p.calf_com), (0.0, p.calf_com - l2), 0.7 * w, OFF_GROUND)])
     for i, name in enumerate(LEG_NAMES):
         b.add_pin(f"{name}_hip", BODY_TORSO, thigh_body(i), anchor_world=(hips_x[i], ty), ref_angle=0.0,
                   limit=(p.hip_lower, p.hip_upper))
