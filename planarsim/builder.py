@@ -192,8 +192,8 @@ class ModelBuilder:
         mask: filter bits (a pair collides when each one's category meets the other's mask);
         ground=False: it touches other shapes but not the analytic ground (a foot whose own
         contacts already touch it).
-        Bodies of one mechanism (linked by pins or rods) do not collide with each other
-        unless enable_collision names the pair."""
+        Bodies of one mechanism (linked by pins, rods or actuators) do not collide with each
+        other unless enable_collision names the pair."""
         if kind not in SHAPE_PARAMS:
             raise ModelError(f"shape on body {body}: kind={kind!r} must be one of "
                              f"{', '.join(SHAPE_PARAMS)}")
@@ -234,8 +234,8 @@ class ModelBuilder:
                     restitution=e, category=int(category), mask=int(mask), label=label)
 
     def enable_collision(self, body_a, body_b):
-        """Let two bodies of one mechanism (linked by pins or rods, which keeps them apart by
-        default) collide: their colliding shapes then touch each other."""
+        """Let two bodies of one mechanism (linked by pins, rods or actuators, which keeps them
+        apart by default) collide: their colliding shapes then touch each other."""
         a = self._body_id("collision pair", None, 0, "body_a", body_a)
         b = self._body_id("collision pair", None, 0, "body_b", body_b)
         if a == b:
@@ -494,7 +494,11 @@ class ModelBuilder:
                                 sh["radius"], **common)
                     c["verts"] = [np.asarray(core[(k + 1) % len(core)], float)]
                     out.append(c)
+        # a mechanism: bodies linked by pins, rods or actuators (a leg that is a force)
         joints = [p["body"] for p in self._pins] + [r["body"] for r in self._rods]
+        for a in self._acts:
+            bodies = [x for x in a["bodies"] if x >= 0]
+            joints += [(x, y) for k, x in enumerate(bodies) for y in bodies[k + 1:]]
         for i, j in collision_pairs(self._collide, len(self._bodies), joints, self._enabled_pairs):
             if self._collide[i]["body"] < 0:
                 i, j = j, i     # the world's shape second: contact_body is always a body

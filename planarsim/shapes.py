@@ -13,7 +13,8 @@ Which pairs of shapes can touch is decided once, here, when the model is compile
 world), their category and mask bits accept each other (``cat_a & mask_b`` and
 ``cat_b & mask_a`` non-zero, as Box2D and MuJoCo's contype/conaffinity), and their bodies are
 not parts of one mechanism (bodies linked by pins or rods, directly or through others, do
-not collide with each other unless the pair is enabled by ``ModelBuilder.enable_collision``).
+not collide with each other unless the pair is enabled by ``ModelBuilder.enable_collision``;
+actuators link bodies too: the Simple Biped's legs are forces between its point masses).
 """
 from __future__ import annotations
 

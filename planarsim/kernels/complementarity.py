@@ -1,8 +1,8 @@
 """The guaranteed solves: contact modes and impulses as one complementarity problem.
 
 Velocity stage (solve_contacts): every candidate contact (touching, or one the motion would
-push into the ground) enters with its normal and tangent rows, every candidate limit with its
-row; solve_mixed_lcp finds impulses that push, friction inside its cone and opposing any slip,
+push into the ground; every shape pair's point within touch) enters with its normal and
+tangent rows, every candidate limit with its row; solve_mixed_lcp finds impulses that push, friction inside its cone and opposing any slip,
 joints held; the modes are read off the answer. A contact outside the problem that the new
 velocity would still push into the ground joins it and the problem is solved again (at most
 once per contact: a finite loop, no cap to reach). If the problem with friction has no answer
@@ -22,7 +22,7 @@ from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
 from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
 from .contacts import query_contact
-from .pair import find_pair
+from .pair import PAIR_MARGIN, find_pair
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, is_joint_row, solve_mixed_lcp
@@ -50,12 +50,22 @@ def _drop_tangent_rows(ws):
 
 
 @kernel
+def touching_pair(m, s, ws, i):
+    """Contact i is an enabled shape pair's point touching (within PAIR_MARGIN): a candidate
+    of the complementarity problem even while free. Bodies resting on bodies move alike, so
+    the motion pushes none of them in until the one below has stopped: engaged one by one a
+    column of N boxes would take N solves, while as candidates those not needed end free."""
+    return (m.contact_kind[i] == CONTACT_PAIR and s.contact_enabled[i] == 1
+            and ws.contact_gap[i] <= PAIR_MARGIN)
+
+
+@kernel
 def _lcp_once(m, s, ws, h):
     """Build the rows of every candidate (contacts pinned: normal and tangent rows) and solve
     the complementarity problem; v_new from its impulses. Returns True if solved."""
     for i in range(m.contact_body.shape[0]):
         ws.contact_candidate[i] = 0
-        if s.contact_mode[i] != MODE_FREE:
+        if s.contact_mode[i] != MODE_FREE or touching_pair(m, s, ws, i):
             s.contact_mode[i] = MODE_PINNED
             ws.contact_candidate[i] = 1
     for j in range(m.pin_body.shape[0]):

@@ -40,6 +40,7 @@ from typing import NamedTuple
 import numpy as np
 
 from planarsim.compiled import jit_inline, kernel
+from planarsim.kernels.codes import CONTACT_PAIR
 
 from walkers.common.bezier import rectangle_bezier
 from walkers.common.pd import clamp
@@ -203,16 +204,32 @@ def _rate_target(v_top, l, phi, g):
 
 
 @kernel
-def next_state(p, s, mem, g):
-    """Transitions of the state machine (writes mem); g is the gravity magnitude [m/s^2]."""
+def foot_contact(m, s, foot):
+    """The most holding mode of foot `foot`'s contacts (0 free, 1 pinned, 2 sliding; pinned
+    first): its ground contact (contact `foot`) and the shape contacts of its body (steps,
+    obstacles a scene adds, kernels/pair.py)."""
+    body = foot + 1
+    best = 0
+    for k in range(m.contact_body.shape[0]):
+        if k != foot and not (m.contact_kind[k] == CONTACT_PAIR and (
+                m.contact_body[k] == body or m.contact_other[k] == body)):
+            continue
+        mode = s.contact_mode[k] if s.contact_enabled[k] != 0 else 0
+        if mode == 1 or (mode == 2 and best == 0):
+            best = mode
+    return best
+
+
+@kernel
+def next_state(p, s, mem, g, c0, c1):
+    """Transitions of the state machine (writes mem); g is the gravity magnitude [m/s^2]; c0,
+    c1: the feet touch something (foot_contact)."""
     q = s.q
     v = s.v
     t = s.time[0]
     state = int(mem[M_STATE])
     gait = int(mem[M_GAIT])
     t_in = t - mem[M_T_ENTER]
-    c0 = s.contact_mode[0] != 0 and s.contact_enabled[0] != 0
-    c1 = s.contact_mode[1] != 0 and s.contact_enabled[1] != 0
     if state == ST_STAND:
         if gait == GAIT_WALK and c0 and c1:
             mem[M_STANCE] = 0 if q[1, 0] > q[2, 0] else 1
@@ -326,7 +343,7 @@ def _flight(p, r, q, v, u):
 
 
 @kernel
-def _double_stance(p, r, s, mem, gx, gy, g, u):
+def _double_stance(p, r, s, mem, gx, gy, g, front_mode, u):
     """Eq. 1 normal force on the front leg toward r[R_LENGTH], eqs. 2-3 tangential force, split
     into the two legs."""
     q = s.q
@@ -343,7 +360,7 @@ def _double_stance(p, r, s, mem, gx, gy, g, u):
     # compensation -mh g split into its n and t parts
     f_n = mh * (a_n - (gx * nx + gy * ny))
     f_t = mh * (a_t - (-gx * ny + gy * nx))
-    if s.contact_mode[front] != 1 and f_t < 0.0:
+    if front_mode != 1 and f_t < 0.0:
         f_t = 0.0  # front foot not stuck (sliding or free): no forward push onto it
     push_hip_pendulum(q, front, f_n, f_t, p[P.I_DS_FRONT_LOAD] * mh * g,
                       min(p[P.I_LEG_FORCE_MAX], p[P.I_DS_FORCE_MAX] * (mh + 2.0 * p[P.I_FOOT_MASS]) * g), u)
@@ -392,7 +409,9 @@ def control(m, s, ws, tab, mem, u):
     gx = m.gravity[0]
     gy = m.gravity[1]
     g = math.sqrt(gx * gx + gy * gy)
-    next_state(p, s, mem, g)
+    c0 = foot_contact(m, s, 0)
+    c1 = foot_contact(m, s, 1)
+    next_state(p, s, mem, g, c0 != 0, c1 != 0)
     r = tab.row[int(mem[M_STATE])]
     law = int(r[R_LAW])
     if law == LAW_HIP:
@@ -400,7 +419,7 @@ def control(m, s, ws, tab, mem, u):
     elif law == LAW_FLIGHT:
         _flight(p, r, s.q, s.v, u)
     elif law == LAW_DOUBLE:
-        _double_stance(p, r, s, mem, gx, gy, g, u)
+        _double_stance(p, r, s, mem, gx, gy, g, c1 if int(mem[M_STANCE]) == 1 else c0, u)
     else:
         _single_stance(p, r, s.q, s.v, mem, gx, gy, g, u)
 

@@ -23,9 +23,16 @@ BODY_HIP, BODY_FOOT0, BODY_FOOT1 = 0, 1, 2
 ACT_LEG0, ACT_LEG1, ACT_HIP = 0, 1, 2
 
 
+# [l0] radius of the feet's disks against shapes (the ground meets the foot's centre)
+FOOT_RADIUS = 0.01
+
+
 def build(params: SimpleBipedParams | None = None, terrain: Terrain | None = None,
-          dt: float = 1e-3, x0: float = 0.0):
-    """Model of the Simple Biped standing at x0 [m] on `terrain` (default flat)."""
+          dt: float = 1e-3, x0: float = 0.0, extras=None):
+    """Model of the Simple Biped standing at x0 [m] on `terrain` (default flat).
+    extras(builder), if given, adds bodies and shapes after the walker's own (stairs of
+    static boxes, obstacles): each foot is a disk of FOOT_RADIUS l0 that touches their shapes
+    (the ground through its own point contact)."""
     p = params if params is not None else SimpleBipedParams()
     terrain = terrain if terrain is not None else ps.terrain.flat()
     l0 = p.leg_length
@@ -42,5 +49,9 @@ def build(params: SimpleBipedParams | None = None, terrain: Terrain | None = Non
     b.add_hip_torque("hip", hip, feet[0], feet[1], limit=(-p.hip_torque_max, p.hip_torque_max))
     for i, foot in enumerate(feet):
         b.add_point_contact(f"foot{i}", foot, mu=p.mu)
+    for foot in feet:
+        b.add_shape(foot, "circle", (0.0, 0.0), FOOT_RADIUS * l0, mu=p.mu, ground=False)
+    if extras is not None:
+        extras(b)
     # legs are massless lines hip-foot: drawn from meta["segments"] (pairs of body ids)
     return b.compile(walker="simple-biped", segments=((hip, feet[0]), (hip, feet[1])))

@@ -81,6 +81,7 @@ class Walker(WalkerRun):
     record_every : steps between recorded frames
     seed : 0 starts from the exact standing pose; other seeds shift the hip by up to 1 cm in x
     options : StepOptions (the engine defaults if None)
+    extras : extras(builder) adds bodies and shapes to the scene (stairs, obstacles; model.build)
     """
 
     NAME = "simple-biped"
@@ -90,9 +91,9 @@ class Walker(WalkerRun):
     LABEL_SLOTS = LABEL_SLOTS
 
     def __init__(self, params=None, terrain=None, dt=1e-3, gait="walk", speed=None,
-                 record_every=10, seed=0, options=None):
+                 record_every=10, seed=0, options=None, extras=None):
         params = params if params is not None else SimpleBipedParams()
-        model = build(params, terrain_of(terrain), dt)
+        model = build(params, terrain_of(terrain), dt, extras=extras)
         memory = np.zeros(C.N_MEMORY)
         memory[C.M_STATE] = C.ST_STAND
         memory[C.M_SPEED] = params.speed if speed is None else float(speed)
