@@ -103,7 +103,8 @@ def model_extent(model) -> float:
     """Size [m] of the model in its build pose (largest side of the shapes' bounding box)."""
     pts = [model.q0[:, :2]]
     for s in model.shapes:
-        pts.append(world_points(model.q0, s.body, shape_outline(s, 8)))
+        if s.body >= 0:     # world shapes (steps, walls) are scenery, not the model's size
+            pts.append(world_points(model.q0, s.body, shape_outline(s, 8)))
     pts = np.vstack(pts)
     return float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1]), 0.2))
 
