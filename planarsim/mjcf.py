@@ -59,6 +59,7 @@ _CHILDREN = {
 }
 DEFAULT_DENSITY = 1000.0  # [kg/m^3] MuJoCo's default geom density
 DRAWN = {"collide": False}  # add_shape's options for a geom that is only drawn
+COLLIDES = {"collide": True}
 
 
 @dataclass
@@ -100,7 +101,7 @@ class RigidBody:
     mass: float = 0.0                       # [kg]
     com: np.ndarray = None                  # (2,) world COM [m]
     inertia: float = 0.0                    # about the COM [kg m^2]
-    parts: list = field(default_factory=list)   # (mass, (x, y), I_own, shape) per geom
+    parts: list = field(default_factory=list)   # (mass, (x, y), I_own, shape, name) per geom
     mjcf_bodies: list = field(default_factory=list)
 
 
@@ -237,7 +238,7 @@ class _Loader:
         for c in node.children:
             if c.tag == "geom":
                 self.check(c)
-                self.rigid[rid].parts.append(self.geom(c))
+                self.rigid[rid].parts.append(self.geom(c) + (c.attrib.get("name", ""),))
             elif c.tag == "body":
                 self.walk(c, rid)
 
@@ -368,15 +369,17 @@ class _Loader:
             d2 = ((x - rb.com) ** 2).sum(1)
             rb.inertia = float(sum(p[2] for p in rb.parts) + (m * d2).sum())
             shapes = []
-            for _, c, _, s in rb.parts:
-                # drawn only: the model touches the ground through its own contact points
+            for _, c, _, s, geom_name in rb.parts:
+                # drawn only unless named in collide: the model touches the ground through
+                # its own contact points
+                how = COLLIDES if geom_name in self.collide else DRAWN
                 if s[0] == "circle":
-                    shapes.append(("circle", tuple(c - rb.com), s[1], DRAWN))
+                    shapes.append(("circle", tuple(c - rb.com), s[1], how))
                 elif s[0] == "box":
-                    shapes.append(("box", tuple(c - rb.com), s[1], s[2], DRAWN))
+                    shapes.append(("box", tuple(c - rb.com), s[1], s[2], how))
                 else:
                     shapes.append(("capsule", tuple(s[1] - rb.com), tuple(s[2] - rb.com), s[3],
-                                   DRAWN))
+                                   how))
             ids.append(builder.add_body(rb.name, mass=rb.mass, inertia=rb.inertia,
                                         pos=tuple(rb.com), shapes=shapes))
         pins = {}
@@ -391,7 +394,8 @@ class _Loader:
                          root=ids[0], name=model_name, free_joints=self.free)
 
 
-def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), **builder_kw) -> MJCFModel:
+def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), collide=(),
+              **builder_kw) -> MJCFModel:
     """Load a planar MJCF character.
 
     source : path to an .xml file, or the XML text itself (a string starting with '<')
@@ -399,6 +403,9 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), **
         terrain)
     offset : (2,) [m] translation of the whole character in the plane (e.g. to stand it on
         the ground)
+    collide : names of the geoms that collide (with the ground and other bodies' shapes); the
+        others are drawn only (the character touches the ground through contacts added to the
+        builder)
 
     Returns an MJCFModel (builder, name maps, per-body mass properties). Raises ModelError
     naming the element and line for malformed or unsupported input.
@@ -414,4 +421,12 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), **
         text, name = str(source), "<string>"
     root = parse_xml(text, name)
     b = builder if builder is not None else ModelBuilder(**builder_kw)
-    return _Loader(root, name).load(b, offset)
+    loader = _Loader(root, name)
+    loader.collide = frozenset(collide)
+    out = loader.load(b, offset)
+    known = {p[4] for rb in loader.rigid for p in rb.parts}
+    unknown = sorted(loader.collide - known)
+    if unknown:
+        raise ModelError(f"{name}: collide names geoms {unknown} that the file does not have; "
+                         f"its named geoms: {sorted(n for n in known if n)}")
+    return out

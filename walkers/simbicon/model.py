@@ -7,9 +7,10 @@ This module adds, with the public builder only:
   * a pin motor per joint, saturated at the params' torque limits;
   * the feet as box contacts (4 corners of the 0.3 x 0.15 m foot box, friction mu);
   * the start pose: the MJCF pose (legs straight, standing) raised so the soles touch y = 0.
-Only the feet carry contacts; ``non_foot_clearance`` checks from the drawing shapes that
-nothing else reaches the ground (the ankle spheres, which reach 2.5 cm below the sole in the
-MJCF file, count as part of the foot, as in the thesis' contact test).
+The feet touch the ground through their corner contacts; the other geoms (torso, hip and knee
+spheres, thigh and shin capsules) collide with it, so a fall leaves no part inside the ground;
+``non_foot_clearance`` measures how close they come (the ankle spheres, which reach 2.5 cm
+below the sole in the MJCF file, count as part of the foot, as in the thesis' contact test).
 """
 from __future__ import annotations
 
@@ -30,6 +31,11 @@ _PIN_NAMES = {  # MJCF joint names of legs.xml per side (the file is not quite s
     "right": ("right_hip_to_right_thigh", "right_knee_to_right_shin", "right_ankle_to_right_foot"),
     "left": ("left_hip_to_left_thigh", "left_thigh_to_left_shin", "left_ankle_to_left_foot"),
 }
+# geoms that collide with the ground and with what a scene adds (a fall leaves no part inside
+# the ground): all but the feet and the ankle spheres, which reach 2.5 cm below the sole (the
+# feet's corner contacts hold the character up, as in the thesis' contact test)
+COLLIDING_GEOMS = tuple(f"{side}_{part}_geom" for side in SIDES
+                        for part in ("hip", "thigh", "knee", "shin")) + ("base",)
 SOLE_DEPTH = 1.275   # [m] sole below the MJCF origin: foot box centre z = -1.2, half height 0.075
 FOOT_BOX = (0.15, -1.2, 0.3, 0.15)   # MJCF foot box: centre x, z; width, height [m]
 
@@ -45,7 +51,7 @@ def build(params: SimbiconParams | None = None, terrain=None, dt: float = 1e-3):
     terrain = terrain if terrain is not None else flat()
     ground = float(terrain.height(0.0))
     b = ModelBuilder(dt=dt, terrain=terrain)
-    char = load_mjcf(XML, builder=b, offset=(0.0, ground + SOLE_DEPTH))
+    char = load_mjcf(XML, builder=b, offset=(0.0, ground + SOLE_DEPTH), collide=COLLIDING_GEOMS)
     limits = {"hip": p.hip_torque_max, "knee": p.knee_torque_max, "ankle": p.ankle_torque_max}
     pin = np.zeros((2, 3), np.int64)
     act = np.zeros((2, 3), np.int64)
