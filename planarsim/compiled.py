@@ -19,6 +19,8 @@ Engine, from compiled code:
     height(coef, x), height_derivs(coef, x)  the ground h(x) [m] and (h, h', h'')
     closest_point(coef, px, py)              (gx, gy, nx, ny, gap) of the nearest ground point
     pin_angle_rate(m, q, v, j)               pin j's angle [rad] and rate [rad/s]
+    shape_contact_mode(m, s, body)           most holding mode (0 free, 1 pinned, 2 sliding) of
+                                             body's shape contacts (on a box, a step, a body)
 From Python:
     step_from_python(m, s, ws, opt, u)       the same step (about 1 us a call on top of the
                                              step, as Simulator.step)
@@ -38,6 +40,7 @@ from .errors import diverged
 from .kernels._jit import drop_stale_caches, jit, jit_inline, kernel
 from .kernels.audit import audit_counts
 from .kernels.forces import pin_angle_rate
+from .kernels.pair import shape_contact_mode
 from .kernels.info import step_info
 from .kernels.guards import (GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE,
                              GUARD_NONFINITE_COMMAND, GUARD_OK, GUARD_TOO_LARGE)
@@ -85,7 +88,8 @@ def check_run(code, model, ws, options, who="simulation") -> int:
 
 __all__ = ["jit", "jit_inline", "kernel", "step", "step_from_python", "record_frame",
            "make_recorder", "height", "height_derivs", "closest_point", "gap_of_point",
-           "pin_angle_rate", "audit_counts", "step_info", "drop_stale_caches", "kernel_cache",
+           "pin_angle_rate", "shape_contact_mode", "audit_counts", "step_info", "drop_stale_caches",
+           "kernel_cache",
            "check_run", "engine_failed",
            "RUN_OK", "RUN_NONFINITE", "RUN_TOO_LARGE", "RUN_AUDIT", "RUN_BAD_COMMANDS",
            "RUN_NONFINITE_COMMAND", "RUN_WALKER", "RUN_FELL", "RUN_NO_EVENT"]

@@ -23,7 +23,7 @@ the bodies' speed bounds times h, plus PAIR_MARGIN) skips the narrow phase.
 import math
 
 from ._jit import kernel
-from .codes import MODE_FREE
+from .codes import CONTACT_PAIR, MODE_FREE
 from .collide import collide
 from .math2d import rotate, set_dir, world_point
 
@@ -287,4 +287,21 @@ def pair_gap_now(m, q, cs, ws, i):
     best = math.inf
     for k in range(n):
         best = min(best, ws.manifold[k, 8])
+    return best
+
+
+@kernel
+def shape_contact_mode(m, s, body):
+    """The most holding mode of the enabled shape-pair contacts of `body` (0 free, 1 pinned,
+    2 sliding; pinned first): whether it stands on, or leans on, another body's shape or a
+    world shape (a controller's touchdown test beside its own ground contacts)."""
+    best = 0
+    for k in range(m.contact_body.shape[0]):
+        if m.contact_kind[k] != CONTACT_PAIR or s.contact_enabled[k] == 0:
+            continue
+        if m.contact_body[k] != body and m.contact_other[k] != body:
+            continue
+        mode = s.contact_mode[k]
+        if mode == 1 or (mode == 2 and best == 0):
+            best = mode
     return best

@@ -39,8 +39,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planarsim.compiled import jit_inline, kernel
-from planarsim.kernels.codes import CONTACT_PAIR
+from planarsim.compiled import jit_inline, kernel, shape_contact_mode
 
 from walkers.common.bezier import rectangle_bezier
 from walkers.common.pd import clamp
@@ -207,17 +206,12 @@ def _rate_target(v_top, l, phi, g):
 def foot_contact(m, s, foot):
     """The most holding mode of foot `foot`'s contacts (0 free, 1 pinned, 2 sliding; pinned
     first): its ground contact (contact `foot`) and the shape contacts of its body (steps,
-    obstacles a scene adds, kernels/pair.py)."""
-    body = foot + 1
-    best = 0
-    for k in range(m.contact_body.shape[0]):
-        if k != foot and not (m.contact_kind[k] == CONTACT_PAIR and (
-                m.contact_body[k] == body or m.contact_other[k] == body)):
-            continue
-        mode = s.contact_mode[k] if s.contact_enabled[k] != 0 else 0
-        if mode == 1 or (mode == 2 and best == 0):
-            best = mode
-    return best
+    obstacles a scene adds)."""
+    own = s.contact_mode[foot] if s.contact_enabled[foot] != 0 else 0
+    shapes = shape_contact_mode(m, s, foot + 1)
+    if own == 1 or shapes == 1:
+        return 1
+    return max(own, shapes)
 
 
 @kernel
