@@ -79,15 +79,21 @@ def note(ws, step, kind, who, body, value):
 
 
 @kernel
+def _impulse_floor(ws):
+    """IMPULSE_FLOOR of the step's largest normal contact impulse [N s]."""
+    largest = 0.0
+    for i in range(ws.contact_impulse.shape[0]):
+        largest = max(largest, abs(ws.contact_impulse[i, 0]))
+    return IMPULSE_FLOOR * largest
+
+
+@kernel
 def audit_impulses(m, s, ws):
     """Pulling contacts, friction outside its cone and positive contact work, from
     ws.contact_impulse and the constrained velocity ws.v_new. Returns the violations found."""
     found = 0
     step = s.step[0]
-    largest = 0.0
-    for i in range(m.contact_body.shape[0]):
-        largest = max(largest, abs(ws.contact_impulse[i, 0]))
-    floor = IMPULSE_FLOOR * largest
+    floor = -1.0        # IMPULSE_FLOOR of the largest impulse, found when first needed
     for i in range(m.contact_body.shape[0]):
         ln = ws.contact_impulse[i, 0]
         lt = ws.contact_impulse[i, 1]
@@ -95,22 +101,27 @@ def audit_impulses(m, s, ws):
             continue
         size = abs(ln) + abs(lt)
         b = m.contact_body[i]
-        if ln < -(IMPULSE_REL_TOL * size + floor):
-            note(ws, step, AUDIT_PULL, i, b, ln)
-            found += 1
-        if abs(lt) > m.contact_mu[i] * ln + IMPULSE_REL_TOL * size + floor:
+        if ln < -IMPULSE_REL_TOL * size or abs(lt) > m.contact_mu[i] * ln + IMPULSE_REL_TOL * size:
+            if floor < 0.0:
+                floor = _impulse_floor(ws)
+            if ln < -(IMPULSE_REL_TOL * size + floor):
+                note(ws, step, AUDIT_PULL, i, b, ln)
+                found += 1
+        if abs(lt) > m.contact_mu[i] * ln + IMPULSE_REL_TOL * size + max(floor, 0.0):
             note(ws, step, AUDIT_CONE, i, b, abs(lt) - m.contact_mu[i] * ln)
             found += 1
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
         # restitution's rebound (at most e times the approach speed) is work it may do
         work = ln * (vn - ws.contact_bounce[i]) + lt * vt
         scale = WORK_REL_TOL * (abs(vn) + abs(vt)) + VELOCITY_FLOOR
+        if work > size * scale and floor < 0.0:
+            floor = _impulse_floor(ws)
         # an impulse of rounding size (below the floor) does rounding work at any speed
-        if work > size * scale + floor * (abs(vn) + abs(vt)):
+        if work > size * scale + max(floor, 0.0) * (abs(vn) + abs(vt)):
             # the tolerance also scales with the free motion's speed (computed only here)
             vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
             if work > (size * (scale + WORK_REL_TOL * (abs(vp_n) + abs(vp_t)))
-                       + floor * (abs(vn) + abs(vt))):
+                       + max(floor, 0.0) * (abs(vn) + abs(vt))):
                 note(ws, step, AUDIT_WORK, i, b, work)
                 found += 1
     return found

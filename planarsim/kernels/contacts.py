@@ -106,7 +106,7 @@ def _edge_minimum(coef, x0, y0, dx, dy, u0, u1, rounded):
     return u, y0 + u * dy - height_derivs(coef, x0 + u * dx)[0]
 
 
-@kernel
+@kernel_call
 def edge_deepest(m, q, cs, i):
     """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
     fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
@@ -162,7 +162,7 @@ def edge_deepest(m, q, cs, i):
     return inside, x0 + best_u * dx, y0 + best_u * dy
 
 
-@kernel
+@kernel_call
 def find_edge(m, q, ws, i):
     """Edge contact i at q: its deepest core point, pushed out by the shape's radius along the
     ground normal (a capsule's side), as a material point held for the step; gap inf where the
@@ -293,7 +293,8 @@ def engage_contact(m, s, ws, i, vn, vt):
     else:
         s.contact_mode[i] = MODE_PINNED
     ws.contact_new[i] = 1
-    ws.contact_bounce[i] = bounce_of(m, s, ws, i)
+    if m.contact_restitution[i] != 0.0:
+        ws.contact_bounce[i] = bounce_of(m, s, ws, i)
 
 
 # [m/s] restitution acts on impacts faster than this (slower ones are plastic: a body coming
@@ -333,7 +334,7 @@ def pair_motion_scale(s, ws, i, vel):
     return abs(vx) + abs(vy) + abs(ux) + abs(uy)
 
 
-@kernel
+@kernel_call
 def bounce_of(m, s, ws, i):
     """The normal velocity [m/s] restitution asks of contact i after an impact: e times its
     approach speed at the step's start, 0 below BOUNCE_SPEED."""
@@ -358,7 +359,7 @@ def find_contacts(m, s, ws, h):
                 find_pair(m, s, ws, i, h, 0.0, False)
             if s.contact_enabled[i] == 0:
                 s.contact_mode[i] = MODE_FREE
-            else:
+            elif m.contact_restitution[i] != 0.0:
                 ws.contact_bounce[i] = bounce_of(m, s, ws, i)
             continue
         if (lazy and s.contact_mode[i] == MODE_FREE and s.contact_enabled[i] == 1
@@ -374,5 +375,5 @@ def find_contacts(m, s, ws, h):
             nx = ws.contact_normal[i, 0]
             ny = ws.contact_normal[i, 1]
             engage_contact(m, s, ws, i, nx * vx + ny * vy, ny * vx - nx * vy)
-        else:
+        elif m.contact_restitution[i] != 0.0:
             ws.contact_bounce[i] = bounce_of(m, s, ws, i)

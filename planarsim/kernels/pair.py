@@ -17,12 +17,13 @@ Rows act at the incident body's surface point ps = p - r_inc n (its friction act
 disk rolls). The reference body is the row's body a (-1: a world shape), the incident body
 its body b (ws.contact_bodies); either may be the pair's first shape.
 
-Broad phase: a pair whose bounding circles are farther apart than the step can close (twice
+The pair's stages are calls (kernel_call), not inlined: a model without shapes keeps the
+step's hot loops as small as before. Broad phase: a pair whose bounding circles are farther apart than the step can close (twice
 the bodies' speed bounds times h, plus PAIR_MARGIN) skips the narrow phase.
 """
 import math
 
-from ._jit import kernel
+from ._jit import kernel, kernel_call
 from .codes import CONTACT_PAIR, MODE_FREE
 from .collide import collide
 from .math2d import rotate, set_dir, world_point
@@ -162,7 +163,7 @@ def _clear_slot(s, ws, c):
     s.last_contact_impulse[c, 1] = 0.0
 
 
-@kernel
+@kernel_call
 def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
     """Stage 3 for the pair whose slot 0 is contact i, at s.q (ws.body_cs current): the
     manifold within the step's reach (PAIR_MARGIN, or margin_floor if larger, plus what
@@ -245,7 +246,7 @@ def pair_surface_point(q, cs, ws, o):
     return px - r_inc * nx, py - r_inc * ny, nx, ny, gap
 
 
-@kernel
+@kernel_call
 def pair_row(q, cs, ws, o, J, tangent):
     """Jacobian blocks J (2, 3) and error of pair contact o's normal row (its exact gap [m]
     at q) or tangent row (tangent: the surface points' slip along t = (n_y, -n_x) since the
@@ -274,7 +275,7 @@ def pair_speed(m, ws, i, vel):
     return _speed_bound(m, vel, m.shape_body[sa], sa) + _speed_bound(m, vel, m.shape_body[sb], sb)
 
 
-@kernel
+@kernel_call
 def pair_gap_now(m, q, cs, ws, i):
     """The signed gap [m] of pair contact i's shapes at q, measured afresh (the audit): the
     deepest point of the manifold on slot 0, +inf on slot 1 (a pair is measured once) and
@@ -290,7 +291,7 @@ def pair_gap_now(m, q, cs, ws, i):
     return best
 
 
-@kernel
+@kernel_call
 def shape_contact_mode(m, s, body):
     """The most holding mode of the enabled shape-pair contacts of `body` (0 free, 1 pinned,
     2 sliding; pinned first): whether it stands on, or leans on, another body's shape or a
