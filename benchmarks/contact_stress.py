@@ -20,7 +20,7 @@ Families (every scene drawn from numpy.random.default_rng(seed); friction mu in 
 - mass_ratio: two pinned boxes with a mass ratio of 1 to 1000 at most, hitting flat ground at
   10-100 m/s within 60 deg of straight down, tumbling at up to 10 rad/s.
 
-- shape_pile: 4-8 colliding shapes (boxes, capsules, circles, convex polygons of 3-6
+- shape_pile: 4-12 colliding shapes (boxes, capsules, circles, convex polygons of 3-6
   vertices; 2-40 cm) with masses 10^U(-1.5, 1.5) kg (ratios to 1:1000), stacked loosely with
   random offsets and tilts and thrown down at 1-30 m/s (and up to 10 rad/s) onto each other
   and flat ground.
@@ -270,7 +270,7 @@ def random_shape(rng):
 
 
 def shape_scene(rng, dt, hills):
-    """4-8 random shapes in a loose column over flat ground or sine hills; returns the model
+    """4-12 random shapes in a loose column over flat ground or sine hills; returns the model
     and the start velocities (n_body, 3)."""
     if hills:
         n_sines = int(rng.integers(1, 3))
@@ -284,7 +284,7 @@ def shape_scene(rng, dt, hills):
     x0 = rng.uniform(-2.0, 2.0)
     y = ground.height(x0) + 0.45
     v = []
-    for k in range(int(rng.integers(4, 9))):
+    for k in range(int(rng.integers(4, 13))):
         kind, params, mass, inertia = random_shape(rng)
         b.add_body(f"s{k}", mass, inertia, pos=(x0 + rng.uniform(-0.15, 0.15), y),
                    angle=rng.uniform(-math.pi, math.pi), shapes=[(kind, *params, {"mu": mu})])

@@ -7,7 +7,8 @@ After the velocity stage (impulses as applied):
             IMPULSE_FLOOR of the step's largest)
   work      a contact's impulse does positive work at the step's end velocity
             (lambda_n v_n + lambda_t v_t > 0: it would add energy) beyond rounding: more
-            than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR)
+            than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR), |v| the contact's speed, free
+            and constrained, and the fastest body's
 After the position stage (the configuration the step ends at):
   pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
   depth     a contact point below the ground, or two shapes overlapping, by more than
@@ -88,6 +89,16 @@ def _impulse_floor(ws):
 
 
 @kernel
+def _speed_scale(ws):
+    """The largest |v_x| + |v_y| [m/s] of any body, free or constrained, in the step."""
+    top = 0.0
+    for b in range(ws.v_new.shape[0]):
+        top = max(top, abs(ws.v_new[b, 0]) + abs(ws.v_new[b, 1]),
+                  abs(ws.v_pred[b, 0]) + abs(ws.v_pred[b, 1]))
+    return top
+
+
+@kernel
 def audit_impulses(m, s, ws):
     """Pulling contacts, friction outside its cone and positive contact work, from
     ws.contact_impulse and the constrained velocity ws.v_new. Returns the violations found."""
@@ -120,7 +131,9 @@ def audit_impulses(m, s, ws):
         if work > size * scale + max(floor, 0.0) * (abs(vn) + abs(vt)):
             # the tolerance also scales with the free motion's speed (computed only here)
             vp_n, vp_t = contact_velocity(m, s, ws, i, ws.v_pred)
-            if work > (size * (scale + WORK_REL_TOL * (abs(vp_n) + abs(vp_t)))
+            # ... and with the fastest body's (a resting contact under a falling pile: the
+            # solve's rounding is relative to the largest velocities it handles)
+            if work > (size * (scale + WORK_REL_TOL * (abs(vp_n) + abs(vp_t) + _speed_scale(ws)))
                        + max(floor, 0.0) * (abs(vn) + abs(vt))):
                 note(ws, step, AUDIT_WORK, i, b, work)
                 found += 1
