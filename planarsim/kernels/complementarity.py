@@ -25,10 +25,10 @@ from .contacts import query_contact
 from .pair import PAIR_MARGIN, find_pair
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
-from .mixed_lcp import assemble_dense, is_joint_row, solve_mixed_lcp
+from .mixed_lcp import assemble_dense, solve_mixed_lcp
 from .modes import engage_contacts, engage_limits, gather_contact_impulses, modes_from_solution
 from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
-                   add_row, build_rows, eval_rows, move_row)
+                   add_row, build_rows, eval_rows, is_joint_row, move_row)
 from .solve import apply_impulses, fill_row_b
 
 # Lemke's path is finite; the cap only stops a path that rounding has sent astray

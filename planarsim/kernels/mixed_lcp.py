@@ -21,7 +21,7 @@ from ._jit import kernel, kernel_call
 from .lcp import ANSWER_TOL, LCP_INACCURATE, LCP_RAY, LCP_SOLVED, lemke, polish
 from .codes import CONTACT_PAIR
 from .contacts import pair_motion_scale
-from .rows import ROW_CONTACT_T, ROW_ROD
+from .rows import ROW_CONTACT_T, is_joint_row
 from .solve import _entry
 
 # a joint-only loop: a joint row whose pivot falls to this share of its diagonal is an exact
@@ -47,9 +47,6 @@ def assemble_dense(m, ws, n):
             ws.A[j, i] = a
 
 
-@kernel
-def is_joint_row(kind):
-    return kind <= ROW_ROD
 
 
 @kernel

@@ -25,6 +25,19 @@ ROW_LIMIT_LO = 3
 ROW_LIMIT_HI = 4
 ROW_CONTACT_N = 5
 ROW_CONTACT_T = 6
+# a row kind's class is asked by name (is_joint_row, is_mode_row), never by its number's order
+
+
+@kernel
+def is_joint_row(kind):
+    """An equality of a joint (pin x / y, rod): its impulse is free, its error always held."""
+    return kind == ROW_PIN_X or kind == ROW_PIN_Y or kind == ROW_ROD
+
+
+@kernel
+def is_mode_row(kind):
+    """A row with a rule a solve can break (a joint limit, a contact's normal or tangent)."""
+    return not is_joint_row(kind)
 
 
 @kernel
@@ -32,7 +45,7 @@ def has_mode_rows(ws, n):
     """Some row among 0..n-1 belongs to a contact or a joint limit (whose rule a solve can
     break); otherwise the rows are joints only."""
     for r in range(n):
-        if ws.row_kind[r] >= ROW_LIMIT_LO:
+        if is_mode_row(ws.row_kind[r]):
             return True
     return False
 

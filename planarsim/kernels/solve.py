@@ -18,7 +18,7 @@ Without sliding contacts F = J and the matrix is symmetric: it is assembled in i
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ._jit import kernel, kernel_inline
-from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_LO
+from .rows import ROW_CONTACT_N, ROW_CONTACT_T, is_joint_row
 from .warm_start import start_impulses
 
 
@@ -261,7 +261,7 @@ def row_dot(ws, r, J, vel):
 def fill_row_b(ws, h, n):
     """ws.row_b: each row's end-of-step residual without impulses [m/s], w = A lam + b."""
     for r in range(n):
-        if ws.row_kind[r] < ROW_LIMIT_LO:
+        if is_joint_row(ws.row_kind[r]):
             # a joint's error at the end of the step without impulses, c(q + h v*): c + h J v*
             # plus the second-order drift of its rotating anchors, which the position
             # correction would otherwise remove (one Newton iteration fewer)
