@@ -20,9 +20,12 @@ import numpy as np
 from benchmarks.scenes import G
 
 #: episode of the timing runs and of the accuracy runs per scene kind [s] (scenes.py)
-ACCURACY_SECONDS = {"chain": 10.0, "biped_collapse": 3.0, "rod_drop": 2.0}
-#: scenes that the peers build (the chains N = 2..64, the biped collapse, the rod drop)
-PEER_SCENES = ("chain2", "chain4", "chain8", "chain16", "chain32", "chain64", "biped_collapse", "rod_drop")
+ACCURACY_SECONDS = {"chain": 10.0, "biped_collapse": 3.0, "rod_drop": 2.0, "box_column10": 10.0,
+                    "box_pyramid": 10.0}
+#: scenes that the peers build (the chains N = 2..64, the biped collapse, the rod drop, a
+#: column of ten boxes and the 20-box pyramid, whose boxes collide with each other)
+PEER_SCENES = ("chain2", "chain4", "chain8", "chain16", "chain32", "chain64", "biped_collapse", "rod_drop",
+               "box_column10", "box_pyramid")
 
 
 @dataclass(frozen=True)
@@ -35,6 +38,7 @@ class SceneSpec:
     pin_body : (n_pin, 2) int body a, body b (-1: world)
     pin_anchor : (n_pin, 2, 2) local anchors on a and b (world coordinates for -1) [m]
     ground : True when a flat ground at y = 0 is present (friction 1, restitution 0)
+    bodies_collide : the boxes collide with each other (stacks); else only with the ground
     """
     name: str
     dt: float
@@ -47,6 +51,7 @@ class SceneSpec:
     ground: bool
     seconds: float
     energy_scale: float
+    bodies_collide: bool = False
 
     @property
     def n_body(self) -> int:
@@ -64,8 +69,9 @@ def spec_from_model(name: str, model, seconds: float) -> SceneSpec:
     a = model.arrays
     nb = model.n_body
     box = np.full((nb, 2), np.nan)
+    pair = a.contact_kind == 2          # a shape pair's contacts: the boxes touch each other
     for body in range(nb):
-        pts = a.contact_local[a.contact_body == body]
+        pts = a.contact_local[(a.contact_body == body) & ~pair]
         if len(pts) == 4:
             if np.abs(pts.mean(axis=0)).max() > 1e-12:
                 raise ValueError(f"scene {name!r}: box of body {model.body_names[body]!r} is not centred on its COM")
@@ -80,7 +86,8 @@ def spec_from_model(name: str, model, seconds: float) -> SceneSpec:
         scale = float(np.sum(a.body_mass * model.q0[:, 1]) * G)
     return SceneSpec(name=name, dt=float(a.dt), mass=a.body_mass.copy(), inertia=a.body_inertia.copy(),
                      q0=model.q0.copy(), box=box, pin_body=a.pin_body.copy(), pin_anchor=a.pin_anchor.copy(),
-                     ground=bool(len(a.contact_body)), seconds=seconds, energy_scale=scale)
+                     ground=bool(len(a.contact_body)), seconds=seconds, energy_scale=scale,
+                     bodies_collide=bool(pair.any()))
 
 
 def world_points(q, body, local):
@@ -140,6 +147,9 @@ def accuracy(spec: SceneSpec, q, v) -> dict:
         low = lowest_point(spec, q)
         out["penetration_m"] = float(max(0.0, -np.min(low)))
         out["rest_gap_m"] = float(low[-1])
+    if spec.bodies_collide:
+        # stacks start at rest, touching: any move is a sink or a slide (a stack's accuracy)
+        out["stack_drift_m"] = float(np.max(np.hypot(q[..., 0] - q[0, :, 0], q[..., 1] - q[0, :, 1])))
     if spec.name == "rod_drop":
         vy = v[:, 0, 1]
         k_impact = int(np.argmin(vy))

@@ -45,7 +45,8 @@ class World:
             w, h = spec.box[b]
             if not np.isnan(w):
                 body.CreatePolygonFixture(box=(float(w) / 2, float(h) / 2), density=1.0, friction=1.0,
-                                          restitution=0.0, groupIndex=-1)
+                                          restitution=0.0,
+                                          groupIndex=0 if spec.bodies_collide else -1)
             md = b2.b2MassData()
             md.mass, md.center, md.I = float(spec.mass[b]), (0.0, 0.0), float(spec.inertia[b])
             body.massData = md

@@ -70,8 +70,11 @@ def mjcf(spec) -> str:
         lines += [f"{pad}  {jx}" for jx in joints]
         w, h = spec.box[b]
         if not np.isnan(w):
-            lines.append(f'{pad}  <geom type="box" size="{w / 2:.17g} 0.05 {h / 2:.17g}" contype="2" '
-                         'conaffinity="1" friction="1 0.005 0.0001" mass="0"/>')
+            # contype 2 / conaffinity 1: the ground only; 3 / 3: the ground and each other
+            ct = 3 if spec.bodies_collide else 2
+            ca = 3 if spec.bodies_collide else 1
+            lines.append(f'{pad}  <geom type="box" size="{w / 2:.17g} 0.05 {h / 2:.17g}" contype="{ct}" '
+                         f'conaffinity="{ca}" friction="1 0.005 0.0001" mass="0"/>')
         for child in children.get(b, []):
             lines += body_xml(child, indent + 2)
         lines.append(f"{pad}</body>")

@@ -37,7 +37,8 @@ class World:
         space.gravity = (0.0, -9.81)
         space.collision_slop = COLLISION_SLOP
         bodies = []
-        group = pm.ShapeFilter(group=1)
+        # one group: the character's own bodies do not collide; a stack's boxes do
+        group = pm.ShapeFilter() if spec.bodies_collide else pm.ShapeFilter(group=1)
         for b in range(spec.n_body):
             body = pm.Body(float(spec.mass[b]), float(spec.inertia[b]))
             body.position = float(spec.q0[b, 0]), float(spec.q0[b, 1])
