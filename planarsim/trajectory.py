@@ -21,7 +21,7 @@ FORMAT_VERSION = 1
 FRAME_DIMS = dict(  # shape of each per-frame array of a Trajectory (K frames)
     t=("K",), q=("K", "n_body", 3), v=("K", "n_body", 3), contact_mode=("K", "n_contact"),
     contact_impulse=("K", "n_contact", 2), contact_point=("K", "n_contact", 2),
-    act_u=("K", "n_act"), act_power=("K", "n_act"))
+    act_u=("K", "n_act"), act_power=("K", "n_act"), contact_normal=("K", "n_contact", 2))
 
 
 class Recorder(NamedTuple):
@@ -34,6 +34,8 @@ class Recorder(NamedTuple):
     contact_point: np.ndarray    # (K, n_contact, 2) [m]
     act_u: np.ndarray            # (K, n_act)
     act_power: np.ndarray        # (K, n_act) [W]
+    contact_normal: np.ndarray   # (K, n_contact, 2) unit normal of each contact (the ground's,
+                                 #   or a shape pair's, from the reference shape to the other)
 
 
 def make_recorder(model, n_frames: int) -> Recorder:
@@ -41,7 +43,7 @@ def make_recorder(model, n_frames: int) -> Recorder:
     z = np.zeros
     return Recorder(t=z(K), q=z((K, nb, 3)), v=z((K, nb, 3)), contact_mode=z((K, nc), np.int64),
                     contact_impulse=z((K, nc, 2)), contact_point=z((K, nc, 2)), act_u=z((K, na)),
-                    act_power=z((K, na)))
+                    act_power=z((K, na)), contact_normal=z((K, nc, 2)))
 
 
 @dataclass
@@ -56,13 +58,15 @@ class Trajectory:
     contact_point: np.ndarray
     act_u: np.ndarray
     act_power: np.ndarray
+    contact_normal: np.ndarray = None   # (K, n_contact, 2); NaN where a file had none
     body_names: tuple = ()
     contact_names: tuple = ()
     act_names: tuple = ()
     labels: dict = field(default_factory=dict)
     info: dict = field(default_factory=dict)
 
-    _ARRAYS = ("t", "q", "v", "contact_mode", "contact_impulse", "contact_point", "act_u", "act_power")
+    _ARRAYS = ("t", "q", "v", "contact_mode", "contact_impulse", "contact_point", "act_u", "act_power",
+               "contact_normal")
 
     @classmethod
     def from_recorder(cls, model, rec: Recorder, n: int | None = None, **kw) -> "Trajectory":
@@ -134,6 +138,9 @@ class Trajectory:
         if version != FORMAT_VERSION:
             raise ValueError(f"{path}: trajectory format version {version}; this planarsim reads "
                              f"version {FORMAT_VERSION}")
+        if "contact_normal" not in data and "contact_point" in data:
+            # written before normals were recorded: unknown (drawn along the ground's normal)
+            data["contact_normal"] = np.full(np.shape(data["contact_point"]), np.nan)
         missing = [k for k in cls._ARRAYS if k not in data]
         if missing:
             raise ValueError(f"{path}: trajectory is missing arrays {missing}")

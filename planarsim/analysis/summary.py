@@ -22,11 +22,12 @@ def frame_from_state(model, state, ws=None):
     nc, na = model.n_contact, model.n_act
     imp = np.array(ws.contact_impulse)[None] if ws is not None else np.zeros((1, nc, 2))
     pt = np.array(ws.contact_point)[None] if ws is not None else np.zeros((1, nc, 2))
+    nrm = np.array(ws.contact_normal)[None] if ws is not None else np.full((1, nc, 2), np.nan)
     act_u = np.array(ws.act_u)[None] if ws is not None else np.zeros((1, na))
     act_p = np.array(ws.act_power)[None] if ws is not None else np.zeros((1, na))
     return Trajectory(t=np.array([float(s.time[0])]), q=np.array(s.q)[None], v=np.array(s.v)[None],
                       contact_mode=mode, contact_impulse=imp, contact_point=pt, act_u=act_u,
-                      act_power=act_p, body_names=model.body_names, contact_names=model.contact_names,
+                      act_power=act_p, contact_normal=nrm, body_names=model.body_names, contact_names=model.contact_names,
                       act_names=model.act_names)
 
 

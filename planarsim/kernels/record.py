@@ -15,6 +15,7 @@ def record_frame(s, ws, rec, k):
         for c in range(2):
             rec.contact_impulse[k, i, c] = ws.contact_impulse[i, c]
             rec.contact_point[k, i, c] = ws.contact_point[i, c]
+            rec.contact_normal[k, i, c] = ws.contact_normal[i, c]
     for a in range(ws.act_u.shape[0]):
         rec.act_u[k, a] = ws.act_u[a]
         rec.act_power[k, a] = ws.act_power[a]

@@ -320,9 +320,11 @@ class Scene:
             else:
                 lab.set_visible(False)
 
-    def impulse_segments(self, points, impulses, modes=None):
+    def impulse_segments(self, points, impulses, modes=None, normals=None):
         """Arrow segments (shaft and two head strokes) for contact impulses (n_contact, 2)
-        (normal, tangential) [N s] at points (n_contact, 2), drawn as mean force x impulse_scale."""
+        (normal, tangential) [N s] at points (n_contact, 2), drawn as mean force x impulse_scale,
+        along the contacts' normals (n_contact, 2) where given (a shape pair's), else the
+        ground's."""
         segs = []
         dt = self.step_length
         ter = self.model.terrain
@@ -330,7 +332,10 @@ class Scene:
             ln, lt = impulses[i]
             if ln == 0.0 and lt == 0.0:
                 continue
-            n = ter.normal(points[i, 0]).reshape(2)
+            if normals is not None and np.all(np.isfinite(normals[i])):
+                n = np.asarray(normals[i], float)
+            else:
+                n = ter.normal(points[i, 0]).reshape(2)
             t = np.array([n[1], -n[0]])
             vec = (ln * n + lt * t) / dt * self.impulse_scale
             size = float(np.hypot(*vec))
@@ -385,7 +390,7 @@ class Scene:
         self.ax.set_ylim(center[1] - h / 2, center[1] + h / 2)
 
     def draw_state(self, q, center=None, t=None, contact_point=None, contact_impulse=None,
-                   labels=None, speed=None) -> list:
+                   labels=None, speed=None, contact_normal=None) -> list:
         """Move every artist to poses q (n_body, 3) with the view centred on `center` [m]
         (default: the COM); t [s] and speed [m/s] go in the overlay. Returns the artists
         (for blitting)."""
@@ -409,7 +414,8 @@ class Scene:
         pins = self.pin_points(q)
         self.pins.set_data(pins[:, 0], pins[:, 1])
         show_imp = self.show_impulses and contact_point is not None and contact_impulse is not None
-        self.impulses.set_segments(self.impulse_segments(np.asarray(contact_point), np.asarray(contact_impulse))
+        self.impulses.set_segments(self.impulse_segments(np.asarray(contact_point), np.asarray(contact_impulse),
+                                                         normals=contact_normal)
                                    if show_imp else [])
         self.impulses.set_visible(show_imp)
         self.com.set_data([com[0]], [com[1]])
@@ -431,7 +437,8 @@ class Scene:
         self.step_length = float(traj.info.get("dt", self.model.dt))
         return self.draw_state(traj.q[k], center=center, t=float(traj.t[k]) if t is None else float(t),
                                contact_point=traj.contact_point[k], contact_impulse=traj.contact_impulse[k],
-                               labels=labels, speed=speed)
+                               labels=labels, speed=speed,
+                               contact_normal=None if traj.contact_normal is None else traj.contact_normal[k])
 
 
 def com_marker():

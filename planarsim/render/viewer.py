@@ -279,7 +279,8 @@ class Viewer:
             labels.setdefault("gait", self.gait)
         speed = float(com_v[0])
         arts = self.scene.draw_state(q, center=center, t=sim.t, contact_point=sim.ws.contact_point,
-                                     contact_impulse=sim.ws.contact_impulse, labels=labels, speed=speed)
+                                     contact_impulse=sim.ws.contact_impulse, labels=labels, speed=speed,
+                                     contact_normal=sim.ws.contact_normal)
         if self.message:
             self.scene.text.set_text(self.scene.text.get_text() + "\n" + self.message[:120])
         self._present()
