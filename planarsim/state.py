@@ -211,6 +211,8 @@ class Workspace(NamedTuple):
     contact_radii: np.ndarray    # (n_contact, 2) radius of the reference and the other shape [m]
     contact_bounce: np.ndarray   # (n_contact,) normal velocity restitution asks for [m/s]
     manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/collide.py)
+    shape_reach: np.ndarray      # (n_shape, 4) each shape's bounding circle in the world (x, y,
+                                 #   radius [m]) and a bound on its points' speed [m/s]
     row_body: np.ndarray         # (R, 2) int
     row_J: np.ndarray            # (R, 2, 3)
     row_F: np.ndarray            # (R, 2, 3)
@@ -293,7 +295,7 @@ def make_workspace(model: Model) -> Workspace:
                                              axis=1).reshape(nc, 2).copy(),
                      contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
                      contact_refpt=z((nc, 2)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
-                     manifold=z((2, 10)),
+                     manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
                      row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),

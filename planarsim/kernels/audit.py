@@ -29,7 +29,7 @@ from .info import INFO_CCD_SPLITS
 from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
 from .contacts import contact_velocity, edge_deepest, point_reach, sole_facing
 from .math2d import world_point
-from .pair import pair_gap_now
+from .pair import pair_gap_now, place_shapes
 from .rows import ROW_CONTACT_N
 from .terrain import ground_point
 
@@ -289,6 +289,8 @@ def worst_violation(m, s, ws, bounded, rows_held):
         for j in range(m.rod_body.shape[0]):
             gap = max(gap, rod_error(m, s.q, ws.body_cs, j))
     depth = 0.0
+    if m.shape_body.shape[0] > 0:
+        place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
     for i in range(m.contact_body.shape[0]):
         if not depth_known(m, s, ws, i, bounded, rows_held):
             depth = max(depth, contact_depth(m, s, ws, i))
@@ -321,6 +323,8 @@ def audit_positions(m, s, ws, step):
         if g > PIN_GAP_TOL:
             note(ws, step, AUDIT_PIN_GAP, n_pin + j, m.rod_body[j, 1], g)
             found += 1
+    if m.shape_body.shape[0] > 0:
+        place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:
             continue

@@ -22,7 +22,7 @@ from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
 from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
 from .contacts import query_contact
-from .pair import PAIR_MARGIN, find_pair
+from .pair import PAIR_MARGIN, find_pair, place_shapes
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, solve_mixed_lcp
@@ -134,6 +134,8 @@ def _projection_rows(m, s, ws, h):
                 n = add_row(ws, n, ROW_LIMIT_LO + e, j, m.pin_body[j, 0], m.pin_body[j, 1])
     for j in range(m.rod_body.shape[0]):
         n = add_row(ws, n, ROW_ROD, j, m.rod_body[j, 0], m.rod_body[j, 1])
+    if m.shape_body.shape[0] > 0:
+        place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:
             continue

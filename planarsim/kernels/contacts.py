@@ -23,7 +23,7 @@ from .terrain import ground_point, height_derivs
 
 from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
 from .forces import point_velocity
-from .pair import find_pair
+from .pair import find_pair, place_shapes
 
 
 @kernel
@@ -353,6 +353,8 @@ def find_contacts(m, s, ws, h):
     (contact_new == 2) is engaged here, where its ground normal is known."""
     # on flat or sloped ground a query costs no more than the bound that would spare it
     lazy = m.terrain_coef[2] != 0.0
+    if m.shape_body.shape[0] > 0:
+        place_shapes(m, s.q, ws.body_cs, s.v, ws.v_pred, ws)
     for i in range(m.contact_body.shape[0]):
         if m.contact_kind[i] == CONTACT_PAIR:
             if m.contact_pair[i, 2] == 0:

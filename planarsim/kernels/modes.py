@@ -107,7 +107,8 @@ def may_reach_ground(m, ws, i, h, vel):
     vel: its gap exceeds h (|v_x| + |v_y| + |omega| r), r its distance from the COM (a
     bound on its speed; no trigonometry)."""
     if m.contact_kind[i] == CONTACT_PAIR:
-        return ws.contact_gap[i] <= h * pair_speed(m, ws, i, vel)
+        # a slot without a point (gap inf) is out of reach until the next narrow phase
+        return ws.contact_gap[i] < math.inf and ws.contact_gap[i] <= h * pair_speed(m, ws, i, vel)
     b = m.contact_body[i]
     ax = ws.contact_anchor[i, 0]
     ay = ws.contact_anchor[i, 1]

@@ -67,15 +67,27 @@ def _speed_bound(m, v, b, shape):
 
 
 @kernel
-def pair_clearance(m, q, cs, i):
-    """Distance [m] between the bounding circles of pair contact i's shapes (a lower bound on
-    the gap between the shapes)."""
-    sa = m.contact_pair[i, 0]
-    sb = m.contact_pair[i, 1]
-    ax, ay = world_point(q, cs, m.shape_body[sa], m.shape_bound[sa, 0], m.shape_bound[sa, 1])
-    bx, by = world_point(q, cs, m.shape_body[sb], m.shape_bound[sb, 0], m.shape_bound[sb, 1])
-    return (math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
-            - m.shape_bound[sa, 2] - m.shape_bound[sb, 2])
+def place_shapes(m, q, cs, v0, v1, ws):
+    """ws.shape_reach: every shape's bounding circle at q (cs its cos / sin) and a bound on
+    its points' speed under velocities v0 and v1 (the larger), once per configuration: the
+    pairs' broad phase then costs a few flops each."""
+    for k in range(m.shape_body.shape[0]):
+        b = m.shape_body[k]
+        x, y = world_point(q, cs, b, m.shape_bound[k, 0], m.shape_bound[k, 1])
+        ws.shape_reach[k, 0] = x
+        ws.shape_reach[k, 1] = y
+        ws.shape_reach[k, 2] = m.shape_bound[k, 2]
+        ws.shape_reach[k, 3] = max(_speed_bound(m, v0, b, k), _speed_bound(m, v1, b, k))
+
+
+@kernel
+def pair_apart(ws, i_a, i_b, margin):
+    """The bounding circles of shapes i_a and i_b (ws.shape_reach, placed) are more than
+    margin [m] apart (no square root)."""
+    dx = ws.shape_reach[i_b, 0] - ws.shape_reach[i_a, 0]
+    dy = ws.shape_reach[i_b, 1] - ws.shape_reach[i_a, 1]
+    reach = ws.shape_reach[i_a, 2] + ws.shape_reach[i_b, 2] + margin
+    return dx * dx + dy * dy > reach * reach
 
 
 @kernel
@@ -165,7 +177,8 @@ def _clear_slot(s, ws, c):
 
 @kernel_call
 def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
-    """Stage 3 for the pair whose slot 0 is contact i, at s.q (ws.body_cs current): the
+    """Stage 3 for the pair whose slot 0 is contact i, at s.q (ws.body_cs current, the
+    shapes placed there: place_shapes): the
     manifold within the step's reach (PAIR_MARGIN, or margin_floor if larger, plus what
     SPECULATIVE_FACTOR times the bodies' speed bounds can close in h) and its points given to
     the two slots by their features. keep_modes: only the geometry (the position projection,
@@ -174,14 +187,10 @@ def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
     cs = ws.body_cs
     sa = m.contact_pair[i, 0]
     sb = m.contact_pair[i, 1]
-    ba = m.shape_body[sa]
-    bb = m.shape_body[sb]
-    speed = (max(_speed_bound(m, s.v, ba, sa), _speed_bound(m, ws.v_pred, ba, sa))
-             + max(_speed_bound(m, s.v, bb, sb), _speed_bound(m, ws.v_pred, bb, sb)))
+    speed = ws.shape_reach[sa, 3] + ws.shape_reach[sb, 3]
     margin = max(PAIR_MARGIN, margin_floor) + SPECULATIVE_FACTOR * h * speed
-    clear = pair_clearance(m, q, cs, i)
     n = 0
-    if clear <= margin:
+    if not pair_apart(ws, sa, sb, margin):
         n = manifold(m, q, cs, ws, i, margin)
     # slots that keep their features keep their points
     taken0 = -1
@@ -277,12 +286,13 @@ def pair_speed(m, ws, i, vel):
 
 @kernel_call
 def pair_gap_now(m, q, cs, ws, i):
-    """The signed gap [m] of pair contact i's shapes at q, measured afresh (the audit): the
+    """The signed gap [m] of pair contact i's shapes at q (the shapes placed there:
+    place_shapes), measured afresh (the audit): the
     deepest point of the manifold on slot 0, +inf on slot 1 (a pair is measured once) and
     where nothing touches."""
     if m.contact_pair[i, 2] != 0:
         return math.inf
-    if pair_clearance(m, q, cs, i) > 0.0:
+    if pair_apart(ws, m.contact_pair[i, 0], m.contact_pair[i, 1], 0.0):
         return math.inf
     n = manifold(m, q, cs, ws, i, 0.0)
     best = math.inf
