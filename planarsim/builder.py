@@ -571,7 +571,8 @@ class ModelBuilder:
             vnum.append(len(c["verts"]))
             verts.extend(c["verts"])
         arrays = M.ModelArrays(
-            dt=dt, gravity=ro(g),
+            dt=dt, n_shape_pair=int(sum(c["kind"] == CONTACT_PAIR for c in contacts) // 2),
+            gravity=ro(g),
             body_mass=ro(mass), body_inertia=ro(inertia), body_inv_mass=ro(1.0 / mass),
             body_inv_inertia=ro(inv_inertia),
             pin_body=ro([p["body"] for p in self._pins] or np.zeros((0, 2)), np.int64).reshape(npin, 2),

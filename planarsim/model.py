@@ -24,6 +24,7 @@ ACT_KIND_NAMES = ("pin_torque", "axial", "hip_torque", "body_force", "body_torqu
 class ModelArrays(NamedTuple):
     """Flat arrays for the kernels (SI units). Shapes use n_body, n_pin, n_rod, n_contact, n_act."""
     dt: float                       # step size [s]
+    n_shape_pair: int               # pairs of shapes that may touch (two contacts each)
     gravity: np.ndarray             # (2,) [m/s^2]
     body_mass: np.ndarray           # (n_body,) [kg]
     body_inertia: np.ndarray        # (n_body,) about the COM [kg m^2]; 0 for point masses

@@ -289,7 +289,7 @@ def worst_violation(m, s, ws, bounded, rows_held):
         for j in range(m.rod_body.shape[0]):
             gap = max(gap, rod_error(m, s.q, ws.body_cs, j))
     depth = 0.0
-    if m.shape_body.shape[0] > 0:
+    if m.n_shape_pair > 0:
         place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
     for i in range(m.contact_body.shape[0]):
         if not depth_known(m, s, ws, i, bounded, rows_held):
@@ -323,7 +323,7 @@ def audit_positions(m, s, ws, step):
         if g > PIN_GAP_TOL:
             note(ws, step, AUDIT_PIN_GAP, n_pin + j, m.rod_body[j, 1], g)
             found += 1
-    if m.shape_body.shape[0] > 0:
+    if m.n_shape_pair > 0:
         place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:

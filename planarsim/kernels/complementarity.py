@@ -134,7 +134,7 @@ def _projection_rows(m, s, ws, h):
                 n = add_row(ws, n, ROW_LIMIT_LO + e, j, m.pin_body[j, 0], m.pin_body[j, 1])
     for j in range(m.rod_body.shape[0]):
         n = add_row(ws, n, ROW_ROD, j, m.rod_body[j, 0], m.rod_body[j, 1])
-    if m.shape_body.shape[0] > 0:
+    if m.n_shape_pair > 0:
         place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
     for i in range(m.contact_body.shape[0]):
         if s.contact_enabled[i] == 0:

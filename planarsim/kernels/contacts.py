@@ -353,7 +353,7 @@ def find_contacts(m, s, ws, h):
     (contact_new == 2) is engaged here, where its ground normal is known."""
     # on flat or sloped ground a query costs no more than the bound that would spare it
     lazy = m.terrain_coef[2] != 0.0
-    if m.shape_body.shape[0] > 0:
+    if m.n_shape_pair > 0:
         place_shapes(m, s.q, ws.body_cs, s.v, ws.v_pred, ws)
     for i in range(m.contact_body.shape[0]):
         if m.contact_kind[i] == CONTACT_PAIR:

@@ -301,12 +301,14 @@ def pair_gap_now(m, q, cs, ws, i):
     return best
 
 
-@kernel_call
+@kernel
 def shape_contact_mode(m, s, body):
     """The most holding mode of the enabled shape-pair contacts of `body` (0 free, 1 pinned,
     2 sliding; pinned first): whether it stands on, or leans on, another body's shape or a
     world shape (a controller's touchdown test beside its own ground contacts)."""
     best = 0
+    if m.n_shape_pair == 0:
+        return best
     for k in range(m.contact_body.shape[0]):
         if m.contact_kind[k] != CONTACT_PAIR or s.contact_enabled[k] == 0:
             continue
