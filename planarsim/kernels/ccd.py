@@ -12,6 +12,7 @@ import math
 
 from ._jit import kernel
 from .codes import MODE_FREE
+from .info import INFO_CCD_SPLITS
 from .terrain import ground_point_call
 
 N_SAMPLES = 8
@@ -102,3 +103,20 @@ def advance_to_impact(s, ws, h, tau):
             vk = s.v[i, k] + tau * (ws.v_new[i, k] - s.v[i, k]) / h
             s.v[i, k] = vk
             s.q[i, k] += tau * vk
+
+
+@kernel
+def split_at_impact(m, s, ws, h):
+    """The time-of-impact split: if a free CCD contact would hit the ground inside the step of
+    h [s] (not at its very end, which the next step takes: tau = 0 there), move every body to
+    the impact (advance_to_impact), engage that contact at the next sub-step's find_contacts
+    (contact_new = 2) and return the time tau >= 0 [s] taken; -1 when the step is not split."""
+    tau, hit = time_of_impact(m, s, ws, h)
+    if hit < 0 or not tau < h * (1.0 - 1e-9):
+        return -1.0
+    advance_to_impact(s, ws, h, tau)
+    s.time[0] += tau
+    ws.impact_time[0] = s.time[0]
+    ws.contact_new[hit] = 2
+    ws.info[INFO_CCD_SPLITS] += 1
+    return tau

@@ -7,23 +7,24 @@ function (inlined, but for a few long or rarely run parts kept as calls: build_a
 complementarity solve, the skip test of the correction, the measured end-of-step audit),
 compiled once per machine and called by address from every compiled caller (a walker's
 rollout, run_steps; kernels/link.py). A time-of-impact split (CCD) repeats
-stages 1-6 for the remainder of the step with the new contact pinned.
+stages 1-5 for the remainder of the step with the new contact pinned. Each stage lives in its
+module (README's table "How the engine works" names them); this file only orders them, and
+solve_modes, the guess-check-solve of stages 3-5.
 """
 from ._jit import kernel, kernel_call, kernel_inline
-from .ccd import advance_to_impact, time_of_impact
-from .audit import (DEPTH_TOL, PIN_GAP_TOL, audit_impulses, audit_positions, audit_total,
-                    mark_held_contacts, needs_ground_query, worst_violation)
-from .complementarity import project_positions, solve_contacts
+from .audit import audit_impulses, audit_total
+from .ccd import split_at_impact
+from .codes import MODES_ALTERNATING
+from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import GUARD_AUDIT, check_guards
+from .info import INFO_SOLVES, STEP_COUNTS
+from .integrate import predict_configuration
 from .math2d import update_trig
-from .info import INFO_CCD_SPLITS, INFO_PROJECTIONS, INFO_SOLVES, STEP_COUNTS
-from .integrate import (bound_correction_work, correct_positions, integrate_positions,
-                        keep_correction_rows, predict_configuration, rows_hold_within)
-from .codes import MODES_ALTERNATING
 from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
+from .position import position_stage
 from .rows import build_rows
 from .solve import solve_impulses
 from .warm_start import remember_impulses
@@ -59,14 +60,6 @@ def copy_state(src, dst):
     _copy2(src.last_pin_impulse, dst.last_pin_impulse)
     _copy1(src.last_rod_impulse, dst.last_rod_impulse)
     _copy1(src.contact_feature, dst.contact_feature)
-
-
-# Newton iterations of the complementarity projection of the positions (quadratic)
-PROJECTION_ITERS = 20
-# rows held to refine_tol count as within the audit's tolerances when refine_tol is at most
-# this share of them (a pin's gap is at most sqrt(2) times its rows' errors; the settling
-# threshold is a tenth of the tolerance)
-ROWS_HELD_SHARE = 0.05
 
 
 @kernel_call
@@ -122,38 +115,6 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     return ok
 
 
-@kernel
-def settle_positions(m, s, ws, h, opt, rows_held):
-    """After the Newton correction: the end-of-step pin gaps and contact depths; where one is
-    above a tenth of its audit tolerance, the complementarity projection (it also catches a
-    free contact whose turning body dipped it below the ground). rows_held: the correction
-    proved its rows within a tenth of the tolerances (audit.worst_violation then skips
-    them). Returns the violations the audit counts at the configuration the step ends at.
-    Where the rows are held and every other contact is surely clear (a body at rest on the
-    ground) that is known without a ground query; the rest is one call (_settle_measured)."""
-    if rows_held:
-        if m.contact_body.shape[0] == 0:
-            return 0        # joints held, nothing else to check
-        mark_held_contacts(m, ws)
-        if not needs_ground_query(m, s, ws):
-            return 0        # joints and touching contacts held, the others surely clear
-    return _settle_measured(m, s, ws, h, opt, rows_held)
-
-
-@kernel_call
-def _settle_measured(m, s, ws, h, opt, rows_held):
-    """settle_positions where the ground must be asked (rows_held: contact_held is marked)."""
-    update_trig(s.q, ws.body_cs)
-    gap, depth = worst_violation(m, s, ws, True, rows_held)
-    if gap > 0.1 * PIN_GAP_TOL or depth > 0.1 * DEPTH_TOL:
-        project_positions(m, s, ws, h, PROJECTION_ITERS, opt.refine_tol)
-        update_trig(s.q, ws.body_cs)
-        gap, depth = worst_violation(m, s, ws, False, False)
-    if gap > PIN_GAP_TOL or depth > DEPTH_TOL:
-        return audit_positions(m, s, ws, s.step[0])
-    return 0
-
-
 @kernel_inline
 def _step(m, s, ws, opt, u):
     """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u;
@@ -172,49 +133,20 @@ def _step(m, s, ws, opt, u):
     step_length = opt.dt if opt.dt > 0.0 else m.dt
     h = step_length
     for split in range(opt.max_ccd_splits + 1):
-        update_trig(s.q, ws.body_cs)
-        apply_forces(m, s, ws, u)
-        predict_velocity(m, s, ws, h)
-        predict_configuration(m, s, ws, h)
-        find_contacts(m, s, ws, h)
+        update_trig(s.q, ws.body_cs)                        # cos / sin of the angles
+        apply_forces(m, s, ws, u)                           # 1. forces
+        predict_velocity(m, s, ws, h)                       #    v* = v + h M^-1 f
+        predict_configuration(m, s, ws, h)                  #    q + h v* (joints' drift)
+        find_contacts(m, s, ws, h)                          # 2. contacts
         ccd_on = split < opt.max_ccd_splits
-        answered = solve_modes(m, s, ws, opt, h, not ccd_on)
+        answered = solve_modes(m, s, ws, opt, h, not ccd_on)  # 3-5. rows, impulses, modes
         if ccd_on:
-            tau, hit = time_of_impact(m, s, ws, h)
-            # an impact at the very end of the step is left to the next step (tau = 0 there)
-            if hit >= 0 and tau < h * (1.0 - 1e-9):
-                # split the step at the impact; the rest of it runs with the contact engaged
-                advance_to_impact(s, ws, h, tau)
-                s.time[0] += tau
-                ws.impact_time[0] = s.time[0]
+            tau = split_at_impact(m, s, ws, h)              # 7. a point mass hits mid-step:
+            if tau >= 0.0:                                  #    the rest of the step again
                 h -= tau
-                ws.contact_new[hit] = 2  # engaged by find_contacts of the next sub-step
-                ws.info[INFO_CCD_SPLITS] += 1
                 continue
-        audit_impulses(m, s, ws)
-        integrate_positions(s, ws, ws.v_new, h)
-        kept_all = keep_correction_rows(s, ws) == 0
-        # the solve's envelope stands where its rows all stay (no need to compute it again)
-        envelope_ready = answered and kept_all
-        # the correction only when the rows may be off by more than refine_tol: a bound of
-        # half of it (far above rounding) proves the correction would find nothing to do
-        # (bodies at rest, translating), at a few flops per row instead of re-evaluating them
-        held = True
-        corrected = False
-        if opt.refine_iters > 0 and ws.n_row[0] > 0 and not (
-                opt.refine_tol > 0.0 and rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol)):
-            held = correct_positions(m, s, ws, h, opt.refine_iters, opt.refine_tol,
-                                     opt.refine_pivot_tol, envelope_ready) <= opt.refine_tol
-            corrected = True
-        if opt.refine_iters > 0:
-            # rows held to refine_tol are within the audit's tolerances where a point
-            # contact's row is its exact gap (flat or sloped ground; pin rows are exact)
-            held = (held and m.terrain_coef[2] == 0.0
-                    and opt.refine_tol <= ROWS_HELD_SHARE * min(PIN_GAP_TOL, DEPTH_TOL))
-            settle_positions(m, s, ws, h, opt, held)
-            if corrected or ws.info[INFO_PROJECTIONS] > 0:
-                # only a correction or a projection changes the velocity the solve gave
-                bound_correction_work(m, s, ws)
+        audit_impulses(m, s, ws)                            # 9. the audit of the impulses
+        position_stage(m, s, ws, opt, h, answered)          # 6. integrate, correct, settle
         break
     s.time[0] = ws.prev.time[0] + step_length
     s.step[0] += 1
