@@ -56,4 +56,4 @@ if __name__ == "__main__":
     args = ap.parse_args()
     climbed, summary = main(args.duration, args.gif)
     print(f"climbed {climbed} of {N_STAIRS} stairs; on top: {summary['on_top']}; walked "
-          f"{summary['distance_m']:.2f} m; fell: {summary['fell']}; audit {summary['audit']}")
+          f"{summary['distance']:.2f} m; fell: {summary['fell']}; audit {summary['audit']}")

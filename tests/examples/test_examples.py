@@ -83,3 +83,13 @@ def test_the_stairs_need_the_clearance():
     ex = load("stairs")
     climbed, summary = ex.main(duration=15.0, clearance=0.08)
     assert climbed < ex.N_STAIRS
+
+
+@pytest.mark.parametrize("name", ["stairs", "push_box"])
+def test_new_examples_run_as_scripts(name):
+    """As a reader runs them: `python examples/NAME.py --duration 3` prints its summary line."""
+    import subprocess
+    out = subprocess.run([sys.executable, str(EXAMPLES / f"{name}.py"), "--duration", "3"],
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "fell: False" in out.stdout
