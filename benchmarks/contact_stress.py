@@ -1,9 +1,10 @@
 """A seeded stress corpus of closed contact loops through the ground, no actuation (not a test).
 
-    python benchmarks/contact_stress.py                       # 4 families x 40 seeds x 2 strategies
+    python benchmarks/contact_stress.py                       # 6 families x 40 seeds x 2 strategies
     python benchmarks/contact_stress.py --quick               # seeds 0-4, one strategy each (20 runs)
     python benchmarks/contact_stress.py --families chain_hills --runs-per-family 10
     python benchmarks/contact_stress.py --only chain_hills:7:all --only mass_ratio:3:alternating
+    python benchmarks/contact_stress.py --families shape_pile shape_hills --extreme   # beyond the targets
 
 Families (every scene drawn from numpy.random.default_rng(seed); friction mu in [0.2, 1.2]):
 
@@ -22,8 +23,8 @@ Families (every scene drawn from numpy.random.default_rng(seed); friction mu in 
 
 - shape_pile: 4-12 colliding shapes (boxes, capsules, circles, convex polygons of 3-6
   vertices; 2-40 cm) with masses 10^U(-1.5, 1.5) kg (ratios to 1:1000), stacked loosely with
-  random offsets and tilts and thrown down at 1-30 m/s (and up to 10 rad/s) onto each other
-  and flat ground.
+  random offsets and tilts and thrown down at 1-30 m/s (log-uniform; up to 10 rad/s) onto
+  each other and flat ground. --extreme: masses 10^U(-2, 2) (1:10^4) and 1-200 m/s.
 - shape_hills: the same onto sine hills (slopes up to about 30 deg).
   Depth there is the deepest overlap of any two shapes (the narrow phase, kernels/collide.py,
   tested against an independent reference in tests/physics/test_collide.py) and of any shape
@@ -67,6 +68,9 @@ from benchmarks.scenes import G, biped_collapse  # noqa: E402
 FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio", "shape_pile",
             "shape_hills")
 SHAPE_FAMILIES = ("shape_pile", "shape_hills")   # bodies touching bodies (colliding shapes)
+# their masses 10^U(-d, d) kg and launch speeds 1..speed m/s (log-uniform); --extreme widens them
+SHAPE_RANGES = {"mass_decades": 1.5, "speed": 30.0}
+EXTREME_SHAPE_RANGES = {"mass_decades": 2.0, "speed": 200.0}
 STRATEGIES = ("alternating", "all")
 DTS = (1e-4, 3e-4, 1e-3, 3e-3, 1e-2)      # [s] step sizes; seed k runs at DTS[k % 5]
 SECONDS = {"biped_stance": 2.0, "biped_collapse": 2.0, "chain_hills": 3.0, "mass_ratio": 1.0,
@@ -228,7 +232,8 @@ def random_shape(rng):
     """(kind, params, mass [kg], inertia [kg m^2]) of a random colliding shape centred on its
     body's COM (uniform density; a polygon's vertices about its centroid)."""
     kind = ("box", "capsule", "circle", "polygon")[int(rng.integers(4))]
-    mass = 10.0 ** rng.uniform(-1.5, 1.5)
+    decades = SHAPE_RANGES["mass_decades"]
+    mass = 10.0 ** rng.uniform(-decades, decades)
     if kind == "box":
         w, h = rng.uniform(0.02, 0.4, size=2)
         return kind, ((0.0, 0.0), w, h), mass, mass * (w * w + h * h) / 12
@@ -289,7 +294,8 @@ def shape_scene(rng, dt, hills):
         b.add_body(f"s{k}", mass, inertia, pos=(x0 + rng.uniform(-0.15, 0.15), y),
                    angle=rng.uniform(-math.pi, math.pi), shapes=[(kind, *params, {"mu": mu})])
         y += 0.45
-        speed, heading = rng.uniform(1.0, 30.0), rng.uniform(-math.pi / 4, math.pi / 4)
+        speed = 10.0 ** rng.uniform(0.0, math.log10(SHAPE_RANGES["speed"]))
+        heading = rng.uniform(-math.pi / 4, math.pi / 4)
         v.append((speed * math.sin(heading), -speed * math.cos(heading), rng.uniform(-10, 10)))
     return b.compile(), np.array(v)
 
@@ -584,7 +590,11 @@ def main(argv=None) -> int:
     ap.add_argument("--only", action="append", default=[], metavar="FAMILY:SEED:STRATEGY",
                     help="run just these cases (repeatable)")
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), help="processes")
+    ap.add_argument("--extreme", action="store_true",
+                    help="shape families at mass ratios to 1:10^4 and speeds to 200 m/s")
     args = ap.parse_args(argv)
+    if args.extreme:
+        SHAPE_RANGES.update(EXTREME_SHAPE_RANGES)
     if args.only:
         cases = []
         for text in args.only:

@@ -1,15 +1,13 @@
 """The robot dog pushes a box along the ground: bodies that touch.
 
 The dog walks at its commanded speed; a 0.3 x 0.25 m box (2 kg, friction 0.3 with the ground)
-stands just in front of its torso. The torso's box shape and the box's collide (the dog's own
-parts do not collide with each other, its feet are its contacts), so the dog shoves the box
-ahead of it, against the box's sliding friction (about 5.9 N).
+stands just in front of it. The dog's torso box and leg capsules collide with the box (the
+dog's own parts do not collide with each other, its feet are its contacts), so it shoves the
+box ahead of it, against the box's sliding friction (about 5.9 N).
 
     python examples/push_box.py [--duration 12] [--gif docs/gifs/push_box.gif]
 """
 import argparse
-
-import numpy as np
 
 import walkers
 

@@ -17,6 +17,8 @@ complementarity problem without friction, linearised at the current configuratio
 repeated until every error is below tolerance. Joint corrections also change the velocity by
 dq / h (as the Newton correction does); contact corrections move positions only.
 """
+import math
+
 from ._jit import kernel, kernel_call
 from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
@@ -33,6 +35,8 @@ from .solve import apply_impulses, fill_row_b
 
 # Lemke's path is finite; the cap only stops a path that rounding has sent astray
 PIVOTS_PER_VARIABLE = 20
+# a projection move that raised the error is halved at most this many times
+PROJECTION_HALVINGS = 6
 
 
 @kernel
@@ -167,13 +171,27 @@ def _largest_error(ws, n):
 @kernel_call
 def project_positions(m, s, ws, h, iters, tol):
     """Project the configuration onto closed joints and contacts not below the ground (see
-    the module's docstring). Returns the largest remaining error [m or rad]."""
+    the module's docstring). Returns the largest remaining error [m or rad]. A move that
+    leaves a larger error than it started from (its linearisation crossed a change of the
+    touching features, a light body wedged between heavy ones) is halved, up to
+    PROJECTION_HALVINGS times, before the next one is solved."""
     worst = 0.0
+    best = math.inf         # the error where the last move started (q_keep)
+    share = 1.0             # of the last move taken
     for it in range(iters + 1):
         n = _projection_rows(m, s, ws, h)
         worst = _largest_error(ws, n)
         if worst <= tol or it == iters:
             break
+        if worst > best and share > 0.5 ** PROJECTION_HALVINGS:
+            share *= 0.5
+            for i in range(s.q.shape[0]):
+                for k in range(3):
+                    s.q[i, k] = ws.q_keep[i, k] + share * ws.dq_correction[i, k]
+                    s.v[i, k] = ws.v_keep[i, k] + share * ws.dv_correction[i, k]
+            continue
+        best = worst
+        share = 1.0
         for r in range(n):
             ws.row_b[r] = ws.row_c[r]
         assemble_dense(m, ws, n)
@@ -194,6 +212,8 @@ def project_positions(m, s, ws, h, iters, tol):
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
         for i in range(s.q.shape[0]):
             for k in range(3):
+                ws.q_keep[i, k] = s.q[i, k]
+                ws.v_keep[i, k] = s.v[i, k]
                 s.q[i, k] += ws.dq_correction[i, k]
                 s.v[i, k] += ws.dv_correction[i, k]
     return worst

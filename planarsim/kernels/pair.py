@@ -18,8 +18,10 @@ disk rolls). The reference body is the row's body a (-1: a world shape), the inc
 its body b (ws.contact_bodies); either may be the pair's first shape.
 
 The pair's stages are calls (kernel_call), not inlined: a model without shapes keeps the
-step's hot loops as small as before. Broad phase: a pair whose bounding circles are farther apart than the step can close (twice
-the bodies' speed bounds times h, plus PAIR_MARGIN) skips the narrow phase.
+step's hot loops as small as before. Broad phase: each shape's bounding circle and speed
+bound are placed once per configuration (place_shapes); a pair whose circles are farther
+apart than the step can close (SPECULATIVE_FACTOR times the speed bounds times h, plus
+PAIR_MARGIN) skips the narrow phase. Every pair of the model is tested, O(pairs) a step.
 """
 import math
 

@@ -26,16 +26,6 @@ def column(masses, dt=1e-3, gap=0.0, mu=0.6, x_offsets=None):
     return b.compile()
 
 
-def run(model, seconds, strategy="alternating"):
-    sim = ps.Simulator(model, ps.make_options(strategy))
-    worst_depth = 0.0
-    steps = int(round(seconds / model.dt))
-    for _ in range(steps // 100):
-        sim.steps(100)
-    sim.steps(steps % 100)
-    return sim
-
-
 def assert_clean(sim):
     counts = audit_counts(sim.ws)
     assert all(v == 0 for v in counts.values()), counts

@@ -1,6 +1,5 @@
 """The walkers' shapes that collide: a fallen SIMBICON lies on the ground, not in it; the
 MJCF loader's collide names."""
-import numpy as np
 import pytest
 
 import planarsim as ps
