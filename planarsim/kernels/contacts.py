@@ -106,8 +106,8 @@ def _edge_minimum(coef, x0, y0, dx, dy, u0, u1, rounded):
     return u, y0 + u * dy - height_derivs(coef, x0 + u * dx)[0]
 
 
-@kernel_call
-def edge_deepest(m, q, cs, i):
+@kernel
+def _edge_by_rate(m, q, cs, i):
     """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
     fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
     the segment (else the segment's ends, the shape's corners or end circles, are lowest).
@@ -160,6 +160,111 @@ def edge_deepest(m, q, cs, i):
             best_u = u
     inside = best < math.inf and 0.0 < best_u < 1.0
     return inside, x0 + best_u * dx, y0 + best_u * dy
+
+
+# samples of an edge's clearance per shortest wavelength of the ground; golden-section steps
+# of the refinement around the lowest sample (the bracket shrinks by 0.618 a step)
+EDGE_SAMPLES_PER_WAVELENGTH = 64
+EDGE_GOLDEN_STEPS = 60
+GOLDEN = 0.6180339887498949
+
+
+@kernel
+def _edge_clearance(coef, x0, y0, dx, dy, u, rounded):
+    """Clearance [m] of the point p(u) = p0 + u (dx, dy) above the ground: its distance along
+    the normal (rounded: a capsule's side, whose surface lies r along it) or its height."""
+    if rounded:
+        return ground_point(coef, x0 + u * dx, y0 + u * dy)[4]
+    return y0 + u * dy - height_derivs(coef, x0 + u * dx)[0]
+
+
+@kernel
+def _edge_by_samples(m, q, cs, i):
+    """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
+    fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
+    the segment, below both ends (else an end, the shape's corner or end circle, is lowest:
+    its own contact holds it). The clearance is sampled along the segment
+    (EDGE_SAMPLES_PER_WAVELENGTH of the shortest wavelength) and its minimum refined by
+    golden-section search between the lowest sample's neighbours: no assumption on where the
+    ground's curvature turns (a capsule nearly along the ground has a clearance that dips
+    and rises within a few centimetres). For a capsule's side (radius > 0) the distance along
+    the ground's normal is minimised (its surface lies r along it), for a polygon's side the
+    height (the same to second order at the depths that matter)."""
+    coef = m.terrain_coef
+    b = m.contact_body[i]
+    k = m.contact_vert_adr[i]
+    x0, y0 = world_point(q, cs, b, m.contact_local[i, 0], m.contact_local[i, 1])
+    x1, y1 = world_point(q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1])
+    dx = x1 - x0
+    dy = y1 - y0
+    rounded = m.contact_radius[i] > 0.0
+    shortest = math.inf
+    for j in range(int(coef[2])):
+        shortest = min(shortest, coef[4 + 3 * j])
+    n = 8 if shortest == math.inf else max(
+        8, int(math.ceil(abs(dx) * EDGE_SAMPLES_PER_WAVELENGTH / shortest)) + 1)
+    f_start = _edge_clearance(coef, x0, y0, dx, dy, 0.0, rounded)
+    f_end = _edge_clearance(coef, x0, y0, dx, dy, 1.0, rounded)
+    low = 0
+    f_low = f_start
+    for j in range(1, n + 1):
+        f = f_end if j == n else _edge_clearance(coef, x0, y0, dx, dy, j / n, rounded)
+        if f < f_low:
+            low = j
+            f_low = f
+    # golden-section search for the minimum on the lowest sample's bracket (next to an end:
+    # the clearance may dip just inside it, a corner resting on a crest's flank)
+    lo = max(low - 1, 0) / n
+    hi = min(low + 1, n) / n
+    u1 = hi - GOLDEN * (hi - lo)
+    u2 = lo + GOLDEN * (hi - lo)
+    f1 = _edge_clearance(coef, x0, y0, dx, dy, u1, rounded)
+    f2 = _edge_clearance(coef, x0, y0, dx, dy, u2, rounded)
+    for _ in range(EDGE_GOLDEN_STEPS):
+        if f1 <= f2:
+            hi = u2
+            u2 = u1
+            f2 = f1
+            u1 = hi - GOLDEN * (hi - lo)
+            f1 = _edge_clearance(coef, x0, y0, dx, dy, u1, rounded)
+        else:
+            lo = u1
+            u1 = u2
+            f1 = f2
+            u2 = lo + GOLDEN * (hi - lo)
+            f2 = _edge_clearance(coef, x0, y0, dx, dy, u2, rounded)
+        if hi - lo <= 1e-15:
+            break
+    u = u1 if f1 <= f2 else u2
+    f = min(f1, f2)
+    if f_low < f:
+        u = low / n
+        f = f_low
+    inside = 0.0 < u < 1.0 and f < min(f_start, f_end)
+    return inside, x0 + u * dx, y0 + u * dy
+
+
+@kernel_call
+def edge_deepest(m, q, cs, i):
+    """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
+    fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
+    the segment (else an end, the shape's corner or end circle, is lowest: its own contact
+    holds it). Two searches, the deeper answer kept: the rate's sign changes between the
+    ground's inflections (_edge_by_rate: exact where the rate is monotone in its pieces) and
+    the sampled clearance refined by golden section (_edge_by_samples: no assumption on the
+    curvature; it can miss a dip narrower than its spacing next to an end)."""
+    in_a, ax, ay = _edge_by_rate(m, q, cs, i)
+    in_b, bx, by = _edge_by_samples(m, q, cs, i)
+    if not in_b:
+        return in_a, ax, ay
+    if not in_a:
+        return in_b, bx, by
+    rounded = m.contact_radius[i] > 0.0
+    fa = _edge_clearance(m.terrain_coef, ax, ay, 0.0, 0.0, 0.0, rounded)
+    fb = _edge_clearance(m.terrain_coef, bx, by, 0.0, 0.0, 0.0, rounded)
+    if fb < fa:
+        return in_b, bx, by
+    return in_a, ax, ay
 
 
 @kernel_call
