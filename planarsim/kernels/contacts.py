@@ -165,6 +165,7 @@ def _edge_by_rate(m, q, cs, i):
 # samples of an edge's clearance per shortest wavelength of the ground; golden-section steps
 # of the refinement around the lowest sample (the bracket shrinks by 0.618 a step)
 EDGE_SAMPLES_PER_WAVELENGTH = 64
+EDGE_MIN_SAMPLES = 16
 EDGE_GOLDEN_STEPS = 60
 GOLDEN = 0.6180339887498949
 
@@ -179,43 +180,9 @@ def _edge_clearance(coef, x0, y0, dx, dy, u, rounded):
 
 
 @kernel
-def _edge_by_samples(m, q, cs, i):
-    """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
-    fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
-    the segment, below both ends (else an end, the shape's corner or end circle, is lowest:
-    its own contact holds it). The clearance is sampled along the segment
-    (EDGE_SAMPLES_PER_WAVELENGTH of the shortest wavelength) and its minimum refined by
-    golden-section search between the lowest sample's neighbours: no assumption on where the
-    ground's curvature turns (a capsule nearly along the ground has a clearance that dips
-    and rises within a few centimetres). For a capsule's side (radius > 0) the distance along
-    the ground's normal is minimised (its surface lies r along it), for a polygon's side the
-    height (the same to second order at the depths that matter)."""
-    coef = m.terrain_coef
-    b = m.contact_body[i]
-    k = m.contact_vert_adr[i]
-    x0, y0 = world_point(q, cs, b, m.contact_local[i, 0], m.contact_local[i, 1])
-    x1, y1 = world_point(q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1])
-    dx = x1 - x0
-    dy = y1 - y0
-    rounded = m.contact_radius[i] > 0.0
-    shortest = math.inf
-    for j in range(int(coef[2])):
-        shortest = min(shortest, coef[4 + 3 * j])
-    n = 8 if shortest == math.inf else max(
-        8, int(math.ceil(abs(dx) * EDGE_SAMPLES_PER_WAVELENGTH / shortest)) + 1)
-    f_start = _edge_clearance(coef, x0, y0, dx, dy, 0.0, rounded)
-    f_end = _edge_clearance(coef, x0, y0, dx, dy, 1.0, rounded)
-    low = 0
-    f_low = f_start
-    for j in range(1, n + 1):
-        f = f_end if j == n else _edge_clearance(coef, x0, y0, dx, dy, j / n, rounded)
-        if f < f_low:
-            low = j
-            f_low = f
-    # golden-section search for the minimum on the lowest sample's bracket (next to an end:
-    # the clearance may dip just inside it, a corner resting on a crest's flank)
-    lo = max(low - 1, 0) / n
-    hi = min(low + 1, n) / n
+def _golden_minimum(coef, x0, y0, dx, dy, lo, hi, rounded):
+    """(u, f): the minimum of the clearance on [lo, hi] by golden-section search (a single
+    dip assumed there)."""
     u1 = hi - GOLDEN * (hi - lo)
     u2 = lo + GOLDEN * (hi - lo)
     f1 = _edge_clearance(coef, x0, y0, dx, dy, u1, rounded)
@@ -235,13 +202,50 @@ def _edge_by_samples(m, q, cs, i):
             f2 = _edge_clearance(coef, x0, y0, dx, dy, u2, rounded)
         if hi - lo <= 1e-15:
             break
-    u = u1 if f1 <= f2 else u2
-    f = min(f1, f2)
-    if f_low < f:
-        u = low / n
-        f = f_low
-    inside = 0.0 < u < 1.0 and f < min(f_start, f_end)
-    return inside, x0 + u * dx, y0 + u * dy
+    if f1 <= f2:
+        return u1, f1
+    return u2, f2
+
+
+@kernel
+def _edge_by_samples(m, q, cs, i):
+    """edge_deepest by the clearance sampled along the segment (EDGE_SAMPLES_PER_WAVELENGTH
+    of the shortest wavelength, at least EDGE_MIN_SAMPLES), every sample lower than its
+    neighbours refined by golden-section search between them: no assumption on where the
+    ground's curvature turns (a capsule nearly along a flank dips between samples)."""
+    coef = m.terrain_coef
+    b = m.contact_body[i]
+    k = m.contact_vert_adr[i]
+    x0, y0 = world_point(q, cs, b, m.contact_local[i, 0], m.contact_local[i, 1])
+    x1, y1 = world_point(q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1])
+    dx = x1 - x0
+    dy = y1 - y0
+    rounded = m.contact_radius[i] > 0.0
+    shortest = math.inf
+    for j in range(int(coef[2])):
+        shortest = min(shortest, coef[4 + 3 * j])
+    n = EDGE_MIN_SAMPLES if shortest == math.inf else max(
+        EDGE_MIN_SAMPLES, int(math.ceil(abs(dx) * EDGE_SAMPLES_PER_WAVELENGTH / shortest)) + 1)
+    f_start = _edge_clearance(coef, x0, y0, dx, dy, 0.0, rounded)
+    f_end = _edge_clearance(coef, x0, y0, dx, dy, 1.0, rounded)
+    best = math.inf
+    best_u = 0.0
+    f_prev = f_start
+    f_here = f_start
+    for j in range(n + 1):
+        f_next = f_end if j + 1 == n else (
+            _edge_clearance(coef, x0, y0, dx, dy, (j + 1) / n, rounded) if j + 1 < n else math.inf)
+        if f_here <= f_prev and f_here <= f_next:
+            # a dip at sample j (at an end: just inside it) refined between its neighbours
+            u, f = _golden_minimum(coef, x0, y0, dx, dy, max(j - 1, 0) / n, min(j + 1, n) / n,
+                                   rounded)
+            if f < best and 0.0 < u < 1.0:
+                best = f
+                best_u = u
+        f_prev = f_here
+        f_here = f_next
+    inside = best < min(f_start, f_end)
+    return inside, x0 + best_u * dx, y0 + best_u * dy
 
 
 @kernel_call
