@@ -107,6 +107,21 @@ def _edge_minimum(coef, x0, y0, dx, dy, u0, u1, rounded):
 
 
 @kernel
+def _edge_segment(m, q, cs, i):
+    """(x0, y0, dx, dy, rounded, shortest): edge contact i's core segment in the world at q
+    [m] (start and direction, contact_local to its one fallback vertex), whether it is a
+    capsule's side (radius > 0), and the ground's shortest wavelength [m] (inf: no sines)."""
+    b = m.contact_body[i]
+    k = m.contact_vert_adr[i]
+    x0, y0 = world_point(q, cs, b, m.contact_local[i, 0], m.contact_local[i, 1])
+    x1, y1 = world_point(q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1])
+    shortest = math.inf
+    for j in range(int(m.terrain_coef[2])):
+        shortest = min(shortest, m.terrain_coef[4 + 3 * j])
+    return x0, y0, x1 - x0, y1 - y0, m.contact_radius[i] > 0.0, shortest
+
+
+@kernel
 def _edge_by_rate(m, q, cs, i):
     """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
     fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
@@ -119,16 +134,7 @@ def _edge_by_rate(m, q, cs, i):
     the distance along the ground's normal is minimised instead (its surface lies r along
     the normal from the deepest point of its core)."""
     coef = m.terrain_coef
-    b = m.contact_body[i]
-    k = m.contact_vert_adr[i]
-    x0, y0 = world_point(q, cs, b, m.contact_local[i, 0], m.contact_local[i, 1])
-    x1, y1 = world_point(q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1])
-    dx = x1 - x0
-    dy = y1 - y0
-    rounded = m.contact_radius[i] > 0.0
-    shortest = math.inf
-    for j in range(int(coef[2])):
-        shortest = min(shortest, coef[4 + 3 * j])
+    x0, y0, dx, dy, rounded, shortest = _edge_segment(m, q, cs, i)
     pieces = 1 if shortest == math.inf else int(math.ceil(abs(dx) / (EDGE_PIECE * shortest))) + 1
     best = math.inf
     best_u = 0.0
@@ -214,16 +220,7 @@ def _edge_by_samples(m, q, cs, i):
     neighbours refined by golden-section search between them: no assumption on where the
     ground's curvature turns (a capsule nearly along a flank dips between samples)."""
     coef = m.terrain_coef
-    b = m.contact_body[i]
-    k = m.contact_vert_adr[i]
-    x0, y0 = world_point(q, cs, b, m.contact_local[i, 0], m.contact_local[i, 1])
-    x1, y1 = world_point(q, cs, b, m.vert_local[k, 0], m.vert_local[k, 1])
-    dx = x1 - x0
-    dy = y1 - y0
-    rounded = m.contact_radius[i] > 0.0
-    shortest = math.inf
-    for j in range(int(coef[2])):
-        shortest = min(shortest, coef[4 + 3 * j])
+    x0, y0, dx, dy, rounded, shortest = _edge_segment(m, q, cs, i)
     n = EDGE_MIN_SAMPLES if shortest == math.inf else max(
         EDGE_MIN_SAMPLES, int(math.ceil(abs(dx) * EDGE_SAMPLES_PER_WAVELENGTH / shortest)) + 1)
     f_start = _edge_clearance(coef, x0, y0, dx, dy, 0.0, rounded)
