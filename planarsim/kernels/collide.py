@@ -109,16 +109,6 @@ def core_point_world(vert, k, x, y, c, s):
 
 
 @kernel
-def shape_bound(vert, adr, num, r):
-    """Radius [m] of the circle about the body origin that holds the rounded core:
-    max |v| over the core's vertices, plus r (for a broad phase)."""
-    b = 0.0
-    for k in range(adr, adr + num):
-        b = max(b, math.hypot(vert[k, 0], vert[k, 1]))
-    return b + r
-
-
-@kernel
 def _feature_id(flip, kind, ref, inc, clip):
     return float(((flip * 2 + kind) * MAX_CORE_VERTICES + ref) * (4 * MAX_CORE_VERTICES)
                  + inc * 4 + clip)

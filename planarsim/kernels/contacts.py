@@ -68,8 +68,8 @@ def sole_facing(m, cs, b, i, nx, ny):
 
 # bisection steps of an edge's deepest point (the interval shrinks below rounding of u)
 EDGE_BISECTIONS = 60
-# an edge is searched in pieces at most this share of the ground's shortest wavelength long
-# (within a piece the slope h' is monotone: a sine's slope turns every half wavelength)
+# _edge_by_rate searches an edge in pieces at most this share of the ground's shortest
+# wavelength long, each cut at the ground's inflection if it holds one
 EDGE_PIECE = 0.125
 
 
@@ -101,9 +101,7 @@ def _edge_minimum(coef, x0, y0, dx, dy, u0, u1, rounded):
         else:
             hi = u
     u = 0.5 * (lo + hi)
-    if rounded:
-        return u, ground_point(coef, x0 + u * dx, y0 + u * dy)[4]
-    return u, y0 + u * dy - height_derivs(coef, x0 + u * dx)[0]
+    return u, _edge_clearance(coef, x0, y0, dx, dy, u, rounded)
 
 
 @kernel

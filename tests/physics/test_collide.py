@@ -12,8 +12,7 @@ from numba import njit
 
 from planarsim.kernels._jit import _OPTIONS
 from planarsim.kernels.collide import (FLIP_A, FLIP_B, KIND_DIST, KIND_FACE, REFERENCE_TOL, collide,
-                                       core_normals, core_point_world, shape_bound,
-                                       split_feature_id)
+                                       core_normals, core_point_world, split_feature_id)
 
 # not cached: numba checks a cached function against its own file only
 jit = njit(**dict(_OPTIONS, cache=False))
@@ -27,9 +26,8 @@ def _collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
 
 
 @jit
-def _bound_and_point(vert, adr, num, r, k, x, y, c, s):
-    wx, wy = core_point_world(vert, k, x, y, c, s)
-    return shape_bound(vert, adr, num, r), wx, wy
+def _point(vert, k, x, y, c, s):
+    return core_point_world(vert, k, x, y, c, s)
 
 
 # ---------------------------------------------------------------- shapes and the call
@@ -519,7 +517,7 @@ def test_degenerate_contacts_stay_finite():
             assert abs(rows[:, 8].min() - expected_gap(*order)) < 1e-12
 
 
-def test_core_normals_and_bound():
+def test_core_normals_and_world_point():
     assert np.array_equal(core_normals([[0.3, 0.4]]), [[0.0, 0.0]])
     assert np.allclose(core_normals([[0.0, 0.0], [2.0, 0.0]]), [[0.0, -1.0], [0.0, 1.0]])
     assert np.allclose(core_normals(box(1.0, 0.5)[0]), [[0, -1], [1, 0], [0, 1], [-1, 0]])
@@ -530,5 +528,5 @@ def test_core_normals_and_bound():
     with pytest.raises(ValueError):
         core_normals([[0, 0], [2, 0], [1, 0.2], [1, 1]])   # not convex
     vert = np.array([[3.0, 4.0], [0.0, 1.0], [-1.0, 0.0]])
-    b, wx, wy = _bound_and_point(vert, 1, 2, 0.5, 1, 2.0, 3.0, 0.0, 1.0)
-    assert b == 1.5 and (wx, wy) == (1.0, 3.0)
+    wx, wy = _point(vert, 1, 2.0, 3.0, 0.0, 1.0)
+    assert (wx, wy) == (1.0, 3.0)
