@@ -30,7 +30,7 @@ from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
 from .contacts import contact_velocity, edge_deepest, point_reach, sole_facing
 from .math2d import world_point
 from .pair import pair_gap_now, place_shapes
-from .rows import ROW_CONTACT_N
+from .rows import is_normal_row
 from .terrain import ground_point
 
 AUDIT_PULL = 0
@@ -303,7 +303,7 @@ def mark_held_contacts(m, ws):
     for i in range(ws.contact_held.shape[0]):
         ws.contact_held[i] = 0
     for r in range(ws.n_row[0]):
-        if ws.row_kind[r] == ROW_CONTACT_N:
+        if is_normal_row(ws.row_kind[r]):
             ws.contact_held[ws.row_owner[r]] = 1
 
 

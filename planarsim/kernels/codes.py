@@ -11,3 +11,13 @@ MODE_SLIDING = 2       # slipping, Coulomb friction at the cone's edge
 # how the modes carried over from the last step are checked (StepOptions.mode_strategy)
 MODES_ALTERNATING = 0  # one contact re-examined per step, in turn, before the guaranteed solve
 MODES_ALL = 1          # straight to the guaranteed (complementarity) solve when the guess fails
+# row kinds (workspace.row_kind): each kind's rows are evaluated in its own module (pin.py,
+# rod.py, limit.py, contacts.py for the ground, pair.py for shapes) and dispatched in one place
+# (rows.py); a kind's class is asked through rows.py's named predicates, never by number order
+ROW_PIN_X = 0
+ROW_PIN_Y = 1
+ROW_ROD = 2
+ROW_LIMIT_LO = 3
+ROW_LIMIT_HI = 4
+ROW_CONTACT_N = 5
+ROW_CONTACT_T = 6

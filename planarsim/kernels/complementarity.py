@@ -29,8 +29,11 @@ from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, solve_mixed_lcp
 from .modes import engage_contacts, engage_limits, gather_contact_impulses, modes_from_solution
-from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
-                   add_row, build_rows, eval_rows, is_joint_row, move_row)
+from .limit import add_limit_rows
+from .pin import add_pin_rows
+from .rod import add_rod_row
+from .rows import (add_contact_rows, build_rows, eval_rows, is_joint_row, is_tangent_row,
+                   move_row)
 from .solve import apply_impulses, fill_row_b
 
 # Lemke's path is finite; the cap only stops a path that rounding has sent astray
@@ -44,7 +47,7 @@ def _drop_tangent_rows(ws):
     """Remove the friction rows (the frictionless rule); returns the rows left."""
     k = 0
     for r in range(ws.n_row[0]):
-        if ws.row_kind[r] == ROW_CONTACT_T:
+        if is_tangent_row(ws.row_kind[r]):
             continue
         if k != r:
             move_row(ws, k, r)
@@ -131,13 +134,10 @@ def _projection_rows(m, s, ws, h):
     update_trig(s.q, ws.body_cs)
     n = 0
     for j in range(m.pin_body.shape[0]):
-        n = add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
-        n = add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
-        for e in range(2):
-            if s.limit_active[j, e]:
-                n = add_row(ws, n, ROW_LIMIT_LO + e, j, m.pin_body[j, 0], m.pin_body[j, 1])
+        n = add_pin_rows(m, ws, n, j)
+        n = add_limit_rows(m, s, ws, n, j)
     for j in range(m.rod_body.shape[0]):
-        n = add_row(ws, n, ROW_ROD, j, m.rod_body[j, 0], m.rod_body[j, 1])
+        n = add_rod_row(m, ws, n, j)
     if m.n_shape_pair > 0:
         place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
     for i in range(m.contact_body.shape[0]):
@@ -150,7 +150,7 @@ def _projection_rows(m, s, ws, h):
         else:
             query_contact(m, s.q, ws, i)
         if ws.contact_gap[i] < PROJECTION_MARGIN:
-            n = add_row(ws, n, ROW_CONTACT_N, i, ws.contact_bodies[i, 0], ws.contact_bodies[i, 1])
+            n = add_contact_rows(ws, n, i, True, False)
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     return n

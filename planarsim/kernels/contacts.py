@@ -18,7 +18,7 @@ every contact every step.
 import math
 
 from ._jit import kernel, kernel_call
-from .math2d import rotate, world_point
+from .math2d import rotate, set_dir, world_point
 from .terrain import ground_point, height_derivs
 
 from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
@@ -483,3 +483,43 @@ def find_contacts(m, s, ws, h):
             engage_contact(m, s, ws, i, nx * vx + ny * vy, ny * vx - nx * vy)
         elif m.contact_restitution[i] != 0.0:
             ws.contact_bounce[i] = bounce_of(m, s, ws, i)
+
+
+@kernel
+def ground_row(m, q, cs, ws, o, b, tangent, J, found):
+    """Jacobian blocks J (2, 3) and error [m] of ground contact o (on body b): its normal row
+    (tangent False: the exact gap of the material point, or of the sole's centre minus r, along
+    the normal of its closest ground point; the same as the start-of-step values at q0 and
+    exact on curved ground when the position correction evaluates it at q+) or its tangent row
+    (the material point stays at the ground point found at the step's start). found: this q
+    is the one the contact was found at (stage 2), whose gap and normal are reused."""
+    for k in range(3):
+        J[0, k] = 0.0
+    if not tangent:
+        if ws.contact_on_arc[o] == 1:
+            px, py = world_point(q, cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
+        else:
+            px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+        if found:
+            # find_contact's query at this q: its gap is already the sole's (centre's - r)
+            set_dir(q, b, px, py, ws.contact_normal[o, 0], ws.contact_normal[o, 1], 1.0, J[1])
+            return ws.contact_gap[o]
+        gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
+        set_dir(q, b, px, py, nx, ny, 1.0, J[1])
+        if ws.contact_on_arc[o] == 1:
+            return gap - m.contact_radius[o]
+        return gap
+    px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+    tx = ws.contact_normal[o, 1]
+    ty = -ws.contact_normal[o, 0]
+    set_dir(q, b, px, py, tx, ty, 1.0, J[1])
+    return tx * (px - ws.contact_ground[o, 0]) + ty * (py - ws.contact_ground[o, 1])
+
+
+@kernel
+def ground_lever(m, ws, o, tangent):
+    """|x| + |y| [m] from its body's COM of the point ground contact o's row moves: the sole's
+    centre for a rolling sole's normal row, the material point otherwise."""
+    if not tangent and ws.contact_on_arc[o] == 1:
+        return abs(m.contact_local[o, 0]) + abs(m.contact_local[o, 1])
+    return abs(ws.contact_anchor[o, 0]) + abs(ws.contact_anchor[o, 1])

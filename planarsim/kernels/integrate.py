@@ -17,11 +17,12 @@ find nothing to do (bodies at rest or translating), so the step skips it exactly
 import math
 
 from ._jit import kernel, kernel_call, kernel_inline
-from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
+from .codes import MODE_FREE, MODE_PINNED
 from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
-from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
-                   ROW_PIN_Y, eval_rows, move_row)
+from .limit import limit_side
+from .rows import (eval_rows, is_contact_row, is_limit_row, is_normal_row, is_tangent_row,
+                   is_unilateral, move_row, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 
 
@@ -42,12 +43,6 @@ STALLED_RATIO = 0.5
 
 
 @kernel
-def is_unilateral(kind):
-    """Contact normal and joint-limit rows: their corrections remove overlap, not velocity."""
-    return kind == ROW_CONTACT_N or kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI
-
-
-@kernel
 def keep_correction_rows(s, ws):
     """Keep the rows the Newton correction holds: joints, active limits, the normal row of
     every touching contact and the tangent row of every sticking one (a sticking foot does
@@ -59,13 +54,13 @@ def keep_correction_rows(s, ws):
     for r in range(ws.n_row[0]):
         kind = ws.row_kind[r]
         o = ws.row_owner[r]
-        if kind == ROW_CONTACT_T and s.contact_mode[o] != MODE_PINNED:
+        if is_tangent_row(kind) and s.contact_mode[o] != MODE_PINNED:
             continue
-        if kind == ROW_CONTACT_N and s.contact_mode[o] == MODE_FREE:
+        if is_normal_row(kind) and s.contact_mode[o] == MODE_FREE:
             continue
-        if (kind == ROW_CONTACT_N or kind == ROW_CONTACT_T) and ws.contact_bounce[o] > 0.0:
+        if is_contact_row(kind) and ws.contact_bounce[o] > 0.0:
             continue    # rebounding (restitution): it leaves the surface, not held to it
-        if (kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI) and s.limit_active[o, kind - ROW_LIMIT_LO] == 0:
+        if is_limit_row(kind) and s.limit_active[o, limit_side(kind)] == 0:
             continue
         if k != r:
             move_row(ws, k, r)
@@ -138,24 +133,6 @@ def predict_configuration(m, s, ws, h):
 ROUNDING = 16 * 2.220446049250313e-16
 
 
-@kernel
-def _lever(m, ws, r, e):
-    """An upper bound |x| + |y| [m] on the distance from its body's COM of the point whose
-    motion row r constrains on body slot e (a pin's anchor, a contact's material point or its
-    sole's centre); no square root. inf for rows it does not know."""
-    o = ws.row_owner[r]
-    kind = ws.row_kind[r]
-    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-        return abs(m.pin_anchor[o, e, 0]) + abs(m.pin_anchor[o, e, 1])
-    if (kind == ROW_CONTACT_N or kind == ROW_CONTACT_T) and m.contact_kind[o] == CONTACT_PAIR:
-        return math.inf     # a face turning with its body: not linear in the points
-    if kind == ROW_CONTACT_N and ws.contact_on_arc[o] == 1:
-        return abs(m.contact_local[o, 0]) + abs(m.contact_local[o, 1])
-    if kind == ROW_CONTACT_N or kind == ROW_CONTACT_T:
-        return abs(ws.contact_anchor[o, 0]) + abs(ws.contact_anchor[o, 1])
-    return math.inf
-
-
 @kernel_call
 def rows_hold_within(m, s, ws, h, limit):
     """True if every row's error after integrating is provably at most `limit` [m or rad],
@@ -176,7 +153,7 @@ def rows_hold_within(m, s, ws, h, limit):
             return False
     for r in range(n):
         err = ws.rhs[r]
-        angular = ws.row_kind[r] == ROW_LIMIT_LO or ws.row_kind[r] == ROW_LIMIT_HI
+        angular = is_limit_row(ws.row_kind[r])
         for e in range(2):
             b = ws.row_body[r, e]
             if b < 0:
@@ -184,7 +161,7 @@ def rows_hold_within(m, s, ws, h, limit):
             if angular:
                 err += ROUNDING * (1.0 + abs(s.q[b, 2]))
                 continue
-            lever = _lever(m, ws, r, e)
+            lever = row_lever(m, ws, r, e)
             if lever == math.inf:
                 return False   # (0 * inf would give NaN, which compares as within the limit)
             d = abs(h * s.v[b, 2])

@@ -21,7 +21,7 @@ from ._jit import kernel, kernel_call
 from .lcp import ANSWER_TOL, LCP_INACCURATE, LCP_RAY, LCP_SOLVED, lemke, polish
 from .codes import CONTACT_PAIR
 from .contacts import pair_motion_scale
-from .rows import ROW_CONTACT_T, is_joint_row
+from .rows import is_joint_row, is_tangent_row
 from .solve import _entry
 
 # a joint-only loop: a joint row whose pivot falls to this share of its diagonal is an exact
@@ -127,7 +127,7 @@ def solve_mixed_lcp(m, ws, n, max_pivots):
         r = ws.lcp_rows[nb + i]
         ws.lcp_var[r] = nv
         ws.lcp_pos[i] = nv
-        nv += 3 if ws.row_kind[r] == ROW_CONTACT_T else 1
+        nv += 3 if is_tangent_row(ws.row_kind[r]) else 1
     Mx = ws.lcp_M
     qx = ws.lcp_q
     d = ws.lcp_scale
@@ -143,18 +143,18 @@ def solve_mixed_lcp(m, ws, n, max_pivots):
         sii = S[i, i]
         sc = 1.0 / math.sqrt(sii) if sii > 0.0 else 1.0
         d[p] = sc
-        if ws.row_kind[r] == ROW_CONTACT_T:
+        if is_tangent_row(ws.row_kind[r]):
             d[p + 1] = sc
             d[p + 2] = 1.0 / sc
     for i in range(nx):
         ri = ws.lcp_rows[nb + i]
         pi = ws.lcp_pos[i]
-        ti = ws.row_kind[ri] == ROW_CONTACT_T
+        ti = is_tangent_row(ws.row_kind[ri])
         for j in range(nx):
             rj = ws.lcp_rows[nb + j]
             pj = ws.lcp_pos[j]
             sij = S[i, j]
-            if ws.row_kind[rj] == ROW_CONTACT_T:
+            if is_tangent_row(ws.row_kind[rj]):
                 Mx[pi, pj] = sij
                 Mx[pi, pj + 1] = -sij
                 if ti:
@@ -226,7 +226,7 @@ def solve_mixed_lcp(m, ws, n, max_pivots):
     for i in range(nx):
         r = ws.lcp_rows[nb + i]
         p = ws.lcp_pos[i]
-        if ws.row_kind[r] == ROW_CONTACT_T:
+        if is_tangent_row(ws.row_kind[r]):
             ws.lam[r] = ws.lcp_z[p] - ws.lcp_z[p + 1]
             # rounding (or a regularised answer polish could not mend) may leave |x_t| a
             # hair above mu x_n: clip to the cone (the clip changes other rows' velocities

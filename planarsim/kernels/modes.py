@@ -21,7 +21,8 @@ from .contacts import contact_velocity, engage_contact, pair_motion_scale, refre
 from .pair import PAIR_ENGAGE_SLACK, pair_speed
 from .audit import IMPULSE_FLOOR
 from .mixed_lcp import is_sliding_solution
-from .rows import ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, has_mode_rows
+from .limit import limit_side
+from .rows import has_mode_rows, is_limit_row, is_normal_row, is_tangent_row
 from .solve import row_dot
 
 # a solve's answer breaks a rule when it misses it by more than this share of its own scale
@@ -37,11 +38,11 @@ def gather_contact_impulses(m, s, ws):
         ws.contact_impulse[i, 1] = 0.0
     for r in range(ws.n_row[0]):
         o = ws.row_owner[r]
-        if ws.row_kind[r] == ROW_CONTACT_N:
+        if is_normal_row(ws.row_kind[r]):
             ws.contact_impulse[o, 0] = ws.lam[r]
             if s.contact_mode[o] == MODE_SLIDING:
                 ws.contact_impulse[o, 1] = -m.contact_mu[o] * s.contact_slip[o] * ws.lam[r]
-        elif ws.row_kind[r] == ROW_CONTACT_T:
+        elif is_tangent_row(ws.row_kind[r]):
             ws.contact_impulse[o, 1] = ws.lam[r]
 
 
@@ -142,7 +143,7 @@ def engage_limits(m, s, ws, h, vel):
 def _contact_size(m, s, ws, r):
     """|lambda_n| + |lambda_t| [N s] of the contact whose normal row is r (its tangent row
     follows it; a sliding contact has none, its friction is mu lambda_n)."""
-    if r + 1 < ws.n_row[0] and ws.row_kind[r + 1] == ROW_CONTACT_T:
+    if r + 1 < ws.n_row[0] and is_tangent_row(ws.row_kind[r + 1]):
         return abs(ws.lam[r]) + abs(ws.lam[r + 1])
     return abs(ws.lam[r]) * (1.0 + m.contact_mu[ws.row_owner[r]])
 
@@ -166,7 +167,7 @@ def rule_breaks(m, s, ws, h, equalities):
     for r in range(n):
         big_lam = max(big_lam, abs(ws.lam[r]))
         big_b = max(big_b, abs(ws.row_b[r]))
-        if ws.row_kind[r] == ROW_CONTACT_N:
+        if is_normal_row(ws.row_kind[r]):
             big_normal = max(big_normal, abs(ws.lam[r]))
     tol_lam = SOLVE_REL_TOL * big_lam
     # rounding of a contact that carries no load (statically indeterminate: a box on two)
@@ -182,10 +183,10 @@ def rule_breaks(m, s, ws, h, equalities):
                  + ws.row_b[r])
             if abs(w) > tol_w:
                 breaks += 1
-        if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
+        if is_limit_row(kind):
             if ws.lam[r] < -tol_lam:
                 breaks += 1
-        elif kind == ROW_CONTACT_N:
+        elif is_normal_row(kind):
             # a contact's rules are judged against its own impulse (as the audit judges them)
             if ws.lam[r] < -(SOLVE_REL_TOL * _contact_size(m, s, ws, r) + floor):
                 breaks += 1
@@ -200,7 +201,7 @@ def rule_breaks(m, s, ws, h, equalities):
                     scale += pair_motion_scale(s, ws, o, ws.v_pred)
                 if vt * s.contact_slip[o] < -SLIP_ROUNDING * scale:
                     breaks += 1
-        elif kind == ROW_CONTACT_T:
+        elif is_tangent_row(kind):
             size = abs(ws.lam[r]) + abs(ws.lam[r - 1])
             if abs(ws.lam[r]) > m.contact_mu[o] * ws.lam[r - 1] + SOLVE_REL_TOL * size + floor:
                 breaks += 1
@@ -232,14 +233,14 @@ def modes_from_solution(m, s, ws):
     for r in range(n):
         kind = ws.row_kind[r]
         o = ws.row_owner[r]
-        if kind == ROW_CONTACT_N and (r + 1 == n or ws.row_kind[r + 1] != ROW_CONTACT_T):
+        if is_normal_row(kind) and (r + 1 == n or not is_tangent_row(ws.row_kind[r + 1])):
             # solved without friction (the frictionless rule): F = n, a slip of 0
             if ws.lam[r] <= 0.0:
                 s.contact_mode[o] = MODE_FREE
             else:
                 s.contact_mode[o] = MODE_SLIDING
                 s.contact_slip[o] = 0.0
-        elif kind == ROW_CONTACT_T:
+        elif is_tangent_row(kind):
             if ws.lam[r - 1] <= 0.0:
                 s.contact_mode[o] = MODE_FREE
             elif is_sliding_solution(m, s, ws, r) and ws.lam[r] != 0.0:
@@ -247,6 +248,6 @@ def modes_from_solution(m, s, ws):
                 s.contact_slip[o] = -1.0 if ws.lam[r] > 0.0 else 1.0
             else:
                 s.contact_mode[o] = MODE_PINNED
-        elif kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
+        elif is_limit_row(kind):
             if ws.lam[r] <= 0.0:
-                s.limit_active[o, kind - ROW_LIMIT_LO] = 0
+                s.limit_active[o, limit_side(kind)] = 0

@@ -10,22 +10,32 @@ at the start of the step (no slip).
 Sliding contacts keep only the normal row; their impulse direction F = n - mu s t carries the
 Coulomb friction -mu lambda_n s along the tangent t.
 """
+"""Stage 3: the active rows, and the one dispatch on a row's kind.
+
+Each kind of constraint has its own module that evaluates its rows: pin.py (two equalities,
+ROW_PIN_X / ROW_PIN_Y), rod.py (ROW_ROD), limit.py (ROW_LIMIT_LO / ROW_LIMIT_HI, inequalities
+on a pin's angle), contacts.py (a ground contact's normal and tangent rows) and pair.py (a
+shape pair's, acting on both bodies). This module is the one place that dispatches on the
+kind (eval_row, row_lever, last_impulse, store_impulse) and names the kinds' classes
+(is_joint_row, is_mode_row, is_unilateral, ...): nothing else compares row codes or relies on
+their order. Adding a kind = its module, one arm in each dispatch here, a builder method.
+
+A row along unit direction d at point p of a body with COM x has J = (d_x, d_y, (p - x) x d).
+Sliding contacts keep only the normal row; their impulse direction F = n - mu s t carries the
+Coulomb friction -mu lambda_n s along the tangent t.
+"""
 import math
 
 from ._jit import kernel
+from .codes import (CONTACT_PAIR, MODE_PINNED, MODE_SLIDING, ROW_CONTACT_N, ROW_CONTACT_T,
+                    ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD)
+from .contacts import ground_lever, ground_row
+from .limit import add_limit_rows, limit_row, limit_side
 from .math2d import set_dir, world_point
-from .codes import CONTACT_PAIR, MODE_PINNED, MODE_SLIDING
 from .pair import pair_row
-from .terrain import ground_point
-
-ROW_PIN_X = 0
-ROW_PIN_Y = 1
-ROW_ROD = 2
-ROW_LIMIT_LO = 3
-ROW_LIMIT_HI = 4
-ROW_CONTACT_N = 5
-ROW_CONTACT_T = 6
-# a row kind's class is asked by name (is_joint_row, is_mode_row), never by its number's order
+from .pin import add_pin_rows, pin_axis, pin_lever, pin_row, pin_rows
+from .rod import add_rod_row, rod_row
+from .row_list import add_row, move_row  # noqa: F401  (move_row: re-exported)
 
 
 @kernel
@@ -38,6 +48,37 @@ def is_joint_row(kind):
 def is_mode_row(kind):
     """A row with a rule a solve can break (a joint limit, a contact's normal or tangent)."""
     return not is_joint_row(kind)
+
+
+@kernel
+def is_limit_row(kind):
+    """A joint limit's row (either side)."""
+    return kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI
+
+
+@kernel
+def is_normal_row(kind):
+    """A contact's normal row (its impulse pushes; a ground or a shape contact)."""
+    return kind == ROW_CONTACT_N
+
+
+@kernel
+def is_tangent_row(kind):
+    """A sticking contact's tangent (friction) row; it follows its normal row."""
+    return kind == ROW_CONTACT_T
+
+
+@kernel
+def is_contact_row(kind):
+    """A contact's normal or tangent row."""
+    return kind == ROW_CONTACT_N or kind == ROW_CONTACT_T
+
+
+@kernel
+def is_unilateral(kind):
+    """Contact normal and joint-limit rows: their impulses only push, their corrections
+    remove overlap, not velocity."""
+    return is_normal_row(kind) or is_limit_row(kind)
 
 
 @kernel
@@ -54,87 +95,73 @@ def has_mode_rows(ws, n):
 def eval_row(m, q, cs, ws, r, J, found):
     """Jacobian blocks J (2, 3) and error c of row r at configuration q (cs: its cos / sin,
     math2d.update_trig); returns c. found: the contacts' ground points, normals and gaps in ws
-    were found at this q (stage 3), so a normal row reuses them instead of asking the
+    were found at this q (stage 2), so a normal row reuses them instead of asking the
     terrain again (the same numbers)."""
     kind = ws.row_kind[r]
     o = ws.row_owner[r]
     a = ws.row_body[r, 0]
     b = ws.row_body[r, 1]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-        ax, ay = world_point(q, cs, a, m.pin_anchor[o, 0, 0], m.pin_anchor[o, 0, 1])
-        bx, by = world_point(q, cs, b, m.pin_anchor[o, 1, 0], m.pin_anchor[o, 1, 1])
-        dx = 1.0 if kind == ROW_PIN_X else 0.0
-        dy = 1.0 - dx
-        set_dir(q, a, ax, ay, dx, dy, -1.0, J[0])
-        set_dir(q, b, bx, by, dx, dy, 1.0, J[1])
-        return (bx - ax) * dx + (by - ay) * dy
+        return pin_row(m, q, cs, o, a, b, pin_axis(kind), J)
     if kind == ROW_ROD:
-        ax, ay = world_point(q, cs, a, m.rod_anchor[o, 0, 0], m.rod_anchor[o, 0, 1])
-        bx, by = world_point(q, cs, b, m.rod_anchor[o, 1, 0], m.rod_anchor[o, 1, 1])
-        ex = bx - ax
-        ey = by - ay
-        L = math.sqrt(ex * ex + ey * ey)
-        ex /= L
-        ey /= L
-        set_dir(q, a, ax, ay, ex, ey, -1.0, J[0])
-        set_dir(q, b, bx, by, ex, ey, 1.0, J[1])
-        return L - m.rod_length[o]
-    if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
-        sign = 1.0 if kind == ROW_LIMIT_LO else -1.0
-        ang = q[b, 2] - m.pin_ref[o]
-        if a >= 0:
-            ang -= q[a, 2]
-        for k in range(3):
-            J[0, k] = 0.0
-            J[1, k] = 0.0
-        if a >= 0:
-            J[0, 2] = -sign
-        J[1, 2] = sign
-        if kind == ROW_LIMIT_LO:
-            return ang - m.pin_limit[o, 0]
-        return m.pin_limit[o, 1] - ang
-    # contact rows
+        return rod_row(m, q, cs, o, a, b, J)
+    if is_limit_row(kind):
+        return limit_row(m, q, o, a, b, limit_side(kind), J)
     if m.contact_kind[o] == CONTACT_PAIR:
         return pair_row(q, cs, ws, o, J, kind == ROW_CONTACT_T)
-    for k in range(3):
-        J[0, k] = 0.0
-    if kind == ROW_CONTACT_N:
-        # exact gap of the material point (or of the sole's centre, minus r) at q, along the
-        # normal of its closest ground point: the same as the start-of-step values at q0, and
-        # exact on curved ground when the position correction evaluates it at q+
-        if ws.contact_on_arc[o] == 1:
-            px, py = world_point(q, cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
-        else:
-            px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
-        if found:
-            # find_contact's query at this q: its gap is already the sole's (centre's - r)
-            set_dir(q, b, px, py, ws.contact_normal[o, 0], ws.contact_normal[o, 1], 1.0, J[1])
-            return ws.contact_gap[o]
-        gx, gy, nx, ny, gap = ground_point(m.terrain_coef, px, py)
-        set_dir(q, b, px, py, nx, ny, 1.0, J[1])
-        if ws.contact_on_arc[o] == 1:
-            return gap - m.contact_radius[o]
-        return gap
-    # tangent row: the material point stays at the ground point found at the step's start
-    px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
-    tx = ws.contact_normal[o, 1]
-    ty = -ws.contact_normal[o, 0]
-    set_dir(q, b, px, py, tx, ty, 1.0, J[1])
-    return tx * (px - ws.contact_ground[o, 0]) + ty * (py - ws.contact_ground[o, 1])
+    return ground_row(m, q, cs, ws, o, b, kind == ROW_CONTACT_T, J, found)
 
 
 @kernel
-def _pin_rows(q, cs, anchor, o, a, b, J, c, r):
-    """Rows r (x) and r + 1 (y) of pin o between bodies a and b: both from one evaluation of
-    the two anchor points (the same arithmetic as eval_row, half the work)."""
-    ax, ay = world_point(q, cs, a, anchor[o, 0, 0], anchor[o, 0, 1])
-    bx, by = world_point(q, cs, b, anchor[o, 1, 0], anchor[o, 1, 1])
-    set_dir(q, a, ax, ay, 1.0, 0.0, -1.0, J[r, 0])
-    set_dir(q, b, bx, by, 1.0, 0.0, 1.0, J[r, 1])
-    c[r] = (bx - ax) * 1.0 + (by - ay) * 0.0
-    set_dir(q, a, ax, ay, 0.0, 1.0, -1.0, J[r + 1, 0])
-    set_dir(q, b, bx, by, 0.0, 1.0, 1.0, J[r + 1, 1])
-    c[r + 1] = (bx - ax) * 0.0 + (by - ay) * 1.0
+def row_lever(m, ws, r, e):
+    """An upper bound |x| + |y| [m] on the distance from its body's COM of the point whose
+    motion row r constrains on body slot e (a pin's anchor, a contact's material point or its
+    sole's centre); no square root. inf where no such bound holds (a shape pair's face turns
+    with its body; a rod's direction turns), 0 for a limit (angular)."""
+    kind = ws.row_kind[r]
+    o = ws.row_owner[r]
+    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
+        return pin_lever(m, o, e)
+    if is_limit_row(kind):
+        return 0.0
+    if is_contact_row(kind):
+        if m.contact_kind[o] == CONTACT_PAIR:
+            return math.inf
+        return ground_lever(m, ws, o, kind == ROW_CONTACT_T)
+    return math.inf
+
+
+@kernel
+def last_impulse(s, ws, r):
+    """Row r's impulse in the last step (State.last_*_impulse; 0 where it had none). A sliding
+    contact's single row (impulse lambda_n along n - mu s t) starts at lambda_n."""
+    o = ws.row_owner[r]
+    kind = ws.row_kind[r]
+    if kind == ROW_CONTACT_N:
+        return s.last_contact_impulse[o, 0]
+    if kind == ROW_CONTACT_T:
+        return s.last_contact_impulse[o, 1]
+    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
+        return s.last_pin_impulse[o, pin_axis(kind)]
+    if is_limit_row(kind):
+        return s.last_pin_impulse[o, 2 + limit_side(kind)]
+    if kind == ROW_ROD:
+        return s.last_rod_impulse[o]
+    return 0.0
+
+
+@kernel
+def store_joint_impulse(s, ws, r, lam):
+    """Joint row r's impulse lam [N s] into the State (pins, limits, rods; a contact's are
+    gathered per contact, modes.gather_contact_impulses)."""
+    o = ws.row_owner[r]
+    kind = ws.row_kind[r]
+    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
+        s.last_pin_impulse[o, pin_axis(kind)] = lam
+    elif is_limit_row(kind):
+        s.last_pin_impulse[o, 2 + limit_side(kind)] = lam
+    elif kind == ROW_ROD:
+        s.last_rod_impulse[o] = lam
 
 
 @kernel
@@ -145,8 +172,8 @@ def eval_rows(m, q, cs, ws, J, c, n, found):
     r = 0
     while r < n:
         if ws.row_kind[r] == ROW_PIN_X:
-            _pin_rows(q, cs, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
-                      ws.row_body[r, 1], J, c, r)
+            pin_rows(q, cs, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
+                     ws.row_body[r, 1], J, c, r)
             r += 2
         else:
             c[r] = eval_row(m, q, cs, ws, r, J[r], found)
@@ -161,8 +188,8 @@ def predict_joint_errors(m, ws, n):
     while r < n:
         kind = ws.row_kind[r]
         if kind == ROW_PIN_X:
-            _pin_rows(ws.q_pred, ws.cs_pred, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
-                      ws.row_body[r, 1], ws.row_Jp, ws.row_c_pred, r)
+            pin_rows(ws.q_pred, ws.cs_pred, m.pin_anchor, ws.row_owner[r], ws.row_body[r, 0],
+                     ws.row_body[r, 1], ws.row_Jp, ws.row_c_pred, r)
             r += 2
             continue
         if kind == ROW_ROD:
@@ -171,29 +198,16 @@ def predict_joint_errors(m, ws, n):
 
 
 @kernel
-def move_row(ws, k, r):
-    """Row r's kind, owner, bodies, error, Jacobian and impulse direction into slot k <= r
-    (compacting the row list in place)."""
-    ws.row_kind[k] = ws.row_kind[r]
-    ws.row_owner[k] = ws.row_owner[r]
-    ws.row_body[k, 0] = ws.row_body[r, 0]
-    ws.row_body[k, 1] = ws.row_body[r, 1]
-    ws.row_c[k] = ws.row_c[r]
-    ws.row_c_pred[k] = ws.row_c_pred[r]
-    ws.row_b[k] = ws.row_b[r]
-    for e in range(2):
-        for c in range(3):
-            ws.row_J[k, e, c] = ws.row_J[r, e, c]
-            ws.row_F[k, e, c] = ws.row_F[r, e, c]
-
-
-@kernel
-def add_row(ws, n, kind, owner, a, b):
-    ws.row_kind[n] = kind
-    ws.row_owner[n] = owner
-    ws.row_body[n, 0] = a
-    ws.row_body[n, 1] = b
-    return n + 1
+def add_contact_rows(ws, n, i, normal, tangent):
+    """Append contact i's normal row (if normal) and tangent row (if tangent) at slot n, on
+    its bodies as found this step (ws.contact_bodies); returns the next free slot."""
+    a = ws.contact_bodies[i, 0]
+    b = ws.contact_bodies[i, 1]
+    if normal:
+        n = add_row(ws, n, ROW_CONTACT_N, i, a, b)
+    if tangent:
+        n = add_row(ws, n, ROW_CONTACT_T, i, a, b)
+    return n
 
 
 @kernel
@@ -227,26 +241,16 @@ def build_rows(m, s, ws):
         kr = _later_body(m.rod_body, jr) if jr < n_rod else big
         kc = max(m.contact_body[ic], m.contact_other[ic]) if ic < n_con else big
         if kp <= kr and kp <= kc:
-            j = jp
-            n = add_row(ws, n, ROW_PIN_X, j, m.pin_body[j, 0], m.pin_body[j, 1])
-            n = add_row(ws, n, ROW_PIN_Y, j, m.pin_body[j, 0], m.pin_body[j, 1])
-            if s.limit_active[j, 0]:
-                n = add_row(ws, n, ROW_LIMIT_LO, j, m.pin_body[j, 0], m.pin_body[j, 1])
-            if s.limit_active[j, 1]:
-                n = add_row(ws, n, ROW_LIMIT_HI, j, m.pin_body[j, 0], m.pin_body[j, 1])
+            n = add_pin_rows(m, ws, n, jp)
+            n = add_limit_rows(m, s, ws, n, jp)
             jp += 1
         elif kr <= kc:
-            n = add_row(ws, n, ROW_ROD, jr, m.rod_body[jr, 0], m.rod_body[jr, 1])
+            n = add_rod_row(m, ws, n, jr)
             jr += 1
         else:
-            i = ic
-            mode = s.contact_mode[i]
-            a = ws.contact_bodies[i, 0]
-            b = ws.contact_bodies[i, 1]
-            if mode == MODE_PINNED or mode == MODE_SLIDING:
-                n = add_row(ws, n, ROW_CONTACT_N, i, a, b)
-            if mode == MODE_PINNED:
-                n = add_row(ws, n, ROW_CONTACT_T, i, a, b)
+            mode = s.contact_mode[ic]
+            n = add_contact_rows(ws, n, ic, mode == MODE_PINNED or mode == MODE_SLIDING,
+                                 mode == MODE_PINNED)
             ic += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)

@@ -18,7 +18,7 @@ Without sliding contacts F = J and the matrix is symmetric: it is assembled in i
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ._jit import kernel, kernel_inline
-from .rows import ROW_CONTACT_N, ROW_CONTACT_T, is_joint_row
+from .rows import is_joint_row, is_normal_row, is_tangent_row
 from .warm_start import start_impulses
 
 
@@ -268,12 +268,12 @@ def fill_row_b(ws, h, n):
             ws.row_b[r] = ws.row_c_pred[r] / h
             continue
         c = ws.row_c[r]
-        if c < 0.0 and ws.row_kind[r] != ROW_CONTACT_T:
+        if c < 0.0 and not is_tangent_row(ws.row_kind[r]):
             # a unilateral row that starts violated only stops approaching; the position
             # correction removes the overlap without turning it into velocity (energy)
             c = 0.0
         bounce = 0.0
-        if ws.row_kind[r] == ROW_CONTACT_N:
+        if is_normal_row(ws.row_kind[r]):
             bounce = ws.contact_bounce[ws.row_owner[r]]
             if bounce > 0.0:
                 # an impact with restitution: the rebound e v_approach, from the surface (the

@@ -11,27 +11,7 @@ rows keep theirs, and a resting loop, whose change is then zero, keeps its split
 The impulses live in the State (last_*_impulse), so a restored run continues bit for bit.
 """
 from ._jit import kernel
-from .rows import (ROW_CONTACT_N, ROW_CONTACT_T, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X,
-                   ROW_PIN_Y, ROW_ROD, has_mode_rows)
-
-
-@kernel
-def last_impulse(s, ws, r):
-    """Row r's impulse in the last step (0 where it had none). A sliding contact's single row
-    (impulse lambda_n along n - mu s t) starts at lambda_n."""
-    o = ws.row_owner[r]
-    kind = ws.row_kind[r]
-    if kind == ROW_CONTACT_N:
-        return s.last_contact_impulse[o, 0]
-    if kind == ROW_CONTACT_T:
-        return s.last_contact_impulse[o, 1]
-    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-        return s.last_pin_impulse[o, kind - ROW_PIN_X]
-    if kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
-        return s.last_pin_impulse[o, 2 + kind - ROW_LIMIT_LO]
-    if kind == ROW_ROD:
-        return s.last_rod_impulse[o]
-    return 0.0
+from .rows import has_mode_rows, is_joint_row, is_limit_row, last_impulse, store_joint_impulse
 
 
 @kernel
@@ -62,11 +42,5 @@ def remember_impulses(s, ws):
     for j in range(s.last_rod_impulse.shape[0]):
         s.last_rod_impulse[j] = 0.0
     for r in range(ws.n_row[0]):
-        o = ws.row_owner[r]
-        kind = ws.row_kind[r]
-        if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-            s.last_pin_impulse[o, kind - ROW_PIN_X] = ws.lam[r]
-        elif kind == ROW_LIMIT_LO or kind == ROW_LIMIT_HI:
-            s.last_pin_impulse[o, 2 + kind - ROW_LIMIT_LO] = ws.lam[r]
-        elif kind == ROW_ROD:
-            s.last_rod_impulse[o] = ws.lam[r]
+        if is_joint_row(ws.row_kind[r]) or is_limit_row(ws.row_kind[r]):
+            store_joint_impulse(s, ws, r, ws.lam[r])
