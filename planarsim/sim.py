@@ -16,7 +16,8 @@ from .errors import diverged
 from .kernels.refs import TableHandle
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
-from .state import State, Workspace, check_state, forget_ground_queries, make_state, make_workspace
+from .state import (State, Workspace, check_state, forget_ground_queries, forget_pairs, make_state,
+                    make_workspace)
 from .trajectory import Trajectory, make_recorder
 
 
@@ -69,6 +70,7 @@ class Simulator:
         self._model = value
         # the ground queries' references belong to the old terrain and contact points
         forget_ground_queries(self._ws)
+        forget_pairs(self._ws)
         self._repack()
         self._recorded_entry = None
 
@@ -115,6 +117,7 @@ class Simulator:
             raise TypeError(f"state must be a planarsim State, got {type(value).__name__}")
         check_state(value, self._model)
         self._state.restore(value)
+        forget_pairs(self._ws)
 
     # commands -------------------------------------------------------------------------------
     def _commands(self, u):

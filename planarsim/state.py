@@ -9,6 +9,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .kernels.info import N_INFO
+from .kernels.codes import CONTACT_PAIR
 from .model import Model
 
 
@@ -213,6 +214,20 @@ class Workspace(NamedTuple):
     manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/collide.py)
     shape_reach: np.ndarray      # (n_shape, 4) each shape's bounding circle in the world (x, y,
                                  #   radius [m]) and a bound on its points' speed [m/s]
+    sweep_box: np.ndarray        # (n_shape, 4) each shape's widened bounding box [m]
+                                 #   (left, right, bottom, top; kernels/broad_phase.py)
+    sweep_order: np.ndarray      # (n_shape,) int the shapes by their boxes' left ends
+    shape_pair_slot: np.ndarray  # (n_shape, n_shape) int slot-0 contact of the pair of two
+                                 #   shapes (-1: they never collide); (0, 0) without pairs
+    live_pairs: np.ndarray       # (n_pair,) int this step's pairs (slot-0 contacts), ascending
+    last_pairs: np.ndarray       # (n_pair,) int the list before the last update
+    n_live_pairs: np.ndarray     # (1,) int pairs listed
+    sweep_pairs: np.ndarray      # (n_pair,) int scratch list of a sweep (projection, audit)
+    pair_flag: np.ndarray        # (n_contact,) int a pair's slot 0: broad_phase.FLAG_* bits
+    ground_contacts: np.ndarray  # (n_ground,) int every contact that is not a shape pair's
+    live: np.ndarray             # (n_contact,) int the contacts a step visits, ascending:
+                                 #   the ground contacts and both slots of each listed pair
+    n_live: np.ndarray           # (1,) int contacts listed
     row_body: np.ndarray         # (R, 2) int
     row_J: np.ndarray            # (R, 2, 3)
     row_F: np.ndarray            # (R, 2, 3)
@@ -264,6 +279,15 @@ def forget_ground_queries(ws: Workspace) -> None:
     ws.contact_stale[:] = 0
 
 
+def forget_pairs(ws: Workspace) -> None:
+    """Take every shape pair as listed in the last step, so that the next sweep clears each
+    one it does not find (kernels/broad_phase.py): for a state put in from outside, whose
+    pairs' contacts its positions may no longer have."""
+    slot0 = np.unique(ws.shape_pair_slot[ws.shape_pair_slot >= 0])
+    ws.last_pairs[:] = slot0
+    ws.n_live_pairs[0] = slot0.size
+
+
 def max_rows(model: Model) -> int:
     return max(1, 2 * model.n_pin + model.n_rod + 2 * model.n_pin + 2 * model.n_contact)
 
@@ -272,6 +296,29 @@ def max_lcp(model: Model) -> int:
     """Variables of the largest complementarity problem: joint limits and contact normals one
     each, a contact's friction three (beta+, beta-, gamma)."""
     return max(1, 2 * model.n_pin + 4 * model.n_contact)
+
+
+def _broad_phase_lists(model: Model) -> dict:
+    """The broad phase's tables and lists (kernels/broad_phase.py): the pair table of the
+    shapes, every ground contact, and the live list, which holds every contact until the
+    first sweep (a model without shapes keeps it so)."""
+    arr = model.arrays
+    nc, ns = model.n_contact, model.n_shape
+    pair_slot0 = [i for i in range(nc) if arr.contact_kind[i] == CONTACT_PAIR
+                  and arr.contact_pair[i, 2] == 0]
+    n_pair = len(pair_slot0)
+    table = np.full((ns, ns) if n_pair else (0, 0), -1, np.int64)
+    for i in pair_slot0:
+        a, b = arr.contact_pair[i, 0], arr.contact_pair[i, 1]
+        table[a, b] = table[b, a] = i
+    ground = np.array([i for i in range(nc) if arr.contact_kind[i] != CONTACT_PAIR], np.int64)
+    live = np.arange(nc, dtype=np.int64)
+    return dict(sweep_box=np.zeros((ns, 4)), sweep_order=np.arange(ns, dtype=np.int64),
+                shape_pair_slot=table, live_pairs=np.zeros(n_pair, np.int64),
+                last_pairs=np.array(pair_slot0, np.int64).reshape(n_pair),
+                n_live_pairs=np.array([n_pair], np.int64),
+                sweep_pairs=np.zeros(n_pair, np.int64), pair_flag=np.zeros(nc, np.int64),
+                ground_contacts=ground, live=live, n_live=np.array([nc], np.int64))
 
 
 def make_workspace(model: Model) -> Workspace:
@@ -296,6 +343,7 @@ def make_workspace(model: Model) -> Workspace:
                      contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
                      contact_refpt=z((nc, 2)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
+                     **_broad_phase_lists(model),
                      row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),

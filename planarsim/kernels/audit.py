@@ -29,6 +29,7 @@ from .info import INFO_CCD_SPLITS
 from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
 from .contacts import contact_velocity, edge_deepest, point_reach, sole_facing
 from .math2d import world_point
+from .broad_phase import sweep_pairs
 from .pair import pair_gap_now, place_shapes
 from .rows import is_normal_row
 from .terrain import ground_point
@@ -83,8 +84,8 @@ def note(ws, step, kind, who, body, value):
 def _impulse_floor(ws):
     """IMPULSE_FLOOR of the step's largest normal contact impulse [N s]."""
     largest = 0.0
-    for i in range(ws.contact_impulse.shape[0]):
-        largest = max(largest, abs(ws.contact_impulse[i, 0]))
+    for k in range(ws.n_live[0]):
+        largest = max(largest, abs(ws.contact_impulse[ws.live[k], 0]))
     return IMPULSE_FLOOR * largest
 
 
@@ -105,7 +106,8 @@ def audit_impulses(m, s, ws):
     found = 0
     step = s.step[0]
     floor = -1.0        # IMPULSE_FLOOR of the largest impulse, found when first needed
-    for i in range(m.contact_body.shape[0]):
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
         ln = ws.contact_impulse[i, 0]
         lt = ws.contact_impulse[i, 1]
         if ln == 0.0 and lt == 0.0:
@@ -207,6 +209,28 @@ def contact_depth(m, s, ws, i):
 
 
 @kernel
+def _audit_depth(m, s, ws, step, i):
+    """Contact i (enabled) deeper than DEPTH_TOL: noted; returns 1 if so, else 0."""
+    if s.contact_enabled[i] == 0:
+        return 0
+    d = contact_depth(m, s, ws, i)
+    if d > DEPTH_TOL:
+        note(ws, step, AUDIT_DEPTH, i, m.contact_body[i], d)
+        return 1
+    return 0
+
+
+@kernel
+def near_pairs(m, s, ws):
+    """The pairs (slot-0 contacts) whose shapes' bounding circles touch or overlap at s.q, in
+    ws.sweep_pairs (the shapes placed there; kernels/broad_phase.py); returns how many (0
+    without shapes). Every other pair is apart: its depth is negative, nothing to audit."""
+    if m.n_shape_pair == 0:
+        return 0
+    place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
+    return sweep_pairs(ws, 0.0, 0.0, ws.sweep_pairs)
+
+@kernel
 def surely_clear(m, s, ws, i):
     """Point contact i cannot be below the ground at s.q: its gap at the start of the step
     (ws.contact_gap, found at ws.prev.q or a lower bound of it; no time-of-impact split)
@@ -268,8 +292,11 @@ def needs_ground_query(m, s, ws):
     """Some contact's depth needs a ground query after a correction that held its rows
     (depth_known, bounded; ws.contact_held marked): otherwise worst_violation would find
     nothing."""
-    for i in range(m.contact_body.shape[0]):
-        if not depth_known(m, s, ws, i, True, True):
+    for k in range(ws.ground_contacts.shape[0]):
+        if not depth_known(m, s, ws, ws.ground_contacts[k], True, True):
+            return True
+    for k in range(near_pairs(m, s, ws)):
+        if s.contact_enabled[ws.sweep_pairs[k]] == 1:
             return True
     return False
 
@@ -289,10 +316,13 @@ def worst_violation(m, s, ws, bounded, rows_held):
         for j in range(m.rod_body.shape[0]):
             gap = max(gap, rod_error(m, s.q, ws.body_cs, j))
     depth = 0.0
-    if m.n_shape_pair > 0:
-        place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
-    for i in range(m.contact_body.shape[0]):
+    for k in range(ws.ground_contacts.shape[0]):
+        i = ws.ground_contacts[k]
         if not depth_known(m, s, ws, i, bounded, rows_held):
+            depth = max(depth, contact_depth(m, s, ws, i))
+    for k in range(near_pairs(m, s, ws)):
+        i = ws.sweep_pairs[k]
+        if s.contact_enabled[i] == 1:
             depth = max(depth, contact_depth(m, s, ws, i))
     return gap, depth
 
@@ -300,8 +330,8 @@ def worst_violation(m, s, ws, bounded, rows_held):
 @kernel
 def mark_held_contacts(m, ws):
     """ws.contact_held[i] = 1 if contact i's normal row is among the rows 0..n_row-1."""
-    for i in range(ws.contact_held.shape[0]):
-        ws.contact_held[i] = 0
+    for k in range(ws.n_live[0]):
+        ws.contact_held[ws.live[k]] = 0
     for r in range(ws.n_row[0]):
         if is_normal_row(ws.row_kind[r]):
             ws.contact_held[ws.row_owner[r]] = 1
@@ -323,16 +353,12 @@ def audit_positions(m, s, ws, step):
         if g > PIN_GAP_TOL:
             note(ws, step, AUDIT_PIN_GAP, n_pin + j, m.rod_body[j, 1], g)
             found += 1
-    if m.n_shape_pair > 0:
-        place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
-    for i in range(m.contact_body.shape[0]):
-        if s.contact_enabled[i] == 0:
-            continue
-        d = contact_depth(m, s, ws, i)
-        if d > DEPTH_TOL:
-            note(ws, step, AUDIT_DEPTH, i, m.contact_body[i], d)
-            found += 1
+    for k in range(ws.ground_contacts.shape[0]):
+        found += _audit_depth(m, s, ws, step, ws.ground_contacts[k])
+    for k in range(near_pairs(m, s, ws)):
+        found += _audit_depth(m, s, ws, step, ws.sweep_pairs[k])
     return found
+
 
 
 def audit_counts(ws) -> dict:

@@ -85,7 +85,8 @@ def time_of_impact(m, s, ws, h):
     """Earliest impact (tau, contact) over free, enabled CCD contacts; contact -1 if none."""
     best = math.inf
     which = -1
-    for i in range(m.contact_body.shape[0]):
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
         if m.contact_ccd[i] == 0 or s.contact_mode[i] != MODE_FREE or s.contact_enabled[i] == 0:
             continue
         tau = impact_time(m, s, ws, m.contact_body[i], h)

@@ -24,6 +24,7 @@ from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
 from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
 from .contacts import query_contact
+from .broad_phase import sweep_pairs
 from .pair import PAIR_MARGIN, find_pair, place_shapes
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
@@ -70,7 +71,8 @@ def touching_pair(m, s, ws, i):
 def _lcp_once(m, s, ws, h):
     """Build the rows of every candidate (contacts pinned: normal and tangent rows) and solve
     the complementarity problem; v_new from its impulses. Returns True if solved."""
-    for i in range(m.contact_body.shape[0]):
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
         ws.contact_candidate[i] = 0
         if s.contact_mode[i] != MODE_FREE or touching_pair(m, s, ws, i):
             s.contact_mode[i] = MODE_PINNED
@@ -114,8 +116,8 @@ def solve_contacts(m, s, ws, h, include_ccd):
                 m, s, ws, h, ws.v_new) == 0:
             break
     gather_contact_impulses(m, s, ws)
-    for i in range(m.contact_body.shape[0]):
-        ws.contact_candidate[i] = 0
+    for k in range(ws.n_live[0]):
+        ws.contact_candidate[ws.live[k]] = 0
     for j in range(m.pin_body.shape[0]):
         ws.limit_candidate[j, 0] = 0
         ws.limit_candidate[j, 1] = 0
@@ -124,6 +126,20 @@ def solve_contacts(m, s, ws, h, include_ccd):
 # contacts within this gap [m] of the ground take part in the position projection (their
 # row may become active as others move)
 PROJECTION_MARGIN = 1e-6
+
+
+@kernel
+def _projection_contact(m, s, ws, n, i):
+    """Append contact i's normal row at slot n if it is enabled and within PROJECTION_MARGIN
+    of the ground or of its pair's other shape (a ground contact is found again here first);
+    returns the next free slot."""
+    if s.contact_enabled[i] == 0:
+        return n
+    if m.contact_kind[i] != CONTACT_PAIR:
+        query_contact(m, s.q, ws, i)
+    if ws.contact_gap[i] < PROJECTION_MARGIN:
+        n = add_contact_rows(ws, n, i, True, False)
+    return n
 
 
 @kernel
@@ -138,19 +154,33 @@ def _projection_rows(m, s, ws, h):
         n = add_limit_rows(m, s, ws, n, j)
     for j in range(m.rod_body.shape[0]):
         n = add_rod_row(m, ws, n, j)
+    n_near = 0
     if m.n_shape_pair > 0:
+        # the features touching now (modes left as they are) of the pairs within reach; the
+        # step's other pairs have none
         place_shapes(m, s.q, ws.body_cs, s.v, s.v, ws)
-    for i in range(m.contact_body.shape[0]):
-        if s.contact_enabled[i] == 0:
-            continue
-        if m.contact_kind[i] == CONTACT_PAIR:
-            if m.contact_pair[i, 2] == 0:
-                # the features touching now (modes left as they are)
+        for k in range(ws.n_live_pairs[0]):
+            i = ws.live_pairs[k]
+            if s.contact_enabled[i] == 1:
+                ws.contact_gap[i] = math.inf
+                ws.contact_gap[i + 1] = math.inf
+        n_near = sweep_pairs(ws, max(PAIR_MARGIN, PROJECTION_MARGIN), h, ws.sweep_pairs)
+        for k in range(n_near):
+            i = ws.sweep_pairs[k]
+            if s.contact_enabled[i] == 1:
                 find_pair(m, s, ws, i, h, PROJECTION_MARGIN, True)
+    # in the contacts' order: the ground contacts and the slots of the pairs within reach
+    ground = ws.ground_contacts
+    g = 0
+    p = 0
+    while g < ground.shape[0] or p < n_near:
+        if p >= n_near or (g < ground.shape[0] and ground[g] < ws.sweep_pairs[p]):
+            n = _projection_contact(m, s, ws, n, ground[g])
+            g += 1
         else:
-            query_contact(m, s.q, ws, i)
-        if ws.contact_gap[i] < PROJECTION_MARGIN:
-            n = add_contact_rows(ws, n, i, True, False)
+            n = _projection_contact(m, s, ws, n, ws.sweep_pairs[p])
+            n = _projection_contact(m, s, ws, n, ws.sweep_pairs[p] + 1)
+            p += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     return n

@@ -23,7 +23,8 @@ from .terrain import ground_point, height_derivs
 
 from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, MODE_FREE, MODE_PINNED, MODE_SLIDING
 from .forces import point_velocity
-from .pair import find_pair, place_shapes
+from .broad_phase import update_live
+from .pair import PAIR_MARGIN, find_pair, place_shapes
 
 
 @kernel
@@ -459,7 +460,9 @@ def find_contacts(m, s, ws, h):
     lazy = m.terrain_coef[2] != 0.0
     if m.n_shape_pair > 0:
         place_shapes(m, s.q, ws.body_cs, s.v, ws.v_pred, ws)
-    for i in range(m.contact_body.shape[0]):
+        update_live(m, s, ws, PAIR_MARGIN, h)
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
         if m.contact_kind[i] == CONTACT_PAIR:
             if m.contact_pair[i, 2] == 0:
                 find_pair(m, s, ws, i, h, 0.0, False)

@@ -33,7 +33,8 @@ SLIP_ROUNDING = 1e-12
 @kernel
 def gather_contact_impulses(m, s, ws):
     """ws.contact_impulse[i] = (lambda_n, lambda_t) from the last solve (zero when free)."""
-    for i in range(ws.contact_impulse.shape[0]):
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
         ws.contact_impulse[i, 0] = 0.0
         ws.contact_impulse[i, 1] = 0.0
     for r in range(ws.n_row[0]):
@@ -77,7 +78,8 @@ def engage_contacts(m, s, ws, h, include_ccd, vel):
     that would end the step below the ground under velocity vel (contacts with CCD are left to
     the time-of-impact split unless include_ccd). Returns how many."""
     changed = 0
-    for i in range(m.contact_body.shape[0]):
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
         if s.contact_mode[i] != MODE_FREE or s.contact_enabled[i] == 0:
             continue
         if ws.contact_candidate[i] == 1:
@@ -217,7 +219,8 @@ def seed_rule(m, s, ws, i):
     the impulses of the other contacts may hold it clear. Returns how many changed."""
     gather_contact_impulses(m, s, ws)
     changed = check_contact(m, s, ws, i)
-    for k in range(m.contact_body.shape[0]):
+    for j in range(ws.n_live[0]):
+        k = ws.live[j]
         if k != i and ws.contact_new[k] == 1:
             changed += check_contact(m, s, ws, k)
     return changed

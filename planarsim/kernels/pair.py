@@ -21,7 +21,8 @@ The pair's stages are calls (kernel_call), not inlined: a model without shapes k
 step's hot loops as small as before. Broad phase: each shape's bounding circle and speed
 bound are placed once per configuration (place_shapes); a pair whose circles are farther
 apart than the step can close (SPECULATIVE_FACTOR times the speed bounds times h, plus
-PAIR_MARGIN) skips the narrow phase. Every pair of the model is tested, O(pairs) a step.
+PAIR_MARGIN) skips the narrow phase. Which pairs are tested at all is the sweep's answer
+(kernels/broad_phase.py): O(shapes + nearby pairs) a step, not O(pairs of the model).
 """
 import math
 
@@ -165,7 +166,7 @@ def _store_point(m, q, cs, ws, c, k):
 
 
 @kernel
-def _clear_slot(s, ws, c):
+def clear_slot(s, ws, c):
     """Contact c has no manifold point: free, no features, out of reach (gap inf: nothing
     engages it before the next narrow phase, whose margin covers the step's motion)."""
     ws.contact_gap[c] = math.inf
@@ -215,7 +216,7 @@ def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
         k = taken0 if e == 0 else taken1
         if k < 0:
             if not keep_modes:
-                _clear_slot(s, ws, c)
+                clear_slot(s, ws, c)
             else:
                 ws.contact_gap[c] = math.inf
             continue

@@ -128,8 +128,8 @@ def _step(m, s, ws, opt, u):
         ws.info[k] = 0
     ws.lcp_eps[0] = 0.0
     audited = audit_total(ws)
-    for i in range(m.contact_body.shape[0]):
-        ws.contact_new[i] = 0
+    for k in range(ws.n_live[0]):
+        ws.contact_new[ws.live[k]] = 0
     step_length = opt.dt if opt.dt > 0.0 else m.dt
     h = step_length
     for split in range(opt.max_ccd_splits + 1):

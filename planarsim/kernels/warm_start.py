@@ -33,7 +33,8 @@ def start_impulses(s, ws, n, dropped):
 def remember_impulses(s, ws):
     """The step's impulses into the State (rows 0..n_row-1 with ws.lam; contacts from
     ws.contact_impulse, which holds the friction of sliding contacts too)."""
-    for i in range(s.last_contact_impulse.shape[0]):
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
         s.last_contact_impulse[i, 0] = ws.contact_impulse[i, 0]
         s.last_contact_impulse[i, 1] = ws.contact_impulse[i, 1]
     for j in range(s.last_pin_impulse.shape[0]):
