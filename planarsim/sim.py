@@ -43,9 +43,9 @@ class Simulator:
             raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
         self._model = model
         self._state = make_state(model)
+        self._ws = make_workspace(model)
         if state is not None:
             self.state = state
-        self._ws = make_workspace(model)
         self._u0 = np.zeros(model.n_act)
         self._recorded_entry = None
         self._args = None
