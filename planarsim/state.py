@@ -262,6 +262,15 @@ class Workspace(NamedTuple):
     lcp_scale: np.ndarray        # (L,) diagonal scaling of the variables
     lcp_T: np.ndarray            # (L, 2L + 2) Lemke's tableau
     lcp_basis: np.ndarray        # (L,) int
+    row_slip: np.ndarray         # (R,) slip speed gamma of a tangent row in the last
+                                 #   complementarity solve [m/s] (mixed_lcp.solve_mixed_lcp)
+    island_parent: np.ndarray    # (n_body,) int union-find of the bodies (kernels/islands.py)
+    island_label: np.ndarray     # (n_body,) int island of a representative body (-1: none)
+    island_start: np.ndarray     # (n_body + 2,) int first entry of each island in island_rows
+    island_fill: np.ndarray      # (n_body + 1,) int scratch cursor of the grouping
+    island_rows: np.ndarray      # (R,) int the rows grouped by island
+    row_island: np.ndarray       # (R,) int each row's island
+    island_failed: np.ndarray    # (n_body + 1,) int 1: the island's problem had no answer
     audit: np.ndarray            # (N_AUDIT,) int violations counted since the workspace was
                                  #   made (kernels/audit.py: AUDIT_NAMES)
     audit_last: np.ndarray       # (4,) int the last violation: step, kind, contact or pin, body
@@ -353,6 +362,10 @@ def make_workspace(model: Model) -> Workspace:
                      lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),
                      lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),
                      lcp_q=z(L), lcp_z=z(L), lcp_scale=z(L), lcp_T=z((L, 2 * L + 2)),
-                     lcp_basis=z(L, np.int64), audit=z(N_AUDIT, np.int64),
+                     lcp_basis=z(L, np.int64), row_slip=z(R), island_parent=z(nb, np.int64),
+                     island_label=z(nb, np.int64), island_start=z(nb + 2, np.int64),
+                     island_fill=z(nb + 1, np.int64), island_rows=z(R, np.int64),
+                     row_island=z(R, np.int64), island_failed=z(nb + 1, np.int64),
+                     audit=z(N_AUDIT, np.int64),
                      audit_last=z(4, np.int64), audit_value=z(1), lcp_eps=z(1),
                      impact_time=z(1), prev=make_state(model))

@@ -26,6 +26,7 @@ from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
 from .contacts import query_contact
 from .broad_phase import sweep_pairs
 from .pair import PAIR_MARGIN, find_pair, place_shapes
+from .islands import group_rows
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
 from .mixed_lcp import assemble_dense, solve_mixed_lcp
@@ -44,17 +45,36 @@ PROJECTION_HALVINGS = 6
 
 
 @kernel
-def _drop_tangent_rows(ws):
-    """Remove the friction rows (the frictionless rule); returns the rows left."""
+def _drop_tangent_rows(ws, n):
+    """Remove the friction rows of the islands that failed (ws.island_failed; the
+    frictionless rule) from rows 0..n-1, the other rows keeping their impulses; returns the
+    rows left."""
     k = 0
-    for r in range(ws.n_row[0]):
-        if is_tangent_row(ws.row_kind[r]):
+    for r in range(n):
+        if is_tangent_row(ws.row_kind[r]) and ws.island_failed[ws.row_island[r]] == 1:
             continue
         if k != r:
             move_row(ws, k, r)
+            ws.lam[k] = ws.lam[r]
+            ws.row_slip[k] = ws.row_slip[r]
+            ws.row_island[k] = ws.row_island[r]
         k += 1
     ws.n_row[0] = k
     return k
+
+
+@kernel
+def _solve_island(m, ws, k, vars_per_row):
+    """The complementarity problem of island k (kernels/islands.py, grouped); Lemke's path
+    capped at PIVOTS_PER_VARIABLE per possible variable (vars_per_row per row). Returns True
+    if solved."""
+    start = ws.island_start[k]
+    count = ws.island_start[k + 1] - start
+    assemble_dense(m, ws, ws.island_rows, start, count)
+    cap = PIVOTS_PER_VARIABLE * (vars_per_row * count + 10)
+    status, pivots = solve_mixed_lcp(m, ws, ws.island_rows, start, count, cap)
+    ws.info[INFO_LCP_PIVOTS] += pivots
+    return status == LCP_SOLVED
 
 
 @kernel
@@ -83,27 +103,32 @@ def _lcp_once(m, s, ws, h):
     build_rows(m, s, ws)
     n = ws.n_row[0]
     fill_row_b(ws, h, n)
-    assemble_dense(m, ws, n)
-    cap = PIVOTS_PER_VARIABLE * (4 * n + 10)
-    status, pivots = solve_mixed_lcp(m, ws, n, cap)
     ws.info[INFO_LCP_SOLVES] += 1
-    ws.info[INFO_LCP_PIVOTS] += pivots
-    if status != LCP_SOLVED:
-        # no answer with friction on Lemke's path: the frictionless rule
-        n = _drop_tangent_rows(ws)
-        assemble_dense(m, ws, n)
-        status, pivots = solve_mixed_lcp(m, ws, n, cap)
-        ws.info[INFO_LCP_PIVOTS] += pivots
-        body = m.contact_body[0] if m.contact_body.shape[0] > 0 else -1
-        if status == LCP_SOLVED:
-            note(ws, s.step[0], AUDIT_FALLBACK, 0, body, 0.0)
-        else:
-            note(ws, s.step[0], AUDIT_UNSOLVED, 0, body, 0.0)
+    n_island = group_rows(ws, n)
+    failed = 0
+    for k in range(n_island):
+        ws.island_failed[k] = 1 - _solve_island(m, ws, k, 4)
+        failed += ws.island_failed[k]
+    solved = failed == 0
+    if not solved:
+        # an island without an answer with friction on Lemke's path: the frictionless rule
+        n = _drop_tangent_rows(ws, n)
+        group_rows(ws, n)       # the same islands (a tangent row's bodies are its normal's)
+        solved = True
+        for k in range(n_island):
+            if ws.island_failed[k] == 0:
+                continue
+            body = ws.row_body[ws.island_rows[ws.island_start[k]], 1]
+            if _solve_island(m, ws, k, 4):
+                note(ws, s.step[0], AUDIT_FALLBACK, 0, body, 0.0)
+            else:
+                note(ws, s.step[0], AUDIT_UNSOLVED, 0, body, 0.0)
+                solved = False
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
             ws.v_new[i, k] = ws.v_pred[i, k]
     apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.v_new, 1.0)
-    return status == LCP_SOLVED
+    return solved
 
 
 @kernel_call
@@ -224,11 +249,13 @@ def project_positions(m, s, ws, h, iters, tol):
         share = 1.0
         for r in range(n):
             ws.row_b[r] = ws.row_c[r]
-        assemble_dense(m, ws, n)
-        status, pivots = solve_mixed_lcp(m, ws, n, PIVOTS_PER_VARIABLE * (n + 10))
-        ws.info[INFO_LCP_PIVOTS] += pivots
         ws.info[INFO_PROJECTIONS] += 1
-        if status != LCP_SOLVED:
+        solved = True
+        for k in range(group_rows(ws, n)):
+            if not _solve_island(m, ws, k, 1):
+                solved = False
+                break
+        if not solved:
             break
         for i in range(s.q.shape[0]):
             for k in range(3):

@@ -38,13 +38,17 @@ REGULARISATION = (1e-12, 1e-10, 1e-8, 1e-6)
 
 
 @kernel
-def assemble_dense(m, ws, n):
-    """ws.A[:n, :n] = J W J^T in full (rows touching no common body give 0)."""
-    for i in range(n):
+def assemble_dense(m, ws, rows, start, count):
+    """ws.A[r, s] = (J W J^T)[r, s] in full for the rows r, s in rows[start:start + count]
+    (an island's: kernels/islands.py; rows touching no common body give 0)."""
+    for i in range(count):
+        ri = rows[start + i]
         for j in range(i + 1):
-            a = _entry(ws.row_J, ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, i, j)
-            ws.A[i, j] = a
-            ws.A[j, i] = a
+            rj = rows[start + j]
+            a = _entry(ws.row_J, ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia,
+                       ri, rj)
+            ws.A[ri, rj] = a
+            ws.A[rj, ri] = a
 
 
 
@@ -84,19 +88,21 @@ def _solve_joints(B, nb, G, col):
 
 
 @kernel_call
-def solve_mixed_lcp(m, ws, n, max_pivots):
-    """Impulses ws.lam[:n] of rows 0..n-1 (ws.A dense from assemble_dense, ws.row_b) that meet
-    the complementarity rules above. ws.lcp_var[r] gives row r's first LCP variable (a
-    tangent row: beta+, beta-, gamma at var, var + 1, var + 2); ws.lcp_z their values.
+def solve_mixed_lcp(m, ws, rows, start, count, max_pivots):
+    """Impulses ws.lam[r] of the rows r in rows[start:start + count] (an island's, in their
+    order: a tangent row follows its normal row; ws.A from assemble_dense, ws.row_b) that meet
+    the complementarity rules above; ws.row_slip[r] of a tangent row its slip speed gamma.
     Returns (status lcp.LCP_*, pivots); impulses are left at 0 unless solved."""
     nb = 0
     nx = 0
-    for r in range(n):
+    for k in range(count):
+        r = rows[start + k]
         ws.lam[r] = 0.0
         if is_joint_row(ws.row_kind[r]):
             ws.lcp_rows[nb] = r
             nb += 1
-    for r in range(n):
+    for k in range(count):
+        r = rows[start + k]
         if not is_joint_row(ws.row_kind[r]):
             ws.lcp_rows[nb + nx] = r
             nx += 1
@@ -227,6 +233,7 @@ def solve_mixed_lcp(m, ws, n, max_pivots):
         r = ws.lcp_rows[nb + i]
         p = ws.lcp_pos[i]
         if is_tangent_row(ws.row_kind[r]):
+            ws.row_slip[r] = ws.lcp_z[p + 2]
             ws.lam[r] = ws.lcp_z[p] - ws.lcp_z[p + 1]
             # rounding (or a regularised answer polish could not mend) may leave |x_t| a
             # hair above mu x_n: clip to the cone (the clip changes other rows' velocities
@@ -252,11 +259,10 @@ def is_sliding_solution(m, s, ws, r):
     """After solve_mixed_lcp: does the contact of tangent row r slide (slip speed gamma > 0
     and its friction at the cone's edge; a gamma of rounding size on a contact well inside
     its cone is not a slip; of a shape pair, rounding of both bodies' motion)?"""
-    p = ws.lcp_var[r]
     o = ws.row_owner[r]
     edge = m.contact_mu[o] * ws.lam[r - 1]
     scale = abs(ws.row_b[r]) + abs(ws.row_b[r - 1])
     if m.contact_kind[o] == CONTACT_PAIR:
         scale += pair_motion_scale(s, ws, o, ws.v_pred)
     slip_floor = CONE_EDGE_TOL * scale
-    return ws.lcp_z[p + 2] > slip_floor and abs(ws.lam[r]) >= edge * (1.0 - CONE_EDGE_TOL)
+    return ws.row_slip[r] > slip_floor and abs(ws.lam[r]) >= edge * (1.0 - CONE_EDGE_TOL)
