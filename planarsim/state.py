@@ -271,6 +271,8 @@ class Workspace(NamedTuple):
     island_rows: np.ndarray      # (R,) int the rows grouped by island
     row_island: np.ndarray       # (R,) int each row's island
     island_failed: np.ndarray    # (n_body + 1,) int 1: the island's problem had no answer
+    island_fallback: np.ndarray  # (n_body + 1,) int 1: solved by the frictionless rule
+    island_scale: np.ndarray     # (n_body + 1,) its problem's largest approach (scaled units)
     audit: np.ndarray            # (N_AUDIT,) int violations counted since the workspace was
                                  #   made (kernels/audit.py: AUDIT_NAMES)
     audit_last: np.ndarray       # (4,) int the last violation: step, kind, contact or pin, body
@@ -366,6 +368,7 @@ def make_workspace(model: Model) -> Workspace:
                      island_label=z(nb, np.int64), island_start=z(nb + 2, np.int64),
                      island_fill=z(nb + 1, np.int64), island_rows=z(R, np.int64),
                      row_island=z(R, np.int64), island_failed=z(nb + 1, np.int64),
+                     island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),
                      audit=z(N_AUDIT, np.int64),
                      audit_last=z(4, np.int64), audit_value=z(1), lcp_eps=z(1),
                      impact_time=z(1), prev=make_state(model))

@@ -64,17 +64,68 @@ def _drop_tangent_rows(ws, n):
 
 
 @kernel
-def _solve_island(m, ws, k, vars_per_row):
-    """The complementarity problem of island k (kernels/islands.py, grouped); Lemke's path
-    capped at PIVOTS_PER_VARIABLE per possible variable (vars_per_row per row). Returns True
-    if solved."""
+def _solve_island(m, ws, k, vars_per_row, floor):
+    """The complementarity problem of island k (kernels/islands.py, grouped), its answer
+    checked at a scale of at least floor; Lemke's path capped at PIVOTS_PER_VARIABLE per
+    possible variable (vars_per_row per row). Its own scale into ws.island_scale[k]. Returns
+    True if solved."""
     start = ws.island_start[k]
     count = ws.island_start[k + 1] - start
     assemble_dense(m, ws, ws.island_rows, start, count)
     cap = PIVOTS_PER_VARIABLE * (vars_per_row * count + 10)
-    status, pivots = solve_mixed_lcp(m, ws, ws.island_rows, start, count, cap)
+    status, pivots, scale = solve_mixed_lcp(m, ws, ws.island_rows, start, count, cap, floor)
     ws.info[INFO_LCP_PIVOTS] += pivots
+    ws.island_scale[k] = scale
     return status == LCP_SOLVED
+
+
+@kernel
+def _solve_islands(m, ws, n_island, vars_per_row, only_failed):
+    """Each island's problem (only those marked in ws.island_failed if only_failed); an island
+    without an answer at its own scale is solved again at the largest island's, the scale its
+    answer would be checked at inside one problem of all islands. Marks ws.island_failed;
+    returns how many islands have no answer."""
+    top = 0.0
+    for k in range(n_island):
+        if only_failed and ws.island_failed[k] == 0:
+            top = max(top, ws.island_scale[k])
+            continue
+        ws.island_failed[k] = 0 if _solve_island(m, ws, k, vars_per_row, 0.0) else 1
+        top = max(top, ws.island_scale[k])
+    failed = 0
+    for k in range(n_island):
+        if ws.island_failed[k] == 1 and ws.island_scale[k] < top:
+            if _solve_island(m, ws, k, vars_per_row, top):
+                ws.island_failed[k] = 0
+        failed += ws.island_failed[k]
+    return failed
+
+
+@kernel
+def _solve_by_islands(m, ws, n, vars_per_row):
+    """Rows 0..n-1 grouped by island (kernels/islands.py) and every island's problem solved
+    (_solve_islands). Where one has no answer and there are others, all rows are solved as
+    one problem once more: Lemke's path through the joint problem is another path (its
+    covering vector differs on each island), which may end where the island's alone did not.
+    Returns (islands, how many have no answer; ws.island_failed marks them, and the rows stay
+    grouped)."""
+    n_island = group_rows(ws, n)
+    failed = _solve_islands(m, ws, n_island, vars_per_row, False)
+    if failed == 0 or n_island == 1:
+        return n_island, failed
+    for r in range(n):
+        ws.island_rows[r] = r
+    assemble_dense(m, ws, ws.island_rows, 0, n)
+    status, pivots, scale = solve_mixed_lcp(m, ws, ws.island_rows, 0, n,
+                                            PIVOTS_PER_VARIABLE * (vars_per_row * n + 10), 0.0)
+    ws.info[INFO_LCP_PIVOTS] += pivots
+    group_rows(ws, n)
+    if status == LCP_SOLVED:
+        for k in range(n_island):
+            ws.island_failed[k] = 0
+        return n_island, 0
+    # the joint solve left every impulse at 0: each island's answer again
+    return n_island, _solve_islands(m, ws, n_island, vars_per_row, False)
 
 
 @kernel
@@ -104,26 +155,20 @@ def _lcp_once(m, s, ws, h):
     n = ws.n_row[0]
     fill_row_b(ws, h, n)
     ws.info[INFO_LCP_SOLVES] += 1
-    n_island = group_rows(ws, n)
-    failed = 0
-    for k in range(n_island):
-        ws.island_failed[k] = 1 - _solve_island(m, ws, k, 4)
-        failed += ws.island_failed[k]
+    n_island, failed = _solve_by_islands(m, ws, n, 4)
     solved = failed == 0
     if not solved:
         # an island without an answer with friction on Lemke's path: the frictionless rule
+        for k in range(n_island):
+            ws.island_fallback[k] = ws.island_failed[k]
         n = _drop_tangent_rows(ws, n)
         group_rows(ws, n)       # the same islands (a tangent row's bodies are its normal's)
-        solved = True
+        solved = _solve_islands(m, ws, n_island, 4, True) == 0
         for k in range(n_island):
-            if ws.island_failed[k] == 0:
-                continue
-            body = ws.row_body[ws.island_rows[ws.island_start[k]], 1]
-            if _solve_island(m, ws, k, 4):
-                note(ws, s.step[0], AUDIT_FALLBACK, 0, body, 0.0)
-            else:
-                note(ws, s.step[0], AUDIT_UNSOLVED, 0, body, 0.0)
-                solved = False
+            if ws.island_fallback[k] == 1:
+                body = ws.row_body[ws.island_rows[ws.island_start[k]], 1]
+                kind = AUDIT_UNSOLVED if ws.island_failed[k] == 1 else AUDIT_FALLBACK
+                note(ws, s.step[0], kind, 0, body, 0.0)
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
             ws.v_new[i, k] = ws.v_pred[i, k]
@@ -250,12 +295,7 @@ def project_positions(m, s, ws, h, iters, tol):
         for r in range(n):
             ws.row_b[r] = ws.row_c[r]
         ws.info[INFO_PROJECTIONS] += 1
-        solved = True
-        for k in range(group_rows(ws, n)):
-            if not _solve_island(m, ws, k, 1):
-                solved = False
-                break
-        if not solved:
+        if _solve_by_islands(m, ws, n, 1)[1] > 0:
             break
         for i in range(s.q.shape[0]):
             for k in range(3):

@@ -125,10 +125,11 @@ def covering(i, m, cover):
 
 
 @kernel_call
-def lemke(M, q, m, T, basis, z, max_pivots, cover):
+def lemke(M, q, m, T, basis, z, max_pivots, cover, floor):
     """Solve LCP(M[:m, :m], q[:m]) into z[:m] along the path of covering vector `cover`
-    (see covering); T (>= m, >= 2m + 2) and basis (>= m) are scratch. Returns (status
-    LCP_*, pivots)."""
+    (see covering); T (>= m, >= 2m + 2) and basis (>= m) are scratch. floor: a lower bound
+    of the answer check's scale (_is_answer; 0: this problem's own). Returns (status LCP_*,
+    pivots)."""
     for i in range(m):
         z[i] = 0.0
     if m == 0:
@@ -169,7 +170,7 @@ def lemke(M, q, m, T, basis, z, max_pivots, cover):
             status = LCP_SOLVED
             break
     if status == LCP_SOLVED:
-        status = _refine_basis(M, q, m, T, basis, z)
+        status = _refine_basis(M, q, m, T, basis, z, floor)
     if status == LCP_SOLVED:
         _answer(T, m, basis, z)
     return status, pivots
@@ -249,7 +250,7 @@ def _min_change(M, q, m, T, basis, res):
 
 
 @kernel_call
-def polish(M, q, m, T, basis, z):
+def polish(M, q, m, T, basis, z, floor):
     """After lemke solved a nearby problem (M + eps I, say) into z on `basis`: the same
     basis's answer for M and q themselves, checked as lemke checks its own. First refined and
     re-solved (_refine_basis); where the basis is singular for M (redundant contacts), the
@@ -259,11 +260,11 @@ def polish(M, q, m, T, basis, z):
     rhs = 2 * m + 1
     for i in range(m):
         T[i, 2 * m] = T[i, rhs]
-    status = _refine_basis(M, q, m, T, basis, z)
+    status = _refine_basis(M, q, m, T, basis, z, floor)
     if status != LCP_SOLVED:
         for i in range(m):
             T[i, rhs] = T[i, 2 * m]
-        if _min_change(M, q, m, T, basis, z) and _is_answer(M, q, m, T, basis, z):
+        if _min_change(M, q, m, T, basis, z) and _is_answer(M, q, m, T, basis, z, floor):
             status = LCP_SOLVED
         else:
             for i in range(m):
@@ -295,10 +296,12 @@ def _basic_residual(M, q, m, T, basis, res):
 
 
 @kernel
-def _is_answer(M, q, m, T, basis, res):
+def _is_answer(M, q, m, T, basis, res, floor):
     """The basic values (T's rhs column) solve B x = q to ANSWER_TOL max(-q) and are all >=
-    -ANSWER_TOL max(-q) (the non-basic ones are 0, so z . w = 0); res is scratch."""
-    scale = _basic_residual(M, q, m, T, basis, res)
+    -ANSWER_TOL max(-q) (the non-basic ones are 0, so z . w = 0); res is scratch. max(-q) is
+    taken at least `floor`: an island's problem is checked at the scale of the step's largest
+    approach (kernels/islands.py), as it would be inside one problem of every island."""
+    scale = max(_basic_residual(M, q, m, T, basis, res), floor)
     for i in range(m):
         if abs(res[i]) > ANSWER_TOL * scale or T[i, 2 * m + 1] < -ANSWER_TOL * scale:
             return False
@@ -350,7 +353,7 @@ def _solve_basis(M, q, m, T, basis, x):
 
 
 @kernel
-def _refine_basis(M, q, m, T, basis, res):
+def _refine_basis(M, q, m, T, basis, res, floor):
     """The basic values x (rhs column of T) of the final basis B, made accurate and checked.
     Every pivot rounds the tableau, and a path of hundreds of pivots can leave x far from
     B^-1 q (measured: a resting 16-box chain kicked to 7 m/s by such an answer). First
@@ -362,7 +365,7 @@ def _refine_basis(M, q, m, T, basis, res):
     rhs = 2 * m + 1
     last = math.inf
     for _ in range(REFINE_PASSES):
-        scale = _basic_residual(M, q, m, T, basis, res)
+        scale = max(_basic_residual(M, q, m, T, basis, res), floor)
         size = 0.0
         for i in range(m):
             size = max(size, abs(res[i]))
@@ -376,8 +379,8 @@ def _refine_basis(M, q, m, T, basis, res):
             for k in range(m):
                 acc += T[i, k] * res[k]
             T[i, rhs] += acc
-    if _is_answer(M, q, m, T, basis, res):
+    if _is_answer(M, q, m, T, basis, res, floor):
         return LCP_SOLVED
-    if _solve_basis(M, q, m, T, basis, res) and _is_answer(M, q, m, T, basis, res):
+    if _solve_basis(M, q, m, T, basis, res) and _is_answer(M, q, m, T, basis, res, floor):
         return LCP_SOLVED
     return LCP_INACCURATE

@@ -88,11 +88,13 @@ def _solve_joints(B, nb, G, col):
 
 
 @kernel_call
-def solve_mixed_lcp(m, ws, rows, start, count, max_pivots):
+def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     """Impulses ws.lam[r] of the rows r in rows[start:start + count] (an island's, in their
     order: a tangent row follows its normal row; ws.A from assemble_dense, ws.row_b) that meet
     the complementarity rules above; ws.row_slip[r] of a tangent row its slip speed gamma.
-    Returns (status lcp.LCP_*, pivots); impulses are left at 0 unless solved."""
+    floor: a lower bound of the answers' check scale (lcp.lemke; 0: this problem's own).
+    Returns (status lcp.LCP_*, pivots, this problem's own scale: its largest approach -q in
+    scaled units); impulses are left at 0 unless solved."""
     nb = 0
     nx = 0
     for k in range(count):
@@ -196,24 +198,28 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots):
     status = LCP_RAY
     pivots = 0
     eps = 0.0
+    own_scale = 0.0
+    for i in range(nv):
+        own_scale = max(own_scale, -qx[i])
     for cover in range(2):
         for attempt in range(len(REGULARISATION) + 1):
             target = 0.0 if attempt == 0 else REGULARISATION[attempt - 1]
             for i in range(nv):
                 Mx[i, i] += target - eps
             eps = target
-            status, more = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots, cover)
+            status, more = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots, cover,
+                                 floor)
             pivots += more
             if status == LCP_SOLVED:
                 break
         if status == LCP_SOLVED:
             break
     if status != LCP_SOLVED:
-        return status, pivots
+        return status, pivots, own_scale
     if eps > 0.0:
         for i in range(nv):
             Mx[i, i] -= eps
-        if polish(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z) == LCP_SOLVED:
+        if polish(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, floor) == LCP_SOLVED:
             eps = 0.0
         else:
             # the nearby problem's answer misses the rules of M by eps z (scaled units): kept
@@ -224,8 +230,8 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots):
             for i in range(nv):
                 z_max = max(z_max, ws.lcp_z[i])
                 q_neg = max(q_neg, -qx[i])
-            if eps * z_max > ANSWER_TOL * q_neg:
-                return LCP_INACCURATE, pivots
+            if eps * z_max > ANSWER_TOL * max(q_neg, floor):
+                return LCP_INACCURATE, pivots, own_scale
     ws.lcp_eps[0] = max(ws.lcp_eps[0], eps)
     for i in range(nv):
         ws.lcp_z[i] *= d[i]
@@ -251,7 +257,7 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots):
         for j in range(nx):
             acc += G[k, j] * ws.lam[ws.lcp_rows[nb + j]]
         ws.lam[ws.lcp_rows[k]] = -acc
-    return status, pivots
+    return status, pivots, own_scale
 
 
 @kernel

@@ -20,14 +20,14 @@ def _solve_in(M, q, eps, z_reg, z, T, basis):
     m = q.shape[0]
     for i in range(m):
         M[i, i] += eps
-    status, pivots = lemke(M, q, m, T, basis, z, 40 * m + 10, 0)
+    status, pivots = lemke(M, q, m, T, basis, z, 40 * m + 10, 0, 0.0)
     for i in range(m):
         M[i, i] -= eps
     for i in range(m):
         z_reg[i] = z[i]
     if status != LCP_SOLVED:
         return status, -1
-    return status, polish(M, q, m, T, basis, z)
+    return status, polish(M, q, m, T, basis, z, 0.0)
 
 
 def _solve(M, q, eps, z_reg, z):
