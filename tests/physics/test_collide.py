@@ -254,7 +254,10 @@ def check_points(rows, shape_a, pose_a, shape_b, pose_b, margin):
         else:
             # n: the outward normal of reference edge ref_k (vertex ref_k to the next)
             a, e = ref[ref_k], ref[(ref_k + 1) % len(ref)] - ref[ref_k]
-            assert np.allclose(n, np.array([e[1], -e[0]]) / np.hypot(*e), rtol=0.0, atol=1e-12)
+            # the reference normal from world vertices: rounding of e = b - a at the
+            # coordinates' scale, relative to the edge's length (a 60 um edge at 1 m: 4e-12)
+            tol = 1e-12 + 8 * np.finfo(float).eps * scale / np.hypot(*e)
+            assert np.allclose(n, np.array([e[1], -e[0]]) / np.hypot(*e), rtol=0.0, atol=tol)
             assert abs(np.dot(n, g - a)) <= 1e-12 * scale
             on = min([point_segment(p, c, d) for c, d in edges(inc)]
                      + [float(np.hypot(*(p - v))) for v in inc])
