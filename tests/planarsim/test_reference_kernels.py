@@ -34,13 +34,16 @@ def _rows_at(m, s, ws):
     find_contacts(m, s, ws, m.dt)
     build_rows(m, s, ws)
     n = ws.n_row[0]
-    assemble_dense(m, ws, n)
+    for r in range(n):
+        ws.island_rows[r] = r
+    assemble_dense(m, ws, ws.island_rows, 0, n)
     return n
 
 
 @jit
 def _solve(m, ws, n):
-    return solve_mixed_lcp(m, ws, n, 40 * (4 * n + 10))
+    status, pivots, scale = solve_mixed_lcp(m, ws, ws.island_rows, 0, n, 40 * (4 * n + 10), 0.0)
+    return status, pivots
 
 
 def _mechanism(n_body, slope_deg, seed):
