@@ -17,7 +17,7 @@ from .kernels.refs import TableHandle
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .state import State, Workspace, check_state, forget_ground_queries, make_state, make_workspace
-from .trajectory import Trajectory, make_recorder
+from .trajectory import Trajectory, check_recording, make_recorder
 
 
 def _link():
@@ -189,6 +189,8 @@ class Simulator:
         every = int(record_every)
         if every < 1 or int(control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")
+        check_recording(self.model, n // every + 1,
+                        f"run of {n:,} steps of {self.dt:g} s, a frame every {every} steps")
         rec = make_recorder(self.model, n // every + 1)
         k = 0
         if controller is None:

@@ -38,8 +38,44 @@ class Recorder(NamedTuple):
                                  #   or a shape pair's, from the reference shape to the other)
 
 
+def frame_bytes(model, extra_columns: int = 0) -> int:
+    """Memory [bytes] of one recorded frame of `model` (a Recorder's arrays, plus
+    `extra_columns` float64 labels per frame)."""
+    nb, nc, na = model.n_body, model.n_contact, model.n_act
+    return 8 * (1 + 6 * nb + 7 * nc + 2 * na + int(extra_columns))
+
+
+def machine_memory() -> int:
+    """This machine's physical memory [bytes]; 0 where the system does not say."""
+    try:
+        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (AttributeError, OSError, ValueError):
+        return 0
+
+
+def _gib(nbytes) -> str:
+    return f"{nbytes / 2 ** 30:.3g} GiB"
+
+
+def check_recording(model, n_frames, what: str = "", extra_columns: int = 0) -> None:
+    """Raise RecordingTooLarge, before anything is allocated, when `n_frames` frames of
+    `model` (frame_bytes) need more memory than the machine has (machine_memory). `what`
+    says what asked for them (a run's duration, say)."""
+    from .errors import RecordingTooLarge
+    need = int(n_frames) * frame_bytes(model, extra_columns)
+    have = machine_memory()
+    if have and need > have:
+        raise RecordingTooLarge(
+            f"{what + ': ' if what else ''}recording {int(n_frames):,} frames needs "
+            f"{_gib(need)} of memory, more than this machine's {_gib(have)}; record fewer frames "
+            f"(a shorter run, or a frame every more steps)", n_frames, need, have)
+
+
 def make_recorder(model, n_frames: int) -> Recorder:
+    """Zeroed frame arrays for `n_frames` frames (RecordingTooLarge, before allocating, if
+    they cannot fit in the machine's memory)."""
     nb, nc, na, K = model.n_body, model.n_contact, model.n_act, int(n_frames)
+    check_recording(model, K)
     z = np.zeros
     return Recorder(t=z(K), q=z((K, nb, 3)), v=z((K, nb, 3)), contact_mode=z((K, nc), np.int64),
                     contact_impulse=z((K, nc, 2)), contact_point=z((K, nc, 2)), act_u=z((K, na)),

@@ -134,15 +134,7 @@ class WalkerRun:
         this chunk's Trajectory. Engine failures raise (planarsim.compiled.check_run)."""
         from planarsim.compiled import check_run, make_recorder
         from planarsim.trajectory import Trajectory
-        try:
-            seconds = float(seconds)
-        except (TypeError, ValueError):
-            raise ValueError(f"seconds={seconds!r} must be a number of seconds") from None
-        if not (math.isfinite(seconds) and seconds >= 0.0):
-            raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
-        # a walker that fell stays where it fell: its rollout would otherwise take one more step
-        n = 0 if self.fell else int(round(seconds / self.dt))
-        frames = self.frames(n)
+        n, frames = self.check_memory(seconds)
         rec = make_recorder(self.model, frames)
         lab = np.zeros((frames, len(self.LABELS)))
         code, k = self.advance(n, max(self.record_every, 1), rec, lab)
@@ -152,6 +144,25 @@ class WalkerRun:
                                         info={"dt": self.dt, "walker": self.NAME})
         self.chunks.append(traj)
         return traj
+
+    def check_memory(self, seconds: float) -> tuple:
+        """(steps, frames) that run(seconds) would take and record; ValueError for a bad
+        `seconds`, planarsim.errors.RecordingTooLarge (a ValueError) for frames that cannot
+        fit in the machine's memory, before anything is allocated or run."""
+        from planarsim.trajectory import check_recording
+        try:
+            seconds = float(seconds)
+        except (TypeError, ValueError):
+            raise ValueError(f"seconds={seconds!r} must be a number of seconds") from None
+        if not (math.isfinite(seconds) and seconds >= 0.0):
+            raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
+        # a walker that fell stays where it fell: its rollout would otherwise take one more step
+        n = 0 if self.fell else int(round(seconds / self.dt))
+        frames = self.frames(n)
+        check_recording(self.model, frames,
+                        f"{self.NAME}: run({seconds:g} s) at dt={self.dt:g} s, a frame every "
+                        f"{self.record_every} steps", extra_columns=len(self.LABELS))
+        return n, frames
 
     def trajectory(self):
         """All chunks run so far, joined (empty ones left out)."""

@@ -137,6 +137,7 @@ def cmd_run(args):
         kw["terrain"] = ter
     if args.dt is not None:
         kw["dt"] = args.dt
+    _check_duration_fits(mod, kw, args.duration)
     from planarsim.progress import Elapsed, stderr_is_terminal
     bars = not args.json and stderr_is_terminal()      # progress only where someone watches
     from walkers.common.summary import walker_summary
@@ -195,6 +196,19 @@ def cmd_run(args):
             else:
                 print(f"  {k:34s} {_show(v)}")
     return 0
+
+
+def _check_duration_fits(mod, kw, duration):
+    """UsageError naming --duration when its recording cannot fit in this machine's memory
+    (checked on the walker's run before anything is compiled or allocated)."""
+    from planarsim.errors import RecordingTooLarge
+    run = mod.Run(**{k: v for k, v in kw.items() if k != "duration"})
+    try:
+        run.check_memory(duration)
+    except RecordingTooLarge as e:
+        raise UsageError(f"--duration {duration:g} s would record {e.frames:,} frames, which need "
+                         f"{e.nbytes / 2 ** 30:.3g} GiB of memory (this machine has "
+                         f"{e.available / 2 ** 30:.3g} GiB); give a shorter --duration") from None
 
 
 def _show(v):
@@ -553,6 +567,10 @@ def _main(argv) -> int:
     except (OSError, ValueError) as e:
         # bad input detected deeper down (ModelError is a ValueError): one line, exit 2
         print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except MemoryError as e:
+        # an allocation no check foresaw: one line, not numpy's traceback
+        print(f"planarsim {args.command}: error: not enough memory: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"planarsim {args.command}: interrupted", file=sys.stderr)

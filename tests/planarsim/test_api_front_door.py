@@ -1,0 +1,35 @@
+"""What a new user meets first in the Python API: a run that cannot be recorded is refused
+with a clear error before anything is allocated."""
+import numpy as np
+import pytest
+
+import planarsim as ps
+
+
+def point_mass_model():
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_point_mass("ball", 1.0, pos=(0.0, 1.0))
+    return b.compile()
+
+
+# a duration that cannot fit in memory ----------------------------------------------------------
+def test_a_run_too_long_to_record_is_a_value_error_naming_the_memory():
+    sim = ps.Simulator(point_mass_model())
+    with pytest.raises(ValueError, match="GiB of memory") as err:
+        sim.run(1e12)
+    from planarsim.errors import RecordingTooLarge
+    assert isinstance(err.value, RecordingTooLarge)
+    assert err.value.frames > 10 ** 14 and err.value.nbytes > err.value.available > 0
+    assert "steps of 0.001 s" in str(err.value)
+
+
+def test_a_walker_run_too_long_to_record_is_refused_before_it_runs():
+    import walkers
+    mod = walkers.load("simple-biped")
+    with pytest.raises(ValueError, match="simple-biped: run\\(1e\\+09 s\\).*GiB of memory"):
+        mod.simulate(1e9)
+    from planarsim.errors import RecordingTooLarge
+    run = mod.Run()
+    with pytest.raises(RecordingTooLarge):
+        run.run(1e9)
+    assert run.time == 0.0
