@@ -19,8 +19,6 @@ import sys
 import time
 from pathlib import Path
 
-from planarsim import __version__
-
 ANIMATION_EXTS = (".gif", ".mp4", ".html")
 PLOT_EXTS = (".png", ".svg", ".pdf")
 
@@ -151,7 +149,7 @@ def cmd_run(args):
         mod.simulate(**{**kw, "duration": 0.01})
     t1 = time.perf_counter()
     with Elapsed(f"simulating {args.duration:g} s", enabled=bars):
-        traj, raw, model = mod.simulate(**kw)
+        traj, raw, model = _simulate_in_chunks(mod, kw)
     t2 = time.perf_counter()
     wall = {"compile": round(load_s + t1 - t0, 3), "run": round(t2 - t1, 3)}
     gait = args.gait or inspect.signature(mod.simulate).parameters["gait"].default
@@ -196,6 +194,31 @@ def cmd_run(args):
             else:
                 print(f"  {k:34s} {_show(v)}")
     return 0
+
+
+RUN_CHUNK_S = 10.0   # [s] simulated per compiled call of `run`: Ctrl-C is answered between calls
+
+
+def _simulate_in_chunks(mod, kw):
+    """mod.simulate(**kw), run RUN_CHUNK_S at a time (bit for bit the same: a walker run
+    continues exactly), so that an interrupt is answered within one chunk rather than at the
+    end of a long compiled run. Returns (Trajectory, raw summary, Model)."""
+    kw = dict(kw)
+    duration = float(kw.pop("duration"))
+    run = mod.Run(**kw)
+    steps = int(round(duration / run.dt))
+    chunk = max(1, int(round(RUN_CHUNK_S / run.dt)))
+    done = 0
+    while done < steps and not run.fell:
+        n = min(chunk, steps - done)
+        run.run(n * run.dt)
+        done += n
+    if not run.chunks:
+        run.run(0.0)
+    traj = run.trajectory()
+    gait = kw.get("gait", inspect.signature(mod.simulate).parameters["gait"].default)
+    traj.info.update(gait=gait, seed=kw.get("seed", 0))
+    return traj, run.summary(), run.model
 
 
 def _check_duration_fits(mod, kw, duration):
@@ -303,6 +326,7 @@ def cmd_info(args):
     import numba
     import numpy
     import matplotlib
+    from planarsim import __version__
     from planarsim.compiled import kernel_cache
     folder, cached = kernel_cache()
     print(f"planarsim {__version__}")
@@ -422,6 +446,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def make_parser():
+    from planarsim import __version__
     ap = _Parser(prog="planarsim", description="Planar physics for walking machines.")
     ap.add_argument("--version", action="version", version=f"planarsim {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -527,10 +552,39 @@ class _ReaderMayLeave:
 
 def main(argv=None) -> int:
     """The command line; `argv` None reads sys.argv (and, as the program itself, ends the
-    process for the QUICK_EXIT commands once their output is flushed)."""
+    process for the QUICK_EXIT commands once their output is flushed). Ctrl-C at any moment,
+    the imports and the first compile included, prints one line and returns (as the program:
+    exits with) 130."""
     program = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     stdout = sys.stdout
+    try:
+        code = _serve(argv, stdout)
+    except KeyboardInterrupt:
+        code = _interrupted(argv, stdout, program)
+    if program and (code == INTERRUPTED or argv and argv[0] in QUICK_EXIT):
+        sys.stderr.flush()
+        os._exit(code)
+    return code
+
+
+INTERRUPTED = 130       # the exit code of a command ended by Ctrl-C (128 + SIGINT)
+
+
+def _interrupted(argv, stdout, program) -> int:
+    """One line for an interrupt, wherever it came; as the program, later interrupts are
+    ignored while that line is written (the process then ends without its teardown)."""
+    if program:
+        import signal
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.stdout = stdout
+    command = argv[0] if argv and not argv[0].startswith("-") else None
+    print(f"planarsim{' ' + command if command else ''}: interrupted", file=sys.stderr, flush=True)
+    return INTERRUPTED
+
+
+def _serve(argv, stdout) -> int:
+    """_main with stdout guarded against a reader that leaves (_ReaderMayLeave)."""
     sys.stdout = _ReaderMayLeave(stdout)
     code = 1
     try:
@@ -545,9 +599,6 @@ def main(argv=None) -> int:
     if left:
         # nothing more may reach the closed pipe, not even at the interpreter's exit
         os.dup2(os.open(os.devnull, os.O_WRONLY), stdout.fileno())
-    if program and argv and argv[0] in QUICK_EXIT:
-        sys.stderr.flush()
-        os._exit(code)
     return code
 
 
@@ -572,9 +623,6 @@ def _main(argv) -> int:
         # an allocation no check foresaw: one line, not numpy's traceback
         print(f"planarsim {args.command}: error: not enough memory: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"planarsim {args.command}: interrupted", file=sys.stderr)
-        return 130
 
 
 if __name__ == "__main__":

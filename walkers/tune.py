@@ -118,8 +118,27 @@ def _make_executor(executor, scheduler, workers):
                               "pip install 'planarsim[tune]'") from None
         client = Client(scheduler)
         return client.get_executor(), client.close
-    pool = ProcessPoolExecutor(max_workers=max(1, int(workers)))
+    pool = ProcessPoolExecutor(max_workers=max(1, int(workers)), initializer=_quiet_worker)
     return pool, (lambda: pool.shutdown(cancel_futures=True))
+
+
+def _quiet_worker():
+    """A local worker ignores Ctrl-C (the whole terminal group gets it): the tuning process
+    alone answers it, ending the workers (_end_workers), so no worker prints a traceback."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _end_workers(pool):
+    """Terminate a local pool's worker processes at once (an interrupted tuning run does not
+    wait for the evaluations under way)."""
+    stop = getattr(pool, "terminate_workers", None)
+    if stop is not None:
+        stop()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
 
 
 def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | None = None,
@@ -180,6 +199,10 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
                       f"best {h['best']:9.3f}  median {h['median']:9.3f}  best so far "
                       f"{h['best_so_far']:9.3f}  sigma {h['sigma']:.3f}  "
                       f"{time.time() - t_start:6.1f} s", file=sys.stderr, flush=True)
+    except KeyboardInterrupt:
+        if isinstance(pool, ProcessPoolExecutor):
+            _end_workers(pool)
+        raise
     finally:
         close()
     return result

@@ -29,3 +29,41 @@ def test_a_duration_that_cannot_be_recorded_is_one_line_naming_the_option(capsys
     assert out == ""
     assert err.count("\n") == 1 and "Traceback" not in err
     assert "--duration" in err and "GiB" in err and "memory" in err
+
+
+# Ctrl-C at any moment ---------------------------------------------------------------------------
+def _interrupt_after(delay, *argv):
+    """Run `planarsim ARGV` as its own process, send it SIGINT after `delay` [s]; (exit code,
+    stderr)."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    p = subprocess.Popen([sys.executable, "-m", "walkers.cli", *argv], cwd=ROOT, env=env,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=120)
+    return p.returncode, err
+
+
+@pytest.mark.parametrize("delay", [0.2, 0.35, 0.6, 1.5])
+def test_ctrl_c_at_any_moment_is_one_line_and_exit_130(delay):
+    """From the imports (the first few tenths of a second), through loading or compiling the
+    engine, to a long simulation: one line, exit code 130, no traceback."""
+    code, err = _interrupt_after(delay, "run", "simple-biped", "--no-animation", "--duration", "3000")
+    assert code == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    assert err.splitlines()[-1] == "planarsim run: interrupted"
+
+
+def test_an_interrupt_before_the_command_is_known_is_one_line(monkeypatch, capsys):
+    import walkers.cli as cli
+
+    def interrupted():
+        raise KeyboardInterrupt
+    monkeypatch.setattr(cli, "make_parser", interrupted)
+    try:
+        code = main(["list"])
+    except KeyboardInterrupt:
+        pytest.fail("the interrupt escaped planarsim's main")
+    assert code == 130
+    out, err = capsys.readouterr()
+    assert err == "planarsim list: interrupted\n"
