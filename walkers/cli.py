@@ -179,10 +179,11 @@ def cmd_run(args):
         written.append(str(out))
     summary["wall_time_s"]["output"] = round(time.perf_counter() - t2, 3)
     if summary_path is not None:
+        written.append(str(summary_path))
+    summary["files"] = written     # the summary file lists itself too: the same summary everywhere
+    if summary_path is not None:
         from planarsim.trajectory import atomic_write
         atomic_write(summary_path, lambda f: f.write(json.dumps(summary, indent=2) + "\n"), binary=False)
-        written.append(str(summary_path))
-    summary["files"] = written
     if args.json:
         print(json.dumps(summary))
     else:

@@ -67,3 +67,13 @@ def test_an_interrupt_before_the_command_is_known_is_one_line(monkeypatch, capsy
     assert code == 130
     out, err = capsys.readouterr()
     assert err == "planarsim list: interrupted\n"
+
+
+# the summary file carries the files README promises ----------------------------------------------
+def test_the_summary_file_lists_the_files_the_run_wrote(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, "run", "simple-biped", "--duration", "0.5", "--fps", "5")
+    assert code == 0, err
+    saved = json.loads((tmp_path / "out" / "simple-biped_summary.json").read_text())
+    assert saved["files"] == ["out/simple-biped.gif", "out/simple-biped_summary.json"]
+    assert all((tmp_path / f).exists() for f in saved["files"])
