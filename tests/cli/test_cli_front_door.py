@@ -77,3 +77,12 @@ def test_the_summary_file_lists_the_files_the_run_wrote(tmp_path, monkeypatch, c
     saved = json.loads((tmp_path / "out" / "simple-biped_summary.json").read_text())
     assert saved["files"] == ["out/simple-biped.gif", "out/simple-biped_summary.json"]
     assert all((tmp_path / f).exists() for f in saved["files"])
+
+
+# progress goes to a terminal only ---------------------------------------------------------------
+def test_analyze_writes_no_progress_bar_into_a_pipe(capsys):
+    code, out, err = run_cli(capsys, "analyze", "simplest-walker", "--param", "slope",
+                             "--range", "0.009:0.0095", "--points", "2", "--workers", "1")
+    assert code == 0, err
+    assert "\r" not in err and "points" not in err
+    assert "period-1 branch" in out

@@ -33,3 +33,25 @@ def test_a_walker_run_too_long_to_record_is_refused_before_it_runs():
     with pytest.raises(RecordingTooLarge):
         run.run(1e9)
     assert run.time == 0.0
+
+
+# progress goes to a terminal only ---------------------------------------------------------------
+def test_export_animation_draws_no_bar_into_a_pipe(tmp_path, capsys):
+    """pytest's captured stderr is no terminal, as a pipe or a log is not."""
+    from planarsim.render import export_animation
+    sim = ps.Simulator(point_mass_model())
+    traj = sim.run(0.2, record_every=10)
+    capsys.readouterr()
+    export_animation(traj, sim.model, tmp_path / "drop.gif", fps=20, workers=1)
+    err = capsys.readouterr().err
+    assert "\r" not in err and "frames" not in err
+    assert (tmp_path / "drop.gif").stat().st_size > 0
+
+
+def test_the_text_bar_draws_on_stderr_only_when_it_is_a_terminal(capsys, monkeypatch):
+    import planarsim.progress as progress
+    progress.TextProgress(3, "points")(3)
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(progress, "stderr_is_terminal", lambda: True)
+    progress.TextProgress(3, "points")(3)
+    assert capsys.readouterr().err.endswith("3/3 points\n")
