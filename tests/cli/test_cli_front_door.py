@@ -86,3 +86,24 @@ def test_analyze_writes_no_progress_bar_into_a_pipe(capsys):
     assert code == 0, err
     assert "\r" not in err and "points" not in err
     assert "period-1 branch" in out
+
+
+# tune: the budget is what is evaluated, and --help shows the defaults -----------------------------
+def test_tune_evaluates_its_whole_budget_or_says_why_not(tmp_path, capsys):
+    """simple-biped's generations hold 11 candidates: a budget of 14 is one generation and
+    three candidates of the next, all evaluated."""
+    out = tmp_path / "tuned.json"
+    code, stdout, err = run_cli(capsys, "tune", "simple-biped", "--budget", "14", "--duration", "0.3",
+                                "--workers", "1", "--out", out)
+    assert code == 0, err
+    result = json.loads(stdout)
+    assert result["evaluations"] == 14 and result["stopped"] is None
+
+
+def test_tune_help_shows_the_defaults(capsys):
+    with pytest.raises(SystemExit) as done:
+        main(["tune", "--help"])
+    assert done.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for default in ("(default: 200)", "(default: 0.1)", "(default: 2)", "(default: tuned.json)"):
+        assert default in text
