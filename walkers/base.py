@@ -5,6 +5,8 @@ command line, tuning, batches, the viewer and the summary treat every walker ali
 A walker module has
   NAME            its command-line name
   GAITS           its gait names; simulate's `gait` default is one of them
+  GAIT_DOCS       {gait: what the walker does in it, one line}: every gait of GAITS
+                  (planarsim list shows them)
   Params          its parameter dataclass (walkers.common.params.WalkerParams: every field with
                   unit, bounds and doc; TUNABLE names the fields tuning may vary)
   SUMMARY_EXTRAS  {raw summary key: (name with unit, meaning) or None}: its own numbers beyond
@@ -226,6 +228,9 @@ def contract_problems(name: str, module) -> list:
         problems.append(f"simulate() lacks the keywords {missing}")
     elif sig.parameters["gait"].default not in module.GAITS:
         problems.append(f"simulate()'s default gait {sig.parameters['gait'].default!r} is not in GAITS")
+    undocumented = [g for g in module.GAITS if not getattr(module, "GAIT_DOCS", {}).get(g)]
+    if undocumented:
+        problems.append(f"GAIT_DOCS does not explain the gaits {undocumented}")
     from walkers.common.params import WalkerParams
     if not (isinstance(module.Run, type) and issubclass(module.Run, WalkerRun)):
         problems.append("Run is not a WalkerRun subclass")

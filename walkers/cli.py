@@ -90,6 +90,8 @@ def cmd_list(args):
         except Exception:
             tunable = False
         print(f"  {name:16s} {gaits}{'   [tunable]' if tunable else ''}")
+        for gait, doc in getattr(mod, "GAIT_DOCS", {}).items():
+            print(f"  {'':16s}   {gait + ':':8s} {doc}")
     print("  (planarsim params WALKER lists a walker's parameters; [tunable]: planarsim tune WALKER)")
     print("terrains:")
     print("  flat             level ground")

@@ -107,3 +107,22 @@ def test_tune_help_shows_the_defaults(capsys):
     text = " ".join(capsys.readouterr().out.split())
     for default in ("(default: 200)", "(default: 0.1)", "(default: 2)", "(default: tuned.json)"):
         assert default in text
+
+
+# every gait `list` shows is explained -----------------------------------------------------------
+def test_list_explains_every_gait_it_shows(capsys):
+    import walkers
+    code, out, err = run_cli(capsys, "list")
+    assert code == 0, err
+    lines = out.splitlines()
+    for name in walkers.WALKERS:
+        start = next(i for i, line in enumerate(lines) if line.split()[:1] == [name])
+        block = []
+        for line in lines[start + 1:]:
+            if not line.startswith(" " * 19):
+                break
+            block.append(line.split(":", 1))
+        explained = {gait.strip(): doc.strip() for gait, doc in block}
+        for gait in walkers.load(name).GAITS:
+            assert len(explained.get(gait, "")) > 10, (name, gait)
+    assert "gui:" in out and "by hand" in out
