@@ -24,6 +24,14 @@ FRAME_DIMS = dict(  # shape of each per-frame array of a Trajectory (K frames)
     act_u=("K", "n_act"), act_power=("K", "n_act"), contact_normal=("K", "n_contact", 2))
 
 
+def terrain_info(model) -> dict:
+    """{terrain: name, terrain_coef: coefficients as a tuple} of the model's terrain: what a
+    Trajectory records so that it reproduces its ground."""
+    coef = np.asarray(model.arrays.terrain_coef, dtype=np.float64)
+    ter = getattr(model, "terrain", None)
+    return {"terrain": str(getattr(ter, "name", "terrain")), "terrain_coef": tuple(coef.tolist())}
+
+
 class Recorder(NamedTuple):
     """Preallocated frame arrays filled by kernels.record.record_frame."""
     t: np.ndarray                # (K,) [s]
@@ -85,7 +93,10 @@ def make_recorder(model, n_frames: int) -> Recorder:
 @dataclass
 class Trajectory:
     """Recorded run. Arrays as in Recorder; `labels` holds extra per-frame series (e.g. the
-    controller's gait/state as ints under 'phase'); `info` holds scalars (walker, dt, ...)."""
+    controller's gait/state as ints under 'phase'); `info` holds scalars (walker, dt, ...) and
+    the terrain the run was on: ``terrain`` (its name, a spec planarsim.terrain.parse reads
+    for the command line's terrains) and ``terrain_coef`` (its coefficients, exact; see
+    terrain())."""
     t: np.ndarray
     q: np.ndarray
     v: np.ndarray
@@ -108,8 +119,19 @@ class Trajectory:
     def from_recorder(cls, model, rec: Recorder, n: int | None = None, **kw) -> "Trajectory":
         n = len(rec.t) if n is None else int(n)
         arrs = {k: np.array(getattr(rec, k)[:n]) for k in cls._ARRAYS}
+        kw["info"] = {**terrain_info(model), **kw.get("info", {})}
         return cls(**arrs, body_names=model.body_names, contact_names=model.contact_names,
                    act_names=model.act_names, **kw)
+
+    def terrain(self):
+        """The planarsim.terrain.Terrain the run was on (from info's terrain_coef and
+        terrain), or None for a recording that did not keep it."""
+        from .terrain import from_coef
+        coef = self.info.get("terrain_coef")
+        if coef is None:
+            return None
+        name = self.info.get("terrain")
+        return from_coef(np.asarray(coef, dtype=np.float64), None if name is None else str(name))
 
     @classmethod
     def concatenate(cls, chunks) -> "Trajectory":

@@ -126,3 +126,18 @@ def test_list_explains_every_gait_it_shows(capsys):
         for gait in walkers.load(name).GAITS:
             assert len(explained.get(gait, "")) > 10, (name, gait)
     assert "gui:" in out and "by hand" in out
+
+
+# the terrain's parameters are recorded ------------------------------------------------------------
+def test_custom_hills_are_recorded_with_their_coefficients(tmp_path, capsys):
+    from planarsim import Trajectory, terrain
+    spec = "hills:0.05,2.5,0.3;0.02,1.1"
+    code, out, err = run_cli(capsys, "run", "simple-biped", "--duration", "0.3", "--terrain", spec,
+                             "--save", tmp_path / "run.npz", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    asked = terrain.parse(spec)
+    assert summary["terrain"] != "hills"
+    assert terrain.parse(summary["terrain"]).coef.tolist() == asked.coef.tolist()
+    saved = Trajectory.load(tmp_path / "run.npz").terrain()
+    assert saved.coef.tolist() == asked.coef.tolist()

@@ -55,3 +55,19 @@ def test_the_text_bar_draws_on_stderr_only_when_it_is_a_terminal(capsys, monkeyp
     monkeypatch.setattr(progress, "stderr_is_terminal", lambda: True)
     progress.TextProgress(3, "points")(3)
     assert capsys.readouterr().err.endswith("3/3 points\n")
+
+
+# the terrain's parameters are recorded ------------------------------------------------------------
+def test_a_saved_trajectory_reproduces_its_terrain(tmp_path):
+    from planarsim import terrain
+    for ground in (terrain.hills([0.04, 0.01], [2.0, 0.7], [0.5, 0.0], grade=0.02, height=0.1),
+                   terrain.slope(-4.25), terrain.flat(0.3)):
+        b = ps.ModelBuilder(dt=1e-3, terrain=ground)
+        b.add_point_mass("ball", 1.0, pos=(0.0, 2.0))
+        traj = ps.Simulator(b.compile()).run(0.01)
+        traj.save(tmp_path / "run.npz")
+        again = ps.Trajectory.load(tmp_path / "run.npz").terrain()
+        assert again.coef.tolist() == ground.coef.tolist()
+        assert again.name == ground.name
+    custom = terrain.hills([0.05], [2.5], [0.3])
+    assert custom.name != "hills" and terrain.parse(custom.name).coef.tolist() == custom.coef.tolist()
