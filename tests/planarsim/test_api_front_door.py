@@ -71,3 +71,44 @@ def test_a_saved_trajectory_reproduces_its_terrain(tmp_path):
         assert again.name == ground.name
     custom = terrain.hills([0.05], [2.5], [0.3])
     assert custom.name != "hills" and terrain.parse(custom.name).coef.tolist() == custom.coef.tolist()
+
+
+# whole steps only for a model that steps ----------------------------------------------------------
+def rocking_stand(seconds=4.0):
+    """A frame standing on two point feet 0.4 m apart, rocked from foot to foot by a PD torque
+    (+-0.12 rad every 0.5 s): each foot lifts for about 0.5 s and lands where it was."""
+    b = ps.ModelBuilder(dt=1e-3)
+    body = b.add_body("frame", mass=10.0, inertia=0.4, pos=(0.0, 0.3))
+    b.add_point_contact("left_foot", body, (-0.2, -0.3))
+    b.add_point_contact("right_foot", body, (0.2, -0.3))
+    b.add_body_torque("rock", body)
+    model = b.compile()
+
+    def rock(sim):
+        target = 0.12 if int(sim.t / 0.5) % 2 else -0.12
+        return np.array([300.0 * (target - sim.state.q[0, 2]) - 30.0 * sim.state.v[0, 2]])
+    return model, ps.Simulator(model).run(seconds, controller=rock, record_every=10)
+
+
+def test_a_model_that_only_stands_makes_no_whole_steps():
+    from planarsim import measure
+    model, traj = rocking_stand()
+    on = np.isin(traj.contact_mode, (1, 2))
+    lifts = (~on[1:] & on[:-1]).sum(axis=0)
+    assert (lifts >= 3).all()                     # both feet lift again and again ...
+    s = measure.summary(traj, model)
+    assert s["whole_steps"] == 0                  # ... and land where they were: no steps
+    assert np.isnan(s["step_length"]) and np.isnan(s["step_period"])
+    assert abs(s["distance"]) < 0.02
+
+
+def test_a_foot_that_lands_elsewhere_is_a_step():
+    """The same frame walked forward: a foot that lifts and lands 5 cm ahead is a step."""
+    from planarsim import measure
+    from planarsim.analysis import step_events
+    model, traj = rocking_stand()
+    moved = traj.q.copy()
+    moved[:, 0, 0] += 0.05 * np.floor(traj.t / 0.5)       # 5 cm further every half second
+    walked = ps.Trajectory(**{**traj.__dict__, "q": moved})
+    assert measure.summary(walked, model)["whole_steps"] >= 5
+    assert len(step_events(traj, feet=[[0], [1]], min_air=0.05)) >= 5   # landings, wherever
