@@ -39,14 +39,33 @@ def _load_walker(name):
     return w.load(name)
 
 
-def _say_if_compiling():
-    """Before the first simulation on a cold cache: a note on stderr (the step compiles,
-    about half a minute once)."""
+def _compile_note() -> str:
+    """What the first compile takes on this machine: the last one measured, or that none was."""
+    from planarsim.compiled import measured_compile
+    last = measured_compile()
+    if last is None:
+        return "not yet measured on this machine"
+    return f"the last one measured on this machine took {last:.0f} s"
+
+
+def _say_if_compiling() -> bool:
+    """Before the first simulation on a cold cache: a note on stderr (the engine compiles
+    once, and what that took here last time); True when the cache is cold."""
     if "NUMBA_CACHE_DIR" in os.environ:
-        return
+        return False
     from planarsim.compiled import kernel_cache
-    if not kernel_cache()[1]:
-        print("compiling the engine (first run only, about half a minute)", file=sys.stderr, flush=True)
+    if kernel_cache()[1]:
+        return False
+    print(f"compiling the engine (first run only; {_compile_note()})", file=sys.stderr, flush=True)
+    return True
+
+
+def _said_compiled(seconds: float) -> None:
+    """After a first compile: what it took, on stderr, and kept for the next one."""
+    from planarsim.compiled import record_compile
+    record_compile(seconds)
+    print(f"first compile: measured {seconds:.0f} s on this machine (later runs load it from "
+          f"numba's cache)", file=sys.stderr, flush=True)
 
 
 def _check_out(path, exts, what):
@@ -145,11 +164,13 @@ def cmd_run(args):
         print(f"running {args.walker} for {args.duration:g} s", file=sys.stderr, flush=True)
     # a 10 ms run first: compiling (or loading from numba's cache) and building the model,
     # timed apart from the simulation itself
-    _say_if_compiling()
+    cold = _say_if_compiling()
     t0 = time.perf_counter()
     with Elapsed("compiling or loading the compiled code", enabled=bars):
         mod.simulate(**{**kw, "duration": 0.01})
     t1 = time.perf_counter()
+    if cold:
+        _said_compiled(load_s + t1 - t0)
     with Elapsed(f"simulating {args.duration:g} s", enabled=bars):
         traj, raw, model = _simulate_in_chunks(mod, kw)
     t2 = time.perf_counter()
@@ -336,7 +357,7 @@ def cmd_info(args):
     print(f"python {sys.version.split()[0]}, numpy {numpy.__version__}, numba {numba.__version__}, "
           f"matplotlib {matplotlib.__version__}")
     print(f"numba cache: {len(cached)} kernel index files in {folder}"
-          f"{' (cold: the first run compiles, about half a minute)' if not cached else ' (warm)'}")
+          f"{f' (cold: the first run compiles; {_compile_note()})' if not cached else ' (warm)'}")
     try:
         from planarsim.render import ffmpeg_exe
         print(f"ffmpeg: {ffmpeg_exe()}")

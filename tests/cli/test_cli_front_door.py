@@ -141,3 +141,26 @@ def test_custom_hills_are_recorded_with_their_coefficients(tmp_path, capsys):
     assert terrain.parse(summary["terrain"]).coef.tolist() == asked.coef.tolist()
     saved = Trajectory.load(tmp_path / "run.npz").terrain()
     assert saved.coef.tolist() == asked.coef.tolist()
+
+
+# the first compile states what this machine measures ----------------------------------------------
+def test_the_first_compile_message_states_what_this_machine_measured(tmp_path, monkeypatch, capsys):
+    """A cold cache (pretended: no index files in a folder of the test's own): the note says
+    no figure was measured yet, the run then says what it measured and keeps it, and the next
+    cold start quotes that figure."""
+    import re
+
+    import planarsim.compiled as compiled
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setattr(compiled, "kernel_cache", lambda: (tmp_path, []))
+    code, _, err = run_cli(capsys, "run", "simple-biped", "--duration", "0.1", "--json")
+    assert code == 0, err
+    assert "compiling the engine (first run only; not yet measured on this machine)" in err
+    said = re.search(r"first compile: measured (\d+) s on this machine", err)
+    assert said, err
+    assert compiled.measured_compile() is not None
+    code, _, err = run_cli(capsys, "run", "simple-biped", "--duration", "0.1", "--json")
+    assert code == 0, err
+    assert re.search(r"the last one measured on this machine took \d+ s", err), err
+    code, out, _ = run_cli(capsys, "info")
+    assert "cold: the first run compiles; the last one measured on this machine took" in out
