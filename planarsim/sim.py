@@ -16,6 +16,7 @@ from .errors import diverged
 from .kernels.refs import TableHandle
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
+from .start_check import check_start
 from .state import State, Workspace, check_state, forget_ground_queries, make_state, make_workspace
 from .trajectory import Trajectory, check_recording, make_recorder
 
@@ -35,15 +36,21 @@ class Simulator:
     model : Model
     options : StepOptions (contact-mode strategy, position refinement, guards)
     state : State to start from (default: the model's build pose)
+    allow_below_ground : start even where a contact is more than START_TOLERANCE (1 mm) below
+        the ground (the first step then moves it to the surface); by default that start is a
+        ModelError naming the contact, its body and its depth (planarsim.start_check)
     """
 
-    def __init__(self, model: Model, options: StepOptions | None = None, state: State | None = None):
+    def __init__(self, model: Model, options: StepOptions | None = None, state: State | None = None,
+                 allow_below_ground: bool = False):
         if not isinstance(model, Model):
             raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
         self._model = model
         self._state = make_state(model)
         if state is not None:
             self.state = state
+        if not allow_below_ground:
+            check_start(model, self._state)
         self._ws = make_workspace(model)
         self._u0 = np.zeros(model.n_act)
         self._recorded_entry = None

@@ -137,6 +137,8 @@ class WalkerRun:
         from planarsim.compiled import check_run, make_recorder
         from planarsim.trajectory import Trajectory
         n, frames = self.check_memory(seconds)
+        if not self.chunks:
+            self.start_below_ground = self.contacts_below_ground()
         rec = make_recorder(self.model, frames)
         lab = np.zeros((frames, len(self.LABELS)))
         code, k = self.advance(n, max(self.record_every, 1), rec, lab)
@@ -178,10 +180,30 @@ class WalkerRun:
         return Trajectory.from_recorder(self.model, make_recorder(self.model, 0), 0,
                                         info={"dt": self.dt, "walker": self.NAME})
 
+    def contacts_below_ground(self) -> int:
+        """How many contacts are more than planarsim.start_check.START_TOLERANCE (1 mm) below
+        the ground now (at the start: a foot set flat on hills dips into them; the first
+        step lifts it onto the surface). Each is reported once on stderr (a warning naming
+        the deepest) and counted in the summary's audit as ``start_below_ground``."""
+        import warnings
+
+        from planarsim.start_check import START_TOLERANCE, check_start, contact_depths
+        deep = [c for c in contact_depths(self.model, self.state.q, self.state.contact_enabled)
+                if c[1] > START_TOLERANCE]
+        if deep:
+            try:
+                check_start(self.model, self.state, who=self.NAME)
+            except ValueError as e:
+                warnings.warn(str(e).split("; the first step")[0] + "; the first step moves it "
+                              "to the surface (counted as audit start_below_ground)", stacklevel=3)
+        return len(deep)
+
     def summary(self) -> dict:
-        """The walker's numbers (numbers()) and `audit`, the engine's audit counts."""
+        """The walker's numbers (numbers()) and `audit`, the engine's audit counts plus
+        ``start_below_ground`` (contacts that started more than 1 mm below the ground)."""
         from planarsim.compiled import audit_counts
-        return {**self.numbers(), "audit": audit_counts(self.ws)}
+        return {**self.numbers(), "audit": {**audit_counts(self.ws),
+                                            "start_below_ground": getattr(self, "start_below_ground", 0)}}
 
 
 def simulation(run_class):

@@ -166,13 +166,19 @@ def cmd_run(args):
     # timed apart from the simulation itself
     cold = _say_if_compiling()
     t0 = time.perf_counter()
-    with Elapsed("compiling or loading the compiled code", enabled=bars):
+    import warnings
+    with Elapsed("compiling or loading the compiled code", enabled=bars), warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # said once, by the run itself
         mod.simulate(**{**kw, "duration": 0.01})
     t1 = time.perf_counter()
     if cold:
         _said_compiled(load_s + t1 - t0)
-    with Elapsed(f"simulating {args.duration:g} s", enabled=bars):
+    with Elapsed(f"simulating {args.duration:g} s", enabled=bars), \
+            warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("default")
         traj, raw, model = _simulate_in_chunks(mod, kw)
+    for w in said:
+        print(f"planarsim run: warning: {w.message}", file=sys.stderr)
     t2 = time.perf_counter()
     wall = {"compile": round(load_s + t1 - t0, 3), "run": round(t2 - t1, 3)}
     gait = args.gait or inspect.signature(mod.simulate).parameters["gait"].default

@@ -112,3 +112,48 @@ def test_a_foot_that_lands_elsewhere_is_a_step():
     walked = ps.Trajectory(**{**traj.__dict__, "q": moved})
     assert measure.summary(walked, model)["whole_steps"] >= 5
     assert len(step_events(traj, feet=[[0], [1]], min_air=0.05)) >= 5   # landings, wherever
+
+
+# a body that starts below the ground ------------------------------------------------------------
+def shin_model(y, terrain=None):
+    """A shin whose arc foot (radius 0.05 m) has its lowest point 0.3 m below its centre of
+    mass: built with the centre at height y."""
+    b = ps.ModelBuilder(dt=1e-3, terrain=terrain)
+    shin = b.add_body("shin", mass=2.0, inertia=0.05, pos=(0.4, y))
+    b.add_arc_contact("heel", shin, center=(0.0, -0.25), radius=0.05)
+    return b.compile()
+
+
+def test_a_body_built_below_the_ground_is_a_model_error_naming_it():
+    from planarsim.errors import ModelError
+    with pytest.raises(ModelError, match=r"contact 'heel' \(0\) of body 'shin' \(0\) starts 1 m "
+                                         r"below the ground at x=0.4 m") as err:
+        ps.Simulator(shin_model(-0.7))
+    assert "allow_below_ground=True" in str(err.value)
+    # on hills, against the normal of the ground
+    from planarsim import terrain
+    with pytest.raises(ModelError, match="'heel'"):
+        ps.Simulator(shin_model(0.25, terrain.hills([0.1], [2.0])))
+
+
+def test_a_start_on_the_ground_or_allowed_below_it_runs():
+    sim = ps.Simulator(shin_model(0.3 - 5e-4))        # half a millimetre: rounding, allowed
+    sim.steps(10)
+    deep = ps.Simulator(shin_model(-0.7), allow_below_ground=True)
+    deep.steps(1)
+    assert deep.state.q[0, 1] == pytest.approx(0.3, abs=1e-6)   # lifted onto the ground, as asked
+
+
+def test_a_walker_that_starts_in_the_ground_says_so_in_its_summary():
+    """SIMBICON's feet start flat: on the default hills a sole's corner starts 3 cm inside."""
+    import warnings
+
+    import walkers
+    mod = walkers.load("simbicon")
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        _, raw, _ = mod.simulate(0.05, terrain="hills")
+    assert raw["audit"]["start_below_ground"] == 2
+    assert any("'right_sole/1'" in str(w.message) and "below the ground" in str(w.message) for w in said)
+    _, raw, _ = mod.simulate(0.05, terrain="flat")
+    assert raw["audit"]["start_below_ground"] == 0
