@@ -53,3 +53,12 @@ def test_readme_api_section_gives_what_a_model_builder_needs():
     for code, meaning in ((codes.MODE_FREE, "free"), (codes.MODE_PINNED, "pinned"),
                           (codes.MODE_SLIDING, "sliding"), (-1, "in a recording `-1` marks")):
         assert (f"`{code}` {meaning}" in api) or (meaning.endswith("marks") and meaning in api)
+
+
+def test_readme_gives_the_expected_time_of_both_commands():
+    text = README.read_text()
+    part = " ".join(text[text.index("## Two commands"):text.index("## The command line")].split())
+    assert re.search(r"command 1: about \d+ minutes?", part)
+    assert re.search(r"command 2: about \d+ minutes?", part)
+    assert "first compile: measured N s on this machine" in part
+    assert "about half a minute" not in text
