@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 import planarsim as ps
 from planarsim import terrain
 
@@ -39,8 +41,11 @@ def boxes_on_hills(n=10, dt=1e-3):
     b = ps.ModelBuilder(dt=dt, terrain=ter)
     for i in range(n):
         x = 1.3 * i
+        # 2 cm above the ground under its centre and its corners (in a trough the corners'
+        # ground is the higher: a box set by its centre alone would start inside the hill)
+        ground = float(np.max(ter.height(np.array([x - 0.2, x, x + 0.2]))))
         box = b.add_body(f"box{i}", mass=3.0, inertia=3.0 * (0.16 + 0.04) / 12,
-                         pos=(x, float(ter.height(x)) + 0.12))
+                         pos=(x, ground + 0.12))
         b.add_box_contacts(f"box{i}", box, (0.0, 0.0), 0.4, 0.2, mu=1.0)
     return b.compile()
 

@@ -29,6 +29,7 @@ From Python:
     step_info(ws)                            what the last step did (solves, splits, pivots)
     drop_stale_caches(folder)                call on import of a package with compiled code
     kernel_cache()                           (folder, index files) of the engine's numba cache
+    measured_compile(), record_compile(s)    the last first compile measured on this machine [s]
 
 Run codes. step returns RUN_OK or an engine failure: RUN_NONFINITE / RUN_TOO_LARGE (the state
 blew up), RUN_AUDIT (StepOptions.audit_raise and a rule broken), RUN_BAD_COMMANDS /
@@ -62,12 +63,40 @@ RUN_NO_EVENT = 101      # a step map found no section event (touchdown, mid-stan
 
 def kernel_cache():
     """(folder, sorted index files) of the engine kernels' numba cache: no files means the next
-    run compiles (about half a minute)."""
+    run compiles (measured_compile() says how long that took on this machine last time)."""
     from pathlib import Path
 
     from .kernels import _jit
     folder = Path(_jit.__file__).resolve().parent / "__pycache__"
     return folder, sorted(folder.glob("*.nbi"))
+
+
+COMPILE_RECORD = "first_compile_s.txt"   # in kernel_cache()'s folder: the last first compile [s]
+
+
+def measured_compile():
+    """Seconds the last first compile (a cold cache) took on this machine, as recorded by
+    record_compile, or None if none was recorded."""
+    try:
+        text = (kernel_cache()[0] / COMPILE_RECORD).read_text().split()
+        seconds = float(text[0])
+    except (OSError, ValueError, IndexError):
+        return None
+    return seconds if seconds >= 0 else None
+
+
+def record_compile(seconds: float) -> None:
+    """Keep `seconds` [s], a first compile just measured, beside the cache (numba's cache
+    clearing leaves it); nothing where the install is read-only."""
+    import os
+    folder = kernel_cache()[0]
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tmp = folder / f"{COMPILE_RECORD}.{os.getpid()}.tmp"
+        tmp.write_text(f"{float(seconds):.3f}\n")
+        os.replace(tmp, folder / COMPILE_RECORD)
+    except OSError:
+        pass
 
 
 def engine_failed(code) -> bool:
@@ -89,7 +118,7 @@ def check_run(code, model, ws, options, who="simulation") -> int:
 __all__ = ["jit", "jit_inline", "kernel", "step", "step_from_python", "record_frame",
            "make_recorder", "height", "height_derivs", "closest_point", "gap_of_point",
            "pin_angle_rate", "shape_contact_mode", "audit_counts", "step_info", "drop_stale_caches",
-           "kernel_cache",
+           "kernel_cache", "measured_compile", "record_compile",
            "check_run", "engine_failed",
            "RUN_OK", "RUN_NONFINITE", "RUN_TOO_LARGE", "RUN_AUDIT", "RUN_BAD_COMMANDS",
            "RUN_NONFINITE_COMMAND", "RUN_WALKER", "RUN_FELL", "RUN_NO_EVENT"]

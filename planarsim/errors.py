@@ -5,6 +5,9 @@ index, field, value and the rule broken. ``SimulationDiverged`` is raised when a
 compiled step fires (non-finite or huge state); it carries the last finite state.
 ``AuditViolation`` is raised, with StepOptions.audit_raise = 1, when a step breaks a rule of
 its own audit (kernels/audit.py); it names the step, time, rule, contact or pin and body.
+``RecordingTooLarge`` is raised before a recording is allocated that would not fit in the
+machine's memory (a duration far too long for its frame interval); it names the frames and
+the memory they would need.
 """
 from .kernels.audit import AUDIT_DEPTH, AUDIT_NAMES, AUDIT_PIN_GAP
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
@@ -13,6 +16,27 @@ from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE_COM
 
 class ModelError(ValueError):
     """A malformed model: the message names the culprit and the rule."""
+
+
+class RecordingTooLarge(ValueError):
+    """A recording that cannot fit in this machine's memory, refused before it is allocated.
+
+    Attributes
+    ----------
+    frames : int      frames the recording would hold
+    nbytes : int      memory they would need [bytes]
+    available : int   the machine's physical memory [bytes]
+    """
+
+    def __init__(self, message, frames=0, nbytes=0, available=0):
+        super().__init__(message)
+        self.frames = int(frames)
+        self.nbytes = int(nbytes)
+        self.available = int(available)
+
+    def __reduce__(self):
+        # picklable, so that a tuning worker's refusal reaches the command line intact
+        return (type(self), (str(self), self.frames, self.nbytes, self.available))
 
 
 class SimulationDiverged(RuntimeError):

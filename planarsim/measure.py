@@ -56,14 +56,20 @@ def pin_angle_rate(model, q, v, pin) -> tuple:
     return float(ang), float(rate)
 
 
-def summary(traj, model, feet=None, min_air=0.05, together=0.05) -> dict:
+MIN_STRIDE = 0.02   # [m] a landing is a step when the foot lands this far from where it lifted
+
+
+def summary(traj, model, feet=None, min_air=0.05, together=0.05, min_stride=MIN_STRIDE) -> dict:
     """Whole-step summary of any recorded run (planarsim.analysis.step_summary): feet default
-    to the contacts grouped by name (a box foot's corners are one foot), a landing counts after
-    min_air [s] off the ground, feet landing within `together` [s] of each other land once. Adds distance [m] and mean_speed [m/s] of the centre of mass
-    over the whole recording."""
+    to the contacts grouped by name (a box foot's corners are one foot); a landing is a step
+    when the foot was off the ground at least min_air [s] and lands at least min_stride [m]
+    from where it lifted (a model that stands, rocks or hops in place makes none); feet
+    landing within `together` [s] of each other land once. Adds distance [m] and mean_speed
+    [m/s] of the centre of mass over the whole recording."""
     from .analysis import foot_groups
     feet = foot_groups(traj.contact_names) if feet is None else feet
-    out = step_summary(traj, model, feet=feet, min_air=min_air, together=together)
+    out = step_summary(traj, model, feet=feet, min_air=min_air, together=together,
+                       min_stride=min_stride)
     com = traj.com(model)
     t = np.asarray(traj.t)
     dist = float(com[-1, 0] - com[0, 0]) if len(com) else 0.0

@@ -1,6 +1,7 @@
 """Progress bars on stderr for work that takes longer than a second (no heavy imports here).
 
-``TextProgress(total, label)(done)`` redraws one line ``[#####.....] 30/60 frames``;
+``TextProgress(total, label)(done)`` redraws one line ``[#####.....] 30/60 frames`` (on a
+terminal only: nothing goes into a pipe or a log);
 ``progress_for(progress, total, label)`` turns the usual ``progress=`` argument (True, False,
 or a callable(done, total)) into a callable(done); ``Elapsed(label)`` shows the seconds spent
 on work that has no count (a compiled simulation call) once it passes a second.
@@ -11,14 +12,20 @@ import sys
 
 
 class TextProgress:
-    """A one-line text progress bar on stderr: ``[#####.....] 30/60 frames``."""
+    """A one-line text progress bar on stderr: ``[#####.....] 30/60 frames``.
+
+    On stderr (no `stream` given) the bar is drawn only when stderr is a terminal: a pipe or
+    a log gets no carriage returns. A `stream` given is drawn on as asked."""
 
     def __init__(self, total: int, label: str = "frames", stream=None, width: int = 30):
         self.total, self.label, self.width = int(total), label, width
+        self.enabled = stream is not None or stderr_is_terminal()
         self.stream = stream if stream is not None else sys.stderr
         self._last = -1
 
     def __call__(self, done: int) -> None:
+        if not self.enabled:
+            return
         filled = int(self.width * done / max(1, self.total))
         if filled == self._last and done < self.total:
             return

@@ -16,9 +16,10 @@ from .errors import diverged
 from .kernels.refs import TableHandle
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
+from .start_check import check_start
 from .state import (State, Workspace, check_state, forget_ground_queries, forget_pairs, make_state,
                     make_workspace)
-from .trajectory import Trajectory, make_recorder
+from .trajectory import Trajectory, check_recording, make_recorder
 
 
 def _link():
@@ -36,9 +37,13 @@ class Simulator:
     model : Model
     options : StepOptions (contact-mode strategy, position refinement, guards)
     state : State to start from (default: the model's build pose)
+    allow_below_ground : start even where a contact is more than START_TOLERANCE (1 mm) below
+        the ground (the first step then moves it to the surface); by default that start is a
+        ModelError naming the contact, its body and its depth (planarsim.start_check)
     """
 
-    def __init__(self, model: Model, options: StepOptions | None = None, state: State | None = None):
+    def __init__(self, model: Model, options: StepOptions | None = None, state: State | None = None,
+                 allow_below_ground: bool = False):
         if not isinstance(model, Model):
             raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
         self._model = model
@@ -46,6 +51,8 @@ class Simulator:
         self._ws = make_workspace(model)
         if state is not None:
             self.state = state
+        if not allow_below_ground:
+            check_start(model, self._state)
         self._u0 = np.zeros(model.n_act)
         self._recorded_entry = None
         self._args = None
@@ -192,6 +199,8 @@ class Simulator:
         every = int(record_every)
         if every < 1 or int(control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")
+        check_recording(self.model, n // every + 1,
+                        f"run of {n:,} steps of {self.dt:g} s, a frame every {every} steps")
         rec = make_recorder(self.model, n // every + 1)
         k = 0
         if controller is None:

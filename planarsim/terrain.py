@@ -19,6 +19,8 @@ class Terrain:
     """Ground profile. Build with :func:`flat`, :func:`slope`, :func:`hills` or :func:`parse`.
 
     coef : (3 + 3K,) array  [h0, s, K, A_1, L_1, phi_1, ...]
+    name : what it is: flat, slope:DEG, hills (the default hills) or hills:A,L,PHI;... with
+        every coefficient (parse reads these back to the same coefficients)
     """
 
     coef: np.ndarray
@@ -85,6 +87,39 @@ def validate_coef(coef: np.ndarray) -> None:
             raise ModelError(f"terrain: sine {j}: wavelength={wavelength} must be > 0")
 
 
+def _num(x) -> str:
+    """x as short text that reads back to exactly x (%g where that is exact, else repr)."""
+    x = float(x)
+    short = f"{x:g}"
+    return short if float(short) == x else repr(x)
+
+
+def from_coef(coef, name: str | None = None) -> Terrain:
+    """The Terrain of coefficients [h0, s, K, A_1, L_1, phi_1, ...] (a model's terrain_coef or
+    a trajectory's recorded ``terrain_coef``), named as flat, slope or hills name theirs."""
+    coef = np.asarray(coef, dtype=np.float64)
+    validate_coef(coef)
+    if name is None:
+        h0, s, k = coef[0], coef[1], int(coef[2])
+        if k == 0 and s == 0.0:
+            name = "flat" if h0 == 0.0 else f"flat (height {_num(h0)} m)"
+        elif k == 0:
+            name = f"slope:{_num(math.degrees(math.atan(s)))}"
+            name += "" if h0 == 0.0 else f" (height {_num(h0)} m)"
+        else:
+            name = _hills_name(coef[3::3], coef[4::3], coef[5::3], s, h0)
+    return Terrain(coef, name=name)
+
+
+def _hills_name(a, lam, phi, grade, height) -> str:
+    """hills:A,L,PHI;... with every coefficient (exact, parse reads it back), then the grade
+    and height when they are not 0 (which the spec cannot hold)."""
+    name = "hills:" + ";".join(f"{_num(x)},{_num(y)},{_num(z)}" for x, y, z in zip(a, lam, phi))
+    extra = [f"grade {_num(grade)}" for _ in [0] if grade != 0.0]
+    extra += [f"height {_num(height)} m" for _ in [0] if height != 0.0]
+    return name + (f" ({', '.join(extra)})" if extra else "")
+
+
 def flat(height: float = 0.0) -> Terrain:
     """Level ground at `height` [m]."""
     return Terrain(np.array([height, 0.0, 0.0]), name="flat")
@@ -94,7 +129,8 @@ def slope(angle_deg: float, height: float = 0.0) -> Terrain:
     """Constant slope rising toward +x by `angle_deg` degrees (negative: downhill)."""
     if not math.isfinite(angle_deg) or abs(angle_deg) >= 89.0:
         raise ModelError(f"terrain: slope angle={angle_deg} deg must be finite and within (-89, 89)")
-    return Terrain(np.array([height, math.tan(math.radians(angle_deg)), 0.0]), name=f"slope:{angle_deg:g}")
+    return Terrain(np.array([height, math.tan(math.radians(angle_deg)), 0.0]),
+                   name=f"slope:{_num(angle_deg)}")
 
 
 def hills(amplitudes, wavelengths, phases=None, grade: float = 0.0, height: float = 0.0) -> Terrain:
@@ -106,7 +142,7 @@ def hills(amplitudes, wavelengths, phases=None, grade: float = 0.0, height: floa
         raise ModelError(f"terrain: amplitudes, wavelengths, phases must have one length, got "
                          f"{a.size}, {lam.size}, {phi.size}")
     coef = np.concatenate([[height, grade, float(a.size)], np.stack([a, lam, phi], axis=1).ravel()])
-    return Terrain(coef, name="hills")
+    return Terrain(coef, name=_hills_name(a, lam, phi, float(grade), float(height)))
 
 
 def max_slope_deg(terrain: Terrain, x0: float = -50.0, x1: float = 150.0, n: int = 200001) -> float:
@@ -148,5 +184,6 @@ def parse(spec: str) -> Terrain:
 
 
 def default_hills() -> Terrain:
-    """Rolling hills: max slope about 12 deg, peak-to-trough about 0.33 m (Kelly 2014's figure)."""
-    return hills([0.12, 0.045], [7.0, 2.9], [0.0, 1.3])
+    """Rolling hills: max slope about 12 deg, peak-to-trough about 0.33 m (Kelly 2014's figure);
+    named "hills" (the spec that parse reads back to them)."""
+    return Terrain(hills([0.12, 0.045], [7.0, 2.9], [0.0, 1.3]).coef, name="hills")

@@ -24,6 +24,14 @@ FRAME_DIMS = dict(  # shape of each per-frame array of a Trajectory (K frames)
     act_u=("K", "n_act"), act_power=("K", "n_act"), contact_normal=("K", "n_contact", 2))
 
 
+def terrain_info(model) -> dict:
+    """{terrain: name, terrain_coef: coefficients as a tuple} of the model's terrain: what a
+    Trajectory records so that it reproduces its ground."""
+    coef = np.asarray(model.arrays.terrain_coef, dtype=np.float64)
+    ter = getattr(model, "terrain", None)
+    return {"terrain": str(getattr(ter, "name", "terrain")), "terrain_coef": tuple(coef.tolist())}
+
+
 class Recorder(NamedTuple):
     """Preallocated frame arrays filled by kernels.record.record_frame."""
     t: np.ndarray                # (K,) [s]
@@ -38,8 +46,44 @@ class Recorder(NamedTuple):
                                  #   or a shape pair's, from the reference shape to the other)
 
 
+def frame_bytes(model, extra_columns: int = 0) -> int:
+    """Memory [bytes] of one recorded frame of `model` (a Recorder's arrays, plus
+    `extra_columns` float64 labels per frame)."""
+    nb, nc, na = model.n_body, model.n_contact, model.n_act
+    return 8 * (1 + 6 * nb + 7 * nc + 2 * na + int(extra_columns))
+
+
+def machine_memory() -> int:
+    """This machine's physical memory [bytes]; 0 where the system does not say."""
+    try:
+        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (AttributeError, OSError, ValueError):
+        return 0
+
+
+def _gib(nbytes) -> str:
+    return f"{nbytes / 2 ** 30:.3g} GiB"
+
+
+def check_recording(model, n_frames, what: str = "", extra_columns: int = 0) -> None:
+    """Raise RecordingTooLarge, before anything is allocated, when `n_frames` frames of
+    `model` (frame_bytes) need more memory than the machine has (machine_memory). `what`
+    says what asked for them (a run's duration, say)."""
+    from .errors import RecordingTooLarge
+    need = int(n_frames) * frame_bytes(model, extra_columns)
+    have = machine_memory()
+    if have and need > have:
+        raise RecordingTooLarge(
+            f"{what + ': ' if what else ''}recording {int(n_frames):,} frames needs "
+            f"{_gib(need)} of memory, more than this machine's {_gib(have)}; record fewer frames "
+            f"(a shorter run, or a frame every more steps)", n_frames, need, have)
+
+
 def make_recorder(model, n_frames: int) -> Recorder:
+    """Zeroed frame arrays for `n_frames` frames (RecordingTooLarge, before allocating, if
+    they cannot fit in the machine's memory)."""
     nb, nc, na, K = model.n_body, model.n_contact, model.n_act, int(n_frames)
+    check_recording(model, K)
     z = np.zeros
     return Recorder(t=z(K), q=z((K, nb, 3)), v=z((K, nb, 3)), contact_mode=z((K, nc), np.int64),
                     contact_impulse=z((K, nc, 2)), contact_point=z((K, nc, 2)), act_u=z((K, na)),
@@ -49,7 +93,10 @@ def make_recorder(model, n_frames: int) -> Recorder:
 @dataclass
 class Trajectory:
     """Recorded run. Arrays as in Recorder; `labels` holds extra per-frame series (e.g. the
-    controller's gait/state as ints under 'phase'); `info` holds scalars (walker, dt, ...)."""
+    controller's gait/state as ints under 'phase'); `info` holds scalars (walker, dt, ...) and
+    the terrain the run was on: ``terrain`` (its name, a spec planarsim.terrain.parse reads
+    for the command line's terrains) and ``terrain_coef`` (its coefficients, exact; see
+    terrain())."""
     t: np.ndarray
     q: np.ndarray
     v: np.ndarray
@@ -72,8 +119,19 @@ class Trajectory:
     def from_recorder(cls, model, rec: Recorder, n: int | None = None, **kw) -> "Trajectory":
         n = len(rec.t) if n is None else int(n)
         arrs = {k: np.array(getattr(rec, k)[:n]) for k in cls._ARRAYS}
+        kw["info"] = {**terrain_info(model), **kw.get("info", {})}
         return cls(**arrs, body_names=model.body_names, contact_names=model.contact_names,
                    act_names=model.act_names, **kw)
+
+    def terrain(self):
+        """The planarsim.terrain.Terrain the run was on (from info's terrain_coef and
+        terrain), or None for a recording that did not keep it."""
+        from .terrain import from_coef
+        coef = self.info.get("terrain_coef")
+        if coef is None:
+            return None
+        name = self.info.get("terrain")
+        return from_coef(np.asarray(coef, dtype=np.float64), None if name is None else str(name))
 
     @classmethod
     def concatenate(cls, chunks) -> "Trajectory":

@@ -5,6 +5,8 @@ command line, tuning, batches, the viewer and the summary treat every walker ali
 A walker module has
   NAME            its command-line name
   GAITS           its gait names; simulate's `gait` default is one of them
+  GAIT_DOCS       {gait: what the walker does in it, one line}: every gait of GAITS
+                  (planarsim list shows them)
   Params          its parameter dataclass (walkers.common.params.WalkerParams: every field with
                   unit, bounds and doc; TUNABLE names the fields tuning may vary)
   SUMMARY_EXTRAS  {raw summary key: (name with unit, meaning) or None}: its own numbers beyond
@@ -134,15 +136,9 @@ class WalkerRun:
         this chunk's Trajectory. Engine failures raise (planarsim.compiled.check_run)."""
         from planarsim.compiled import check_run, make_recorder
         from planarsim.trajectory import Trajectory
-        try:
-            seconds = float(seconds)
-        except (TypeError, ValueError):
-            raise ValueError(f"seconds={seconds!r} must be a number of seconds") from None
-        if not (math.isfinite(seconds) and seconds >= 0.0):
-            raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
-        # a walker that fell stays where it fell: its rollout would otherwise take one more step
-        n = 0 if self.fell else int(round(seconds / self.dt))
-        frames = self.frames(n)
+        n, frames = self.check_memory(seconds)
+        if not self.chunks:
+            self.start_below_ground = self.contacts_below_ground()
         rec = make_recorder(self.model, frames)
         lab = np.zeros((frames, len(self.LABELS)))
         code, k = self.advance(n, max(self.record_every, 1), rec, lab)
@@ -152,6 +148,25 @@ class WalkerRun:
                                         info={"dt": self.dt, "walker": self.NAME})
         self.chunks.append(traj)
         return traj
+
+    def check_memory(self, seconds: float) -> tuple:
+        """(steps, frames) that run(seconds) would take and record; ValueError for a bad
+        `seconds`, planarsim.errors.RecordingTooLarge (a ValueError) for frames that cannot
+        fit in the machine's memory, before anything is allocated or run."""
+        from planarsim.trajectory import check_recording
+        try:
+            seconds = float(seconds)
+        except (TypeError, ValueError):
+            raise ValueError(f"seconds={seconds!r} must be a number of seconds") from None
+        if not (math.isfinite(seconds) and seconds >= 0.0):
+            raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
+        # a walker that fell stays where it fell: its rollout would otherwise take one more step
+        n = 0 if self.fell else int(round(seconds / self.dt))
+        frames = self.frames(n)
+        check_recording(self.model, frames,
+                        f"{self.NAME}: run({seconds:g} s) at dt={self.dt:g} s, a frame every "
+                        f"{self.record_every} steps", extra_columns=len(self.LABELS))
+        return n, frames
 
     def trajectory(self):
         """All chunks run so far, joined (empty ones left out)."""
@@ -165,10 +180,30 @@ class WalkerRun:
         return Trajectory.from_recorder(self.model, make_recorder(self.model, 0), 0,
                                         info={"dt": self.dt, "walker": self.NAME})
 
+    def contacts_below_ground(self) -> int:
+        """How many contacts are more than planarsim.start_check.START_TOLERANCE (1 mm) below
+        the ground now (at the start: a foot set flat on hills dips into them; the first
+        step lifts it onto the surface). Each is reported once on stderr (a warning naming
+        the deepest) and counted in the summary's audit as ``start_below_ground``."""
+        import warnings
+
+        from planarsim.start_check import START_TOLERANCE, check_start, contact_depths
+        deep = [c for c in contact_depths(self.model, self.state.q, self.state.contact_enabled)
+                if c[1] > START_TOLERANCE]
+        if deep:
+            try:
+                check_start(self.model, self.state, who=self.NAME)
+            except ValueError as e:
+                warnings.warn(str(e).split("; the first step")[0] + "; the first step moves it "
+                              "to the surface (counted as audit start_below_ground)", stacklevel=3)
+        return len(deep)
+
     def summary(self) -> dict:
-        """The walker's numbers (numbers()) and `audit`, the engine's audit counts."""
+        """The walker's numbers (numbers()) and `audit`, the engine's audit counts plus
+        ``start_below_ground`` (contacts that started more than 1 mm below the ground)."""
         from planarsim.compiled import audit_counts
-        return {**self.numbers(), "audit": audit_counts(self.ws)}
+        return {**self.numbers(), "audit": {**audit_counts(self.ws),
+                                            "start_below_ground": getattr(self, "start_below_ground", 0)}}
 
 
 def simulation(run_class):
@@ -215,6 +250,9 @@ def contract_problems(name: str, module) -> list:
         problems.append(f"simulate() lacks the keywords {missing}")
     elif sig.parameters["gait"].default not in module.GAITS:
         problems.append(f"simulate()'s default gait {sig.parameters['gait'].default!r} is not in GAITS")
+    undocumented = [g for g in module.GAITS if not getattr(module, "GAIT_DOCS", {}).get(g)]
+    if undocumented:
+        problems.append(f"GAIT_DOCS does not explain the gaits {undocumented}")
     from walkers.common.params import WalkerParams
     if not (isinstance(module.Run, type) and issubclass(module.Run, WalkerRun)):
         problems.append("Run is not a WalkerRun subclass")

@@ -19,8 +19,6 @@ import sys
 import time
 from pathlib import Path
 
-from planarsim import __version__
-
 ANIMATION_EXTS = (".gif", ".mp4", ".html")
 PLOT_EXTS = (".png", ".svg", ".pdf")
 
@@ -41,14 +39,33 @@ def _load_walker(name):
     return w.load(name)
 
 
-def _say_if_compiling():
-    """Before the first simulation on a cold cache: a note on stderr (the step compiles,
-    about half a minute once)."""
+def _compile_note() -> str:
+    """What the first compile takes on this machine: the last one measured, or that none was."""
+    from planarsim.compiled import measured_compile
+    last = measured_compile()
+    if last is None:
+        return "not yet measured on this machine"
+    return f"the last one measured on this machine took {last:.0f} s"
+
+
+def _say_if_compiling() -> bool:
+    """Before the first simulation on a cold cache: a note on stderr (the engine compiles
+    once, and what that took here last time); True when the cache is cold."""
     if "NUMBA_CACHE_DIR" in os.environ:
-        return
+        return False
     from planarsim.compiled import kernel_cache
-    if not kernel_cache()[1]:
-        print("compiling the engine (first run only, about half a minute)", file=sys.stderr, flush=True)
+    if kernel_cache()[1]:
+        return False
+    print(f"compiling the engine (first run only; {_compile_note()})", file=sys.stderr, flush=True)
+    return True
+
+
+def _said_compiled(seconds: float) -> None:
+    """After a first compile: what it took, on stderr, and kept for the next one."""
+    from planarsim.compiled import record_compile
+    record_compile(seconds)
+    print(f"first compile: measured {seconds:.0f} s on this machine (later runs load it from "
+          f"numba's cache)", file=sys.stderr, flush=True)
 
 
 def _check_out(path, exts, what):
@@ -92,6 +109,8 @@ def cmd_list(args):
         except Exception:
             tunable = False
         print(f"  {name:16s} {gaits}{'   [tunable]' if tunable else ''}")
+        for gait, doc in getattr(mod, "GAIT_DOCS", {}).items():
+            print(f"  {'':16s}   {gait + ':':8s} {doc}")
     print("  (planarsim params WALKER lists a walker's parameters; [tunable]: planarsim tune WALKER)")
     print("terrains:")
     print("  flat             level ground")
@@ -137,6 +156,7 @@ def cmd_run(args):
         kw["terrain"] = ter
     if args.dt is not None:
         kw["dt"] = args.dt
+    _check_duration_fits(mod, kw, args.duration)
     from planarsim.progress import Elapsed, stderr_is_terminal
     bars = not args.json and stderr_is_terminal()      # progress only where someone watches
     from walkers.common.summary import walker_summary
@@ -144,13 +164,21 @@ def cmd_run(args):
         print(f"running {args.walker} for {args.duration:g} s", file=sys.stderr, flush=True)
     # a 10 ms run first: compiling (or loading from numba's cache) and building the model,
     # timed apart from the simulation itself
-    _say_if_compiling()
+    cold = _say_if_compiling()
     t0 = time.perf_counter()
-    with Elapsed("compiling or loading the compiled code", enabled=bars):
+    import warnings
+    with Elapsed("compiling or loading the compiled code", enabled=bars), warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # said once, by the run itself
         mod.simulate(**{**kw, "duration": 0.01})
     t1 = time.perf_counter()
-    with Elapsed(f"simulating {args.duration:g} s", enabled=bars):
-        traj, raw, model = mod.simulate(**kw)
+    if cold:
+        _said_compiled(load_s + t1 - t0)
+    with Elapsed(f"simulating {args.duration:g} s", enabled=bars), \
+            warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("default")
+        traj, raw, model = _simulate_in_chunks(mod, kw)
+    for w in said:
+        print(f"planarsim run: warning: {w.message}", file=sys.stderr)
     t2 = time.perf_counter()
     wall = {"compile": round(load_s + t1 - t0, 3), "run": round(t2 - t1, 3)}
     gait = args.gait or inspect.signature(mod.simulate).parameters["gait"].default
@@ -180,10 +208,11 @@ def cmd_run(args):
         written.append(str(out))
     summary["wall_time_s"]["output"] = round(time.perf_counter() - t2, 3)
     if summary_path is not None:
+        written.append(str(summary_path))
+    summary["files"] = written     # the summary file lists itself too: the same summary everywhere
+    if summary_path is not None:
         from planarsim.trajectory import atomic_write
         atomic_write(summary_path, lambda f: f.write(json.dumps(summary, indent=2) + "\n"), binary=False)
-        written.append(str(summary_path))
-    summary["files"] = written
     if args.json:
         print(json.dumps(summary))
     else:
@@ -195,6 +224,44 @@ def cmd_run(args):
             else:
                 print(f"  {k:34s} {_show(v)}")
     return 0
+
+
+RUN_CHUNK_S = 10.0   # [s] simulated per compiled call of `run`: Ctrl-C is answered between calls
+
+
+def _simulate_in_chunks(mod, kw):
+    """mod.simulate(**kw), run RUN_CHUNK_S at a time (bit for bit the same: a walker run
+    continues exactly), so that an interrupt is answered within one chunk rather than at the
+    end of a long compiled run. Returns (Trajectory, raw summary, Model)."""
+    kw = dict(kw)
+    duration = float(kw.pop("duration"))
+    run = mod.Run(**kw)
+    steps = int(round(duration / run.dt))
+    chunk = max(1, int(round(RUN_CHUNK_S / run.dt)))
+    done = 0
+    while done < steps and not run.fell:
+        n = min(chunk, steps - done)
+        run.run(n * run.dt)
+        done += n
+    if not run.chunks:
+        run.run(0.0)
+    traj = run.trajectory()
+    gait = kw.get("gait", inspect.signature(mod.simulate).parameters["gait"].default)
+    traj.info.update(gait=gait, seed=kw.get("seed", 0))
+    return traj, run.summary(), run.model
+
+
+def _check_duration_fits(mod, kw, duration):
+    """UsageError naming --duration when its recording cannot fit in this machine's memory
+    (checked on the walker's run before anything is compiled or allocated)."""
+    from planarsim.errors import RecordingTooLarge
+    run = mod.Run(**{k: v for k, v in kw.items() if k != "duration"})
+    try:
+        run.check_memory(duration)
+    except RecordingTooLarge as e:
+        raise UsageError(f"--duration {duration:g} s would record {e.frames:,} frames, which need "
+                         f"{e.nbytes / 2 ** 30:.3g} GiB of memory (this machine has "
+                         f"{e.available / 2 ** 30:.3g} GiB); give a shorter --duration") from None
 
 
 def _show(v):
@@ -289,13 +356,14 @@ def cmd_info(args):
     import numba
     import numpy
     import matplotlib
+    from planarsim import __version__
     from planarsim.compiled import kernel_cache
     folder, cached = kernel_cache()
     print(f"planarsim {__version__}")
     print(f"python {sys.version.split()[0]}, numpy {numpy.__version__}, numba {numba.__version__}, "
           f"matplotlib {matplotlib.__version__}")
     print(f"numba cache: {len(cached)} kernel index files in {folder}"
-          f"{' (cold: the first run compiles, about half a minute)' if not cached else ' (warm)'}")
+          f"{f' (cold: the first run compiles; {_compile_note()})' if not cached else ' (warm)'}")
     try:
         from planarsim.render import ffmpeg_exe
         print(f"ffmpeg: {ffmpeg_exe()}")
@@ -408,6 +476,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def make_parser():
+    from planarsim import __version__
     ap = _Parser(prog="planarsim", description="Planar physics for walking machines.")
     ap.add_argument("--version", action="version", version=f"planarsim {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -513,10 +582,39 @@ class _ReaderMayLeave:
 
 def main(argv=None) -> int:
     """The command line; `argv` None reads sys.argv (and, as the program itself, ends the
-    process for the QUICK_EXIT commands once their output is flushed)."""
+    process for the QUICK_EXIT commands once their output is flushed). Ctrl-C at any moment,
+    the imports and the first compile included, prints one line and returns (as the program:
+    exits with) 130."""
     program = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     stdout = sys.stdout
+    try:
+        code = _serve(argv, stdout)
+    except KeyboardInterrupt:
+        code = _interrupted(argv, stdout, program)
+    if program and (code == INTERRUPTED or argv and argv[0] in QUICK_EXIT):
+        sys.stderr.flush()
+        os._exit(code)
+    return code
+
+
+INTERRUPTED = 130       # the exit code of a command ended by Ctrl-C (128 + SIGINT)
+
+
+def _interrupted(argv, stdout, program) -> int:
+    """One line for an interrupt, wherever it came; as the program, later interrupts are
+    ignored while that line is written (the process then ends without its teardown)."""
+    if program:
+        import signal
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.stdout = stdout
+    command = argv[0] if argv and not argv[0].startswith("-") else None
+    print(f"planarsim{' ' + command if command else ''}: interrupted", file=sys.stderr, flush=True)
+    return INTERRUPTED
+
+
+def _serve(argv, stdout) -> int:
+    """_main with stdout guarded against a reader that leaves (_ReaderMayLeave)."""
     sys.stdout = _ReaderMayLeave(stdout)
     code = 1
     try:
@@ -531,9 +629,6 @@ def main(argv=None) -> int:
     if left:
         # nothing more may reach the closed pipe, not even at the interpreter's exit
         os.dup2(os.open(os.devnull, os.O_WRONLY), stdout.fileno())
-    if program and argv and argv[0] in QUICK_EXIT:
-        sys.stderr.flush()
-        os._exit(code)
     return code
 
 
@@ -554,9 +649,10 @@ def _main(argv) -> int:
         # bad input detected deeper down (ModelError is a ValueError): one line, exit 2
         print(f"planarsim {args.command}: error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"planarsim {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except MemoryError as e:
+        # an allocation no check foresaw: one line, not numpy's traceback
+        print(f"planarsim {args.command}: error: not enough memory: {e}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

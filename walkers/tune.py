@@ -71,7 +71,8 @@ class TuneResult:
     settings: dict = field(default_factory=dict)
     seed: int = 0
     names: tuple = ()
-    evaluations: int = 0
+    evaluations: int = 0    # candidates evaluated (the start point's evaluation not counted)
+    stopped: str = ""       # why fewer than `budget` candidates were evaluated ("" if not)
 
     def params(self):
         """The best parameters as the walker's params dataclass."""
@@ -81,7 +82,7 @@ class TuneResult:
         return dict(format_version=FORMAT_VERSION, walker=self.walker, best_params=self.best_params,
                     best_score=self.best_score, start_score=self.start_score, history=self.history,
                     settings=self.settings, seed=self.seed, names=list(self.names),
-                    evaluations=self.evaluations)
+                    evaluations=self.evaluations, stopped=self.stopped)
 
     def save(self, path) -> Path:
         path = Path(path)
@@ -106,6 +107,19 @@ def load_result(path) -> TuneResult:
     return TuneResult(**data)
 
 
+_STOP_TEXT = {"tolfun": "the scores of recent generations differ by less than tolfun (converged)",
+              "tolx": "the step size fell below tolx (converged)",
+              "tolfunhist": "the best scores of recent generations agree (converged)",
+              "tolstagnation": "no progress over many generations",
+              "tolflatfitness": "every candidate of several generations scored the same",
+              "maxiter": "the iteration limit", "maxfevals": "the evaluation limit"}
+
+
+def _stop_reasons(stop: dict) -> str:
+    """CMA-ES's reasons to stop (es.stop()), in words."""
+    return "; ".join(_STOP_TEXT.get(k, k) for k in stop) or "no reason given"
+
+
 def _make_executor(executor, scheduler, workers):
     """(executor, closer) from the user's choice."""
     if executor is not None:
@@ -118,8 +132,27 @@ def _make_executor(executor, scheduler, workers):
                               "pip install 'planarsim[tune]'") from None
         client = Client(scheduler)
         return client.get_executor(), client.close
-    pool = ProcessPoolExecutor(max_workers=max(1, int(workers)))
+    pool = ProcessPoolExecutor(max_workers=max(1, int(workers)), initializer=_quiet_worker)
     return pool, (lambda: pool.shutdown(cancel_futures=True))
+
+
+def _quiet_worker():
+    """A local worker ignores Ctrl-C (the whole terminal group gets it): the tuning process
+    alone answers it, ending the workers (_end_workers), so no worker prints a traceback."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _end_workers(pool):
+    """Terminate a local pool's worker processes at once (an interrupted tuning run does not
+    wait for the evaluations under way)."""
+    stop = getattr(pool, "terminate_workers", None)
+    if stop is not None:
+        stop()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
 
 
 def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | None = None,
@@ -128,7 +161,9 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
     """Tune the walker's controller parameters with CMA-ES; returns a TuneResult.
 
     x0 : start parameters (a params dataclass; default the walker's defaults)
-    budget : maximum number of objective evaluations (whole generations)
+    budget : candidates to evaluate (besides the start point): whole generations, then the
+        first candidates of one more; fewer only when CMA-ES stops first (converged), and
+        then TuneResult.stopped says why
     popsize : CMA-ES population (default 4 + 3 ln n)
     sigma0 : initial step size in the unit-scaled space (fraction of each bound's width)
     seed : CMA-ES random seed (same seed, same settings -> same result)
@@ -158,11 +193,15 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
         start = list(pool.map(_evaluate, [(walker, None, base, settings)]))[0]["score"]
         result = TuneResult(walker=walker, best_params=base, best_score=start, start_score=start,
                             settings=settings, seed=int(seed), names=params0.names(True))
-        while not es.stop() and result.evaluations + es.popsize <= budget:
+        while not es.stop() and result.evaluations < budget:
             zs = es.ask()
+            # the budget's last candidates: the first ones of a generation, evaluated, not told
+            # (CMA-ES learns from whole generations only)
+            zs = zs[:budget - result.evaluations]
             scores = [r["score"] for r in pool.map(_evaluate, [(walker, np.asarray(z), base, settings)
                                                                 for z in zs])]
-            es.tell(zs, [-f for f in scores])
+            if len(zs) == es.popsize:
+                es.tell(zs, [-f for f in scores])
             result.evaluations += len(zs)
             i = int(np.argmax(scores))
             if scores[i] > result.best_score:
@@ -180,23 +219,38 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
                       f"best {h['best']:9.3f}  median {h['median']:9.3f}  best so far "
                       f"{h['best_so_far']:9.3f}  sigma {h['sigma']:.3f}  "
                       f"{time.time() - t_start:6.1f} s", file=sys.stderr, flush=True)
+        if result.evaluations < budget:
+            result.stopped = (f"CMA-ES stopped after {result.evaluations} of {budget} evaluations: "
+                              f"{_stop_reasons(es.stop())}")
+            if progress:
+                print(f"[tune {walker}] {result.stopped}", file=sys.stderr, flush=True)
+    except KeyboardInterrupt:
+        if isinstance(pool, ProcessPoolExecutor):
+            _end_workers(pool)
+        raise
     finally:
         close()
     return result
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="planarsim tune", description="CMA-ES tuning of a walker")
-    ap.add_argument("walker")
-    ap.add_argument("--budget", type=int, default=200, help="objective evaluations")
-    ap.add_argument("--popsize", type=int, default=None)
-    ap.add_argument("--sigma0", type=float, default=0.1)
-    ap.add_argument("--seed", type=int, default=0)
+    ap = argparse.ArgumentParser(prog="planarsim tune", description="CMA-ES tuning of a walker",
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("walker", help="a tunable walker (marked [tunable] by 'planarsim list')")
+    ap.add_argument("--budget", type=int, default=200,
+                    help="candidates evaluated (besides the start point); fewer only if CMA-ES "
+                         "converges first, which the output says")
+    ap.add_argument("--popsize", type=int, default=None,
+                    help="candidates per generation (None: CMA-ES's 4 + 3 ln n)")
+    ap.add_argument("--sigma0", type=float, default=0.1,
+                    help="initial step, a fraction of each parameter's bounds")
+    ap.add_argument("--seed", type=int, default=0, help="CMA-ES random seed")
     ap.add_argument("--workers", type=int, default=2, help="local processes")
     ap.add_argument("--scheduler", default=None, help="dask scheduler address (tcp://host:port)")
     ap.add_argument("--start", default=None, help="JSON result to start from (its best params)")
-    ap.add_argument("--duration", type=float, default=None, help="seconds per objective run")
-    ap.add_argument("--out", default="tuned.json")
+    ap.add_argument("--duration", type=float, default=None,
+                    help="simulated seconds per objective run (None: the objective's own)")
+    ap.add_argument("--out", default="tuned.json", help="result file, written after every generation")
     a = ap.parse_args(argv)
     try:
         objective_module(a.walker)
@@ -213,7 +267,8 @@ def main(argv=None) -> int:
         print(f"planarsim tune: {e}", file=sys.stderr)
         return 2
     print(json.dumps(dict(start_score=r.start_score, best_score=r.best_score,
-                          evaluations=r.evaluations, out=a.out)))
+                          evaluations=r.evaluations, budget=a.budget, stopped=r.stopped or None,
+                          out=a.out)))
     return 0
 
 

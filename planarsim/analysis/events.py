@@ -69,8 +69,36 @@ def foot_groups(contact_names) -> list:
     return list(groups.values())
 
 
+def foot_x(traj, model, idx) -> np.ndarray:
+    """(K,) horizontal position [m] of a foot (contact indices `idx`): the mean of its
+    contacts' body-fixed points (an arc's centre, a pair slot's body) at every frame."""
+    a = model.arrays
+    q = np.asarray(traj.q)
+    xs = []
+    for c in idx:
+        b = int(a.contact_body[c])
+        lx, ly = a.contact_local[c]
+        th = q[:, b, 2]
+        xs.append(q[:, b, 0] + np.cos(th) * lx - np.sin(th) * ly)
+    return np.mean(xs, axis=0)
+
+
+def _lands_elsewhere(f, on, x, min_stride):
+    """The landings `f` of one foot (on: (K,) in contact; x: (K,) its position) that follow a
+    lift from the ground and land at least min_stride [m] from where the foot left it (a
+    foot's first touch, with no lift before it, is a landing but not a step: a body dropped
+    or falling onto the ground)."""
+    left = np.flatnonzero(~on[1:] & on[:-1])       # last frames on the ground before a lift
+    keep = []
+    for k in f:
+        before = left[left < k]
+        keep.append(len(before) > 0 and abs(x[k] - x[before[-1]]) >= min_stride)
+    return f[np.array(keep, dtype=bool)] if len(f) else f
+
+
 def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = None,
-                min_air: float = 0.0, together: float = 0.0) -> StepEvents:
+                min_air: float = 0.0, together: float = 0.0, min_stride: float = 0.0,
+                model=None) -> StepEvents:
     """Touchdown events of `contacts` (names or indices; default all) in a Trajectory.
 
     feet : groups of contacts (names or indices) that touch down as one: a foot touches down at
@@ -81,7 +109,13 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
         long (a foot that bounces or chatters for a few frames at landing lands once).
     together : [s] with feet, touchdowns of several feet within this time of the first of
         them are one landing (a jump landing on both feet; the event names the first foot).
+    min_stride : [m] with feet (and the model), a touchdown counts only where the foot lifted
+        from the ground before it and lands at least this far (horizontally) from where it
+        left: a step, not a foot rocking, chattering or hopping in place, nor a body's first
+        touch (0: every landing counts).
     """
+    if min_stride > 0.0 and (feet is None or model is None):
+        raise ValueError(f"min_stride={min_stride} m needs feet and the model (the feet's positions)")
     if feet is not None:
         frames, which = [], []
         for group in feet:
@@ -98,6 +132,8 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
                     left = lift[lift < k]
                     keep.append(len(left) == 0 or t[k] - t[left[-1]] >= min_air)
                 f = f[np.array(keep, dtype=bool)]
+            if min_stride > 0.0:
+                f = _lands_elsewhere(f, on, foot_x(traj, model, idx), min_stride)
             frames.append(f)
             which.append(np.full(len(f), idx[0]))
         frame = np.concatenate(frames) if frames else np.zeros(0, int)

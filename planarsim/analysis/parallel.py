@@ -15,6 +15,7 @@ from __future__ import annotations
 import multiprocessing as mp
 import threading
 from collections import OrderedDict
+import signal
 from concurrent.futures import ThreadPoolExecutor
 from typing import Callable, Sequence
 
@@ -87,6 +88,9 @@ def iterate_task(maps: _Maps, item):
 
 
 def _process_init(family, cache):
+    # Ctrl-C reaches every process of the terminal's group: the caller alone answers it (and
+    # ends the workers), so a worker prints no traceback of its own
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _WORKER["maps"] = _Maps(family, cache)
 
 

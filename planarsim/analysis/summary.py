@@ -32,10 +32,10 @@ def frame_from_state(model, state, ws=None):
 
 
 def step_summary(traj, model, contacts=None, direction=None, feet=None, min_air=0.0,
-                 together=0.0) -> dict:
+                 together=0.0, min_stride=0.0) -> dict:
     """Whole-step summary of a recorded run, from its first to its last touchdown
     (planarsim.analysis.step_events of `contacts`, default all, or of `feet`: groups of
-    contacts that touch down as one, with min_air and together: see step_events).
+    contacts that touch down as one, with min_air, together and min_stride: see step_events).
 
     direction : unit vector of travel (default +x); a walker on a slope passes the slope's
         downhill tangent to measure distance along the slope.
@@ -46,7 +46,7 @@ def step_summary(traj, model, contacts=None, direction=None, feet=None, min_air=
     energy_spent [J], first_touchdown, last_touchdown [s]. NaN where fewer than two
     touchdowns (or no forward motion for the cost of transport).
     """
-    ev = step_events(traj, contacts, feet, min_air, together)
+    ev = step_events(traj, contacts, feet, min_air, together, min_stride, model)
     out = dict(whole_steps=0, step_period=math.nan, step_length=math.nan, speed=math.nan,
                cost_of_transport=math.nan, energy_spent=math.nan, first_touchdown=math.nan,
                last_touchdown=math.nan)

@@ -103,7 +103,8 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
     fps : video frames per second; speed : simulated seconds per video second (1 real time,
     0.25 slow motion, 4 faster); start, duration : simulated time window [s] (default: all);
     size : figure size [inch] at `dpi`; camera : a Camera (default Camera()); progress :
-    True for a text bar on stderr, a callable(done, total), or False; bitrate : MP4 bitrate
+    True for a text bar on stderr when stderr is a terminal (nothing in a pipe or a log), a
+    callable(done, total), or False; bitrate : MP4 bitrate
     [kbit/s] (None: ffmpeg's default quality); embed_limit_mb : size cap of an HTML page (an
     error, not silently dropped frames, when exceeded); colors : GIF palette size (2..256);
     workers : processes drawing frames (default: the usable cores, at most 2, for 40 frames

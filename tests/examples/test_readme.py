@@ -31,3 +31,34 @@ def test_readme_python_blocks_run_in_order(tmp_path, monkeypatch):
                 px = x + math.cos(th) * dx - math.sin(th) * dy
                 py = y + math.sin(th) * dx + math.cos(th) * dy
                 assert py - ground.height(px) > -1e-6
+
+
+def test_readme_api_section_gives_what_a_model_builder_needs():
+    """Without reading the source: the angle convention, the shape tuples, add_box_contacts'
+    arguments, terrain.slope's unit and what each contact_mode code means."""
+    text = README.read_text()
+    api = text[text.index("## A five-minute tour of the API"):text.index("## Shapes that collide")]
+    api = " ".join(api.split())
+    assert "counter-clockwise from the world's x axis" in api
+    for shape in ('("circle", center, r)', '("capsule", p0, p1, r)',
+                  '("box", center, width, height[, angle])', '("polygon", [(x, y), ...])'):
+        assert shape in api
+    import inspect
+
+    import planarsim as ps
+    signature = str(inspect.signature(ps.ModelBuilder.add_box_contacts)).replace("self, ", "")
+    assert f"add_box_contacts{signature.split(' ->')[0]}" in api
+    assert "`terrain.slope(angle_deg, height=0.0)` takes degrees" in api
+    from planarsim.kernels import codes
+    for code, meaning in ((codes.MODE_FREE, "free"), (codes.MODE_PINNED, "pinned"),
+                          (codes.MODE_SLIDING, "sliding"), (-1, "in a recording `-1` marks")):
+        assert (f"`{code}` {meaning}" in api) or (meaning.endswith("marks") and meaning in api)
+
+
+def test_readme_gives_the_expected_time_of_both_commands():
+    text = README.read_text()
+    part = " ".join(text[text.index("## Two commands"):text.index("## The command line")].split())
+    assert re.search(r"command 1: about \d+ minutes?", part)
+    assert re.search(r"command 2: about \d+ minutes?", part)
+    assert "first compile: measured N s on this machine" in part
+    assert "about half a minute" not in text

@@ -242,9 +242,10 @@ def test_head_on_disks_follow_newtons_law_of_restitution(e, ratio):
     m1, m2 = 1.0, ratio
     v1, v2 = 3.0, -1.0
     b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, 0.0))
-    b.add_body("a", m1, 0.5 * m1 * 0.01, pos=(-0.5, 0.0), vel=(v1, 0.0),
+    # 1 m up: in free space, clear of the ground (at y = 0 they started half inside it)
+    b.add_body("a", m1, 0.5 * m1 * 0.01, pos=(-0.5, 1.0), vel=(v1, 0.0),
                shapes=[("circle", (0, 0), 0.1, {"restitution": e, "mu": 0.0})])
-    b.add_body("b", m2, 0.5 * m2 * 0.01, pos=(0.5, 0.0), vel=(v2, 0.0),
+    b.add_body("b", m2, 0.5 * m2 * 0.01, pos=(0.5, 1.0), vel=(v2, 0.0),
                shapes=[("circle", (0, 0), 0.1, {"restitution": e, "mu": 0.0})])
     sim = ps.Simulator(b.compile())
     sim.steps(500)

@@ -392,12 +392,14 @@ def test_interrupted_export_leaves_no_half_written_file(sliding_run, tmp_path, e
     assert [p.name for p in tmp_path.iterdir()] == [target.name]
 
 
-def test_progress_bar_counts_every_frame(sliding_run, tmp_path, capsys):
+def test_progress_bar_counts_every_frame(sliding_run, tmp_path, capsys, monkeypatch):
     model, traj = sliding_run
     seen = []
     export_animation(traj, model, tmp_path / "a.gif", fps=10, duration=1.0, size=(1.6, 0.9), dpi=50,
                      progress=lambda done, total: seen.append((done, total)))
     assert seen == [(k, 10) for k in range(1, 11)]
+    import planarsim.progress
+    monkeypatch.setattr(planarsim.progress, "stderr_is_terminal", lambda: True)  # the bar: terminals only
     export_animation(traj, model, tmp_path / "b.gif", fps=10, duration=1.0, size=(1.6, 0.9), dpi=50)
     err = capsys.readouterr().err
     assert "10/10 frames" in err and "#" * 30 in err

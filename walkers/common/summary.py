@@ -71,7 +71,9 @@ def walker_summary(mod, traj, model, raw: dict, *, walker, gait, terrain, durati
                        f"{mod.__name__}.SUMMARY_EXTRAS (name with unit, explanation)")
     t = float(raw.get("time", raw.get("duration", traj.t[-1] if len(traj.t) else 0.0)))
     feet = feet_of(mod, model)
-    ss = measure_summary(traj, model, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S)
+    # a walker's landings are its steps, wherever they land (a jump or a trot in place lands
+    # once per flight: the walker's own gaits say which it does)
+    ss = measure_summary(traj, model, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S, min_stride=0.0)
     dist = ss["distance"]
     touchdowns = len(step_events(traj, feet=feet, min_air=MIN_AIR_S, together=MIN_AIR_S))
     out = {"walker": walker, "gait": gait, "terrain": terrain, "duration_s": float(duration),

@@ -12,7 +12,7 @@ import numpy as np
 from walkers.base import simulation
 
 from .params import CompassParams
-from .run import GAITS, PassiveRun  # noqa: F401
+from .run import GAIT_DOCS, GAITS, PassiveRun  # noqa: F401
 
 NAME = "compass-gait"
 SUMMARY_EXTRAS = {

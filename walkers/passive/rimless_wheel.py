@@ -7,7 +7,7 @@ from walkers.base import simulation
 
 from .params import RimlessParams
 from .reference import rimless_fixed_point
-from .run import GAITS, PassiveRun  # noqa: F401
+from .run import GAIT_DOCS, GAITS, PassiveRun  # noqa: F401
 
 NAME = "rimless-wheel"
 SUMMARY_EXTRAS = {

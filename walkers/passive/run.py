@@ -25,6 +25,7 @@ from .gait import PassiveWalker
 from .rollout import DETECT, FELL, NO_EVENT
 
 GAITS = ("passive",)
+GAIT_DOCS = {"passive": "no motors: walks down the slope under gravity alone"}
 IMPACTS = ("refined", "engine")
 MIN_STEP_PERIOD = 0.05   # [s] touchdowns assumed at most this often (room for event frames)
 

@@ -8,7 +8,7 @@ from walkers.base import simulation
 
 from .params import SimplestParams
 from .reference import GARCIA_THETA, GARCIA_THETA_DOT, simplest_heel_strike
-from .run import GAITS, PassiveRun  # noqa: F401
+from .run import GAIT_DOCS, GAITS, PassiveRun  # noqa: F401
 
 NAME = "simplest-walker"
 SUMMARY_EXTRAS = {

@@ -25,8 +25,13 @@ SUMMARY_EXTRAS = {
     "speed_command": ("speed_command_m_per_s", "commanded forward speed"),
     "steps": ("controller_steps", "pair lifts counted by the stepping state machine"),
 }
+GAIT_DOCS = {
+    "stand": "stands on all four feet, no stepping",
+    "piaffe": "trots in place: diagonal pairs of feet lift and land where they were (speed 0)",
+    "walk": "trots forward, diagonal pairs of feet together, at the commanded speed",
+}
 Params = QuadrupedParams   # the walker's parameters (planarsim params quadruped)
 
-__all__ = ["NAME", "GAITS", "simulate", "Run", "Quadruped", "QuadrupedParams", "Controller", "Gait",
+__all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "Quadruped", "QuadrupedParams", "Controller", "Gait",
            "FootState", "build", "leg_fk", "leg_ik", "puppet_pose", "rollout_quadruped",
            "LEG_NAMES", "PAIR", "live"]

@@ -69,7 +69,14 @@ SUMMARY_EXTRAS = {
     "push_current_mean": ("push_current_mean_A", "mean push-off current of the ankle motors"),
     "steps": ("controller_steps", "heel strikes counted by the controller"),
 }
+GAIT_DOCS = {
+    "walk": "walks: push-off and swing by Kelly's state machine, step-to-step push-off feedback",
+    "stand": "stands still on both feet, holding the pose it has when STAND begins",
+    "gui": ("Kelly's test mode: each joint (hip, both ankles) held by PD at a target set by "
+            "hand (the viewer's sliders); from the command line the targets are the stand "
+            "pose, so it stands"),
+}
 Params = RangerParams   # the walker's parameters (planarsim params ranger)
 
-__all__ = ["NAME", "GAITS", "simulate", "Run", "RangerParams", "build", "Controller", "Tables", "make_tables", "Gait", "Phase",
+__all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "RangerParams", "build", "Controller", "Tables", "make_tables", "Gait", "Phase",
            "Program", "RangerSim", "instantaneous_cot", "live"]

@@ -19,6 +19,8 @@ SUMMARY_EXTRAS = {
     "timeouts": ("timeouts", "states ended by their timeout rather than a foot strike"),
     "steps": ("controller_steps", "swing-foot strikes counted by the controller"),
 }
+GAIT_DOCS = {"walk": "walks with SIMBICON's four-state machine: PD joints, torso held through the "
+                     "stance hip, swing-hip balance feedback"}
 Params = SimbiconParams   # the walker's parameters (planarsim params simbicon)
 
-__all__ = ["NAME", "GAITS", "simulate", "Run", "SimbiconRun", "run", "live", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]
+__all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "SimbiconRun", "run", "live", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]

@@ -25,6 +25,11 @@ SUMMARY_EXTRAS = {
 }
 Params = SimpleBipedParams   # the walker's parameters (planarsim params simple-biped)
 GAITS = tuple(g.name.lower() for g in Gait)
+GAIT_DOCS = {
+    "stand": "stands in double stance, the hip held above the middle of the feet",
+    "walk": "walks forward: double and single stance by Kelly's state machine",
+    "jump": "jumps in place again and again: crouch, thrust, flight with both feet up, landing",
+}
 
-__all__ = ["NAME", "GAITS", "Gait", "State", "Tables", "make_tables", "SimpleBipedParams", "Run", "Walker", "build", "simulate", "live",
+__all__ = ["NAME", "GAITS", "GAIT_DOCS", "Gait", "State", "Tables", "make_tables", "SimpleBipedParams", "Run", "Walker", "build", "simulate", "live",
            "rollout_simple_biped"]
