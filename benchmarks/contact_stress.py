@@ -480,9 +480,8 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
                e0=float(energy(spec, q0[None], v0[None])[0]), e_tol=energy_bound(spec, ground, q0, v0),
                gain=math.nan, pin=math.nan, depth=math.nan, diverged="")
     try:
-        traj = sim.run(n_steps=steps, record_every=1)   # frames after steps 1..steps
-        q = np.concatenate([q0[None], traj.q])
-        v = np.concatenate([v0[None], traj.v])
+        traj = sim.run(n_steps=steps, record_every=1)   # frames: the start, then steps 1..steps
+        q, v = traj.q, traj.v
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
             out["diverged"] = "non-finite state"
         else:

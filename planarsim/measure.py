@@ -115,7 +115,9 @@ def joint_angles(traj, model) -> dict:
 
 def cost_of_transport(traj, model, power=None):
     """(instantaneous CoT (K,) [-], averaged CoT [-]) from positive actuator power, or from
-    `power` (K,) [W]. The average is work / (m g |x_end - x_start|) (nan if the COM did not move)."""
+    `power` (K,) [W]. The average is work / (m g |x_end - x_start|) (nan if the COM did not
+    move), the work each frame's power times the time since the frame before (the steps that
+    frame ends; exact when every step is recorded)."""
     if power is None:
         power = np.clip(traj.act_power, 0.0, None).sum(axis=1) if traj.act_power.size else np.zeros(len(traj.t))
     power = np.asarray(power, float)
@@ -126,6 +128,6 @@ def cost_of_transport(traj, model, power=None):
     inst[~np.isfinite(inst)] = np.nan
     com = traj.com(model)
     dist = abs(com[-1, 0] - com[0, 0]) if len(com) else 0.0
-    work = float(np.trapezoid(power, traj.t)) if len(traj.t) > 1 else 0.0
+    work = float(np.sum(power[1:] * np.diff(traj.t))) if len(traj.t) > 1 else 0.0
     avg = work / (weight * dist) if dist > 1e-12 and weight > 0 else math.nan
     return inst, avg

@@ -19,7 +19,7 @@ from .options import StepOptions, check_options
 from .start_check import check_start
 from .state import (State, Workspace, check_state, forget_ground_queries, forget_pairs, make_state,
                     make_workspace)
-from .trajectory import Trajectory, check_recording, make_recorder
+from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
 
 def _link():
@@ -191,7 +191,8 @@ class Simulator:
         u : constant commands (n_act,), or
         controller : callable ``controller(sim) -> u`` called every `control_every` steps (the
             Python path; compiled walkers have their own rollout kernels). Between calls the
-            steps run compiled. Frames are recorded every `record_every` steps.
+            steps run compiled. Frame 0 is the state the run starts from (at sim.t), then a
+            frame after every step whose count is a multiple of `record_every`.
         labels : optional callable ``labels(sim) -> dict of scalars`` sampled at each frame
             (only with a controller), stored in Trajectory.labels.
         """
@@ -199,16 +200,19 @@ class Simulator:
         every = int(record_every)
         if every < 1 or int(control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")
-        check_recording(self.model, n // every + 1,
+        # frame 0: the start; then the steps whose count is a multiple of `every`
+        check_recording(self.model, n // every + 2,
                         f"run of {n:,} steps of {self.dt:g} s, a frame every {every} steps")
-        rec = make_recorder(self.model, n // every + 1)
-        k = 0
+        rec = make_recorder(self.model, n // every + 2)
+        record_state(rec, 0, self._state, self._ws)
+        k = 1
         if controller is None:
-            code, done, k = self._run_recorded(self._commands(u), n, every, rec, 0)
+            code, done, k = self._run_recorded(self._commands(u), n, every, rec, k)
             if code:
                 self._raise(code)
         else:
-            series = {}
+            series = {} if labels is None else {key: np.full(len(rec.t), float(val))
+                                                for key, val in labels(self).items()}
             done = 0
             chunk = int(control_every)
             while done < n:

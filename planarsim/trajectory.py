@@ -1,6 +1,8 @@
 """Trajectory: recorded arrays of a run, with save/load (.npz, atomic) and CSV export.
 
-Frames hold the state AFTER each recorded step. contact_mode is 0 free, 1 pinned, 2 sliding,
+Frame 0 holds the state a run starts from (its impulses, commands and powers are those of the
+step before it, zero for a fresh state); every later frame the state after a recorded step
+(steps whose count is a multiple of record_every). contact_mode is 0 free, 1 pinned, 2 sliding,
 -1 disabled. contact_impulse is (normal, tangential) impulse of the step [N s]; divide by dt
 for a mean force [N]. act_power is the mechanical power of each actuator [W].
 """
@@ -88,6 +90,20 @@ def make_recorder(model, n_frames: int) -> Recorder:
     return Recorder(t=z(K), q=z((K, nb, 3)), v=z((K, nb, 3)), contact_mode=z((K, nc), np.int64),
                     contact_impulse=z((K, nc, 2)), contact_point=z((K, nc, 2)), act_u=z((K, na)),
                     act_power=z((K, na)), contact_normal=z((K, nc, 2)))
+
+
+def record_state(rec: Recorder, k: int, state, ws) -> None:
+    """Write State `state` and Workspace `ws` into frame k of rec, as the compiled
+    kernels.record.record_frame does after a step (here from Python, for a run's first frame)."""
+    rec.t[k] = state.time[0]
+    rec.q[k] = state.q
+    rec.v[k] = state.v
+    rec.contact_mode[k] = np.where(np.asarray(state.contact_enabled) != 0, state.contact_mode, -1)
+    rec.contact_impulse[k] = ws.contact_impulse
+    rec.contact_point[k] = ws.contact_point
+    rec.contact_normal[k] = ws.contact_normal
+    rec.act_u[k] = ws.act_u
+    rec.act_power[k] = ws.act_power
 
 
 @dataclass

@@ -133,7 +133,8 @@ class WalkerRun:
 
     def run(self, seconds: float):
         """Advance `seconds` [s] (rounded to whole steps; stops early on a fall) and return
-        this chunk's Trajectory. Engine failures raise (planarsim.compiled.check_run)."""
+        this chunk's Trajectory; the first chunk's frame 0 is the initial state. Engine
+        failures raise (planarsim.compiled.check_run)."""
         from planarsim.compiled import check_run, make_recorder
         from planarsim.trajectory import Trajectory
         n, frames = self.check_memory(seconds)
@@ -141,11 +142,14 @@ class WalkerRun:
             self.start_below_ground = self.contacts_below_ground()
         rec = make_recorder(self.model, frames)
         lab = np.zeros((frames, len(self.LABELS)))
+        start = self.start_frame() if self.record_every and not self.chunks else None
         code, k = self.advance(n, max(self.record_every, 1), rec, lab)
         check_run(self.stopped(int(code)), self.model, self.ws, self.options, self.NAME)
         traj = Trajectory.from_recorder(self.model, rec, k,
                                         labels={name: lab[:k, j].copy() for j, name in enumerate(self.LABELS)},
                                         info={"dt": self.dt, "walker": self.NAME})
+        if start is not None:
+            traj = Trajectory.concatenate([start, traj])
         self.chunks.append(traj)
         return traj
 
@@ -167,6 +171,18 @@ class WalkerRun:
                         f"{self.NAME}: run({seconds:g} s) at dt={self.dt:g} s, a frame every "
                         f"{self.record_every} steps", extra_columns=len(self.LABELS))
         return n, frames
+
+    def start_frame(self):
+        """A one-frame Trajectory of the walker as it stands now (the first chunk's frame 0:
+        its initial state), labelled with its memory slots LABEL_SLOTS."""
+        from planarsim.compiled import make_recorder
+        from planarsim.trajectory import Trajectory, record_state
+        rec = make_recorder(self.model, 1)
+        record_state(rec, 0, self.state, self.ws)
+        slots = self.LABEL_SLOTS if self.LABEL_SLOTS is not None else ()
+        labels = {name: np.array([float(self.memory[slots[j]])]) for j, name in enumerate(self.LABELS)}
+        return Trajectory.from_recorder(self.model, rec, 1, labels=labels,
+                                        info={"dt": self.dt, "walker": self.NAME})
 
     def trajectory(self):
         """All chunks run so far, joined (empty ones left out)."""

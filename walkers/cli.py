@@ -449,7 +449,10 @@ def cmd_analyze(args):
                 print(f"period-{k.period} branch: {len(k.points)} points, {k.end}")
                 for bf in k.bifurcations:
                     print(f"  {bf.kind} at {args.param} = {bf.p:.7g}"
-                          f"{'' if bf.located else f' (within {bf.bracket:.2g})'}")
+                          f"{'' if bf.located else f' (not located: within {bf.bracket:.2g})'}"
+                          f"{f' (+- {bf.p_error:.1g} from the multipliers error)' if bf.located and math.isfinite(bf.p_error) and bf.p_error > bf.bracket else ''}")
+                    if bf.note:
+                        print(f"    {bf.note}")
             if csv:
                 from planarsim.analysis import write_csv
                 write_csv(csv, [r for k in branches for r in k.rows(family.names)])

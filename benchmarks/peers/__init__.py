@@ -137,8 +137,7 @@ def measure_scene(name, peers=None, repeats=5, n_steps=None, accuracy_seconds=No
     if spec is not None:
         sim.restore(start)
         traj = sim.run(n_steps=k, record_every=1)
-        row.update(accuracy(spec, np.concatenate([model.q0[None], traj.q]),
-                            np.concatenate([start.v[None], traj.v])))
+        row.update(accuracy(spec, traj.q, traj.v))   # frame 0: the start
     peer_rows = []
     for key, world in worlds.items():
         mod = peers[key]

@@ -6,6 +6,13 @@ gait, 2^k after k period doublings) followed as p changes, with their multiplier
   regula falsi on det(J + I) over p, re-solving the fixed point at each trial p;
 - fold: a real multiplier through +1 (det(J - I) changes sign; arclength continuation turns
   back in p there);
+
+The multipliers come from polynomial fits of the map (stepmap.multipliers_by_fit) with an
+error estimate. A point whose multiplier nearest -1 (+1) lies within its error of it does not
+tell the sign of det(J + I) (det(J - I)): its multipliers are refined (more samples, a
+smaller window) and, if that does not settle it, the crossing is taken between the resolved
+points on either side of it (the branch's next points: a finer spacing there). Such a
+bifurcation's `note` says so, and its p is located to within the multipliers' error.
 - Neimark-Sacker: a complex pair through the unit circle (located by interpolating its
   modulus).
 
@@ -25,7 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .parallel import MapPool
-from .stepmap import StepMapError, central_jacobian, central_points, multipliers_with_error
+from .stepmap import (FIT_POINTS, FIT_WINDOW, StepMapError, central_jacobian, central_points,
+                      map_noise, multipliers_by_fit, noise_tolerance)
 
 KINDS = ("period-doubling", "fold", "neimark-sacker")
 
@@ -50,7 +58,10 @@ class BranchPoint:
 class Bifurcation:
     """A bifurcation found between two branch points: kind (KINDS), parameter p, state x,
     the multipliers there, period of the orbit it happens to, located (refined by solving
-    at trial p to p_tol) or not, bracket: width of the last bracket in p."""
+    at trial p to p_tol, or to the width the multipliers' error allows: p_error) or not,
+    bracket: width of the last bracket in p, p_error: the error in p that the multipliers'
+    error estimate implies (error / |d lambda / dp|), note: how a crossing within the
+    multipliers' noise was refined."""
     kind: str
     p: float
     x: np.ndarray
@@ -58,6 +69,8 @@ class Bifurcation:
     period: int
     located: bool = False
     bracket: float = math.nan
+    p_error: float = math.nan
+    note: str = ""
 
 
 @dataclass
@@ -131,13 +144,21 @@ def bifurcation_tests(lam) -> dict:
 
 
 # Newton --------------------------------------------------------------------------------------
-def newton_fixed_point(pool: MapPool, p, x0, period=1, tol=1e-9, max_iter=20, eps=1e-4,
+def fixed_point_tolerance(pool: MapPool, p, x, period=1, tol="auto") -> float:
+    """Newton's tolerance on |P^period(x) - x| at p: tol ("auto": stepmap.AUTO_TOL) raised to
+    NOISE_FACTOR x the map's noise measured at x (stepmap.map_noise)."""
+    return noise_tolerance(tol, map_noise(pool.evaluator(p, period), x))
+
+
+def newton_fixed_point(pool: MapPool, p, x0, period=1, tol="auto", max_iter=20, eps=1e-4,
                        max_halvings=8):
     """Newton on P^period(x; p) - x with the Jacobian's columns (central differences, step
     eps: a simulated map is piecewise smooth below ~1e-5, see multipliers_with_error)
-    evaluated in one batch.
+    evaluated in one batch; tol "auto" or a number: fixed_point_tolerance.
     Returns (x, residual, converged, J at the last iterate)."""
     x = np.asarray(x0, dtype=np.float64).copy()
+    if isinstance(tol, str):
+        tol = fixed_point_tolerance(pool, p, x, period, tol)
     d = x.size
     J = None
     r = np.inf
@@ -167,9 +188,22 @@ def newton_fixed_point(pool: MapPool, p, x0, period=1, tol=1e-9, max_iter=20, ep
     return x, r, r <= tol, J
 
 
+def _multipliers(pool, p, x, period, mult_tol, points=FIT_POINTS):
+    """multipliers_by_fit of P^period at x: the window FIT_WINDOW / period, then half of it
+    if the error exceeds mult_tol; the estimate with the smaller error."""
+    best = None
+    for window in (FIT_WINDOW / period, 0.5 * FIT_WINDOW / period):
+        m = multipliers_by_fit(None, x, window, points, tol=mult_tol,
+                               evaluate=pool.evaluator(p, period), warn=False)
+        if best is None or m.error < best.error:
+            best = m
+        if best.converged:
+            break
+    return best
+
+
 def _point(pool, p, x, period, residual, mult_tol):
-    m = multipliers_with_error(None, x, "auto", tol=mult_tol, evaluate=pool.evaluator(p, period),
-                               warn=False)
+    m = _multipliers(pool, p, x, period, mult_tol)
     return BranchPoint(float(p), x, m.values, m.error, residual, period)
 
 
@@ -201,8 +235,22 @@ def _locate(pool, a: BranchPoint, b: BranchPoint, kind, tol, p_tol, mult_tol, ma
             if side == 1:
                 fa *= 0.5
             side = 1
-    located = abs(pb - pa) <= p_tol or abs(bifurcation_tests(best.multipliers)[kind]) < 1e-9
-    return Bifurcation(kind, best.p, best.x, best.multipliers, a.period, located, abs(pb - pa))
+    p_err = _p_error(a, b, best, -1.0 if kind == "period-doubling" else 1.0)
+    located = (abs(pb - pa) <= max(p_tol, p_err)
+               or abs(bifurcation_tests(best.multipliers)[kind]) < 1e-9)
+    return Bifurcation(kind, best.p, best.x, best.multipliers, a.period, located, abs(pb - pa),
+                       p_err)
+
+
+def _nearest(q, critical) -> complex:
+    return q.multipliers[np.argmin(np.abs(q.multipliers - critical))]
+
+
+def _p_error(a, b, c, critical) -> float:
+    """The error in p of a crossing at c that c's multiplier error implies: c.error over the
+    rate of change of the crossing multiplier between a and b."""
+    slope = abs((_nearest(b, critical) - _nearest(a, critical)) / (b.p - a.p)) if b.p != a.p else 0.0
+    return float(c.error / slope) if slope > 0 else math.inf
 
 
 def _interpolated(a, b, kind):
@@ -219,32 +267,106 @@ def _interpolated(a, b, kind):
                        abs(b.p - a.p))
 
 
-def _resolved(a, b, critical):
-    """Whether the multiplier nearest `critical` (+1 or -1) is farther from it than its error
-    estimate at both points (else a sign change of the test function may be noise: just past
-    a period doubling the new orbit's multiplier sits at +1)."""
-    return all(np.min(np.abs(q.multipliers - critical)) > q.error for q in (a, b))
+def _side(q, kind) -> int:
+    """Sign of q's test function for `kind` ("period-doubling" or "fold") when the multiplier
+    nearest -1 (+1) is farther from it than its error estimate; 0 when it is not (the sign
+    may be noise)."""
+    critical = -1.0 if kind == "period-doubling" else 1.0
+    if abs(_nearest(q, critical) - critical) <= q.error:
+        return 0
+    return int(np.sign(bifurcation_tests(q.multipliers)[kind]))
 
 
-def _detect(pool, a, b, locate, tol, p_tol, mult_tol, folded=False, born=False):
-    """Bifurcations between branch points a and b. born: a is the first point of a period-2n
-    branch, half a step past the doubling where it was born: there its multiplier passes +1
-    by construction (P^2n's pitchfork), so a +1 crossing next to it is the birth, not a fold."""
-    ta, tb = bifurcation_tests(a.multipliers), bifurcation_tests(b.multipliers)
+def _refine(pool, q, kind, mult_tol):
+    """q with its multipliers re-estimated from twice the samples (FIT_POINTS * 2 - 1 per
+    coordinate) when its crossing multiplier lies within its error of +-1; the estimate with
+    the smaller error is kept. Returns (q, whether it was refined)."""
+    if pool is None or _side(q, kind) != 0:
+        return q, False
+    m = _multipliers(pool, q.p, q.x, q.period, mult_tol, points=2 * FIT_POINTS - 1)
+    if m.error < q.error:
+        q.multipliers, q.error = m.values, m.error
+    return q, True
+
+
+def _last_resolved(points, kind, skip_first=False):
+    """Index of the last point of `points` whose sign for `kind` is resolved, or None."""
+    first = 1 if skip_first else 0
+    for i in range(len(points) - 1, first - 1, -1):
+        if _side(points[i], kind) != 0:
+            return i
+    return None
+
+
+def _note(points, i, b, kind, refined):
+    """How a crossing within the multipliers' noise was settled ('' when it was not)."""
+    critical = -1 if kind == "period-doubling" else 1
+    unresolved = [q.p for q in points[i + 1:]]
+    samples = f"{2 * FIT_POINTS - 1} samples a coordinate"
+    parts = []
+    if refined:
+        parts.append(f"multipliers at p={b.p:.7g} refined ({samples})")
+    if unresolved:
+        parts.append(f"multiplier within its error of {critical:+d} at p=" +
+                     ", ".join(f"{v:.7g}" for v in unresolved) +
+                     f" (refined with {samples}): crossing taken between p={points[i].p:.7g} "
+                     f"and {b.p:.7g}")
+    return "; ".join(parts)
+
+
+def _detect(pool, points, b, locate, tol, p_tol, mult_tol, folded=False, born=False):
+    """Bifurcations between the branch's points so far (`points`) and its new point b: a
+    period doubling or fold where the resolved sign of the test function (_side) differs
+    from that of the last resolved point; unresolved points are refined (_refine) and
+    otherwise skipped, so the crossing is taken between the resolved points around them.
+    born: points[0] lies half a step past the doubling the branch was born at
+    (period_doubling_branch), where its multiplier passes +1 by construction (P^2n's
+    pitchfork): it is no reference for a fold."""
+    a = points[-1]
     found = []
-    if np.sign(ta["period-doubling"]) != np.sign(tb["period-doubling"]) and _resolved(a, b, -1.0):
-        found.append(_locate(pool, a, b, "period-doubling", tol, p_tol, mult_tol) if locate
-                     else _interpolated(a, b, "period-doubling"))
-    if folded or (not born and np.sign(ta["fold"]) != np.sign(tb["fold"]) and _resolved(a, b, 1.0)):
-        found.append(_interpolated(a, b, "fold"))
-    if ta["neimark-sacker"] != tb["neimark-sacker"]:
+    for kind in ("period-doubling", "fold"):
+        if kind == "fold" and folded:
+            found.append(_interpolated(a, b, "fold"))
+            continue
+        b, refined = _refine(pool, b, kind, mult_tol)
+        sb = _side(b, kind)
+        i = _last_resolved(points, kind, skip_first=born and kind == "fold")
+        if sb == 0 or i is None or _side(points[i], kind) == sb:
+            continue
+        if kind == "period-doubling" and locate:
+            bf = _locate(pool, points[i], b, kind, tol, p_tol, mult_tol)
+        else:
+            bf = _interpolated(points[i], b, kind)
+        bf.note = _note(points, i, b, kind, refined)
+        found.append(bf)
+    if bifurcation_tests(a.multipliers)["neimark-sacker"] != bifurcation_tests(b.multipliers)["neimark-sacker"]:
         found.append(_interpolated(a, b, "neimark-sacker"))
     return found
 
 
+def _pending(branch):
+    """A crossing the branch's last points leave open: their test functions' signs differ
+    from the last resolved point's but all lie within the multipliers' noise. Reported
+    (not located) so that it is not lost."""
+    out = []
+    pts = branch.points
+    for kind in ("period-doubling", "fold"):
+        i = _last_resolved(pts, kind)
+        if i is None or i == len(pts) - 1:
+            continue
+        s0 = np.sign(bifurcation_tests(pts[i].multipliers)[kind])
+        last = pts[-1]
+        if np.sign(bifurcation_tests(last.multipliers)[kind]) != s0:
+            bf = _interpolated(pts[i], last, kind)
+            bf.note = (f"the multiplier stays within its error of {-1 if kind == 'period-doubling' else 1:+d} "
+                       f"from p={pts[i + 1].p:.7g} to the branch's end: extend the range to locate it")
+            out.append(bf)
+    return out
+
+
 # continuation --------------------------------------------------------------------------------
 def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
-                    method: str = "natural", period: int = 1, tol: float = 1e-9,
+                    method: str = "natural", period: int = 1, tol="auto",
                     locate: bool = True, p_tol: float | None = None, mult_tol: float = 3e-3,
                     param: str = "p", progress=None, max_points: int | None = None,
                     subperiod: int | None = None, born_at_doubling: bool = False) -> Branch:
@@ -270,6 +392,7 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
     p_tol = 1e-5 * abs(p1 - p0) if p_tol is None else p_tol
     ev0 = pool.evaluations
     branch = Branch(param, int(period))
+    tol = fixed_point_tolerance(pool, p0, np.asarray(x0, dtype=np.float64), period, tol)
     x, r, conv, _ = newton_fixed_point(pool, p0, x0, period, tol)
     if not conv:
         branch.end = f"no fixed point of period {period} near x0 at {param}={p0:g} (residual {r:.2g})"
@@ -285,6 +408,7 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
     else:
         _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, progress, total,
                    born_at_doubling)
+    branch.bifurcations += _pending(branch)
     branch.evaluations = pool.evaluations - ev0
     return branch
 
@@ -312,8 +436,8 @@ def _natural(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, prog
             continue
         halvings = max(0, halvings - 1)
         b = _point(pool, pn, x, period, r, mult_tol)
-        branch.bifurcations += _detect(pool, pts[-1], b, locate, tol, p_tol, mult_tol,
-                                       born=born_at_doubling and len(pts) == 1)
+        branch.bifurcations += _detect(pool, pts, b, locate, tol, p_tol, mult_tol,
+                                       born=born_at_doubling)
         pts.append(b)
         p = pn
         if progress:
@@ -359,8 +483,8 @@ def _arclength(pool, branch, p0, p1, h, period, tol, locate, p_tol, mult_tol, pr
         r = float(np.max(np.abs(pool.evaluate(xn[None, :], pn, period)[0][0] - xn)))
         b = _point(pool, pn, xn, period, r, mult_tol)
         folded = len(branch.points) >= 2 and (pn - a.p) * (a.p - branch.points[-2].p) < 0
-        found = _detect(pool, a, b, locate and not folded, tol, p_tol, mult_tol,
-                        born=born_at_doubling and len(branch.points) == 1)
+        found = _detect(pool, branch.points, b, locate and not folded, tol, p_tol, mult_tol,
+                        born=born_at_doubling)
         for bf in found:
             if bf.kind == "fold" and len(branch.points) >= 2:
                 # p is quadratic in the fold's test function near the fold: fit three points
@@ -401,28 +525,31 @@ def _arclength_newton(pool, yp, t, period, tol, dp_fd, max_iter=10):
 
 
 def period_doubling_branch(pool: MapPool, bif: Bifurcation, p1: float, points: int = 20,
-                           tol: float = 1e-6, amplitudes=(1e-3, 3e-3, 1e-2, 3e-2, 0.1), **kw) -> Branch:
+                           tol=1e-6, amplitudes=(1e-3, 3e-3, 1e-2, 3e-2, 0.1), **kw) -> Branch:
     """The period-2n orbit born at period doubling `bif` (of the period-n orbit), continued
     from just past bif.p toward p1 (the side where it exists: where the period-n gait lost
     stability). Starts Newton on P^2n from x* +- a v (v: eigenvector of the multiplier
     nearest -1) for the amplitudes a in turn and takes the first solution that is not the
     period-n point. Raises StepMapError when none is found. tol: Newton's residual on
-    P^2n (a simulated map's noise, ~1e-7 for the passive walkers, compounds over 2n steps)."""
+    P^2n, raised to the map's noise (fixed_point_tolerance); Newton on P^2n is ill-conditioned
+    next to the doubling (a multiplier of P^2n near +1), hence 1e-6 by default."""
     n = bif.period
-    d = bif.x.size
     dp = (p1 - bif.p) / max(int(points) - 1, 1)
     pstart = bif.p + 0.5 * dp
-    J = multipliers_with_error(None, bif.x, evaluate=pool.evaluator(pstart, n), warn=False).jacobian
+    J = _multipliers(pool, pstart, bif.x, n, 3e-3).jacobian
     lam, V = np.linalg.eig(J)
     v = np.real(V[:, np.argmin(np.abs(lam + 1.0))])
     v /= np.max(np.abs(v))
-    x1, r1, c1, _ = newton_fixed_point(pool, pstart, bif.x, n, tol)
+    tol_n = fixed_point_tolerance(pool, pstart, bif.x, n, tol)
+    tol_2n = fixed_point_tolerance(pool, pstart, bif.x, 2 * n, tol)
+    x1, r1, c1, _ = newton_fixed_point(pool, pstart, bif.x, n, tol_n)
     base = x1 if c1 else bif.x
+    apart = 100 * max(tol_n, tol_2n, 1e-10)
     for a in amplitudes:
         for s in (1.0, -1.0):
-            x, r, conv, _ = newton_fixed_point(pool, pstart, base + s * a * v, 2 * n, tol)
-            if conv and np.max(np.abs(x - base)) > 100 * tol and \
-                    np.max(np.abs(pool.evaluate(x[None, :], pstart, n)[0][0] - x)) > 100 * tol:
-                return continue_branch(pool, x, pstart, p1, points, period=2 * n, tol=tol,
+            x, r, conv, _ = newton_fixed_point(pool, pstart, base + s * a * v, 2 * n, tol_2n)
+            if conv and np.max(np.abs(x - base)) > apart and \
+                    np.max(np.abs(pool.evaluate(x[None, :], pstart, n)[0][0] - x)) > apart:
+                return continue_branch(pool, x, pstart, p1, points, period=2 * n, tol=tol_2n,
                                        subperiod=n, born_at_doubling=True, **kw)
     raise StepMapError(f"no period-{2 * n} orbit found next to the period doubling at {bif.p:g}")

@@ -1,6 +1,10 @@
 """Step events from a recorded run: the touchdown of a contact is a frame whose contact mode is
 in contact (pinned or sliding) after a frame where it was not (free, or disabled: -1);
-Poincare-section points at those frames."""
+Poincare-section points at those frames.
+
+Frame 0 of a recording is the state the run started from: its contact modes are the ones that
+state was built with (a fresh state calls a foot standing on the ground free), not modes a step
+found, so a change of mode from frame 0 to frame 1 is no event."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -17,13 +21,18 @@ def touchdowns(contact_mode: np.ndarray) -> np.ndarray:
 
     contact_mode : (K,) modes of one contact per recorded frame (0 free, 1 pinned, 2 sliding,
         -1 disabled).
-    Returns the frame indices k >= 1 with mode[k] in contact and mode[k-1] not.
+    Returns the frame indices k >= 2 with mode[k] in contact and mode[k-1] not (frame 0 is
+    the run's start: module doc).
     """
     mode = np.asarray(contact_mode)
     if mode.ndim != 1:
         raise ValueError(f"contact_mode must be 1-D (frames of one contact), got shape {mode.shape}")
-    on = np.isin(mode, IN_CONTACT)
-    return np.flatnonzero(on[1:] & ~on[:-1]) + 1
+    return _entries(np.isin(mode, IN_CONTACT))
+
+
+def _entries(on: np.ndarray) -> np.ndarray:
+    """Frames k >= 2 where `on` (K,) bool turns True."""
+    return np.flatnonzero(on[2:] & ~on[1:-1]) + 2
 
 
 @dataclass(frozen=True)
@@ -123,7 +132,7 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
             if not idx:
                 raise ValueError(f"feet={feet!r}: a foot needs at least one contact")
             on = np.isin(traj.contact_mode[:, idx], IN_CONTACT).any(axis=1)
-            f = np.flatnonzero(on[1:] & ~on[:-1]) + 1
+            f = _entries(on)
             if min_air > 0.0 and len(f):
                 t = np.asarray(traj.t)
                 lift = np.flatnonzero(~on[1:] & on[:-1]) + 1      # frames the foot left

@@ -117,6 +117,8 @@ class FixedPoint:
     x : (d,) fixed point;  residual : |P(x) - x|_inf;  converged : residual <= tol
     jacobian : (d, d) dP/dx at x;  multipliers : its eigenvalues, largest modulus first
     iterations : Newton steps;  evaluations : map evaluations used;  history : residual per step
+    noise : the map's measured noise (map_noise, units of x);  tol : the tolerance applied:
+    the one asked for, raised to NOISE_FACTOR x noise where the map is noisier than that
     """
     x: np.ndarray
     residual: float
@@ -126,6 +128,8 @@ class FixedPoint:
     iterations: int
     evaluations: int
     history: list = field(default_factory=list)
+    noise: float = float("nan")
+    tol: float = float("nan")
 
     @property
     def stable(self) -> bool:
@@ -137,13 +141,53 @@ class FixedPoint:
         return float(np.max(np.abs(self.multipliers)))
 
 
-def find_fixed_point(f: Callable, x0, tol: float = 1e-10, max_iter: int = 30, eps=1e-6,
+# a fixed point counts as converged when its residual is within this many times the map's noise
+NOISE_FACTOR = 4.0
+# probe step of map_noise, relative to max(1, |x|_inf)
+NOISE_PROBE = 1e-8
+
+
+def map_noise(evaluate, x, probes: int = 3, seed: int = 0) -> float:
+    """The map's noise at x [units of x]: the largest |P(x + d) + P(x - d) - 2 P(x)| / 2 over
+    `probes` random steps d of size NOISE_PROBE (a smooth map's second difference there is
+    ~1e-16 of its curvature; a simulated map's is its noise: solver tolerances, touchdown
+    root finding). evaluate(X) -> (Y, ok) as multipliers_with_error's. NaN if the map fails."""
+    x = np.asarray(x, dtype=np.float64)
+    h = NOISE_PROBE * max(1.0, float(np.max(np.abs(x))))
+    D = h * np.random.default_rng(seed).choice([-1.0, 1.0], size=(probes, x.size))
+    Y, ok = evaluate(np.vstack([x[None, :], x + D, x - D]))
+    if not ok.all():
+        return float("nan")
+    second = Y[1:probes + 1] + Y[probes + 1:] - 2.0 * Y[0]
+    return float(np.max(np.abs(second)) / 2.0)
+
+
+# the tolerance "auto" asks for where the map is quieter than that [units of x]
+AUTO_TOL = 1e-9
+
+
+def noise_tolerance(tol, noise) -> float:
+    """The residual a fixed point must reach: tol ("auto": AUTO_TOL), raised to NOISE_FACTOR x
+    noise (a residual below the map's noise cannot be asked for)."""
+    floor = NOISE_FACTOR * noise if np.isfinite(noise) else 0.0
+    if isinstance(tol, str):
+        if tol != "auto":
+            raise ValueError(f"tol={tol!r} must be 'auto' or a number")
+        return max(floor, AUTO_TOL)
+    tol = float(tol)
+    if not tol > 0:
+        raise ValueError(f"tol={tol} must be > 0")
+    return max(tol, floor)
+
+
+def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
                      central: bool = True, max_halvings: int = 12) -> FixedPoint:
     """Newton's method on F(x) = f(x) - x with a finite-difference Jacobian.
 
     Each step solves (J - I) dx = -F (least squares if singular); the step is halved while the
-    new residual is not smaller or the map fails (StepMapError). Stops when |F|_inf <= tol.
-    The returned Jacobian is evaluated at the final x.
+    new residual is not smaller or the map fails (StepMapError). Stops when |F|_inf <= tol,
+    with tol raised to NOISE_FACTOR x the map's noise measured at x0 (map_noise; "auto":
+    AUTO_TOL, raised likewise). The returned Jacobian is evaluated at the final x.
     """
     count = [0]
 
@@ -157,6 +201,8 @@ def find_fixed_point(f: Callable, x0, tol: float = 1e-10, max_iter: int = 30, ep
     except StepMapError as e:
         raise StepMapError(f"the step map fails at the initial guess x0={x0}: {e}") from None
     r = float(np.max(np.abs(F)))
+    noise = map_noise(serial_evaluator(g), x)
+    tol = noise_tolerance(tol, noise)
     history = [r]
     it = 0
     eye = np.eye(x.size)
@@ -185,7 +231,7 @@ def find_fixed_point(f: Callable, x0, tol: float = 1e-10, max_iter: int = 30, ep
     J = jacobian(g, x, eps, central, fx=F + x)
     return FixedPoint(x=x, residual=r, converged=r <= tol, jacobian=J,
                       multipliers=sort_multipliers(np.linalg.eigvals(J)), iterations=it,
-                      evaluations=count[0], history=history)
+                      evaluations=count[0], history=history, noise=noise, tol=tol)
 
 
 # multipliers with an error estimate ----------------------------------------------------------
@@ -331,4 +377,67 @@ change keeps falling by more than 4x (truncation regime): the finer rung gives t
         warnings.warn(f"Floquet multipliers not converged in the finite-difference step: estimated "
                       f"error {res.error:.2g} > tol {tol:g} (eps {res.eps:.2g})", MultiplierWarning,
                       stacklevel=2)
+    return res
+
+
+# multipliers from a polynomial fit -----------------------------------------------------------
+FIT_WINDOW = 2e-3   # [units of x] half-width of the samples along each coordinate
+FIT_POINTS = 17     # samples per coordinate (odd: x itself among them)
+FIT_DEGREE = 5      # degree of the polynomial fitted to them
+
+
+def _fit_columns(s, Y, ok, degree):
+    """Slope at s = 0 of a least-squares polynomial of `degree` through (s[ok], Y[ok]) (each
+    column of Y), and the fit's rms residual; (None, inf) with too few samples."""
+    if np.count_nonzero(ok) < degree + 2:
+        return None, np.inf
+    c = np.polyfit(s[ok], Y[ok], degree)
+    fitted = np.stack([np.polyval(c[:, j], s[ok]) for j in range(Y.shape[1])], axis=1)
+    return c[-2], float(np.sqrt(np.mean((Y[ok] - fitted) ** 2)))
+
+
+def multipliers_by_fit(f: Callable | None, x, window: float = FIT_WINDOW, points: int = FIT_POINTS,
+                       degree: int = FIT_DEGREE, tol: float = 3e-3, evaluate=None,
+                       warn: bool = True) -> Multipliers:
+    """Multipliers of the step map f at x from least-squares polynomials: along each coordinate,
+    `points` samples x +- s e_i (|s| <= window, units of x) are fitted by a polynomial of
+    `degree` in s, whose slope at 0 is that column of the Jacobian.
+
+    A simulated map is piecewise smooth below ~1e-4 (the touchdown falls in another sim step)
+    and strongly curved above ~1e-3 (central differences of the simplest walker near its period
+    doubling are off by 1e-2 at eps 1e-3): the fit averages the pieces over the window and
+    takes the curvature into its higher terms. The same fit over the inner half of the
+    samples (|s| <= window / 2) gives the error estimate (their multipliers' distance);
+    `noise` is the full fit's rms residual. Multipliers(eps=window, ladder=[(window, values),
+    (window / 2, inner values)]). Samples where the map fails are left out.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    points, degree = int(points), int(degree)
+    if points < 2 * degree + 3 or points % 2 == 0:
+        raise ValueError(f"points={points} must be odd and >= 2 * degree + 3 = {2 * degree + 3} "
+                         "(the inner half is fitted too)")
+    if not (window > 0 and np.isfinite(window)):
+        raise ValueError(f"window={window} must be > 0 (units of x)")
+    evaluate = evaluate or serial_evaluator(f)
+    d = x.size
+    s = window * np.linspace(-1.0, 1.0, points)
+    inner = np.abs(s) <= 0.5 * window * (1 + 1e-12)
+    Y, ok = evaluate(np.concatenate([x + np.outer(s, np.eye(d)[i]) for i in range(d)]))
+    J, Jin, noise = np.zeros((d, d)), np.zeros((d, d)), 0.0
+    for i in range(d):
+        rows = slice(i * points, (i + 1) * points)
+        col, rms = _fit_columns(s, Y[rows], ok[rows], degree)
+        col_in, _ = _fit_columns(s[inner], Y[rows][inner], ok[rows][inner], degree)
+        if col is None or col_in is None:
+            raise StepMapError(f"the step map fails at too many samples along coordinate {i} "
+                               f"around x={x} (window {window:g})")
+        J[:, i], Jin[:, i], noise = col, col_in, max(noise, rms)
+    lam, lam_in = sort_multipliers(np.linalg.eigvals(J)), sort_multipliers(np.linalg.eigvals(Jin))
+    err = match_distance(lam, lam_in)
+    res = Multipliers(lam, err, float(window), noise, bool(err <= tol), J,
+                      [(float(window), lam), (0.5 * float(window), lam_in)], len(s) * d)
+    if warn and not res.converged:
+        import warnings
+        warnings.warn(f"Floquet multipliers by fit not converged: estimated error {err:.2g} > "
+                      f"tol {tol:g} (window {window:.2g})", MultiplierWarning, stacklevel=2)
     return res

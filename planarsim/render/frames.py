@@ -2,8 +2,8 @@
 
 Frames are sampled from the trajectory's times: video frame k (k = 0 .. n-1) shows the
 recorded frame nearest to simulated time t_start + k * speed / fps, with
-n = round(duration * fps / speed); a trajectory recorded every h seconds with frames at
-t_1 .. t_K lasts t_K - t_1 + h. So ``speed=1`` is real time, ``speed=0.25`` slow motion
+n = round(duration * fps / speed); a trajectory with frames at t_0 .. t_K (frame 0: the state
+the run started from) lasts t_K - t_0. So ``speed=1`` is real time, ``speed=0.25`` slow motion
 (4x longer video) and ``speed=4`` four times faster than real time; a 2 s run at 30 fps gives
 60 frames. The camera (camera.py) follows the COM in simulated time, so the picture is the
 same at every playback speed. The time printed on frame k is t_start + k * speed / fps minus
@@ -34,10 +34,10 @@ def frame_times(traj, fps: float = 30.0, speed: float = 1.0, start=None, duratio
         raise ValueError(f"speed={speed} must be finite and > 0 (1 real time, <1 slow motion, >1 faster)")
     if len(traj.t) == 0:
         raise ValueError("the trajectory has no frames to animate")
-    # each recorded frame stands for one recording interval h: frames at h, 2h, .. T cover T
+    # frame 0 is the run's start: frames at 0, h, .. T cover T
     h = float(np.median(np.diff(traj.t))) if len(traj.t) > 1 else 0.0
     t0 = float(traj.t[0]) if start is None else float(start)
-    t_end = float(traj.t[-1]) + h
+    t_end = float(traj.t[-1])
     if duration is None:
         duration = t_end - t0
     duration = float(duration)

@@ -41,3 +41,55 @@ def test_continuation_and_diagram_write_csv(tmp_path, capsys):
     rows = list(csv.DictReader(d.open()))
     assert len(rows) == 8 and all(math.isfinite(float(r["theta_dot"])) for r in rows)
     assert "period 1" in capsys.readouterr().out
+
+
+PD_1_2 = 0.0149350880   # [rad] period 1 -> 2 at foot mass ratio 1e-3 (test docstring below)
+PD_2_4 = 0.0175182647   # [rad] period 2 -> 4
+
+
+def _doublings(dt, rng, points, follow, capsys):
+    argv = ["analyze", "simplest-walker", "--param", "slope", "--range", rng, "--points", str(points),
+            "--dt", str(dt), "--workers", "1", "--quiet"] + ([] if follow else ["--no-follow"])
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    found = [float(line.split("=")[1].split()[0]) for line in out.splitlines()
+             if line.strip().startswith("period-doubling at slope") and "not located" not in line]
+    return found, out
+
+
+def test_analyze_finds_the_period_doublings_at_every_step_size(capsys):
+    """`planarsim analyze` locates the 1 -> 2 doubling at dt 1e-3, 5e-4 and 2.5e-4 s and the
+    2 -> 4 doubling at 1e-3 and 5e-4 s.
+
+    Reference: the simplest walker at its default foot mass ratio beta = 1e-3 (hip mass M =
+    1 kg, point feet beta M, massless legs of 1 m, g = 9.81 m/s^2) is Goswami et al.'s compass
+    gait (walkers/passive/reference.py: compass_rhs, compass_heel_strike) with each leg's mass
+    at its foot (com_from_foot a = 0, b = l) and no leg inertia (I = 0). Integrated by scipy's
+    DOP853 at rtol 1e-12, atol 1e-13; fixed points of P and P^2 by Newton to 1e-12,
+    multipliers by central differences of step 1e-6, and the slope where det(J + I) = 0 by
+    brentq (xtol 1e-12): 1 -> 2 at 0.0149350880 rad, 2 -> 4 at 0.0175182647 rad. The same
+    computation at beta = 1e-6 gives 0.0150883 and 0.0176692, the beta -> 0 values of the
+    reduced model (0.0150884, 0.0176694: benchmarks/gait_analysis.py).
+
+    The engine's error is first order in dt (semi-implicit Euler between exactly located
+    touchdowns), 11 dt / 1 s relative: measured 1.10e-2, 5.98e-3, 3.05e-3 for 1 -> 2 (1.54e-3
+    at dt 1.25e-4 s) and 1.10e-2, 5.5e-3 for 2 -> 4. So within 2e-3 of the reference only from
+    dt 1.25e-4 s; here each halving of dt must halve the error, and the extrapolation
+    2 p(dt / 2) - p(dt) must lie within 2e-3 of the reference (it does within 2e-4)."""
+    first, second = {}, {}
+    for dt in (1e-3, 5e-4, 2.5e-4):
+        follow = dt >= 5e-4
+        found, out = _doublings(dt, "0.0138:0.0182" if follow else "0.0138:0.0156", 5 if follow else 4,
+                                follow, capsys)
+        assert len(found) == (2 if follow else 1), out
+        first[dt] = found[0]
+        if follow:
+            second[dt] = found[1]
+    for refp, got in ((PD_1_2, first), (PD_2_4, second)):
+        err = {dt: p / refp - 1.0 for dt, p in got.items()}
+        dts = sorted(err, reverse=True)
+        for dt in dts:
+            assert 0.0 < err[dt] < 15.0 * dt, (refp, err)          # first order, ~11 dt
+        for big, small in zip(dts, dts[1:]):
+            assert 1.6 < err[big] / err[small] < 2.5, (refp, err)   # converging at first order
+            assert abs((2 * got[small] - got[big]) / refp - 1.0) < 2e-3, (refp, got)

@@ -200,5 +200,55 @@ def test_the_birth_of_a_period_two_orbit_is_not_a_fold():
     from planarsim.analysis.continuation import BranchPoint, _detect
     a = BranchPoint(0.015144, np.zeros(2), np.array([1.1322, 0.0102]), 0.041, 1e-7, 2)
     b = BranchPoint(0.015540, np.zeros(2), np.array([0.7212, 0.0386]), 0.037, 1e-7, 2)
-    assert [f.kind for f in _detect(None, a, b, False, 1e-6, 1e-6, 3e-3)] == ["fold"]
-    assert _detect(None, a, b, False, 1e-6, 1e-6, 3e-3, born=True) == []
+    assert [f.kind for f in _detect(None, [a], b, False, 1e-6, 1e-6, 3e-3)] == ["fold"]
+    assert _detect(None, [a], b, False, 1e-6, 1e-6, 3e-3, born=True) == []
+
+
+def noisy_logistic(amplitude):
+    """The logistic map with a rough perturbation (piecewise constant on a 1e-6 grid) of
+    `amplitude`: a simulated map's noise, which the multipliers' error estimate must see."""
+    def family(r):
+        g = logistic(r)
+        return lambda x: g(x) + amplitude * np.sin(np.floor(x * 1e6))
+    return family
+
+
+def test_a_crossing_within_the_noise_is_refined_and_located_not_discarded():
+    """At r = 3 the multiplier 2 - r is exactly -1, inside any error estimate: the doubling is
+    taken between the resolved points around it (r = 2.9 and 3.1), located by regula falsi,
+    and its note says how."""
+    with MapPool(noisy_logistic(1e-7), backend="serial") as pool:
+        br = continue_branch(pool, [0.6], 2.8, 3.2, points=5, param="r")
+    middle = br.points[2]
+    assert middle.p == pytest.approx(3.0) and abs(middle.multipliers[0] + 1.0) <= middle.error
+    pd = br.first("period-doubling")
+    assert pd is not None and pd.located and abs(pd.p - 3.0) < max(1e-4, 2 * pd.p_error)
+    assert "within its error of -1 at p=3 (refined" in pd.note and "between p=2.9 and 3.1" in pd.note
+    assert [b.kind for b in br.bifurcations] == ["period-doubling"]
+
+
+def test_a_crossing_left_open_at_the_branch_end_is_reported():
+    """The branch ends at r = 3.0001, its multiplier -1.0001 within its error of -1: the
+    crossing is reported, not located, with a note to extend the range."""
+    with MapPool(noisy_logistic(1e-7), backend="serial") as pool:
+        br = continue_branch(pool, [0.6], 2.8, 3.0001, points=3, param="r")
+    last = br.points[-1]
+    assert abs(last.multipliers[0] + 1.0) <= last.error
+    assert bifurcation_tests(last.multipliers)["period-doubling"] < 0
+    pd = br.first("period-doubling")
+    assert pd is not None and not pd.located and "extend the range" in pd.note
+
+
+def test_fixed_point_tolerance_follows_the_map_noise():
+    """A map with noise 1e-9 cannot be solved to 1e-12: find_fixed_point raises its tolerance
+    to a few times the measured noise and says so (FixedPoint.noise, .tol), and converges."""
+    from planarsim.analysis import find_fixed_point, map_noise, serial_evaluator
+    f = noisy_logistic(1e-9)(2.8)
+    noise = map_noise(serial_evaluator(f), np.array([0.6]))
+    assert 1e-10 < noise < 3e-9
+    fp = find_fixed_point(f, [0.6], tol=1e-12, eps=1e-4)
+    assert fp.converged and fp.tol > 1e-12 and fp.tol == pytest.approx(4 * fp.noise)
+    assert abs(fp.x[0] - (1 - 1 / 2.8)) < 1e-7
+    smooth_fp = find_fixed_point(logistic(2.8), [0.6], tol=1e-12)
+    assert smooth_fp.tol == 1e-12 and smooth_fp.residual <= 1e-12
+    assert find_fixed_point(f, [0.6], eps=1e-4).tol == max(1e-9, 4 * fp.noise)   # "auto"

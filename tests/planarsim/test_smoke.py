@@ -157,5 +157,41 @@ def test_a_simulator_runs_its_duration_with_the_options_step_length():
     sim = ps.Simulator(chain(2), ps.make_options(dt=5e-4))
     assert sim.dt == 5e-4
     traj = sim.run(1.0, record_every=1)
-    assert abs(sim.state.time[0] - 1.0) < 1e-9 and len(traj.t) == 2000
+    assert abs(sim.state.time[0] - 1.0) < 1e-9 and len(traj.t) == 2001   # frame 0: t = 0
+    assert traj.t[0] == 0.0 and traj.t[1] == 5e-4
     assert traj.info["dt"] == 5e-4
+
+
+def test_a_run_records_its_start_then_the_same_states_as_stepping(tmp_path):
+    """Frame 0 is the state the run starts from; frame k the state after k * record_every
+    steps, bit for bit the state of plain stepping; the CSV's first row is t = 0."""
+    from benchmarks.scenes import chain
+    model = chain(3)
+    sim = ps.Simulator(model)
+    start = sim.snapshot()
+    traj = sim.run(n_steps=40, record_every=4)
+    assert len(traj) == 11 and traj.t[0] == 0.0
+    assert np.array_equal(traj.q[0], start.q) and np.array_equal(traj.v[0], start.v)
+    plain = ps.Simulator(model)
+    for k in range(1, 11):
+        plain.steps(4)
+        assert np.array_equal(traj.q[k], plain.state.q) and traj.t[k] == plain.t, k
+    again = sim.run(n_steps=8, record_every=4)   # a second run starts where the first ended
+    assert again.t[0] == traj.t[-1] and np.array_equal(again.q[0], traj.q[-1]) and len(again) == 3
+    rows = np.loadtxt(traj.to_csv(tmp_path / "run.csv", model), delimiter=",", skiprows=1)
+    assert rows.shape[0] == 11 and rows[0, 0] == 0.0 and rows[0, 1] == start.q[0, 0]
+
+
+def test_a_controlled_run_labels_its_start():
+    from benchmarks.scenes import chain
+    sim = ps.Simulator(chain(2))
+    calls = []
+
+    def controller(s):
+        calls.append(s.t)
+        return np.zeros(s.model.n_act)
+
+    traj = sim.run(n_steps=6, controller=controller, control_every=2,
+                   labels=lambda s: {"calls": len(calls)})
+    assert traj.t[0] == 0.0 and len(traj) == 7
+    assert traj.labels["calls"].tolist() == [0, 1, 1, 2, 2, 3, 3]

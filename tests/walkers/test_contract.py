@@ -51,6 +51,29 @@ def test_chunked_run_ends_where_one_run_does(name):
     assert chunked.summary()["fell"] == whole.summary()["fell"]
 
 
+@pytest.mark.parametrize("name", sorted(walkers.WALKERS))
+def test_frame_0_is_the_initial_state_at_t_0(name):
+    """The first chunk's frame 0 is the state the walker starts from, at t = 0; frame 1 is the
+    state after the first record_every steps, bit for bit that of a run recording nothing."""
+    mod = walkers.load(name)
+    run = mod.Run(record_every=5)
+    start = run.state.copy()
+    first = run.run(0.3)
+    assert first.t[0] == 0.0 and start.time[0] == 0.0
+    assert np.array_equal(first.q[0], start.q) and np.array_equal(first.v[0], start.v)
+    assert np.array_equal(first.contact_mode[0],
+                          np.where(start.contact_enabled != 0, start.contact_mode, -1))
+    assert first.t[1] == pytest.approx(5 * run.dt, rel=1e-12)
+    assert set(first.labels) == set(mod.Run.LABELS) and all(len(v) == len(first) for v in first.labels.values())
+    blind = mod.Run(record_every=0)
+    blind.run(5 * run.dt)
+    assert np.array_equal(first.q[1], blind.state.q) and np.array_equal(first.v[1], blind.state.v)
+    second = run.run(0.1)   # a later chunk starts after the first one's last frame
+    assert second.t[0] > first.t[-1]
+    traj, _, _ = mod.simulate(0.05)
+    assert traj.t[0] == 0.0 and np.array_equal(traj.q[0], mod.Run().state.q)
+
+
 # a start or terrain each walker falls on within 6 s
 FALLS = {"simple-biped": dict(terrain="hills:0.15,1.0"), "simbicon": dict(terrain="hills:0.1,1.5"),
          "compass-gait": dict(terrain="slope:-8")}

@@ -22,7 +22,7 @@ def test_registered_and_uniform_interface():
     assert WALKERS["simbicon"] == "walkers.simbicon"
     assert simbicon.NAME == "simbicon" and "walk" in simbicon.GAITS
     traj, summary, model = simbicon.simulate(0.5)
-    assert len(traj.t) == 50 and model.n_act == 6
+    assert len(traj.t) == 51 and traj.t[0] == 0.0 and model.n_act == 6   # start + 50 frames
     assert {"distance", "speed", "steps", "fell"} <= set(summary)
     with pytest.raises(ValueError, match="gait 'run' unknown"):
         simbicon.simulate(0.5, gait="run")
@@ -75,7 +75,7 @@ def _paths(duration):
     sim = ps.Simulator(model, ps.make_options(STRATEGY),
                        state=start_state(model, p.start_lean, p.start_speed))
     ctrl = Controller(p, model)
-    for k in range(len(traj.t)):
+    for k in range(len(traj.t) - 1):   # frame 0 is the start: one step per later frame
         sim.step(ctrl(sim))
     return sim.state.q, traj.q[-1]
 

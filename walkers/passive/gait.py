@@ -21,7 +21,7 @@ from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
 from planarsim.state import State
-from planarsim.trajectory import Trajectory, make_recorder
+from planarsim.trajectory import Trajectory, make_recorder, record_state
 
 from .model import build_compass, build_rimless, build_simplest, leg_up, slope_frame
 from .params import CompassParams, RimlessParams, SimplestParams
@@ -225,14 +225,19 @@ class PassiveWalker:
 
     # running -----------------------------------------------------------------------------------
     def rollout(self, n_steps: int, stop_after: int, record_every: int = 0, max_events: int = 0):
-        """Compiled rollout from the current state; returns (code, steps, Trajectory | None)."""
+        """Compiled rollout from the current state; returns (code, steps, Trajectory | None),
+        the Trajectory's frame 0 the state it started from."""
         extra = max_events if self.toggle != DETECT else 0   # touchdown frames
-        rec = make_recorder(self.model, n_steps // record_every + 1 + extra) if record_every > 0 else self._no_rec
+        rec = make_recorder(self.model, n_steps // record_every + 2 + extra) if record_every > 0 else self._no_rec
         if max_events > self.event_time.size:
             self.event_time = np.zeros(max_events)
             self.event_contact = np.zeros(max_events, np.int64)
         sim = self.sim
-        code, done, k = self.run_compiled(n_steps, stop_after, rec, record_every, 0)
+        k0 = 0
+        if record_every > 0:
+            record_state(rec, 0, sim.state, sim.ws)
+            k0 = 1
+        code, done, k = self.run_compiled(n_steps, stop_after, rec, record_every, k0)
         check_run(code, self.model, sim.ws, sim.options, self.kind)
         traj = None
         if record_every > 0:
