@@ -13,9 +13,14 @@ import math
 from ._jit import kernel
 from .codes import MODE_FREE
 from .info import INFO_CCD_SPLITS
-from .terrain import ground_point_call
+from .terrain import TWO_PI, ground_point_call, height_derivs, max_curvature
 
 N_SAMPLES = 8
+# [m] per metre of coordinates: a path whose height above the ground falls this low while it
+# approaches the ground touches it (rounding of the height at those coordinates)
+TOUCH_GAP = 1e-12
+# conservative advancement's steps on hills before it takes the point as touching
+MAX_ADVANCES = 500
 
 
 @kernel
@@ -25,6 +30,55 @@ def _path_gap(m, s, ws, b, h, tau):
     px = s.q[b, 0] + tau * s.v[b, 0] + tau * tau * ax
     py = s.q[b, 1] + tau * s.v[b, 1] + tau * tau * ay
     return ground_point_call(m.terrain_coef, px, py)[4]
+
+
+@kernel
+def _height_gap(coef, x0, y0, vx, vy, ax, ay, tau):
+    """The path's height above the ground f(tau) = y(tau) - h(x(tau)) [m] and its rate
+    f'(tau) [m/s] (the same sign as the gap: the ground is a height field)."""
+    x = x0 + tau * vx + tau * tau * ax
+    y = y0 + tau * vy + tau * tau * ay
+    hgt, dh, ddh = height_derivs(coef, x)
+    return y - hgt, (vy + 2.0 * tau * ay) - dh * (vx + 2.0 * tau * ax), abs(x) + abs(y)
+
+
+@kernel
+def _impact_on_hills(m, s, ws, b, h):
+    """First time tau in [0, h] [s] at which point-mass body b's path touches sine hills, or
+    inf: conservative advancement on the path's height above the ground f(tau). With K a bound
+    of |f''| over the step (the path's acceleration and speed, the hills' largest slope and
+    curvature), f(t + u) >= f(t) + f'(t) u - K u^2 / 2, so no root lies before the first
+    zero u* of that bound: tau advances by u* and f is evaluated again. Far from the ground
+    the steps are long; towards a crossing they shrink as Newton's do, from the near side, so
+    a fast point can neither cross a crest and out again unseen nor be placed beyond its first
+    contact. A point that skims the ground within TOUCH_GAP while approaching it touches."""
+    coef = m.terrain_coef
+    x0 = s.q[b, 0]
+    y0 = s.q[b, 1]
+    vx = s.v[b, 0]
+    vy = s.v[b, 1]
+    ax = (ws.v_new[b, 0] - vx) / h
+    ay = (ws.v_new[b, 1] - vy) / h
+    slope = abs(coef[1])
+    for k in range(int(coef[2])):
+        slope += abs(coef[3 + 3 * k]) * TWO_PI / coef[4 + 3 * k]
+    speed_x = abs(vx) + 2.0 * h * abs(ax)
+    bound = 2.0 * abs(ay) + max_curvature(coef) * speed_x * speed_x + 2.0 * slope * abs(ax)
+    t = 0.0
+    for _ in range(MAX_ADVANCES):
+        f, rate, size = _height_gap(coef, x0, y0, vx, vy, ax, ay, t)
+        if f <= TOUCH_GAP * (1.0 + size) and rate <= 0.0:
+            return t
+        if bound > 0.0:
+            u = (rate + math.sqrt(max(rate * rate + 2.0 * bound * f, 0.0))) / bound
+        elif rate < 0.0:
+            u = f / -rate
+        else:
+            return math.inf
+        t += max(u, 0.0)
+        if t >= h:
+            return math.inf
+    return t        # still advancing after MAX_ADVANCES: touching here, conservatively
 
 
 @kernel
@@ -41,6 +95,8 @@ def impact_time(m, s, ws, b, h):
     g_end = _path_gap(m, s, ws, b, h, h)
     if g_lo <= 0.0:
         return 0.0 if g_end < 0.0 else math.inf
+    if m.terrain_coef[2] != 0.0:
+        return _impact_on_hills(m, s, ws, b, h)
     t_hi = -1.0
     g_hi = 0.0
     for k in range(1, N_SAMPLES + 1):

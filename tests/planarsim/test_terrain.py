@@ -74,3 +74,29 @@ def test_default_hills_meet_the_seed_claim():
     assert 11.0 < terrain.max_slope_deg(t) <= 12.0
     x = np.linspace(0, 200, 200001)
     assert np.ptp(t.height(x)) > 0.3
+
+
+@st.composite
+def tight_hills(draw):
+    """Steep, tight hills: wavelengths 0.1-2 m, amplitudes 0.05-0.4 m (slopes to ~25, 87 deg)."""
+    n = draw(st.integers(1, 3))
+    a = [draw(st.floats(0.05, 0.4)) for _ in range(n)]
+    lam = [draw(st.floats(0.1, 2.0)) for _ in range(n)]
+    phi = [draw(st.floats(-math.pi, math.pi)) for _ in range(n)]
+    return terrain.hills(a, lam, phi)
+
+
+@settings(max_examples=300, deadline=None)
+@given(tight_hills(), st.floats(-2, 2), st.floats(-0.8, 0.8))
+def test_closest_point_on_tight_hills_is_the_nearest(ter, px, dy):
+    """Far below or above tight hills the nearest ground point may lie a valley away: the
+    search finds it (a Newton step that would take it to another valley's wall is not taken)
+    and its gap has the height field's sign."""
+    py = float(ter.height(px)) + dy
+    gx, gy, nx, ny, gap = closest_point(ter.coef, px, py)
+    assert abs(gy - ter.height(gx)) < 1e-12
+    xs = np.linspace(px - 1.5, px + 1.5, 60001)
+    d = np.hypot(xs - px, ter.height(xs) - py)
+    assert abs(gap) <= d.min() + 1e-9       # no sampled ground point is closer
+    if abs(dy) > 1e-9:
+        assert np.sign(gap) == np.sign(dy)
