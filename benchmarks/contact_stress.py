@@ -936,7 +936,8 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
     out = dict(family=family, seed=seed, strategy=strategy, dt=dt, steps=steps, e0=e0,
                e_tol=math.nan if u is not None else energy_bound(spec, ground, q0, v0),
                gain=math.nan, pin=math.nan, depth=math.nan, diverged="", raised="", speed=math.nan,
-               speed_ratio=math.nan, step_gain=math.nan, step_k=-1, step_note="", tunnel=math.nan)
+               speed_ratio=math.nan, step_gain=math.nan, step_k=-1, step_note="", tunnel=math.nan,
+               slide_leave_gain=math.nan, slide_leave_k=-1)
     nb, nc, npin = model.n_body, model.n_contact, model.n_pin
     q, v = np.empty((steps + 1, nb, 3)), np.empty((steps + 1, nb, 3))
     mode, limit = np.empty((steps + 1, nc), np.int64), np.empty((steps + 1, npin, 2), np.int64)
@@ -981,6 +982,12 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
             left = bool(np.any((limit[k] == 1) & (limit[k + 1] == 0)))
             out["step_note"] = (("slide" if slid else "no slide") + ", " +
                                 ("ankle left its limit" if left else "no limit left"))
+            sliding = np.any(mode == int(ps.ContactMode.SLIDING), axis=1)
+            leaving = np.any((limit[:-1] == 1) & (limit[1:] == 0), axis=(1, 2))
+            both = np.nonzero(leaving & (sliding[1:] | sliding[:-1]))[0]
+            if len(both):
+                j = both[int(np.argmax(excess[both]))]
+                out["slide_leave_gain"], out["slide_leave_k"] = float(excess[j]), int(j) + 1
     counts = getattr(sim.ws, "audit", None)
     out["audit"] = None if counts is None else dict(zip(audit_names(len(counts)), (int(c) for c in counts)))
     out["failed"] = [name for name, bad in (
@@ -1085,11 +1092,12 @@ def report(results, n_worst=8) -> bool:
             if family == "hills_fast":
                 line += f"; worst tunnel {_worst(r['tunnel'] for r in rs):.3g} m"
             if family == "ranger_loop":
-                both = [r for r in rs if r["step_note"] == "slide, ankle left its limit"]
-                line += (f"; runs whose worst step has a sliding sole and an ankle leaving its "
-                         f"limit: {len(both)}" + "".join(
-                             f"\n{'':17s}{r['family']}:{r['seed']}:{r['strategy']} step {r['step_k']} "
-                             f"gains {r['step_gain']:.3g} J (E_tol {r['e_tol']:.2g})" for r in both))
+                both = sorted((r for r in rs if r["slide_leave_gain"] > 0.0),
+                              key=lambda r: -r["slide_leave_gain"] / r["e_tol"])
+                line += (f"\n{'':15s} steps with a sliding sole and an ankle leaving its limit that "
+                         f"gain energy: in {len(both)} runs; the largest gains:" + "".join(
+                             f"\n{'':17s}{r['family']}:{r['seed']}:{r['strategy']} step {r['slide_leave_k']} "
+                             f"gains {r['slide_leave_gain']:.3g} J (E_tol {r['e_tol']:.2g})" for r in both[:4]))
             print(f"{'':15s} {line}")
     bad = [r for r in results if r["failed"]]
     if bad:
