@@ -1,10 +1,12 @@
-"""A seeded stress corpus of closed contact loops through the ground, no actuation (not a test).
+"""A seeded stress corpus of closed contact loops through the ground (not a test); no actuation but in stiff_motors.
 
     python benchmarks/contact_stress.py                       # 6 families x 40 seeds x 2 strategies
     python benchmarks/contact_stress.py --quick               # seeds 0-4, one strategy each (20 runs)
     python benchmarks/contact_stress.py --families chain_hills --runs-per-family 10
     python benchmarks/contact_stress.py --only chain_hills:7:all --only mass_ratio:3:alternating
     python benchmarks/contact_stress.py --families shape_pile shape_hills --extreme   # beyond the targets
+    python benchmarks/contact_stress.py --families extremes --runs-per-family 40 --jobs 1
+    python benchmarks/contact_stress.py --families loop_inertia hills_fast ranger_loop stiff_motors
 
 Families (every scene drawn from numpy.random.default_rng(seed); friction mu in [0.2, 1.2]):
 
@@ -30,7 +32,54 @@ Families (every scene drawn from numpy.random.default_rng(seed); friction mu in 
   tested against an independent reference in tests/physics/test_collide.py) and of any shape
   below the ground (corners and edges sampled every 5 mm, circles by their centre's gap).
 
-Seed k runs at dt = DTS[k % 5] (1e-4 ... 1e-2 s). A run simulates SECONDS[family] (or --seconds) but at most
+Beyond the corpus (EXTREME_FAMILIES, run only when --families names them; `extremes` names
+all four; not in the default run, --quick or its test):
+
+- loop_inertia: a free four-bar: four bars (boxes with corner contacts, 0.2-1 m) pinned end to
+  end and closed, standing upright 0-0.3 m over flat ground, unactuated. Its inertias are
+  10^U(-4, 4) kg m^2 and its masses 10^U(-1, 1) kg, each drawn on its own (radii of gyration
+  from 3 mm to 300 m). 40 % of the loops are parallelograms and 30 % kites (lengths that fold
+  flat: every bar on the ground, the pin rows dependent), the rest any convex quadrilateral.
+  Start velocities: random bar velocities (sd 0.5 m/s, 2 rad/s) with the part that would open
+  a pin removed (loop_velocity). Even seeds run at LOOP_DT = 2e-3 s, odd seeds at every DTS in
+  turn. What it exposes: energy rising by orders of magnitude while the pins stay closed and
+  every audit count is 0.
+- hills_fast: four point masses, or three pairs of point masses joined by a rod (0.1-1 m;
+  seeds 5-9, 15-19, ...: pairs), 0.1-10 kg, over steep sine hills (one or two sines of
+  wavelength 0.3-2 m, the steepest slope 30-60 deg), 1 cm to 2 m above them, thrown at 1-200
+  m/s (log-uniform) within 85 deg of straight down (pairs turning at up to 20 rad/s). Point
+  contacts on point masses (continuous collision detection). Depth is each point's signed
+  distance from the ground curve at every frame (ground_gap); tunnel (see below) the deepest
+  point of its path inside a free step. What it exposes: tunnelling and rod pairs' energy jumps.
+- ranger_loop: a Ranger-like four-body loop, unactuated and without springs: two legs (0.8-1.1
+  m, 3-7 kg) pinned at a hip, each with a light foot (10-300 g) pinned at an ankle with joint
+  limits (-U(0.05, 0.6), U(0.05, 0.6)) rad about the build pose, each foot on a circular-arc
+  sole (add_arc_contact: radius 0.15-0.3 m, centre 0.08-0.14 m above the ankle, span about
+  Ranger's, heel and top vertices) standing on flat ground (a closed loop through the ground),
+  then random pin rates (sd 1 rad/s) and leg velocity. Depth is each sole's lowest point
+  (contact_clearance). What it exposes: single steps that gain energy where a sliding sole
+  meets an ankle leaving its limit (each run's worst step is noted: slide, limit left).
+- stiff_motors: a chain of 3-6 boxes (0.5-3 kg, 0.2-0.5 m) pinned end to end, bent, on flat
+  ground (seeds 0, 1 mod 4), or biped_stance's 7-body tree on box feet (seeds 2, 3 mod 4), a
+  pin motor on every pin saturated at 10^U(2, 3) N m, driven bang-bang at that torque, the
+  sign flipping every 1-5 steps (per motor, seeded: commands()), at dt MOTOR_DTS[k % 2] = 1e-2
+  or 2e-2 s. The runner applies the commands each step (sim.step(u)). Motors do work, so there
+  is no energy target: its runs are judged by pin gap, depth, divergence, audit and speed, a
+  body faster than the motors' torque limits can make it (motor_speed_ratio > 1). Its gain
+  column is the energy gained beyond the motors' work (motor_work), for information. What
+  it exposes: blow-ups (pins opening by metres, bodies at hundreds of m/s) that nothing stops.
+
+The extreme families are stepped one step at a time (run_extreme_case), so that the frames
+before an engine error are judged too, and add three targets: step, the largest energy change
+of a single step beyond its own gravity term, dE - (dt / 2) g dp_y (the exact change of a step
+without impulses; see energy_bound) and the motors' work, against the run's whole E_tol
+(contacts only take energy out, pins' work in one step is O(dt^2)); tunnel (hills_fast) above
+DEPTH_TOL; speed (stiff_motors). A run the engine stops with an error of its own (planarsim's
+SimulationDiverged or any planarsim error, naming why) is "raised"; a run missing a target
+without one is "silent" (an audit count alone is silent: nothing stopped the run). The summary
+gives both per family, the silent misses by cause and the audit counts by rule.
+
+Seed k runs at dt = DTS[k % 5] (1e-4 ... 1e-2 s) unless its family says otherwise. A run simulates SECONDS[family] (or --seconds) but at most
 MAX_STEPS steps, so runs at small dt cover less time. Every run is recorded at every step and
 judged on each end-of-step state (and the start):
 
@@ -42,6 +91,9 @@ judged on each end-of-step state (and the start):
   metrics.lowest_point; hills: see clearance);
 - divergence: planarsim.SimulationDiverged, or a non-finite state;
 - audit: the engine's own violation counters sim.ws.audit (n/a where the engine has none).
+
+Each family's line also counts the runs the engine stopped with an error ('raise') and the
+runs missing a target without one ('silent').
 
 Exit status 1 when any run misses a target, else 0.
 """
@@ -67,6 +119,9 @@ from benchmarks.scenes import G, biped_collapse  # noqa: E402
 
 FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio", "shape_pile",
             "shape_hills")
+# beyond the default corpus (selected with --families): see the module docstring
+EXTREME_FAMILIES = ("loop_inertia", "hills_fast", "ranger_loop", "stiff_motors")
+ALL_FAMILIES = FAMILIES + EXTREME_FAMILIES
 SHAPE_FAMILIES = ("shape_pile", "shape_hills")   # bodies touching bodies (colliding shapes)
 # their masses 10^U(-d, d) kg and launch speeds 1..speed m/s (log-uniform); --extreme widens them
 SHAPE_RANGES = {"mass_decades": 1.5, "speed": 30.0}
@@ -74,7 +129,10 @@ EXTREME_SHAPE_RANGES = {"mass_decades": 2.0, "speed": 200.0}
 STRATEGIES = ("alternating", "all")
 DTS = (1e-4, 3e-4, 1e-3, 3e-3, 1e-2)      # [s] step sizes; seed k runs at DTS[k % 5]
 SECONDS = {"biped_stance": 2.0, "biped_collapse": 2.0, "chain_hills": 3.0, "mass_ratio": 1.0,
-           "shape_pile": 2.0, "shape_hills": 2.0}  # [s]
+           "shape_pile": 2.0, "shape_hills": 2.0, "loop_inertia": 4.0, "hills_fast": 2.0,
+           "ranger_loop": 2.0, "stiff_motors": 2.0}  # [s]
+LOOP_DT = 2e-3            # [s] loop_inertia's step at even seeds
+MOTOR_DTS = (1e-2, 2e-2)  # [s] stiff_motors' steps: seed k runs at MOTOR_DTS[k % 2]
 MAX_STEPS = 3000          # cap on steps per run (dt = 1e-4 s: 0.3 s simulated)
 RUNS_PER_FAMILY = 40      # seeds per family of the default corpus
 QUICK_RUNS = 5            # seeds per family with --quick (one strategy each, in turn)
@@ -152,9 +210,10 @@ def place(model, ground, q, gap):
     return q
 
 
-def biped_stance(rng, dt):
+def biped_stance(rng, dt, motor_torques=None):
     """A 5-link biped on two box feet, both flat on flat ground (pose from two-link inverse
-    kinematics, knees forward), torso on top. Returns the model."""
+    kinematics, knees forward), torso on top. Returns the model. motor_torques (6,) [N m]: a
+    pin motor on each pin (hip, knee, ankle of L then R) saturated at +-motor_torques[j]."""
     b = ps.ModelBuilder(dt=dt)
     mu = rng.uniform(0.2, 1.2)
     scale = rng.uniform(0.8, 1.2, size=4)                 # mass factors
@@ -183,6 +242,9 @@ def biped_stance(rng, dt):
         b.add_pin(f"hip_{side}", torso, thigh, anchor_world=hip)
         b.add_pin(f"knee_{side}", thigh, shin, anchor_world=knee)
         b.add_pin(f"ankle_{side}", shin, foot, anchor_world=ankle)
+    if motor_torques is not None:
+        for j, pin in enumerate(("hip_L", "knee_L", "ankle_L", "hip_R", "knee_R", "ankle_R")):
+            b.add_pin_motor(f"{pin}_motor", pin, limit=(-motor_torques[j], motor_torques[j]))
     return b.compile()
 
 
@@ -300,10 +362,203 @@ def shape_scene(rng, dt, hills):
     return b.compile(), np.array(v)
 
 
+# --- the extreme families (EXTREME_FAMILIES) ---------------------------------------------------
+def loop_velocity(model, q, v):
+    """v (n_body, 3) with its pin-violating part removed: the least-squares change of v that
+    makes every pin's two anchor points move together at q (closed loops included)."""
+    a = model.arrays
+    rows = []
+    for j in range(model.n_pin):
+        row = np.zeros((2, 3 * model.n_body))
+        for side, sign in ((0, -1.0), (1, 1.0)):
+            body = int(a.pin_body[j, side])
+            if body < 0:
+                continue
+            r = world_points(q[None], body, a.pin_anchor[j, side])[0] - q[body, :2]
+            row[:, 3 * body:3 * body + 2] += sign * np.eye(2)
+            row[:, 3 * body + 2] += sign * np.array([-r[1], r[0]])
+        rows.append(row)
+    jac = np.vstack(rows)
+    flat = v.reshape(-1)
+    flat = flat - jac.T @ np.linalg.solve(jac @ jac.T, jac @ flat)
+    return flat.reshape(v.shape)
+
+
+def loop_inertia(rng, dt):
+    """A free four-bar: four bars (boxes with corner contacts) pinned end to end and closed,
+    standing upright over flat ground; inertias 10^U(-4, 4) kg m^2, masses 10^U(-1, 1) kg,
+    each drawn on its own. Returns the model."""
+    b = ps.ModelBuilder(dt=dt)
+    mu = rng.uniform(0.2, 1.2)
+    kind = rng.random()
+    if kind < 0.7:      # a parallelogram or a kite: lengths that fold flat, every bar on the ground
+        la, lb, turn = rng.uniform(0.2, 1.0), rng.uniform(0.2, 1.0), rng.uniform(0.3, math.pi - 0.3)
+        tilt = rng.uniform(-0.5, 0.5)
+        ea, eb = (np.array([math.cos(tilt + t), math.sin(tilt + t)]) for t in (0.0, turn))
+        if kind < 0.4:
+            corner = np.array([(0, 0), la * ea, la * ea + lb * eb, lb * eb])
+        else:           # kite: la, la, lb, lb about the diagonal from corner 0 to corner 2
+            tip = la * ea + la * eb
+            far = tip + lb * (tip / np.hypot(*tip))
+            side = np.array([-tip[1], tip[0]]) / np.hypot(*tip)
+            half = math.sqrt(max(la ** 2 - (np.hypot(*tip) / 2) ** 2, 0.0))
+            mid = tip / 2
+            corner = np.array([(0.0, 0.0), mid + half * side, far, mid - half * side])
+            # sides 0-1 and 3-0 are la; 1-2 and 2-3 are equal (the kite's other pair)
+        corner = corner - corner.mean(axis=0) + (0.0, 1.0)
+    else:               # a convex quadrilateral of any lengths
+        gaps = rng.uniform(0.6, 1.0, size=4)
+        ang = rng.uniform(0, 2 * math.pi) + np.cumsum(gaps / gaps.sum() * 2 * math.pi)
+        rad = rng.uniform(0.2, 0.6, size=4)
+        corner = np.stack([rad * np.cos(ang), rad * np.sin(ang)], axis=1) + (0.0, 1.0)
+    height = rng.uniform(0.02, 0.06)
+    bars = []
+    for i in range(4):
+        p0, p1 = corner[i], corner[(i + 1) % 4]
+        d = p1 - p0
+        name = f"bar{i}"
+        body = b.add_body(name, 10.0 ** rng.uniform(-1, 1), 10.0 ** rng.uniform(-4, 4),
+                          pos=tuple((p0 + p1) / 2), angle=math.atan2(d[1], d[0]))
+        b.add_box_contacts(f"{name}_c", body, (0.0, 0.0), float(np.hypot(*d)), height, mu=mu)
+        bars.append(body)
+    for i in range(1, 4):
+        b.add_pin(f"pin{i}", bars[i - 1], bars[i], anchor_world=tuple(corner[i]))
+    b.add_pin("pin0", bars[3], bars[0], anchor_world=tuple(corner[0]))   # closes the loop
+    return b.compile()
+
+
+def hills_fast(rng, dt, pairs):
+    """Four point masses, or three pairs of point masses joined by a rod, over steep sine
+    hills (slopes up to 30-60 deg, wavelengths 0.3-2 m), thrown at the ground at 1-200 m/s.
+    Returns the model and the start velocities (n_body, 3)."""
+    n_sines = int(rng.integers(1, 3))
+    lam = rng.uniform(0.3, 2.0, size=n_sines)
+    steepest = math.tan(math.radians(rng.uniform(30.0, 60.0)))
+    share = rng.uniform(0.3, 1.0, size=n_sines)
+    amp = steepest * share / share.sum() * lam / (2 * math.pi)      # max slope <= steepest
+    ground = terrain.hills(amp, lam, rng.uniform(0, 2 * math.pi, size=n_sines))
+    b = ps.ModelBuilder(dt=dt, terrain=ground)
+    mu = rng.uniform(0.2, 1.2)
+    v = []
+    for i in range(3 if pairs else 4):
+        x = 1.5 * i + rng.uniform(-0.5, 0.5)
+        gap = 10.0 ** rng.uniform(-2.0, 0.3)                            # 1 cm .. 2 m
+        speed = 10.0 ** rng.uniform(0.0, math.log10(200.0))
+        heading = -math.pi / 2 + rng.uniform(-1.48, 1.48)                # within 85 deg of down
+        vel = np.array([speed * math.cos(heading), speed * math.sin(heading)])
+        if not pairs:
+            pos = np.array([x, ground.height(x) + gap])
+            body = b.add_point_mass(f"mass{i}", 10.0 ** rng.uniform(-1, 1), pos=tuple(pos), vel=tuple(vel))
+            b.add_point_contact(f"mass{i}_c", body, mu=mu)
+            v.append((*vel, 0.0))
+            continue
+        length, turn, rate = rng.uniform(0.1, 1.0), rng.uniform(-math.pi, math.pi), rng.uniform(-20, 20)
+        e = np.array([math.cos(turn), math.sin(turn)]) * length / 2     # mid to end 1
+        lift = max(ground.height(x + sx * e[0]) + gap - sx * e[1] for sx in (-1.0, 1.0))
+        ends = []
+        for k, sx in enumerate((-1.0, 1.0)):                            # turning about the mid
+            p = np.array([x, lift]) + sx * e
+            pv = vel + rate * sx * np.array([-e[1], e[0]])
+            body = b.add_point_mass(f"pair{i}_{k}", 10.0 ** rng.uniform(-1, 1), pos=tuple(p), vel=tuple(pv))
+            b.add_point_contact(f"pair{i}_{k}_c", body, mu=mu)
+            ends.append(body)
+            v.append((*pv, 0.0))
+        b.add_rod(f"rod{i}", ends[0], ends[1])
+    return b.compile(), np.array(v)
+
+
+def ranger_loop(rng, dt):
+    """A Ranger-like four-body loop (see the module docstring), both feet on flat ground;
+    returns the model."""
+    b = ps.ModelBuilder(dt=dt)
+    mu = rng.uniform(0.2, 1.2)
+    length, leg_com = rng.uniform(0.8, 1.1), rng.uniform(0.1, 0.3)      # [m] hip to ankle, to COM
+    r, d = rng.uniform(0.15, 0.3), rng.uniform(0.08, 0.14)              # sole radius, centre height
+    a0, a1 = rng.uniform(-1.9, -1.5), rng.uniform(-1.1, -0.8)           # sole span [rad]
+    fx, fy = rng.uniform(0.0, 0.06), rng.uniform(-0.04, 0.0)            # foot COM from the ankle
+    # foot angles whose lowest sole point lies inside the span: -pi/2 - phi in (a0, a1)
+    phi = rng.uniform(-math.pi / 2 - a1 + 0.05, -math.pi / 2 - a0 - 0.05, size=2)
+    th_front = rng.uniform(0.15, 0.4)
+    ankle_y = r - d * np.cos(phi)                                        # soles touching y = 0
+    hip = np.array([-length * math.sin(th_front), ankle_y[1] + length * math.cos(th_front)])
+    c = (hip[1] - ankle_y[0]) / length
+    if c >= 1.0:                         # the rear foot cannot reach: turn it like the front one
+        phi[0] = phi[1]
+        ankle_y[0] = ankle_y[1]
+        c = (hip[1] - ankle_y[0]) / length
+    angles = (-math.acos(c), th_front)                                   # rear (outer), front (inner)
+    legs, ankles = [], []
+    for s, th in enumerate(angles):
+        e = np.array([math.sin(th), -math.cos(th)])
+        legs.append(b.add_body(("outer_leg", "inner_leg")[s], rng.uniform(3.0, 7.0), rng.uniform(0.2, 0.7),
+                               pos=tuple(hip + leg_com * e), angle=th,
+                               shapes=[("capsule", (0.0, leg_com), (0.0, leg_com - length), 0.02,
+                                        {"collide": False})]))
+        ankles.append(hip + length * e)
+    feet = []
+    for s in range(2):
+        cf, sf = math.cos(phi[s]), math.sin(phi[s])
+        feet.append(b.add_body(("outer_foot", "inner_foot")[s], 10.0 ** rng.uniform(-2, -0.5),
+                               10.0 ** rng.uniform(-3.5, -2),
+                               pos=(ankles[s][0] + cf * fx - sf * fy, ankles[s][1] + sf * fx + cf * fy),
+                               angle=phi[s]))
+    b.add_pin("hip", legs[0], legs[1], anchor_world=tuple(hip))
+    for s in range(2):
+        b.add_pin(("outer_ankle", "inner_ankle")[s], legs[s], feet[s], anchor_world=tuple(ankles[s]),
+                  limit=(-rng.uniform(0.05, 0.6), rng.uniform(0.05, 0.6)))
+    for s in range(2):
+        centre = np.array([-fx, -fy + d])                                # ankle at (-fx, -fy)
+        # a back corner behind the heel and a top (inside the circle, as Ranger's are)
+        verts = [tuple(centre + 0.92 * r * np.array([math.cos(a0 - 0.15), math.sin(a0 - 0.15)])),
+                 tuple(centre + 0.65 * r * np.array([math.cos(a1 + 0.5), math.sin(a1 + 0.5)]))]
+        b.add_arc_contact(("outer_sole", "inner_sole")[s], feet[s], center=tuple(centre), radius=r,
+                          span=(a0, a1), vertices=verts, mu=mu)
+    return b.compile()
+
+
+def motor_chain(rng, dt, torques):
+    """3-6 boxes pinned end to end, bent and tilted, over flat ground, a pin motor on every pin
+    saturated at +-torques[j] [N m]; returns the model."""
+    b = ps.ModelBuilder(dt=dt)
+    mu = rng.uniform(0.2, 1.2)
+    length, height, tilt = rng.uniform(0.2, 0.5), rng.uniform(0.03, 0.08), rng.uniform(-0.3, 0.3)
+    e = np.array([math.cos(tilt), math.sin(tilt)])
+    prev = None
+    for i in range(len(torques) + 1):
+        link = box(b, f"link{i}", rng.uniform(0.5, 3.0), length, height,
+                   ((i + 0.5) * length * e[0], (i + 0.5) * length * e[1]), tilt, mu)
+        if prev is not None:
+            b.add_pin(f"pin{i}", prev, link, anchor_world=(i * length * e[0], i * length * e[1]))
+            b.add_pin_motor(f"pin{i}_motor", f"pin{i}", limit=(-torques[i - 1], torques[i - 1]))
+        prev = link
+    return b.compile()
+
+
+def commands(family, seed, model, steps):
+    """(steps, n_act) commands [N m] of a run: for stiff_motors each motor bang-bang at its
+    torque limit, the sign flipping every 1-5 steps (per motor, seeded, random phase); None
+    for the unactuated families."""
+    if family != "stiff_motors":
+        return None
+    rng = np.random.default_rng([seed, 7])          # its own stream: the scene's draws are kept
+    u = np.empty((steps, model.n_act))
+    k = np.arange(steps)
+    for j in range(model.n_act):
+        period = int(rng.integers(1, 6))
+        phase = int(rng.integers(0, period))
+        sign = 1.0 if rng.random() < 0.5 else -1.0
+        u[:, j] = model.arrays.act_range[j, 1] * sign * (-1.0) ** ((k + phase) // period)
+    return u
+
+
 def build(family, seed):
     """(model, ground, q0, v0) of one corpus case; q0, v0 the start state [m, rad, m/s, rad/s]."""
     rng = np.random.default_rng(seed)
     dt = DTS[seed % len(DTS)]       # every five seeds cover every step size
+    if family == "loop_inertia":    # even seeds at LOOP_DT, odd ones at every DTS in turn
+        dt = LOOP_DT if seed % 2 == 0 else DTS[(seed // 2) % len(DTS)]
+    elif family == "stiff_motors":
+        dt = MOTOR_DTS[seed % len(MOTOR_DTS)]
     if family in ("biped_stance", "biped_collapse"):
         model = biped_stance(rng, dt) if family == "biped_stance" else biped_collapse(dt)
         root_v = (rng.normal(0, 0.1), rng.normal(0, 0.1), rng.normal(0, 0.3))
@@ -317,6 +572,33 @@ def build(family, seed):
     elif family in SHAPE_FAMILIES:
         model, v = shape_scene(rng, dt, family == "shape_hills")
         return model, model.terrain, model.q0.copy(), v
+    elif family == "loop_inertia":
+        model = loop_inertia(rng, dt)
+        v = np.zeros((model.n_body, 3))
+        v[:, :2] = rng.normal(0.0, 0.5, size=(model.n_body, 2))
+        v[:, 2] = rng.normal(0.0, 2.0, size=model.n_body)          # bars turning: pins at ~2-3 rad/s
+        q = model.q0.copy()
+        v = loop_velocity(model, q, v)
+        gap = rng.uniform(0.0, 0.3)
+    elif family == "hills_fast":
+        model, v = hills_fast(rng, dt, pairs=bool((seed // len(DTS)) % 2))
+        return model, model.terrain, model.q0.copy(), v
+    elif family == "ranger_loop":
+        model = ranger_loop(rng, dt)
+        root_v = (rng.normal(0, 0.2), rng.normal(0, 0.1), rng.normal(0, 0.5))
+        q, v = joint_pose(model, np.zeros(model.n_pin), rng.normal(0, 1.0, model.n_pin), root_v)
+        return model, model.terrain, q, v
+    elif family == "stiff_motors":
+        if seed % 4 < 2:    # a chain of 3-6 boxes; else the biped on box feet
+            n_motor = int(rng.integers(2, 6))
+            model = motor_chain(rng, dt, 10.0 ** rng.uniform(2, 3, size=n_motor))
+            spread, rate = 0.3, 0.5
+        else:
+            model = biped_stance(rng, dt, motor_torques=10.0 ** rng.uniform(2, 3, size=6))
+            spread, rate = 0.03, 0.3
+        root_v = (rng.normal(0, 0.1), rng.normal(0, 0.1), rng.normal(0, 0.3))
+        q, v = joint_pose(model, rng.normal(0, spread, model.n_pin), rng.normal(0, rate, model.n_pin), root_v)
+        gap = rng.uniform(0.0, 0.2) if rng.random() < 0.5 else 0.0
     elif family == "mass_ratio":
         model = mass_ratio(rng, dt)
         speed, heading = rng.uniform(10, 100), rng.uniform(-math.pi / 3, math.pi / 3)
@@ -324,7 +606,7 @@ def build(family, seed):
         q, v = joint_pose(model, rng.uniform(-1.0, 1.0, 1), rng.uniform(-10, 10, 1), root_v)
         gap = rng.uniform(0.01, 0.3)
     else:
-        raise ValueError(f"family {family!r} unknown; choose from {', '.join(FAMILIES)}")
+        raise ValueError(f"family {family!r} unknown; choose from {', '.join(ALL_FAMILIES)}")
     ground = model.terrain
     return model, ground, place(model, ground, q, gap), v
 
@@ -469,6 +751,8 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
     e_tol [J], pin [m], depth [m] (>= 0), diverged ('' or the message), audit (dict of counts,
     or None when the engine has no ws.audit), wall [s], failed (list of missed targets).
     """
+    if family in EXTREME_FAMILIES:
+        return run_extreme_case(family, seed, strategy, seconds, max_steps)
     t_start = time.perf_counter()
     model, ground, q0, v0 = build(family, seed)
     dt = model.dt
@@ -492,11 +776,225 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
             out["depth"] = max(0.0, -float(np.min(low)))
     except ps.SimulationDiverged as exc:
         out["diverged"] = str(exc).splitlines()[0][:160]
+        out["raised"] = out["diverged"]
     counts = getattr(sim.ws, "audit", None)
     out["audit"] = None if counts is None else dict(zip(audit_names(len(counts)), (int(c) for c in counts)))
     out["failed"] = [name for name, bad in (
         ("energy", out["gain"] > out["e_tol"]), ("pin", out["pin"] > PIN_TOL),
         ("depth", out["depth"] > DEPTH_TOL), ("diverged", bool(out["diverged"])),
+        ("audit", out["audit"] is not None and sum(out["audit"].values()) > 0)) if bad]
+    out["wall"] = time.perf_counter() - t_start
+    return out
+
+
+def ground_gap(ground, x, y):
+    """Signed distance [m] of the points (x, y) from the ground curve (negative: below). Level
+    and sloped ground: exact. Hills: above the ground, the vertical height times cos(slope)
+    (only its sign matters there); below it, the smallest distance to any of: the ground point
+    straight above, ground_distance's Newton foot point, and 201 ground points sampled within
+    the vertical depth either side. Each is a point of the curve, so the depth given is never
+    below the true one and equals it for the shallow depths a step can leave (Newton's)."""
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    c = ground.coef
+    vert = y - ground.height(x)
+    if int(c[2]) == 0:
+        return vert / math.sqrt(1.0 + c[1] ** 2)
+    out = vert / np.sqrt(1.0 + ground.slope(x) ** 2)
+    below = np.nonzero(vert < 0.0)[0]
+    if len(below):
+        xb, yb, db = x[below], y[below], -vert[below]
+        depth = np.fmin(db, np.abs(ground_distance(ground, xb, yb)))
+        u = np.linspace(-1.0, 1.0, 201)
+        xs = xb[:, None] + db[:, None] * u[None, :]
+        depth = np.fmin(depth, np.min(np.hypot(xs - xb[:, None], ground.height(xs) - yb[:, None]), axis=1))
+        out[below] = -depth
+    return out
+
+
+def contact_clearance(model, q):
+    """(K,) smallest signed distance [m] of any ground contact from the ground over frames q
+    (negative: below): a point contact's point (ground_gap); an arc sole (level ground only)
+    by its lowest point, the circle's bottom when that direction lies inside the sole's span,
+    else its end points, and its fallback vertices."""
+    from planarsim.kernels.codes import CONTACT_ARC, CONTACT_POINT
+    a = model.arrays
+    ground = model.terrain
+    low = np.full(q.shape[0], np.inf)
+    for i in range(model.n_contact):
+        body, kind = int(a.contact_body[i]), int(a.contact_kind[i])
+        if kind == CONTACT_POINT:
+            x, y = world_points(q, body, a.contact_local[i]).T
+            low = np.minimum(low, ground_gap(ground, x, y))
+            continue
+        if kind != CONTACT_ARC or np.any(ground.coef[1:] != 0.0):
+            raise ValueError(f"contact_clearance: contact {model.contact_names[i]!r} of kind {kind} "
+                             "(only points anywhere, arcs on level ground)")
+        r = a.contact_radius[i]
+        a0, a1 = a.contact_span[i]
+        cx, cy = world_points(q, body, a.contact_local[i]).T
+        down = np.mod(-math.pi / 2 - q[:, body, 2] - a0, 2 * math.pi) + a0   # body-frame angle
+        gap = np.where(down <= a1, cy - r, np.inf)
+        pts = [a.contact_local[i] + r * np.array([math.cos(t), math.sin(t)]) for t in (a0, a1)]
+        adr, num = int(a.contact_vert_adr[i]), int(a.contact_vert_num[i])
+        pts += list(a.vert_local[adr:adr + num])
+        for p in pts:
+            gap = np.minimum(gap, world_points(q, body, p)[:, 1])
+        low = np.minimum(low, gap - ground.coef[0])
+    return low
+
+
+def tunnel_depth(model, q, v, mode, dt, samples=128):
+    """Deepest point [m] below the ground of any point mass's path within a step that began
+    and ended clear of the ground with its contact free (mode 0 at both frames) and ended where
+    the plain step puts it (q1 = q0 + h v1, no time-of-impact split): the engine's own path
+    model p(tau) = p0 + tau v0 + tau^2 (v1 - v0) / h (kernels/ccd.py), sampled at `samples`
+    points of the step. A point that crosses a crest and comes out again between two frames,
+    which no frame's depth shows, is a tunnel."""
+    a = model.arrays
+    worst = 0.0
+    tau = np.linspace(0.0, dt, samples)[None, :]
+    for i in range(model.n_contact):
+        body = int(a.contact_body[i])
+        if not model.is_point(body):
+            continue
+        p0, p1, v0, v1 = q[:-1, body, :2], q[1:, body, :2], v[:-1, body, :2], v[1:, body, :2]
+        plain = np.all(np.abs(p1 - (p0 + dt * v1)) <= 1e-9 * (1.0 + np.abs(p1)), axis=1)
+        free = (mode[:-1, i] == 0) & (mode[1:, i] == 0) & plain
+        ks = np.nonzero(free)[0]
+        if not len(ks):
+            continue
+        acc = (v1[ks] - v0[ks]) / dt
+        x = p0[ks, 0, None] + tau * v0[ks, 0, None] + tau * tau * acc[:, 0, None]
+        y = p0[ks, 1, None] + tau * v0[ks, 1, None] + tau * tau * acc[:, 1, None]
+        worst = max(worst, -float(np.min(ground_gap(model.terrain, x.ravel(), y.ravel()))))
+    return max(worst, 0.0)
+
+
+def joint_gap(model, q):
+    """Largest pin opening or rod length error [m] over frames q."""
+    spec = shape_spec("gap", model, 0.0)
+    worst = pin_separation(spec, q) if model.n_pin else 0.0
+    a = model.arrays
+    for j in range(model.n_rod):
+        pa = world_points(q, int(a.rod_body[j, 0]), a.rod_anchor[j, 0])
+        pb = world_points(q, int(a.rod_body[j, 1]), a.rod_anchor[j, 1])
+        worst = max(worst, float(np.max(np.abs(np.hypot(*(pb - pa).T) - a.rod_length[j]))))
+    return worst
+
+
+def motor_work(model, q, u):
+    """(K,) work [J] the pin motors did from frame 0 to each frame: sum over steps and motors
+    of the command times the pin angle's change over the step (the work symplectic Euler's
+    motor impulse does at the step's end velocity)."""
+    a = model.arrays
+    work = np.zeros(q.shape[0])
+    for j in range(model.n_act):
+        pa, pb = (int(x) for x in a.pin_body[int(a.act_ref[j])])
+        rel = q[:, pb, 2] - (q[:, pa, 2] if pa >= 0 else 0.0)
+        work[1:] += u[:q.shape[0] - 1, j] * np.diff(rel)
+    return np.cumsum(work)
+
+
+def motor_speed_ratio(model, spec, q, v, dt):
+    """max over frames of sqrt(E'(t)) / (sqrt(E'(0)) + C t): how far a run's energy above its
+    floor, E' = E - M g y_floor (>= the kinetic energy while no box corner is below the
+    ground), exceeds what the motors can give. A motor's power is at most tau (|omega_a| +
+    |omega_b|) <= tau sqrt(2 E') (I_a^-1/2 + I_b^-1/2), contacts take energy out, pins do no
+    work, so sqrt(E') grows at most at C / 2, C = sum_j sqrt(2) tau_j (I_a^-1/2 + I_b^-1/2)
+    (twice that is allowed here for the discrete steps). Any body's speed is at most
+    sqrt(2 E' / m): a ratio above 1 is a body faster than the motors' torque limits allow."""
+    a = model.arrays
+    c = 0.0
+    for j in range(model.n_act):
+        tau = float(np.max(np.abs(a.act_range[j])))
+        for body in a.pin_body[int(a.act_ref[j])]:
+            if body >= 0:
+                c += math.sqrt(2.0) * tau / math.sqrt(a.body_inertia[body])
+    floor = G * float(spec.mass.sum()) * float(model.terrain.coef[0])
+    above = np.maximum(energy(spec, q, v) - floor, 0.0)
+    t = dt * np.arange(q.shape[0])
+    return float(np.max(np.sqrt(above) / (math.sqrt(above[0]) + c * t + 1e-300)))
+
+
+def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
+    """run_case for EXTREME_FAMILIES: stepped one step at a time (sim.step(u): stiff_motors'
+    commands change every step), so that the frames before an engine error are judged too.
+    Adds to run_case's dict: raised ('' or the planarsim error that stopped the run), speed
+    (fastest body [m/s]), speed_ratio (stiff_motors: motor_speed_ratio; else nan), step_gain
+    (largest single-step energy change beyond the step's own gravity term and the motors'
+    work [J], see the module docstring) at step step_k, and step_note (ranger_loop: whether a
+    sole slid and an ankle left its limit in that step)."""
+    t_start = time.perf_counter()
+    model, ground, q0, v0 = build(family, seed)
+    dt = model.dt
+    steps = min(int(round((SECONDS[family] if seconds is None else seconds) / dt)), max_steps)
+    spec = shape_spec(family, model, steps * dt)
+    u = commands(family, seed, model, steps)
+    sim = ps.Simulator(model, ps.make_options(strategy), ps.make_state(model, q0, v0))
+    e0 = float(energy(spec, q0[None], v0[None])[0])
+    out = dict(family=family, seed=seed, strategy=strategy, dt=dt, steps=steps, e0=e0,
+               e_tol=math.nan if u is not None else energy_bound(spec, ground, q0, v0),
+               gain=math.nan, pin=math.nan, depth=math.nan, diverged="", raised="", speed=math.nan,
+               speed_ratio=math.nan, step_gain=math.nan, step_k=-1, step_note="", tunnel=math.nan,
+               slide_leave_gain=math.nan, slide_leave_k=-1)
+    nb, nc, npin = model.n_body, model.n_contact, model.n_pin
+    q, v = np.empty((steps + 1, nb, 3)), np.empty((steps + 1, nb, 3))
+    mode, limit = np.empty((steps + 1, nc), np.int64), np.empty((steps + 1, npin, 2), np.int64)
+    s = sim.state
+    q[0], v[0], mode[0], limit[0] = s.q, s.v, s.contact_mode, s.limit_active
+    n = steps + 1
+    k = 0
+    try:
+        for k in range(1, steps + 1):
+            sim.step(None if u is None else u[k - 1])
+            s = sim.state
+            q[k], v[k], mode[k], limit[k] = s.q, s.v, s.contact_mode, s.limit_active
+    except Exception as exc:          # an error of the engine's, naming why: raised, not silent
+        if not type(exc).__module__.startswith("planarsim"):
+            raise
+        out["raised"] = out["diverged"] = f"{type(exc).__name__}: {str(exc).splitlines()[0][:160]}"
+        n = k
+    finite = np.all(np.isfinite(q[:n]), axis=(1, 2)) & np.all(np.isfinite(v[:n]), axis=(1, 2))
+    if not finite.all():
+        n = int(np.argmin(finite))
+        out["diverged"] = out["diverged"] or "non-finite state"
+    q, v, mode, limit = q[:n], v[:n], mode[:n], limit[:n]
+    if n >= 1:
+        work = motor_work(model, q, u) if u is not None else np.zeros(n)
+        net = energy(spec, q, v) - e0 - work
+        out["gain"] = float(np.max(net))
+        out["pin"] = joint_gap(model, q)
+        out["depth"] = max(0.0, -float(np.min(contact_clearance(model, q))))
+        if family == "hills_fast" and n >= 2:
+            out["tunnel"] = tunnel_depth(model, q, v, mode, dt)
+        out["speed"] = float(np.max(np.hypot(v[..., 0], v[..., 1])))
+        if u is not None:
+            out["speed_ratio"] = motor_speed_ratio(model, spec, q, v, dt)
+    if n >= 2:
+        py = np.sum(spec.mass * v[..., 1], axis=1)
+        excess = np.diff(net) - 0.5 * dt * G * np.diff(py)
+        k = int(np.argmax(excess))
+        out["step_gain"], out["step_k"] = float(excess[k]), k + 1
+        if family == "ranger_loop":
+            slid = bool(np.any(mode[k + 1] == int(ps.ContactMode.SLIDING)) or
+                        np.any(mode[k] == int(ps.ContactMode.SLIDING)))
+            left = bool(np.any((limit[k] == 1) & (limit[k + 1] == 0)))
+            out["step_note"] = (("slide" if slid else "no slide") + ", " +
+                                ("ankle left its limit" if left else "no limit left"))
+            sliding = np.any(mode == int(ps.ContactMode.SLIDING), axis=1)
+            leaving = np.any((limit[:-1] == 1) & (limit[1:] == 0), axis=(1, 2))
+            both = np.nonzero(leaving & (sliding[1:] | sliding[:-1]))[0]
+            if len(both):
+                j = both[int(np.argmax(excess[both]))]
+                out["slide_leave_gain"], out["slide_leave_k"] = float(excess[j]), int(j) + 1
+    counts = getattr(sim.ws, "audit", None)
+    out["audit"] = None if counts is None else dict(zip(audit_names(len(counts)), (int(c) for c in counts)))
+    out["failed"] = [name for name, bad in (
+        ("energy", out["gain"] > out["e_tol"]), ("step", out["step_gain"] > out["e_tol"]),
+        ("pin", out["pin"] > PIN_TOL), ("depth", out["depth"] > DEPTH_TOL),
+        ("tunnel", out["tunnel"] > DEPTH_TOL), ("speed", out["speed_ratio"] > 1.0),
+        ("diverged", bool(out["diverged"])),
         ("audit", out["audit"] is not None and sum(out["audit"].values()) > 0)) if bad]
     out["wall"] = time.perf_counter() - t_start
     return out
@@ -535,13 +1033,22 @@ def _worst(values):
     return max(values) if values else math.nan
 
 
+def _silent(r):
+    """True when run r misses a target and the engine did not stop it with an error."""
+    return bool(r["failed"]) and not r.get("raised")
+
+
 def report(results, n_worst=8) -> bool:
-    """Print one line per family (runs, runs missing any target, runs above E0 + E_tol, ...)
-    and the worst runs; True when every run meets every target."""
+    """Print one line per family (runs, runs missing any target, runs above E0 + E_tol, runs
+    the engine stopped with an error naming why ('raise') and runs missing a target without
+    one ('silent'), ...), its silent misses by cause, its audit counts by rule, and the worst
+    runs; True when every run meets every target."""
     print(f"targets: energy gained <= E_tol (energy_bound), pin gap <= {PIN_TOL:g} m, depth <= "
-          f"{DEPTH_TOL:g} m, no divergence, no audit violation")
+          f"{DEPTH_TOL:g} m, no divergence, no audit violation"
+          + ("; stiff_motors: no energy target, speed ratio <= 1 (motor_speed_ratio)"
+             if any(r["family"] == "stiff_motors" for r in results) else ""))
     head = (f"{'family':15s} {'runs':>4s} {'miss':>4s} {'>E0':>4s} {'worst gain J (of E0)':>21s} {'pin gap m':>9s} "
-            f"{'depth m':>9s} {'div':>4s} {'audit':>6s}  E_tol [J] (of E0)")
+            f"{'depth m':>9s} {'div':>4s} {'raise':>5s} {'silent':>6s} {'audit':>6s}  E_tol [J] (of E0)")
     print(head)
     print("-" * len(head))
     for family in dict.fromkeys(r["family"] for r in results):
@@ -550,35 +1057,76 @@ def report(results, n_worst=8) -> bool:
         gain = max(rs, key=lambda r: -math.inf if math.isnan(r["gain"]) else r["gain"])
         audits = [r["audit"] for r in rs if r["audit"] is not None]
         audit = "n/a" if not audits else str(sum(sum(a.values()) for a in audits))
-        tol = [r["e_tol"] for r in rs]
-        share = [r["e_tol"] / r["e0"] for r in rs if r["e0"] > 0]
+        tol = [r["e_tol"] for r in rs if not math.isnan(r["e_tol"])]
+        share = [r["e_tol"] / r["e0"] for r in rs if r["e0"] > 0 and not math.isnan(r["e_tol"])]
+        bound = (f"{min(tol):.2g}..{max(tol):.2g} ({min(share):.1g}..{max(share):.1g})" if tol
+                 else "none (motors do work)")
+        silent = [r for r in rs if _silent(r)]
         print(f"{family:15s} {len(rs):4d} {sum(bool(r['failed']) for r in rs):4d} {len(above):4d} "
               f"{gain['gain']:10.3g} ({gain['gain'] / gain['e0']:8.2g}) "
               f"{_worst(r['pin'] for r in rs):9.2g} {_worst(r['depth'] for r in rs):9.2g} "
-              f"{sum(bool(r['diverged']) for r in rs):4d} {audit:>6s}  {min(tol):.2g}..{max(tol):.2g} "
-              f"({min(share):.1g}..{max(share):.1g})")
+              f"{sum(bool(r['diverged']) for r in rs):4d} {sum(bool(r.get('raised')) for r in rs):5d} "
+              f"{len(silent):6d} {audit:>6s}  {bound}")
+        if silent:
+            causes = {c: sum(c in r["failed"] for r in silent)
+                      for c in ("energy", "step", "pin", "depth", "tunnel", "speed", "diverged", "audit")}
+            print(f"{'':15s} silent misses by cause: "
+                  + ", ".join(f"{c if c != 'diverged' else 'non-finite'} {n}" for c, n in causes.items()))
+        raised = [r for r in rs if r.get("raised")]
+        if raised:
+            kinds = {}
+            for r in raised:
+                name = r["raised"].split(":")[0] if family in EXTREME_FAMILIES else "SimulationDiverged"
+                kinds[name] = kinds.get(name, 0) + 1
+            print(f"{'':15s} raised: " + ", ".join(f"{k} {n}" for k, n in kinds.items()))
         if audits:
             kinds = {k: sum(a[k] for a in audits) for k in audits[0]}
             print(f"{'':15s} audit by rule: " + ", ".join(f"{k} {n}" for k, n in kinds.items()))
+        if family in EXTREME_FAMILIES:
+            step = max(rs, key=lambda r: -math.inf if math.isnan(r["step_gain"]) else r["step_gain"])
+            line = (f"worst speed {_worst(r['speed'] for r in rs):.3g} m/s; worst single-step gain "
+                    f"{step['step_gain']:.3g} J ({family}:{step['seed']}:{step['strategy']} step "
+                    f"{step['step_k']})")
+            if family == "stiff_motors":
+                line += f"; worst speed ratio {_worst(r['speed_ratio'] for r in rs):.3g}"
+            if family == "hills_fast":
+                line += f"; worst tunnel {_worst(r['tunnel'] for r in rs):.3g} m"
+            if family == "ranger_loop":
+                both = sorted((r for r in rs if r["slide_leave_gain"] > 0.0),
+                              key=lambda r: -r["slide_leave_gain"] / r["e_tol"])
+                line += (f"\n{'':15s} steps with a sliding sole and an ankle leaving its limit that "
+                         f"gain energy: in {len(both)} runs; the largest gains:" + "".join(
+                             f"\n{'':17s}{r['family']}:{r['seed']}:{r['strategy']} step {r['slide_leave_k']} "
+                             f"gains {r['slide_leave_gain']:.3g} J (E_tol {r['e_tol']:.2g})" for r in both[:4]))
+            print(f"{'':15s} {line}")
     bad = [r for r in results if r["failed"]]
     if bad:
         def badness(r):
             ratios = [r["gain"] / r["e_tol"], r["pin"] / PIN_TOL, r["depth"] / DEPTH_TOL]
             worst = max((x for x in ratios if not math.isnan(x)), default=0.0)
             return bool(r["diverged"]), len(r["failed"]), worst
-        print(f"worst runs (of {len(bad)} missing a target; rerun one with --only family:seed:strategy):")
+        print(f"worst runs (of {len(bad)} missing a target, {sum(_silent(r) for r in bad)} silent; "
+              f"rerun one with --only family:seed:strategy):")
         for r in sorted(bad, key=badness, reverse=True)[:n_worst]:
             audit = "n/a" if r["audit"] is None else {k: n for k, n in r["audit"].items() if n}
+            extra = ""
+            if r["family"] in EXTREME_FAMILIES:
+                extra = f"  speed {r['speed']:.3g} m/s  step gain {r['step_gain']:.3g} J at step {r['step_k']}"
+                if r["step_note"]:
+                    extra += f" ({r['step_note']})"
             print(f"  {r['family']}:{r['seed']}:{r['strategy']}  dt={r['dt']:g} s x {r['steps']}  "
                   f"gain {r['gain']:.3g} J (E_tol {r['e_tol']:.2g})  pin {r['pin']:.2g} m  "
                   f"depth {r['depth']:.2g} m  audit {audit}  misses {'/'.join(r['failed'])}"
+                  + (" RAISED" if r.get("raised") else " SILENT") + extra
                   + (f"  [{r['diverged']}]" if r["diverged"] else ""))
     return not bad
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--families", nargs="+", choices=FAMILIES, default=list(FAMILIES))
+    ap.add_argument("--families", nargs="+", choices=ALL_FAMILIES + ("extremes",), default=list(FAMILIES),
+                    help=f"families to run (default the six of the corpus; 'extremes': "
+                         f"{' '.join(EXTREME_FAMILIES)})")
     ap.add_argument("--runs-per-family", type=int, default=None,
                     help=f"seeds per family (default {RUNS_PER_FAMILY}, {QUICK_RUNS} with --quick)")
     ap.add_argument("--quick", action="store_true", help="a small subset")
@@ -598,12 +1146,14 @@ def main(argv=None) -> int:
         cases = []
         for text in args.only:
             family, seed, strategy = text.split(":")
-            if family not in FAMILIES or strategy not in STRATEGIES:
-                ap.error(f"--only {text!r}: want family:seed:strategy, family in {FAMILIES}, "
+            if family not in ALL_FAMILIES or strategy not in STRATEGIES:
+                ap.error(f"--only {text!r}: want family:seed:strategy, family in {ALL_FAMILIES}, "
                          f"strategy in {STRATEGIES}")
             cases.append((family, int(seed), strategy))
     else:
-        cases = corpus(args.quick, args.families, args.runs_per_family, args.strategy)
+        families = [f for name in args.families
+                    for f in (EXTREME_FAMILIES if name == "extremes" else (name,))]
+        cases = corpus(args.quick, list(dict.fromkeys(families)), args.runs_per_family, args.strategy)
     t0 = time.perf_counter()
     results = run_all(cases, args.seconds, args.jobs)
     wall = time.perf_counter() - t0
