@@ -11,7 +11,7 @@ the memory they would need.
 """
 from .kernels.audit import AUDIT_DEPTH, AUDIT_NAMES, AUDIT_PIN_GAP
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
-from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE_COMMAND
+from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS, GUARD_NONFINITE_COMMAND
 
 
 class ModelError(ValueError):
@@ -120,6 +120,35 @@ def audit_violation(model, ws, who="simulation"):
                           step, t, body_name, rule, value, last, rule, element_name)
 
 
+def _element_name(model, kind, element):
+    """'pin NAME (j)', 'rod NAME (j)' or 'contact NAME (i)' of an audit record."""
+    if kind == AUDIT_PIN_GAP and element < len(model.pin_names):
+        return f"pin {model.pin_names[element]!r} ({element})"
+    if kind == AUDIT_PIN_GAP:
+        rod = element - len(model.pin_names)
+        return f"rod {model.rod_names[rod]!r} ({rod})"
+    return f"contact {model.contact_names[element]!r} ({element})"
+
+
+def gross_violation(model, ws, who="simulation"):
+    """The SimulationDiverged of a step that ended with a pin open, or a contact below the
+    ground or inside another shape, by more than StepOptions.gross_limit (ws.audit_worst)."""
+    step, kind, element, body = (int(x) for x in ws.audit_worst)
+    value = float(ws.audit_worst_value[0])
+    t = float(ws.prev.time[0])
+    body_name = model.body_names[body] if 0 <= body < len(model.body_names) else "-"
+    what = ("is open by" if kind == AUDIT_PIN_GAP
+            else "is below the ground (or inside another shape) by")
+    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    return SimulationDiverged(
+        f"{who} stopped at step {step} (t={t:.6g} s): {_element_name(model, kind, element)} on "
+        f"body {body_name!r} ({body}) {what} {value:.3g} m at the end of the step; the step "
+        f"could not hold it (actuators too stiff, or an impact too violent, for this step "
+        f"size). Take a smaller dt, lower the actuators' limits, or raise "
+        f"StepOptions.gross_limit (0: count it in the audit and go on)",
+        step, t, body_name, AUDIT_NAMES[kind], value, last)
+
+
 def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
@@ -128,6 +157,8 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
     nothing was stepped, give a ValueError instead."""
     if code == GUARD_AUDIT:
         return audit_violation(model, ws, who)
+    if code == GUARD_GROSS:
+        return gross_violation(model, ws, who)
     if code == GUARD_BAD_COMMANDS:
         return ValueError(f"{who}: the commands u have {int(ws.info[INFO_COMMAND])} entries; the model has "
                           f"{len(model.act_names)} actuators {list(model.act_names)}")

@@ -45,6 +45,11 @@ class StepOptions(NamedTuple):
         its cone, positive contact work, a pin open by more than 1e-9 m, a contact deeper than
         1e-8 m, a solve that fell back; kernels/audit.py) into an error naming the step, time,
         contact or pin and body; 0 (default) only counts them in Workspace.audit
+    gross_limit : [m] a pin open or a contact below the ground (or inside another shape) by
+        more than this at the end of a step stops the run at once (SimulationDiverged naming
+        the step, time, pin or contact, body and how far; what to change): the step could
+        not hold it (stiff actuators or a violent impact at this step size), and the run
+        after it would not be physics. 0: never stop (the audit still counts it)
     """
     mode_strategy: int = MODES_ALTERNATING
     refine_iters: int = 4
@@ -54,6 +59,7 @@ class StepOptions(NamedTuple):
     pivot_tol: float = 1e-11
     refine_pivot_tol: float = 1e-7
     audit_raise: int = 0
+    gross_limit: float = 1e-6
     dt: float = 0.0
 
 
@@ -79,6 +85,7 @@ _OPTION_RULES = {
     "pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
     "refine_pivot_tol": (float, lambda x: math.isfinite(x) and 0.0 < x < 1.0, "must be within (0, 1)"),
     "audit_raise": (int, lambda x: x in (0, 1), "must be 0 or 1"),
+    "gross_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0"),
     "dt": (float, lambda x: math.isfinite(x) and 0.0 <= x <= 1.0, "must be 0 (the model's dt) or a step in (0, 1] s"),
 }
 

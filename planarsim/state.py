@@ -277,6 +277,9 @@ class Workspace(NamedTuple):
                                  #   made (kernels/audit.py: AUDIT_NAMES)
     audit_last: np.ndarray       # (4,) int the last violation: step, kind, contact or pin, body
     audit_value: np.ndarray      # (1,) its size (impulse [N s], work [J], gap or depth [m])
+    audit_worst: np.ndarray      # (4,) int the step's largest pin gap or depth violation: step,
+                                 #   kind, pin or contact, body (StepOptions.gross_limit)
+    audit_worst_value: np.ndarray  # (1,) its size [m] (0: none this step)
     lcp_eps: np.ndarray          # (1,) largest diagonal term the complementarity solves of
                                  #   this step added (mixed_lcp.REGULARISATION; scaled units)
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
@@ -370,5 +373,6 @@ def make_workspace(model: Model) -> Workspace:
                      row_island=z(R, np.int64), island_failed=z(nb + 1, np.int64),
                      island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),
                      audit=z(N_AUDIT, np.int64),
-                     audit_last=z(4, np.int64), audit_value=z(1), lcp_eps=z(1),
+                     audit_last=z(4, np.int64), audit_value=z(1),
+                     audit_worst=z(4, np.int64), audit_worst_value=z(1), lcp_eps=z(1),
                      impact_time=z(1), prev=make_state(model))

@@ -78,6 +78,12 @@ def note(ws, step, kind, who, body, value):
     ws.audit_last[2] = who
     ws.audit_last[3] = body
     ws.audit_value[0] = value
+    if (kind == AUDIT_PIN_GAP or kind == AUDIT_DEPTH) and value > ws.audit_worst_value[0]:
+        ws.audit_worst[0] = step
+        ws.audit_worst[1] = kind
+        ws.audit_worst[2] = who
+        ws.audit_worst[3] = body
+        ws.audit_worst_value[0] = value
 
 
 @kernel

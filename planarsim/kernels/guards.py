@@ -8,6 +8,8 @@ GUARD_OK = 0
 GUARD_NONFINITE = 1
 GUARD_TOO_LARGE = 2
 GUARD_AUDIT = 3           # the step broke a rule of its own audit (StepOptions.audit_raise = 1)
+GUARD_GROSS = 4           # a pin open or a contact deep beyond StepOptions.gross_limit at the end
+                          # of the step (ws.audit_worst: which, ws.audit_worst_value: how far)
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[INFO_COMMAND]:
                           # its length); negative, so that no walker's own return code clashes
 GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[INFO_COMMAND]: its index,

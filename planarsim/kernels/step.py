@@ -18,7 +18,7 @@ from .codes import MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import GUARD_AUDIT, check_guards
+from .guards import GUARD_AUDIT, GUARD_GROSS, check_guards
 from .info import INFO_SOLVES, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
@@ -127,6 +127,7 @@ def _step(m, s, ws, opt, u):
     for k in STEP_COUNTS:
         ws.info[k] = 0
     ws.lcp_eps[0] = 0.0
+    ws.audit_worst_value[0] = 0.0
     audited = audit_total(ws)
     for k in range(ws.n_live[0]):
         ws.contact_new[ws.live[k]] = 0
@@ -153,6 +154,8 @@ def _step(m, s, ws, opt, u):
     if m.contact_body.shape[0] > 0:
         s.mode_cursor[0] = (s.mode_cursor[0] + 1) % m.contact_body.shape[0]
     code = check_guards(s, ws, opt.guard_limit)
+    if code == 0 and opt.gross_limit > 0.0 and ws.audit_worst_value[0] > opt.gross_limit:
+        return GUARD_GROSS
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
     return code
