@@ -11,13 +11,16 @@ amps = st.lists(st.floats(0.0, 0.3), min_size=0, max_size=3)
 
 
 @st.composite
-def terrains(draw):
-    n = draw(st.integers(0, 3))
-    a = [draw(st.floats(0.0, 0.3)) for _ in range(n)]
-    lam = [draw(st.floats(0.5, 10.0)) for _ in range(n)]
+def terrains(draw, sines=(0, 3), amplitude=(0.0, 0.3), wavelength=(0.5, 10.0), grade=0.3,
+             height=1.0):
+    """Hills of `sines` sines (amplitudes, wavelengths in the given ranges [m]) on a grade
+    within +-grade, at a height within +-height [m]."""
+    n = draw(st.integers(*sines))
+    a = [draw(st.floats(*amplitude)) for _ in range(n)]
+    lam = [draw(st.floats(*wavelength)) for _ in range(n)]
     phi = [draw(st.floats(-math.pi, math.pi)) for _ in range(n)]
-    grade = draw(st.floats(-0.3, 0.3))
-    return terrain.hills(a, lam, phi, grade=grade, height=draw(st.floats(-1, 1)))
+    return terrain.hills(a, lam, phi, grade=draw(st.floats(-grade, grade)),
+                         height=draw(st.floats(-height, height)))
 
 
 @settings(max_examples=200, deadline=None)
@@ -76,14 +79,10 @@ def test_default_hills_meet_the_seed_claim():
     assert np.ptp(t.height(x)) > 0.3
 
 
-@st.composite
-def tight_hills(draw):
+def tight_hills():
     """Steep, tight hills: wavelengths 0.1-2 m, amplitudes 0.05-0.4 m (slopes to ~25, 87 deg)."""
-    n = draw(st.integers(1, 3))
-    a = [draw(st.floats(0.05, 0.4)) for _ in range(n)]
-    lam = [draw(st.floats(0.1, 2.0)) for _ in range(n)]
-    phi = [draw(st.floats(-math.pi, math.pi)) for _ in range(n)]
-    return terrain.hills(a, lam, phi)
+    return terrains(sines=(1, 3), amplitude=(0.05, 0.4), wavelength=(0.1, 2.0), grade=0.0,
+                    height=0.0)
 
 
 @settings(max_examples=300, deadline=None)
