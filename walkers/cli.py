@@ -591,6 +591,8 @@ def main(argv=None) -> int:
     program = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     stdout = sys.stdout
+    if program:
+        _exit_on_interrupt(argv, stdout)
     try:
         code = _serve(argv, stdout)
     except KeyboardInterrupt:
@@ -602,6 +604,19 @@ def main(argv=None) -> int:
 
 
 INTERRUPTED = 130       # the exit code of a command ended by Ctrl-C (128 + SIGINT)
+
+
+def _exit_on_interrupt(argv, stdout) -> None:
+    """As the program: Ctrl-C writes its one line and ends the process at once, from wherever
+    it lands. A KeyboardInterrupt raised inside a callback from compiled code (numba's
+    compiler calls Python back through ctypes) would be printed and swallowed there, and the
+    command would go on."""
+    import signal
+
+    def handler(signum, frame):
+        _interrupted(argv, stdout, True)
+        os._exit(INTERRUPTED)
+    signal.signal(signal.SIGINT, handler)
 
 
 def _interrupted(argv, stdout, program) -> int:
