@@ -147,12 +147,15 @@ def box_piles(piles=5, n=10, dt=1e-3):
     return b.compile()
 
 
-def box_drop(dt=1e-3):
-    """Ten boxes dropped from 0.5-2.75 m, tilted and offset, onto each other and the ground."""
+def box_drop(dt=1e-3, piles=1):
+    """Ten boxes dropped from 0.5-2.75 m, tilted and offset, onto each other and the ground;
+    `piles` such drops 3 m apart (separate islands)."""
     b = ps.ModelBuilder(dt=dt)
-    for k in range(10):
-        _box(b, f"box{k}", 0.07 * ((k * 37) % 7 - 3), 0.5 + 0.25 * k,
-             angle=0.3 * ((k * 53) % 5 - 2))
+    for p in range(piles):
+        for k in range(10):
+            name = f"box{k}" if piles == 1 else f"box{p}_{k}"
+            _box(b, name, 3.0 * p + 0.07 * ((k * 37) % 7 - 3), 0.5 + 0.25 * k,
+                 angle=0.3 * ((k * 53) % 5 - 2))
     return b.compile()
 
 
@@ -164,4 +167,5 @@ SCENES.update({
     "box_pyramid": (box_pyramid, 1000),
     "box_piles": (box_piles, 1000),
     "box_drop": (box_drop, 2000),
+    "box_drops5": (lambda: box_drop(piles=5), 2000),
 })
