@@ -274,3 +274,26 @@ def test_rotor_inertia_on_foot():
     i_without = foot_inertia_com(RangerParams(rotor_on_foot=0.0))
     assert abs(i_with - i_without - 34 ** 2 * 1.6e-6) < 1e-12
     assert T.N_PROG == len(T.Program)
+
+
+def test_a_gait_that_falls_going_backwards_has_no_negative_cost_of_transport():
+    """Parameters a tuner found when energy over whole steps that went backwards counted as a
+    negative cost of transport (-23): the gait falls after 0.7 m. Its cost of transport is
+    none (nan), and the tuning objective scores it below the default gait."""
+    import dataclasses
+    import math
+
+    from walkers.ranger.objective import evaluate
+    from walkers.ranger.params import RangerParams
+    from walkers.ranger.rollout import simulate
+    exploit = dataclasses.replace(
+        RangerParams(), hold_kp=26.699653533315313, hold_kd=0.059409676925623794,
+        hip_kp=24.094411216302234, hip_kd=1.513264352804669, scissor_gain=1.0276643049320275,
+        scissor_offset=0.11656512424465526, land_angle=-0.06407713145947247,
+        land_leg_angle=0.3113702793948107, push_leg_angle=0.012177812876523642,
+        push_current=3.3330209815304013, push_gain=19.448881232657033,
+        target_speed=0.4382490559121427, air_omega=31.275424778571782, air_zeta=0.5192561354882955)
+    _, summary, _ = simulate(10.0, gait="walk", params=exploit, record_every=1000)
+    for key in ("cost_of_transport", "cost_of_transport_electrical"):
+        assert math.isnan(summary[key]) or summary[key] >= 0.0, (key, summary[key])
+    assert evaluate(exploit)["score"] < evaluate(RangerParams())["score"]

@@ -122,12 +122,16 @@ class RangerSim(WalkerRun):
             d = log[last, 1] - log[first, 1]
             dt = log[last, 0] - log[first, 0]
             e = log[last, 2:6] - log[first, 2:6]
+            # a cost of transport is per distance travelled forward: none (nan) for whole
+            # steps that went nowhere or backwards (energy over a negative distance would read
+            # as a negative cost, and a tuner would take it for a gain)
+            per = weight * d if d > 0.0 else float("nan")
             out.update(step_speed=d / dt, step_length=d / (last - first), step_period=dt / (last - first),
-                       cost_of_transport_electrical=e[0] / (weight * d),
-                       cost_of_transport=(e[0] + p.overhead_power * dt) / (weight * d),
-                       cost_of_transport_electrical_net=e[1] / (weight * d),
-                       cost_of_transport_mechanical=e[2] / (weight * d),
-                       cost_of_transport_mechanical_net=e[3] / (weight * d),
+                       cost_of_transport_electrical=e[0] / per,
+                       cost_of_transport=(e[0] + p.overhead_power * dt) / per,
+                       cost_of_transport_electrical_net=e[1] / per,
+                       cost_of_transport_mechanical=e[2] / per,
+                       cost_of_transport_mechanical_net=e[3] / per,
                        push_current_mean=float(log[first:last + 1, 6].mean()))
         else:
             out.update({key: float("nan") for key in (
