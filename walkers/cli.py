@@ -120,6 +120,21 @@ def cmd_list(args):
     return 0
 
 
+def _params_path(given, mod):
+    """The file of --params: a path, or the name of a set shipped beside the walker's module
+    (walkers/<walker>/<name>.json, e.g. ranger's 'efficient')."""
+    from pathlib import Path
+    path = Path(given)
+    if path.suffix != ".json" and not path.exists():
+        shipped = Path(mod.__file__).resolve().parent / f"{given}.json"
+        if shipped.exists():
+            return shipped
+        names = sorted(p.stem for p in shipped.parent.glob("*.json"))
+        raise ValueError(f"--params {given}: no such file, nor a parameter set of this walker "
+                         f"(its sets: {', '.join(names) or 'none'})")
+    return path
+
+
 def cmd_run(args):
     from planarsim import terrain as T
     t_load = time.perf_counter()
@@ -275,7 +290,7 @@ def _walker_params(mod, args) -> dict:
     from walkers.common.params import load_values, parse_assignments
     changed = {}
     if args.params:
-        changed.update(load_values(args.params, mod.Params))
+        changed.update(load_values(_params_path(args.params, mod), mod.Params))
     changed.update(parse_assignments(args.set or (), mod.Params))
     defaults = mod.Params().as_dict()
     return {k: v for k, v in changed.items() if v != defaults[k]}
@@ -505,9 +520,10 @@ def make_parser():
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help="change a walker parameter (repeatable; see 'planarsim params WALKER')")
-    p.add_argument("--params", default=None, metavar="FILE.json",
+    p.add_argument("--params", default=None, metavar="FILE.json|NAME",
                    help="walker parameters from a file: a 'planarsim tune' result or "
-                        "{\"name\": value, ...} (--set wins over it)")
+                        "{\"name\": value, ...}, or a set shipped with the walker by name "
+                        "(ranger: efficient) (--set wins over it)")
     p.set_defaults(func=cmd_run)
     p = sub.add_parser("params", help="a walker's parameters: units, bounds, defaults")
     p.add_argument("walker", help="walker name (see 'planarsim list')")

@@ -297,3 +297,22 @@ def test_a_gait_that_falls_going_backwards_has_no_negative_cost_of_transport():
     for key in ("cost_of_transport", "cost_of_transport_electrical"):
         assert math.isnan(summary[key]) or summary[key] >= 0.0, (key, summary[key])
     assert evaluate(exploit)["score"] < evaluate(RangerParams())["score"]
+
+
+def test_the_efficient_set_walks_further_for_less():
+    """The shipped parameter set 'efficient' (planarsim run ranger --params efficient): 20 s
+    on flat ground without a fall, at >= 0.4 m/s, at a lower electrical cost of transport
+    than the default gait's."""
+    import dataclasses
+    from pathlib import Path
+
+    import walkers.ranger as ranger
+    from walkers.common.params import load_values
+    from walkers.ranger.params import RangerParams
+    from walkers.ranger.rollout import simulate
+    values = load_values(Path(ranger.__file__).parent / "efficient.json", RangerParams)
+    _, tuned, _ = simulate(20.0, gait="walk", params=dataclasses.replace(RangerParams(), **values),
+                           record_every=1000)
+    _, default, _ = simulate(20.0, gait="walk", record_every=1000)
+    assert not tuned["fell"] and tuned["mean_speed"] >= 0.4
+    assert tuned["cost_of_transport_electrical"] < 0.8 * default["cost_of_transport_electrical"]

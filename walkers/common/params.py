@@ -158,6 +158,8 @@ def load_values(path, cls) -> dict:
     path = Path(path)
     try:
         data = json.loads(path.read_text())
+        if isinstance(data, dict):
+            data = {k: v for k, v in data.items() if not k.startswith("_")}   # "_about" notes
     except OSError as e:
         raise ValueError(f"--params {path}: cannot read it ({e.strerror or e})") from None
     except json.JSONDecodeError as e:
