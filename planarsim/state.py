@@ -228,6 +228,7 @@ class Workspace(NamedTuple):
     live: np.ndarray             # (n_contact,) int the contacts a step visits, ascending:
                                  #   the ground contacts and both slots of each listed pair
     n_live: np.ndarray           # (1,) int contacts listed
+    near_contacts: np.ndarray    # (n_contact,) int scratch list of contacts (the projection's)
     row_body: np.ndarray         # (R, 2) int
     row_J: np.ndarray            # (R, 2, 3)
     row_F: np.ndarray            # (R, 2, 3)
@@ -332,7 +333,8 @@ def _broad_phase_lists(model: Model) -> dict:
                 last_pairs=np.array(pair_slot0, np.int64).reshape(n_pair),
                 n_live_pairs=np.array([n_pair], np.int64),
                 sweep_pairs=np.zeros(n_pair, np.int64), pair_flag=np.zeros(nc, np.int64),
-                ground_contacts=ground, live=live, n_live=np.array([nc], np.int64))
+                ground_contacts=ground, live=live, n_live=np.array([nc], np.int64),
+                near_contacts=np.zeros(nc, np.int64))
 
 
 def make_workspace(model: Model) -> Workspace:

@@ -366,7 +366,6 @@ def audit_positions(m, s, ws, step):
     return found
 
 
-
 def audit_counts(ws) -> dict:
     """{rule: violations counted} of a workspace (Python side; for summaries)."""
     return {name: int(ws.audit[k]) for k, name in enumerate(AUDIT_NAMES)}

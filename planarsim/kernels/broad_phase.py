@@ -97,24 +97,23 @@ def sweep_pairs(ws, margin, h, out):
 
 
 @kernel
-def _merge_live(ws, n_pairs):
-    """ws.live <- the ground contacts and both slots of each listed pair, ascending."""
-    ground = ws.ground_contacts
-    pairs = ws.live_pairs
+def merge_contacts(ground, pairs, n_pairs, out):
+    """out <- the ground contacts (ascending) and both slots of pairs[:n_pairs] (slot-0
+    contacts, ascending), merged in ascending order; returns how many."""
     n = 0
     g = 0
     p = 0
     while g < ground.shape[0] or p < n_pairs:
         if p >= n_pairs or (g < ground.shape[0] and ground[g] < pairs[p]):
-            ws.live[n] = ground[g]
+            out[n] = ground[g]
             n += 1
             g += 1
         else:
-            ws.live[n] = pairs[p]
-            ws.live[n + 1] = pairs[p] + 1
+            out[n] = pairs[p]
+            out[n + 1] = pairs[p] + 1
             n += 2
             p += 1
-    ws.n_live[0] = n
+    return n
 
 
 @kernel_call
@@ -141,5 +140,5 @@ def update_live(m, s, ws, margin, h):
     for k in range(n):
         ws.last_pairs[k] = ws.live_pairs[k]
     ws.n_live_pairs[0] = n
-    _merge_live(ws, n)
+    ws.n_live[0] = merge_contacts(ws.ground_contacts, ws.live_pairs, n, ws.live)
     return n

@@ -13,7 +13,7 @@ import math
 from ._jit import kernel
 from .codes import MODE_FREE
 from .info import INFO_CCD_SPLITS
-from .terrain import TWO_PI, ground_point_call, height_derivs, max_curvature
+from .terrain import ground_point_call, height_derivs, max_curvature, max_slope
 
 N_SAMPLES = 8
 # [m] per metre of coordinates: a path whose height above the ground falls this low while it
@@ -59,9 +59,7 @@ def _impact_on_hills(m, s, ws, b, h):
     vy = s.v[b, 1]
     ax = (ws.v_new[b, 0] - vx) / h
     ay = (ws.v_new[b, 1] - vy) / h
-    slope = abs(coef[1])
-    for k in range(int(coef[2])):
-        slope += abs(coef[3 + 3 * k]) * TWO_PI / coef[4 + 3 * k]
+    slope = max_slope(coef)
     speed_x = abs(vx) + 2.0 * h * abs(ax)
     bound = 2.0 * abs(ay) + max_curvature(coef) * speed_x * speed_x + 2.0 * slope * abs(ax)
     t = 0.0

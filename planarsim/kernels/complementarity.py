@@ -24,7 +24,7 @@ from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
 from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
 from .contacts import query_contact
-from .broad_phase import sweep_pairs
+from .broad_phase import merge_contacts, sweep_pairs
 from .pair import PAIR_MARGIN, find_pair, place_shapes
 from .islands import group_rows
 from .lcp import LCP_SOLVED
@@ -34,8 +34,8 @@ from .modes import engage_contacts, engage_limits, gather_contact_impulses, mode
 from .limit import add_limit_rows
 from .pin import add_pin_rows
 from .rod import add_rod_row
-from .rows import (add_contact_rows, build_rows, eval_rows, is_joint_row, is_tangent_row,
-                   move_row)
+from .row_list import move_row
+from .rows import add_contact_rows, build_rows, eval_rows, is_joint_row, is_tangent_row
 from .solve import apply_impulses, fill_row_b
 
 # Lemke's path is finite; the cap only stops a path that rounding has sent astray
@@ -240,17 +240,8 @@ def _projection_rows(m, s, ws, h):
             if s.contact_enabled[i] == 1:
                 find_pair(m, s, ws, i, h, PROJECTION_MARGIN, True)
     # in the contacts' order: the ground contacts and the slots of the pairs within reach
-    ground = ws.ground_contacts
-    g = 0
-    p = 0
-    while g < ground.shape[0] or p < n_near:
-        if p >= n_near or (g < ground.shape[0] and ground[g] < ws.sweep_pairs[p]):
-            n = _projection_contact(m, s, ws, n, ground[g])
-            g += 1
-        else:
-            n = _projection_contact(m, s, ws, n, ws.sweep_pairs[p])
-            n = _projection_contact(m, s, ws, n, ws.sweep_pairs[p] + 1)
-            p += 1
+    for k in range(merge_contacts(ws.ground_contacts, ws.sweep_pairs, n_near, ws.near_contacts)):
+        n = _projection_contact(m, s, ws, n, ws.near_contacts[k])
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     return n

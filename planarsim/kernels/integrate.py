@@ -21,8 +21,9 @@ from .codes import MODE_FREE, MODE_PINNED
 from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
 from .limit import limit_side
+from .row_list import move_row
 from .rows import (eval_rows, is_contact_row, is_limit_row, is_normal_row, is_tangent_row,
-                   is_unilateral, move_row, row_lever)
+                   is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 
 

@@ -51,8 +51,6 @@ def assemble_dense(m, ws, rows, start, count):
             ws.A[rj, ri] = a
 
 
-
-
 @kernel
 def _factor_joints(B, nb):
     """B = L D L^T in place (dense, lower triangle and diagonal); rows of a joint-only loop

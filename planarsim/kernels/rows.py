@@ -35,7 +35,7 @@ from .math2d import set_dir, world_point
 from .pair import pair_row
 from .pin import add_pin_rows, pin_axis, pin_lever, pin_row, pin_rows
 from .rod import add_rod_row, rod_row
-from .row_list import add_row, move_row  # noqa: F401  (move_row: re-exported)
+from .row_list import add_row
 
 
 @kernel
