@@ -102,22 +102,19 @@ def audit_violation(model, ws, who="simulation"):
     step, kind, element, body = (int(x) for x in ws.audit_last)
     rule = AUDIT_NAMES[kind]
     value = float(ws.audit_value[0])
-    if kind == AUDIT_PIN_GAP and element < len(model.pin_names):
-        element_name = f"pin {model.pin_names[element]!r} ({element})"
-    elif kind == AUDIT_PIN_GAP:
-        rod = element - len(model.pin_names)
-        element_name = f"rod {model.rod_names[rod]!r} ({rod})"
-    elif kind <= AUDIT_DEPTH:
-        element_name = f"contact {model.contact_names[element]!r} ({element})"
-    else:
-        element_name = "contacts"
-    body_name = model.body_names[body] if 0 <= body < len(model.body_names) else "-"
+    element_name = _element_name(model, kind, element) if kind <= AUDIT_DEPTH else "contacts"
+    body_name = _body_name(model, body)
     t = float(ws.prev.time[0])
     last = type(ws.prev)(*(a.copy() for a in ws.prev))
     return AuditViolation(f"{who}: audit at step {step} (t={t:.6g} s): "
                           f"{_AUDIT_TEXT[rule].format(v=value)}; {element_name} on body "
                           f"{body_name!r} ({body}); all counts {dict(zip(AUDIT_NAMES, ws.audit.tolist()))}",
                           step, t, body_name, rule, value, last, rule, element_name)
+
+
+def _body_name(model, body) -> str:
+    """A body's name, or '-' for the world (-1)."""
+    return model.body_names[body] if 0 <= body < len(model.body_names) else "-"
 
 
 def _element_name(model, kind, element):
@@ -136,7 +133,7 @@ def gross_violation(model, ws, who="simulation"):
     step, kind, element, body = (int(x) for x in ws.audit_worst)
     value = float(ws.audit_worst_value[0])
     t = float(ws.prev.time[0])
-    body_name = model.body_names[body] if 0 <= body < len(model.body_names) else "-"
+    body_name = _body_name(model, body)
     what = ("is open by" if kind == AUDIT_PIN_GAP
             else "is below the ground (or inside another shape) by")
     last = type(ws.prev)(*(a.copy() for a in ws.prev))

@@ -81,18 +81,25 @@ def contact_depths(model, q, enabled=None) -> list:
     return out
 
 
-def check_start(model, state, tolerance: float = START_TOLERANCE, who: str = "simulator") -> None:
-    """ModelError naming the deepest contact that starts more than `tolerance` [m] below the
-    ground at `state` (its body, depth and x), else nothing."""
+def below_ground(model, state, tolerance: float = START_TOLERANCE, who: str = "simulator"):
+    """(how many contacts start more than `tolerance` [m] below the ground at `state`, a
+    sentence naming the deepest: its body, depth and x; '' when none)."""
     deep = [c for c in contact_depths(model, state.q, state.contact_enabled) if c[1] > tolerance]
     if not deep:
-        return
+        return 0, ""
     i, depth, x = max(deep, key=lambda c: c[1])
     b = int(model.arrays.contact_body[i])
     more = len(deep) - 1
     others = f" (and {more} more contact{'s' if more > 1 else ''})" if more else ""
-    raise ModelError(
-        f"{who}: contact {model.contact_names[i]!r} ({i}) of body {model.body_names[b]!r} ({b}) "
-        f"starts {depth:.4g} m below the ground at x={x:.4g} m{others}, more than "
-        f"{tolerance:g} m; the first step would move it to the surface. Build the body higher "
-        f"(its pos), or pass allow_below_ground=True to start it there")
+    return len(deep), (f"{who}: contact {model.contact_names[i]!r} ({i}) of body "
+                       f"{model.body_names[b]!r} ({b}) starts {depth:.4g} m below the ground at "
+                       f"x={x:.4g} m{others}, more than {tolerance:g} m")
+
+
+def check_start(model, state, tolerance: float = START_TOLERANCE, who: str = "simulator") -> None:
+    """ModelError naming the deepest contact that starts more than `tolerance` [m] below the
+    ground at `state` (its body, depth and x), else nothing."""
+    count, said = below_ground(model, state, tolerance, who)
+    if count:
+        raise ModelError(f"{said}; the first step would move it to the surface. Build the body "
+                         f"higher (its pos), or pass allow_below_ground=True to start it there")

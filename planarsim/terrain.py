@@ -115,8 +115,11 @@ def _hills_name(a, lam, phi, grade, height) -> str:
     """hills:A,L,PHI;... with every coefficient (exact, parse reads it back), then the grade
     and height when they are not 0 (which the spec cannot hold)."""
     name = "hills:" + ";".join(f"{_num(x)},{_num(y)},{_num(z)}" for x, y, z in zip(a, lam, phi))
-    extra = [f"grade {_num(grade)}" for _ in [0] if grade != 0.0]
-    extra += [f"height {_num(height)} m" for _ in [0] if height != 0.0]
+    extra = []
+    if grade != 0.0:
+        extra.append(f"grade {_num(grade)}")
+    if height != 0.0:
+        extra.append(f"height {_num(height)} m")
     return name + (f" ({', '.join(extra)})" if extra else "")
 
 

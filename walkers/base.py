@@ -203,16 +203,12 @@ class WalkerRun:
         the deepest) and counted in the summary's audit as ``start_below_ground``."""
         import warnings
 
-        from planarsim.start_check import START_TOLERANCE, check_start, contact_depths
-        deep = [c for c in contact_depths(self.model, self.state.q, self.state.contact_enabled)
-                if c[1] > START_TOLERANCE]
-        if deep:
-            try:
-                check_start(self.model, self.state, who=self.NAME)
-            except ValueError as e:
-                warnings.warn(str(e).split("; the first step")[0] + "; the first step moves it "
-                              "to the surface (counted as audit start_below_ground)", stacklevel=3)
-        return len(deep)
+        from planarsim.start_check import below_ground
+        count, said = below_ground(self.model, self.state, who=self.NAME)
+        if count:
+            warnings.warn(f"{said}; the first step moves it to the surface (counted as audit "
+                          f"start_below_ground)", stacklevel=3)
+        return count
 
     def summary(self) -> dict:
         """The walker's numbers (numbers()) and `audit`, the engine's audit counts plus

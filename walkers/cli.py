@@ -123,7 +123,6 @@ def cmd_list(args):
 def _params_path(given, mod):
     """The file of --params: a path, or the name of a set shipped beside the walker's module
     (walkers/<walker>/<name>.json, e.g. ranger's 'efficient')."""
-    from pathlib import Path
     path = Path(given)
     if path.suffix != ".json" and not path.exists():
         shipped = Path(mod.__file__).resolve().parent / f"{given}.json"
