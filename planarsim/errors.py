@@ -9,7 +9,8 @@ its own audit (kernels/audit.py); it names the step, time, rule, contact or pin 
 machine's memory (a duration far too long for its frame interval); it names the frames and
 the memory they would need.
 """
-from .kernels.audit import AUDIT_DEPTH, AUDIT_NAMES, AUDIT_PIN_GAP
+from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_WORK,
+                            AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS, GUARD_NONFINITE_COMMAND
 
@@ -94,6 +95,10 @@ _AUDIT_TEXT = {
     "depth": "a contact is {v:.3g} m below the ground",
     "fallback": "the contact solve with friction found no answer: solved without friction",
     "unsolved": "the contact solve found no consistent answer",
+    "joint_work": "joint impulses added {v:.3g} J beyond their second-order share, even as "
+                  "a projection (J v = 0)",
+    "limit_work": "a joint limit's impulse does positive work ({v:.3g} J)",
+    "correction_work": "the position correction added {v:.3g} J beyond its allowance",
 }
 
 
@@ -102,7 +107,7 @@ def audit_violation(model, ws, who="simulation"):
     step, kind, element, body = (int(x) for x in ws.audit_last)
     rule = AUDIT_NAMES[kind]
     value = float(ws.audit_value[0])
-    element_name = _element_name(model, kind, element) if kind <= AUDIT_DEPTH else "contacts"
+    element_name = _element_name(model, kind, element)
     body_name = _body_name(model, body)
     t = float(ws.prev.time[0])
     last = type(ws.prev)(*(a.copy() for a in ws.prev))
@@ -118,12 +123,17 @@ def _body_name(model, body) -> str:
 
 
 def _element_name(model, kind, element):
-    """'pin NAME (j)', 'rod NAME (j)' or 'contact NAME (i)' of an audit record."""
-    if kind == AUDIT_PIN_GAP and element < len(model.pin_names):
+    """'pin NAME (j)', 'rod NAME (j)', 'contact NAME (i)' or what else an audit record of rule
+    `kind` names."""
+    if kind in (AUDIT_PIN_GAP, AUDIT_JOINT_WORK, AUDIT_LIMIT_WORK) and element < len(model.pin_names):
         return f"pin {model.pin_names[element]!r} ({element})"
-    if kind == AUDIT_PIN_GAP:
+    if kind in (AUDIT_PIN_GAP, AUDIT_JOINT_WORK):
         rod = element - len(model.pin_names)
         return f"rod {model.rod_names[rod]!r} ({rod})"
+    if kind == AUDIT_CORRECTION_WORK:
+        return "the position correction"
+    if kind in (AUDIT_FALLBACK, AUDIT_UNSOLVED) or element < 0:
+        return "contacts"
     return f"contact {model.contact_names[element]!r} ({element})"
 
 

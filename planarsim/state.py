@@ -182,6 +182,8 @@ class Workspace(NamedTuple):
     v_keep: np.ndarray           #   correction (put back if the step diverges)
     dq_correction: np.ndarray    # (n_body, 3) a position correction's move [m, rad] (Newton, projection)
     dv_correction: np.ndarray    # (n_body, 3) its change of velocity [m/s, rad/s] (joints: move / h)
+    q_solved: np.ndarray         # (n_body, 3) q integrated with v_solved, before the position
+                                 #   correction (its work is measured from here)
     v_solved: np.ndarray         # (n_body, 3) velocity the contact solve ended at, before the
                                  #   position correction changed it (bound_correction_work)
     contact_point: np.ndarray    # (n_contact, 2) world contact point [m]
@@ -281,6 +283,8 @@ class Workspace(NamedTuple):
     audit_worst: np.ndarray      # (4,) int the step's largest pin gap or depth violation: step,
                                  #   kind, pin or contact, body (StepOptions.gross_limit)
     audit_worst_value: np.ndarray  # (1,) its size [m] (0: none this step)
+    first_order: np.ndarray      # (1,) int 1: this step's joint rows aim at J v = 0 (a
+                                 #   projection) after the second-order target added energy
     lcp_eps: np.ndarray          # (1,) largest diagonal term the complementarity solves of
                                  #   this step added (mixed_lcp.REGULARISATION; scaled units)
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
@@ -348,7 +352,8 @@ def make_workspace(model: Model) -> Workspace:
                      row_reach=z(R, np.int64), v_pred=z((nb, 3)), v_new=z((nb, 3)),
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),
-                     v_solved=z((nb, 3)), contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
+                     q_solved=z((nb, 3)), v_solved=z((nb, 3)),
+                     contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_stale=z(nc, np.int64),
                      contact_found=np.full((nc, 4), -np.inf), contact_anchor=z((nc, 2)),
                      contact_impulse=z((nc, 2)), contact_held=z(nc, np.int64), contact_on_arc=z(nc, np.int64),
@@ -376,5 +381,6 @@ def make_workspace(model: Model) -> Workspace:
                      island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),
                      audit=z(N_AUDIT, np.int64),
                      audit_last=z(4, np.int64), audit_value=z(1),
-                     audit_worst=z(4, np.int64), audit_worst_value=z(1), lcp_eps=z(1),
+                     audit_worst=z(4, np.int64), audit_worst_value=z(1), first_order=z(1, np.int64),
+                     lcp_eps=z(1),
                      impact_time=z(1), prev=make_state(model))

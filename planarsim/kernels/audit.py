@@ -9,10 +9,17 @@ After the velocity stage (impulses as applied):
             (lambda_n v_n + lambda_t v_t > 0: it would add energy) beyond rounding: more
             than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR), |v| the contact's speed, free
             and constrained, and the fastest body's
+  joint_work  the pins' and rods' impulses add more kinetic energy than their second-order
+            terms may (kernels/work.py: CONSTRAINT_SHARE of KE(v*)), even after the step
+            aimed them at J v = 0 (the step's own remedy, kernels/step.py)
+  limit_work  a joint limit's impulse does positive work at the end velocity beyond rounding
 After the position stage (the configuration the step ends at):
   pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
   depth     a contact point below the ground, or two shapes overlapping, by more than
             DEPTH_TOL
+  correction_work  the position correction or projection added energy (kinetic, less the
+            applied forces' work along its move) beyond what bound_correction_work allows
+            (kernels/integrate.py): rounding only, once it has bounded its velocity change
 And of the solver itself:
   fallback  the complementarity solve with friction found no answer and the frictionless
             rule was used (it can only remove energy)
@@ -26,13 +33,14 @@ import math
 
 from ._jit import kernel
 from .info import INFO_CCD_SPLITS
-from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
+from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, ROW_ROD
 from .contacts import contact_velocity, edge_deepest, point_reach, sole_facing
 from .math2d import world_point
 from .broad_phase import sweep_pairs
 from .pair import pair_gap_now, place_shapes
-from .rows import is_normal_row
+from .rows import is_limit_row, is_normal_row
 from .terrain import ground_point
+from .work import VELOCITY_FLOOR, WORK_REL_TOL, fastest, joints_add_energy, limit_work
 
 AUDIT_PULL = 0
 AUDIT_CONE = 1
@@ -41,8 +49,12 @@ AUDIT_PIN_GAP = 3
 AUDIT_DEPTH = 4
 AUDIT_FALLBACK = 5
 AUDIT_UNSOLVED = 6
-N_AUDIT = 7
-AUDIT_NAMES = ("pull", "cone", "work", "pin_gap", "depth", "fallback", "unsolved")
+AUDIT_JOINT_WORK = 7
+AUDIT_LIMIT_WORK = 8
+AUDIT_CORRECTION_WORK = 9
+N_AUDIT = 10
+AUDIT_NAMES = ("pull", "cone", "work", "pin_gap", "depth", "fallback", "unsolved",
+               "joint_work", "limit_work", "correction_work")
 
 PIN_GAP_TOL = 1e-9       # [m]
 DEPTH_TOL = 1e-8         # [m]
@@ -52,12 +64,6 @@ IMPULSE_REL_TOL = 1e-8
 # statically indeterminate contact (a box resting on two boxes) carries none, and the solve
 # leaves it about 1e-16 of the load, of either sign
 IMPULSE_FLOOR = 1e-10
-WORK_REL_TOL = 1e-7      # the accuracy the complementarity solve accepts (lcp.ANSWER_TOL)
-# [m/s] a contact velocity this small is the solve's rounding, not motion: it moves a point by
-# 1e-8 h m in a step, a hundredth of DEPTH_TOL or less (h <= 1e-2 s), below what the position
-# audit can see; the complementarity solve of a resting 16-box chain (condition 3e9) leaves
-# velocities of 3e-9 m/s
-VELOCITY_FLOOR = 1e-8
 
 
 @kernel
@@ -145,6 +151,38 @@ def audit_impulses(m, s, ws):
                        + max(floor, 0.0) * (abs(vn) + abs(vt))):
                 note(ws, step, AUDIT_WORK, i, b, work)
                 found += 1
+    return found + audit_joints(m, s, ws)
+
+
+@kernel
+def joint_element(m, ws, r):
+    """The audit's element of joint or limit row r: pin j, or n_pin + j for rod j."""
+    if ws.row_kind[r] == ROW_ROD:
+        return m.pin_body.shape[0] + ws.row_owner[r]
+    return ws.row_owner[r]
+
+
+@kernel
+def audit_joints(m, s, ws):
+    """Joint limits whose impulse does positive work at the end velocity, and joints whose
+    impulses added energy (work.joints_add_energy), beyond rounding; returns how many."""
+    found = 0
+    step = s.step[0]
+    speed = -1.0
+    for r in range(ws.n_row[0]):
+        if not is_limit_row(ws.row_kind[r]):
+            continue
+        if speed < 0.0:
+            speed = fastest(ws.v_new) + fastest(ws.v_pred)
+        work, rounding = limit_work(ws, r, speed)
+        if work > rounding:
+            note(ws, step, AUDIT_LIMIT_WORK, ws.row_owner[r], ws.row_body[r, 1], work)
+            found += 1
+    if m.pin_body.shape[0] + m.rod_body.shape[0] > 0:
+        excess, r = joints_add_energy(m, ws)
+        if excess > 0.0 and r >= 0:
+            note(ws, step, AUDIT_JOINT_WORK, joint_element(m, ws, r), ws.row_body[r, 1], excess)
+            found += 1
     return found
 
 

@@ -25,12 +25,10 @@ from .row_list import move_row
 from .rows import (eval_rows, is_contact_row, is_limit_row, is_normal_row, is_tangent_row,
                    is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
+from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
+                   force_step_energy)
 
 
-# SHAKE's regime: the correction's velocity change dv is at most this share of the velocity
-# (mass-weighted norms); it is about h w / 2 there (measured at most 0.02 in smooth motion,
-# 0.1 at the 99th percentile of hard impacts at dt = 3 ms)
-SHAKE_REGIME = 0.1
 # relative pivot below which the position correction drops a row after a Newton step diverged:
 # rows within about 1e-2 rad of dependent
 LOOSE_PIVOT_TOL = 1e-4
@@ -73,31 +71,46 @@ def keep_correction_rows(s, ws):
 
 @kernel
 def integrate_positions(s, ws, vel, h):
-    """v = vel; q += h v; ws.v_solved = vel (bound_correction_work measures from it)."""
+    """v = vel; q += h v; ws.v_solved = vel, ws.q_solved = q (bound_correction_work measures
+    from them)."""
     for i in range(s.q.shape[0]):
         for k in range(3):
             s.v[i, k] = vel[i, k]
             ws.v_solved[i, k] = vel[i, k]
             s.q[i, k] += h * vel[i, k]
+            ws.q_solved[i, k] = s.q[i, k]
 
 
 @kernel
-def bound_correction_work(m, s, ws):
+def bound_correction_work(m, s, ws, h):
     """The position correction's velocity change dv = s.v - ws.v_solved (SHAKE: a joint's
-    correction / h), kept in full within SHAKE's regime, |dv| <= SHAKE_REGIME |v_solved|
-    (mass-weighted), where it is a second-order correction of a step that turns each body by
-    h w << 1 and keeps the integrator symplectic (energy oscillates, momenta are kept).
-    Beyond it, kept only as far as it adds no kinetic energy: v = v_solved + k dv with the
-    largest k in [0, 1] such that KE(v) <= KE(v_solved). Returns k.
+    correction / h) kept as far as the correction adds no energy beyond its allowance:
+    v = v_solved + k dv with the largest k in [0, 1] such that
+
+        KE(v) - KE(v_solved) - f . (q - q_solved) <= allowance
+
+    (kinetic energy gained less the applied forces' work along the correction's move; the move
+    itself is kept). Within SHAKE's regime, |dv| <= SHAKE_REGIME |v_solved| (mass-weighted),
+    the correction is a second-order term of a step that turns each body by h w << 1; it
+    keeps the integrator symplectic (energy oscillates, momenta are kept) and may move the
+    energy by CONSTRAINT_SHARE of the kinetic energy (work.py); beyond it the allowance is 0.
+    The move's own lift against the applied forces (a contact point pushed out of the ground)
+    is allowed up to that share plus the step's own error under the forces (h [s] the
+    integrated step's), in either regime. Returns the energy [J] the correction still adds beyond its allowance (only the move's
+    own work can leave some: k = 0 keeps no velocity change).
 
     A body turning by h w ~ 1 in one step (a light body spinning after a hard impact)
     leaves first-order errors; Newton can then end on a far solution of the joint
     equations, and its move / h would be energy from nowhere (measured: a 11 g box pinned
-    to a 1.6 kg one went from 222 to 6089 rad/s in one 3 ms step, |dv| = 2.5 |v|).
+    to a 1.6 kg one went from 222 to 6089 rad/s in one 3 ms step, |dv| = 2.5 |v|). In a
+    closed loop of bodies whose inertias differ by 1e8 the correction's impulses, set by the
+    light bodies' drift, turn a heavy body: a small dv of large momentum (measured: +8 J of
+    1136 J in one 10 ms step).
     KE(v_solved + k dv) - KE(v_solved) = k a + k^2 b (a = v_solved . M dv, b = dv . M dv / 2)."""
     a = 0.0
     b = 0.0
     kinetic = 0.0
+    momentum = 0.0
     for i in range(s.v.shape[0]):
         mass = m.body_mass[i]
         inertia = m.body_inertia[i]
@@ -108,13 +121,32 @@ def bound_correction_work(m, s, ws):
         b += 0.5 * (mass * (dx * dx + dy * dy) + inertia * dw * dw)
         kinetic += 0.5 * (mass * (ws.v_solved[i, 0] ** 2 + ws.v_solved[i, 1] ** 2)
                           + inertia * ws.v_solved[i, 2] ** 2)
-    if a + b <= 0.0 or b <= SHAKE_REGIME * SHAKE_REGIME * kinetic:
-        return 1.0
-    k = 0.0 if a >= 0.0 else -a / b
+        momentum += mass * (abs(dx) + abs(dy) + abs(ws.v_solved[i, 0]) + abs(ws.v_solved[i, 1]))
+    in_regime = b <= SHAKE_REGIME * SHAKE_REGIME * kinetic
+    # what the correction may gain: its share in the regime; the applied forces' work along
+    # its move (what the move takes from them), less what it gives them beyond that share
+    # (the move's own lift against gravity: a turning body's contact point pushed out of
+    # the ground by its (h w)^2 r dip, a joint's drift closed through a contact; also up to
+    # the step's own first-order error under the forces, work.force_step_energy); rounding
+    share = CONSTRAINT_SHARE * kinetic
+    force_work = correction_force_work(s, ws)
+    lift = share + force_step_energy(m, ws, h)
+    room = (share if in_regime else 0.0) + force_work + min(max(-force_work, 0.0), lift)
+    room += correction_rounding(m, ws, momentum, kinetic + abs(a) + b)
+    if a + b <= room or (in_regime and a + b <= 0.0):
+        return 0.0
+    if b <= 0.0:
+        return 0.0
+    # the largest k in [0, 1] with b k^2 + a k <= room (none: the k of least energy, -a / 2b)
+    disc = a * a + 4.0 * b * room
+    k = (-a + math.sqrt(disc)) / (2.0 * b) if disc >= 0.0 else -a / (2.0 * b)
+    # room reached (up to the root's rounding) unless no k in [0, 1] reaches it
+    short = disc < 0.0 or k < 0.0
+    k = min(max(k, 0.0), 1.0)
     for i in range(s.v.shape[0]):
         for c in range(3):
             s.v[i, c] = ws.v_solved[i, c] + k * (s.v[i, c] - ws.v_solved[i, c])
-    return k
+    return max(k * a + k * k * b - room, 0.0) if short else 0.0
 
 
 @kernel

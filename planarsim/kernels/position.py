@@ -9,16 +9,17 @@ position_stage(m, s, ws, opt, h, answered):
      the complementarity projection where one is above a tenth of its audit tolerance
      (complementarity.project_positions), the audit of what is left;
   5. bound_correction_work: the velocity change of a correction or projection kept only as
-     far as it adds no kinetic energy beyond SHAKE's regime.
+     far as it adds no energy beyond its allowance (audited: correction_work).
 """
 from ._jit import kernel, kernel_call, kernel_inline
-from .audit import (DEPTH_TOL, PIN_GAP_TOL, audit_positions, mark_held_contacts,
-                    needs_ground_query, worst_violation)
+from .audit import (AUDIT_CORRECTION_WORK, DEPTH_TOL, PIN_GAP_TOL, audit_positions,
+                    mark_held_contacts, needs_ground_query, note, worst_violation)
 from .complementarity import project_positions
 from .info import INFO_PROJECTIONS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, rows_hold_within)
 from .math2d import update_trig
+from .work import most_gaining_body
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
 PROJECTION_ITERS = 20
@@ -86,4 +87,6 @@ def position_stage(m, s, ws, opt, h, answered):
         settle_positions(m, s, ws, h, opt, held)
         if corrected or ws.info[INFO_PROJECTIONS] > 0:
             # only a correction or a projection changes the velocity the solve gave
-            bound_correction_work(m, s, ws)
+            excess = bound_correction_work(m, s, ws, h)
+            if excess > 0.0:
+                note(ws, s.step[0], AUDIT_CORRECTION_WORK, -1, most_gaining_body(m, s, ws), excess)

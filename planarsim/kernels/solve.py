@@ -264,8 +264,15 @@ def fill_row_b(ws, h, n):
         if is_joint_row(ws.row_kind[r]):
             # a joint's error at the end of the step without impulses, c(q + h v*): c + h J v*
             # plus the second-order drift of its rotating anchors, which the position
-            # correction would otherwise remove (one Newton iteration fewer)
-            ws.row_b[r] = ws.row_c_pred[r] / h
+            # correction would otherwise remove (one Newton iteration fewer). Where that
+            # target added energy (ws.first_order, kernels/step.py): J v = 0, a projection,
+            # which cannot add energy; the position correction, whose work is bounded,
+            # closes the joints' errors (c / h as velocity would be energy from nowhere
+            # after a time-of-impact split moved the bodies off their joints)
+            if ws.first_order[0] == 0:
+                ws.row_b[r] = ws.row_c_pred[r] / h
+            else:
+                ws.row_b[r] = row_dot(ws, r, ws.row_J, ws.v_pred)
             continue
         c = ws.row_c[r]
         if c < 0.0 and not is_tangent_row(ws.row_kind[r]):

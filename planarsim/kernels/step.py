@@ -28,6 +28,7 @@ from .position import position_stage
 from .rows import build_rows
 from .solve import solve_impulses
 from .warm_start import remember_impulses
+from .work import joints_add_energy
 
 
 @kernel
@@ -115,6 +116,29 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     return ok
 
 
+@kernel
+def forget_impulses(s):
+    """Zero the State's last impulses: a solve repeated with the joints aimed at J v = 0
+    starts from zero, so that a row dropped as dependent keeps none (the first solve's
+    impulses, or an earlier step's, could do work at this step's velocities)."""
+    s.last_contact_impulse[:] = 0.0
+    s.last_pin_impulse[:] = 0.0
+    s.last_rod_impulse[:] = 0.0
+
+
+@kernel
+def second_order_gains(m, ws):
+    """The joints' second-order target (solve.fill_row_b) made their impulses add energy
+    beyond what it may (work.joints_add_energy): a closed loop near a dead point, whose
+    nearly dependent rows turn an inconsistent drift into huge impulses, or a rod turning by
+    a radian in the step. The step then solves again with the joints aimed at J v = 0
+    (a projection, which cannot add energy) and leaves the drift to the position correction,
+    whose work is bounded (integrate.bound_correction_work)."""
+    if m.pin_body.shape[0] + m.rod_body.shape[0] == 0:
+        return False
+    return joints_add_energy(m, ws)[0] > 0.0
+
+
 @kernel_inline
 def _step(m, s, ws, opt, u):
     """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u;
@@ -128,6 +152,7 @@ def _step(m, s, ws, opt, u):
         ws.info[k] = 0
     ws.lcp_eps[0] = 0.0
     ws.audit_worst_value[0] = 0.0
+    ws.first_order[0] = 0
     audited = audit_total(ws)
     for k in range(ws.n_live[0]):
         ws.contact_new[ws.live[k]] = 0
@@ -140,7 +165,12 @@ def _step(m, s, ws, opt, u):
         predict_configuration(m, s, ws, h)                  #    q + h v* (joints' drift)
         find_contacts(m, s, ws, h)                          # 2. contacts
         ccd_on = split < opt.max_ccd_splits
-        answered = solve_modes(m, s, ws, opt, h, not ccd_on)  # 3-5. rows, impulses, modes
+        for attempt in range(2):                            # 3-5. rows, impulses, modes
+            answered = solve_modes(m, s, ws, opt, h, not ccd_on)
+            if attempt == 1 or ws.first_order[0] == 1 or not second_order_gains(m, ws):
+                break
+            ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
+            forget_impulses(s)                              #    from zero impulses
         if ccd_on:
             tau = split_at_impact(m, s, ws, h)              # 7. a point mass hits mid-step:
             if tau >= 0.0:                                  #    the rest of the step again

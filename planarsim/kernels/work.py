@@ -1,0 +1,154 @@
+"""The work [J] each cause does on the bodies in a step: the energy audit's measures
+(kernels/audit.py counts what breaks its rules).
+
+  joints      the pins' and rods' impulses at the velocity solve's end velocity,
+              sum_r lam_r J_r v: with each row's end-of-step error aimed at c(q + h v*) (the
+              second-order target, kernels/solve.fill_row_b) this is -sum_r lam_r c_r(q + h v*) / h,
+              the drift of rotating anchors: about (h w)^2 KE in smooth motion (a pendulum:
+              tension h m v^2 / L times drift h v^2 / 2L over h)
+  limits      each active joint limit's impulse times its rate at the end velocity: an
+              inequality's, like a contact's, is at most rounding
+  correction  the position correction's and projection's change of kinetic energy less the
+              work of the applied forces along its move, KE(v) - KE(v_solved) - f . (q - q_solved)
+
+The constraints' share of a step's energy: within SHAKE's regime (a step that turns each body
+by h w <= SHAKE_REGIME) the joints' second-order terms move the kinetic energy by at most
+about SHAKE_REGIME^2 of it, up or down, and the energy oscillates about its value (symplectic
+Euler); more than that is energy from nowhere.
+"""
+from ._jit import kernel
+from .rows import is_joint_row
+from .solve import row_dot
+
+# SHAKE's regime: the correction's velocity change dv is at most this share of the velocity
+# (mass-weighted norms); it is about h w / 2 there (measured at most 0.02 in smooth motion,
+# 0.1 at the 99th percentile of hard impacts at dt = 3 ms)
+SHAKE_REGIME = 0.1
+# the share of the kinetic energy the constraints' second-order terms may add in a step
+CONSTRAINT_SHARE = SHAKE_REGIME * SHAKE_REGIME
+WORK_REL_TOL = 1e-7      # the accuracy the complementarity solve accepts (lcp.ANSWER_TOL)
+# [m/s] a contact velocity this small is the solve's rounding, not motion: it moves a point by
+# 1e-8 h m in a step, a hundredth of DEPTH_TOL or less (h <= 1e-2 s), below what the position
+# audit can see; the complementarity solve of a resting 16-box chain (condition 3e9) leaves
+# velocities of 3e-9 m/s
+VELOCITY_FLOOR = 1e-8
+# [m] a correction's move this small is closing an error the audit accepts (audit.DEPTH_TOL):
+# lifting a body by it against gravity is not energy worth counting
+CORRECTION_MOVE_FLOOR = 1e-8
+RELATIVE_ROUNDING = 1e-12
+
+
+@kernel
+def kinetic_energy(m, v):
+    """sum_i (m_i |v_i|^2 + I_i w_i^2) / 2 [J] of velocities v (n_body, 3)."""
+    total = 0.0
+    for i in range(v.shape[0]):
+        total += m.body_mass[i] * (v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1])
+        total += m.body_inertia[i] * v[i, 2] * v[i, 2]
+    return 0.5 * total
+
+
+@kernel
+def fastest(v):
+    """The largest |v_x| + |v_y| [m/s] of any body in v (n_body, 3)."""
+    top = 0.0
+    for i in range(v.shape[0]):
+        top = max(top, abs(v[i, 0]) + abs(v[i, 1]))
+    return top
+
+
+@kernel
+def row_rounding(ws, r, speed):
+    """The work [J] row r's impulse may do by rounding alone: |lam| (WORK_REL_TOL speed +
+    VELOCITY_FLOOR), speed [m/s] the step's largest."""
+    return abs(ws.lam[r]) * (WORK_REL_TOL * speed + VELOCITY_FLOOR)
+
+
+@kernel
+def joint_work(m, ws, v):
+    """(work [J] of the pins' and rods' impulses ws.lam at velocity v, its rounding [J], the
+    row doing the most work or -1): rows 0..n_row-1 (F = J for joints)."""
+    speed = fastest(v) + fastest(ws.v_pred)
+    total = 0.0
+    rounding = 0.0
+    most = 0.0
+    row = -1
+    for r in range(ws.n_row[0]):
+        if not is_joint_row(ws.row_kind[r]):
+            continue
+        w = ws.lam[r] * row_dot(ws, r, ws.row_J, v)
+        total += w
+        rounding += row_rounding(ws, r, speed)
+        if w > most:
+            most = w
+            row = r
+    return total, rounding, row
+
+
+@kernel
+def joints_add_energy(m, ws):
+    """The joints' impulses of the velocity solve added more kinetic energy than their
+    second-order terms may (CONSTRAINT_SHARE of KE(v*)) beyond rounding: returns the excess
+    [J] (<= 0: none) and the row doing the most work."""
+    work, rounding, row = joint_work(m, ws, ws.v_new)
+    return work - CONSTRAINT_SHARE * kinetic_energy(m, ws.v_pred) - rounding, row
+
+
+@kernel
+def limit_work(ws, r, speed):
+    """(work [J] of limit row r's impulse at the end velocity ws.v_new, its rounding [J])."""
+    return ws.lam[r] * row_dot(ws, r, ws.row_J, ws.v_new), row_rounding(ws, r, speed)
+
+
+@kernel
+def correction_force_work(s, ws):
+    """f . (q - q_solved) [J]: the applied forces' (ws.force) work along the position
+    correction's and projection's move."""
+    total = 0.0
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            total += ws.force[i, k] * (s.q[i, k] - ws.q_solved[i, k])
+    return total
+
+
+
+@kernel
+def correction_rounding(m, ws, momentum, energy):
+    """The energy [J] a position correction may change by rounding: its velocities exact to
+    VELOCITY_FLOOR (momentum: sum_i m_i (|dv_i| + |v_i|) [kg m/s]), its moves to
+    CORRECTION_MOVE_FLOOR against the applied forces (ws.force), and its sums (energy [J],
+    the size of the terms summed) to RELATIVE_ROUNDING."""
+    forces = 0.0
+    for i in range(ws.force.shape[0]):
+        forces += abs(ws.force[i, 0]) + abs(ws.force[i, 1])
+    return VELOCITY_FLOOR * momentum + CORRECTION_MOVE_FLOOR * forces + RELATIVE_ROUNDING * energy
+
+
+@kernel
+def force_step_energy(m, ws, h):
+    """(h^2 / 2) f . M^-1 f [J]: how far one symplectic Euler step of h [s] under the applied
+    forces ws.force moves the energy by itself (exactly, for constant forces: a falling body's
+    step gains (h / 2) g dp_y); a position correction moving bodies by this step's own
+    first-order error trades about this much energy with the forces."""
+    total = 0.0
+    for i in range(ws.force.shape[0]):
+        total += m.body_inv_mass[i] * (ws.force[i, 0] ** 2 + ws.force[i, 1] ** 2)
+        total += m.body_inv_inertia[i] * ws.force[i, 2] ** 2
+    return 0.5 * h * h * total
+
+
+@kernel
+def most_gaining_body(m, s, ws):
+    """The body whose kinetic energy the position correction raised the most (s.v against
+    ws.v_solved), or -1 if none gained."""
+    best = 0.0
+    body = -1
+    for i in range(s.v.shape[0]):
+        gain = 0.0
+        for k in range(3):
+            inertia = m.body_mass[i] if k < 2 else m.body_inertia[i]
+            gain += 0.5 * inertia * (s.v[i, k] * s.v[i, k] - ws.v_solved[i, k] * ws.v_solved[i, k])
+        if gain > best:
+            best = gain
+            body = i
+    return body
