@@ -281,6 +281,11 @@ def _num(text):
     return [float(t) for t in str(text).split()]
 
 
+def _vec(v):
+    """A vector as a tuple of plain floats for messages."""
+    return tuple(float(x) + 0.0 for x in np.round(v, 12))
+
+
 def _mj_pair(a, b) -> bool:
     """MuJoCo's filter: two geoms may touch when contype of one meets conaffinity of the other."""
     return bool((a["contype"] & b["conaffinity"]) or (b["contype"] & a["conaffinity"]))
@@ -660,11 +665,11 @@ class _Loader:
         for j in joints:
             a = j["axis"]
             if j["type"] == "hinge" and abs(abs(a[normal]) - 1) > AXIS_TOL:
-                self.fail(j["node"], f"hinge axis={tuple(np.round(a, 12))} is not normal to the "
+                self.fail(j["node"], f"hinge axis={_vec(a)} is not normal to the "
                                      f"{self.plane_name} plane of motion: it must be {want}; a "
                                      f"joint leaving the plane is not supported")
             if j["type"] == "slide" and abs(a[normal]) > AXIS_TOL:
-                self.fail(j["node"], f"slide axis={tuple(np.round(a, 12))} leaves the "
+                self.fail(j["node"], f"slide axis={_vec(a)} leaves the "
                                      f"{self.plane_name} plane of motion")
 
     def plane(self, p) -> np.ndarray:
@@ -714,7 +719,7 @@ class _Loader:
                 self.report.ignore("geom plane parallel to the plane of motion", g["node"].line)
                 continue
             if abs(n[self.i2] - 1) > AXIS_TOL:
-                self.fail(g["node"], f"a plane whose normal {tuple(np.round(n, 12))} is not the "
+                self.fail(g["node"], f"a plane whose normal {_vec(n)} is not the "
                                      f"plane of motion's up is not supported")
             if found is not None:
                 self.fail(g["node"], "a second ground plane is not supported")
