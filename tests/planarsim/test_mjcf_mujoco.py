@@ -241,3 +241,17 @@ def test_empty_tendon_and_sites_are_ignored_and_reported():
     rep = load_mjcf(xml).report
     assert rep.ignored["<site>"] == [2] and "geom rgba" in rep.ignored
     assert "<tendon> (empty)" in rep.ignored and "<default><tendon>" in rep.ignored
+
+
+def test_loaded_hopper_lands_on_its_floor():
+    """The loaded model runs: the hopper, dropped 4 cm onto the file's floor, comes to rest on
+    its foot (nothing below the ground, the torso still up)."""
+    import planarsim as ps
+    loaded = load_mjcf(gym_asset("hopper"), drop=("armature",))
+    model = loaded.compile()
+    sim = ps.Simulator(model)
+    sim.steps(250)                                   # 0.5 s at the file's 0.002 s
+    q = sim.state.q
+    foot = loaded.body["foot"]
+    assert q[foot, 1] > 0.06 - 1e-6                  # capsule radius 0.06 above y = 0
+    assert q[loaded.root, 1] > 1.0
