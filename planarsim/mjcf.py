@@ -1,34 +1,54 @@
-"""Loader for the planar subset of MJCF (MuJoCo XML) used by 2D characters such as SIMBICON's.
+"""Loader for planar MJCF (MuJoCo XML): characters that move in one plane, as MuJoCo's
+ecosystem writes them (gymnasium's Hopper, Walker2d, HalfCheetah; the SIMBICON character).
 
-Supported (everything else is a ``ModelError`` naming the element and its line):
+What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
 
-* ``<mujoco model>``, ``<compiler angle="degree|radian" coordinate="global">`` (global
-  coordinates only), ``<default>`` with ``<joint>`` / ``<geom>`` attribute defaults,
-  ``<worldbody>`` holding one root ``<body>``.
-* ``<body name>`` nested to any depth. A body without a joint is welded to its parent: its
-  geoms' mass and inertia are merged into the parent's rigid body.
-* ``<joint type="slide|hinge" axis pos range limited stiffness damping armature=0>``. The root
-  body either has two slide joints spanning the x-z plane plus a hinge about y ("free in the
-  plane", no pin), or a single hinge (pinned to the world). Every other body has at most one
-  hinge about +-y, which becomes ``add_pin`` with its limits (radians) and passive
-  stiffness [N m/rad] / damping [N m s/rad].
-* ``<geom type="capsule|box|sphere" size pos fromto mass density>``.
+* ``<compiler angle coordinate="local|global" inertiafromgeom settotalmass eulerseq>``:
+  MuJoCo's default local frames (a body's ``pos``/orientation are in its parent's frame, its
+  joints' and geoms' in its own) or the older global form (everything in the world's frame).
+* ``<option timestep gravity viscosity density>``: timestep -> the model's dt [s]; gravity
+  [m/s^2] -> the model's gravity, its component along the plane's normal dropped (the
+  joints carry it: a planar model cannot move that way); a fluid (viscosity or density
+  non-zero) is a ModelError unless ``drop`` names "fluid".
+* ``<default>`` with nested classes, ``class`` and ``childclass``.
+* ``<body pos quat axisangle euler zaxis xyaxes>``; a body without joints is welded to its
+  parent (its geoms join the parent's rigid body, or the world's).
+* ``<joint type="hinge|slide" pos axis ref range limited stiffness damping springref armature>``.
+  A root body with two slides spanning the plane and a hinge about its normal is free in the
+  plane (no constraint); one hinge pins a body to its parent (``add_pin``, limits [rad],
+  passive stiffness [N m/rad] toward springref, damping [N m s/rad]); a slide needs the
+  builder's ``add_slider`` and armature ``add_pin(armature=...)``: where the builder lacks
+  them, a ModelError says so (``drop={"armature"}`` loads without armature, reported).
+* ``<geom type="sphere|capsule|cylinder|box|ellipsoid|plane" size pos orientation fromto
+  mass density friction contype conaffinity condim>``: mass properties as MuJoCo's compiler
+  computes them (planarsim.mjcf_frames), shapes that collide by MuJoCo's contype/conaffinity
+  rule; a plane in the world whose normal is the plane's "up" becomes flat terrain.
+* ``<inertial pos mass diaginertia fullinertia orientation>`` (with inertiafromgeom auto/false).
+* ``<actuator><motor joint gear ctrlrange ctrllimited forcerange forcelimited>``: a pin motor
+  (a body torque or force on a free root's joints) whose torque input [N m] is
+  ``gear * ctrl`` in the pin's sign (``MJCFModel.actuator[name].gear``), saturated to
+  gear * ctrlrange.
 
-Plane mapping: MJCF (x, y, z) -> planarsim (x, y) = (x_mjcf, z_mjcf); the MJCF y coordinate is
-dropped (left and right legs overlap in the plane). A hinge about +y turns x toward -z, which
-is clockwise in our plane, so a pin angle is ``-axis_y * (MJCF joint angle)`` and a range
-[lo, hi] about +y becomes [-hi, -lo].
+Purely visual or solver-tuning elements and attributes (rgba, material, asset, visual, light,
+camera, site, solref, margin, integrator, ...) are ignored and listed in ``MJCFModel.report``;
+anything else that changes physics and is not supported (tendons, equality constraints, a
+joint leaving the plane, a fluid) is a ModelError naming the element and its line.
 
-Mass properties per rigid body, about the axis normal to the plane (MJCF y):
-  sphere  I = 2/5 m r^2
-  box     I = m (a^2 + c^2) / 3           (half sizes a along x, c along z)
-  capsule cylinder (length L, radius r) plus two hemispheres, mass split by volume:
-          I_perp = m_c (r^2/4 + L^2/12) + 2 m_h (83/320 r^2 + (L/2 + 3r/8)^2)
-          I_axis = m_c r^2/2 + 2 m_h (2/5 r^2); I_y = I_perp + (I_axis - I_perp) (axis . y)^2
-then the parallel-axis theorem with in-plane offsets (x, z) from the body COM.
+Plane mapping. The plane of motion is the one normal to the hinges: MJCF y (x-z plane, the
+walkers: planarsim (x, y) = (x_mjcf, z_mjcf)) or MJCF z (x-y plane, swimmer and reacher:
+(x, y) = (x_mjcf, y_mjcf)). The coordinate along the normal is dropped (left and right legs
+overlap). A hinge about the unit axis a turns by its MJCF angle about a; the plane's
+counter-clockwise normal is e1 x e2 (-y for x-z, +z for x-y), so the pin angle is
+``sign * (q - ref)`` with sign = a . (e1 x e2) and q the MJCF joint value (``ref`` at the
+file's pose), and a range [lo, hi] becomes sorted(sign * ([lo, hi] - ref)).
+
+Mass properties per rigid body about the plane's normal: each geom's principal inertia
+turned into the world (I_n = sum_i I_i (R^T n)_i^2), then the parallel-axis theorem with
+in-plane offsets from the body's COM.
 """
 from __future__ import annotations
 
+import inspect
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,28 +58,74 @@ import numpy as np
 
 from .builder import ModelBuilder
 from .errors import ModelError
+from . import mjcf_frames as F
+from .terrain import flat
 
-_ALLOWED = {
-    "mujoco": {"model"},
-    "compiler": {"angle", "coordinate"},
-    "default": set(),
-    "worldbody": set(),
-    "body": {"name"},
-    "joint": {"name", "type", "axis", "pos", "range", "limited", "stiffness", "damping", "armature"},
-    "geom": {"name", "type", "size", "pos", "fromto", "mass", "density"},
-}
-_CHILDREN = {
-    "mujoco": {"compiler", "default", "worldbody"},
-    "compiler": set(),
-    "default": {"joint", "geom"},
-    "worldbody": {"body"},
-    "body": {"joint", "geom", "body"},
-    "joint": set(),
-    "geom": set(),
-}
 DEFAULT_DENSITY = 1000.0  # [kg/m^3] MuJoCo's default geom density
+DEFAULT_TIMESTEP = 0.002  # [s] MuJoCo's default option timestep
+DEFAULT_GRAVITY = (0.0, 0.0, -9.81)  # [m/s^2] MuJoCo's default option gravity
+DEFAULT_FRICTION = (1.0, 0.005, 0.0001)  # MuJoCo's default geom friction (slide, spin, roll)
 DRAWN = {"collide": False}  # add_shape's options for a geom that is only drawn
 COLLIDES = {"collide": True}
+AXIS_TOL = 1e-9  # how far a unit joint axis may lean from the plane's normal (or into it)
+DROPPABLE = ("armature", "fluid")  # physics the caller may choose to load without
+
+# Per element: attributes it reads ("use"), ignores and reports ("ignore"), and accepts only
+# at MuJoCo's default value ("default": value; any other value changes physics this loader
+# does not model, a ModelError). Any attribute not listed is a ModelError.
+_ORIENT = {"quat", "axisangle", "euler", "zaxis", "xyaxes"}
+ATTRIBUTES = {
+    "mujoco": dict(use={"model"}),
+    "compiler": dict(
+        use={"angle", "coordinate", "inertiafromgeom", "settotalmass", "eulerseq", "autolimits"},
+        ignore={"meshdir", "texturedir", "assetdir", "discardvisual", "strippath", "fusestatic",
+                "convexhull", "usethread", "saveinertial", "alignfree"},
+        default={"boundmass": "0", "boundinertia": "0", "balanceinertia": "false"}),
+    "option": dict(
+        use={"timestep", "gravity", "viscosity", "density"},
+        ignore={"integrator", "cone", "impratio", "tolerance", "iterations", "ls_iterations",
+                "ls_tolerance", "solver", "noslip_iterations", "noslip_tolerance",
+                "ccd_iterations", "ccd_tolerance", "mpr_iterations", "mpr_tolerance",
+                "sdf_iterations", "sdf_initpoints", "jacobian", "apirate", "magnetic",
+                "o_margin", "o_solref", "o_solimp", "o_friction", "collision",
+                "actuatorgroupdisable"},
+        default={"wind": "0 0 0"}),
+    "body": dict(use={"name", "childclass", "pos"} | _ORIENT, ignore={"user"},
+                 default={"mocap": "false", "gravcomp": "0"}),
+    "joint": dict(
+        use={"name", "class", "type", "pos", "axis", "range", "limited", "stiffness", "damping",
+             "armature", "ref", "springref"},
+        ignore={"group", "margin", "solreflimit", "solimplimit", "solreffriction",
+                "solimpfriction", "user"},
+        default={"frictionloss": "0", "springdamper": "0 0", "actuatorfrclimited": "auto",
+                 "actuatorgravcomp": "false"}),
+    "geom": dict(
+        use={"name", "class", "type", "size", "pos", "fromto", "mass", "density", "friction",
+             "contype", "conaffinity", "condim"} | _ORIENT,
+        ignore={"rgba", "material", "group", "margin", "gap", "solimp", "solref", "solmix",
+                "priority", "user"},
+        default={"shellinertia": "false", "fluidshape": "none", "fitscale": "1"}),
+    "inertial": dict(use={"pos", "mass", "diaginertia", "fullinertia"} | _ORIENT),
+    "motor": dict(
+        use={"name", "class", "joint", "gear", "ctrlrange", "ctrllimited", "forcerange",
+             "forcelimited"},
+        ignore={"group", "user", "lengthrange", "actdim"},
+        default={"actlimited": "auto", "actrange": "0 0"}),
+}
+# elements read by the loader, per parent
+_CHILDREN = {
+    "mujoco": {"compiler", "option", "default", "worldbody", "actuator"},
+    "worldbody": {"body", "geom"},
+    "body": {"body", "geom", "joint", "inertial"},
+    "actuator": {"motor"},
+}
+# elements ignored (and reported) wherever they appear: drawing, cameras, sensing, bookkeeping
+_IGNORED_ELEMENTS = {"size", "visual", "statistic", "custom", "asset", "keyframe", "sensor",
+                     "light", "camera", "site", "extension", "exclude"}
+# elements that are ignored when empty (a declaration with nothing in it) and a ModelError
+# otherwise: each changes physics this loader does not model
+_EMPTY_ONLY = {"tendon": "tendons", "equality": "equality constraints", "contact": "explicit contact pairs"}
+SUPPORTED_GEOMS = ("sphere", "capsule", "cylinder", "box", "ellipsoid", "plane")
 
 
 @dataclass
@@ -94,27 +160,91 @@ def parse_xml(text: str, source: str = "<string>") -> Node:
     return root[0]
 
 
+
 @dataclass
 class RigidBody:
     """A planarsim rigid body assembled from one MJCF body and the bodies welded to it."""
     name: str
     mass: float = 0.0                       # [kg]
     com: np.ndarray = None                  # (2,) world COM [m]
-    inertia: float = 0.0                    # about the COM [kg m^2]
-    parts: list = field(default_factory=list)   # (mass, (x, y), I_own, shape, name) per geom
+    inertia: float = 0.0                    # about the COM, normal to the plane [kg m^2]
+    parts: list = field(default_factory=list)   # (mass, (x, y), I_own, shape, name, geom)
     mjcf_bodies: list = field(default_factory=list)
+
+
+@dataclass
+class JointMap:
+    """How an MJCF joint maps onto planarsim: kind 'pin' (id: pin id), 'free' (id: the root
+    body; axis: index 0/1 of a slide's in-plane direction or 2 for the hinge) or 'slider'.
+    The MJCF joint value is q = ref + sign * (planarsim coordinate)."""
+    kind: str
+    id: int
+    sign: float = 1.0
+    ref: float = 0.0
+    axis: tuple = ()
+
+
+@dataclass
+class ActuatorMap:
+    """A <motor>: planarsim actuator id, its MJCF joint, and gear: the actuator's input
+    [N m or N] is ``gear * ctrl`` (the pin's sign included), saturated to ctrlrange * gear."""
+    id: int
+    joint: str
+    gear: float
+    ctrlrange: tuple = (-math.inf, math.inf)
+
+
+@dataclass
+class LoadReport:
+    """What the loader did not turn into physics.
+
+    ignored : "what" -> lines: visual, solver-tuning and bookkeeping elements and attributes
+        (e.g. "<light>", "geom rgba", "option integrator")
+    dropped : "what" -> lines: physics left out because ``drop`` asked for it (e.g. armature)
+    notes : sentences on approximations the mapping makes (gravity along the normal, self
+        collisions planarsim does not model, ...)
+    """
+    ignored: dict = field(default_factory=dict)
+    dropped: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+
+    def ignore(self, what: str, line: int):
+        self.ignored.setdefault(what, []).append(line)
+
+    def drop(self, what: str, line: int):
+        self.dropped.setdefault(what, []).append(line)
+
+    def note(self, text: str):
+        if text not in self.notes:
+            self.notes.append(text)
+
+    def __str__(self):
+        def lines(d):
+            return [f"  {k} (line{'s' if len(v) > 1 else ''} {', '.join(map(str, sorted(set(v))))})"
+                    for k, v in sorted(d.items())]
+        out = ["ignored:"] + (lines(self.ignored) or ["  nothing"])
+        if self.dropped:
+            out += ["dropped (changes physics):"] + lines(self.dropped)
+        if self.notes:
+            out += ["notes:"] + [f"  {n}" for n in self.notes]
+        return "\n".join(out)
 
 
 @dataclass
 class MJCFModel:
     """Result of :func:`load_mjcf`.
 
-    builder : ModelBuilder with bodies and pins added (add actuators/contacts, then compile())
-    body    : MJCF body name -> planarsim body id (welded bodies map to their rigid parent)
+    builder : ModelBuilder with bodies, pins and motors added (add contacts, then compile())
+    body    : MJCF body name -> planarsim body id (welded bodies map to their rigid parent;
+              bodies welded to the world are absent)
     pin     : MJCF hinge name -> planarsim pin id
     rigid   : planarsim body id -> RigidBody (mass [kg], com (2,) [m], inertia [kg m^2])
-    root    : planarsim id of the root body
+    root    : planarsim id of the first root body
     free_joints : names of the root's planar joints (slides + hinge) that became "free"
+    joint   : MJCF joint name -> JointMap (kind, id, sign, ref)
+    actuator : MJCF motor name (or its joint's) -> ActuatorMap (id, joint, gear, ctrlrange)
+    plane   : "x-z" or "x-y": the MJCF plane the model moves in
+    report  : LoadReport: what was ignored, dropped or approximated
     """
     builder: ModelBuilder
     body: dict
@@ -123,50 +253,110 @@ class MJCFModel:
     root: int
     name: str = "mjcf"
     free_joints: tuple = ()
+    joint: dict = field(default_factory=dict)
+    actuator: dict = field(default_factory=dict)
+    plane: str = "x-z"
+    report: LoadReport = field(default_factory=LoadReport)
 
     def compile(self, **meta):
         return self.builder.compile(**meta)
 
 
+@dataclass
+class Body3D:
+    """An MJCF body at the file's pose: world position [m], rotation (columns: its axes)."""
+    node: Node
+    name: str
+    parent: "Body3D | None"
+    pos: np.ndarray
+    R: np.ndarray
+    joints: list = field(default_factory=list)      # dicts: node, eff, type, pos, axis
+    geoms: list = field(default_factory=list)       # dicts: node, eff, kind, pos, R, ...
+    inertials: list = field(default_factory=list)   # dicts: node, mass, pos, I_n
+    children: list = field(default_factory=list)
+    rid: int | None = None                          # planarsim rigid body (None: the world)
+
+
+def _num(text):
+    return [float(t) for t in str(text).split()]
+
+
+def _vec(v):
+    """A vector as a tuple of plain floats for messages."""
+    return tuple(float(x) + 0.0 for x in np.round(v, 12))
+
+
+def _mj_pair(a, b) -> bool:
+    """MuJoCo's filter: two geoms may touch when contype of one meets conaffinity of the other."""
+    return bool((a["contype"] & b["conaffinity"]) or (b["contype"] & a["conaffinity"]))
+
+
 class _Loader:
-    def __init__(self, root: Node, source: str):
+    def __init__(self, root: Node, source: str, drop=()):
         self.src = source
         self.root = root
         self.angle_scale = math.pi / 180.0   # MuJoCo's default compiler angle is degrees
-        self.defaults = {"joint": {}, "geom": {}}
+        self.eulerseq = "xyz"
+        self.global_coords = False
+        self.inertiafromgeom = "auto"
+        self.settotalmass = None
+        self.option = {}
+        self.classes = {"main": {}}           # class -> tag -> attributes
+        self.report = LoadReport()
+        bad = sorted(set(drop) - set(DROPPABLE))
+        if bad:
+            raise ModelError(f"load_mjcf: drop={sorted(drop)} names {bad}; it may name {DROPPABLE}")
+        self.drop = frozenset(drop)
 
-    # errors and attribute parsing -----------------------------------------------------------
+    # errors and attributes --------------------------------------------------------------------
     def fail(self, node, msg):
         raise ModelError(f"{self.src}:{node.line}: <{node.tag}"
                          f"{' name=' + repr(node.attrib['name']) if 'name' in node.attrib else ''}> "
                          f"(line {node.line}): {msg}")
 
-    def check(self, node):
-        if node.tag not in _ALLOWED:
-            self.fail(node, f"element <{node.tag}> is not supported by the planar MJCF loader "
-                            f"(supported: {sorted(_ALLOWED)})")
-        bad = sorted(set(node.attrib) - _ALLOWED[node.tag])
-        if bad:
-            self.fail(node, f"attribute(s) {bad} not supported on <{node.tag}> "
-                            f"(supported: {sorted(_ALLOWED[node.tag])})")
-        for c in node.children:
-            if c.tag not in _CHILDREN[node.tag]:
-                self.fail(c, f"element <{c.tag}> is not supported inside <{node.tag}> "
-                             f"(allowed: {sorted(_CHILDREN[node.tag]) or 'none'})")
+    def effective(self, node, cls="main", tag=None):
+        """The node's attributes over its class's defaults (class attribute, else the
+        inherited childclass, else 'main'); checks each against ATTRIBUTES."""
+        cls = node.attrib.get("class", cls)
+        if cls not in self.classes:
+            self.fail(node, f"class={cls!r} is not defined by any <default class=...>")
+        eff = dict(self.classes[cls].get(tag or node.tag, {}))
+        eff.update(node.attrib)
+        eff.pop("class", None)
+        self.vet(node, eff)
+        return eff
 
-    def attr(self, node, key, default=None):
-        if key in node.attrib:
-            return node.attrib[key]
-        return self.defaults.get(node.tag, {}).get(key, default)
+    def vet(self, node, eff):
+        rules = ATTRIBUTES[node.tag]
+        use, ignore, default = rules.get("use", set()), rules.get("ignore", set()), rules.get("default", {})
+        for key in sorted(eff):
+            if key in use:
+                continue
+            if key in ignore:
+                self.report.ignore(f"{node.tag} {key}", node.line)
+            elif key in default:
+                if not self.same(eff[key], default[key]):
+                    self.fail(node, f"{key}={eff[key]!r} changes physics this loader does not "
+                                    f"model (only {default[key]!r} is supported)")
+            else:
+                self.fail(node, f"attribute(s) [{key!r}] not supported on <{node.tag}> "
+                                f"(read: {sorted(use)}; ignored: {sorted(ignore)})")
 
-    def floats(self, node, key, n=None, default=None):
-        raw = self.attr(node, key)
+    @staticmethod
+    def same(a, b):
+        try:
+            return np.allclose(_num(a), _num(b), rtol=0, atol=0) and len(_num(a)) == len(_num(b))
+        except ValueError:
+            return str(a).strip() == str(b).strip()
+
+    def floats(self, node, eff, key, n=None, default=None):
+        raw = eff.get(key)
         if raw is None:
             if default is None:
                 self.fail(node, f"attribute {key!r} is required")
             return np.asarray(default, dtype=np.float64)
         try:
-            vals = np.array([float(t) for t in raw.split()], dtype=np.float64)
+            vals = np.array(_num(raw), dtype=np.float64)
         except ValueError:
             self.fail(node, f"{key}={raw!r} must be numbers separated by spaces")
         if n is not None and vals.size not in ((n,) if isinstance(n, int) else n):
@@ -175,240 +365,768 @@ class _Loader:
             self.fail(node, f"{key}={raw!r} must be finite")
         return vals
 
+    def scalar(self, node, eff, key, default):
+        return float(self.floats(node, eff, key, 1, default=(default,))[0])
+
+    def flag(self, node, eff, key, default="auto", allowed=("true", "false", "auto")):
+        v = eff.get(key, default)
+        if v not in allowed:
+            self.fail(node, f"{key}={v!r} must be one of {allowed}")
+        return v
+
+    def orientation(self, node, eff) -> np.ndarray:
+        """Rotation of an element's frame from quat | axisangle | euler | zaxis | xyaxes."""
+        given = [k for k in ("quat", "axisangle", "euler", "zaxis", "xyaxes") if k in eff]
+        if len(given) > 1:
+            self.fail(node, f"orientation given twice: {given}")
+        if not given:
+            return np.eye(3)
+        k = given[0]
+        v = self.floats(node, eff, k, {"quat": 4, "axisangle": 4, "euler": 3, "zaxis": 3,
+                                       "xyaxes": 6}[k])
+        if k != "euler" and not np.linalg.norm(v[:3] if k != "quat" else v) > 0:
+            self.fail(node, f"{k}={tuple(v)} must be non-zero")
+        if k == "quat":
+            return F.quat_matrix(v)
+        if k == "axisangle":
+            return F.axis_angle_matrix(v[:3], v[3] * self.angle_scale)
+        if k == "euler":
+            return F.euler_matrix(v * self.angle_scale, self.eulerseq)
+        if k == "zaxis":
+            return F.zaxis_matrix(v)
+        return F.xyaxes_matrix(v)
+
+    def frame(self, node, eff, parent_pos, parent_R):
+        """World position [m] and rotation of an element given in its parent's frame (local
+        coordinates) or in the world's (global)."""
+        pos = self.floats(node, eff, "pos", 3, default=(0.0, 0.0, 0.0))
+        R = self.orientation(node, eff)
+        if self.global_coords:
+            return pos, R
+        return parent_pos + parent_R @ pos, parent_R @ R
+
     # top level ------------------------------------------------------------------------------
-    def load(self, builder, offset) -> MJCFModel:
+    def load(self, builder_kw, builder, offset, collide) -> MJCFModel:
         root = self.root
         if root.tag != "mujoco":
             self.fail(root, "the root element must be <mujoco>")
-        self.check(root)
-        worldbody = None
-        for node in root.children:
-            self.check(node)
+        self.vet(root, root.attrib)
+        worldbody, actuators = None, []
+        for node in root.children:      # compiler first: it sets the angle unit for the rest
             if node.tag == "compiler":
                 self.compiler(node)
+        for node in root.children:
+            if node.tag in ("compiler",):
+                continue
+            if node.tag == "option":
+                self.options(node)
             elif node.tag == "default":
-                for d in node.children:
-                    self.check(d)
-                    self.defaults[d.tag].update(d.attrib)
-            elif worldbody is None:
+                self.defaults(node, parent="main", top=True)
+            elif node.tag == "worldbody":
+                if worldbody is not None:
+                    self.fail(node, "only one <worldbody> is allowed")
                 worldbody = node
+            elif node.tag == "actuator":
+                actuators.append(node)
             else:
-                self.fail(node, "only one <worldbody> is allowed")
-        if worldbody is None or len(worldbody.children) != 1:
-            self.fail(worldbody or root, "<worldbody> must hold exactly one root <body>")
+                self.elsewhere(node, "mujoco")
+        if worldbody is None:
+            self.fail(root, "<worldbody> is missing")
         self.offset = np.asarray(offset, dtype=np.float64)
-        self.rigid, self.body_map, self.pins = [], {}, []
-        self.walk(worldbody.children[0], parent=None)
-        return self.emit(builder, root.attrib.get("model", "mjcf"))
+        world = Body3D(worldbody, "world", None, np.zeros(3), np.eye(3))
+        self.bodies = []
+        self.walk_children(worldbody, world, "main")
+        self.choose_plane()
+        self.world = world
+        self.collide = None if collide is None else frozenset(collide)
+        b = self.builder(builder_kw, builder)
+        out = self.emit(b, root.attrib.get("model", "mjcf"))
+        for node in actuators:
+            self.actuators(node, out)
+        return out
+
+    def elsewhere(self, node, parent):
+        """An element the loader does not read: ignored and reported when it only draws,
+        senses or tunes; otherwise a ModelError naming it."""
+        if node.tag in _IGNORED_ELEMENTS:
+            self.report.ignore(f"<{node.tag}>", node.line)
+            return
+        if node.tag in _EMPTY_ONLY:
+            kids = [c for c in node.children if not (node.tag == "contact" and c.tag == "exclude")]
+            if kids:
+                self.fail(kids[0], f"<{kids[0].tag}> inside <{node.tag}>: {_EMPTY_ONLY[node.tag]} "
+                                   f"change physics and are not supported")
+            for c in node.children:
+                self.report.ignore(f"<{node.tag}><{c.tag}>", c.line)
+            if not node.children:
+                self.report.ignore(f"<{node.tag}> (empty)", node.line)
+            return
+        if node.tag == "freejoint":
+            self.fail(node, "a free joint leaves the plane; use two slides and a hinge")
+        self.fail(node, f"element <{node.tag}> is not supported inside <{parent}> "
+                        f"(read: {sorted(_CHILDREN.get(parent, set()))}; ignored: "
+                        f"{sorted(_IGNORED_ELEMENTS)})")
 
     def compiler(self, node):
-        angle = node.attrib.get("angle", "degree")
+        eff = dict(node.attrib)
+        self.vet(node, eff)
+        angle = eff.get("angle", "degree")
         if angle not in ("degree", "radian"):
             self.fail(node, f"angle={angle!r} must be 'degree' or 'radian'")
         self.angle_scale = math.pi / 180.0 if angle == "degree" else 1.0
-        coord = node.attrib.get("coordinate", "global")
-        if coord != "global":
-            self.fail(node, f"coordinate={coord!r} is not supported; only 'global' coordinates")
+        coord = eff.get("coordinate", "local")
+        if coord not in ("local", "global"):
+            self.fail(node, f"coordinate={coord!r} must be 'local' or 'global'")
+        self.global_coords = coord == "global"
+        self.inertiafromgeom = self.flag(node, eff, "inertiafromgeom")
+        seq = eff.get("eulerseq", "xyz")
+        if len(seq) != 3 or any(c not in "xyzXYZ" for c in seq):
+            self.fail(node, f"eulerseq={seq!r} must be three of x, y, z, X, Y, Z")
+        self.eulerseq = seq
+        if "settotalmass" in eff:
+            total = self.scalar(node, eff, "settotalmass", -1.0)
+            self.settotalmass = total if total > 0 else None
 
-    def plane(self, vec3):
-        """MJCF (x, y, z) -> planarsim (x, y) = (x, z) + offset [m]."""
-        return np.array([vec3[0], vec3[2]]) + self.offset
+    def options(self, node):
+        eff = dict(node.attrib)
+        self.vet(node, eff)
+        for c in node.children:
+            self.fail(c, f"<{c.tag}> inside <option> is not supported (flags change physics)")
+        self.option["timestep"] = self.scalar(node, eff, "timestep", DEFAULT_TIMESTEP)
+        if not self.option["timestep"] > 0:
+            self.fail(node, f"timestep={self.option['timestep']} must be > 0")
+        self.option["gravity"] = self.floats(node, eff, "gravity", 3, default=DEFAULT_GRAVITY)
+        fluid = {k: self.scalar(node, eff, k, 0.0) for k in ("viscosity", "density")}
+        if any(fluid.values()):
+            what = ", ".join(f"{k}={v}" for k, v in fluid.items() if v)
+            if "fluid" not in self.drop:
+                self.fail(node, f"{what} needs fluid forces, not supported yet (drop={{'fluid'}} "
+                                f"loads without them)")
+            self.report.drop(f"option {what} (fluid forces)", node.line)
+        self.option_line = node.line
+
+    def defaults(self, node, parent, top=False):
+        """<default class=...>: attributes per element tag, inherited by nested classes."""
+        extra = sorted(set(node.attrib) - {"class"})
+        if extra:
+            self.fail(node, f"attribute(s) {extra} not supported on <default>")
+        name = node.attrib.get("class", "main" if top else None)
+        if name is None:
+            self.fail(node, "a nested <default> needs class=")
+        if not top and name in self.classes:
+            self.fail(node, f"class={name!r} is defined twice")
+        table = self.classes["main"] if top else {t: dict(a) for t, a in self.classes[parent].items()}
+        self.classes[name] = table
+        for c in node.children:
+            if c.tag == "default":
+                self.defaults(c, name)
+            elif c.tag in ("joint", "geom", "inertial"):
+                table.setdefault(c.tag, {}).update(c.attrib)
+            elif c.tag in ("motor", "general"):
+                table.setdefault("motor", {}).update(c.attrib)
+            else:
+                self.report.ignore(f"<default><{c.tag}>", c.line)
 
     # bodies, joints, geoms --------------------------------------------------------------------
-    def walk(self, node, parent):
-        self.check(node)
-        name = node.attrib.get("name") or f"body@{node.line}"
-        if name in self.body_map:
-            self.fail(node, f"duplicate body name {name!r}")
-        joints = [c for c in node.children if c.tag == "joint"]
-        for j in joints:
-            self.check(j)
-        if parent is None:
-            rid = self.new_rigid(name)
-            self.root_joints(node, joints, rid)
-        elif not joints:
-            rid = parent                      # welded: merge into the parent's rigid body
-        else:
-            if len(joints) != 1 or self.attr(joints[0], "type", "hinge") != "hinge":
-                self.fail(joints[0], "a non-root body must have at most one joint, a hinge")
-            rid = self.new_rigid(name)
-            self.pins.append(self.hinge(joints[0], parent, rid))
-        self.body_map[name] = rid
-        self.rigid[rid].mjcf_bodies.append(name)
+    def walk_children(self, node, body: Body3D, cls):
         for c in node.children:
-            if c.tag == "geom":
-                self.check(c)
-                self.rigid[rid].parts.append(self.geom(c) + (c.attrib.get("name", ""),))
-            elif c.tag == "body":
-                self.walk(c, rid)
+            if c.tag == "body":
+                self.walk(c, body, cls)
+            elif c.tag == "geom":
+                body.geoms.append(self.geom(c, self.effective(c, cls), body))
+            elif c.tag == "joint" and node.tag == "body":
+                body.joints.append(self.joint(c, self.effective(c, cls), body))
+            elif c.tag == "inertial" and node.tag == "body":
+                body.inertials.append(self.inertial(c, body))
+            else:
+                self.elsewhere(c, node.tag)
 
-    def new_rigid(self, name):
-        self.rigid.append(RigidBody(name))
-        return len(self.rigid) - 1
+    def walk(self, node, parent: Body3D, cls):
+        eff = dict(node.attrib)
+        self.vet(node, eff)
+        name = eff.get("name") or f"body@{node.line}"
+        if any(b.name == name for b in self.bodies):
+            self.fail(node, f"duplicate body name {name!r}")
+        pos, R = self.frame(node, eff, parent.pos, parent.R)
+        body = Body3D(node, name, parent, pos, R)
+        parent.children.append(body)
+        self.bodies.append(body)
+        self.walk_children(node, body, eff.get("childclass", cls))
+        if "childclass" in eff and eff["childclass"] not in self.classes:
+            self.fail(node, f"childclass={eff['childclass']!r} is not defined")
 
-    def axis(self, j):
-        a = self.floats(j, "axis", 3, default=(0.0, 0.0, 1.0))
-        n = np.linalg.norm(a)
-        if not n > 0:
+    def joint(self, j, eff, body):
+        kind = eff.get("type", "hinge")
+        if kind in ("free", "ball"):
+            self.fail(j, f"type={kind!r} leaves the plane; use slides and a hinge")
+        if kind not in ("hinge", "slide"):
+            self.fail(j, f"type={kind!r} must be 'hinge' or 'slide'")
+        a = self.floats(j, eff, "axis", 3, default=(0.0, 0.0, 1.0))
+        if not np.linalg.norm(a) > 0:
             self.fail(j, f"axis={tuple(a)} must be non-zero")
-        return a / n
+        a = a / np.linalg.norm(a)
+        p = self.floats(j, eff, "pos", 3, default=(0.0, 0.0, 0.0))
+        if not self.global_coords:
+            a, p = body.R @ a, body.pos + body.R @ p
+        return dict(node=j, eff=eff, type=kind, axis=a, pos=p,
+                    name=eff.get("name") or f"joint@{j.line}")
 
-    def passive(self, j):
-        armature = float(self.floats(j, "armature", 1, default=(0.0,))[0])
-        if armature != 0.0:
-            self.fail(j, f"armature={armature} is not supported (must be 0)")
-        k = float(self.floats(j, "stiffness", 1, default=(0.0,))[0])
-        c = float(self.floats(j, "damping", 1, default=(0.0,))[0])
-        if k < 0 or c < 0:
-            self.fail(j, f"stiffness={k} and damping={c} must be >= 0")
-        return k, c
-
-    def root_joints(self, node, joints, rid):
-        kinds = sorted(self.attr(j, "type", "hinge") for j in joints)
-        if kinds == ["hinge", "slide", "slide"]:
-            slides = [self.axis(j) for j in joints if self.attr(j, "type", "hinge") == "slide"]
-            hinge = [j for j in joints if self.attr(j, "type", "hinge") == "hinge"][0]
-            a = self.axis(hinge)
-            span = np.cross(slides[0], slides[1])
-            if abs(abs(a[1]) - 1) > 1e-9 or any(abs(s[1]) > 1e-9 for s in slides) or np.linalg.norm(span) < 1e-9:
-                self.fail(node, "the root's joints must be two slides spanning the x-z plane and a "
-                                "hinge about y (free in the plane)")
-            for j in joints:
-                k, c = self.passive(j)
-                if k or c or self.limited(j):
-                    self.fail(j, "stiffness, damping or limits on the root's planar joints are not "
-                                 "supported")
-            self.free = tuple(j.attrib.get("name", "") for j in joints)
-            self.root_pin = None
-        elif kinds == ["hinge"]:
-            self.free = ()
-            self.root_pin = self.hinge(joints[0], None, rid)
-        else:
-            self.fail(node, f"root body joints {kinds} unsupported: use slide x + slide z + hinge y "
-                            f"(free in the plane) or one hinge (pinned to the world)")
-
-    def limited(self, j):
-        lim = self.attr(j, "limited", "auto")
-        if lim not in ("true", "false", "auto"):
-            self.fail(j, f"limited={lim!r} must be true, false or auto")
-        return lim == "true" or (lim == "auto" and self.attr(j, "range") is not None)
-
-    def hinge(self, j, parent, child):
-        a = self.axis(j)
-        if abs(abs(a[1]) - 1.0) > 1e-9:
-            self.fail(j, f"hinge axis={tuple(j.attrib.get('axis', '0 0 1').split())} must be "
-                         f"(0, +-1, 0): normal to the x-z plane")
-        sign = -float(np.sign(a[1]))      # pin angle = sign * MJCF angle
-        pos = self.plane(self.floats(j, "pos", 3, default=(0.0, 0.0, 0.0)))
-        limit = None
-        if self.limited(j):
-            rng = self.floats(j, "range", 2) * self.angle_scale
-            if rng[0] > rng[1]:
-                self.fail(j, f"range={tuple(rng / self.angle_scale)} has lower > upper")
-            limit = tuple(sorted((sign * rng[0], sign * rng[1])))
-        k, c = self.passive(j)
-        name = j.attrib.get("name") or f"joint@{j.line}"
-        return dict(name=name, parent=parent, child=child, pos=pos, limit=limit, k=k, c=c, node=j)
-
-    def geom(self, g):
-        kind = self.attr(g, "type", "sphere")
-        size = self.floats(g, "size", (1, 2, 3))
+    def geom(self, g, eff, body):
+        """World pose, size and mass of one geom (see planarsim.mjcf_frames)."""
+        kind = eff.get("type", "sphere")
+        if kind not in SUPPORTED_GEOMS:
+            self.fail(g, f"type={kind!r} is not supported ({', '.join(SUPPORTED_GEOMS)})")
+        if kind == "plane":
+            pos, R = self.frame(g, eff, body.pos, body.R)
+            return dict(node=g, eff=eff, kind=kind, pos=pos, R=R, mass=0.0, name=eff.get("name", ""),
+                        **self.contact_params(g, eff))
+        size = self.floats(g, eff, "size", (1, 2, 3))
         if np.any(size <= 0):
             self.fail(g, f"size={tuple(size)} must be > 0")
-        if kind == "sphere":
-            r = size[0]
-            vol = 4 / 3 * math.pi * r ** 3
-            center = self.floats(g, "pos", 3, default=(0.0, 0.0, 0.0))
-            i_unit, shape = 0.4 * r * r, ("circle", r)
-        elif kind == "box":
-            if size.size != 3:
-                self.fail(g, f"box size={tuple(size)} must be three half-lengths")
-            if "fromto" in g.attrib:
-                self.fail(g, "fromto on a box is not supported; use pos and size")
-            vol = 8 * size[0] * size[1] * size[2]
-            center = self.floats(g, "pos", 3, default=(0.0, 0.0, 0.0))
-            i_unit, shape = (size[0] ** 2 + size[2] ** 2) / 3, ("box", 2 * size[0], 2 * size[2])
-        elif kind == "capsule":
-            r = size[0]
-            if "fromto" not in g.attrib:
-                self.fail(g, "a capsule needs fromto (pos + half-length is not supported)")
-            ft = self.floats(g, "fromto", 6)
+        need = {"sphere": 1, "capsule": 1 if "fromto" in eff else 2,
+                "cylinder": 1 if "fromto" in eff else 2, "box": 2 if "fromto" in eff else 3,
+                "ellipsoid": 2 if "fromto" in eff else 3}[kind]
+        if size.size < need:
+            self.fail(g, f"{kind} size={tuple(size)} needs {need} number(s)")
+        if "fromto" in eff and kind != "sphere":
+            ft = self.floats(g, eff, "fromto", 6)
             p0, p1 = ft[:3], ft[3:]
-            L = float(np.linalg.norm(p1 - p0))
-            if not L > 0:
+            if not self.global_coords:
+                p0, p1 = body.pos + body.R @ p0, body.pos + body.R @ p1
+            half = 0.5 * float(np.linalg.norm(p1 - p0))
+            if not half > 0:
                 self.fail(g, "fromto end points must differ")
-            vol_c, vol_h = math.pi * r * r * L, 4 / 3 * math.pi * r ** 3
-            vol = vol_c + vol_h
-            fc, fh = vol_c / vol, vol_h / vol
-            i_perp = fc * (r * r / 4 + L * L / 12) + fh * (83 / 320 * r * r + (L / 2 + 3 * r / 8) ** 2)
-            i_axis = fc * r * r / 2 + fh * 0.4 * r * r
-            ay = (p1 - p0)[1] / L
-            i_unit = i_perp + (i_axis - i_perp) * ay * ay
-            center = 0.5 * (p0 + p1)
-            shape = ("capsule", self.plane(p0), self.plane(p1), r)
+            pos, R, ends = 0.5 * (p0 + p1), F.zaxis_matrix(p1 - p0), (p0, p1)
+            dims = (size[0], half) if kind in ("capsule", "cylinder") else (size[0], size[1], half)
         else:
-            self.fail(g, f"geom type={kind!r} is not supported (capsule, box or sphere)")
-        if "mass" in g.attrib or "mass" in self.defaults["geom"]:
-            mass = float(self.floats(g, "mass", 1)[0])
+            pos, R = self.frame(g, eff, body.pos, body.R)
+            dims = tuple(size[:need])
+            ends = (pos - dims[-1] * R[:, 2], pos + dims[-1] * R[:, 2])
+        vol, unit = F.unit_inertia(kind, dims)
+        if "mass" in eff:
+            mass = self.scalar(g, eff, "mass", 0.0)
+            if mass < 0:
+                self.fail(g, f"mass={mass} must be > 0 (or 0 for a massless geom)")
         else:
-            mass = float(self.floats(g, "density", 1, default=(DEFAULT_DENSITY,))[0]) * vol
+            density = self.scalar(g, eff, "density", DEFAULT_DENSITY)
+            if density < 0:
+                self.fail(g, f"density={density} must be >= 0")
+            mass = density * vol
+        return dict(node=g, eff=eff, kind=kind, pos=pos, R=R, dims=dims, unit=unit, mass=mass, ends=ends,
+                    name=eff.get("name", ""), **self.contact_params(g, eff))
+
+    def contact_params(self, g, eff):
+        """contype, conaffinity (bits), condim and sliding friction of a geom."""
+        out = {}
+        for key in ("contype", "conaffinity"):
+            v = eff.get(key, "1")
+            if not v.strip().isdigit():
+                self.fail(g, f"{key}={v!r} must be a non-negative integer (bits)")
+            out[key] = int(v)
+        out["condim"] = int(self.scalar(g, eff, "condim", 3))
+        if out["condim"] not in (1, 3, 4, 6):
+            self.fail(g, f"condim={out['condim']} must be 1, 3, 4 or 6")
+        fr = self.floats(g, eff, "friction", (1, 2, 3), default=DEFAULT_FRICTION)
+        if fr[0] < 0:
+            self.fail(g, f"friction={tuple(fr)} must be >= 0")
+        out["mu"] = float(fr[0])
+        return out
+
+    def inertial(self, node, body):
+        eff = dict(node.attrib)
+        self.vet(node, eff)
+        pos, R = self.frame(node, eff, body.pos, body.R)
+        mass = self.scalar(node, eff, "mass", -1.0)
         if not mass > 0:
-            self.fail(g, f"mass={mass} must be > 0")
-        return mass, self.plane(center), mass * i_unit, shape
+            self.fail(node, f"mass={mass} must be > 0")
+        if "fullinertia" in eff:
+            f6 = self.floats(node, eff, "fullinertia", 6)
+            tensor = np.array([[f6[0], f6[3], f6[4]], [f6[3], f6[1], f6[5]], [f6[4], f6[5], f6[2]]])
+            tensor = R @ tensor @ R.T
+        else:
+            d = self.floats(node, eff, "diaginertia", 3)
+            tensor = R @ np.diag(d) @ R.T
+        return dict(node=node, mass=mass, pos=pos, tensor=tensor)
+
+    # the plane of motion ----------------------------------------------------------------------
+    def choose_plane(self):
+        """The plane normal to the hinges (MJCF y -> x-z, z -> x-y; x-z without hinges); every
+        hinge must be normal to it and every slide in it."""
+        joints = [j for b in self.bodies for j in b.joints]
+        hinges = [j for j in joints if j["type"] == "hinge"]
+        normal = 1
+        if hinges and abs(abs(hinges[0]["axis"][2]) - 1) <= AXIS_TOL:
+            normal = 2
+        self.i1, self.i2 = (0, 2) if normal == 1 else (0, 1)
+        self.normal = normal
+        self.plane_name = "x-z" if normal == 1 else "x-y"
+        self.ccw = np.cross(np.eye(3)[self.i1], np.eye(3)[self.i2])   # -y or +z
+        want = "(0, +-1, 0)" if normal == 1 else "(0, 0, +-1)"
+        for j in joints:
+            a = j["axis"]
+            if j["type"] == "hinge" and abs(abs(a[normal]) - 1) > AXIS_TOL:
+                self.fail(j["node"], f"hinge axis={_vec(a)} is not normal to the "
+                                     f"{self.plane_name} plane of motion: it must be {want}; a "
+                                     f"joint leaving the plane is not supported")
+            if j["type"] == "slide" and abs(a[normal]) > AXIS_TOL:
+                self.fail(j["node"], f"slide axis={_vec(a)} leaves the "
+                                     f"{self.plane_name} plane of motion")
+
+    def plane(self, p) -> np.ndarray:
+        """World point (x, y, z) -> planarsim (x, y) [m], shifted by the offset."""
+        return np.array([p[self.i1], p[self.i2]]) + self.offset
+
+    def sign(self, j) -> float:
+        """+1 when the MJCF joint turns (hinge) counter-clockwise in planarsim's plane."""
+        return float(np.sign(j["axis"] @ self.ccw))
+
+    def builder(self, builder_kw, builder):
+        """A ModelBuilder with the file's timestep and in-plane gravity (caller's builder or
+        builder_kw win, noted in the report), and flat terrain from a ground plane."""
+        dt = self.option.get("timestep", DEFAULT_TIMESTEP)
+        g3 = np.asarray(self.option.get("gravity", DEFAULT_GRAVITY), dtype=np.float64)
+        g = (float(g3[self.i1]), float(g3[self.i2]))
+        if g3[self.normal] != 0:
+            self.report.note(f"gravity along the plane's normal ({g3[self.normal]} m/s^2) is "
+                             f"carried by the joints: the model cannot move that way")
+        self.ground = self.ground_plane()
+        if builder is not None:
+            if builder.dt != dt or tuple(np.asarray(builder.gravity, float)) != g:
+                self.report.note(f"the caller's builder keeps dt={builder.dt} s and gravity="
+                                 f"{tuple(builder.gravity)}; the file has dt={dt} s, gravity={g}")
+            if self.ground is not None:
+                self.report.note("the caller's builder keeps its terrain; the file's ground plane "
+                                 "is not applied")
+            return builder
+        kw = dict(dt=dt, gravity=g)
+        if self.ground is not None:
+            kw["terrain"] = flat(self.ground[1])
+        for k, v in builder_kw.items():
+            if k in kw and k != "terrain":
+                self.report.note(f"{k}={v} given to load_mjcf overrides the file's {kw[k]}")
+            kw[k] = v
+        return ModelBuilder(**kw)
+
+    def ground_plane(self):
+        """(geom, height [m]) of the world's plane that faces up in the plane of motion, or
+        None. Planes parallel to the plane of motion are ignored (they meet nothing)."""
+        found = None
+        for g in self.world_geoms():
+            if g["kind"] != "plane":
+                continue
+            n = g["R"][:, 2]
+            if abs(abs(n[self.normal]) - 1) <= AXIS_TOL:
+                self.report.ignore("geom plane parallel to the plane of motion", g["node"].line)
+                continue
+            if abs(n[self.i2] - 1) > AXIS_TOL:
+                self.fail(g["node"], f"a plane whose normal {_vec(n)} is not the "
+                                     f"plane of motion's up is not supported")
+            if found is not None:
+                self.fail(g["node"], "a second ground plane is not supported")
+            found = (g, float(self.plane(g["pos"])[1]))
+        return found
+
+    def world_geoms(self):
+        """Geoms of the world and of the bodies welded to it (no joint on the way)."""
+        out, stack = [], [self.world]
+        while stack:
+            b = stack.pop()
+            out += b.geoms
+            stack += [c for c in b.children if not c.joints]
+        return out
+
+    # rigid bodies -----------------------------------------------------------------------------
+    def group(self):
+        """Assign each MJCF body to a planarsim rigid body (None: welded to the world) and
+        collect the joints that link them: pins, sliders and free roots."""
+        self.rigid, self.links, self.free, self.body_map = [], [], (), {}
+        for b in self.bodies:
+            parent_rid = b.parent.rid if b.parent is not None else None
+            if not b.joints:
+                b.rid = parent_rid
+                if b.rid is not None:
+                    self.body_map[b.name] = b.rid
+                    self.rigid[b.rid].mjcf_bodies.append(b.name)
+                continue
+            b.rid = len(self.rigid)
+            self.rigid.append(RigidBody(b.name, mjcf_bodies=[b.name]))
+            self.body_map[b.name] = b.rid
+            kinds = sorted(j["type"] for j in b.joints)
+            if kinds == ["hinge"]:
+                self.links.append(("pin", b.joints[0], parent_rid, b.rid))
+            elif kinds == ["slide"]:
+                self.links.append(("slider", b.joints[0], parent_rid, b.rid))
+            elif set(kinds) == {"slide"}:
+                self.fail(b.node, f"{len(kinds)} slides on one body need slider joints "
+                                  f"(ModelBuilder.add_slider) through intermediate bodies, not "
+                                  f"supported yet")
+            elif kinds == ["hinge", "slide", "slide"] and parent_rid is None:
+                s = [j["axis"] for j in b.joints if j["type"] == "slide"]
+                if abs(np.cross(s[0], s[1]) @ self.ccw) < 1e-9:
+                    self.fail(b.node, "the root's two slides must span the plane of motion")
+                self.free_root(b)
+            else:
+                self.fail(b.node, f"joints {kinds} on one body are not supported: use one hinge, "
+                                  f"one slide, or (a root) two slides and a hinge, free in the plane")
+
+    def free_root(self, b):
+        """Two slides and a hinge on a root: a body free in the plane (no constraint)."""
+        for j in b.joints:
+            eff, node = j["eff"], j["node"]
+            k, c = self.scalar(node, eff, "stiffness", 0.0), self.scalar(node, eff, "damping", 0.0)
+            if k or c or self.limited(j):
+                self.fail(node, "stiffness, damping or limits on the root's planar joints are "
+                                "not supported")
+            self.armature(j, supported=False)
+        self.free += tuple(j["name"] for j in b.joints)
+        self.free_bodies = getattr(self, "free_bodies", []) + [b]
+
+    def limited(self, j):
+        v = self.flag(j["node"], j["eff"], "limited")
+        return v == "true" or (v == "auto" and "range" in j["eff"])
+
+    def armature(self, j, supported):
+        """Joint armature [kg m^2 or kg]: passed on when the builder takes it (supported),
+        dropped when the caller asked, else a ModelError."""
+        a = self.scalar(j["node"], j["eff"], "armature", 0.0)
+        if a == 0.0 or supported:
+            return a
+        if "armature" in self.drop:
+            self.report.drop(f"joint armature", j["node"].line)
+            return 0.0
+        self.fail(j["node"], f"armature={a} needs joint armature, not supported yet "
+                             f"(drop={{'armature'}} loads without it)")
+
+    def parts(self):
+        """Mass [kg], in-plane COM [m], own inertia about the normal [kg m^2] and the shape of
+        every geom (and <inertial>) of every rigid body; static geoms go to self.static."""
+        n = np.eye(3)[self.normal]
+        self.static = []
+        for b in self.bodies:
+            use_inertial = self.inertiafromgeom == "false" or (self.inertiafromgeom == "auto"
+                                                                and b.inertials)
+            if self.inertiafromgeom == "true":
+                for i in b.inertials:
+                    self.report.ignore("<inertial> (inertiafromgeom='true')", i["node"].line)
+            for g in b.geoms:
+                shape = self.shape(g)
+                if g["kind"] == "plane":
+                    if b.rid is not None:
+                        self.fail(g["node"], "a plane must belong to the world")
+                    continue
+                if b.rid is None:
+                    self.static.append((g, shape))
+                    continue
+                mass = 0.0 if use_inertial else g["mass"]
+                self.rigid[b.rid].parts.append((mass, self.plane(g["pos"]), mass * self.own_inertia(g, n),
+                                                shape, g["name"], g))
+            if use_inertial and b.rid is not None:
+                for i in b.inertials:
+                    self.rigid[b.rid].parts.append((i["mass"], self.plane(i["pos"]),
+                                                    float(n @ i["tensor"] @ n), None, "", i))
+
+    def own_inertia(self, g, n) -> float:
+        """Inertia per unit mass [m^2] about the normal through the geom's centre."""
+        if g["kind"] in ("capsule", "cylinder", "sphere"):
+            i_perp, i_axis = g["unit"][0], g["unit"][2]
+            ay = g["R"][self.normal, 2]         # axis . n
+            return i_perp + (i_axis - i_perp) * ay * ay
+        return F.inertia_about(g["unit"], g["R"], n)
+
+    def shape(self, g):
+        """The geom's silhouette in the plane (world coordinates [m], offset applied):
+        ('circle', c, r) | ('capsule', p0, p1, r) | ('box', c, w, h, angle) | ('polygon', vs)."""
+        kind, R, c = g["kind"], g["R"], self.plane(g["pos"])
+        if kind == "plane":
+            return None
+        nz = abs(R[self.normal, 2])               # geom z axis . plane normal
+        if kind == "sphere":
+            return ("circle", c, g["dims"][0])
+        if kind == "capsule":
+            r = g["dims"][0]
+            p0, p1 = (self.plane(e) for e in g["ends"])
+            if np.hypot(*(p1 - p0)) < 1e-12:
+                return ("circle", c, r)
+            return ("capsule", p0, p1, r)
+        if kind == "cylinder":
+            r, h = g["dims"]
+            if abs(nz - 1) <= AXIS_TOL:
+                return ("circle", c, r)
+            if nz <= AXIS_TOL:
+                u = R[:, 2]
+                return ("box", c, 2 * h, 2 * r, math.atan2(u[self.i2], u[self.i1]))
+            self.fail(g["node"], "a cylinder tilted out of the plane has no planar shape here")
+        half = np.asarray(g["dims"][:3] if kind == "box" else g["dims"], dtype=np.float64)
+        along = [k for k in range(3) if abs(abs(R[self.normal, k]) - 1) <= AXIS_TOL]
+        if kind == "ellipsoid":
+            if not along:
+                self.fail(g["node"], "an ellipsoid tilted out of the plane has no planar shape here")
+            k1, k2 = [k for k in range(3) if k != along[0]]
+            ts = np.linspace(0, 2 * math.pi, 24, endpoint=False)
+            pts = [self.plane(g["pos"] + half[k1] * math.cos(t) * R[:, k1]
+                              + half[k2] * math.sin(t) * R[:, k2]) for t in ts]
+            return ("polygon", pts, "approximate")
+        if along:
+            k1, k2 = [k for k in range(3) if k != along[0]]
+            u = R[:, k1]
+            return ("box", c, 2 * half[k1], 2 * half[k2], math.atan2(u[self.i2], u[self.i1]))
+        corners = [self.plane(g["pos"] + R @ (half * np.array(s)))
+                   for s in np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).T.reshape(-1, 3)]
+        return ("polygon", _hull(corners))
 
     # build ------------------------------------------------------------------------------------
     def emit(self, builder, model_name) -> MJCFModel:
+        self.group()
+        self.parts()
+        if not self.rigid:
+            self.fail(self.root, "no body with a joint: nothing moves")
+        self.scale_total_mass()
         ids = []
         for rb in self.rigid:
-            if not rb.parts:
-                self.fail(self.root, f"body {rb.name!r} has no geom with mass")
             m = np.array([p[0] for p in rb.parts])
+            if not rb.parts or not m.sum() > 0:
+                self.fail(self.root, f"body {rb.name!r} has no mass (give its geoms mass or "
+                                     f"density, or an <inertial>)")
             x = np.array([p[1] for p in rb.parts])
             rb.mass = float(m.sum())
             rb.com = (m[:, None] * x).sum(0) / rb.mass
             d2 = ((x - rb.com) ** 2).sum(1)
             rb.inertia = float(sum(p[2] for p in rb.parts) + (m * d2).sum())
-            shapes = []
-            for _, c, _, s, geom_name in rb.parts:
-                # drawn only unless named in collide: the model touches the ground through
-                # its own contact points
-                how = COLLIDES if geom_name in self.collide else DRAWN
-                if s[0] == "circle":
-                    shapes.append(("circle", tuple(c - rb.com), s[1], how))
-                elif s[0] == "box":
-                    shapes.append(("box", tuple(c - rb.com), s[1], s[2], how))
-                else:
-                    shapes.append(("capsule", tuple(s[1] - rb.com), tuple(s[2] - rb.com), s[3],
-                                   how))
+            shapes = [self.body_shape(s, g, rb.com) for _, _, _, s, _, g in rb.parts if s is not None]
             ids.append(builder.add_body(rb.name, mass=rb.mass, inertia=rb.inertia,
                                         pos=tuple(rb.com), shapes=shapes))
-        pins = {}
-        if self.root_pin is not None:
-            self.pins.insert(0, self.root_pin)
-        for p in self.pins:
-            a = None if p["parent"] is None else ids[p["parent"]]
-            pins[p["name"]] = builder.add_pin(p["name"], a, ids[p["child"]], anchor_world=tuple(p["pos"]),
-                                              limit=p["limit"], stiffness=p["k"], damping=p["c"])
-        return MJCFModel(builder=builder, body={k: ids[v] for k, v in self.body_map.items()},
-                         pin=pins, rigid={ids[i]: rb for i, rb in enumerate(self.rigid)},
-                         root=ids[0], name=model_name, free_joints=self.free)
+        for g, s in self.static:
+            self.world_shape(builder, g, s)
+        self.self_collisions()
+        out = MJCFModel(builder=builder, body={k: ids[v] for k, v in self.body_map.items()},
+                        pin={}, rigid={ids[i]: rb for i, rb in enumerate(self.rigid)},
+                        root=ids[0], name=model_name, free_joints=self.free,
+                        plane=self.plane_name, report=self.report)
+        for b in getattr(self, "free_bodies", []):
+            slides = 0
+            for j in b.joints:
+                if j["type"] == "hinge":
+                    out.joint[j["name"]] = JointMap("free", ids[b.rid], self.sign(j),
+                                                    self.scalar(j["node"], j["eff"], "ref", 0.0), (2,))
+                else:
+                    a = j["axis"]
+                    out.joint[j["name"]] = JointMap("free", ids[b.rid], 1.0,
+                                                    self.scalar(j["node"], j["eff"], "ref", 0.0),
+                                                    (a[self.i1], a[self.i2]))
+                    slides += 1
+        for kind, j, parent, child in self.links:
+            a = None if parent is None else ids[parent]
+            if kind == "pin":
+                pid = self.add_pin(builder, j, a, ids[child])
+                out.pin[j["name"]] = pid
+                out.joint[j["name"]] = JointMap("pin", pid, self.sign(j), self.ref(j))
+            else:
+                out.joint[j["name"]] = JointMap("slider", self.add_slider(builder, j, a, ids[child]),
+                                                1.0, self.ref(j))
+        return out
+
+    def ref(self, j):
+        """The joint's value at the file's pose (rad for a hinge, m for a slide)."""
+        s = self.angle_scale if j["type"] == "hinge" else 1.0
+        return self.scalar(j["node"], j["eff"], "ref", 0.0) * s
+
+    def joint_terms(self, j):
+        """Limits, stiffness, damping and rest value of a hinge or slide in planarsim's sign:
+        (limit (lo, hi) or None, k, c, rest)."""
+        node, eff = j["node"], j["eff"]
+        s = self.angle_scale if j["type"] == "hinge" else 1.0
+        sign = self.sign(j) if j["type"] == "hinge" else 1.0
+        ref = self.ref(j)
+        limit = None
+        if self.limited(j):
+            rng = self.floats(node, eff, "range", 2) * s
+            if rng[0] > rng[1]:
+                self.fail(node, f"range={tuple(rng / s)} has lower > upper")
+            limit = tuple(sorted((sign * (rng[0] - ref), sign * (rng[1] - ref))))
+        k = self.scalar(node, eff, "stiffness", 0.0)
+        c = self.scalar(node, eff, "damping", 0.0)
+        if k < 0 or c < 0:
+            self.fail(node, f"stiffness={k} and damping={c} must be >= 0")
+        rest = sign * (self.scalar(node, eff, "springref", 0.0) * s - ref) + 0.0   # no -0.0
+        return limit, k, c, rest
+
+    def add_pin(self, builder, j, a, b):
+        """A hinge -> ModelBuilder.add_pin at the joint's world position; armature goes to
+        add_pin(armature=...) when the builder takes it."""
+        limit, k, c, rest = self.joint_terms(j)
+        takes = "armature" in inspect.signature(builder.add_pin).parameters
+        arm = self.armature(j, supported=takes)
+        kw = dict(armature=arm) if takes and arm else {}
+        return builder.add_pin(j["name"], a, b, anchor_world=tuple(self.plane(j["pos"])),
+                               limit=limit, stiffness=k, damping=c, rest_angle=rest, **kw)
+
+    def add_slider(self, builder, j, a, b):
+        """A slide between bodies -> ModelBuilder.add_slider (axis: unit in-plane direction;
+        limit [m]; stiffness [N/m], damping [N s/m]), when the builder has it."""
+        if not hasattr(builder, "add_slider"):
+            self.fail(j["node"], "needs slider joints (ModelBuilder.add_slider), not supported yet")
+        limit, k, c, rest = self.joint_terms(j)
+        takes = "armature" in inspect.signature(builder.add_slider).parameters
+        arm = self.armature(j, supported=takes)
+        kw = dict(armature=arm) if takes and arm else {}
+        ax = j["axis"]
+        return builder.add_slider(j["name"], a, b, axis=(ax[self.i1], ax[self.i2]),
+                                  anchor_world=tuple(self.plane(j["pos"])), limit=limit,
+                                  stiffness=k, damping=c, rest=rest, **kw)
+
+    def scale_total_mass(self):
+        """<compiler settotalmass>: scale every mass and inertia so the bodies total it [kg]."""
+        if self.settotalmass is None:
+            return
+        total = sum(p[0] for rb in self.rigid for p in rb.parts)
+        total += sum(g["mass"] for g, _ in self.static)
+        f = self.settotalmass / total
+        for rb in self.rigid:
+            rb.parts = [(m * f, x, i * f, *rest) for m, x, i, *rest in rb.parts]
+
+    # collision shapes ---------------------------------------------------------------------
+    def body_shape(self, s, g, com):
+        """A shape tuple for add_body: relative to the COM, with add_shape's options."""
+        how = self.collision(g)
+        if s[0] == "circle":
+            return ("circle", tuple(s[1] - com), s[2], how)
+        if s[0] == "capsule":
+            return ("capsule", tuple(s[1] - com), tuple(s[2] - com), s[3], how)
+        if s[0] == "box":
+            angle = () if s[4] == 0.0 else (s[4],)
+            return ("box", tuple(s[1] - com), s[2], s[3], *angle, how)
+        if len(s) > 2 and how.get("collide"):
+            self.fail(g["node"], "an ellipsoid that collides is not supported (only drawn ones)")
+        return ("polygon", [tuple(v - com) for v in s[1]], how)
+
+    def collision(self, g):
+        """add_shape options of a body geom: the caller's ``collide`` names, else MuJoCo's
+        contype/conaffinity (ground contact with the ground plane, friction the larger of
+        the two, none where both have condim 1)."""
+        if self.collide is not None:
+            return COLLIDES if g["name"] in self.collide else DRAWN
+        ground = self.ground is not None and _mj_pair(g, self.ground[0])
+        others = [h for h, _ in self.static] + [p[5] for rb in self.rigid for p in rb.parts
+                                                 if p[3] is not None]
+        if not ground and not any(_mj_pair(g, h) for h in others if h is not g):
+            return dict(DRAWN)
+        mu = g["mu"]
+        if ground:
+            plane = self.ground[0]
+            mu = 0.0 if max(g["condim"], plane["condim"]) == 1 else max(mu, plane["mu"])
+        return dict(collide=True, ground=ground, mu=mu, category=g["contype"],
+                    mask=g["conaffinity"], name=g["name"] or None)
+
+    def world_shape(self, builder, g, s):
+        """A static geom that collides with some body geom -> a world shape; else ignored."""
+        bodies = [p[5] for rb in self.rigid for p in rb.parts if p[3] is not None]
+        if self.collide is not None or not any(_mj_pair(g, h) for h in bodies):
+            self.report.ignore("world geom that collides with nothing", g["node"].line)
+            return
+        if s[0] == "polygon" and len(s) > 2:
+            self.fail(g["node"], "an ellipsoid that collides is not supported")
+        params = [tuple(p) if isinstance(p, np.ndarray) else p for p in s[1:]]
+        if s[0] == "polygon":
+            params = [[tuple(v) for v in s[1]]]
+        builder.add_shape(None, s[0], *params, mu=g["mu"], category=g["contype"],
+                          mask=g["conaffinity"], name=g["name"] or None)
+
+    def self_collisions(self):
+        """Note pairs of one tree that MuJoCo may collide (not parent and child) and planarsim
+        does not (bodies linked by joints never collide here)."""
+        if self.collide is not None:
+            return
+        parent = {b.rid: (b.parent.rid if b.parent is not None else None)
+                  for b in self.bodies if b.joints}
+        geoms = [(rid, p[5]) for rid, rb in enumerate(self.rigid) for p in rb.parts if p[3] is not None]
+        for i, (ra, ga) in enumerate(geoms):
+            for rb_, gb in geoms[i + 1:]:
+                if ra == rb_ or parent.get(ra) == rb_ or parent.get(rb_) == ra:
+                    continue
+                if _mj_pair(ga, gb):
+                    self.report.note(f"geoms {ga['name'] or ga['node'].line!r} and "
+                                     f"{gb['name'] or gb['node'].line!r} may touch in MuJoCo; "
+                                     f"planarsim's bodies linked by joints do not collide")
+
+    # actuators --------------------------------------------------------------------------------
+    def actuators(self, node, out: MJCFModel):
+        for a in node.children:
+            if a.tag != "motor":
+                if a.tag in ("general", "position", "velocity", "intvelocity", "damper",
+                             "cylinder", "muscle", "adhesion"):
+                    self.fail(a, f"<{a.tag}> actuators are not supported (only <motor>)")
+                self.elsewhere(a, "actuator")
+                continue
+            eff = self.effective(a, tag="motor")
+            for key in ("tendon", "site", "body", "jointinparent"):
+                if key in eff:
+                    self.fail(a, f"a motor on a {key} is not supported (only joint=)")
+            jname = eff.get("joint")
+            if jname is None or jname not in out.joint:
+                self.fail(a, f"joint={jname!r} names no joint of the model")
+            jm = out.joint[jname]
+            gear = self.floats(a, eff, "gear", (1, 6), default=(1.0,))
+            if np.any(gear[1:] != 0):
+                self.fail(a, f"gear={tuple(gear)}: only the first component acts on a joint")
+            signed = float(gear[0]) * jm.sign
+            lo, hi = -math.inf, math.inf
+            for rng, lim in (("ctrlrange", "ctrllimited"), ("forcerange", "forcelimited")):
+                v = self.flag(a, eff, lim)
+                if v == "true" or (v == "auto" and rng in eff):
+                    r = self.floats(a, eff, rng, 2)
+                    if r[0] > r[1]:
+                        self.fail(a, f"{rng}={tuple(r)} has lower > upper")
+                    lo, hi = max(lo, r[0]), min(hi, r[1])
+            ctrl = (lo, hi)
+            limit = tuple(sorted((signed * lo, signed * hi))) if math.isfinite(lo) else (-math.inf, math.inf)
+            name = eff.get("name") or jname
+            b = out.builder
+            if jm.kind == "pin":
+                aid = b.add_pin_motor(name, jm.id, limit=limit)
+            elif jm.kind == "free" and jm.axis == (2,):
+                aid = b.add_body_torque(name, jm.id, limit=limit)
+            elif jm.kind == "free":
+                aid = b.add_body_force(name, jm.id, direction=jm.axis, limit=limit)
+            else:
+                if not hasattr(b, "add_slider_motor"):
+                    self.fail(a, "a motor on a slider needs ModelBuilder.add_slider_motor, not "
+                                 "supported yet")
+                aid = b.add_slider_motor(name, jm.id, limit=limit)
+            out.actuator[name] = ActuatorMap(aid, jname, signed, ctrl)
 
 
-def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), collide=(),
-              **builder_kw) -> MJCFModel:
-    """Load a planar MJCF character.
+def _hull(points) -> list:
+    """Convex hull (counter-clockwise) of 2D points (monotone chain)."""
+    pts = sorted({(round(float(p[0]), 12), round(float(p[1]), 12)) for p in points})
+
+    def half(seq):
+        out = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(p)
+        return out[:-1]
+    return half(pts) + half(pts[::-1])
+
+
+def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), collide=None,
+              drop=(), **builder_kw) -> MJCFModel:
+    """Load a planar MJCF model (see the module's docstring for what is read).
 
     source : path to an .xml file, or the XML text itself (a string starting with '<')
-    builder : add to this ModelBuilder (default: a new one from ``builder_kw``: dt, gravity,
-        terrain)
-    offset : (2,) [m] translation of the whole character in the plane (e.g. to stand it on
-        the ground)
-    collide : names of the geoms that collide (with the ground and other bodies' shapes); the
-        others are drawn only (the character touches the ground through contacts added to the
-        builder)
+    builder : add to this ModelBuilder (it keeps its dt, gravity and terrain); default: a new
+        one with the file's timestep [s], in-plane gravity [m/s^2] and ground plane (flat
+        terrain), overridden by ``builder_kw`` (dt, gravity, terrain)
+    offset : (2,) [m] translation of the whole file (bodies, world geoms, ground plane) in
+        the plane
+    collide : None: geoms collide by MuJoCo's contype/conaffinity; or names of the geoms that
+        collide (with the ground and other bodies' shapes), the others drawn only
+    drop : physics to load without instead of a ModelError: "armature", "fluid" (reported)
 
-    Returns an MJCFModel (builder, name maps, per-body mass properties). Raises ModelError
-    naming the element and line for malformed or unsupported input.
+    Returns an MJCFModel (builder, name maps, per-body mass properties, ``report`` of what
+    was ignored). Raises ModelError naming the element and line for malformed or unsupported
+    input.
     """
     if isinstance(source, (str, Path)) and not str(source).lstrip().startswith("<"):
         path = Path(source)
@@ -420,13 +1138,12 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
     else:
         text, name = str(source), "<string>"
     root = parse_xml(text, name)
-    b = builder if builder is not None else ModelBuilder(**builder_kw)
-    loader = _Loader(root, name)
-    loader.collide = frozenset(collide)
-    out = loader.load(b, offset)
-    known = {p[4] for rb in loader.rigid for p in rb.parts}
-    unknown = sorted(loader.collide - known)
-    if unknown:
-        raise ModelError(f"{name}: collide names geoms {unknown} that the file does not have; "
-                         f"its named geoms: {sorted(n for n in known if n)}")
+    loader = _Loader(root, name, drop)
+    out = loader.load(builder_kw, builder, offset, collide)
+    if collide is not None:
+        known = {p[4] for rb in loader.rigid for p in rb.parts}
+        unknown = sorted(frozenset(collide) - known)
+        if unknown:
+            raise ModelError(f"{name}: collide names geoms {unknown} that the file does not have; "
+                             f"its named geoms: {sorted(n for n in known if n)}")
     return out

@@ -124,15 +124,15 @@ def _rot(th):
     ("<mujoco><worldbody><body name='a'>\n<geom type='sphere' size='0.1'/>\n</body>",
      r"malformed XML.*line 3"),
     ("<mujoco><compiler coordinate='global'/><worldbody>\n<body name='a'>\n"
-     "<joint type='hinge' axis='0 1 0'/><geom type='cylinder' size='0.1 0.2' mass='1'/></body></worldbody></mujoco>",
-     r"line 3.*type='cylinder' is not supported"),
+     "<joint type='hinge' axis='0 1 0'/><geom type='mesh' size='0.1 0.2' mass='1'/></body></worldbody></mujoco>",
+     r"line 3.*type='mesh' is not supported"),
     ("<mujoco><compiler coordinate='global'/><worldbody>\n<body name='a'>\n"
-     "<joint type='hinge' axis='0 1 0'/><geom type='sphere' size='0.1' mass='1' euler='0 0 1'/></body></worldbody></mujoco>",
-     r"<geom> \(line 3\).*\['euler'\] not supported"),
-    ("<mujoco><compiler coordinate='global'/>\n<asset/><worldbody/></mujoco>",
-     r"line 2.*<asset> is not supported inside <mujoco>"),
-    ("<mujoco><compiler coordinate='local'/><worldbody/></mujoco>",
-     r"coordinate='local' is not supported"),
+     "<joint type='hinge' axis='0 1 0'/><geom type='sphere' size='0.1' mass='1' spin='0 0 1'/></body></worldbody></mujoco>",
+     r"<geom> \(line 3\).*\['spin'\] not supported"),
+    ("<mujoco><compiler coordinate='global'/>\n<deformable/><worldbody/></mujoco>",
+     r"line 2.*<deformable> is not supported inside <mujoco>"),
+    ("<mujoco><compiler coordinate='polar'/><worldbody/></mujoco>",
+     r"coordinate='polar' must be 'local' or 'global'"),
     ("<mujoco><compiler coordinate='global'/><worldbody><body name='a'>\n"
      "<joint type='hinge' axis='0 1 0'/>\n<geom type='sphere' size='0.1' mass='1'/>\n"
      "<body name='b'><joint name='k' type='hinge' axis='1 0 0'/>\n"
