@@ -22,8 +22,8 @@ from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
 from .limit import limit_side
 from .row_list import move_row
-from .rows import (eval_rows, is_contact_row, is_limit_row, is_normal_row, is_tangent_row,
-                   is_unilateral, row_lever)
+from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_normal_row,
+                   is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 
 
@@ -63,6 +63,8 @@ def keep_correction_rows(s, ws):
             continue    # rebounding (restitution): it leaves the surface, not held to it
         if is_limit_row(kind) and s.limit_active[o, limit_side(kind)] == 0:
             continue
+        if is_soft_row(kind):
+            continue    # a joint's armature / spring-damper row: no position error to hold
         if k != r:
             move_row(ws, k, r)
         k += 1
@@ -154,7 +156,7 @@ def rows_hold_within(m, s, ws, h, limit):
             return False
     for r in range(n):
         err = ws.rhs[r]
-        angular = is_limit_row(ws.row_kind[r])
+        angular = is_angular_row(m, ws, r)
         for e in range(2):
             b = ws.row_body[r, e]
             if b < 0:

@@ -18,7 +18,8 @@ Without sliding contacts F = J and the matrix is symmetric: it is assembled in i
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ._jit import kernel, kernel_inline
-from .rows import is_joint_row, is_normal_row, is_tangent_row
+from .rows import is_joint_row, is_normal_row, is_soft_row, is_tangent_row
+from .soft import soft_compliance, soft_row_b
 from .warm_start import start_impulses
 
 
@@ -261,6 +262,10 @@ def row_dot(ws, r, J, vel):
 def fill_row_b(ws, h, n):
     """ws.row_b: each row's end-of-step residual without impulses [m/s], w = A lam + b."""
     for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            # armature and implicit spring-damper (soft.py); its compliance is set here
+            ws.row_b[r] = soft_row_b(ws, r, h, row_dot(ws, r, ws.row_J, ws.v_pred))
+            continue
         if is_joint_row(ws.row_kind[r]):
             # a joint's error at the end of the step without impulses, c(q + h v*): c + h J v*
             # plus the second-order drift of its rotating anchors, which the position
@@ -282,6 +287,14 @@ def fill_row_b(ws, h, n):
         ws.row_b[r] = c / h + row_dot(ws, r, ws.row_J, ws.v_pred) - bounce
 
 
+@kernel
+def add_compliance(ws, n):
+    """A[r, r] += gamma of each soft row (soft.py; after fill_row_b, which sets gamma)."""
+    for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            ws.A[r, r] += soft_compliance(ws, r)
+
+
 @kernel_inline
 def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
@@ -297,6 +310,7 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     compute_envelope(ws, n, ws.v_new.shape[0])
     assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     fill_row_b(ws, h, n)
+    add_compliance(ws, n)
     if symmetric:
         dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
     else:
