@@ -15,8 +15,8 @@ MODES_ALL = 1          # straight to the guaranteed (complementarity) solve when
 JOINT_HINGE = 0
 JOINT_SLIDER = 1
 # row kinds (workspace.row_kind): each kind's rows are evaluated in its own module (pin.py,
-# rod.py, limit.py, slider.py, soft.py, contacts.py for the ground, pair.py for shapes) and dispatched in one place
-# (rows.py); a kind's class is asked through rows.py's named predicates, never by number order
+# slider.py, rod.py, limit.py, soft.py, contacts.py for the ground, pair.py for shapes) and
+# dispatched in one place (rows.py); a kind's class is asked through rows.py's named predicates, never by number order
 ROW_PIN_X = 0
 ROW_PIN_Y = 1
 ROW_ROD = 2

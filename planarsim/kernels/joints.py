@@ -1,9 +1,10 @@
 """A joint's coordinate, whatever its kind (the pin table's model.pin_kind): a hinge's angle
 theta_b - theta_a - ref [rad], a slider's slide s = d.(p_b - p_a) [m] (slider.py). The one
 dispatch on a joint's kind, for what acts on its coordinate: limits (limit.py, modes.py),
-springs, dampers and armature (soft.py), motors (forces.py)."""
+springs, dampers and armature (soft.py)."""
 from ._jit import kernel
 from .codes import JOINT_SLIDER
+from .forces import pin_angle_rate
 from .slider import slide_position_rate, slide_row
 
 
@@ -14,25 +15,12 @@ def is_slider(m, j):
 
 
 @kernel
-def hinge_angle_rate(m, q, v, j):
-    """Hinge j's angle theta_b - theta_a - ref [rad] and its rate [rad/s]."""
-    a = m.pin_body[j, 0]
-    b = m.pin_body[j, 1]
-    ang = q[b, 2] - m.pin_ref[j]
-    rate = v[b, 2]
-    if a >= 0:
-        ang -= q[a, 2]
-        rate -= v[a, 2]
-    return ang, rate
-
-
-@kernel
 def joint_position_rate(m, q, cs, v, j):
     """Joint j's coordinate [rad or m] and its rate [rad/s or m/s] at (q, v) (cs: cos / sin
     of the angles at q)."""
     if m.pin_kind[j] == JOINT_SLIDER:
         return slide_position_rate(m, q, cs, v, j)
-    return hinge_angle_rate(m, q, v, j)
+    return pin_angle_rate(m, q, v, j)
 
 
 @kernel
@@ -53,16 +41,3 @@ def joint_rate_row(m, q, cs, j, J):
     J[1, 2] = 1.0
     return ang
 
-
-@kernel
-def add_joint_force(m, q, cs, f, j, tau, scratch):
-    """f += tau J^T: a generalised force tau [N m on a hinge, N on a slider] on joint j's
-    coordinate (a hinge: +tau on body b, -tau on a; a slider: +tau d on b and -tau d on a, both
-    at anchor b). scratch: a (2, 3) array."""
-    joint_rate_row(m, q, cs, j, scratch)
-    for e in range(2):
-        body = m.pin_body[j, e]
-        if body < 0:
-            continue
-        for k in range(3):
-            f[body, k] += tau * scratch[e, k]

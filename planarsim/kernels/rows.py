@@ -1,7 +1,8 @@
 """Stage 4: constraint rows J (Jacobian blocks on bodies a, b) and position errors c.
 
-Row kinds: pin x / y (p_b - p_a = 0), rod (|p_b - p_a| - L = 0), joint limit (angle - lower
->= 0, upper - angle >= 0), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0); a shape
+Row kinds: pin x / y (p_b - p_a = 0), slider (n.(p_b - p_a) = 0 and theta_b - theta_a - ref
+= 0), rod (|p_b - p_a| - L = 0), joint limit (coordinate - lower >= 0, upper - coordinate >= 0),
+a joint's soft row (armature and implicit spring-damper, a compliant equality), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0); a shape
 pair's contact rows act on both its bodies (kernels/pair.py). For a
 point p on a body with COM x, J = (d_x, d_y, (p - x) x d) for a row along unit direction d.
 A contact's normal row uses the exact gap (a rolling sole: the gap of its centre minus r, which
@@ -16,8 +17,8 @@ Each kind of constraint has its own module that evaluates its rows: pin.py (two 
 ROW_PIN_X / ROW_PIN_Y), slider.py (ROW_SLIDE_PERP / ROW_SLIDE_ANGLE), rod.py (ROW_ROD),
 limit.py (ROW_LIMIT_LO / ROW_LIMIT_HI, inequalities on a joint's coordinate: a hinge's angle,
 a slider's slide), soft.py (ROW_JOINT_SOFT, a joint coordinate's armature and implicit
-spring-damper: an equality with a compliance), contacts.py (a ground contact's normal and tangent rows) and pair.py (a
-shape pair's, acting on both bodies). This module is the one place that dispatches on the
+spring-damper: an equality with a compliance), contacts.py (a ground contact's normal and
+tangent rows) and pair.py (a shape pair's, acting on both bodies). This module is the one place that dispatches on the
 kind (eval_row, row_lever, last_impulse, store_impulse) and names the kinds' classes
 (is_joint_row, is_mode_row, is_unilateral, ...): nothing else compares row codes or relies on
 their order. Adding a kind = its module, one arm in each dispatch here, a builder method.
@@ -289,7 +290,8 @@ def build_rows(m, s, ws):
     """Fill the active rows at the current configuration: J, F (impulse directions) and c;
     return how many are sliding-contact rows (F != J there; none: J W F^T is symmetric).
 
-    Rows go body by body: a pin's or slider's (and its limits' and soft row's) and a rod's rows after the later of their
+    Rows go body by body: a pin's or slider's (and its limits' and soft row's) and a rod's
+    rows after the later of their
     two bodies, a contact's after its body, pins and rods first (a merge of the three lists in
     their model order, O(rows)). For a chain or walker built parent first every row then shares
     bodies only with rows close to it, and the solve's envelope stays narrow; contact rows

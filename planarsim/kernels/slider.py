@@ -87,7 +87,8 @@ def slide_position_rate(m, q, cs, v, o):
     # J_s v with both blocks at p_b
     rate = dx * (v[b, 0] - v[b, 2] * (by - q[b, 1])) + dy * (v[b, 1] + v[b, 2] * (bx - q[b, 0]))
     if a >= 0:
-        rate -= dx * (v[a, 0] - v[a, 2] * (by - q[a, 1])) + dy * (v[a, 1] + v[a, 2] * (bx - q[a, 0]))
+        rate -= (dx * (v[a, 0] - v[a, 2] * (by - q[a, 1]))
+                 + dy * (v[a, 1] + v[a, 2] * (bx - q[a, 0])))
     return s, rate
 
 

@@ -42,9 +42,11 @@ def mujoco_angles(dt, armature, T=1.0):
     mujoco = pytest.importorskip("mujoco")
     xml = f"""<mujoco><option timestep="{dt}" integrator="Euler" gravity="0 0 -{G}">
       <flag contact="disable"/></option>
-      <worldbody><body name="l1"><joint name="shoulder" type="hinge" axis="0 -1 0" armature="{armature}"/>
+      <worldbody><body name="l1">
+        <joint name="shoulder" type="hinge" axis="0 -1 0" armature="{armature}"/>
         <inertial pos="0 0 {-L / 2}" mass="{M}" diaginertia="{I} {I} {I}"/>
-        <body name="l2" pos="0 0 {-L}"><joint name="elbow" type="hinge" axis="0 -1 0" armature="{armature}"/>
+        <body name="l2" pos="0 0 {-L}">
+          <joint name="elbow" type="hinge" axis="0 -1 0" armature="{armature}"/>
           <inertial pos="0 0 {-L / 2}" mass="{M}" diaginertia="{I} {I} {I}"/></body></body>
       </worldbody></mujoco>"""
     model = mujoco.MjModel.from_xml_string(xml)

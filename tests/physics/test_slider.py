@@ -56,8 +56,8 @@ def test_limit_stops_the_slide():
     assert np.max(slide) < 0.5 + 1e-9
     assert abs(slide[-1] - 0.5) < 1e-9 and abs(rate[-1]) < 1e-9
     # the upper side's impulse carries the weight's component along the axis each step
-    assert sim.state.last_pin_impulse[0, 3] == pytest.approx(2.0 * G * math.sin(math.radians(30)) * 1e-3,
-                                                             rel=1e-9)
+    weight_along = 2.0 * G * math.sin(math.radians(30))
+    assert sim.state.last_pin_impulse[0, 3] == pytest.approx(weight_along * 1e-3, rel=1e-9)
     assert sim.state.limit_active[0, 1] == 1
     assert sim.ws.audit.sum() == 0
 
@@ -162,7 +162,8 @@ def cartpole_mujoco(dt):
       <worldbody><body name="cart"><joint name="rail" type="slide" axis="1 0 0"/>
         <inertial pos="0 0 0" mass="{M_CART}" diaginertia="0.1 0.1 0.1"/>
         <body name="pole"><joint name="hinge" type="hinge" axis="0 -1 0"/>
-          <inertial pos="0 0 {-L_POLE / 2}" mass="{M_POLE}" diaginertia="{I_POLE} {I_POLE} {I_POLE}"/>
+          <inertial pos="0 0 {-L_POLE / 2}" mass="{M_POLE}"
+                    diaginertia="{I_POLE} {I_POLE} {I_POLE}"/>
         </body></body></worldbody></mujoco>"""
     model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
