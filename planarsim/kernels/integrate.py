@@ -48,7 +48,8 @@ def keep_correction_rows(s, ws):
     """Keep the rows the Newton correction holds: joints, active limits, the normal row of
     every touching contact and the tangent row of every sticking one (a sticking foot does
     not creep along the ground while the correction closes the joints). Rows of contacts the
-    solve set free or that rebound (restitution), and the tangent rows of sliding ones, are
+    solve set free or that rebound (restitution), the tangent rows of sliding ones, and the
+    joints' soft rows (soft.py: armature and spring-damper, no position error), are
     dropped. Returns how many were
     dropped."""
     k = 0

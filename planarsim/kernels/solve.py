@@ -14,6 +14,8 @@ that is a combination of earlier ones; its impulse is zero and the rows it depen
 the load. This is the guess solve: which rows carry the load is arbitrary here, so its answer
 is checked (modes.rule_breaks) and one that pulls or misses a row goes to the
 complementarity solve (complementarity.py), which needs no threshold.
+A joint's soft row (armature and implicit spring-damper, soft.py) is an equality with a
+compliance gamma > 0: it adds gamma to its diagonal, (J W F^T + diag(gamma)) lambda = -b.
 Without sliding contacts F = J and the matrix is symmetric: it is assembled in its lower
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
