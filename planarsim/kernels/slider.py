@@ -94,7 +94,8 @@ def slide_position_rate(m, q, cs, v, o):
 
 @kernel
 def slider_gap(m, q, cs, o):
-    """How far slider o is off [m]: anchor b's distance from the axis line."""
+    """How far slider o is off [m]: anchor b's distance from the axis line (the audit's
+    pin_gap; its angle row is held by the position correction, not audited)."""
     a = m.pin_body[o, 0]
     b = m.pin_body[o, 1]
     dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, o, a, b)

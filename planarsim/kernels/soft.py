@@ -21,6 +21,8 @@ and w = 0. The row is an equality (joints.py's class: its impulse is free) with 
 compliance, so it never depends on the others and is never dropped; the position correction
 leaves it out (it has no position error to remove).
 ws.row_soft[r] holds (a, k, c, g v at the step's start, gamma of the last fill_row_b).
+Not covered: the position correction's velocity change (integrate.py, SHAKE's second-order
+c / h) and its kinetic-energy bound weigh the bodies' masses only, without the rotors'.
 """
 from ._jit import kernel
 from .codes import ROW_JOINT_SOFT
