@@ -1,4 +1,5 @@
-"""ModelBuilder: describe bodies, pins, rods, feet and actuators, then ``compile()`` a Model.
+"""ModelBuilder: describe bodies, pins, sliders, rods, feet and actuators, then ``compile()``
+a Model.
 
 Every ``add_*`` returns a small integer id. All checking happens here; errors are
 ``ModelError`` naming the element kind, its name and index, the field, the value and the rule.
@@ -18,7 +19,8 @@ import math
 import numpy as np
 
 from . import model as M
-from .kernels.codes import CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
+from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, JOINT_HINGE,
+                            JOINT_SLIDER)
 from .errors import ModelError
 from .kernels.collide import core_normals
 from .shapes import bounding_circle, collision_core, collision_pairs
@@ -278,14 +280,17 @@ class ModelBuilder:
 
     # joints ---------------------------------------------------------------------------------
     def add_pin(self, name, body_a, body_b, anchor_world=None, anchor_a=None, anchor_b=None,
-                limit=None, stiffness=0.0, damping=0.0, rest_angle=0.0, ref_angle=None) -> int:
+                limit=None, stiffness=0.0, damping=0.0, rest_angle=0.0, ref_angle=None,
+                armature=0.0) -> int:
         """Pin joint between body_a and body_b (None: the world).
 
         Anchors: give ``anchor_world`` (a point both bodies share at the build pose), or local
         ``anchor_a`` / ``anchor_b``. The pin angle is theta_b - theta_a - ref_angle [rad];
         ref_angle defaults to the relative angle at the build pose (pin angle 0 there).
         ``limit=(lower, upper)`` [rad] adds unilateral limits; stiffness [N m/rad] and
-        damping [N m s/rad] add a passive spring-damper toward ``rest_angle``.
+        damping [N m s/rad] add a passive spring-damper toward ``rest_angle`` (implicit in the
+        velocity solve, kernels/soft.py); armature [kg m^2] a reflected rotor inertia on the
+        pin angle (M_joint += armature, as MuJoCo's).
         """
         idx = len(self._pins)
         self._register("pin", name, idx)
@@ -304,19 +309,85 @@ class ModelBuilder:
             raise ModelError(f"pin {name!r} ({idx}): anchors are {gap:.3g} m apart at the build pose "
                              f"(must be <= {PIN_ANCHOR_TOL:g} m)")
         ref = self._angle(b) - self._angle(a) if ref_angle is None else _scalar("pin", name, idx, "ref_angle", ref_angle)
+        lo, hi = self._joint_limit("pin", name, idx, limit)
+        k, c, arm = self._joint_passive("pin", name, idx, stiffness, damping, armature)
+        self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=ref, limit=(lo, hi),
+                               k=k, c=c, rest=_scalar("pin", name, idx, "rest_angle", rest_angle),
+                               kind=JOINT_HINGE, axis=(0.0, 0.0), armature=arm))
+        return idx
+
+    @staticmethod
+    def _joint_limit(kind, name, idx, limit):
         lo, hi = (-math.inf, math.inf) if limit is None else limit
         lo = float(lo)
         hi = float(hi)
         if math.isnan(lo) or math.isnan(hi):
-            raise ModelError(f"pin {name!r} ({idx}): limit=({lo}, {hi}) must not be NaN")
+            raise ModelError(f"{kind} {name!r} ({idx}): limit=({lo}, {hi}) must not be NaN")
         if lo > hi:
-            raise ModelError(f"pin {name!r} ({idx}): limit lower={lo} > upper={hi}")
-        k = _scalar("pin", name, idx, "stiffness", stiffness)
-        c = _scalar("pin", name, idx, "damping", damping)
+            raise ModelError(f"{kind} {name!r} ({idx}): limit lower={lo} > upper={hi}")
+        return lo, hi
+
+    @staticmethod
+    def _joint_passive(kind, name, idx, stiffness, damping, armature):
+        k = _scalar(kind, name, idx, "stiffness", stiffness)
+        c = _scalar(kind, name, idx, "damping", damping)
         if k < 0 or c < 0:
-            raise ModelError(f"pin {name!r} ({idx}): stiffness={k} and damping={c} must be >= 0")
+            raise ModelError(f"{kind} {name!r} ({idx}): stiffness={k} and damping={c} must be >= 0")
+        arm = _scalar(kind, name, idx, "armature", armature)
+        if arm < 0:
+            raise ModelError(f"{kind} {name!r} ({idx}): armature={arm} must be >= 0")
+        return k, c, arm
+
+    def add_slider(self, name, body_a, body_b, axis=(1.0, 0.0), anchor_world=None, anchor_a=None,
+                   anchor_b=None, limit=None, stiffness=0.0, damping=0.0, rest=0.0,
+                   ref_angle=None, armature=0.0) -> int:
+        """Slider (prismatic) joint: body_b moves along ``axis`` of body_a (None: the world)
+        and keeps its angle relative to body_a.
+
+        ``axis`` (ax, ay) is a direction in body_a's frame (the world's if body_a is None),
+        normalised here. Anchors: ``anchor_world`` (a point both bodies share at the build
+        pose), or local ``anchor_a`` / ``anchor_b``; by default body_b's COM at the build pose.
+        Anchor b must lie on the line through anchor a along the axis (within 1e-6 m). The
+        slide s = d.(p_b - p_a) [m] (d the axis in the world) is the joint's coordinate:
+        ``limit=(lower, upper)`` [m] adds unilateral limits on it, stiffness [N/m] and damping
+        [N s/m] a passive spring-damper toward ``rest`` [m] (implicit, kernels/soft.py),
+        armature [kg] a reflected rotor inertia on it. The relative angle held is
+        theta_b - theta_a = ref_angle [rad] (default: as at the build pose). The slider shares
+        the pins' table (names, State.limit_active, State.last_pin_impulse: perpendicular,
+        angle, lower, upper impulse) with kind JOINT_SLIDER.
+        """
+        idx = len(self._pins)
+        self._register("pin", name, idx)
+        a = self._body_id("slider", name, idx, "body_a", body_a, allow_world=True)
+        b = self._body_id("slider", name, idx, "body_b", body_b, allow_world=False)
+        if a == b:
+            raise ModelError(f"slider {name!r} ({idx}): body_a and body_b are the same ({a})")
+        if self._bodies[b]["point"] or (a >= 0 and self._bodies[a]["point"]):
+            raise ModelError(f"slider {name!r} ({idx}): a slider holds an angle: its bodies must "
+                             f"not be point masses")
+        d = _vec2("slider", name, idx, "axis", axis)
+        norm = float(np.hypot(*d))
+        if not norm > 1e-12:
+            raise ModelError(f"slider {name!r} ({idx}): axis={tuple(d)} must not be zero")
+        d = d / norm
+        if anchor_world is None and anchor_a is None and anchor_b is None:
+            anchor_world = self._world(b, np.zeros(2))
+        la, lb = self._anchors("slider", name, idx, a, b, anchor_world, anchor_a, anchor_b)
+        th_a = self._angle(a)
+        dw = np.array([math.cos(th_a) * d[0] - math.sin(th_a) * d[1],
+                       math.sin(th_a) * d[0] + math.cos(th_a) * d[1]])
+        e = self._world(b, lb) - self._world(a, la)
+        off = abs(float(-dw[1] * e[0] + dw[0] * e[1]))
+        if off > PIN_ANCHOR_TOL:
+            raise ModelError(f"slider {name!r} ({idx}): anchor b is {off:.3g} m off the axis line "
+                             f"at the build pose (must be <= {PIN_ANCHOR_TOL:g} m)")
+        ref = (self._angle(b) - th_a if ref_angle is None
+               else _scalar("slider", name, idx, "ref_angle", ref_angle))
+        lo, hi = self._joint_limit("slider", name, idx, limit)
+        k, c, arm = self._joint_passive("slider", name, idx, stiffness, damping, armature)
         self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=ref, limit=(lo, hi),
-                               k=k, c=c, rest=_scalar("pin", name, idx, "rest_angle", rest_angle)))
+                               k=k, c=c, rest=_scalar("slider", name, idx, "rest", rest),
+                               kind=JOINT_SLIDER, axis=tuple(d), armature=arm))
         return idx
 
     def add_rod(self, name, body_a, body_b, anchor_a=(0.0, 0.0), anchor_b=(0.0, 0.0), length=None) -> int:
@@ -420,8 +491,25 @@ class ModelBuilder:
             pin = self._names["pin"][pin]
         if not (isinstance(pin, (int, np.integer)) and 0 <= pin < len(self._pins)):
             raise ModelError(f"actuator {name!r} ({idx}): pin={pin!r} is not a pin id")
+        if self._pins[pin]["kind"] != JOINT_HINGE:
+            raise ModelError(f"actuator {name!r} ({idx}): pin={self._pins[pin]['name']!r} is a "
+                             f"slider (use add_slider_motor)")
         a, b = self._pins[pin]["body"]
         return self._act(name, M.ACT_PIN_TORQUE, (a, b, -1), int(pin), limit=limit)
+
+    def add_slider_motor(self, name, slider, limit=(-math.inf, math.inf)) -> int:
+        """Force [N] along a slider's axis: +f on body b at its anchor, -f on body a at the
+        same point (it does work f ds/dt); saturated to limit."""
+        idx = len(self._acts)
+        if isinstance(slider, str):
+            if slider not in self._names["pin"]:
+                raise ModelError(f"actuator {name!r} ({idx}): slider={slider!r} names no slider")
+            slider = self._names["pin"][slider]
+        if not (isinstance(slider, (int, np.integer)) and 0 <= slider < len(self._pins)
+                and self._pins[slider]["kind"] == JOINT_SLIDER):
+            raise ModelError(f"actuator {name!r} ({idx}): slider={slider!r} is not a slider id")
+        a, b = self._pins[slider]["body"]
+        return self._act(name, M.ACT_SLIDER_FORCE, (a, b, -1), int(slider), limit=limit)
 
     def add_axial(self, name, body_a, body_b, anchor_a=(0.0, 0.0), anchor_b=(0.0, 0.0),
                   limit=(-math.inf, math.inf)) -> int:
@@ -582,6 +670,9 @@ class ModelBuilder:
             pin_stiffness=ro([p["k"] for p in self._pins]).reshape(npin),
             pin_damping=ro([p["c"] for p in self._pins]).reshape(npin),
             pin_rest=ro([p["rest"] for p in self._pins]).reshape(npin),
+            pin_kind=ro([p["kind"] for p in self._pins], np.int64).reshape(npin),
+            pin_axis=ro([p["axis"] for p in self._pins] or np.zeros((0, 2))).reshape(npin, 2),
+            pin_armature=ro([p["armature"] for p in self._pins]).reshape(npin),
             rod_body=ro([r["body"] for r in self._rods] or np.zeros((0, 2)), np.int64).reshape(nr, 2),
             rod_anchor=ro([r["anchor"] for r in self._rods] or np.zeros((0, 2, 2))).reshape(nr, 2, 2),
             rod_length=ro([r["length"] for r in self._rods]).reshape(nr),

@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from .analysis import StepEvents, step_events, step_summary
+from .energy import joint_position_rate
 from .model import ACT_AXIAL
 
 __all__ = ["centre_of_mass", "centre_of_mass_velocity", "energy", "pin_angle_rate", "summary",
@@ -41,7 +42,8 @@ def energy(traj, model) -> dict:
 
 def pin_angle_rate(model, q, v, pin) -> tuple:
     """Angle theta_b - theta_a - ref [rad] and rate [rad/s] of pin `pin` (name or index) at one
-    state (q, v: (n_body, 3), e.g. sim.state.q, sim.state.v)."""
+    state (q, v: (n_body, 3), e.g. sim.state.q, sim.state.v); a slider's slide [m] and its
+    rate [m/s]."""
     names = list(model.pin_names)
     if isinstance(pin, str):
         if pin not in names:
@@ -49,10 +51,7 @@ def pin_angle_rate(model, q, v, pin) -> tuple:
         pin = names.index(pin)
     elif not 0 <= int(pin) < len(names):
         raise IndexError(f"pin index {pin} out of range 0..{len(names) - 1}; pins: {names}")
-    a = model.arrays
-    ba, bb = a.pin_body[pin]
-    ang = q[bb, 2] - a.pin_ref[pin] - (q[ba, 2] if ba >= 0 else 0.0)
-    rate = v[bb, 2] - (v[ba, 2] if ba >= 0 else 0.0)
+    ang, rate = joint_position_rate(model, q, v, int(pin))
     return float(ang), float(rate)
 
 
@@ -79,16 +78,14 @@ def summary(traj, model, feet=None, min_air=0.05, together=0.05, min_stride=MIN_
 
 
 def joint_angles(traj, model) -> dict:
-    """{name: (angle (K,) [rad], rate (K,) [rad/s])} for every pin, else for every rod and
+    """{name: (angle (K,) [rad], rate (K,) [rad/s])} for every pin (a slider: slide [m], rate
+    [m/s]), else for every rod and
     axial actuator segment (angle from the downward vertical)."""
     a = model.arrays
     out = {}
     q, v = traj.q, traj.v
     for j, name in enumerate(model.pin_names):
-        ba, bb = a.pin_body[j]
-        th_a = q[:, ba, 2] if ba >= 0 else 0.0
-        w_a = v[:, ba, 2] if ba >= 0 else 0.0
-        out[name] = (q[:, bb, 2] - th_a - a.pin_ref[j], v[:, bb, 2] - w_a)
+        out[name] = joint_position_rate(model, q, v, j)
     if out:
         return out
     segs = [(n, a.rod_body[j], a.rod_anchor[j]) for j, n in enumerate(model.rod_names)]

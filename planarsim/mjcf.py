@@ -792,7 +792,7 @@ class _Loader:
         if a == 0.0 or supported:
             return a
         if "armature" in self.drop:
-            self.report.drop(f"joint armature", j["node"].line)
+            self.report.drop("joint armature", j["node"].line)
             return 0.0
         self.fail(j["node"], f"armature={a} needs joint armature, not supported yet "
                              f"(drop={{'armature'}} loads without it)")

@@ -18,7 +18,10 @@ ACT_AXIAL = 1        # force along the line a->b between two anchors, + pushes a
 ACT_HIP_TORQUE = 2   # torque between two point-mass legs about a hip point mass [N m]
 ACT_BODY_FORCE = 3   # force along a fixed world direction at the body origin [N]
 ACT_BODY_TORQUE = 4  # torque on one body [N m]
-ACT_KIND_NAMES = ("pin_torque", "axial", "hip_torque", "body_force", "body_torque")
+ACT_SLIDER_FORCE = 5  # force along a slider's axis: +f on body b, -f on body a [N]
+ACT_KIND_NAMES = ("pin_torque", "axial", "hip_torque", "body_force", "body_torque",
+                  "slider_force")
+from .kernels.codes import JOINT_HINGE, JOINT_SLIDER  # noqa: E402,F401  (pin_kind)
 
 
 class ModelArrays(NamedTuple):
@@ -36,7 +39,17 @@ class ModelArrays(NamedTuple):
     pin_limit: np.ndarray           # (n_pin, 2) lower, upper pin angle [rad] (+-inf: none)
     pin_stiffness: np.ndarray       # (n_pin,) passive spring [N m/rad]
     pin_damping: np.ndarray         # (n_pin,) passive damper [N m s/rad]
-    pin_rest: np.ndarray            # (n_pin,) spring rest angle [rad]
+    pin_rest: np.ndarray            # (n_pin,) spring rest angle [rad] (slider: position [m])
+    pin_kind: np.ndarray            # (n_pin,) int JOINT_HINGE | JOINT_SLIDER. A slider keeps its
+                                    #   two bodies' relative angle (theta_b - theta_a - ref = 0)
+                                    #   and anchor b on the line through anchor a along pin_axis;
+                                    #   its coordinate is the slide s = d.(p_b - p_a) [m], which
+                                    #   pin_limit, pin_stiffness [N/m], pin_damping [N s/m] and
+                                    #   pin_rest [m] then refer to
+    pin_axis: np.ndarray            # (n_pin, 2) a slider's unit axis d in body a's frame (world
+                                    #   if a = -1); (0, 0) for a hinge
+    pin_armature: np.ndarray        # (n_pin,) reflected rotor inertia on the joint coordinate
+                                    #   [kg m^2 hinge, kg slider] (kernels/soft.py)
     rod_body: np.ndarray            # (n_rod, 2) int
     rod_anchor: np.ndarray          # (n_rod, 2, 2) local anchors [m]
     rod_length: np.ndarray          # (n_rod,) [m]

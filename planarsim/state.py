@@ -251,6 +251,8 @@ class Workspace(NamedTuple):
     guard_value: np.ndarray      # (1,) offending value when a guard fired
     row_b: np.ndarray            # (R,) residual of each row without impulses: w = A lam + b
                                  #   [m/s] (velocity stage) or [m, rad] (position projection)
+    row_soft: np.ndarray         # (R, 5) a soft row's armature, stiffness, damping, joint rate
+                                 #   at the step's start, compliance (kernels/soft.py)
     contact_candidate: np.ndarray  # (n_contact,) int 1: in the complementarity problem
     limit_candidate: np.ndarray  # (n_pin, 2) int 1: in the complementarity problem
     lcp_rows: np.ndarray         # (R,) int rows: joints first, then the others
@@ -308,7 +310,8 @@ def forget_pairs(ws: Workspace) -> None:
 
 
 def max_rows(model: Model) -> int:
-    return max(1, 2 * model.n_pin + model.n_rod + 2 * model.n_pin + 2 * model.n_contact)
+    # a joint's two equalities, two limit sides and its soft row; a rod's; a contact's two
+    return max(1, 5 * model.n_pin + model.n_rod + 2 * model.n_contact)
 
 
 def max_lcp(model: Model) -> int:
@@ -369,7 +372,7 @@ def make_workspace(model: Model) -> Workspace:
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R), act_u=z(na), act_power=z(na),
-                     info=z(N_INFO, np.int64), guard_value=z(1), row_b=z(R),
+                     info=z(N_INFO, np.int64), guard_value=z(1), row_b=z(R), row_soft=z((R, 5)),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
                      lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),
                      lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),

@@ -11,9 +11,12 @@ MODE_SLIDING = 2       # slipping, Coulomb friction at the cone's edge
 # how the modes carried over from the last step are checked (StepOptions.mode_strategy)
 MODES_ALTERNATING = 0  # one contact re-examined per step, in turn, before the guaranteed solve
 MODES_ALL = 1          # straight to the guaranteed (complementarity) solve when the guess fails
+# joint kinds (model.pin_kind): an entry of the pin table is a hinge or a slider (prismatic)
+JOINT_HINGE = 0
+JOINT_SLIDER = 1
 # row kinds (workspace.row_kind): each kind's rows are evaluated in its own module (pin.py,
-# rod.py, limit.py, contacts.py for the ground, pair.py for shapes) and dispatched in one place
-# (rows.py); a kind's class is asked through rows.py's named predicates, never by number order
+# slider.py, rod.py, limit.py, soft.py, contacts.py for the ground, pair.py for shapes) and
+# dispatched in one place (rows.py); a kind's class is asked through rows.py's named predicates, never by number order
 ROW_PIN_X = 0
 ROW_PIN_Y = 1
 ROW_ROD = 2
@@ -21,3 +24,6 @@ ROW_LIMIT_LO = 3
 ROW_LIMIT_HI = 4
 ROW_CONTACT_N = 5
 ROW_CONTACT_T = 6
+ROW_SLIDE_PERP = 7     # a slider's anchor b held on its axis line (slider.py)
+ROW_SLIDE_ANGLE = 8    # a slider's relative angle held (slider.py)
+ROW_JOINT_SOFT = 9     # a joint coordinate's armature and implicit spring-damper (soft.py)

@@ -32,10 +32,10 @@ from .math2d import update_trig
 from .mixed_lcp import assemble_dense, solve_mixed_lcp
 from .modes import engage_contacts, engage_limits, gather_contact_impulses, modes_from_solution
 from .limit import add_limit_rows
-from .pin import add_pin_rows
 from .rod import add_rod_row
 from .row_list import move_row
-from .rows import add_contact_rows, build_rows, eval_rows, is_joint_row, is_tangent_row
+from .rows import (add_contact_rows, add_joint_rows, build_rows, eval_rows, is_joint_row,
+                   is_tangent_row)
 from .solve import apply_impulses, fill_row_b
 
 # Lemke's path is finite; the cap only stops a path that rounding has sent astray
@@ -220,7 +220,7 @@ def _projection_rows(m, s, ws, h):
     update_trig(s.q, ws.body_cs)
     n = 0
     for j in range(m.pin_body.shape[0]):
-        n = add_pin_rows(m, ws, n, j)
+        n = add_joint_rows(m, ws, n, j)
         n = add_limit_rows(m, s, ws, n, j)
     for j in range(m.rod_body.shape[0]):
         n = add_rod_row(m, ws, n, j)

@@ -1,19 +1,23 @@
-"""Stage 1-2: applied forces (gravity, pin springs, actuators, pushes) and v* = v + h M^-1 f.
+"""Stage 1-2: applied forces (gravity, actuators, pushes) and v* = v + h M^-1 f.
 
 Actuator kinds (see planarsim/model.py): pin torque, axial force between anchors, hip torque
 between point-mass legs (as perpendicular forces), body force along a world direction, body
-torque. Commands are saturated to act_range; act_power records the mechanical power [W].
+torque, force along a slider's axis. Commands are saturated to act_range; act_power records
+the mechanical power [W]. Joint springs, dampers and armature are not forces here: they act
+implicitly in the velocity solve (soft.py).
 """
 import math
 
 from ._jit import kernel, kernel_inline
 from .math2d import cross2, world_point
+from .slider import slide_position_rate, slider_frame
 
 ACT_PIN_TORQUE = 0
 ACT_AXIAL = 1
 ACT_HIP_TORQUE = 2
 ACT_BODY_FORCE = 3
 ACT_BODY_TORQUE = 4
+ACT_SLIDER_FORCE = 5
 
 
 @kernel
@@ -99,6 +103,15 @@ def apply_actuator(m, q, cs, v, f, k, u):
             w = cross2(dx, dy, v[leg, 0] - v[h, 0], v[leg, 1] - v[h, 1]) / d2
             power += sign * u * w
         return power
+    if kind == ACT_SLIDER_FORCE:
+        # +u d on body b and -u d on body a, both at anchor b: the slide's generalised force
+        j = m.act_ref[k]
+        ja = m.pin_body[j, 0]
+        jb = m.pin_body[j, 1]
+        dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, ja, jb)
+        add_point_force(q, f, jb, bx, by, u * dx, u * dy)
+        add_point_force(q, f, ja, bx, by, -u * dx, -u * dy)
+        return u * slide_position_rate(m, q, cs, v, j)[1]
     if kind == ACT_BODY_FORCE:
         f[a, 0] += u * m.act_dir[k, 0]
         f[a, 1] += u * m.act_dir[k, 1]
@@ -111,7 +124,7 @@ def apply_actuator(m, q, cs, v, f, k, u):
 
 @kernel
 def apply_forces(m, s, ws, u):
-    """f = m g + pushes + pin springs/dampers + saturated actuator commands u."""
+    """f = m g + pushes + saturated actuator commands u (joint springs and dampers: soft.py)."""
     q = s.q
     v = s.v
     f = ws.force
@@ -119,17 +132,6 @@ def apply_forces(m, s, ws, u):
         f[i, 0] = m.body_mass[i] * m.gravity[0] + s.ext_force[i, 0]
         f[i, 1] = m.body_mass[i] * m.gravity[1] + s.ext_force[i, 1]
         f[i, 2] = s.ext_force[i, 2] if m.body_inv_inertia[i] > 0.0 else 0.0
-    # passive pin springs and dampers
-    for j in range(m.pin_body.shape[0]):
-        k = m.pin_stiffness[j]
-        c = m.pin_damping[j]
-        if k == 0.0 and c == 0.0:
-            continue
-        ang, rate = pin_angle_rate(m, q, v, j)
-        tau = -k * (ang - m.pin_rest[j]) - c * rate
-        f[m.pin_body[j, 1], 2] += tau
-        if m.pin_body[j, 0] >= 0:
-            f[m.pin_body[j, 0], 2] -= tau
     # actuators, saturated
     for k in range(m.act_kind.shape[0]):
         uk = u[k]

@@ -22,8 +22,8 @@ from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
 from .limit import limit_side
 from .row_list import move_row
-from .rows import (eval_rows, is_contact_row, is_limit_row, is_normal_row, is_tangent_row,
-                   is_unilateral, row_lever)
+from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_normal_row,
+                   is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
                    force_step_energy)
@@ -46,7 +46,8 @@ def keep_correction_rows(s, ws):
     """Keep the rows the Newton correction holds: joints, active limits, the normal row of
     every touching contact and the tangent row of every sticking one (a sticking foot does
     not creep along the ground while the correction closes the joints). Rows of contacts the
-    solve set free or that rebound (restitution), and the tangent rows of sliding ones, are
+    solve set free or that rebound (restitution), the tangent rows of sliding ones, and the
+    joints' soft rows (soft.py: armature and spring-damper, no position error), are
     dropped. Returns how many were
     dropped."""
     k = 0
@@ -61,6 +62,8 @@ def keep_correction_rows(s, ws):
             continue    # rebounding (restitution): it leaves the surface, not held to it
         if is_limit_row(kind) and s.limit_active[o, limit_side(kind)] == 0:
             continue
+        if is_soft_row(kind):
+            continue    # a joint's armature / spring-damper row: no position error to hold
         if k != r:
             move_row(ws, k, r)
         k += 1
@@ -186,7 +189,7 @@ def rows_hold_within(m, s, ws, h, limit):
             return False
     for r in range(n):
         err = ws.rhs[r]
-        angular = is_limit_row(ws.row_kind[r])
+        angular = is_angular_row(m, ws, r)
         for e in range(2):
             b = ws.row_body[r, e]
             if b < 0:

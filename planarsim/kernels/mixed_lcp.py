@@ -21,7 +21,8 @@ from ._jit import kernel, kernel_call
 from .lcp import ANSWER_TOL, LCP_INACCURATE, LCP_RAY, LCP_SOLVED, lemke, polish
 from .codes import CONTACT_PAIR
 from .contacts import pair_motion_scale
-from .rows import is_joint_row, is_tangent_row
+from .rows import is_joint_row, is_soft_row, is_tangent_row
+from .soft import soft_compliance
 from .solve import _entry
 
 # a joint-only loop: a joint row whose pivot falls to this share of its diagonal is an exact
@@ -47,6 +48,8 @@ def assemble_dense(m, ws, rows, start, count):
             rj = rows[start + j]
             a = _entry(ws.row_J, ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia,
                        ri, rj)
+            if j == i and is_soft_row(ws.row_kind[ri]):
+                a += soft_compliance(ws, ri)     # a joint's soft row (soft.py)
             ws.A[ri, rj] = a
             ws.A[rj, ri] = a
 

@@ -22,7 +22,9 @@ from .pair import PAIR_ENGAGE_SLACK, pair_speed
 from .audit import IMPULSE_FLOOR
 from .mixed_lcp import is_sliding_solution
 from .limit import limit_side
-from .rows import has_mode_rows, is_limit_row, is_normal_row, is_tangent_row
+from .joints import is_slider, joint_position_rate
+from .rows import has_mode_rows, is_limit_row, is_normal_row, is_soft_row, is_tangent_row
+from .soft import soft_compliance
 from .solve import row_dot
 
 # a solve's answer breaks a rule when it misses it by more than this share of its own scale
@@ -121,17 +123,23 @@ def may_reach_ground(m, ws, i, h, vel):
 
 @kernel
 def engage_limits(m, s, ws, h, vel):
-    """Engage every joint limit, not yet in the complementarity problem, that the angle would
-    pass under velocity vel. Returns how many."""
+    """Engage every joint limit, not yet in the complementarity problem, that the joint's
+    coordinate (a hinge's angle, a slider's slide) would pass under velocity vel. Returns how
+    many."""
     changed = 0
     for j in range(m.pin_body.shape[0]):
         lo = m.pin_limit[j, 0]
         hi = m.pin_limit[j, 1]
-        a = m.pin_body[j, 0]
-        b = m.pin_body[j, 1]
-        ang = s.q[b, 2] - m.pin_ref[j] + h * vel[b, 2]
-        if a >= 0:
-            ang -= s.q[a, 2] + h * vel[a, 2]
+        if is_slider(m, j):
+            # the slide at the end of the step, to first order
+            x, rate = joint_position_rate(m, s.q, ws.body_cs, vel, j)
+            ang = x + h * rate
+        else:
+            a = m.pin_body[j, 0]
+            b = m.pin_body[j, 1]
+            ang = s.q[b, 2] - m.pin_ref[j] + h * vel[b, 2]
+            if a >= 0:
+                ang -= s.q[a, 2] + h * vel[a, 2]
         if s.limit_active[j, 0] == 0 and ws.limit_candidate[j, 0] == 0 and ang < lo:
             s.limit_active[j, 0] = 1
             changed += 1
@@ -183,6 +191,8 @@ def rule_breaks(m, s, ws, h, equalities):
         if equalities:
             w = (row_dot(ws, r, ws.row_J, ws.v_new) - row_dot(ws, r, ws.row_J, ws.v_pred)
                  + ws.row_b[r])
+            if is_soft_row(kind):
+                w += soft_compliance(ws, r) * ws.lam[r]
             if abs(w) > tol_w:
                 breaks += 1
         if is_limit_row(kind):

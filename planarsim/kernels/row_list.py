@@ -25,6 +25,8 @@ def move_row(ws, k, r):
     ws.row_c[k] = ws.row_c[r]
     ws.row_c_pred[k] = ws.row_c_pred[r]
     ws.row_b[k] = ws.row_b[r]
+    for c in range(ws.row_soft.shape[1]):
+        ws.row_soft[k, c] = ws.row_soft[r, c]
     for e in range(2):
         for c in range(3):
             ws.row_J[k, e, c] = ws.row_J[r, e, c]

@@ -1,7 +1,8 @@
 """Stage 4: constraint rows J (Jacobian blocks on bodies a, b) and position errors c.
 
-Row kinds: pin x / y (p_b - p_a = 0), rod (|p_b - p_a| - L = 0), joint limit (angle - lower
->= 0, upper - angle >= 0), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0); a shape
+Row kinds: pin x / y (p_b - p_a = 0), slider (n.(p_b - p_a) = 0 and theta_b - theta_a - ref
+= 0), rod (|p_b - p_a| - L = 0), joint limit (coordinate - lower >= 0, upper - coordinate >= 0),
+a joint's soft row (armature and implicit spring-damper, a compliant equality), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0); a shape
 pair's contact rows act on both its bodies (kernels/pair.py). For a
 point p on a body with COM x, J = (d_x, d_y, (p - x) x d) for a row along unit direction d.
 A contact's normal row uses the exact gap (a rolling sole: the gap of its centre minus r, which
@@ -13,9 +14,11 @@ Coulomb friction -mu lambda_n s along the tangent t.
 """Stage 3: the active rows, and the one dispatch on a row's kind.
 
 Each kind of constraint has its own module that evaluates its rows: pin.py (two equalities,
-ROW_PIN_X / ROW_PIN_Y), rod.py (ROW_ROD), limit.py (ROW_LIMIT_LO / ROW_LIMIT_HI, inequalities
-on a pin's angle), contacts.py (a ground contact's normal and tangent rows) and pair.py (a
-shape pair's, acting on both bodies). This module is the one place that dispatches on the
+ROW_PIN_X / ROW_PIN_Y), slider.py (ROW_SLIDE_PERP / ROW_SLIDE_ANGLE), rod.py (ROW_ROD),
+limit.py (ROW_LIMIT_LO / ROW_LIMIT_HI, inequalities on a joint's coordinate: a hinge's angle,
+a slider's slide), soft.py (ROW_JOINT_SOFT, a joint coordinate's armature and implicit
+spring-damper: an equality with a compliance), contacts.py (a ground contact's normal and
+tangent rows) and pair.py (a shape pair's, acting on both bodies). This module is the one place that dispatches on the
 kind (eval_row, row_lever, last_impulse, store_impulse) and names the kinds' classes
 (is_joint_row, is_mode_row, is_unilateral, ...): nothing else compares row codes or relies on
 their order. Adding a kind = its module, one arm in each dispatch here, a builder method.
@@ -28,7 +31,9 @@ import math
 
 from ._jit import kernel
 from .codes import (CONTACT_PAIR, MODE_PINNED, MODE_SLIDING, ROW_CONTACT_N, ROW_CONTACT_T,
-                    ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD)
+                    ROW_JOINT_SOFT, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
+                    ROW_SLIDE_ANGLE, ROW_SLIDE_PERP)
+from .joints import is_slider, joint_rate_row
 from .contacts import ground_lever, ground_row
 from .limit import add_limit_rows, limit_row, limit_side
 from .math2d import set_dir, world_point
@@ -36,12 +41,33 @@ from .pair import pair_row
 from .pin import add_pin_rows, pin_axis, pin_lever, pin_row, pin_rows
 from .rod import add_rod_row, rod_row
 from .row_list import add_row
+from .slider import add_slider_rows, slider_angle_row, slider_lever, slider_perp_row
+from .soft import add_soft_row, soft_row, start_soft_row
 
 
 @kernel
 def is_joint_row(kind):
-    """An equality of a joint (pin x / y, rod): its impulse is free, its error always held."""
-    return kind == ROW_PIN_X or kind == ROW_PIN_Y or kind == ROW_ROD
+    """An equality of a joint (pin x / y, slider, rod; a joint's soft row): its impulse is
+    free; its error always held (but a soft row's, which is a compliant velocity equation)."""
+    return (kind == ROW_PIN_X or kind == ROW_PIN_Y or kind == ROW_ROD or kind == ROW_SLIDE_PERP
+            or kind == ROW_SLIDE_ANGLE or kind == ROW_JOINT_SOFT)
+
+
+@kernel
+def is_soft_row(kind):
+    """A joint coordinate's soft row (armature, implicit spring-damper; soft.py): an equality
+    with a compliance on its diagonal and no position error to hold."""
+    return kind == ROW_JOINT_SOFT
+
+
+@kernel
+def is_angular_row(m, ws, r):
+    """Row r constrains an angle only (a hinge's limit, a slider's angle row): its error is
+    linear in the bodies' angles."""
+    kind = ws.row_kind[r]
+    if kind == ROW_SLIDE_ANGLE:
+        return True
+    return is_limit_row(kind) and not is_slider(m, ws.row_owner[r])
 
 
 @kernel
@@ -105,11 +131,32 @@ def eval_row(m, q, cs, ws, r, J, found):
         return pin_row(m, q, cs, o, a, b, pin_axis(kind), J)
     if kind == ROW_ROD:
         return rod_row(m, q, cs, o, a, b, J)
+    if kind == ROW_SLIDE_PERP:
+        return slider_perp_row(m, q, cs, o, a, b, J)
+    if kind == ROW_SLIDE_ANGLE:
+        return slider_angle_row(m, q, o, a, b, J)
+    if kind == ROW_JOINT_SOFT:
+        return soft_row(m, q, cs, o, J)
     if is_limit_row(kind):
+        if is_slider(m, o):
+            return slide_limit_row(m, q, cs, o, limit_side(kind), J)
         return limit_row(m, q, o, a, b, limit_side(kind), J)
     if m.contact_kind[o] == CONTACT_PAIR:
         return pair_row(q, cs, ws, o, J, kind == ROW_CONTACT_T)
     return ground_row(m, q, cs, ws, o, b, kind == ROW_CONTACT_T, J, found)
+
+
+@kernel
+def slide_limit_row(m, q, cs, o, side, J):
+    """Jacobian blocks J (2, 3) and error [m] (distance inside the limit) of slider o's limit
+    row on `side` (0: s - lower >= 0, 1: upper - s >= 0)."""
+    x = joint_rate_row(m, q, cs, o, J)
+    if side == 0:
+        return x - m.pin_limit[o, 0]
+    for e in range(2):
+        for k in range(3):
+            J[e, k] = -J[e, k]
+    return m.pin_limit[o, 1] - x
 
 
 @kernel
@@ -122,8 +169,12 @@ def row_lever(m, ws, r, e):
     o = ws.row_owner[r]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
         return pin_lever(m, o, e)
-    if is_limit_row(kind):
+    if kind == ROW_SLIDE_ANGLE:
         return 0.0
+    if kind == ROW_SLIDE_PERP:
+        return slider_lever(m, o, e)
+    if is_limit_row(kind):
+        return slider_lever(m, o, e) if is_slider(m, o) else 0.0
     if is_contact_row(kind):
         if m.contact_kind[o] == CONTACT_PAIR:
             return math.inf
@@ -143,6 +194,10 @@ def last_impulse(s, ws, r):
         return s.last_contact_impulse[o, 1]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
         return s.last_pin_impulse[o, pin_axis(kind)]
+    if kind == ROW_SLIDE_PERP:
+        return s.last_pin_impulse[o, 0]
+    if kind == ROW_SLIDE_ANGLE:
+        return s.last_pin_impulse[o, 1]
     if is_limit_row(kind):
         return s.last_pin_impulse[o, 2 + limit_side(kind)]
     if kind == ROW_ROD:
@@ -152,12 +207,16 @@ def last_impulse(s, ws, r):
 
 @kernel
 def store_joint_impulse(s, ws, r, lam):
-    """Joint row r's impulse lam [N s] into the State (pins, limits, rods; a contact's are
-    gathered per contact, modes.gather_contact_impulses)."""
+    """Joint row r's impulse lam [N s] into the State (pins, sliders, limits, rods; a contact's
+    are gathered per contact, modes.gather_contact_impulses; a soft row's is not kept)."""
     o = ws.row_owner[r]
     kind = ws.row_kind[r]
     if kind == ROW_PIN_X or kind == ROW_PIN_Y:
         s.last_pin_impulse[o, pin_axis(kind)] = lam
+    elif kind == ROW_SLIDE_PERP:
+        s.last_pin_impulse[o, 0] = lam
+    elif kind == ROW_SLIDE_ANGLE:
+        s.last_pin_impulse[o, 1] = lam
     elif is_limit_row(kind):
         s.last_pin_impulse[o, 2 + limit_side(kind)] = lam
     elif kind == ROW_ROD:
@@ -182,8 +241,8 @@ def eval_rows(m, q, cs, ws, J, c, n, found):
 
 @kernel
 def predict_joint_errors(m, ws, n):
-    """row_c_pred[r] = c(q_pred) of the pin and rod rows (the velocity solve's target);
-    contact and limit rows are left alone (row_Jp is scratch here)."""
+    """row_c_pred[r] = c(q_pred) of the pin, slider and rod rows (the velocity solve's target);
+    contact, limit and soft rows are left alone (row_Jp is scratch here)."""
     r = 0
     while r < n:
         kind = ws.row_kind[r]
@@ -192,7 +251,7 @@ def predict_joint_errors(m, ws, n):
                      ws.row_body[r, 1], ws.row_Jp, ws.row_c_pred, r)
             r += 2
             continue
-        if kind == ROW_ROD:
+        if kind == ROW_ROD or kind == ROW_SLIDE_PERP or kind == ROW_SLIDE_ANGLE:
             ws.row_c_pred[r] = eval_row(m, ws.q_pred, ws.cs_pred, ws, r, ws.row_Jp[r], False)
         r += 1
 
@@ -211,6 +270,15 @@ def add_contact_rows(ws, n, i, normal, tangent):
 
 
 @kernel
+def add_joint_rows(m, ws, n, j):
+    """Append joint j's equality rows at slot n (a hinge's pin rows, a slider's); returns the
+    next free slot."""
+    if is_slider(m, j):
+        return add_slider_rows(m, ws, n, j)
+    return add_pin_rows(m, ws, n, j)
+
+
+@kernel
 def _later_body(bodies, j):
     """Body after which the rows of joint j (a pin or rod; bodies (n, 2)) go: the later of its
     two bodies (in a chain or tree built parent first, the child)."""
@@ -222,7 +290,8 @@ def build_rows(m, s, ws):
     """Fill the active rows at the current configuration: J, F (impulse directions) and c;
     return how many are sliding-contact rows (F != J there; none: J W F^T is symmetric).
 
-    Rows go body by body: a pin's (and its limits') and a rod's rows after the later of their
+    Rows go body by body: a pin's or slider's (and its limits' and soft row's) and a rod's
+    rows after the later of their
     two bodies, a contact's after its body, pins and rods first (a merge of the three lists in
     their model order, O(rows)). For a chain or walker built parent first every row then shares
     bodies only with rows close to it, and the solve's envelope stays narrow; contact rows
@@ -241,8 +310,9 @@ def build_rows(m, s, ws):
         kr = _later_body(m.rod_body, jr) if jr < n_rod else big
         kc = max(m.contact_body[ic], m.contact_other[ic]) if ic < n_con else big
         if kp <= kr and kp <= kc:
-            n = add_pin_rows(m, ws, n, jp)
+            n = add_joint_rows(m, ws, n, jp)
             n = add_limit_rows(m, s, ws, n, jp)
+            n = add_soft_row(m, ws, n, jp)
             jp += 1
         elif kr <= kc:
             n = add_rod_row(m, ws, n, jr)
@@ -257,6 +327,8 @@ def build_rows(m, s, ws):
     predict_joint_errors(m, ws, n)
     sliding = 0
     for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            start_soft_row(m, s, ws, r)
         for e in range(2):
             for k in range(3):
                 ws.row_F[r, e, k] = ws.row_J[r, e, k]

@@ -14,11 +14,14 @@ that is a combination of earlier ones; its impulse is zero and the rows it depen
 the load. This is the guess solve: which rows carry the load is arbitrary here, so its answer
 is checked (modes.rule_breaks) and one that pulls or misses a row goes to the
 complementarity solve (complementarity.py), which needs no threshold.
+A joint's soft row (armature and implicit spring-damper, soft.py) is an equality with a
+compliance gamma > 0: it adds gamma to its diagonal, (J W F^T + diag(gamma)) lambda = -b.
 Without sliding contacts F = J and the matrix is symmetric: it is assembled in its lower
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ._jit import kernel, kernel_inline
-from .rows import is_joint_row, is_normal_row, is_tangent_row
+from .rows import is_joint_row, is_normal_row, is_soft_row, is_tangent_row
+from .soft import soft_compliance, soft_row_b
 from .warm_start import start_impulses
 
 
@@ -261,6 +264,10 @@ def row_dot(ws, r, J, vel):
 def fill_row_b(ws, h, n):
     """ws.row_b: each row's end-of-step residual without impulses [m/s], w = A lam + b."""
     for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            # armature and implicit spring-damper (soft.py); its compliance is set here
+            ws.row_b[r] = soft_row_b(ws, r, h, row_dot(ws, r, ws.row_J, ws.v_pred))
+            continue
         if is_joint_row(ws.row_kind[r]):
             # a joint's error at the end of the step without impulses, c(q + h v*): c + h J v*
             # plus the second-order drift of its rotating anchors, which the position
@@ -289,6 +296,14 @@ def fill_row_b(ws, h, n):
         ws.row_b[r] = c / h + row_dot(ws, r, ws.row_J, ws.v_pred) - bounce
 
 
+@kernel
+def add_compliance(ws, n):
+    """A[r, r] += gamma of each soft row (soft.py; after fill_row_b, which sets gamma)."""
+    for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            ws.A[r, r] += soft_compliance(ws, r)
+
+
 @kernel_inline
 def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
@@ -304,6 +319,7 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     compute_envelope(ws, n, ws.v_new.shape[0])
     assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     fill_row_b(ws, h, n)
+    add_compliance(ws, n)
     if symmetric:
         dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
     else:

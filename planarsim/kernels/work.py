@@ -17,7 +17,7 @@ about SHAKE_REGIME^2 of it, up or down, and the energy oscillates about its valu
 Euler); more than that is energy from nowhere.
 """
 from ._jit import kernel
-from .rows import is_joint_row
+from .rows import is_joint_row, is_soft_row
 from .solve import row_dot
 
 # SHAKE's regime: the correction's velocity change dv is at most this share of the velocity
@@ -66,16 +66,16 @@ def row_rounding(ws, r, speed):
 
 @kernel
 def joint_work(m, ws, v):
-    """(work [J] of the pins' and rods' impulses ws.lam at velocity v, its rounding [J], the
-    row doing the most work or -1): rows 0..n_row-1 (F = J for joints)."""
+    """(work [J] of the pins', sliders' and rods' impulses ws.lam at velocity v, its rounding
+    [J], the row doing the most work or -1): rows 0..n_row-1 (F = J for joints)."""
     speed = fastest(v) + fastest(ws.v_pred)
     total = 0.0
     rounding = 0.0
     most = 0.0
     row = -1
     for r in range(ws.n_row[0]):
-        if not is_joint_row(ws.row_kind[r]):
-            continue
+        if not is_joint_row(ws.row_kind[r]) or is_soft_row(ws.row_kind[r]):
+            continue    # a soft row's work is its spring's and damper's (soft.py)
         w = ws.lam[r] * row_dot(ws, r, ws.row_J, v)
         total += w
         rounding += row_rounding(ws, r, speed)
