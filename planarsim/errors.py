@@ -12,7 +12,8 @@ the memory they would need.
 from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_WORK,
                             AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
-from .kernels.guards import GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS, GUARD_NONFINITE_COMMAND
+from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
+                             GUARD_ENERGY, GUARD_NONFINITE_COMMAND, GUARD_SPEED)
 
 
 class ModelError(ValueError):
@@ -156,6 +157,44 @@ def gross_violation(model, ws, who="simulation"):
         step, t, body_name, AUDIT_NAMES[kind], value, last)
 
 
+def energy_from_nowhere(model, ws, who="simulation"):
+    """The SimulationDiverged of a step that gained energy from nowhere beyond
+    StepOptions.energy_limit (kernels/work.judge_energy; the cause in ws.audit_last)."""
+    step, kind, element, body = (int(x) for x in ws.audit_last)
+    rule = AUDIT_NAMES[kind]
+    value = float(ws.audit_value[0])
+    t = float(ws.prev.time[0])
+    name = _body_name(model, body)
+    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    return SimulationDiverged(
+        f"{who} stopped at step {step} (t={t:.6g} s): {_AUDIT_TEXT[rule].format(v=value)} "
+        f"({rule}; {_element_name(model, kind, element)}; body {name!r} ({body})), more than "
+        f"StepOptions.energy_limit of the energy the step had: the step is too large for "
+        f"these actuators, impacts or inertias. Take a smaller dt (or raise energy_limit; "
+        f"0 counts it in the audit and goes on)", step, t, name, rule, value, last)
+
+
+def too_fast(model, ws, who="simulation"):
+    """The SimulationDiverged of a step that ended with a body faster than
+    StepOptions.speed_limit (guards.check_speeds)."""
+    body = int(ws.info[INFO_GUARD_BODY])
+    speed, bound = float(ws.guard_value[0]), float(ws.guard_value[1])
+    turning = int(ws.info[INFO_GUARD_FIELD]) != FIELD_SPEED
+    field = "turning speed" if turning else "speed"
+    step = int(ws.prev.step[0])
+    t = float(ws.prev.time[0])
+    name = _body_name(model, body)
+    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    how = (" (|omega| times its radius of gyration)" if turning else "")
+    return SimulationDiverged(
+        f"{who} stopped at step {step} (t={t:.6g} s): body {name!r} ({body}) reached a {field} "
+        f"of {speed:.4g} m/s{how}, beyond the bound of {bound:.4g} m/s set from the model (100 "
+        f"times the fastest speed its gravity, size, start and actuators explain): the run "
+        f"has left physics (a step too large for its actuators or impacts). Take a smaller dt, "
+        f"or if such speeds are real, set StepOptions.speed_limit higher (0: no bound)",
+        step, t, name, field, speed, last)
+
+
 def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
@@ -174,6 +213,10 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
         return ValueError(f"{who}: command u[{k}] for actuator {model.act_names[k]!r} is "
                           f"{float(ws.guard_value[0])}; commands must be finite (N or N m); "
                           f"nothing was stepped")
+    if code == GUARD_SPEED:
+        return too_fast(model, ws, who)
+    if code == GUARD_ENERGY:
+        return energy_from_nowhere(model, ws, who)
     body = int(ws.info[INFO_GUARD_BODY])
     field = FIELD_NAMES[int(ws.info[INFO_GUARD_FIELD])]
     value = float(ws.guard_value[0])

@@ -50,6 +50,17 @@ class StepOptions(NamedTuple):
         the step, time, pin or contact, body and how far; what to change): the step could
         not hold it (stiff actuators or a violent impact at this step size), and the run
         after it would not be physics. 0: never stop (the audit still counts it)
+    speed_limit : [m/s] a body moving, or turning (|omega| times its radius of gyration),
+        faster than this at the end of a step stops the run (SimulationDiverged naming the
+        body, its speed and the bound): -1 (default) takes the bound from the model and the
+        start state (planarsim.speed_bound.speed_bound: 100 times the fastest speed its
+        gravity, size, start velocities and actuators can explain); 0: no bound (the
+        guard_limit of 1e10 only)
+    energy_limit : a step whose audited energy from nowhere (joint_work, correction_work:
+        what its joints or position correction added beyond their allowance) exceeds this
+        share of the energy it had to work with (its kinetic energy plus its own error under
+        the forces) stops the run (SimulationDiverged naming step, time, cause and body);
+        smaller gains are counted in the audit. 0: never stop
     """
     mode_strategy: int = MODES_ALTERNATING
     refine_iters: int = 4
@@ -61,6 +72,8 @@ class StepOptions(NamedTuple):
     audit_raise: int = 0
     gross_limit: float = 1e-6
     dt: float = 0.0
+    speed_limit: float = -1.0
+    energy_limit: float = 0.25
 
 
 def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:
@@ -87,6 +100,9 @@ _OPTION_RULES = {
     "audit_raise": (int, lambda x: x in (0, 1), "must be 0 or 1"),
     "gross_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0"),
     "dt": (float, lambda x: math.isfinite(x) and 0.0 <= x <= 1.0, "must be 0 (the model's dt) or a step in (0, 1] s"),
+    "energy_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0"),
+    "speed_limit": (float, lambda x: x == -1.0 or (math.isfinite(x) and x >= 0.0),
+                    "must be -1 (from the model), 0 (none) or a speed > 0 [m/s]"),
 }
 
 

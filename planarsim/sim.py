@@ -16,6 +16,7 @@ from .errors import diverged
 from .kernels.refs import TableHandle
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
+from .speed_bound import resolve_speed_limit
 from .start_check import check_start
 from .state import (State, Workspace, check_state, forget_ground_queries, forget_pairs, make_state,
                     make_workspace)
@@ -98,7 +99,11 @@ class Simulator:
 
     @options.setter
     def options(self, value: StepOptions) -> None:
-        self._options = check_options(value)
+        """Options for the steps to come; speed_limit -1 is resolved here from the model and
+        the current state (planarsim.speed_bound; again when a state is put in)."""
+        value = check_options(value)
+        self._speed_from_model = value.speed_limit == -1.0
+        self._options = resolve_speed_limit(value, self._model, self._state.v, self._state.q)
         self._repack()
 
     def _repack(self):
@@ -125,6 +130,10 @@ class Simulator:
         check_state(value, self._model)
         self._state.restore(value)
         forget_pairs(self._ws)
+        if getattr(self, "_speed_from_model", False):
+            self._options = resolve_speed_limit(self._options._replace(speed_limit=-1.0),
+                                                self._model, self._state.v, self._state.q)
+            self._repack()
 
     # commands -------------------------------------------------------------------------------
     def _commands(self, u):

@@ -248,7 +248,8 @@ class Workspace(NamedTuple):
     act_power: np.ndarray        # (n_act,) mechanical power [W]
     info: np.ndarray             # (N_INFO,) int: what the last step did, slots named in
                                  #   kernels/info.py (INFO_*; step_info(ws) by name)
-    guard_value: np.ndarray      # (1,) offending value when a guard fired
+    guard_value: np.ndarray      # (2,) offending value when a guard fired; the speed bound
+                                 #   [m/s] when it was a speed (GUARD_SPEED)
     row_b: np.ndarray            # (R,) residual of each row without impulses: w = A lam + b
                                  #   [m/s] (velocity stage) or [m, rad] (position projection)
     row_soft: np.ndarray         # (R, 5) a soft row's armature, stiffness, damping, joint rate
@@ -285,6 +286,8 @@ class Workspace(NamedTuple):
     audit_worst: np.ndarray      # (4,) int the step's largest pin gap or depth violation: step,
                                  #   kind, pin or contact, body (StepOptions.gross_limit)
     audit_worst_value: np.ndarray  # (1,) its size [m] (0: none this step)
+    energy_stop: np.ndarray      # (1,) int 1: this step gained energy from nowhere beyond
+                                 #   StepOptions.energy_limit (kernels/work.judge_energy)
     first_order: np.ndarray      # (1,) int 1: this step's joint rows aim at J v = 0 (a
                                  #   projection) after the second-order target added energy
     lcp_eps: np.ndarray          # (1,) largest diagonal term the complementarity solves of
@@ -372,7 +375,7 @@ def make_workspace(model: Model) -> Workspace:
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R), act_u=z(na), act_power=z(na),
-                     info=z(N_INFO, np.int64), guard_value=z(1), row_b=z(R), row_soft=z((R, 5)),
+                     info=z(N_INFO, np.int64), guard_value=z(2), row_b=z(R), row_soft=z((R, 5)),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
                      lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),
                      lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),
@@ -385,5 +388,6 @@ def make_workspace(model: Model) -> Workspace:
                      audit=z(N_AUDIT, np.int64),
                      audit_last=z(4, np.int64), audit_value=z(1),
                      audit_worst=z(4, np.int64), audit_worst_value=z(1), first_order=z(1, np.int64),
+                     energy_stop=z(1, np.int64),
                      lcp_eps=z(1),
                      impact_time=z(1), prev=make_state(model))

@@ -82,7 +82,9 @@ class WalkerRun:
         self.memory = memory
         self.state = state if state is not None else ps.make_state(model)
         self.ws = ws if ws is not None else make_workspace(model)
-        self.options = ps.StepOptions() if options is None else check_options(options)
+        from planarsim.speed_bound import resolve_speed_limit
+        self.options = resolve_speed_limit(ps.StepOptions() if options is None else check_options(options),
+                                           model, self.state.v, self.state.q)
         if self.options.dt not in (0.0, model.dt):
             # the controllers integrate (work, effort, motor currents, ramps) with the model's dt
             raise ValueError(f"{self.NAME}: options.dt={self.options.dt} s differs from the model's "

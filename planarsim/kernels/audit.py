@@ -42,7 +42,8 @@ from .rows import is_limit_row, is_normal_row
 from .joints import is_slider
 from .slider import slider_gap
 from .terrain import ground_point
-from .work import VELOCITY_FLOOR, WORK_REL_TOL, fastest, joints_add_energy, limit_work
+from .work import (VELOCITY_FLOOR, WORK_REL_TOL, fastest, joints_add_energy, judge_energy,
+                   limit_work)
 
 AUDIT_PULL = 0
 AUDIT_CONE = 1
@@ -114,7 +115,7 @@ def _speed_scale(ws):
 
 
 @kernel
-def audit_impulses(m, s, ws):
+def audit_impulses(m, s, ws, opt, h):
     """Pulling contacts, friction outside its cone and positive contact work, from
     ws.contact_impulse and the constrained velocity ws.v_new. Returns the violations found."""
     found = 0
@@ -153,7 +154,7 @@ def audit_impulses(m, s, ws):
                        + max(floor, 0.0) * (abs(vn) + abs(vt))):
                 note(ws, step, AUDIT_WORK, i, b, work)
                 found += 1
-    return found + audit_joints(m, s, ws)
+    return found + audit_joints(m, s, ws, opt, h)
 
 
 @kernel
@@ -165,7 +166,7 @@ def joint_element(m, ws, r):
 
 
 @kernel
-def audit_joints(m, s, ws):
+def audit_joints(m, s, ws, opt, h):
     """Joint limits whose impulse does positive work at the end velocity, and joints whose
     impulses added energy (work.joints_add_energy), beyond rounding; returns how many."""
     found = 0
@@ -184,6 +185,7 @@ def audit_joints(m, s, ws):
         excess, r = joints_add_energy(m, ws)
         if excess > 0.0 and r >= 0:
             note(ws, step, AUDIT_JOINT_WORK, joint_element(m, ws, r), ws.row_body[r, 1], excess)
+            judge_energy(m, ws, opt, h, excess)
             found += 1
     return found
 

@@ -18,7 +18,7 @@ from .codes import MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import GUARD_AUDIT, GUARD_GROSS, check_guards
+from .guards import GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_guards, check_speeds
 from .info import INFO_SOLVES, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
@@ -153,6 +153,7 @@ def _step(m, s, ws, opt, u):
     ws.lcp_eps[0] = 0.0
     ws.audit_worst_value[0] = 0.0
     ws.first_order[0] = 0
+    ws.energy_stop[0] = 0
     audited = audit_total(ws)
     for k in range(ws.n_live[0]):
         ws.contact_new[ws.live[k]] = 0
@@ -176,7 +177,7 @@ def _step(m, s, ws, opt, u):
             if tau >= 0.0:                                  #    the rest of the step again
                 h -= tau
                 continue
-        audit_impulses(m, s, ws)                            # 9. the audit of the impulses
+        audit_impulses(m, s, ws, opt, h)                    # 9. the audit of the impulses
         position_stage(m, s, ws, opt, h, answered)          # 6. integrate, correct, settle
         break
     s.time[0] = ws.prev.time[0] + step_length
@@ -184,8 +185,12 @@ def _step(m, s, ws, opt, u):
     if m.contact_body.shape[0] > 0:
         s.mode_cursor[0] = (s.mode_cursor[0] + 1) % m.contact_body.shape[0]
     code = check_guards(s, ws, opt.guard_limit)
+    if code == 0 and opt.speed_limit > 0.0:
+        code = check_speeds(m, s, ws, opt.speed_limit)
     if code == 0 and opt.gross_limit > 0.0 and ws.audit_worst_value[0] > opt.gross_limit:
         return GUARD_GROSS
+    if code == 0 and ws.energy_stop[0] == 1:
+        return GUARD_ENERGY
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
     return code

@@ -152,3 +152,16 @@ def most_gaining_body(m, s, ws):
             best = gain
             body = i
     return body
+
+
+@kernel
+def judge_energy(m, ws, opt, h, excess):
+    """An energy gain from nowhere of `excess` [J] in this step of h [s] is gross when it
+    exceeds StepOptions.energy_limit times the energy the step had to work with: the kinetic
+    energy it solved for (ws.v_solved) plus its own error under the forces
+    (force_step_energy). A gross one marks the step (ws.energy_stop): it ends with
+    GUARD_ENERGY, the run stops naming the cause (ws.audit_last)."""
+    if opt.energy_limit <= 0.0:
+        return
+    if excess > opt.energy_limit * (kinetic_energy(m, ws.v_solved) + force_step_energy(m, ws, h)):
+        ws.energy_stop[0] = 1

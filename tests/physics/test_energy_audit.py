@@ -1,0 +1,156 @@
+"""The energy audit (kernels/work.py, kernels/audit.py): the joints' and the position
+correction's work in a step, checked against what the integrator explains, on the corpus's
+extreme scenes (benchmarks/contact_stress.py: folded four-bar loops with inertias 1e-4 to 1e4
+kg m^2, rod-joined point masses thrown at steep hills, stiff bang-bang motors at large steps);
+and the speed bound set from the model."""
+import math
+
+import numpy as np
+import pytest
+
+import planarsim as ps
+from planarsim.compiled import audit_counts
+
+G = 9.81
+
+
+def corpus_run(family, seed, steps=None, **options):
+    """(model, frames q, frames v, the simulator, the error raised or None) of the stress
+    corpus's case (family, seed), stepped one step at a time."""
+    from benchmarks.contact_stress import MAX_STEPS, SECONDS, build, commands
+    model, ground, q0, v0 = build(family, seed)
+    n = steps or min(int(round(SECONDS[family] / model.dt)), MAX_STEPS)
+    u = commands(family, seed, model, n)
+    sim = ps.Simulator(model, ps.make_options(**options), ps.make_state(model, q0, v0))
+    q, v = [q0.copy()], [v0.copy()]
+    error = None
+    try:
+        for k in range(n):
+            sim.step(None if u is None else u[k])
+            q.append(sim.state.q.copy())
+            v.append(sim.state.v.copy())
+    except ps.SimulationDiverged as exc:
+        error = exc
+    return model, np.array(q), np.array(v), sim, error
+
+
+def energy(model, q, v):
+    """Kinetic plus gravitational energy [J] of frames q, v."""
+    a = model.arrays
+    return (0.5 * np.sum(a.body_mass * (v[..., 0] ** 2 + v[..., 1] ** 2) + a.body_inertia * v[..., 2] ** 2, axis=-1)
+            + G * np.sum(a.body_mass * q[..., 1], axis=-1))
+
+
+def step_gains(model, q, v):
+    """Each step's energy change beyond its own gravity term, dE - (dt / 2) g dp_y [J] (the
+    exact change of a step without impulses), and each step's kinetic energy at its start."""
+    a = model.arrays
+    e = energy(model, q, v)
+    py = np.sum(a.body_mass * v[..., 1], axis=-1)
+    kinetic = 0.5 * np.sum(a.body_mass * (v[..., 0] ** 2 + v[..., 1] ** 2) + a.body_inertia * v[..., 2] ** 2, axis=-1)
+    return np.diff(e) - 0.5 * model.dt * G * np.diff(py), kinetic[:-1]
+
+
+SELF_STRESS = pytest.mark.xfail(strict=True, reason=(
+    "known: a loop folded flat on the ground keeps a self-stress of 5e5 N s in its pins "
+    "(the warm start of rows dropped as dependent carries it from step to step); unfolding, it "
+    "does 0.009 J of work in one step at 3e-5 J of motion, within the audit's rounding of "
+    "such impulses, so nothing counts it"))
+
+
+@pytest.mark.parametrize("seed", [22, pytest.param(36, marks=SELF_STRESS), 42])
+def test_a_folded_loop_gains_no_energy_from_its_nearly_dependent_pins(seed):
+    """Four bars pinned in a closed loop, folding flat onto the ground: at the fold the pin
+    rows are nearly dependent, and the second-order target of the velocity solve once turned
+    an inconsistent drift into impulses of 1e5 N s (seed 42: 0.1 J of motion became 808 J in
+    one step, 3 J of it kept). No step may now gain more than the constraints' second-order
+    share (1 % of its kinetic energy) beyond its gravity term."""
+    model, q, v, sim, error = corpus_run("loop_inertia", seed)
+    assert error is None
+    gains, kinetic = step_gains(model, q, v)
+    worst = int(np.argmax(gains - 0.01 * kinetic))
+    assert gains[worst] <= 0.01 * kinetic[worst] + 1e-6, (worst + 1, gains[worst], kinetic[worst])
+    assert audit_counts(sim.ws)["joint_work"] == 0
+
+
+@pytest.mark.parametrize("seed", [9, 69, 79])
+def test_rods_thrown_at_hills_keep_their_energy(seed):
+    """Point masses joined by rods, thrown at 1-200 m/s onto steep sine hills: a rod turning
+    by a radian in a step once jumped from 1.2e4 J to 3.2e6 J (seed 79). The run's energy now
+    never rises above its start by more than symplectic Euler's own oscillation under
+    gravity (the corpus's energy_bound)."""
+    from benchmarks.contact_stress import build, energy_bound, shape_spec
+    model, ground, q0, v0 = build("hills_fast", seed)
+    model, q, v, sim, error = corpus_run("hills_fast", seed)
+    assert error is None
+    spec = shape_spec("hills_fast", model, 0.0)
+    e = energy(model, q, v)
+    assert np.max(e - e[0]) <= energy_bound(spec, ground, q0, v0), np.max(e - e[0])
+    assert audit_counts(sim.ws)["joint_work"] == 0
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_stiff_motors_at_large_steps_run_clean_or_stop_at_once(seed):
+    """Pin motors of 100-1000 N m driven bang-bang at dt 1e-2 and 2e-2 s: nothing between a
+    clean run (every audit count 0) and a SimulationDiverged saying what to change."""
+    model, q, v, sim, error = corpus_run("stiff_motors", seed)
+    if error is None:
+        assert sum(audit_counts(sim.ws).values()) == 0, audit_counts(sim.ws)
+    else:
+        assert "smaller dt" in str(error) or "Take a smaller dt" in str(error), str(error)
+
+
+def test_energy_from_nowhere_names_cause_step_time_and_body():
+    """A gross gain (more than energy_limit of the step's energy) stops the run with an error
+    naming the step, time, cause and body; with energy_limit = 0 the audit counts it."""
+    model, q, v, sim, error = corpus_run("stiff_motors", 0)
+    assert error is not None
+    text = str(error)
+    assert f"step {error.step}" in text and "t=" in text and "body '" in text
+    stopped = [e for e in (error,) if "energy_limit" in str(e)]
+    if stopped:
+        assert error.field in ("correction_work", "joint_work")
+        model, q, v, sim, error = corpus_run("stiff_motors", 0, energy_limit=0.0, gross_limit=0.0)
+        assert audit_counts(sim.ws)["correction_work"] + audit_counts(sim.ws)["joint_work"] > 0
+
+
+def pushed_mass(push, **options):
+    """A 1 kg point mass 1 m over flat ground under a constant push [N] (State.ext_force)."""
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_point_mass("puck", 1.0, pos=(0.0, 1.0))
+    model = b.compile()
+    sim = ps.Simulator(model, ps.make_options(**options))
+    sim.state.ext_force[0] = (push, 0.0, 0.0)
+    return sim
+
+
+def test_a_body_faster_than_the_model_explains_stops_the_run_naming_it():
+    """The speed bound from the model: 100 times sqrt(2 g (height + size)) here (443 m/s); a
+    push the model does not know of (1e5 N on 1 kg) passes it in 5 ms."""
+    sim = pushed_mass(1e5)
+    bound = sim.options.speed_limit
+    assert bound == pytest.approx(100 * math.sqrt(2 * G * 2.0))
+    with pytest.raises(ps.SimulationDiverged) as err:
+        for _ in range(100):
+            sim.step()
+    text = str(err.value)
+    assert "'puck'" in text and "speed_limit" in text and f"{bound:.4g}" in text
+    assert err.value.value > bound and sim.state.step[0] < 10
+
+
+@pytest.mark.parametrize("limit", [0.0, 1e6])
+def test_a_user_raises_or_removes_the_speed_bound(limit):
+    sim = pushed_mass(1e5, speed_limit=limit)
+    for _ in range(100):
+        sim.step()
+    assert sim.state.v[0, 0] == pytest.approx(1e4, rel=1e-9)
+
+
+def test_the_speed_bound_follows_a_state_put_in():
+    """A start faster than the model's own scale raises the bound with it (100 times)."""
+    sim = pushed_mass(0.0)
+    state = ps.make_state(sim.model, sim.model.q0, np.array([[2000.0, 0.0, 0.0]]))
+    sim.state = state
+    assert sim.options.speed_limit == pytest.approx(2e5)
+    for _ in range(10):
+        sim.step()
