@@ -176,12 +176,14 @@ class RigidBody:
 class JointMap:
     """How an MJCF joint maps onto planarsim: kind 'pin' (id: pin id), 'free' (id: the root
     body; axis: index 0/1 of a slide's in-plane direction or 2 for the hinge) or 'slider'.
-    The MJCF joint value is q = ref + sign * (planarsim coordinate)."""
+    The MJCF joint value is q = ref + sign * (planarsim coordinate). anchor: the joint's
+    position in the plane at the file's pose [m] (a free root's hinge turns about it)."""
     kind: str
     id: int
     sign: float = 1.0
     ref: float = 0.0
     axis: tuple = ()
+    anchor: tuple = ()
 
 
 @dataclass
@@ -907,12 +909,13 @@ class _Loader:
             for j in b.joints:
                 if j["type"] == "hinge":
                     out.joint[j["name"]] = JointMap("free", ids[b.rid], self.sign(j),
-                                                    self.scalar(j["node"], j["eff"], "ref", 0.0), (2,))
+                                                    self.ref(j), (2,),
+                                                    tuple(float(x) for x in self.plane(j["pos"])))
                 else:
                     a = j["axis"]
-                    out.joint[j["name"]] = JointMap("free", ids[b.rid], 1.0,
-                                                    self.scalar(j["node"], j["eff"], "ref", 0.0),
-                                                    (a[self.i1], a[self.i2]))
+                    out.joint[j["name"]] = JointMap("free", ids[b.rid], 1.0, self.ref(j),
+                                                    (a[self.i1], a[self.i2]),
+                                                    tuple(float(x) for x in self.plane(j["pos"])))
                     slides += 1
         for kind, j, parent, child in self.links:
             a = None if parent is None else ids[parent]

@@ -19,7 +19,7 @@ from .info import INFO_PROJECTIONS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, rows_hold_within)
 from .math2d import update_trig
-from .work import judge_energy, most_gaining_body
+from .work import gravity_lift, judge_energy, most_gaining_body
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
 PROJECTION_ITERS = 20
@@ -90,4 +90,6 @@ def position_stage(m, s, ws, opt, h, answered):
             excess = bound_correction_work(m, s, ws, h)
             if excess > 0.0:
                 note(ws, s.step[0], AUDIT_CORRECTION_WORK, -1, most_gaining_body(m, s, ws), excess)
-                judge_energy(m, ws, opt, h, excess)
+                # bodies lifted out of the ground (a start below it, a terrain put in)
+                # are the depth's business, counted here but not a reason to stop
+                judge_energy(m, ws, opt, h, excess - gravity_lift(m, s, ws))

@@ -165,3 +165,14 @@ def judge_energy(m, ws, opt, h, excess):
         return
     if excess > opt.energy_limit * (kinetic_energy(m, ws.v_solved) + force_step_energy(m, ws, h)):
         ws.energy_stop[0] = 1
+
+
+@kernel
+def gravity_lift(m, s, ws):
+    """The energy [J] the position correction's move gave the bodies against gravity,
+    max(0, -sum_i m_i g . (q_i - q_solved_i)): a body pushed out of the ground."""
+    work = 0.0
+    for i in range(s.q.shape[0]):
+        work += m.body_mass[i] * (m.gravity[0] * (s.q[i, 0] - ws.q_solved[i, 0])
+                                  + m.gravity[1] * (s.q[i, 1] - ws.q_solved[i, 1]))
+    return max(0.0, -work)

@@ -30,7 +30,7 @@ def test_a_pin_torn_open_by_stiff_motors_stops_the_run_naming_it():
 
 def test_without_a_gross_limit_the_audit_counts_it_and_the_run_goes_on():
     model, start, u = stiff_scene()
-    sim = ps.Simulator(model, ps.make_options(gross_limit=0.0), state=start)
+    sim = ps.Simulator(model, ps.make_options(gross_limit=0.0, energy_limit=0.0), state=start)
     for k in range(len(u)):
         sim.step(u[k])
     assert audit_counts(sim.ws)["pin_gap"] > 0

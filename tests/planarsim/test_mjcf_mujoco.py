@@ -19,14 +19,11 @@ ROOT = Path(__file__).resolve().parents[2]
 LEGS = ROOT / "walkers" / "simbicon" / "legs.xml"
 LEGS_LOCAL = ROOT / "walkers" / "simbicon" / "legs_local.xml"
 REL = 1e-9
-# the gymnasium files that load today (armature dropped: the engine has none yet) and those
-# that need what the engine lacks, with the words of the error
-LOADS = {"hopper": ("armature",), "walker2d": ("armature",), "walker2d_v5": ("armature",),
-         "half_cheetah": ("armature",), "swimmer": ("armature", "fluid")}
-BLOCKED = {"hopper": "armature=1.0 needs joint armature", "half_cheetah": "needs joint armature",
-           "swimmer": "needs fluid forces",
-           "inverted_pendulum": "needs slider joints", "inverted_double_pendulum": "needs slider joints",
-           "reacher": "need slider joints"}
+# the gymnasium files that load today (with what they drop) and those that need what the
+# engine lacks, with the words of the error
+LOADS = {"hopper": (), "walker2d": (), "walker2d_v5": (), "half_cheetah": (),
+         "inverted_pendulum": (), "inverted_double_pendulum": (), "swimmer": ("armature", "fluid")}
+BLOCKED = {"swimmer": "needs fluid forces", "reacher": "need slider joints"}
 
 
 def gym_asset(name):
@@ -91,6 +88,7 @@ def check_against_mujoco(path, loaded):
             assert tuple(a.pin_limit[pid]) == (-math.inf, math.inf), name
         assert close(a.pin_stiffness[pid], mm.jnt_stiffness[j]), name
         assert close(a.pin_damping[pid], mm.dof_damping[mm.jnt_dofadr[j]]), name
+        assert close(a.pin_armature[pid], mm.dof_armature[mm.jnt_dofadr[j]]), name
     # motors: gear (in the pin's sign) and torque range
     assert len(loaded.actuator) == mm.nu
     for u in range(mm.nu):
@@ -110,8 +108,9 @@ def test_gymnasium_model_matches_mujoco(name):
     loaded = load_mjcf(path, drop=LOADS[name])
     mm, model = check_against_mujoco(path, loaded)
     assert model.total_mass == pytest.approx(mm.body_mass.sum(), rel=REL)
-    assert model.n_pin == sum(mm.jnt_type == mujoco.mjtJoint.mjJNT_HINGE) - 1   # root hinge free
-    assert "joint armature" in loaded.report.dropped
+    assert model.n_pin == mm.njnt - len(loaded.free_joints)   # the root's joints are free
+    # armature is modelled on pins and sliders; only the swimmer's free root carries some
+    assert ("joint armature" in loaded.report.dropped) == (name == "swimmer")
 
 
 @pytest.mark.parametrize("name, words", sorted(BLOCKED.items()))
@@ -122,7 +121,7 @@ def test_gymnasium_model_that_needs_more_names_what(name, words):
 
 
 def test_half_cheetah_total_mass_and_springs():
-    loaded = load_mjcf(gym_asset("half_cheetah"), drop=("armature",))
+    loaded = load_mjcf(gym_asset("half_cheetah"), )
     model = loaded.compile()
     assert model.total_mass == pytest.approx(14.0, rel=REL)           # settotalmass
     assert model.arrays.pin_stiffness[loaded.pin["bthigh"]] == 240.0
@@ -137,20 +136,20 @@ def test_swimmer_moves_in_the_x_y_plane_without_gravity():
 
 
 def test_hopper_stands_on_the_floor_and_reports_what_it_ignored():
-    loaded = load_mjcf(gym_asset("hopper"), drop=("armature",))
+    loaded = load_mjcf(gym_asset("hopper"), )
     model = loaded.compile()
     assert model.terrain.height(0.0) == 0.0
     assert any(n.endswith("/ground0") for n in model.contact_names)    # feet touch the floor
     text = str(loaded.report)
     for what in ("<light>", "<camera>", "<asset>", "geom rgba", "option integrator"):
         assert what in loaded.report.ignored and what in text
-    assert loaded.report.dropped["joint armature"] == [27, 30, 33]
+    assert loaded.report.dropped == {}                                   # armature is modelled
 
 
 def test_walker_motor_torque_follows_the_pin_sign():
     """thigh_joint turns about -y: a positive MJCF torque is counter-clockwise in our plane,
     so the pin motor's gear is +100 and its range +-100 N m."""
-    loaded = load_mjcf(gym_asset("walker2d"), drop=("armature",))
+    loaded = load_mjcf(gym_asset("walker2d"), )
     act = loaded.actuator["thigh_joint"]
     assert act.gear == 100.0 and act.ctrlrange == (-1.0, 1.0)
     assert tuple(loaded.compile().arrays.act_range[act.id]) == (-100.0, 100.0)
@@ -247,7 +246,7 @@ def test_loaded_hopper_lands_on_its_floor():
     """The loaded model runs: the hopper, dropped 4 cm onto the file's floor, comes to rest on
     its foot (nothing below the ground, the torso still up)."""
     import planarsim as ps
-    loaded = load_mjcf(gym_asset("hopper"), drop=("armature",))
+    loaded = load_mjcf(gym_asset("hopper"), )
     model = loaded.compile()
     sim = ps.Simulator(model)
     sim.steps(250)                                   # 0.5 s at the file's 0.002 s

@@ -1,0 +1,36 @@
+"""Gymnasium environments on planarsim: gymnasium's planar MuJoCo tasks (v5 observation,
+action space, rewards, termination, reset noise and frame skip) on planarsim's engine.
+
+Importing this package registers ``planarsim/Hopper-v0``, ``planarsim/Walker2d-v0``,
+``planarsim/HalfCheetah-v0``, ``planarsim/InvertedPendulum-v0`` and
+``planarsim/InvertedDoublePendulum-v0`` with gymnasium. Reacher (its target body needs two
+slides on one body) and Swimmer (viscous fluid drag) are not provided: the engine lacks them.
+"""
+try:
+    import gymnasium
+except ImportError as e:  # pragma: no cover - exercised without gymnasium only
+    raise ImportError("planarsim.envs needs gymnasium: pip install -e '.[gym]'") from e
+
+from .core import GeneralizedCoords, PlanarMujocoEnv
+from .tasks import HalfCheetah, Hopper, InvertedDoublePendulum, InvertedPendulum, Walker2d
+
+ENVS = {
+    "planarsim/Hopper-v0": ("planarsim.envs.tasks:Hopper", 1000),
+    "planarsim/Walker2d-v0": ("planarsim.envs.tasks:Walker2d", 1000),
+    "planarsim/HalfCheetah-v0": ("planarsim.envs.tasks:HalfCheetah", 1000),
+    "planarsim/InvertedPendulum-v0": ("planarsim.envs.tasks:InvertedPendulum", 1000),
+    "planarsim/InvertedDoublePendulum-v0": ("planarsim.envs.tasks:InvertedDoublePendulum", 1000),
+}
+
+
+def register_all():
+    """Register the environments with gymnasium (idempotent)."""
+    for env_id, (entry, steps) in ENVS.items():
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point=entry, max_episode_steps=steps)
+
+
+register_all()
+
+__all__ = ["ENVS", "GeneralizedCoords", "PlanarMujocoEnv", "Hopper", "Walker2d", "HalfCheetah",
+           "InvertedPendulum", "InvertedDoublePendulum", "register_all"]

@@ -1,0 +1,277 @@
+"""The base of planarsim's gymnasium environments: an MJCF model loaded by planarsim.mjcf,
+stepped by planarsim, seen through MuJoCo's generalized coordinates (qpos, qvel).
+
+Coordinates. planarsim keeps every rigid body's pose (x, y, angle) and velocity; MuJoCo keeps
+joint values in file order. ``GeneralizedCoords`` maps between them through the loader's
+JointMap: a hinge's MJCF value is ``ref + sign * (pin angle)`` (sign = -1 for a hinge about
++y in the x-z plane: MuJoCo's positive rotation about +y is clockwise in planarsim's plane),
+a slide's ``ref + displacement along its axis``; a free root (two slides then a hinge, as
+MuJoCo composes them) translates its hinge's anchor by the slides and turns about it.
+"""
+from __future__ import annotations
+
+import math
+import os
+from types import SimpleNamespace
+
+import numpy as np
+import gymnasium
+from gymnasium import spaces
+
+from ..mjcf import load_mjcf
+from ..model import JOINT_SLIDER
+from ..sim import Simulator
+from ..state import make_state
+
+
+def gym_asset(name: str) -> str:
+    """Path of gymnasium's MJCF file `name` (gymnasium ships them without mujoco)."""
+    return os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets", name)
+
+
+def _rot(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s], [s, c]])
+
+
+def _cross(w, r):
+    """omega x r in the plane."""
+    return np.array([-w * r[1], w * r[0]])
+
+
+class GeneralizedCoords:
+    """MuJoCo's (qpos, qvel) <-> planarsim's maximal (q, v) (n_body, 3) for a loaded model."""
+
+    def __init__(self, loaded, model):
+        self.names = list(loaded.joint)
+        self.jm = [loaded.joint[n] for n in self.names]
+        self.nq = len(self.names)
+        self.n_body = model.n_body
+        self.q0 = np.array(model.q0, float).reshape(-1, 3)
+        a = model.arrays
+        self.pin_body, self.pin_anchor = np.asarray(a.pin_body), np.asarray(a.pin_anchor)
+        self.pin_ref, self.pin_kind = np.asarray(a.pin_ref), np.asarray(a.pin_kind)
+        self.pin_axis = np.asarray(a.pin_axis)
+        # free roots: body -> (slide indices, hinge index)
+        self.free = {}
+        for i, jm in enumerate(self.jm):
+            if jm.kind == "free":
+                slides, hinge = self.free.setdefault(jm.id, ([], [None]))
+                if jm.axis == (2,):
+                    hinge[0] = i
+                else:
+                    slides.append(i)
+        self.links = [i for i, jm in enumerate(self.jm) if jm.kind != "free"]
+
+    def _free_parts(self, body):
+        slides, (h,) = self.free[body]
+        A = np.array([self.jm[i].axis for i in slides], float).T      # (2, 2) columns: axes
+        return slides, h, A, np.array(self.jm[h].anchor, float)
+
+    def to_maximal(self, qpos, qvel):
+        """(nq,), (nv,) MuJoCo values -> q, v (n_body, 3)."""
+        qpos, qvel = np.asarray(qpos, float), np.asarray(qvel, float)
+        q = np.full((self.n_body, 3), np.nan)
+        v = np.full((self.n_body, 3), np.nan)
+        for body in self.free:
+            slides, h, A, A0 = self._free_parts(body)
+            jh = self.jm[h]
+            d = A @ np.array([qpos[i] - self.jm[i].ref for i in slides])
+            phi = jh.sign * (qpos[h] - jh.ref)
+            anchor = A0 + d
+            c = anchor + _rot(phi) @ (self.q0[body, :2] - A0)
+            w = jh.sign * qvel[h]
+            q[body] = (c[0], c[1], self.q0[body, 2] + phi)
+            v[body, :2] = A @ np.array([qvel[i] for i in slides]) + _cross(w, c - anchor)
+            v[body, 2] = w
+        pending = list(self.links)
+        while pending:
+            progressed = False
+            for i in list(pending):
+                jm = self.jm[i]
+                a, b = self.pin_body[jm.id]
+                if a >= 0 and np.isnan(q[a, 0]):
+                    continue
+                qa = q[a] if a >= 0 else np.zeros(3)
+                va = v[a] if a >= 0 else np.zeros(3)
+                la, lb = self.pin_anchor[jm.id]
+                Ra = _rot(qa[2])
+                Pa = qa[:2] + Ra @ la
+                vPa = va[:2] + _cross(va[2], Pa - qa[:2])
+                if self.pin_kind[jm.id] == JOINT_SLIDER:
+                    th = qa[2] + self.pin_ref[jm.id]
+                    dw = Ra @ self.pin_axis[jm.id]
+                    s = qpos[i] - jm.ref
+                    P = Pa + dw * s
+                    vP = vPa + _cross(va[2], dw * s) + dw * qvel[i]
+                    w = va[2]
+                else:
+                    th = qa[2] + self.pin_ref[jm.id] + jm.sign * (qpos[i] - jm.ref)
+                    P, vP = Pa, vPa
+                    w = va[2] + jm.sign * qvel[i]
+                c = P - _rot(th) @ lb
+                q[b] = (c[0], c[1], th)
+                v[b, :2] = vP + _cross(w, c - P)
+                v[b, 2] = w
+                pending.remove(i)
+                progressed = True
+            if not progressed:
+                raise RuntimeError(f"joints {[self.names[i] for i in pending]} hang from no body")
+        return q, v
+
+    def from_maximal(self, q, v):
+        """q, v (n_body, 3) -> MuJoCo's (qpos, qvel) (nq,), (nv,)."""
+        q, v = np.asarray(q, float), np.asarray(v, float)
+        qpos, qvel = np.zeros(self.nq), np.zeros(self.nq)
+        for body in self.free:
+            slides, h, A, A0 = self._free_parts(body)
+            jh = self.jm[h]
+            phi = q[body, 2] - self.q0[body, 2]
+            anchor = q[body, :2] - _rot(phi) @ (self.q0[body, :2] - A0)
+            d = np.linalg.solve(A, anchor - A0)
+            vA = v[body, :2] - _cross(v[body, 2], q[body, :2] - anchor)
+            ds = np.linalg.solve(A, vA)
+            for k, i in enumerate(slides):
+                qpos[i] = self.jm[i].ref + d[k]
+                qvel[i] = ds[k]
+            qpos[h] = jh.ref + jh.sign * phi
+            qvel[h] = jh.sign * v[body, 2]
+        for i in self.links:
+            jm = self.jm[i]
+            a, b = self.pin_body[jm.id]
+            qa = q[a] if a >= 0 else np.zeros(3)
+            va = v[a] if a >= 0 else np.zeros(3)
+            if self.pin_kind[jm.id] == JOINT_SLIDER:
+                la, lb = self.pin_anchor[jm.id]
+                Ra = _rot(qa[2])
+                Pa = qa[:2] + Ra @ la
+                Pb = q[b, :2] + _rot(q[b, 2]) @ lb
+                dw = Ra @ self.pin_axis[jm.id]
+                vPa = va[:2] + _cross(va[2], Pa - qa[:2])
+                vPb = v[b, :2] + _cross(v[b, 2], Pb - q[b, :2])
+                qpos[i] = jm.ref + dw @ (Pb - Pa)
+                qvel[i] = dw @ (vPb - vPa)
+            else:
+                qpos[i] = jm.ref + jm.sign * (q[b, 2] - qa[2] - self.pin_ref[jm.id])
+                qvel[i] = jm.sign * (v[b, 2] - va[2])
+        return qpos, qvel
+
+
+class PlanarMujocoEnv(gymnasium.Env):
+    """A gymnasium Env with MuJoCo's MujocoEnv interface (data.qpos / data.qvel, init_qpos,
+    init_qvel, set_state, do_simulation, state_vector, dt = timestep * frame_skip) on planarsim.
+
+    Differences from gymnasium's MuJoCo environments: contacts are planarsim's exact hard
+    (complementarity) contacts with Coulomb friction, not MuJoCo's soft, slightly penetrating
+    ones; only the collisions planarsim.mjcf loads are modelled (see its LoadReport, e.g. no
+    self-collision beyond it); the integrator is planarsim's (semi-implicit, one velocity
+    solve per step), not MuJoCo's; joint springs and dampers are implicit. Episodes therefore
+    differ from MuJoCo's beyond the first contacts; observations use MuJoCo's layout exactly.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(self, xml_file: str, frame_skip: int, observation_space=None,
+                 render_mode: str | None = None, width: int = 480, height: int = 480, **load_kw):
+        path = xml_file if os.path.isabs(xml_file) else gym_asset(xml_file)
+        self.loaded = load_mjcf(path, **load_kw)
+        self.sim_model = self.loaded.compile()
+        self.coords = GeneralizedCoords(self.loaded, self.sim_model)
+        self.frame_skip = int(frame_skip)
+        self.timestep = float(self.sim_model.arrays.dt)
+        self._act = list(self.loaded.actuator.values())
+        self.model = SimpleNamespace(nq=self.coords.nq, nv=self.coords.nq, nu=len(self._act))
+        low = np.array([a.ctrlrange[0] for a in self._act], dtype=np.float32)
+        high = np.array([a.ctrlrange[1] for a in self._act], dtype=np.float32)
+        self.action_space = spaces.Box(low=low, high=high, dtype=np.float32)
+        if observation_space is not None:
+            self.observation_space = observation_space
+        self.init_qpos, self.init_qvel = self.coords.from_maximal(self.sim_model.q0, self.sim_model.v0)
+        self.data = SimpleNamespace(qpos=self.init_qpos.copy(), qvel=self.init_qvel.copy())
+        self._u = np.zeros(self.sim_model.n_act)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode={render_mode!r}: planarsim's environments render "
+                             f"{self.metadata['render_modes']} only")
+        self.render_mode = render_mode
+        self.width, self.height = int(width), int(height)
+        self.sim = Simulator(self.sim_model, None, make_state(self.sim_model))
+
+    @property
+    def dt(self) -> float:
+        return self.timestep * self.frame_skip
+
+    # MuJoCo's MujocoEnv interface -------------------------------------------------------
+    def _sync(self):
+        st = self.sim.state
+        self.data.qpos, self.data.qvel = self.coords.from_maximal(st.q, st.v)
+
+    def set_state(self, qpos, qvel):
+        qpos, qvel = np.asarray(qpos, float), np.asarray(qvel, float)
+        if qpos.shape != (self.model.nq,) or qvel.shape != (self.model.nv,):
+            raise ValueError(f"set_state: qpos shape {qpos.shape} and qvel shape {qvel.shape} "
+                             f"must be ({self.model.nq},) and ({self.model.nv},)")
+        q, v = self.coords.to_maximal(qpos, qvel)
+        # a new simulator: no contact modes, warm starts or ground queries carry over. Like
+        # MuJoCo's set_state, any pose is accepted (one below the floor is pushed out by the
+        # first step)
+        self.sim = Simulator(self.sim_model, None, make_state(self.sim_model, q, v),
+                             allow_below_ground=True)
+        self._sync()
+
+    def check_action(self, action) -> np.ndarray:
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != self.action_space.shape:
+            raise ValueError(f"action has shape {a.shape}; {type(self).__name__} takes shape "
+                             f"{self.action_space.shape} (one control per actuator: "
+                             f"{[x.joint for x in self._act]})")
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"action {a.tolist()} has NaN or infinite entries")
+        return a
+
+    def do_simulation(self, ctrl, n_frames):
+        ctrl = self.check_action(ctrl)
+        for k, act in enumerate(self._act):
+            lo, hi = act.ctrlrange
+            self._u[act.id] = act.gear * min(max(ctrl[k], lo), hi)   # MuJoCo clamps ctrl
+        self.sim.steps(int(n_frames), self._u)
+        self._sync()
+
+    def state_vector(self):
+        return np.concatenate([self.data.qpos.flat, self.data.qvel.flat])
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        obs = self.reset_model()
+        return obs, self._get_reset_info()
+
+    def _get_reset_info(self):
+        return {}
+
+    def reset_model(self):  # pragma: no cover - each task defines it
+        raise NotImplementedError
+
+    def point(self, body: str, local_mjcf) -> np.ndarray:
+        """World (plane) position of a point fixed in MJCF body `body`, given at the file's
+        pose in the plane's coordinates (e.g. a site's position)."""
+        bid = self.loaded.body[body]
+        q = self.sim.state.q[bid]
+        off = np.asarray(local_mjcf, float) - self.sim_model.q0[bid, :2]
+        return q[:2] + _rot(q[2] - self.sim_model.q0[bid, 2]) @ off
+
+    # rendering ----------------------------------------------------------------------------
+    def render(self):
+        if self.render_mode is None:
+            gymnasium.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
+            return None
+        from ..render.draw import render_state
+        import matplotlib.pyplot as plt
+        dpi = 100
+        fig, _ = render_state(self.sim_model, self.sim.state.q, size=(self.width / dpi, self.height / dpi),
+                              dpi=dpi)
+        fig.canvas.draw()
+        img = np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
+        plt.close(fig)
+        return img
+
+    def close(self):
+        pass

@@ -1,0 +1,147 @@
+"""planarsim.envs: gymnasium's planar v5 tasks on planarsim. The env checker passes; a seed
+fixes an episode bit for bit; bad actions raise; and against gymnasium's MuJoCo envs: the
+coordinate mapping (body poses and observations for the same qpos/qvel) and, before any
+contact, the motion of both pendulums."""
+import sys
+import types
+
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium", reason="gymnasium is not installed (pip install -e '.[gym]')")
+import planarsim.envs  # noqa: E402,F401  (registers the environments)
+
+NAMES = ["Hopper", "Walker2d", "HalfCheetah", "InvertedPendulum", "InvertedDoublePendulum"]
+
+
+def make(name, **kw):
+    return gym.make(f"planarsim/{name}-v0", **kw)
+
+
+def mujoco_env(name):
+    """gymnasium's own v5 env (needs mujoco; imageio only for its video recorder)."""
+    mujoco = pytest.importorskip("mujoco", reason="mujoco is not installed")
+    sys.modules.setdefault("imageio", types.ModuleType("imageio"))
+    return mujoco, gym.make(f"{name}-v5").unwrapped
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_env_checker_passes(name):
+    from gymnasium.utils.env_checker import check_env
+    env = make(name)
+    check_env(env.unwrapped, skip_render_check=True)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_same_seed_same_episode(name):
+    def episode():
+        env = make(name)
+        obs, _ = env.reset(seed=123)
+        env.action_space.seed(7)
+        out = [obs]
+        for _ in range(50):
+            obs, r, term, trunc, _ = env.step(env.action_space.sample())
+            out.append(np.append(obs, r))
+            if term or trunc:
+                obs, _ = env.reset()
+                out.append(obs)
+        return out
+    a, b = episode(), episode()
+    assert len(a) == len(b) and all(np.array_equal(x, y) for x, y in zip(a, b))
+    env = make(name)
+    assert not np.array_equal(env.reset(seed=1)[0], env.reset(seed=2)[0])
+
+
+@pytest.mark.parametrize("name", ["Hopper", "InvertedPendulum"])
+def test_bad_actions_raise(name):
+    env = make(name)
+    env.reset(seed=0)
+    n = env.action_space.shape[0]
+    with pytest.raises(ValueError, match=r"action has shape \(\d+,\).*takes shape"):
+        env.step(np.zeros(n + 1))
+    nan = np.zeros(n)
+    nan[0] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        env.step(nan)
+
+
+def test_import_without_gymnasium_says_how_to_install(monkeypatch):
+    for mod in [m for m in sys.modules if m == "planarsim.envs" or m.startswith("planarsim.envs.")]:
+        monkeypatch.delitem(sys.modules, mod)
+    monkeypatch.setitem(sys.modules, "gymnasium", None)
+    with pytest.raises(ImportError, match=r"pip install -e '\.\[gym\]'"):
+        import planarsim.envs  # noqa: F401
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_coordinates_and_observation_match_mujoco(name):
+    """For the same qpos/qvel (the noise-free start, and a random one): MuJoCo's and our
+    observations agree to 1e-9, and each planarsim body's COM and angle are MuJoCo's."""
+    mujoco, ref = mujoco_env(name)
+    env = make(name).unwrapped
+    assert env.coords.names == [mujoco.mj_id2name(ref.model, mujoco.mjtObj.mjOBJ_JOINT, j)
+                                for j in range(ref.model.njnt)]
+    assert np.array_equal(env.action_space.low, ref.action_space.low)
+    assert np.array_equal(env.action_space.high, ref.action_space.high)
+    assert env.dt == pytest.approx(ref.dt, rel=1e-12)
+    ref.set_state(ref.init_qpos, ref.init_qvel)
+    xmat0 = ref.data.xmat.copy()            # the file's pose: planarsim's build pose
+    rng = np.random.default_rng(0)
+    for qp, qv in [(ref.init_qpos, ref.init_qvel),
+                   (ref.init_qpos + rng.uniform(-0.2, 0.2, ref.model.nq), rng.uniform(-1, 1, ref.model.nv))]:
+        ref.set_state(qp, qv)
+        env.set_state(qp, qv)
+        np.testing.assert_allclose(env._get_obs(), ref._get_obs(), rtol=0, atol=1e-9)
+        # the mapping itself: body COM (mass-weighted over welded MJCF bodies) and angle
+        (i1, i2) = (0, 2)
+        q = env.sim.state.q
+        for bid, rb in env.loaded.rigid.items():
+            ids = [mujoco.mj_name2id(ref.model, mujoco.mjtObj.mjOBJ_BODY, n) for n in rb.mjcf_bodies]
+            m = ref.model.body_mass[ids]
+            com = (m[:, None] * ref.data.xipos[ids]).sum(0) / m.sum()
+            np.testing.assert_allclose(q[bid, :2], (com[i1], com[i2]), atol=1e-9, err_msg=rb.name)
+            # rotation since the file's pose, about -y (counter-clockwise in our x-z plane)
+            R = ref.data.xmat[ids[0]].reshape(3, 3) @ xmat0[ids[0]].reshape(3, 3).T
+            ang = np.arctan2(R[2, 0], R[0, 0])
+            d = (q[bid, 2] - env.sim_model.q0[bid, 2]) - ang
+            assert abs((d + np.pi) % (2 * np.pi) - np.pi) < 1e-9, rb.name
+        # velocities: the derivative of the position map
+        e = 1e-7
+        q1, _ = env.coords.to_maximal(qp + e * qv, qv)
+        q0, v0 = env.coords.to_maximal(qp, qv)
+        np.testing.assert_allclose((q1 - q0) / e, v0, atol=1e-5)
+    if name == "InvertedDoublePendulum":
+        np.testing.assert_allclose(env.tip(), ref.data.site_xpos[0][[0, 2]], atol=1e-9)
+
+
+@pytest.mark.parametrize("name, tilt", [("InvertedPendulum", 0.01), ("InvertedDoublePendulum", 0.01)])
+def test_motion_before_contact_matches_mujoco_euler(name, tilt):
+    """Zero actions from a tilted start, 20 env steps, no contact and no limit reached: our
+    observations against MuJoCo with its Euler integrator at the same step h. Both are
+    first-order, so each is off the exact motion by about 2 |M(h) - M(h/2)| (Richardson);
+    the bound is twice that: |ours - M(h)| <= 4 max |M(h) - M(h/2)|."""
+    mujoco, ref = mujoco_env(name)
+    env = make(name).unwrapped
+    qp = env.init_qpos.copy()
+    qp[1] = tilt
+    qv = np.zeros(env.model.nv)
+    env.set_state(qp, qv)
+    ours = np.array([env.step(np.zeros(1))[0] for _ in range(20)])
+
+    def mj(sub):
+        ref.model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+        ref.model.opt.timestep = env.timestep / sub
+        ref.frame_skip = env.frame_skip * sub
+        ref.set_state(qp, qv)
+        return np.array([ref.step(np.zeros(1))[0] for _ in range(20)])
+    m1, m2 = mj(1), mj(2)
+    assert np.abs(qp[1] - ours[:, 1]).max() > 0.1          # it really moved
+    err, delta = np.abs(ours - m1).max(), np.abs(m1 - m2).max()
+    assert err <= 4 * delta, (err, delta)
+
+
+def test_rgb_array_render():
+    env = make("Hopper", render_mode="rgb_array", width=96, height=64)
+    env.reset(seed=0)
+    img = env.render()
+    assert img.shape == (64, 96, 3) and img.dtype == np.uint8 and img.std() > 0
