@@ -60,7 +60,9 @@ class StepOptions(NamedTuple):
         what its joints or position correction added beyond their allowance) exceeds this
         share of the energy it had to work with (its kinetic energy plus its own error under
         the forces) stops the run (SimulationDiverged naming step, time, cause and body);
-        smaller gains are counted in the audit. 0: never stop
+        smaller gains are counted in the audit. 0 (default, for now): never stop, count only
+        (0.25 stops 96 of 100 stiff bang-bang motor runs at once, but also a walker started
+        below uneven ground, whose first steps lift it out against its controller)
     """
     mode_strategy: int = MODES_ALTERNATING
     refine_iters: int = 4
@@ -73,7 +75,7 @@ class StepOptions(NamedTuple):
     gross_limit: float = 1e-6
     dt: float = 0.0
     speed_limit: float = -1.0
-    energy_limit: float = 0.25
+    energy_limit: float = 0.0
 
 
 def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:

@@ -90,6 +90,8 @@ def position_stage(m, s, ws, opt, h, answered):
             excess = bound_correction_work(m, s, ws, h)
             if excess > 0.0:
                 note(ws, s.step[0], AUDIT_CORRECTION_WORK, -1, most_gaining_body(m, s, ws), excess)
-                # bodies lifted out of the ground (a start below it, a terrain put in)
-                # are the depth's business, counted here but not a reason to stop
-                judge_energy(m, ws, opt, h, excess - gravity_lift(m, s, ws))
+                # bodies lifted out of the ground (a terrain put in) are the depth's
+                # business, counted here but not a reason to stop; so is a run's first step,
+                # which moves a start below the ground to the surface (start_check names it)
+                if s.step[0] > 0:
+                    judge_energy(m, ws, opt, h, excess - gravity_lift(m, s, ws))
