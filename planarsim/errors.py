@@ -111,11 +111,16 @@ def audit_violation(model, ws, who="simulation"):
     element_name = _element_name(model, kind, element)
     body_name = _body_name(model, body)
     t = float(ws.prev.time[0])
-    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    last = _start_of_step(ws)
     return AuditViolation(f"{who}: audit at step {step} (t={t:.6g} s): "
                           f"{_AUDIT_TEXT[rule].format(v=value)}; {element_name} on body "
                           f"{body_name!r} ({body}); all counts {dict(zip(AUDIT_NAMES, ws.audit.tolist()))}",
                           step, t, body_name, rule, value, last, rule, element_name)
+
+
+def _start_of_step(ws):
+    """A copy of the state at the start of the step that failed (ws.prev)."""
+    return type(ws.prev)(*(a.copy() for a in ws.prev))
 
 
 def _body_name(model, body) -> str:
@@ -147,7 +152,7 @@ def gross_violation(model, ws, who="simulation"):
     body_name = _body_name(model, body)
     what = ("is open by" if kind == AUDIT_PIN_GAP
             else "is below the ground (or inside another shape) by")
-    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    last = _start_of_step(ws)
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): {_element_name(model, kind, element)} on "
         f"body {body_name!r} ({body}) {what} {value:.3g} m at the end of the step; the step "
@@ -165,7 +170,7 @@ def energy_from_nowhere(model, ws, who="simulation"):
     value = float(ws.audit_value[0])
     t = float(ws.prev.time[0])
     name = _body_name(model, body)
-    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    last = _start_of_step(ws)
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): {_AUDIT_TEXT[rule].format(v=value)} "
         f"({rule}; {_element_name(model, kind, element)}; body {name!r} ({body})), more than "
@@ -184,7 +189,7 @@ def too_fast(model, ws, who="simulation"):
     step = int(ws.prev.step[0])
     t = float(ws.prev.time[0])
     name = _body_name(model, body)
-    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    last = _start_of_step(ws)
     how = (" (|omega| times its radius of gyration)" if turning else "")
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): body {name!r} ({body}) reached a {field} "
@@ -224,6 +229,6 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
     t = float(ws.prev.time[0])
     name = model.body_names[body]
     what = "is not finite" if code == 1 else f"exceeds {guard_limit:g} in magnitude"
-    last = type(ws.prev)(*(a.copy() for a in ws.prev))
+    last = _start_of_step(ws)
     return SimulationDiverged(f"{who} diverged at step {step} (t={t:.6g} s): body {name!r} ({body}) "
                               f"{field}={value} {what}", step, t, name, field, value, last)
