@@ -73,8 +73,10 @@ The extreme families are stepped one step at a time (run_extreme_case), so that 
 before an engine error are judged too, and add three targets: step, the largest energy change
 of a single step beyond its own gravity term, dE - (dt / 2) g dp_y (the exact change of a step
 without impulses; see energy_bound) and the motors' work, against the run's whole E_tol
-(contacts only take energy out, pins' work in one step is O(dt^2)); tunnel (hills_fast) above
-DEPTH_TOL; speed (stiff_motors). A run the engine stops with an error of its own (planarsim's
+(contacts only take energy out), less the joints' second-order share of the step's kinetic
+energy (CONSTRAINT_SHARE, kernels/work.py: an oscillation the energy target bounds over the
+run); tunnel (hills_fast) above DEPTH_TOL, beyond rod_sag for a point on a rod; speed
+(stiff_motors). A run the engine stops with an error of its own (planarsim's
 SimulationDiverged or any planarsim error, naming why) is "raised"; a run missing a target
 without one is "silent" (an audit count alone is silent: nothing stopped the run). The summary
 gives both per family, the silent misses by cause and the audit counts by rule.
@@ -116,6 +118,7 @@ from planarsim import terrain  # noqa: E402
 from benchmarks.metrics import (energy, lowest_point, pin_separation,  # noqa: E402
                                      spec_from_model, world_points)
 from benchmarks.scenes import G, biped_collapse  # noqa: E402
+from planarsim.kernels.work import CONSTRAINT_SHARE  # noqa: E402
 
 FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio", "shape_pile",
             "shape_hills")
@@ -867,8 +870,31 @@ def tunnel_depth(model, q, v, mode, dt, samples=128):
         acc = (v1[ks] - v0[ks]) / dt
         x = p0[ks, 0, None] + tau * v0[ks, 0, None] + tau * tau * acc[:, 0, None]
         y = p0[ks, 1, None] + tau * v0[ks, 1, None] + tau * tau * acc[:, 1, None]
-        worst = max(worst, -float(np.min(ground_gap(model.terrain, x.ravel(), y.ravel()))))
+        dip = -np.min(ground_gap(model.terrain, x.ravel(), y.ravel()).reshape(x.shape), axis=1)
+        worst = max(worst, float(np.max(dip - rod_sag(model, q, v, body, dt)[ks])))
     return max(worst, 0.0)
+
+
+def rod_sag(model, q, v, body, dt):
+    """(K - 1,) how far [m] the path a tunnel is measured on may stray from the motion the
+    engine integrated, per step: for a point on a rod of length L turning at omega, the
+    rod's position correction moves it by up to L (h omega)^2 / 2 (what the rod lengthens
+    when its ends move straight while it turns by h omega) after the engine's own
+    time-of-impact search, which ran on the path before that correction (the path measured
+    here, from the corrected velocity, differs from it by tau^2 / h^2 of that move); 0 for a
+    free point."""
+    a = model.arrays
+    sag = np.zeros(q.shape[0] - 1)
+    for j in range(a.rod_body.shape[0]):
+        ends = [int(x) for x in a.rod_body[j]]
+        if body not in ends:
+            continue
+        d = q[1:, ends[1], :2] - q[1:, ends[0], :2]
+        dv = v[1:, ends[1], :2] - v[1:, ends[0], :2]
+        length = np.hypot(d[:, 0], d[:, 1])
+        omega = (d[:, 0] * dv[:, 1] - d[:, 1] * dv[:, 0]) / np.maximum(length, 1e-300) ** 2
+        sag = np.maximum(sag, length * (dt * omega) ** 2 / 2.0)
+    return sag
 
 
 def joint_gap(model, q):
@@ -974,6 +1000,13 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
     if n >= 2:
         py = np.sum(spec.mass * v[..., 1], axis=1)
         excess = np.diff(net) - 0.5 * dt * G * np.diff(py)
+        if model.n_pin + model.arrays.rod_body.shape[0] > 0:
+            # the joints' second-order terms move a step's energy by up to CONSTRAINT_SHARE
+            # of its kinetic energy, up or down (symplectic: it oscillates, the energy
+            # target above holds the run's drift)
+            kinetic = 0.5 * np.sum(spec.mass * (v[:-1, :, 0] ** 2 + v[:-1, :, 1] ** 2)
+                                   + spec.inertia * v[:-1, :, 2] ** 2, axis=-1)
+            excess = excess - CONSTRAINT_SHARE * kinetic
         k = int(np.argmax(excess))
         out["step_gain"], out["step_k"] = float(excess[k]), k + 1
         if family == "ranger_loop":

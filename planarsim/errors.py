@@ -9,11 +9,14 @@ its own audit (kernels/audit.py); it names the step, time, rule, contact or pin 
 machine's memory (a duration far too long for its frame interval); it names the frames and
 the memory they would need.
 """
+import math
+
 from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_WORK,
                             AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
-                             GUARD_ENERGY, GUARD_NONFINITE_COMMAND, GUARD_SPEED)
+                             GUARD_ENERGY, GUARD_NONFINITE_COMMAND, GUARD_SPEED,
+                             GUARD_STIFF_ACTUATOR)
 
 
 class ModelError(ValueError):
@@ -200,6 +203,27 @@ def too_fast(model, ws, who="simulation"):
         step, t, name, field, speed, last)
 
 
+def stiff_actuator(model, ws, who="simulation"):
+    """The SimulationDiverged of a step not taken because a torque actuator's command would
+    turn what it drives further in one step than the step resolves (guards.check_actuator_turns,
+    StepOptions.turn_limit)."""
+    k = int(ws.info[INFO_COMMAND])
+    turn, kappa, limit = (float(x) for x in ws.guard_value[:3])
+    torque = float(ws.act_u[k])
+    step = int(ws.prev.step[0])
+    t = float(ws.prev.time[0])
+    h = math.sqrt(turn / (abs(torque) * kappa))            # turn = h^2 |u| kappa
+    name = model.act_names[k]
+    return SimulationDiverged(
+        f"{who} stopped before step {step} (t={t:.6g} s): actuator {name!r} commands "
+        f"{torque:.4g} N m, which alone would turn what it drives (inertia {1.0 / kappa:.3g} "
+        f"kg m^2) by {turn:.3g} rad in one step of {h:.3g} s, more than the {limit:g} rad a "
+        f"step resolves (StepOptions.turn_limit): the motor acts faster than the step. Take "
+        f"dt <= {math.sqrt(limit / (abs(torque) * kappa)):.3g} s, or limit its torque to "
+        f"{limit / (h * h * kappa):.3g} N m (or give the joint an armature; turn_limit 0: "
+        f"no check)", step, t, name, "torque", torque, _start_of_step(ws))
+
+
 def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
@@ -222,6 +246,8 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
         return too_fast(model, ws, who)
     if code == GUARD_ENERGY:
         return energy_from_nowhere(model, ws, who)
+    if code == GUARD_STIFF_ACTUATOR:
+        return stiff_actuator(model, ws, who)
     body = int(ws.info[INFO_GUARD_BODY])
     field = FIELD_NAMES[int(ws.info[INFO_GUARD_FIELD])]
     value = float(ws.guard_value[0])

@@ -63,6 +63,14 @@ class StepOptions(NamedTuple):
         smaller gains are counted in the audit. 0 (default, for now): never stop, count only
         (0.25 stops 96 of 100 stiff bang-bang motor runs at once, but also a walker started
         below uneven ground, whose first steps lift it out against its controller)
+    turn_limit : [rad] a torque actuator whose command (saturated) would by itself turn what
+        it drives by more than this in one step from rest, dt^2 |u| / I (I the joint's
+        effective inertia on free bodies, armature included: an upper bound of the turn) stops
+        the run before that step (SimulationDiverged naming the actuator, its torque, the
+        turn, and the dt or torque limit that would do). 0.2 (default): a step resolves
+        turns of about 2 * 0.1 rad (the position correction's regime, kernels/work.py); a
+        bang-bang 100-1000 N m motor on a light link at dt 1e-2 turns it 0.3 to 100 rad.
+        0: no check
     """
     mode_strategy: int = MODES_ALTERNATING
     refine_iters: int = 4
@@ -76,6 +84,7 @@ class StepOptions(NamedTuple):
     dt: float = 0.0
     speed_limit: float = -1.0
     energy_limit: float = 0.0
+    turn_limit: float = 0.2
 
 
 def make_options(strategy="alternating", refine=True, **kw) -> StepOptions:
@@ -103,6 +112,7 @@ _OPTION_RULES = {
     "gross_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0"),
     "dt": (float, lambda x: math.isfinite(x) and 0.0 <= x <= 1.0, "must be 0 (the model's dt) or a step in (0, 1] s"),
     "energy_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0"),
+    "turn_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0 [rad]"),
     "speed_limit": (float, lambda x: x == -1.0 or (math.isfinite(x) and x >= 0.0),
                     "must be -1 (from the model), 0 (none) or a speed > 0 [m/s]"),
 }

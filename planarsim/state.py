@@ -209,8 +209,9 @@ class Workspace(NamedTuple):
     contact_face: np.ndarray     # (n_contact, 4) a pair's reference face in its body's frame:
                                  #   unit normal, and a point on the face's core line (or the
                                  #   core vertex where contact_dist) [m]
-    contact_refpt: np.ndarray    # (n_contact, 2) the reference body's material point where the
-                                 #   contact touched at the step's start (its frame) [m]
+    contact_refpt: np.ndarray    # (n_contact, 4) the reference body's material point where the
+                                 #   contact touched at the step's start (its frame) [m], the
+                                 #   other body's angle and the normal's angle then [rad]
     contact_radii: np.ndarray    # (n_contact, 2) radius of the reference and the other shape [m]
     contact_bounce: np.ndarray   # (n_contact,) normal velocity restitution asks for [m/s]
     manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/collide.py)
@@ -248,8 +249,9 @@ class Workspace(NamedTuple):
     act_power: np.ndarray        # (n_act,) mechanical power [W]
     info: np.ndarray             # (N_INFO,) int: what the last step did, slots named in
                                  #   kernels/info.py (INFO_*; step_info(ws) by name)
-    guard_value: np.ndarray      # (2,) offending value when a guard fired; the speed bound
-                                 #   [m/s] when it was a speed (GUARD_SPEED)
+    guard_value: np.ndarray      # (3,) offending value when a guard fired; the speed bound
+                                 #   [m/s] when it was a speed (GUARD_SPEED); a torque's turn,
+                                 #   inverse inertia and limit (GUARD_STIFF_ACTUATOR)
     row_b: np.ndarray            # (R,) residual of each row without impulses: w = A lam + b
                                  #   [m/s] (velocity stage) or [m, rad] (position projection)
     row_soft: np.ndarray         # (R, 5) a soft row's armature, stiffness, damping, joint rate
@@ -368,14 +370,14 @@ def make_workspace(model: Model) -> Workspace:
                                               np.asarray(model.arrays.contact_body, np.int64)],
                                              axis=1).reshape(nc, 2).copy(),
                      contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
-                     contact_refpt=z((nc, 2)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
+                     contact_refpt=z((nc, 4)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
                      **_broad_phase_lists(model),
                      row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
                      row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
                      row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
                      A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R), act_u=z(na), act_power=z(na),
-                     info=z(N_INFO, np.int64), guard_value=z(2), row_b=z(R), row_soft=z((R, 5)),
+                     info=z(N_INFO, np.int64), guard_value=z(3), row_b=z(R), row_soft=z((R, 5)),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
                      lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),
                      lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),

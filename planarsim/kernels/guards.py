@@ -2,6 +2,7 @@
 import math
 
 from ._jit import kernel
+from .forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 
 GUARD_OK = 0
@@ -13,6 +14,9 @@ GUARD_GROSS = 4           # a pin open or a contact deep beyond StepOptions.gros
 GUARD_ENERGY = 6          # the step gained energy from nowhere beyond StepOptions.energy_limit
                           # (work.judge_energy; ws.audit_last: cause, element, body; audit_value)
 GUARD_SPEED = 5           # a body faster than StepOptions.speed_limit (check_speeds)
+GUARD_STIFF_ACTUATOR = 7  # a torque too strong for the step (check_actuator_turns; ws.info[INFO_COMMAND]:
+                          # the actuator, ws.guard_value: its turn in one step [rad], the inverse
+                          # inertia it drives [1/(kg m^2)], the limit [rad]); nothing is stepped
 FIELD_SPEED = 6           # ws.info[INFO_GUARD_FIELD] of a body's speed |v| [m/s]
 FIELD_TURNING = 7         # ... of its turning speed |omega| r_g [m/s] (r_g its radius of gyration)
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[INFO_COMMAND]:
@@ -69,4 +73,42 @@ def check_speeds(m, s, ws, bound):
             ws.guard_value[0] = speed if speed > bound else turning
             ws.guard_value[1] = bound
             return GUARD_SPEED
+    return GUARD_OK
+
+
+@kernel
+def turn_gain(m, k):
+    """1 / [kg m^2]: how fast torque actuator k turns what it drives, from rest, on free bodies:
+    g M^-1 g^T of its joint coordinate (1/I_a + 1/I_b; a joint's armature a gives
+    kappa / (1 + a kappa)) or of its body's angle (1/I); 0 for the actuators that push (forces,
+    point-mass hips, sliders). Joints and contacts only slow the turn: an upper bound."""
+    kind = m.act_kind[k]
+    if kind == ACT_BODY_TORQUE:
+        return m.body_inv_inertia[m.act_body[k, 0]]
+    if kind != ACT_PIN_TORQUE:
+        return 0.0
+    j = m.act_ref[k]
+    kappa = 0.0
+    for e in range(2):
+        if m.pin_body[j, e] >= 0:
+            kappa += m.body_inv_inertia[m.pin_body[j, e]]
+    return kappa / (1.0 + m.pin_armature[j] * kappa)
+
+
+@kernel
+def check_actuator_turns(m, ws, h, limit):
+    """GUARD_STIFF_ACTUATOR if some torque actuator's saturated command (ws.act_u) alone would
+    turn what it drives by more than `limit` [rad] in one step of h [s] from rest,
+    h^2 |u| kappa (turn_gain): a torque that acts faster than the step can resolve (the
+    joints' and contacts' corrections hold only turns of a few tenths of a radian per step).
+    Recorded: the actuator (ws.info[INFO_COMMAND]), the turn, kappa and limit (ws.guard_value)."""
+    for k in range(m.act_kind.shape[0]):
+        kappa = turn_gain(m, k)
+        turn = h * h * abs(ws.act_u[k]) * kappa
+        if turn > limit:
+            ws.info[INFO_COMMAND] = k
+            ws.guard_value[0] = turn
+            ws.guard_value[1] = kappa
+            ws.guard_value[2] = limit
+            return GUARD_STIFF_ACTUATOR
     return GUARD_OK

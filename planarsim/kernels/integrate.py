@@ -26,7 +26,7 @@ from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_n
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
-                   force_step_energy)
+                   force_step_energy, kinetic_energy)
 
 
 # relative pivot below which the position correction drops a row after a Newton step diverged:
@@ -99,7 +99,8 @@ def bound_correction_work(m, s, ws, h):
     energy by CONSTRAINT_SHARE of the kinetic energy (work.py); beyond it the allowance is 0.
     The move's own lift against the applied forces (a contact point pushed out of the ground)
     is allowed up to that share plus the step's own error under the forces (h [s] the
-    integrated step's), in either regime. Returns the energy [J] the correction still adds beyond its allowance (only the move's
+    integrated step's), in either regime. Returns the energy [J] the correction still adds
+    beyond its allowance and beyond what the step's velocity solve took out (only the move's
     own work can leave some: k = 0 keeps no velocity change).
 
     A body turning by h w ~ 1 in one step (a light body spinning after a hard impact)
@@ -149,7 +150,13 @@ def bound_correction_work(m, s, ws, h):
     for i in range(s.v.shape[0]):
         for c in range(3):
             s.v[i, c] = ws.v_solved[i, c] + k * (s.v[i, c] - ws.v_solved[i, c])
-    return max(k * a + k * k * b - room, 0.0) if short else 0.0
+    if not short:
+        return 0.0
+    # what is left is the move's own work. The velocity stage's loss in this step (contacts
+    # absorbing an approach, friction) pays for it first: a step whose velocity solve took out
+    # more than the move then puts back (a box pushed out of the overlap it hit) gains nothing
+    loss = kinetic_energy(m, ws.v_pred) - kinetic_energy(m, ws.v_solved)
+    return max(k * a + k * k * b - room - max(loss, 0.0), 0.0)
 
 
 @kernel

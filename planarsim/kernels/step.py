@@ -18,7 +18,8 @@ from .codes import MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_guards, check_speeds
+from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_actuator_turns, check_guards,
+                     check_speeds)
 from .info import INFO_SOLVES, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
@@ -162,6 +163,10 @@ def _step(m, s, ws, opt, u):
     for split in range(opt.max_ccd_splits + 1):
         update_trig(s.q, ws.body_cs)                        # cos / sin of the angles
         apply_forces(m, s, ws, u)                           # 1. forces
+        if split == 0 and opt.turn_limit > 0.0:             #    a torque the step cannot
+            code = check_actuator_turns(m, ws, h, opt.turn_limit)   # resolve: stop before it
+            if code != 0:
+                return code
         predict_velocity(m, s, ws, h)                       #    v* = v + h M^-1 f
         predict_configuration(m, s, ws, h)                  #    q + h v* (joints' drift)
         find_contacts(m, s, ws, h)                          # 2. contacts

@@ -89,28 +89,65 @@ def test_rods_thrown_at_hills_keep_their_energy(seed):
     assert audit_counts(sim.ws)["joint_work"] == 0
 
 
+def motor_turn(model, u):
+    """The largest turn [rad] one step of commands u gives a motor's joint from rest on free
+    bodies: dt^2 |u| (1/I_a + 1/I_b) (these joints have no armature)."""
+    a = model.arrays
+    turn = 0.0
+    for k in range(model.n_act):
+        inverse = sum(a.body_inv_inertia[b] for b in a.pin_body[int(a.act_ref[k])] if b >= 0)
+        turn = max(turn, model.dt ** 2 * float(np.max(np.abs(u[:, k]))) * inverse)
+    return turn
+
+
 @pytest.mark.parametrize("seed", range(8))
-def test_stiff_motors_at_large_steps_run_clean_or_stop_at_once(seed):
-    """Pin motors of 100-1000 N m driven bang-bang at dt 1e-2 and 2e-2 s: nothing between a
-    clean run (every audit count 0) and a SimulationDiverged saying what to change."""
-    model, q, v, sim, error = corpus_run("stiff_motors", seed, energy_limit=0.25)
-    if error is None:
-        assert sum(audit_counts(sim.ws).values()) == 0, audit_counts(sim.ws)
-    else:
-        assert "smaller dt" in str(error) or "Take a smaller dt" in str(error), str(error)
+def test_stiff_motors_at_large_steps_stop_at_once_saying_what_to_change(seed):
+    """Pin motors of 100-1000 N m driven bang-bang at dt 1e-2 and 2e-2 s on 0.5-3 kg links
+    turn a joint 0.3 to 100 rad in one step: beyond what a step resolves. The run stops before
+    its first step, naming the motor, its torque and turn, the dt and the torque that would do;
+    nothing between that and a clean run."""
+    from benchmarks.contact_stress import build, commands
+    model = build("stiff_motors", seed)[0]
+    assert motor_turn(model, commands("stiff_motors", seed, model, 8)) > 0.2
+    model, q, v, sim, error = corpus_run("stiff_motors", seed)
+    assert error is not None and error.step == 0 and len(q) == 1
+    text = str(error)
+    assert "acts faster than the step" in text and "Take dt <=" in text and "_motor'" in text, text
+    assert sum(audit_counts(sim.ws).values()) == 0
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_motors_within_the_turn_limit_run_clean(seed):
+    """The same scenes with every command scaled to turn its joint at most 0.18 rad in one
+    step (under the default turn_limit of 0.2 rad): two seconds with every audit count 0, no
+    pin open, no stop."""
+    import benchmarks.contact_stress as cs
+    model = cs.build("stiff_motors", seed)[0]
+    u = cs.commands("stiff_motors", seed, model, 400)
+    scale = 0.18 / motor_turn(model, u)
+    original = cs.commands
+    try:
+        cs.commands = lambda *args: original(*args) * scale
+        model, q, v, sim, error = corpus_run("stiff_motors", seed, steps=int(round(2.0 / model.dt)))
+    finally:
+        cs.commands = original
+    assert error is None, str(error)
+    assert sum(audit_counts(sim.ws).values()) == 0, audit_counts(sim.ws)
 
 
 def test_energy_from_nowhere_names_cause_step_time_and_body():
-    """A gross gain (more than energy_limit of the step's energy) stops the run with an error
-    naming the step, time, cause and body; with energy_limit = 0 the audit counts it."""
-    model, q, v, sim, error = corpus_run("stiff_motors", 0, energy_limit=0.25)
+    """With the turn check off, a stiff motor's step that gains more than energy_limit of the
+    step's energy stops the run with an error naming the step, time, cause and body; with
+    energy_limit = 0 the audit counts it."""
+    model, q, v, sim, error = corpus_run("stiff_motors", 0, energy_limit=0.25, turn_limit=0.0)
     assert error is not None
     text = str(error)
     assert f"step {error.step}" in text and "t=" in text and "body '" in text
     stopped = [e for e in (error,) if "energy_limit" in str(e)]
     if stopped:
         assert error.field in ("correction_work", "joint_work")
-        model, q, v, sim, error = corpus_run("stiff_motors", 0, energy_limit=0.0, gross_limit=0.0)
+        model, q, v, sim, error = corpus_run("stiff_motors", 0, energy_limit=0.0, gross_limit=0.0,
+                                             turn_limit=0.0)
         assert audit_counts(sim.ws)["correction_work"] + audit_counts(sim.ws)["joint_work"] > 0
 
 
