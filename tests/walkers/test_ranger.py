@@ -316,3 +316,20 @@ def test_the_efficient_set_walks_further_for_less():
     _, default, _ = simulate(20.0, gait="walk", record_every=1000)
     assert not tuned["fell"] and tuned["mean_speed"] >= 0.4
     assert tuned["cost_of_transport_electrical"] < 0.8 * default["cost_of_transport_electrical"]
+
+
+def test_cost_of_transport_sweep_smoke(tmp_path, capsys):
+    """benchmarks/ranger_cot.py (README's plot of cost of transport against speed), two
+    target speeds per gait over 6 s walks: every walk reported, the tuned gait at its own
+    target walks faster and cheaper than the default at the same target, the PNG written."""
+    from benchmarks.ranger_cot import main as cot_main
+    out = tmp_path / "cot.png"
+    rows = cot_main(["--duration", "6", "--points", "2", "--range", "0.55:0.6", "--workers", "1",
+                     "--out", str(out)])
+    assert [(r["gait"], r["target_speed"]) for r in rows] == [
+        ("default", 0.55), ("default", 0.6), ("efficient", 0.55), ("efficient", 0.6)]
+    assert not any(r["fell"] for r in rows)
+    d, e = rows[0], rows[2]
+    assert e["speed"] > d["speed"] and e["cot_electrical"] < d["cot_electrical"]
+    assert out.stat().st_size > 10_000
+    assert "wrote" in capsys.readouterr().out
