@@ -7,9 +7,11 @@
    rimless wheel (closed form eta^2);
 3. the simplest walker's first period doubling and 2 -> 4 doubling against dt, with the
    same located on the scipy reference (beta -> 0);
+3b. acceptance: what `planarsim analyze` locates at the walker's foot mass ratio (1e-3)
+   against the scipy reference for that ratio, per dt, with the relative errors;
 4. cost of transport over whole steps against the run's duration.
 
-    python benchmarks/gait_analysis.py [--only speedup multipliers doubling cot]
+    python benchmarks/gait_analysis.py [--only speedup multipliers doubling acceptance cot]
 """
 from __future__ import annotations
 
@@ -24,7 +26,8 @@ from planarsim.analysis import (MapPool, MultiplierWarning, continue_branch, fin
                                 match_distance, multipliers_with_error, period_doubling_branch)
 from walkers.passive import CompassParams, PassiveWalker, RimlessParams, SimplestParams
 from walkers.passive.family import WalkerFamily
-from walkers.passive.reference import compass_fixed_point, simplest_fixed_point, simplest_map
+from walkers.passive.reference import (compass_fixed_point, simplest_feet_doublings,
+                                       simplest_fixed_point, simplest_map)
 
 DTS = (1e-3, 5e-4, 2.5e-4, 1.25e-4)
 BETA = 1e-5   # foot mass ratio: the reference is beta -> 0
@@ -132,6 +135,38 @@ def doubling():
         print(f"    {o[0]:9.3g} {o[1]:10.7f} {a:9.2e} {oa:>5} {o[2]:10.7f} {b:9.2e} {ob:>5} {o[4]:5.0f} s")
 
 
+def acceptance():
+    """`planarsim analyze simplest-walker --param slope` (the command's own calls: 5 points over
+    0.0138:0.0182, the period-2 orbit followed; at dt <= 2.5e-4 only the period-1 branch over
+    0.0138:0.0156, 4 points) against the scipy reference at the walker's foot mass ratio."""
+    beta = SimplestParams().foot_mass_ratio
+    t0 = time.perf_counter()
+    ref = simplest_feet_doublings(beta)
+    print(f"== analyze simplest-walker (foot mass ratio {beta:g}) against the scipy reference: "
+          f"1 -> 2 at {ref[0]:.10f}, 2 -> 4 at {ref[1]:.10f} rad ({time.perf_counter() - t0:.0f} s)")
+    print(f"    {'dt [s]':>9} {'1 -> 2':>13} {'rel. error':>11} order {'2 -> 4':>13} {'rel. error':>11} order  time")
+    rows = []
+    for dt in DTS:
+        follow = dt >= 5e-4
+        a, b, points = (0.0138, 0.0182, 5) if follow else (0.0138, 0.0156, 4)
+        fam = WalkerFamily("simplest-walker", "slope", dt=dt)
+        t0 = time.perf_counter()
+        with MapPool(fam) as pool:
+            br = continue_branch(pool, fam.guess(a), a, b, points, param="slope")
+            pd = br.first("period-doubling")
+            p24 = math.nan
+            if follow:
+                b2 = period_doubling_branch(pool, pd, b, max(4, points // 2), param="slope")
+                pd2 = b2.first("period-doubling")
+                p24 = pd2.p if pd2 else math.nan
+        rows.append((dt, pd.p, p24, time.perf_counter() - t0))
+    e1 = [abs(r[1] / ref[0] - 1) for r in rows]
+    e2 = [abs(r[2] / ref[1] - 1) for r in rows]
+    o1, o2 = order(e1), order(e2)
+    for r, a, oa, b, ob in zip(rows, e1, o1, e2, o2):
+        print(f"    {r[0]:9.3g} {r[1]:13.10f} {a:11.2e} {oa:>5} {r[2]:13.10f} {b:11.2e} {ob:>5} {r[3]:5.0f} s")
+
+
 def cot():
     import walkers
     print("== cost of transport over whole steps / sin(slope) against the run's duration")
@@ -146,7 +181,7 @@ def cot():
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--only", nargs="*", default=["speedup", "multipliers", "doubling", "cot"])
+    ap.add_argument("--only", nargs="*", default=["speedup", "multipliers", "doubling", "acceptance", "cot"])
     a = ap.parse_args(argv)
     for name in a.only:
         globals()[name]()

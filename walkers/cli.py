@@ -462,7 +462,7 @@ def cmd_analyze(args):
             for k in branches:
                 print(f"period-{k.period} branch: {len(k.points)} points, {k.end}")
                 for bf in k.bifurcations:
-                    print(f"  {bf.kind} at {args.param} = {bf.p:.7g}"
+                    print(f"  {bf.kind} at {args.param} = {bf.p:.9g}"
                           f"{'' if bf.located else f' (not located: within {bf.bracket:.2g})'}"
                           f"{f' (+- {bf.p_error:.1g} from the multipliers error)' if bf.located and math.isfinite(bf.p_error) and bf.p_error > bf.bracket else ''}")
                     if bf.note:

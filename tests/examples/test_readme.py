@@ -19,6 +19,9 @@ def test_readme_python_blocks_run_in_order(tmp_path, monkeypatch):
     assert (tmp_path / "tour.gif").stat().st_size > 0
     assert (tmp_path / "tour.png").stat().st_size > 0
     assert namespace["code"] == 0 and namespace["traj"].t.shape[0] == namespace["k"]
+    # the gait analysis example's doubling is located, where README's text puts it
+    pd = namespace["pd"]
+    assert pd.located and abs(pd.p - 0.014935) < 5e-7, (pd.p, pd.located, pd.note)
     # the tour's torso and leg are shapes that collide: whatever the controller does, no corner
     # of the torso's box ends up inside the hill (it used to fall 0.5 m into it)
     model, traj = namespace["model"], namespace["traj"]

@@ -20,6 +20,7 @@ import numpy as np
 from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
+from planarsim.half_step import kick, project_velocities, to_instant_velocity, to_step_velocity  # noqa: F401
 from planarsim.state import State
 from planarsim.trajectory import Trajectory, make_recorder, record_state
 
@@ -39,55 +40,6 @@ def _cross(a, b):
 def _dup(theta):
     """d leg_up / d theta in slope coordinates (t, n): (-cos theta, -sin theta)."""
     return np.array([-math.cos(theta), -math.sin(theta)])
-
-
-def _point_rows(q, b, local):
-    """World lever arm of a body-fixed point and the (2, 3) rows mapping the body velocity
-    (vx, vy, omega) to the point velocity."""
-    c, sn = math.cos(q[b, 2]), math.sin(q[b, 2])
-    rx, ry = c * local[0] - sn * local[1], sn * local[0] + c * local[1]
-    return np.array([[1.0, 0.0, -ry], [0.0, 1.0, rx]]), np.array([q[b, 0] + rx, q[b, 1] + ry])
-
-
-def project_velocities(model, q, v, pinned=()) -> np.ndarray:
-    """Velocities (n_body, 3) made consistent with the model's rods and pins and with the
-    contacts in `pinned` (their points at rest) at configuration q, by the mass-weighted
-    projection v - W J^T (J W J^T)^+ J v (the smallest kinetic-energy change).
-
-    The engine's position-level step leaves velocities tangent to the constraints of the
-    START of the step, O(dt) off those at its end; a section state, or a shorter step taken
-    from it, needs them consistent with its own configuration."""
-    a = model.arrays
-    nb = model.n_body
-    w = np.repeat(np.c_[a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia], 1, axis=0).ravel()
-    rows = []
-
-    def point(b, local):
-        Jb, p = _point_rows(q, b, local)
-        full = np.zeros((2, 3 * nb))
-        full[:, 3 * b:3 * b + 3] = Jb
-        return full, p
-
-    for j in range(model.n_rod):
-        (ba, bb), (la, lb) = a.rod_body[j], a.rod_anchor[j]
-        Ja, pa = point(ba, la) if ba >= 0 else (np.zeros((2, 3 * nb)), la)
-        Jb, pb = point(bb, lb) if bb >= 0 else (np.zeros((2, 3 * nb)), lb)
-        e = (pb - pa) / np.hypot(*(pb - pa))
-        rows.append(e @ (Jb - Ja))
-    for j in range(model.n_pin):
-        (ba, bb), (la, lb) = a.pin_body[j], a.pin_anchor[j]
-        Ja = point(ba, la)[0] if ba >= 0 else np.zeros((2, 3 * nb))
-        Jb = point(bb, lb)[0] if bb >= 0 else np.zeros((2, 3 * nb))
-        rows.extend(Jb - Ja)
-    for c in pinned:
-        rows.extend(point(a.contact_body[c], a.contact_local[c])[0])
-    if not rows:
-        return v.copy()
-    J = np.array(rows)
-    x = v.ravel()
-    A = (J * w) @ J.T
-    mu = np.linalg.lstsq(A, J @ x, rcond=1e-12)[0]
-    return (x - w * (J.T @ mu)).reshape(nb, 3)
 
 
 class PassiveWalker:
@@ -253,7 +205,7 @@ class PassiveWalker:
                                self.hip, self.fall_height, rec, int(record_every), int(k0),
                                self.event_time, self.event_contact)
 
-    def refine_touchdown(self, old: int) -> float:
+    def refine_touchdown(self, old: int, instant: bool = False) -> float:
         """Move the state from the end of a DETECT rollout to the touchdown instant itself and
         resolve the impact there.
 
@@ -263,6 +215,13 @@ class PassiveWalker:
         velocities onto the constraints there (project_velocities), then enables and pins the
         foot and takes a step of IMPACT_DT, in which the engine resolves the
         impact and (with the "all" strategy) releases the old stance foot `old`.
+        instant: the start of that step has its velocity over the step before (the engine's
+        own); it is first made the velocity at that instant (planarsim.half_step) and the
+        sub-step is a velocity-Verlet one (half kick back, the engine's step of tau, half
+        kick forward and projection), so that the state at the touchdown is second order in
+        dt and smooth in the start state (a symplectic Euler sub-step puts a sawtooth of
+        tau^2 a / 2 into the map, whose slope is first order in dt). The step map starts from
+        to_step_velocity; a walker's run takes the engine's velocities as they are.
         Returns tau [s]."""
         from scipy.optimize import brentq
 
@@ -273,11 +232,18 @@ class PassiveWalker:
         prev = State(*(a.copy() for a in ws.prev))
         # velocities consistent with the start configuration, so that a sub-step shorter
         # than dt does not read the O(dt) mismatch as the stance foot leaving the ground
-        prev.v[...] = project_velocities(self.model, prev.q, prev.v, [int(self.feet[old])])
+        if instant:
+            to_instant_velocity(self.model, prev, ws, m.dt, self.u0, [int(self.feet[old])])
+        else:
+            prev.v[...] = project_velocities(self.model, prev.q, prev.v, [int(self.feet[old])])
+
+        pinned = [int(self.feet[old])]
 
         def sub_step(tau):
             s.restore(prev)
             if tau > 0.0:
+                if instant:
+                    to_step_velocity(self.model, s, ws, tau, self.u0)
                 check_run(step_from_python(m, s, ws, sim.options._replace(dt=tau), self.u0),
                           self.model, ws, sim.options, self.kind)
             p = self.foot_point(c)[0]
@@ -288,11 +254,22 @@ class PassiveWalker:
         if sub_step(0.0) > 0.0:
             tau = brentq(sub_step, 0.0, h, xtol=1e-16, rtol=1e-15, maxiter=200)
         sub_step(tau)
-        s.v[...] = project_velocities(self.model, s.q, s.v, [int(self.feet[old])])
+        if instant and tau > 0.0:
+            to_instant_velocity(self.model, s, ws, tau, self.u0, pinned)
+        else:
+            s.v[...] = project_velocities(self.model, s.q, s.v, pinned)
         s.contact_enabled[c] = 1
         s.contact_mode[c] = 1
+        touch = s.q.copy()
         check_run(step_from_python(m, s, ws, sim.options._replace(dt=IMPACT_DT), self.u0),
                   self.model, ws, sim.options, self.kind)
+        if instant:
+            # the impact's velocity change at the touchdown itself: the configuration before
+            # the step of IMPACT_DT, less that step's kick of the applied forces (else the
+            # section state is that of IMPACT_DT later: theta off by theta_dot IMPACT_DT)
+            s.q[...] = touch
+            kick(m, s, ws, self.u0, -IMPACT_DT)
+            s.v[...] = project_velocities(self.model, s.q, s.v, [c])
         s.time[0] = prev.time[0] + tau
         return tau
 
@@ -301,6 +278,9 @@ class PassiveWalker:
         the walker falls or takes no step within 20 s). With record_every > 0 the step (up to
         the end of the sim step containing the touchdown) is kept in self.last_traj."""
         self.set_coords(x)
+        # x holds velocities at the touchdown instant; the step wants them over its first step
+        # (planarsim.half_step: with both ends converted the map is second order in dt)
+        to_step_velocity(self.model, self.sim.state, self.sim.ws, self.dt, self.u0)
         old = int(self.memory[0])
         start = self.foot_point(self.feet[old])[0]
         toggle = self.toggle
@@ -314,7 +294,7 @@ class PassiveWalker:
             raise StepMapError(f"{self.kind}: the walker fell from x={x}")
         if code == NO_EVENT:
             raise StepMapError(f"{self.kind}: no touchdown within 20 s from x={x}")
-        self.refine_touchdown(old)
+        self.refine_touchdown(old, instant=True)
         self.last_release_ok = bool(self.sim.state.contact_mode[self.feet[old]] == 0)
         self.sim.state.contact_enabled[self.feet[old]] = 0
         self.last_period = float(self.sim.state.time[0])

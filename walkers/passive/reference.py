@@ -227,15 +227,16 @@ def _from_section(x):
     return np.array([x[0], x[0] - x[2], x[1], x[1] - x[3]])
 
 
-def compass_step(x, p, rtol=1e-12, atol=1e-13, t_max=10.0):
+def compass_step(x, p, rtol=1e-12, atol=1e-13, t_max=10.0, consts=None):
     """One step of the compass gait: section state x (theta, theta_dot [rad/s], phi,
     phi_dot [rad/s]) just after heel strike -> (next x, step period [s], step length [m],
-    y(t) -> (th1, th2, th1', th2') over the step). p: CompassParams.
+    y(t) -> (th1, th2, th1', th2') over the step). p: CompassParams (or consts: the tuple of
+    _compass_consts, p then unused).
 
     The strike event is terminal; at a crossing that is not a heel strike (the scuff at
     mid-stance) the integration restarts from the crossing."""
     from scipy.integrate import solve_ivp
-    c = _compass_consts(p)
+    c = _compass_consts(p) if consts is None else consts
 
     def strike(t, y, c):
         return math.cos(y[0]) - math.cos(y[1])          # swing-foot height / l
@@ -296,3 +297,83 @@ def compass_fixed_point(p=None, x0=None, tol=1e-12, eps=1e-6):
     _, period, step, _ = compass_step(fp.x, p)
     return dict(x=fp.x, period=period, step_length=step, speed=step / period,
                 multipliers=floquet_multipliers(f, fp.x, eps=eps), jacobian=fp.jacobian)
+
+
+# simplest walker with feet of finite mass ---------------------------------------------------
+# The simplest walking model with foot mass ratio beta > 0 (walkers.passive.model.build_simplest:
+# hip point mass M, point feet beta M on massless rods of length l) is the compass gait above
+# with each leg's mass at its foot (a = 0, b = l) and no leg inertia (I = 0); its section
+# coordinates are the engine's (rates in units of sqrt(g / l)).
+
+def simplest_feet_consts(p):
+    """_compass_consts of the simplest walker with SimplestParams p (feet of mass beta M)."""
+    return (p.hip_mass, p.foot_mass_ratio * p.hip_mass, p.leg_length, 0.0, p.leg_length, 0.0,
+            p.gravity, p.slope)
+
+
+def simplest_feet_step(x, p, rtol=1e-12, atol=1e-13):
+    """One step of the simplest walker with feet of mass beta M (SimplestParams p): section
+    state x (theta, theta_dot, phi, phi_dot; rates in units of sqrt(g / l)) -> (next x,
+    step period [s])."""
+    k = math.sqrt(p.gravity / p.leg_length)
+    scale = np.array([1.0, k, 1.0, k])
+    xn, period, _, _ = compass_step(np.asarray(x, float) * scale, None, rtol, atol,
+                                    consts=simplest_feet_consts(p))
+    return xn / scale, period
+
+
+def simplest_feet_map(p):
+    """The step map of simplest_feet_step at SimplestParams p (a fall raises StepMapError)."""
+    from planarsim.analysis import StepMapError
+
+    def f(x):
+        try:
+            return simplest_feet_step(x, p)[0]
+        except RuntimeError as e:
+            raise StepMapError(str(e)) from None
+    return f
+
+
+class SimplestFeetFamily:
+    """slope -> simplest_feet_map, for planarsim.analysis (MapPool, continue_branch), at foot
+    mass ratio beta."""
+
+    def __init__(self, beta: float):
+        from .params import SimplestParams
+        self.base = SimplestParams(foot_mass_ratio=beta)
+
+    def __call__(self, slope):
+        return simplest_feet_map(self.base.replace(slope=float(slope)))
+
+
+def simplest_feet_doublings(beta, width=2e-4):
+    """Slopes [rad] of the 1 -> 2 and 2 -> 4 period doublings of the simplest walker with foot
+    mass ratio beta on the scipy reference (simplest_feet_step: DOP853 at rtol 1e-12). The
+    doublings are found by continuation (planarsim.analysis, period-1 branch from the
+    published gait at 0.009 rad to 0.0154, period-2 branch to 0.018), then each slope where
+    det(J + I) = 0 by brentq (xtol 1e-12) within +-width of it: fixed points of P (P^2) by
+    Newton to 1e-12, multipliers by central differences of step 1e-6. About 15 s."""
+    from scipy.optimize import brentq
+    from planarsim.analysis import (MapPool, continue_branch, find_fixed_point,
+                                    floquet_multipliers, period_doubling_branch)
+    fam = SimplestFeetFamily(beta)
+    with MapPool(fam, workers=1) as pool:
+        br = continue_branch(pool, simplest_fixed_point(0.009)["x"], 0.009, 0.0154, points=6,
+                             param="slope")
+        pd = br.first("period-doubling")
+        b2 = period_doubling_branch(pool, pd, 0.0180, points=6, param="slope")
+    pd2 = b2.first("period-doubling")
+    if pd is None or pd2 is None:
+        raise RuntimeError(f"reference (beta {beta}): doublings not found by continuation")
+    start = {1: pd.x, 2: b2.points[0].x}      # Newton's start, then the last fixed point
+
+    def det(p, period):
+        f1 = fam(p)
+        f = f1 if period == 1 else (lambda x: f1(f1(x)))
+        fp = find_fixed_point(f, start[period], tol=1e-12, eps=1e-7)
+        if not fp.converged:
+            raise RuntimeError(f"reference fixed point at slope {p} did not converge")
+        start[period] = fp.x
+        return float(np.prod(1.0 + floquet_multipliers(f, fp.x, eps=1e-6)).real)
+    return (brentq(lambda p: det(p, 1), pd.p - width, pd.p + width, xtol=1e-12),
+            brentq(lambda p: det(p, 2), pd2.p - width, pd2.p + width, xtol=1e-12))
