@@ -352,7 +352,8 @@ class ModelBuilder:
             d = _vec2("free coordinate", name, idx, "axis", axis)
             norm = float(np.hypot(*d))
             if not norm > 1e-12:
-                raise ModelError(f"free coordinate {name!r} ({idx}): axis={tuple(d)} must not be zero")
+                raise ModelError(f"free coordinate {name!r} ({idx}): axis={tuple(map(float, d))} "
+                                 f"must not be zero")
             d = tuple(d / norm)
         lo, hi = self._joint_limit("free coordinate", name, idx, limit)
         k, c, arm = self._joint_passive("free coordinate", name, idx, stiffness, damping, armature)
