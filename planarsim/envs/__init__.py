@@ -4,7 +4,8 @@ action space, rewards, termination, reset noise and frame skip) on planarsim's e
 Importing this package registers ``planarsim/Hopper-v0``, ``planarsim/Walker2d-v0``,
 ``planarsim/HalfCheetah-v0``, ``planarsim/InvertedPendulum-v0``,
 ``planarsim/InvertedDoublePendulum-v0``, ``planarsim/Reacher-v0`` and ``planarsim/Swimmer-v0``
-with gymnasium (episode lengths as gymnasium's: 1000 steps, Reacher 50).
+with gymnasium (episode lengths as gymnasium's: 1000 steps, Reacher 50). ``PlanarVectorEnv``
+(vector.py) steps many copies of one of them on every core.
 """
 try:
     import gymnasium
@@ -12,6 +13,7 @@ except ImportError as e:  # pragma: no cover - exercised without gymnasium only
     raise ImportError("planarsim.envs needs gymnasium: pip install -e '.[gym]'") from e
 
 from .core import GeneralizedCoords, PlanarMujocoEnv
+from .vector import PlanarVectorEnv
 from .tasks import (HalfCheetah, Hopper, InvertedDoublePendulum, InvertedPendulum, Reacher, Swimmer,
                     Walker2d)
 
@@ -35,5 +37,5 @@ def register_all():
 
 register_all()
 
-__all__ = ["ENVS", "GeneralizedCoords", "PlanarMujocoEnv", "Hopper", "Walker2d", "HalfCheetah",
+__all__ = ["ENVS", "GeneralizedCoords", "PlanarMujocoEnv", "PlanarVectorEnv", "Hopper", "Walker2d", "HalfCheetah",
            "InvertedPendulum", "InvertedDoublePendulum", "Reacher", "Swimmer", "register_all"]
