@@ -42,16 +42,19 @@ def _worker(conn, env_id, n, kwargs):
     try:
         while True:
             cmd, arg = conn.recv()
-            if cmd == "step":
-                conn.send(("ok", envs.step(arg)))
-            elif cmd == "reset":
-                seeds, options = arg
-                conn.send(("ok", envs.reset(seed=seeds, options=options)))
-            elif cmd == "call":
-                name, args, kw = arg
-                conn.send(("ok", envs.call(name, *args, **kw)))
-            else:
+            if cmd not in ("step", "reset", "call"):
                 break
+            try:
+                if cmd == "step":
+                    out = envs.step(arg)
+                elif cmd == "reset":
+                    out = envs.reset(seed=arg[0], options=arg[1])
+                else:
+                    out = envs.call(arg[0], *arg[1], **arg[2])
+            except Exception as e:      # the parent raises it
+                conn.send(("error", e))
+            else:
+                conn.send(("ok", out))
     finally:
         envs.close()
         conn.close()
@@ -131,7 +134,11 @@ class PlanarVectorEnv(VectorEnv):
         return [x[a:b] for a, b in zip(edges[:-1], edges[1:])]
 
     def _gather(self):
-        return [c.recv()[1] for c in self._conns]
+        replies = [c.recv() for c in self._conns]
+        for status, value in replies:
+            if status == "error":
+                raise value
+        return [value for _, value in replies]
 
     def reset(self, *, seed=None, options=None):
         if seed is None:
@@ -139,7 +146,7 @@ class PlanarVectorEnv(VectorEnv):
         elif isinstance(seed, (int, np.integer)):
             seeds = [int(seed) + i for i in range(self.num_envs)]
         else:
-            seeds = list(seed)
+            seeds = [None if s is None else int(s) for s in seed]
             if len(seeds) != self.num_envs:
                 raise ValueError(f"reset: {len(seeds)} seeds for num_envs={self.num_envs}")
         if self._local is not None:
