@@ -1,7 +1,8 @@
 """Many copies of one planarsim environment on every core: ``PlanarVectorEnv``.
 
-Each worker process holds a contiguous share of the copies as a gymnasium ``SyncVectorEnv``
-(gymnasium's own autoreset and info batching) and steps them; the physics and the map to
+The copies are split into contiguous shares, one per worker: this process steps the first
+share, a worker process each other one, every share as a gymnasium ``SyncVectorEnv``
+(gymnasium's own autoreset and info batching); the physics and the map to
 MuJoCo's (qpos, qvel) run in compiled code, the observation and reward in Python. A step
 sends each worker its rows of the actions and gathers the rows back, so copy i is the same
 environment, with the same seed, as the i-th copy of ``gymnasium.vector.SyncVectorEnv``:
@@ -35,8 +36,19 @@ def _make_sync(env_id, n, kwargs):
                          autoreset_mode=AutoresetMode.NEXT_STEP)
 
 
+def _apply(envs, cmd, arg):
+    """One command on a share of the copies: "step" (actions), "reset" ((seeds, options)) or
+    "call" ((name, args, kwargs))."""
+    if cmd == "step":
+        return envs.step(arg)
+    if cmd == "reset":
+        return envs.reset(seed=arg[0], options=arg[1])
+    return envs.call(arg[0], *arg[1], **arg[2])
+
+
 def _worker(conn, env_id, n, kwargs):
-    """A worker's loop: ("reset", (seeds, options)) | ("step", actions) | ("close", None)."""
+    """A worker's loop: (command, argument) -> ("ok", result) | ("error", exception) until
+    ("close", None)."""
     envs = _make_sync(env_id, n, kwargs)
     conn.send(("ready", None))
     try:
@@ -45,12 +57,7 @@ def _worker(conn, env_id, n, kwargs):
             if cmd not in ("step", "reset", "call"):
                 break
             try:
-                if cmd == "step":
-                    out = envs.step(arg)
-                elif cmd == "reset":
-                    out = envs.reset(seed=arg[0], options=arg[1])
-                else:
-                    out = envs.call(arg[0], *arg[1], **arg[2])
+                out = _apply(envs, cmd, arg)
             except Exception as e:      # the parent raises it
                 conn.send(("error", e))
             else:
@@ -84,7 +91,8 @@ def _merge_into(out, info, start, n, num_envs):
 
 class PlanarVectorEnv(VectorEnv):
     """``num_envs`` copies of ``gymnasium.make(env_id, **kwargs)`` stepped on ``workers``
-    processes (default: the cores this process may use; 1: in this process, no workers).
+    processes, this one included (default: the cores this process may use; 1: this process
+    alone).
     Autoreset: gymnasium's NEXT_STEP (a copy that ended is reset by the next step, which
     ignores its action and returns its first observation with reward 0).
 
@@ -111,19 +119,16 @@ class PlanarVectorEnv(VectorEnv):
         self.render_mode = None
         self.spec = probe.spec
         probe.close()
-        self._local = None
         self._conns, self._procs = [], []
-        if workers == 1:
-            self._local = _make_sync(env_id, num_envs, kwargs)
-            return
         ctx = mp.get_context(context or ("fork" if "fork" in mp.get_all_start_methods() else "spawn"))
-        for n in self.sizes:
+        for n in self.sizes[1:]:
             parent, child = ctx.Pipe()
             p = ctx.Process(target=_worker, args=(child, env_id, n, kwargs), daemon=True)
             p.start()
             child.close()
             self._conns.append(parent)
             self._procs.append(p)
+        self._local = _make_sync(env_id, self.sizes[0], kwargs)     # the first share, here
         for c in self._conns:
             c.recv()
 
@@ -133,12 +138,19 @@ class PlanarVectorEnv(VectorEnv):
         edges = np.cumsum([0] + self.sizes)
         return [x[a:b] for a, b in zip(edges[:-1], edges[1:])]
 
-    def _gather(self):
-        replies = [c.recv() for c in self._conns]
+    def _run(self, cmd, args):
+        """Command `cmd` on every share (args: one per share); their results in share order.
+        The workers run theirs while this process runs the first share's."""
+        for c, arg in zip(self._conns, args[1:]):
+            c.send((cmd, arg))
+        try:
+            local = _apply(self._local, cmd, args[0])
+        finally:
+            replies = [c.recv() for c in self._conns]     # the pipes stay in step
         for status, value in replies:
             if status == "error":
                 raise value
-        return [value for _, value in replies]
+        return [local] + [value for _, value in replies]
 
     def reset(self, *, seed=None, options=None):
         if seed is None:
@@ -149,11 +161,10 @@ class PlanarVectorEnv(VectorEnv):
             seeds = [None if s is None else int(s) for s in seed]
             if len(seeds) != self.num_envs:
                 raise ValueError(f"reset: {len(seeds)} seeds for num_envs={self.num_envs}")
-        if self._local is not None:
-            return self._local.reset(seed=seeds, options=options)
-        for c, s in zip(self._conns, self._rows(np.array(seeds, dtype=object))):
-            c.send(("reset", (list(s), options)))
-        parts = self._gather()
+        parts = self._run("reset", [(list(s), options)
+                                    for s in self._rows(np.array(seeds, dtype=object))])
+        if len(parts) == 1:
+            return parts[0]
         obs = np.concatenate([p[0] for p in parts])
         return obs, _merge_infos([p[1] for p in parts], self.sizes, self.num_envs)
 
@@ -166,25 +177,19 @@ class PlanarVectorEnv(VectorEnv):
         if bad.size:     # before any copy steps: all copies stay in step with each other
             raise ValueError(f"actions of copies {bad.tolist()} have NaN or infinite entries: "
                              f"{actions[bad[0]].tolist()}")
-        if self._local is not None:
-            return self._local.step(actions)
-        for c, a in zip(self._conns, self._rows(actions)):
-            c.send(("step", a))
-        parts = self._gather()
+        parts = self._run("step", self._rows(actions))
+        if len(parts) == 1:
+            return parts[0]
         obs, rew, term, trunc = (np.concatenate([p[k] for p in parts]) for k in range(4))
         return obs, rew, term, trunc, _merge_infos([p[4] for p in parts], self.sizes, self.num_envs)
 
     def call(self, name, *args, **kwargs):
         """Call the method or read the attribute `name` of every copy (a tuple in copy order)."""
-        if self._local is not None:
-            return self._local.call(name, *args, **kwargs)
-        for c in self._conns:
-            c.send(("call", (name, args, kwargs)))
-        return tuple(x for part in self._gather() for x in part)
+        parts = self._run("call", [(name, args, kwargs)] * self.workers)
+        return tuple(x for part in parts for x in part)
 
     def close_extras(self, **kwargs):
-        if self._local is not None:
-            self._local.close()
+        self._local.close()
         for c in self._conns:
             try:
                 c.send(("close", None))

@@ -53,6 +53,22 @@ def test_same_seed_same_episode(name):
     assert not np.array_equal(env.reset(seed=1)[0], env.reset(seed=2)[0])
 
 
+@pytest.mark.parametrize("name", ["Hopper", "HalfCheetah", "Reacher"])
+def test_reset_forgets_the_last_episode(name):
+    """A reset is as a new environment: the same seed gives the same episode after any
+    history (no contact modes, warm starts or ground queries carry over)."""
+    def episode(env, seed, n=40):
+        out = [env.reset(seed=seed)[0]]
+        rng = np.random.default_rng(seed)
+        for _ in range(n):
+            out.append(env.step(rng.uniform(-1, 1, env.action_space.shape))[0])
+        return out
+    fresh = episode(make(name).unwrapped, 5)
+    used = make(name).unwrapped
+    episode(used, 99, 60)
+    assert all(np.array_equal(a, b) for a, b in zip(fresh, episode(used, 5)))
+
+
 @pytest.mark.parametrize("name", ["Hopper", "InvertedPendulum", "Reacher", "Swimmer"])
 def test_bad_actions_raise(name):
     env = make(name)
