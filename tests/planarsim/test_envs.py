@@ -151,6 +151,30 @@ MOTIONS = [("InvertedPendulum", {1: 0.01}, {}, 0.0, 1),
            ("Swimmer", {2: 0.3, 3: -0.4}, {0: 0.5, 1: -0.3, 2: 0.2, 3: 1.0, 4: -1.0}, 0.0, 3)]
 
 
+def start(env, dq, dv):
+    """The env's initial qpos, qvel offset by dq, dv ({index: offset})."""
+    qp, qv = env.init_qpos.copy(), env.init_qvel.copy()
+    for i, x in dq.items():
+        qp[i] += x
+    for i, x in dv.items():
+        qv[i] += x
+    return qp, qv
+
+
+def ours_run(env, qp, qv, u, n=20):
+    env.set_state(qp, qv)
+    return np.array([env.step(u)[0] for _ in range(n)])
+
+
+def mujoco_euler_run(mujoco, ref, qp, qv, u, timestep, frame_skip, n=20):
+    """gymnasium's MuJoCo env stepped with MuJoCo's Euler integrator at `timestep`."""
+    ref.model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    ref.model.opt.timestep = timestep
+    ref.frame_skip = frame_skip
+    ref.set_state(qp, qv)
+    return np.array([ref.step(u)[0] for _ in range(n)])
+
+
 @pytest.mark.parametrize("name, dq, dv, action, moving", MOTIONS)
 def test_motion_before_contact_matches_mujoco_euler(name, dq, dv, action, moving):
     """Constant actions from an offset start, 20 env steps, no contact and no limit
@@ -159,22 +183,11 @@ def test_motion_before_contact_matches_mujoco_euler(name, dq, dv, action, moving
     (Richardson); the bound is twice that: |ours - M(h)| <= 4 max |M(h) - M(h/2)|."""
     mujoco, ref = mujoco_env(name)
     env = make(name).unwrapped
-    qp, qv = env.init_qpos.copy(), env.init_qvel.copy()
-    for i, x in dq.items():
-        qp[i] += x
-    for i, x in dv.items():
-        qv[i] += x
+    qp, qv = start(env, dq, dv)
     u = np.full(env.action_space.shape, action)
-    env.set_state(qp, qv)
-    ours = np.array([env.step(u)[0] for _ in range(20)])
-
-    def mj(sub):
-        ref.model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
-        ref.model.opt.timestep = env.timestep / sub
-        ref.frame_skip = env.frame_skip * sub
-        ref.set_state(qp, qv)
-        return np.array([ref.step(u)[0] for _ in range(20)])
-    m1, m2 = mj(1), mj(2)
+    ours = ours_run(env, qp, qv, u)
+    m1, m2 = (mujoco_euler_run(mujoco, ref, qp, qv, u, env.timestep / k, env.frame_skip * k)
+              for k in (1, 2))
     assert np.abs(ours[0, moving] - ours[:, moving]).max() > 0.1     # it really moved
     err, delta = np.abs(ours - m1).max(), np.abs(m1 - m2).max()
     assert err <= 4 * delta, (err, delta)
@@ -185,3 +198,22 @@ def test_rgb_array_render():
     env.reset(seed=0)
     img = env.render()
     assert img.shape == (64, 96, 3) and img.dtype == np.uint8 and img.std() > 0
+
+
+@pytest.mark.parametrize("name, dq, dv, action, moving", MOTIONS[2:])
+def test_difference_from_mujoco_euler_halves_with_the_step(name, dq, dv, action, moving):
+    """Reacher and Swimmer (no contact at all): ours and MuJoCo's Euler, both at step h / k
+    over the same 20 env steps, differ by O(h): halving the step halves the difference (both
+    first-order methods converge to one motion: damping, armature and drag included)."""
+    mujoco, ref = mujoco_env(name)
+    base = make(name).unwrapped
+    diffs = []
+    for k in (1, 2, 4):
+        env = make(name, dt=base.timestep / k, frame_skip=base.frame_skip * k).unwrapped
+        qp, qv = start(env, dq, dv)
+        u = np.full(env.action_space.shape, action)
+        theirs = mujoco_euler_run(mujoco, ref, qp, qv, u, env.timestep, env.frame_skip)
+        diffs.append(np.abs(ours_run(env, qp, qv, u) - theirs).max())
+    assert diffs[0] > 1e-4                       # a difference to watch shrink
+    for a, b in zip(diffs, diffs[1:]):
+        assert 0.4 < b / a < 0.6, diffs
