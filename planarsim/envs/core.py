@@ -229,6 +229,10 @@ class PlanarMujocoEnv(gymnasium.Env):
         self.init_qpos, self.init_qvel = self.coords.from_maximal(self.sim_model.q0, self.sim_model.v0)
         self.data = SimpleNamespace(qpos=self.init_qpos.copy(), qvel=self.init_qvel.copy())
         self._u = np.zeros(self.sim_model.n_act)
+        self._act_id = np.array([a.id for a in self._act], np.int64)
+        self._act_gear = np.array([a.gear for a in self._act], float)
+        self._act_lo = np.array([a.ctrlrange[0] for a in self._act], float)
+        self._act_hi = np.array([a.ctrlrange[1] for a in self._act], float)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode={render_mode!r}: planarsim's environments render "
                              f"{self.metadata['render_modes']} only")
@@ -274,9 +278,8 @@ class PlanarMujocoEnv(gymnasium.Env):
 
     def do_simulation(self, ctrl, n_frames):
         ctrl = self.check_action(ctrl)
-        for k, act in enumerate(self._act):
-            lo, hi = act.ctrlrange
-            self._u[act.id] = act.gear * min(max(ctrl[k], lo), hi)   # MuJoCo clamps ctrl
+        # MuJoCo clamps ctrl to ctrlrange; the actuator's input is gear * ctrl
+        self._u[self._act_id] = self._act_gear * np.clip(ctrl, self._act_lo, self._act_hi)
         self.sim.steps(int(n_frames), self._u)
         self._sync()
 

@@ -106,9 +106,10 @@ class _Healthy(_Locomotion):
 
     def step(self, action):
         (x_after,), (x_velocity,), observation, forward_reward, ctrl_cost = self.advance(action)
-        healthy_reward = self.healthy_reward
+        healthy = self.is_healthy
+        healthy_reward = healthy * self._healthy_reward
         reward = forward_reward + healthy_reward - ctrl_cost
-        terminated = (not self.is_healthy) and self._terminate_when_unhealthy
+        terminated = (not healthy) and self._terminate_when_unhealthy
         info = {"x_position": x_after, "z_distance_from_origin": self.data.qpos[1] - self.init_qpos[1],
                 "x_velocity": x_velocity, "reward_forward": forward_reward,
                 "reward_ctrl": -ctrl_cost, "reward_survive": healthy_reward}
