@@ -7,7 +7,10 @@ JointMap: a hinge's MJCF value is ``ref + sign * (pin angle)`` (sign = -1 for a 
 +y in the x-z plane: MuJoCo's positive rotation about +y is clockwise in planarsim's plane),
 a slide's ``ref + displacement along its axis``; a free root (two slides then a hinge, as
 MuJoCo composes them) translates its hinge's anchor by the slides and turns about it; a root
-with two slides and no hinge (reacher's target) only translates.
+with two slides and no hinge (reacher's target) only translates. Every MJCF joint is an entry
+of the pin table (a free root's are free coordinates), so after each step (qpos, qvel) come
+from that table in compiled code (``joint_values``); ``to_maximal`` (a reset's set_state) and
+``from_maximal`` are the same map in Python, inverse and forward.
 """
 from __future__ import annotations
 
