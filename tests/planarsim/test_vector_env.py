@@ -59,3 +59,22 @@ def test_bad_actions_are_clear_errors():
         envs.close()
     with pytest.raises(ValueError, match="num_envs=0 must be a positive integer"):
         PlanarVectorEnv("planarsim/Reacher-v0", 0)
+
+
+def test_works_under_gymnasiums_vector_wrappers():
+    """gymnasium's own vector wrappers take it: episode statistics (they read the autoreset
+    mode and the batched infos) and normalised observations."""
+    from gymnasium.wrappers.vector import NormalizeObservation, RecordEpisodeStatistics
+    envs = RecordEpisodeStatistics(NormalizeObservation(
+        PlanarVectorEnv("planarsim/InvertedPendulum-v0", 4, workers=2)))
+    try:
+        envs.reset(seed=0)
+        rng = np.random.default_rng(1)
+        lengths = []
+        for _ in range(80):
+            *_, info = envs.step(rng.uniform(-3, 3, size=(4, 1)))
+            if "episode" in info:
+                lengths += info["episode"]["l"][info["_episode"]].tolist()
+        assert lengths and all(n >= 1 for n in lengths)
+    finally:
+        envs.close()
