@@ -28,21 +28,12 @@ from ..kernels.math2d import update_trig
 from ..mjcf import load_mjcf
 from ..model import JOINT_SLIDE_BIT
 from ..sim import Simulator
-from ..state import make_state, make_workspace
+from ..state import make_state
 
 
 def gym_asset(name: str) -> str:
     """Path of gymnasium's MJCF file `name` (gymnasium ships them without mujoco)."""
     return os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets", name)
-
-
-def _copy_into(dst, src):
-    """Copy a NamedTuple of arrays (nested ones too) into another of the same shapes."""
-    for a, b in zip(dst, src):
-        if isinstance(a, tuple):
-            _copy_into(a, b)
-        else:
-            a[...] = b
 
 
 def _rot(a):
@@ -243,9 +234,8 @@ class PlanarMujocoEnv(gymnasium.Env):
         self.width, self.height = int(width), int(height)
         self.sim = Simulator(self.sim_model, None, make_state(self.sim_model))
         # the speed bound (StepOptions.speed_limit) is set once, from the file's pose at rest,
-        # so that a reset only copies a state in (no new simulator: a reset costs microseconds)
+        # so that a reset only copies a state in (Simulator.start_over: microseconds)
         self.sim.options = self.sim.options
-        self._ws0 = make_workspace(self.sim_model)      # a fresh workspace, copied in by resets
 
     @property
     def dt(self) -> float:
@@ -262,11 +252,10 @@ class PlanarMujocoEnv(gymnasium.Env):
             raise ValueError(f"set_state: qpos shape {qpos.shape} and qvel shape {qvel.shape} "
                              f"must be ({self.model.nq},) and ({self.model.nv},)")
         q, v = self.coords.to_maximal(qpos, qvel)
-        # as a new simulator: a fresh workspace and the state alone, so that no contact modes,
-        # warm starts or ground queries carry over. Like MuJoCo's set_state, any pose is
-        # accepted (one below the floor is pushed out by the first step)
-        _copy_into(self.sim.ws, self._ws0)
-        self.sim.state = make_state(self.sim_model, q, v)
+        # as a new simulator: no contact modes, warm starts or ground queries carry over.
+        # Like MuJoCo's set_state, any pose is accepted (one below the floor is pushed out by
+        # the first step)
+        self.sim.start_over(q, v)
         self._sync()
 
     def check_action(self, action) -> np.ndarray:
