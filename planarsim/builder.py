@@ -1,5 +1,5 @@
-"""ModelBuilder: describe bodies, pins, sliders, rods, feet and actuators, then ``compile()``
-a Model.
+"""ModelBuilder: describe bodies, pins, sliders, a free body's coordinates, rods, feet,
+actuators and fluid drag, then ``compile()`` a Model.
 
 Every ``add_*`` returns a small integer id. All checking happens here; errors are
 ``ModelError`` naming the element kind, its name and index, the field, the value and the rule.

@@ -1,5 +1,6 @@
 """Loader for planar MJCF (MuJoCo XML): characters that move in one plane, as MuJoCo's
-ecosystem writes them (gymnasium's Hopper, Walker2d, HalfCheetah; the SIMBICON character).
+ecosystem writes them (gymnasium's eight planar models, Hopper to Swimmer and Reacher; the
+SIMBICON character).
 
 What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
 

@@ -9,7 +9,7 @@ environment, with the same seed, as the i-th copy of ``gymnasium.vector.SyncVect
 the two give the same episodes bit for bit (a test).
 
 Why processes, not one compiled call over a batch of states (numba ``prange``): an env step
-is 3-25 us of compiled physics and about as much Python (actions, observation, reward,
+is 2-50 us of compiled physics and 20-40 us of Python (actions, observation, reward,
 termination, autoreset), so threads sharing one interpreter gain little; a process per core
 runs both parts in parallel. ``planarsim bench --parts envs`` measures it.
 
