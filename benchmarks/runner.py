@@ -2,7 +2,7 @@
 
     planarsim bench                        # everything (same as: python benchmarks/run.py)
     planarsim bench chain4 rod_drop        # only these scenes and their peer comparison
-    planarsim bench --parts scenes,peers   # parts: scenes, peers, walkers, batch, startup
+    planarsim bench --parts scenes,peers   # parts: scenes, peers, walkers, batch, startup, envs
     planarsim bench --peers pymunk,box2d   # peers to compare (default: all; 'none' skips)
     planarsim bench --no-cold              # skip the cold-cache start-up (about half a minute)
     planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
@@ -20,6 +20,10 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
 - batch: 64 Simple Biped walks on 1 and 2 worker threads (walkers.batch).
 - startup: import-to-first-step times in fresh subprocesses, warm and cold numba cache
   (startup.py says how the cache is made cold).
+- envs: env.step calls per second of every planarsim gymnasium environment, single and
+  vectorised (PlanarVectorEnv, --env-copies copies on 2 processes), beside gymnasium's MuJoCo
+  environment of the same name in the same run (env_speed.py; needs gymnasium, and mujoco
+  for the MuJoCo figures).
 Then a table of every benchmark target with the measured figure, met or not met. Targets are
 measured here, never asserted by the tests.
 """
@@ -42,7 +46,7 @@ from benchmarks.report import (plot_chain_scaling, print_peers, print_scenes, pr
                            print_walkers, targets)
 from benchmarks.scenes import SCENES
 
-PARTS = ("scenes", "peers", "walkers", "batch", "startup")
+PARTS = ("scenes", "peers", "walkers", "batch", "startup", "envs")
 
 
 def machine_name() -> str:
@@ -116,6 +120,7 @@ def parse_args(argv):
     ap.add_argument("--walker-seconds", type=float, default=60.0, help="simulated seconds per walk (60)")
     ap.add_argument("--batch-jobs", type=int, default=64)
     ap.add_argument("--batch-seconds", type=float, default=10.0, help="simulated seconds per batch job (10)")
+    ap.add_argument("--env-copies", type=int, default=16, help="copies in the vectorised env figure (16)")
     ap.add_argument("--no-cold", action="store_true", help="skip the cold-cache start-up measurement")
     ap.add_argument("--csv", metavar="DIR", default=None, help="write DIR/<machine>/<scene>.csv")
     args = ap.parse_args(argv)
@@ -183,6 +188,12 @@ def main(argv=None):
         else:
             rows += batch
             print_walkers(results, batch_only=True)
+    if "envs" in parts:
+        from benchmarks.env_speed import measure_envs, print_envs
+        env_rows = measure_envs(repeats=min(args.repeats, 3), copies=args.env_copies)
+        results["envs"] = env_rows
+        rows += env_rows
+        print_envs(env_rows)
     if "startup" in parts:
         from benchmarks.startup import measure_startup
         results["startup"] = measure_startup(cold=not args.no_cold)

@@ -1,5 +1,5 @@
-"""ModelBuilder: describe bodies, pins, sliders, rods, feet and actuators, then ``compile()``
-a Model.
+"""ModelBuilder: describe bodies, pins, sliders, a free body's coordinates, rods, feet,
+actuators and fluid drag, then ``compile()`` a Model.
 
 Every ``add_*`` returns a small integer id. All checking happens here; errors are
 ``ModelError`` naming the element kind, its name and index, the field, the value and the rule.
@@ -19,7 +19,8 @@ import math
 import numpy as np
 
 from . import model as M
-from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, JOINT_HINGE,
+from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT,
+                            JOINT_FREE_HINGE, JOINT_FREE_SLIDE, JOINT_HINGE, JOINT_SLIDE_BIT,
                             JOINT_SLIDER)
 from .errors import ModelError
 from .kernels.collide import core_normals
@@ -112,6 +113,7 @@ class ModelBuilder:
         self.terrain = terrain if terrain is not None else flat()
         self._bodies, self._pins, self._rods, self._contacts, self._acts = [], [], [], [], []
         self._shapes = []
+        self._fluid = []            # (body, fluid_coef row): kernels/fluid.py
         self._collide = []          # colliding shapes: dicts (shape, body, core, radius, ...)
         self._enabled_pairs = set()
         self._names = {"body": {}, "pin": {}, "rod": {}, "contact": {}, "actuator": {}}
@@ -292,12 +294,7 @@ class ModelBuilder:
         velocity solve, kernels/soft.py); armature [kg m^2] a reflected rotor inertia on the
         pin angle (M_joint += armature, as MuJoCo's).
         """
-        idx = len(self._pins)
-        self._register("pin", name, idx)
-        a = self._body_id("pin", name, idx, "body_a", body_a, allow_world=True)
-        b = self._body_id("pin", name, idx, "body_b", body_b, allow_world=True)
-        if a == b:
-            raise ModelError(f"pin {name!r} ({idx}): body_a and body_b are the same ({a})")
+        idx, a, b = self._joint_bodies("pin", name, body_a, body_b, world_b=True)
         if a < 0 and b < 0:
             raise ModelError(f"pin {name!r} ({idx}): cannot pin the world to itself")
         if a >= 0 and b < 0:  # keep the world as body a
@@ -315,6 +312,78 @@ class ModelBuilder:
                                k=k, c=c, rest=_scalar("pin", name, idx, "rest_angle", rest_angle),
                                kind=JOINT_HINGE, axis=(0.0, 0.0), armature=arm))
         return idx
+
+    def _joint_bodies(self, kind, name, body_a, body_b, world_b):
+        """Register joint `name` in the pin table: (its index, body a, body b) checked (ids;
+        None or -1 the world for a, for b too where world_b; two different bodies)."""
+        idx = len(self._pins)
+        self._register("pin", name, idx)
+        a = self._body_id(kind, name, idx, "body_a", body_a, allow_world=True)
+        b = self._body_id(kind, name, idx, "body_b", body_b, allow_world=world_b)
+        if a == b:
+            raise ModelError(f"{kind} {name!r} ({idx}): body_a and body_b are the same ({a})")
+        return idx, a, b
+
+    def add_free_coordinate(self, name, body, kind="slide", axis=(1.0, 0.0), anchor_world=None,
+                            limit=None, stiffness=0.0, damping=0.0, rest=0.0, armature=0.0) -> int:
+        """One coordinate of a body otherwise free in the plane, measured from the world and
+        holding nothing (no constraint rows): what acts on it acts as on a joint's coordinate.
+
+        kind "slide": s = d.(p - p0) [m], the displacement along the world axis ``axis`` of
+        the body's point at ``anchor_world`` (default its COM) from where it is at the build
+        pose; kind "hinge": the body's turn theta - theta0 [rad] (anchor_world is only drawn).
+        ``limit`` [m or rad] adds unilateral limits, stiffness / damping a passive implicit
+        spring-damper toward ``rest``, armature [kg or kg m^2] a reflected inertia on the
+        coordinate (as MuJoCo's on a free root's slide or hinge: M_joint += armature), and
+        add_slider_motor / add_pin_motor a force [N] along the axis at the anchor / a torque
+        [N m]. An MJCF free root (two slides and a hinge) is three of these on one body.
+        It shares the pins' table with kind JOINT_FREE_SLIDE or JOINT_FREE_HINGE.
+        """
+        if kind not in ("slide", "hinge"):
+            raise ModelError(f"free coordinate {name!r}: kind={kind!r} must be 'slide' or 'hinge'")
+        idx, a, b = self._joint_bodies("free coordinate", name, None, body, world_b=False)
+        if kind == "hinge" and self._bodies[b]["point"]:
+            raise ModelError(f"free coordinate {name!r} ({idx}): a point mass does not turn")
+        if anchor_world is None:
+            anchor_world = self._world(b, np.zeros(2))
+        la, lb = self._anchors("free coordinate", name, idx, a, b, anchor_world, None, None)
+        d = (0.0, 0.0)
+        if kind == "slide":
+            d = _vec2("free coordinate", name, idx, "axis", axis)
+            norm = float(np.hypot(*d))
+            if not norm > 1e-12:
+                raise ModelError(f"free coordinate {name!r} ({idx}): axis={tuple(map(float, d))} "
+                                 f"must not be zero")
+            d = tuple(d / norm)
+        lo, hi = self._joint_limit("free coordinate", name, idx, limit)
+        k, c, arm = self._joint_passive("free coordinate", name, idx, stiffness, damping, armature)
+        self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=self._angle(b),
+                               limit=(lo, hi), k=k, c=c,
+                               rest=_scalar("free coordinate", name, idx, "rest", rest),
+                               kind=JOINT_FREE_SLIDE if kind == "slide" else JOINT_FREE_HINGE,
+                               axis=d, armature=arm))
+        return idx
+
+    def add_fluid_box(self, body, size, viscosity=0.0, density=0.0, local=(0.0, 0.0),
+                      angle=0.0) -> int:
+        """Drag of a still fluid on a box fixed to `body` (MuJoCo's inertia-box fluid model
+        in the plane, kernels/fluid.py): full sides size = (l1, l2, ln) [m] > 0 (l1 along the
+        box's first in-plane axis, at ``angle`` [rad] in the body's frame; ln along the plane's
+        normal), centre at ``local`` [m]; the fluid's viscosity [Pa s] >= 0 (linear drag) and
+        density [kg/m^3] >= 0 (quadratic drag). Returns the box's index."""
+        b = self._body_id("fluid box", None, len(self._fluid), "body", body)
+        who = f"fluid box on body {self._bodies[b]['name']!r}"
+        l1, l2, ln = (_length(who, None, len(self._fluid), f"size[{i}]", x)
+                      for i, x in enumerate(np.asarray(size, dtype=np.float64).reshape(3)))
+        mu = _length(who, None, len(self._fluid), "viscosity", viscosity, zero_ok=True)
+        rho = _length(who, None, len(self._fluid), "density", density, zero_ok=True)
+        c = _vec2(who, None, len(self._fluid), "local", local)
+        th = _scalar(who, None, len(self._fluid), "angle", angle)
+        d = (l1 + l2 + ln) / 3.0
+        self._fluid.append((b, (c[0], c[1], th, 3.0 * math.pi * d * mu, math.pi * d ** 3 * mu,
+                                0.5 * rho * l2 * ln, 0.5 * rho * l1 * ln,
+                                rho * ln * (l1 ** 4 + l2 ** 4) / 64.0)))
+        return len(self._fluid) - 1
 
     @staticmethod
     def _joint_limit(kind, name, idx, limit):
@@ -356,12 +425,7 @@ class ModelBuilder:
         the pins' table (names, State.limit_active, State.last_pin_impulse: perpendicular,
         angle, lower, upper impulse) with kind JOINT_SLIDER.
         """
-        idx = len(self._pins)
-        self._register("pin", name, idx)
-        a = self._body_id("slider", name, idx, "body_a", body_a, allow_world=True)
-        b = self._body_id("slider", name, idx, "body_b", body_b, allow_world=False)
-        if a == b:
-            raise ModelError(f"slider {name!r} ({idx}): body_a and body_b are the same ({a})")
+        idx, a, b = self._joint_bodies("slider", name, body_a, body_b, world_b=False)
         if self._bodies[b]["point"] or (a >= 0 and self._bodies[a]["point"]):
             raise ModelError(f"slider {name!r} ({idx}): a slider holds an angle: its bodies must "
                              f"not be point masses")
@@ -491,7 +555,7 @@ class ModelBuilder:
             pin = self._names["pin"][pin]
         if not (isinstance(pin, (int, np.integer)) and 0 <= pin < len(self._pins)):
             raise ModelError(f"actuator {name!r} ({idx}): pin={pin!r} is not a pin id")
-        if self._pins[pin]["kind"] != JOINT_HINGE:
+        if self._pins[pin]["kind"] & JOINT_SLIDE_BIT:
             raise ModelError(f"actuator {name!r} ({idx}): pin={self._pins[pin]['name']!r} is a "
                              f"slider (use add_slider_motor)")
         a, b = self._pins[pin]["body"]
@@ -506,7 +570,7 @@ class ModelBuilder:
                 raise ModelError(f"actuator {name!r} ({idx}): slider={slider!r} names no slider")
             slider = self._names["pin"][slider]
         if not (isinstance(slider, (int, np.integer)) and 0 <= slider < len(self._pins)
-                and self._pins[slider]["kind"] == JOINT_SLIDER):
+                and self._pins[slider]["kind"] & JOINT_SLIDE_BIT):
             raise ModelError(f"actuator {name!r} ({idx}): slider={slider!r} is not a slider id")
         a, b = self._pins[slider]["body"]
         return self._act(name, M.ACT_SLIDER_FORCE, (a, b, -1), int(slider), limit=limit)
@@ -695,6 +759,8 @@ class ModelBuilder:
             act_anchor=ro([a["anchors"] for a in self._acts] or np.zeros((0, 2, 2))).reshape(na, 2, 2),
             act_dir=ro([a["dir"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
             act_range=ro([a["limit"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
+            fluid_body=ro([b for b, _ in self._fluid], np.int64).reshape(len(self._fluid)),
+            fluid_coef=ro([c for _, c in self._fluid] or np.zeros((0, 8))).reshape(len(self._fluid), 8),
             terrain_coef=ro(self.terrain.coef),
             **self._shape_arrays(ro),
         )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels.codes import JOINT_SLIDER
+from .kernels.codes import JOINT_SLIDE_BIT
 
 
 def joint_position_rate(model, q, v, j):
@@ -15,7 +15,7 @@ def joint_position_rate(model, q, v, j):
     q = np.asarray(q)
     v = np.asarray(v)
     ba, bb = a.pin_body[j]
-    if a.pin_kind[j] != JOINT_SLIDER:
+    if not a.pin_kind[j] & JOINT_SLIDE_BIT:
         ang = q[..., bb, 2] - a.pin_ref[j] - (q[..., ba, 2] if ba >= 0 else 0.0)
         rate = v[..., bb, 2] - (v[..., ba, 2] if ba >= 0 else 0.0)
         return ang, rate

@@ -1,5 +1,6 @@
 """Loader for planar MJCF (MuJoCo XML): characters that move in one plane, as MuJoCo's
-ecosystem writes them (gymnasium's Hopper, Walker2d, HalfCheetah; the SIMBICON character).
+ecosystem writes them (gymnasium's eight planar models, Hopper to Swimmer and Reacher; the
+SIMBICON character).
 
 What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
 
@@ -9,16 +10,19 @@ What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
 * ``<option timestep gravity viscosity density>``: timestep -> the model's dt [s]; gravity
   [m/s^2] -> the model's gravity, its component along the plane's normal dropped (the
   joints carry it: a planar model cannot move that way); a fluid (viscosity or density
-  non-zero) is a ModelError unless ``drop`` names "fluid".
+  non-zero) -> MuJoCo's inertia-box drag on every body (ModelBuilder.add_fluid_box), unless
+  ``drop`` names "fluid".
 * ``<default>`` with nested classes, ``class`` and ``childclass``.
 * ``<body pos quat axisangle euler zaxis xyaxes>``; a body without joints is welded to its
   parent (its geoms join the parent's rigid body, or the world's).
 * ``<joint type="hinge|slide" pos axis ref range limited stiffness damping springref armature>``.
   A root body with two slides spanning the plane and a hinge about its normal is free in the
-  plane (no constraint); one hinge pins a body to its parent (``add_pin``, limits [rad],
-  passive stiffness [N m/rad] toward springref, damping [N m s/rad]); a slide needs the
-  builder's ``add_slider`` and armature ``add_pin(armature=...)``: where the builder lacks
-  them, a ModelError says so (``drop={"armature"}`` loads without armature, reported).
+  plane, each joint a free coordinate (``add_free_coordinate``: limits, springs, dampers,
+  armature and motors act on it, nothing is constrained); without the hinge it translates
+  only (a point mass: reacher's target). One hinge pins a body to its parent (``add_pin``,
+  limits [rad], passive stiffness [N m/rad] toward springref, damping [N m s/rad], armature
+  [kg m^2]); one slide is a slider (``add_slider``); ``drop={"armature"}`` loads without
+  armature (reported).
 * ``<geom type="sphere|capsule|cylinder|box|ellipsoid|plane" size pos orientation fromto
   mass density friction contype conaffinity condim>``: mass properties as MuJoCo's compiler
   computes them (planarsim.mjcf_frames), shapes that collide by MuJoCo's contype/conaffinity
@@ -32,7 +36,7 @@ What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
 Purely visual or solver-tuning elements and attributes (rgba, material, asset, visual, light,
 camera, site, solref, margin, integrator, ...) are ignored and listed in ``MJCFModel.report``;
 anything else that changes physics and is not supported (tendons, equality constraints, a
-joint leaving the plane, a fluid) is a ModelError naming the element and its line.
+joint leaving the plane) is a ModelError naming the element and its line.
 
 Plane mapping. The plane of motion is the one normal to the hinges: MJCF y (x-z plane, the
 walkers: planarsim (x, y) = (x_mjcf, z_mjcf)) or MJCF z (x-y plane, swimmer and reacher:
@@ -175,15 +179,18 @@ class RigidBody:
 @dataclass
 class JointMap:
     """How an MJCF joint maps onto planarsim: kind 'pin' (id: pin id), 'free' (id: the root
-    body; axis: index 0/1 of a slide's in-plane direction or 2 for the hinge) or 'slider'.
-    The MJCF joint value is q = ref + sign * (planarsim coordinate). anchor: the joint's
-    position in the plane at the file's pose [m] (a free root's hinge turns about it)."""
+    body; axis: a slide's in-plane direction, or (2,) for the hinge; pin: its free coordinate
+    in the pin table, ModelBuilder.add_free_coordinate) or 'slider' (id: pin id).
+    The MJCF joint value is q = ref + sign * (planarsim coordinate). anchor: for a free
+    root's joints, the point the hinge turns about, which the slides move, at the file's
+    pose [m]."""
     kind: str
     id: int
     sign: float = 1.0
     ref: float = 0.0
     axis: tuple = ()
     anchor: tuple = ()
+    pin: int = -1
 
 
 @dataclass
@@ -247,6 +254,8 @@ class MJCFModel:
     actuator : MJCF motor name (or its joint's) -> ActuatorMap (id, joint, gear, ctrlrange)
     plane   : "x-z" or "x-y": the MJCF plane the model moves in
     report  : LoadReport: what was ignored, dropped or approximated
+    com     : MJCF body name -> its own centre of mass in the plane at the file's pose [m]
+              (the body's origin where it has no mass), for bodies that move
     """
     builder: ModelBuilder
     body: dict
@@ -259,6 +268,7 @@ class MJCFModel:
     actuator: dict = field(default_factory=dict)
     plane: str = "x-z"
     report: LoadReport = field(default_factory=LoadReport)
+    com: dict = field(default_factory=dict)
 
     def compile(self, **meta):
         return self.builder.compile(**meta)
@@ -499,12 +509,15 @@ class _Loader:
             self.fail(node, f"timestep={self.option['timestep']} must be > 0")
         self.option["gravity"] = self.floats(node, eff, "gravity", 3, default=DEFAULT_GRAVITY)
         fluid = {k: self.scalar(node, eff, k, 0.0) for k in ("viscosity", "density")}
+        if any(v < 0 for v in fluid.values()):
+            self.fail(node, f"viscosity={fluid['viscosity']} and density={fluid['density']} "
+                            f"must be >= 0")
         if any(fluid.values()):
             what = ", ".join(f"{k}={v}" for k, v in fluid.items() if v)
-            if "fluid" not in self.drop:
-                self.fail(node, f"{what} needs fluid forces, not supported yet (drop={{'fluid'}} "
-                                f"loads without them)")
-            self.report.drop(f"option {what} (fluid forces)", node.line)
+            if "fluid" in self.drop:
+                self.report.drop(f"option {what} (fluid forces)", node.line)
+            else:
+                self.option["fluid"] = fluid
         self.option_line = node.line
 
     def defaults(self, node, parent, top=False):
@@ -742,6 +755,7 @@ class _Loader:
         """Assign each MJCF body to a planarsim rigid body (None: welded to the world) and
         collect the joints that link them: pins, sliders and free roots."""
         self.rigid, self.links, self.free, self.body_map = [], [], (), {}
+        self.translating = set()      # rigid bodies that translate only (two slides, no hinge)
         for b in self.bodies:
             parent_rid = b.parent.rid if b.parent is not None else None
             if not b.joints:
@@ -758,28 +772,31 @@ class _Loader:
                 self.links.append(("pin", b.joints[0], parent_rid, b.rid))
             elif kinds == ["slide"]:
                 self.links.append(("slider", b.joints[0], parent_rid, b.rid))
-            elif set(kinds) == {"slide"}:
-                self.fail(b.node, f"{len(kinds)} slides on one body need slider joints "
-                                  f"(ModelBuilder.add_slider) through intermediate bodies, not "
-                                  f"supported yet")
-            elif kinds == ["hinge", "slide", "slide"] and parent_rid is None:
+            elif kinds in (["hinge", "slide", "slide"], ["slide", "slide"]) and parent_rid is None:
                 s = [j["axis"] for j in b.joints if j["type"] == "slide"]
-                if abs(np.cross(s[0], s[1]) @ self.ccw) < 1e-9:
-                    self.fail(b.node, "the root's two slides must span the plane of motion")
+                if abs(abs(np.cross(s[0], s[1]) @ self.ccw) - 1) > 1e-9:
+                    self.fail(b.node, "the root's two slides must be orthogonal (each its own "
+                                      "coordinate of the plane; MuJoCo's armature and limits act "
+                                      "on each)")
                 self.free_root(b)
+                if "hinge" not in kinds:
+                    self.translating.add(b.name)
             else:
                 self.fail(b.node, f"joints {kinds} on one body are not supported: use one hinge, "
-                                  f"one slide, or (a root) two slides and a hinge, free in the plane")
+                                  f"one slide, or (a root) two slides spanning the plane, with or "
+                                  f"without a hinge")
 
     def free_root(self, b):
-        """Two slides and a hinge on a root: a body free in the plane (no constraint)."""
-        for j in b.joints:
-            eff, node = j["eff"], j["node"]
-            k, c = self.scalar(node, eff, "stiffness", 0.0), self.scalar(node, eff, "damping", 0.0)
-            if k or c or self.limited(j):
-                self.fail(node, "stiffness, damping or limits on the root's planar joints are "
-                                "not supported")
-            self.armature(j, supported=False)
+        """Two slides (and a hinge) on a root: a body free in the plane, each joint a free
+        coordinate (ModelBuilder.add_free_coordinate: its limits, spring-damper, armature and
+        motor act, nothing is constrained). Without a hinge the body translates only: a point
+        mass. MuJoCo composes the joints in file order: the slides must come before the hinge
+        (they then move the hinge's anchor)."""
+        types = [j["type"] for j in b.joints]
+        if "hinge" in types and types.index("hinge") != len(types) - 1:
+            self.fail(b.joints[types.index("hinge")]["node"],
+                      "a free root's hinge must follow its two slides (MuJoCo turns the body "
+                      "about the hinge after the slides moved it)")
         self.free += tuple(j["name"] for j in b.joints)
         self.free_bodies = getattr(self, "free_bodies", []) + [b]
 
@@ -895,8 +912,11 @@ class _Loader:
             d2 = ((x - rb.com) ** 2).sum(1)
             rb.inertia = float(sum(p[2] for p in rb.parts) + (m * d2).sum())
             shapes = [self.body_shape(s, g, rb.com) for _, _, _, s, _, g in rb.parts if s is not None]
-            ids.append(builder.add_body(rb.name, mass=rb.mass, inertia=rb.inertia,
-                                        pos=tuple(rb.com), shapes=shapes))
+            if rb.name in self.translating:
+                ids.append(self.point_body(builder, rb, shapes))
+            else:
+                ids.append(builder.add_body(rb.name, mass=rb.mass, inertia=rb.inertia,
+                                            pos=tuple(rb.com), shapes=shapes))
         for g, s in self.static:
             self.world_shape(builder, g, s)
         self.self_collisions()
@@ -904,19 +924,6 @@ class _Loader:
                         pin={}, rigid={ids[i]: rb for i, rb in enumerate(self.rigid)},
                         root=ids[0], name=model_name, free_joints=self.free,
                         plane=self.plane_name, report=self.report)
-        for b in getattr(self, "free_bodies", []):
-            slides = 0
-            for j in b.joints:
-                if j["type"] == "hinge":
-                    out.joint[j["name"]] = JointMap("free", ids[b.rid], self.sign(j),
-                                                    self.ref(j), (2,),
-                                                    tuple(float(x) for x in self.plane(j["pos"])))
-                else:
-                    a = j["axis"]
-                    out.joint[j["name"]] = JointMap("free", ids[b.rid], 1.0, self.ref(j),
-                                                    (a[self.i1], a[self.i2]),
-                                                    tuple(float(x) for x in self.plane(j["pos"])))
-                    slides += 1
         for kind, j, parent, child in self.links:
             a = None if parent is None else ids[parent]
             if kind == "pin":
@@ -926,6 +933,30 @@ class _Loader:
             else:
                 out.joint[j["name"]] = JointMap("slider", self.add_slider(builder, j, a, ids[child]),
                                                 1.0, self.ref(j))
+        # a free root's coordinates after the links (the links keep pin ids 0..)
+        for b in getattr(self, "free_bodies", []):
+            hinge = [j for j in b.joints if j["type"] == "hinge"]
+            # the slides move the hinge's anchor (the point the body turns about)
+            anchor = tuple(float(x) for x in self.plane((hinge or b.joints)[0]["pos"]))
+            for j in b.joints:
+                limit, k, c, rest = self.joint_terms(j)
+                arm = self.armature(j, supported=True)
+                kind = j["type"]
+                a = j["axis"]
+                axis = (2,) if kind == "hinge" else (float(a[self.i1]), float(a[self.i2]))
+                pid = builder.add_free_coordinate(
+                    j["name"], ids[b.rid], kind=kind, axis=(1.0, 0.0) if kind == "hinge" else axis,
+                    anchor_world=anchor, limit=limit, stiffness=k, damping=c, rest=rest,
+                    armature=arm)
+                out.joint[j["name"]] = JointMap("free", ids[b.rid],
+                                                self.sign(j) if kind == "hinge" else 1.0,
+                                                self.ref(j), axis, anchor, pin=pid)
+        self.fluid(builder, ids)
+        for b in self.bodies:
+            if b.rid is not None:
+                mass, com, _ = self.inertia_3d(b)
+                out.com[b.name] = self.plane(com if mass > 0 else b.pos)
+        out.joint = {j["name"]: out.joint[j["name"]] for b in self.bodies for j in b.joints}  # file order
         return out
 
     def ref(self, j):
@@ -977,13 +1008,73 @@ class _Loader:
                                   anchor_world=tuple(self.plane(j["pos"])), limit=limit,
                                   stiffness=k, damping=c, rest=rest, **kw)
 
+    def point_body(self, builder, rb, shapes):
+        """A body that translates only (a root with two slides, no hinge): a point mass. Its
+        geoms must be drawn only and be one sphere at its centre (the drawn disk)."""
+        ok = len(shapes) == 1 and shapes[0][0] == "circle" and not shapes[0][-1].get("collide")
+        if not ok or np.hypot(*shapes[0][1]) > 1e-9:
+            g = rb.parts[0][5]
+            self.fail(g["node"], f"body {rb.name!r} translates without turning (two slides, no "
+                                 f"hinge): it becomes a point mass, so its geoms must be one "
+                                 f"sphere at its centre that collides with nothing")
+        return builder.add_point_mass(rb.name, rb.mass, pos=tuple(rb.com), radius=shapes[0][2])
+
+    def fluid(self, builder, ids):
+        """<option viscosity density>: MuJoCo's inertia-box fluid model on every MJCF body
+        with mass: the box of the body's own mass and principal inertia about its COM
+        (sides sqrt(6 (I_j + I_k - I_i) / m)), one principal axis along the plane's normal."""
+        fluid = self.option.get("fluid")
+        if not fluid:
+            return
+        for b in self.bodies:
+            if b.rid is None or b.name in self.translating:
+                if b.rid is not None and (b.geoms or b.inertials):
+                    self.fail(b.node, "fluid forces on a body that translates only (a point "
+                                      "mass) are not supported")
+                continue
+            mass, com, T = self.inertia_3d(b)
+            if not mass > 1e-15:
+                continue
+            n, i1, i2 = self.normal, self.i1, self.i2
+            if abs(T[n, i1]) + abs(T[n, i2]) > 1e-9 * max(np.trace(T), 1e-300):
+                self.fail(b.node, "fluid forces need one principal axis of the body's inertia "
+                                  "normal to the plane of motion")
+            w, e = np.linalg.eigh(np.array([[T[i1, i1], T[i1, i2]], [T[i1, i2], T[i2, i2]]]))
+            moments = (w[0], w[1], T[n, n])
+            box = [math.sqrt(max(1e-15, moments[(k + 1) % 3] + moments[(k + 2) % 3] - moments[k])
+                             / mass * 6.0) for k in range(3)]
+            rb = self.rigid[b.rid]
+            builder.add_fluid_box(ids[b.rid], box, viscosity=fluid["viscosity"],
+                                  density=fluid["density"], local=tuple(self.plane(com) - rb.com),
+                                  angle=math.atan2(e[1, 0], e[0, 0]))
+
+    def inertia_3d(self, b):
+        """Mass [kg], COM (3,) [m] and inertia tensor (3, 3) about it [kg m^2] of MJCF body b
+        alone, in world axes at the file's pose (as MuJoCo's body_mass, body_ipos, body_inertia)."""
+        use_inertial = self.inertiafromgeom == "false" or (self.inertiafromgeom == "auto"
+                                                            and b.inertials)
+        items = ([(i["mass"], i["pos"], i["tensor"]) for i in b.inertials] if use_inertial else
+                 [(g["mass"], g["pos"], g["mass"] * g["R"] @ np.diag(g["unit"]) @ g["R"].T)
+                  for g in b.geoms if g["kind"] != "plane"])
+        f = self.mass_scale
+        mass = sum(m for m, _, _ in items) * f
+        if not mass > 0:
+            return 0.0, np.zeros(3), np.zeros((3, 3))
+        com = sum(m * np.asarray(p) for m, p, _ in items) * f / mass
+        T = np.zeros((3, 3))
+        for m, p, I in items:
+            r = np.asarray(p) - com
+            T += f * (I + m * (r @ r * np.eye(3) - np.outer(r, r)))
+        return mass, com, T
+
     def scale_total_mass(self):
         """<compiler settotalmass>: scale every mass and inertia so the bodies total it [kg]."""
+        self.mass_scale = 1.0
         if self.settotalmass is None:
             return
         total = sum(p[0] for rb in self.rigid for p in rb.parts)
         total += sum(g["mass"] for g, _ in self.static)
-        f = self.settotalmass / total
+        f = self.mass_scale = self.settotalmass / total
         for rb in self.rigid:
             rb.parts = [(m * f, x, i * f, *rest) for m, x, i, *rest in rb.parts]
 
@@ -1087,9 +1178,9 @@ class _Loader:
             if jm.kind == "pin":
                 aid = b.add_pin_motor(name, jm.id, limit=limit)
             elif jm.kind == "free" and jm.axis == (2,):
-                aid = b.add_body_torque(name, jm.id, limit=limit)
+                aid = b.add_pin_motor(name, jm.pin, limit=limit)
             elif jm.kind == "free":
-                aid = b.add_body_force(name, jm.id, direction=jm.axis, limit=limit)
+                aid = b.add_slider_motor(name, jm.pin, limit=limit)
             else:
                 if not hasattr(b, "add_slider_motor"):
                     self.fail(a, "a motor on a slider needs ModelBuilder.add_slider_motor, not "

@@ -21,7 +21,8 @@ ACT_BODY_TORQUE = 4  # torque on one body [N m]
 ACT_SLIDER_FORCE = 5  # force along a slider's axis: +f on body b, -f on body a [N]
 ACT_KIND_NAMES = ("pin_torque", "axial", "hip_torque", "body_force", "body_torque",
                   "slider_force")
-from .kernels.codes import JOINT_HINGE, JOINT_SLIDER  # noqa: E402,F401  (pin_kind)
+from .kernels.codes import (JOINT_FREE_BIT, JOINT_FREE_HINGE, JOINT_FREE_SLIDE,  # noqa: E402,F401
+                           JOINT_HINGE, JOINT_SLIDE_BIT, JOINT_SLIDER)  # (pin_kind)
 
 
 class ModelArrays(NamedTuple):
@@ -40,7 +41,9 @@ class ModelArrays(NamedTuple):
     pin_stiffness: np.ndarray       # (n_pin,) passive spring [N m/rad]
     pin_damping: np.ndarray         # (n_pin,) passive damper [N m s/rad]
     pin_rest: np.ndarray            # (n_pin,) spring rest angle [rad] (slider: position [m])
-    pin_kind: np.ndarray            # (n_pin,) int JOINT_HINGE | JOINT_SLIDER. A slider keeps its
+    pin_kind: np.ndarray            # (n_pin,) int JOINT_HINGE | JOINT_SLIDER | JOINT_FREE_HINGE |
+                                    #   JOINT_FREE_SLIDE (a free body's coordinate: measured as a
+                                    #   hinge's or slider's, no constraint rows). A slider keeps its
                                     #   two bodies' relative angle (theta_b - theta_a - ref = 0)
                                     #   and anchor b on the line through anchor a along pin_axis;
                                     #   its coordinate is the slide s = d.(p_b - p_a) [m], which
@@ -74,6 +77,11 @@ class ModelArrays(NamedTuple):
     act_anchor: np.ndarray          # (n_act, 2, 2) local anchors for ACT_AXIAL [m]
     act_dir: np.ndarray             # (n_act, 2) world direction for ACT_BODY_FORCE
     act_range: np.ndarray           # (n_act, 2) saturation [min, max] [N or N m]
+    fluid_body: np.ndarray          # (n_fluid,) int body of each fluid-drag box (kernels/fluid.py)
+    fluid_coef: np.ndarray          # (n_fluid, 8) local centre x, y [m], angle of its first
+                                    #   in-plane axis in the body frame [rad], linear [N s/m] and
+                                    #   angular [N m s] viscous coefficients, quadratic [kg/m]
+                                    #   along both in-plane axes, angular quadratic [kg m^2]
     terrain_coef: np.ndarray        # (3 + 3K,) see kernels/terrain.py
     shape_body: np.ndarray          # (n_shape,) int body of each colliding shape (-1: the world)
     shape_vert_adr: np.ndarray      # (n_shape,) int first core vertex (planarsim/shapes.py)

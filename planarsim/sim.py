@@ -18,8 +18,8 @@ from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
 from .start_check import check_start
-from .state import (State, Workspace, check_state, forget_ground_queries, forget_pairs, make_state,
-                    make_workspace)
+from .state import (State, Workspace, check_state, copy_arrays, forget_ground_queries, forget_pairs,
+                    make_state, make_workspace)
 from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
 
@@ -251,6 +251,28 @@ class Simulator:
     @property
     def t(self) -> float:
         return float(self.state.time[0])
+
+    def start_over(self, q=None, v=None) -> None:
+        """Start again from poses q and velocities v (n_body, 3) [m, rad; m/s, rad/s] (default:
+        the model's build pose and velocities) as a new Simulator would: time 0, no contact
+        modes, impulses, warm starts or ground queries carried over; but keeping this one's
+        compiled binding and options, so it takes microseconds (an environment's reset). Like
+        the `state` setter it does not check the start against the ground; q and v must be
+        finite (ValueError naming the body)."""
+        st = make_state(self._model, q, v)
+        for name, a in (("q", st.q), ("v", st.v)):
+            bad = np.flatnonzero(~np.all(np.isfinite(a), axis=1))
+            if bad.size:
+                raise ValueError(f"start_over: {name} of body {self._model.body_names[bad[0]]!r} "
+                                 f"({bad[0]}) is {a[bad[0]].tolist()}; it must be finite")
+        if getattr(self, "_fresh_ws", None) is None:
+            self._fresh_ws = make_workspace(self._model)
+        copy_arrays(self._ws, self._fresh_ws)
+        if getattr(self, "_speed_from_model", False):
+            self.state = st          # the setter bounds the speeds again from this start
+        else:                        # made by make_state: shapes and codes right already
+            self._state.restore(st)
+            forget_pairs(self._ws)
 
     def snapshot(self) -> State:
         return self.state.copy()

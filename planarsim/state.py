@@ -298,6 +298,16 @@ class Workspace(NamedTuple):
     prev: State                  # the state at the start of the last step (for guard errors)
 
 
+def copy_arrays(dst, src) -> None:
+    """Copy a NamedTuple of arrays (nested ones too: Workspace.prev) into one of the same
+    shapes, in place."""
+    for a, b in zip(dst, src):
+        if isinstance(a, tuple):
+            copy_arrays(a, b)
+        else:
+            a[...] = b
+
+
 def forget_ground_queries(ws: Workspace) -> None:
     """Drop the contacts' last ground queries (the next step queries every contact): for a
     workspace kept across a change of terrain or contact points."""

@@ -2,9 +2,10 @@
 action space, rewards, termination, reset noise and frame skip) on planarsim's engine.
 
 Importing this package registers ``planarsim/Hopper-v0``, ``planarsim/Walker2d-v0``,
-``planarsim/HalfCheetah-v0``, ``planarsim/InvertedPendulum-v0`` and
-``planarsim/InvertedDoublePendulum-v0`` with gymnasium. Reacher (its target body needs two
-slides on one body) and Swimmer (viscous fluid drag) are not provided: the engine lacks them.
+``planarsim/HalfCheetah-v0``, ``planarsim/InvertedPendulum-v0``,
+``planarsim/InvertedDoublePendulum-v0``, ``planarsim/Reacher-v0`` and ``planarsim/Swimmer-v0``
+with gymnasium (episode lengths as gymnasium's: 1000 steps, Reacher 50). ``PlanarVectorEnv``
+(vector.py) steps many copies of one of them on every core.
 """
 try:
     import gymnasium
@@ -12,7 +13,9 @@ except ImportError as e:  # pragma: no cover - exercised without gymnasium only
     raise ImportError("planarsim.envs needs gymnasium: pip install -e '.[gym]'") from e
 
 from .core import GeneralizedCoords, PlanarMujocoEnv
-from .tasks import HalfCheetah, Hopper, InvertedDoublePendulum, InvertedPendulum, Walker2d
+from .vector import PlanarVectorEnv
+from .tasks import (HalfCheetah, Hopper, InvertedDoublePendulum, InvertedPendulum, Reacher, Swimmer,
+                    Walker2d)
 
 ENVS = {
     "planarsim/Hopper-v0": ("planarsim.envs.tasks:Hopper", 1000),
@@ -20,6 +23,8 @@ ENVS = {
     "planarsim/HalfCheetah-v0": ("planarsim.envs.tasks:HalfCheetah", 1000),
     "planarsim/InvertedPendulum-v0": ("planarsim.envs.tasks:InvertedPendulum", 1000),
     "planarsim/InvertedDoublePendulum-v0": ("planarsim.envs.tasks:InvertedDoublePendulum", 1000),
+    "planarsim/Reacher-v0": ("planarsim.envs.tasks:Reacher", 50),
+    "planarsim/Swimmer-v0": ("planarsim.envs.tasks:Swimmer", 1000),
 }
 
 
@@ -32,5 +37,5 @@ def register_all():
 
 register_all()
 
-__all__ = ["ENVS", "GeneralizedCoords", "PlanarMujocoEnv", "Hopper", "Walker2d", "HalfCheetah",
-           "InvertedPendulum", "InvertedDoublePendulum", "register_all"]
+__all__ = ["ENVS", "GeneralizedCoords", "PlanarMujocoEnv", "PlanarVectorEnv", "Hopper", "Walker2d", "HalfCheetah",
+           "InvertedPendulum", "InvertedDoublePendulum", "Reacher", "Swimmer", "register_all"]

@@ -6,7 +6,11 @@ joint values in file order. ``GeneralizedCoords`` maps between them through the 
 JointMap: a hinge's MJCF value is ``ref + sign * (pin angle)`` (sign = -1 for a hinge about
 +y in the x-z plane: MuJoCo's positive rotation about +y is clockwise in planarsim's plane),
 a slide's ``ref + displacement along its axis``; a free root (two slides then a hinge, as
-MuJoCo composes them) translates its hinge's anchor by the slides and turns about it.
+MuJoCo composes them) translates its hinge's anchor by the slides and turns about it; a root
+with two slides and no hinge (reacher's target) only translates. Every MJCF joint is an entry
+of the pin table (a free root's are free coordinates), so after each step (qpos, qvel) come
+from that table in compiled code (``joint_values``); ``to_maximal`` (a reset's set_state) and
+``from_maximal`` are the same map in Python, inverse and forward.
 """
 from __future__ import annotations
 
@@ -18,8 +22,11 @@ import numpy as np
 import gymnasium
 from gymnasium import spaces
 
+from ..compiled import jit
+from ..kernels.joints import joint_position_rate
+from ..kernels.math2d import update_trig
 from ..mjcf import load_mjcf
-from ..model import JOINT_SLIDER
+from ..model import JOINT_SLIDE_BIT
 from ..sim import Simulator
 from ..state import make_state
 
@@ -37,6 +44,19 @@ def _rot(a):
 def _cross(w, r):
     """omega x r in the plane."""
     return np.array([-w * r[1], w * r[0]])
+
+
+@jit
+def joint_values(m, q, v, cs, pins, sign, ref, qpos, qvel):
+    """MuJoCo's qpos, qvel from planarsim's q, v (n_body, 3): every MJCF joint i is joint
+    pins[i] of the pin table (a free root's slides and hinge are free coordinates), its value
+    ref[i] + sign[i] * coordinate and its rate sign[i] * rate (cs: an (n_body, 3) buffer of
+    the angles' cos / sin)."""
+    update_trig(q, cs)
+    for i in range(pins.shape[0]):
+        x, rate = joint_position_rate(m, q, cs, v, pins[i])
+        qpos[i] = ref[i] + sign[i] * x
+        qvel[i] = sign[i] * rate
 
 
 class GeneralizedCoords:
@@ -62,11 +82,26 @@ class GeneralizedCoords:
                 else:
                     slides.append(i)
         self.links = [i for i, jm in enumerate(self.jm) if jm.kind != "free"]
+        # the compiled map (joint_values): each joint's pin, sign and ref
+        self.pins = np.array([jm.pin if jm.kind == "free" else jm.id for jm in self.jm], np.int64)
+        self.sign = np.array([jm.sign for jm in self.jm], float)
+        self.ref = np.array([jm.ref for jm in self.jm], float)
+        self._cs = np.full((self.n_body, 3), np.nan)
+        self._arrays = model.arrays
+
+    def values(self, q, v, qpos=None, qvel=None):
+        """The same as from_maximal, compiled (into qpos, qvel if given)."""
+        qpos = np.empty(self.nq) if qpos is None else qpos
+        qvel = np.empty(self.nq) if qvel is None else qvel
+        joint_values(self._arrays, q, v, self._cs, self.pins, self.sign, self.ref, qpos, qvel)
+        return qpos, qvel
 
     def _free_parts(self, body):
+        """(slide indices, hinge index or None, (2, 2) slide axes as columns, anchor at the
+        file's pose) of a free root."""
         slides, (h,) = self.free[body]
-        A = np.array([self.jm[i].axis for i in slides], float).T      # (2, 2) columns: axes
-        return slides, h, A, np.array(self.jm[h].anchor, float)
+        A = np.array([self.jm[i].axis for i in slides], float).T
+        return slides, h, A, np.array(self.jm[slides[0]].anchor, float)
 
     def to_maximal(self, qpos, qvel):
         """(nq,), (nv,) MuJoCo values -> q, v (n_body, 3)."""
@@ -75,12 +110,11 @@ class GeneralizedCoords:
         v = np.full((self.n_body, 3), np.nan)
         for body in self.free:
             slides, h, A, A0 = self._free_parts(body)
-            jh = self.jm[h]
             d = A @ np.array([qpos[i] - self.jm[i].ref for i in slides])
-            phi = jh.sign * (qpos[h] - jh.ref)
+            phi = 0.0 if h is None else self.jm[h].sign * (qpos[h] - self.jm[h].ref)
             anchor = A0 + d
             c = anchor + _rot(phi) @ (self.q0[body, :2] - A0)
-            w = jh.sign * qvel[h]
+            w = 0.0 if h is None else self.jm[h].sign * qvel[h]
             q[body] = (c[0], c[1], self.q0[body, 2] + phi)
             v[body, :2] = A @ np.array([qvel[i] for i in slides]) + _cross(w, c - anchor)
             v[body, 2] = w
@@ -98,7 +132,7 @@ class GeneralizedCoords:
                 Ra = _rot(qa[2])
                 Pa = qa[:2] + Ra @ la
                 vPa = va[:2] + _cross(va[2], Pa - qa[:2])
-                if self.pin_kind[jm.id] == JOINT_SLIDER:
+                if self.pin_kind[jm.id] & JOINT_SLIDE_BIT:
                     th = qa[2] + self.pin_ref[jm.id]
                     dw = Ra @ self.pin_axis[jm.id]
                     s = qpos[i] - jm.ref
@@ -125,7 +159,6 @@ class GeneralizedCoords:
         qpos, qvel = np.zeros(self.nq), np.zeros(self.nq)
         for body in self.free:
             slides, h, A, A0 = self._free_parts(body)
-            jh = self.jm[h]
             phi = q[body, 2] - self.q0[body, 2]
             anchor = q[body, :2] - _rot(phi) @ (self.q0[body, :2] - A0)
             d = np.linalg.solve(A, anchor - A0)
@@ -134,14 +167,15 @@ class GeneralizedCoords:
             for k, i in enumerate(slides):
                 qpos[i] = self.jm[i].ref + d[k]
                 qvel[i] = ds[k]
-            qpos[h] = jh.ref + jh.sign * phi
-            qvel[h] = jh.sign * v[body, 2]
+            if h is not None:
+                qpos[h] = self.jm[h].ref + self.jm[h].sign * phi
+                qvel[h] = self.jm[h].sign * v[body, 2]
         for i in self.links:
             jm = self.jm[i]
             a, b = self.pin_body[jm.id]
             qa = q[a] if a >= 0 else np.zeros(3)
             va = v[a] if a >= 0 else np.zeros(3)
-            if self.pin_kind[jm.id] == JOINT_SLIDER:
+            if self.pin_kind[jm.id] & JOINT_SLIDE_BIT:
                 la, lb = self.pin_anchor[jm.id]
                 Ra = _rot(qa[2])
                 Pa = qa[:2] + Ra @ la
@@ -189,12 +223,19 @@ class PlanarMujocoEnv(gymnasium.Env):
         self.init_qpos, self.init_qvel = self.coords.from_maximal(self.sim_model.q0, self.sim_model.v0)
         self.data = SimpleNamespace(qpos=self.init_qpos.copy(), qvel=self.init_qvel.copy())
         self._u = np.zeros(self.sim_model.n_act)
+        self._act_id = np.array([a.id for a in self._act], np.int64)
+        self._act_gear = np.array([a.gear for a in self._act], float)
+        self._act_lo = np.array([a.ctrlrange[0] for a in self._act], float)
+        self._act_hi = np.array([a.ctrlrange[1] for a in self._act], float)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode={render_mode!r}: planarsim's environments render "
                              f"{self.metadata['render_modes']} only")
         self.render_mode = render_mode
         self.width, self.height = int(width), int(height)
         self.sim = Simulator(self.sim_model, None, make_state(self.sim_model))
+        # the speed bound (StepOptions.speed_limit) is set once, from the file's pose at rest,
+        # so that a reset only copies a state in (Simulator.start_over: microseconds)
+        self.sim.options = self.sim.options
 
     @property
     def dt(self) -> float:
@@ -203,7 +244,7 @@ class PlanarMujocoEnv(gymnasium.Env):
     # MuJoCo's MujocoEnv interface -------------------------------------------------------
     def _sync(self):
         st = self.sim.state
-        self.data.qpos, self.data.qvel = self.coords.from_maximal(st.q, st.v)
+        self.data.qpos, self.data.qvel = self.coords.values(st.q, st.v)
 
     def set_state(self, qpos, qvel):
         qpos, qvel = np.asarray(qpos, float), np.asarray(qvel, float)
@@ -211,11 +252,10 @@ class PlanarMujocoEnv(gymnasium.Env):
             raise ValueError(f"set_state: qpos shape {qpos.shape} and qvel shape {qvel.shape} "
                              f"must be ({self.model.nq},) and ({self.model.nv},)")
         q, v = self.coords.to_maximal(qpos, qvel)
-        # a new simulator: no contact modes, warm starts or ground queries carry over. Like
-        # MuJoCo's set_state, any pose is accepted (one below the floor is pushed out by the
-        # first step)
-        self.sim = Simulator(self.sim_model, None, make_state(self.sim_model, q, v),
-                             allow_below_ground=True)
+        # as a new simulator: no contact modes, warm starts or ground queries carry over.
+        # Like MuJoCo's set_state, any pose is accepted (one below the floor is pushed out by
+        # the first step)
+        self.sim.start_over(q, v)
         self._sync()
 
     def check_action(self, action) -> np.ndarray:
@@ -230,9 +270,8 @@ class PlanarMujocoEnv(gymnasium.Env):
 
     def do_simulation(self, ctrl, n_frames):
         ctrl = self.check_action(ctrl)
-        for k, act in enumerate(self._act):
-            lo, hi = act.ctrlrange
-            self._u[act.id] = act.gear * min(max(ctrl[k], lo), hi)   # MuJoCo clamps ctrl
+        # MuJoCo clamps ctrl to ctrlrange; the actuator's input is gear * ctrl
+        self._u[self._act_id] = self._act_gear * np.clip(ctrl, self._act_lo, self._act_hi)
         self.sim.steps(int(n_frames), self._u)
         self._sync()
 
@@ -249,6 +288,11 @@ class PlanarMujocoEnv(gymnasium.Env):
 
     def reset_model(self):  # pragma: no cover - each task defines it
         raise NotImplementedError
+
+    def body_com(self, body: str) -> np.ndarray:
+        """World (plane) position [m] of MJCF body `body`'s own centre of mass (MuJoCo's
+        get_body_com, in the plane's two coordinates)."""
+        return self.point(body, self.loaded.com[body])
 
     def point(self, body: str, local_mjcf) -> np.ndarray:
         """World (plane) position of a point fixed in MJCF body `body`, given at the file's

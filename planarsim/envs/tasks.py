@@ -14,24 +14,54 @@ from ..mjcf import parse_xml
 from .core import PlanarMujocoEnv, gym_asset
 
 
-class _Locomotion(PlanarMujocoEnv, utils.EzPickle):
-    """Hopper, Walker2d and HalfCheetah: obs = qpos[1:] and qvel (clipped for some)."""
-    clip_qvel = True
+class _Task(PlanarMujocoEnv, utils.EzPickle):
+    """A task's keyword arguments and their defaults are its class's DEFAULTS (gymnasium's
+    v5 defaults), each kept as the attribute "_" + name; any other keyword goes to
+    PlanarMujocoEnv (render_mode, width, height) or load_mjcf. obs_size(): the observation's
+    length."""
+    DEFAULTS: dict = {}
 
-    def __init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                 reset_noise_scale, exclude_current_positions_from_observation=True,
-                 render_mode=None, **kw):
-        self._forward_reward_weight = forward_reward_weight
-        self._ctrl_cost_weight = ctrl_cost_weight
-        self._reset_noise_scale = reset_noise_scale
-        self._exclude = exclude_current_positions_from_observation
-        PlanarMujocoEnv.__init__(self, xml_file, frame_skip, render_mode=render_mode, **kw)
+    def __init__(self, **kw):
+        args = {**self.DEFAULTS, **kw}
+        utils.EzPickle.__init__(self, **args)
+        for key in self.DEFAULTS:
+            if key not in ("xml_file", "frame_skip"):
+                setattr(self, "_" + key, args.pop(key))
+        PlanarMujocoEnv.__init__(self, args.pop("xml_file"), args.pop("frame_skip"), **args)
         self.metadata = {"render_modes": ["rgb_array"], "render_fps": int(np.round(1.0 / self.dt))}
-        n = self.model.nq + self.model.nv - int(self._exclude)
-        self.observation_space = Box(low=-np.inf, high=np.inf, shape=(n,), dtype=np.float64)
+        self.observation_space = Box(low=-np.inf, high=np.inf, shape=(self.obs_size(),),
+                                     dtype=np.float64)
+
+    def obs_size(self) -> int:  # pragma: no cover - each task defines it
+        raise NotImplementedError
+
+
+class _Locomotion(_Task):
+    """Hopper, Walker2d, HalfCheetah and Swimmer: obs = qpos without the first n_excluded
+    (the root's position) and qvel (clipped to +-10 for some)."""
+    clip_qvel = True
+    n_excluded = 1
+
+    @property
+    def _exclude(self):
+        return self._exclude_current_positions_from_observation
+
+    def obs_size(self):
+        return self.model.nq + self.model.nv - self.n_excluded * int(self._exclude)
 
     def control_cost(self, action):
         return self._ctrl_cost_weight * np.sum(np.square(action))
+
+    def advance(self, action, n=1):
+        """Simulate one env step; return the root's first n qpos after it, their velocity
+        over the step, the observation, the forward reward (weight * x velocity) and the
+        control cost."""
+        before = self.data.qpos[:n].copy()
+        self.do_simulation(action, self.frame_skip)
+        after = self.data.qpos[:n].copy()
+        velocity = (after - before) / self.dt
+        return (after, velocity, self._get_obs(), self._forward_reward_weight * velocity[0],
+                self.control_cost(action))
 
     def _get_obs(self):
         position = self.data.qpos.flatten()
@@ -39,7 +69,7 @@ class _Locomotion(PlanarMujocoEnv, utils.EzPickle):
         if self.clip_qvel:
             velocity = np.clip(velocity, -10, 10)
         if self._exclude:
-            position = position[1:]
+            position = position[self.n_excluded:]
         return np.concatenate((position, velocity)).ravel()
 
     def reset_model(self):
@@ -50,31 +80,36 @@ class _Locomotion(PlanarMujocoEnv, utils.EzPickle):
         return self._get_obs()
 
 
-class _Healthy(_Locomotion):
-    """Hopper and Walker2d: forward + healthy reward - ctrl cost; terminates when unhealthy."""
+_HEALTHY = dict(frame_skip=4, forward_reward_weight=1.0, ctrl_cost_weight=1e-3, healthy_reward=1.0,
+                terminate_when_unhealthy=True, reset_noise_scale=5e-3,
+                exclude_current_positions_from_observation=True)
 
-    def __init__(self, xml_file, frame_skip=4, forward_reward_weight=1.0, ctrl_cost_weight=1e-3,
-                 healthy_reward=1.0, terminate_when_unhealthy=True, reset_noise_scale=5e-3, **kw):
-        self._healthy_reward = healthy_reward
-        self._terminate_when_unhealthy = terminate_when_unhealthy
-        _Locomotion.__init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                             reset_noise_scale, **kw)
+
+class _Healthy(_Locomotion):
+    """Hopper and Walker2d: forward + healthy reward - ctrl cost; terminates when unhealthy
+    (z and the root's angle outside their ranges; Hopper also any state beyond its range)."""
 
     @property
     def healthy_reward(self):
         return self.is_healthy * self._healthy_reward
 
+    @property
+    def is_healthy(self):
+        z, angle = self.data.qpos[1:3]
+        healthy = (self._healthy_z_range[0] < z < self._healthy_z_range[1]
+                   and self._healthy_angle_range[0] < angle < self._healthy_angle_range[1])
+        state_range = getattr(self, "_healthy_state_range", None)
+        if state_range is not None:
+            state = self.state_vector()[2:]
+            healthy = healthy and bool(np.all((state_range[0] < state) & (state < state_range[1])))
+        return bool(healthy)
+
     def step(self, action):
-        x_before = self.data.qpos[0]
-        self.do_simulation(action, self.frame_skip)
-        x_after = self.data.qpos[0]
-        x_velocity = (x_after - x_before) / self.dt
-        observation = self._get_obs()
-        forward_reward = self._forward_reward_weight * x_velocity
-        healthy_reward = self.healthy_reward
-        ctrl_cost = self.control_cost(action)
+        (x_after,), (x_velocity,), observation, forward_reward, ctrl_cost = self.advance(action)
+        healthy = self.is_healthy
+        healthy_reward = healthy * self._healthy_reward
         reward = forward_reward + healthy_reward - ctrl_cost
-        terminated = (not self.is_healthy) and self._terminate_when_unhealthy
+        terminated = (not healthy) and self._terminate_when_unhealthy
         info = {"x_position": x_after, "z_distance_from_origin": self.data.qpos[1] - self.init_qpos[1],
                 "x_velocity": x_velocity, "reward_forward": forward_reward,
                 "reward_ctrl": -ctrl_cost, "reward_survive": healthy_reward}
@@ -87,86 +122,28 @@ class _Healthy(_Locomotion):
 
 class Hopper(_Healthy):
     """gymnasium Hopper-v5 on planarsim (hopper.xml, frame_skip 4, dt 0.008 s)."""
-
-    def __init__(self, xml_file="hopper.xml", frame_skip=4, forward_reward_weight=1.0,
-                 ctrl_cost_weight=1e-3, healthy_reward=1.0, terminate_when_unhealthy=True,
-                 healthy_state_range=(-100.0, 100.0), healthy_z_range=(0.7, float("inf")),
-                 healthy_angle_range=(-0.2, 0.2), reset_noise_scale=5e-3,
-                 exclude_current_positions_from_observation=True, render_mode=None, **kw):
-        utils.EzPickle.__init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                                healthy_reward, terminate_when_unhealthy, healthy_state_range,
-                                healthy_z_range, healthy_angle_range, reset_noise_scale,
-                                exclude_current_positions_from_observation, render_mode, **kw)
-        self._healthy_state_range = healthy_state_range
-        self._healthy_z_range = healthy_z_range
-        self._healthy_angle_range = healthy_angle_range
-        _Healthy.__init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                          healthy_reward, terminate_when_unhealthy, reset_noise_scale,
-                          exclude_current_positions_from_observation=exclude_current_positions_from_observation,
-                          render_mode=render_mode, **kw)
-
-    @property
-    def is_healthy(self):
-        z, angle = self.data.qpos[1:3]
-        state = self.state_vector()[2:]
-        lo, hi = self._healthy_state_range
-        healthy_state = np.all(np.logical_and(lo < state, state < hi))
-        healthy_z = self._healthy_z_range[0] < z < self._healthy_z_range[1]
-        healthy_angle = self._healthy_angle_range[0] < angle < self._healthy_angle_range[1]
-        return bool(healthy_state and healthy_z and healthy_angle)
+    DEFAULTS = dict(xml_file="hopper.xml", **_HEALTHY, healthy_state_range=(-100.0, 100.0),
+                    healthy_z_range=(0.7, float("inf")), healthy_angle_range=(-0.2, 0.2))
 
 
 class Walker2d(_Healthy):
     """gymnasium Walker2d-v5 on planarsim (walker2d_v5.xml, frame_skip 4, dt 0.008 s).
     Both legs move in one plane and only touch the floor (as in MuJoCo's file, whose geoms
     do not collide with each other)."""
-
-    def __init__(self, xml_file="walker2d_v5.xml", frame_skip=4, forward_reward_weight=1.0,
-                 ctrl_cost_weight=1e-3, healthy_reward=1.0, terminate_when_unhealthy=True,
-                 healthy_z_range=(0.8, 2.0), healthy_angle_range=(-1.0, 1.0),
-                 reset_noise_scale=5e-3, exclude_current_positions_from_observation=True,
-                 render_mode=None, **kw):
-        utils.EzPickle.__init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                                healthy_reward, terminate_when_unhealthy, healthy_z_range,
-                                healthy_angle_range, reset_noise_scale,
-                                exclude_current_positions_from_observation, render_mode, **kw)
-        self._healthy_z_range = healthy_z_range
-        self._healthy_angle_range = healthy_angle_range
-        _Healthy.__init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                          healthy_reward, terminate_when_unhealthy, reset_noise_scale,
-                          exclude_current_positions_from_observation=exclude_current_positions_from_observation,
-                          render_mode=render_mode, **kw)
-
-    @property
-    def is_healthy(self):
-        z, angle = self.data.qpos[1:3]
-        return bool(self._healthy_z_range[0] < z < self._healthy_z_range[1]
-                    and self._healthy_angle_range[0] < angle < self._healthy_angle_range[1])
+    DEFAULTS = dict(xml_file="walker2d_v5.xml", **_HEALTHY, healthy_z_range=(0.8, 2.0),
+                    healthy_angle_range=(-1.0, 1.0))
 
 
 class HalfCheetah(_Locomotion):
     """gymnasium HalfCheetah-v5 on planarsim (half_cheetah.xml, frame_skip 5, dt 0.05 s).
     Its observation does not clip qvel; reset adds Gaussian noise to qvel."""
     clip_qvel = False
-
-    def __init__(self, xml_file="half_cheetah.xml", frame_skip=5, forward_reward_weight=1.0,
-                 ctrl_cost_weight=0.1, reset_noise_scale=0.1,
-                 exclude_current_positions_from_observation=True, render_mode=None, **kw):
-        utils.EzPickle.__init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                                reset_noise_scale, exclude_current_positions_from_observation,
-                                render_mode, **kw)
-        _Locomotion.__init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight,
-                             reset_noise_scale, exclude_current_positions_from_observation,
-                             render_mode=render_mode, **kw)
+    DEFAULTS = dict(xml_file="half_cheetah.xml", frame_skip=5, forward_reward_weight=1.0,
+                    ctrl_cost_weight=0.1, reset_noise_scale=0.1,
+                    exclude_current_positions_from_observation=True)
 
     def step(self, action):
-        x_before = self.data.qpos[0]
-        self.do_simulation(action, self.frame_skip)
-        x_after = self.data.qpos[0]
-        x_velocity = (x_after - x_before) / self.dt
-        observation = self._get_obs()
-        forward_reward = self._forward_reward_weight * x_velocity
-        ctrl_cost = self.control_cost(action)
+        (x_after,), (x_velocity,), observation, forward_reward, ctrl_cost = self.advance(action)
         info = {"x_position": x_after, "x_velocity": x_velocity,
                 "reward_forward": forward_reward, "reward_ctrl": -ctrl_cost}
         return observation, forward_reward - ctrl_cost, False, False, info
@@ -182,17 +159,89 @@ class HalfCheetah(_Locomotion):
         return {"x_position": self.data.qpos[0]}
 
 
-class InvertedPendulum(PlanarMujocoEnv, utils.EzPickle):
-    """gymnasium InvertedPendulum-v5 on planarsim (inverted_pendulum.xml, frame_skip 2)."""
+class Swimmer(_Locomotion):
+    """gymnasium Swimmer-v5 on planarsim (swimmer.xml, frame_skip 4, dt 0.04 s): three links
+    in the x-y plane, no gravity, MuJoCo's inertia-box drag (viscosity 0.1, density 4000;
+    kernels/fluid.py) and armature 0.1 on every joint, the root's included. Reward: the
+    velocity of qpos[0] minus 1e-4 |action|^2. What differs: MuJoCo's file asks for RK4,
+    planarsim steps it with its own first-order integrator (the drag explicit, as MuJoCo's
+    Euler has it)."""
+    clip_qvel = False
+    n_excluded = 2
+    DEFAULTS = dict(xml_file="swimmer.xml", frame_skip=4, forward_reward_weight=1.0,
+                    ctrl_cost_weight=1e-4, reset_noise_scale=0.1,
+                    exclude_current_positions_from_observation=True)
 
-    def __init__(self, xml_file="inverted_pendulum.xml", frame_skip=2, reset_noise_scale=0.01,
-                 render_mode=None, **kw):
-        utils.EzPickle.__init__(self, xml_file, frame_skip, reset_noise_scale, render_mode, **kw)
-        self._reset_noise_scale = reset_noise_scale
-        PlanarMujocoEnv.__init__(self, xml_file, frame_skip,
-                                 Box(low=-np.inf, high=np.inf, shape=(4,), dtype=np.float64),
-                                 render_mode=render_mode, **kw)
-        self.metadata = {"render_modes": ["rgb_array"], "render_fps": int(np.round(1.0 / self.dt))}
+    def step(self, action):
+        xy_after, (x_velocity, y_velocity), observation, forward_reward, ctrl_cost = \
+            self.advance(action, 2)
+        info = {"x_position": xy_after[0], "y_position": xy_after[1],
+                "distance_from_origin": np.linalg.norm(xy_after, ord=2),
+                "x_velocity": x_velocity, "y_velocity": y_velocity,
+                "reward_forward": forward_reward, "reward_ctrl": -ctrl_cost}
+        return observation, forward_reward - ctrl_cost, False, False, info
+
+    def _get_reset_info(self):
+        return {"x_position": self.data.qpos[0], "y_position": self.data.qpos[1],
+                "distance_from_origin": np.linalg.norm(self.data.qpos[0:2], ord=2)}
+
+
+class Reacher(_Task):
+    """gymnasium Reacher-v5 on planarsim (reacher.xml, frame_skip 2, dt 0.02 s): a two-link
+    arm in the x-y plane (no gravity; armature 1 and damping 1 on its hinges) reaching for a
+    target that translates only (two slides: a point mass here). obs: cos and sin of the two
+    arm angles, the target's qpos, the arm's qvel, fingertip - target (x, y); reward
+    -|fingertip - target| - |action|^2 (the bodies lie at one height: the distance is the
+    plane's). What differs: MuJoCo's file asks for RK4, planarsim steps it with its own
+    first-order integrator."""
+
+    DEFAULTS = dict(xml_file="reacher.xml", frame_skip=2, reward_dist_weight=1.0,
+                    reward_control_weight=1.0)
+
+    def __init__(self, **kw):
+        _Task.__init__(self, **kw)
+        self.goal = self.init_qpos[-2:].copy()
+
+    def obs_size(self):
+        return 10
+
+    def _get_rew(self, action):
+        vec = self.body_com("fingertip") - self.body_com("target")
+        reward_dist = -np.linalg.norm(vec) * self._reward_dist_weight
+        reward_ctrl = -np.square(action).sum() * self._reward_control_weight
+        return reward_dist + reward_ctrl, {"reward_dist": reward_dist, "reward_ctrl": reward_ctrl}
+
+    def step(self, action):
+        self.do_simulation(action, self.frame_skip)
+        observation = self._get_obs()
+        reward, info = self._get_rew(action)
+        return observation, reward, False, False, info
+
+    def reset_model(self):
+        qpos = self.np_random.uniform(low=-0.1, high=0.1, size=self.model.nq) + self.init_qpos
+        while True:
+            self.goal = self.np_random.uniform(low=-0.2, high=0.2, size=2)
+            if np.linalg.norm(self.goal) < 0.2:
+                break
+        qpos[-2:] = self.goal
+        qvel = self.init_qvel + self.np_random.uniform(low=-0.005, high=0.005, size=self.model.nv)
+        qvel[-2:] = 0
+        self.set_state(qpos, qvel)
+        return self._get_obs()
+
+    def _get_obs(self):
+        theta = self.data.qpos.flatten()[:2]
+        return np.concatenate([np.cos(theta), np.sin(theta), self.data.qpos.flatten()[2:],
+                               self.data.qvel.flatten()[:2],
+                               self.body_com("fingertip") - self.body_com("target")])
+
+
+class InvertedPendulum(_Task):
+    """gymnasium InvertedPendulum-v5 on planarsim (inverted_pendulum.xml, frame_skip 2)."""
+    DEFAULTS = dict(xml_file="inverted_pendulum.xml", frame_skip=2, reset_noise_scale=0.01)
+
+    def obs_size(self):
+        return 4
 
     def step(self, action):
         self.do_simulation(action, self.frame_skip)
@@ -233,24 +282,23 @@ def _site(path, name):
     return body, np.array([p[0], p[2]])
 
 
-class InvertedDoublePendulum(PlanarMujocoEnv, utils.EzPickle):
+class InvertedDoublePendulum(_Task):
     """gymnasium InvertedDoublePendulum-v5 on planarsim (inverted_double_pendulum.xml,
     frame_skip 5). The last observation entry, MuJoCo's qfrc_constraint[0] (the constraint
     force on the cart's slide), is here the slider's limit impulse of the last step over the
     step length [N] (clipped to +-10); without a limit hit both are 0."""
 
-    def __init__(self, xml_file="inverted_double_pendulum.xml", frame_skip=5, healthy_reward=10.0,
-                 reset_noise_scale=0.1, render_mode=None, **kw):
-        utils.EzPickle.__init__(self, xml_file, frame_skip, healthy_reward, reset_noise_scale,
-                                render_mode, **kw)
-        self._healthy_reward = healthy_reward
-        self._reset_noise_scale = reset_noise_scale
-        PlanarMujocoEnv.__init__(self, xml_file, frame_skip,
-                                 Box(low=-np.inf, high=np.inf, shape=(9,), dtype=np.float64),
-                                 render_mode=render_mode, **kw)
-        self.metadata = {"render_modes": ["rgb_array"], "render_fps": int(np.round(1.0 / self.dt))}
+    DEFAULTS = dict(xml_file="inverted_double_pendulum.xml", frame_skip=5, healthy_reward=10.0,
+                    reset_noise_scale=0.1)
+
+    def __init__(self, **kw):
+        _Task.__init__(self, **kw)
+        xml_file = kw.get("xml_file", self.DEFAULTS["xml_file"])
         self._tip = _site(gym_asset(xml_file) if "/" not in xml_file else xml_file, "tip")
         self._slider = self.loaded.joint[self.coords.names[0]].id
+
+    def obs_size(self):
+        return 9
 
     def tip(self):
         return self.point(*self._tip)

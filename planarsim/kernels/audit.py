@@ -39,7 +39,7 @@ from .math2d import world_point
 from .broad_phase import sweep_pairs
 from .pair import pair_gap_now, place_shapes
 from .rows import is_limit_row, is_normal_row
-from .joints import is_slider
+from .joints import is_free_joint, is_slider
 from .slider import slider_gap
 from .terrain import ground_point
 from .work import (VELOCITY_FLOOR, WORK_REL_TOL, fastest, joints_add_energy, judge_energy,
@@ -202,7 +202,9 @@ def anchor_distance(q, cs, bodies, anchors, j):
 @kernel
 def pin_gap(m, q, cs, j):
     """Distance [m] between the two anchors of pin j at configuration q (a slider: its anchor
-    b's distance from its axis line)."""
+    b's distance from its axis line; 0 for a free body's coordinate, which holds nothing)."""
+    if is_free_joint(m, j):
+        return 0.0
     if is_slider(m, j):
         return slider_gap(m, q, cs, j)
     return anchor_distance(q, cs, m.pin_body, m.pin_anchor, j)

@@ -11,9 +11,16 @@ MODE_SLIDING = 2       # slipping, Coulomb friction at the cone's edge
 # how the modes carried over from the last step are checked (StepOptions.mode_strategy)
 MODES_ALTERNATING = 0  # one contact re-examined per step, in turn, before the guaranteed solve
 MODES_ALL = 1          # straight to the guaranteed (complementarity) solve when the guess fails
-# joint kinds (model.pin_kind): an entry of the pin table is a hinge or a slider (prismatic)
+# joint kinds (model.pin_kind): an entry of the pin table is a hinge or a slider (prismatic),
+# whose coordinate is an angle or a slide (bit JOINT_SLIDE_BIT); a free body's coordinate
+# (bit JOINT_FREE_BIT: an MJCF free root's slide or hinge) has that coordinate's limits,
+# spring-damper, armature and motor but no constraint rows
+JOINT_SLIDE_BIT = 1
+JOINT_FREE_BIT = 2
 JOINT_HINGE = 0
-JOINT_SLIDER = 1
+JOINT_SLIDER = JOINT_SLIDE_BIT
+JOINT_FREE_HINGE = JOINT_FREE_BIT
+JOINT_FREE_SLIDE = JOINT_FREE_BIT | JOINT_SLIDE_BIT
 # row kinds (workspace.row_kind): each kind's rows are evaluated in its own module (pin.py,
 # slider.py, rod.py, limit.py, soft.py, contacts.py for the ground, pair.py for shapes) and
 # dispatched in one place (rows.py); a kind's class is asked through rows.py's named predicates, never by number order

@@ -9,6 +9,7 @@ implicitly in the velocity solve (soft.py).
 import math
 
 from ._jit import kernel, kernel_inline
+from .fluid import apply_fluid
 from .math2d import cross2, world_point
 from .slider import slide_position_rate, slider_frame
 
@@ -124,7 +125,8 @@ def apply_actuator(m, q, cs, v, f, k, u):
 
 @kernel
 def apply_forces(m, s, ws, u):
-    """f = m g + pushes + saturated actuator commands u (joint springs and dampers: soft.py)."""
+    """f = m g + pushes + fluid drag + saturated actuator commands u (joint springs and
+    dampers: soft.py)."""
     q = s.q
     v = s.v
     f = ws.force
@@ -132,6 +134,8 @@ def apply_forces(m, s, ws, u):
         f[i, 0] = m.body_mass[i] * m.gravity[0] + s.ext_force[i, 0]
         f[i, 1] = m.body_mass[i] * m.gravity[1] + s.ext_force[i, 1]
         f[i, 2] = s.ext_force[i, 2] if m.body_inv_inertia[i] > 0.0 else 0.0
+    if m.fluid_body.shape[0] > 0:
+        apply_fluid(m, q, ws.body_cs, v, f)
     # actuators, saturated
     for k in range(m.act_kind.shape[0]):
         uk = u[k]

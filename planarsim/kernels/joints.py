@@ -1,24 +1,31 @@
 """A joint's coordinate, whatever its kind (the pin table's model.pin_kind): a hinge's angle
 theta_b - theta_a - ref [rad], a slider's slide s = d.(p_b - p_a) [m] (slider.py). The one
 dispatch on a joint's kind, for what acts on its coordinate: limits (limit.py, modes.py),
-springs, dampers and armature (soft.py)."""
+springs, dampers and armature (soft.py). A free body's coordinate (codes.JOINT_FREE_BIT) is
+measured the same way but holds nothing: it has no constraint rows."""
 from ._jit import kernel
-from .codes import JOINT_SLIDER
+from .codes import JOINT_FREE_BIT, JOINT_SLIDE_BIT
 from .forces import pin_angle_rate
-from .slider import slide_position_rate, slide_row
+from .slider import slide_position_rate, slide_row, slider_angle_row
 
 
 @kernel
 def is_slider(m, j):
-    """Joint j is a slider (prismatic), not a hinge."""
-    return m.pin_kind[j] == JOINT_SLIDER
+    """Joint j's coordinate is a slide [m] (a slider, or a free body's slide), not an angle."""
+    return (m.pin_kind[j] & JOINT_SLIDE_BIT) != 0
+
+
+@kernel
+def is_free_joint(m, j):
+    """Joint j only measures a free body's coordinate: no constraint rows, no gap."""
+    return (m.pin_kind[j] & JOINT_FREE_BIT) != 0
 
 
 @kernel
 def joint_position_rate(m, q, cs, v, j):
     """Joint j's coordinate [rad or m] and its rate [rad/s or m/s] at (q, v) (cs: cos / sin
     of the angles at q)."""
-    if m.pin_kind[j] == JOINT_SLIDER:
+    if is_slider(m, j):
         return slide_position_rate(m, q, cs, v, j)
     return pin_angle_rate(m, q, v, j)
 
@@ -29,15 +36,7 @@ def joint_rate_row(m, q, cs, j, J):
     coordinate x [rad or m]."""
     a = m.pin_body[j, 0]
     b = m.pin_body[j, 1]
-    if m.pin_kind[j] == JOINT_SLIDER:
+    if is_slider(m, j):
         return slide_row(m, q, cs, j, a, b, J)
-    for k in range(3):
-        J[0, k] = 0.0
-        J[1, k] = 0.0
-    ang = q[b, 2] - m.pin_ref[j]
-    if a >= 0:
-        ang -= q[a, 2]
-        J[0, 2] = -1.0
-    J[1, 2] = 1.0
-    return ang
+    return slider_angle_row(m, q, j, a, b, J)     # the same relative angle as a hinge's
 

@@ -33,7 +33,7 @@ from ._jit import kernel
 from .codes import (CONTACT_PAIR, MODE_PINNED, MODE_SLIDING, ROW_CONTACT_N, ROW_CONTACT_T,
                     ROW_JOINT_SOFT, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
                     ROW_SLIDE_ANGLE, ROW_SLIDE_PERP)
-from .joints import is_slider, joint_rate_row
+from .joints import is_free_joint, is_slider, joint_rate_row
 from .contacts import ground_lever, ground_row
 from .limit import add_limit_rows, limit_row, limit_side
 from .math2d import set_dir, world_point
@@ -271,8 +271,10 @@ def add_contact_rows(ws, n, i, normal, tangent):
 
 @kernel
 def add_joint_rows(m, ws, n, j):
-    """Append joint j's equality rows at slot n (a hinge's pin rows, a slider's); returns the
-    next free slot."""
+    """Append joint j's equality rows at slot n (a hinge's pin rows, a slider's; none for a
+    free body's coordinate); returns the next free slot."""
+    if is_free_joint(m, j):
+        return n
     if is_slider(m, j):
         return add_slider_rows(m, ws, n, j)
     return add_pin_rows(m, ws, n, j)

@@ -57,7 +57,7 @@ def slider_perp_row(m, q, cs, o, a, b, J):
 @kernel
 def slider_angle_row(m, q, o, a, b, J):
     """Jacobian blocks J (2, 3) and error [rad] of slider o's angle row:
-    theta_b - theta_a - ref."""
+    theta_b - theta_a - ref (also a hinge's coordinate row, joints.joint_rate_row)."""
     for k in range(3):
         J[0, k] = 0.0
         J[1, k] = 0.0

@@ -22,7 +22,7 @@ import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.patches import Polygon
 
-from ..model import ACT_AXIAL
+from ..model import ACT_AXIAL, JOINT_FREE_BIT
 from .sides import SIDE_ORDER, model_sides, side_index
 from .legend import legend_bitmap
 from .stamps import ImageStamp, TextStamp
@@ -279,8 +279,10 @@ class Scene:
         return polys
 
     def pin_points(self, q) -> np.ndarray:
+        """World positions of the joints (a free body's coordinates are no joints: not drawn)."""
         a = self.model.arrays
-        pts = [world_points(q, a.pin_body[j, 1], a.pin_anchor[j, 1])[0] for j in range(self.model.n_pin)]
+        pts = [world_points(q, a.pin_body[j, 1], a.pin_anchor[j, 1])[0] for j in range(self.model.n_pin)
+               if not a.pin_kind[j] & JOINT_FREE_BIT]
         return np.array(pts).reshape(-1, 2)
 
     def _segments(self, q, bodies, anchors):

@@ -11,7 +11,8 @@ import pytest
 gym = pytest.importorskip("gymnasium", reason="gymnasium is not installed (pip install -e '.[gym]')")
 import planarsim.envs  # noqa: E402,F401  (registers the environments)
 
-NAMES = ["Hopper", "Walker2d", "HalfCheetah", "InvertedPendulum", "InvertedDoublePendulum"]
+NAMES = ["Hopper", "Walker2d", "HalfCheetah", "InvertedPendulum", "InvertedDoublePendulum",
+         "Reacher", "Swimmer"]
 
 
 def make(name, **kw):
@@ -52,7 +53,23 @@ def test_same_seed_same_episode(name):
     assert not np.array_equal(env.reset(seed=1)[0], env.reset(seed=2)[0])
 
 
-@pytest.mark.parametrize("name", ["Hopper", "InvertedPendulum"])
+@pytest.mark.parametrize("name", ["Hopper", "HalfCheetah", "Reacher"])
+def test_reset_forgets_the_last_episode(name):
+    """A reset is as a new environment: the same seed gives the same episode after any
+    history (no contact modes, warm starts or ground queries carry over)."""
+    def episode(env, seed, n=40):
+        out = [env.reset(seed=seed)[0]]
+        rng = np.random.default_rng(seed)
+        for _ in range(n):
+            out.append(env.step(rng.uniform(-1, 1, env.action_space.shape))[0])
+        return out
+    fresh = episode(make(name).unwrapped, 5)
+    used = make(name).unwrapped
+    episode(used, 99, 60)
+    assert all(np.array_equal(a, b) for a, b in zip(fresh, episode(used, 5)))
+
+
+@pytest.mark.parametrize("name", ["Hopper", "InvertedPendulum", "Reacher", "Swimmer"])
 def test_bad_actions_raise(name):
     env = make(name)
     env.reset(seed=0)
@@ -92,8 +109,12 @@ def test_coordinates_and_observation_match_mujoco(name):
         ref.set_state(qp, qv)
         env.set_state(qp, qv)
         np.testing.assert_allclose(env._get_obs(), ref._get_obs(), rtol=0, atol=1e-9)
+        # the compiled map (from the joint table) is the Python one
+        st = env.sim.state
+        for ours, theirs in zip(env.coords.values(st.q, st.v), env.coords.from_maximal(st.q, st.v)):
+            np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12)
         # the mapping itself: body COM (mass-weighted over welded MJCF bodies) and angle
-        (i1, i2) = (0, 2)
+        (i1, i2) = (0, 2) if env.loaded.plane == "x-z" else (0, 1)
         q = env.sim.state.q
         for bid, rb in env.loaded.rigid.items():
             ids = [mujoco.mj_name2id(ref.model, mujoco.mjtObj.mjOBJ_BODY, n) for n in rb.mjcf_bodies]
@@ -101,8 +122,9 @@ def test_coordinates_and_observation_match_mujoco(name):
             com = (m[:, None] * ref.data.xipos[ids]).sum(0) / m.sum()
             np.testing.assert_allclose(q[bid, :2], (com[i1], com[i2]), atol=1e-9, err_msg=rb.name)
             # rotation since the file's pose, about -y (counter-clockwise in our x-z plane)
+            # or +z (x-y plane)
             R = ref.data.xmat[ids[0]].reshape(3, 3) @ xmat0[ids[0]].reshape(3, 3).T
-            ang = np.arctan2(R[2, 0], R[0, 0])
+            ang = np.arctan2(R[i2, i1], R[i1, i1])
             d = (q[bid, 2] - env.sim_model.q0[bid, 2]) - ang
             assert abs((d + np.pi) % (2 * np.pi) - np.pi) < 1e-9, rb.name
         # velocities: the derivative of the position map
@@ -112,30 +134,61 @@ def test_coordinates_and_observation_match_mujoco(name):
         np.testing.assert_allclose((q1 - q0) / e, v0, atol=1e-5)
     if name == "InvertedDoublePendulum":
         np.testing.assert_allclose(env.tip(), ref.data.site_xpos[0][[0, 2]], atol=1e-9)
+    if name == "Reacher":       # the reward's distance and its terms
+        ref.set_state(qp, qv)
+        env.set_state(qp, qv)
+        a = np.array([0.3, -0.2])
+        assert env._get_rew(a)[0] == pytest.approx(ref._get_rew(a)[0], abs=1e-9)
 
 
-@pytest.mark.parametrize("name, tilt", [("InvertedPendulum", 0.01), ("InvertedDoublePendulum", 0.01)])
-def test_motion_before_contact_matches_mujoco_euler(name, tilt):
-    """Zero actions from a tilted start, 20 env steps, no contact and no limit reached: our
-    observations against MuJoCo with its Euler integrator at the same step h. Both are
-    first-order, so each is off the exact motion by about 2 |M(h) - M(h/2)| (Richardson);
-    the bound is twice that: |ours - M(h)| <= 4 max |M(h) - M(h/2)|."""
+# (name, start qpos offsets, start qvel, action, which obs entry must move by > 0.1)
+MOTIONS = [("InvertedPendulum", {1: 0.01}, {}, 0.0, 1),
+           ("InvertedDoublePendulum", {1: 0.01}, {}, 0.0, 1),
+           # the arm swung by its motors (no contact in the file); its hinges' damping and
+           # armature implicit in both
+           ("Reacher", {0: 0.3, 1: -0.5}, {0: 1.0, 1: -2.0}, 0.0, 0),
+           # a swimmer coasting and turning through the fluid: the drag slows every link
+           ("Swimmer", {2: 0.3, 3: -0.4}, {0: 0.5, 1: -0.3, 2: 0.2, 3: 1.0, 4: -1.0}, 0.0, 3)]
+
+
+def start(env, dq, dv):
+    """The env's initial qpos, qvel offset by dq, dv ({index: offset})."""
+    qp, qv = env.init_qpos.copy(), env.init_qvel.copy()
+    for i, x in dq.items():
+        qp[i] += x
+    for i, x in dv.items():
+        qv[i] += x
+    return qp, qv
+
+
+def ours_run(env, qp, qv, u, n=20):
+    env.set_state(qp, qv)
+    return np.array([env.step(u)[0] for _ in range(n)])
+
+
+def mujoco_euler_run(mujoco, ref, qp, qv, u, timestep, frame_skip, n=20):
+    """gymnasium's MuJoCo env stepped with MuJoCo's Euler integrator at `timestep`."""
+    ref.model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    ref.model.opt.timestep = timestep
+    ref.frame_skip = frame_skip
+    ref.set_state(qp, qv)
+    return np.array([ref.step(u)[0] for _ in range(n)])
+
+
+@pytest.mark.parametrize("name, dq, dv, action, moving", MOTIONS)
+def test_motion_before_contact_matches_mujoco_euler(name, dq, dv, action, moving):
+    """Constant actions from an offset start, 20 env steps, no contact and no limit
+    reached: our observations against MuJoCo with its Euler integrator at the same step h.
+    Both are first-order, so each is off the exact motion by about 2 |M(h) - M(h/2)|
+    (Richardson); the bound is twice that: |ours - M(h)| <= 4 max |M(h) - M(h/2)|."""
     mujoco, ref = mujoco_env(name)
     env = make(name).unwrapped
-    qp = env.init_qpos.copy()
-    qp[1] = tilt
-    qv = np.zeros(env.model.nv)
-    env.set_state(qp, qv)
-    ours = np.array([env.step(np.zeros(1))[0] for _ in range(20)])
-
-    def mj(sub):
-        ref.model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
-        ref.model.opt.timestep = env.timestep / sub
-        ref.frame_skip = env.frame_skip * sub
-        ref.set_state(qp, qv)
-        return np.array([ref.step(np.zeros(1))[0] for _ in range(20)])
-    m1, m2 = mj(1), mj(2)
-    assert np.abs(qp[1] - ours[:, 1]).max() > 0.1          # it really moved
+    qp, qv = start(env, dq, dv)
+    u = np.full(env.action_space.shape, action)
+    ours = ours_run(env, qp, qv, u)
+    m1, m2 = (mujoco_euler_run(mujoco, ref, qp, qv, u, env.timestep / k, env.frame_skip * k)
+              for k in (1, 2))
+    assert np.abs(ours[0, moving] - ours[:, moving]).max() > 0.1     # it really moved
     err, delta = np.abs(ours - m1).max(), np.abs(m1 - m2).max()
     assert err <= 4 * delta, (err, delta)
 
@@ -145,3 +198,22 @@ def test_rgb_array_render():
     env.reset(seed=0)
     img = env.render()
     assert img.shape == (64, 96, 3) and img.dtype == np.uint8 and img.std() > 0
+
+
+@pytest.mark.parametrize("name, dq, dv, action, moving", MOTIONS[2:])
+def test_difference_from_mujoco_euler_halves_with_the_step(name, dq, dv, action, moving):
+    """Reacher and Swimmer (no contact at all): ours and MuJoCo's Euler, both at step h / k
+    over the same 20 env steps, differ by O(h): halving the step halves the difference (both
+    first-order methods converge to one motion: damping, armature and drag included)."""
+    mujoco, ref = mujoco_env(name)
+    base = make(name).unwrapped
+    diffs = []
+    for k in (1, 2, 4):
+        env = make(name, dt=base.timestep / k, frame_skip=base.frame_skip * k).unwrapped
+        qp, qv = start(env, dq, dv)
+        u = np.full(env.action_space.shape, action)
+        theirs = mujoco_euler_run(mujoco, ref, qp, qv, u, env.timestep, env.frame_skip)
+        diffs.append(np.abs(ours_run(env, qp, qv, u) - theirs).max())
+    assert diffs[0] > 1e-4                       # a difference to watch shrink
+    for a, b in zip(diffs, diffs[1:]):
+        assert 0.4 < b / a < 0.6, diffs

@@ -74,7 +74,7 @@ def test_legs_joint_positions_ranges_and_passive_terms(legs):
               ("left_hip_to_left_thigh", "base", "left_thigh", (0, -0.4), (-90, 90)),
               ("left_thigh_to_left_shin", "left_thigh", "left_shin", (0, -0.8), (-90, 0)),
               ("left_ankle_to_left_foot", "left_shin", "left_foot", (0, -1.2), (-90, 15))]
-    assert m.n_pin == 6
+    assert len(legs.pin) == 6 and m.n_pin == 6 + len(legs.free_joints)   # + the root's coordinates
     for name, parent, child, pos, rng in expect:
         j = m.pin(name)
         assert tuple(a.pin_body[j]) == (m.body(parent), m.body(child))
@@ -105,7 +105,7 @@ def test_falling_legs_keep_their_pins(legs):
     sim = ps.Simulator(m)
     sim.steps(300)
     a = m.arrays
-    for j in range(m.n_pin):
+    for j in legs.pin.values():
         ba, bb = a.pin_body[j]
         q = sim.state.q
         pa = q[ba, :2] + _rot(q[ba, 2]) @ a.pin_anchor[j, 0]

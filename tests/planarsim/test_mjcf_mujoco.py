@@ -1,8 +1,8 @@
 """MJCF loader against MuJoCo itself: for gymnasium's planar models and the SIMBICON character,
 masses, COMs, inertias about the plane's normal, joint anchors at the file's pose, limits,
 passive terms, gears and the model's dt and gravity match mujoco.MjModel (1e-9 relative);
-what the engine lacks (sliders, armature, fluids) and what leaves the plane are ModelErrors
-naming the element and its line."""
+the fluid drag matches MuJoCo's passive forces; what the engine lacks and what leaves the
+plane are ModelErrors naming the element and its line."""
 import math
 import os
 from pathlib import Path
@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 from planarsim import ModelError
+from planarsim.compiled import jit
+from planarsim.kernels.fluid import apply_fluid
 from planarsim.mjcf import load_mjcf
 
 mujoco = pytest.importorskip("mujoco", reason="mujoco is not installed (pip install planarsim[test])")
@@ -19,11 +21,9 @@ ROOT = Path(__file__).resolve().parents[2]
 LEGS = ROOT / "walkers" / "simbicon" / "legs.xml"
 LEGS_LOCAL = ROOT / "walkers" / "simbicon" / "legs_local.xml"
 REL = 1e-9
-# the gymnasium files that load today (with what they drop) and those that need what the
-# engine lacks, with the words of the error
-LOADS = {"hopper": (), "walker2d": (), "walker2d_v5": (), "half_cheetah": (),
-         "inverted_pendulum": (), "inverted_double_pendulum": (), "swimmer": ("armature", "fluid")}
-BLOCKED = {"swimmer": "needs fluid forces", "reacher": "need slider joints"}
+# gymnasium's planar files: all load, nothing dropped
+LOADS = ["hopper", "walker2d", "walker2d_v5", "half_cheetah", "inverted_pendulum",
+         "inverted_double_pendulum", "swimmer", "reacher"]
 
 
 def gym_asset(name):
@@ -68,7 +68,10 @@ def check_against_mujoco(path, loaded):
             inertia += n @ R @ np.diag(mm.body_inertia[i]) @ R.T @ n + m_i * (d[i1] ** 2 + d[i2] ** 2)
         assert close(a.body_mass[bid], masses.sum()), rb.name
         assert close(model.q0[bid, :2], (com3[i1], com3[i2])), rb.name
-        assert close(a.body_inertia[bid], inertia), rb.name
+        if model.is_point(bid):             # translates only (two slides): no rotation
+            assert a.body_inertia[bid] == 0.0, rb.name
+        else:
+            assert close(a.body_inertia[bid], inertia), rb.name
     # hinges: anchors in the world at the file's pose, limits, stiffness, damping
     for name, pid in loaded.pin.items():
         j = mujoco.mj_name2id(mm, mujoco.mjtObj.mjOBJ_JOINT, name)
@@ -89,6 +92,19 @@ def check_against_mujoco(path, loaded):
         assert close(a.pin_stiffness[pid], mm.jnt_stiffness[j]), name
         assert close(a.pin_damping[pid], mm.dof_damping[mm.jnt_dofadr[j]]), name
         assert close(a.pin_armature[pid], mm.dof_armature[mm.jnt_dofadr[j]]), name
+    # a free root's joints: free coordinates with MuJoCo's armature, limits and passive terms
+    for name in loaded.free_joints:
+        j = mujoco.mj_name2id(mm, mujoco.mjtObj.mjOBJ_JOINT, name)
+        jm = loaded.joint[name]
+        pid = jm.pin
+        assert a.pin_kind[pid] & 2, name                        # JOINT_FREE_BIT: no rows
+        assert close(a.pin_armature[pid], mm.dof_armature[mm.jnt_dofadr[j]]), name
+        assert close(a.pin_damping[pid], mm.dof_damping[mm.jnt_dofadr[j]]), name
+        assert close(jm.ref, mm.qpos0[mm.jnt_qposadr[j]]), name
+        if mm.jnt_limited[j]:
+            assert close(a.pin_limit[pid], sorted(jm.sign * (mm.jnt_range[j] - jm.ref))), name
+        else:
+            assert tuple(a.pin_limit[pid]) == (-math.inf, math.inf), name
     # motors: gear (in the pin's sign) and torque range
     assert len(loaded.actuator) == mm.nu
     for u in range(mm.nu):
@@ -102,22 +118,71 @@ def check_against_mujoco(path, loaded):
     return mm, model
 
 
-@pytest.mark.parametrize("name", sorted(LOADS))
+@pytest.mark.parametrize("name", LOADS)
 def test_gymnasium_model_matches_mujoco(name):
     path = gym_asset(name)
-    loaded = load_mjcf(path, drop=LOADS[name])
+    loaded = load_mjcf(path)
     mm, model = check_against_mujoco(path, loaded)
     assert model.total_mass == pytest.approx(mm.body_mass.sum(), rel=REL)
-    assert model.n_pin == mm.njnt - len(loaded.free_joints)   # the root's joints are free
-    # armature is modelled on pins and sliders; only the swimmer's free root carries some
-    assert ("joint armature" in loaded.report.dropped) == (name == "swimmer")
+    assert model.n_pin == mm.njnt          # a free root's joints are free coordinates
+    assert loaded.report.dropped == {}     # armature and fluid are modelled
+    assert list(loaded.joint) == [mujoco.mj_id2name(mm, mujoco.mjtObj.mjOBJ_JOINT, j)
+                                  for j in range(mm.njnt)]
 
 
-@pytest.mark.parametrize("name, words", sorted(BLOCKED.items()))
-def test_gymnasium_model_that_needs_more_names_what(name, words):
-    path = gym_asset(name)
-    with pytest.raises(ModelError, match=rf"{path.name}:\d+: <\w+[^>]*> \(line \d+\): .*{words}"):
-        load_mjcf(path)
+def test_two_slides_below_the_root_name_the_body():
+    xml = """<mujoco><worldbody><body name="a"><joint name="h" axis="0 0 1"/>
+      <geom size=".1"/><body name="b" pos="1 0 0">
+      <joint name="x" type="slide" axis="1 0 0"/><joint name="y" type="slide" axis="0 1 0"/>
+      <geom size=".1"/></body></body></worldbody></mujoco>"""
+    with pytest.raises(ModelError, match=r"<body name='b'> \(line 2\): joints \['slide', 'slide'\]"):
+        load_mjcf(xml)
+
+
+def test_reacher_target_is_a_point_mass_on_two_limited_slides():
+    loaded = load_mjcf(gym_asset("reacher"))
+    model = loaded.compile()
+    target = loaded.body["target"]
+    assert model.is_point(target)
+    assert loaded.plane == "x-y" and tuple(model.arrays.gravity) == (0.0, 0.0)
+    for name in ("target_x", "target_y"):
+        assert tuple(model.arrays.pin_limit[loaded.joint[name].pin]) == pytest.approx((-0.37, 0.17)
+                                                                                    if name == "target_x"
+                                                                                    else (-0.17, 0.37))
+
+
+@jit
+def _fluid_forces(m, q, cs, v, f):
+    apply_fluid(m, q, cs, v, f)
+
+
+def test_swimmer_drag_is_mujocos_passive_force():
+    """At a random state, the generalized force of planarsim's fluid boxes (their body
+    forces mapped through the joints' Jacobian) equals MuJoCo's qfrc_passive (1e-9)."""
+    from planarsim.envs.core import GeneralizedCoords
+    path = gym_asset("swimmer")
+    loaded = load_mjcf(path)
+    model = loaded.compile()
+    coords = GeneralizedCoords(loaded, model)
+    mm = mujoco.MjModel.from_xml_path(str(path))
+    md = mujoco.MjData(mm)
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        qpos, qvel = rng.normal(size=mm.nq) * 0.5, rng.normal(size=mm.nv) * 2
+        md.qpos[:], md.qvel[:] = qpos, qvel
+        mujoco.mj_forward(mm, md)
+        q, v = coords.to_maximal(qpos, qvel)
+        f = np.zeros_like(q)
+        cs = np.column_stack([np.cos(q[:, 2]), np.sin(q[:, 2]), q[:, 2]])
+        _fluid_forces(model.arrays, q, cs, v, f)
+        # generalized force: the power of f at v is qfrc . qvel for every qvel (unit vectors)
+        gen = np.zeros(mm.nv)
+        for i in range(mm.nv):
+            e = np.zeros(mm.nv)
+            e[i] = 1.0
+            _, vi = coords.to_maximal(qpos, e)
+            gen[i] = np.sum(f * vi)
+        np.testing.assert_allclose(gen, md.qfrc_passive, rtol=1e-9, atol=1e-9 * np.abs(md.qfrc_passive).max())
 
 
 def test_half_cheetah_total_mass_and_springs():
@@ -129,7 +194,7 @@ def test_half_cheetah_total_mass_and_springs():
 
 
 def test_swimmer_moves_in_the_x_y_plane_without_gravity():
-    loaded = load_mjcf(gym_asset("swimmer"), drop=("armature", "fluid"))
+    loaded = load_mjcf(gym_asset("swimmer"))
     assert loaded.plane == "x-y"
     assert tuple(loaded.compile().arrays.gravity) == (0.0, 0.0)
     assert loaded.free_joints == ("slider1", "slider2", "free_body_rot")
