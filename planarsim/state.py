@@ -209,9 +209,9 @@ class Workspace(NamedTuple):
     contact_face: np.ndarray     # (n_contact, 4) a pair's reference face in its body's frame:
                                  #   unit normal, and a point on the face's core line (or the
                                  #   core vertex where contact_dist) [m]
-    contact_refpt: np.ndarray    # (n_contact, 4) the reference body's material point where the
-                                 #   contact touched at the step's start (its frame) [m], the
-                                 #   other body's angle and the normal's angle then [rad]
+    contact_refpt: np.ndarray    # (n_contact, 4) the reference body's and the other body's
+                                 #   material points where the contact touched at the step's
+                                 #   start (each in its body's frame) [m]
     contact_radii: np.ndarray    # (n_contact, 2) radius of the reference and the other shape [m]
     contact_bounce: np.ndarray   # (n_contact,) normal velocity restitution asks for [m/s]
     manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/collide.py)

@@ -158,8 +158,9 @@ def _store_point(m, q, cs, ws, c, k):
     rx, ry = to_local(q, cs, ref, sx, sy)
     ws.contact_refpt[c, 0] = rx
     ws.contact_refpt[c, 1] = ry
-    ws.contact_refpt[c, 2] = q[inc, 2] if inc >= 0 else 0.0
-    ws.contact_refpt[c, 3] = math.atan2(ny, nx)
+    ix, iy = to_local(q, cs, inc, ws.contact_point[c, 0], ws.contact_point[c, 1])
+    ws.contact_refpt[c, 2] = ix
+    ws.contact_refpt[c, 3] = iy
     ws.contact_normal[c, 0] = nx
     ws.contact_normal[c, 1] = ny
     ws.contact_gap[c] = out[k, 8]
@@ -264,10 +265,10 @@ def pair_surface_point(q, cs, ws, o):
 def pair_row(q, cs, ws, o, J, tangent):
     """Jacobian blocks J (2, 3) and error of pair contact o's normal row (its exact gap [m]
     at q) or tangent row (tangent: the slip [m] along t = (n_y, -n_x) since the step's start:
-    how far the touching point moved along the reference body's surface, from the material
-    point it touched there, less how far it moved along the other body's rounded surface,
-    r_b (change of the normal's angle - change of b's angle). A disk rolling on a face without
-    slipping has none: rolling is exact motion for the position correction too)."""
+    the two bodies' material points that touched at the step's start, relative to each other.
+    A disk rolling on a face without slipping has r (phi - sin phi) of it for a roll of phi
+    in the step: third order, where holding the disk's surface point (which rolls along)
+    pulled it back by r phi every step)."""
     a = ws.contact_bodies[o, 0]
     b = ws.contact_bodies[o, 1]
     sx, sy, nx, ny, gap = pair_surface_point(q, cs, ws, o)
@@ -280,11 +281,8 @@ def pair_row(q, cs, ws, o, J, tangent):
     rx, ry = world_point(q, cs, a, ws.contact_refpt[o, 0], ws.contact_refpt[o, 1])
     set_dir(q, a, sx, sy, tx, ty, -1.0, J[0])
     set_dir(q, b, sx, sy, tx, ty, 1.0, J[1])
-    turn = math.atan2(ny, nx) - ws.contact_refpt[o, 3]        # the normal's, wrapped
-    turn -= 2.0 * math.pi * math.floor((turn + math.pi) / (2.0 * math.pi))
-    if b >= 0:
-        turn -= q[b, 2] - ws.contact_refpt[o, 2]
-    return tx * (sx - rx) + ty * (sy - ry) - ws.contact_radii[o, 1] * turn
+    ix, iy = world_point(q, cs, b, ws.contact_refpt[o, 2], ws.contact_refpt[o, 3])
+    return tx * (ix - rx) + ty * (iy - ry)
 
 
 @kernel
