@@ -265,16 +265,22 @@ def compass_step(x, p, rtol=1e-12, atol=1e-13, t_max=10.0, consts=None):
     raise RuntimeError(f"compass gait: no heel strike within {t_max} s from x={x}")
 
 
-def compass_map(p):
-    """The reference compass gait's step map x -> next x (a fall raises StepMapError)."""
+def _as_map(step):
+    """The step map x -> step(x)[0] of a reference step function (a fall, which the step
+    function raises as RuntimeError, raises StepMapError)."""
     from planarsim.analysis import StepMapError
 
     def f(x):
         try:
-            return compass_step(x, p)[0]
+            return step(x)[0]
         except RuntimeError as e:
             raise StepMapError(str(e)) from None
     return f
+
+
+def compass_map(p):
+    """The reference compass gait's step map x -> next x (a fall raises StepMapError)."""
+    return _as_map(lambda x: compass_step(x, p))
 
 
 def compass_fixed_point(p=None, x0=None, tol=1e-12, eps=1e-6):
@@ -324,14 +330,7 @@ def simplest_feet_step(x, p, rtol=1e-12, atol=1e-13):
 
 def simplest_feet_map(p):
     """The step map of simplest_feet_step at SimplestParams p (a fall raises StepMapError)."""
-    from planarsim.analysis import StepMapError
-
-    def f(x):
-        try:
-            return simplest_feet_step(x, p)[0]
-        except RuntimeError as e:
-            raise StepMapError(str(e)) from None
-    return f
+    return _as_map(lambda x: simplest_feet_step(x, p))
 
 
 class SimplestFeetFamily:
