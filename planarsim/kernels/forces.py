@@ -8,7 +8,7 @@ implicitly in the velocity solve (soft.py).
 """
 import math
 
-from ._jit import kernel, kernel_inline
+from ..compile import kernel
 from .math2d import cross2, world_point
 from .slider import slide_position_rate, slider_frame
 
@@ -53,7 +53,7 @@ def pin_angle_rate(m, q, v, j):
     return ang, rate
 
 
-@kernel_inline
+@kernel(inline="always")
 def apply_actuator(m, q, cs, v, f, k, u):
     """Add actuator k's saturated command u to f; return its mechanical power [W]."""
     kind = m.act_kind[k]

@@ -1,7 +1,7 @@
 """Stage 9: guards. Every q and v component must be finite and below the magnitude bound."""
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 
 GUARD_OK = 0

@@ -2,7 +2,7 @@
 theta_b - theta_a - ref [rad], a slider's slide s = d.(p_b - p_a) [m] (slider.py). The one
 dispatch on a joint's kind, for what acts on its coordinate: limits (limit.py, modes.py),
 springs, dampers and armature (soft.py)."""
-from ._jit import kernel
+from ..compile import kernel
 from .codes import JOINT_SLIDER
 from .forces import pin_angle_rate
 from .slider import slide_position_rate, slide_row

@@ -2,7 +2,7 @@
 ang = theta_b - theta_a - ref [rad]: ang - lower >= 0 (side 0, ROW_LIMIT_LO) and
 upper - ang >= 0 (side 1, ROW_LIMIT_HI). A side has a row only while it is active
 (State.limit_active; engaged and released by the mode rules, kernels/modes.py)."""
-from ._jit import kernel
+from ..compile import kernel
 from .codes import ROW_LIMIT_HI, ROW_LIMIT_LO
 from .row_list import add_row
 
