@@ -25,14 +25,13 @@ from llvmlite import ir
 from numba import cfunc, types
 from numba.core import cgutils
 from numba.core.compiler_lock import global_compiler_lock
-from numba.core.errors import TypingError
 from numba.extending import intrinsic
 
 from ..kernels.guards import GUARD_BAD_COMMANDS, check_commands
 from ..kernels.info import INFO_COMMAND
 from ..kernels.step import _step
-from ..options import StepOptions
 from . import refs
+from .engine import check_step_types, samples
 from .fast import KERNEL_OPTIONS, code_layout
 
 _ENGINE = {}
@@ -42,16 +41,7 @@ _LOADING = []     # this thread is compiling the step (see load_step)
 def engine_types():
     """(model, state, workspace, options) numba types the step is compiled for."""
     if "types" not in _ENGINE:
-        from ..builder import ModelBuilder
-        from ..state import make_state, make_workspace
-        b = ModelBuilder()
-        body = b.add_body("b", 1.0, 1.0)
-        b.add_pin("p", None, body, anchor_world=(0.0, 0.0))
-        b.add_point_contact("c", body, (0.0, 0.0))
-        b.add_pin_motor("m", "p")
-        model = b.compile()
-        samples = (model.arrays, make_state(model), make_workspace(model), StepOptions())
-        found = tuple(refs.TableRef(refs.layout_of(x)) for x in samples)
+        found = tuple(refs.TableRef(refs.layout_of(x)) for x in samples())
         text = "|".join(t.name for t in found)
         symbol = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
         _ENGINE.update(symbol=symbol, types=found)     # one update: another thread sees both or none
@@ -99,13 +89,7 @@ def step(typingctx, m, s, ws, opt, u):
     Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), -1 when u does not have one
     entry per actuator, -2 when a command is NaN or infinite (for both nothing is changed;
     planarsim.errors.diverged explains any code)."""
-    expected = engine_types()
-    for name, got, want in zip(("model", "state", "workspace", "options"), (m, s, ws, opt), expected):
-        if got != want:
-            raise TypingError(f"step: {name} is {got}; the step is compiled for {want} "
-                              "(pass model.arrays, a State, a Workspace and StepOptions)")
-    if not (isinstance(u, types.Array) and u.dtype == types.float64 and u.ndim == 1 and u.layout == "C"):
-        raise TypingError(f"step: commands u must be a C-contiguous 1-d float64 array, got {u}")
+    check_step_types((m, s, ws, opt, u), engine_types())
     symbol = load_step()
 
     def codegen(context, builder, signature, args):

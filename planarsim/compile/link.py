@@ -20,7 +20,7 @@ from ..model import ModelArrays
 from ..options import StepOptions, check_options
 from ..state import State, Workspace, forget_ground_queries
 from .decorators import jit, kernel, register
-from .mode import FAST, MODE, TABLES
+from .mode import FAST, MODE, PYTHON, TABLES
 
 if MODE == FAST:
     from numba import types
@@ -28,6 +28,9 @@ if MODE == FAST:
     from .fast_step import _ENGINE, load_step, step   # noqa: F401  (re-exported)
     from .refs import TableHandle as Handle
 else:
+    from numba.extending import overload
+
+    from .engine import check_step_types
     _ENGINE = {}
 
     def load_step():
@@ -35,11 +38,7 @@ else:
         return None
 
     @kernel
-    def step(m, s, ws, opt, u):
-        """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0:
-        m.dt) under actuator commands u (one per actuator). Returns 0 ok, 1 non-finite, 2 too
-        large (kernels/guards.py), -1 when u does not have one entry per actuator, -2 when a
-        command is NaN or infinite (for both nothing is changed)."""
+    def _step_checked(m, s, ws, opt, u):
         n_u = u.shape[0]
         if n_u != m.act_kind.shape[0]:
             ws.info[INFO_COMMAND] = n_u   # nothing is read or changed
@@ -48,6 +47,35 @@ else:
         if code != 0:
             return code
         return _step(m, s, ws, opt, u)
+
+    if MODE == PYTHON:
+        step = _step_checked
+    else:
+        def step(m, s, ws, opt, u):
+            """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0:
+            m.dt) under actuator commands u (one per actuator). Returns 0 ok, 1 non-finite,
+            2 too large (kernels/guards.py), -1 when u does not have one entry per actuator,
+            -2 when a command is NaN or infinite (for both nothing is changed)."""
+            return _step_checked(m, s, ws, opt, u)
+
+        @overload(step)
+        def _step_typed(m, s, ws, opt, u):
+            """Name a wrong argument when a caller is typed (as the fast mode's intrinsic)."""
+            check_step_types((m, s, ws, opt, u), _expected_types())
+            return lambda m, s, ws, opt, u: _step_checked(m, s, ws, opt, u)
+
+        _EXPECTED = []
+
+        def _expected_types():
+            if not _EXPECTED:
+                import numba
+                from .engine import samples
+                if TABLES:
+                    from .refs import TableRef, layout_of
+                    _EXPECTED.append(tuple(TableRef(layout_of(x)) for x in samples()))
+                else:
+                    _EXPECTED.append(tuple(numba.typeof(x) for x in samples()))
+            return _EXPECTED[0]
 
     if TABLES:
         from .refs import TableHandle as Handle

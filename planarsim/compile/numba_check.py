@@ -10,8 +10,6 @@ and each changed internal. Checked with numba 0.59 to 0.68.
 import importlib
 import inspect
 
-import numba
-
 CHECKED = "0.59-0.68"
 
 # module: attributes (dotted below a class) of every internal used: the fast mode's code

@@ -19,7 +19,7 @@ only true crossings (stance leg within CROSS_TOL of vertical): with the shipped 
 landing foot bounces, the estimator swaps the stance to the trailing leg for a few ms and the
 mid-stance feedback fires there too, far behind vertical.
 
-Findings (dt = 1 ms, shipped parameters, engine default StepOptions (cap_policy=1); figures
+Findings (dt = 1 ms, shipped parameters, engine default StepOptions; figures
 from ``python -c "from walkers.ranger.gait_map import RangerGaitMap; ..."``, see the test file):
 the map is piecewise smooth with small jumps: the controller acts at 1 ms steps (contact
 engagement, estimator hysteresis, program switches and the section event itself fall on step
@@ -30,9 +30,9 @@ parameter), so the Jacobian here is a least-squares slope over perturbations of 
 per coordinate, eps = 1e-2 (EPS), whose radius is consistent across eps = 2e-3..2e-2 (0.2..0.8
 measured on the shipped and on nearby parameter sets).
 The shipped gait settles on an exactly repeating stride on the engine at c758571
-(|P(x0) - x0| = 3e-7: every event falls on the same step each stride); with the pending
-frictionless cap rule in planarsim/kernels/step.py it wanders within 1.9e-2 (spectral radius
-0.48), and nearby parameter sets (1 % changes) mostly wander as well, within
+(|P(x0) - x0| = 3e-7: every event falls on the same step each stride); with the engine's
+frictionless rule for a heel landing in Painleve's configuration it wanders within 1.9e-2
+(spectral radius 0.48), and nearby parameter sets (1 % changes) mostly wander as well, within
 ~2e-2 of a mean section state (the jump scale) with multipliers of the same size (4 of 11 sets
 measured return within 1e-3, spectral radius 0.37..0.78).
 A perturbation rolls the stance foot on its sole (flat ground) and rebuilds every body pose

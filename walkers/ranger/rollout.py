@@ -58,8 +58,7 @@ def rollout_ranger(m, s, ws, opt, tab, mem, u, n, every, rec, lab, lab_idx, k0):
 
 
 def step_options(strategy: str = "alternating") -> ps.StepOptions:
-    """Ranger's StepOptions: the engine defaults (cap_policy=1: a contact engaged in a step
-    whose mode rounds hit the cap sticks) with the chosen contact-mode strategy."""
+    """Ranger's StepOptions: the engine defaults with the chosen contact-mode strategy."""
     return ps.make_options(strategy)
 
 

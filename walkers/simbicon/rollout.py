@@ -23,7 +23,7 @@ from .params import SimbiconParams
 
 FELL = RUN_FELL   # rollout return code: the torso came down
 GLITCH = RUN_WALKER + 2  # rollout return code: the torso moved faster than a walker can (solver blow-up)
-STRATEGY = "all"   # engine contact-mode strategy (see the report: "alternating" hits its cap often with box feet)
+STRATEGY = "all"   # engine contact-mode strategy: every contact's mode decided together (box feet)
 GLITCH_SPEED = 10.0   # [m/s] torso COM speed taken as a solver glitch
 GLITCH_SPIN = 30.0    # [rad/s] torso angular speed taken as a solver glitch
 GAITS = ("walk",)
