@@ -41,16 +41,23 @@ def add_point_force(q, f, body, px, py, fx, fy):
 
 
 @kernel
+def pin_angle(m, q, j):
+    """Pin angle theta_b - theta_a - ref [rad] (the one place it is computed in compiled code)."""
+    a = m.pin_body[j, 0]
+    ang = q[m.pin_body[j, 1], 2] - m.pin_ref[j]
+    if a >= 0:
+        ang -= q[a, 2]
+    return ang
+
+
+@kernel
 def pin_angle_rate(m, q, v, j):
     """Pin angle theta_b - theta_a - ref [rad] and its rate [rad/s]."""
     a = m.pin_body[j, 0]
-    b = m.pin_body[j, 1]
-    ang = q[b, 2] - m.pin_ref[j]
-    rate = v[b, 2]
+    rate = v[m.pin_body[j, 1], 2]
     if a >= 0:
-        ang -= q[a, 2]
         rate -= v[a, 2]
-    return ang, rate
+    return pin_angle(m, q, j), rate
 
 
 @kernel(inline="always")

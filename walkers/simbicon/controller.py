@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planarsim.compiled import jit_inline, kernel
+from planarsim.compiled import jit_inline, kernel, pin_angle_rate
 
 from .params import SimbiconParams
 
@@ -90,14 +90,6 @@ def make_memory(phase=0, t0=0.0) -> np.ndarray:
 
 
 @kernel
-def pin_angle(m, q, v, j):
-    """Relative angle [rad] and rate [rad/s] of pin j."""
-    a = m.pin_body[j, 0]
-    b = m.pin_body[j, 1]
-    return q[b, 2] - q[a, 2] - m.pin_ref[j], v[b, 2] - v[a, 2]
-
-
-@kernel
 def foot_in_contact(s, tab, side):
     """1 if any corner of `side`'s foot is pinned or sliding."""
     for c in range(tab.contact.shape[1]):
@@ -157,7 +149,7 @@ def control(m, s, ws, tab, mem, u):
         col = SWING_KNEE if side == swing else STANCE_KNEE
         for jt in range(KNEE, ANKLE + 1):
             j = tab.pin[side, jt]
-            ang, rate = pin_angle(m, q, v, j)
+            ang, rate = pin_angle_rate(m, q, v, j)
             u[tab.act[side, jt]] = tab.kp[jt] * (tab.target[half, col + jt - KNEE] - ang) - tab.kd[jt] * rate
 
 
