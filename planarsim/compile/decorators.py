@@ -38,36 +38,30 @@ _JIT_INLINE = (None, "force", "always")
 _KERNEL_INLINE = ("force", "always", "never")
 
 
-def _check(inline, allowed, who):
-    if inline not in allowed:
-        raise ValueError(f"{who}(inline={inline!r}): choose one of {allowed}")
-
-
 def _python(fn):
     fn.py_func = fn   # as a dispatcher has it (code that asks for the Python function)
     return fn
 
 
-def _make(fast_decorator, inline):
+def _decorator(who, allowed, fn, inline):
+    """The decorator `who` (jit or kernel) of this mode with `inline`, applied to fn if given."""
+    if inline not in allowed:
+        raise ValueError(f"{who}(inline={inline!r}): choose one of {allowed}")
     if MODE == PYTHON:
-        return _python
-    if MODE == FAST:
-        return fast_decorator(inline)
-    import numba
-    options = dict(PLAIN_OPTIONS, inline="always") if inline == "always" else PLAIN_OPTIONS
-    return numba.njit(**options)
+        decorate = _python
+    elif MODE == FAST:
+        from . import fast
+        decorate = getattr(fast, who)(inline)
+    else:
+        import numba
+        decorate = numba.njit(**dict(PLAIN_OPTIONS, **({"inline": "always"} if inline == "always" else {})))
+    return decorate if fn is None else decorate(fn)
 
 
 def jit(fn=None, *, inline=None):
     """Compile `fn`, callable from Python and from compiled code (see the module's docstring);
     use as ``@jit`` or ``@jit(inline="force")``."""
-    _check(inline, _JIT_INLINE, "jit")
-    if MODE == FAST:
-        from . import fast
-        decorate = _make(fast.jit, inline)
-    else:
-        decorate = _make(None, inline)
-    return decorate if fn is None else decorate(fn)
+    return _decorator("jit", _JIT_INLINE, fn, inline)
 
 
 def jit_inline(fn):
@@ -78,13 +72,7 @@ def jit_inline(fn):
 def kernel(fn=None, *, inline="force"):
     """Compile `fn` for compiled callers only (see the module's docstring); use as ``@kernel``,
     ``@kernel(inline="always")`` or ``@kernel(inline="never")``."""
-    _check(inline, _KERNEL_INLINE, "kernel")
-    if MODE == FAST:
-        from . import fast
-        decorate = _make(fast.kernel, inline)
-    else:
-        decorate = _make(None, inline)
-    return decorate if fn is None else decorate(fn)
+    return _decorator("kernel", _KERNEL_INLINE, fn, inline)
 
 
 def register(cls=None, *, readonly=False):
