@@ -156,7 +156,7 @@ def test_step_from_python_steps_as_the_simulator_does():
     Simulator's step bit for bit, and refuses commands of the wrong length with its code."""
     from planarsim.compiled import RUN_BAD_COMMANDS, step_from_python
     from planarsim.state import make_workspace
-    from conftest import make_chain
+    from tests.conftest import make_chain
     model = make_chain(3)
     sim = ps.Simulator(model)
     s, ws, opt = ps.make_state(model), make_workspace(model), ps.StepOptions()
@@ -172,7 +172,7 @@ def test_step_from_python_follows_new_options_on_the_same_state():
     """A new StepOptions each call (a sub-step of another length) takes effect at once."""
     from planarsim.compiled import step_from_python
     from planarsim.state import make_workspace
-    from conftest import make_chain
+    from tests.conftest import make_chain
     model = make_chain(2)
     sim = ps.Simulator(model, ps.StepOptions(dt=2.5e-4))
     s, ws = ps.make_state(model), make_workspace(model)
@@ -189,7 +189,7 @@ def test_step_from_python_follows_new_options_on_the_same_state():
 def test_step_from_python_names_bad_options_and_commands():
     from planarsim.compiled import step_from_python
     from planarsim.state import make_workspace
-    from conftest import make_chain
+    from tests.conftest import make_chain
     model = make_chain(2)
     s, ws = ps.make_state(model), make_workspace(model)
     u = np.zeros(model.n_act)
