@@ -8,12 +8,11 @@ enters the contact solve (planarsim/kernels/solve.py solve_impulses): `n` steps 
 steps into a call, `p ws.lam[:n]` prints the impulses, `c` finishes the step. Without the
 variable the walk is compiled and no breakpoint can stop inside it: the script says so.
 """
-import pdb
 import sys
 
 import walkers
 from planarsim.compile import MODE, PYTHON
-from planarsim.kernels import solve
+from planarsim.compile.debug import break_in
 
 
 def main(seconds=0.3):
@@ -22,9 +21,7 @@ def main(seconds=0.3):
                  "(compiled code has no line for pdb to stop on)")
     run = walkers.load("ranger").Run(gait="walk")
     run.run(seconds)                                  # as Python: the same numbers as compiled
-    debugger = pdb.Pdb()
-    code = solve.solve_impulses.__code__
-    debugger.set_break(code.co_filename, code.co_firstlineno, funcname=code.co_name)
+    debugger = break_in("solve.solve_impulses")   # planarsim/kernels/solve.py
     print(f"t = {run.trajectory().t[-1]:.3f} s; stepping once: 'c' runs on to the contact solve")
     debugger.runcall(run.run, run.model.dt)           # one step, stopping in solve_impulses
     return run

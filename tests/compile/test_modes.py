@@ -96,3 +96,18 @@ def test_three_decorators_and_their_options():
         layer.kernel(inline="sometimes")
     with pytest.raises(ValueError, match=r"jit\(inline='never'\)"):
         layer.jit(inline="never")
+
+
+def test_break_in_needs_python_mode_and_names_an_unknown_stage():
+    from planarsim.compile import debug
+    if mode.PYTHON != planarsim.compile.MODE:
+        with pytest.raises(RuntimeError, match="NUMBA_DISABLE_JIT=1"):
+            debug.break_in("solve.solve_impulses")
+    code = ("from planarsim.compile.debug import break_in\n"
+            "d = break_in('solve.solve_impulses'); print(len(d.get_all_breaks()))\n"
+            "try:\n    break_in('solve.no_such_stage')\nexcept ValueError as e:\n    print(e)\n")
+    env = dict(os.environ, PYTHONPATH=os.getcwd(), NUMBA_DISABLE_JIT="1")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = out.stdout.splitlines()
+    assert lines[0] == "1" and "no function 'no_such_stage' in planarsim/kernels/solve.py" in lines[1]
