@@ -635,10 +635,10 @@ def _overlap_kernel():
     global _OVERLAP
     if _OVERLAP is None:
         from numba import njit
-        from planarsim.kernels._jit import _OPTIONS
+        from planarsim.compile import options as compile_options
         from planarsim.kernels.collide import collide
 
-        @njit(**dict(_OPTIONS, cache=False))
+        @njit(**dict(compile_options(), cache=False))
         def overlap(vert, norm, adr, num, rad, body, pairs, q, out, scratch):
             for k in range(q.shape[0]):
                 worst = 0.0

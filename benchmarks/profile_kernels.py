@@ -30,14 +30,14 @@ from pathlib import Path
 if __name__ == "__main__" and "NUMBA_CACHE_DIR" not in os.environ:
     # before numba is imported: a fresh cache, so every function is compiled here (see above)
     os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="planarsim-profile-")
-    os.environ["PLANARSIM_KERNEL_CALLS"] = "1"   # stages as calls, not inlined (see _jit.py)
+    os.environ["PLANARSIM_KERNEL_CALLS"] = "1"   # stages as calls, not inlined (see compile/fast.py)
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
 def _compiled_functions(dispatchers):
     """{address: symbol} of every function in the libraries of the dispatchers' overloads."""
-    from planarsim.kernels.link import _ENGINE, load_step
+    from planarsim.compile.link import _ENGINE, load_step
     load_step()
     libraries = [cres.library for disp in dispatchers for cres in disp.overloads.values()]
     libraries.append(_ENGINE["cfunc"]._library)   # the step: called by address, not linked
@@ -87,7 +87,7 @@ def _workload(target, seconds):
         return (lambda: mod.simulate(seconds)), disps
     import planarsim as ps
     from benchmarks.scenes import SCENES
-    from planarsim.kernels.link import run_steps
+    from planarsim.compile.link import run_steps
     model = SCENES[target][0]()
     sim = ps.Simulator(model)
     sim.steps(10)

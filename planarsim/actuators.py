@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from .kernels._jit import jit
+from .compile import jit
 
 MOTOR_GEAR = 0          # G [-] gear ratio
 MOTOR_TORQUE_CONST = 1  # K [N m/A]

@@ -1,19 +1,23 @@
 """What compiled code uses from the engine: a walker's controller and rollout, or your own.
 
-Decorators (the three you need; all never allocate and keep the NaN checks that fastmath
-would drop; jit and jit_inline cache their machine code on disk, a kernel is cached inside
-its compiled callers):
-    jit          compiled, callable from Python and from compiled code (a rollout)
+Decorators (three; planarsim/compile/decorators.py. All never allocate and keep the NaN checks
+that fastmath would drop; jit and jit_inline cache their machine code on disk, a kernel is
+cached inside its compiled callers):
+    jit          compiled, callable from Python and from compiled code (a rollout);
+                 jit(inline="force"): always inlined where compiled code calls it
     jit_inline   the same, inlined into its compiled callers (a controller run every step)
     kernel       compiled code only, inlined (small helpers; calling one from Python raises
-                 a TypeError that says so)
+                 a TypeError that says so); kernel(inline="never") stays a call
+The compiler layer runs in one of three modes, with the same numbers (planarsim/compile/mode.py):
+fast (the default), plain numba (PLANARSIM_PLAIN_NUMBA=1, or when numba lacks an internal the
+fast mode uses) and Python (NUMBA_DISABLE_JIT=1: a breakpoint inside the step works).
 
 Engine, from compiled code:
     step(m, s, ws, opt, u) -> run code      advance State s by one step of opt.dt (0: m.dt).
                                              The step is one C function, compiled once per
                                              machine and loaded before the first jit function
                                              runs; every caller calls it by address (the
-                                             linkage is all in planarsim/kernels/link.py).
+                                             linkage is all in planarsim/compile/link.py).
                                              Decorate callers with jit, not numba.njit
     record_frame(s, ws, rec, k)              write frame k of a Recorder (make_recorder)
     height(coef, x), height_derivs(coef, x)  the ground h(x) [m] and (h, h', h'')
@@ -38,7 +42,8 @@ RUN_WALKER up (RUN_FELL, RUN_NO_EVENT, or more of its own), so that one test,
 ``engine_failed(code)``, tells the two apart everywhere.
 """
 from .errors import diverged
-from .kernels._jit import drop_stale_caches, jit, jit_inline, kernel
+from .compile import drop_stale_caches, jit, jit_inline, kernel
+from .compile.link import step, step_from_python
 from .kernels.audit import audit_counts
 from .kernels.forces import pin_angle_rate
 from .kernels.pair import shape_contact_mode
@@ -46,7 +51,6 @@ from .kernels.info import step_info
 from .kernels.guards import (GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE,
                              GUARD_NONFINITE_COMMAND, GUARD_OK, GUARD_TOO_LARGE)
 from .kernels.record import record_frame
-from .kernels.link import step, step_from_python
 from .kernels.terrain import closest_point, gap_of_point, height, height_derivs
 from .trajectory import make_recorder
 
@@ -66,8 +70,8 @@ def kernel_cache():
     run compiles (measured_compile() says how long that took on this machine last time)."""
     from pathlib import Path
 
-    from .kernels import _jit
-    folder = Path(_jit.__file__).resolve().parent / "__pycache__"
+    from . import compile as layer
+    folder = Path(layer.__file__).resolve().parent / "__pycache__"
     return folder, sorted(folder.glob("*.nbi"))
 
 

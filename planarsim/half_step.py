@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from .errors import ModelError
-from .kernels._jit import jit
+from .compile import jit
 from .kernels.codes import JOINT_SLIDER
 from .kernels.forces import apply_forces, predict_velocity
 from .kernels.math2d import update_trig

@@ -13,7 +13,6 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import diverged
-from .kernels.refs import TableHandle
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
@@ -24,9 +23,9 @@ from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
 
 def _link():
-    """kernels.link, imported with the first Simulator (its compiled functions publish the
+    """compile.link, imported with the first Simulator (its compiled functions publish the
     step before their first call: from the numba cache, or its first-ever compile)."""
-    from .kernels import link
+    from .compile import link
     return link
 
 
@@ -110,7 +109,7 @@ class Simulator:
         """The table that Simulator.step / steps hand to the compiled run_steps."""
         args = _link().StepArgs(self._model.arrays, self._state, self._ws, self._options)
         if self._args is None:
-            self._args = TableHandle(args)
+            self._args = _link().Handle(args)
         else:
             self._args.repack(args)
         self._steps_entry = None  # bound on the first step (_bind_steps)
@@ -164,12 +163,11 @@ class Simulator:
     def _bind_steps(self):
         """run_steps compiled (or loaded from the cache) for this simulator's handle, then
         called directly: numba's type dispatch is skipped (the handle's type never changes)."""
-        from numba import float64, int64
-        self._steps_entry = _link().run_steps.compile((self._args.numba_type, float64[::1], int64))
+        self._steps_entry = _link().bind_steps(self._args)
         return self._steps_entry
 
     def _run_recorded(self, u, n, every, rec, k0):
-        """kernels.link.run_recorded on this simulator (bound once: see _bind)."""
+        """compile.link.run_recorded on this simulator (bound once: see _bind)."""
         entry = self._recorded_entry
         if entry is None:
             entry = self._recorded_entry = self._bind(_link().run_recorded, (n, every, rec, k0))
@@ -181,7 +179,7 @@ class Simulator:
         recorder's arrays would be typed again on every call); the simulator owns its arrays,
         so their types cannot change."""
         args = (self.model.arrays, self._state, self.ws, self.options, self._u0) + tuple(extra)
-        return kernel.compile(tuple(kernel.typeof_pyval(a) for a in args))
+        return _link().bind(kernel, args)
 
     def steps(self, n: int, u=None) -> None:
         """n steps under constant commands, compiled as one loop."""

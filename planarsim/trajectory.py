@@ -20,10 +20,24 @@ from .state import check_shapes
 
 FORMAT_VERSION = 1
 
-FRAME_DIMS = dict(  # shape of each per-frame array of a Trajectory (K frames)
-    t=("K",), q=("K", "n_body", 3), v=("K", "n_body", 3), contact_mode=("K", "n_contact"),
-    contact_impulse=("K", "n_contact", 2), contact_point=("K", "n_contact", 2),
-    act_u=("K", "n_act"), act_power=("K", "n_act"), contact_normal=("K", "n_contact", 2))
+# Every recorded per-frame array, declared once: its name, its dimensions over K frames, its
+# dtype and where a frame's value comes from (a State or Workspace field). Recorder,
+# FRAME_DIMS, make_recorder, record_state and Trajectory's arrays follow this table; a new
+# quantity also needs its Trajectory field and its line in kernels/record.py (compiled code).
+RECORDED = (
+    ("t", ("K",), np.float64, "state.time"),                       # [s]
+    ("q", ("K", "n_body", 3), np.float64, "state.q"),              # x [m], y [m], theta [rad]
+    ("v", ("K", "n_body", 3), np.float64, "state.v"),              # [m/s], [m/s], [rad/s]
+    ("contact_mode", ("K", "n_contact"), np.int64, "state.contact_mode"),   # -1 disabled
+    ("contact_impulse", ("K", "n_contact", 2), np.float64, "ws.contact_impulse"),   # [N s]
+    ("contact_point", ("K", "n_contact", 2), np.float64, "ws.contact_point"),       # [m]
+    ("act_u", ("K", "n_act"), np.float64, "ws.act_u"),             # [N or N m]
+    ("act_power", ("K", "n_act"), np.float64, "ws.act_power"),     # [W]
+    # unit normal of each contact (the ground's, or a shape pair's, from the reference shape
+    # to the other)
+    ("contact_normal", ("K", "n_contact", 2), np.float64, "ws.contact_normal"),
+)
+FRAME_DIMS = {name: dims for name, dims, _, _ in RECORDED}   # shape of each per-frame array
 
 
 def terrain_info(model) -> dict:
@@ -34,25 +48,16 @@ def terrain_info(model) -> dict:
     return {"terrain": str(getattr(ter, "name", "terrain")), "terrain_coef": tuple(coef.tolist())}
 
 
-class Recorder(NamedTuple):
-    """Preallocated frame arrays filled by kernels.record.record_frame."""
-    t: np.ndarray                # (K,) [s]
-    q: np.ndarray                # (K, n_body, 3)
-    v: np.ndarray                # (K, n_body, 3)
-    contact_mode: np.ndarray     # (K, n_contact) int
-    contact_impulse: np.ndarray  # (K, n_contact, 2) [N s]
-    contact_point: np.ndarray    # (K, n_contact, 2) [m]
-    act_u: np.ndarray            # (K, n_act)
-    act_power: np.ndarray        # (K, n_act) [W]
-    contact_normal: np.ndarray   # (K, n_contact, 2) unit normal of each contact (the ground's,
-                                 #   or a shape pair's, from the reference shape to the other)
+Recorder = NamedTuple("Recorder", [(name, np.ndarray) for name, *_ in RECORDED])
+Recorder.__doc__ = "Preallocated frame arrays (RECORDED) filled by kernels.record.record_frame."
 
 
 def frame_bytes(model, extra_columns: int = 0) -> int:
     """Memory [bytes] of one recorded frame of `model` (a Recorder's arrays, plus
     `extra_columns` float64 labels per frame)."""
-    nb, nc, na = model.n_body, model.n_contact, model.n_act
-    return 8 * (1 + 6 * nb + 7 * nc + 2 * na + int(extra_columns))
+    sizes = dict(n_body=model.n_body, n_contact=model.n_contact, n_act=model.n_act)
+    items = sum(int(np.prod([sizes.get(d, d) for d in dims[1:]])) for dims in FRAME_DIMS.values())
+    return 8 * (items + int(extra_columns))   # every recorded dtype is 8 bytes
 
 
 def machine_memory() -> int:
@@ -84,26 +89,22 @@ def check_recording(model, n_frames, what: str = "", extra_columns: int = 0) -> 
 def make_recorder(model, n_frames: int) -> Recorder:
     """Zeroed frame arrays for `n_frames` frames (RecordingTooLarge, before allocating, if
     they cannot fit in the machine's memory)."""
-    nb, nc, na, K = model.n_body, model.n_contact, model.n_act, int(n_frames)
-    check_recording(model, K)
-    z = np.zeros
-    return Recorder(t=z(K), q=z((K, nb, 3)), v=z((K, nb, 3)), contact_mode=z((K, nc), np.int64),
-                    contact_impulse=z((K, nc, 2)), contact_point=z((K, nc, 2)), act_u=z((K, na)),
-                    act_power=z((K, na)), contact_normal=z((K, nc, 2)))
+    sizes = dict(K=int(n_frames), n_body=model.n_body, n_contact=model.n_contact, n_act=model.n_act)
+    check_recording(model, sizes["K"])
+    return Recorder(*(np.zeros(tuple(sizes.get(d, d) for d in dims), dtype)
+                      for _, dims, dtype, _ in RECORDED))
 
 
 def record_state(rec: Recorder, k: int, state, ws) -> None:
     """Write State `state` and Workspace `ws` into frame k of rec, as the compiled
     kernels.record.record_frame does after a step (here from Python, for a run's first frame)."""
-    rec.t[k] = state.time[0]
-    rec.q[k] = state.q
-    rec.v[k] = state.v
-    rec.contact_mode[k] = np.where(np.asarray(state.contact_enabled) != 0, state.contact_mode, -1)
-    rec.contact_impulse[k] = ws.contact_impulse
-    rec.contact_point[k] = ws.contact_point
-    rec.contact_normal[k] = ws.contact_normal
-    rec.act_u[k] = ws.act_u
-    rec.act_power[k] = ws.act_power
+    sources = {"state": state, "ws": ws}
+    for name, _, _, source in RECORDED:
+        owner, attr = source.split(".")
+        value = np.asarray(getattr(sources[owner], attr))
+        if name == "contact_mode":   # a disabled contact is -1
+            value = np.where(np.asarray(state.contact_enabled) != 0, value, -1)
+        getattr(rec, name)[k] = value[0] if name == "t" else value
 
 
 @dataclass
@@ -128,8 +129,7 @@ class Trajectory:
     labels: dict = field(default_factory=dict)
     info: dict = field(default_factory=dict)
 
-    _ARRAYS = ("t", "q", "v", "contact_mode", "contact_impulse", "contact_point", "act_u", "act_power",
-               "contact_normal")
+    _ARRAYS = tuple(FRAME_DIMS)
 
     @classmethod
     def from_recorder(cls, model, rec: Recorder, n: int | None = None, **kw) -> "Trajectory":
@@ -242,6 +242,12 @@ class Trajectory:
 _BODY_COLS = ("x_m", "y_m", "theta_rad", "vx_m_per_s", "vy_m_per_s", "omega_rad_per_s")
 # actuator kinds (model.ACT_*): what their command is, once saturated
 _EFFORT = {0: "torque_Nm", 1: "force_N", 2: "torque_Nm", 3: "force_N", 4: "torque_Nm"}
+
+
+# Trajectory's array fields are RECORDED's, in its order (a field added to one and not the other
+# fails here, on import)
+assert tuple(f for f in Trajectory.__dataclass_fields__ if f in FRAME_DIMS) == Trajectory._ARRAYS, \
+    "Trajectory's array fields must be trajectory.RECORDED's"
 
 
 def csv_columns(traj, model=None) -> tuple:

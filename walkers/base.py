@@ -27,7 +27,8 @@ A run (WalkerRun) holds the model, State, Workspace, StepOptions, parameters, co
 and memory of one walker in the world; ``run(seconds)`` advances it with the walker's compiled
 rollout and returns that chunk's Trajectory, so running a then b seconds ends bit for bit where
 running a + b seconds does. A subclass supplies only what differs: it builds model, table and
-memory in its __init__, names its LABELS (per-frame copies of memory slots LABEL_SLOTS),
+memory in its __init__, names its LABELS (per-frame copies of memory slots LABEL_SLOTS,
+walkers.common.slots.label_slots of its memory layout),
 FELL_SLOT and ROLLOUT (its compiled rollout; advance() calls it, or a walker whose rollout takes
 more overrides advance) and implements ``numbers`` (its raw summary numbers). A rollout records
 through walkers.common.record.record_labelled.

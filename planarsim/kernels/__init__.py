@@ -1,6 +1,3 @@
-"""Compiled kernels (numba). Private: use the public wrappers in planarsim.
+"""The physics stages of the step (numba kernels). Private: use the public wrappers in planarsim.
 
-Importing them first checks the numba internals they build on (numba_check.py)."""
-from .numba_check import check_numba
-
-check_numba()
+Their decorators and the step's linkage are planarsim's compiler layer (planarsim/compile)."""

@@ -31,7 +31,7 @@ planarsim.errors.diverged turns into an AuditViolation naming all of it.
 """
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .info import INFO_CCD_SPLITS
 from .codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, ROW_ROD
 from .contacts import contact_velocity, edge_deepest, point_reach, sole_facing

@@ -17,7 +17,7 @@ no manifold point (free, no features, no impulse), so a contact outside the list
 free, far and without impulse, and every stage may loop over the list alone. A model without
 shapes has every contact in the list, once (make_workspace), and never calls this module.
 """
-from ._jit import kernel, kernel_call
+from ..compile import kernel
 from .pair import SPECULATIVE_FACTOR, clear_slot
 
 # relative widening of a shape's box [-] and its absolute floor [m]: the rounding of the box's
@@ -116,7 +116,7 @@ def merge_contacts(ground, pairs, n_pairs, out):
     return n
 
 
-@kernel_call
+@kernel(inline="never")
 def update_live(m, s, ws, margin, h):
     """The step's pairs (sweep_pairs for the pair margin [m] and step h [s]) and contacts
     (ws.live); a pair that left since the last call is cleared (both slots: free, no features,

@@ -10,7 +10,7 @@ precision. The step is then split at tau (Kelly 2014, section 3).
 """
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .codes import MODE_FREE
 from .info import INFO_CCD_SPLITS
 from .terrain import ground_point_call, height_derivs, max_curvature, max_slope

@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from ._jit import kernel
+from ..compile import kernel
 from .math2d import rotate
 
 # out[k, 0]: which core holds the reference feature (n points away from it)

@@ -17,7 +17,7 @@ every contact every step.
 """
 import math
 
-from ._jit import kernel, kernel_call
+from ..compile import kernel
 from .math2d import rotate, set_dir, world_point
 from .terrain import ground_point, height_derivs
 
@@ -244,7 +244,7 @@ def _edge_by_samples(m, q, cs, i):
     return inside, x0 + best_u * dx, y0 + best_u * dy
 
 
-@kernel_call
+@kernel(inline="never")
 def edge_deepest(m, q, cs, i):
     """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
     fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
@@ -267,7 +267,7 @@ def edge_deepest(m, q, cs, i):
     return in_a, ax, ay
 
 
-@kernel_call
+@kernel(inline="never")
 def find_edge(m, q, ws, i):
     """Edge contact i at q: its deepest core point, pushed out by the shape's radius along the
     ground normal (a capsule's side), as a material point held for the step; gap inf where the
@@ -348,7 +348,7 @@ def query_contact(m, q, ws, i):
     ws.contact_stale[i] = 0
 
 
-@kernel_call
+@kernel(inline="never")
 def _stays_clear(m, q, ws, i):
     """Point contact i is surely above the ground at q: its gap when last queried minus how far
     its point can have moved since (point_reach; the signed distance to the ground changes by at
@@ -439,7 +439,7 @@ def pair_motion_scale(s, ws, i, vel):
     return abs(vx) + abs(vy) + abs(ux) + abs(uy)
 
 
-@kernel_call
+@kernel(inline="never")
 def bounce_of(m, s, ws, i):
     """The normal velocity [m/s] restitution asks of contact i after an impact: e times its
     approach speed at the step's start, 0 below BOUNCE_SPEED."""

@@ -14,7 +14,7 @@ centre. It only takes energy out (each term opposes its own velocity component).
 """
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .math2d import cross2, rotate
 
 

@@ -8,7 +8,7 @@ implicitly in the velocity solve (soft.py).
 """
 import math
 
-from ._jit import kernel, kernel_inline
+from ..compile import kernel
 from .fluid import apply_fluid
 from .math2d import cross2, world_point
 from .slider import slide_position_rate, slider_frame
@@ -42,19 +42,26 @@ def add_point_force(q, f, body, px, py, fx, fy):
 
 
 @kernel
+def pin_angle(m, q, j):
+    """Pin angle theta_b - theta_a - ref [rad] (the one place it is computed in compiled code)."""
+    a = m.pin_body[j, 0]
+    ang = q[m.pin_body[j, 1], 2] - m.pin_ref[j]
+    if a >= 0:
+        ang -= q[a, 2]
+    return ang
+
+
+@kernel
 def pin_angle_rate(m, q, v, j):
     """Pin angle theta_b - theta_a - ref [rad] and its rate [rad/s]."""
     a = m.pin_body[j, 0]
-    b = m.pin_body[j, 1]
-    ang = q[b, 2] - m.pin_ref[j]
-    rate = v[b, 2]
+    rate = v[m.pin_body[j, 1], 2]
     if a >= 0:
-        ang -= q[a, 2]
         rate -= v[a, 2]
-    return ang, rate
+    return pin_angle(m, q, j), rate
 
 
-@kernel_inline
+@kernel(inline="always")
 def apply_actuator(m, q, cs, v, f, k, u):
     """Add actuator k's saturated command u to f; return its mechanical power [W]."""
     kind = m.act_kind[k]

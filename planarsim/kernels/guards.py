@@ -1,7 +1,7 @@
 """Stage 9: guards. Every q and v component must be finite and below the magnitude bound."""
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 

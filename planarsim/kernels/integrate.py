@@ -16,7 +16,7 @@ find nothing to do (bodies at rest or translating), so the step skips it exactly
 """
 import math
 
-from ._jit import kernel, kernel_call, kernel_inline
+from ..compile import kernel
 from .codes import MODE_FREE, MODE_PINNED
 from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
@@ -176,7 +176,7 @@ def predict_configuration(m, s, ws, h):
 ROUNDING = 16 * 2.220446049250313e-16
 
 
-@kernel_call
+@kernel(inline="never")
 def rows_hold_within(m, s, ws, h, limit):
     """True if every row's error after integrating is provably at most `limit` [m or rad],
     without evaluating the rows again: the error predicted to first order, c + h J v (rows
@@ -230,7 +230,7 @@ def max_residual(m, s, ws):
     return worst
 
 
-@kernel_inline
+@kernel(inline="always")
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     """Newton-SHAKE; returns the final max residual [m or rad]. envelope_ready: the rows are
     those of the velocity solve's envelope (ws.row_first / row_reach): none was dropped since

@@ -8,7 +8,7 @@ problems (work ~ sum of n_k^3), not one large one (~ (sum n_k)^3). The grouping 
 union-find over the rows' bodies, O(rows + bodies) per grouping; a step with one island solves
 exactly as it did without islands (the same rows in the same order).
 """
-from ._jit import kernel
+from ..compile import kernel
 
 
 @kernel

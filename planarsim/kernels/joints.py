@@ -3,7 +3,7 @@ theta_b - theta_a - ref [rad], a slider's slide s = d.(p_b - p_a) [m] (slider.py
 dispatch on a joint's kind, for what acts on its coordinate: limits (limit.py, modes.py),
 springs, dampers and armature (soft.py). A free body's coordinate (codes.JOINT_FREE_BIT) is
 measured the same way but holds nothing: it has no constraint rows."""
-from ._jit import kernel
+from ..compile import kernel
 from .codes import JOINT_FREE_BIT, JOINT_SLIDE_BIT
 from .forces import pin_angle_rate
 from .slider import slide_position_rate, slide_row, slider_angle_row

@@ -20,7 +20,7 @@ A pivot costs m (2m + 2) multiply-adds.
 """
 import math
 
-from ._jit import kernel, kernel_call
+from ..compile import kernel
 
 LCP_SOLVED = 0
 LCP_RAY = 1     # no blocking row for the entering variable: no solution on this path
@@ -124,7 +124,7 @@ def covering(i, m, cover):
     return 1.0 + 0.5 * ((i * GOLDEN) % 1.0)
 
 
-@kernel_call
+@kernel(inline="never")
 def lemke(M, q, m, T, basis, z, max_pivots, cover, floor):
     """Solve LCP(M[:m, :m], q[:m]) into z[:m] along the path of covering vector `cover`
     (see covering); T (>= m, >= 2m + 2) and basis (>= m) are scratch. floor: a lower bound
@@ -249,7 +249,7 @@ def _min_change(M, q, m, T, basis, res):
     return True
 
 
-@kernel_call
+@kernel(inline="never")
 def polish(M, q, m, T, basis, z, floor):
     """After lemke solved a nearby problem (M + eps I, say) into z on `basis`: the same
     basis's answer for M and q themselves, checked as lemke checks its own. First refined and

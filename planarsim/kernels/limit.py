@@ -2,8 +2,9 @@
 ang = theta_b - theta_a - ref [rad]: ang - lower >= 0 (side 0, ROW_LIMIT_LO) and
 upper - ang >= 0 (side 1, ROW_LIMIT_HI). A side has a row only while it is active
 (State.limit_active; engaged and released by the mode rules, kernels/modes.py)."""
-from ._jit import kernel
+from ..compile import kernel
 from .codes import ROW_LIMIT_HI, ROW_LIMIT_LO
+from .forces import pin_angle
 from .row_list import add_row
 
 
@@ -18,9 +19,7 @@ def limit_row(m, q, o, a, b, side, J):
     """Jacobian blocks J (2, 3) and error [rad] (distance inside the limit) of pin o's limit
     row on `side`."""
     sign = 1.0 if side == 0 else -1.0
-    ang = q[b, 2] - m.pin_ref[o]
-    if a >= 0:
-        ang -= q[a, 2]
+    ang = pin_angle(m, q, o)
     for k in range(3):
         J[0, k] = 0.0
         J[1, k] = 0.0

@@ -1,7 +1,7 @@
 """Tiny 2D helpers: cross products, rotation, world points."""
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 
 
 @kernel

@@ -17,7 +17,7 @@ The velocity stage calls this with b = c / h + J v*; the position projection wit
 """
 import math
 
-from ._jit import kernel, kernel_call
+from ..compile import kernel
 from .lcp import ANSWER_TOL, LCP_INACCURATE, LCP_RAY, LCP_SOLVED, lemke, polish
 from .codes import CONTACT_PAIR
 from .contacts import pair_motion_scale
@@ -88,7 +88,7 @@ def _solve_joints(B, nb, G, col):
         G[i, col] = acc
 
 
-@kernel_call
+@kernel(inline="never")
 def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     """Impulses ws.lam[r] of the rows r in rows[start:start + count] (an island's, in their
     order: a tangent row follows its normal row; ws.A from assemble_dense, ws.row_b) that meet

@@ -15,7 +15,7 @@ reversal); modes_from_solution reads the modes off a complementarity solution.
 """
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED, MODE_SLIDING
 from .contacts import contact_velocity, engage_contact, pair_motion_scale, refresh_contact
 from .pair import PAIR_ENGAGE_SLACK, pair_speed

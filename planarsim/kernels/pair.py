@@ -17,7 +17,7 @@ Rows act at the incident body's surface point ps = p - r_inc n (its friction act
 disk rolls). The reference body is the row's body a (-1: a world shape), the incident body
 its body b (ws.contact_bodies); either may be the pair's first shape.
 
-The pair's stages are calls (kernel_call), not inlined: a model without shapes keeps the
+The pair's stages are calls (kernel(inline="never")), not inlined: a model without shapes keeps the
 step's hot loops as small as before. Broad phase: each shape's bounding circle and speed
 bound are placed once per configuration (place_shapes); a pair whose circles are farther
 apart than the step can close (SPECULATIVE_FACTOR times the speed bounds times h, plus
@@ -26,7 +26,7 @@ PAIR_MARGIN) skips the narrow phase. Which pairs are tested at all is the sweep'
 """
 import math
 
-from ._jit import kernel, kernel_call
+from ..compile import kernel
 from .codes import CONTACT_PAIR, MODE_FREE
 from .collide import collide
 from .math2d import rotate, set_dir, world_point
@@ -181,7 +181,7 @@ def clear_slot(s, ws, c):
     s.last_contact_impulse[c, 1] = 0.0
 
 
-@kernel_call
+@kernel(inline="never")
 def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
     """Stage 3 for the pair whose slot 0 is contact i, at s.q (ws.body_cs current, the
     shapes placed there: place_shapes): the
@@ -261,7 +261,7 @@ def pair_surface_point(q, cs, ws, o):
     return px - r_inc * nx, py - r_inc * ny, nx, ny, gap
 
 
-@kernel_call
+@kernel(inline="never")
 def pair_row(q, cs, ws, o, J, tangent):
     """Jacobian blocks J (2, 3) and error of pair contact o's normal row (its exact gap [m]
     at q) or tangent row (tangent: the slip [m] along t = (n_y, -n_x) since the step's start:
@@ -294,7 +294,7 @@ def pair_speed(m, ws, i, vel):
     return _speed_bound(m, vel, m.shape_body[sa], sa) + _speed_bound(m, vel, m.shape_body[sb], sb)
 
 
-@kernel_call
+@kernel(inline="never")
 def pair_gap_now(m, q, cs, ws, i):
     """The signed gap [m] of pair contact i's shapes at q (the shapes placed there:
     place_shapes), measured afresh (the audit): the

@@ -2,7 +2,7 @@
 for the anchor points fixed in bodies a and b (a < 0: the world). A pin's x row is always
 followed by its y row, so both come from one evaluation of the anchors (pin_rows).
 """
-from ._jit import kernel
+from ..compile import kernel
 from .codes import ROW_PIN_X, ROW_PIN_Y
 from .math2d import set_dir, world_point
 from .row_list import add_row

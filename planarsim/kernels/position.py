@@ -11,7 +11,7 @@ position_stage(m, s, ws, opt, h, answered):
   5. bound_correction_work: the velocity change of a correction or projection kept only as
      far as it adds no energy beyond its allowance (audited: correction_work).
 """
-from ._jit import kernel, kernel_call, kernel_inline
+from ..compile import kernel
 from .audit import (AUDIT_CORRECTION_WORK, DEPTH_TOL, PIN_GAP_TOL, audit_positions,
                     mark_held_contacts, needs_ground_query, note, worst_violation)
 from .complementarity import project_positions
@@ -47,7 +47,7 @@ def settle_positions(m, s, ws, h, opt, rows_held):
     return _settle_measured(m, s, ws, h, opt, rows_held)
 
 
-@kernel_call
+@kernel(inline="never")
 def _settle_measured(m, s, ws, h, opt, rows_held):
     """settle_positions where the ground must be asked (rows_held: contact_held is marked)."""
     update_trig(s.q, ws.body_cs)
@@ -61,7 +61,7 @@ def _settle_measured(m, s, ws, h, opt, rows_held):
     return 0
 
 
-@kernel_inline
+@kernel(inline="always")
 def position_stage(m, s, ws, opt, h, answered):
     """Stage 6 (the module's docstring) after a velocity solve over a step of h [s];
     answered: a linear solve's answer stood (its rows' envelope in ws is reused)."""

@@ -1,5 +1,5 @@
 """Recording one frame of a run into preallocated arrays (a Recorder NamedTuple)."""
-from ._jit import kernel
+from ..compile import kernel
 
 
 @kernel

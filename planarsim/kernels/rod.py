@@ -2,7 +2,7 @@
 and b (a massless rigid link of length L [m]); its row acts along the unit vector a -> b."""
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .codes import ROW_ROD
 from .math2d import set_dir, world_point
 from .row_list import add_row

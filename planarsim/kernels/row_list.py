@@ -1,7 +1,7 @@
 """The workspace's list of active rows: appending a row (its kind, owner and two bodies) and
 moving one to an earlier slot (compacting the list in place). The kinds' modules append their
 rows here; what a row means is theirs (codes.ROW_*, dispatched in rows.py)."""
-from ._jit import kernel
+from ..compile import kernel
 
 
 @kernel

@@ -29,7 +29,7 @@ Coulomb friction -mu lambda_n s along the tangent t.
 """
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .codes import (CONTACT_PAIR, MODE_PINNED, MODE_SLIDING, ROW_CONTACT_N, ROW_CONTACT_T,
                     ROW_JOINT_SOFT, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
                     ROW_SLIDE_ANGLE, ROW_SLIDE_PERP)

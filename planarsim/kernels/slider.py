@@ -14,7 +14,7 @@ Its limit rows (ROW_LIMIT_LO / HI, limit.py's kinds) are s - lower >= 0 and uppe
 """
 import math
 
-from ._jit import kernel
+from ..compile import kernel
 from .codes import ROW_SLIDE_ANGLE, ROW_SLIDE_PERP
 from .math2d import set_dir, world_point
 from .row_list import add_row

@@ -24,7 +24,7 @@ ws.row_soft[r] holds (a, k, c, g v at the step's start, gamma of the last fill_r
 Not covered: the position correction's velocity change (integrate.py, SHAKE's second-order
 c / h) and its kinetic-energy bound weigh the bodies' masses only, without the rotors'.
 """
-from ._jit import kernel
+from ..compile import kernel
 from .codes import ROW_JOINT_SOFT
 from .joints import joint_rate_row
 from .row_list import add_row

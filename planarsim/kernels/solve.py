@@ -19,7 +19,7 @@ compliance gamma > 0: it adds gamma to its diagonal, (J W F^T + diag(gamma)) lam
 Without sliding contacts F = J and the matrix is symmetric: it is assembled in its lower
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
-from ._jit import kernel, kernel_inline
+from ..compile import kernel
 from .rows import is_joint_row, is_normal_row, is_soft_row, is_tangent_row
 from .soft import soft_compliance, soft_row_b
 from .warm_start import start_impulses
@@ -218,7 +218,7 @@ def substitute_symmetric(A, first, reach, rhs, x, n):
         x[k] = acc
 
 
-@kernel_inline
+@kernel(inline="always")
 def factor_solve(ws, rhs, x, n, tol):
     """Factor ws.A and solve A x = rhs; returns #dropped rows."""
     dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, x)
@@ -304,7 +304,7 @@ def add_compliance(ws, n):
             ws.A[r, r] += soft_compliance(ws, r)
 
 
-@kernel_inline
+@kernel(inline="always")
 def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
     Where a row is dropped as dependent, the solve finds the change from the last step's

@@ -2,16 +2,16 @@
 
 step(m, s, ws, opt, u) advances State s in place by one step of opt.dt (0: the model's m.dt)
 and returns a guard code (0 ok, 1 non-finite, 2 too large). Model, state, workspace and
-options arrive as one pointer each (kernels/refs.py). The stages are compiled into one C
+options arrive as one pointer each (compile/refs.py). The stages are compiled into one C
 function (inlined, but for a few long or rarely run parts kept as calls: build_and_solve, the
 complementarity solve, the skip test of the correction, the measured end-of-step audit),
 compiled once per machine and called by address from every compiled caller (a walker's
-rollout, run_steps; kernels/link.py). A time-of-impact split (CCD) repeats
+rollout, run_steps; compile/link.py). A time-of-impact split (CCD) repeats
 stages 1-5 for the remainder of the step with the new contact pinned. Each stage lives in its
 module (README's table "How the engine works" names them); this file only orders them, and
 solve_modes, the guess-check-solve of stages 3-5.
 """
-from ._jit import kernel, kernel_call, kernel_inline
+from ..compile import kernel
 from .audit import audit_impulses, audit_total
 from .ccd import split_at_impact
 from .codes import MODES_ALTERNATING
@@ -45,7 +45,7 @@ def _copy2(src, dst):
             dst[i, k] = src[i, k]
 
 
-@kernel_inline
+@kernel(inline="always")
 def copy_state(src, dst):
     """dst <- src, array by array (dst is a State of the same shapes; no allocation)."""
     _copy2(src.q, dst.q)
@@ -64,7 +64,7 @@ def copy_state(src, dst):
     _copy1(src.contact_feature, dst.contact_feature)
 
 
-@kernel_call
+@kernel(inline="never")
 def build_and_solve(m, s, ws, opt, h):
     """Stages 4-5: the active rows at the current configuration and their impulses under the
     modes as they stand. Returns True if the answer's equations need checking (a dependent
@@ -85,7 +85,7 @@ def answer_holds(m, s, ws, h, include_ccd, equalities):
     return ok and engaged == 0
 
 
-@kernel_inline
+@kernel(inline="always")
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 4-6: impulses and contact modes that meet every rule (modes.rule_breaks).
 
@@ -140,7 +140,7 @@ def second_order_gains(m, ws):
     return joints_add_energy(m, ws)[0] > 0.0
 
 
-@kernel_inline
+@kernel(inline="always")
 def _step(m, s, ws, opt, u):
     """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u;
     return the guard code."""

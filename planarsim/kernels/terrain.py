@@ -5,7 +5,7 @@ with h0 [m], s [-], A [m], L [m], phi [rad]. Flat ground is ``[0, 0, 0]``.
 """
 import math
 
-from ._jit import jit, jit_force, kernel, kernel_call
+from ..compile import jit, kernel
 
 TWO_PI = 2.0 * math.pi
 # a Newton step of the closest-point search this small [m] (plus the rounding of x) is its last:
@@ -15,7 +15,7 @@ NEWTON_LAST_STEP = 1e-10
 MAX_HALF_SAMPLES = 512
 
 
-@jit_force
+@jit(inline="force")
 def height(coef, x):
     """Ground height h(x) [m]."""
     h = coef[0] + coef[1] * x
@@ -26,7 +26,7 @@ def height(coef, x):
     return h
 
 
-@jit_force
+@jit(inline="force")
 def height_derivs(coef, x):
     """(h, h', h'') at x: height [m], slope dh/dx [-], curvature term d2h/dx2 [1/m]."""
     h = coef[0] + coef[1] * x
@@ -52,7 +52,7 @@ def normal_at(coef, x):
     return -dh * inv, inv
 
 
-@jit_force
+@jit(inline="force")
 def max_curvature(coef):
     """Upper bound on |h''| [1/m]: sum_k A_k (2 pi / L_k)^2."""
     acc = 0.0
@@ -62,7 +62,7 @@ def max_curvature(coef):
     return acc
 
 
-@jit_force
+@jit(inline="force")
 def max_slope(coef):
     """Upper bound on |h'| [-]: |s| + sum_k A_k 2 pi / L_k."""
     acc = abs(coef[1])
@@ -71,7 +71,7 @@ def max_slope(coef):
     return acc
 
 
-@jit_force
+@jit(inline="force")
 def min_wavelength(coef):
     """The shortest wavelength L_k [m] of the sines (inf without any)."""
     shortest = math.inf
@@ -94,7 +94,7 @@ def _closest_on_line(h0, slope, px, py):
     return x, h, nx, ny, gap
 
 
-@jit_force
+@jit(inline="force")
 def _descend(coef, px, py, x, bound):
     """Newton on f(x) = (x - px) + (h(x) - py) h'(x) = 0 from x, each step at most `bound`
     [m] and never taking the ground point farther from p (a step that would is halved: the
@@ -136,13 +136,13 @@ def _descend(coef, px, py, x, bound):
     return x, h, dh
 
 
-@jit_force
+@jit(inline="force")
 def _sample_distance(coef, px, py, x):
     hs = height(coef, x)
     return math.sqrt((x - px) * (x - px) + (hs - py) * (hs - py))
 
 
-@jit_force
+@jit(inline="force")
 def closest_point(coef, px, py):
     """Closest ground point to (px, py) and the signed gap along its normal.
 
@@ -201,7 +201,7 @@ def ground_point(coef, px, py):
     return closest_point(coef, px, py)
 
 
-@kernel_call
+@kernel(inline="never")
 def _closest_on_hills(coef, px, py):
     """closest_point as one call (see ground_point_call)."""
     return closest_point(coef, px, py)

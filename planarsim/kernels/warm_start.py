@@ -10,7 +10,7 @@ the solve starts from the last step's impulses and finds the change from them: t
 rows keep theirs, and a resting loop, whose change is then zero, keeps its split bit for bit.
 The impulses live in the State (last_*_impulse), so a restored run continues bit for bit.
 """
-from ._jit import kernel
+from ..compile import kernel
 from .rows import has_mode_rows, is_joint_row, is_limit_row, last_impulse, store_joint_impulse
 
 

@@ -16,7 +16,7 @@ by h w <= SHAKE_REGIME) the joints' second-order terms move the kinetic energy b
 about SHAKE_REGIME^2 of it, up or down, and the energy oscillates about its value (symplectic
 Euler); more than that is energy from nowhere.
 """
-from ._jit import kernel
+from ..compile import kernel
 from .rows import is_joint_row, is_soft_row
 from .solve import row_dot
 

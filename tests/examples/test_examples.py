@@ -115,3 +115,21 @@ def test_random_search_learns_to_swim(tmp_path):
     ex.record_gif(out["policy"], gif, seconds=2.0)
     with Image.open(gif) as im:
         assert im.n_frames == 5
+
+
+def test_debug_step_stops_in_the_contact_solve_under_numba_disable_jit():
+    """README's debugging paragraph as written: pdb stops in solve_impulses of Ranger's step."""
+    import os
+    import subprocess
+    root = EXAMPLES.parent
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=str(root))
+    out = subprocess.run([sys.executable, str(EXAMPLES / "debug_step.py")], input="c\nn\np int(n)\nc\n",
+                         capture_output=True, text=True, env=env, cwd=root, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    stop = out.stdout.index("solve.py")
+    assert "solve_impulses()" in out.stdout[stop:]
+    rows = int(out.stdout[stop:].split("(Pdb) ")[2].split()[0])
+    assert rows > 0        # Ranger stands on the ground: the solve has rows
+    compiled = subprocess.run([sys.executable, str(EXAMPLES / "debug_step.py")], capture_output=True,
+                              text=True, env=dict(env, NUMBA_DISABLE_JIT="0"), cwd=root)
+    assert compiled.returncode != 0 and "NUMBA_DISABLE_JIT=1" in compiled.stderr

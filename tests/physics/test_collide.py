@@ -10,12 +10,12 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from numba import njit
 
-from planarsim.kernels._jit import _OPTIONS
+from planarsim.compile import options as compile_options
 from planarsim.kernels.collide import (FLIP_A, FLIP_B, KIND_DIST, KIND_FACE, REFERENCE_TOL, collide,
                                        core_normals, core_point_world, split_feature_id)
 
 # not cached: numba checks a cached function against its own file only
-jit = njit(**dict(_OPTIONS, cache=False))
+jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit

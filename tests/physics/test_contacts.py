@@ -204,11 +204,11 @@ def test_point_on_a_hill_sticks_below_the_friction_angle_and_slides_above(mu, sh
 @pytest.mark.parametrize("strategy", ["alternating", "all"])
 def test_seven_link_biped_collapse_only_loses_energy(strategy):
     """The benchmark's 7-link biped falling onto flat ground (28 box corners, closed loops
-    through the ground). At t = 0.413 s many corners strike at once and the mode rounds hit
-    their cap; the final solve of nearly dependent rows once gave two contacts opposite
+    through the ground). At t = 0.413 s many corners strike at once and no guessed mode
+    stands; the final solve of nearly dependent rows once gave two contacts opposite
     impulses of 5e4 N s, one pulling (+2300 J, a corner 37 mm deep; 'all': 1e10 J). Now the
-    pulling contacts are released: energy never exceeds its start, pins stay closed, and a
-    corner ends a capped step at most about a millimetre deep (removed by the next step's
+    contact problem is solved as one: energy never exceeds its start, pins stay closed, and a
+    corner ends such a step at most about a millimetre deep (removed by the next step's
     correction)."""
     from benchmarks.scenes import biped_collapse
     from tests.physics.test_contact_properties import contact_gaps
@@ -234,7 +234,7 @@ def test_seven_link_biped_collapse_perturbed_by_nanometres_comes_to_rest_above_g
     loop through the other contacts, and at rest a corner switched to sliding and added
     0.78 J; on another path a Newton step of the position correction near a dead point
     diverged (+2.7e6 J in one step; such steps are now taken back). Every path must only
-    lose energy (within the correction's m g overlap), never sink a corner more than a capped
+    lose energy (within the correction's m g overlap), never sink a corner more than such a
     step does, and come to rest on the ground."""
     from benchmarks.scenes import biped_collapse
     from tests.physics.test_contact_properties import contact_gaps

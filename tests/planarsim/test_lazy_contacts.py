@@ -8,7 +8,7 @@ from numba import njit
 
 import planarsim as ps
 from planarsim import terrain
-from planarsim.kernels._jit import _OPTIONS
+from planarsim.compile import options as compile_options
 from planarsim.kernels.math2d import update_trig
 from planarsim.kernels.modes import engage_contacts
 from planarsim.kernels.terrain import closest_point
@@ -72,7 +72,7 @@ def test_kept_gap_is_a_lower_bound_on_hills():
     assert checked > 1000
 
 
-_jit = njit(**dict(_OPTIONS, cache=False))   # not cached: it must follow the kernels it calls
+_jit = njit(**dict(compile_options(), cache=False))   # not cached: it must follow the kernels it calls
 
 
 @_jit

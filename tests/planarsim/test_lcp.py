@@ -7,12 +7,12 @@ from hypothesis import given, settings, strategies as st
 
 from numba import njit
 
-from planarsim.kernels._jit import _OPTIONS
+from planarsim.compile import options as compile_options
 from planarsim.kernels.lcp import LCP_SOLVED, lemke, polish
 
 # not cached: numba checks a cached function against its own file only, and this wrapper
 # must follow the kernels it calls
-jit = njit(**dict(_OPTIONS, cache=False))
+jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit

@@ -8,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 from numba import njit
 
 import planarsim as ps
-from planarsim.kernels._jit import _OPTIONS
+from planarsim.compile import options as compile_options
 from planarsim.kernels.contacts import find_contacts
 from planarsim.kernels.lcp import LCP_SOLVED
 from planarsim.kernels.math2d import update_trig
@@ -20,7 +20,7 @@ import reference as ref
 
 # not cached: numba checks a cached function against its own file only, and these wrappers
 # must follow the kernels they call
-jit = njit(**dict(_OPTIONS, cache=False))
+jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit

@@ -6,13 +6,13 @@ from hypothesis import given, settings, strategies as st
 
 from numba import njit
 
-from planarsim.kernels._jit import _OPTIONS
+from planarsim.compile import options as compile_options
 from planarsim.kernels.solve import factor, factor_symmetric, substitute, substitute_symmetric
 
 TOL = 1e-11
 # not cached: numba checks a cached function against its own file only, and these wrappers
 # must follow the kernels they call
-jit = njit(**dict(_OPTIONS, cache=False))
+jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit

@@ -8,15 +8,15 @@ Bounds, stated:
   of the map's jumps from the controller switching at step boundaries); multipliers bit for bit
   reproducible, inside the unit circle at eps = 3e-3 and 1e-2, and a 1e-2 perturbation decays.
 - Ranger (dt = 1 ms, section: controller mid-stance, stride map, 11 coordinates), with the
-  engine's default StepOptions that Ranger runs with (cap_policy=1): the acceptance asks for a
+  engine's default StepOptions that Ranger runs with: the acceptance asks for a
   period-one gait with all multipliers inside the unit circle. The controller acts at 1 ms
   steps, so the map jumps by up to ~1.6e-2 (rad/s) between nearby points (see
   walkers/ranger/gait_map.py) and a settled gait either repeats exactly (every event on the
   same step each stride) or wanders within that jitter. Period-one is therefore asserted as:
   12 strides from the settled section state all return within PERIOD_TOL = 5e-2 of it
   (measured: 0 on the engine at c758571, exactly repeating, |P(x0) - x0| = 3e-7; 1.9e-2 with the
-  pending frictionless cap rule of planarsim/kernels/step.py; up to 4.2e-2 over ten 1 %
-  parameter changes; the previous parameters under cap_policy=1 wandered 0.16 off, irregular).
+  engine's frictionless rule for a heel landing in Painleve's configuration; up to 4.2e-2 over
+  ten 1 % parameter changes; an earlier parameter set wandered 0.16 off, irregular).
   The Jacobian is a least-squares slope over perturbations of 0.5..2 x 1e-2 (measured
   spectral radius 0.66 / 0.48 on those two engines; 0.2..0.8 over eps 2e-3..2e-2 and 1 %
   parameter changes); a two-point central difference at eps = 1e-3 measured the jumps (radius

@@ -212,7 +212,7 @@ def test_gait_switch_at_run_time():
     dog.run(3.0)
     s = dog.summary()
     assert not s["fell"] and abs(s["distance"] - x) < 0.5
-    assert np.all(dog.memory[C.M_STATE:C.M_STATE + 4] == C.F_GROUND)
+    assert np.all(dog.memory[C.MEM.state:C.MEM.state + 4] == C.F_GROUND)
 
 
 def test_live_hook_for_the_viewer():
@@ -220,12 +220,12 @@ def test_live_hook_for_the_viewer():
     spec = qd.live(gait="stand")
     sim, ctrl = spec["sim"], spec["controller"]
     sim.run(0.5, controller=ctrl)
-    assert ctrl.memory[C.M_STEP_I] == 0
+    assert ctrl.memory[C.MEM.step_i] == 0
     spec["on_gait"](spec["gait_keys"]["w"])
     spec["gains"]["speed [m/s]"][3](0.3)
     x0 = float(sim.state.q[0, 0])
     sim.run(2.0, controller=ctrl)
-    assert ctrl.memory[C.M_STEP_I] >= 3 and sim.state.q[0, 0] - x0 > 0.2
+    assert ctrl.memory[C.MEM.step_i] >= 3 and sim.state.q[0, 0] - x0 > 0.2
 
 
 @pytest.mark.parametrize("spec", ["hills", "slope:5", "slope:-5"])

@@ -11,7 +11,7 @@ import pytest
 import planarsim as ps
 from planarsim import terrain as T
 from walkers import simple_biped as sb
-from walkers.simple_biped.controller import M_SPEED, Controller, State
+from walkers.simple_biped.controller import MEM, Controller, State
 
 PARAMS = sb.SimpleBipedParams()
 L0 = PARAMS.leg_length
@@ -38,7 +38,7 @@ def assert_walked(walker, traj, distance):
     assert hip_clearance(traj, walker.model).min() > 0.6 * L0
     assert walker.model.contact_names == ("foot0", "foot1")
     # walking means stepping, with both feet on the ground in turn
-    assert walker.summary()["steps"] >= distance / (2 * PARAMS.step_length(walker.memory[M_SPEED]))
+    assert walker.summary()["steps"] >= distance / (2 * PARAMS.step_length(walker.memory[MEM.speed]))
 
 
 def speed_over_last(traj, distance):

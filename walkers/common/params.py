@@ -1,11 +1,11 @@
 """What every walker's parameter dataclass shares: fields with unit, doc and bounds, the
-bounds check on construction, the float64 vector the compiled controller reads, and the
-``I_<FIELD>`` index constants (written out in each params.py; index_constants checks them).
+bounds check on construction and the float64 vector the compiled controller reads, by
+name through walkers.common.slots.param_slots.
 
 >>> @dataclass(frozen=True)                                          # doctest: +SKIP
 ... class MyParams(WalkerParams):
 ...     hip_mass: float = param(10.0, "kg", "hip point mass", 0.1, 1e3)
->>> I_HIP_MASS, N_PARAMS = 0, 1    # written out; index_constants(MyParams) checks them in a test
+>>> FIELD = param_slots(MyParams)   # doctest: +SKIP   compiled code reads p[FIELD.hip_mass]
 """
 from __future__ import annotations
 
@@ -44,7 +44,7 @@ class WalkerParams:
                 object.__setattr__(self, f.name, int(value))
 
     def to_array(self) -> np.ndarray:
-        """Every field as float64 in declaration order (index with the I_<FIELD> constants)."""
+        """Every field as float64 in declaration order (read by name: slots.param_slots)."""
         return np.array([float(getattr(self, f.name)) for f in fields(self)])
 
     def as_dict(self) -> dict:
@@ -99,15 +99,6 @@ class WalkerParams:
         """One line per field: name, default, unit, doc."""
         return "\n".join(f"{f.name:22s} {f.default!s:>9} {f.metadata['unit']:10s} {f.metadata['doc']}"
                          for f in fields(cls))
-
-
-def index_constants(cls) -> dict:
-    """{"I_<FIELD>": index, ..., "N_PARAMS": count}: what a params module's written-out
-    compile-time constants must be (tests/walkers/test_param_indices.py checks them)."""
-    names = [f.name for f in fields(cls)]
-    out = {f"I_{name.upper()}": i for i, name in enumerate(names)}
-    out["N_PARAMS"] = len(names)
-    return out
 
 
 def _is_int_field(f) -> bool:

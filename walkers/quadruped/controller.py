@@ -50,14 +50,10 @@ import numpy as np
 from planarsim.compiled import jit, jit_inline, kernel, pin_angle_rate, height, height_derivs
 
 from walkers.common.pd import clamp
+from walkers.common.slots import size, slots
 
 from .model import HIP_SIGN, N_LEG, PAIR
-from .params import (I_ACCEL, I_CALF_LENGTH, I_FALL_HEIGHT, I_FALL_PITCH, I_FOOT_RADIUS, I_FOOT_STEP,
-                     I_GOAL_TOL, I_HIP_LOWER, I_HIP_UPPER, I_HIP_X, I_KD, I_KNEE_LOWER,
-                     I_KNEE_UPPER, I_KP, I_LEAD_MAX, I_LIFT_HEIGHT, I_PLACEMENT_GAIN,
-                     I_PLANT_DELAY, I_PLANT_DEPTH, I_SETTLE_TIME, I_STAND_HEIGHT, I_STANCE_TIME,
-                     I_THIGH_LENGTH, I_TORQUE_LIMIT, I_TOUCH_TIMEOUT, I_TORSO_TRACK_MAX, I_UPDATE_RATE,
-                     I_WEIGHT_FF, QuadrupedParams)
+from .params import FIELD, QuadrupedParams
 from .puppet import hip_world, leg_angles_for
 
 
@@ -76,16 +72,17 @@ class FootState(IntEnum):
 G_STAND, G_PIAFFE, G_WALK = 0, 1, 2
 F_GROUND, F_LIFT, F_PLANT = 0, 1, 2
 
-# memory layout mem[...]
-M_GAIT, M_SPEED, M_STEP_I, M_STEPS, M_FELL = 0, 1, 2, 3, 4
-M_T_UPDATE, M_READY_AT, M_X_DESIRED, M_X_PREV, M_V_EST = 5, 6, 7, 8, 9
-M_WEIGHT, M_IK_CLAMPS, M_MAX_PITCH, M_V_RAMP, M_WORK, M_PLANT_T = 10, 11, 12, 13, 14, 15
-M_STATE = 16      # foot state, per leg 16..19
-M_TARGET = 20     # puppet foot target (x, y) world, per leg: 20 + 2i, 21 + 2i
-M_GOAL = 28       # foot goal (x, y) world, per leg: 28 + 2i, 29 + 2i
-M_QREF = 36       # puppet joint angles (hip, knee) per leg: 36 + 2i, 37 + 2i
-M_FLAG = 44       # IK flags per leg 44..47
-N_MEMORY = 48
+# controller memory mem[...] (float64 vector), the fields in this order
+MEM = slots("QuadrupedMemory", (
+    "gait", "speed", "step_i", "steps", "fell", "t_update", "ready_at", "x_desired", "x_prev",
+    "v_est", "weight", "ik_clamps", "max_pitch", "v_ramp", "work", "plant_t",
+    ("state", N_LEG, "foot state, per leg"),
+    ("target", 2 * N_LEG, "puppet foot target (x, y) world, per leg: target + 2i, + 1"),
+    ("goal", 2 * N_LEG, "foot goal (x, y) world, per leg: goal + 2i, + 1"),
+    ("qref", 2 * N_LEG, "puppet joint angles (hip, knee) per leg: qref + 2i, + 1"),
+    ("flag", N_LEG, "IK flags per leg"),
+))
+N_MEMORY = size(MEM)
 
 
 @kernel
@@ -94,11 +91,11 @@ def foot_centre(s, p, i):
     # hip -> knee along the thigh, knee -> foot along the calf
     th = s.q[2 + 2 * i, 2]
     tb = 1 + 2 * i
-    l1 = p[I_THIGH_LENGTH]
-    hx, hy = hip_world(s.q[0, 0], s.q[0, 1], s.q[0, 2], HIP_SIGN[i] * p[I_HIP_X])
+    l1 = p[FIELD.thigh_length]
+    hx, hy = hip_world(s.q[0, 0], s.q[0, 1], s.q[0, 2], HIP_SIGN[i] * p[FIELD.hip_x])
     kx = hx + l1 * math.sin(s.q[tb, 2])
     ky = hy - l1 * math.cos(s.q[tb, 2])
-    return kx + p[I_CALF_LENGTH] * math.sin(th), ky - p[I_CALF_LENGTH] * math.cos(th)
+    return kx + p[FIELD.calf_length] * math.sin(th), ky - p[FIELD.calf_length] * math.cos(th)
 
 
 @kernel
@@ -106,16 +103,16 @@ def rest_height(m, p, x):
     """Height [m] of the centre of a round foot resting on the ground near x (r / cos(slope)
     above it), lowered by plant_depth."""
     h, dh, _ = height_derivs(m.terrain_coef, x)
-    return h + p[I_FOOT_RADIUS] * math.sqrt(1.0 + dh * dh) - p[I_PLANT_DEPTH]
+    return h + p[FIELD.foot_radius] * math.sqrt(1.0 + dh * dh) - p[FIELD.plant_depth]
 
 
 @kernel
 def placement_x(m, s, p, mem, i, t_left):
     """Raibert foot placement for leg i: world x of the landing goal [m]."""
-    hx, hy = hip_world(s.q[0, 0], s.q[0, 1], s.q[0, 2], HIP_SIGN[i] * p[I_HIP_X])
-    v, vc = mem[M_V_EST], mem[M_V_RAMP]
-    lead = vc * t_left + 0.5 * v * p[I_STANCE_TIME] + p[I_PLACEMENT_GAIN] * (v - vc)
-    return hx + clamp(lead, -p[I_LEAD_MAX], p[I_LEAD_MAX])
+    hx, hy = hip_world(s.q[0, 0], s.q[0, 1], s.q[0, 2], HIP_SIGN[i] * p[FIELD.hip_x])
+    v, vc = mem[MEM.v_est], mem[MEM.v_ramp]
+    lead = vc * t_left + 0.5 * v * p[FIELD.stance_time] + p[FIELD.placement_gain] * (v - vc)
+    return hx + clamp(lead, -p[FIELD.lead_max], p[FIELD.lead_max])
 
 
 @jit
@@ -124,89 +121,89 @@ def update_feet(m, s, p, mem):
     reached their goals, start the next step when all four are down (and the plant delay has
     passed), then refresh the goals of the moving feet (placement from the body velocity)."""
     t = s.time[0]
-    pair = int(mem[M_STEP_I]) % 2
+    pair = int(mem[MEM.step_i]) % 2
     # the moving pair reached its goals: next state
     reached = True
     n_lift = 0
     n_plant = 0
     for i in range(N_LEG):
-        st = mem[M_STATE + i]
+        st = mem[MEM.state + i]
         if PAIR[i] != pair or st == F_GROUND:
             continue
         n_lift += st == F_LIFT
         n_plant += st == F_PLANT
-        if math.hypot(mem[M_GOAL + 2 * i] - mem[M_TARGET + 2 * i],
-                      mem[M_GOAL + 2 * i + 1] - mem[M_TARGET + 2 * i + 1]) >= p[I_GOAL_TOL]:
+        if math.hypot(mem[MEM.goal + 2 * i] - mem[MEM.target + 2 * i],
+                      mem[MEM.goal + 2 * i + 1] - mem[MEM.target + 2 * i + 1]) >= p[FIELD.goal_tol]:
             reached = False
-        elif st == F_PLANT and s.contact_mode[i] == 0 and t < mem[M_PLANT_T] + p[I_TOUCH_TIMEOUT]:
+        elif st == F_PLANT and s.contact_mode[i] == 0 and t < mem[MEM.plant_t] + p[FIELD.touch_timeout]:
             reached = False     # ours: the real foot must touch too (or time out)
     if reached and n_lift + n_plant > 0:
         for i in range(N_LEG):
-            if PAIR[i] != pair or mem[M_STATE + i] == F_GROUND:
+            if PAIR[i] != pair or mem[MEM.state + i] == F_GROUND:
                 continue
             if n_lift > 0:
-                mem[M_STATE + i] = F_PLANT
-                mem[M_PLANT_T] = t
+                mem[MEM.state + i] = F_PLANT
+                mem[MEM.plant_t] = t
             else:
-                mem[M_STATE + i] = F_GROUND
-                mem[M_READY_AT] = t + p[I_PLANT_DELAY]
+                mem[MEM.state + i] = F_GROUND
+                mem[MEM.ready_at] = t + p[FIELD.plant_delay]
         if n_lift == 0:
-            mem[M_STEPS] += 1.0     # a pair has landed: one step
+            mem[MEM.steps] += 1.0     # a pair has landed: one step
     # all four feet down: the next pair lifts
     n_ground = 0
     for i in range(N_LEG):
-        n_ground += mem[M_STATE + i] == F_GROUND
-    if n_ground == N_LEG and mem[M_GAIT] != G_STAND and t >= mem[M_READY_AT]:
-        mem[M_STEP_I] += 1.0
+        n_ground += mem[MEM.state + i] == F_GROUND
+    if n_ground == N_LEG and mem[MEM.gait] != G_STAND and t >= mem[MEM.ready_at]:
+        mem[MEM.step_i] += 1.0
         for i in range(N_LEG):
-            if PAIR[i] == int(mem[M_STEP_I]) % 2:
-                mem[M_STATE + i] = F_LIFT
+            if PAIR[i] == int(mem[MEM.step_i]) % 2:
+                mem[MEM.state + i] = F_LIFT
     # goals of the moving feet follow the body
-    foot_speed = p[I_FOOT_STEP] * p[I_UPDATE_RATE]
+    foot_speed = p[FIELD.foot_step] * p[FIELD.update_rate]
     for i in range(N_LEG):
-        st = mem[M_STATE + i]
+        st = mem[MEM.state + i]
         if st == F_GROUND:
             continue
-        tx, ty = mem[M_TARGET + 2 * i], mem[M_TARGET + 2 * i + 1]
+        tx, ty = mem[MEM.target + 2 * i], mem[MEM.target + 2 * i + 1]
         # time the puppet foot still needs to reach the ground (heights above the ground)
         up = ty - height(m.terrain_coef, tx)
         rest = rest_height(m, p, tx) - height(m.terrain_coef, tx)
-        path = (p[I_LIFT_HEIGHT] - up) + (p[I_LIFT_HEIGHT] - rest) if st == F_LIFT else up - rest
+        path = (p[FIELD.lift_height] - up) + (p[FIELD.lift_height] - rest) if st == F_LIFT else up - rest
         t_left = max(path, 0.0) / foot_speed
         gx = placement_x(m, s, p, mem, i, t_left)
-        mem[M_GOAL + 2 * i] = gx
-        mem[M_GOAL + 2 * i + 1] = (height(m.terrain_coef, gx) + p[I_LIFT_HEIGHT] if st == F_LIFT
+        mem[MEM.goal + 2 * i] = gx
+        mem[MEM.goal + 2 * i + 1] = (height(m.terrain_coef, gx) + p[FIELD.lift_height] if st == F_LIFT
                                    else rest_height(m, p, gx))
 
 
 @kernel
 def move_targets(m, s, p, mem):
     """Move each puppet foot towards its goal at foot_step * update_rate [m/s]."""
-    dmax = p[I_FOOT_STEP] * p[I_UPDATE_RATE] * m.dt
+    dmax = p[FIELD.foot_step] * p[FIELD.update_rate] * m.dt
     for i in range(N_LEG):
-        if mem[M_STATE + i] == F_GROUND:
+        if mem[MEM.state + i] == F_GROUND:
             continue
-        dx = mem[M_GOAL + 2 * i] - mem[M_TARGET + 2 * i]
-        dy = mem[M_GOAL + 2 * i + 1] - mem[M_TARGET + 2 * i + 1]
+        dx = mem[MEM.goal + 2 * i] - mem[MEM.target + 2 * i]
+        dy = mem[MEM.goal + 2 * i + 1] - mem[MEM.target + 2 * i + 1]
         d = math.hypot(dx, dy)
         f = 1.0 if d <= dmax else dmax / d
-        mem[M_TARGET + 2 * i] += f * dx
-        mem[M_TARGET + 2 * i + 1] += f * dy
+        mem[MEM.target + 2 * i] += f * dx
+        mem[MEM.target + 2 * i + 1] += f * dy
 
 
 @jit
 def command_speed(mem):
     """Commanded forward speed of the current gait [m/s] (0 in STAND and PIAFFE)."""
-    return mem[M_SPEED] if mem[M_GAIT] == G_WALK else 0.0
+    return mem[MEM.speed] if mem[MEM.gait] == G_WALK else 0.0
 
 
 @kernel
 def ramp_speed(m, s, p, mem):
     """The puppet torso's speed [m/s]: 0 until settle_time, then towards the command at accel."""
-    if s.time[0] >= p[I_SETTLE_TIME]:
-        dv = p[I_ACCEL] * m.dt
-        mem[M_V_RAMP] = clamp(command_speed(mem), mem[M_V_RAMP] - dv, mem[M_V_RAMP] + dv)
-    return mem[M_V_RAMP]
+    if s.time[0] >= p[FIELD.settle_time]:
+        dv = p[FIELD.accel] * m.dt
+        mem[MEM.v_ramp] = clamp(command_speed(mem), mem[MEM.v_ramp] - dv, mem[MEM.v_ramp] + dv)
+    return mem[MEM.v_ramp]
 
 
 @kernel
@@ -215,7 +212,7 @@ def stance_forces(s, p, mem, xc):
     the torso COM x = xc; all of it on one end when only that end is down)."""
     xf, xr, nf, nr = 0.0, 0.0, 0, 0
     for i in range(N_LEG):
-        if mem[M_STATE + i] != F_GROUND:
+        if mem[MEM.state + i] != F_GROUND:
             continue
         x, _ = foot_centre(s, p, i)
         if HIP_SIGN[i] > 0:
@@ -224,7 +221,7 @@ def stance_forces(s, p, mem, xc):
         else:
             xr += x
             nr += 1
-    w = p[I_WEIGHT_FF] * mem[M_WEIGHT]
+    w = p[FIELD.weight_ff] * mem[MEM.weight]
     if nf == 0 and nr == 0:
         return 0.0, 0.0
     if nr == 0:
@@ -244,37 +241,37 @@ def control(m, s, ws, p, mem, u):
     t, dt = s.time[0], m.dt
     tx, ty, th = s.q[0, 0], s.q[0, 1], s.q[0, 2]
     # fall monitor
-    if ty - height(m.terrain_coef, tx) < p[I_FALL_HEIGHT] or abs(th) > p[I_FALL_PITCH]:
-        mem[M_FELL] = 1.0
-    mem[M_MAX_PITCH] = max(mem[M_MAX_PITCH], abs(th))
+    if ty - height(m.terrain_coef, tx) < p[FIELD.fall_height] or abs(th) > p[FIELD.fall_pitch]:
+        mem[MEM.fell] = 1.0
+    mem[MEM.max_pitch] = max(mem[MEM.max_pitch], abs(th))
     # the post's step() at update_rate, with the torso speed over the last period
-    if t >= mem[M_T_UPDATE] - 1e-9:
-        period = 1.0 / p[I_UPDATE_RATE]
-        mem[M_V_EST] = (tx - mem[M_X_PREV]) / period
-        mem[M_X_PREV] = tx
-        mem[M_T_UPDATE] += period
+    if t >= mem[MEM.t_update] - 1e-9:
+        period = 1.0 / p[FIELD.update_rate]
+        mem[MEM.v_est] = (tx - mem[MEM.x_prev]) / period
+        mem[MEM.x_prev] = tx
+        mem[MEM.t_update] += period
         update_feet(m, s, p, mem)
     move_targets(m, s, p, mem)
     # the puppet's torso: x_d runs at the command, tied to the measured torso
-    lead = p[I_TORSO_TRACK_MAX]
-    xd = clamp(mem[M_X_DESIRED] + ramp_speed(m, s, p, mem) * dt, tx - lead, tx + lead)
-    mem[M_X_DESIRED] = xd
-    yd = height(m.terrain_coef, xd) + p[I_STAND_HEIGHT]
+    lead = p[FIELD.torso_track_max]
+    xd = clamp(mem[MEM.x_desired] + ramp_speed(m, s, p, mem) * dt, tx - lead, tx + lead)
+    mem[MEM.x_desired] = xd
+    yd = height(m.terrain_coef, xd) + p[FIELD.stand_height]
     f_front, f_rear = stance_forces(s, p, mem, tx)
-    l1, l2 = p[I_THIGH_LENGTH], p[I_CALF_LENGTH]
-    kp, kd, lim = p[I_KP], p[I_KD], p[I_TORQUE_LIMIT]
+    l1, l2 = p[FIELD.thigh_length], p[FIELD.calf_length]
+    kp, kd, lim = p[FIELD.kp], p[FIELD.kd], p[FIELD.torque_limit]
     for i in range(N_LEG):
-        ground = mem[M_STATE + i] == F_GROUND
+        ground = mem[MEM.state + i] == F_GROUND
         # stance legs: posed to the desired torso; swing legs: to the measured torso
         px, py, pth = (xd, yd, 0.0) if ground else (tx, ty, th)
-        q1, q2, flag = leg_angles_for(mem[M_TARGET + 2 * i], mem[M_TARGET + 2 * i + 1], px, py, pth,
-                                      HIP_SIGN[i] * p[I_HIP_X], l1, l2, p[I_HIP_LOWER], p[I_HIP_UPPER],
-                                      p[I_KNEE_LOWER], p[I_KNEE_UPPER])
-        mem[M_QREF + 2 * i] = q1
-        mem[M_QREF + 2 * i + 1] = q2
-        mem[M_FLAG + i] = flag
+        q1, q2, flag = leg_angles_for(mem[MEM.target + 2 * i], mem[MEM.target + 2 * i + 1], px, py, pth,
+                                      HIP_SIGN[i] * p[FIELD.hip_x], l1, l2, p[FIELD.hip_lower], p[FIELD.hip_upper],
+                                      p[FIELD.knee_lower], p[FIELD.knee_upper])
+        mem[MEM.qref + 2 * i] = q1
+        mem[MEM.qref + 2 * i + 1] = q2
+        mem[MEM.flag + i] = flag
         if flag != 0:
-            mem[M_IK_CLAMPS] += 1.0
+            mem[MEM.ik_clamps] += 1.0
         # weight feed-forward tau = -J^T (0, F) of a foot on the ground
         fy = 0.0
         if ground:
@@ -287,27 +284,27 @@ def control(m, s, ws, p, mem, u):
             pin = 2 * i + j
             ang, rate = pin_angle_rate(m, s.q, s.v, pin)
             ff = ff_hip if j == 0 else ff_knee
-            u[pin] = clamp(kp * (mem[M_QREF + pin] - ang) - kd * rate + ff, -lim, lim)
+            u[pin] = clamp(kp * (mem[MEM.qref + pin] - ang) - kd * rate + ff, -lim, lim)
             # positive mechanical work of the motors [J] (power at the start of the step)
-            mem[M_WORK] += max(u[pin] * rate, 0.0) * dt
+            mem[MEM.work] += max(u[pin] * rate, 0.0) * dt
 
 
 def make_memory(model, params: QuadrupedParams, gait: int, speed: float) -> np.ndarray:
     """Controller memory for a run starting from the model's build pose."""
     mem = np.zeros(N_MEMORY)
-    mem[M_GAIT] = gait
-    mem[M_SPEED] = speed
-    mem[M_WEIGHT] = 9.81 * float(np.sum(model.arrays.body_mass))
-    mem[M_READY_AT] = params.settle_time
+    mem[MEM.gait] = gait
+    mem[MEM.speed] = speed
+    mem[MEM.weight] = 9.81 * float(np.sum(model.arrays.body_mass))
+    mem[MEM.ready_at] = params.settle_time
     x0 = float(model.q0[0, 0])
-    mem[M_X_DESIRED] = mem[M_X_PREV] = x0
+    mem[MEM.x_desired] = mem[MEM.x_prev] = x0
     p = params.to_array()
 
     class _S:  # the build pose as a state-like object for foot_centre
         q = np.ascontiguousarray(model.q0)
     for i in range(N_LEG):
-        mem[M_TARGET + 2 * i], mem[M_TARGET + 2 * i + 1] = foot_centre.py_func(_S, p, i)
-        mem[M_GOAL + 2 * i], mem[M_GOAL + 2 * i + 1] = mem[M_TARGET + 2 * i], mem[M_TARGET + 2 * i + 1]
+        mem[MEM.target + 2 * i], mem[MEM.target + 2 * i + 1] = foot_centre.py_func(_S, p, i)
+        mem[MEM.goal + 2 * i], mem[MEM.goal + 2 * i + 1] = mem[MEM.target + 2 * i], mem[MEM.target + 2 * i + 1]
     return mem
 
 

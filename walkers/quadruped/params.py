@@ -25,9 +25,10 @@ foot, as on the A1). The A1's joint angles map as hip = -thigh_A1, knee = -calf_
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from walkers.common.params import WalkerParams, param as _p
+from walkers.common.slots import param_slots
 
 
 
@@ -120,49 +121,5 @@ def leg_reach(p: QuadrupedParams):
     return d(p.knee_upper), d(p.knee_lower)
 
 
-PARAM_NAMES = tuple(f.name for f in fields(QuadrupedParams))
-PARAM_INDEX = {n: i for i, n in enumerate(PARAM_NAMES)}
-# the index of each field in to_array(): compile-time constants for the controller, written
-# out so that they can be read and searched (a test checks them against the field order)
-I_TORSO_MASS = 0
-I_TORSO_INERTIA = 1
-I_TORSO_LENGTH = 2
-I_TORSO_HEIGHT = 3
-I_HIP_X = 4
-I_THIGH_LENGTH = 5
-I_CALF_LENGTH = 6
-I_THIGH_MASS = 7
-I_THIGH_COM = 8
-I_THIGH_INERTIA = 9
-I_CALF_MASS = 10
-I_CALF_COM = 11
-I_CALF_INERTIA = 12
-I_ARMATURE = 13
-I_FOOT_RADIUS = 14
-I_FRICTION = 15
-I_HIP_LOWER = 16
-I_HIP_UPPER = 17
-I_KNEE_LOWER = 18
-I_KNEE_UPPER = 19
-I_TORQUE_LIMIT = 20
-I_KP = 21
-I_KD = 22
-I_WEIGHT_FF = 23
-I_STAND_HEIGHT = 24
-I_UPDATE_RATE = 25
-I_FOOT_STEP = 26
-I_LIFT_HEIGHT = 27
-I_PLANT_DEPTH = 28
-I_PLANT_DELAY = 29
-I_TOUCH_TIMEOUT = 30
-I_SETTLE_TIME = 31
-I_GOAL_TOL = 32
-I_SPEED = 33
-I_ACCEL = 34
-I_STANCE_TIME = 35
-I_PLACEMENT_GAIN = 36
-I_LEAD_MAX = 37
-I_TORSO_TRACK_MAX = 38
-I_FALL_HEIGHT = 39
-I_FALL_PITCH = 40
-N_PARAMS = 41
+# the slot of each field in to_array(), by name: compiled code reads p[FIELD.torso_mass]
+FIELD = param_slots(QuadrupedParams)

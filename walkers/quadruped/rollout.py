@@ -22,6 +22,7 @@ import planarsim as ps
 
 from walkers.base import WalkerRun, simulation, terrain_of
 from walkers.common.record import record_labelled
+from walkers.common.slots import label_slots
 
 from . import controller as C
 from .model import build
@@ -29,8 +30,9 @@ from .params import QuadrupedParams
 
 LABELS = ("gait", "step_i", "state_FL", "state_FR", "state_RL", "state_RR", "speed_estimate",
           "x_desired")
-LABEL_SLOTS = np.array([C.M_GAIT, C.M_STEP_I, C.M_STATE, C.M_STATE + 1, C.M_STATE + 2,
-                        C.M_STATE + 3, C.M_V_EST, C.M_X_DESIRED], dtype=np.int64)
+# the memory fields recorded under those names
+LABEL_SLOTS = label_slots(C.MEM, ("gait", "step_i", "state:0", "state:1", "state:2", "state:3",
+                                  "v_est", "x_desired"))
 GAITS = tuple(g.name.lower() for g in C.Gait)
 
 
@@ -41,7 +43,7 @@ def rollout_quadruped(m, s, ws, opt, p, mem, u, n, every, rec, lab, slots, k0):
     k = k0
     for i in range(n):
         C.control(m, s, ws, p, mem, u)
-        if mem[C.M_FELL] != 0.0:
+        if mem[C.MEM.fell] != 0.0:
             return RUN_FELL, i, k
         code = step(m, s, ws, opt, u)
         if code != 0:
@@ -68,7 +70,7 @@ class Quadruped(WalkerRun):
 
     NAME = "quadruped"
     LABELS = LABELS
-    FELL_SLOT = C.M_FELL
+    FELL_SLOT = C.MEM.fell
     ROLLOUT = staticmethod(rollout_quadruped)
     LABEL_SLOTS = LABEL_SLOTS
 
@@ -81,16 +83,16 @@ class Quadruped(WalkerRun):
             state.q[:, 1] += 0.005 * np.random.default_rng(seed).uniform()
         memory = C.make_memory(model, params, C.gait_id(gait),
                                params.speed if speed is None else float(speed))
-        memory[C.M_TARGET + 1:C.M_TARGET + 8:2] += state.q[0, 1] - model.q0[0, 1]
+        memory[C.MEM.target + 1:C.MEM.target + 8:2] += state.q[0, 1] - model.q0[0, 1]
         super().__init__(model, params, params.to_array(), memory, state=state,
                          options=ps.make_options(strategy), record_every=record_every)
         self.x_start = float(self.state.q[0, 0])
 
     def set_gait(self, gait, speed=None) -> None:
         """Switch gait ("stand" | "piaffe" | "walk") and optionally the speed [m/s] at run time."""
-        self.memory[C.M_GAIT] = C.gait_id(gait)
+        self.memory[C.MEM.gait] = C.gait_id(gait)
         if speed is not None:
-            self.memory[C.M_SPEED] = float(speed)
+            self.memory[C.MEM.speed] = float(speed)
 
     @property
     def p(self) -> np.ndarray:
@@ -103,14 +105,14 @@ class Quadruped(WalkerRun):
         cost_of_transport = positive motor work / (m g |distance|) (NaN below 0.1 m)."""
         t = self.time
         dist = float(self.state.q[0, 0]) - self.x_start
-        weight = float(self.memory[C.M_WEIGHT])
-        cot = float(self.memory[C.M_WORK]) / (weight * abs(dist)) if abs(dist) >= 0.1 else float("nan")
+        weight = float(self.memory[C.MEM.weight])
+        cot = float(self.memory[C.MEM.work]) / (weight * abs(dist)) if abs(dist) >= 0.1 else float("nan")
         return {"time": t, "distance": dist, "mean_speed": dist / t if t > 0 else 0.0,
-                "steps": int(self.memory[C.M_STEPS]), "fell": self.fell, "falls": int(self.fell),
-                "max_pitch_deg": float(np.degrees(self.memory[C.M_MAX_PITCH])),
-                "ik_clamps": int(self.memory[C.M_IK_CLAMPS]),
-                "motor_work_positive": float(self.memory[C.M_WORK]), "cost_of_transport": cot,
-                "gait": C.Gait(int(self.memory[C.M_GAIT])).name.lower(),
+                "steps": int(self.memory[C.MEM.steps]), "fell": self.fell, "falls": int(self.fell),
+                "max_pitch_deg": float(np.degrees(self.memory[C.MEM.max_pitch])),
+                "ik_clamps": int(self.memory[C.MEM.ik_clamps]),
+                "motor_work_positive": float(self.memory[C.MEM.work]), "cost_of_transport": cot,
+                "gait": C.Gait(int(self.memory[C.MEM.gait])).name.lower(),
                 "speed_command": float(C.command_speed(self.memory))}
 
 
@@ -129,17 +131,17 @@ def live(gait="walk", terrain=None, speed=None, params=None, strategy="all") -> 
     mem = ctrl.memory
 
     def on_gait(name):
-        mem[C.M_GAIT] = C.gait_id(name)
+        mem[C.MEM.gait] = C.gait_id(name)
 
     def set_kp(x):
-        ctrl.p[C.I_KP] = float(x)
+        ctrl.p[C.FIELD.kp] = float(x)
 
     def labels(_sim):
-        return {"gait": mem[C.M_GAIT], "step_i": mem[C.M_STEP_I]}
+        return {"gait": mem[C.MEM.gait], "step_i": mem[C.MEM.step_i]}
 
     return dict(sim=sim, controller=ctrl, on_gait=on_gait,
                 gait_keys={"w": "walk", "p": "piaffe", "s": "stand"},
-                gains={"speed [m/s]": (-0.5, 0.5, lambda: float(mem[C.M_SPEED]),
-                                       lambda x: mem.__setitem__(C.M_SPEED, float(x))),
-                       "kp [N m/rad]": (10.0, 300.0, lambda: float(ctrl.p[C.I_KP]), set_kp)},
+                gains={"speed [m/s]": (-0.5, 0.5, lambda: float(mem[C.MEM.speed]),
+                                       lambda x: mem.__setitem__(C.MEM.speed, float(x))),
+                       "kp [N m/rad]": (10.0, 300.0, lambda: float(ctrl.p[C.FIELD.kp]), set_kp)},
                 labels=labels, label_names={"gait": {int(g): g.name.lower() for g in C.Gait}})

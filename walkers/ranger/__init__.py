@@ -6,24 +6,19 @@ model, FSM WALK / STAND / GUI with a step-to-step push-off feedback, cost of tra
 
 Choices (numbers in params.py, each with its reason):
 - Contact-mode strategy: Kelly's "alternating" by default (RangerSim(strategy=...)); "all"
-  also walks 1000 steps, fresh or after 0.3 s / 2 s of STAND (measured on a6cac2a; on c758571,
-  whose capped rounds could leave a sliding contact with a pulling impulse, one 'all' run
-  after 0.3 s of STAND blew up at t = 23.6 s).
+  also walks 1000 steps, fresh or after 0.3 s / 2 s of STAND (measured on a6cac2a).
 - Rotor inertia: the ankle rotor's G^2 Jm is added to the foot body (armature), and ankle
   currents on a foot in the air are capped (free_foot_max_accel), see model.py/controller.py.
 - Poses: every run starts at rest in the STAND pose (hip centred over feet 0.19 m apart). WALK
   gets going from it through the controller's START phase (a double stance whose rear-foot
   push uses start_push_current until the front leg is past start_leg_angle), whether WALK is
   asked for at the start or set on a running STAND (Controller.set_gait).
-- Step options: the engine defaults (cap_policy=1), rollout.step_options(). A landing foot
-  that comes down on its heel (the sole arc's back end, a vertex) while sliding forward is in
-  Painleve's configuration (sliding friction would drive it into the ground: A_nn < mu A_nt;
-  measured A_nn 0.10, A_nt 0.30 [1/kg] at mu 0.8): engaged sliding it pulls, is released,
-  penetrates, is engaged again, ... until the mode-round cap. cap_policy=0 leaves it free there
-  (the old gait relied on the heel sinking for a few ms); cap_policy=1 gives it a frictionless
-  normal impulse for that step (engine a6cac2a; sticking it before). The gait parameters are
-  tuned under cap_policy=1 (on c758571); the settled gait lands on the arc and meets the cap
-  3 or 4 times in 120 s (the first at t = 0; measured on c758571 and a6cac2a).
+- Step options: the engine defaults, rollout.step_options(). A landing foot that comes down
+  on its heel (the sole arc's back end, a vertex) while sliding forward is in Painleve's
+  configuration (sliding friction would drive it into the ground: A_nn < mu A_nt; measured
+  A_nn 0.10, A_nt 0.30 [1/kg] at mu 0.8): the step's contact problem then has no answer with
+  friction, and the engine's frictionless rule gives the foot a normal impulse for that step
+  (planarsim/kernels/complementarity.py; the audit's `fallback` counts it).
 - Figures: ``python benchmarks/ranger.py --repeats 3 --steps 1000``.
 """
 from pathlib import Path as _Path

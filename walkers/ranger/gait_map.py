@@ -1,8 +1,8 @@
 """Step-to-step map of the walking Ranger, for planarsim.analysis.
 
 Section: the controller's own mid-stance event (controller.choose_programs: the stance leg
-passes vertical in single stance, M_MID_DONE 0 -> 1, and the step-to-step feedback sets this
-step's push-off current M_PUSH_I from the hip speed, i.e. the memory that would carry the
+passes vertical in single stance, MEM.mid_done 0 -> 1, and the step-to-step feedback sets this
+step's push-off current MEM.push_i from the hip speed, i.e. the memory that would carry the
 previous step over is rewritten from the state here). The section state is the simulation
 just BEFORE the ``control`` call that fires the event: State, the last step's contact
 impulses (the estimator's input), and the controller memory before that call (so replaying the
@@ -19,7 +19,7 @@ only true crossings (stance leg within CROSS_TOL of vertical): with the shipped 
 landing foot bounces, the estimator swaps the stance to the trailing leg for a few ms and the
 mid-stance feedback fires there too, far behind vertical.
 
-Findings (dt = 1 ms, shipped parameters, engine default StepOptions (cap_policy=1); figures
+Findings (dt = 1 ms, shipped parameters, engine default StepOptions; figures
 from ``python -c "from walkers.ranger.gait_map import RangerGaitMap; ..."``, see the test file):
 the map is piecewise smooth with small jumps: the controller acts at 1 ms steps (contact
 engagement, estimator hysteresis, program switches and the section event itself fall on step
@@ -30,9 +30,9 @@ parameter), so the Jacobian here is a least-squares slope over perturbations of 
 per coordinate, eps = 1e-2 (EPS), whose radius is consistent across eps = 2e-3..2e-2 (0.2..0.8
 measured on the shipped and on nearby parameter sets).
 The shipped gait settles on an exactly repeating stride on the engine at c758571
-(|P(x0) - x0| = 3e-7: every event falls on the same step each stride); with the pending
-frictionless cap rule in planarsim/kernels/step.py it wanders within 1.9e-2 (spectral radius
-0.48), and nearby parameter sets (1 % changes) mostly wander as well, within
+(|P(x0) - x0| = 3e-7: every event falls on the same step each stride); with the engine's
+frictionless rule for a heel landing in Painleve's configuration it wanders within 1.9e-2
+(spectral radius 0.48), and nearby parameter sets (1 % changes) mostly wander as well, within
 ~2e-2 of a mean section state (the jump scale) with multipliers of the same size (4 of 11 sets
 measured return within 1e-3, spectral radius 0.37..0.78).
 A perturbation rolls the stance foot on its sole (flat ground) and rebuilds every body pose
@@ -51,7 +51,7 @@ from planarsim.compiled import (RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, 
 
 from walkers.common.section import GaitMapMixin, chain_poses, chain_velocities, copy_tuple, restore_tuple
 
-from . import controller as C
+from . import controller as C, tables as T
 from .rollout import RangerSim
 
 NAMES = ("stance_foot_angle", "swing_leg_angle", "swing_foot_angle", "stance_leg_rate",
@@ -79,9 +79,9 @@ def rollout_to_midstance(m, s, ws, opt, tab, mem, mem_before, u, side, cross_tol
         for j in range(mem.shape[0]):
             mem_before[j] = mem[j]
         C.control(m, s, ws, tab, mem, u)
-        st = int(mem[C.M_STANCE])
-        if (mem_before[C.M_MID_DONE] == 0.0 and mem[C.M_MID_DONE] == 1.0 and st == side
-                and int(mem_before[C.M_STANCE]) == side and s.q[st, 2] > -cross_tol):
+        st = int(mem[C.MEM.stance])
+        if (mem_before[C.MEM.mid_done] == 0.0 and mem[C.MEM.mid_done] == 1.0 and st == side
+                and int(mem_before[C.MEM.stance]) == side and s.q[st, 2] > -cross_tol):
             count += 1
             if count >= n_events:
                 for j in range(mem.shape[0]):
@@ -90,7 +90,7 @@ def rollout_to_midstance(m, s, ws, opt, tab, mem, mem_before, u, side, cross_tol
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i
-        if mem[C.M_FELL] != 0.0:
+        if mem[C.MEM.fell] != 0.0:
             return RUN_FELL, i + 1
     return RUN_NO_EVENT, max_steps
 
@@ -113,7 +113,7 @@ class RangerGaitMap(GaitMapMixin):
         self.rs = rs = RangerSim(params, dt=dt, gait="walk", max_steps=16)
         self.model = rs.model
         self.m = rs.model.arrays
-        self.tables = rs.tables._replace(steplog=np.zeros((16, C.N_LOG)))
+        self.tables = rs.tables._replace(steplog=np.zeros((16, T.N_LOG)))
         self.mem_before = np.zeros_like(rs.memory)
         self.max_steps = int(round(3.0 / dt))
         self.stance = int(stance)
@@ -156,10 +156,10 @@ class RangerGaitMap(GaitMapMixin):
 
     # coordinates ---------------------------------------------------------------------------------
     def coords(self, s, mem) -> np.ndarray:
-        st = int(mem[C.M_STANCE])
+        st = int(mem[C.MEM.stance])
         sw = 1 - st
         q, v = s.q, s.v
-        z = mem[C.M_FILT:C.M_FILT + 4]
+        z = mem[C.MEM.filt:C.MEM.filt + 4]
         return np.array([q[2 + st, 2], q[sw, 2], q[2 + sw, 2], v[st, 2], v[sw, 2], v[2 + st, 2],
                          v[2 + sw, 2], z[0], z[1], z[2], z[3]])
 
@@ -208,7 +208,7 @@ class RangerGaitMap(GaitMapMixin):
         self.s.q[:, :2] += pos_new - pos_ref
         self.s.q[:, 2] = ang
         self.s.v[:] += vel_new - vel_ref
-        self.mem[C.M_FILT:C.M_FILT + 4] += d[7:11]
+        self.mem[C.MEM.filt:C.MEM.filt + 4] += d[7:11]
 
     def advance(self, x) -> np.ndarray:
         """One stride (two mid-stances) from section coordinates x; the coordinates after it."""

@@ -21,6 +21,7 @@ from planarsim.trajectory import Trajectory
 
 from walkers.base import WalkerRun, simulation, terrain_of
 from walkers.common.record import record_labelled
+from walkers.common.slots import label_slots
 
 from . import controller as C
 from . import tables as T
@@ -28,16 +29,17 @@ from .controller import Controller, control
 from .model import build
 from .params import RangerParams
 
-# controller memory recorded with every frame (Trajectory.labels)
-LABELS = {"gait": C.M_GAIT, "phase": C.M_PHASE, "stance": C.M_STANCE,
-          "load_outer": C.M_RAW, "load_inner": C.M_RAW + 1,
-          "load_filtered_outer": C.M_SIG, "load_filtered_inner": C.M_SIG + 1,
-          "contact_outer": C.M_CONTACT, "contact_inner": C.M_CONTACT + 1,
-          "program_hip": C.M_PROG, "program_outer_ankle": C.M_PROG + 1, "program_inner_ankle": C.M_PROG + 2,
-          "current_hip": C.M_CUR, "current_outer_ankle": C.M_CUR + 1, "current_inner_ankle": C.M_CUR + 2,
-          "power_hip": C.M_PEL, "power_outer_ankle": C.M_PEL + 1, "power_inner_ankle": C.M_PEL + 2,
-          "push_current": C.M_PUSH_I, "steps": C.M_STEPS}
-LABEL_INDEX = np.array(list(LABELS.values()), dtype=np.int64)
+# controller memory recorded with every frame (Trajectory.labels): label -> memory field
+# ("field:k": its slot k)
+LABELS = {"gait": "gait", "phase": "phase", "stance": "stance",
+          "load_outer": "raw", "load_inner": "raw:1",
+          "load_filtered_outer": "sig", "load_filtered_inner": "sig:1",
+          "contact_outer": "contact", "contact_inner": "contact:1",
+          "program_hip": "prog", "program_outer_ankle": "prog:1", "program_inner_ankle": "prog:2",
+          "current_hip": "cur", "current_outer_ankle": "cur:1", "current_inner_ankle": "cur:2",
+          "power_hip": "pel", "power_outer_ankle": "pel:1", "power_inner_ankle": "pel:2",
+          "push_current": "push_i", "steps": "steps"}
+LABEL_INDEX = label_slots(C.MEM, LABELS.values())
 GAITS = ("walk", "stand", "gui")
 
 
@@ -52,14 +54,13 @@ def rollout_ranger(m, s, ws, opt, tab, mem, u, n, every, rec, lab, lab_idx, k0):
         if code != 0:
             return code, i, kf
         kf = record_labelled(s, ws, rec, lab, mem, lab_idx, every, kf)
-        if mem[C.M_FELL] != 0.0:
+        if mem[C.MEM.fell] != 0.0:
             return 0, i + 1, kf
     return 0, n, kf
 
 
 def step_options(strategy: str = "alternating") -> ps.StepOptions:
-    """Ranger's StepOptions: the engine defaults (cap_policy=1: a contact engaged in a step
-    whose mode rounds hit the cap sticks) with the chosen contact-mode strategy."""
+    """Ranger's StepOptions: the engine defaults with the chosen contact-mode strategy."""
     return ps.make_options(strategy)
 
 
@@ -75,7 +76,7 @@ class RangerSim(WalkerRun):
 
     NAME = "ranger"
     LABELS = tuple(LABELS)
-    FELL_SLOT = C.M_FELL
+    FELL_SLOT = C.MEM.fell
     ROLLOUT = staticmethod(rollout_ranger)
     LABEL_SLOTS = LABEL_INDEX
 
@@ -99,7 +100,7 @@ class RangerSim(WalkerRun):
 
     @property
     def steps(self) -> int:
-        return int(self.memory[C.M_STEPS])
+        return int(self.memory[C.MEM.steps])
 
     def hip(self):
         """Hip position [m]."""
@@ -111,7 +112,7 @@ class RangerSim(WalkerRun):
         """Distance, speed, steps and whole-step costs of transport from the step log (see the
         module doc)."""
         mem, model, p = self.memory, self.model, self.params
-        n = int(mem[C.M_STEPS])
+        n = int(mem[C.MEM.steps])
         log = self.tables.steplog[:min(n, len(self.tables.steplog))]
         weight = 9.81 * float(model.arrays.body_mass.sum())
         out = {"steps": n, "fell": self.fell, "time": self.time,
@@ -119,9 +120,9 @@ class RangerSim(WalkerRun):
         out["mean_speed"] = out["distance"] / out["time"] if out["time"] > 0 else 0.0
         if len(log) >= 3:
             first, last = 1, len(log) - 1          # skip the start-up step
-            d = log[last, 1] - log[first, 1]
-            dt = log[last, 0] - log[first, 0]
-            e = log[last, 2:6] - log[first, 2:6]
+            d = log[last, T.LOG.hip_x] - log[first, T.LOG.hip_x]
+            dt = log[last, T.LOG.t] - log[first, T.LOG.t]
+            e = log[last, T.LOG.e:T.LOG.e + 4] - log[first, T.LOG.e:T.LOG.e + 4]
             # a cost of transport is per distance travelled forward: none (nan) for whole
             # steps that went nowhere or backwards (energy over a negative distance would read
             # as a negative cost, and a tuner would take it for a gain)
@@ -172,6 +173,6 @@ def live(gait: str = "walk", terrain=None, params: RangerParams | None = None,
                 gait_keys={"w": "walk", "s": "stand", "g": "gui"},
                 gains={"GUI hip [rad]": slider(0, -0.8, 0.8), "GUI outer ankle [rad]": slider(1, -1.5, 1.5),
                        "GUI inner ankle [rad]": slider(2, -1.5, 1.5)},
-                labels=lambda _sim: {"gait": mem[C.M_GAIT], "phase": mem[C.M_PHASE]},
+                labels=lambda _sim: {"gait": mem[C.MEM.gait], "phase": mem[C.MEM.phase]},
                 label_names={"gait": {int(g): g.name.lower() for g in C.Gait},
                              "phase": {int(p): p.name.lower() for p in T.Phase}})

@@ -10,6 +10,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from walkers.common.slots import size, slots
+
 from .estimator import butterworth2
 from .model import foot_inertia_com
 from .motor import motor_table
@@ -47,54 +49,60 @@ PH_SINGLE, PH_DOUBLE, PH_FLIGHT, PH_STANDING, PH_START = 0, 1, 2, 3, 4
 PR_OFF, PR_HOLD, PR_PUSH, PR_FLIP, PR_SWING, PR_GUI, PR_LAND, PR_KEEP, PR_STAND = 0, 1, 2, 3, 4, 5, 6, 7, 8
 N_PROG = 9
 FR_REL, FR_ABS, FR_SCISSOR, FR_PUSH, FR_NONE = 0, 1, 2, 3, 4
-PC_FRAME, PC_TARGET, PC_KP, PC_KD, PC_IFF = 0, 1, 2, 3, 4
+PC = slots("ProgramColumns", ("frame", "target", "kp", "kd", "iff"))   # of the program table
 
-# scalar constants k[...]
-K_DT, K_WEIGHT, K_EST_ON, K_EST_OFF = 0, 1, 2, 3
-K_B0 = 4                       # 5 Butterworth coefficients 4..8
-K_FOOT_I, K_FOOT_M, K_FOOT_CX, K_FOOT_CY = 9, 10, 11, 12
-K_AIR_W, K_AIR_Z, K_AIR_ACC = 13, 14, 15
-K_SCISSOR, K_SCISSOR_OFF = 16, 17
-K_LAND_LEG, K_PUSH_LEG = 18, 19
-K_PUSH_I0, K_PUSH_GAIN, K_V_TARGET, K_IMAX = 20, 21, 22, 23
-K_LEG_COM, K_FALL_H, K_GRAV, K_DS_TIME = 24, 25, 26, 27
-K_START_I, K_START_LEG = 28, 29
-N_K = 30
+# scalar constants k[...], the fields in this order
+CONST = slots("RangerConstants", (
+    ("dt", "step [s]"), ("weight", "weight on the feet [N]"), "est_on", "est_off",
+    ("b0", 5, "Butterworth coefficients b0, b1, b2, a1, a2 of the load estimator"),
+    "foot_i", "foot_m", "foot_cx", "foot_cy", "air_w", "air_z", "air_acc", "scissor",
+    "scissor_off", "land_leg", "push_leg", "push_i0", "push_gain", "v_target", "imax", "leg_com",
+    "fall_h", "grav", "ds_time", "start_i", "start_leg",
+))
+N_K = size(CONST)
 
-# memory mem[...]
-M_GAIT, M_PHASE, M_STANCE = 0, 1, 2
-M_FILT = 3        # biquad state, 2 per foot: 3..6
-M_SIG = 7         # filtered load fraction per foot: 7, 8
-M_CONTACT = 9     # estimator flag per foot: 9, 10
-M_PUSH_I, M_V_MID, M_MID_DONE, M_STEPS, M_T_STRIKE = 11, 12, 13, 14, 15
-M_E = 16          # energies [J]: electrical positive, electrical net, mechanical positive, mechanical net
-M_PROG = 20       # program per motor: 20..22
-M_CUR = 23        # current per motor [A]: 23..25
-M_PEL = 26        # electrical power per motor [W]: 26..28
-M_KEEP = 29       # joint angles held in flight: 29..31
-M_FELL, M_RAW = 32, 33   # fell flag; raw load fraction per foot 33, 34
-M_TOUCH = 35      # estimator touchdowns per foot: 35, 36
-M_STRIKE_X = 37   # hip x at the last heel strike
-M_AIRBORNE = 38   # 1 once the swing foot has been seen in the air this step
-N_MEM = 40
-N_LOG = 7         # step log row: t, hip x, 4 energies, push current
+# controller memory mem[...] (float64 vector), the fields in this order
+MEM = slots("RangerMemory", (
+    "gait", "phase", "stance",
+    ("filt", 4, "biquad state, 2 per foot"),
+    ("sig", 2, "filtered load fraction per foot"),
+    ("contact", 2, "estimator flag per foot"),
+    "push_i", "v_mid", "mid_done", "steps", "t_strike",
+    ("e", 4, "energies [J]: electrical positive, electrical net, mechanical positive, mechanical net"),
+    ("prog", 3, "program per motor"),
+    ("cur", 3, "current per motor [A]"),
+    ("pel", 3, "electrical power per motor [W]"),
+    ("keep", 3, "joint angles held in flight [rad]"),
+    ("fell", "fell flag"),
+    ("raw", 2, "raw load fraction per foot"),
+    ("touch", 2, "estimator touchdowns per foot"),
+    ("strike_x", "hip x at the last heel strike [m]"),
+    ("airborne", "1 once the swing foot has been seen in the air this step"),
+))
+N_MEM = size(MEM)
+# columns of the step log (one row per heel strike), in this order
+LOG = slots("StepLogColumns", (
+    ("t", "time of the heel strike [s]"), ("hip_x", "hip x [m]"),
+    ("e", 4, "the energies of mem's e [J]"), ("push_i", "push-off current [A]"),
+))
+N_LOG = size(LOG)
 
 
 def make_constants(p: RangerParams, dt: float) -> np.ndarray:
     k = np.zeros(N_K)
-    k[K_DT] = dt
-    k[K_WEIGHT] = 9.81 * (2 * p.leg_mass + 2 * p.foot_mass)
-    k[K_EST_ON], k[K_EST_OFF] = p.est_on, p.est_off
-    k[K_B0:K_B0 + 5] = butterworth2(p.est_cutoff, dt)
-    k[K_FOOT_I] = foot_inertia_com(p) + p.foot_mass * (p.foot_com_x ** 2 + p.foot_com_y ** 2)
-    k[K_FOOT_M], k[K_FOOT_CX], k[K_FOOT_CY] = p.foot_mass, p.foot_com_x, p.foot_com_y
-    k[K_AIR_W], k[K_AIR_Z], k[K_AIR_ACC] = p.air_omega, p.air_zeta, p.free_foot_max_accel
-    k[K_SCISSOR], k[K_SCISSOR_OFF] = p.scissor_gain, p.scissor_offset
-    k[K_LAND_LEG], k[K_PUSH_LEG] = p.land_leg_angle, p.push_leg_angle
-    k[K_PUSH_I0], k[K_PUSH_GAIN], k[K_V_TARGET], k[K_IMAX] = p.push_current, p.push_gain, p.target_speed, p.current_max
-    k[K_LEG_COM], k[K_FALL_H], k[K_GRAV] = p.leg_com, p.fall_height, 9.81
-    k[K_DS_TIME] = p.ds_time
-    k[K_START_I], k[K_START_LEG] = p.start_push_current, p.start_leg_angle
+    k[CONST.dt] = dt
+    k[CONST.weight] = 9.81 * (2 * p.leg_mass + 2 * p.foot_mass)
+    k[CONST.est_on], k[CONST.est_off] = p.est_on, p.est_off
+    k[CONST.b0:CONST.b0 + 5] = butterworth2(p.est_cutoff, dt)
+    k[CONST.foot_i] = foot_inertia_com(p) + p.foot_mass * (p.foot_com_x ** 2 + p.foot_com_y ** 2)
+    k[CONST.foot_m], k[CONST.foot_cx], k[CONST.foot_cy] = p.foot_mass, p.foot_com_x, p.foot_com_y
+    k[CONST.air_w], k[CONST.air_z], k[CONST.air_acc] = p.air_omega, p.air_zeta, p.free_foot_max_accel
+    k[CONST.scissor], k[CONST.scissor_off] = p.scissor_gain, p.scissor_offset
+    k[CONST.land_leg], k[CONST.push_leg] = p.land_leg_angle, p.push_leg_angle
+    k[CONST.push_i0], k[CONST.push_gain], k[CONST.v_target], k[CONST.imax] = p.push_current, p.push_gain, p.target_speed, p.current_max
+    k[CONST.leg_com], k[CONST.fall_h], k[CONST.grav] = p.leg_com, p.fall_height, 9.81
+    k[CONST.ds_time] = p.ds_time
+    k[CONST.start_i], k[CONST.start_leg] = p.start_push_current, p.start_leg_angle
     return k
 
 
@@ -115,10 +123,10 @@ def make_programs(p: RangerParams) -> np.ndarray:
 
 def make_memory(gait: int = GAIT_WALK) -> np.ndarray:
     mem = np.zeros(N_MEM)
-    mem[M_GAIT] = gait
-    mem[M_PHASE] = PH_STANDING if gait == GAIT_WALK else PH_SINGLE   # STAND captures on entry
-    mem[M_STANCE] = 1
-    mem[M_T_STRIKE] = -1.0
+    mem[MEM.gait] = gait
+    mem[MEM.phase] = PH_STANDING if gait == GAIT_WALK else PH_SINGLE   # STAND captures on entry
+    mem[MEM.stance] = 1
+    mem[MEM.t_strike] = -1.0
     return mem
 
 
@@ -126,14 +134,14 @@ def set_standing_estimator(mem: np.ndarray, k: np.ndarray) -> None:
     """Estimator memory of a robot standing at rest on both feet (each foot carrying half the
     weight, filters at their steady state, both flags on), so a run that starts standing does
     not begin with a spurious flight."""
-    b0, b1, b2, a1, a2 = k[K_B0:K_B0 + 5]
+    b0, b1, b2, a1, a2 = k[CONST.b0:CONST.b0 + 5]
     x = 0.5
     for side in range(2):
-        mem[M_FILT + 2 * side] = x - b0 * x           # y = x at steady state
-        mem[M_FILT + 2 * side + 1] = (b2 - a2) * x
-        mem[M_SIG + side] = x
-        mem[M_RAW + side] = x
-        mem[M_CONTACT + side] = 1
+        mem[MEM.filt + 2 * side] = x - b0 * x           # y = x at steady state
+        mem[MEM.filt + 2 * side + 1] = (b2 - a2) * x
+        mem[MEM.sig + side] = x
+        mem[MEM.raw + side] = x
+        mem[MEM.contact + side] = 1
 
 
 def make_gui(p: RangerParams) -> np.ndarray:
@@ -149,11 +157,11 @@ def make_gui(p: RangerParams) -> np.ndarray:
 
 class Tables(NamedTuple):
     """What the compiled controller reads, as one argument (and the step log it writes)."""
-    k: np.ndarray         # (N_K,) constants, indices K_*
-    prog: np.ndarray      # (N_PROG, 5) motor programs, columns PC_*
+    k: np.ndarray         # (N_K,) constants, slots CONST
+    prog: np.ndarray      # (N_PROG, 5) motor programs, columns PC
     motor: np.ndarray     # (3, MOTOR_NPARAM) motor rows: hip, outer ankle, inner ankle
     gui: np.ndarray       # (3, 3) GUI joint target [rad], kp [A/rad], kd [A s/rad] (set at run time)
-    steplog: np.ndarray   # (max_steps, N_LOG) one row per heel strike, written by the controller
+    steplog: np.ndarray   # (max_steps, N_LOG) one row per heel strike (columns LOG), written by the controller
 
 
 def make_tables(p: RangerParams, dt: float, max_steps: int = 20000) -> Tables:

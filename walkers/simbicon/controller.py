@@ -26,16 +26,19 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planarsim.compiled import jit_inline, kernel
+from planarsim.compiled import jit_inline, kernel, pin_angle_rate
+
+from walkers.common.slots import size, slots
 
 from .params import SimbiconParams
 
 # target columns
 SWING_HIP, SWING_KNEE, SWING_ANKLE, STANCE_KNEE, STANCE_ANKLE = range(5)
 HIP, KNEE, ANKLE, TORSO = range(4)
-# memory slots
-M_PHASE, M_T0, M_STRIKES, M_TIMEOUTS, M_FELL, M_LAST_STRIKE_T, M_EFFORT, M_GLITCH = range(8)
-MEMORY_SIZE = 8
+# controller memory (float64 vector), the fields in this order
+MEM = slots("SimbiconMemory", ("phase", "t0", "strikes", "timeouts", "fell", "last_strike_t",
+                               "effort", "glitch"))
+MEMORY_SIZE = size(MEM)
 
 
 class Phase(IntEnum):
@@ -83,18 +86,10 @@ def make_tables(p: SimbiconParams, model) -> Tables:
 
 def make_memory(phase=0, t0=0.0) -> np.ndarray:
     mem = np.zeros(MEMORY_SIZE)
-    mem[M_PHASE] = phase
-    mem[M_T0] = t0
-    mem[M_LAST_STRIKE_T] = t0
+    mem[MEM.phase] = phase
+    mem[MEM.t0] = t0
+    mem[MEM.last_strike_t] = t0
     return mem
-
-
-@kernel
-def pin_angle(m, q, v, j):
-    """Relative angle [rad] and rate [rad/s] of pin j."""
-    a = m.pin_body[j, 0]
-    b = m.pin_body[j, 1]
-    return q[b, 2] - q[a, 2] - m.pin_ref[j], v[b, 2] - v[a, 2]
 
 
 @kernel
@@ -110,29 +105,29 @@ def foot_in_contact(s, tab, side):
 def next_phase(s, tab, mem):
     """Table 1 transitions (plus the contact timeout); updates mem in place."""
     t = s.time[0]
-    phase = int(mem[M_PHASE])
-    t_in = t - mem[M_T0]
+    phase = int(mem[MEM.phase])
+    t_in = t - mem[MEM.t0]
     if phase % 2 == 0:
         if t_in >= tab.state_time:
-            mem[M_PHASE] = phase + 1
-            mem[M_T0] = t
+            mem[MEM.phase] = phase + 1
+            mem[MEM.t0] = t
         return
     contact = foot_in_contact(s, tab, phase // 2) == 1 and t_in >= tab.min_contact_time
     if contact or t_in >= tab.contact_timeout:
-        mem[M_PHASE] = (phase + 1) % 4
-        mem[M_T0] = t
+        mem[MEM.phase] = (phase + 1) % 4
+        mem[MEM.t0] = t
         if contact:
-            mem[M_STRIKES] += 1
-            mem[M_LAST_STRIKE_T] = t
+            mem[MEM.strikes] += 1
+            mem[MEM.last_strike_t] = t
         else:
-            mem[M_TIMEOUTS] += 1
+            mem[MEM.timeouts] += 1
 
 
 @jit_inline
 def control(m, s, ws, tab, mem, u):
     """Write the six motor torques into u (n_act,) for the current state."""
     next_phase(s, tab, mem)
-    phase = int(mem[M_PHASE])
+    phase = int(mem[MEM.phase])
     swing = phase // 2
     stance = 1 - swing
     half = phase % 2
@@ -157,7 +152,7 @@ def control(m, s, ws, tab, mem, u):
         col = SWING_KNEE if side == swing else STANCE_KNEE
         for jt in range(KNEE, ANKLE + 1):
             j = tab.pin[side, jt]
-            ang, rate = pin_angle(m, q, v, j)
+            ang, rate = pin_angle_rate(m, q, v, j)
             u[tab.act[side, jt]] = tab.kp[jt] * (tab.target[half, col + jt - KNEE] - ang) - tab.kd[jt] * rate
 
 
@@ -176,7 +171,7 @@ class Controller:
 
     @property
     def phase(self) -> Phase:
-        return Phase(int(self.memory[M_PHASE]))
+        return Phase(int(self.memory[MEM.phase]))
 
     def __call__(self, sim):
         control(self.model.arrays, sim.state, sim.ws, self.tables, self.memory, self.u)

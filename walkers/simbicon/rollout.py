@@ -16,14 +16,13 @@ from planarsim.compiled import RUN_FELL, RUN_NONFINITE, RUN_TOO_LARGE, RUN_WALKE
 from walkers.base import WalkerRun, simulation, terrain_of
 from walkers.common.record import record_labelled
 
-from .controller import (M_EFFORT, M_FELL, M_GLITCH, M_PHASE, M_STRIKES, M_TIMEOUTS, Phase, control,
-                         make_memory, make_tables)
+from .controller import MEM, Phase, control, make_memory, make_tables
 from .model import build, non_foot_clearance, start_state
 from .params import SimbiconParams
 
 FELL = RUN_FELL   # rollout return code: the torso came down
 GLITCH = RUN_WALKER + 2  # rollout return code: the torso moved faster than a walker can (solver blow-up)
-STRATEGY = "all"   # engine contact-mode strategy (see the report: "alternating" hits its cap often with box feet)
+STRATEGY = "all"   # engine contact-mode strategy: every contact's mode decided together (box feet)
 GLITCH_SPEED = 10.0   # [m/s] torso COM speed taken as a solver glitch
 GLITCH_SPIN = 30.0    # [rad/s] torso angular speed taken as a solver glitch
 GAITS = ("walk",)
@@ -47,15 +46,15 @@ def rollout_simbicon(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, k0, 
         if code != 0:
             return code, i, k
         for a in range(u.shape[0]):
-            mem[M_EFFORT] += ws.act_u[a] * ws.act_u[a] * m.dt
+            mem[MEM.effort] += ws.act_u[a] * ws.act_u[a] * m.dt
         jump = max(abs(s.q[tr, 0] - x_before), abs(s.q[tr, 1] - y_before)) / m.dt
         if (abs(s.v[tr, 0]) > GLITCH_SPEED or abs(s.v[tr, 1]) > GLITCH_SPEED
                 or abs(s.v[tr, 2]) > GLITCH_SPIN or jump > GLITCH_SPEED):
-            mem[M_FELL] = 1.0
+            mem[MEM.fell] = 1.0
             return GLITCH, i + 1, k
         k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
         if s.q[tr, 1] - height(m.terrain_coef, s.q[tr, 0]) < tab.fall_height:
-            mem[M_FELL] = 1.0
+            mem[MEM.fell] = 1.0
             return FELL, i + 1, k
     return 0, n, k
 
@@ -96,7 +95,7 @@ class SimbiconRun(WalkerRun):
     """
 
     NAME = "simbicon"
-    FELL_SLOT = M_FELL
+    FELL_SLOT = MEM.fell
     LABEL_SLOTS = np.zeros(0, np.int64)   # no per-frame labels
 
     def __init__(self, params: SimbiconParams | None = None, terrain=None, dt=1e-3, gait="walk",
@@ -126,8 +125,8 @@ class SimbiconRun(WalkerRun):
             code = GLITCH
             self.state.restore(self.ws.prev)
         if code == GLITCH:
-            self.memory[M_FELL] = 1.0
-            self.memory[M_GLITCH] = 1.0
+            self.memory[MEM.fell] = 1.0
+            self.memory[MEM.glitch] = 1.0
         return code
 
     def numbers(self) -> dict:
@@ -139,8 +138,8 @@ class SimbiconRun(WalkerRun):
         mem = self.memory
         t = self.time
         out = dict(distance=float(self.state.q[self.tables.torso, 0] - self.x_start), time=t,
-                   steps=int(mem[M_STRIKES]), timeouts=int(mem[M_TIMEOUTS]), fell=self.fell,
-                   glitch=bool(mem[M_GLITCH]), phase=int(mem[M_PHASE]), effort=float(mem[M_EFFORT]))
+                   steps=int(mem[MEM.strikes]), timeouts=int(mem[MEM.timeouts]), fell=self.fell,
+                   glitch=bool(mem[MEM.glitch]), phase=int(mem[MEM.phase]), effort=float(mem[MEM.effort]))
         out["speed"] = out["distance"] / t if t > 0 else 0.0
         if self.record_every:
             traj = self.trajectory()
@@ -188,5 +187,5 @@ def live(gait="walk", terrain=None, params=None) -> dict:
 
     return dict(sim=sim, controller=controller,
                 gains={"push [N]": (-150.0, 150.0, lambda: push[0], set_push)},
-                labels=lambda _sim: {"phase": mem[M_PHASE]},
+                labels=lambda _sim: {"phase": mem[MEM.phase]},
                 label_names={"phase": {int(p): p.name.lower() for p in Phase}})

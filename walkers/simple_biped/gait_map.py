@@ -1,11 +1,11 @@
 """Step-to-step map of the walking Simple Biped, for planarsim.analysis.
 
 Section: the controller's own touchdown (controller.next_state: WALK_SINGLE -> WALK_DOUBLE,
-M_STEPS += 1), taken just after ``control`` made that switch and before the physics step, so
+MEM.steps += 1), taken just after ``control`` made that switch and before the physics step, so
 the section state is (State, controller memory) with the memory already reset for the new
 step: the swing Bezier, lift-off / strike x and phase are rewritten at the next lift-off,
-M_STEP_T / M_STEP_X equal the section time and hip x. The one memory value that carries over
-is the adapted pendulum top speed M_V_TOP (an integrator). Replaying ``control`` on the
+MEM.step_t / MEM.step_x equal the section time and hip x. The one memory value that carries over
+is the adapted pendulum top speed MEM.v_top (an integrator). Replaying ``control`` on the
 restored section state recomputes the same commands (t_in = 0 < ds_time_min: no transition).
 
 Section coordinates (stance = the foot that just touched down, front foot; rear = the other;
@@ -13,7 +13,7 @@ both feet on the ground, pinned, at rest):
   x = (hip x - front foot x [m], hip y - front foot y [m], hip vx [m/s], hip vy [m/s],
        rear foot x - front foot x [m], v_top [m/s])
 The map runs two touchdowns, back to the same stance foot (no symmetry assumption).
-Perturbations move the hip (and M_STEP_X with it) and the rear foot along the ground; the foot
+Perturbations move the hip (and MEM.step_x with it) and the rear foot along the ground; the foot
 velocities and contact modes stay those of the reference section.
 """
 from __future__ import annotations
@@ -26,7 +26,7 @@ from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, s
 from walkers.common.section import GaitMapMixin, copy_tuple, restore_tuple
 
 from . import controller as C
-from .params import I_FALL_HEIGHT, I_FALL_LEG_LENGTH, I_LEG_LENGTH
+from .params import FIELD
 from .rollout import Walker, _longest_leg
 
 NAMES = ("hip_dx", "hip_dy", "hip_vx", "hip_vy", "rear_dx", "v_top")
@@ -43,17 +43,17 @@ def rollout_to_touchdown(m, s, ws, opt, tab, mem, u, n_events, max_steps):
     after the ``control`` call that counted the last one (before its physics step).
     Returns (code, steps done): 0 ok, 1/2 engine guard, 3 fell, 4 no touchdown in max_steps."""
     p = tab.p
-    start = mem[C.M_STEPS]
+    start = mem[C.MEM.steps]
     for i in range(max_steps):
         C.control(m, s, ws, tab, mem, u)
-        if mem[C.M_STEPS] - start >= n_events:
+        if mem[C.MEM.steps] - start >= n_events:
             return 0, i
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i
-        if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]
-                or _longest_leg(s.q) > p[I_FALL_LEG_LENGTH] * p[I_LEG_LENGTH]):
-            mem[C.M_FALLEN] = 1.0
+        if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[FIELD.fall_height] * p[FIELD.leg_length]
+                or _longest_leg(s.q) > p[FIELD.fall_leg_length] * p[FIELD.leg_length]):
+            mem[C.MEM.fallen] = 1.0
             return RUN_FELL, i + 1
     return RUN_NO_EVENT, max_steps
 
@@ -80,7 +80,7 @@ class SimpleBipedGaitMap(GaitMapMixin):
             raise StepMapError(f"the Simple Biped failed while settling (code {code})")
         for _ in range(3):   # to a touchdown of the requested foot
             self._run(w.state, w.ws, w.memory, 1)
-            if int(w.memory[C.M_STANCE]) == stance:
+            if int(w.memory[C.MEM.stance]) == stance:
                 break
         else:
             raise StepMapError(f"no touchdown of foot {stance} while settling")
@@ -107,11 +107,11 @@ class SimpleBipedGaitMap(GaitMapMixin):
 
     def coords(self, s, mem) -> np.ndarray:
         """Section coordinates (see module doc) of a section state."""
-        st = int(mem[C.M_STANCE])
+        st = int(mem[C.MEM.stance])
         q, v = s.q, s.v
         f, r = st + 1, 2 - st
         return np.array([q[0, 0] - q[f, 0], q[0, 1] - q[f, 1], v[0, 0], v[0, 1], q[r, 0] - q[f, 0],
-                         mem[C.M_V_TOP]])
+                         mem[C.MEM.v_top]])
 
     def set_section(self, x) -> None:
         """Scratch simulation := reference section with coordinates x."""
@@ -125,14 +125,14 @@ class SimpleBipedGaitMap(GaitMapMixin):
         self.s.v[0, 0] += d[2]
         self.s.v[0, 1] += d[3]
         self.s.q[r, 0] += d[4]
-        self.mem[C.M_V_TOP] += d[5]
-        self.mem[C.M_STEP_X] = self.s.q[0, 0]
+        self.mem[C.MEM.v_top] += d[5]
+        self.mem[C.MEM.step_x] = self.s.q[0, 0]
 
     def advance(self, x) -> np.ndarray:
         """Two touchdowns from section coordinates x; the coordinates at the second one."""
         self.set_section(x)
         self._run(self.s, self.ws, self.mem, 2)
-        if int(self.mem[C.M_STANCE]) != self.stance:
+        if int(self.mem[C.MEM.stance]) != self.stance:
             raise StepMapError("Simple Biped step map: the two touchdowns did not alternate feet")
         return self.coords(self.s, self.mem)
 

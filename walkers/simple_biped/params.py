@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from walkers.common.params import WalkerParams, param as _p
+from walkers.common.slots import param_slots
 
 
 @dataclass(frozen=True)
@@ -89,50 +90,5 @@ class SimpleBipedParams(WalkerParams):
         return (self.step_length0 + self.step_length_per_speed * v) * self.leg_length
 
 
-# the index of each field in to_array(): compile-time constants for the controller, written
-# out so that they can be read and searched (a test checks them against the field order)
-I_HIP_MASS = 0
-I_FOOT_MASS = 1
-I_LEG_LENGTH = 2
-I_LEG_LENGTH_MAX = 3
-I_MU = 4
-I_LEG_FORCE_MAX = 5
-I_HIP_TORQUE_MAX = 6
-I_STAND_HEIGHT = 7
-I_STAND_WIDTH = 8
-I_STAND_KP = 9
-I_STAND_KD = 10
-I_SPEED = 11
-I_STEP_LENGTH0 = 12
-I_STEP_LENGTH_PER_SPEED = 13
-I_CLEARANCE = 14
-I_SLOPE_TRUST = 15
-I_STRIKE_PUSH = 16
-I_DESCENT_RATE = 17
-I_SPEED_GAIN = 18
-I_STOP_SPEED = 19
-I_WALK_LENGTH = 20
-I_DS_KP = 21
-I_DS_KD = 22
-I_ENERGY_GAIN = 23
-I_DS_FRONT_LOAD = 24
-I_DS_ACCEL_MAX = 25
-I_DS_FORCE_MAX = 26
-I_DS_TIME_MIN = 27
-I_DS_TIME_MAX = 28
-I_DS_ENERGY_TOL = 29
-I_SS_KP = 30
-I_SS_KD = 31
-I_SWING_KP = 32
-I_SWING_KD = 33
-I_STANCE_MU = 34
-I_TOUCHDOWN_PHASE = 35
-I_CROUCH_HEIGHT = 36
-I_CROUCH_TIME = 37
-I_THRUST_ACCEL = 38
-I_TAKEOFF_HEIGHT = 39
-I_FLIGHT_LENGTH = 40
-I_LAND_TIME = 41
-I_FALL_HEIGHT = 42
-I_FALL_LEG_LENGTH = 43
-N_PARAMS = 44
+# the slot of each field in to_array(), by name: compiled code reads p[FIELD.hip_mass]
+FIELD = param_slots(SimpleBipedParams)

@@ -18,13 +18,14 @@ import planarsim as ps
 
 from walkers.base import WalkerRun, simulation, terrain_of
 from walkers.common.record import record_labelled
+from walkers.common.slots import label_slots
 
 from . import controller as C
 from .model import build
-from .params import I_FALL_HEIGHT, I_FALL_LEG_LENGTH, I_LEG_LENGTH, SimpleBipedParams
+from .params import FIELD, SimpleBipedParams
 
 LABELS = ("gait", "state", "stance", "phase", "steps", "jumps")
-LABEL_SLOTS = np.array([C.M_GAIT, C.M_STATE, C.M_STANCE, C.M_PHASE, C.M_STEPS, C.M_JUMPS], dtype=np.int64)
+LABEL_SLOTS = label_slots(C.MEM, LABELS)   # the memory fields of those names
 
 
 @jit
@@ -38,7 +39,7 @@ def _longest_leg(q):
 @jit
 def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, k0):
     """n steps of control + physics, recording every `every`-th step into rec / lab (memory
-    slots `slots`) from frame k0. Stops on a fall (RUN_FELL, mem[M_FALLEN]=1): the hip below
+    slots `slots`) from frame k0. Stops on a fall (RUN_FELL, mem[MEM.fallen]=1): the hip below
     fall_height above the ground, or a leg longer than fall_leg_length; or on an engine failure
     (planarsim.compiled run codes). Returns (code, steps done, next frame)."""
     p = tab.p
@@ -50,11 +51,11 @@ def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, 
             return code, i, k
         for a in range(ws.act_power.shape[0]):
             if ws.act_power[a] > 0.0:
-                mem[C.M_WORK] += ws.act_power[a] * m.dt
+                mem[C.MEM.work] += ws.act_power[a] * m.dt
         k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
-        if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[I_FALL_HEIGHT] * p[I_LEG_LENGTH]
-                or _longest_leg(s.q) > p[I_FALL_LEG_LENGTH] * p[I_LEG_LENGTH]):
-            mem[C.M_FALLEN] = 1.0
+        if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[FIELD.fall_height] * p[FIELD.leg_length]
+                or _longest_leg(s.q) > p[FIELD.fall_leg_length] * p[FIELD.leg_length]):
+            mem[C.MEM.fallen] = 1.0
             return RUN_FELL, i + 1, k
     return 0, n, k
 
@@ -86,7 +87,7 @@ class Walker(WalkerRun):
 
     NAME = "simple-biped"
     LABELS = LABELS
-    FELL_SLOT = C.M_FALLEN
+    FELL_SLOT = C.MEM.fallen
     ROLLOUT = staticmethod(rollout_simple_biped)
     LABEL_SLOTS = LABEL_SLOTS
 
@@ -95,9 +96,9 @@ class Walker(WalkerRun):
         params = params if params is not None else SimpleBipedParams()
         model = build(params, terrain_of(terrain), dt, extras=extras)
         memory = np.zeros(C.N_MEMORY)
-        memory[C.M_STATE] = C.ST_STAND
-        memory[C.M_SPEED] = params.speed if speed is None else float(speed)
-        memory[C.M_GAIT] = _gait_id(gait)
+        memory[C.MEM.state] = C.ST_STAND
+        memory[C.MEM.speed] = params.speed if speed is None else float(speed)
+        memory[C.MEM.gait] = _gait_id(gait)
         super().__init__(model, params, C.make_tables(params), memory, options=options,
                          record_every=record_every)
         if seed:
@@ -107,17 +108,17 @@ class Walker(WalkerRun):
     # run-time switches ------------------------------------------------------------------------
     def set_gait(self, gait) -> None:
         """Request gait "stand" | "walk" | "jump"; the state machine switches when it safely can."""
-        self.memory[C.M_GAIT] = _gait_id(gait)
+        self.memory[C.MEM.gait] = _gait_id(gait)
 
     def set_speed(self, speed: float) -> None:
         """Target walking speed [m/s]."""
         if not 0.0 <= speed <= 3.0:
             raise ValueError(f"speed={speed} m/s must be within [0, 3]")
-        self.memory[C.M_SPEED] = float(speed)
+        self.memory[C.MEM.speed] = float(speed)
 
     @property
     def gait(self) -> str:
-        return C.Gait(int(self.memory[C.M_GAIT])).name.lower()
+        return C.Gait(int(self.memory[C.MEM.gait])).name.lower()
 
     # the contract -----------------------------------------------------------------------------
     def numbers(self) -> dict:
@@ -126,14 +127,14 @@ class Walker(WalkerRun):
         t = self.time
         dist = float(self.state.q[0, 0]) - self.x_start
         weight = self.model.total_mass * float(np.hypot(*self.model.arrays.gravity))
-        work = float(self.memory[C.M_WORK])
+        work = float(self.memory[C.MEM.work])
         return {"time": t, "distance": dist, "mean_speed": dist / t if t > 0 else 0.0,
                 "positive_work": work,
                 "cost_of_transport": work / (weight * dist) if dist > 0.1 else float("nan"),
-                "steps": int(self.memory[C.M_STEPS]), "jumps": int(self.memory[C.M_JUMPS]),
-                "scuffs": int(self.memory[C.M_SCUFFS]),
-                "retries": int(self.memory[C.M_RETRIES]), "fell": self.fell, "falls": int(self.fell),
-                "gait": self.gait, "state": C.State(int(self.memory[C.M_STATE])).name.lower()}
+                "steps": int(self.memory[C.MEM.steps]), "jumps": int(self.memory[C.MEM.jumps]),
+                "scuffs": int(self.memory[C.MEM.scuffs]),
+                "retries": int(self.memory[C.MEM.retries]), "fell": self.fell, "falls": int(self.fell),
+                "gait": self.gait, "state": C.State(int(self.memory[C.MEM.state])).name.lower()}
 
 
 Run = Walker
@@ -154,7 +155,7 @@ def live(gait="walk", terrain=None, params=None, speed=None) -> dict:
 
     return dict(sim=sim, controller=controller, on_gait=w.set_gait,
                 gait_keys={"s": "stand", "w": "walk", "j": "jump"},
-                gains={"speed [m/s]": (0.0, 2.0, lambda: float(mem[C.M_SPEED]), w.set_speed)},
-                labels=lambda _sim: {"gait": mem[C.M_GAIT], "state": mem[C.M_STATE]},
+                gains={"speed [m/s]": (0.0, 2.0, lambda: float(mem[C.MEM.speed]), w.set_speed)},
+                labels=lambda _sim: {"gait": mem[C.MEM.gait], "state": mem[C.MEM.state]},
                 label_names={"gait": {int(g): g.name.lower() for g in C.Gait},
                              "state": {int(s): s.name.lower() for s in C.State}})

@@ -1,20 +1,19 @@
-"""The numba internals planarsim's compiled layer builds on, checked when it is imported.
+"""The numba internals planarsim's fast mode builds on, checked when planarsim is imported.
 
-Beyond numba's documented extension API (numba.extending), kernels/_jit.py lowers kernels into
-its own code library (numba.core.codegen, numba.core.compiler), and kernels/refs.py and
-kernels/link.py build arrays and calls in LLVM IR (numba.core.cgutils, numba.np.arrayobj).
-A numba release that renames or drops one of them fails here, on import, with an error that
-names the numba version and each changed internal, instead of an AttributeError deep inside
-the first compile. Checked with numba 0.59 to 0.68; pyproject.toml pins numba below 0.69.
+Beyond numba's documented extension API (numba.extending), compile/fast.py lowers kernels into
+its own code library (numba.core.codegen, numba.core.compiler), and compile/refs.py and
+compile/link.py build arrays and calls in LLVM IR (numba.core.cgutils, numba.np.arrayobj).
+A numba release that renames or drops one of them is found here, before anything compiles,
+and planarsim runs on plain numba instead (compile/mode.py), warning with the numba version
+and each changed internal. Checked with numba 0.59 to 0.68.
 """
 import importlib
 import inspect
 
-import numba
-
 CHECKED = "0.59-0.68"
 
-# module: attributes (dotted below a class) of every internal used
+# module: attributes (dotted below a class) of every internal used: the fast mode's code
+# library and pipeline (fast.py, fast_step.py)
 NEEDED = {
     "numba.core.codegen": "JITCodeLibrary.add_ir_module JITCodeLibrary.finalize "
                           "JITCodeLibrary.get_pointer_to_function JITCodeLibrary.codegen "
@@ -24,6 +23,13 @@ NEEDED = {
     "numba.core.compiler_lock": "require_global_compiler_lock global_compiler_lock",
     "numba.core.registry": "CPUDispatcher CPUDispatcher.compile CPUDispatcher.enable_caching "
                            "CPUDispatcher.get_call_template",
+}
+# numba's low-level extension API as refs.py uses it (numba.extending and the helpers its
+# documentation's examples use): model, state and workspace as one pointer each, in both the
+# fast and the plain mode
+NEEDED_TABLES = {
+    "numba.extending": "NativeValue infer_getattr intrinsic lower_getattr_generic models "
+                       "register_model typeof_impl unbox",
     "numba.core.imputils": "impl_ret_borrowed",
     "numba.core.typing.templates": "AttributeTemplate",
     "numba.np.arrayobj": "populate_array",
@@ -32,12 +38,8 @@ NEEDED = {
 }
 # fields of a code library that KernelCodeLibrary.finalize reads and sets
 LIBRARY_FIELDS = ("_linking_libraries", "_final_module", "_finalized", "_codegen")
-# keyword arguments of the dispatcher's constructor that _jit passes
+# keyword arguments of the dispatcher's constructor that fast.py passes
 DISPATCHER_ARGS = ("py_func", "locals", "targetoptions", "pipeline_class")
-
-
-class NumbaChanged(ImportError):
-    """The installed numba lacks an internal that planarsim's compiled layer uses."""
 
 
 def _has(module, path):
@@ -50,10 +52,19 @@ def _has(module, path):
     return True
 
 
+def _missing(needed):
+    return [f"{module}.{path}" for module, paths in needed.items() for path in paths.split()
+            if not _has(module, path)]
+
+
+def changed_tables():
+    """The extension API pieces refs.py uses (as 'module.attribute') missing from numba."""
+    return _missing(NEEDED_TABLES)
+
+
 def changed_internals():
-    """The internals (as 'module.attribute' text) missing from the installed numba."""
-    missing = [f"{module}.{path}" for module, paths in NEEDED.items() for path in paths.split()
-               if not _has(module, path)]
+    """The internals of the fast mode (as 'module.attribute' text) missing from numba."""
+    missing = _missing(NEEDED) + changed_tables()
     try:
         from numba.core.registry import CPUDispatcher, cpu_target
         params = inspect.signature(CPUDispatcher.__init__).parameters
@@ -65,13 +76,3 @@ def changed_internals():
     except Exception as exc:   # any change in how these are made counts as a change
         missing.append(f"numba.core.registry (making a code library: {type(exc).__name__}: {exc})")
     return missing
-
-
-def check_numba():
-    """Raise NumbaChanged naming the numba version and every changed internal, if any."""
-    missing = changed_internals()
-    if missing:
-        raise NumbaChanged(
-            f"planarsim's compiled layer does not work with numba {numba.__version__}: it "
-            f"builds on numba internals (checked with numba {CHECKED}) and this numba changed "
-            + ", ".join(missing) + ". Install a numba below 0.69: pip install 'numba<0.69'")

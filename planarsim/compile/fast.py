@@ -1,4 +1,5 @@
-"""The decorators of every compiled function, and the guard against stale numba caches.
+"""The fast mode's compiler (compile/mode.py): numba's dispatchers with planarsim's own code
+library, and the code layout of planarsim's machine code.
 
 cache=True: compiled once per machine, loaded from disk afterwards. Kernels themselves are not
 cached: they are IR linked into their compiled callers (the step, rollouts), which are.
@@ -8,18 +9,13 @@ model/state/workspace NamedTuples (dozens of arrays) between stages costs nothin
 with it every call increments and decrements every array (about 1 us per call).
 
 The kernels' code library and pipeline use numba internals (numba_check.py checks them on
-import). Measured with numba 0.68.1: plain `njit` kernels with numba's own library (each
-kernel optimised and emitted as machine code at every nesting level) took the cold start to
-a walker's first step from about 36 s to 59-68 s on one machine (same steps/s, same bits).
-
-Numba checks a cached function against its own file only; a kernel that calls into another
-file would keep stale machine code after that file changes. ``_drop_stale_caches`` hashes all
-kernel sources and clears the numba caches of planarsim and walkers when the hash changes.
+import; without them planarsim runs on plain numba). Measured with numba 0.68.1: plain `njit`
+kernels with numba's own library (each kernel optimised and emitted as machine code at every
+nesting level) took the cold start to a walker's first step from about 36 s to 59-68 s on one
+machine (same steps/s, same bits).
 """
 import contextlib
-import hashlib
 import os
-from pathlib import Path
 
 import llvmlite.binding as llvm
 from numba import types
@@ -68,7 +64,7 @@ def code_layout():
 class CallerDispatcher(CPUDispatcher):
     """Dispatcher of a `jit` function. Its machine code may call the compiled step by a
     symbol that LLVM resolves when the code is compiled or loaded from the cache; so before
-    either, the step is published (kernels/link.py: loaded from the cache, or compiled the
+    either, the step is published (compile/fast_step.py: loaded from the cache, or compiled the
     first time ever). Importing a module of compiled code therefore compiles nothing: a
     command that only lists walkers or parameters never waits for the step."""
 
@@ -82,13 +78,13 @@ _LINKED = []     # the step is published in this process
 
 
 def link_step():
-    """Publish the compiled step's symbol (kernels/link.py load_step, which waits under
+    """Publish the compiled step's symbol (compile/fast_step.py load_step, which waits under
     numba's compiler lock while another thread publishes it), once per process."""
     if _LINKED:
         return
-    from . import link
-    link.load_step()
-    if "cfunc" in link._ENGINE:
+    from . import fast_step
+    fast_step.load_step()
+    if "cfunc" in fast_step._ENGINE:
         _LINKED.append(True)
 
 
@@ -104,12 +100,11 @@ def _caller_decorator(**extra):
     return decorate
 
 
-jit = _caller_decorator()
 # for numba.cfunc (the step's C entry, cached by its own argument): a C function holds no GIL
 KERNEL_OPTIONS = {k: v for k, v in _OPTIONS.items() if k not in ("cache", "nogil")}
 # PLANARSIM_KERNEL_CALLS=1 keeps kernels as calls, so that a profiler sees each stage
 # (benchmarks/profile_kernels.py sets it, with a cache of its own)
-_KERNEL_CALLS = os.environ.get("PLANARSIM_KERNEL_CALLS") == "1"
+KERNEL_CALLS = os.environ.get("PLANARSIM_KERNEL_CALLS") == "1"
 # kernel: a function called only from other compiled code. numba then builds neither its Python
 # wrapper (which unboxes every array of the model, state and workspace: thousands of lines of
 # LLVM IR per function) nor its C wrapper; this halves the first-ever compile of the step.
@@ -144,7 +139,7 @@ class KernelCodeLibrary(JITCodeLibrary):
     copies reaching a caller along several paths merge); the caller optimises and emits
     everything once."""
 
-    noinline = False   # mark the kernel's function noinline (kernel_call)
+    noinline = False   # mark the kernel's function noinline (kernel(inline="never"))
 
     def add_ir_module(self, ir_module):
         if self.noinline:
@@ -202,7 +197,7 @@ class KernelCompiler(compiler.Compiler):
 
 
 class KernelCallCompiler(KernelCompiler):
-    """As KernelCompiler, for a kernel that stays a call (kernel_call)."""
+    """As KernelCompiler, for a kernel that stays a call (kernel(inline="never"))."""
     noinline = True
 
 
@@ -217,61 +212,22 @@ def _kernel_decorator(pipeline_class=KernelCompiler, **extra):
     return decorate
 
 
-# kernel: inlined by LLVM into its compiled callers (forceinline). A call passes model, state and
-# workspace as three pointers (kernels/refs.py), so LLVM's inliner no longer sees much to gain
-# and left small hot kernels as calls (a fifth slower on the smallest models).
-kernel = _kernel_decorator(forceinline=not _KERNEL_CALLS)
-kernel_inline = _kernel_decorator(inline="always")
-# kernel_call: never inlined (LLVM's noinline). For long code that runs rarely and would
-# otherwise be copied into every caller (the closest point on hills: a Newton loop of sines),
-# where a copy per call site costs compile time and buys nothing.
-kernel_call = _kernel_decorator(pipeline_class=KernelCallCompiler, forceinline=False)
-# callable from Python and inlined into compiled callers (a walker's controller: the Python
-# controller path calls it, its rollout inlines it, which saves passing ~40 arrays each step)
-jit_inline = _caller_decorator(inline="always")
-# callable from Python and always inlined by LLVM into compiled callers (the terrain's height
-# and closest point). A plain `jit` function takes the inlining setting of the caller that
-# compiles it first (numba's flag inheritance: forced inline under a kernel, not under a
-# kernel_call, and the cache keeps that choice); where that matters for speed, say it here.
-# Inside kernel_call's closest point a call per height was a third slower.
-jit_force = _caller_decorator(forceinline=True)
+def jit(inline=None):
+    """The decorator of a `jit` function (compile/decorators.py): inline None (LLVM decides),
+    "always" (numba inlines it into its compiled callers) or "force" (LLVM always inlines it)."""
+    if inline == "always":
+        return _caller_decorator(inline="always")
+    if inline == "force":
+        return _caller_decorator(forceinline=True)
+    return _caller_decorator()
 
 
-def _sources_hash(folder: Path, extra: str = "") -> str:
-    digest = hashlib.blake2b(extra.encode(), digest_size=16)
-    for path in sorted(folder.rglob("*.py")):
-        digest.update(str(path.relative_to(folder)).encode())
-        digest.update(path.read_bytes())
-    return digest.hexdigest()
-
-
-# the kernels compile differently with PLANARSIM_KERNEL_CALLS=1: a switch clears the caches
-KERNEL_HASH = _sources_hash(Path(__file__).resolve().parent, "calls" if _KERNEL_CALLS else "")
-
-
-def drop_stale_caches(folder, clear=None) -> None:
-    """Clear the numba caches below `clear` (default `folder`) when the sources of `folder`
-    or of planarsim's kernels changed since the caches were written.
-
-    Walker packages call this on import with their own folder, since their rollout kernels
-    link the engine's step and their controller files.
-    """
-    folder = Path(folder).resolve()
-    clear = folder if clear is None else Path(clear).resolve()
-    new = _sources_hash(folder, KERNEL_HASH)
-    stamp = folder / "__pycache__" / "numba_sources.hash"
-    try:
-        if stamp.exists() and stamp.read_text() == new:
-            return
-        for pattern in ("*.nbi", "*.nbc"):
-            for f in clear.rglob(pattern):
-                f.unlink(missing_ok=True)
-        stamp.parent.mkdir(exist_ok=True)
-        tmp = stamp.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(new)
-        os.replace(tmp, stamp)
-    except OSError:
-        pass  # read-only install: its sources cannot change either
-
-
-drop_stale_caches(Path(__file__).resolve().parent, clear=Path(__file__).resolve().parent.parent)
+def kernel(inline="force"):
+    """The decorator of a kernel (compile/decorators.py): inline "force" (LLVM inlines it into
+    its compiled callers; a call under PLANARSIM_KERNEL_CALLS=1), "always" (numba inlines it
+    before LLVM sees it) or "never" (one copy of its code that callers call)."""
+    if inline == "always":
+        return _kernel_decorator(inline="always")
+    if inline == "never":
+        return _kernel_decorator(pipeline_class=KernelCallCompiler, forceinline=False)
+    return _kernel_decorator(forceinline=not KERNEL_CALLS)

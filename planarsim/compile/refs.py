@@ -233,6 +233,13 @@ class TableHandle:
         self.table = pack(obj, self.layout)
         self.numba_type = HandleType(self.layout)
 
+    def refill(self, obj, name):
+        """Rewrite only field `name`'s slots from `obj` (of the same layout): a new StepOptions
+        costs a few slots, not the whole table."""
+        field = self.layout.by_name[name]
+        fill(getattr(obj, name), field[6], self.table, field[5])
+        self.obj = obj
+
 
 @typeof_impl.register(TableHandle)
 def _typeof_handle(val, c):
