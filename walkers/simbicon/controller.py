@@ -32,9 +32,12 @@ from walkers.common.slots import size, slots
 
 from .params import SimbiconParams
 
-# target columns
-SWING_HIP, SWING_KNEE, SWING_ANKLE, STANCE_KNEE, STANCE_ANKLE = range(5)
-HIP, KNEE, ANKLE, TORSO = range(4)
+# the target table's columns (each a parameter <column>_0 / _1 for the two halves of a step)
+# and the joints of the gain tables (kp_<joint>, kd_<joint>; the pin and actuator tables
+# take the first three)
+TARGET = slots("SimbiconTarget", ("swing_hip", "swing_knee", "swing_ankle", "stance_knee",
+                                  "stance_ankle"))
+JOINT = slots("SimbiconJoint", ("hip", "knee", "ankle", "torso"))
 # controller memory (float64 vector), the fields in this order
 MEM = slots("SimbiconMemory", ("phase", "t0", "strikes", "timeouts", "fell", "last_strike_t",
                                "effort", "glitch"))
@@ -72,11 +75,10 @@ def make_tables(p: SimbiconParams, model) -> Tables:
     mt = model.meta
     f = np.float64
     return Tables(
-        target=np.array([[p.swing_hip_0, p.swing_knee_0, p.swing_ankle_0, p.stance_knee_0, p.stance_ankle_0],
-                         [p.swing_hip_1, p.swing_knee_1, p.swing_ankle_1, p.stance_knee_1, p.stance_ankle_1]], f),
+        target=np.array([[getattr(p, f"{col}_{half}") for col in TARGET._fields] for half in range(2)], f),
         cd=np.array([p.cd_0, p.cd_1], f), cv=np.array([p.cv_0, p.cv_1], f),
-        kp=np.array([p.kp_hip, p.kp_knee, p.kp_ankle, p.kp_torso], f),
-        kd=np.array([p.kd_hip, p.kd_knee, p.kd_ankle, p.kd_torso], f),
+        kp=np.array([getattr(p, f"kp_{joint}") for joint in JOINT._fields], f),
+        kd=np.array([getattr(p, f"kd_{joint}") for joint in JOINT._fields], f),
         torso_target=float(p.torso), state_time=float(p.state_time),
         contact_timeout=float(p.contact_timeout), min_contact_time=float(p.min_contact_time),
         fall_height=float(p.fall_height), torso=int(mt["torso"]),
@@ -135,25 +137,25 @@ def control(m, s, ws, tab, mem, u):
     v = s.v
     tr = tab.torso
     # eq. 3: swing-hip target from the torso's position over the stance ankle and its speed
-    ankle = tab.pin[stance, ANKLE]
+    ankle = tab.pin[stance, JOINT.ankle]
     foot = m.pin_body[ankle, 1]
     phi = q[foot, 2]
     ax = q[foot, 0] + math.cos(phi) * m.pin_anchor[ankle, 1, 0] - math.sin(phi) * m.pin_anchor[ankle, 1, 1]
     d = q[tr, 0] - ax
-    hip_d = tab.target[half, SWING_HIP] + tab.cd[half] * d + tab.cv[half] * v[tr, 0]
+    hip_d = tab.target[half, TARGET.swing_hip] + tab.cd[half] * d + tab.cv[half] * v[tr, 0]
     th = tab.thigh[swing]
-    tau_swing = tab.kp[HIP] * (hip_d - q[th, 2]) - tab.kd[HIP] * v[th, 2]
+    tau_swing = tab.kp[JOINT.hip] * (hip_d - q[th, 2]) - tab.kd[JOINT.hip] * v[th, 2]
     # eq. 2: the stance hip supplies the torso torque
-    tau_torso = tab.kp[TORSO] * (tab.torso_target - q[tr, 2]) - tab.kd[TORSO] * v[tr, 2]
-    u[tab.act[swing, HIP]] = tau_swing
-    u[tab.act[stance, HIP]] = -tau_torso - tau_swing
+    tau_torso = tab.kp[JOINT.torso] * (tab.torso_target - q[tr, 2]) - tab.kd[JOINT.torso] * v[tr, 2]
+    u[tab.act[swing, JOINT.hip]] = tau_swing
+    u[tab.act[stance, JOINT.hip]] = -tau_torso - tau_swing
     # eq. 1: knees and ankles
     for side in range(2):
-        col = SWING_KNEE if side == swing else STANCE_KNEE
-        for jt in range(KNEE, ANKLE + 1):
+        col = TARGET.swing_knee if side == swing else TARGET.stance_knee
+        for jt in range(JOINT.knee, JOINT.ankle + 1):
             j = tab.pin[side, jt]
             ang, rate = pin_angle_rate(m, q, v, j)
-            u[tab.act[side, jt]] = tab.kp[jt] * (tab.target[half, col + jt - KNEE] - ang) - tab.kd[jt] * rate
+            u[tab.act[side, jt]] = tab.kp[jt] * (tab.target[half, col + jt - JOINT.knee] - ang) - tab.kd[jt] * rate
 
 
 class Controller:
