@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import math
 
-from benchmarks.pareto import ERRORS, FLOORS, _err, curves
+from benchmarks.pareto import ERRORS, FLOORS, _err, curves, figures
 from benchmarks.report import _len, _num
 
 LABELS = {"energy_err_max": "energy error |dE| max / scale", "pin_error_m": "pin error [m]",
-          "penetration_m": "ground penetration [m]"}
-SHORT = {"energy_err_max": "energy", "pin_error_m": "pin", "penetration_m": "penetration"}
+          "contact_error_m": "contact error: max(sink, |end gap|) [m]"}
+SHORT = {"energy_err_max": "energy", "pin_error_m": "pin", "contact_error_m": "contact"}
 
 
 def _e(x):
@@ -33,11 +33,11 @@ def print_points(rows, repeats, timing_seconds):
     print(f"\npareto {scene}: cost = wall s per simulated s (median of {repeats} runs of {timing_seconds:g} s), "
           "accuracy over the accuracy run, same metrics for every engine")
     print(f"{'curve':22s} {'step':>6s} {'[s]':>8s} {'cost s/s':>9s} {'steps/s':>8s} {'pin error':>10s} "
-          f"{'|dE| max':>9s} {'E drift':>9s} {'penetration':>11s}")
+          f"{'|dE| max':>9s} {'E drift':>9s} {'penetration':>11s} {'end gap':>10s}")
     for r in rows:
         line = (f"{r['curve']:22s} {step_label(r['k']):>6s} {r['dt']:8.2e} {r['cost_s_per_s']:9.3g} "
                 f"{_num(r['steps_per_s']):>8s} {_len(r.get('pin_error_m')):>10s} {_e(r['energy_err_max']):>9s} "
-                f"{r['energy_drift']:+9.2e} {_len(r.get('penetration_m')):>11s}")
+                f"{r['energy_drift']:+9.2e} {_len(r.get('penetration_m')):>11s} {_len(r.get('rest_gap_m')):>10s}")
         if r.get("warning"):
             line += f"  [warning: {r['warning']}]"
         print(line)
@@ -74,14 +74,17 @@ def plot_scene(rows, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     scene = rows[0]["scene"]
-    metrics = [m for m in ERRORS if any(not math.isnan(_err(r, m)) for r in rows)
-               and len({_err(r, m) for r in rows}) > 1]
+    metrics = figures(rows)
     if not metrics:
         return None
     fig, axes = plt.subplots(1, len(metrics), figsize=(5.2 * len(metrics), 4.2), squeeze=False)
     by = curves(rows)
+    diverged = sum(bool(r.get("warning")) for r in rows)
     for ax, m in zip(axes[0], metrics):
         for label, pts in by.items():
+            pts = [r for r in pts if not r.get("warning")]
+            if not pts:
+                continue
             xs = [_err(r, m) for r in pts]
             ys = [r["cost_s_per_s"] for r in pts]
             style = dict(lw=2.5, color="k") if label == "planarsim" else dict(lw=1.2)
@@ -96,7 +99,8 @@ def plot_scene(rows, path):
                                    else ""))
         ax.set_ylabel("wall s per simulated s")
         ax.grid(True, which="both", alpha=0.3)
-        ax.set_title(f"{scene}: cost vs {SHORT[m]} error")
+        ax.set_title(f"{scene}: cost vs {SHORT[m]} error"
+                     + (f" ({diverged} diverged runs not drawn)" if diverged else ""), fontsize=10)
     axes[0][0].legend(fontsize=7)
     fig.text(0.01, 0.01, "labels: step (dt = the scene's 1 ms); dotted: planarsim's error at dt",
              fontsize=7)
