@@ -194,7 +194,7 @@ def order(rows, metric):
     (k >= 1: the observed order of the method in that figure; nan with fewer than 2 points
     above the figure's floor)."""
     pts = [(r["dt"], _err(r, metric)) for r in rows
-           if r["k"] >= 1 and not math.isnan(_err(r, metric)) and _err(r, metric) > FLOORS[metric]]
+           if r["k"] >= 1 and not r.get("warning") and not math.isnan(_err(r, metric)) and _err(r, metric) > FLOORS[metric]]
     if len(pts) < 2 or len({p[0] for p in pts}) < 2:
         return math.nan
     h, e = np.log(np.array(pts)).T
@@ -211,7 +211,7 @@ def curves(rows):
 
 def figures(rows):
     """The accuracy figures of ERRORS that the scene of `rows` has (no energy with a ground)."""
-    ground = any("contact_error_m" in r for r in rows)
+    ground = any(not math.isnan(_err(r, "contact_error_m")) for r in rows)
     return [m for m in ERRORS if any(not math.isnan(_err(r, m)) for r in rows)
             and not (ground and m == "energy_err_max")]
 
@@ -222,7 +222,8 @@ def matched(rows, metrics=None):
     target = planarsim's error at dt; ratio = the curve's cost on its Pareto front at that
     error over planarsim's cost at dt (nan: not reached; note as cost_at); peer_target = the
     curve's error at dt, ratio_at_peer = the curve's cost at dt over planarsim's cost on its
-    front at that error (nan: planarsim does not reach it); cross = errors where the two fronts
+    front at that error (nan: planarsim does not reach it, or note "diverged": the curve's run
+    at dt diverged); cross = errors where the two fronts
     cross; order, our_order = observed orders (slope of log error vs log step)."""
     metrics = figures(rows) if metrics is None else metrics
     by = curves(rows)
@@ -239,6 +240,8 @@ def matched(rows, metrics=None):
                 continue
             cost, note = cost_at(front(pts, m), target)
             our_cost, our_note = cost_at(front(ours, m), peer_target)
+            if own.get("warning"):      # the peer diverged at dt: no accuracy to match
+                our_cost, our_note = math.nan, "diverged"
             s[m] = dict(target=target, ratio=cost / base["cost_s_per_s"], note=note,
                         peer_target=peer_target, ratio_at_peer=own["cost_s_per_s"] / our_cost,
                         note_at_peer=our_note, cross=crossing(front(ours, m), front(pts, m)),

@@ -24,6 +24,8 @@ def step_label(k):
 def _ratio(ratio, note):
     if note is None:
         return "not reached"
+    if note == "diverged":
+        return "diverged"
     return f"{ratio:.3g}x" + (" cheapest" if note == "cheapest" else "")
 
 
@@ -51,7 +53,7 @@ def print_matched(summary):
     print(f"pareto {summary[0]['scene']}: planarsim speed-up = peer cost / planarsim cost. raw: both at dt; "
           "at ours: the peer's Pareto front at planarsim's error at dt; at peer's: planarsim's front at "
           "the peer's error at dt ('cheapest': that front's cheapest point is already as accurate; "
-          "'not reached': not on its ladder); order: slope of log error vs log step, peer/planarsim")
+          "'not reached': not on its ladder; 'diverged': the peer's run at dt diverged); order: slope of log error vs log step, peer/planarsim")
     print(f"{'curve':22s} {'figure':11s} {'raw':>7s} {'ours':>9s} {'at ours':>15s} {'peer':>9s} "
           f"{'at peer':>15s} {'order':>11s}  fronts cross at")
     for s in summary:

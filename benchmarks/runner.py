@@ -116,7 +116,7 @@ def run_pareto(args, peers):
         print(f"pareto: none of the scenes {args.scenes} has a peer version; peer scenes: {list(PEER_SCENES)}")
     if not peers:
         print("pareto: no peer installed (pip install planarsim[compare]); planarsim's ladder only")
-    repeats = min(args.repeats, 3)
+    repeats = args.repeats
     rows = []
     for name in args.pareto_scenes:
         pts = measure_ladder(name, peers, quick=args.quick, repeats=repeats, timing_seconds=args.timing_seconds,

@@ -105,3 +105,13 @@ def test_a_diverged_run_is_not_on_the_front():
     rows = [dict(cost_s_per_s=1.0, energy_err_max=1e-1), dict(cost_s_per_s=2.0, energy_err_max=1e-6,
                                                             warning="unstable (frame 10)")]
     assert front(rows, "energy_err_max") == [(1.0, 1e-1)]
+
+
+def test_a_peer_that_diverged_at_dt_is_not_matched_at_its_error():
+    ours = _rows("planarsim", [(1.0, 1e-3), (2.0, 5e-4)], "planarsim")
+    theirs = _rows("peer", [(0.5, 1e9), (1.0, 1e-4)], "peer")
+    theirs[0]["warning"] = "unstable (frame 10)"
+    [s] = matched(ours + theirs, metrics=("energy_err_max",))
+    m = s["energy_err_max"]
+    assert m["note_at_peer"] == "diverged" and math.isnan(m["ratio_at_peer"])
+    assert m["ratio"] == pytest.approx(1.0) and m["note"] == "cheapest"   # its k = 2 point
