@@ -5,13 +5,14 @@ planarsim at a step of dt / k; pymunk and Box2D at more solver iterations and a 
 MuJoCo with its Euler, implicitfast and RK4 integrators at dt / k. k < 1 (a step longer than
 the scene's dt) shows the cheap end of each curve. Every point is judged by the same code
 (metrics.accuracy on frames every max(dt, dt / k): every state a coarse step produces, every
-scene dt otherwise) and timed the same way: the points of a scene go round in turn (peers._rates), each running `timing_seconds` of
-simulated time from the start state; cost = wall-clock seconds per simulated second (median).
+scene dt otherwise) and timed the same way: the points of a scene go round in turn
+(peers._rates), each running `timing_seconds` of simulated time from the start state;
+cost = wall-clock seconds per simulated second (median).
 
-A curve is one engine configuration along its ladder (e.g. "mujoco RK4" at dt, dt/2, ...).
-The ratio at matched accuracy of a curve is its cost, interpolated log-log on its Pareto
-front to the error that planarsim reaches at the scene's dt, over planarsim's cost there;
-the raw ratio is the curve's first point (its default effort) over planarsim's default.
+A curve is one engine configuration along its ladder (e.g. "mujoco RK4" at dt*8 ... dt/8).
+Its ratio at matched accuracy (matched) is its cost, interpolated log-log on its Pareto front
+at the error planarsim reaches at the scene's dt, over planarsim's cost there; the raw ratio
+compares both at dt (k = 1).
 """
 from __future__ import annotations
 
