@@ -20,12 +20,11 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
 - walkers: every registered walker walking --walker-seconds (60 s) via its simulate().
 - batch: 64 Simple Biped walks on 1 and 2 worker threads (walkers.batch).
 - pareto: accuracy-matched comparison (pareto.py) of the named peer scenes (default chain4,
-  chain32, rod_drop, biped_collapse): planarsim at dt / 1, 2, 4, 8 and each peer along its
-  effort ladder (pymunk 10 and 40 iterations, Box2D 8/3 and 30/10 iterations, each with 1, 2,
-  4, 8 substeps; MuJoCo Euler, implicitfast and RK4 at dt / 1, 2, 4, 8; --quick: the first
-  configuration at k = 1, 2): cost per simulated second against pin, energy and penetration
-  error, the ratio at planarsim's accuracy beside the raw ratio, one Pareto plot per scene in
-  --pareto-out (default out/pareto/<machine>).
+  chain32, rod_drop, biped_collapse): planarsim, pymunk (10 and 40 iterations), Box2D (8/3 and
+  30/10 iterations) and MuJoCo (Euler, implicitfast, RK4), each at steps dt*8 ... dt/8
+  (--quick: the first configuration at dt and dt/2): cost per simulated second against pin,
+  energy (chains) and contact error, the ratio at matched accuracy beside the raw ratio, one
+  Pareto plot per scene and pareto.csv in --pareto-out (default out/pareto/<machine>).
 - startup: import-to-first-step times in fresh subprocesses, warm and cold numba cache
   (startup.py says how the cache is made cold).
 - envs: env.step calls per second of every planarsim gymnasium environment, single and
