@@ -6,6 +6,7 @@
     planarsim bench --peers pymunk,box2d   # peers to compare (default: all; 'none' skips)
     planarsim bench --no-cold              # skip the cold-cache start-up (about half a minute)
     planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
+    planarsim bench chain32 --parts pareto --pareto-out out/pareto   # accuracy-matched comparison
 
 Parts (each warm after compilation; steps/s = median and min-max of --repeats runs):
 - scenes: the named scenes of scenes.py (chains N = 2..64, rod drop, 7-link biped
@@ -18,6 +19,12 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
   penetration. Needs `pip install planarsim[compare]`; a missing peer is named and skipped.
 - walkers: every registered walker walking --walker-seconds (60 s) via its simulate().
 - batch: 64 Simple Biped walks on 1 and 2 worker threads (walkers.batch).
+- pareto: accuracy-matched comparison (pareto.py) of the named peer scenes (default chain4,
+  chain32, rod_drop, biped_collapse): planarsim, pymunk (10 and 40 iterations), Box2D (8/3 and
+  30/10 iterations) and MuJoCo (Euler, implicitfast, RK4), each at steps dt*8 ... dt/8
+  (--quick: the first configuration at dt and dt/2): cost per simulated second against pin,
+  energy (chains) and contact error, the ratio at matched accuracy beside the raw ratio, one
+  Pareto plot per scene and pareto.csv in --pareto-out (default out/pareto/<machine>).
 - startup: import-to-first-step times in fresh subprocesses, warm and cold numba cache
   (startup.py says how the cache is made cold).
 - envs: env.step calls per second of every planarsim gymnasium environment, single and
@@ -41,12 +48,13 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.metrics import PEER_SCENES
+from benchmarks.pareto import DEFAULT_SCENES
 from benchmarks.peers import PEER_MODULES, available_peers, measure_scene
 from benchmarks.report import (plot_chain_scaling, print_peers, print_scenes, print_startup, print_targets,
                            print_walkers, targets)
 from benchmarks.scenes import SCENES
 
-PARTS = ("scenes", "peers", "walkers", "batch", "startup", "envs")
+PARTS = ("scenes", "peers", "pareto", "walkers", "batch", "startup", "envs")
 
 
 def machine_name() -> str:
@@ -96,6 +104,38 @@ def write_csv(results, folder) -> Path:
     return out
 
 
+def run_pareto(args, peers):
+    """Rows of the accuracy-matched comparison of args.pareto_scenes; prints the tables and
+    writes one Pareto plot per scene and pareto.csv to args.pareto_out."""
+    from benchmarks.pareto import matched, measure_scene as measure_ladder
+    from benchmarks.pareto_report import plot_scene, print_matched, print_points
+    folder = Path(args.pareto_out or Path("out") / "pareto" / machine_name())
+    folder.mkdir(parents=True, exist_ok=True)
+    if not args.pareto_scenes:
+        print(f"pareto: none of the scenes {args.scenes} has a peer version; peer scenes: {list(PEER_SCENES)}")
+    if not peers:
+        print("pareto: no peer installed (pip install planarsim[compare]); planarsim's ladder only")
+    repeats = args.repeats
+    rows = []
+    for name in args.pareto_scenes:
+        pts = measure_ladder(name, peers, quick=args.quick, repeats=repeats, timing_seconds=args.timing_seconds,
+                             accuracy_seconds=args.accuracy_seconds)
+        print_points(pts, repeats, args.timing_seconds)
+        print_matched(matched(pts))
+        plot_scene(pts, folder / f"pareto_{name}.png")
+        rows += pts
+    if rows:
+        keys = []
+        for r in rows:
+            keys += [k for k in r if k not in keys]
+        with open(folder / "pareto.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=keys)
+            w.writeheader()
+            w.writerows(rows)
+        print(f"pareto: wrote {folder}", flush=True)
+    return rows
+
+
 def _list(text, known, what):
     items = [x for x in text.split(",") if x]
     bad = [x for x in items if x not in known]
@@ -123,14 +163,22 @@ def parse_args(argv):
     ap.add_argument("--env-copies", type=int, default=16, help="copies in the vectorised env figure (16)")
     ap.add_argument("--no-cold", action="store_true", help="skip the cold-cache start-up measurement")
     ap.add_argument("--csv", metavar="DIR", default=None, help="write DIR/<machine>/<scene>.csv")
+    ap.add_argument("--pareto-out", metavar="DIR", default=None,
+                    help="folder of the Pareto plots and pareto.csv (default out/pareto/<machine>)")
+    ap.add_argument("--quick", action="store_true", help="pareto: short ladder (first configuration, k = 1, 2)")
+    ap.add_argument("--timing-seconds", type=float, default=1.0,
+                    help="pareto: simulated seconds per timed run (default 1)")
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error(f"--repeats {args.repeats} must be >= 1")
     unknown = [n for n in args.scenes if n not in SCENES]
     if unknown:
         ap.error(f"unknown scene(s) {unknown}; choose from {list(SCENES)}")
+    if args.timing_seconds <= 0:
+        ap.error(f"--timing-seconds {args.timing_seconds} must be > 0")
     if args.parts is None:
         args.parts = "scenes,peers" if args.scenes else ",".join(PARTS)
+    args.pareto_scenes = [n for n in args.scenes if n in PEER_SCENES] if args.scenes else list(DEFAULT_SCENES)
     args.scenes = args.scenes or list(SCENES)
     args.parts = _list(args.parts, PARTS, "part(s)")
     args.peers = [] if args.peers == "none" else _list(args.peers, PEER_MODULES, "peer(s)")
@@ -148,13 +196,13 @@ def main(argv=None):
     rows = results["rows"]
     parts = set(args.parts)
     found = {}
-    if "peers" in parts:
+    if parts & {"peers", "pareto"}:
         found, missing = available_peers(args.peers)
         for msg in missing:
             print(msg, flush=True)
     if parts & {"scenes", "peers"}:
         for name in args.scenes:
-            compare = found if name in PEER_SCENES else {}
+            compare = found if name in PEER_SCENES and "peers" in parts else {}
             row, peer_rows = measure_scene(name, compare, args.repeats, args.steps, args.accuracy_seconds)
             results["scenes"][name] = row
             rows.append(row)
@@ -163,10 +211,12 @@ def main(argv=None):
                 rows += peer_rows
         results["slopes"] = chain_slopes(list(results["scenes"].values()))
         print_scenes(results)
-    if found:
+    if results["peers"]:
         print_peers(results)
     elif "peers" in parts and args.peers:
         print("peer comparison skipped: no peer installed (pip install planarsim[compare])\n")
+    if "pareto" in parts:
+        results["pareto"] = run_pareto(args, found)
     if "walkers" in parts and args.walkers:
         from benchmarks.walker_runs import measure_walker
         for name in args.walkers:

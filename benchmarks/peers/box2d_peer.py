@@ -7,7 +7,8 @@ skin radius of 1 cm included, as Box2D has it) with groupIndex -1 (no collisions
 character's own bodies), then the mass data set explicitly (centre at the body origin); pins
 are revolute joints at the local anchors; the ground is a static edge at y = 0. Friction 1,
 restitution 0, gravity 9.81, dt 1 ms, doSleep False, 8 velocity and 3 position iterations (the
-Box2D manual's recommendation). Timing: a Python loop of world.Step from a freshly built world.
+Box2D manual's recommendation). Effort (the accuracy ladder of pareto.py): the iteration
+counts and `substeps` world.Step(dt / substeps) calls per frame of the scene's dt. Timing: a Python loop of world.Step from a freshly built world.
 """
 from __future__ import annotations
 
@@ -26,10 +27,17 @@ def version() -> str:
 class World:
     """A Box2D world of the scene with run(n) (timed), reset() and record(n)."""
 
-    def __init__(self, spec):
+    def __init__(self, spec, velocity_iterations: int = VELOCITY_ITERATIONS,
+                 position_iterations: int = POSITION_ITERATIONS, substeps: int = 1):
         import Box2D
+        if min(int(velocity_iterations), int(position_iterations), int(substeps)) < 1:
+            raise ValueError(f"Box2D peer: velocity_iterations {velocity_iterations}, position_iterations "
+                             f"{position_iterations} and substeps {substeps} must be >= 1")
         self.b2, self.spec = Box2D, spec
-        self.timing = "Python loop of world.Step (8 velocity, 3 position iterations)"
+        self.iterations = int(velocity_iterations), int(position_iterations)
+        self.substeps = int(substeps)
+        self.timing = (f"Python loop of world.Step ({self.iterations[0]} velocity, {self.iterations[1]} "
+                       "position iterations)")
         self.reset()
 
     def reset(self):
@@ -59,10 +67,11 @@ class World:
         self.world, self.bodies = world, bodies
 
     def run(self, n: int):
-        step, dt = self.world.Step, self.spec.dt
-        vi, pi = VELOCITY_ITERATIONS, POSITION_ITERATIONS
-        for _ in range(n):
-            step(dt, vi, pi)
+        """n frames of the scene's dt (n * substeps steps)."""
+        step, h = self.world.Step, self.spec.dt / self.substeps
+        vi, pi = self.iterations
+        for _ in range(n * self.substeps):
+            step(h, vi, pi)
 
     def pose(self, q, v, k):
         for b, body in enumerate(self.bodies):
@@ -71,13 +80,15 @@ class World:
             v[k, b] = u[0], u[1], body.angularVelocity
 
     def record(self, n: int):
-        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state."""
+        """Poses and velocities (n + 1, n_body, 3) of an n-frame run from the start state."""
         self.reset()
         q = np.zeros((n + 1, self.spec.n_body, 3))
         v = np.zeros_like(q)
         self.pose(q, v, 0)
-        step, dt = self.world.Step, self.spec.dt
+        step, h, sub = self.world.Step, self.spec.dt / self.substeps, self.substeps
+        vi, pi = self.iterations
         for k in range(1, n + 1):
-            step(dt, VELOCITY_ITERATIONS, POSITION_ITERATIONS)
+            for _ in range(sub):
+                step(h, vi, pi)
             self.pose(q, v, k)
         return q, v

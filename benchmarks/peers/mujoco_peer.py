@@ -8,7 +8,8 @@ body frame sits at its centre of mass with an explicit inertia (only the -y comp
 Boxes are 3D boxes 0.1 m deep; collisions between the character's own bodies are off
 (contype 2 / conaffinity 1 against a ground plane of contype 1 / conaffinity 2); friction 1;
 MuJoCo's default soft contact (solref 0.02 1, no restitution parameter); Euler integrator,
-timestep 1 ms, gravity 9.81.
+timestep 1 ms, gravity 9.81. Effort (the accuracy ladder of pareto.py): `integrator` (Euler,
+implicitfast, RK4) and `substeps` MuJoCo steps of dt / substeps per frame of the scene's dt.
 
 Timing: `mujoco.rollout.rollout` with one MjData (one thread), the episode as one call from the
 start state, preallocated output. Recording (accuracy): an mj_step loop reading the body poses
@@ -38,8 +39,14 @@ def _parents(spec):
     return parent
 
 
-def mjcf(spec) -> str:
-    """The MJCF text of the scene."""
+INTEGRATORS = ("Euler", "implicitfast", "implicit", "RK4")
+
+
+def mjcf(spec, integrator: str = "Euler", timestep: float | None = None) -> str:
+    """The MJCF text of the scene (timestep: default the scene's dt) [s]."""
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"MuJoCo peer: integrator {integrator!r}; choose from {INTEGRATORS}")
+    timestep = spec.dt if timestep is None else float(timestep)
     parent = _parents(spec)
     children = {}
     for b, (j, a) in parent.items():
@@ -88,15 +95,18 @@ def mjcf(spec) -> str:
     return "\n".join([
         '<mujoco model="planarsim-bench">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',
-        f'  <option timestep="{spec.dt:.17g}" gravity="0 0 {-9.81:.17g}" integrator="Euler"/>',
+        f'  <option timestep="{timestep:.17g}" gravity="0 0 {-9.81:.17g}" integrator="{integrator}"/>',
         "  <worldbody>", *world, "  </worldbody>", "</mujoco>"])
 
 
 class World:
     """A MuJoCo model of the scene with run(n) (timed), reset() and record(n)."""
 
-    def __init__(self, spec):
+    def __init__(self, spec, integrator: str = "Euler", substeps: int = 1):
         import mujoco
+        if int(substeps) < 1:
+            raise ValueError(f"MuJoCo peer: substeps {substeps} must be >= 1")
+        self.substeps = int(substeps)
         try:
             from mujoco import rollout
         except ImportError:  # MuJoCo < 3.1: no rollout module
@@ -104,7 +114,7 @@ class World:
         self.mj, self._rollout, self.spec = mujoco, rollout, spec
         self.timing = ("mujoco.rollout, one thread" if rollout is not None
                        else "Python loop of mj_step (this MuJoCo has no rollout module)")
-        self.model = mujoco.MjModel.from_xml_string(mjcf(spec))
+        self.model = mujoco.MjModel.from_xml_string(mjcf(spec, integrator, spec.dt / self.substeps))
         self.data = mujoco.MjData(self.model)
         self.kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
         self.x0 = np.zeros(mujoco.mj_stateSize(self.model, self.kind))
@@ -117,8 +127,10 @@ class World:
         self.mj.mj_resetData(self.model, self.data)
 
     def run(self, n: int):
-        """n steps from the start state in one single-threaded rollout call (or an mj_step
-        loop after reset() where mujoco.rollout is missing)."""
+        """n frames of the scene's dt (n * substeps steps) from the start state in one
+        single-threaded rollout call (or an mj_step loop after reset() where mujoco.rollout is
+        missing)."""
+        n = n * self.substeps
         if self._rollout is None:
             step, m, d = self.mj.mj_step, self.model, self.data
             for _ in range(n):
@@ -146,7 +158,7 @@ class World:
             v[k, b] = res[3], res[5], -res[1]
 
     def record(self, n: int):
-        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state. A
+        """Poses and velocities (n + 1, n_body, 3) of an n-frame run from the start state. A
         MuJoCo warning (e.g. unstable QACC, after which MuJoCo resets the state) is kept in
         `self.warnings` as (step, text) and the frames stop before that step."""
         mj = self.mj
@@ -162,7 +174,8 @@ class World:
         try:
             for k in range(1, n + 1):
                 step[0] = k
-                mj.mj_step(self.model, self.data)
+                for _ in range(self.substeps):
+                    mj.mj_step(self.model, self.data)
                 if self.warnings:
                     return q[:k], v[:k]
                 self._kinematics()

@@ -6,7 +6,9 @@ one ShapeFilter group (no collisions between the character's own bodies); the gr
 static Segment at y = 0. Friction 1, elasticity 0, gravity 9.81, dt 1 ms, sleeping off
 (pymunk's default sleep_time_threshold = inf), default 10 solver iterations. pymunk's default
 collision_slop (0.1) is meant for pixel units; for metres it is set to 0.5 mm here.
-Timing: a Python loop of space.step(dt) from a freshly built space (build not timed).
+Effort (the accuracy ladder of pareto.py): `iterations` solver iterations and `substeps`
+space.step(dt / substeps) calls per frame of the scene's dt.
+Timing: a Python loop of space.step from a freshly built space (build not timed).
 """
 from __future__ import annotations
 
@@ -25,9 +27,12 @@ def version() -> str:
 class World:
     """A pymunk space of the scene with run(n) (timed), reset() and record(n)."""
 
-    def __init__(self, spec):
+    def __init__(self, spec, iterations: int = 10, substeps: int = 1):
         import pymunk
+        if int(iterations) < 1 or int(substeps) < 1:
+            raise ValueError(f"pymunk peer: iterations {iterations} and substeps {substeps} must be >= 1")
         self.pm, self.spec = pymunk, spec
+        self.iterations, self.substeps = int(iterations), int(substeps)
         self.timing = "Python loop of space.step"
         self.reset()
 
@@ -36,6 +41,7 @@ class World:
         space = pm.Space()
         space.gravity = (0.0, -9.81)
         space.collision_slop = COLLISION_SLOP
+        space.iterations = self.iterations
         bodies = []
         # one group: the character's own bodies do not collide; a stack's boxes do
         group = pm.ShapeFilter() if spec.bodies_collide else pm.ShapeFilter(group=1)
@@ -66,9 +72,10 @@ class World:
         self.space, self.bodies = space, bodies
 
     def run(self, n: int):
-        step, dt = self.space.step, self.spec.dt
-        for _ in range(n):
-            step(dt)
+        """n frames of the scene's dt (n * substeps steps)."""
+        step, h = self.space.step, self.spec.dt / self.substeps
+        for _ in range(n * self.substeps):
+            step(h)
 
     def pose(self, q, v, k):
         for b, body in enumerate(self.bodies):
@@ -77,13 +84,14 @@ class World:
             v[k, b] = u.x, u.y, body.angular_velocity
 
     def record(self, n: int):
-        """Poses and velocities (n + 1, n_body, 3) of an n-step run from the start state."""
+        """Poses and velocities (n + 1, n_body, 3) of an n-frame run from the start state."""
         self.reset()
         q = np.zeros((n + 1, self.spec.n_body, 3))
         v = np.zeros_like(q)
         self.pose(q, v, 0)
-        step, dt = self.space.step, self.spec.dt
+        step, h, sub = self.space.step, self.spec.dt / self.substeps, self.substeps
         for k in range(1, n + 1):
-            step(dt)
+            for _ in range(sub):
+                step(h)
             self.pose(q, v, k)
         return q, v

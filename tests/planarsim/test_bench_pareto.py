@@ -1,0 +1,117 @@
+"""The accuracy-matched comparison (`planarsim bench --parts pareto`) on a tiny ladder, and the
+Pareto-front arithmetic on fronts whose answer is known. No timing is asserted."""
+import csv
+import math
+import sys
+
+import pytest
+
+from benchmarks import runner as bench
+from benchmarks.pareto import cost_at, crossing, front, ladder, matched, order
+from benchmarks.peers import available_peers
+
+TINY = ["chain2", "--parts", "pareto", "--quick", "--repeats", "1", "--timing-seconds", "0.02",
+        "--accuracy-seconds", "0.05"]
+
+
+def _rows(curve, pts, engine="x"):
+    return [dict(scene="s", engine=engine, curve=curve, k=k, dt=1e-3 / k, cost_s_per_s=c, energy_err_max=e)
+            for k, (c, e) in zip((1, 2, 4, 8), pts)]
+
+
+def test_quick_ladder_prints_tables_plot_and_csv(tmp_path, capsys):
+    assert bench.main([*TINY, "--pareto-out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    found, missing = available_peers()
+    for msg in missing:
+        assert msg in out
+    rows = list(csv.DictReader(open(tmp_path / "pareto.csv")))
+    curves = [(r["curve"], float(r["k"])) for r in rows]
+    expected = [(label, k) for engine in ("planarsim", *found) for label, _, k in ladder(engine, quick=True)]
+    assert curves == expected
+    for r in rows:
+        assert float(r["cost_s_per_s"]) > 0 and float(r["energy_err_max"]) >= 0
+    # planarsim's pins hold at every step of its ladder (physics, not timing)
+    assert all(float(r["pin_error_m"]) <= 1e-9 for r in rows if r["engine"] == "planarsim")
+    assert "pareto chain2: cost = wall s per simulated s" in out
+    assert "planarsim speed-up = peer cost / planarsim cost" in out
+    for label, _, _ in [c for engine in found for c in ladder(engine, quick=True)]:
+        assert label in out
+    assert (tmp_path / "pareto_chain2.png").stat().st_size > 1000
+
+
+def test_missing_peer_is_named_and_the_ladder_runs_without_it(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "pymunk", None)  # import pymunk now raises ImportError
+    assert bench.main([*TINY, "--peers", "pymunk", "--pareto-out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "peer pymunk: not installed" in out and "pareto: no peer installed" in out
+    engines = {r["engine"] for r in csv.DictReader(open(tmp_path / "pareto.csv"))}
+    assert engines == {"planarsim"}
+
+
+def test_scene_without_peer_version_is_named():
+    from benchmarks.pareto import build_model
+    with pytest.raises(ValueError, match="boxes_on_hills"):
+        build_model("boxes_on_hills", 1e-3)
+
+
+def test_front_drops_dominated_points_and_interpolates_log_log():
+    # error = 1e-3 / cost^2 on the front; (3, 1e-3) costs more and is less accurate than (2, ...)
+    pts = [(1.0, 1e-3), (2.0, 2.5e-4), (3.0, 1e-3), (4.0, 6.25e-5)]
+    f = front([dict(cost_s_per_s=c, energy_err_max=e) for c, e in pts], "energy_err_max")
+    assert f == [(1.0, 1e-3), (2.0, 2.5e-4), (4.0, 6.25e-5)]
+    cost, note = cost_at(f, 1e-3 / 3.0 ** 2)
+    assert note == "interpolated" and cost == pytest.approx(3.0, rel=1e-12)
+    assert cost_at(f, 1e-2) == (1.0, "cheapest")
+    cost, note = cost_at(f, 1e-6)
+    assert math.isnan(cost) and note is None
+
+
+def test_crossing_of_a_first_and_a_fourth_order_method():
+    # ours: cost = 1e-3 / err (first order); theirs: cost = a err^(-1/4) (fourth order), with a
+    # chosen so that the two cost the same at err = 1e-5: theirs is dearer below, cheaper above
+    errs = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7]
+    a = (1e-3 / 1e-5) * 1e-5 ** 0.25
+    ours = front([dict(cost_s_per_s=1e-3 / e, energy_err_max=e) for e in errs], "energy_err_max")
+    theirs = front([dict(cost_s_per_s=a * e ** -0.25, energy_err_max=e) for e in errs], "energy_err_max")
+    cross = crossing(ours, theirs)
+    assert len(cross) == 1 and cross[0] == pytest.approx(1e-5, rel=0.2)
+    assert crossing(ours, [(c * 1e3, e) for c, e in theirs]) == []
+
+
+def test_matched_ratio_and_order_against_a_known_ladder():
+    ours = _rows("planarsim", [(1.0, 1e-3), (2.0, 5e-4), (4.0, 2.5e-4), (8.0, 1.25e-4)], "planarsim")
+    # a second-order peer at twice our cost per k: our error 1e-3 is its k = 2 point (cost 4)
+    theirs = _rows("peer", [(2.0, 4e-3), (4.0, 1e-3), (8.0, 2.5e-4), (16.0, 6.25e-5)], "peer")
+    [s] = matched(ours + theirs, metrics=("energy_err_max",))
+    assert s["raw_ratio"] == pytest.approx(2.0)
+    m = s["energy_err_max"]
+    assert m["target"] == 1e-3 and m["ratio"] == pytest.approx(4.0) and m["note"] == "interpolated"
+    assert m["order"] == pytest.approx(2.0) and m["our_order"] == pytest.approx(1.0)
+    assert order(ours, "energy_err_max") == pytest.approx(1.0)
+
+
+def test_contact_scene_is_matched_on_contact_error_not_energy():
+    from benchmarks.pareto import figures, measure_scene
+    rows = measure_scene("rod_drop", {}, quick=True, repeats=1, timing_seconds=0.02, accuracy_seconds=0.6)
+    # the rod hits the ground at 0.32 s and loses its energy there by physics: no energy figure
+    assert figures(rows) == ["contact_error_m"]
+    for r in rows:
+        assert r["contact_error_m"] == max(r["penetration_m"], abs(r["rest_gap_m"]))
+        assert r["contact_error_m"] < 1e-3      # planarsim's contacts neither sink nor hover
+
+
+def test_a_diverged_run_is_not_on_the_front():
+    rows = [dict(cost_s_per_s=1.0, energy_err_max=1e-1), dict(cost_s_per_s=2.0, energy_err_max=1e-6,
+                                                            warning="unstable (frame 10)")]
+    assert front(rows, "energy_err_max") == [(1.0, 1e-1)]
+
+
+def test_a_peer_that_diverged_at_dt_is_not_matched_at_its_error():
+    ours = _rows("planarsim", [(1.0, 1e-3), (2.0, 5e-4)], "planarsim")
+    theirs = _rows("peer", [(0.5, 1e9), (1.0, 1e-4)], "peer")
+    theirs[0]["warning"] = "unstable (frame 10)"
+    [s] = matched(ours + theirs, metrics=("energy_err_max",))
+    m = s["energy_err_max"]
+    assert m["note_at_peer"] == "diverged" and math.isnan(m["ratio_at_peer"])
+    assert m["ratio"] == pytest.approx(1.0) and m["note"] == "cheapest"   # its k = 2 point
