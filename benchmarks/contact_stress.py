@@ -74,8 +74,8 @@ before an engine error are judged too, and add three targets: step, the largest 
 of a single step beyond its own gravity term, dE - (dt / 2) g dp_y (the exact change of a step
 without impulses; see energy_bound) and the motors' work, against the run's whole E_tol
 (contacts only take energy out), less the joints' second-order share of the step's kinetic
-energy (CONSTRAINT_SHARE, kernels/work.py: an oscillation the energy target bounds over the
-run); tunnel (hills_fast) above DEPTH_TOL, beyond rod_sag for a point on a rod; speed
+energy ((h w)^2 for the fastest turn w, at least CONSTRAINT_SHARE, kernels/work.py: an
+oscillation the energy target bounds over the run); tunnel (hills_fast) above DEPTH_TOL, beyond rod_sag for a point on a rod; speed
 (stiff_motors). A run the engine stops with an error of its own (planarsim's
 SimulationDiverged or any planarsim error, naming why) is "raised"; a run missing a target
 without one is "silent" (an audit count alone is silent: nothing stopped the run). The summary
@@ -875,6 +875,20 @@ def tunnel_depth(model, q, v, mode, dt, samples=128):
     return max(worst, 0.0)
 
 
+def fastest_turn(model, q, v):
+    """(K,) the fastest turning rate [rad/s] at each frame: of a body (|omega|) or of a rod
+    (|d x dv| / |d|^2 of its bodies' centres)."""
+    a = model.arrays
+    fastest = np.max(np.abs(v[..., 2]), axis=-1)
+    for j in range(a.rod_body.shape[0]):
+        i, k = (int(x) for x in a.rod_body[j])
+        d = q[:, k, :2] - (q[:, i, :2] if i >= 0 else 0.0)
+        dv = v[:, k, :2] - (v[:, i, :2] if i >= 0 else 0.0)
+        d2 = np.maximum(np.sum(d * d, axis=-1), 1e-300)
+        fastest = np.maximum(fastest, np.abs(d[:, 0] * dv[:, 1] - d[:, 1] * dv[:, 0]) / d2)
+    return fastest
+
+
 def rod_sag(model, q, v, body, dt):
     """(K - 1,) how far [m] the path a tunnel is measured on may stray from the motion the
     engine integrated, per step: for a point on a rod of length L turning at omega, the
@@ -1001,12 +1015,13 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
         py = np.sum(spec.mass * v[..., 1], axis=1)
         excess = np.diff(net) - 0.5 * dt * G * np.diff(py)
         if model.n_pin + model.arrays.rod_body.shape[0] > 0:
-            # the joints' second-order terms move a step's energy by up to CONSTRAINT_SHARE
-            # of its kinetic energy, up or down (symplectic: it oscillates, the energy
-            # target above holds the run's drift)
+            # the joints' second-order terms move a step's energy by about (h w)^2 of its
+            # kinetic energy, at least CONSTRAINT_SHARE, up or down (symplectic: it
+            # oscillates, the energy target above holds the run's drift)
             kinetic = 0.5 * np.sum(spec.mass * (v[:-1, :, 0] ** 2 + v[:-1, :, 1] ** 2)
                                    + spec.inertia * v[:-1, :, 2] ** 2, axis=-1)
-            excess = excess - CONSTRAINT_SHARE * kinetic
+            turn = dt * fastest_turn(model, q[:-1], v[:-1])
+            excess = excess - np.maximum(CONSTRAINT_SHARE, turn ** 2) * kinetic
         k = int(np.argmax(excess))
         out["step_gain"], out["step_k"] = float(excess[k]), k + 1
         if family == "ranger_loop":

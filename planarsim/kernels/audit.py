@@ -10,7 +10,7 @@ After the velocity stage (impulses as applied):
             than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR), |v| the contact's speed, free
             and constrained, and the fastest body's
   joint_work  the pins' and rods' impulses add more kinetic energy than their second-order
-            terms may (kernels/work.py: CONSTRAINT_SHARE of KE(v*)), even after the step
+            terms may (kernels/work.joints_add_energy), even after the step
             aimed them at J v = 0 (the step's own remedy, kernels/step.py)
   limit_work  a joint limit's impulse does positive work at the end velocity beyond rounding
 After the position stage (the configuration the step ends at):
@@ -182,7 +182,7 @@ def audit_joints(m, s, ws, opt, h):
             note(ws, step, AUDIT_LIMIT_WORK, ws.row_owner[r], ws.row_body[r, 1], work)
             found += 1
     if m.pin_body.shape[0] + m.rod_body.shape[0] > 0:
-        excess, r = joints_add_energy(m, ws)
+        excess, r = joints_add_energy(m, s, ws, h)
         if excess > 0.0 and r >= 0:
             note(ws, step, AUDIT_JOINT_WORK, joint_element(m, ws, r), ws.row_body[r, 1], excess)
             judge_energy(m, ws, opt, h, excess)

@@ -128,16 +128,16 @@ def forget_impulses(s):
 
 
 @kernel
-def second_order_gains(m, ws):
+def second_order_gains(m, s, ws, h):
     """The joints' second-order target (solve.fill_row_b) made their impulses add energy
     beyond what it may (work.joints_add_energy): a closed loop near a dead point, whose
-    nearly dependent rows turn an inconsistent drift into huge impulses, or a rod turning by
-    a radian in the step. The step then solves again with the joints aimed at J v = 0
+    nearly dependent rows turn an inconsistent drift into huge impulses, a rod turning by
+    a radian in the step, or an armature whose velocity solve ends far from q + h v*. The step then solves again with the joints aimed at J v = 0
     (a projection, which cannot add energy) and leaves the drift to the position correction,
     whose work is bounded (integrate.bound_correction_work)."""
     if m.pin_body.shape[0] + m.rod_body.shape[0] == 0:
         return False
-    return joints_add_energy(m, ws)[0] > 0.0
+    return joints_add_energy(m, s, ws, h)[0] > 0.0
 
 
 @kernel(inline="always")
@@ -173,7 +173,7 @@ def _step(m, s, ws, opt, u):
         ccd_on = split < opt.max_ccd_splits
         for attempt in range(2):                            # 3-5. rows, impulses, modes
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
-            if attempt == 1 or ws.first_order[0] == 1 or not second_order_gains(m, ws):
+            if attempt == 1 or ws.first_order[0] == 1 or not second_order_gains(m, s, ws, h):
                 break
             ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
