@@ -19,13 +19,23 @@ import numpy as np
 
 from benchmarks.scenes import G
 
-#: episode of the timing runs and of the accuracy runs per scene kind [s] (scenes.py)
-ACCURACY_SECONDS = {"chain": 10.0, "biped_collapse": 3.0, "rod_drop": 2.0, "box_column10": 10.0,
-                    "box_pyramid": 10.0}
-#: scenes that the peers build (the chains N = 2..64, the biped collapse, the rod drop, a
-#: column of ten boxes and the 20-box pyramid, whose boxes collide with each other)
+#: episode of the timing runs and of the accuracy runs per scene kind [s] (scenes.py; a
+#: family of sizes, chainN or box_columnN, by its prefix: scene_seconds)
+ACCURACY_SECONDS = {"chain": 10.0, "biped_collapse": 3.0, "rod_drop": 2.0, "box_column": 10.0,
+                    "box_pyramid": 10.0, "box_piles": 10.0}
+#: scenes that the peers build (the chains N = 2..64, the biped collapse, the rod drop, the
+#: box columns N = 5..40, the 20-box pyramid and five 10-box piles, whose boxes collide with
+#: each other)
 PEER_SCENES = ("chain2", "chain4", "chain8", "chain16", "chain32", "chain64", "biped_collapse", "rod_drop",
-               "box_column10", "box_pyramid")
+               "box_column5", "box_column10", "box_column20", "box_column40", "box_pyramid", "box_piles")
+
+
+def scene_seconds(name: str) -> float:
+    """The accuracy run's length [s] of peer scene `name` (ACCURACY_SECONDS, sizes by prefix)."""
+    for family in ("chain", "box_column"):
+        if name.startswith(family):
+            return ACCURACY_SECONDS[family]
+    return ACCURACY_SECONDS[name]
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ from dataclasses import replace
 import numpy as np
 
 import planarsim as ps
-from benchmarks.metrics import ACCURACY_SECONDS, PEER_SCENES, accuracy, spec_from_model
+from benchmarks.metrics import PEER_SCENES, accuracy, scene_seconds, spec_from_model
 from benchmarks.peers import _rates
 from benchmarks.scenes import biped_collapse, box_column, box_pyramid, chain, rod_drop
 
@@ -108,7 +108,7 @@ def measure_scene(name, peers, quick=False, repeats=3, timing_seconds=1.0, accur
     if name not in PEER_SCENES:
         raise ValueError(f"scene {name!r} has no peer version; peer scenes: {PEER_SCENES}")
     dt = SCENE_DT
-    seconds = accuracy_seconds or ACCURACY_SECONDS["chain" if name.startswith("chain") else name]
+    seconds = accuracy_seconds or scene_seconds(name)
     n_acc = max(1, int(round(seconds / dt)))
     spec = spec_from_model(name, build_model(name, dt), n_acc * dt)
     points = {}

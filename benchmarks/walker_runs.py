@@ -23,7 +23,7 @@ import time
 import walkers
 
 #: the steps/s targets of walkers (one core)
-WALKER_TARGETS = {"simple-biped": 1e6, "ranger": 5e5, "simbicon": 3e5}
+WALKER_TARGETS = {"simple-biped": 2e6, "ranger": 5e5, "simbicon": 3e5, "quadruped": 3e5}
 
 
 def _gait(module):

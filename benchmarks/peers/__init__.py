@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import planarsim as ps
-from benchmarks.metrics import ACCURACY_SECONDS, PEER_SCENES, accuracy, spec_from_model
+from benchmarks.metrics import PEER_SCENES, accuracy, scene_seconds, spec_from_model
 from benchmarks.scenes import SCENES
 from planarsim.compiled import jit
 
@@ -73,7 +73,7 @@ def _summary(rates, dt):
 def accuracy_steps(name, dt, seconds=None):
     """Steps of the accuracy run of scene `name` (`seconds` overrides the default)."""
     if seconds is None:
-        seconds = ACCURACY_SECONDS["chain" if name.startswith("chain") else name]
+        seconds = scene_seconds(name)
     return max(1, int(round(seconds / dt)))
 
 

@@ -95,3 +95,14 @@ def test_peer_builds_the_same_scene(peer, scene):
         traj = ps.Simulator(model).run(n_steps=n, record_every=1)
         assert np.allclose(q[-1], traj.q[-1], atol=1e-2)
     assert np.isfinite(accuracy(spec, q, v)["energy_drift"])
+
+
+def test_box_columns_report_their_cost_growth_and_peer_ratio(capsys):
+    """Two box columns give the log-log slope of their cost per step against N in the
+    targets table, and each peer's raw ratio beside the engine's figures."""
+    assert bench.main(["box_column5", "box_column10", "--parts", "scenes,peers", *TINY]) == 0
+    out = capsys.readouterr().out
+    line = next(x for x in out.splitlines() if "box columns: cost per step grows" in x)
+    assert "slope" in line and ("met" in line or "NOT MET" in line)
+    for name in available_peers()[0]:
+        assert f"box_column10    {name}" in out
