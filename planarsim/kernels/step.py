@@ -76,13 +76,13 @@ def build_and_solve(m, s, ws, opt, h):
 
 
 @kernel
-def answer_holds(m, s, ws, h, include_ccd, equalities):
-    """The last solve's answer breaks no rule (modes.rule_breaks) and leaves no contact or
-    limit outside the problem that its velocity would push through (those are engaged)."""
-    ok = rule_breaks(m, s, ws, h, equalities) == 0
+def answer_check(m, s, ws, h, include_ccd, equalities):
+    """(rules the last solve's answer breaks (modes.rule_breaks), contacts and limits left
+    outside the problem that its velocity would push through, which are engaged now)."""
+    breaks = rule_breaks(m, s, ws, h, equalities)
     engaged = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
         m, s, ws, h, ws.v_new)
-    return ok and engaged == 0
+    return breaks, engaged
 
 
 @kernel(inline="always")
@@ -91,23 +91,32 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
 
     The modes carried over from the last step (plus contacts and limits the free motion would
     push into the ground or past their limit) are a guess: one linear solve, then its answer
-    is checked against every rule. Alternating strategy: if it breaks one, the contact under
-    the cursor is re-examined by the alternating rule and solved once more. An answer that still
-    breaks a rule goes to the complementarity solve, which ends at a consistent answer
-    (complementarity.solve_contacts). No rounds, no cap. Returns True if a linear solve's
-    answer stood (its rows, and their envelope where there are rows, are in ws), False if
-    the complementarity solve replaced it."""
+    is checked against every rule. An answer that breaks none but whose velocity pushes
+    further contacts or limits through is solved again with them engaged, as long as each
+    solve engages more (at most once per contact and limit: a stack landing or settling
+    engages one level per solve, each solve linear in its size). Alternating strategy: an
+    answer that breaks a rule has the contact under the cursor re-examined by the
+    alternating rule and is solved once more. An answer that still breaks a rule goes to the
+    complementarity solve, which ends at a consistent answer (complementarity.solve_contacts).
+    No rounds, no cap. Returns True if a linear solve's answer stood (its rows, and their
+    envelope where there are rows, are in ws), False if the complementarity solve replaced it."""
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
     equalities = build_and_solve(m, s, ws, opt, h)
     rounds = 1
-    ok = answer_holds(m, s, ws, h, include_ccd, equalities)
+    breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
+    while breaks == 0 and engaged > 0:
+        equalities = build_and_solve(m, s, ws, opt, h)
+        rounds += 1
+        breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
+    ok = breaks == 0 and engaged == 0
     nc = m.contact_body.shape[0]
     if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
         seed_rule(m, s, ws, s.mode_cursor[0] % nc)
         equalities = build_and_solve(m, s, ws, opt, h)
         rounds += 1
-        ok = answer_holds(m, s, ws, h, include_ccd, equalities)
+        breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
+        ok = breaks == 0 and engaged == 0
     if ok:
         gather_contact_impulses(m, s, ws)
     else:
