@@ -330,3 +330,26 @@ def test_disk_rolls_on_a_box_at_constant_speed_without_slipping(dt):
     assert abs(v[0] - speed) <= speed * phi ** 2 / 6.0, v
     assert abs(v[2] + speed / r) <= speed / r * phi ** 2 / 6.0, v
     assert sum(audit_counts(sim.ws).values()) == 0
+
+
+@pytest.mark.parametrize("n", [3, 12, 30])
+def test_a_flush_box_column_settles_with_linear_solves_and_keeps_its_corner_names(n):
+    """N boxes of one width stacked flush: their corners sit on the side lines of the faces
+    below, where rounding could clip or keep them. Their contacts keep their names (feature
+    ids) from step to step, and the column settles engaging one level per linear solve,
+    never needing the complementarity solve; it stays put to 1e-9 m with no audit count."""
+    from benchmarks.scenes import box_column
+    from planarsim.compiled import step_info
+    model = box_column(n)
+    sim = ps.Simulator(model)
+    lcp_steps = 0
+    features = None
+    for k in range(300):
+        sim.step()
+        lcp_steps += step_info(sim.ws)["lcp_solves"] > 0
+        if k == 5:
+            features = sim.state.contact_feature.copy()
+    assert lcp_steps == 0
+    assert np.array_equal(sim.state.contact_feature, features)
+    assert np.max(np.abs(sim.state.q - model.q0)) <= 1e-9
+    assert sum(audit_counts(sim.ws).values()) == 0
