@@ -24,7 +24,11 @@ from numba.core.codegen import JITCodeLibrary
 from numba.core.compiler_lock import global_compiler_lock, require_global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
+from . import flags
+
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
+
+flags.install()   # numba's compile flags hashed and compared without rebuilding them (flags.py)
 
 
 # LLVM's code layout while planarsim's machine code is emitted: every function and every block
