@@ -32,9 +32,6 @@ def _eq(self, other):
 
 
 def install():
-    import os
-    if os.environ.get("WTA_NOFLAGS"):
-        return
     """Replace TargetConfig's hash and equality by the quick ones (once per process)."""
     if TargetConfig.__hash__ is not _hash:
         TargetConfig.__hash__ = _hash
