@@ -245,7 +245,7 @@ def test_planarsim_compiles_its_step_and_callers_under_code_layout():
         calls = []
         real = llvm.set_option
         llvm.set_option = lambda name, option: (calls.append(option), real(name, option))[1]
-        from planarsim.compile.fast import CODE_LAYOUT, LLVM_LAYOUT_DEFAULTS
+        from planarsim.compile.fast import LLVM_DEFAULTS, PLANARSIM_LLVM
         from planarsim.compile.link import load_step
         load_step()
         step_calls = list(calls)
@@ -256,8 +256,8 @@ def test_planarsim_compiles_its_step_and_callers_under_code_layout():
         def twice(x):
             return 2.0 * x
         twice(1.5)
-        ok_step = step_calls == list(CODE_LAYOUT) + list(LLVM_LAYOUT_DEFAULTS)
-        ok_jit = calls == list(CODE_LAYOUT) + list(LLVM_LAYOUT_DEFAULTS)
+        ok_step = step_calls == list(PLANARSIM_LLVM) + list(LLVM_DEFAULTS)
+        ok_jit = calls == list(PLANARSIM_LLVM) + list(LLVM_DEFAULTS)
         print(ok_step, ok_jit)
     """)
     assert out == ["True", "True"], out
