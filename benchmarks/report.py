@@ -228,7 +228,7 @@ def targets(res):
         out.append((target, f"{ratio:.2f}x ({batch[0]['jobs']} jobs; machine check {batch[0]['machine_capacity']:.2f}x)",
                     _status(ratio >= 1.8 and batch[0]["jobs"] >= 64)))
     st = {r["cache"]: r for r in res["startup"] or []}
-    for cache, goal in (("cold", 30.0), ("warm", 2.0)):
+    for cache, goal in (("cold", 15.0), ("warm", 2.0)):
         target = f"start-up, {cache} cache: <= {goal:g} s to a walker's first step"
         r = st.get(cache)
         if r is None:

@@ -261,3 +261,18 @@ def test_planarsim_compiles_its_step_and_callers_under_code_layout():
         print(ok_step, ok_jit)
     """)
     assert out == ["True", "True"], out
+
+
+def test_a_callers_caches_follow_only_the_kernels_its_code_can_inline(tmp_path):
+    """drop_stale_caches(folder) of a package of compiled callers hashes the kernel modules
+    its files import (through planarsim.compiled or planarsim.kernels) and theirs in turn; the
+    step is reached by address, so the kernels only the step uses are not among them."""
+    from planarsim.compile.caches import caller_kernels
+    (tmp_path / "a.py").write_text("from planarsim.compiled import jit, step, height\n")
+    assert caller_kernels(tmp_path) == {"terrain"}
+    (tmp_path / "b.py").write_text("from planarsim.kernels.pair import shape_contact_mode\n")
+    got = caller_kernels(tmp_path)
+    assert {"terrain", "pair", "collide", "math2d", "codes"} <= got      # pair's own imports
+    assert not got & {"lcp", "complementarity", "step", "solve", "audit"}
+    (tmp_path / "c.py").write_text("from planarsim import compiled\n")
+    assert {"record", "forces", "terrain", "pair"} <= caller_kernels(tmp_path)
