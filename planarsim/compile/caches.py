@@ -6,16 +6,19 @@ built from, and clears the folder's numba caches when the hash changes. planarsi
 caches (the step among them) follow all engine sources: kernels/ and compile/, and the mode.
 A package of compiled callers (a walker) follows compile/ and only the kernel modules its
 compiled code can inline: those it imports (from planarsim.compiled or planarsim.kernels)
-and the modules they import in turn. In the fast mode its code reaches the step by address,
-so an edit of a kernel only the step uses (the contact solve, say) recompiles the step and
-leaves the walkers' rollouts cached; in the other modes the step is inlined into every
-caller, which then follows all engine sources.
+and the modules they import in turn; and the other sources it can inline: planarsim's modules
+with compiled code that it imports, and the modules of its own top-level package outside its
+folder (a walker's shared helpers), with what they import. In the fast mode its code
+reaches the step by address, so an edit of a kernel only the step uses (the contact solve,
+say) recompiles the step and leaves the walkers' rollouts cached; in the other modes the step
+is inlined into every caller, which then follows all engine sources.
 """
 from __future__ import annotations
 
-import ast
+import functools
 import hashlib
 import os
+import re
 from pathlib import Path
 
 from .mode import FAST, MODE, PYTHON
@@ -46,24 +49,66 @@ _KERNELS = "planarsim.kernels"
 
 
 def _imported_modules(path: Path):
-    """(module, names) of each import statement of source file `path`: absolute module names,
-    names None for ``import module``; relative imports resolved within planarsim.kernels
-    (the only package whose relative imports matter here)."""
+    """(module, names) of each import statement of source file `path`: absolute module names
+    (relative imports resolved by the file's folders, up to `level` packages), names None for
+    ``import module``."""
     try:
-        tree = ast.parse(path.read_text(), str(path))
-    except (OSError, SyntaxError, ValueError):
+        stat = path.stat()
+        return _imports_of(str(path), stat.st_mtime_ns, stat.st_size)
+    except OSError:
+        return ()
+
+
+@functools.lru_cache(maxsize=None)
+def _imports_of(name: str, mtime_ns: int, size: int) -> tuple:
+    return tuple(_parse_imports(Path(name)))
+
+
+# import statements, wherever they stand (lazy ones inside functions too): "from M import
+# names" (names possibly in parentheses over several lines) and "import M[, M2]"
+_FROM = re.compile(r"^[ \t]*from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)", re.M)
+_IMPORT = re.compile(r"^[ \t]*import[ \t]+([^\n#]+)", re.M)
+
+
+def _parse_imports(path: Path):
+    try:
+        text = path.read_text()
+    except (OSError, ValueError):
         return
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            for alias in node.names:
-                yield alias.name, None
-        elif isinstance(node, ast.ImportFrom):
-            module = node.module or ""
-            if node.level:
-                if path.parent != _PLANARSIM / "kernels" or node.level != 1:
-                    continue
-                module = f"{_KERNELS}.{module}" if module else _KERNELS
-            yield module, [alias.name for alias in node.names]
+    for level, module, names in _FROM.findall(text):
+        names = [n.split()[0] for n in names.strip("()").replace("\\", " ").split(",")
+                 if n.split()]
+        if level:
+            package = _dotted(path.parent)
+            if package is None:
+                continue
+            parts = package.split(".")
+            if len(level) > len(parts):
+                continue
+            module = ".".join(parts[:len(parts) - len(level) + 1] + ([module] if module else []))
+        yield module, names
+    for modules in _IMPORT.findall(text):
+        for m in modules.split(","):
+            if m.split():
+                yield m.split()[0], None
+
+
+def _dotted(folder: Path):
+    """Dotted name of the package in `folder` (None if it is not one)."""
+    parts = []
+    while (folder / "__init__.py").exists():
+        parts.insert(0, folder.name)
+        folder = folder.parent
+    return ".".join(parts) or None
+
+
+def _module_file(module: str, roots):
+    base = [root.joinpath(*module.split(".")) for root in roots]
+    for b in base:
+        for candidate in (b.with_suffix(".py"), b / "__init__.py"):
+            if candidate.is_file():
+                return candidate
+    return None
 
 
 def _exported_kernels(names=None) -> set:
@@ -79,23 +124,51 @@ def _exported_kernels(names=None) -> set:
     return found
 
 
-def caller_kernels(folder) -> set:
-    """The kernel modules (short names: "terrain") whose code compiled functions of the .py
-    files below `folder` may inline (fast mode: the step itself is reached by address):
-    those imported from planarsim.kernels or through planarsim.compiled, and, in turn, every
-    kernel module those import."""
-    wanted = set()
-    for path in Path(folder).rglob("*.py"):
-        for module, names in _imported_modules(path):
+def _has_compiled_code(path: Path) -> bool:
+    text = path.read_text()
+    return "@jit" in text or "@kernel" in text
+
+
+def caller_sources(folder) -> tuple:
+    """(kernel modules, other files) that compiled functions of the .py files below `folder`
+    may inline, besides the folder's own files (fast mode: the step itself is reached by
+    address). Kernel modules (short names: "terrain"): those imported from planarsim.kernels
+    or through planarsim.compiled and, in turn, every kernel module those import. Other files:
+    planarsim's modules with compiled code that are imported (planarsim/actuators.py), and
+    the modules of the folder's own top-level package outside it (walkers/common/pd.py for a
+    walker) with, in turn, what those import."""
+    folder = Path(folder).resolve()
+    root = folder
+    while (root / "__init__.py").exists():
+        root = root.parent
+    roots = (root, _PLANARSIM.parent)
+    kernels, files = set(), set()
+    todo = list(folder.rglob("*.py"))
+    seen = set(todo)
+    while todo:
+        for module, names in _imported_modules(todo.pop()):
             if module == "planarsim.compiled":
-                wanted |= _exported_kernels(names)
+                kernels |= _exported_kernels(names)
             elif module == "planarsim" and names and "compiled" in names:
-                wanted |= _exported_kernels()
+                kernels |= _exported_kernels()
             elif module == _KERNELS:
-                wanted |= set(names or ())
+                kernels |= set(names or ())
             elif module.startswith(_KERNELS + "."):
-                wanted.add(module[len(_KERNELS) + 1:].split(".")[0])
-    todo, closure = list(wanted), set()
+                kernels.add(module[len(_KERNELS) + 1:].split(".")[0])
+            elif module == "planarsim" or module.startswith("planarsim.compile"):
+                continue       # the package's front (everything) / the compiler (hashed whole)
+            else:
+                path = _module_file(module, roots)
+                if path is None or path in seen or folder in path.parents:
+                    continue
+                seen.add(path)
+                if _PLANARSIM in path.parents:
+                    if _has_compiled_code(path):
+                        files.add(path)
+                else:
+                    files.add(path)
+                    todo.append(path)
+    todo, closure = list(kernels), set()
     while todo:
         name = todo.pop()
         path = _PLANARSIM / "kernels" / f"{name}.py"
@@ -107,16 +180,23 @@ def caller_kernels(folder) -> set:
                 todo += list(names or ())
             elif module.startswith(_KERNELS + "."):
                 todo.append(module[len(_KERNELS) + 1:].split(".")[0])
-    return closure
+    return closure, files
 
 
 def _caller_engine_hash(folder: Path) -> str:
-    """ENGINE_HASH as it matters to the compiled callers below `folder` (module docstring)."""
+    """ENGINE_HASH as it matters to the compiled callers below `folder` (module docstring),
+    with the other files they may inline (caller_sources)."""
+    kernel_names, files = caller_sources(folder)
+    others = hashlib.blake2b(digest_size=16)
+    for path in sorted(files):
+        others.update(str(path).encode())
+        others.update(path.read_bytes())
     if MODE != FAST:
-        return ENGINE_HASH
+        return ENGINE_HASH + others.hexdigest()
     kernels = _PLANARSIM / "kernels"
-    files = [kernels / f"{name}.py" for name in sorted(caller_kernels(folder))]
-    return _sources_hash(_PLANARSIM / "compile", _sources_hash(kernels, _mode_tag(), files))
+    inlined = [kernels / f"{name}.py" for name in sorted(kernel_names)]
+    return _sources_hash(_PLANARSIM / "compile",
+                         _sources_hash(kernels, _mode_tag() + others.hexdigest(), inlined))
 
 
 def drop_stale_caches(folder, clear=None) -> None:
