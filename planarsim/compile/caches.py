@@ -189,7 +189,7 @@ def _caller_engine_hash(folder: Path) -> str:
     kernel_names, files = caller_sources(folder)
     others = hashlib.blake2b(digest_size=16)
     for path in sorted(files):
-        others.update(str(path).encode())
+        others.update(f"{path.parent.name}/{path.name}".encode())   # a moved checkout keeps it
         others.update(path.read_bytes())
     if MODE != FAST:
         return ENGINE_HASH + others.hexdigest()
