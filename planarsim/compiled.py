@@ -34,6 +34,7 @@ From Python:
     drop_stale_caches(folder)                call on import of a package with compiled code
     kernel_cache()                           (folder, index files) of the engine's numba cache
     measured_compile(), record_compile(s)    the last first compile measured on this machine [s]
+    TYPICAL_COMPILE_S                        a first compile on a quiet two-core machine [s]
 
 Run codes. step returns RUN_OK or an engine failure: RUN_NONFINITE / RUN_TOO_LARGE (the state
 blew up), RUN_AUDIT (StepOptions.audit_raise and a rule broken), RUN_BAD_COMMANDS /
@@ -76,6 +77,10 @@ def kernel_cache():
 
 
 COMPILE_RECORD = "first_compile_s.txt"   # in kernel_cache()'s folder: the last first compile [s]
+# what a first compile takes where none was measured yet [s]: import to a walker's first step
+# with an empty numba cache on a quiet two-core machine (AMD EPYC, numba 0.68;
+# benchmarks/startup.py); a busy machine takes longer
+TYPICAL_COMPILE_S = 36.0
 
 
 def measured_compile():
@@ -122,7 +127,7 @@ def check_run(code, model, ws, options, who="simulation") -> int:
 __all__ = ["jit", "jit_inline", "kernel", "step", "step_from_python", "record_frame",
            "make_recorder", "height", "height_derivs", "closest_point", "gap_of_point",
            "pin_angle_rate", "shape_contact_mode", "audit_counts", "step_info", "drop_stale_caches",
-           "kernel_cache", "measured_compile", "record_compile",
+           "kernel_cache", "measured_compile", "record_compile", "TYPICAL_COMPILE_S",
            "check_run", "engine_failed",
            "RUN_OK", "RUN_NONFINITE", "RUN_TOO_LARGE", "RUN_AUDIT", "RUN_BAD_COMMANDS",
            "RUN_NONFINITE_COMMAND", "RUN_WALKER", "RUN_FELL", "RUN_NO_EVENT"]

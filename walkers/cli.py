@@ -40,11 +40,13 @@ def _load_walker(name):
 
 
 def _compile_note() -> str:
-    """What the first compile takes on this machine: the last one measured, or that none was."""
-    from planarsim.compiled import measured_compile
+    """What the first compile takes on this machine: the last one measured, or, where none was,
+    what it takes on a quiet two-core machine."""
+    from planarsim.compiled import TYPICAL_COMPILE_S, measured_compile
     last = measured_compile()
     if last is None:
-        return "not yet measured on this machine"
+        return (f"about {TYPICAL_COMPILE_S:.0f} s on a quiet two-core machine, longer on a busy "
+                "one; not yet measured on this machine")
     return f"the last one measured on this machine took {last:.0f} s"
 
 

@@ -1,13 +1,24 @@
 """Stale numba caches: numba checks a cached function against its own file only.
 
 A kernel that calls into another file would keep stale machine code after that file changes.
-``drop_stale_caches`` hashes all engine sources (kernels/ and compile/, and the mode) and
-clears the numba caches of planarsim and walkers when the hash changes.
+``drop_stale_caches`` hashes a folder's sources with the engine sources its compiled code is
+built from, and clears the folder's numba caches when the hash changes. planarsim's own
+caches (the step among them) follow all engine sources: kernels/ and compile/, and the mode.
+A package of compiled callers (a walker) follows compile/ and only the kernel modules its
+compiled code can inline: those it imports (from planarsim.compiled or planarsim.kernels)
+and the modules they import in turn; and the other sources it can inline: planarsim's modules
+with compiled code that it imports, and the modules of its own top-level package outside its
+folder (a walker's shared helpers), with what they import. In the fast mode its code
+reaches the step by address, so an edit of a kernel only the step uses (the contact solve,
+say) recompiles the step and leaves the walkers' rollouts cached; in the other modes the step
+is inlined into every caller, which then follows all engine sources.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
+import re
 from pathlib import Path
 
 from .mode import FAST, MODE, PYTHON
@@ -15,9 +26,10 @@ from .mode import FAST, MODE, PYTHON
 _PLANARSIM = Path(__file__).resolve().parent.parent
 
 
-def _sources_hash(folder: Path, extra: str = "") -> str:
+def _sources_hash(folder: Path, extra: str = "", files=None) -> str:
+    """Hash of the .py files below `folder` (or of `files`, paths below it) and `extra`."""
     digest = hashlib.blake2b(extra.encode(), digest_size=16)
-    for path in sorted(folder.rglob("*.py")):
+    for path in sorted(folder.rglob("*.py") if files is None else files):
         digest.update(str(path.relative_to(folder)).encode())
         digest.update(path.read_bytes())
     return digest.hexdigest()
@@ -33,21 +45,175 @@ def _mode_tag() -> str:
 # the engine's compiled code changes with its kernels, this compiler layer and the mode
 ENGINE_HASH = _sources_hash(_PLANARSIM / "compile",
                             _sources_hash(_PLANARSIM / "kernels", _mode_tag()))
+_KERNELS = "planarsim.kernels"
+
+
+def _imported_modules(path: Path):
+    """(module, names) of each import statement of source file `path`: absolute module names
+    (relative imports resolved by the file's folders, up to `level` packages), names None for
+    ``import module``."""
+    try:
+        stat = path.stat()
+        return _imports_of(str(path), stat.st_mtime_ns, stat.st_size)
+    except OSError:
+        return ()
+
+
+@functools.lru_cache(maxsize=None)
+def _imports_of(name: str, mtime_ns: int, size: int) -> tuple:
+    return tuple(_parse_imports(Path(name)))
+
+
+# import statements, wherever they stand (lazy ones inside functions too): "from M import
+# names" (names possibly in parentheses over several lines) and "import M[, M2]"
+_FROM = re.compile(r"^[ \t]*from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)", re.M)
+_IMPORT = re.compile(r"^[ \t]*import[ \t]+([^\n#]+)", re.M)
+
+
+def _parse_imports(path: Path):
+    try:
+        text = path.read_text()
+    except (OSError, ValueError):
+        return
+    for level, module, names in _FROM.findall(text):
+        names = [n.split()[0] for n in names.strip("()").replace("\\", " ").split(",")
+                 if n.split()]
+        if level:
+            package = _dotted(path.parent)
+            if package is None:
+                continue
+            parts = package.split(".")
+            if len(level) > len(parts):
+                continue
+            module = ".".join(parts[:len(parts) - len(level) + 1] + ([module] if module else []))
+        yield module, names
+    for modules in _IMPORT.findall(text):
+        for m in modules.split(","):
+            if m.split():
+                yield m.split()[0], None
+
+
+def _dotted(folder: Path):
+    """Dotted name of the package in `folder` (None if it is not one)."""
+    parts = []
+    while (folder / "__init__.py").exists():
+        parts.insert(0, folder.name)
+        folder = folder.parent
+    return ".".join(parts) or None
+
+
+def _module_file(module: str, roots):
+    base = [root.joinpath(*module.split(".")) for root in roots]
+    for b in base:
+        for candidate in (b.with_suffix(".py"), b / "__init__.py"):
+            if candidate.is_file():
+                return candidate
+    return None
+
+
+def _exported_kernels(names=None) -> set:
+    """Kernel modules (short names) of the compiled functions planarsim.compiled exports
+    (`names` of them; None: all)."""
+    from .. import compiled
+    found = set()
+    for name in compiled.__all__ if names is None else names:
+        fn = getattr(compiled, name, None)
+        module = getattr(getattr(fn, "py_func", None), "__module__", "") or ""
+        if module.startswith(_KERNELS + "."):
+            found.add(module[len(_KERNELS) + 1:])
+    return found
+
+
+def _has_compiled_code(path: Path) -> bool:
+    text = path.read_text()
+    return "@jit" in text or "@kernel" in text
+
+
+def caller_sources(folder) -> tuple:
+    """(kernel modules, other files) that compiled functions of the .py files below `folder`
+    may inline, besides the folder's own files (fast mode: the step itself is reached by
+    address). Kernel modules (short names: "terrain"): those imported from planarsim.kernels
+    or through planarsim.compiled and, in turn, every kernel module those import. Other files:
+    planarsim's modules with compiled code that are imported (planarsim/actuators.py), and
+    the modules of the folder's own top-level package outside it (walkers/common/pd.py for a
+    walker) with, in turn, what those import."""
+    folder = Path(folder).resolve()
+    root = folder
+    while (root / "__init__.py").exists():
+        root = root.parent
+    roots = (root, _PLANARSIM.parent)
+    kernels, files = set(), set()
+    todo = list(folder.rglob("*.py"))
+    seen = set(todo)
+    while todo:
+        for module, names in _imported_modules(todo.pop()):
+            if module == "planarsim.compiled":
+                kernels |= _exported_kernels(names)
+            elif module == "planarsim" and names and "compiled" in names:
+                kernels |= _exported_kernels()
+            elif module == _KERNELS:
+                kernels |= set(names or ())
+            elif module.startswith(_KERNELS + "."):
+                kernels.add(module[len(_KERNELS) + 1:].split(".")[0])
+            elif module == "planarsim" or module.startswith("planarsim.compile"):
+                continue       # the package's front (everything) / the compiler (hashed whole)
+            else:
+                path = _module_file(module, roots)
+                if path is None or path in seen or folder in path.parents:
+                    continue
+                seen.add(path)
+                if _PLANARSIM in path.parents:
+                    if _has_compiled_code(path):
+                        files.add(path)
+                else:
+                    files.add(path)
+                    todo.append(path)
+    todo, closure = list(kernels), set()
+    while todo:
+        name = todo.pop()
+        path = _PLANARSIM / "kernels" / f"{name}.py"
+        if name in closure or not path.exists():
+            continue
+        closure.add(name)
+        for module, names in _imported_modules(path):
+            if module == _KERNELS:
+                todo += list(names or ())
+            elif module.startswith(_KERNELS + "."):
+                todo.append(module[len(_KERNELS) + 1:].split(".")[0])
+    return closure, files
+
+
+def _caller_engine_hash(folder: Path) -> str:
+    """ENGINE_HASH as it matters to the compiled callers below `folder` (module docstring),
+    with the other files they may inline (caller_sources)."""
+    kernel_names, files = caller_sources(folder)
+    others = hashlib.blake2b(digest_size=16)
+    for path in sorted(files):
+        others.update(f"{path.parent.name}/{path.name}".encode())   # a moved checkout keeps it
+        others.update(path.read_bytes())
+    if MODE != FAST:
+        return ENGINE_HASH + others.hexdigest()
+    kernels = _PLANARSIM / "kernels"
+    inlined = [kernels / f"{name}.py" for name in sorted(kernel_names)]
+    return _sources_hash(_PLANARSIM / "compile",
+                         _sources_hash(kernels, _mode_tag() + others.hexdigest(), inlined))
 
 
 def drop_stale_caches(folder, clear=None) -> None:
     """Clear the numba caches below `clear` (default `folder`) when the sources of `folder`
-    or of planarsim's engine changed since the caches were written (nothing under
-    NUMBA_DISABLE_JIT=1, which neither reads nor writes them).
+    or the engine sources its compiled code is built from changed since the caches were
+    written (the module's docstring; nothing under NUMBA_DISABLE_JIT=1, which neither reads
+    nor writes them).
 
-    Walker packages call this on import with their own folder, since their rollout kernels
-    link the engine's step and their controller files.
+    Walker packages call this on import with their own folder, since their rollouts inline
+    their controller files and the engine kernels they import.
     """
     if MODE == PYTHON:
         return
     folder = Path(folder).resolve()
     clear = folder if clear is None else Path(clear).resolve()
-    new = _sources_hash(folder, ENGINE_HASH)
+    engine = ENGINE_HASH if clear == _PLANARSIM else _caller_engine_hash(folder)
+    new = _sources_hash(folder, engine)
     stamp = folder / "__pycache__" / "numba_sources.hash"
     try:
         if stamp.exists() and stamp.read_text() == new:

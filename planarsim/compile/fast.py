@@ -24,7 +24,11 @@ from numba.core.codegen import JITCodeLibrary
 from numba.core.compiler_lock import global_compiler_lock, require_global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
+from . import flags
+
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
+
+flags.install()   # numba's compile flags hashed and compared without rebuilding them (flags.py)
 
 
 # LLVM's code layout while planarsim's machine code is emitted: every function and every block
@@ -35,21 +39,30 @@ _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nr
 # either way (with it, by 2-7%). Measured with it (numba 0.68.1, AMD EPYC): 2-12% more
 # steps/s on the bench scenes and walkers, none slower. LLVM keeps such options
 # process-wide, so they are set only while planarsim compiles (under numba's compiler lock)
-# and then set to LLVM's defaults (0): numba code compiled outside planarsim's compiles is
-# laid out as without planarsim (a plain numba function compiled as part of a planarsim
-# caller gets the layout; a user's own setting of these two options is not kept). numba's
+# and then set to LLVM's defaults (LLVM_DEFAULTS): numba code compiled outside planarsim's
+# compiles is laid out as without planarsim (a plain numba function compiled as part of a
+# planarsim caller gets the layout; a user's own setting of these options is not kept). numba's
 # cache does not record the options: code cached before them runs unaligned (only slower).
 CODE_LAYOUT = ("-align-all-functions=6", "-align-all-nofallthru-blocks=6")
-LLVM_LAYOUT_DEFAULTS = ("-align-all-functions=0", "-align-all-nofallthru-blocks=0")
+# GVN (redundant load elimination) scans at most this many instructions back within a block
+# for what a load depends on (LLVM's default 100). On the step's few very long blocks its
+# scans were the largest part of O3: 20 takes about 2 s off the step's first compile, with
+# steps/s the same within the noise on the bench scenes and walkers (measured, numba 0.68.1).
+MEMDEP_SCAN = ("-memdep-block-scan-limit=20",)
+# set while planarsim compiles, and LLVM's defaults set back afterwards
+PLANARSIM_LLVM = CODE_LAYOUT + MEMDEP_SCAN
+LLVM_DEFAULTS = ("-align-all-functions=0", "-align-all-nofallthru-blocks=0",
+                 "-memdep-block-scan-limit=100")
 _LAYOUT_DEPTH = [0]
 
 
 @contextlib.contextmanager
 def code_layout():
-    """Compile planarsim's machine code inside this block (reentrant; see CODE_LAYOUT)."""
+    """Compile planarsim's machine code inside this block (reentrant; see CODE_LAYOUT and
+    MEMDEP_SCAN)."""
     with global_compiler_lock:
         if _LAYOUT_DEPTH[0] == 0:
-            for option in CODE_LAYOUT:
+            for option in PLANARSIM_LLVM:
                 llvm.set_option("planarsim", option)
         _LAYOUT_DEPTH[0] += 1
         try:
@@ -57,7 +70,7 @@ def code_layout():
         finally:
             _LAYOUT_DEPTH[0] -= 1
             if _LAYOUT_DEPTH[0] == 0:
-                for option in LLVM_LAYOUT_DEFAULTS:
+                for option in LLVM_DEFAULTS:
                     llvm.set_option("planarsim", option)
 
 

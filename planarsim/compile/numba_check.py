@@ -5,7 +5,7 @@ its own code library (numba.core.codegen, numba.core.compiler), and compile/refs
 compile/link.py build arrays and calls in LLVM IR (numba.core.cgutils, numba.np.arrayobj).
 A numba release that renames or drops one of them is found here, before anything compiles,
 and planarsim runs on plain numba instead (compile/mode.py), warning with the numba version
-and each changed internal. Checked with numba 0.59 to 0.68.
+and each changed internal (flags.py reads numba's compile flags). Checked with numba 0.59 to 0.68.
 """
 import importlib
 import inspect
@@ -23,6 +23,7 @@ NEEDED = {
     "numba.core.compiler_lock": "require_global_compiler_lock global_compiler_lock",
     "numba.core.registry": "CPUDispatcher CPUDispatcher.compile CPUDispatcher.enable_caching "
                            "CPUDispatcher.get_call_template",
+    "numba.core.targetconfig": "TargetConfig.options TargetConfig.__slots__",   # flags.py
 }
 # numba's low-level extension API as refs.py uses it (numba.extending and the helpers its
 # documentation's examples use): model, state and workspace as one pointer each, in both the
@@ -73,6 +74,9 @@ def changed_internals():
         library = cpu_target.target_context.codegen().create_library("planarsim_check")
         missing += [f"numba.core.codegen.JITCodeLibrary().{f}" for f in LIBRARY_FIELDS
                     if not hasattr(library, f)]
+        from numba.core.targetconfig import TargetConfig
+        if "_values" not in TargetConfig.__slots__:   # flags.py compares the set options
+            missing.append("numba.core.targetconfig.TargetConfig._values")
     except Exception as exc:   # any change in how these are made counts as a change
         missing.append(f"numba.core.registry (making a code library: {type(exc).__name__}: {exc})")
     return missing

@@ -13,7 +13,7 @@ import math
 from ..compile import kernel
 from .codes import MODE_FREE
 from .info import INFO_CCD_SPLITS
-from .terrain import ground_point_call, height_derivs, max_curvature, max_slope
+from .terrain import ground_point, height_derivs, max_curvature, max_slope
 
 N_SAMPLES = 8
 # [m] per metre of coordinates: a path whose height above the ground falls this low while it
@@ -29,7 +29,7 @@ def _path_gap(m, s, ws, b, h, tau):
     ay = (ws.v_new[b, 1] - s.v[b, 1]) / h
     px = s.q[b, 0] + tau * s.v[b, 0] + tau * tau * ax
     py = s.q[b, 1] + tau * s.v[b, 1] + tau * tau * ay
-    return ground_point_call(m.terrain_coef, px, py)[4]
+    return ground_point(m.terrain_coef, px, py)[4]
 
 
 @kernel

@@ -193,26 +193,18 @@ def closest_point(coef, px, py):
     return x, h, nx, ny, gap
 
 
-@kernel
-def ground_point(coef, px, py):
-    """closest_point inlined into the caller, its flat and sloped case in closed form."""
-    if coef[2] == 0.0:
-        return _closest_on_line(coef[0], coef[1], px, py)
-    return closest_point(coef, px, py)
-
-
 @kernel(inline="never")
 def _closest_on_hills(coef, px, py):
-    """closest_point as one call (see ground_point_call)."""
+    """closest_point as one call (see ground_point)."""
     return closest_point(coef, px, py)
 
 
 @kernel
-def ground_point_call(coef, px, py):
-    """ground_point whose hills case is one call, for call sites that are many and rarely run
-    (the time-of-impact root search): LLVM would otherwise copy the Newton loop of sines
-    into each of them (once hundreds of copies in the step, seconds of a first-ever
-    compile)."""
+def ground_point(coef, px, py):
+    """closest_point for the engine's stages: the flat and sloped case in closed form,
+    inlined; the hills case (the Newton loop of sines) one call. Inlined, that loop was
+    copied into each of the step's ground queries (over 90 copies, 60 % of the step's code
+    and most of a first-ever compile), for a call that costs a few ns beside its sines."""
     if coef[2] == 0.0:
         return _closest_on_line(coef[0], coef[1], px, py)
     return _closest_on_hills(coef, px, py)

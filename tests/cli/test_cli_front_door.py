@@ -145,9 +145,9 @@ def test_custom_hills_are_recorded_with_their_coefficients(tmp_path, capsys):
 
 # the first compile states what this machine measures ----------------------------------------------
 def test_the_first_compile_message_states_what_this_machine_measured(tmp_path, monkeypatch, capsys):
-    """A cold cache (pretended: no index files in a folder of the test's own): the note says
-    no figure was measured yet, the run then says what it measured and keeps it, and the next
-    cold start quotes that figure."""
+    """A cold cache (pretended: no index files in a folder of the test's own): the note gives
+    the figure of a quiet two-core machine and says none was measured here yet, the run then
+    says what it measured and keeps it, and the next cold start quotes that figure."""
     import re
 
     import planarsim.compiled as compiled
@@ -155,7 +155,9 @@ def test_the_first_compile_message_states_what_this_machine_measured(tmp_path, m
     monkeypatch.setattr(compiled, "kernel_cache", lambda: (tmp_path, []))
     code, _, err = run_cli(capsys, "run", "simple-biped", "--duration", "0.1", "--json")
     assert code == 0, err
-    assert "compiling the engine (first run only; not yet measured on this machine)" in err
+    assert ("compiling the engine (first run only; about "
+            f"{compiled.TYPICAL_COMPILE_S:.0f} s on a quiet two-core machine") in err
+    assert "not yet measured on this machine)" in err
     said = re.search(r"first compile: measured (\d+) s on this machine", err)
     assert said, err
     assert compiled.measured_compile() is not None

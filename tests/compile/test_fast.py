@@ -5,6 +5,7 @@ import os
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import numba
 import pytest
@@ -245,7 +246,7 @@ def test_planarsim_compiles_its_step_and_callers_under_code_layout():
         calls = []
         real = llvm.set_option
         llvm.set_option = lambda name, option: (calls.append(option), real(name, option))[1]
-        from planarsim.compile.fast import CODE_LAYOUT, LLVM_LAYOUT_DEFAULTS
+        from planarsim.compile.fast import LLVM_DEFAULTS, PLANARSIM_LLVM
         from planarsim.compile.link import load_step
         load_step()
         step_calls = list(calls)
@@ -256,8 +257,39 @@ def test_planarsim_compiles_its_step_and_callers_under_code_layout():
         def twice(x):
             return 2.0 * x
         twice(1.5)
-        ok_step = step_calls == list(CODE_LAYOUT) + list(LLVM_LAYOUT_DEFAULTS)
-        ok_jit = calls == list(CODE_LAYOUT) + list(LLVM_LAYOUT_DEFAULTS)
+        ok_step = step_calls == list(PLANARSIM_LLVM) + list(LLVM_DEFAULTS)
+        ok_jit = calls == list(PLANARSIM_LLVM) + list(LLVM_DEFAULTS)
         print(ok_step, ok_jit)
     """)
     assert out == ["True", "True"], out
+
+
+def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
+    """drop_stale_caches(folder) of a package of compiled callers hashes the kernel modules
+    its files import (through planarsim.compiled or planarsim.kernels) and theirs in turn; the
+    step is reached by address, so the kernels only the step uses are not among them. It
+    hashes too the modules of its own top-level package outside it that it imports (a shared
+    helper: walkers/common for a walker) and planarsim's modules with compiled code."""
+    from planarsim.compile.caches import caller_sources
+    top = tmp_path / "top"
+    own, shared = top / "own", top / "shared"
+    for package in (top, own, shared):
+        package.mkdir(exist_ok=True)
+        (package / "__init__.py").write_text("")
+    (own / "a.py").write_text("from planarsim.compiled import jit, step, height\n")
+    assert caller_sources(own) == ({"terrain"}, set())
+    (own / "b.py").write_text("from planarsim.kernels.pair import shape_contact_mode\n")
+    kernels, _ = caller_sources(own)
+    assert {"terrain", "pair", "collide", "math2d", "codes"} <= kernels    # pair's own imports
+    assert not kernels & {"lcp", "complementarity", "step", "solve", "audit"}
+    (own / "c.py").write_text("from planarsim import compiled\n"
+                              "from planarsim.actuators import motor_torque\n"
+                              "from planarsim.model import Model\n"
+                              "from top.shared.helpers import clamp\n")
+    (shared / "helpers.py").write_text("from .more import LIMIT\n")
+    (shared / "more.py").write_text("LIMIT = 2.0\n")
+    kernels, files = caller_sources(own)
+    assert {"record", "forces", "terrain", "pair"} <= kernels
+    import planarsim
+    actuators = Path(planarsim.__file__).resolve().parent / "actuators.py"
+    assert files == {actuators, shared / "helpers.py", shared / "more.py"}   # not model.py
