@@ -1,0 +1,137 @@
+"""The energy-accurate integrators (StepOptions.integrator): RATTLE and its fourth-order
+composition, built around the default step (kernels/step.py).
+
+The default step is symplectic Euler with SHAKE: v+ = v + h M^-1 (f(q) + J(q)^T lam),
+q+ = q + h v+, c(q+) = 0, with the correction along J(q) (integrate.py). Read with v the
+velocity at the START of the step, its energy error is first order in h. RATTLE (Andersen
+1983; Hairer, Lubich & Wanner, Geometric Numerical Integration, VII.1.4) keeps the velocity
+of the instant, on the joints' tangent space:
+
+    v_half = v + h/2 M^-1 (f(q) + J(q)^T lam),  q+ = q + h v_half,  c(q+) = 0     (SHAKE)
+    v+ = v_half + h/2 M^-1 (f(q+) + J(q+)^T mu),  J(q+) v+ = 0                    (RATTLE)
+
+so one RATTLE step is: a half kick back, v - h/2 M^-1 f(q) (rattle_begin; the default step's
+full kick then leaves the half kick forward), the default step (its SHAKE solve finds lam: an
+input velocity's part along M^-1 J(q)^T only changes lam), a half kick at q+ and the
+mass-weighted projection onto J(q+) v = 0 (rattle_end). RATTLE is symmetric and symplectic:
+its energy error is O(h^2) and stays bounded (no drift), the pins are closed to the position
+correction's tolerance (StepOptions.refine_tol). Its symmetric composition with the weights
+of Yoshida (1990) / Suzuki's fractal, w1 = 1 / (2 - 2^(1/3)), w0 = 1 - 2 w1 < 0, is fourth
+order: three RATTLE stages of w1 h, w0 h, w1 h (the middle one backwards in time).
+
+Only mechanisms of pins, sliders and rods under position-dependent forces (gravity, pushes,
+actuator commands held over the step) are supported: a contact, a joint limit, a joint's
+spring, damper or armature (solved implicitly inside the velocity solve) or a fluid drag
+(velocity-dependent) would make the half kicks wrong. A model with any of them is refused
+(unsupported: GUARD_UNSUPPORTED, errors.accurate_unsupported names the culprit) before
+anything is stepped.
+"""
+import math
+
+from ..compile import kernel
+from .codes import INTEGRATOR_RATTLE4
+from .forces import apply_forces
+from .guards import GUARD_OK, GUARD_UNSUPPORTED
+from .info import INFO_GUARD_BODY, INFO_GUARD_FIELD
+from .math2d import update_trig
+from .rows import build_rows
+from .solve import (apply_impulses, assemble, compute_envelope, factor_symmetric, row_dot,
+                    substitute_symmetric)
+
+# Yoshida's fourth-order triple jump: stages of w1 h, w0 h, w1 h
+YOSHIDA_W1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
+YOSHIDA_W0 = 1.0 - 2.0 * YOSHIDA_W1
+
+# what a model has that the accurate integrators cannot take (ws.info[INFO_GUARD_FIELD] of
+# GUARD_UNSUPPORTED; ws.info[INFO_GUARD_BODY] holds the element's index; the same test from
+# Python: planarsim/integrator.py)
+UNSUPPORTED_CONTACT = 0   # a contact (index: the contact)
+UNSUPPORTED_LIMIT = 1     # a joint limit (index: the joint)
+UNSUPPORTED_SOFT = 2      # a joint's spring, damper or armature (index: the joint)
+UNSUPPORTED_FLUID = 3     # a body under fluid drag (index: the fluid entry)
+
+
+@kernel
+def stage_count(integrator):
+    """Stages (default steps) of one step of `integrator`."""
+    return 3 if integrator == INTEGRATOR_RATTLE4 else 1
+
+
+@kernel
+def stage_weight(integrator, k):
+    """Stage k's share of the step (the shares sum to 1)."""
+    if integrator == INTEGRATOR_RATTLE4:
+        return YOSHIDA_W0 if k == 1 else YOSHIDA_W1
+    return 1.0
+
+
+@kernel
+def _refuse(ws, what, index):
+    ws.info[INFO_GUARD_FIELD] = what
+    ws.info[INFO_GUARD_BODY] = index
+    return GUARD_UNSUPPORTED
+
+
+@kernel
+def unsupported(m, ws):
+    """GUARD_UNSUPPORTED (the culprit recorded in ws.info) if the model has a contact, a
+    joint limit, a joint's spring, damper or armature, or a fluid drag; else GUARD_OK."""
+    if m.contact_body.shape[0] > 0:
+        return _refuse(ws, UNSUPPORTED_CONTACT, 0)
+    for j in range(m.pin_body.shape[0]):
+        if math.isfinite(m.pin_limit[j, 0]) or math.isfinite(m.pin_limit[j, 1]):
+            return _refuse(ws, UNSUPPORTED_LIMIT, j)
+        if m.pin_armature[j] > 0.0 or m.pin_stiffness[j] > 0.0 or m.pin_damping[j] > 0.0:
+            return _refuse(ws, UNSUPPORTED_SOFT, j)
+    if m.fluid_body.shape[0] > 0:
+        return _refuse(ws, UNSUPPORTED_FLUID, 0)
+    return GUARD_OK
+
+
+@kernel
+def half_kick(m, s, ws, u, h):
+    """s.v += h M^-1 f(q) [m/s, rad/s] with f the applied forces at s.q under commands u (h
+    may be negative). Leaves ws.act_power at the velocity it was called with."""
+    update_trig(s.q, ws.body_cs)
+    apply_forces(m, s, ws, u)
+    for i in range(s.v.shape[0]):
+        s.v[i, 0] += h * m.body_inv_mass[i] * ws.force[i, 0]
+        s.v[i, 1] += h * m.body_inv_mass[i] * ws.force[i, 1]
+        s.v[i, 2] += h * m.body_inv_inertia[i] * ws.force[i, 2]
+
+
+@kernel
+def project_velocities(m, s, ws, pivot_tol):
+    """s.v <- s.v - W J^T (J W J^T)^-1 J s.v with the joints' rows J at s.q: the velocity of
+    least kinetic-energy change that keeps every pin, slider and rod (RATTLE's velocity
+    equation). Rows dependent to within pivot_tol (a closed loop) are dropped: the others
+    hold them."""
+    update_trig(s.q, ws.body_cs)
+    build_rows(m, s, ws)
+    n = ws.n_row[0]
+    if n == 0:
+        return
+    compute_envelope(ws, n, s.v.shape[0])
+    assemble(m, ws, ws.row_J, ws.row_J, n, True)
+    factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, pivot_tol, ws.lam)
+    for r in range(n):
+        ws.rhs[r] = -row_dot(ws, r, ws.row_J, s.v)
+    substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+    apply_impulses(m, ws, ws.row_J, ws.lam, n, s.v, 1.0)
+
+
+@kernel
+def rattle_begin(m, s, ws, u, h):
+    """Before a default step of h [s]: the half kick back (the step's full kick then gives
+    RATTLE's first half kick)."""
+    half_kick(m, s, ws, u, -0.5 * h)
+
+
+@kernel
+def rattle_end(m, s, ws, u, h, pivot_tol, project):
+    """After a default step of h [s]: RATTLE's second half kick at the new configuration and,
+    if `project`, the projection onto the joints' tangent space there (between stages of a
+    composition it is left out: the next stage's SHAKE solve absorbs that component)."""
+    half_kick(m, s, ws, u, 0.5 * h)
+    if project:
+        project_velocities(m, s, ws, pivot_tol)
