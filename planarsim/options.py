@@ -75,8 +75,8 @@ class StepOptions(NamedTuple):
     integrator : 0 'euler' (default): symplectic Euler with SHAKE, energy error O(h);
         1 'rattle': RATTLE, the velocity of the instant kept on the joints' tangent space,
         energy error O(h^2) (bounded, no drift), pins closed as by the default step, about
-        1.3 times its cost; 2 'rattle4': RATTLE composed in three stages (Yoshida), energy
-        and trajectory errors O(h^4) at about three times the cost of 'rattle'. The accurate
+        1.3 to 1.5 times its cost; 2 'rattle4': RATTLE composed in five stages (Suzuki),
+        energy and trajectory errors O(h^4) at about four times the cost of 'rattle'. The accurate
         two take mechanisms of pins, sliders and rods under gravity, pushes and actuators
         only: a model with a contact, a joint limit, a joint spring, damper or armature or a
         fluid drag is refused (ModelError naming it; kernels/rattle.py)
