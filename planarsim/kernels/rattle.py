@@ -36,9 +36,8 @@ from .forces import apply_forces
 from .guards import GUARD_OK, GUARD_UNSUPPORTED
 from .info import INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .math2d import update_trig
-from .rows import build_rows
-from .solve import (apply_impulses, assemble, compute_envelope, factor_symmetric, row_dot,
-                    substitute_symmetric)
+from .rows import eval_rows
+from .solve import apply_impulses, assemble, factor_symmetric, row_dot, substitute_symmetric
 
 # Suzuki's fourth-order fractal: stages of p h, p h, (1 - 4 p) h, p h, p h
 SUZUKI_P = 1.0 / (4.0 - 4.0 ** (1.0 / 3.0))
@@ -107,13 +106,13 @@ def project_velocities(m, s, ws, pivot_tol):
     """s.v <- s.v - W J^T (J W J^T)^-1 J s.v with the joints' rows J at s.q: the velocity of
     least kinetic-energy change that keeps every pin, slider and rod (RATTLE's velocity
     equation). Rows dependent to within pivot_tol (a closed loop) are dropped: the others
-    hold them."""
-    update_trig(s.q, ws.body_cs)
-    build_rows(m, s, ws)
+    hold them. After a default step of a supported model (unsupported) ws holds the rows it
+    built, the joints' and no others, and their envelope: only J is evaluated again."""
     n = ws.n_row[0]
     if n == 0:
         return
-    compute_envelope(ws, n, s.v.shape[0])
+    update_trig(s.q, ws.body_cs)
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, False)
     assemble(m, ws, ws.row_J, ws.row_J, n, True)
     factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, pivot_tol, ws.lam)
     for r in range(n):

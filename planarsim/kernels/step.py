@@ -176,6 +176,8 @@ def step_of_length(m, s, ws, opt, u, step_length):
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
             if attempt == 1 or ws.first_order[0] == 1 or not second_order_gains(m, s, ws, h):
                 break
+            if opt.integrator != INTEGRATOR_EULER:
+                break                                       #    (not for RATTLE: kernels/rattle.py)
             ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
         if ccd_on:
