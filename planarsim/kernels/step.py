@@ -9,7 +9,9 @@ compiled once per machine and called by address from every compiled caller (a wa
 rollout, run_steps; compile/link.py). A time-of-impact split (CCD) repeats
 stages 1-5 for the remainder of the step with the new contact pinned. Each stage lives in its
 module (README's table "How the engine works" names them); this file only orders them, and
-solve_modes, the guess-check-solve of stages 3-5.
+solve_modes, the guess-check-solve of stages 3-5. StepOptions.integrator other than the default
+wraps the same stages (step_of_length) in RATTLE's half kicks and projection, or in its
+five-stage composition (accurate_step; kernels/rattle.py).
 """
 from ..compile import kernel
 from .audit import audit_impulses, audit_total
