@@ -92,7 +92,7 @@ def plot_scene(rows, path):
             ys = [r["cost_s_per_s"] for r in pts]
             style = (dict(lw=2.5, color="k") if label == "planarsim" else
                      dict(lw=2.0, ls="--") if label.startswith("planarsim") else dict(lw=1.2))
-            line, = ax.loglog(xs, ys, "o-", label=label, **style)
+            line, = ax.loglog(xs, ys, marker="o", ls=style.pop("ls", "-"), label=label, **style)
             for x, y, r in zip(xs, ys, pts):
                 ax.annotate(step_label(r["k"]), (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7,
                             color=line.get_color())
