@@ -211,7 +211,8 @@ def accurate_step(m, s, ws, opt, u, step_length):
     """One step of step_length [s] of StepOptions.integrator's RATTLE or its composition
     (kernels/rattle.py): per stage a half kick back, the default step, a half kick forward;
     the velocity projected onto the joints at the end. The State counts one step; a failing
-    stage's guard code is returned at once (ws.prev then holds that stage's start)."""
+    stage's guard code is returned at once (ws.prev then holds that stage's start, counted as
+    this step)."""
     code = unsupported(m, ws)
     if code != 0:
         return code
@@ -220,6 +221,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
     n = stage_count(opt.integrator)
     for k in range(n):
         h = stage_weight(opt.integrator, k) * step_length
+        s.step[0] = count                                   # an error names this step
         rattle_begin(m, s, ws, u, h)
         code = step_of_length(m, s, ws, opt, u, h)
         if code != 0:
