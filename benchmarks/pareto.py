@@ -46,7 +46,8 @@ CURVES = {
     # the default step (first order in the energy) and the accurate integrators
     # (StepOptions.integrator; mechanisms without contacts only: measure_scene skips them there)
     "planarsim": [("planarsim", {}), ("planarsim-rattle", {"integrator": "rattle"}),
-                  ("planarsim-rattle4", {"integrator": "rattle4"})],
+                  ("planarsim-rattle4", {"integrator": "rattle4"}),
+                  ("planarsim-rattle6", {"integrator": "rattle6"})],
     "pymunk": [("pymunk it10", {"iterations": 10}), ("pymunk it40", {"iterations": 40})],
     "box2d": [("box2d it8/3", {"velocity_iterations": 8, "position_iterations": 3}),
               ("box2d it30/10", {"velocity_iterations": 30, "position_iterations": 10})],

@@ -21,7 +21,7 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
 - batch: 64 Simple Biped walks on 1 and 2 worker threads (walkers.batch).
 - pareto: accuracy-matched comparison (pareto.py) of the named peer scenes (default chain4,
   chain32, rod_drop, biped_collapse): planarsim (its default step, and on scenes without
-  contacts its accurate integrators 'rattle' and 'rattle4'), pymunk (10 and 40 iterations), Box2D (8/3 and
+  contacts its accurate integrators 'rattle', 'rattle4' and 'rattle6'), pymunk (10 and 40 iterations), Box2D (8/3 and
   30/10 iterations) and MuJoCo (Euler, implicitfast, RK4), each at steps dt*8 ... dt/8
   (--quick: the first configuration at dt and dt/2): cost per simulated second against pin,
   energy (chains) and contact error, the ratio at matched accuracy beside the raw ratio, one

@@ -1,4 +1,4 @@
-"""Which models the accurate integrators (StepOptions.integrator 'rattle', 'rattle4';
+"""Which models the accurate integrators (StepOptions.integrator 'rattle', 'rattle4', 'rattle6';
 kernels/rattle.py) can step, checked from Python before the first step.
 
 The compiled step makes the same test (kernels/rattle.py unsupported) and stops with

@@ -76,8 +76,9 @@ class StepOptions(NamedTuple):
         1 'rattle': RATTLE, the velocity of the instant kept on the joints' tangent space,
         energy error O(h^2) (bounded, no drift), pins closed as by the default step, about
         1.3 to 1.5 times its cost; 2 'rattle4': RATTLE composed in five stages (Suzuki),
-        energy and trajectory errors O(h^4) at about four times the cost of 'rattle'. The accurate
-        two take mechanisms of pins, sliders and rods under gravity, pushes and actuators
+        energy and trajectory errors O(h^4) at about four times the cost of 'rattle'; 3
+        'rattle6': seven stages (Yoshida), O(h^6) at 7/5 the cost of 'rattle4'. The accurate
+        ones take mechanisms of pins, sliders and rods under gravity, pushes and actuators
         only: a model with a contact, a joint limit, a joint spring, damper or armature or a
         fluid drag is refused (ModelError naming it; kernels/rattle.py)
     """
@@ -99,7 +100,7 @@ class StepOptions(NamedTuple):
 
 def make_options(strategy="alternating", refine=True, integrator="euler", **kw) -> StepOptions:
     """StepOptions from friendly names: strategy 'alternating' | 'all'; refine on/off;
-    integrator 'euler' | 'rattle' | 'rattle4' (StepOptions.integrator)."""
+    integrator 'euler' | 'rattle' | 'rattle4' | 'rattle6' (StepOptions.integrator)."""
     names = {"alternating": MODES_ALTERNATING, "all": MODES_ALL}
     if isinstance(strategy, str):
         if strategy not in names:

@@ -38,4 +38,5 @@ ROW_JOINT_SOFT = 9     # a joint coordinate's armature and implicit spring-dampe
 INTEGRATOR_EULER = 0      # StepOptions.integrator: the default step, symplectic Euler with SHAKE
 INTEGRATOR_RATTLE = 1     # RATTLE, second order (kernels/rattle.py)
 INTEGRATOR_RATTLE4 = 2    # RATTLE composed in five stages (Suzuki), fourth order
-INTEGRATOR_NAMES = ("euler", "rattle", "rattle4")
+INTEGRATOR_RATTLE6 = 3    # RATTLE composed in seven stages (Yoshida), sixth order
+INTEGRATOR_NAMES = ("euler", "rattle", "rattle4", "rattle6")
