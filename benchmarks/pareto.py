@@ -23,6 +23,7 @@ from dataclasses import replace
 import numpy as np
 
 import planarsim as ps
+from planarsim.integrator import unsupported_feature
 from benchmarks.metrics import PEER_SCENES, accuracy, scene_seconds, spec_from_model
 from benchmarks.peers import _rates
 from benchmarks.scenes import biped_collapse, box_column, box_pyramid, chain, rod_drop
@@ -42,7 +43,11 @@ DEFAULT_SCENES = ("chain4", "chain32", "rod_drop", "biped_collapse")
 _FULL_K, _QUICK_K = (0.125, 0.25, 0.5, 1, 2, 4, 8), (1, 2)
 #: engine -> [(curve label, World keyword arguments)]; each curve runs at every k of the ladder
 CURVES = {
-    "planarsim": [("planarsim", {})],
+    # the default step (first order in the energy) and the accurate integrators
+    # (StepOptions.integrator; mechanisms without contacts only: measure_scene skips them there)
+    "planarsim": [("planarsim", {}), ("planarsim-rattle", {"integrator": "rattle"}),
+                  ("planarsim-rattle4", {"integrator": "rattle4"}),
+                  ("planarsim-rattle6", {"integrator": "rattle6"})],
     "pymunk": [("pymunk it10", {"iterations": 10}), ("pymunk it40", {"iterations": 40})],
     "box2d": [("box2d it8/3", {"velocity_iterations": 8, "position_iterations": 3}),
               ("box2d it30/10", {"velocity_iterations": 30, "position_iterations": 10})],
@@ -83,10 +88,11 @@ def frames(k):
 
 
 class _Planarsim:
-    """planarsim at frame_dt / k steps per frame, with the peers' World interface."""
+    """planarsim at frame_dt / k steps per frame, with the peers' World interface; options:
+    make_options keywords (integrator='rattle', say)."""
 
-    def __init__(self, name, frame_dt, k):
-        self.sim = ps.Simulator(build_model(name, frame_dt / k))
+    def __init__(self, name, frame_dt, k, **options):
+        self.sim = ps.Simulator(build_model(name, frame_dt / k), options=ps.make_options(**options))
         self.start, self.k = self.sim.snapshot(), k
 
     def reset(self):
@@ -112,11 +118,14 @@ def measure_scene(name, peers, quick=False, repeats=3, timing_seconds=1.0, accur
     n_acc = max(1, int(round(seconds / dt)))
     spec = spec_from_model(name, build_model(name, dt), n_acc * dt)
     points = {}
+    accurate_ok = unsupported_feature(build_model(name, dt)) is None
     for engine in ("planarsim", *peers):
         for label, kw, k in ladder(engine, quick):
             m, sub = frames(k)
             if engine == "planarsim":
-                world = _Planarsim(name, m * dt, sub)
+                if kw.get("integrator", "euler") != "euler" and not accurate_ok:
+                    continue    # an accurate integrator refuses contacts (planarsim.integrator)
+                world = _Planarsim(name, m * dt, sub, **kw)
             else:
                 world = peers[engine].World(replace(spec, dt=m * dt), substeps=sub, **kw)
             points[(engine, label, k)] = (world, m)
@@ -217,35 +226,41 @@ def figures(rows):
             and not (ground and m == "energy_err_max")]
 
 
-def matched(rows, metrics=None):
-    """[summary per peer curve] of one scene; every ratio is peer cost / planarsim cost (how
-    many times faster planarsim is). raw_ratio: both at the scene's dt (k = 1). Per figure:
-    target = planarsim's error at dt; ratio = the curve's cost on its Pareto front at that
-    error over planarsim's cost at dt (nan: not reached; note as cost_at); peer_target = the
-    curve's error at dt, ratio_at_peer = the curve's cost at dt over planarsim's cost on its
-    front at that error (nan: planarsim does not reach it, or note "diverged": the curve's run
+def our_curves(rows):
+    """Labels of planarsim's curves among `rows` (the default step first)."""
+    return list(dict.fromkeys(r["curve"] for r in rows if r["engine"] == "planarsim"))
+
+
+def matched(rows, metrics=None, ours="planarsim"):
+    """[summary per peer curve] of one scene against planarsim's curve `ours` (the default
+    step, or an accurate integrator's); every ratio is peer cost / our cost (how many times
+    faster planarsim is). raw_ratio: both at the scene's dt (k = 1). Per figure:
+    target = our error at dt; ratio = the curve's cost on its Pareto front at that
+    error over our cost at dt (nan: not reached; note as cost_at); peer_target = the
+    curve's error at dt, ratio_at_peer = the curve's cost at dt over our cost on our
+    front at that error (nan: we do not reach it, or note "diverged": the curve's run
     at dt diverged); cross = errors where the two fronts
     cross; order, our_order = observed orders (slope of log error vs log step)."""
     metrics = figures(rows) if metrics is None else metrics
-    by = curves(rows)
-    ours = by.pop("planarsim")
-    base = next(r for r in ours if r["k"] == 1)
+    by = {label: pts for label, pts in curves(rows).items() if pts[0]["engine"] != "planarsim"}
+    mine = curves(rows)[ours]
+    base = next(r for r in mine if r["k"] == 1)
     out = []
     for label, pts in by.items():
         own = next(r for r in pts if r["k"] == 1)
-        s = dict(scene=base["scene"], curve=label, engine=pts[0]["engine"],
+        s = dict(scene=base["scene"], ours=ours, curve=label, engine=pts[0]["engine"],
                  raw_ratio=own["cost_s_per_s"] / base["cost_s_per_s"])
         for m in metrics:
             target, peer_target = _err(base, m), _err(own, m)
             if math.isnan(target) or math.isnan(peer_target):
                 continue
             cost, note = cost_at(front(pts, m), target)
-            our_cost, our_note = cost_at(front(ours, m), peer_target)
+            our_cost, our_note = cost_at(front(mine, m), peer_target)
             if own.get("warning"):      # the peer diverged at dt: no accuracy to match
                 our_cost, our_note = math.nan, "diverged"
             s[m] = dict(target=target, ratio=cost / base["cost_s_per_s"], note=note,
                         peer_target=peer_target, ratio_at_peer=own["cost_s_per_s"] / our_cost,
-                        note_at_peer=our_note, cross=crossing(front(ours, m), front(pts, m)),
-                        order=order(pts, m), our_order=order(ours, m))
+                        note_at_peer=our_note, cross=crossing(front(mine, m), front(pts, m)),
+                        order=order(pts, m), our_order=order(mine, m))
         out.append(s)
     return out

@@ -50,8 +50,9 @@ def print_matched(summary):
     error at dt and at the peer's error at dt, the observed orders and where the fronts cross."""
     if not summary:
         return
-    print(f"pareto {summary[0]['scene']}: planarsim speed-up = peer cost / planarsim cost. raw: both at dt; "
-          "at ours: the peer's Pareto front at planarsim's error at dt; at peer's: planarsim's front at "
+    ours = summary[0].get("ours", "planarsim")
+    print(f"pareto {summary[0]['scene']}: {ours} speed-up = peer cost / {ours} cost. raw: both at dt; "
+          f"at ours: the peer's Pareto front at {ours}'s error at dt; at peer's: {ours}'s front at "
           "the peer's error at dt ('cheapest': that front's cheapest point is already as accurate; "
           "'not reached': not on its ladder; 'diverged': the peer's run at dt diverged); order: slope of log error vs log step, peer/planarsim")
     print(f"{'curve':22s} {'figure':11s} {'raw':>7s} {'ours':>9s} {'at ours':>15s} {'peer':>9s} "
@@ -89,8 +90,9 @@ def plot_scene(rows, path):
                 continue
             xs = [_err(r, m) for r in pts]
             ys = [r["cost_s_per_s"] for r in pts]
-            style = dict(lw=2.5, color="k") if label == "planarsim" else dict(lw=1.2)
-            line, = ax.loglog(xs, ys, "o-", label=label, **style)
+            style = (dict(lw=2.5, color="k") if label == "planarsim" else
+                     dict(lw=2.0, ls="--") if label.startswith("planarsim") else dict(lw=1.2))
+            line, = ax.loglog(xs, ys, marker="o", ls=style.pop("ls", "-"), label=label, **style)
             for x, y, r in zip(xs, ys, pts):
                 ax.annotate(step_label(r["k"]), (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7,
                             color=line.get_color())

@@ -20,7 +20,8 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
 - walkers: every registered walker walking --walker-seconds (60 s) via its simulate().
 - batch: 64 Simple Biped walks on 1 and 2 worker threads (walkers.batch).
 - pareto: accuracy-matched comparison (pareto.py) of the named peer scenes (default chain4,
-  chain32, rod_drop, biped_collapse): planarsim, pymunk (10 and 40 iterations), Box2D (8/3 and
+  chain32, rod_drop, biped_collapse): planarsim (its default step, and on scenes without
+  contacts its accurate integrators 'rattle', 'rattle4' and 'rattle6'), pymunk (10 and 40 iterations), Box2D (8/3 and
   30/10 iterations) and MuJoCo (Euler, implicitfast, RK4), each at steps dt*8 ... dt/8
   (--quick: the first configuration at dt and dt/2): cost per simulated second against pin,
   energy (chains) and contact error, the ratio at matched accuracy beside the raw ratio, one
@@ -107,7 +108,7 @@ def write_csv(results, folder) -> Path:
 def run_pareto(args, peers):
     """Rows of the accuracy-matched comparison of args.pareto_scenes; prints the tables and
     writes one Pareto plot per scene and pareto.csv to args.pareto_out."""
-    from benchmarks.pareto import matched, measure_scene as measure_ladder
+    from benchmarks.pareto import matched, measure_scene as measure_ladder, our_curves
     from benchmarks.pareto_report import plot_scene, print_matched, print_points
     folder = Path(args.pareto_out or Path("out") / "pareto" / machine_name())
     folder.mkdir(parents=True, exist_ok=True)
@@ -121,7 +122,8 @@ def run_pareto(args, peers):
         pts = measure_ladder(name, peers, quick=args.quick, repeats=repeats, timing_seconds=args.timing_seconds,
                              accuracy_seconds=args.accuracy_seconds)
         print_points(pts, repeats, args.timing_seconds)
-        print_matched(matched(pts))
+        for ours in our_curves(pts):
+            print_matched(matched(pts, ours=ours))
         plot_scene(pts, folder / f"pareto_{name}.png")
         rows += pts
     if rows:

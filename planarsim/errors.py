@@ -14,9 +14,10 @@ import math
 from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_WORK,
                             AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
+from .kernels.codes import INTEGRATOR_NAMES
 from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
                              GUARD_ENERGY, GUARD_NONFINITE_COMMAND, GUARD_SPEED,
-                             GUARD_STIFF_ACTUATOR)
+                             GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
 
 
 class ModelError(ValueError):
@@ -224,6 +225,29 @@ def stiff_actuator(model, ws, who="simulation"):
         f"no check)", step, t, name, "torque", torque, _start_of_step(ws))
 
 
+# kernels/rattle.py's UNSUPPORTED_* codes: what the accurate integrators cannot step
+_UNSUPPORTED = ("contact", "joint limit", "joint spring, damper or armature", "fluid drag")
+
+
+def accurate_unsupported(model, what, index, integrator=None, who="simulation"):
+    """The ModelError of a model that an accurate StepOptions.integrator (kernels/rattle.py;
+    `integrator` its code, None: not known here) cannot step: `what` an UNSUPPORTED_* code,
+    `index` the element."""
+    if what == 0:
+        element = f"contact {model.contact_names[index]!r} ({index})"
+    elif what == 3:
+        element = f"the fluid drag on body {_body_name(model, int(model.arrays.fluid_body[index]))!r}"
+    else:
+        element = f"joint {model.pin_names[index]!r} ({index})"
+    which = ("an accurate StepOptions.integrator" if integrator is None else
+             f"StepOptions.integrator={integrator} ({INTEGRATOR_NAMES[integrator]!r})")
+    return ModelError(
+        f"{who}: {which} steps mechanisms of pins, "
+        f"sliders and rods under gravity, pushes and actuators only; the model has a "
+        f"{_UNSUPPORTED[what]}: {element}. Use the default integrator (0, 'euler') for it; "
+        f"nothing was stepped")
+
+
 def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
@@ -248,6 +272,9 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
         return energy_from_nowhere(model, ws, who)
     if code == GUARD_STIFF_ACTUATOR:
         return stiff_actuator(model, ws, who)
+    if code == GUARD_UNSUPPORTED:
+        return accurate_unsupported(model, int(ws.info[INFO_GUARD_FIELD]),
+                                    int(ws.info[INFO_GUARD_BODY]), None, who)
     body = int(ws.info[INFO_GUARD_BODY])
     field = FIELD_NAMES[int(ws.info[INFO_GUARD_FIELD])]
     value = float(ws.guard_value[0])

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import diverged
+from .integrator import check_integrator
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
@@ -74,6 +75,7 @@ class Simulator:
             if isinstance(a, np.ndarray) and np.shape(a) != np.shape(b):
                 raise ValueError(f"model.arrays.{name} has shape {np.shape(b)}; this simulator's "
                                  f"model has {np.shape(a)} (build a new Simulator instead)")
+        check_integrator(value, self._options)
         self._model = value
         # the ground queries' references belong to the old terrain and contact points
         forget_ground_queries(self._ws)
@@ -101,6 +103,7 @@ class Simulator:
         """Options for the steps to come; speed_limit -1 is resolved here from the model and
         the current state (planarsim.speed_bound; again when a state is put in)."""
         value = check_options(value)
+        check_integrator(self._model, value)
         self._speed_from_model = value.speed_limit == -1.0
         self._options = resolve_speed_limit(value, self._model, self._state.v, self._state.q)
         self._repack()

@@ -19,6 +19,9 @@ GUARD_STIFF_ACTUATOR = 7  # a torque too strong for the step (check_actuator_tur
                           # inertia it drives [1/(kg m^2)], the limit [rad]); nothing is stepped
 FIELD_SPEED = 6           # ws.info[INFO_GUARD_FIELD] of a body's speed |v| [m/s]
 FIELD_TURNING = 7         # ... of its turning speed |omega| r_g [m/s] (r_g its radius of gyration)
+GUARD_UNSUPPORTED = 8     # StepOptions.integrator cannot step this model (kernels/rattle.py
+                          # unsupported; ws.info[INFO_GUARD_FIELD]: what, [INFO_GUARD_BODY]:
+                          # which element); nothing is stepped
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[INFO_COMMAND]:
                           # its length); negative, so that no walker's own return code clashes
 GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[INFO_COMMAND]: its index,

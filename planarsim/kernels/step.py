@@ -9,12 +9,14 @@ compiled once per machine and called by address from every compiled caller (a wa
 rollout, run_steps; compile/link.py). A time-of-impact split (CCD) repeats
 stages 1-5 for the remainder of the step with the new contact pinned. Each stage lives in its
 module (README's table "How the engine works" names them); this file only orders them, and
-solve_modes, the guess-check-solve of stages 3-5.
+solve_modes, the guess-check-solve of stages 3-5. StepOptions.integrator other than the default
+wraps the same stages (step_of_length) in RATTLE's half kicks and projection, or in its
+five-stage composition (accurate_step; kernels/rattle.py).
 """
 from ..compile import kernel
 from .audit import audit_impulses, audit_total
 from .ccd import split_at_impact
-from .codes import MODES_ALTERNATING
+from .codes import INTEGRATOR_EULER, MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
@@ -28,6 +30,7 @@ from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
 from .position import position_stage
 from .rows import build_rows
 from .solve import solve_impulses
+from .rattle import rattle_begin, rattle_end, stage_count, stage_weight, unsupported
 from .warm_start import remember_impulses
 from .work import joints_add_energy
 
@@ -149,10 +152,11 @@ def second_order_gains(m, s, ws, h):
     return joints_add_energy(m, s, ws, h)[0] > 0.0
 
 
-@kernel(inline="always")
-def _step(m, s, ws, opt, u):
-    """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u;
-    return the guard code."""
+@kernel(inline="never")
+def step_of_length(m, s, ws, opt, u, step_length):
+    """Advance s by one default step of step_length [s] under actuator commands u; return the
+    guard code. A call (one copy of its code for the default step and for every stage of the
+    accurate integrators, kernels/rattle.py)."""
     copy_state(s, ws.prev)
     # a state handed in from outside (restored, edited) is checked before it is used
     code = check_guards(s, ws, opt.guard_limit)
@@ -167,7 +171,6 @@ def _step(m, s, ws, opt, u):
     audited = audit_total(ws)
     for k in range(ws.n_live[0]):
         ws.contact_new[ws.live[k]] = 0
-    step_length = opt.dt if opt.dt > 0.0 else m.dt
     h = step_length
     for split in range(opt.max_ccd_splits + 1):
         update_trig(s.q, ws.body_cs)                        # cos / sin of the angles
@@ -184,6 +187,8 @@ def _step(m, s, ws, opt, u):
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
             if attempt == 1 or ws.first_order[0] == 1 or not second_order_gains(m, s, ws, h):
                 break
+            if opt.integrator != INTEGRATOR_EULER:
+                break                                       #    (not for RATTLE: kernels/rattle.py)
             ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
         if ccd_on:
@@ -208,3 +213,39 @@ def _step(m, s, ws, opt, u):
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
     return code
+
+
+@kernel(inline="never")
+def accurate_step(m, s, ws, opt, u, step_length):
+    """One step of step_length [s] of StepOptions.integrator's RATTLE or its composition
+    (kernels/rattle.py): per stage a half kick back, the default step, a half kick forward;
+    the velocity projected onto the joints at the end. The State counts one step; a failing
+    stage's guard code is returned at once (ws.prev then holds that stage's start, counted as
+    this step)."""
+    code = unsupported(m, ws)
+    if code != 0:
+        return code
+    t0 = s.time[0]
+    count = s.step[0]
+    n = stage_count(opt.integrator)
+    for k in range(n):
+        h = stage_weight(opt.integrator, k) * step_length
+        s.step[0] = count                                   # an error names this step
+        rattle_begin(m, s, ws, u, h)
+        code = step_of_length(m, s, ws, opt, u, h)
+        if code != 0:
+            return code
+        rattle_end(m, s, ws, u, h, opt.pivot_tol, k == n - 1)
+    s.time[0] = t0 + step_length
+    s.step[0] = count + 1
+    return check_guards(s, ws, opt.guard_limit)
+
+
+@kernel(inline="always")
+def _step(m, s, ws, opt, u):
+    """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u with
+    StepOptions.integrator; return the guard code."""
+    step_length = opt.dt if opt.dt > 0.0 else m.dt
+    if opt.integrator == INTEGRATOR_EULER:
+        return step_of_length(m, s, ws, opt, u, step_length)
+    return accurate_step(m, s, ws, opt, u, step_length)

@@ -5,6 +5,8 @@ import re
 import runpy
 from pathlib import Path
 
+import planarsim as ps
+
 README = Path(__file__).resolve().parents[2] / "README.md"
 
 
@@ -19,6 +21,10 @@ def test_readme_python_blocks_run_in_order(tmp_path, monkeypatch):
     assert (tmp_path / "tour.gif").stat().st_size > 0
     assert (tmp_path / "tour.png").stat().st_size > 0
     assert namespace["code"] == 0 and namespace["traj"].t.shape[0] == namespace["k"]
+    # the accurate integrator's double pendulum: the energy error README's comment gives
+    swing, tr = namespace["swing"], namespace["swing_traj"]
+    e = ps.total_energy(swing.model, tr.q, tr.v)
+    assert abs(float(max(abs(e - e[0]))) - 1.0e-4) < 0.05e-4
     # the gait analysis example's doubling is located, where README's text puts it
     pd = namespace["pd"]
     assert pd.located and abs(pd.p - 0.014935) < 5e-7, (pd.p, pd.located, pd.note)
@@ -48,7 +54,6 @@ def test_readme_api_section_gives_what_a_model_builder_needs():
         assert shape in api
     import inspect
 
-    import planarsim as ps
     signature = str(inspect.signature(ps.ModelBuilder.add_box_contacts)).replace("self, ", "")
     assert f"add_box_contacts{signature.split(' ->')[0]}" in api
     assert "`terrain.slope(angle_deg, height=0.0)` takes degrees" in api

@@ -115,3 +115,34 @@ def test_a_peer_that_diverged_at_dt_is_not_matched_at_its_error():
     m = s["energy_err_max"]
     assert m["note_at_peer"] == "diverged" and math.isnan(m["ratio_at_peer"])
     assert m["ratio"] == pytest.approx(1.0) and m["note"] == "cheapest"   # its k = 2 point
+
+
+def test_accurate_curves_run_on_chains_and_are_skipped_with_contacts(monkeypatch):
+    from benchmarks import pareto
+    assert [label for label, _, _ in ladder("planarsim")][::7] == ["planarsim", "planarsim-rattle",
+                                                                   "planarsim-rattle4", "planarsim-rattle6"]
+    two = [("planarsim", {}, 1), ("planarsim-rattle", {"integrator": "rattle"}, 1)]
+    monkeypatch.setattr(pareto, "ladder", lambda engine, quick=False: two)
+    short = dict(quick=True, repeats=1, timing_seconds=0.01, accuracy_seconds=0.05)
+    rows = pareto.measure_scene("chain2", {}, **short)
+    assert [r["curve"] for r in rows] == ["planarsim", "planarsim-rattle"]
+    # RATTLE is second order: its energy error is below the default step's at the same step
+    assert rows[1]["energy_err_max"] < rows[0]["energy_err_max"] and rows[1]["pin_error_m"] <= 1e-9
+    # the rod drop has contacts, which the accurate integrators refuse: only the default runs
+    assert [r["curve"] for r in pareto.measure_scene("rod_drop", {}, **short)] == ["planarsim"]
+
+
+def test_matched_against_each_planarsim_curve():
+    from benchmarks.pareto import our_curves
+    ours = _rows("planarsim", [(1.0, 1e-3), (2.0, 5e-4)], "planarsim")
+    accurate = _rows("planarsim-rattle", [(1.5, 1e-4), (3.0, 2.5e-5)], "planarsim")
+    theirs = _rows("peer", [(2.0, 4e-3), (4.0, 1e-3), (8.0, 2.5e-4), (16.0, 6.25e-5)], "peer")
+    rows = ours + accurate + theirs
+    assert our_curves(rows) == ["planarsim", "planarsim-rattle"]
+    [s] = matched(rows, metrics=("energy_err_max",), ours="planarsim-rattle")
+    assert s["ours"] == "planarsim-rattle" and s["curve"] == "peer"
+    # the peer reaches 1e-4 between its k = 4 (2.5e-4, cost 8) and k = 8 (6.25e-5, cost 16) points
+    m = s["energy_err_max"]
+    assert m["target"] == 1e-4 and m["ratio"] == pytest.approx(8.0 * 2 ** (math.log(2.5) / math.log(4)) / 1.5)
+    [d] = matched(rows, metrics=("energy_err_max",))
+    assert d["ours"] == "planarsim" and d["energy_err_max"]["ratio"] == pytest.approx(4.0)
