@@ -1,10 +1,17 @@
 """Shared fixtures: tiny canonical models."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import planarsim as ps
+from planarsim.compiled import drop_stale_caches
+
+# the tests' own compiled helpers inline engine kernels: their numba caches follow those
+# sources as a walker's do (numba checks a cached function against its own file only)
+for _folder in ("physics", "planarsim"):
+    drop_stale_caches(Path(__file__).resolve().parent / _folder)
 
 
 def make_chain(n_links=4, length=0.5, mass=1.0, dt=1e-3, gravity=(0.0, -9.81), limit=None):
