@@ -129,15 +129,8 @@ def child(top: int) -> dict:
     profiler = Profiler()
     import numba  # noqa: F401
     install(profiler)
-    import planarsim as ps
-    t_import = time.perf_counter() - t0
-    from benchmarks.scenes import chain
-    sim = ps.Simulator(chain(2))
-    sim.step()
-    t_engine = time.perf_counter() - t0
-    from walkers import simple_biped
-    simple_biped.simulate(0.001)
-    t_walker = time.perf_counter() - t0
+    from benchmarks.startup import first_steps
+    phases = first_steps(t0)
     cpu_walker = time.process_time() - c0
     by_kind = defaultdict(float)
     by_function = defaultdict(lambda: defaultdict(float))
@@ -150,7 +143,7 @@ def child(top: int) -> dict:
         size[name] = (b + before, a + after)
     rows = sorted(by_function.items(), key=lambda kv: -sum(kv[1].values()))
     return dict(
-        phases=dict(import_s=t_import, engine_step_s=t_engine, walker_step_s=t_walker,
+        phases=dict(**phases,
                     walker_step_cpu_s=cpu_walker),
         passes=dict(sorted(profiler.passes.items(), key=lambda kv: -kv[1])[:top]),
         by_kind=dict(by_kind),

@@ -29,19 +29,25 @@ import sys
 import tempfile
 import time
 
+def first_steps(t0: float) -> dict:
+    """Import planarsim, make one engine step (a 2-link chain) and a walker's first step (the
+    Simple Biped's simulate of one step); the times [s] from t0 (perf_counter) at each."""
+    import planarsim as ps
+    t_import = time.perf_counter() - t0
+    from benchmarks.scenes import chain
+    sim = ps.Simulator(chain(2))
+    sim.step()
+    t_engine = time.perf_counter() - t0
+    from walkers import simple_biped
+    simple_biped.simulate(0.001)
+    return {"import_s": t_import, "engine_step_s": t_engine, "walker_step_s": time.perf_counter() - t0}
+
+
 CHILD = r"""
 import json, time
 t0 = time.perf_counter()
-import planarsim as ps
-t_import = time.perf_counter() - t0
-from benchmarks.scenes import chain
-sim = ps.Simulator(chain(2))
-sim.step()
-t_engine = time.perf_counter() - t0
-from walkers import simple_biped
-simple_biped.simulate(0.001)
-t_walker = time.perf_counter() - t0
-print("STARTUP " + json.dumps({"import_s": t_import, "engine_step_s": t_engine, "walker_step_s": t_walker}))
+from benchmarks.startup import first_steps
+print("STARTUP " + json.dumps(first_steps(t0)))
 """
 
 
