@@ -159,8 +159,8 @@ def box_drop(dt=1e-3, piles=1):
     return b.compile()
 
 
-# the box columns all run the same 2 s (their first steps settle the stack, which takes the
-# complementarity solve: a shorter run would weigh that start more at larger N)
+# the box columns all run the same 2 s (their first steps settle the stack, one level per
+# linear solve: a shorter run would weigh that start more at larger N)
 SCENES.update({
     "box_column5": (lambda: box_column(5), 2000),
     "box_column10": (lambda: box_column(10), 2000),

@@ -71,6 +71,15 @@ def stage_count(integrator):
 
 
 @kernel
+def longest_stage(integrator):
+    """The largest |share| of the step any stage of `integrator` takes."""
+    top = 0.0
+    for k in range(stage_count(integrator)):
+        top = max(top, abs(stage_weight(integrator, k)))
+    return top
+
+
+@kernel
 def stage_weight(integrator, k):
     """Stage k's share of the step (the shares sum to 1)."""
     if integrator == INTEGRATOR_RATTLE4:

@@ -30,7 +30,8 @@ from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
 from .position import position_stage
 from .rows import build_rows
 from .solve import solve_impulses
-from .rattle import rattle_begin, rattle_end, stage_count, stage_weight, unsupported
+from .rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
+                     unsupported)
 from .warm_start import remember_impulses
 from .work import joints_add_energy
 
@@ -101,8 +102,9 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     answer that breaks a rule has the contact under the cursor re-examined by the
     alternating rule and is solved once more. An answer that still breaks a rule goes to the
     complementarity solve, which ends at a consistent answer (complementarity.solve_contacts).
-    No rounds, no cap. Returns True if a linear solve's answer stood (its rows, and their
-    envelope where there are rows, are in ws), False if the complementarity solve replaced it."""
+    No other rounds, no cap: at most 2 linear solves plus one per contact and limit. Returns
+    True if a linear solve's answer stood (its rows, and their envelope where there are rows,
+    are in ws), False if the complementarity solve replaced it."""
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
     equalities = build_and_solve(m, s, ws, opt, h)
@@ -144,20 +146,23 @@ def second_order_gains(m, s, ws, h):
     """The joints' second-order target (solve.fill_row_b) made their impulses add energy
     beyond what it may (work.joints_add_energy): a closed loop near a dead point, whose
     nearly dependent rows turn an inconsistent drift into huge impulses, a rod turning by
-    a radian in the step, or an armature whose velocity solve ends far from q + h v*. The step then solves again with the joints aimed at J v = 0
-    (a projection, which cannot add energy) and leaves the drift to the position correction,
-    whose work is bounded (integrate.bound_correction_work)."""
+    a radian in the step, or an armature whose velocity solve ends far from q + h v*. The
+    step then solves again with the joints aimed at J v = 0 (a projection, which cannot add
+    energy) and leaves the drift to the position correction, whose work is bounded
+    (integrate.bound_correction_work)."""
     if m.pin_body.shape[0] + m.rod_body.shape[0] == 0:
         return False
     return joints_add_energy(m, s, ws, h)[0] > 0.0
 
 
 @kernel(inline="never")
-def step_of_length(m, s, ws, opt, u, step_length):
+def step_of_length(m, s, ws, opt, u, step_length, stage):
     """Advance s by one default step of step_length [s] under actuator commands u; return the
     guard code. A call (one copy of its code for the default step and for every stage of the
-    accurate integrators, kernels/rattle.py)."""
-    copy_state(s, ws.prev)
+    accurate integrators, kernels/rattle.py). stage: a stage of an accurate step, which keeps
+    the step's start in ws.prev and has checked the actuators' turns for all its stages."""
+    if not stage:
+        copy_state(s, ws.prev)
     # a state handed in from outside (restored, edited) is checked before it is used
     code = check_guards(s, ws, opt.guard_limit)
     if code != 0:
@@ -175,7 +180,7 @@ def step_of_length(m, s, ws, opt, u, step_length):
     for split in range(opt.max_ccd_splits + 1):
         update_trig(s.q, ws.body_cs)                        # cos / sin of the angles
         apply_forces(m, s, ws, u)                           # 1. forces
-        if split == 0 and opt.turn_limit > 0.0:             #    a torque the step cannot
+        if split == 0 and opt.turn_limit > 0.0 and not stage:  # a torque the step cannot
             code = check_actuator_turns(m, ws, h, opt.turn_limit)   # resolve: stop before it
             if code != 0:
                 return code
@@ -185,10 +190,10 @@ def step_of_length(m, s, ws, opt, u, step_length):
         ccd_on = split < opt.max_ccd_splits
         for attempt in range(2):                            # 3-5. rows, impulses, modes
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
-            if attempt == 1 or ws.first_order[0] == 1 or not second_order_gains(m, s, ws, h):
+            if attempt == 1 or ws.first_order[0] == 1 or opt.integrator != INTEGRATOR_EULER:
+                break                                       #    (RATTLE keeps its target)
+            if not second_order_gains(m, s, ws, h):
                 break
-            if opt.integrator != INTEGRATOR_EULER:
-                break                                       #    (not for RATTLE: kernels/rattle.py)
             ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
         if ccd_on:
@@ -219,12 +224,21 @@ def step_of_length(m, s, ws, opt, u, step_length):
 def accurate_step(m, s, ws, opt, u, step_length):
     """One step of step_length [s] of StepOptions.integrator's RATTLE or its composition
     (kernels/rattle.py): per stage a half kick back, the default step, a half kick forward;
-    the velocity projected onto the joints at the end. The State counts one step; a failing
-    stage's guard code is returned at once (ws.prev then holds that stage's start, counted as
-    this step)."""
+    the velocity projected onto the joints at the end. The State counts one step. ws.prev
+    holds the step's start throughout (an error reports it as the failed step's start); the
+    actuators' turns are checked once, before any stage, over the longest stage (a stage of
+    rattle6 is 1.32 steps long); a failing stage's guard code is returned at once."""
     code = unsupported(m, ws)
     if code != 0:
         return code
+    copy_state(s, ws.prev)
+    if opt.turn_limit > 0.0:
+        update_trig(s.q, ws.body_cs)
+        apply_forces(m, s, ws, u)
+        code = check_actuator_turns(m, ws, longest_stage(opt.integrator) * step_length,
+                                    opt.turn_limit)
+        if code != 0:
+            return code
     t0 = s.time[0]
     count = s.step[0]
     n = stage_count(opt.integrator)
@@ -232,7 +246,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
         h = stage_weight(opt.integrator, k) * step_length
         s.step[0] = count                                   # an error names this step
         rattle_begin(m, s, ws, u, h)
-        code = step_of_length(m, s, ws, opt, u, h)
+        code = step_of_length(m, s, ws, opt, u, h, True)
         if code != 0:
             return code
         rattle_end(m, s, ws, u, h, opt.pivot_tol, k == n - 1)
@@ -247,5 +261,5 @@ def _step(m, s, ws, opt, u):
     StepOptions.integrator; return the guard code."""
     step_length = opt.dt if opt.dt > 0.0 else m.dt
     if opt.integrator == INTEGRATOR_EULER:
-        return step_of_length(m, s, ws, opt, u, step_length)
+        return step_of_length(m, s, ws, opt, u, step_length, False)
     return accurate_step(m, s, ws, opt, u, step_length)

@@ -258,3 +258,27 @@ def test_integrator_option_is_checked_by_name():
     with pytest.raises(ValueError, match="StepOptions.integrator=4"):
         ps.Simulator(make_chain(2), options=ps.StepOptions(integrator=4))
     assert ps.StepOptions().integrator == 0
+
+
+def test_a_torque_too_strong_for_the_longest_stage_stops_before_the_step():
+    """rattle6's stages are up to 1.32 steps long: a torque that the default step resolves
+    (0.16 rad in one step of 10 ms, under the 0.2 rad turn limit) is too strong for them.
+    The step stops before its first stage: the state is as it was, and the error reports
+    the step's start (step 0, t = 0, last_state bit for bit), not a stage's."""
+    b = ps.ModelBuilder(dt=1e-2)
+    rod = b.add_body("rod", mass=1.0, inertia=1.0 / 12, pos=(0.5, 0.0))
+    b.add_pin("pivot", None, rod, anchor_world=(0.0, 0.0))
+    b.add_pin_motor("motor", "pivot")
+    model = b.compile()
+    u = np.array([130.0])
+    for integrator in ("euler", "rattle", "rattle4"):
+        sim = ps.Simulator(model, options=ps.make_options(integrator=integrator))
+        sim.step(u)
+        assert sim.state.step[0] == 1
+    sim = ps.Simulator(model, options=ps.make_options(integrator="rattle6"))
+    start = [a.copy() for a in sim.state]
+    with pytest.raises(ps.SimulationDiverged, match="motor") as err:
+        sim.step(u)
+    assert err.value.step == 0 and err.value.time == 0.0
+    for before, now, reported in zip(start, sim.state, err.value.last_state):
+        assert np.array_equal(before, now) and np.array_equal(before, reported)
