@@ -74,8 +74,8 @@ class StepOptions(NamedTuple):
         0: no check
     integrator : 0 'euler' (default): symplectic Euler with SHAKE, energy error O(h);
         1 'rattle': RATTLE, the velocity of the instant kept on the joints' tangent space,
-        energy error O(h^2) (bounded, no drift), pins closed as by the default step, about
-        1.3 to 1.5 times its cost; 2 'rattle4': RATTLE composed in five stages (Suzuki),
+        energy error O(h^2) (bounded, no drift), pins closed as by the default step, 1.26
+        to 1.35 times its cost; 2 'rattle4': RATTLE composed in five stages (Suzuki),
         energy and trajectory errors O(h^4) at about four times the cost of 'rattle'; 3
         'rattle6': seven stages (Yoshida), O(h^6) at 7/5 the cost of 'rattle4'. The accurate
         ones take mechanisms of pins, sliders and rods under gravity, pushes and actuators

@@ -204,7 +204,8 @@ def ground_point(coef, px, py):
     """closest_point for the engine's stages: the flat and sloped case in closed form,
     inlined; the hills case (the Newton loop of sines) one call. Inlined, that loop was
     copied into each of the step's ground queries (over 90 copies, 60 % of the step's code
-    and most of a first-ever compile), for a call that costs a few ns beside its sines."""
+    and about a third of a first-ever compile), for a call that costs a few ns beside its
+    sines."""
     if coef[2] == 0.0:
         return _closest_on_line(coef[0], coef[1], px, py)
     return _closest_on_hills(coef, px, py)
