@@ -20,6 +20,7 @@ the step ends near the configuration it was linearized at (joints_add_energy), t
 correction CONSTRAINT_SHARE (integrate.bound_correction_work); more is energy from nowhere.
 """
 from ..compile import kernel
+from .forces import point_velocity
 from .math2d import world_point
 from .rows import is_joint_row, is_soft_row
 from .solve import row_dot
@@ -95,14 +96,12 @@ def joint_work(m, ws, v):
 
 
 @kernel
-def _anchor_change(s, ws, body, px, py):
-    """(dvx, dvy) [m/s]: how the velocity solve changed the velocity of world point p fixed
-    in `body` (ws.v_new against ws.v_pred; zero for the world, body < 0)."""
-    if body < 0:
-        return 0.0, 0.0
-    dw = ws.v_new[body, 2] - ws.v_pred[body, 2]
-    return (ws.v_new[body, 0] - ws.v_pred[body, 0] - dw * (py - s.q[body, 1]),
-            ws.v_new[body, 1] - ws.v_pred[body, 1] + dw * (px - s.q[body, 0]))
+def _rod_rate(s, v, a, b, ax, ay, bx, by):
+    """(p_b - p_a) x (v_b - v_a) [m^2/s] of anchors p_a, p_b on bodies a, b under velocity v:
+    the rod's turning rate times its length squared."""
+    vax, vay = point_velocity(s.q, v, a, ax, ay)
+    vbx, vby = point_velocity(s.q, v, b, bx, by)
+    return (bx - ax) * (vby - vay) - (by - ay) * (vbx - vax)
 
 
 @kernel
@@ -121,13 +120,11 @@ def prediction_turn(m, s, ws, h):
         b = m.rod_body[j, 1]
         ax, ay = world_point(s.q, ws.body_cs, a, m.rod_anchor[j, 0, 0], m.rod_anchor[j, 0, 1])
         bx, by = world_point(s.q, ws.body_cs, b, m.rod_anchor[j, 1, 0], m.rod_anchor[j, 1, 1])
-        dax, day = _anchor_change(s, ws, a, ax, ay)
-        dbx, dby = _anchor_change(s, ws, b, bx, by)
-        ex = bx - ax
-        ey = by - ay
-        length2 = ex * ex + ey * ey
+        length2 = (bx - ax) ** 2 + (by - ay) ** 2
         if length2 > 0.0:
-            top = max(top, abs(h) * abs(ex * (dby - day) - ey * (dbx - dax)) / length2)
+            change = (_rod_rate(s, ws.v_new, a, b, ax, ay, bx, by)
+                      - _rod_rate(s, ws.v_pred, a, b, ax, ay, bx, by))
+            top = max(top, abs(h) * abs(change) / length2)
     return top
 
 
