@@ -29,20 +29,14 @@ import numpy as np
 from .errors import ModelError
 from .compile import jit
 from .kernels.codes import JOINT_SLIDER
-from .kernels.forces import apply_forces, predict_velocity
-from .kernels.math2d import update_trig
+from .kernels.forces import kick as forces_kick
 
 
 @jit
 def kick(m, s, ws, u, h):
-    """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s (apply_forces); uses ws's
-    force scratch (the next step computes it again)."""
-    update_trig(s.q, ws.body_cs)
-    apply_forces(m, s, ws, u)
-    predict_velocity(m, s, ws, h)
-    for i in range(s.v.shape[0]):
-        for k in range(3):
-            s.v[i, k] = ws.v_pred[i, k]
+    """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s (kernels/forces.kick),
+    callable from Python."""
+    forces_kick(m, s, ws, u, h)
 
 
 def _commands(model, u):

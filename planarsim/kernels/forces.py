@@ -10,7 +10,7 @@ import math
 
 from ..compile import kernel
 from .fluid import apply_fluid
-from .math2d import cross2, world_point
+from .math2d import cross2, update_trig, world_point
 from .slider import slide_position_rate, slider_frame
 
 ACT_PIN_TORQUE = 0
@@ -152,6 +152,20 @@ def apply_forces(m, s, ws, u):
             uk = m.act_range[k, 1]
         ws.act_u[k] = uk
         ws.act_power[k] = apply_actuator(m, q, ws.body_cs, v, f, k, uk)
+
+
+@kernel
+def kick(m, s, ws, u, h):
+    """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s.q under commands u (h may be
+    negative; a half kick of the step-to-instant conversions and of RATTLE). Uses ws's force
+    scratch (the next step computes it again) and leaves ws.act_power at the velocity it was
+    called with."""
+    update_trig(s.q, ws.body_cs)
+    apply_forces(m, s, ws, u)
+    for i in range(s.v.shape[0]):
+        s.v[i, 0] += h * m.body_inv_mass[i] * ws.force[i, 0]
+        s.v[i, 1] += h * m.body_inv_mass[i] * ws.force[i, 1]
+        s.v[i, 2] += h * m.body_inv_inertia[i] * ws.force[i, 2]
 
 
 @kernel

@@ -35,7 +35,7 @@ import math
 
 from ..compile import kernel
 from .codes import INTEGRATOR_RATTLE4, INTEGRATOR_RATTLE6
-from .forces import apply_forces
+from .forces import kick
 from .guards import GUARD_OK, GUARD_UNSUPPORTED
 from .info import INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .math2d import update_trig
@@ -118,18 +118,6 @@ def unsupported(m, ws):
 
 
 @kernel
-def half_kick(m, s, ws, u, h):
-    """s.v += h M^-1 f(q) [m/s, rad/s] with f the applied forces at s.q under commands u (h
-    may be negative). Leaves ws.act_power at the velocity it was called with."""
-    update_trig(s.q, ws.body_cs)
-    apply_forces(m, s, ws, u)
-    for i in range(s.v.shape[0]):
-        s.v[i, 0] += h * m.body_inv_mass[i] * ws.force[i, 0]
-        s.v[i, 1] += h * m.body_inv_mass[i] * ws.force[i, 1]
-        s.v[i, 2] += h * m.body_inv_inertia[i] * ws.force[i, 2]
-
-
-@kernel
 def project_velocities(m, s, ws, pivot_tol):
     """s.v <- s.v - W J^T (J W J^T)^-1 J s.v with the joints' rows J at s.q: the velocity of
     least kinetic-energy change that keeps every pin, slider and rod (RATTLE's velocity
@@ -153,7 +141,7 @@ def project_velocities(m, s, ws, pivot_tol):
 def rattle_begin(m, s, ws, u, h):
     """Before a default step of h [s]: the half kick back (the step's full kick then gives
     RATTLE's first half kick)."""
-    half_kick(m, s, ws, u, -0.5 * h)
+    kick(m, s, ws, u, -0.5 * h)
 
 
 @kernel
@@ -161,6 +149,6 @@ def rattle_end(m, s, ws, u, h, pivot_tol, project):
     """After a default step of h [s]: RATTLE's second half kick at the new configuration and,
     if `project`, the projection onto the joints' tangent space there (between stages of a
     composition it is left out: the next stage's SHAKE solve absorbs that component)."""
-    half_kick(m, s, ws, u, 0.5 * h)
+    kick(m, s, ws, u, 0.5 * h)
     if project:
         project_velocities(m, s, ws, pivot_tol)
