@@ -28,7 +28,7 @@ import numpy as np
 
 from .errors import ModelError
 from .compile import jit
-from .kernels.codes import JOINT_SLIDER
+from .kernels.codes import JOINT_FREE_BIT, JOINT_SLIDER
 from .kernels.forces import kick as forces_kick
 
 
@@ -103,6 +103,8 @@ def project_velocities(model, q, v, pinned=()) -> np.ndarray:
         e = (pb - pa) / np.hypot(*(pb - pa))
         rows.append(e @ (Jb - Ja))
     for j in range(model.n_pin):
+        if a.pin_kind[j] & JOINT_FREE_BIT:
+            continue        # a free body's coordinate: measured, holds nothing
         (ba, bb), (la, lb) = a.pin_body[j], a.pin_anchor[j]
         Ja = point(ba, la)[0] if ba >= 0 else np.zeros((2, 3 * nb))
         Jb = point(bb, lb)[0] if bb >= 0 else np.zeros((2, 3 * nb))

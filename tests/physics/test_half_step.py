@@ -114,3 +114,20 @@ def test_bad_input_names_the_culprit():
         to_instant_velocity(model, sim.state, sim.ws, 1e-3)
     with pytest.raises(ValueError, match="u has shape"):
         to_step_velocity(model, sim.state, sim.ws, 1e-3, u=[1.0])
+
+
+def test_free_coordinates_hold_nothing_in_the_projection():
+    """A body on free coordinates (an MJCF free root's slides and hinge) moves as it likes:
+    the projection leaves its velocity as it is, while a pin next to it still holds."""
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_body("float", 1.0, 0.1, pos=(0.0, 1.0))
+    b.add_free_coordinate("float_x", "float", kind="slide", axis=(1.0, 0.0))
+    b.add_free_coordinate("float_a", "float", kind="hinge")
+    b.add_body("arm", 1.0, 0.1, pos=(0.5, 0.0))
+    b.add_pin("shoulder", None, "arm", anchor_world=(0.0, 0.0))
+    model = b.compile()
+    v = np.array([[1.0, -2.0, 3.0], [0.4, 0.3, 0.0]])
+    out = project_velocities(model, model.q0, v)
+    np.testing.assert_array_equal(out[0], v[0])
+    # the arm's pin point at the origin is at rest after the projection
+    assert abs(out[1, 0] - 0.0 * out[1, 2]) < 1e-12 and abs(out[1, 1] - 0.5 * out[1, 2]) < 1e-12
