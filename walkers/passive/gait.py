@@ -20,7 +20,7 @@ import numpy as np
 from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.half_step import kick, project_velocities, to_instant_velocity, to_step_velocity  # noqa: F401
+from planarsim.half_step import kick, project_velocities, to_instant_velocity, to_step_velocity
 from planarsim.state import State
 from planarsim.trajectory import Trajectory, make_recorder, record_state
 

@@ -67,14 +67,7 @@ def simplest_step(x, gamma, rtol=1e-12, atol=1e-13, t_max=10.0):
 def simplest_map(gamma):
     """The reduced model's step map x -> next x at slope gamma [rad], for planarsim.analysis
     (a step without heel strike, a fall, raises StepMapError)."""
-    from planarsim.analysis import StepMapError
-
-    def f(x):
-        try:
-            return simplest_step(x, gamma)[0]
-        except RuntimeError as e:
-            raise StepMapError(str(e)) from None
-    return f
+    return _as_map(lambda x: simplest_step(x, gamma))
 
 
 def simplest_fixed_point(gamma=GARCIA_GAMMA, x0=None, tol=1e-12):
