@@ -292,6 +292,9 @@ class Workspace(NamedTuple):
                                  #   StepOptions.energy_limit (kernels/work.judge_energy)
     first_order: np.ndarray      # (1,) int 1: this step's joint rows aim at J v = 0 (a
                                  #   projection) after the second-order target added energy
+    joint_gain: np.ndarray       # (3,) the joints' energy gain of the step's answer beyond
+                                 #   their allowance [J], its row, 1 where measured for the
+                                 #   answer standing (work.joints_add_energy, computed once)
     lcp_eps: np.ndarray          # (1,) largest diagonal term the complementarity solves of
                                  #   this step added (mixed_lcp.REGULARISATION; scaled units)
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
@@ -401,5 +404,5 @@ def make_workspace(model: Model) -> Workspace:
                      audit_last=z(4, np.int64), audit_value=z(1),
                      audit_worst=z(4, np.int64), audit_worst_value=z(1), first_order=z(1, np.int64),
                      energy_stop=z(1, np.int64),
-                     lcp_eps=z(1),
+                     joint_gain=z(3), lcp_eps=z(1),
                      impact_time=z(1), prev=make_state(model))

@@ -238,8 +238,9 @@ def jit(inline=None):
 def kernel(inline="force"):
     """The decorator of a kernel (compile/decorators.py): inline "force" (LLVM inlines it into
     its compiled callers; a call under PLANARSIM_KERNEL_CALLS=1), "always" (numba inlines it
-    before LLVM sees it) or "never" (one copy of its code that callers call)."""
-    if inline == "always":
+    before LLVM sees it; a call too under PLANARSIM_KERNEL_CALLS=1) or "never" (one copy of
+    its code that callers call)."""
+    if inline == "always" and not KERNEL_CALLS:
         return _kernel_decorator(inline="always")
     if inline == "never":
         return _kernel_decorator(pipeline_class=KernelCallCompiler, forceinline=False)

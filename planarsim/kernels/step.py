@@ -105,6 +105,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     No other rounds, no cap: at most 2 linear solves plus one per contact and limit. Returns
     True if a linear solve's answer stood (its rows, and their envelope where there are rows,
     are in ws), False if the complementarity solve replaced it."""
+    ws.joint_gain[2] = 0.0      # a new answer: the joints' work is not known yet
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
     equalities = build_and_solve(m, s, ws, opt, h)
@@ -152,7 +153,12 @@ def second_order_gains(m, s, ws, h):
     (integrate.bound_correction_work)."""
     if m.pin_body.shape[0] + m.rod_body.shape[0] == 0:
         return False
-    return joints_add_energy(m, s, ws, h)[0] > 0.0
+    excess, row = joints_add_energy(m, s, ws, h)
+    # the audit of this very answer reads it from here (audit.audit_joints)
+    ws.joint_gain[0] = excess
+    ws.joint_gain[1] = row
+    ws.joint_gain[2] = 1.0
+    return excess > 0.0
 
 
 @kernel(inline="never")
