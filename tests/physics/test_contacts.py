@@ -253,7 +253,7 @@ def test_seven_link_biped_collapse_perturbed_by_nanometres_comes_to_rest_above_g
 
 
 def test_position_correction_at_a_fold_adds_no_energy():
-    """A state of a 16-box chain on hills (stress corpus chain_hills seed 21, step 1280, dt 3e-4 s)
+    """A state of a 16-box chain on hills (stress corpus chain_hills seed 21, step 1271, dt 3e-4 s)
     where the Newton correction's step diverges and is taken back. The complementarity
     projection then closes the pins and lifts the corners (positions only for contacts): the
     step adds no energy, leaves every pin within 1e-9 m and breaks no audit rule. (The first
