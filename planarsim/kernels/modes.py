@@ -130,6 +130,8 @@ def engage_limits(m, s, ws, h, vel):
     for j in range(m.pin_body.shape[0]):
         lo = m.pin_limit[j, 0]
         hi = m.pin_limit[j, 1]
+        if lo == -math.inf and hi == math.inf:
+            continue        # no limit to engage
         if is_slider(m, j):
             # the slide at the end of the step, to first order
             x, rate = joint_position_rate(m, s.q, ws.body_cs, vel, j)
