@@ -133,8 +133,9 @@ def caller_sources(folder) -> tuple:
     """(kernel modules, other files) that compiled functions of the .py files below `folder`
     may inline, besides the folder's own files (fast mode: the step itself is reached by
     address). Kernel modules (short names: "terrain"): those imported from planarsim.kernels
-    or through planarsim.compiled and, in turn, every kernel module those import. Other files:
-    planarsim's modules with compiled code that are imported (planarsim/actuators.py), and
+    or through planarsim.compiled, or by planarsim's modules with compiled code that are
+    imported (planarsim/half_step.py: forces), and in turn every kernel module those import.
+    Other files: planarsim's modules with compiled code that are imported (planarsim/actuators.py), and
     the modules of the folder's own top-level package outside it (walkers/common/pd.py for a
     walker) with, in turn, what those import."""
     folder = Path(folder).resolve()
@@ -164,7 +165,8 @@ def caller_sources(folder) -> tuple:
                 seen.add(path)
                 if _PLANARSIM in path.parents:
                     if _has_compiled_code(path):
-                        files.add(path)
+                        files.add(path)         # and the kernels its compiled code inlines
+                        todo.append(path)
                 else:
                     files.add(path)
                     todo.append(path)

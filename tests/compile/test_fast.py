@@ -269,7 +269,8 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
     its files import (through planarsim.compiled or planarsim.kernels) and theirs in turn; the
     step is reached by address, so the kernels only the step uses are not among them. It
     hashes too the modules of its own top-level package outside it that it imports (a shared
-    helper: walkers/common for a walker) and planarsim's modules with compiled code."""
+    helper: walkers/common for a walker) and planarsim's modules with compiled code, with the
+    kernels those import (planarsim/half_step.py inlines kernels/forces.py)."""
     from planarsim.compile.caches import caller_sources
     top = tmp_path / "top"
     own, shared = top / "own", top / "shared"
@@ -293,3 +294,10 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
     import planarsim
     actuators = Path(planarsim.__file__).resolve().parent / "actuators.py"
     assert files == {actuators, shared / "helpers.py", shared / "more.py"}   # not model.py
+    # a planarsim module with compiled code brings the kernels its code inlines
+    other = top / "other"
+    other.mkdir()
+    (other / "__init__.py").write_text("")
+    (other / "d.py").write_text("from planarsim.half_step import kick\n")
+    kernels, files = caller_sources(other)
+    assert "forces" in kernels and files == {actuators.parent / "half_step.py"}
