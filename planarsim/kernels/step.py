@@ -161,20 +161,28 @@ def second_order_gains(m, s, ws, h):
     return excess > 0.0
 
 
+@kernel
+def reset_counts(ws):
+    """Zero the counts of what a step did (info.STEP_COUNTS; step_info reads them)."""
+    for k in STEP_COUNTS:
+        ws.info[k] = 0
+
+
 @kernel(inline="never")
 def step_of_length(m, s, ws, opt, u, step_length, stage):
     """Advance s by one default step of step_length [s] under actuator commands u; return the
     guard code. A call (one copy of its code for the default step and for every stage of the
     accurate integrators, kernels/rattle.py). stage: a stage of an accurate step, which keeps
-    the step's start in ws.prev and has checked the actuators' turns for all its stages."""
+    the step's start in ws.prev, has checked the actuators' turns for all its stages and
+    counts what they all did (step_info)."""
     if not stage:
         copy_state(s, ws.prev)
     # a state handed in from outside (restored, edited) is checked before it is used
     code = check_guards(s, ws, opt.guard_limit)
     if code != 0:
         return code
-    for k in STEP_COUNTS:
-        ws.info[k] = 0
+    if not stage:
+        reset_counts(ws)            # (an accurate step counts over all its stages)
     ws.lcp_eps[0] = 0.0
     ws.audit_worst_value[0] = 0.0
     ws.first_order[0] = 0
@@ -233,11 +241,13 @@ def accurate_step(m, s, ws, opt, u, step_length):
     the velocity projected onto the joints at the end. The State counts one step. ws.prev
     holds the step's start throughout (an error reports it as the failed step's start); the
     actuators' turns are checked once, before any stage, over the longest stage (a stage of
-    rattle6 is 1.32 steps long); a failing stage's guard code is returned at once."""
+    rattle6 is 1.32 steps long); a failing stage's guard code is returned at once. step_info
+    counts what all the stages did."""
     code = unsupported(m, ws)
     if code != 0:
         return code
     copy_state(s, ws.prev)
+    reset_counts(ws)
     if opt.turn_limit > 0.0:
         update_trig(s.q, ws.body_cs)
         apply_forces(m, s, ws, u)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import planarsim as ps
-from planarsim.compiled import RUN_OK, step_from_python
+from planarsim.compiled import RUN_OK, step_from_python, step_info
 from planarsim.errors import ModelError
 from planarsim.kernels.guards import GUARD_UNSUPPORTED
 from planarsim.state import make_state, make_workspace
@@ -179,6 +179,16 @@ def test_runs_are_deterministic_and_restore_continues_identically():
     sim.restore(snap)
     sim.steps(100)
     assert np.array_equal(sim.state.q, q1) and np.array_equal(sim.state.v, v1)
+
+
+@pytest.mark.parametrize("integrator, stages", [("euler", 1), ("rattle", 1), ("rattle4", 5),
+                                                 ("rattle6", 7)])
+def test_step_info_counts_every_stage_of_a_step(integrator, stages):
+    """step_info after an accurate step counts what all its stages did: a joints-only chain
+    takes one linear solve per stage."""
+    sim = ps.Simulator(make_chain(3, dt=1e-3), options=ps.make_options(integrator=integrator))
+    sim.steps(5)
+    assert step_info(sim.ws)["solves"] == stages
 
 
 def test_actuated_pendulum_balances_energy_and_work_at_second_order():
