@@ -121,6 +121,18 @@ def _edge_segment(m, q, cs, i):
 
 
 @kernel
+def _edge_curvature(coef, x0, y0, dx, dy, u, rounded):
+    """The ground's curvature h'' [1/m] that sets the sign of the clearance's second
+    derivative at p(u) = p0 + u (dx, dy): under the point (its height), or at the foot of its
+    normal (rounded: a capsule's side, whose clearance is its distance along the normal; the
+    foot lies up to r sin(slope) aside, where the curvature may already have turned)."""
+    if rounded:
+        gx = ground_point(coef, x0 + u * dx, y0 + u * dy)[0]
+        return height_derivs(coef, gx)[2]
+    return height_derivs(coef, x0 + u * dx)[2]
+
+
+@kernel
 def _edge_by_rate(m, q, cs, i):
     """(inside, px, py): the point of edge contact i's core segment (contact_local to its one
     fallback vertex, body frame) lowest above the ground, and whether it lies strictly inside
@@ -131,7 +143,8 @@ def _edge_by_rate(m, q, cs, i):
     one, and where f' turns from negative to positive on a monotone part the local minimum
     is found by bisection; the lowest of them is returned. For a capsule's side (radius > 0)
     the distance along the ground's normal is minimised instead (its surface lies r along
-    the normal from the deepest point of its core)."""
+    the normal from the deepest point of its core); its rate n . (dx, dy) turns where the
+    curvature at the normal's foot does, which the cuts follow (_edge_curvature)."""
     coef = m.terrain_coef
     x0, y0, dx, dy, rounded, shortest = _edge_segment(m, q, cs, i)
     pieces = 1 if shortest == math.inf else int(math.ceil(abs(dx) / (EDGE_PIECE * shortest))) + 1
@@ -140,8 +153,8 @@ def _edge_by_rate(m, q, cs, i):
     for piece in range(pieces):
         ua = piece / pieces
         ub = (piece + 1) / pieces
-        ca = height_derivs(coef, x0 + ua * dx)[2]
-        cb = height_derivs(coef, x0 + ub * dx)[2]
+        ca = _edge_curvature(coef, x0, y0, dx, dy, ua, rounded)
+        cb = _edge_curvature(coef, x0, y0, dx, dy, ub, rounded)
         ue = ub
         if ca * cb < 0.0:
             # an inflection: f' turns back there; the two sides are monotone
@@ -149,7 +162,7 @@ def _edge_by_rate(m, q, cs, i):
             hi = ub
             for _ in range(EDGE_BISECTIONS):
                 u = 0.5 * (lo + hi)
-                if height_derivs(coef, x0 + u * dx)[2] * ca > 0.0:
+                if _edge_curvature(coef, x0, y0, dx, dy, u, rounded) * ca > 0.0:
                     lo = u
                 else:
                     hi = u
