@@ -4,8 +4,9 @@ After the velocity stage (impulses as applied):
   pull      a contact's normal impulse pulls (lambda_n < 0)
   cone      friction outside its cone (|lambda_t| > mu lambda_n)
             (both beyond rounding: IMPULSE_REL_TOL of the contact's own impulse plus
-            IMPULSE_FLOOR of the step's largest, in each component: (1 + mu) times that
-            for the cone)
+            IMPULSE_FLOOR of the step's largest, in each component: (mu + max(mu, 1))
+            times that for the cone, which a sliding contact's friction -mu s lambda_n
+            moves by 2 mu times its lambda_n's rounding)
   work      a contact's impulse does positive work at the step's end velocity
             (lambda_n v_n + lambda_t v_t > 0: it would add energy) beyond rounding: more
             than |lambda| (WORK_REL_TOL |v| + VELOCITY_FLOOR), |v| the contact's speed, free
@@ -136,11 +137,11 @@ def audit_impulses(m, s, ws, opt, h):
             if ln < -(IMPULSE_REL_TOL * size + floor):
                 note(ws, step, AUDIT_PULL, i, b, ln)
                 found += 1
-        # each component's rounding moves |lambda_t| - mu lambda_n by (1 + mu) times it: a
-        # sliding contact (lambda_t = -mu s lambda_n) whose lambda_n rounds below zero, within
-        # the pull rule, is on its cone
+        # each component's rounding moves |lambda_t| - mu lambda_n by (1 + mu) times it, and
+        # a sliding contact's friction -mu s lambda_n follows its lambda_n: 2 mu times it. So a
+        # sliding contact whose lambda_n rounds below zero, within the pull rule, is on its cone
         mu = m.contact_mu[i]
-        if abs(lt) > mu * ln + (1.0 + mu) * (IMPULSE_REL_TOL * size + max(floor, 0.0)):
+        if abs(lt) > mu * ln + (mu + max(mu, 1.0)) * (IMPULSE_REL_TOL * size + max(floor, 0.0)):
             note(ws, step, AUDIT_CONE, i, b, abs(lt) - mu * ln)
             found += 1
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)

@@ -292,40 +292,38 @@ def build_rows(m, s, ws):
     """Fill the active rows at the current configuration: J, F (impulse directions) and c;
     return how many are sliding-contact rows (F != J there; none: J W F^T is symmetric).
 
-    Rows go body by body from the last body to the first: a contact's rows with its body (the
-    later of its two), then a rod's and a pin's or slider's (and its limits' and soft row's)
-    with the later of their two bodies (a merge of the three lists in reverse model order,
-    O(rows)). For a chain, tree or walker built parent first this puts every row before the
-    rows of the joints nearer the root: the elimination (solve.factor) then runs from the
-    leaves to the root, as a tree's should (Baraff 1996), and the envelope of each row reaches
-    only back to its siblings' rows. A trunk with four legs couples the hips' rows to each
-    other, not to every row of the legs built before them; contact rows placed after all the
-    joints would couple every joint row to them (a dense block).
+    Rows go body by body: a pin's or slider's (and its limits' and soft row's) and a rod's
+    rows after the later of their
+    two bodies, a contact's after its body, pins and rods first (a merge of the three lists in
+    their model order, O(rows)). For a chain or walker built parent first every row then shares
+    bodies only with rows close to it, and the solve's envelope stays narrow; contact rows
+    placed after all the joints would couple every joint row to them (a dense block).
     """
     n = 0
     n_pin = m.pin_body.shape[0]
     n_rod = m.rod_body.shape[0]
     n_con = m.contact_body.shape[0]
-    jp = n_pin - 1
-    jr = n_rod - 1
-    ic = n_con - 1
-    while jp >= 0 or jr >= 0 or ic >= 0:
-        kp = _later_body(m.pin_body, jp) if jp >= 0 else -1
-        kr = _later_body(m.rod_body, jr) if jr >= 0 else -1
-        kc = max(m.contact_body[ic], m.contact_other[ic]) if ic >= 0 else -1
-        if kc >= kp and kc >= kr:
-            mode = s.contact_mode[ic]
-            n = add_contact_rows(ws, n, ic, mode == MODE_PINNED or mode == MODE_SLIDING,
-                                 mode == MODE_PINNED)
-            ic -= 1
-        elif kr >= kp:
-            n = add_rod_row(m, ws, n, jr)
-            jr -= 1
-        else:
+    big = m.body_inv_mass.shape[0] + 1
+    jp = 0
+    jr = 0
+    ic = 0
+    while jp < n_pin or jr < n_rod or ic < n_con:
+        kp = _later_body(m.pin_body, jp) if jp < n_pin else big
+        kr = _later_body(m.rod_body, jr) if jr < n_rod else big
+        kc = max(m.contact_body[ic], m.contact_other[ic]) if ic < n_con else big
+        if kp <= kr and kp <= kc:
             n = add_joint_rows(m, ws, n, jp)
             n = add_limit_rows(m, s, ws, n, jp)
             n = add_soft_row(m, ws, n, jp)
-            jp -= 1
+            jp += 1
+        elif kr <= kc:
+            n = add_rod_row(m, ws, n, jr)
+            jr += 1
+        else:
+            mode = s.contact_mode[ic]
+            n = add_contact_rows(ws, n, ic, mode == MODE_PINNED or mode == MODE_SLIDING,
+                                 mode == MODE_PINNED)
+            ic += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     predict_joint_errors(m, ws, n)

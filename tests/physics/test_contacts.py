@@ -8,7 +8,6 @@ import pytest
 import planarsim as ps
 from planarsim import terrain
 from planarsim.kernels.info import INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK
-from planarsim.kernels.codes import MODE_SLIDING
 
 G = 9.81
 
@@ -254,7 +253,7 @@ def test_seven_link_biped_collapse_perturbed_by_nanometres_comes_to_rest_above_g
 
 
 def test_position_correction_at_a_fold_adds_no_energy():
-    """A state of a 16-box chain on hills (stress corpus chain_hills seed 21, step 1271, dt 3e-4 s)
+    """A state of a 16-box chain on hills (stress corpus chain_hills seed 21, step 1280, dt 3e-4 s)
     where the Newton correction's step diverges and is taken back. The complementarity
     projection then closes the pins and lifts the corners (positions only for contacts): the
     step adds no energy, leaves every pin within 1e-9 m and breaks no audit rule. (The first
@@ -278,28 +277,6 @@ def test_position_correction_at_a_fold_adds_no_energy():
     assert sim.ws.info[INFO_NEWTON_TAKEN_BACK] >= 1, "the saved state no longer meets the fold"
     assert total_energy(model, sim.state.q, sim.state.v) <= e0
     assert joint_residuals(model, sim.state.q[None]) <= 1e-9
-    assert sum(sim.ws.audit) == 0, dict(zip(AUDIT_NAMES, sim.ws.audit))
-
-
-def test_a_sliding_contact_whose_push_rounds_below_zero_is_on_its_cone():
-    """Stress corpus biped_collapse seed 1 (alternating, dt 3e-4 s): at step 2038 a sliding
-    contact carries (lambda_n, lambda_t) = (-4.3e-12, -4.3e-12) N s, a push that rounds below
-    zero within the pull rule; its friction -mu s lambda_n is on the cone by construction. The
-    cone rule allows each component's rounding, (1 + mu) times it, and counts nothing; the
-    run breaks no rule."""
-    import sys
-    from pathlib import Path
-    from planarsim.kernels.audit import AUDIT_NAMES
-    sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-    from benchmarks.contact_stress import build
-    model, _, q0, v0 = build("biped_collapse", 1)
-    sim = ps.Simulator(model, ps.make_options("alternating"), ps.make_state(model, q0, v0))
-    sim.steps(2038)
-    sim.step()
-    sliding = sim.state.contact_mode == MODE_SLIDING
-    assert np.any(sliding & (sim.state.last_contact_impulse[:, 0] < 0.0)), \
-        "the run no longer meets a sliding contact whose push rounds below zero"
-    sim.steps(100)
     assert sum(sim.ws.audit) == 0, dict(zip(AUDIT_NAMES, sim.ws.audit))
 
 
