@@ -135,9 +135,9 @@ def caller_sources(folder) -> tuple:
     address). Kernel modules (short names: "terrain"): those imported from planarsim.kernels
     or through planarsim.compiled, or by planarsim's modules with compiled code that are
     imported (planarsim/half_step.py: forces), and in turn every kernel module those import.
-    Other files: planarsim's modules with compiled code that are imported (planarsim/actuators.py), and
-    the modules of the folder's own top-level package outside it (walkers/common/pd.py for a
-    walker) with, in turn, what those import."""
+    Other files: planarsim's modules with compiled code that are imported
+    (planarsim/actuators.py), and the modules of the folder's own top-level package outside
+    it (walkers/common/pd.py for a walker) with, in turn, what those import."""
     folder = Path(folder).resolve()
     root = folder
     while (root / "__init__.py").exists():

@@ -386,7 +386,8 @@ def test_a_capsules_side_finds_its_deepest_point_where_the_curvature_at_its_foot
     a = model.arrays
     q = q0.copy()
     q[0] = (0.297554234060498, 0.13338907063268585, -8.932737903186709)
-    edge = [i for i in range(model.n_contact) if a.contact_body[i] == 0 and a.contact_kind[i] == CONTACT_EDGE]
+    edge = [i for i in range(model.n_contact)
+            if a.contact_body[i] == 0 and a.contact_kind[i] == CONTACT_EDGE]
     assert len(edge) == 1 and a.contact_radius[edge[0]] > 0.0       # the capsule's side
     inside, px, py = _edge_deepest(a, q, np.full((q.shape[0], 3), np.nan), edge[0])
     r = a.shape_radius[0]
