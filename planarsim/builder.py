@@ -745,6 +745,9 @@ class ModelBuilder:
             contact_local=ro([c["local"] for c in contacts] or np.zeros((0, 2))).reshape(nc, 2),
             contact_radius=ro([c["radius"] for c in contacts]).reshape(nc),
             contact_span=ro([c["span"] for c in contacts] or np.zeros((0, 2))).reshape(nc, 2),
+            contact_span_dir=ro([(math.cos(c["span"][0]), math.sin(c["span"][0]),
+                                  math.cos(c["span"][1]), math.sin(c["span"][1]))
+                                 for c in contacts] or np.zeros((0, 4))).reshape(nc, 4),
             contact_mu=ro([c["mu"] for c in contacts]).reshape(nc),
             contact_ccd=ro([c["ccd"] for c in contacts], np.int64).reshape(nc),
             contact_vert_adr=ro(vadr, np.int64).reshape(nc),

@@ -61,6 +61,7 @@ class ModelArrays(NamedTuple):
     contact_local: np.ndarray       # (n_contact, 2) point, or arc centre, in the body frame [m]
     contact_radius: np.ndarray      # (n_contact,) arc radius [m] (0 for points)
     contact_span: np.ndarray        # (n_contact, 2) body-frame angle range of the sole [rad]
+    contact_span_dir: np.ndarray    # (n_contact, 4) cos, sin of the span's start, of its end
     contact_mu: np.ndarray          # (n_contact,) Coulomb friction coefficient [-]
     contact_ccd: np.ndarray         # (n_contact,) 1: continuous collision (point on point mass)
     contact_vert_adr: np.ndarray    # (n_contact,) first fallback vertex (heel, toe, ...)

@@ -55,16 +55,19 @@ def _try_vertex(m, q, ws, i, b, lx, ly, best):
 @kernel
 def sole_facing(m, cs, b, i, nx, ny):
     """(in_span, dlx, dly): the direction -n (ground normal n) in body b's frame, and whether
-    it points into arc contact i's angular span (then the sole's point closest to the ground
-    is the centre plus r times it)."""
+    it points into arc contact i's angular span, ends included (then the sole's point closest
+    to the ground is the centre plus r times it). By the sides of the span's end directions
+    (contact_span_dir), no angle computed: within a span of at most half a turn a direction
+    lies on the inner side of both ends; within a wider one it does not lie beyond both."""
     dlx, dly = rotate(cs[b, 0], -cs[b, 1], -nx, -ny)
-    a = math.atan2(dly, dlx)
-    a0 = m.contact_span[i, 0]
-    while a < a0:
-        a += 2.0 * math.pi
-    while a >= a0 + 2.0 * math.pi:
-        a -= 2.0 * math.pi
-    return a <= m.contact_span[i, 1], dlx, dly
+    width = m.contact_span[i, 1] - m.contact_span[i, 0]
+    if width >= 2.0 * math.pi:
+        return True, dlx, dly
+    after_start = m.contact_span_dir[i, 0] * dly - m.contact_span_dir[i, 1] * dlx >= 0.0
+    before_end = dlx * m.contact_span_dir[i, 3] - dly * m.contact_span_dir[i, 2] >= 0.0
+    if width <= math.pi:
+        return after_start and before_end, dlx, dly
+    return after_start or before_end, dlx, dly
 
 
 # bisection steps of an edge's deepest point (the interval shrinks below rounding of u)
