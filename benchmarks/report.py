@@ -94,7 +94,7 @@ def print_peers(res):
 FAMILIES = {"chain": "chain", "box_column": "box column"}
 
 
-def _chain_costs(res, family="chain"):
+def _family_costs(res, family="chain"):
     """{engine: [(N, seconds per step)]} of the family's scenes (chains, box columns) in the
     peer comparison, planarsim's also where no peer ran."""
     out = {}
@@ -111,7 +111,7 @@ def _chain_costs(res, family="chain"):
 def engine_slopes(res, family="chain"):
     """{engine: log-log slope of cost per step against N} (engines with >= 2 sizes)."""
     out = {}
-    for engine, pts in _chain_costs(res, family).items():
+    for engine, pts in _family_costs(res, family).items():
         if len(pts) >= 2:
             n, cost = np.array(sorted(pts)).T
             out[engine] = float(np.polyfit(np.log(n), np.log(cost), 1)[0])
@@ -124,7 +124,7 @@ def plot_chain_scaling(res, path):
     import matplotlib.ticker
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    costs, slopes = _chain_costs(res), engine_slopes(res)
+    costs, slopes = _family_costs(res), engine_slopes(res)
     if not slopes:
         return None
     fig, ax = plt.subplots(figsize=(5.5, 4))

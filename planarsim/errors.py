@@ -15,6 +15,8 @@ from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_W
                             AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.codes import INTEGRATOR_NAMES
+from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
+                             UNSUPPORTED_SOFT)
 from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
                              GUARD_ENERGY, GUARD_NONFINITE_COMMAND, GUARD_SPEED,
                              GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
@@ -225,17 +227,18 @@ def stiff_actuator(model, ws, who="simulation"):
         f"no check)", step, t, name, "torque", torque, _start_of_step(ws))
 
 
-# kernels/rattle.py's UNSUPPORTED_* codes: what the accurate integrators cannot step
-_UNSUPPORTED = ("contact", "joint limit", "joint spring, damper or armature", "fluid drag")
+# what the accurate integrators cannot step, by kernels/rattle.py's UNSUPPORTED_* code
+_UNSUPPORTED = {UNSUPPORTED_CONTACT: "contact", UNSUPPORTED_LIMIT: "joint limit",
+                UNSUPPORTED_SOFT: "joint spring, damper or armature", UNSUPPORTED_FLUID: "fluid drag"}
 
 
 def accurate_unsupported(model, what, index, integrator=None, who="simulation"):
     """The ModelError of a model that an accurate StepOptions.integrator (kernels/rattle.py;
     `integrator` its code, None: not known here) cannot step: `what` an UNSUPPORTED_* code,
     `index` the element."""
-    if what == 0:
+    if what == UNSUPPORTED_CONTACT:
         element = f"contact {model.contact_names[index]!r} ({index})"
-    elif what == 3:
+    elif what == UNSUPPORTED_FLUID:
         element = f"the fluid drag on body {_body_name(model, int(model.arrays.fluid_body[index]))!r}"
     else:
         element = f"joint {model.pin_names[index]!r} ({index})"

@@ -10,9 +10,8 @@ import numpy as np
 
 from .errors import accurate_unsupported
 from .kernels.codes import INTEGRATOR_EULER
-
-# kernels/rattle.py's UNSUPPORTED_* codes
-_CONTACT, _LIMIT, _SOFT, _FLUID = 0, 1, 2, 3
+from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
+                             UNSUPPORTED_SOFT)
 
 
 def unsupported_feature(model):
@@ -20,14 +19,14 @@ def unsupported_feature(model):
     joint limit, a joint's spring, damper or armature, a fluid drag), or None."""
     a = model.arrays
     if len(a.contact_body):
-        return _CONTACT, 0
+        return UNSUPPORTED_CONTACT, 0
     for j in range(len(a.pin_body)):
         if np.isfinite(a.pin_limit[j]).any():
-            return _LIMIT, j
+            return UNSUPPORTED_LIMIT, j
         if a.pin_armature[j] > 0.0 or a.pin_stiffness[j] > 0.0 or a.pin_damping[j] > 0.0:
-            return _SOFT, j
+            return UNSUPPORTED_SOFT, j
     if len(a.fluid_body):
-        return _FLUID, 0
+        return UNSUPPORTED_FLUID, 0
     return None
 
 

@@ -7,8 +7,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .kernels.codes import MODE_FREE, MODE_PINNED, MODE_SLIDING, MODES_ALL, MODES_ALTERNATING
-from .kernels.codes import INTEGRATOR_EULER, INTEGRATOR_NAMES
+from .kernels.codes import (INTEGRATOR_EULER, INTEGRATOR_NAMES, MODE_FREE, MODE_PINNED,
+                            MODE_SLIDING, MODES_ALL, MODES_ALTERNATING)
 
 
 class ModeStrategy(IntEnum):
