@@ -362,7 +362,8 @@ def _refine_basis(M, q, m, T, basis, res, floor):
     B. A refinement that stalls inside the tolerance is kept, not replaced by the fresh
     elimination: on a nearly singular B (loaded rows' M with an eigenvalue below the path's
     eps) B^-1 q can carry large impulses along the near-null direction (measured: a folded
-    four-bar on the ground, the corpus's loop_inertia seed 42, then gained 0.04 J in one step). The check (_is_answer): B x = q holds, and every basic variable (z of a row in the
+    four-bar on the ground, the corpus's loop_inertia seed 42, then gained 0.04 J in one
+    step). The check (_is_answer): B x = q holds, and every basic variable (z of a row in the
     problem, w of a row out of it) is >= 0, both to ANSWER_TOL max(-q). Returns LCP_SOLVED
     or LCP_INACCURATE; res (>= m) is scratch."""
     rhs = 2 * m + 1
