@@ -822,8 +822,7 @@ class _Loader:
         n = np.eye(3)[self.normal]
         self.static = []
         for b in self.bodies:
-            use_inertial = self.inertiafromgeom == "false" or (self.inertiafromgeom == "auto"
-                                                                and b.inertials)
+            use_inertial = self.uses_inertial(b)
             if self.inertiafromgeom == "true":
                 for i in b.inertials:
                     self.report.ignore("<inertial> (inertiafromgeom='true')", i["node"].line)
@@ -1048,11 +1047,16 @@ class _Loader:
                                   density=fluid["density"], local=tuple(self.plane(com) - rb.com),
                                   angle=math.atan2(e[1, 0], e[0, 0]))
 
+    def uses_inertial(self, b) -> bool:
+        """Body b's mass comes from its <inertial> elements, not its geoms (the compiler's
+        inertiafromgeom: "false" always, "auto" where the body has an <inertial>)."""
+        return self.inertiafromgeom == "false" or (self.inertiafromgeom == "auto"
+                                                   and bool(b.inertials))
+
     def inertia_3d(self, b):
         """Mass [kg], COM (3,) [m] and inertia tensor (3, 3) about it [kg m^2] of MJCF body b
         alone, in world axes at the file's pose (as MuJoCo's body_mass, body_ipos, body_inertia)."""
-        use_inertial = self.inertiafromgeom == "false" or (self.inertiafromgeom == "auto"
-                                                            and b.inertials)
+        use_inertial = self.uses_inertial(b)
         items = ([(i["mass"], i["pos"], i["tensor"]) for i in b.inertials] if use_inertial else
                  [(g["mass"], g["pos"], g["mass"] * g["R"] @ np.diag(g["unit"]) @ g["R"].T)
                   for g in b.geoms if g["kind"] != "plane"])
