@@ -19,10 +19,12 @@ is a larger share of the whole; the joints' target may add up to JOINT_WORK_SHAR
 the step ends near the configuration it was linearized at (joints_add_energy), the position
 correction CONSTRAINT_SHARE (integrate.bound_correction_work); more is energy from nowhere.
 """
+import math
+
 from ..compile import kernel
 from .forces import point_velocity
 from .math2d import world_point
-from .rows import is_joint_row, is_soft_row
+from .rows import is_joint_row, is_normal_row, is_soft_row, is_tangent_row
 from .solve import row_dot
 
 # SHAKE's regime: the correction's velocity change dv is at most this share of the velocity
@@ -143,10 +145,60 @@ def joints_add_energy(m, s, ws, h):
     was linearized at the wrong place: beyond CONSTRAINT_SHARE of KE(v*) is from nowhere."""
     work, rounding, row = joint_work(m, ws, ws.v_new)
     kinetic = kinetic_energy(m, ws.v_pred)
-    excess = work - CONSTRAINT_SHARE * kinetic - rounding
+    # impulses so large that their work's rounding alone hides the share (a folded loop's
+    # self-stress of 1e5 N s at 1e-5 J of motion): the velocities bound what they added
+    gain = -math.inf
+    if rounding > CONSTRAINT_SHARE * kinetic:
+        gain = gain_from_velocities(m, ws, h, kinetic)
+    excess = max(work - CONSTRAINT_SHARE * kinetic - rounding, gain - CONSTRAINT_SHARE * kinetic)
     if excess > 0.0 and prediction_turn(m, s, ws, h) <= SHAKE_REGIME:
-        excess = work - JOINT_WORK_SHARE * kinetic - rounding
+        excess = max(work - JOINT_WORK_SHARE * kinetic - rounding,
+                     gain - JOINT_WORK_SHARE * kinetic)
+    if excess > 0.0 and row < 0:
+        row = largest_joint_impulse(ws)
     return excess, row
+
+
+@kernel
+def gain_from_velocities(m, ws, h, kinetic):
+    """A lower bound [J] of the joints' work in the velocity solve, from velocities only: the
+    kinetic energy the impulses added, KE(v_new) - KE(v*) (kinetic: KE(v*)), less what the
+    other rows can add: a soft row its own work (its spring's and damper's), a sticking
+    contact's tangent row held at its anchor |lam c| / h, each contact's and limit's rounding
+    (row_rounding), and the sums' rounding. Without the joints' targets the answer is the
+    kinetic metric's projection of v* onto velocities that open no error further, a convex
+    set holding v = 0, which cannot add kinetic energy: what remains came from the joints'
+    targets. Unlike the joints' work (joint_work), it stays exact where their impulses are
+    huge and that work's rounding (|lam| times the solve's accuracy) is not. -inf where a
+    contact bounces (restitution's rule over several contacts can add energy by itself)."""
+    speed = fastest(ws.v_new) + fastest(ws.v_pred)
+    allowed = 0.0
+    for r in range(ws.n_row[0]):
+        kind = ws.row_kind[r]
+        if is_soft_row(kind):
+            allowed += ws.lam[r] * 0.5 * (row_dot(ws, r, ws.row_J, ws.v_pred)
+                                          + row_dot(ws, r, ws.row_J, ws.v_new))
+        elif not is_joint_row(kind):
+            if is_normal_row(kind) and ws.contact_bounce[ws.row_owner[r]] > 0.0:
+                return -math.inf
+            allowed += row_rounding(ws, r, speed)
+            if is_tangent_row(kind):
+                allowed += abs(ws.lam[r] * ws.row_c[r]) / h
+    final = kinetic_energy(m, ws.v_new)
+    return final - kinetic - allowed - RELATIVE_ROUNDING * (final + kinetic)
+
+
+@kernel
+def largest_joint_impulse(ws):
+    """The joint row with the largest |impulse| (-1 if none)."""
+    best = -1.0
+    row = -1
+    for r in range(ws.n_row[0]):
+        if is_joint_row(ws.row_kind[r]) and not is_soft_row(ws.row_kind[r]):
+            if abs(ws.lam[r]) > best:
+                best = abs(ws.lam[r])
+                row = r
+    return row
 
 
 @kernel
