@@ -25,8 +25,9 @@ from .rows import is_joint_row, is_soft_row, is_tangent_row
 from .soft import soft_compliance
 from .solve import _entry
 
-# a joint-only loop: a joint row whose pivot falls to this share of its diagonal is an exact
-# combination of the others (consistent joints), left out with impulse 0
+# a joint-only loop: once the largest remaining pivot is this share of its row's diagonal, the
+# remaining joint rows are exact combinations of the others (consistent joints), left out
+# with impulse 0 (_factor_joints)
 JOINT_LOOP_TOL = 1e-12
 # friction within this share of mu lambda_n is at the cone's edge; a slip speed below this
 # share of the contact's free-motion speed is rounding
@@ -55,20 +56,57 @@ def assemble_dense(m, ws, rows, start, count):
 
 
 @kernel
-def _factor_joints(B, nb):
-    """B = L D L^T in place (dense, lower triangle and diagonal); rows of a joint-only loop
-    that are exact combinations of earlier ones get a zero pivot."""
+def _factor_joints(B, nb, rows, scratch):
+    """B = L D L^T in place (B full and symmetric on entry; L below the diagonal, D on it)
+    with symmetric pivoting: each step eliminates the row whose remaining pivot is the largest
+    share of its own diagonal, and rows[:nb] (the rows' ids) are permuted with B. A loop's
+    dependent rows therefore come last, where all that is left of them is rounding: once
+    the largest remaining share is below JOINT_LOOP_TOL, every remaining row is an exact
+    combination of the others (zero pivot, left out). Without pivoting, which row of a loop
+    is last depends on the order, and its pivot could be the rounding of far larger rows
+    (measured: a folded four-bar with inertias 1e-4..1e4 kg m^2 kept a pivot of 2e-12 of
+    its diagonal on a loop singular to 1e-15, and its pins took 2e5 N s). scratch (>= nb, 2):
+    the remaining pivots and the diagonals."""
+    for i in range(nb):
+        scratch[i, 0] = B[i, i]
+        scratch[i, 1] = B[i, i]
     for k in range(nb):
-        scale = abs(B[k, k])
-        for j in range(k):
-            B[k, k] -= B[k, j] * B[k, j] * B[j, j]
-        if abs(B[k, k]) <= JOINT_LOOP_TOL * scale or scale == 0.0:
-            B[k, k] = 0.0
+        p = k
+        best = -1.0
+        for i in range(k, nb):
+            share = scratch[i, 0] / scratch[i, 1] if scratch[i, 1] > 0.0 else 0.0
+            if share > best:
+                best = share
+                p = i
+        if p != k:
+            for j in range(nb):
+                B[k, j], B[p, j] = B[p, j], B[k, j]
+            for i in range(nb):
+                B[i, k], B[i, p] = B[i, p], B[i, k]
+            rows[k], rows[p] = rows[p], rows[k]
+            for c in range(2):
+                scratch[k, c], scratch[p, c] = scratch[p, c], scratch[k, c]
+        if best <= JOINT_LOOP_TOL:
+            for i in range(k, nb):
+                B[i, i] = 0.0
+                for j in range(i + 1, nb):
+                    B[j, i] = 0.0
+            return
+        piv = B[k, k]
         for i in range(k + 1, nb):
-            acc = B[i, k]
-            for j in range(k):
-                acc -= B[i, j] * B[k, j] * B[j, j]
-            B[i, k] = acc / B[k, k] if B[k, k] != 0.0 else 0.0
+            B[i, k] = B[i, k] / piv
+        for i in range(k + 1, nb):
+            lik = B[i, k]
+            if lik == 0.0:
+                continue
+            for j in range(k + 1, i + 1):
+                B[i, j] -= lik * B[j, k] * piv
+            scratch[i, 0] = B[i, i]
+        for i in range(k + 1, nb):
+            for j in range(i + 1, nb):
+                B[i, j] = B[j, i]
+        for j in range(k + 1, nb):
+            B[k, j] = B[j, k]
 
 
 @kernel
@@ -115,7 +153,7 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     for i in range(nb):
         for j in range(nb):
             B[i, j] = ws.A[ws.lcp_rows[i], ws.lcp_rows[j]]
-    _factor_joints(B, nb)
+    _factor_joints(B, nb, ws.lcp_rows, G)
     for j in range(nx + 1):
         for i in range(nb):
             ri = ws.lcp_rows[i]
