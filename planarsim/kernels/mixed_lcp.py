@@ -7,7 +7,8 @@ Rows r with impulses x_r and residuals w = A x + b (A = J W J^T, dense here, b =
       w_t = 0 inside the cone (sticking) or x_t = -mu x_n sign(w_t) (sliding)
 The joints are eliminated first (Schur complement: x_b = -A_bb^-1 (b_b + A_bx x_x); the joint
 rows of a tree are independent, so A_bb is positive definite; a row of a joint-only loop that
-depends exactly on others is consistent and is left out there, impulse 0). Friction takes the
+depends exactly on others is consistent and is left out there, impulse 0; which rows those
+are is decided by a pivoted factorization wherever a pivot comes near rounding). Friction takes the
 form of Stewart and Trinkle (1996): x_t = beta+ - beta-, with a slip speed gamma,
   beta+ >= 0  _|_  w_t + gamma >= 0,   beta- >= 0  _|_  -w_t + gamma >= 0,
   gamma >= 0  _|_  mu x_n - beta+ - beta- >= 0,
@@ -29,6 +30,9 @@ from .solve import _entry
 # remaining joint rows are exact combinations of the others (consistent joints), left out
 # with impulse 0 (_factor_joints)
 JOINT_LOOP_TOL = 1e-12
+# a kept pivot this small a share of its diagonal may be rounding of larger rows (a loop near
+# a dependent configuration): the joint block is then factored again with pivoting
+PIVOTING_SHARE = 1e-8
 # friction within this share of mu lambda_n is at the cone's edge; a slip speed below this
 # share of the contact's free-motion speed is rounding
 CONE_EDGE_TOL = 1e-9
@@ -56,9 +60,30 @@ def assemble_dense(m, ws, rows, start, count):
 
 
 @kernel
-def _factor_joints(B, nb, rows, scratch):
-    """B = L D L^T in place (B full and symmetric on entry; L below the diagonal, D on it)
-    with symmetric pivoting: each step eliminates the row whose remaining pivot is the largest
+def _factor_plain(B, nb):
+    """B = L D L^T in place (dense, lower triangle and diagonal) in the rows' order; a pivot
+    below JOINT_LOOP_TOL of its diagonal is left out (zero). Returns the smallest share of
+    its diagonal that a kept pivot has (1 if none)."""
+    smallest = 1.0
+    for k in range(nb):
+        scale = abs(B[k, k])
+        for j in range(k):
+            B[k, k] -= B[k, j] * B[k, j] * B[j, j]
+        if abs(B[k, k]) <= JOINT_LOOP_TOL * scale or scale == 0.0:
+            B[k, k] = 0.0
+        else:
+            smallest = min(smallest, abs(B[k, k]) / scale)
+        for i in range(k + 1, nb):
+            acc = B[i, k]
+            for j in range(k):
+                acc -= B[i, j] * B[k, j] * B[j, j]
+            B[i, k] = acc / B[k, k] if B[k, k] != 0.0 else 0.0
+    return smallest
+
+
+@kernel
+def _factor_pivoted(B, nb, rows, scratch):
+    """As _factor_plain (B full and symmetric on entry), with symmetric pivoting: each step eliminates the row whose remaining pivot is the largest
     share of its own diagonal, and rows[:nb] (the rows' ids) are permuted with B. A loop's
     dependent rows therefore come last, where all that is left of them is rounding: once
     the largest remaining share is below JOINT_LOOP_TOL, every remaining row is an exact
@@ -110,6 +135,27 @@ def _factor_joints(B, nb, rows, scratch):
 
 
 @kernel
+def _factor_joints(A, B, nb, rows, scratch):
+    """B = L D L^T of the joint rows rows[:nb] of A (rows may be permuted; see
+    _factor_pivoted). In the rows' order where every kept pivot is at least PIVOTING_SHARE of
+    its diagonal, far above rounding, so the rank is certain; pivoted otherwise (a loop near
+    or at a dependent configuration)."""
+    _fill_joint_block(A, B, nb, rows)
+    if _factor_plain(B, nb) >= PIVOTING_SHARE:
+        return
+    _fill_joint_block(A, B, nb, rows)
+    _factor_pivoted(B, nb, rows, scratch)
+
+
+@kernel
+def _fill_joint_block(A, B, nb, rows):
+    """B[i, j] = A[rows[i], rows[j]] for i, j < nb."""
+    for i in range(nb):
+        for j in range(nb):
+            B[i, j] = A[rows[i], rows[j]]
+
+
+@kernel
 def _solve_joints(B, nb, G, col):
     """G[:nb, col] <- (L D L^T)^-1 G[:nb, col] (a zero pivot gives 0)."""
     for i in range(nb):
@@ -150,10 +196,7 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     # joints: B = A_bb factored; G = A_bb^-1 [A_bx, b_b]
     B = ws.lcp_B
     G = ws.lcp_G
-    for i in range(nb):
-        for j in range(nb):
-            B[i, j] = ws.A[ws.lcp_rows[i], ws.lcp_rows[j]]
-    _factor_joints(B, nb, ws.lcp_rows, G)
+    _factor_joints(ws.A, B, nb, ws.lcp_rows, G)
     for j in range(nx + 1):
         for i in range(nb):
             ri = ws.lcp_rows[i]

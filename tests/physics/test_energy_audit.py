@@ -54,15 +54,16 @@ def step_gains(model, q, v):
     return np.diff(e) - 0.5 * model.dt * G * np.diff(py), kinetic[:-1]
 
 
-@pytest.mark.parametrize("seed", [22, 36, 42])
+@pytest.mark.parametrize("seed", [22, 36, 42, 162])
 def test_a_folded_loop_gains_no_energy_from_its_nearly_dependent_pins(seed):
     """Four bars pinned in a closed loop, folding flat onto the ground: at the fold the pin
     rows are nearly dependent, and the second-order target of the velocity solve once turned
     an inconsistent drift into impulses of 1e5 N s (seed 42: 0.1 J of motion became 808 J in
     one step, 3 J of it kept); the complementarity solve's joint elimination, unpivoted, kept
     a pivot of 2e-12 of its diagonal on a loop singular to 1e-15 (seed 36: 0.009 J gained in
-    one step at 3e-5 J of motion). No step may now gain more than the constraints'
-    second-order share (1 % of its kinetic energy) beyond its gravity term."""
+    one step at 3e-5 J of motion; seed 162, at dt = 10 ms: 1.2e-3 J). No step may now gain
+    more than the constraints' second-order share (1 % of its kinetic energy) beyond its
+    gravity term."""
     model, q, v, sim, error = corpus_run("loop_inertia", seed)
     assert error is None
     gains, kinetic = step_gains(model, q, v)
