@@ -26,12 +26,12 @@ from .rows import is_joint_row, is_soft_row, is_tangent_row
 from .soft import soft_compliance
 from .solve import _entry
 
-# a joint-only loop: once the largest remaining pivot is this share of its row's diagonal, the
-# remaining joint rows are exact combinations of the others (consistent joints), left out
-# with impulse 0 (_factor_joints)
+# a joint-only loop: a pivot below this share of its row's diagonal belongs to a row that is
+# an exact combination of the others (consistent joints), left out with impulse 0
+# (_factor_joints)
 JOINT_LOOP_TOL = 1e-12
-# a kept pivot this small a share of its diagonal may be rounding of larger rows (a loop near
-# a dependent configuration): the joint block is then factored again with pivoting
+# a pivot this small a share of its diagonal may be rounding of larger rows (a loop near a
+# dependent configuration): the joint block is then factored again with pivoting
 PIVOTING_SHARE = 1e-8
 # friction within this share of mu lambda_n is at the cone's edge; a slip speed below this
 # share of the contact's free-motion speed is rounding
@@ -63,7 +63,7 @@ def assemble_dense(m, ws, rows, start, count):
 def _factor_plain(B, nb):
     """B = L D L^T in place (dense, lower triangle and diagonal) in the rows' order; a pivot
     below JOINT_LOOP_TOL of its diagonal is left out (zero). Returns the smallest share of
-    its diagonal that a kept pivot has (1 if none)."""
+    its diagonal that a pivot has (0 if one was left out)."""
     smallest = 1.0
     for k in range(nb):
         scale = abs(B[k, k])
@@ -71,6 +71,7 @@ def _factor_plain(B, nb):
             B[k, k] -= B[k, j] * B[k, j] * B[j, j]
         if abs(B[k, k]) <= JOINT_LOOP_TOL * scale or scale == 0.0:
             B[k, k] = 0.0
+            smallest = 0.0
         else:
             smallest = min(smallest, abs(B[k, k]) / scale)
         for i in range(k + 1, nb):
@@ -83,8 +84,9 @@ def _factor_plain(B, nb):
 
 @kernel
 def _factor_pivoted(B, nb, rows, scratch):
-    """As _factor_plain (B full and symmetric on entry), with symmetric pivoting: each step eliminates the row whose remaining pivot is the largest
-    share of its own diagonal, and rows[:nb] (the rows' ids) are permuted with B. A loop's
+    """As _factor_plain (B full and symmetric on entry), with symmetric pivoting: each step
+    eliminates the row whose remaining pivot is the largest share of its own diagonal (a
+    choice that no row's units change: pins' rows are in m, a slider's angle row in rad), and rows[:nb] (the rows' ids) are permuted with B. A loop's
     dependent rows therefore come last, where all that is left of them is rounding: once
     the largest remaining share is below JOINT_LOOP_TOL, every remaining row is an exact
     combination of the others (zero pivot, left out). Without pivoting, which row of a loop
@@ -137,9 +139,10 @@ def _factor_pivoted(B, nb, rows, scratch):
 @kernel
 def _factor_joints(A, B, nb, rows, scratch):
     """B = L D L^T of the joint rows rows[:nb] of A (rows may be permuted; see
-    _factor_pivoted). In the rows' order where every kept pivot is at least PIVOTING_SHARE of
-    its diagonal, far above rounding, so the rank is certain; pivoted otherwise (a loop near
-    or at a dependent configuration)."""
+    _factor_pivoted). In the rows' order where every pivot is at least PIVOTING_SHARE of its
+    diagonal, far above rounding, so that the rows are certainly independent (a tree's
+    joints); pivoted otherwise: a loop, at or near a dependent configuration, whose rows
+    left out must be the dependent ones whatever the rows' order."""
     _fill_joint_block(A, B, nb, rows)
     if _factor_plain(B, nb) >= PIVOTING_SHARE:
         return
