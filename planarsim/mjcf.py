@@ -52,7 +52,6 @@ in-plane offsets from the body's COM.
 """
 from __future__ import annotations
 
-import inspect
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -315,6 +314,7 @@ class _Loader:
         self.option = {}
         self.classes = {"main": {}}           # class -> tag -> attributes
         self.report = LoadReport()
+        self.free_bodies = []                 # bodies with a free root's slides and hinge
         bad = sorted(set(drop) - set(DROPPABLE))
         if bad:
             raise ModelError(f"load_mjcf: drop={sorted(drop)} names {bad}; it may name {DROPPABLE}")
@@ -798,23 +798,20 @@ class _Loader:
                       "a free root's hinge must follow its two slides (MuJoCo turns the body "
                       "about the hinge after the slides moved it)")
         self.free += tuple(j["name"] for j in b.joints)
-        self.free_bodies = getattr(self, "free_bodies", []) + [b]
+        self.free_bodies.append(b)
 
     def limited(self, j):
         v = self.flag(j["node"], j["eff"], "limited")
         return v == "true" or (v == "auto" and "range" in j["eff"])
 
-    def armature(self, j, supported):
-        """Joint armature [kg m^2 or kg]: passed on when the builder takes it (supported),
-        dropped when the caller asked, else a ModelError."""
+    def armature(self, j):
+        """Joint armature [kg m^2 or kg]; 0 (reported) where the caller dropped it
+        (drop={"armature"})."""
         a = self.scalar(j["node"], j["eff"], "armature", 0.0)
-        if a == 0.0 or supported:
-            return a
-        if "armature" in self.drop:
+        if a != 0.0 and "armature" in self.drop:
             self.report.drop("joint armature", j["node"].line)
             return 0.0
-        self.fail(j["node"], f"armature={a} needs joint armature, not supported yet "
-                             f"(drop={{'armature'}} loads without it)")
+        return a
 
     def parts(self):
         """Mass [kg], in-plane COM [m], own inertia about the normal [kg m^2] and the shape of
@@ -933,13 +930,13 @@ class _Loader:
                 out.joint[j["name"]] = JointMap("slider", self.add_slider(builder, j, a, ids[child]),
                                                 1.0, self.ref(j))
         # a free root's coordinates after the links (the links keep pin ids 0..)
-        for b in getattr(self, "free_bodies", []):
+        for b in self.free_bodies:
             hinge = [j for j in b.joints if j["type"] == "hinge"]
             # the slides move the hinge's anchor (the point the body turns about)
             anchor = tuple(float(x) for x in self.plane((hinge or b.joints)[0]["pos"]))
             for j in b.joints:
                 limit, k, c, rest = self.joint_terms(j)
-                arm = self.armature(j, supported=True)
+                arm = self.armature(j)
                 kind = j["type"]
                 a = j["axis"]
                 axis = (2,) if kind == "hinge" else (float(a[self.i1]), float(a[self.i2]))
@@ -984,28 +981,22 @@ class _Loader:
         return limit, k, c, rest
 
     def add_pin(self, builder, j, a, b):
-        """A hinge -> ModelBuilder.add_pin at the joint's world position; armature goes to
-        add_pin(armature=...) when the builder takes it."""
+        """A hinge -> ModelBuilder.add_pin at the joint's world position (armature [kg m^2]
+        to add_pin(armature=...))."""
         limit, k, c, rest = self.joint_terms(j)
-        takes = "armature" in inspect.signature(builder.add_pin).parameters
-        arm = self.armature(j, supported=takes)
-        kw = dict(armature=arm) if takes and arm else {}
         return builder.add_pin(j["name"], a, b, anchor_world=tuple(self.plane(j["pos"])),
-                               limit=limit, stiffness=k, damping=c, rest_angle=rest, **kw)
+                               limit=limit, stiffness=k, damping=c, rest_angle=rest,
+                               armature=self.armature(j))
 
     def add_slider(self, builder, j, a, b):
         """A slide between bodies -> ModelBuilder.add_slider (axis: unit in-plane direction;
-        limit [m]; stiffness [N/m], damping [N s/m]), when the builder has it."""
-        if not hasattr(builder, "add_slider"):
-            self.fail(j["node"], "needs slider joints (ModelBuilder.add_slider), not supported yet")
+        limit [m]; stiffness [N/m], damping [N s/m]; armature [kg])."""
         limit, k, c, rest = self.joint_terms(j)
-        takes = "armature" in inspect.signature(builder.add_slider).parameters
-        arm = self.armature(j, supported=takes)
-        kw = dict(armature=arm) if takes and arm else {}
         ax = j["axis"]
         return builder.add_slider(j["name"], a, b, axis=(ax[self.i1], ax[self.i2]),
                                   anchor_world=tuple(self.plane(j["pos"])), limit=limit,
-                                  stiffness=k, damping=c, rest=rest, **kw)
+                                  stiffness=k, damping=c, rest=rest,
+                                  armature=self.armature(j))
 
     def point_body(self, builder, rb, shapes):
         """A body that translates only (a root with two slides, no hinge): a point mass. Its
@@ -1186,9 +1177,6 @@ class _Loader:
             elif jm.kind == "free":
                 aid = b.add_slider_motor(name, jm.pin, limit=limit)
             else:
-                if not hasattr(b, "add_slider_motor"):
-                    self.fail(a, "a motor on a slider needs ModelBuilder.add_slider_motor, not "
-                                 "supported yet")
                 aid = b.add_slider_motor(name, jm.id, limit=limit)
             out.actuator[name] = ActuatorMap(aid, jname, signed, ctrl)
 

@@ -88,6 +88,7 @@ _HEALTHY = dict(frame_skip=4, forward_reward_weight=1.0, ctrl_cost_weight=1e-3, 
 class _Healthy(_Locomotion):
     """Hopper and Walker2d: forward + healthy reward - ctrl cost; terminates when unhealthy
     (z and the root's angle outside their ranges; Hopper also any state beyond its range)."""
+    _healthy_state_range = None     # Hopper's DEFAULTS set it
 
     @property
     def healthy_reward(self):
@@ -98,7 +99,7 @@ class _Healthy(_Locomotion):
         z, angle = self.data.qpos[1:3]
         healthy = (self._healthy_z_range[0] < z < self._healthy_z_range[1]
                    and self._healthy_angle_range[0] < angle < self._healthy_angle_range[1])
-        state_range = getattr(self, "_healthy_state_range", None)
+        state_range = self._healthy_state_range
         if state_range is not None:
             state = self.state_vector()[2:]
             healthy = healthy and bool(np.all((state_range[0] < state) & (state < state_range[1])))

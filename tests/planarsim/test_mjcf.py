@@ -87,6 +87,20 @@ def test_legs_joint_positions_ranges_and_passive_terms(legs):
         assert a.pin_stiffness[j] == 5.0 and a.pin_damping[j] == 5.0
 
 
+def test_a_joints_armature_loads_unless_dropped():
+    """<joint armature> goes to the pin's reflected inertia; drop={"armature"} loads the file
+    without it and says so in the report (the line of each armature left out)."""
+    xml = """<mujoco><worldbody><body name="a" pos="0 0 1">
+      <joint type="hinge" axis="0 1 0" pos="0 0 0" armature="0.3"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -1" size="0.05" mass="1"/></body></worldbody></mujoco>"""
+    kept = load_mjcf(xml)
+    assert kept.compile().arrays.pin_armature[0] == pytest.approx(0.3)
+    assert not kept.report.dropped
+    dropped = load_mjcf(xml, drop={"armature"})
+    assert dropped.compile().arrays.pin_armature[0] == 0.0
+    assert dropped.report.dropped == {"joint armature": [2]}
+
+
 def test_hinge_sign_follows_the_axis():
     """A hinge about +y turns x toward -z (clockwise in our plane): a knee flexion that moves
     the foot backward (-x) is a positive MJCF angle and a negative pin angle."""
