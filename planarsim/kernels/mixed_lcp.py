@@ -8,8 +8,9 @@ Rows r with impulses x_r and residuals w = A x + b (A = J W J^T, dense here, b =
 The joints are eliminated first (Schur complement: x_b = -A_bb^-1 (b_b + A_bx x_x); the joint
 rows of a tree are independent, so A_bb is positive definite; a row of a joint-only loop that
 depends exactly on others is consistent and is left out there, impulse 0; which rows those
-are is decided by a pivoted factorization wherever a pivot comes near rounding). Friction takes the
-form of Stewart and Trinkle (1996): x_t = beta+ - beta-, with a slip speed gamma,
+are, a pivoted factorization decides wherever a row is left out or a pivot falls below
+PIVOTING_SHARE of its diagonal). Friction takes the form of Stewart and Trinkle (1996):
+x_t = beta+ - beta-, with a slip speed gamma,
   beta+ >= 0  _|_  w_t + gamma >= 0,   beta- >= 0  _|_  -w_t + gamma >= 0,
   gamma >= 0  _|_  mu x_n - beta+ - beta- >= 0,
 which in the plane is Coulomb's law exactly (the cone has two edges). Variables are scaled to
@@ -28,7 +29,7 @@ from .solve import _entry
 
 # a joint-only loop: a pivot below this share of its row's diagonal belongs to a row that is
 # an exact combination of the others (consistent joints), left out with impulse 0
-# (_factor_joints)
+# (_factor_plain, _factor_pivoted)
 JOINT_LOOP_TOL = 1e-12
 # a pivot this small a share of its diagonal may be rounding of larger rows (a loop near a
 # dependent configuration): the joint block is then factored again with pivoting
@@ -84,15 +85,15 @@ def _factor_plain(B, nb):
 
 @kernel
 def _factor_pivoted(B, nb, rows, scratch):
-    """As _factor_plain (B full and symmetric on entry), with symmetric pivoting: each step
-    eliminates the row whose remaining pivot is the largest share of its own diagonal (a
-    choice that no row's units change: pins' rows are in m, a slider's angle row in rad), and rows[:nb] (the rows' ids) are permuted with B. A loop's
-    dependent rows therefore come last, where all that is left of them is rounding: once
-    the largest remaining share is below JOINT_LOOP_TOL, every remaining row is an exact
-    combination of the others (zero pivot, left out). Without pivoting, which row of a loop
-    is last depends on the order, and its pivot could be the rounding of far larger rows
-    (measured: a folded four-bar with inertias 1e-4..1e4 kg m^2 kept a pivot of 2e-12 of
-    its diagonal on a loop singular to 1e-15, and its pins took 2e5 N s). scratch (>= nb, 2):
+    """B = L D L^T in place as _factor_plain (B full and symmetric on entry; no return), with
+    symmetric pivoting: each step eliminates the row whose remaining pivot is the largest
+    share of its own diagonal (pivoting on the unit-diagonal scaling of B, which no row's
+    units change), and rows[:nb] (the rows' ids) are permuted with B. A loop's dependent
+    rows come last, where all that is left of them is rounding: once the largest remaining
+    share is below JOINT_LOOP_TOL, the remaining rows are left out (zero pivot). In the
+    rows' order, a loop's last row could keep as its pivot the rounding of far larger rows
+    (measured: a folded four-bar with inertias 1e-4..1e4 kg m^2 kept a pivot of 2e-12 of its
+    diagonal on a loop singular to 1e-15, and its pins took 2e5 N s). scratch (>= nb, 2):
     the remaining pivots and the diagonals."""
     for i in range(nb):
         scratch[i, 0] = B[i, i]

@@ -5,7 +5,8 @@
               sum_r lam_r J_r v: with each row's end-of-step error aimed at c(q + h v*) (the
               second-order target, kernels/solve.fill_row_b) this is -sum_r lam_r c_r(q + h v*) / h,
               the drift of rotating anchors: about (h w)^2 KE in smooth motion (a pendulum:
-              tension h m v^2 / L times drift h v^2 / 2L over h)
+              tension h m v^2 / L times drift h v^2 / 2L over h); where the impulses are too
+              large for that sum to be measured, bounded below from the velocities
   limits      each active joint limit's impulse times its rate at the end velocity: an
               inequality's, like a contact's, is at most rounding
   correction  the position correction's and projection's change of kinetic energy less the
@@ -142,7 +143,9 @@ def joints_add_energy(m, s, ws, h):
     JOINT_WORK_SHARE of KE(v*) is energy from nowhere. Where the end turns further from the
     prediction (an armature or stiff spring that the velocity solve, not v*, holds back; a
     closed loop's nearly dependent rows whose huge impulses turn its bodies) the target
-    was linearized at the wrong place: beyond CONSTRAINT_SHARE of KE(v*) is from nowhere."""
+    was linearized at the wrong place: beyond CONSTRAINT_SHARE of KE(v*) is from nowhere.
+    Where the impulses are so large that their work's rounding exceeds that share, the
+    velocities' lower bound of that work (gain_from_velocities) is judged too."""
     work, rounding, row = joint_work(m, ws, ws.v_new)
     kinetic = kinetic_energy(m, ws.v_pred)
     # impulses so large that their work's rounding alone hides the share (a folded loop's
@@ -161,23 +164,22 @@ def joints_add_energy(m, s, ws, h):
 
 @kernel
 def gain_from_velocities(m, ws, h, kinetic):
-    """A lower bound [J] of the joints' work in the velocity solve, from velocities only: the
-    kinetic energy the impulses added, KE(v_new) - KE(v*) (kinetic: KE(v*)), less what the
-    other rows can add: a soft row its own work (its spring's and damper's), a sticking
-    contact's tangent row held at its anchor |lam c| / h, each contact's and limit's rounding
-    (row_rounding), and the sums' rounding. Without the joints' targets the answer is the
-    kinetic metric's projection of v* onto velocities that open no error further, a convex
-    set holding v = 0, which cannot add kinetic energy: what remains came from the joints'
-    targets. Unlike the joints' work (joint_work), it stays exact where their impulses are
-    huge and that work's rounding (|lam| times the solve's accuracy) is not. -inf where a
-    contact bounces (restitution's rule over several contacts can add energy by itself)."""
+    """A lower bound [J] of the joints' work at the answer (joint_work), from velocities:
+    KE(v_new) - KE(v*) (kinetic: KE(v*)) less what the other rows' impulses do at v_new.
+    With v_new - v* = W F^T lam, KE(v_new) - KE(v*) = sum_r lam_r F_r v_new - |v_new - v*|^2 / 2
+    (mass-weighted), so the joints do at least the gain less the other rows' work, each
+    bounded from above: a contact's normal row or a limit's does -lam c / h <= 0 (a violated
+    row's c is taken as 0) plus rounding (row_rounding); a tangent row, sticking or sliding
+    (friction opposes the slip), at most |lam c| / h plus rounding; a soft row exactly its own
+    work (its spring's and damper's). Unlike joint_work, it stays exact where the joints'
+    impulses are huge and their work's rounding (|lam| times the solve's accuracy) is not.
+    -inf where a contact bounces (its target is the rebound, not -c / h)."""
     speed = fastest(ws.v_new) + fastest(ws.v_pred)
     allowed = 0.0
     for r in range(ws.n_row[0]):
         kind = ws.row_kind[r]
         if is_soft_row(kind):
-            allowed += ws.lam[r] * 0.5 * (row_dot(ws, r, ws.row_J, ws.v_pred)
-                                          + row_dot(ws, r, ws.row_J, ws.v_new))
+            allowed += ws.lam[r] * row_dot(ws, r, ws.row_J, ws.v_new)
         elif not is_joint_row(kind):
             if is_normal_row(kind) and ws.contact_bounce[ws.row_owner[r]] > 0.0:
                 return -math.inf
@@ -190,7 +192,7 @@ def gain_from_velocities(m, ws, h, kinetic):
 
 @kernel
 def largest_joint_impulse(ws):
-    """The joint row with the largest |impulse| (-1 if none)."""
+    """The pin, slider or rod row (not a soft row) with the largest |impulse| (-1 if none)."""
     best = -1.0
     row = -1
     for r in range(ws.n_row[0]):

@@ -61,7 +61,7 @@ def test_a_folded_loop_gains_no_energy_from_its_nearly_dependent_pins(seed):
     an inconsistent drift into impulses of 1e5 N s (seed 42: 0.1 J of motion became 808 J in
     one step, 3 J of it kept); the complementarity solve's joint elimination, unpivoted, kept
     a pivot of 2e-12 of its diagonal on a loop singular to 1e-15 (seed 36: 0.009 J gained in
-    one step at 3e-5 J of motion; seed 162, at dt = 10 ms: 1.2e-3 J). No step may now gain
+    one step at 3e-5 J of motion; seed 162: 1.2e-3 J). No step may now gain
     more than the constraints' second-order share (1 % of its kinetic energy) beyond its
     gravity term."""
     model, q, v, sim, error = corpus_run("loop_inertia", seed)
@@ -253,7 +253,8 @@ def test_a_folded_loops_answers_add_no_kinetic_energy_beyond_the_joints_share():
     a = model.arrays
 
     def kinetic(v):
-        return 0.5 * np.sum(a.body_mass * (v[:, 0] ** 2 + v[:, 1] ** 2) + a.body_inertia * v[:, 2] ** 2)
+        return 0.5 * np.sum(a.body_mass * (v[:, 0] ** 2 + v[:, 1] ** 2)
+                            + a.body_inertia * v[:, 2] ** 2)
 
     huge = 0
     for _ in range(900):
@@ -262,7 +263,8 @@ def test_a_folded_loops_answers_add_no_kinetic_energy_beyond_the_joints_share():
         huge += np.abs(sim.state.last_pin_impulse).max() > 1e4
         predicted, final = kinetic(sim.ws.v_pred), kinetic(sim.ws.v_new)
         assert (final - predicted <= JOINT_WORK_SHARE * predicted + 1e-12
-                or audit_counts(sim.ws)["joint_work"] > counted), (sim.state.step[0], final, predicted)
+                or audit_counts(sim.ws)["joint_work"] > counted), (sim.state.step[0], final,
+                                                                    predicted)
     assert huge > 0       # the case stands: some steps carry the huge impulses
 
 
@@ -274,11 +276,11 @@ def _joints_add_energy(m, s, ws, h):
 def test_the_joints_energy_check_reads_velocities_where_their_impulses_hide_their_work():
     """A wheel pinned at its centre to the world; its two pin rows carry 1e5 N s each (put in
     by hand), so their work's rounding allowance, |lam| times the solve's accuracy, is 2e-3
-    J, four thousand times the 1 % share of KE(v*) = 5e-7 J. An answer spinning the wheel ten
-    times faster than v* (50 times the energy) does no work through the pins' rows, so their
-    measured work cannot show it; the velocities' bound (KE(v_new) - KE(v*), which only the
-    joints' targets can raise) does, and the check flags it. At the answer's own speed it is
-    not flagged."""
+    J, 4e5 times the 1 % share of KE(v*) = 5e-7 J. An answer spinning the wheel ten times
+    faster than v* (100 times the energy) does no work through the pins' rows, so their
+    measured work cannot show it; the velocities' lower bound of it (the kinetic energy the
+    impulses added, less what other rows can do) does, and the check flags it. An answer at
+    v*'s own speed is not flagged."""
     b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, 0.0))
     wheel = b.add_body("wheel", 1.0, 1.0, pos=(0.0, 1.0))
     b.add_pin("axle", None, wheel, anchor_world=(0.0, 1.0))

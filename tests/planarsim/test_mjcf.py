@@ -88,17 +88,27 @@ def test_legs_joint_positions_ranges_and_passive_terms(legs):
 
 
 def test_a_joints_armature_loads_unless_dropped():
-    """<joint armature> goes to the pin's reflected inertia; drop={"armature"} loads the file
-    without it and says so in the report (the line of each armature left out)."""
-    xml = """<mujoco><worldbody><body name="a" pos="0 0 1">
-      <joint type="hinge" axis="0 1 0" pos="0 0 0" armature="0.3"/>
-      <geom type="capsule" fromto="0 0 0 0 0 -1" size="0.05" mass="1"/></body></worldbody></mujoco>"""
+    """<joint armature> goes to the reflected inertia of every kind of joint coordinate (a
+    free root's slides and hinge, a hinge, a slide); drop={"armature"} loads the file without
+    any and says so in the report (the line of each armature left out)."""
+    xml = """<mujoco><worldbody><body name="root" pos="0 0 1">
+      <joint name="rx" type="slide" axis="1 0 0" armature="0.1"/>
+      <joint name="rz" type="slide" axis="0 0 1" armature="0.2"/>
+      <joint name="ry" type="hinge" axis="0 1 0" armature="0.3"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.5" size="0.05" mass="1"/>
+      <body name="shin" pos="0 0 -0.5">
+        <joint name="knee" type="hinge" axis="0 1 0" armature="0.4"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.5" size="0.05" mass="1"/>
+        <body name="foot" pos="0 0 -0.5">
+          <joint name="piston" type="slide" axis="0 0 1" armature="0.5"/>
+          <geom type="sphere" size="0.05" mass="1"/>
+        </body></body></body></worldbody></mujoco>"""
     kept = load_mjcf(xml)
-    assert kept.compile().arrays.pin_armature[0] == pytest.approx(0.3)
+    assert sorted(kept.compile().arrays.pin_armature) == pytest.approx([0.1, 0.2, 0.3, 0.4, 0.5])
     assert not kept.report.dropped
     dropped = load_mjcf(xml, drop={"armature"})
-    assert dropped.compile().arrays.pin_armature[0] == 0.0
-    assert dropped.report.dropped == {"joint armature": [2]}
+    assert not dropped.compile().arrays.pin_armature.any()
+    assert sorted(dropped.report.dropped["joint armature"]) == [2, 3, 4, 7, 10]
 
 
 def test_hinge_sign_follows_the_axis():
