@@ -76,10 +76,10 @@ without impulses; see energy_bound) and the motors' work, against the run's whol
 (contacts only take energy out), less the joints' second-order share of the step's kinetic
 energy ((h w)^2 for the fastest turn w, at least CONSTRAINT_SHARE, kernels/work.py: an
 oscillation the energy target bounds over the run); tunnel (hills_fast) above DEPTH_TOL,
-beyond rod_sag for a point on a rod; speed (stiff_motors). A run the engine stops with an error of its own (planarsim's
-SimulationDiverged or any planarsim error, naming why) is "raised"; a run missing a target
-without one is "silent" (an audit count alone is silent: nothing stopped the run). The summary
-gives both per family, the silent misses by cause and the audit counts by rule.
+beyond rod_sag for a point on a rod; speed (stiff_motors). A run the engine stops with an
+error of its own (planarsim's SimulationDiverged or any planarsim error, naming why) is
+"raised"; a run missing a target without one is "silent" (an audit count alone is silent:
+nothing stopped the run). The summary gives both per family, the silent misses by cause and the audit counts by rule.
 
 Seed k runs at dt = DTS[k % 5] (1e-4 ... 1e-2 s) unless its family says otherwise. A run simulates SECONDS[family] (or --seconds) but at most
 MAX_STEPS steps, so runs at small dt cover less time. Every run is recorded at every step and

@@ -229,7 +229,8 @@ def stiff_actuator(model, ws, who="simulation"):
 
 # what the accurate integrators cannot step, by kernels/rattle.py's UNSUPPORTED_* code
 _UNSUPPORTED = {UNSUPPORTED_CONTACT: "contact", UNSUPPORTED_LIMIT: "joint limit",
-                UNSUPPORTED_SOFT: "joint spring, damper or armature", UNSUPPORTED_FLUID: "fluid drag"}
+                UNSUPPORTED_SOFT: "joint spring, damper or armature",
+                UNSUPPORTED_FLUID: "fluid drag"}
 
 
 def accurate_unsupported(model, what, index, integrator=None, who="simulation"):

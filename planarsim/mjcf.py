@@ -191,6 +191,16 @@ class JointMap:
     anchor: tuple = ()
     pin: int = -1
 
+    @property
+    def coordinate(self) -> int:
+        """Its row in the model's pin table (pins, sliders and free coordinates alike)."""
+        return self.pin if self.kind == "free" else self.id
+
+    @property
+    def angular(self) -> bool:
+        """Its coordinate is an angle [rad] (a hinge), not a slide [m]."""
+        return self.kind == "pin" or (self.kind == "free" and self.axis == (2,))
+
 
 @dataclass
 class ActuatorMap:
@@ -1170,14 +1180,8 @@ class _Loader:
             limit = tuple(sorted((signed * lo, signed * hi))) if math.isfinite(lo) else (-math.inf, math.inf)
             name = eff.get("name") or jname
             b = out.builder
-            if jm.kind == "pin":
-                aid = b.add_pin_motor(name, jm.id, limit=limit)
-            elif jm.kind == "free" and jm.axis == (2,):
-                aid = b.add_pin_motor(name, jm.pin, limit=limit)
-            elif jm.kind == "free":
-                aid = b.add_slider_motor(name, jm.pin, limit=limit)
-            else:
-                aid = b.add_slider_motor(name, jm.id, limit=limit)
+            add_motor = b.add_pin_motor if jm.angular else b.add_slider_motor
+            aid = add_motor(name, jm.coordinate, limit=limit)
             out.actuator[name] = ActuatorMap(aid, jname, signed, ctrl)
 
 

@@ -83,7 +83,7 @@ class GeneralizedCoords:
                     slides.append(i)
         self.links = [i for i, jm in enumerate(self.jm) if jm.kind != "free"]
         # the compiled map (joint_values): each joint's pin, sign and ref
-        self.pins = np.array([jm.pin if jm.kind == "free" else jm.id for jm in self.jm], np.int64)
+        self.pins = np.array([jm.coordinate for jm in self.jm], np.int64)
         self.sign = np.array([jm.sign for jm in self.jm], float)
         self.ref = np.array([jm.ref for jm in self.jm], float)
         self._cs = np.full((self.n_body, 3), np.nan)

@@ -130,11 +130,9 @@ def _factor_pivoted(B, nb, rows, scratch):
             for j in range(k + 1, i + 1):
                 B[i, j] -= lik * B[j, k] * piv
             scratch[i, 0] = B[i, i]
-        for i in range(k + 1, nb):
+        for i in range(k + 1, nb):       # the remaining block full again, for the swaps
             for j in range(i + 1, nb):
                 B[i, j] = B[j, i]
-        for j in range(k + 1, nb):
-            B[k, j] = B[j, k]
 
 
 @kernel
