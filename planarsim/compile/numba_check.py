@@ -33,10 +33,12 @@ NEEDED_TABLES = {
                        "register_model typeof_impl unbox",
     "numba.core.imputils": "impl_ret_borrowed",
     "numba.core.typing.templates": "AttributeTemplate",
-    "numba.np.arrayobj": "populate_array",
     "numba.core.cgutils": "alloca_once_value get_or_insert_function is_null pack_array "
                           "unpack_tuple voidptr_t",
 }
+# the fields of numba's array struct (numba.core.datamodel's ArrayModel) that refs._c_array
+# fills by name
+ARRAY_FIELDS = ("meminfo", "parent", "nitems", "itemsize", "data", "shape", "strides")
 # fields of a code library that KernelCodeLibrary.finalize reads and sets
 LIBRARY_FIELDS = ("_linking_libraries", "_final_module", "_finalized", "_codegen")
 # keyword arguments of the dispatcher's constructor that fast.py passes
@@ -59,8 +61,18 @@ def _missing(needed):
 
 
 def changed_tables():
-    """The extension API pieces refs.py uses (as 'module.attribute') missing from numba."""
-    return _missing(NEEDED_TABLES)
+    """The extension API pieces refs.py uses (as 'module.attribute') missing from numba,
+    and the fields of numba's array struct that refs._c_array fills."""
+    missing = _missing(NEEDED_TABLES)
+    try:
+        from numba.core import types
+        from numba.core.registry import cpu_target
+        model = cpu_target.target_context.data_model_manager[types.Array(types.float64, 2, "C")]
+        for name in ARRAY_FIELDS:
+            model.get_field_position(name)
+    except Exception as exc:   # a renamed field, or a changed way to reach the model
+        missing.append(f"numba.core.datamodel ArrayModel fields ({type(exc).__name__}: {exc})")
+    return missing
 
 
 def changed_internals():

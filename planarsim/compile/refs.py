@@ -31,7 +31,6 @@ from numba.core.imputils import impl_ret_borrowed
 from numba.core.typing.templates import AttributeTemplate
 from numba.extending import (NativeValue, infer_getattr, intrinsic, lower_getattr_generic, models,
                              register_model, typeof_impl, unbox)
-from numba.np.arrayobj import populate_array
 
 SLOTS_PER_ARRAY = 4  # address, shape[0], shape[1], shape[2]
 _DTYPES = {"float64": types.float64, "int64": types.int64}
@@ -289,19 +288,41 @@ class _HandleAttributes(_TableRefAttributes):
     key = HandleType
 
 
+_ITEMSIZE = {}
+
+
+def _itemsize(context, dtype):
+    """Bytes per item of dtype (LLVM's ABI size, asked once per dtype: each question builds
+    and parses a small LLVM module)."""
+    size = _ITEMSIZE.get(dtype)
+    if size is None:
+        size = _ITEMSIZE[dtype] = context.get_abi_sizeof(context.get_data_type(dtype))
+    return size
+
+
 def _c_array(context, builder, arrty, data, shape):
     """Array value of C-contiguous type arrty over pointer `data` with the given shape (LLVM
-    i64 values): strides follow from the shape, no memory is owned."""
+    i64 values): strides follow from the shape, no memory is owned (null meminfo and parent).
+
+    The struct value is built with insertvalue. numba's own populate_array builds it in stack
+    memory field by field with checks, which made this function about 2 s of the first-ever
+    compile (it runs for every field read of the model, state and workspace); both give the
+    same struct, so LLVM's optimised code is the same."""
     i64 = ir.IntType(64)
-    itemsize = context.get_abi_sizeof(context.get_data_type(arrty.dtype))
+    itemsize = _itemsize(context, arrty.dtype)
     strides = [ir.Constant(i64, itemsize)]
     for d in range(len(shape) - 1, 0, -1):
         strides.insert(0, builder.mul(strides[0], shape[d]))
-    ary = context.make_array(arrty)(context, builder)
-    populate_array(ary, data=data, shape=cgutils.pack_array(builder, shape, i64),
-                   strides=cgutils.pack_array(builder, strides, i64),
-                   itemsize=ir.Constant(i64, itemsize), meminfo=None)
-    return ary._getvalue()
+    nitems = shape[0]
+    for d in shape[1:]:
+        nitems = builder.mul(nitems, d)
+    model = context.data_model_manager[arrty]
+    value = ir.Constant(model.get_value_type(), None)     # meminfo and parent null
+    for name, field in (("nitems", nitems), ("itemsize", ir.Constant(i64, itemsize)),
+                        ("data", data), ("shape", cgutils.pack_array(builder, shape, i64)),
+                        ("strides", cgutils.pack_array(builder, strides, i64))):
+        value = builder.insert_value(value, field, model.get_field_position(name))
+    return value
 
 
 def _load_slot(builder, base, k):

@@ -2,6 +2,8 @@
 import itertools
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from planarsim.compile import FAST, MODE
 
@@ -45,3 +47,14 @@ def test_flags_differing_only_in_options_set_to_their_defaults_are_equal():
     assert _flags() == _flags(nrt=False)                      # nrt's default is False
     assert _flags() != _flags(nrt=True)
     assert _flags().__eq__(object()) is NotImplemented
+
+
+_BOOL_OPTIONS = sorted(name for name, option in Flags.options.items() if option.type is bool)
+
+
+@given(st.dictionaries(st.sampled_from(_BOOL_OPTIONS), st.booleans(), max_size=6),
+       st.dictionaries(st.sampled_from(_BOOL_OPTIONS), st.booleans(), max_size=6))
+def test_equality_over_any_set_options_answers_as_numbas_own(a, b):
+    x, y = _flags(**a), _flags(**b)
+    assert (x == y) == (x.values() == y.values())
+    assert (x == y) == (y == x)
