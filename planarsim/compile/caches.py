@@ -201,29 +201,40 @@ def _caller_engine_hash(folder: Path) -> str:
                          _sources_hash(kernels, _mode_tag() + others.hexdigest(), inlined))
 
 
-def drop_stale_caches(folder, clear=None) -> None:
-    """Clear the numba caches below `clear` (default `folder`) when the sources of `folder`
-    or the engine sources its compiled code is built from changed since the caches were
-    written (the module's docstring; nothing under NUMBA_DISABLE_JIT=1, which neither reads
-    nor writes them).
+def _user_cache_folders(clear: Path, spellings):
+    """The folders of NUMBA_CACHE_DIR that hold the caches of the sources below `clear` (none
+    when it is not set: numba then writes them in __pycache__ next to the sources). numba
+    names each after the source file's folder as Python imported it, which may be a path
+    through a link: `spellings` are the paths `clear` may be reached by."""
+    from numba.core import config
+    if not config.CACHE_DIR:
+        return []
+    try:
+        from numba.core.caching import _CacheLocator
+        subpath = _CacheLocator.get_suitable_cache_subpath
+    except (ImportError, AttributeError):     # numba's own rule (0.49-0.68), if it moves
+        def subpath(py_file):
+            folder = os.path.dirname(os.path.abspath(py_file))
+            return f"{os.path.basename(folder)}_{hashlib.sha1(folder.encode()).hexdigest()}"
+    root = Path(config.CACHE_DIR)
+    folders = set()
+    for source in clear.rglob("*.py"):
+        for spelling in spellings:
+            folders.add(root / subpath(str(spelling / source.relative_to(clear))))
+    return sorted(folders)
 
-    Walker packages call this on import with their own folder, since their rollouts inline
-    their controller files and the engine kernels they import.
-    """
-    if MODE == PYTHON:
-        return
-    folder = Path(folder).resolve()
-    clear = folder if clear is None else Path(clear).resolve()
-    engine = ENGINE_HASH if clear == _PLANARSIM else _caller_engine_hash(folder)
-    new = _sources_hash(folder, engine)
-    stamp = folder / "__pycache__" / "numba_sources.hash"
+
+def _clear_if_changed(stamp: Path, new: str, folders, recursive: bool) -> None:
+    """Delete the numba cache files in `folders` (and below, if recursive) unless `stamp`
+    holds `new`; then write it."""
     try:
         if stamp.exists() and stamp.read_text() == new:
             return
-        for pattern in ("*.nbi", "*.nbc"):
-            for f in clear.rglob(pattern):
-                f.unlink(missing_ok=True)
-        stamp.parent.mkdir(exist_ok=True)
+        for folder in folders:
+            for pattern in ("*.nbi", "*.nbc"):
+                for f in (folder.rglob(pattern) if recursive else folder.glob(pattern)):
+                    f.unlink(missing_ok=True)
+        stamp.parent.mkdir(parents=True, exist_ok=True)
         tmp = stamp.with_suffix(f".{os.getpid()}.tmp")
         tmp.write_text(new)
         os.replace(tmp, stamp)
@@ -231,4 +242,33 @@ def drop_stale_caches(folder, clear=None) -> None:
         pass  # read-only install: its sources cannot change either
 
 
-drop_stale_caches(_PLANARSIM / "compile", clear=_PLANARSIM)
+def drop_stale_caches(folder, clear=None) -> None:
+    """Clear the numba caches below `clear` (default `folder`) when the sources of `folder`
+    or the engine sources its compiled code is built from changed since the caches were
+    written (the module's docstring; nothing under NUMBA_DISABLE_JIT=1, which neither reads
+    nor writes them). With NUMBA_CACHE_DIR set, numba keeps those caches there instead, one
+    folder per source folder: those are cleared by a stamp of their own in NUMBA_CACHE_DIR
+    (numba checks each function against its own file only, so without this a kernel's edit,
+    or a new planarsim release, would run the step's stale machine code from there).
+
+    Walker packages call this on import with their own folder, since their rollouts inline
+    their controller files and the engine kernels they import.
+    """
+    if MODE == PYTHON:
+        return
+    given = Path(os.path.abspath(folder if clear is None else clear))
+    folder = Path(folder).resolve()
+    clear = folder if clear is None else Path(clear).resolve()
+    engine = ENGINE_HASH if clear == _PLANARSIM else _caller_engine_hash(folder)
+    new = _sources_hash(folder, engine)
+    _clear_if_changed(folder / "__pycache__" / "numba_sources.hash", new, [clear], True)
+    user = _user_cache_folders(clear, {clear, given})
+    if user:
+        from numba.core import config
+        key = hashlib.blake2b(str(folder).encode(), digest_size=8).hexdigest()
+        stamp = Path(config.CACHE_DIR) / f"planarsim_sources_{folder.name}_{key}.hash"
+        _clear_if_changed(stamp, new, user, False)
+
+
+_COMPILE = Path(os.path.abspath(__file__)).parent     # as imported (a link is not resolved)
+drop_stale_caches(_COMPILE, clear=_COMPILE.parent)

@@ -19,8 +19,9 @@ if MODE != FAST:
 from planarsim.compile import fast  # noqa: E402
 
 
-def _run(code, *args, path=(), cwd=None):
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([*map(str, path), os.getcwd()]))
+def _run(code, *args, path=(), cwd=None, env=None):
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([*map(str, path), os.getcwd()]),
+               **(env or {}))
     out = subprocess.run([sys.executable, "-c", textwrap.dedent(code), *args], capture_output=True,
                          text=True, env=env, cwd=cwd or os.getcwd())
     assert out.returncode == 0, (args, out.returncode, out.stderr[-2000:])
@@ -187,6 +188,33 @@ def test_editing_a_kernel_recompiles_its_cached_callers(tmp_path):
                                   f"def value(x):\n    return x + {k}\n")
         outs.append(_run(code, path=[tmp_path]))
     assert outs == [["2.0", "0"], ["2.0", "1"], ["3.0", "0"]]
+
+
+def test_editing_a_kernel_clears_its_callers_caches_in_numba_cache_dir_too(tmp_path):
+    """With NUMBA_CACHE_DIR set numba keeps the caches there, not next to the sources: b.run
+    (cached) calls a.value, and after a.py changes b's stale machine code must not be loaded
+    from there either (its result would be the old one)."""
+    pkg = tmp_path / "upkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("from planarsim.compiled import drop_stale_caches\n"
+                                     "drop_stale_caches(__path__[0])\n")
+    (pkg / "b.py").write_text(textwrap.dedent("""
+        import numba
+        from .a import value
+
+        @numba.njit(cache=True)
+        def run(x):
+            return value(x)
+    """))
+    code = "from upkg.b import run; print(run(1.0), sum(run.stats.cache_hits.values()))"
+    cache = tmp_path / "numba_cache"
+    outs = []
+    for k in (1, 1, 2):
+        (pkg / "a.py").write_text(f"import numba\n\n@numba.njit(cache=True)\n"
+                                  f"def value(x):\n    return x + {k}\n")
+        outs.append(_run(code, path=[tmp_path], env={"NUMBA_CACHE_DIR": str(cache)}))
+    assert outs == [["2.0", "0"], ["2.0", "1"], ["3.0", "0"]]
+    assert not list(pkg.rglob("*.nbi")) and list(cache.rglob("*.nbi"))   # written there
 
 
 _BRANCHY_IR = r'''
