@@ -13,7 +13,10 @@ Options, for speed only (every choice gives the same numbers):
                              height and closest point, called in hot loops)
     @kernel(inline="always") inlined by numba before typing (the step's own stages)
     @kernel(inline="never")  one copy of its code that callers call: long code that runs
-                             rarely and would otherwise be copied into every caller
+                             rarely, or a stage run a few times a step whose code would
+                             otherwise be copied into each of its callers (build_rows,
+                             eval_rows: a call costs nanoseconds, each copy seconds of the
+                             first-ever compile)
 
 All never allocate and keep the NaN checks that fastmath would drop (fastmath=False).
 Under NUMBA_DISABLE_JIT=1 each returns the function itself (its `py_func` is itself too).

@@ -263,7 +263,7 @@ def contact_gap(m, q, cs, i):
     return best
 
 
-@kernel
+@kernel(inline="never")
 def contact_depth(m, s, ws, i):
     """How far [m] contact i is below the ground, or a shape pair's shapes overlap, at s.q
     (ws.body_cs current); negative: clear by that much."""
@@ -365,7 +365,7 @@ def needs_ground_query(m, s, ws):
     return False
 
 
-@kernel
+@kernel(inline="never")
 def worst_violation(m, s, ws, bounded, rows_held):
     """Largest pin gap and largest depth below the ground [m] of enabled contacts at the
     current configuration (ws.body_cs must match s.q). bounded: skip point contacts that

@@ -79,7 +79,7 @@ def _solve_island(m, ws, k, vars_per_row, floor):
     return status == LCP_SOLVED
 
 
-@kernel
+@kernel(inline="never")
 def _solve_islands(m, ws, n_island, vars_per_row, only_failed):
     """Each island's problem (only those marked in ws.island_failed if only_failed); an island
     without an answer at its own scale is solved again at the largest island's, the scale its

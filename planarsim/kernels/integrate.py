@@ -215,7 +215,7 @@ def rows_hold_within(m, s, ws, h, limit):
     return True
 
 
-@kernel
+@kernel(inline="never")
 def max_residual(m, s, ws):
     """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
     update_trig(s.q, ws.body_cs)

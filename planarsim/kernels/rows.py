@@ -223,7 +223,7 @@ def store_joint_impulse(s, ws, r, lam):
         s.last_rod_impulse[o] = lam
 
 
-@kernel
+@kernel(inline="never")
 def eval_rows(m, q, cs, ws, J, c, n, found):
     """J[r] and c[r] of rows 0..n-1 at configuration q (cs holds its cos / sin; found: see
     eval_row). A pin's x row is always followed by its y row (build_rows), so both come from
@@ -287,7 +287,7 @@ def _later_body(bodies, j):
     return max(bodies[j, 0], bodies[j, 1])
 
 
-@kernel
+@kernel(inline="never")
 def build_rows(m, s, ws):
     """Fill the active rows at the current configuration: J, F (impulse directions) and c;
     return how many are sliding-contact rows (F != J there; none: J W F^T is symmetric).

@@ -79,7 +79,7 @@ def build_and_solve(m, s, ws, opt, h):
     return dropped > 0 or sliding > 0
 
 
-@kernel
+@kernel(inline="never")
 def answer_check(m, s, ws, h, include_ccd, equalities):
     """(rules the last solve's answer breaks (modes.rule_breaks), contacts and limits left
     outside the problem that its velocity would push through, which are engaged now)."""
