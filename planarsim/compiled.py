@@ -80,7 +80,7 @@ COMPILE_RECORD = "first_compile_s.txt"   # in kernel_cache()'s folder: the last 
 # what a first compile takes where none was measured yet [s]: import to a walker's first step
 # with an empty numba cache on a quiet two-core machine (AMD EPYC, numba 0.68;
 # benchmarks/startup.py); a busy machine takes longer
-TYPICAL_COMPILE_S = 36.0
+TYPICAL_COMPILE_S = 33.0
 
 
 def measured_compile():
