@@ -72,7 +72,8 @@ def kernel_cache():
     from pathlib import Path
 
     from . import compile as layer
-    folder = Path(layer.__file__).resolve().parent / "__pycache__"
+    from .compile.caches import cache_folder
+    folder = cache_folder(Path(layer.__file__).parent)     # NUMBA_CACHE_DIR's, where set
     return folder, sorted(folder.glob("*.nbi"))
 
 

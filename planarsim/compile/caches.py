@@ -201,7 +201,15 @@ def _caller_engine_hash(folder: Path) -> str:
                          _sources_hash(kernels, _mode_tag() + others.hexdigest(), inlined))
 
 
-def _user_cache_folders(clear: Path, spellings):
+def cache_folder(source_folder) -> Path:
+    """The folder numba keeps the caches of the source files in `source_folder` in: below
+    NUMBA_CACHE_DIR if set, else its __pycache__."""
+    source_folder = Path(os.path.abspath(source_folder))
+    folders = _user_cache_folders(source_folder, {source_folder}, recursive=False)
+    return folders[0] if folders else source_folder / "__pycache__"
+
+
+def _user_cache_folders(clear: Path, spellings, recursive=True):
     """The folders of NUMBA_CACHE_DIR that hold the caches of the sources below `clear` (none
     when it is not set: numba then writes them in __pycache__ next to the sources). numba
     names each after the source file's folder as Python imported it, which may be a path
@@ -218,7 +226,7 @@ def _user_cache_folders(clear: Path, spellings):
             return f"{os.path.basename(folder)}_{hashlib.sha1(folder.encode()).hexdigest()}"
     root = Path(config.CACHE_DIR)
     folders = set()
-    for source in clear.rglob("*.py"):
+    for source in (clear.rglob("*.py") if recursive else [clear / "__init__.py"]):
         for spelling in spellings:
             folders.add(root / subpath(str(spelling / source.relative_to(clear))))
     return sorted(folders)

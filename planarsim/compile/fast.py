@@ -20,6 +20,7 @@ import os
 import llvmlite.binding as llvm
 from numba import types
 from numba.core import compiler
+from numba.core.caching import FunctionCache, IndexDataCacheFile
 from numba.core.codegen import JITCodeLibrary
 from numba.core.compiler_lock import global_compiler_lock, require_global_compiler_lock
 from numba.core.registry import CPUDispatcher
@@ -101,6 +102,24 @@ def link_step():
         _LINKED.append(True)
 
 
+class FastFunctionCache(FunctionCache):
+    """numba's disk cache of a `jit` function, in files of its own ("<name>-fast.nbi"). On
+    plain numba (PLANARSIM_PLAIN_NUMBA=1) the same function has the same cache key, but its
+    code inlines the step where the fast mode's calls the step's published symbol: a process
+    loading the other mode's code would call an address never published (a crash, seen with
+    both modes run at once on one cache). A switch of mode clears the caches anyway
+    (caches.py); this keeps processes of the two modes apart while they run side by side."""
+
+    def __init__(self, py_func):
+        super().__init__(py_func)
+        try:
+            base, stamp = self._impl.filename_base, self._impl.locator.get_source_stamp()
+        except AttributeError:     # a numba that moved them: its own files (both modes share)
+            return
+        self._cache_file = IndexDataCacheFile(cache_path=self._cache_path,
+                                              filename_base=base + "-fast", source_stamp=stamp)
+
+
 def _caller_decorator(**extra):
     options = dict(_OPTIONS, nopython=True, boundscheck=None, **extra)
     cache = options.pop("cache")
@@ -108,7 +127,7 @@ def _caller_decorator(**extra):
     def decorate(fn):
         dispatcher = CallerDispatcher(py_func=fn, locals={}, targetoptions=dict(options))
         if cache:
-            dispatcher.enable_caching()
+            dispatcher._cache = FastFunctionCache(fn)
         return dispatcher
     return decorate
 

@@ -19,6 +19,7 @@ NEEDED = {
                           "JITCodeLibrary.get_pointer_to_function JITCodeLibrary.codegen "
                           "JITCodeLibrary._raise_if_finalized JITCodeLibrary._get_module_for_linking "
                           "JITCPUCodegen.set_env",
+    "numba.core.caching": "FunctionCache IndexDataCacheFile",
     "numba.core.compiler": "Compiler.compile_extra",
     "numba.core.compiler_lock": "require_global_compiler_lock global_compiler_lock",
     "numba.core.registry": "CPUDispatcher CPUDispatcher.compile CPUDispatcher.enable_caching "

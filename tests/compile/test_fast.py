@@ -329,3 +329,31 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
     (other / "d.py").write_text("from planarsim.half_step import kick\n")
     kernels, files = caller_sources(other)
     assert "forces" in kernels and files == {actuators.parent / "half_step.py"}
+
+
+def test_jit_functions_cache_in_files_of_their_own_which_plain_numba_never_loads():
+    """The fast mode's compiled callers reach the step by a published symbol; plain numba's
+    inline it. Their cache keys are the same, so the fast mode names its files apart: a
+    process of either mode never loads the other's machine code."""
+    import numba
+
+    from walkers.simple_biped.rollout import rollout_simple_biped
+    fast = rollout_simple_biped._cache._cache_file._index_name
+    plain = numba.njit(cache=True)(rollout_simple_biped.py_func)._cache._cache_file._index_name
+    assert fast.endswith("-fast.nbi") and not plain.endswith("-fast.nbi")
+    assert fast.replace("-fast.nbi", ".nbi") == plain
+
+
+def test_the_kernels_cache_folder_is_numbas_own_with_numba_cache_dir_set(tmp_path, monkeypatch):
+    """planarsim.compiled.kernel_cache (the first-run message reads it) and the stale-cache
+    clearing look where numba writes: NUMBA_CACHE_DIR's folder for the step's source, if set."""
+    from numba.core import caching, config
+
+    from planarsim.compile import fast_step
+    from planarsim.compile.caches import cache_folder
+    source = Path(fast_step.__file__)
+    if not config.CACHE_DIR:
+        assert cache_folder(source.parent) == Path(os.path.abspath(source.parent)) / "__pycache__"
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path))
+    numbas = caching.UserProvidedCacheLocator(fast_step._step_c, str(source)).get_cache_path()
+    assert cache_folder(source.parent) == Path(numbas)
