@@ -53,9 +53,7 @@ def _compile_note() -> str:
 def _say_if_compiling() -> bool:
     """Before the first simulation on a cold cache: a note on stderr (the engine compiles
     once, and what that took here last time); True when the cache is cold."""
-    if "NUMBA_CACHE_DIR" in os.environ:
-        return False
-    from planarsim.compiled import kernel_cache
+    from planarsim.compiled import kernel_cache     # (NUMBA_CACHE_DIR's, where set)
     if kernel_cache()[1]:
         return False
     print(f"compiling the engine (first run only; {_compile_note()})", file=sys.stderr, flush=True)

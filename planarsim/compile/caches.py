@@ -255,9 +255,10 @@ def drop_stale_caches(folder, clear=None) -> None:
     or the engine sources its compiled code is built from changed since the caches were
     written (the module's docstring; nothing under NUMBA_DISABLE_JIT=1, which neither reads
     nor writes them). With NUMBA_CACHE_DIR set, numba keeps those caches there instead, one
-    folder per source folder: those are cleared by a stamp of their own in NUMBA_CACHE_DIR
-    (numba checks each function against its own file only, so without this a kernel's edit,
-    or a new planarsim release, would run the step's stale machine code from there).
+    folder per source folder and per path it was imported by: each such folder (for the
+    resolved path and the one given) holds a stamp of its own (numba checks each function
+    against its own file only, so without this a kernel's edit, or a new planarsim release,
+    would run the step's stale machine code from there).
 
     Walker packages call this on import with their own folder, since their rollouts inline
     their controller files and the engine kernels they import.
@@ -270,12 +271,10 @@ def drop_stale_caches(folder, clear=None) -> None:
     engine = ENGINE_HASH if clear == _PLANARSIM else _caller_engine_hash(folder)
     new = _sources_hash(folder, engine)
     _clear_if_changed(folder / "__pycache__" / "numba_sources.hash", new, [clear], True)
-    user = _user_cache_folders(clear, {clear, given})
-    if user:
-        from numba.core import config
-        key = hashlib.blake2b(str(folder).encode(), digest_size=8).hexdigest()
-        stamp = Path(config.CACHE_DIR) / f"planarsim_sources_{folder.name}_{key}.hash"
-        _clear_if_changed(stamp, new, user, False)
+    # one stamp in each of NUMBA_CACHE_DIR's folders: a folder is named after the path the
+    # sources were imported by, so each keeps its own record of the sources its code is of
+    for cache in _user_cache_folders(clear, {clear, given}):
+        _clear_if_changed(cache / "planarsim_sources.hash", new, [cache], False)
 
 
 _COMPILE = Path(os.path.abspath(__file__)).parent     # as imported (a link is not resolved)
