@@ -19,6 +19,7 @@ import functools
 import hashlib
 import os
 import re
+import tempfile
 from pathlib import Path
 
 from .mode import FAST, MODE, PYTHON
@@ -203,20 +204,45 @@ def _caller_engine_hash(folder: Path) -> str:
 
 def cache_folder(source_folder) -> Path:
     """The folder numba keeps the caches of the source files in `source_folder` in: below
-    NUMBA_CACHE_DIR if set, else its __pycache__."""
+    NUMBA_CACHE_DIR if set, else its __pycache__ (numba's user-wide cache folder where that
+    cannot be written)."""
     source_folder = Path(os.path.abspath(source_folder))
     folders = _user_cache_folders(source_folder, {source_folder}, recursive=False)
     return folders[0] if folders else source_folder / "__pycache__"
 
 
-def _user_cache_folders(clear: Path, spellings, recursive=True):
-    """The folders of NUMBA_CACHE_DIR that hold the caches of the sources below `clear` (none
-    when it is not set: numba then writes them in __pycache__ next to the sources). numba
-    names each after the source file's folder as Python imported it, which may be a path
-    through a link: `spellings` are the paths `clear` may be reached by."""
+def _in_tree_writable(source_dir: Path) -> bool:
+    """numba's own test of whether it caches in source_dir's __pycache__ (InTreeCacheLocator)."""
+    try:
+        os.makedirs(source_dir / "__pycache__", exist_ok=True)
+        tempfile.TemporaryFile(dir=source_dir / "__pycache__").close()
+        return True
+    except OSError:
+        return False
+
+
+def _outside_root(source_dir: Path):
+    """Where numba caches the functions of source_dir's files when not in its __pycache__:
+    NUMBA_CACHE_DIR if set, numba's user-wide cache folder (~/.cache/numba) if __pycache__
+    cannot be written (a read-only install), else None."""
     from numba.core import config
-    if not config.CACHE_DIR:
-        return []
+    if config.CACHE_DIR:
+        return Path(config.CACHE_DIR)
+    if _in_tree_writable(source_dir):
+        return None
+    try:
+        from numba.misc.appdirs import AppDirs
+        return Path(AppDirs(appname="numba", appauthor=False).user_cache_dir)
+    except Exception:     # a numba without it caches nowhere else planarsim knows of
+        return None
+
+
+def _user_cache_folders(clear: Path, spellings, recursive=True):
+    """The folders outside the source tree (NUMBA_CACHE_DIR's, or the user-wide ones of a
+    read-only install: _outside_root) that hold numba's caches of the sources below `clear`;
+    none where numba writes them in __pycache__ next to the sources. numba names each after
+    the source file's folder as Python imported it, which may be a path through a link:
+    `spellings` are the paths `clear` may be reached by."""
     try:
         from numba.core.caching import _CacheLocator
         subpath = _CacheLocator.get_suitable_cache_subpath
@@ -224,9 +250,13 @@ def _user_cache_folders(clear: Path, spellings, recursive=True):
         def subpath(py_file):
             folder = os.path.dirname(os.path.abspath(py_file))
             return f"{os.path.basename(folder)}_{hashlib.sha1(folder.encode()).hexdigest()}"
-    root = Path(config.CACHE_DIR)
-    folders = set()
+    roots, folders = {}, set()
     for source in (clear.rglob("*.py") if recursive else [clear / "__init__.py"]):
+        if source.parent not in roots:
+            roots[source.parent] = _outside_root(source.parent)
+        root = roots[source.parent]
+        if root is None:
+            continue
         for spelling in spellings:
             folders.add(root / subpath(str(spelling / source.relative_to(clear))))
     return sorted(folders)
@@ -254,8 +284,9 @@ def drop_stale_caches(folder, clear=None) -> None:
     """Clear the numba caches below `clear` (default `folder`) when the sources of `folder`
     or the engine sources its compiled code is built from changed since the caches were
     written (the module's docstring; nothing under NUMBA_DISABLE_JIT=1, which neither reads
-    nor writes them). With NUMBA_CACHE_DIR set, numba keeps those caches there instead, one
-    folder per source folder and per path it was imported by: each such folder (for the
+    nor writes them). With NUMBA_CACHE_DIR set (or, for a read-only install, in its user-wide
+    cache folder) numba keeps those caches there instead, one folder per source folder and
+    per path it was imported by: each such folder (for the
     resolved path and the one given) holds a stamp of its own (numba checks each function
     against its own file only, so without this a kernel's edit, or a new planarsim release,
     would run the step's stale machine code from there).

@@ -357,3 +357,33 @@ def test_the_kernels_cache_folder_is_numbas_own_with_numba_cache_dir_set(tmp_pat
     monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path))
     numbas = caching.UserProvidedCacheLocator(fast_step._step_c, str(source)).get_cache_path()
     assert cache_folder(source.parent) == Path(numbas)
+
+
+def test_a_read_only_installs_stale_caches_in_numbas_user_wide_folder_are_cleared(tmp_path,
+                                                                                    monkeypatch):
+    """A read-only install: numba cannot write __pycache__ next to the sources and caches in
+    its user-wide folder (~/.cache/numba); drop_stale_caches clears stale caches there too,
+    after a change of the sources only."""
+    from numba.core import caching, config
+
+    from planarsim.compile import caches
+    monkeypatch.setattr(config, "CACHE_DIR", "")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user_cache"))
+    monkeypatch.setattr(caches, "_in_tree_writable", lambda folder: False)
+    pkg = tmp_path / "ropkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    source = pkg / "a.py"
+    source.write_text("def f(x):\n    return x\n")
+    namespace = {}
+    exec(compile(source.read_text(), str(source), "exec"), namespace)
+    numbas = Path(caching.UserWideCacheLocator(namespace["f"], str(source)).get_cache_path())
+    assert caches.cache_folder(pkg) == numbas
+    caches.drop_stale_caches(pkg)
+    stale = numbas / "a.f-1.py311.nbi"
+    stale.write_text("machine code of the sources as they were")
+    caches.drop_stale_caches(pkg)            # the same sources: kept
+    assert stale.exists()
+    source.write_text("def f(x):\n    return x + 1\n")
+    caches.drop_stale_caches(pkg)            # changed: cleared
+    assert not stale.exists()
