@@ -79,10 +79,12 @@ oscillation the energy target bounds over the run); tunnel (hills_fast) above DE
 beyond rod_sag for a point on a rod; speed (stiff_motors). A run the engine stops with an
 error of its own (planarsim's SimulationDiverged or any planarsim error, naming why) is
 "raised"; a run missing a target without one is "silent" (an audit count alone is silent:
-nothing stopped the run). The summary gives both per family, the silent misses by cause and the audit counts by rule.
+nothing stopped the run). The summary gives both per family, the silent misses by cause and
+the audit counts by rule.
 
-Seed k runs at dt = DTS[k % 5] (1e-4 ... 1e-2 s) unless its family says otherwise. A run simulates SECONDS[family] (or --seconds) but at most
-MAX_STEPS steps, so runs at small dt cover less time. Every run is recorded at every step and
+Seed k runs at dt = DTS[k % 5] (1e-4 ... 1e-2 s) unless its family says otherwise. A run
+simulates SECONDS[family] (or --seconds) but at most MAX_STEPS steps, so runs at small dt
+cover less time. Every run is recorded at every step and
 judged on each end-of-step state (and the start):
 
 - energy gained: max over the run of E(t) - E0, E = kinetic + gravitational potential

@@ -212,7 +212,11 @@ def cache_folder(source_folder) -> Path:
 
 
 def _in_tree_writable(source_dir: Path) -> bool:
-    """numba's own test of whether it caches in source_dir's __pycache__ (InTreeCacheLocator)."""
+    """Whether numba caches in source_dir's __pycache__ (InTreeCacheLocator): an existing
+    writable folder answers at once; else numba's own test (make it, write a file)."""
+    pycache = source_dir / "__pycache__"
+    if pycache.is_dir() and os.access(pycache, os.W_OK):
+        return True
     try:
         os.makedirs(source_dir / "__pycache__", exist_ok=True)
         tempfile.TemporaryFile(dir=source_dir / "__pycache__").close()
