@@ -8,8 +8,8 @@ for pdb). All three give the same numbers. The step's linkage is link.py; caches
 numba caches whose engine sources changed.
 """
 from .mode import FAST, MODE, PLAIN, PYTHON, TABLES
-from .decorators import jit, jit_inline, kernel, options, register
+from .decorators import jit, jit_inline, kernel, options, part, register
 from .caches import drop_stale_caches
 
-__all__ = ["MODE", "FAST", "PLAIN", "PYTHON", "TABLES", "jit", "jit_inline", "kernel", "register", "options",
+__all__ = ["MODE", "FAST", "PLAIN", "PYTHON", "TABLES", "jit", "jit_inline", "kernel", "part", "register", "options",
            "drop_stale_caches"]

@@ -17,6 +17,9 @@ Options, for speed only (every choice gives the same numbers):
                              otherwise be copied into each of its callers (build_rows,
                              eval_rows: a call costs nanoseconds, each copy seconds of the
                              first-ever compile)
+    @part(types...)          a kernel(inline="never") compiled as a C function of its own that
+                             callers call by address (fast mode: compiled beside the step on a
+                             first-ever start; compile/parts.py)
 
 All never allocate and keep the NaN checks that fastmath would drop (fastmath=False).
 Under NUMBA_DISABLE_JIT=1 each returns the function itself (its `py_func` is itself too).
@@ -76,6 +79,20 @@ def kernel(fn=None, *, inline="force"):
     """Compile `fn` for compiled callers only (see the module's docstring); use as ``@kernel``,
     ``@kernel(inline="always")`` or ``@kernel(inline="never")``."""
     return _decorator("kernel", _KERNEL_INLINE, fn, inline)
+
+
+def part(*args, returns=None):
+    """A kernel compiled on its own and called by address (compile/parts.py). args: the type of
+    each argument, "model", "state", "workspace", "options" or a numba scalar type's name
+    ("float64", "int64", "boolean"); returns: a scalar type's name, or None. Elsewhere than
+    the fast mode, kernel(inline="never")."""
+    def decorate(fn):
+        dispatcher = kernel(fn, inline="never")
+        if MODE != FAST:
+            return dispatcher
+        from . import parts
+        return parts.register(fn, dispatcher, args, returns)
+    return decorate
 
 
 def register(cls=None, *, readonly=False):

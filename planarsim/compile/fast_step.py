@@ -22,7 +22,7 @@ import hashlib
 
 import llvmlite.binding as ll
 from llvmlite import ir
-from numba import cfunc, types
+from numba import types
 from numba.core import cgutils
 from numba.core.compiler_lock import global_compiler_lock
 from numba.extending import intrinsic
@@ -30,9 +30,9 @@ from numba.extending import intrinsic
 from ..kernels.guards import GUARD_BAD_COMMANDS, check_commands
 from ..kernels.info import INFO_COMMAND
 from ..kernels.step import _step
-from . import refs
+from . import parts, refs
 from .engine import check_step_types, samples
-from .fast import KERNEL_OPTIONS, code_layout
+from .fast import code_layout
 
 _ENGINE = {}
 _LOADING = []     # this thread is compiling the step (see load_step)
@@ -71,15 +71,35 @@ def load_step():
         if "cfunc" not in _ENGINE and not _LOADING:
             _LOADING.append(True)
             try:
-                sig = types.int64(*engine_types(), types.CPointer(types.float64), types.int64)
-                with code_layout():
-                    entry = cfunc(sig, cache=True, **KERNEL_OPTIONS)(_step_c)
+                entry = _load_or_compile()
                 ll.add_symbol(_ENGINE["symbol"], entry.address)
                 _ENGINE["cfunc"] = entry
             finally:
                 _LOADING.clear()
     engine_types()
     return _ENGINE["symbol"]
+
+
+def _load_or_compile():
+    """The step's C function, its parts (compile/parts.py) loaded and their table filled: from
+    numba's cache, or compiled, the parts in a child process while this one compiles the rest
+    of the step when both are missing."""
+    missing = parts.missing_parts()       # (publishes the parts' table first)
+    entry = parts.new_cfunc(_step_c, (*engine_types(), types.CPointer(types.float64), types.int64),
+                            types.int64)
+    if parts.load_cached(entry):
+        with code_layout():
+            parts.finish(missing, None)
+        return entry
+    child = parts.start_child(missing)
+    try:
+        with code_layout():
+            entry.compile()
+            parts.finish(missing, child)
+    except BaseException:
+        parts.stop_child(child)
+        raise
+    return entry
 
 
 @intrinsic

@@ -19,7 +19,7 @@ dq / h (as the Newton correction does); contact corrections move positions only.
 """
 import math
 
-from ..compile import kernel
+from ..compile import kernel, part
 from .audit import AUDIT_FALLBACK, AUDIT_UNSOLVED, note
 from .info import INFO_LCP_PIVOTS, INFO_LCP_SOLVES, INFO_PROJECTIONS
 from .codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
@@ -176,7 +176,7 @@ def _lcp_once(m, s, ws, h):
     return solved
 
 
-@kernel(inline="never")
+@part("model", "state", "workspace", "float64", "boolean")
 def solve_contacts(m, s, ws, h, include_ccd):
     """The velocity stage as one complementarity problem (see the module's docstring)."""
     for attempt in range(m.contact_body.shape[0] + 2 * m.pin_body.shape[0] + 1):
@@ -259,7 +259,7 @@ def _largest_error(ws, n):
     return worst
 
 
-@kernel(inline="never")
+@part("model", "state", "workspace", "float64", "int64", "float64", returns="float64")
 def project_positions(m, s, ws, h, iters, tol):
     """Project the configuration onto closed joints and contacts not below the ground (see
     the module's docstring). Returns the largest remaining error [m or rad]. A move that

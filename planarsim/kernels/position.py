@@ -11,7 +11,7 @@ position_stage(m, s, ws, opt, h, answered):
   5. bound_correction_work: the velocity change of a correction or projection kept only as
      far as it adds no energy beyond its allowance (audited: correction_work).
 """
-from ..compile import kernel
+from ..compile import kernel, part
 from .audit import (AUDIT_CORRECTION_WORK, DEPTH_TOL, PIN_GAP_TOL, audit_positions,
                     mark_held_contacts, needs_ground_query, note, worst_violation)
 from .complementarity import project_positions
@@ -47,7 +47,7 @@ def settle_positions(m, s, ws, h, opt, rows_held):
     return _settle_measured(m, s, ws, h, opt, rows_held)
 
 
-@kernel(inline="never")
+@part("model", "state", "workspace", "float64", "options", "boolean", returns="int64")
 def _settle_measured(m, s, ws, h, opt, rows_held):
     """settle_positions where the ground must be asked (rows_held: contact_held is marked)."""
     update_trig(s.q, ws.body_cs)

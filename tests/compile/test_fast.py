@@ -141,8 +141,9 @@ def test_threads_first_calling_cached_rollouts_wait_for_the_step():
 def test_a_cold_cache_compiles_the_step_for_a_plain_njit_caller_first(tmp_path):
     """A first-ever process (an empty numba cache) whose first compiled code is a plain
     numba.njit function calling the step: typing it compiles and publishes the step, whose
-    own compile goes through jit dispatchers (terrain) that must not start it again. A
-    walker's rollout then runs in the same process. About half a minute: a full compile."""
+    own compile goes through jit dispatchers (terrain) that must not start it again, while a
+    child process compiles the step's parts. A walker's rollout then runs in the same
+    process. About half a minute: a full compile."""
     code = textwrap.dedent("""
         import numpy as np
         from numba import njit
@@ -159,11 +160,18 @@ def test_a_cold_cache_compiles_the_step_for_a_plain_njit_caller_first(tmp_path):
         s, ws = ps.make_state(model), make_workspace(model)
         print("step", one(model.arrays, s, ws, ps.StepOptions(), np.zeros(0)))
         print("fell", walkers.load("rimless-wheel").simulate(0.5)[1]["fell"])
+        from planarsim.compile.parts import all_parts
+        print("parts from the child", [p.cfunc.cache_hits for p in all_parts()])
     """)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("PLANARSIM_COMPILE_CHILD", None)
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, env=env)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "step 0" in done.stdout and "fell False" in done.stdout
+    # the step's parts were compiled in a child process (compile/parts.py), which cached them
+    # for this one to load
+    from planarsim.compile.parts import PART_NAMES
+    assert f"parts from the child {[1] * len(PART_NAMES)}" in done.stdout, done.stdout
 
 
 def test_editing_a_kernel_recompiles_its_cached_callers(tmp_path):
