@@ -38,11 +38,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 def _compiled_functions(dispatchers):
     """{address: symbol} of every function in the libraries of the dispatchers' overloads."""
     from planarsim.compile.link import _ENGINE, load_step
-    from planarsim.compile.parts import all_parts
+    from planarsim.compile.parts import PARTS
     load_step()
     libraries = [cres.library for disp in dispatchers for cres in disp.overloads.values()]
     libraries.append(_ENGINE["cfunc"]._library)   # the step: called by address, not linked
-    libraries += [p.cfunc._library for p in all_parts()]   # its parts (compile/parts.py), too
+    libraries.append(PARTS.cfunc._library)   # its parts (compile/parts.py), too
     out = {}
     for library in libraries:
         engine = library._codegen._engine

@@ -26,7 +26,7 @@ PAIR_MARGIN) skips the narrow phase. Which pairs are tested at all is the sweep'
 """
 import math
 
-from ..compile import kernel
+from ..compile import kernel, part
 from .codes import CONTACT_PAIR, MODE_FREE
 from .collide import collide
 from .math2d import rotate, set_dir, world_point
@@ -181,7 +181,7 @@ def clear_slot(s, ws, c):
     s.last_contact_impulse[c, 1] = 0.0
 
 
-@kernel(inline="never")
+@part("model", "state", "workspace", "int64", "float64", "float64", "boolean")
 def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
     """Stage 3 for the pair whose slot 0 is contact i, at s.q (ws.body_cs current, the
     shapes placed there: place_shapes): the

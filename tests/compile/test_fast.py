@@ -160,8 +160,8 @@ def test_a_cold_cache_compiles_the_step_for_a_plain_njit_caller_first(tmp_path):
         s, ws = ps.make_state(model), make_workspace(model)
         print("step", one(model.arrays, s, ws, ps.StepOptions(), np.zeros(0)))
         print("fell", walkers.load("rimless-wheel").simulate(0.5)[1]["fell"])
-        from planarsim.compile.parts import all_parts
-        print("parts from the child", [p.cfunc.cache_hits for p in all_parts()])
+        from planarsim.compile.parts import PARTS
+        print("parts from the child", PARTS.cfunc.cache_hits)
     """)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     env.pop("PLANARSIM_COMPILE_CHILD", None)
@@ -170,8 +170,7 @@ def test_a_cold_cache_compiles_the_step_for_a_plain_njit_caller_first(tmp_path):
     assert "step 0" in done.stdout and "fell False" in done.stdout
     # the step's parts were compiled in a child process (compile/parts.py), which cached them
     # for this one to load
-    from planarsim.compile.parts import PART_NAMES
-    assert f"parts from the child {[1] * len(PART_NAMES)}" in done.stdout, done.stdout
+    assert "parts from the child 1" in done.stdout, done.stdout
 
 
 def test_editing_a_kernel_recompiles_its_cached_callers(tmp_path):

@@ -26,13 +26,25 @@ def _stepped():
     return sim
 
 
-def test_every_part_is_loaded_into_its_slot_before_the_step_runs():
+def test_the_parts_are_loaded_into_the_table_before_the_step_runs():
     _stepped()
-    loaded = parts.all_parts()
-    assert [p.name for p in loaded] == list(parts.PART_NAMES)
-    for p in loaded:
-        assert p.cfunc is not None and p.cfunc.address != 0
-        assert parts._TABLE[p.index] == p.cfunc.address, p.name
+    assert [p.name for p in parts.all_parts()] == list(parts.PART_NAMES)
+    assert parts.PARTS.cfunc is not None and parts.PARTS.cfunc.address != 0
+    assert parts._TABLE[0] == parts.PARTS.cfunc.address
+
+
+def test_each_part_takes_its_arguments_in_slots_of_their_kind():
+    width = parts.slot_counts()
+    first = {"float64": 4, "int64": 4 + width["float64"],
+             "boolean": 4 + width["float64"] + width["int64"]}
+    for p in parts.all_parts():
+        slots = p.slots()
+        assert len(set(slots)) == len(slots), p.name
+        for a, k in zip(p.args, slots):
+            if a in ("model", "state", "workspace", "options"):
+                assert k == ("model", "state", "workspace", "options").index(a)
+            else:
+                assert first[a] <= k < first[a] + width[a], (p.name, a, k)
 
 
 def test_a_part_called_with_a_wrong_argument_is_named_when_its_caller_is_typed():
@@ -59,8 +71,8 @@ def test_a_part_needs_a_slot_and_engine_or_scalar_argument_types():
         part("model", "array")(solve_contacts)
 
 
-class _FakePart:
-    """A part whose cache holds it after the child ran (cached=True) or never (False)."""
+class _FakeParts:
+    """Parts whose cache holds them after the child ran (cached=True) or never (False)."""
 
     def __init__(self, cached):
         self.cached, self.compiled = cached, False
@@ -76,29 +88,30 @@ def _child(code):
     return subprocess.Popen([sys.executable, "-c", code])
 
 
-def test_a_failed_child_leaves_its_parts_to_this_process_and_a_finished_one_to_the_cache():
-    failed = [_FakePart(False), _FakePart(False)]
+def test_a_failed_child_leaves_the_parts_to_this_process_and_a_finished_one_to_the_cache():
+    failed = _FakeParts(False)
     parts.finish(failed, _child("raise SystemExit(3)"))
-    assert all(p.compiled for p in failed)
-    done = [_FakePart(True)]
+    assert failed.compiled
+    done = _FakeParts(True)
     parts.finish(done, _child("pass"))
-    assert not done[0].compiled
-    alone = [_FakePart(True)]
-    parts.finish(alone, None)        # no child: nothing could have cached it since
-    assert alone[0].compiled
+    assert not done.compiled
+    alone = _FakeParts(True)
+    parts.finish(alone, None)        # no child: nothing could have cached them since
+    assert alone.compiled
+    parts.finish(None, None)         # nothing to do
 
 
 def test_a_stuck_child_is_stopped_and_the_parts_it_left_are_compiled_here(monkeypatch):
     monkeypatch.setattr(parts, "CHILD_TIMEOUT", 0.5)
-    stuck = [_FakePart(False)]
+    stuck = _FakeParts(False)
     child = _child("import time; time.sleep(60)")
     parts.finish(stuck, child)
-    assert child.poll() is not None and stuck[0].compiled
+    assert child.poll() is not None and stuck.compiled
 
 
 def test_no_child_is_started_when_switched_off_or_frozen_or_with_nothing_to_do(monkeypatch):
-    some = parts.all_parts()[:1]
-    assert parts.start_child([]) is None
+    some = parts.PARTS
+    assert parts.start_child(None) is None
     monkeypatch.setenv(parts.CHILD_SWITCH, "0")
     assert parts.start_child(some) is None
     monkeypatch.delenv(parts.CHILD_SWITCH)

@@ -135,9 +135,8 @@ def test_a_second_process_loads_the_step_kernel_from_the_cache():
             print(sum(kernel.stats.cache_hits.values()), sum(kernel.stats.cache_misses.values()))
         step = _ENGINE["cfunc"]   # the step itself, a C function every caller calls
         print(step.cache_hits, 0 if step.cache_hits else 1)
-        from planarsim.compile.parts import all_parts   # and its parts (C functions too)
-        for p in all_parts():
-            print(p.cfunc.cache_hits, 0 if p.cfunc.cache_hits else 1)
+        from planarsim.compile.parts import PARTS   # and its parts (a C function too)
+        print(PARTS.cfunc.cache_hits, 0 if PARTS.cfunc.cache_hits else 1)
     """)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     for line in out.stdout.strip().splitlines():
