@@ -79,9 +79,9 @@ def kernel_cache():
 
 COMPILE_RECORD = "first_compile_s.txt"   # in kernel_cache()'s folder: the last first compile [s]
 # what a first compile takes where none was measured yet [s]: import to a walker's first step
-# with an empty numba cache on a quiet two-core machine (AMD EPYC, numba 0.68;
-# benchmarks/startup.py); a busy machine takes longer
-TYPICAL_COMPILE_S = 33.0
+# with an empty numba cache on a quiet two-core machine, both cores compiling (AMD EPYC,
+# numba 0.68; benchmarks/startup.py); a busy machine takes longer
+TYPICAL_COMPILE_S = 20.0
 
 
 def measured_compile():

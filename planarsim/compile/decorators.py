@@ -1,4 +1,4 @@
-"""The three decorators of planarsim's compiled code, the same in every mode (compile/mode.py).
+"""The four decorators of planarsim's compiled code, the same in every mode (compile/mode.py).
 
     @jit                     compiled, callable from Python and from compiled code; its machine
                              code is cached on disk (rollouts, run_recorded, terrain queries)
