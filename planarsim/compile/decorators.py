@@ -83,8 +83,8 @@ def kernel(fn=None, *, inline="force"):
 
 def part(*args, returns=None):
     """A kernel compiled on its own and called by address (compile/parts.py). args: the type of
-    each argument, "model", "state", "workspace", "options" or a numba scalar type's name
-    ("float64", "int64", "boolean"); returns: a scalar type's name, or None. Elsewhere than
+    each argument, "model", "state", "workspace", "options", "float64", "int64" or "boolean";
+    returns: "float64", "int64", or None. Elsewhere than
     the fast mode, kernel(inline="never")."""
     def decorate(fn):
         dispatcher = kernel(fn, inline="never")

@@ -20,6 +20,7 @@ NEEDED = {
                           "JITCodeLibrary._raise_if_finalized JITCodeLibrary._get_module_for_linking "
                           "JITCPUCodegen.set_env",
     "numba.core.caching": "FunctionCache IndexDataCacheFile",
+    "numba.core.ccallback": "CFunc CFunc.compile CFunc.enable_caching CFunc._targetdescr",  # parts.py
     "numba.core.compiler": "Compiler.compile_extra",
     "numba.core.compiler_lock": "require_global_compiler_lock global_compiler_lock",
     "numba.core.registry": "CPUDispatcher CPUDispatcher.compile CPUDispatcher.enable_caching "

@@ -113,7 +113,8 @@ class Parts:
         that numba caches it)."""
         if self._wrapper is None:
             width = slot_counts()
-            names = ["m", "s", "ws", "opt"] + [f"{x[0]}{k}" for x in _SCALARS for k in range(width[x])]
+            names = ["m", "s", "ws", "opt"] + [f"{x[0]}{k}" for x in _SCALARS
+                                               for k in range(width[x])]
             lines = [f"def parts_c(which, {', '.join(names)}):"]
             space = {"__name__": __name__}
             for p in all_parts():
@@ -160,14 +161,18 @@ def new_cfunc(pyfunc, args, ret):
 
 def load_cached(c) -> bool:
     """Load C function c (new_cfunc) from numba's cache, as its compile() does on a hit;
-    False, and nothing compiled, on a miss."""
-    cres = c._cache.load_overload(c._sig, c._targetdescr.target_context)
-    if cres is None:
+    False, and nothing compiled, on a miss (or where a numba release moved the attributes
+    used: compile() then loads or compiles it)."""
+    try:
+        cres = c._cache.load_overload(c._sig, c._targetdescr.target_context)
+        if cres is None:
+            return False
+        c._cache_hits += 1
+        c._library = cres.library
+        c._wrapper_name = cres.fndesc.llvm_cfunc_wrapper_name
+        c._wrapper_address = c._library.get_pointer_to_function(c._wrapper_name)
+    except AttributeError:
         return False
-    c._cache_hits += 1
-    c._library = cres.library
-    c._wrapper_name = cres.fndesc.llvm_cfunc_wrapper_name
-    c._wrapper_address = c._library.get_pointer_to_function(c._wrapper_name)
     return True
 
 
@@ -218,8 +223,8 @@ def _caller(p: Part):
         return ret(*given), codegen
 
     space = {"typer": typer}
-    exec(f"def call(typingctx, {', '.join(names)}):\n    return typer(typingctx, {', '.join(names)})\n",
-         space)
+    listed = ", ".join(names)
+    exec(f"def call(typingctx, {listed}):\n    return typer(typingctx, {listed})\n", space)
     call = space["call"]
     call.__name__ = call.__qualname__ = p.name.rsplit(".", 1)[-1]
     return intrinsic(call)
@@ -232,9 +237,11 @@ def register(fn, dispatcher, args, returns):
     if name not in PART_NAMES:
         raise ValueError(f"part {name} has no slot: add it to compile/parts.py PART_NAMES")
     for a in args:
-        if a not in _ENGINE_ARGS and not isinstance(getattr(types, a, None), (types.Number, types.Boolean)):
-            raise ValueError(f"part {name}: argument type {a!r} is not an engine table or a "
-                             "numba scalar type's name")
+        if a not in _ENGINE_ARGS + _SCALARS:
+            raise ValueError(f"part {name}: argument type {a!r} is none of "
+                             f"{', '.join(_ENGINE_ARGS + _SCALARS)}")
+    if returns not in (None, "float64", "int64"):
+        raise ValueError(f"part {name}: returns {returns!r}; a part returns float64, int64 or None")
     p = Part(name, dispatcher, args, returns)
     _PARTS[name] = p
     caller = _caller(p)

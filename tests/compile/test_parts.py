@@ -69,6 +69,8 @@ def test_a_part_needs_a_slot_and_engine_or_scalar_argument_types():
     solve_contacts.__qualname__ = "solve_contacts"
     with pytest.raises(ValueError, match="'array'"):
         part("model", "array")(solve_contacts)
+    with pytest.raises(ValueError, match="returns 'boolean'"):
+        part("model", "float64", returns="boolean")(solve_contacts)
 
 
 class _FakeParts:
