@@ -5,8 +5,9 @@ file edited (a comment line appended), then the same first steps timed again.
     python -m benchmarks.recompile planarsim/kernels/lcp.py          # your own choice of files
 
 For each edit it prints the time to the first steps (a 2-link chain, then each walker named in
-WALKERS) and the cached compiled functions that compiled again (the engine's step and the `jit`
-functions: rollouts, run_steps, ...), next to the kernels compiled for them. It works on a
+WALKERS) and the cached compiled functions that compiled again (the engine's step, its parts'
+C function, compiled in a child process, and the `jit` functions: rollouts, run_steps, ...),
+next to the kernels compiled for them (in this process). It works on a
 temporary copy (the sources here and their caches are left alone); each edit starts from the
 warm copy.
 """
@@ -51,6 +52,9 @@ import planarsim as ps
 from benchmarks.scenes import chain
 ps.Simulator(chain(2)).step()
 times = {"engine": time.perf_counter() - t0}
+from planarsim.compile.parts import PARTS
+if PARTS.missed:     # compiled in a child process (or here, where none could help)
+    compiled.append(["planarsim.compile.parts.parts_c", "cfunc"])
 import importlib
 for name in sys.argv[1:]:
     importlib.import_module("walkers." + name).simulate(0.001)

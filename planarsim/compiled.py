@@ -74,7 +74,8 @@ def kernel_cache():
     from . import compile as layer
     from .compile.caches import cache_folder
     folder = cache_folder(Path(layer.__file__).parent)     # NUMBA_CACHE_DIR's, where set
-    return folder, sorted(folder.glob("*.nbi"))
+    # (not the step's parts, which a child process caches while the step still compiles)
+    return folder, sorted(f for f in folder.glob("*.nbi") if not f.name.startswith("parts."))
 
 
 COMPILE_RECORD = "first_compile_s.txt"   # in kernel_cache()'s folder: the last first compile [s]

@@ -47,6 +47,7 @@ def _mode_tag() -> str:
 ENGINE_HASH = _sources_hash(_PLANARSIM / "compile",
                             _sources_hash(_PLANARSIM / "kernels", _mode_tag()))
 _KERNELS = "planarsim.kernels"
+_CHILD_HASH = "PLANARSIM_CHILD_ENGINE_HASH"     # parts.py: the hash its parent compiles from
 
 
 def _imported_modules(path: Path):
@@ -127,7 +128,7 @@ def _exported_kernels(names=None) -> set:
 
 def _has_compiled_code(path: Path) -> bool:
     text = path.read_text()
-    return "@jit" in text or "@kernel" in text
+    return "@jit" in text or "@kernel" in text or "@part" in text
 
 
 def caller_sources(folder) -> tuple:
@@ -298,8 +299,8 @@ def drop_stale_caches(folder, clear=None) -> None:
     Walker packages call this on import with their own folder, since their rollouts inline
     their controller files and the engine kernels they import.
     """
-    if MODE == PYTHON:
-        return
+    if MODE == PYTHON or os.environ.get(_CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
+        return   # (a child compiling the step's parts for sources since edited: parts.py)
     given = Path(os.path.abspath(folder if clear is None else clear))
     folder = Path(folder).resolve()
     clear = folder if clear is None else Path(clear).resolve()

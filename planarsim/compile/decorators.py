@@ -17,9 +17,10 @@ Options, for speed only (every choice gives the same numbers):
                              otherwise be copied into each of its callers (build_rows,
                              eval_rows: a call costs nanoseconds, each copy seconds of the
                              first-ever compile)
-    @part(types...)          a kernel(inline="never") compiled as a C function of its own that
-                             callers call by address (fast mode: compiled beside the step on a
-                             first-ever start; compile/parts.py)
+    @part(types...)          a kernel(inline="never") compiled into a C function of its own
+                             that callers call by address (fast mode: compiled beside the step
+                             on a first-ever start; compile/parts.py). From Python, numba
+                             refuses the call ("not usable in pure-python")
 
 All never allocate and keep the NaN checks that fastmath would drop (fastmath=False).
 Under NUMBA_DISABLE_JIT=1 each returns the function itself (its `py_func` is itself too).
@@ -86,6 +87,12 @@ def part(*args, returns=None):
     each argument, "model", "state", "workspace", "options", "float64", "int64" or "boolean";
     returns: "float64", "int64", or None. Elsewhere than
     the fast mode, kernel(inline="never")."""
+    for a in args:
+        if a not in _PART_ARGS:
+            raise ValueError(f"part: argument type {a!r} is none of {', '.join(_PART_ARGS)}")
+    if returns not in (None, "float64", "int64"):
+        raise ValueError(f"part: returns {returns!r}; a part returns float64, int64 or None")
+
     def decorate(fn):
         dispatcher = kernel(fn, inline="never")
         if MODE != FAST:
@@ -93,6 +100,9 @@ def part(*args, returns=None):
         from . import parts
         return parts.register(fn, dispatcher, args, returns)
     return decorate
+
+
+_PART_ARGS = ("model", "state", "workspace", "options", "float64", "int64", "boolean")
 
 
 def register(cls=None, *, readonly=False):

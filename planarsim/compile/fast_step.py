@@ -21,6 +21,7 @@ planarsim.compiled.jit: a plain numba.njit(cache=True) function loaded from the 
 new process would name a symbol nothing has published yet.
 """
 import hashlib
+import time
 
 import llvmlite.binding as ll
 from llvmlite import ir
@@ -96,8 +97,9 @@ def _load_or_compile():
     child = parts.start_child(missing)
     try:
         with code_layout():
+            started = time.perf_counter()
             entry.compile()
-            parts.finish(missing, child)
+            parts.finish(missing, child, time.perf_counter() - started)
     except BaseException:
         parts.stop_child(child)
         raise

@@ -7,9 +7,10 @@ A part is declared with compile/decorators.py's ``part``: its argument types ("m
 type's name, or None). The parts are compiled into one C function (Parts: a numba cfunc
 cached on disk like the step, its callees inlined into it as into the step) that runs the
 part its first argument names. Callers call it by address, read from a table at the call (a
-load and an indirect call: nanoseconds, on paths that run rarely); the table is published
-under one symbol (TABLE_SYMBOL) before any code that calls a part is compiled or loaded, and
-filled once the parts are loaded, before the step runs.
+load and an indirect call: nanoseconds; the contact solve's parts run rarely, the shape
+pairs' search once a step per pair in reach); the table is published under one symbol
+(table_symbol()) and filled, by load_step, before any code that calls a part is compiled or
+loaded (a part's caller, when typed, calls load_step as the step's does).
 
 Why: numba's typing, lowering and LLVM's optimisation run on one core. With the contact
 solve's complementarity parts compiled beside the step's core on a second core, the first-ever
@@ -21,10 +22,10 @@ whatever order the kernel modules are imported in.
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import llvmlite.binding as ll
 import numpy as np
@@ -32,6 +33,7 @@ from llvmlite import ir
 from numba import types
 from numba.core.ccallback import CFunc
 from numba.core.errors import TypingError
+from numba.core.typeconv import Conversion
 from numba.extending import intrinsic
 
 # every part, by module and name: the index is its slot in the table
@@ -41,18 +43,20 @@ PART_NAMES = (
     "planarsim.kernels.position._settle_measured",
     "planarsim.kernels.pair.find_pair",
 )
-TABLE_SYMBOL = "planarsim_parts_" + hashlib.blake2b("|".join(PART_NAMES).encode(),
-                                                    digest_size=8).hexdigest()
 # the parts' C function's address (kept alive for the process: compiled code reads it)
 _TABLE = np.zeros(1, np.uint64)
 _PARTS = {}          # name -> Part
 _PUBLISHED = []
+_SYMBOL = []
+_PROBE_FAILED = []   # numba moved what load_cached reads: no child, compile() loads or compiles
 _ENGINE_ARGS = ("model", "state", "workspace", "options")
 _SCALARS = ("float64", "int64", "boolean")
 CHILD_SWITCH = "PLANARSIM_COMPILE_CHILD"   # "0": never compile parts in a child process
-# a child still compiling after this long [s] (a stuck process) is stopped, and the parts are
-# compiled here
-CHILD_TIMEOUT = 900.0
+# how long a child may still compile once this process has compiled the step: CHILD_WAIT
+# times this process's own compile, at least CHILD_WAIT_MIN [s] (the two take about as
+# long); a child still running then is taken as stuck
+CHILD_WAIT = 2.0
+CHILD_WAIT_MIN = 60.0
 
 
 class Part:
@@ -100,6 +104,7 @@ class Parts:
 
     def __init__(self):
         self.cfunc = None
+        self.missed = False       # not in numba's cache when loaded: compiled in this run
         self._wrapper = None
 
     def signature(self):
@@ -171,16 +176,26 @@ def load_cached(c) -> bool:
         c._library = cres.library
         c._wrapper_name = cres.fndesc.llvm_cfunc_wrapper_name
         c._wrapper_address = c._library.get_pointer_to_function(c._wrapper_name)
-    except AttributeError:
+    except (AttributeError, TypeError):
+        _PROBE_FAILED.append(True)
         return False
     return True
 
 
+def table_symbol() -> str:
+    """The table's symbol: named after every part's name, argument and return types, which
+    set the C function's arguments, so that compiled code built for other parts never links."""
+    if not _SYMBOL:
+        text = "|".join(f"{p.name}{p.args}{p.returns}" for p in all_parts())
+        _SYMBOL.append("planarsim_parts_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest())
+    return _SYMBOL[0]
+
+
 def publish_table():
-    """Publish the table's address under TABLE_SYMBOL (once per process): before any code
+    """Publish the table's address under table_symbol() (once per process): before any code
     that calls a part is compiled or loaded."""
     if not _PUBLISHED:
-        ll.add_symbol(TABLE_SYMBOL, _TABLE.ctypes.data)
+        ll.add_symbol(table_symbol(), _TABLE.ctypes.data)
         _PUBLISHED.append(True)
 
 
@@ -199,15 +214,17 @@ def _caller(p: Part):
     names = [f"a{i}" for i in range(len(p.args))]
 
     def typer(typingctx, *given):
+        from .fast_step import load_step
+        load_step()     # the table published and filled before code that reads it links
         want, ret = p.types()
         for k, (have, need) in enumerate(zip(given, want)):
-            if have != need and not (isinstance(need, (types.Number, types.Boolean))
-                                     and isinstance(have, (types.Number, types.Boolean))):
+            conversion = typingctx.can_convert(have, need)
+            if have != need and (conversion is None or conversion > Conversion.safe):
                 raise TypingError(f"{p.name}: argument {k + 1} is {have}, the part takes {need}")
 
         def codegen(context, builder, signature, args):
             c_args, c_ret = PARTS.signature()
-            table = context.get_c_value(builder, ir.ArrayType(ir.IntType(64), 1), TABLE_SYMBOL)
+            table = context.get_c_value(builder, ir.ArrayType(ir.IntType(64), 1), table_symbol())
             slot = builder.gep(table, [ir.Constant(ir.IntType(32), 0)] * 2)
             fnty = ir.FunctionType(context.get_value_type(c_ret),
                                    [context.get_value_type(t) for t in c_args])
@@ -231,17 +248,11 @@ def _caller(p: Part):
 
 
 def register(fn, dispatcher, args, returns):
-    """The callable compiled code calls part `fn` by (its kernel `dispatcher`); see the
-    module's docstring."""
+    """The callable compiled code calls part `fn` by (its kernel `dispatcher`; args and
+    returns as decorators.part checked them); see the module's docstring."""
     name = f"{fn.__module__}.{fn.__qualname__}"
     if name not in PART_NAMES:
         raise ValueError(f"part {name} has no slot: add it to compile/parts.py PART_NAMES")
-    for a in args:
-        if a not in _ENGINE_ARGS + _SCALARS:
-            raise ValueError(f"part {name}: argument type {a!r} is none of "
-                             f"{', '.join(_ENGINE_ARGS + _SCALARS)}")
-    if returns not in (None, "float64", "int64"):
-        raise ValueError(f"part {name}: returns {returns!r}; a part returns float64, int64 or None")
     p = Part(name, dispatcher, args, returns)
     _PARTS[name] = p
     caller = _caller(p)
@@ -253,36 +264,56 @@ def register(fn, dispatcher, args, returns):
 # ---- compiling the parts beside the step --------------------------------------------------
 
 def missing_parts():
-    """None if the parts' C function is loaded (from numba's cache), else PARTS, to build."""
+    """None if the parts' C function is loaded (from numba's cache), else PARTS, to build
+    (PARTS.missed says which, for a report of what compiled)."""
     publish_table()
-    return None if PARTS.load_cached() else PARTS
+    PARTS.missed = not PARTS.load_cached()
+    return PARTS if PARTS.missed else None
+
+
+def _cores() -> int:
+    """CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
 
 
 def start_child(parts):
     """Start a child process compiling `parts` (PARTS, or None: nothing to do) into numba's
-    cache; None where that cannot help (switched off, no interpreter to start, or an error
-    starting it)."""
-    if (parts is None or os.environ.get(CHILD_SWITCH, "") == "0" or not sys.executable
-            or getattr(sys, "frozen", False)):   # (a frozen app's executable is the app)
+    cache; None where that cannot help: switched off, one CPU, no interpreter to start (a
+    frozen app), numba's cache not readable as planarsim reads it, or an error starting it.
+    The child imports from this process's sys.path, in its order."""
+    if (parts is None or os.environ.get(CHILD_SWITCH, "") == "0" or _cores() < 2
+            or not sys.executable or getattr(sys, "frozen", False) or _PROBE_FAILED):
         return None
-    root = str(Path(__file__).resolve().parents[2])
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([root] + [p for p in sys.path if p]))
-    env[CHILD_SWITCH] = "0"     # the child compiles, it does not start one of its own
+    from .caches import ENGINE_HASH
     try:
-        return subprocess.Popen([sys.executable, "-c",
-                                 "from planarsim.compile.parts import child_main; child_main()"],
-                                env=env, stdin=subprocess.DEVNULL,
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    except OSError:
+        env = dict(os.environ, PYTHONSAFEPATH="1")   # not the working folder first: sys.path's
+        env[CHILD_SWITCH] = "0"          # the child compiles, it does not start one of its own
+        env[_CHILD_PATH] = json.dumps([p for p in sys.path if isinstance(p, str)])
+        env[_CHILD_HASH] = ENGINE_HASH   # the sources this process compiles the step from
+        return subprocess.Popen([sys.executable, "-c", _CHILD_CODE], env=env,
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+    except Exception:
         return None
 
 
-def finish(parts, child):
+_CHILD_PATH = "PLANARSIM_CHILD_SYS_PATH"
+_CHILD_HASH = "PLANARSIM_CHILD_ENGINE_HASH"     # (caches.py reads it too)
+_CHILD_CODE = ("import json, os, sys; sys.path[:] = json.loads(os.environ['" + _CHILD_PATH + "']); "
+               "from planarsim.compile.parts import child_main; child_main()")
+
+
+def finish(parts, child, waited=0.0):
     """Load `parts` (None: nothing to do) once `child` (or None) has ended: from the cache it
-    wrote, or, where it did not (it failed, or the cache cannot be written), compiled here."""
+    wrote, or, where it did not (it failed, or the cache cannot be written), compiled here. A
+    child still running CHILD_WAIT times `waited` [s] (this process's own compile) later, and
+    at least CHILD_WAIT_MIN [s], is taken as stuck: stopped, and the parts compiled here."""
     if child is not None:
         try:
-            child.wait(timeout=CHILD_TIMEOUT)
+            child.wait(timeout=max(CHILD_WAIT_MIN, CHILD_WAIT * waited))
         except subprocess.TimeoutExpired:
             pass
         stop_child(child)
@@ -298,7 +329,12 @@ def stop_child(child):
 
 
 def child_main():
-    """The child process: compile the parts' C function into numba's cache."""
+    """The child process: compile the parts' C function into numba's cache, from the sources
+    its parent compiles the step from (an engine edited meanwhile: exit 3, and the parent
+    compiles them; caches.py leaves the caches alone in such a child)."""
+    from .caches import ENGINE_HASH
+    if os.environ.get(_CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
+        raise SystemExit(3)
     from . import fast_step
     from .fast import code_layout
     fast_step._LOADING.append(True)    # the parts never call the step: do not compile it here

@@ -104,18 +104,38 @@ def test_a_failed_child_leaves_the_parts_to_this_process_and_a_finished_one_to_t
 
 
 def test_a_stuck_child_is_stopped_and_the_parts_it_left_are_compiled_here(monkeypatch):
-    monkeypatch.setattr(parts, "CHILD_TIMEOUT", 0.5)
+    monkeypatch.setattr(parts, "CHILD_WAIT_MIN", 0.5)
     stuck = _FakeParts(False)
     child = _child("import time; time.sleep(60)")
-    parts.finish(stuck, child)
+    parts.finish(stuck, child, 0.1)
     assert child.poll() is not None and stuck.compiled
 
 
-def test_no_child_is_started_when_switched_off_or_frozen_or_with_nothing_to_do(monkeypatch):
+def test_no_child_is_started_when_switched_off_or_frozen_or_on_one_cpu_or_with_nothing_to_do(
+        monkeypatch):
     some = parts.PARTS
     assert parts.start_child(None) is None
     monkeypatch.setenv(parts.CHILD_SWITCH, "0")
     assert parts.start_child(some) is None
     monkeypatch.delenv(parts.CHILD_SWITCH)
-    monkeypatch.setattr(sys, "frozen", True, raising=False)
-    assert parts.start_child(some) is None
+    with monkeypatch.context() as m:
+        m.setattr(sys, "frozen", True, raising=False)
+        assert parts.start_child(some) is None
+    with monkeypatch.context() as m:
+        m.setattr(parts, "_cores", lambda: 1)
+        assert parts.start_child(some) is None
+
+
+def test_the_child_imports_from_this_process_path_and_leaves_edited_sources_to_it(
+        monkeypatch, tmp_path):
+    """The child reads sys.path as this process has it (strings only: a Path in sys.path is
+    skipped, not a crash) and compiles nothing when its engine sources hash otherwise than
+    this process's (an edit meanwhile): it exits 3 and leaves the caches alone."""
+    monkeypatch.setattr(sys, "path", [*sys.path, tmp_path])          # a Path entry
+    monkeypatch.setattr(parts, "_cores", lambda: 2)
+    import planarsim.compile.caches as caches
+    monkeypatch.setattr(caches, "ENGINE_HASH", "edited-since")        # what the child is told
+    monkeypatch.delenv(parts.CHILD_SWITCH, raising=False)
+    child = parts.start_child(parts.PARTS)
+    assert child is not None
+    assert child.wait(timeout=120) == 3
