@@ -11,6 +11,7 @@ from hypothesis import given, settings, strategies as st
 
 import planarsim as ps
 from planarsim import ModelError, SimulationDiverged, terrain
+from planarsim.compile import FAST, MODE
 
 
 def two_link_on_hills():
@@ -120,6 +121,8 @@ def test_two_runs_hash_alike_in_process_and_in_a_fresh_process():
     assert out.stdout.strip() == a
 
 
+@pytest.mark.skipif(MODE != FAST, reason="the step and its parts are C functions of their own "
+                    "in the fast mode only")
 def test_a_second_process_loads_the_step_kernel_from_the_cache():
     sim = ps.Simulator(two_link_on_hills())   # make sure this process compiled (or loaded) them
     sim.step()
