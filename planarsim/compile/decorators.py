@@ -85,8 +85,7 @@ def kernel(fn=None, *, inline="force"):
 def part(*args, returns=None):
     """A kernel compiled on its own and called by address (compile/parts.py). args: the type of
     each argument, "model", "state", "workspace", "options", "float64", "int64" or "boolean";
-    returns: "float64", "int64", or None. Elsewhere than
-    the fast mode, kernel(inline="never")."""
+    returns: "float64", "int64", or None. Elsewhere than the fast mode, kernel(inline="never")."""
     for a in args:
         if a not in _PART_ARGS:
             raise ValueError(f"part: argument type {a!r} is none of {', '.join(_PART_ARGS)}")
@@ -102,7 +101,10 @@ def part(*args, returns=None):
     return decorate
 
 
-_PART_ARGS = ("model", "state", "workspace", "options", "float64", "int64", "boolean")
+# a part's argument types: the engine's tables, then the scalars (parts.py reads both)
+PART_TABLES = ("model", "state", "workspace", "options")
+PART_SCALARS = ("float64", "int64", "boolean")
+_PART_ARGS = PART_TABLES + PART_SCALARS
 
 
 def register(cls=None, *, readonly=False):

@@ -5,8 +5,8 @@ The step (kernels/step.py) is compiled once, as a C function (a numba cfunc, cac
 and every compiled caller (run_steps, run_recorded, step_entry, each walker's rollout, your
 own) calls it by address through the intrinsic ``step``. A plain numba call would link the
 step's code into each caller, where LLVM optimises and compiles it again: that was most of
-the first-ever start-up (about 15 s per rollout). The step's long, rarely run parts are a C
-function of their own that it calls through a table (compile/parts.py): a first-ever start
+the first-ever start-up (about 15 s per rollout). The step's long parts (most run rarely) are
+a C function of their own that it calls through a table (compile/parts.py): a first-ever start
 compiles them in a child process while this one compiles the rest (_load_or_compile).
 
 A caller's machine code names the step by a symbol (``planarsim_step_<hash of the engine

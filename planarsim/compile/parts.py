@@ -1,6 +1,7 @@
-"""The step's parts (fast mode): long, rarely run kernels compiled as C functions of their own,
-which the step calls through a table of addresses, so that a first-ever start compiles them in
-a child process while this one compiles the rest of the step (compile/fast_step.py load_step).
+"""The step's parts (fast mode): long kernels, most of them rarely run, compiled into a C
+function of their own that the step calls through a table of addresses, so that a first-ever
+start compiles them in a child process while this one compiles the rest of the step
+(compile/fast_step.py load_step).
 
 A part is declared with compile/decorators.py's ``part``: its argument types ("model",
 "state", "workspace", "options" or a numba scalar type's name) and its return type (a scalar
@@ -14,7 +15,7 @@ loaded (a part's caller, when typed, calls load_step as the step's does).
 
 Why: numba's typing, lowering and LLVM's optimisation run on one core. With the contact
 solve's complementarity parts compiled beside the step's core on a second core, the first-ever
-compile takes the longer of the two, not their sum (README, "First run").
+compile takes the longer of the two, not their sum (README: "The first compile").
 
 PART_NAMES fixes each part's number: both processes, and every cached caller, agree on it
 whatever order the kernel modules are imported in.
@@ -36,7 +37,9 @@ from numba.core.errors import TypingError
 from numba.core.typeconv import Conversion
 from numba.extending import intrinsic
 
-# every part, by module and name: the index is its slot in the table
+from .decorators import PART_SCALARS, PART_TABLES
+
+# every part, by module and name: its index is its number (parts_c's `which`)
 PART_NAMES = (
     "planarsim.kernels.complementarity.solve_contacts",
     "planarsim.kernels.complementarity.project_positions",
@@ -49,8 +52,8 @@ _PARTS = {}          # name -> Part
 _PUBLISHED = []
 _SYMBOL = []
 _PROBE_FAILED = []   # numba moved what load_cached reads: no child, compile() loads or compiles
-_ENGINE_ARGS = ("model", "state", "workspace", "options")
-_SCALARS = ("float64", "int64", "boolean")
+_ENGINE_ARGS = PART_TABLES
+_SCALARS = PART_SCALARS
 CHILD_SWITCH = "PLANARSIM_COMPILE_CHILD"   # "0": never compile parts in a child process
 # how long a child may still compile once this process has compiled the step: CHILD_WAIT
 # times this process's own compile, at least CHILD_WAIT_MIN [s] (the two take about as
