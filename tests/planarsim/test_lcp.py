@@ -8,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.lcp import ANSWER_TOL, LCP_SOLVED, lemke, polish
+from planarsim.kernels.lcp import ANSWER_TOL, LCP_INACCURATE, LCP_SOLVED, lemke, polish
 
 # not cached: numba checks a cached function against its own file only, and this wrapper
 # must follow the kernels it calls
@@ -79,7 +79,13 @@ def test_polish_turns_a_regularised_answer_into_an_exact_one(problem):
     z = np.zeros(len(q))
     status, polished = _solve(M.copy(), q, 1e-6, z_reg, z)
     assert status == LCP_SOLVED
-    assert polished == LCP_SOLVED
+    if polished != LCP_SOLVED:
+        # polish may fail (about 1 problem in 10 000 here: see the next test); it says so and
+        # leaves the regularised answer, which the contact solve keeps only within ANSWER_TOL
+        # and otherwise reports (mixed_lcp.py)
+        assert polished == LCP_INACCURATE
+        assert np.array_equal(z, z_reg)
+        return
     if _nearly_singular(M, z, 1e-6):
         # refinement with the path's inverse of M + eps I gains eps / (lambda + eps) a pass
         # and stops at the damped answer (kept: see lcp._refine_basis), inside the tolerance
@@ -88,6 +94,41 @@ def test_polish_turns_a_regularised_answer_into_an_exact_one(problem):
     assert _miss(M, q, z) < 1e-9
     # the regularised answer itself misses by about eps z: polish did the work
     assert _miss(M, q, z_reg) > 10 * _miss(M, q, z) or _miss(M, q, z_reg) < 1e-9
+
+
+def _seeded_problem(d, k, seed):
+    """redundant_contacts' problem for d, k and seed."""
+    rng = np.random.default_rng(seed)
+    J = rng.normal(size=(k, d))
+    M = J @ J.T
+    loaded = rng.random(k) < 0.5
+    z_star = np.where(loaded, rng.uniform(0.1, 1.0, k), 0.0)
+    w_star = np.where(loaded, 0.0, rng.uniform(0.0, 1.0, k))
+    return M, w_star - M @ z_star
+
+
+def test_polish_fails_rarely_and_says_so():
+    """Over a seeded corpus of redundant_contacts' problems (every d, k it draws, 600 seeds
+    each: 17 731 that push), polish solves all but a handful; each failure returns
+    LCP_INACCURATE with the regularised answer left as it was. Measured: 2 failures here
+    (d = 4, k = 9, seed 565; d = 6, k = 7, seed 90), 1 in 61 528 problems of d = 6, k = 7;
+    the bound allows 5."""
+    failed = solved = 0
+    for d in range(2, 7):
+        for k in range(d + 1, 2 * d + 3):
+            for seed in range(600):
+                M, q = _seeded_problem(d, k, seed)
+                if q.min() >= 0.0:
+                    continue
+                z_reg, z = np.zeros(k), np.zeros(k)
+                status, polished = _solve(M.copy(), q, 1e-6, z_reg, z)
+                assert status == LCP_SOLVED
+                if polished == LCP_SOLVED:
+                    solved += 1
+                    continue
+                assert polished == LCP_INACCURATE and np.array_equal(z, z_reg), (d, k, seed)
+                failed += 1
+    assert solved > 10_000 and failed <= 5, (solved, failed)
 
 
 def test_polish_shares_a_redundant_load_without_drifting():
