@@ -249,14 +249,48 @@ def _min_change(M, q, m, T, basis, res):
     return True
 
 
+@kernel
+def _swap_to_answer(M, q, m, T, basis, res, floor):
+    """Principal pivots from the nearby problem's basis to one of M's own: while the basis's
+    exact answer (a fresh elimination) has a negative basic value, that variable leaves and
+    its complement enters (a row loaded at a hair below zero is let go, a row whose w is a
+    hair below zero is loaded: the nearby problem's eps can put a row whose share is nearly
+    zero on the wrong side), at most m times. True with T's rhs column and basis holding the
+    answer; False with basis as it was (T's rhs column overwritten). T's z columns keep the
+    basis meanwhile (the path is over)."""
+    rhs = 2 * m + 1
+    for i in range(m):
+        T[i, m] = basis[i]
+    for _ in range(m):
+        if not _solve_basis(M, q, m, T, basis, res):
+            break
+        if _is_answer(M, q, m, T, basis, res, floor):
+            return True
+        worst = 0.0
+        at = -1
+        for i in range(m):
+            if T[i, rhs] < worst:
+                worst = T[i, rhs]
+                at = i
+        if at < 0:
+            break                   # B x = q fails, not a sign: no swap mends that
+        b = basis[at]
+        basis[at] = b + m if b < m else b - m
+    for i in range(m):
+        basis[i] = int(T[i, m])
+    return False
+
+
 @kernel(inline="never")
 def polish(M, q, m, T, basis, z, floor):
     """After lemke solved a nearby problem (M + eps I, say) into z on `basis`: the same
     basis's answer for M and q themselves, checked as lemke checks its own. First refined and
     re-solved (_refine_basis); where the basis is singular for M (redundant contacts), the
-    smallest change of the nearby answer that solves it (_min_change). Returns LCP_SOLVED with
-    z replaced by that answer, or LCP_INACCURATE with z and T's basic values left as they
-    were. T's artificial column keeps the nearby answer meanwhile."""
+    smallest change of the nearby answer that solves it (_min_change); where the nearby
+    problem put a row with a nearly zero share on the wrong side, principal pivots to M's
+    own basis (_swap_to_answer). Returns LCP_SOLVED with z replaced by that answer, or
+    LCP_INACCURATE with z, the basis and T's basic values left as they were. T's
+    artificial column keeps the nearby answer meanwhile."""
     rhs = 2 * m + 1
     for i in range(m):
         T[i, 2 * m] = T[i, rhs]
@@ -265,6 +299,8 @@ def polish(M, q, m, T, basis, z, floor):
         for i in range(m):
             T[i, rhs] = T[i, 2 * m]
         if _min_change(M, q, m, T, basis, z) and _is_answer(M, q, m, T, basis, z, floor):
+            status = LCP_SOLVED
+        elif _swap_to_answer(M, q, m, T, basis, z, floor):
             status = LCP_SOLVED
         else:
             for i in range(m):
