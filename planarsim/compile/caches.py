@@ -47,7 +47,8 @@ def _mode_tag() -> str:
 ENGINE_HASH = _sources_hash(_PLANARSIM / "compile",
                             _sources_hash(_PLANARSIM / "kernels", _mode_tag()))
 _KERNELS = "planarsim.kernels"
-_CHILD_HASH = "PLANARSIM_CHILD_ENGINE_HASH"     # parts.py: the hash its parent compiles from
+# parts.py hands its child the hash it compiles the step from (the child compares its own)
+CHILD_HASH = "PLANARSIM_CHILD_ENGINE_HASH"
 
 
 def _imported_modules(path: Path):
@@ -299,7 +300,7 @@ def drop_stale_caches(folder, clear=None) -> None:
     Walker packages call this on import with their own folder, since their rollouts inline
     their controller files and the engine kernels they import.
     """
-    if MODE == PYTHON or os.environ.get(_CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
+    if MODE == PYTHON or os.environ.get(CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
         return   # (a child compiling the step's parts for sources since edited: parts.py)
     given = Path(os.path.abspath(folder if clear is None else clear))
     folder = Path(folder).resolve()

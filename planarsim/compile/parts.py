@@ -52,8 +52,6 @@ _PARTS = {}          # name -> Part
 _PUBLISHED = []
 _SYMBOL = []
 _PROBE_FAILED = []   # numba moved what load_cached reads: no child, compile() loads or compiles
-_ENGINE_ARGS = PART_TABLES
-_SCALARS = PART_SCALARS
 CHILD_SWITCH = "PLANARSIM_COMPILE_CHILD"   # "0": never compile parts in a child process
 # how long a child may still compile once this process has compiled the step: CHILD_WAIT
 # times this process's own compile, at least CHILD_WAIT_MIN [s] (the two take about as
@@ -75,20 +73,20 @@ class Part:
     def types(self):
         """The numba types (args, return) of the kernel as declared."""
         from .fast_step import engine_types
-        engine = dict(zip(_ENGINE_ARGS, engine_types()))
+        engine = dict(zip(PART_TABLES, engine_types()))
         args = tuple(engine[a] if a in engine else getattr(types, a) for a in self.args)
         return args, (types.none if self.returns is None else getattr(types, self.returns))
 
     def slots(self):
         """For each argument, its position among the C function's arguments (after `which`)."""
-        counts, out = dict.fromkeys(_SCALARS, 0), []
+        counts, out = dict.fromkeys(PART_SCALARS, 0), []
         width = slot_counts()
         for a in self.args:
-            if a in _ENGINE_ARGS:
-                out.append(_ENGINE_ARGS.index(a))
+            if a in PART_TABLES:
+                out.append(PART_TABLES.index(a))
             else:
-                k = _SCALARS.index(a)
-                out.append(len(_ENGINE_ARGS) + sum(width[x] for x in _SCALARS[:k]) + counts[a])
+                k = PART_SCALARS.index(a)
+                out.append(len(PART_TABLES) + sum(width[x] for x in PART_SCALARS[:k]) + counts[a])
                 counts[a] += 1
         return out
 
@@ -96,7 +94,7 @@ class Part:
 def slot_counts():
     """{scalar type: how many arguments of that type the C function takes} (the most any
     part takes)."""
-    return {x: max(p.args.count(x) for p in all_parts()) for x in _SCALARS}
+    return {x: max(p.args.count(x) for p in all_parts()) for x in PART_SCALARS}
 
 
 class Parts:
@@ -113,7 +111,7 @@ class Parts:
     def signature(self):
         from .fast_step import engine_types
         width = slot_counts()
-        scalars = [getattr(types, x) for x in _SCALARS for _ in range(width[x])]
+        scalars = [getattr(types, x) for x in PART_SCALARS for _ in range(width[x])]
         return (types.int64, *engine_types(), *scalars), types.float64
 
     def wrapper(self):
@@ -121,7 +119,7 @@ class Parts:
         that numba caches it)."""
         if self._wrapper is None:
             width = slot_counts()
-            names = ["m", "s", "ws", "opt"] + [f"{x[0]}{k}" for x in _SCALARS
+            names = ["m", "s", "ws", "opt"] + [f"{x[0]}{k}" for x in PART_SCALARS
                                                for k in range(width[x])]
             lines = [f"def parts_c(which, {', '.join(names)}):"]
             space = {"__name__": __name__}
@@ -190,7 +188,8 @@ def table_symbol() -> str:
     set the C function's arguments, so that compiled code built for other parts never links."""
     if not _SYMBOL:
         text = "|".join(f"{p.name}{p.args}{p.returns}" for p in all_parts())
-        _SYMBOL.append("planarsim_parts_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest())
+        digest = hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
+        _SYMBOL.append("planarsim_parts_" + digest)
     return _SYMBOL[0]
 
 
@@ -227,7 +226,8 @@ def _caller(p: Part):
 
         def codegen(context, builder, signature, args):
             c_args, c_ret = PARTS.signature()
-            table = context.get_c_value(builder, ir.ArrayType(ir.IntType(64), 1), table_symbol())
+            table = context.get_c_value(builder, ir.ArrayType(ir.IntType(64), 1),
+                                        table_symbol())
             slot = builder.gep(table, [ir.Constant(ir.IntType(32), 0)] * 2)
             fnty = ir.FunctionType(context.get_value_type(c_ret),
                                    [context.get_value_type(t) for t in c_args])
@@ -290,12 +290,12 @@ def start_child(parts):
     if (parts is None or os.environ.get(CHILD_SWITCH, "") == "0" or _cores() < 2
             or not sys.executable or getattr(sys, "frozen", False) or _PROBE_FAILED):
         return None
-    from .caches import ENGINE_HASH
+    from .caches import CHILD_HASH, ENGINE_HASH
     try:
         env = dict(os.environ, PYTHONSAFEPATH="1")   # not the working folder first: sys.path's
         env[CHILD_SWITCH] = "0"          # the child compiles, it does not start one of its own
         env[_CHILD_PATH] = json.dumps([p for p in sys.path if isinstance(p, str)])
-        env[_CHILD_HASH] = ENGINE_HASH   # the sources this process compiles the step from
+        env[CHILD_HASH] = ENGINE_HASH   # the sources this process compiles the step from
         return subprocess.Popen([sys.executable, "-c", _CHILD_CODE], env=env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
@@ -304,7 +304,6 @@ def start_child(parts):
 
 
 _CHILD_PATH = "PLANARSIM_CHILD_SYS_PATH"
-_CHILD_HASH = "PLANARSIM_CHILD_ENGINE_HASH"     # (caches.py reads it too)
 _CHILD_CODE = ("import json, os, sys; sys.path[:] = json.loads(os.environ['" + _CHILD_PATH + "']); "
                "from planarsim.compile.parts import child_main; child_main()")
 
@@ -335,8 +334,8 @@ def child_main():
     """The child process: compile the parts' C function into numba's cache, from the sources
     its parent compiles the step from (an engine edited meanwhile: exit 3, and the parent
     compiles them; caches.py leaves the caches alone in such a child)."""
-    from .caches import ENGINE_HASH
-    if os.environ.get(_CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
+    from .caches import CHILD_HASH, ENGINE_HASH
+    if os.environ.get(CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
         raise SystemExit(3)
     from . import fast_step
     from .fast import code_layout
