@@ -219,21 +219,44 @@ def _in_tree_writable(source_dir: Path) -> bool:
     pycache = source_dir / "__pycache__"
     if pycache.is_dir() and os.access(pycache, os.W_OK):
         return True
+    return _writable_folder(pycache)
+
+
+def _writable_folder(folder) -> bool:
+    """Whether numba can cache in `folder` (its own test: make it, write a file there)."""
     try:
-        os.makedirs(source_dir / "__pycache__", exist_ok=True)
-        tempfile.TemporaryFile(dir=source_dir / "__pycache__").close()
+        os.makedirs(folder, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
         return True
     except OSError:
         return False
 
 
+_WARNED_CACHE_DIRS = set()
+
+
+def _warn_unusable_cache_dir(folder) -> None:
+    """Say once per folder that NUMBA_CACHE_DIR cannot be written: numba then caches in the
+    next place it knows of, without a word."""
+    if folder in _WARNED_CACHE_DIRS:
+        return
+    _WARNED_CACHE_DIRS.add(folder)
+    import warnings
+    warnings.warn(f"NUMBA_CACHE_DIR={folder!r} cannot be created or written; numba caches "
+                  "the compiled engine in the package's __pycache__ (or its user-wide cache "
+                  "folder) instead", RuntimeWarning, stacklevel=2)
+
+
 def _outside_root(source_dir: Path):
     """Where numba caches the functions of source_dir's files when not in its __pycache__:
-    NUMBA_CACHE_DIR if set, numba's user-wide cache folder (~/.cache/numba) if __pycache__
-    cannot be written (a read-only install), else None."""
+    NUMBA_CACHE_DIR if set and writable, numba's user-wide cache folder (~/.cache/numba) if
+    __pycache__ cannot be written (a read-only install), else None. numba passes over a
+    NUMBA_CACHE_DIR it cannot write without a word; this says so (a RuntimeWarning)."""
     from numba.core import config
     if config.CACHE_DIR:
-        return Path(config.CACHE_DIR)
+        if _writable_folder(config.CACHE_DIR):
+            return Path(config.CACHE_DIR)
+        _warn_unusable_cache_dir(config.CACHE_DIR)
     if _in_tree_writable(source_dir):
         return None
     try:

@@ -366,6 +366,36 @@ def test_the_kernels_cache_folder_is_numbas_own_with_numba_cache_dir_set(tmp_pat
     assert cache_folder(source.parent) == Path(numbas)
 
 
+def test_a_numba_cache_dir_that_cannot_be_written_is_named_and_numbas_fallback_used(
+        tmp_path, monkeypatch):
+    """numba passes over a NUMBA_CACHE_DIR it cannot create (here: below a regular file) and
+    caches in the next place, silently: the first-run message and the stale-cache clearing
+    look there too (not in the unusable folder), and a RuntimeWarning names the folder."""
+    from numba.core import caching, config
+
+    from planarsim.compile import caches, fast_step
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    unusable = str(blocker / "cache")
+    monkeypatch.setattr(config, "CACHE_DIR", unusable)
+    monkeypatch.setattr(caches, "_WARNED_CACHE_DIRS", set())
+    source = Path(fast_step.__file__)
+    with pytest.warns(RuntimeWarning, match="NUMBA_CACHE_DIR=.*a_file/cache.*cannot be"):
+        folder = caches.cache_folder(source.parent)
+    impl = caching.CacheImpl   # numba's own order of locators
+    for cls in impl._locator_classes:
+        locator = cls.from_function(fast_step._step_c, str(source))
+        if locator is None:
+            continue
+        try:
+            locator.ensure_cache_path()
+        except OSError:
+            continue
+        break
+    assert folder == Path(locator.get_cache_path())
+    assert not str(folder).startswith(unusable)
+
+
 def test_a_read_only_installs_stale_caches_in_numbas_user_wide_folder_are_cleared(tmp_path,
                                                                                     monkeypatch):
     """A read-only install: numba cannot write __pycache__ next to the sources and caches in
