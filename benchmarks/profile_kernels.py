@@ -31,6 +31,8 @@ if __name__ == "__main__" and "NUMBA_CACHE_DIR" not in os.environ:
     # before numba is imported: a fresh cache, so every function is compiled here (see above)
     os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="planarsim-profile-")
     os.environ["PLANARSIM_KERNEL_CALLS"] = "1"   # stages as calls, not inlined (see compile/fast.py)
+    # the step's parts compiled here, not loaded from a child's cache (no list of functions)
+    os.environ["PLANARSIM_COMPILE_CHILD"] = "0"
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -84,9 +86,15 @@ def _workload(target, seconds):
         mod.simulate(0.05)   # compile or load
         package = mod.__name__.rsplit(".", 1)[0] if name in ("simplest-walker", "compass-gait",
                                                               "rimless-wheel") else mod.__name__
-        rollout = importlib.import_module(package + ".rollout")
-        disps = [v for v in vars(rollout).values() if isinstance(v, CPUDispatcher) and v.overloads]
-        return (lambda: mod.simulate(seconds)), disps
+        importlib.import_module(package + ".rollout")
+        # the rollout's and every compiled function of the walker's modules it calls (its
+        # controller's, compiled apart where not inlined), and the shared walker code's
+        modules = [m for key, m in list(sys.modules.items())
+                   if m is not None and (key == package or key.startswith(package + ".")
+                                         or key.startswith("walkers.common"))]
+        disps = {id(v): v for m in modules for v in vars(m).values()
+                 if isinstance(v, CPUDispatcher) and v.overloads}
+        return (lambda: mod.simulate(seconds)), list(disps.values())
     import planarsim as ps
     from benchmarks.scenes import SCENES
     from planarsim.compile.link import run_steps
