@@ -27,9 +27,13 @@ from .warm_start import start_impulses
 
 @kernel
 def compute_envelope(ws, n, n_body):
-    """row_first[r]: the first row sharing a body with row r; row_reach[k]: the last row whose
-    envelope reaches column k. Rows touch at most two bodies, so for rows ordered along a
-    chain or tree the envelope is narrow and elimination inside it costs O(n), not O(n^3)."""
+    """row_first[r]: the first row sharing a body with row r; the envelope of row r is columns
+    row_first[r]..r. Rows touch at most two bodies, so for rows ordered along a chain or tree
+    the envelope is narrow and elimination inside it costs O(n), not O(n^3).
+    Column k's elimination updates the rows below it whose envelope reaches it: row_below
+    holds them, ascending, for column k at row_below_start[k]:row_below_start[k + 1] (a
+    counting sort, O(envelope)), so that the elimination and substitution loops visit those
+    rows only, without testing each row of the band."""
     for b in range(n_body):
         ws.body_first_row[b] = -1
     for r in range(n):
@@ -43,10 +47,18 @@ def compute_envelope(ws, n, n_body):
             elif ws.body_first_row[b] < f:
                 f = ws.body_first_row[b]
         ws.row_first[r] = f
-        ws.row_reach[r] = r
-    for i in range(n):
+    start = ws.row_below_start
+    for k in range(n + 2):
+        start[k] = 0
+    for i in range(n):                  # count each column's rows in start[k + 2] ...
         for k in range(ws.row_first[i], i):
-            ws.row_reach[k] = i
+            start[k + 2] += 1
+    for k in range(2, n + 2):           # ... their running sum: start[k + 1] = column k's begin
+        start[k] += start[k - 1]
+    for i in range(n):                  # place them; start[k + 1] ends at column k's end
+        for k in range(ws.row_first[i], i):
+            ws.row_below[start[k + 1]] = i
+            start[k + 1] += 1
 
 
 @kernel
@@ -103,8 +115,8 @@ def is_dependent(piv, scale, tol):
 
 
 @kernel
-def factor(A, first, reach, n, tol, scale):
-    """LU factorisation of A in place, inside the envelope given by first / reach (see
+def factor(A, start, below, n, tol, scale):
+    """LU factorisation of A in place, inside the envelope given by start / below (see
     compute_envelope): U on and above the diagonal, the multipliers L below it. `scale` (n,)
     is scratch.
 
@@ -116,31 +128,31 @@ def factor(A, first, reach, n, tol, scale):
     diagonal_scale(A, n, scale)
     for k in range(n):
         piv = A[k, k]
-        last = reach[k]
+        lo = start[k]
+        hi = start[k + 1]
         if is_dependent(piv, scale[k], tol):
             dropped += 1
-            for j in range(k + 1, last + 1):
-                if first[j] <= k:
-                    A[k, j] = 0.0
-                    A[j, k] = 0.0
+            for p in range(lo, hi):
+                j = below[p]
+                A[k, j] = 0.0
+                A[j, k] = 0.0
             A[k, k] = 0.0
             continue
         inv = 1.0 / piv
-        for i in range(k + 1, last + 1):
-            if first[i] > k:
-                continue
+        for p in range(lo, hi):
+            i = below[p]
             fct = A[i, k] * inv
             A[i, k] = fct
             if fct == 0.0:
                 continue
-            for j in range(k + 1, last + 1):
-                if first[j] <= k:
-                    A[i, j] -= fct * A[k, j]
+            for t in range(lo, hi):
+                j = below[t]
+                A[i, j] -= fct * A[k, j]
     return dropped
 
 
 @kernel
-def forward_substitute(A, first, reach, rhs, n):
+def forward_substitute(A, start, below, rhs, n):
     """rhs <- L^-1 rhs with the unit lower factor below the diagonal of A (both factorisations
     store it there); dropped rows (zero pivot) get 0."""
     for k in range(n):
@@ -148,28 +160,28 @@ def forward_substitute(A, first, reach, rhs, n):
             rhs[k] = 0.0
             continue
         rk = rhs[k]
-        for i in range(k + 1, reach[k] + 1):
-            if first[i] <= k:
-                rhs[i] -= A[i, k] * rk
+        for p in range(start[k], start[k + 1]):
+            i = below[p]
+            rhs[i] -= A[i, k] * rk
 
 
 @kernel
-def substitute(A, first, reach, rhs, x, n):
+def substitute(A, start, below, rhs, x, n):
     """x = A^-1 rhs from the factors of `factor` (rhs destroyed); dropped rows get x = 0."""
-    forward_substitute(A, first, reach, rhs, n)
+    forward_substitute(A, start, below, rhs, n)
     for k in range(n - 1, -1, -1):
         if A[k, k] == 0.0:
             x[k] = 0.0
             continue
         acc = rhs[k]
-        for j in range(k + 1, reach[k] + 1):
-            if first[j] <= k:
-                acc -= A[k, j] * x[j]
+        for p in range(start[k], start[k + 1]):
+            j = below[p]
+            acc -= A[k, j] * x[j]
         x[k] = acc / A[k, k]
 
 
 @kernel
-def factor_symmetric(A, first, reach, n, tol, scale):
+def factor_symmetric(A, start, below, n, tol, scale):
     """As `factor` for a symmetric A, in half the work: A = L D L^T with the multipliers L
     below the diagonal and D on it; the upper triangle is neither read nor written. The same
     pivot test drops dependent rows (zero pivot and multipliers). Returns #dropped."""
@@ -177,52 +189,51 @@ def factor_symmetric(A, first, reach, n, tol, scale):
     diagonal_scale(A, n, scale)
     for k in range(n):
         piv = A[k, k]
-        last = reach[k]
+        lo = start[k]
+        hi = start[k + 1]
         if is_dependent(piv, scale[k], tol):
             dropped += 1
-            for i in range(k + 1, last + 1):
-                if first[i] <= k:
-                    A[i, k] = 0.0
+            for p in range(lo, hi):
+                A[below[p], k] = 0.0
             A[k, k] = 0.0
             continue
         inv = 1.0 / piv
         # rows from the last up: the update of row i reads column k of the rows j <= i, which
         # must still hold A[j, k] (not yet divided by the pivot)
-        for i in range(last, k, -1):
-            if first[i] > k:
-                continue
+        for p in range(hi - 1, lo - 1, -1):
+            i = below[p]
             a_ik = A[i, k]
             if a_ik == 0.0:
                 continue
             fct = a_ik * inv
-            for j in range(k + 1, i + 1):
-                if first[j] <= k:
-                    A[i, j] -= fct * A[j, k]
+            for t in range(lo, p + 1):
+                j = below[t]
+                A[i, j] -= fct * A[j, k]
             A[i, k] = fct
     return dropped
 
 
 @kernel
-def substitute_symmetric(A, first, reach, rhs, x, n):
+def substitute_symmetric(A, start, below, rhs, x, n):
     """x = A^-1 rhs from the factors of `factor_symmetric` (rhs destroyed); dropped rows get
     x = 0. Back substitution uses U = D L^T: x_k = y_k / d_k - sum_j L_jk x_j."""
-    forward_substitute(A, first, reach, rhs, n)
+    forward_substitute(A, start, below, rhs, n)
     for k in range(n - 1, -1, -1):
         if A[k, k] == 0.0:
             x[k] = 0.0
             continue
         acc = rhs[k] / A[k, k]
-        for j in range(k + 1, reach[k] + 1):
-            if first[j] <= k:
-                acc -= A[j, k] * x[j]
+        for p in range(start[k], start[k + 1]):
+            j = below[p]
+            acc -= A[j, k] * x[j]
         x[k] = acc
 
 
 @kernel(inline="always")
 def factor_solve(ws, rhs, x, n, tol):
     """Factor ws.A and solve A x = rhs; returns #dropped rows."""
-    dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, x)
-    substitute(ws.A, ws.row_first, ws.row_reach, rhs, x, n)
+    dropped = factor(ws.A, ws.row_below_start, ws.row_below, n, tol, x)
+    substitute(ws.A, ws.row_below_start, ws.row_below, rhs, x, n)
     return dropped
 
 
@@ -321,9 +332,9 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     fill_row_b(ws, h, n)
     add_compliance(ws, n)
     if symmetric:
-        dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
+        dropped = factor_symmetric(ws.A, ws.row_below_start, ws.row_below, n, tol, ws.lam)
     else:
-        dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam)
+        dropped = factor(ws.A, ws.row_below_start, ws.row_below, n, tol, ws.lam)
     warm = start_impulses(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
@@ -335,9 +346,9 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
         for r in range(n):
             ws.rhs[r] = -ws.row_b[r]
     if symmetric:
-        substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+        substitute_symmetric(ws.A, ws.row_below_start, ws.row_below, ws.rhs, ws.lam, n)
     else:
-        substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+        substitute(ws.A, ws.row_below_start, ws.row_below, ws.rhs, ws.lam, n)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
     if warm:
         for r in range(n):

@@ -7,7 +7,8 @@ from hypothesis import given, settings, strategies as st
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.solve import factor, factor_symmetric, substitute, substitute_symmetric
+from planarsim.kernels.solve import (compute_envelope, factor, factor_symmetric, substitute,
+                                     substitute_symmetric)
 
 TOL = 1e-11
 # not cached: numba checks a cached function against its own file only, and these wrappers
@@ -16,21 +17,32 @@ jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit
-def _lu(A, first, reach, rhs, x, scale, tol):
-    dropped = factor(A, first, reach, A.shape[0], tol, scale)
-    substitute(A, first, reach, rhs, x, A.shape[0])
+def _lu(A, start, below, rhs, x, scale, tol):
+    dropped = factor(A, start, below, A.shape[0], tol, scale)
+    substitute(A, start, below, rhs, x, A.shape[0])
     return dropped
 
 
 @jit
-def _ldl(A, first, reach, rhs, x, scale, tol):
-    dropped = factor_symmetric(A, first, reach, A.shape[0], tol, scale)
-    substitute_symmetric(A, first, reach, rhs, x, A.shape[0])
+def _ldl(A, start, below, rhs, x, scale, tol):
+    dropped = factor_symmetric(A, start, below, A.shape[0], tol, scale)
+    substitute_symmetric(A, start, below, rhs, x, A.shape[0])
     return dropped
 
 
+def _rows_below(first):
+    """(start, below): column k's rows below the diagonal whose envelope reaches it, ascending,
+    at below[start[k]:start[k + 1]] (the definition of kernels.solve.compute_envelope)."""
+    n = len(first)
+    columns = [[i for i in range(k + 1, n) if first[i] <= k] for k in range(n)]
+    start = np.zeros(n + 2, np.int64)
+    start[1:n + 1] = np.cumsum([len(c) for c in columns])
+    below = np.array([i for c in columns for i in c] or [0], np.int64)
+    return start, below
+
+
 def _envelope(row_body, n_body):
-    """first[r]: first row sharing a body with r; reach[k]: last row whose envelope holds k
+    """first[r]: first row sharing a body with r, and the rows below each column (_rows_below)
     (the definition of kernels.solve.compute_envelope)."""
     n = len(row_body)
     seen = [-1] * n_body
@@ -42,10 +54,7 @@ def _envelope(row_body, n_body):
             if seen[b] < 0:
                 seen[b] = r
             first[r] = min(first[r], seen[b])
-    reach = np.arange(n)
-    for i in range(n):
-        reach[first[i]:i] = i
-    return first, reach
+    return _rows_below(first)
 
 
 @st.composite
@@ -90,13 +99,13 @@ def test_symmetric_factor_gives_the_velocity_change_of_lu_and_reads_only_the_low
     W J^T x, is: both must give it, and both must solve A x = rhs."""
     A, rhs, row_body, n_body, J, w = system
     n = len(rhs)
-    first, reach = _envelope(row_body, n_body)
+    start, below = _envelope(row_body, n_body)
     x_lu = np.zeros(n)
-    _lu(A.copy(), first, reach, rhs.copy(), x_lu, np.zeros(n), TOL)
+    _lu(A.copy(), start, below, rhs.copy(), x_lu, np.zeros(n), TOL)
     A_ldl = A.copy()
     A_ldl[np.triu_indices(n, 1)] = np.nan      # must never be read
     x_ldl = np.zeros(n)
-    _ldl(A_ldl, first, reach, rhs.copy(), x_ldl, np.zeros(n), TOL)
+    _ldl(A_ldl, start, below, rhs.copy(), x_ldl, np.zeros(n), TOL)
     assert np.all(np.isfinite(x_ldl))
     dv_lu = w * (J.T @ x_lu)
     dv_ldl = w * (J.T @ x_ldl)
@@ -109,10 +118,50 @@ def test_dependent_rows_are_dropped_by_both():
     """Two copies of one row and a third row: rank 2; both factorisations drop the copy."""
     A = np.array([[2.0, 4.0, 1.0], [4.0, 8.0, 2.0], [1.0, 2.0, 3.0]])
     rhs = A @ np.array([1.0, 0.0, 1.0])
-    first = np.zeros(3, np.int64)
-    reach = np.full(3, 2, np.int64)
+    start, below = _rows_below(np.zeros(3, np.int64))
     for solve in (_lu, _ldl):
         x = np.zeros(3)
-        assert solve(A.copy(), first, reach, rhs.copy(), x, np.zeros(3), TOL) == 1
+        assert solve(A.copy(), start, below, rhs.copy(), x, np.zeros(3), TOL) == 1
         assert x[1] == 0.0
         assert np.allclose(A @ x, rhs)
+
+
+@jit
+def _compute_envelope(ws, n, n_body):
+    compute_envelope(ws, n, n_body)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2 ** 32 - 1))
+def test_the_envelope_kernel_lists_each_columns_rows_below_it(seed):
+    """compute_envelope's first rows and each column's rows below it (what the factorisations
+    and substitutions loop over) against their definitions, for rows in the order build_rows
+    makes (body by body) and out of it, up to the workspace's room for rows."""
+    import planarsim as ps
+    from planarsim.state import make_workspace
+    builder = ps.ModelBuilder(dt=1e-3)
+    prev = None
+    for i in range(6):       # a chain of 6 pinned links: room for 12 rows
+        link = builder.add_body(f"link{i}", mass=1.0, inertia=0.1, pos=(i + 0.5, 0.0))
+        builder.add_pin(f"pin{i}", prev, link, anchor_world=(float(i), 0.0))
+        prev = link
+    model = builder.compile()
+    ws = make_workspace(model)
+    rng = np.random.default_rng(seed)
+    capacity = ws.row_first.shape[0]
+    n = int(rng.integers(0, capacity + 1))
+    a = rng.integers(-1, model.n_body, n)
+    b = rng.integers(0, model.n_body, n)
+    bodies = np.stack([a, b], 1)
+    if rng.random() < 0.5:
+        bodies = bodies[np.argsort(bodies.max(axis=1), kind="stable")]
+    ws.row_body[:n] = bodies
+    _compute_envelope(ws, n, model.n_body)
+    first = []
+    for r in range(n):
+        shared = [k for k in range(r) if set(bodies[k][bodies[k] >= 0]) & set(bodies[r][bodies[r] >= 0])]
+        first.append(min(shared + [r]))
+    assert list(ws.row_first[:n]) == first
+    start, below = _rows_below(np.array(first, np.int64))
+    assert list(ws.row_below_start[:n + 1]) == list(start[:n + 1])
+    assert list(ws.row_below[:start[n]]) == list(below[:start[n]])
