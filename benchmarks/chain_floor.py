@@ -2,6 +2,7 @@
 
     python benchmarks/chain_floor.py                 # N = 4 and 32, median of 5 runs each
     python benchmarks/chain_floor.py --links 4 8 16 32 64
+    python benchmarks/chain_floor.py --peers pymunk  # and a peer's step, timed in the same run
 
 Times the engine on the bench chains (scenes.chain: 0.5 m, 1 kg thin rods, horizontal
 at rest, dt = 1 ms) next to two dedicated chain steps written for this one model, in the
@@ -21,6 +22,12 @@ The first shows what the engine's generality costs; the second what a lighter sc
 and what it gives up (its residual and energy columns). All three are judged alike: the
 largest pin gap over a 10 s run (sampled every 0.1 s), and the energy change over it as a
 share of the bench's scale m g L sum(i + 1/2).
+
+--peers (mujoco, pymunk, box2d; `pip install planarsim[compare]`): the peers' steps of the
+same chains (benchmarks/peers, as `planarsim bench` times them) go round with the three
+above, and each N ends with the dedicated step's ratio to the fastest of them: how fast the
+engine could be against the peers with nothing general left (the peers judged the same way,
+their pin gaps from every step of the run).
 """
 from __future__ import annotations
 
@@ -208,9 +215,24 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--links", type=int, nargs="+", default=[4, 32])
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--peers", default="none",
+                    help="comma-separated peers timed alongside (mujoco, pymunk, box2d; 'all')")
     args = ap.parse_args(argv)
     if any(n < 1 for n in args.links):
         ap.error("--links: every chain needs at least one link")
+    peers = {}
+    if args.peers != "none":
+        from benchmarks.peers import PEER_MODULES, available_peers
+        names = None if args.peers == "all" else [x.strip() for x in args.peers.split(",")]
+        unknown = [x for x in names or () if x not in PEER_MODULES]
+        if unknown:
+            ap.error(f"--peers: unknown {', '.join(unknown)}; peers: {', '.join(sorted(PEER_MODULES))}")
+        peers, missing = available_peers(names)
+        for line in missing:
+            print(line, file=sys.stderr)
+        if not peers:
+            print("chain_floor: no peer to time (see above)", file=sys.stderr)
+            return 1
     n_steps, n_accuracy = 5000, 10000      # 5 s timing episode, 10 s accuracy run (the bench's)
     print(f"{'N':>3s}  {'runner':10s} {'steps/s':>9s}  {'x engine':>8s}  {'largest pin gap':>15s}  "
           f"{'energy change / scale':>21s}")
@@ -233,7 +255,10 @@ def main(argv=None) -> int:
             "light": (lambda n: run_chain(box["q"], box["v"], n, True), reset_dedicated,
                       lambda: (box["q"], box["v"])),
         }
-        timed = _rates({key: r[:2] for key, r in runners.items()}, n_steps, args.repeats)
+        worlds = {key: mod.World(spec) for key, mod in peers.items()}
+        engines = {key: r[:2] for key, r in runners.items()}
+        engines.update({key: (w.run, w.reset) for key, w in worlds.items()})
+        timed = _rates(engines, n_steps, args.repeats)
         rates = {key: statistics.median(r) for key, r in timed.items()}
         for key, (run, reset, pose) in runners.items():
             # accuracy: poses sampled every 100 steps (0.1 s) over the 10 s run
@@ -248,6 +273,17 @@ def main(argv=None) -> int:
             print(f"{n_links:3d}  {key:10s} {rates[key] / 1e3:8.0f}k  "
                   f"{rates[key] / rates['engine']:8.2f}  "
                   f"{pin_separation(spec, np.array(poses)):15.1e}  {drift:+21.2%}")
+        for key, world in worlds.items():
+            q, v = world.record(n_accuracy)
+            drift = (energy(spec, q[-1], v[-1]) - energy(spec, q[0], v[0])) / spec.energy_scale
+            print(f"{n_links:3d}  {key:10s} {rates[key] / 1e3:8.0f}k  "
+                  f"{rates[key] / rates['engine']:8.2f}  "
+                  f"{pin_separation(spec, q):15.1e}  {drift:+21.2%}")
+        if worlds:
+            best = max(worlds, key=lambda k: rates[k])
+            print(f"{n_links:3d}  dedicated / fastest peer ({best}): "
+                  f"{rates['dedicated'] / rates[best]:.2f}x; engine / {best}: "
+                  f"{rates['engine'] / rates[best]:.2f}x")
     return 0
 
 
