@@ -226,7 +226,8 @@ def main(argv=None) -> int:
         names = None if args.peers == "all" else [x.strip() for x in args.peers.split(",")]
         unknown = [x for x in names or () if x not in PEER_MODULES]
         if unknown:
-            ap.error(f"--peers: unknown {', '.join(unknown)}; peers: {', '.join(sorted(PEER_MODULES))}")
+            ap.error(f"--peers: unknown {', '.join(unknown)}; "
+                     f"peers: {', '.join(sorted(PEER_MODULES))}")
         peers, missing = available_peers(names)
         for line in missing:
             print(line, file=sys.stderr)

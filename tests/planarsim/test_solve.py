@@ -157,10 +157,8 @@ def test_the_envelope_kernel_lists_each_columns_rows_below_it(seed):
         bodies = bodies[np.argsort(bodies.max(axis=1), kind="stable")]
     ws.row_body[:n] = bodies
     _compute_envelope(ws, n, model.n_body)
-    first = []
-    for r in range(n):
-        shared = [k for k in range(r) if set(bodies[k][bodies[k] >= 0]) & set(bodies[r][bodies[r] >= 0])]
-        first.append(min(shared + [r]))
+    touched = [set(b[b >= 0]) for b in bodies]
+    first = [min([k for k in range(r) if touched[k] & touched[r]] + [r]) for r in range(n)]
     assert list(ws.row_first[:n]) == first
     start, below = _rows_below(np.array(first, np.int64))
     assert list(ws.row_below_start[:n + 1]) == list(start[:n + 1])
