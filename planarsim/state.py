@@ -173,8 +173,8 @@ class Workspace(NamedTuple):
                                  #   the angles they belong to (NaN: not computed yet)
     body_first_row: np.ndarray   # (n_body,) int first row touching each body (-1: none)
     row_first: np.ndarray        # (R,) int first row sharing a body with row r (envelope)
-    row_below_start: np.ndarray  # (R + 2,) int where column k's rows below the diagonal start
-    row_below: np.ndarray        #   in row_below: the rows whose envelope reaches column k
+    row_reach: np.ndarray        # (R,) int last row r' whose envelope starts at or before r
+    row_list: np.ndarray         # (R,) int scratch: the rows a column's elimination updates
     v_pred: np.ndarray           # (n_body, 3) unconstrained velocity v + h M^-1 f
     v_new: np.ndarray            # (n_body, 3) constrained velocity of the current solve
     q_pred: np.ndarray           # (n_body, 3) predicted end-of-step configuration q + h v_pred
@@ -371,8 +371,7 @@ def make_workspace(model: Model) -> Workspace:
     z = np.zeros
     return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan),
                      body_first_row=z(nb, np.int64), row_first=z(R, np.int64),
-                     row_below_start=z(R + 2, np.int64),
-                     row_below=z(max(R * (R - 1) // 2, 1), np.int64),
+                     row_reach=z(R, np.int64), row_list=z(R, np.int64),
                      v_pred=z((nb, 3)), v_new=z((nb, 3)),
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),

@@ -247,14 +247,29 @@ def _warn_unusable_cache_dir(folder) -> None:
                   "folder) instead", RuntimeWarning, stacklevel=2)
 
 
+def _numba_subpath():
+    """numba's name for a source file's folder below NUMBA_CACHE_DIR or its user-wide cache
+    folder: a function of the file's path."""
+    try:
+        from numba.core.caching import _CacheLocator
+        return _CacheLocator.get_suitable_cache_subpath
+    except (ImportError, AttributeError):     # numba's own rule (0.49-0.68), if it moves
+        def subpath(py_file):
+            folder = os.path.dirname(os.path.abspath(py_file))
+            return f"{os.path.basename(folder)}_{hashlib.sha1(folder.encode()).hexdigest()}"
+        return subpath
+
+
 def _outside_root(source_dir: Path):
     """Where numba caches the functions of source_dir's files when not in its __pycache__:
-    NUMBA_CACHE_DIR if set and writable, numba's user-wide cache folder (~/.cache/numba) if
-    __pycache__ cannot be written (a read-only install), else None. numba passes over a
-    NUMBA_CACHE_DIR it cannot write without a word; this says so (a RuntimeWarning)."""
+    NUMBA_CACHE_DIR if set and numba can write its folder for source_dir there, numba's
+    user-wide cache folder (~/.cache/numba) if __pycache__ cannot be written (a read-only
+    install), else None. numba passes over a NUMBA_CACHE_DIR it cannot write without a word;
+    this says so (a RuntimeWarning)."""
     from numba.core import config
     if config.CACHE_DIR:
-        if _writable_folder(config.CACHE_DIR):
+        own = Path(config.CACHE_DIR) / _numba_subpath()(str(source_dir / "__init__.py"))
+        if _writable_folder(own):     # numba's test is of this folder (ensure_cache_path)
             return Path(config.CACHE_DIR)
         _warn_unusable_cache_dir(config.CACHE_DIR)
     if _in_tree_writable(source_dir):
@@ -272,13 +287,7 @@ def _user_cache_folders(clear: Path, spellings, recursive=True):
     none where numba writes them in __pycache__ next to the sources. numba names each after
     the source file's folder as Python imported it, which may be a path through a link:
     `spellings` are the paths `clear` may be reached by."""
-    try:
-        from numba.core.caching import _CacheLocator
-        subpath = _CacheLocator.get_suitable_cache_subpath
-    except (ImportError, AttributeError):     # numba's own rule (0.49-0.68), if it moves
-        def subpath(py_file):
-            folder = os.path.dirname(os.path.abspath(py_file))
-            return f"{os.path.basename(folder)}_{hashlib.sha1(folder.encode()).hexdigest()}"
+    subpath = _numba_subpath()
     roots, folders = {}, set()
     for source in (clear.rglob("*.py") if recursive else [clear / "__init__.py"]):
         if source.parent not in roots:

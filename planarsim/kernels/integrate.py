@@ -233,7 +233,7 @@ def max_residual(m, s, ws):
 @kernel(inline="always")
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     """Newton-SHAKE; returns the final max residual [m or rad]. envelope_ready: the rows are
-    those of the velocity solve's envelope (ws.row_first, row_below): none was dropped since
+    those of the velocity solve's envelope (ws.row_first / row_reach): none was dropped since
     and no complementarity solve changed them."""
     n = ws.n_row[0]
     if n == 0:
@@ -273,7 +273,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             # (same matrix: its factors are reused)
             for r in range(n):
                 ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
-            substitute(ws.A, ws.row_below_start, ws.row_below, ws.rhs, ws.lam, n)
+            substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
             apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
         for i in range(s.q.shape[0]):
             for k in range(3):

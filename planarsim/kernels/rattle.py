@@ -130,10 +130,10 @@ def project_velocities(m, s, ws, pivot_tol):
     update_trig(s.q, ws.body_cs)
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, False)
     assemble(m, ws, ws.row_J, ws.row_J, n, True)
-    factor_symmetric(ws.A, ws.row_below_start, ws.row_below, n, pivot_tol, ws.lam)
+    factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, pivot_tol, ws.lam, ws.row_list)
     for r in range(n):
         ws.rhs[r] = -row_dot(ws, r, ws.row_J, s.v)
-    substitute_symmetric(ws.A, ws.row_below_start, ws.row_below, ws.rhs, ws.lam, n)
+    substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
     apply_impulses(m, ws, ws.row_J, ws.lam, n, s.v, 1.0)
 
 

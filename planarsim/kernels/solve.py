@@ -27,13 +27,9 @@ from .warm_start import start_impulses
 
 @kernel
 def compute_envelope(ws, n, n_body):
-    """row_first[r]: the first row sharing a body with row r; the envelope of row r is columns
-    row_first[r]..r. Rows touch at most two bodies, so for rows ordered along a chain or tree
-    the envelope is narrow and elimination inside it costs O(n), not O(n^3).
-    Column k's elimination updates the rows below it whose envelope reaches it: row_below
-    holds them, ascending, for column k at row_below_start[k]:row_below_start[k + 1] (a
-    counting sort, O(envelope)), so that the elimination and substitution loops visit those
-    rows only, without testing each row of the band."""
+    """row_first[r]: the first row sharing a body with row r; row_reach[k]: the last row whose
+    envelope reaches column k. Rows touch at most two bodies, so for rows ordered along a
+    chain or tree the envelope is narrow and elimination inside it costs O(n), not O(n^3)."""
     for b in range(n_body):
         ws.body_first_row[b] = -1
     for r in range(n):
@@ -47,18 +43,10 @@ def compute_envelope(ws, n, n_body):
             elif ws.body_first_row[b] < f:
                 f = ws.body_first_row[b]
         ws.row_first[r] = f
-    start = ws.row_below_start
-    for k in range(n + 2):
-        start[k] = 0
-    for i in range(n):                  # count each column's rows in start[k + 2] ...
+        ws.row_reach[r] = r
+    for i in range(n):
         for k in range(ws.row_first[i], i):
-            start[k + 2] += 1
-    for k in range(2, n + 2):           # ... their running sum: start[k + 1] = column k's begin
-        start[k] += start[k - 1]
-    for i in range(n):                  # place them; start[k + 1] ends at column k's end
-        for k in range(ws.row_first[i], i):
-            ws.row_below[start[k + 1]] = i
-            start[k + 1] += 1
+            ws.row_reach[k] = i
 
 
 @kernel
@@ -115,10 +103,23 @@ def is_dependent(piv, scale, tol):
 
 
 @kernel
-def factor(A, start, below, n, tol, scale):
-    """LU factorisation of A in place, inside the envelope given by start / below (see
+def rows_below(first, reach, k, rows):
+    """rows[:count] = the rows below column k whose envelope reaches it (first[i] <= k),
+    ascending; returns count. Listed once per column, the elimination's double loop over them
+    tests nothing (in a tree the rows up to reach[k] include whole branches that do not)."""
+    count = 0
+    for i in range(k + 1, reach[k] + 1):
+        if first[i] <= k:
+            rows[count] = i
+            count += 1
+    return count
+
+
+@kernel
+def factor(A, first, reach, n, tol, scale, rows):
+    """LU factorisation of A in place, inside the envelope given by first / reach (see
     compute_envelope): U on and above the diagonal, the multipliers L below it. `scale` (n,)
-    is scratch.
+    and `rows` (n,) int are scratch.
 
     A row whose pivot falls below tol times its own diagonal depends on earlier rows (a
     closed loop, a box on two corners): it is dropped (impulse 0), marked by a zero pivot.
@@ -128,31 +129,30 @@ def factor(A, start, below, n, tol, scale):
     diagonal_scale(A, n, scale)
     for k in range(n):
         piv = A[k, k]
-        lo = start[k]
-        hi = start[k + 1]
+        count = rows_below(first, reach, k, rows)
         if is_dependent(piv, scale[k], tol):
             dropped += 1
-            for p in range(lo, hi):
-                j = below[p]
+            for a in range(count):
+                j = rows[a]
                 A[k, j] = 0.0
                 A[j, k] = 0.0
             A[k, k] = 0.0
             continue
         inv = 1.0 / piv
-        for p in range(lo, hi):
-            i = below[p]
+        for a in range(count):
+            i = rows[a]
             fct = A[i, k] * inv
             A[i, k] = fct
             if fct == 0.0:
                 continue
-            for t in range(lo, hi):
-                j = below[t]
+            for b in range(count):
+                j = rows[b]
                 A[i, j] -= fct * A[k, j]
     return dropped
 
 
 @kernel
-def forward_substitute(A, start, below, rhs, n):
+def forward_substitute(A, first, reach, rhs, n):
     """rhs <- L^-1 rhs with the unit lower factor below the diagonal of A (both factorisations
     store it there); dropped rows (zero pivot) get 0."""
     for k in range(n):
@@ -160,28 +160,28 @@ def forward_substitute(A, start, below, rhs, n):
             rhs[k] = 0.0
             continue
         rk = rhs[k]
-        for p in range(start[k], start[k + 1]):
-            i = below[p]
-            rhs[i] -= A[i, k] * rk
+        for i in range(k + 1, reach[k] + 1):
+            if first[i] <= k:
+                rhs[i] -= A[i, k] * rk
 
 
 @kernel
-def substitute(A, start, below, rhs, x, n):
+def substitute(A, first, reach, rhs, x, n):
     """x = A^-1 rhs from the factors of `factor` (rhs destroyed); dropped rows get x = 0."""
-    forward_substitute(A, start, below, rhs, n)
+    forward_substitute(A, first, reach, rhs, n)
     for k in range(n - 1, -1, -1):
         if A[k, k] == 0.0:
             x[k] = 0.0
             continue
         acc = rhs[k]
-        for p in range(start[k], start[k + 1]):
-            j = below[p]
-            acc -= A[k, j] * x[j]
+        for j in range(k + 1, reach[k] + 1):
+            if first[j] <= k:
+                acc -= A[k, j] * x[j]
         x[k] = acc / A[k, k]
 
 
 @kernel
-def factor_symmetric(A, start, below, n, tol, scale):
+def factor_symmetric(A, first, reach, n, tol, scale, rows):
     """As `factor` for a symmetric A, in half the work: A = L D L^T with the multipliers L
     below the diagonal and D on it; the upper triangle is neither read nor written. The same
     pivot test drops dependent rows (zero pivot and multipliers). Returns #dropped."""
@@ -189,51 +189,50 @@ def factor_symmetric(A, start, below, n, tol, scale):
     diagonal_scale(A, n, scale)
     for k in range(n):
         piv = A[k, k]
-        lo = start[k]
-        hi = start[k + 1]
+        count = rows_below(first, reach, k, rows)
         if is_dependent(piv, scale[k], tol):
             dropped += 1
-            for p in range(lo, hi):
-                A[below[p], k] = 0.0
+            for a in range(count):
+                A[rows[a], k] = 0.0
             A[k, k] = 0.0
             continue
         inv = 1.0 / piv
         # rows from the last up: the update of row i reads column k of the rows j <= i, which
         # must still hold A[j, k] (not yet divided by the pivot)
-        for p in range(hi - 1, lo - 1, -1):
-            i = below[p]
+        for a in range(count - 1, -1, -1):
+            i = rows[a]
             a_ik = A[i, k]
             if a_ik == 0.0:
                 continue
             fct = a_ik * inv
-            for t in range(lo, p + 1):
-                j = below[t]
+            for b in range(a + 1):
+                j = rows[b]
                 A[i, j] -= fct * A[j, k]
             A[i, k] = fct
     return dropped
 
 
 @kernel
-def substitute_symmetric(A, start, below, rhs, x, n):
+def substitute_symmetric(A, first, reach, rhs, x, n):
     """x = A^-1 rhs from the factors of `factor_symmetric` (rhs destroyed); dropped rows get
     x = 0. Back substitution uses U = D L^T: x_k = y_k / d_k - sum_j L_jk x_j."""
-    forward_substitute(A, start, below, rhs, n)
+    forward_substitute(A, first, reach, rhs, n)
     for k in range(n - 1, -1, -1):
         if A[k, k] == 0.0:
             x[k] = 0.0
             continue
         acc = rhs[k] / A[k, k]
-        for p in range(start[k], start[k + 1]):
-            j = below[p]
-            acc -= A[j, k] * x[j]
+        for j in range(k + 1, reach[k] + 1):
+            if first[j] <= k:
+                acc -= A[j, k] * x[j]
         x[k] = acc
 
 
 @kernel(inline="always")
 def factor_solve(ws, rhs, x, n, tol):
     """Factor ws.A and solve A x = rhs; returns #dropped rows."""
-    dropped = factor(ws.A, ws.row_below_start, ws.row_below, n, tol, x)
-    substitute(ws.A, ws.row_below_start, ws.row_below, rhs, x, n)
+    dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, x, ws.row_list)
+    substitute(ws.A, ws.row_first, ws.row_reach, rhs, x, n)
     return dropped
 
 
@@ -332,9 +331,9 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     fill_row_b(ws, h, n)
     add_compliance(ws, n)
     if symmetric:
-        dropped = factor_symmetric(ws.A, ws.row_below_start, ws.row_below, n, tol, ws.lam)
+        dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
     else:
-        dropped = factor(ws.A, ws.row_below_start, ws.row_below, n, tol, ws.lam)
+        dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
     warm = start_impulses(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
@@ -346,9 +345,9 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
         for r in range(n):
             ws.rhs[r] = -ws.row_b[r]
     if symmetric:
-        substitute_symmetric(ws.A, ws.row_below_start, ws.row_below, ws.rhs, ws.lam, n)
+        substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
     else:
-        substitute(ws.A, ws.row_below_start, ws.row_below, ws.rhs, ws.lam, n)
+        substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
     if warm:
         for r in range(n):

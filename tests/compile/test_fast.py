@@ -366,21 +366,30 @@ def test_the_kernels_cache_folder_is_numbas_own_with_numba_cache_dir_set(tmp_pat
     assert cache_folder(source.parent) == Path(numbas)
 
 
+@pytest.mark.parametrize("blocked", ["the folder", "its folder for the sources"])
 def test_a_numba_cache_dir_that_cannot_be_written_is_named_and_numbas_fallback_used(
-        tmp_path, monkeypatch):
-    """numba passes over a NUMBA_CACHE_DIR it cannot create (here: below a regular file) and
-    caches in the next place, silently: the first-run message and the stale-cache clearing
-    look there too (not in the unusable folder), and a RuntimeWarning names the folder."""
+        tmp_path, monkeypatch, blocked):
+    """numba passes over a NUMBA_CACHE_DIR it cannot write (the folder itself below a regular
+    file, or numba's folder for the sources inside it a regular file) and caches in the next
+    place, silently: the first-run message and the stale-cache clearing look there too (not
+    in the unusable folder), and a RuntimeWarning names the folder."""
     from numba.core import caching, config
 
     from planarsim.compile import caches, fast_step
-    blocker = tmp_path / "a_file"
-    blocker.write_text("not a folder")
-    unusable = str(blocker / "cache")
+    source = Path(fast_step.__file__)
+    if blocked == "the folder":
+        blocker = tmp_path / "a_file"
+        blocker.write_text("not a folder")
+        unusable = str(blocker / "cache")
+    else:
+        unusable = str(tmp_path / "cache")
     monkeypatch.setattr(config, "CACHE_DIR", unusable)
     monkeypatch.setattr(caches, "_WARNED_CACHE_DIRS", set())
-    source = Path(fast_step.__file__)
-    with pytest.warns(RuntimeWarning, match="NUMBA_CACHE_DIR=.*a_file/cache.*cannot be"):
+    if blocked != "the folder":
+        own = Path(caching.UserProvidedCacheLocator(fast_step._step_c, str(source)).get_cache_path())
+        own.parent.mkdir(parents=True)
+        own.write_text("not a folder")
+    with pytest.warns(RuntimeWarning, match="NUMBA_CACHE_DIR=.*cannot be"):
         folder = caches.cache_folder(source.parent)
     impl = caching.CacheImpl   # numba's own order of locators
     for cls in impl._locator_classes:

@@ -17,32 +17,21 @@ jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit
-def _lu(A, start, below, rhs, x, scale, tol):
-    dropped = factor(A, start, below, A.shape[0], tol, scale)
-    substitute(A, start, below, rhs, x, A.shape[0])
+def _lu(A, first, reach, rhs, x, scale, tol, rows):
+    dropped = factor(A, first, reach, A.shape[0], tol, scale, rows)
+    substitute(A, first, reach, rhs, x, A.shape[0])
     return dropped
 
 
 @jit
-def _ldl(A, start, below, rhs, x, scale, tol):
-    dropped = factor_symmetric(A, start, below, A.shape[0], tol, scale)
-    substitute_symmetric(A, start, below, rhs, x, A.shape[0])
+def _ldl(A, first, reach, rhs, x, scale, tol, rows):
+    dropped = factor_symmetric(A, first, reach, A.shape[0], tol, scale, rows)
+    substitute_symmetric(A, first, reach, rhs, x, A.shape[0])
     return dropped
 
 
-def _rows_below(first):
-    """(start, below): column k's rows below the diagonal whose envelope reaches it, ascending,
-    at below[start[k]:start[k + 1]] (the definition of kernels.solve.compute_envelope)."""
-    n = len(first)
-    columns = [[i for i in range(k + 1, n) if first[i] <= k] for k in range(n)]
-    start = np.zeros(n + 2, np.int64)
-    start[1:n + 1] = np.cumsum([len(c) for c in columns])
-    below = np.array([i for c in columns for i in c] or [0], np.int64)
-    return start, below
-
-
 def _envelope(row_body, n_body):
-    """first[r]: first row sharing a body with r, and the rows below each column (_rows_below)
+    """first[r]: first row sharing a body with r; reach[k]: last row whose envelope holds k
     (the definition of kernels.solve.compute_envelope)."""
     n = len(row_body)
     seen = [-1] * n_body
@@ -54,7 +43,10 @@ def _envelope(row_body, n_body):
             if seen[b] < 0:
                 seen[b] = r
             first[r] = min(first[r], seen[b])
-    return _rows_below(first)
+    reach = np.arange(n)
+    for i in range(n):
+        reach[first[i]:i] = i
+    return first, reach
 
 
 @st.composite
@@ -99,13 +91,13 @@ def test_symmetric_factor_gives_the_velocity_change_of_lu_and_reads_only_the_low
     W J^T x, is: both must give it, and both must solve A x = rhs."""
     A, rhs, row_body, n_body, J, w = system
     n = len(rhs)
-    start, below = _envelope(row_body, n_body)
+    first, reach = _envelope(row_body, n_body)
     x_lu = np.zeros(n)
-    _lu(A.copy(), start, below, rhs.copy(), x_lu, np.zeros(n), TOL)
+    _lu(A.copy(), first, reach, rhs.copy(), x_lu, np.zeros(n), TOL, np.zeros(n, np.int64))
     A_ldl = A.copy()
     A_ldl[np.triu_indices(n, 1)] = np.nan      # must never be read
     x_ldl = np.zeros(n)
-    _ldl(A_ldl, start, below, rhs.copy(), x_ldl, np.zeros(n), TOL)
+    _ldl(A_ldl, first, reach, rhs.copy(), x_ldl, np.zeros(n), TOL, np.zeros(n, np.int64))
     assert np.all(np.isfinite(x_ldl))
     dv_lu = w * (J.T @ x_lu)
     dv_ldl = w * (J.T @ x_ldl)
@@ -118,12 +110,109 @@ def test_dependent_rows_are_dropped_by_both():
     """Two copies of one row and a third row: rank 2; both factorisations drop the copy."""
     A = np.array([[2.0, 4.0, 1.0], [4.0, 8.0, 2.0], [1.0, 2.0, 3.0]])
     rhs = A @ np.array([1.0, 0.0, 1.0])
-    start, below = _rows_below(np.zeros(3, np.int64))
+    first = np.zeros(3, np.int64)
+    reach = np.full(3, 2, np.int64)
     for solve in (_lu, _ldl):
         x = np.zeros(3)
-        assert solve(A.copy(), start, below, rhs.copy(), x, np.zeros(3), TOL) == 1
+        assert solve(A.copy(), first, reach, rhs.copy(), x, np.zeros(3), TOL,
+                     np.zeros(3, np.int64)) == 1
         assert x[1] == 0.0
         assert np.allclose(A @ x, rhs)
+
+
+def _reference_lu(A, first, reach, n, tol):
+    """The envelope LU as first written, each row tested against the column (first[i] <= k)
+    in both loops: the operations, and their order, the kernel must keep bit for bit."""
+    dropped = 0
+    scale = [abs(A[k, k]) for k in range(n)]
+    for k in range(n):
+        piv = A[k, k]
+        last = reach[k]
+        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
+            dropped += 1
+            for j in range(k + 1, last + 1):
+                if first[j] <= k:
+                    A[k, j] = 0.0
+                    A[j, k] = 0.0
+            A[k, k] = 0.0
+            continue
+        inv = 1.0 / piv
+        for i in range(k + 1, last + 1):
+            if first[i] > k:
+                continue
+            fct = A[i, k] * inv
+            A[i, k] = fct
+            if fct == 0.0:
+                continue
+            for j in range(k + 1, last + 1):
+                if first[j] <= k:
+                    A[i, j] -= fct * A[k, j]
+    return dropped
+
+
+def _reference_ldl(A, first, reach, n, tol):
+    """The envelope L D L^T as first written (see _reference_lu)."""
+    dropped = 0
+    scale = [abs(A[k, k]) for k in range(n)]
+    for k in range(n):
+        piv = A[k, k]
+        last = reach[k]
+        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
+            dropped += 1
+            for i in range(k + 1, last + 1):
+                if first[i] <= k:
+                    A[i, k] = 0.0
+            A[k, k] = 0.0
+            continue
+        inv = 1.0 / piv
+        for i in range(last, k, -1):
+            if first[i] > k:
+                continue
+            a_ik = A[i, k]
+            if a_ik == 0.0:
+                continue
+            fct = a_ik * inv
+            for j in range(k + 1, i + 1):
+                if first[j] <= k:
+                    A[i, j] -= fct * A[j, k]
+            A[i, k] = fct
+    return dropped
+
+
+@jit
+def _factor_only(A, first, reach, tol, symmetric, scale, rows):
+    n = A.shape[0]
+    if symmetric:
+        return factor_symmetric(A, first, reach, n, tol, scale, rows)
+    return factor(A, first, reach, n, tol, scale, rows)
+
+
+@settings(max_examples=200, deadline=None)
+@given(systems(), st.sampled_from([TOL, 1e-3, 0.0]), st.booleans())
+def test_the_factorisations_keep_the_operations_of_the_envelope_elimination_bit_for_bit(
+        system, tol, unordered):
+    """Each column's rows are listed once (solve.rows_below) instead of tested in every loop:
+    the factors, dropped rows and all, must be those of the elimination as first written, to
+    the bit (signed zeros included), for rows in build order and out of it; a non-symmetric
+    matrix (the position correction's) goes through the LU."""
+    A, rhs, row_body, n_body, J, w = system
+    n = len(rhs)
+    if unordered:
+        order = np.random.default_rng(n).permutation(n)
+        A, row_body = A[np.ix_(order, order)], [row_body[r] for r in order]
+    first, reach = _envelope(row_body, n_body)
+    skew = A + 1e-3 * np.tril(np.ones((n, n)), -1) * A        # as J(q+) W J(q)^T: not symmetric
+    for matrix, symmetric, reference in ((A, True, _reference_ldl), (skew, False, _reference_lu)):
+        mine, theirs = matrix.copy(), matrix.copy()
+        dropped = _factor_only(mine, first, reach, tol, symmetric, np.zeros(n),
+                               np.zeros(n, np.int64))
+        assert dropped == reference(theirs, first, reach, n, tol)
+        keep = np.zeros((n, n), bool)
+        for i in range(n):
+            keep[i, first[i]:i + 1] = True
+        if not symmetric:
+            keep |= keep.T
+        assert mine[keep].tobytes() == theirs[keep].tobytes()
 
 
 @jit
@@ -133,33 +222,27 @@ def _compute_envelope(ws, n, n_body):
 
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2 ** 32 - 1))
-def test_the_envelope_kernel_lists_each_columns_rows_below_it(seed):
-    """compute_envelope's first rows and each column's rows below it (what the factorisations
-    and substitutions loop over) against their definitions, for rows in the order build_rows
-    makes (body by body) and out of it, up to the workspace's room for rows."""
+def test_the_envelope_kernel_gives_each_rows_first_row_and_each_columns_reach(seed):
+    """compute_envelope's first rows and reaches (what the factorisations and substitutions
+    loop within) against their definitions (_envelope), for random rows in the order
+    build_rows makes (body by body) and out of it, up to the workspace's room for rows."""
     import planarsim as ps
     from planarsim.state import make_workspace
     builder = ps.ModelBuilder(dt=1e-3)
     prev = None
-    for i in range(6):       # a chain of 6 pinned links: room for 12 rows
+    for i in range(6):       # a chain of 6 pinned links
         link = builder.add_body(f"link{i}", mass=1.0, inertia=0.1, pos=(i + 0.5, 0.0))
         builder.add_pin(f"pin{i}", prev, link, anchor_world=(float(i), 0.0))
         prev = link
     model = builder.compile()
     ws = make_workspace(model)
     rng = np.random.default_rng(seed)
-    capacity = ws.row_first.shape[0]
-    n = int(rng.integers(0, capacity + 1))
-    a = rng.integers(-1, model.n_body, n)
-    b = rng.integers(0, model.n_body, n)
-    bodies = np.stack([a, b], 1)
+    n = int(rng.integers(0, ws.row_first.shape[0] + 1))
+    bodies = np.stack([rng.integers(-1, model.n_body, n), rng.integers(0, model.n_body, n)], 1)
     if rng.random() < 0.5:
         bodies = bodies[np.argsort(bodies.max(axis=1), kind="stable")]
     ws.row_body[:n] = bodies
     _compute_envelope(ws, n, model.n_body)
-    touched = [set(b[b >= 0]) for b in bodies]
-    first = [min([k for k in range(r) if touched[k] & touched[r]] + [r]) for r in range(n)]
-    assert list(ws.row_first[:n]) == first
-    start, below = _rows_below(np.array(first, np.int64))
-    assert list(ws.row_below_start[:n + 1]) == list(start[:n + 1])
-    assert list(ws.row_below[:start[n]]) == list(below[:start[n]])
+    first, reach = _envelope([tuple(b) for b in bodies], model.n_body)
+    assert list(ws.row_first[:n]) == list(first)
+    assert list(ws.row_reach[:n]) == list(reach)
