@@ -120,62 +120,41 @@ def test_dependent_rows_are_dropped_by_both():
         assert np.allclose(A @ x, rhs)
 
 
-def _reference_lu(A, first, reach, n, tol):
-    """The envelope LU as first written, each row tested against the column (first[i] <= k)
-    in both loops: the operations, and their order, the kernel must keep bit for bit."""
+def _reference_elimination(A, first, reach, n, tol, symmetric):
+    """The envelope LU (L D L^T where symmetric) as first written, each row tested against
+    the column (first[i] <= k) in every loop: the operations, and their order, that the
+    kernels must keep bit for bit. Returns #dropped."""
     dropped = 0
     scale = [abs(A[k, k]) for k in range(n)]
     for k in range(n):
         piv = A[k, k]
-        last = reach[k]
+        below = [i for i in range(k + 1, reach[k] + 1) if first[i] <= k]
         if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
             dropped += 1
-            for j in range(k + 1, last + 1):
-                if first[j] <= k:
+            for j in below:
+                A[j, k] = 0.0
+                if not symmetric:
                     A[k, j] = 0.0
-                    A[j, k] = 0.0
             A[k, k] = 0.0
             continue
         inv = 1.0 / piv
-        for i in range(k + 1, last + 1):
-            if first[i] > k:
-                continue
+        if symmetric:       # rows from the last up, each row's update up to its diagonal
+            for i in reversed(below):
+                if A[i, k] == 0.0:
+                    continue
+                fct = A[i, k] * inv
+                for j in below:
+                    if j <= i:
+                        A[i, j] -= fct * A[j, k]
+                A[i, k] = fct
+            continue
+        for i in below:
             fct = A[i, k] * inv
             A[i, k] = fct
             if fct == 0.0:
                 continue
-            for j in range(k + 1, last + 1):
-                if first[j] <= k:
-                    A[i, j] -= fct * A[k, j]
-    return dropped
-
-
-def _reference_ldl(A, first, reach, n, tol):
-    """The envelope L D L^T as first written (see _reference_lu)."""
-    dropped = 0
-    scale = [abs(A[k, k]) for k in range(n)]
-    for k in range(n):
-        piv = A[k, k]
-        last = reach[k]
-        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
-            dropped += 1
-            for i in range(k + 1, last + 1):
-                if first[i] <= k:
-                    A[i, k] = 0.0
-            A[k, k] = 0.0
-            continue
-        inv = 1.0 / piv
-        for i in range(last, k, -1):
-            if first[i] > k:
-                continue
-            a_ik = A[i, k]
-            if a_ik == 0.0:
-                continue
-            fct = a_ik * inv
-            for j in range(k + 1, i + 1):
-                if first[j] <= k:
-                    A[i, j] -= fct * A[j, k]
-            A[i, k] = fct
+            for j in below:
+                A[i, j] -= fct * A[k, j]
     return dropped
 
 
@@ -202,11 +181,11 @@ def test_the_factorisations_keep_the_operations_of_the_envelope_elimination_bit_
         A, row_body = A[np.ix_(order, order)], [row_body[r] for r in order]
     first, reach = _envelope(row_body, n_body)
     skew = A + 1e-3 * np.tril(np.ones((n, n)), -1) * A        # as J(q+) W J(q)^T: not symmetric
-    for matrix, symmetric, reference in ((A, True, _reference_ldl), (skew, False, _reference_lu)):
+    for matrix, symmetric in ((A, True), (skew, False)):
         mine, theirs = matrix.copy(), matrix.copy()
         dropped = _factor_only(mine, first, reach, tol, symmetric, np.zeros(n),
                                np.zeros(n, np.int64))
-        assert dropped == reference(theirs, first, reach, n, tol)
+        assert dropped == _reference_elimination(theirs, first, reach, n, tol, symmetric)
         keep = np.zeros((n, n), bool)
         for i in range(n):
             keep[i, first[i]:i + 1] = True
