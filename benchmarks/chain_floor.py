@@ -212,6 +212,15 @@ def run_chain(q, v, n_steps, light):
                     v[k, d] += dv[k, d] / DT
 
 
+def _print_row(n_links, key, rates, spec, poses, start, end):
+    """One runner's or peer's line: steps/s, ratio to the engine, largest pin gap over the
+    sampled poses, energy change from start (q, v) to end (q, v) as a share of the scale."""
+    drift = (energy(spec, *end) - energy(spec, *start)) / spec.energy_scale
+    print(f"{n_links:3d}  {key:10s} {rates[key] / 1e3:8.0f}k  "
+          f"{rates[key] / rates['engine']:8.2f}  "
+          f"{pin_separation(spec, poses):15.1e}  {drift:+21.2%}")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--links", type=int, nargs="+", default=[4, 32])
@@ -270,18 +279,10 @@ def main(argv=None) -> int:
             for _ in range(n_accuracy // 100):
                 run(100)
                 poses.append(pose()[0].copy())
-            q1, v1 = pose()
-            drift = (energy(spec, q1, v1) - energy(spec, q0, v0)) / spec.energy_scale
-            print(f"{n_links:3d}  {key:10s} {rates[key] / 1e3:8.0f}k  "
-                  f"{rates[key] / rates['engine']:8.2f}  "
-                  f"{pin_separation(spec, np.array(poses)):15.1e}  {drift:+21.2%}")
+            _print_row(n_links, key, rates, spec, np.array(poses), (q0, v0), pose())
         for key, world in worlds.items():
             q, v = world.record(n_accuracy)      # every step: sampled as the runners'
-            drift = (energy(spec, q[-1], v[-1]) - energy(spec, q[0], v[0])) / spec.energy_scale
-            q = q[::100]
-            print(f"{n_links:3d}  {key:10s} {rates[key] / 1e3:8.0f}k  "
-                  f"{rates[key] / rates['engine']:8.2f}  "
-                  f"{pin_separation(spec, q):15.1e}  {drift:+21.2%}")
+            _print_row(n_links, key, rates, spec, q[::100], (q[0], v[0]), (q[-1], v[-1]))
         if worlds:
             best = max(worlds, key=lambda k: rates[k])
             print(f"{n_links:3d}  dedicated / fastest peer ({best}): "

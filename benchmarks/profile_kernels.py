@@ -27,11 +27,11 @@ import tempfile
 import time
 from pathlib import Path
 
-if __name__ == "__main__" and "NUMBA_CACHE_DIR" not in os.environ:
-    # before numba is imported: a fresh cache, so every function is compiled here (see above)
-    os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="planarsim-profile-")
-    os.environ["PLANARSIM_KERNEL_CALLS"] = "1"   # stages as calls, not inlined (see compile/fast.py)
 if __name__ == "__main__":
+    if "NUMBA_CACHE_DIR" not in os.environ:
+        # before numba is imported: a fresh cache, so every function is compiled here (above)
+        os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="planarsim-profile-")
+        os.environ["PLANARSIM_KERNEL_CALLS"] = "1"   # stages as calls (see compile/fast.py)
     # the step's parts compiled here, not loaded from a child's cache (no list of functions)
     os.environ["PLANARSIM_COMPILE_CHILD"] = "0"
 

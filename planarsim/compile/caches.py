@@ -216,14 +216,15 @@ def cache_folder(source_folder) -> Path:
 def _in_tree_writable(source_dir: Path) -> bool:
     """Whether numba caches in source_dir's __pycache__ (InTreeCacheLocator): an existing
     writable folder answers at once; else numba's own test (make it, write a file)."""
-    pycache = source_dir / "__pycache__"
-    if pycache.is_dir() and os.access(pycache, os.W_OK):
-        return True
-    return _writable_folder(pycache)
+    return _writable_folder(source_dir / "__pycache__")
 
 
 def _writable_folder(folder) -> bool:
-    """Whether numba can cache in `folder` (its own test: make it, write a file there)."""
+    """Whether numba can cache in `folder`: an existing writable folder answers at once (no
+    file written at import); else numba's own test (make it, write a file there)."""
+    folder = Path(folder)
+    if folder.is_dir() and os.access(folder, os.W_OK):
+        return True
     try:
         os.makedirs(folder, exist_ok=True)
         tempfile.TemporaryFile(dir=folder).close()
