@@ -1,4 +1,5 @@
-"""Stage 8: continuous collision detection for point masses.
+"""Stage 8: continuous collision detection for point masses (and the split at a shape pair's
+time of impact, found by kernels/pair_toi.py).
 
 Within-step path model of a free point (the motion a sub-step of length tau would produce,
 with the step's constrained average acceleration a = (v1 - v0) / h):
@@ -13,6 +14,7 @@ import math
 from ..compile import kernel
 from .codes import MODE_FREE
 from .info import INFO_CCD_SPLITS
+from .pair_toi import pair_impact_time
 from .terrain import ground_point, height_derivs, max_curvature, max_slope
 
 N_SAMPLES = 8
@@ -151,27 +153,40 @@ def time_of_impact(m, s, ws, h):
 
 
 @kernel
-def advance_to_impact(s, ws, h, tau):
-    """Move every body along its within-step path to tau: v = v0 + tau a, q += tau v."""
+def advance_to_impact(s, ws, h, tau, drift):
+    """Move every body along its within-step path to tau: v = v0 + tau a, q += tau v; or
+    (drift: a shape pair's impact, kernels/pair_toi.py) q += tau v1, the step's drift at its
+    solved velocity v1 = ws.v_new, whose path the pair's sweep followed (the velocity as
+    before: the step's forces and impulses for the time taken, the rest of the step adds
+    the rest)."""
     for i in range(s.q.shape[0]):
         for k in range(3):
             vk = s.v[i, k] + tau * (ws.v_new[i, k] - s.v[i, k]) / h
             s.v[i, k] = vk
-            s.q[i, k] += tau * vk
+            s.q[i, k] += tau * (ws.v_new[i, k] if drift else vk)
 
 
 @kernel
-def split_at_impact(m, s, ws, h):
+def split_at_impact(m, s, ws, h, splits_left):
     """The time-of-impact split: if a free CCD contact would hit the ground inside the step of
-    h [s] (not at its very end, which the next step takes: tau = 0 there), move every body to
-    the impact (advance_to_impact), engage that contact at the next sub-step's find_contacts
-    (contact_new = 2) and return the time tau >= 0 [s] taken; -1 when the step is not split."""
+    h [s] (not at its very end, which the next step takes: tau = 0 there), or two fast shapes
+    would touch or turn too far (kernels/pair_toi.py; splits_left: this split included), move every body to the earlier impact
+    (advance_to_impact) and return the time tau >= 0 [s] taken; -1 when the step is not
+    split. A point contact is engaged at the next sub-step's find_contacts (contact_new = 2);
+    a pair is found there, about to touch, by its narrow phase (its contacts engage when the
+    motion pushes them in)."""
     tau, hit = time_of_impact(m, s, ws, h)
+    if m.n_shape_pair > 0:
+        tau_pair = pair_impact_time(m, s, ws, h, splits_left)
+        if tau_pair < tau:
+            tau = tau_pair
+            hit = m.contact_body.shape[0]       # no point contact to engage
     if hit < 0 or not tau < h * (1.0 - 1e-9):
         return -1.0
-    advance_to_impact(s, ws, h, tau)
+    advance_to_impact(s, ws, h, tau, hit == m.contact_body.shape[0])
     s.time[0] += tau
     ws.impact_time[0] = s.time[0]
-    ws.contact_new[hit] = 2
+    if hit < m.contact_body.shape[0]:
+        ws.contact_new[hit] = 2
     ws.info[INFO_CCD_SPLITS] += 1
     return tau

@@ -25,6 +25,7 @@ from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_actuator_turn
 from .info import INFO_SOLVES, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
+from .pair_toi import hold_off_fast_pairs
 from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .position import position_stage
@@ -202,6 +203,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         predict_configuration(m, s, ws, h)                  #    q + h v* (joints' drift)
         find_contacts(m, s, ws, h)                          # 2. contacts
         ccd_on = split < opt.max_ccd_splits
+        if ccd_on and m.n_shape_pair > 0:                   #    fast shape pairs apart: left
+            hold_off_fast_pairs(m, s, ws, h)                #    to the sweep of stage 7
         for attempt in range(2):                            # 3-5. rows, impulses, modes
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
             if attempt == 1 or ws.first_order[0] == 1 or opt.integrator != INTEGRATOR_EULER:
@@ -211,8 +214,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
         if ccd_on:
-            tau = split_at_impact(m, s, ws, h)              # 7. a point mass hits mid-step:
-            if tau >= 0.0:                                  #    the rest of the step again
+            tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 7. an impact
+            if tau >= 0.0:                                  #    mid-step: the rest again
                 h -= tau
                 continue
         audit_impulses(m, s, ws, opt, h)                    # 9. the audit of the impulses
