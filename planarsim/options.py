@@ -30,7 +30,9 @@ class StepOptions(NamedTuple):
         consistent answer; see kernels/step.py solve_modes)
     refine_iters : Newton-SHAKE position corrections after integrating (0: off)
     refine_tol : stop refining when every constraint residual is below this [m or rad]
-    max_ccd_splits : cap on time-of-impact splits of one step
+    max_ccd_splits : cap on time-of-impact splits of one step (a point mass reaching the
+        ground, fast shapes touching or turning about a touching point: kernels/ccd.py,
+        kernels/pair_toi.py); the rest of a step beyond it is taken whole
     guard_limit : any |q| or |v| component above this stops the run
     pivot_tol : relative pivot below which the guess solve treats a row as redundant (its
         answer is checked against every rule; one that breaks a rule goes to the
@@ -85,7 +87,7 @@ class StepOptions(NamedTuple):
     mode_strategy: int = MODES_ALTERNATING
     refine_iters: int = 4
     refine_tol: float = 1e-12
-    max_ccd_splits: int = 4
+    max_ccd_splits: int = 16
     guard_limit: float = 1e10
     pivot_tol: float = 1e-11
     refine_pivot_tol: float = 1e-7
