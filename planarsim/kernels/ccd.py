@@ -170,8 +170,9 @@ def advance_to_impact(s, ws, h, tau, drift):
 def split_at_impact(m, s, ws, h, splits_left):
     """The time-of-impact split: if a free CCD contact would hit the ground inside the step of
     h [s] (not at its very end, which the next step takes: tau = 0 there), or two fast shapes
-    would touch or turn too far (kernels/pair_toi.py; splits_left: this split included), move every body to the earlier impact
-    (advance_to_impact) and return the time tau >= 0 [s] taken; -1 when the step is not
+    would touch or turn too far about a touching point (kernels/pair_toi.py; splits_left:
+    the splits the step may still take, this one included), move every body to the earlier
+    time (advance_to_impact) and return the time tau >= 0 [s] taken; -1 when the step is not
     split. A point contact is engaged at the next sub-step's find_contacts (contact_new = 2);
     a pair is found there, about to touch, by its narrow phase (its contacts engage when the
     motion pushes them in)."""

@@ -25,9 +25,9 @@ from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_actuator_turn
 from .info import INFO_SOLVES, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
-from .pair_toi import hold_off_fast_pairs
 from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
+from .pair_toi import hold_off_fast_pairs
 from .position import position_stage
 from .rows import build_rows
 from .solve import solve_impulses
