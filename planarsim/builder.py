@@ -24,7 +24,7 @@ from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POI
                             JOINT_SLIDER)
 from .errors import ModelError
 from .kernels.collide import core_normals
-from .shapes import bounding_circle, collision_core, collision_pairs
+from .shapes import collision_core, collision_pairs, shape_bounds
 from .terrain import Terrain, flat
 
 PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
@@ -682,8 +682,8 @@ class ModelBuilder:
             shape_vert_adr=ro(adr, np.int64).reshape(ns),
             shape_vert_num=ro([len(c) for c in cores], np.int64).reshape(ns),
             shape_radius=ro([sh["radius"] for sh in self._collide]).reshape(ns),
-            shape_bound=ro([bounding_circle(sh["core"], sh["radius"]) for sh in self._collide]
-                           or np.zeros((0, 3))).reshape(ns, 3),
+            shape_bound=ro([shape_bounds(sh["core"], core_normals(sh["core"]), sh["radius"])
+                            for sh in self._collide] or np.zeros((0, 5))).reshape(ns, 5),
             core_vert=ro(core).reshape(len(core), 2),
             core_norm=ro(norm).reshape(len(core), 2))
 

@@ -88,7 +88,8 @@ class ModelArrays(NamedTuple):
     shape_vert_adr: np.ndarray      # (n_shape,) int first core vertex (planarsim/shapes.py)
     shape_vert_num: np.ndarray      # (n_shape,) int core vertices: 1 circle, 2 capsule, >= 3 polygon
     shape_radius: np.ndarray        # (n_shape,) radius around the core [m]
-    shape_bound: np.ndarray         # (n_shape, 3) bounding circle: centre (local) and radius [m]
+    shape_bound: np.ndarray         # (n_shape, 5) bounding circle: centre (local) and radius [m];
+                                    #   width [m] and a turn's lever [m] (shapes.shape_bounds)
     core_vert: np.ndarray           # (n_core, 2) core vertices in the shape's frame [m]
     core_norm: np.ndarray           # (n_core, 2) outward unit normal of the edge from each vertex
 

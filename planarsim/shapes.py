@@ -115,6 +115,21 @@ def bounding_circle(core, radius):
     return float(c[0]), float(c[1]), float(np.max(np.hypot(*(core - c).T))) + radius
 
 
+def shape_bounds(core, normals, radius):
+    """(cx, cy, R, width, lever): the bounding circle (bounding_circle), the shape's width [m]
+    (its core's smallest extent across a face, 0 for a point or a segment, plus twice its
+    radius) and the largest distance [m] of a core vertex from the frame's origin (the body's:
+    the lever of a turn; kernels/pair_toi.py)."""
+    core = np.asarray(core, dtype=np.float64).reshape(-1, 2)
+    width = 0.0
+    if len(core) >= 3:
+        # face k's normal against every vertex: the extent inwards from that face
+        depth = np.einsum("kd,kd->k", normals, core)[:, None] - normals @ core.T
+        width = float(np.min(np.max(depth, axis=1)))
+    lever = float(np.max(np.hypot(core[:, 0], core[:, 1])))
+    return (*bounding_circle(core, radius), width + 2.0 * radius, lever)
+
+
 def mechanism_of(n_body, joints):
     """Component label (n_body,) of the graph whose edges are `joints` (pairs of body ids,
     -1 = the world, which joins nothing): bodies with one label form one mechanism."""

@@ -46,24 +46,6 @@ MAX_PAIR_ADVANCES = 100
 
 
 @kernel
-def shape_width(m, k):
-    """The width [m] of shape k: its core's smallest extent across a face (0 for a point or a
-    segment) plus twice its radius."""
-    adr = m.shape_vert_adr[k]
-    num = m.shape_vert_num[k]
-    width = math.inf if num >= 3 else 0.0
-    for f in range(num if num >= 3 else 0):
-        nx = m.core_norm[adr + f, 0]
-        ny = m.core_norm[adr + f, 1]
-        top = nx * m.core_vert[adr + f, 0] + ny * m.core_vert[adr + f, 1]
-        depth = 0.0
-        for j in range(num):
-            depth = max(depth, top - nx * m.core_vert[adr + j, 0] - ny * m.core_vert[adr + j, 1])
-        width = min(width, depth)
-    return width + 2.0 * m.shape_radius[k]
-
-
-@kernel
 def core_lever(m, adr, num):
     """The largest distance [m] of core vertices adr..adr+num-1 from their body's origin."""
     lever = 0.0
@@ -94,9 +76,9 @@ def drift_velocity(ws, b):
 @kernel
 def drift_speed(m, ws, k):
     """A bound [m/s] on the speed of any point of shape k in its body's drift:
-    |v_x| + |v_y| + |omega| L."""
+    |v_x| + |v_y| + |omega| L (L: m.shape_bound[k, 4], its core's farthest vertex)."""
     vx, vy, w = drift_velocity(ws, m.shape_body[k])
-    return abs(vx) + abs(vy) + abs(w) * core_lever(m, m.shape_vert_adr[k], m.shape_vert_num[k])
+    return abs(vx) + abs(vy) + abs(w) * m.shape_bound[k, 4]
 
 
 @kernel
@@ -177,14 +159,12 @@ def within_reach(ws, sa, sb, reach):
 @kernel
 def fast_before_solve(m, ws, sa, sb, h):
     """(fast, width): whether shapes sa and sb may move, relative to each other, more than
-    GATE_SHARE of the thinner one's width [m] in the step of h [s], by the speed bounds under
-    the step's start and predicted velocities (ws.shape_reach, placed at the sub-step's
-    start: the same answer at stage 2 and stage 7)."""
+    GATE_SHARE of the thinner one's width [m] (m.shape_bound[:, 3]) in the step of h [s], by
+    the speed bounds under the step's start and predicted velocities (ws.shape_reach, placed
+    at the sub-step's start: the same answer at stage 2 and stage 7)."""
+    width = min(m.shape_bound[sa, 3], m.shape_bound[sb, 3])
     reach = h * (ws.shape_reach[sa, 3] + ws.shape_reach[sb, 3])
-    if reach == 0.0 or not within_reach(ws, sa, sb, reach):
-        return False, 0.0
-    width = min(shape_width(m, sa), shape_width(m, sb))
-    return reach > GATE_SHARE * width, width
+    return reach > GATE_SHARE * width and within_reach(ws, sa, sb, reach), width
 
 
 @kernel(inline="never")
@@ -209,15 +189,12 @@ def pair_is_fast(m, ws, sa, sb, h):
     """(fast, reach, width): whether shapes sa and sb must be swept over h [s]: they can move,
     relative to each other, more than GATE_SHARE of the thinner one's width in their drift
     (reach [m]: that motion's bound), or they were fast before the solve (their speculative
-    contact may have been held off); and the thinner width [m]. Bounding circles farther
-    apart than the reach cannot meet in the step."""
+    contact may have been held off), and their bounding circles are within the reach; and
+    the thinner width [m]."""
     reach = h * (drift_speed(m, ws, sa) + drift_speed(m, ws, sb))
-    if reach == 0.0 or not within_reach(ws, sa, sb, reach):
-        return False, reach, 0.0
     held, width = fast_before_solve(m, ws, sa, sb, h)
-    if not held:
-        width = min(shape_width(m, sa), shape_width(m, sb))
-    return held or reach > GATE_SHARE * width, reach, width
+    fast = (held or reach > GATE_SHARE * width) and reach > 0.0
+    return fast and within_reach(ws, sa, sb, reach), reach, width
 
 
 @kernel
@@ -255,7 +232,7 @@ def turn_horizon(m, s, ws, i, sa, sb, h, splits_left, target):
         b = m.shape_body[k]
         if b >= 0:
             w = ws.v_new[b, 2]
-            curve += core_lever(m, m.shape_vert_adr[k], m.shape_vert_num[k]) * w * w
+            curve += m.shape_bound[k, 4] * w * w
     if curve == 0.0:
         return math.inf
     return max(math.sqrt(2.0 * target / curve), h / (splits_left + 1))
