@@ -163,3 +163,19 @@ def test_a_thin_box_at_300_rad_s_and_200_to_300_m_s_stops_at_a_5_cm_wall(seed):
         sim.step()
         assert sim.state.q[0, 0] < -T / 2, (sim.state.step, sim.state.q[0])
     assert audit_counts(sim.ws)["depth"] == 0
+
+
+def test_the_sweeps_gate_reads_each_shapes_width_and_turn_lever():
+    """shape_bound's width (the thinnest extent across a face plus twice the radius) and lever
+    (the core's farthest vertex from the body's origin), against their analytic values."""
+    b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, 0.0))
+    b.add_body("a", 1.0, 1.0, pos=(0.0, 1.0), shapes=[
+        ("box", (0.1, 0.0), 0.2, 0.01, 0.3),
+        ("capsule", (-0.05, 0.0), (0.05, 0.0), 0.02),
+        ("circle", (0.03, 0.04), 0.01),
+        ("polygon", [(0.0, 0.0), (0.03, 0.0), (0.0, 0.04)])])
+    bound = np.asarray(b.compile().arrays.shape_bound)
+    corner = np.hypot(0.1 + 0.1 * math.cos(0.3) + 0.005 * math.sin(0.3),
+                      0.1 * math.sin(0.3) - 0.005 * math.cos(0.3))
+    expected = [(0.01, corner), (0.04, 0.05), (0.02, 0.05), (0.03 * 0.04 / 0.05, 0.04)]
+    np.testing.assert_allclose(bound[:, 3:], expected, rtol=1e-12)
