@@ -348,11 +348,16 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
 def is_sliding_solution(m, s, ws, r):
     """After solve_mixed_lcp: does the contact of tangent row r slide (slip speed gamma > 0
     and its friction at the cone's edge; a gamma of rounding size on a contact well inside
-    its cone is not a slip; of a shape pair, rounding of both bodies' motion)?"""
+    its cone is not a slip; of a shape pair, rounding of both bodies' motion)? The edge is
+    judged at the rounding of the contact's own impulse, lambda_n + |lambda_t|: with a tiny
+    mu the friction mu lambda_n is far below it, and its last digits are rounding of the
+    normal impulse's size (mu 1e-4: a contact sliding at 2 m/s once read as pinned, and
+    the position correction then held it, throwing its body backwards)."""
     o = ws.row_owner[r]
     edge = m.contact_mu[o] * ws.lam[r - 1]
     scale = abs(ws.row_b[r]) + abs(ws.row_b[r - 1])
     if m.contact_kind[o] == CONTACT_PAIR:
         scale += pair_motion_scale(s, ws, o, ws.v_pred)
     slip_floor = CONE_EDGE_TOL * scale
-    return ws.row_slip[r] > slip_floor and abs(ws.lam[r]) >= edge * (1.0 - CONE_EDGE_TOL)
+    size = abs(ws.lam[r - 1]) + abs(ws.lam[r])
+    return ws.row_slip[r] > slip_floor and abs(ws.lam[r]) >= edge - CONE_EDGE_TOL * size
