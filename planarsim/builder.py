@@ -24,21 +24,36 @@ from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POI
                             JOINT_SLIDER)
 from .errors import ModelError
 from .kernels.collide import core_normals
-from .shapes import bounding_circle, collision_core, collision_pairs
+from .shapes import bounding_circle, collision_core, collision_pairs, shape_who
 from .terrain import Terrain, flat
 
 PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
 
 
 def _who(kind, name, idx):
-    """How errors name an element: "pin 'knee' (2)", or "box shape (3)" for unnamed ones."""
+    """How errors name an element: "pin 'knee' (2)", or "fluid box (3)" for unnamed ones; idx
+    None: `kind` is the whole description already (a shape's: shapes.shape_who)."""
+    if idx is None:
+        return kind
     return f"{kind} ({idx})" if name is None else f"{kind} {name!r} ({idx})"
+
+
+def _plain(value):
+    """`value` as messages print it: numpy numbers and arrays as plain floats and lists
+    (0.0, not np.float64(0.0))."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (tuple, list)):
+        return type(value)(_plain(v) for v in value)
+    return value
 
 
 def _finite(kind, name, idx, fieldname, value):
     arr = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(arr)):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value} must be finite")
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)} must be finite")
     return arr
 
 
@@ -46,7 +61,8 @@ def _vec2(kind, name, idx, fieldname, value):
     try:
         arr = np.asarray(value, dtype=np.float64).reshape(2)
     except (TypeError, ValueError):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value!r} must be a pair (x, y)") from None
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)!r} must be a pair "
+                         "(x, y)") from None
     return _finite(kind, name, idx, fieldname, arr)
 
 
@@ -54,7 +70,8 @@ def _scalar(kind, name, idx, fieldname, value):
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value!r} must be a number") from None
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)!r} must be a "
+                         "number") from None
     if not math.isfinite(x):
         raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={x} must be finite")
     return x
@@ -73,28 +90,27 @@ SHAPE_PARAMS = {"capsule": ("p0", "p1", "radius"), "circle": ("center", "radius"
                 "polygon": ("vertices",)}
 
 
-def _check_shape(kind, idx, params):
+def _check_shape(kind, who, params):
     """Parameters of a drawing shape: points (x, y) [m], radius [m] >= 0, box width and
-    height [m] > 0, angle [rad]; all finite."""
+    height [m] > 0, angle [rad]; all finite. Errors name `who` (shapes.shape_who)."""
     fields = SHAPE_PARAMS[kind]
-    what = f"{kind} shape"
     if not (len(fields) - (kind == "box") <= len(params) <= len(fields)):
-        raise ModelError(f"{_who(what, None, idx)}: params={params!r} must be ({', '.join(fields)})")
+        raise ModelError(f"{who}: params={_plain(params)!r} must be ({', '.join(fields)})")
     for f, p in zip(fields, params):
         if f == "vertices":
             try:
                 n = len(p)
             except TypeError:
-                raise ModelError(f"{_who(what, None, idx)}: vertices={p!r} must be a list of "
-                                 "(x, y) pairs") from None
+                raise ModelError(f"{who}: vertices={_plain(p)!r} must be a list of (x, y) "
+                                 "pairs") from None
             for k in range(n):
-                _vec2(what, None, idx, f"vertices[{k}]", p[k])
+                _vec2(who, None, None, f"vertices[{k}]", p[k])
         elif f in ("p0", "p1", "center"):
-            _vec2(what, None, idx, f, p)
+            _vec2(who, None, None, f, p)
         elif f == "angle":
-            _scalar(what, None, idx, f, p)
+            _scalar(who, None, None, f, p)
         else:
-            _length(what, None, idx, f, p, zero_ok=f == "radius")
+            _length(who, None, None, f, p, zero_ok=f == "radius")
 
 
 class ModelBuilder:
@@ -198,44 +214,47 @@ class ModelBuilder:
         contacts already touch it).
         Bodies of one mechanism (linked by pins, rods or actuators) do not collide with each
         other unless enable_collision names the pair."""
-        if kind not in SHAPE_PARAMS:
-            raise ModelError(f"shape on body {body}: kind={kind!r} must be one of "
-                             f"{', '.join(SHAPE_PARAMS)}")
         idx = len(self._shapes)
-        what = f"{kind} shape" if name is None else f"{kind} shape {name!r}"
-        bid = self._body_id(what, None, idx, "body", body, allow_world=body is None)
-        _check_shape(kind, idx, params)
+        bid = self._body_id(shape_who(kind, idx, name if isinstance(name, str) else None), None,
+                            None, "body", body,
+                            allow_world=body is None)
+        body_name = self._bodies[bid]["name"] if bid >= 0 else None
+        if name is not None and (not isinstance(name, str) or not name):
+            raise ModelError(f"{shape_who(kind, idx, None, body_name)}: name={name!r} must be a "
+                             "non-empty string")
+        who = shape_who(kind, idx, name, body_name)
+        if kind not in SHAPE_PARAMS:
+            raise ModelError(f"{who}: kind={kind!r} must be one of {', '.join(SHAPE_PARAMS)}")
+        _check_shape(kind, who, params)
         if not isinstance(collide, (bool, np.bool_)):
-            raise ModelError(f"{_who(what, None, idx)}: collide={collide!r} must be True or False")
+            raise ModelError(f"{who}: collide={collide!r} must be True or False")
         if bid < 0 and not collide:
-            raise ModelError(f"{_who(what, None, idx)}: a world shape (body None) must collide")
+            raise ModelError(f"{who}: a static shape (body None) must collide")
         if collide:
-            self._collide.append(self._collision_shape(idx, what, bid, kind, params, mu,
-                                                       restitution, category, mask, name))
             if not isinstance(ground, (bool, np.bool_)):
-                raise ModelError(f"{_who(what, None, idx)}: ground={ground!r} must be True or False")
+                raise ModelError(f"{who}: ground={ground!r} must be True or False")
+            self._collide.append(self._collision_shape(idx, who, bid, kind, params, mu,
+                                                       restitution, category, mask, name))
             self._collide[-1]["ground"] = bool(ground)
         self._shapes.append(M.Shape(bid, kind, tuple(params)))
         return idx
 
-    def _collision_shape(self, idx, what, bid, kind, params, mu, restitution, category, mask, name):
+    def _collision_shape(self, idx, who, bid, kind, params, mu, restitution, category, mask, name):
         """The record compile() turns into shape_* arrays and contacts (validated here)."""
-        if name is not None and (not isinstance(name, str) or not name):
-            raise ModelError(f"{_who(what, None, idx)}: name={name!r} must be a non-empty string")
-        mu = _scalar(what, None, idx, "mu", mu)
+        mu = _scalar(who, None, None, "mu", mu)
         if mu < 0:
-            raise ModelError(f"{_who(what, None, idx)}: mu={mu} must be >= 0")
-        e = _scalar(what, None, idx, "restitution", restitution)
+            raise ModelError(f"{who}: mu={mu} must be >= 0")
+        e = _scalar(who, None, None, "restitution", restitution)
         if not 0.0 <= e <= 1.0:
-            raise ModelError(f"{_who(what, None, idx)}: restitution={e} must be in [0, 1]")
+            raise ModelError(f"{who}: restitution={e} must be in [0, 1]")
         for field, bits in (("category", category), ("mask", mask)):
             if isinstance(bits, (bool, np.bool_)) or not isinstance(bits, (int, np.integer)) or bits < 0:
-                raise ModelError(f"{_who(what, None, idx)}: {field}={bits!r} must be a non-negative "
-                                 "integer (bits)")
-        core, radius = collision_core(kind, params, idx, name)
+                raise ModelError(f"{who}: {field}={_plain(bits)!r} must be a non-negative integer "
+                                 "(bits)")
+        core, radius = collision_core(kind, params, who)
         label = name or f"{self._bodies[bid]['name'] if bid >= 0 else 'world'}.{kind}{idx}"
         return dict(shape=idx, body=bid, kind=kind, core=core, radius=radius, mu=mu,
-                    restitution=e, category=int(category), mask=int(mask), label=label)
+                    restitution=e, category=int(category), mask=int(mask), label=label, who=who)
 
     def enable_collision(self, body_a, body_b):
         """Let two bodies of one mechanism (linked by pins, rods or actuators, which keeps them

@@ -30,8 +30,15 @@ SHAPE_KINDS = ("circle", "capsule", "box", "polygon")
 CORE_TOL = 1e-12
 
 
-def _who(idx, kind, name):
-    return f"{kind} shape {name!r} ({idx})" if name else f"{kind} shape ({idx})"
+def shape_who(kind, idx, name=None, body=False) -> str:
+    """How messages name a shape: its name= where it has one, its kind and index, its body:
+    "shape 'heel' (circle 0) of body 'shin_L'", "circle shape (3) of body 'shin_L'", "static
+    box shape (2)". body: the body's name, None for a static shape (fixed in the world), False
+    when not known (the shape's body is what is wrong)."""
+    who = f"shape {name!r} ({kind} {idx})" if name else f"{kind} shape ({idx})"
+    if body is False:
+        return who
+    return f"static {who}" if body is None else f"{who} of body {body!r}"
 
 
 def box_vertices(center, width, height, angle=0.0):
@@ -82,10 +89,10 @@ def convex_ccw(vertices, who):
     return v if sign > 0 else v[::-1].copy()
 
 
-def collision_core(kind, params, idx, name=None):
+def collision_core(kind, params, who):
     """(core (n, 2), radius) of a colliding shape's parameters, validated: radii > 0, box
-    sides > 0, a capsule's ends apart, a polygon convex with at least 3 distinct vertices."""
-    who = _who(idx, kind, name)
+    sides > 0, a capsule's ends apart, a polygon convex with at least 3 distinct vertices;
+    errors name `who` (shape_who)."""
     if kind == "circle":
         center, radius = params[0], float(params[1])
         if not radius > 0:
