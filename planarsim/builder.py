@@ -796,4 +796,5 @@ class ModelBuilder:
                        rod_names=tuple(r["name"] for r in self._rods),
                        contact_names=tuple(c["name"] for c in contacts),
                        act_names=tuple(a["name"] for a in self._acts),
-                       q0=q0, v0=v0, shapes=tuple(self._shapes), terrain=self.terrain, meta=dict(meta))
+                       q0=q0, v0=v0, shapes=tuple(self._shapes), terrain=self.terrain, meta=dict(meta),
+                       shape_names=tuple(sh["who"] for sh in self._collide))
