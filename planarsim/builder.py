@@ -121,12 +121,24 @@ class ModelBuilder:
     dt : float        step size [s], > 0
     gravity : (2,)    gravity vector [m/s^2]
     terrain : Terrain ground profile (default: flat ground at y = 0)
+    ground : True (default): the world has that analytic ground; None: it has none (no
+        terrain): shapes touch only other shapes (static ones make the floor, an incline, a
+        bowl), and the contacts that touch only the ground (add_point_contact,
+        add_arc_contact, add_box_contacts) are a ModelError
     """
 
-    def __init__(self, dt: float = 1e-3, gravity=(0.0, -9.81), terrain: Terrain | None = None):
+    def __init__(self, dt: float = 1e-3, gravity=(0.0, -9.81), terrain: Terrain | None = None,
+                 ground=True):
+        if ground is not True and ground is not None:
+            raise ModelError(f"model: ground={ground!r} must be True (the analytic ground) or None "
+                             "(no ground)")
+        if ground is None and terrain is not None:
+            raise ModelError(f"model: terrain={getattr(terrain, 'name', terrain)!r} given with "
+                             "ground=None; a world without ground has no terrain")
         self.dt = dt
         self.gravity = gravity
-        self.terrain = terrain if terrain is not None else flat()
+        self.ground = ground is True
+        self.terrain = (terrain if terrain is not None else flat()) if self.ground else None
         self._bodies, self._pins, self._rods, self._contacts, self._acts = [], [], [], [], []
         self._shapes = []
         self._fluid = []            # (body, fluid_coef row): kernels/fluid.py
@@ -490,6 +502,13 @@ class ModelBuilder:
         return idx
 
     # contacts -------------------------------------------------------------------------------
+    def _needs_ground(self, method, name):
+        """ModelError naming the contact when the model has no ground (ground=None)."""
+        if not self.ground:
+            raise ModelError(f"contact {name!r} ({len(self._contacts)}): {method} touches only "
+                             "the ground, and this model has none (ModelBuilder(ground=None)); "
+                             "give the body a shape (add_shape) to touch other shapes")
+
     def _contact(self, name, body, kind, local, radius, span, mu, verts):
         idx = len(self._contacts)
         self._register("contact", name, idx)
@@ -511,6 +530,7 @@ class ModelBuilder:
     def add_point_contact(self, name, body, local=(0.0, 0.0), mu=1.0) -> int:
         """A point of `body` (local [m]) that touches the ground; on a point mass it uses
         continuous collision detection."""
+        self._needs_ground("add_point_contact", name)
         return self._contact(name, body, CONTACT_POINT, local, 0.0, (0.0, 0.0), mu, [])
 
     def add_arc_contact(self, name, body, center, radius, span=(-math.pi, math.pi), vertices=(),
@@ -519,6 +539,7 @@ class ModelBuilder:
         directions from the centre to the sole (full circle by default). Where the sole's lowest
         point lies outside the span, the lowest of `vertices` (heel, toe, back; local [m]) is
         used instead, so a tipped foot rests on its corners. The foot rolls."""
+        self._needs_ground("add_arc_contact", name)
         idx = len(self._contacts)
         r = _scalar("contact", name, idx, "radius", radius)
         if not r > 0:
@@ -537,6 +558,7 @@ class ModelBuilder:
         """Four corner point contacts of a box (local centre [m], width x height [m]).
         Returns the four contact ids, named ``name/0..3``; also draws the box. width and
         height must be > 0."""
+        self._needs_ground("add_box_contacts", name)
         idx = len(self._contacts)
         c = _vec2("box", name, idx, "center", center)
         width = _length("box", name, idx, "width", width)
@@ -644,10 +666,10 @@ class ModelBuilder:
                         radius=radius, span=span, mu=mu, verts=[], ccd=0, other=other, pair=pair,
                         restitution=restitution)
 
-        curved = self.terrain.coef[2] != 0      # hills: a straight side can touch a crest
+        curved = self.ground and self.terrain.coef[2] != 0   # hills: a straight side can touch a crest
         for sh in self._collide:
-            if sh["body"] < 0 or not sh["ground"]:
-                continue        # world shapes meet bodies, not the ground
+            if sh["body"] < 0 or not sh["ground"] or not self.ground:
+                continue        # world shapes meet bodies, not the ground (nor, if none, any)
             common = dict(mu=sh["mu"], restitution=sh["restitution"])
             core = sh["core"]
             if sh["kind"] in ("box", "polygon"):
@@ -721,8 +743,11 @@ class ModelBuilder:
             raise ModelError(f"model: gravity={self.gravity!r} must be a pair (gx, gy)") from None
         if not np.all(np.isfinite(g)):
             raise ModelError(f"model: gravity={tuple(g)} must be finite")
-        if not isinstance(self.terrain, Terrain):
+        if self.ground and not isinstance(self.terrain, Terrain):
             raise ModelError(f"model: terrain={self.terrain!r} must be a planarsim.terrain.Terrain")
+        if not self.ground and self.terrain is not None:
+            raise ModelError(f"model: terrain={getattr(self.terrain, 'name', self.terrain)!r} set on "
+                             "a builder made with ground=None; a world without ground has no terrain")
         if not self._bodies:
             raise ModelError("model: no bodies; add at least one with add_body or add_point_mass")
         contacts = self._contacts + self._shape_contacts()
@@ -783,7 +808,7 @@ class ModelBuilder:
             act_range=ro([a["limit"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
             fluid_body=ro([b for b, _ in self._fluid], np.int64).reshape(len(self._fluid)),
             fluid_coef=ro([c for _, c in self._fluid] or np.zeros((0, 8))).reshape(len(self._fluid), 8),
-            terrain_coef=ro(self.terrain.coef),
+            terrain_coef=ro((self.terrain if self.ground else flat()).coef),  # no ground: no contact reads it
             **self._shape_arrays(ro),
         )
         q0 = np.array([b["q"] for b in self._bodies])

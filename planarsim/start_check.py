@@ -72,6 +72,8 @@ def contact_depths(model, q, enabled=None) -> list:
     (n_body, 3): how far its deepest point is below the ground (negative: clear by that
     much) and where."""
     out = []
+    if model.terrain is None:
+        return out          # no ground (ModelBuilder(ground=None)): nothing to be below
     q = np.asarray(q, dtype=np.float64)
     ground = from_coef(model.arrays.terrain_coef, "ground")
     for i in range(model.n_contact):
