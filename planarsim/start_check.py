@@ -190,10 +190,11 @@ def shape_overlaps(model, q, enabled=None) -> list:
     ij = np.array(list(pairs), dtype=np.int64).reshape(-1, 2)
     # bounding circles first: only the pairs whose circles overlap are measured
     bound = np.asarray(a.shape_bound, dtype=np.float64)
-    centre = np.empty((len(bound), 2))
-    for s in range(len(bound)):
-        b = int(a.shape_body[s])
-        centre[s] = bound[s, :2] if b < 0 else _world(q, b, bound[s, :2])[0]
+    body = np.asarray(a.shape_body)
+    pose = np.where(body[:, None] >= 0, q[np.maximum(body, 0)], 0.0)   # static: the world's
+    c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+    centre = pose[:, :2] + np.stack([c * bound[:, 0] - s * bound[:, 1],
+                                     s * bound[:, 0] + c * bound[:, 1]], axis=1)
     dist = np.hypot(*(centre[ij[:, 0]] - centre[ij[:, 1]]).T)
     out = []
     for i, j in ij[dist < bound[ij[:, 0], 2] + bound[ij[:, 1], 2]]:
