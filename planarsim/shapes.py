@@ -188,7 +188,8 @@ def shifted(kind, params, d) -> tuple:
     if kind == "polygon":
         return (tuple(tuple(np.asarray(v, dtype=np.float64) - d) for v in params[0]),)
     if kind == "capsule":
-        return (tuple(np.asarray(params[0], float) - d), tuple(np.asarray(params[1], float) - d)) + tuple(params[2:])
+        return (tuple(np.asarray(params[0], float) - d), tuple(np.asarray(params[1], float) - d),
+                *params[2:])
     return (tuple(np.asarray(params[0], float) - d),) + tuple(params[1:])     # circle, box
 
 

@@ -141,7 +141,10 @@ def test_a_body_from_density_has_its_com_at_the_shapes_centroid_and_they_stay_pu
 
 
 def test_shapes_added_one_by_one_with_density_build_the_same_body():
-    parts = [("box", (0.0, 0.0), 0.6, 0.04), ("box", (0.35, 0.0), 0.1, 0.2), ("circle", (-0.3, 0.1), 0.05)]
+    """Every kind moved with its body's frame: the same shapes, pose, mass and inertia."""
+    parts = [("box", (0.0, 0.0), 0.6, 0.04), ("box", (0.35, 0.0), 0.1, 0.2), ("circle", (-0.3, 0.1), 0.05),
+             ("capsule", (0.1, 0.2), (0.3, 0.25), 0.02),
+             ("polygon", [(-0.2, -0.1), (-0.1, -0.1), (-0.15, 0.0)])]
     b = ps.ModelBuilder(ground=None)
     b.add_body("all", pos=(1.0, 2.0), angle=0.3, density=RHO, shapes=parts)
     b.add_body("one_by_one", pos=(1.0, 2.0), angle=0.3)
@@ -152,8 +155,14 @@ def test_shapes_added_one_by_one_with_density_build_the_same_body():
     assert a.body_mass[1] == pytest.approx(a.body_mass[0], rel=1e-14)
     assert a.body_inertia[1] == pytest.approx(a.body_inertia[0], rel=1e-13)
     assert model.q0[1] == pytest.approx(model.q0[0], abs=1e-14)
-    for s0, s1 in zip(model.shapes[:3], model.shapes[3:]):
-        assert np.asarray(s1.params[0]) == pytest.approx(np.asarray(s0.params[0]), abs=1e-14)
+    assert len(model.shapes) == 2 * len(parts)
+    for s0, s1 in zip(model.shapes[:len(parts)], model.shapes[len(parts):]):
+        for p0, p1 in zip(s0.params, s1.params):
+            assert np.asarray(p1, dtype=float) == pytest.approx(np.asarray(p0, dtype=float), abs=1e-14)
+    # and where they were put in the world
+    rot = np.array([[math.cos(0.3), -math.sin(0.3)], [math.sin(0.3), math.cos(0.3)]])
+    placed = model.q0[1, :2] + np.asarray(model.shapes[-1].params[0]) @ rot.T
+    assert placed == pytest.approx(np.array([1.0, 2.0]) + np.asarray(parts[-1][1]) @ rot.T, abs=1e-14)
 
 
 def test_a_pendulum_built_from_density_swings_with_its_physical_period():
