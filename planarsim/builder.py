@@ -24,21 +24,37 @@ from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POI
                             JOINT_SLIDER)
 from .errors import ModelError
 from .kernels.collide import core_normals
-from .shapes import collision_core, collision_pairs, shape_bounds
+from .shapes import (collision_core, collision_pairs, combine_masses, shape_area, shape_bounds,
+                     shape_who, shifted)
 from .terrain import Terrain, flat
 
 PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
 
 
 def _who(kind, name, idx):
-    """How errors name an element: "pin 'knee' (2)", or "box shape (3)" for unnamed ones."""
+    """How errors name an element: "pin 'knee' (2)", or "fluid box (3)" for unnamed ones; idx
+    None: `kind` is the whole description already (a shape's: shapes.shape_who)."""
+    if idx is None:
+        return kind
     return f"{kind} ({idx})" if name is None else f"{kind} {name!r} ({idx})"
+
+
+def _plain(value):
+    """`value` as messages print it: numpy numbers and arrays as plain floats and lists
+    (0.0, not np.float64(0.0))."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (tuple, list)):
+        return type(value)(_plain(v) for v in value)
+    return value
 
 
 def _finite(kind, name, idx, fieldname, value):
     arr = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(arr)):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value} must be finite")
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)} must be finite")
     return arr
 
 
@@ -46,7 +62,8 @@ def _vec2(kind, name, idx, fieldname, value):
     try:
         arr = np.asarray(value, dtype=np.float64).reshape(2)
     except (TypeError, ValueError):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value!r} must be a pair (x, y)") from None
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)!r} must be a pair "
+                         "(x, y)") from None
     return _finite(kind, name, idx, fieldname, arr)
 
 
@@ -54,7 +71,8 @@ def _scalar(kind, name, idx, fieldname, value):
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={value!r} must be a number") from None
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)!r} must be a "
+                         "number") from None
     if not math.isfinite(x):
         raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={x} must be finite")
     return x
@@ -73,28 +91,27 @@ SHAPE_PARAMS = {"capsule": ("p0", "p1", "radius"), "circle": ("center", "radius"
                 "polygon": ("vertices",)}
 
 
-def _check_shape(kind, idx, params):
+def _check_shape(kind, who, params):
     """Parameters of a drawing shape: points (x, y) [m], radius [m] >= 0, box width and
-    height [m] > 0, angle [rad]; all finite."""
+    height [m] > 0, angle [rad]; all finite. Errors name `who` (shapes.shape_who)."""
     fields = SHAPE_PARAMS[kind]
-    what = f"{kind} shape"
     if not (len(fields) - (kind == "box") <= len(params) <= len(fields)):
-        raise ModelError(f"{_who(what, None, idx)}: params={params!r} must be ({', '.join(fields)})")
+        raise ModelError(f"{who}: params={_plain(params)!r} must be ({', '.join(fields)})")
     for f, p in zip(fields, params):
         if f == "vertices":
             try:
                 n = len(p)
             except TypeError:
-                raise ModelError(f"{_who(what, None, idx)}: vertices={p!r} must be a list of "
-                                 "(x, y) pairs") from None
+                raise ModelError(f"{who}: vertices={_plain(p)!r} must be a list of (x, y) "
+                                 "pairs") from None
             for k in range(n):
-                _vec2(what, None, idx, f"vertices[{k}]", p[k])
+                _vec2(who, None, None, f"vertices[{k}]", p[k])
         elif f in ("p0", "p1", "center"):
-            _vec2(what, None, idx, f, p)
+            _vec2(who, None, None, f, p)
         elif f == "angle":
-            _scalar(what, None, idx, f, p)
+            _scalar(who, None, None, f, p)
         else:
-            _length(what, None, idx, f, p, zero_ok=f == "radius")
+            _length(who, None, None, f, p, zero_ok=f == "radius")
 
 
 class ModelBuilder:
@@ -105,12 +122,24 @@ class ModelBuilder:
     dt : float        step size [s], > 0
     gravity : (2,)    gravity vector [m/s^2]
     terrain : Terrain ground profile (default: flat ground at y = 0)
+    ground : True (default): the world has that analytic ground; None: it has none (no
+        terrain): shapes touch only other shapes (static ones make the floor, an incline, a
+        bowl), and the contacts that touch only the ground (add_point_contact,
+        add_arc_contact, add_box_contacts) are a ModelError
     """
 
-    def __init__(self, dt: float = 1e-3, gravity=(0.0, -9.81), terrain: Terrain | None = None):
+    def __init__(self, dt: float = 1e-3, gravity=(0.0, -9.81), terrain: Terrain | None = None,
+                 ground=True):
+        if ground is not True and ground is not None:
+            raise ModelError(f"model: ground={ground!r} must be True (the analytic ground) or None "
+                             "(no ground)")
+        if ground is None and terrain is not None:
+            raise ModelError(f"model: terrain={getattr(terrain, 'name', terrain)!r} given with "
+                             "ground=None; a world without ground has no terrain")
         self.dt = dt
         self.gravity = gravity
-        self.terrain = terrain if terrain is not None else flat()
+        self.ground = ground is True
+        self.terrain = (terrain if terrain is not None else flat()) if self.ground else None
         self._bodies, self._pins, self._rods, self._contacts, self._acts = [], [], [], [], []
         self._shapes = []
         self._fluid = []            # (body, fluid_coef row): kernels/fluid.py
@@ -142,29 +171,90 @@ class ModelBuilder:
                          f"(0..{len(self._bodies) - 1}){' or None for the world' if allow_world else ''}")
 
     # bodies ---------------------------------------------------------------------------------
-    def add_body(self, name, mass, inertia, pos=(0.0, 0.0), angle=0.0, vel=(0.0, 0.0), omega=0.0,
-                 shapes=()) -> int:
-        """Rigid body: mass [kg] > 0, inertia about its COM [kg m^2] > 0, pose of its COM.
-        shapes: tuples (kind, *params) as add_shape takes them, each optionally ending with a
-        dict of add_shape's keywords, e.g. ``("box", (0, 0), 0.2, 0.1, {"mu": 0.5})``; they
-        collide unless that dict says ``"collide": False``."""
+    def add_body(self, name, mass=None, inertia=None, pos=(0.0, 0.0), angle=0.0, vel=(0.0, 0.0),
+                 omega=0.0, shapes=(), density=None) -> int:
+        """Rigid body: mass [kg] > 0 and inertia about its centre of mass (COM) [kg m^2] > 0,
+        pos [m] and angle [rad] the pose of its COM; vel [m/s] and omega [rad/s] its start
+        velocity (the State's v at time 0: the velocity over the step before it, see README's
+        "How the engine works"). shapes: tuples (kind, *params) as add_shape takes them, each
+        optionally ending with a dict of add_shape's keywords, e.g.
+        ``("box", (0, 0), 0.2, 0.1, {"mu": 0.5})``; they collide unless that dict says
+        ``"collide": False``.
+
+        Or, instead of mass and inertia, density [kg/m^2] > 0 (an area density, as Box2D's and
+        pymunk's): the mass, COM and inertia are those of the solid shapes (planarsim.shapes.
+        mass_properties; a shape's dict may give its own "density"). Then pos and angle are
+        the pose of the body's frame in which the shapes are given (and every later local
+        point of the body: anchors, contact points, shapes), and the builder puts the body's
+        pose q, which is always its COM's, at the shapes' centroid: q = pos + R(angle) c. The
+        shapes stay where they were given in the world; vel is the COM's velocity."""
         idx = len(self._bodies)
         self._register("body", name, idx)
-        mass = _scalar("body", name, idx, "mass", mass)
-        inertia = _scalar("body", name, idx, "inertia", inertia)
-        if not mass > 0:
-            raise ModelError(f"body {name!r} ({idx}): mass={mass} must be finite and > 0")
-        if not inertia > 0:
-            raise ModelError(f"body {name!r} ({idx}): inertia={inertia} must be finite and > 0 "
-                             f"(use add_point_mass for a body without rotation)")
         q = np.r_[_vec2("body", name, idx, "pos", pos), _scalar("body", name, idx, "angle", angle)]
         v = np.r_[_vec2("body", name, idx, "vel", vel), _scalar("body", name, idx, "omega", omega)]
-        self._bodies.append(dict(name=name, mass=mass, inertia=inertia, q=q, v=v, point=False))
+        if density is None and (mass is not None or inertia is not None):
+            mass = _scalar("body", name, idx, "mass", mass)
+            inertia = _scalar("body", name, idx, "inertia", inertia)
+            if not mass > 0:
+                raise ModelError(f"body {name!r} ({idx}): mass={mass} must be finite and > 0")
+            if not inertia > 0:
+                raise ModelError(f"body {name!r} ({idx}): inertia={inertia} must be finite and > 0 "
+                                 f"(use add_point_mass for a body without rotation)")
+            origin = None
+        else:
+            if mass is not None or inertia is not None:
+                raise ModelError(f"body {name!r} ({idx}): mass={mass} and inertia={inertia} given "
+                                 f"with density={density}; give mass and inertia, or a density")
+            if density is not None:
+                density = _scalar("body", name, idx, "density", density)
+                if not density > 0:
+                    raise ModelError(f"body {name!r} ({idx}): density={density} must be finite and "
+                                     "> 0 [kg/m^2]")
+            mass, inertia, origin = 0.0, 0.0, np.zeros(2)   # from its shapes' densities
+        self._bodies.append(dict(name=name, mass=mass, inertia=inertia, q=q, v=v, point=False,
+                                 origin=origin))
         for s in shapes:
             s = tuple(s)
-            options = s[-1] if s and isinstance(s[-1], dict) else {}
-            self.add_shape(idx, *(s[:-1] if options else s), **options)
+            options = dict(s[-1]) if s and isinstance(s[-1], dict) else {}
+            if density is not None:
+                options.setdefault("density", density)
+            self.add_shape(idx, *(s[:-1] if s and isinstance(s[-1], dict) else s), **options)
         return idx
+
+    def _local_point(self, bid, p):
+        """A local point [m] given in body bid's frame (origin at its pos) -> the COM frame
+        the model keeps (the same point unless the body's mass came from densities)."""
+        origin = self._bodies[bid]["origin"] if bid >= 0 else None
+        return p if origin is None else np.asarray(p, dtype=np.float64) + origin
+
+    def _attached(self, bid) -> list:
+        """What other than shapes names body bid (pins, rods, contacts, actuators, fluid boxes)."""
+        out = [f"pin {p['name']!r}" for p in self._pins if bid in p["body"]]
+        out += [f"rod {r['name']!r}" for r in self._rods if bid in r["body"]]
+        out += [f"contact {c['name']!r}" for c in self._contacts if c["body"] == bid]
+        out += [f"actuator {a['name']!r}" for a in self._acts if bid in a["bodies"]]
+        out += ["a fluid box" for b, _ in self._fluid if b == bid]
+        return out
+
+    def _add_shape_mass(self, bid, who, kind, params, density):
+        """Add a shape's mass (params in the COM frame, density [kg/m^2]) to body bid, then move
+        the body's frame to the new COM: q, the frame's origin and its shapes follow, so that
+        everything stays where it is in the world."""
+        body = self._bodies[bid]
+        area, c, j = shape_area(kind, params, who)
+        mass, d, inertia = combine_masses([(body["mass"], np.zeros(2), body["inertia"]),
+                                           (density * area, c, density * j)])
+        body["mass"], body["inertia"] = mass, inertia
+        th = body["q"][2]
+        body["q"][:2] += (math.cos(th) * d[0] - math.sin(th) * d[1],
+                          math.sin(th) * d[0] + math.cos(th) * d[1])
+        body["origin"] = body["origin"] - d
+        for k, sh in enumerate(self._shapes):
+            if sh.body == bid:
+                self._shapes[k] = M.Shape(bid, sh.kind, shifted(sh.kind, sh.params, d))
+        for sh in self._collide:
+            if sh["body"] == bid:
+                sh["core"] = sh["core"] - d
 
     def add_point_mass(self, name, mass, pos=(0.0, 0.0), vel=(0.0, 0.0), radius=None) -> int:
         """Point mass [kg] > 0 at pos [m]: no rotational degree of freedom, takes no torque.
@@ -178,12 +268,12 @@ class ModelBuilder:
              else _length("body", name, idx, "radius", radius, zero_ok=True))
         q = np.r_[_vec2("body", name, idx, "pos", pos), 0.0]
         v = np.r_[_vec2("body", name, idx, "vel", vel), 0.0]
-        self._bodies.append(dict(name=name, mass=mass, inertia=0.0, q=q, v=v, point=True))
+        self._bodies.append(dict(name=name, mass=mass, inertia=0.0, q=q, v=v, point=True, origin=None))
         self._shapes.append(M.Shape(idx, "circle", ((0.0, 0.0), r)))
         return idx
 
     def add_shape(self, body, kind, *params, collide=True, mu=1.0, restitution=0.0, category=1,
-                  mask=0xFFFF, ground=True, name=None) -> int:
+                  mask=0xFFFF, ground=True, name=None, density=None) -> int:
         """A shape on a body (local frame [m]), or fixed in the world (body None: world
         coordinates; steps, kerbs, walls): ('circle', center, radius) | ('capsule', p0, p1,
         radius) | ('box', center, width, height[, angle]) | ('polygon', [(x, y), ...]) (convex,
@@ -197,45 +287,79 @@ class ModelBuilder:
         ground=False: it touches other shapes but not the analytic ground (a foot whose own
         contacts already touch it).
         Bodies of one mechanism (linked by pins, rods or actuators) do not collide with each
-        other unless enable_collision names the pair."""
-        if kind not in SHAPE_PARAMS:
-            raise ModelError(f"shape on body {body}: kind={kind!r} must be one of "
-                             f"{', '.join(SHAPE_PARAMS)}")
+        other unless enable_collision names the pair.
+        density [kg/m^2] > 0: the shape's solid mass and inertia join its body's (a body built
+        without mass and inertia, add_body), whose COM and pose then move to the new centroid,
+        the shapes staying where they are in the world; before pins, rods, contacts,
+        actuators or fluid boxes name the body. Without density a shape adds no mass."""
         idx = len(self._shapes)
-        what = f"{kind} shape" if name is None else f"{kind} shape {name!r}"
-        bid = self._body_id(what, None, idx, "body", body, allow_world=body is None)
-        _check_shape(kind, idx, params)
+        bid = self._body_id(shape_who(kind, idx, name if isinstance(name, str) else None), None,
+                            None, "body", body,
+                            allow_world=body is None)
+        body_name = self._bodies[bid]["name"] if bid >= 0 else None
+        if name is not None and (not isinstance(name, str) or not name):
+            raise ModelError(f"{shape_who(kind, idx, None, body_name)}: name={name!r} must be a "
+                             "non-empty string")
+        who = shape_who(kind, idx, name, body_name)
+        if kind not in SHAPE_PARAMS:
+            raise ModelError(f"{who}: kind={kind!r} must be one of {', '.join(SHAPE_PARAMS)}")
+        _check_shape(kind, who, params)
+        if density is not None:
+            density = self._shape_density(bid, who, density)
+        if bid >= 0 and self._bodies[bid]["origin"] is not None:
+            params = shifted(kind, params, -self._bodies[bid]["origin"])
         if not isinstance(collide, (bool, np.bool_)):
-            raise ModelError(f"{_who(what, None, idx)}: collide={collide!r} must be True or False")
+            raise ModelError(f"{who}: collide={collide!r} must be True or False")
         if bid < 0 and not collide:
-            raise ModelError(f"{_who(what, None, idx)}: a world shape (body None) must collide")
+            raise ModelError(f"{who}: a static shape (body None) must collide")
         if collide:
-            self._collide.append(self._collision_shape(idx, what, bid, kind, params, mu,
-                                                       restitution, category, mask, name))
             if not isinstance(ground, (bool, np.bool_)):
-                raise ModelError(f"{_who(what, None, idx)}: ground={ground!r} must be True or False")
+                raise ModelError(f"{who}: ground={ground!r} must be True or False")
+            self._collide.append(self._collision_shape(idx, who, bid, kind, params, mu,
+                                                       restitution, category, mask, name))
             self._collide[-1]["ground"] = bool(ground)
         self._shapes.append(M.Shape(bid, kind, tuple(params)))
+        if density is not None:
+            self._add_shape_mass(bid, who, kind, params, density)
         return idx
 
-    def _collision_shape(self, idx, what, bid, kind, params, mu, restitution, category, mask, name):
+    def _shape_density(self, bid, who, density):
+        """density [kg/m^2] of a shape, checked: finite, > 0, on a body whose mass comes from
+        densities and that nothing but shapes names yet."""
+        density = _scalar(who, None, None, "density", density)
+        if not density > 0:
+            raise ModelError(f"{who}: density={density} must be finite and > 0 [kg/m^2]")
+        if bid < 0:
+            raise ModelError(f"{who}: density={density} on a static shape (body None), which has "
+                             "no mass")
+        body = self._bodies[bid]
+        if body["origin"] is None:
+            raise ModelError(f"{who}: density={density} on body {body['name']!r}, whose mass and "
+                             "inertia were given (add_body(..., density=...) or without mass and "
+                             "inertia builds a body from its shapes' densities)")
+        attached = self._attached(bid)
+        if attached:
+            raise ModelError(f"{who}: density={density} would move the centre of mass of body "
+                             f"{body['name']!r}, which {', '.join(attached)} already use(s); add "
+                             "its shapes with density first")
+        return density
+
+    def _collision_shape(self, idx, who, bid, kind, params, mu, restitution, category, mask, name):
         """The record compile() turns into shape_* arrays and contacts (validated here)."""
-        if name is not None and (not isinstance(name, str) or not name):
-            raise ModelError(f"{_who(what, None, idx)}: name={name!r} must be a non-empty string")
-        mu = _scalar(what, None, idx, "mu", mu)
+        mu = _scalar(who, None, None, "mu", mu)
         if mu < 0:
-            raise ModelError(f"{_who(what, None, idx)}: mu={mu} must be >= 0")
-        e = _scalar(what, None, idx, "restitution", restitution)
+            raise ModelError(f"{who}: mu={mu} must be >= 0")
+        e = _scalar(who, None, None, "restitution", restitution)
         if not 0.0 <= e <= 1.0:
-            raise ModelError(f"{_who(what, None, idx)}: restitution={e} must be in [0, 1]")
+            raise ModelError(f"{who}: restitution={e} must be in [0, 1]")
         for field, bits in (("category", category), ("mask", mask)):
             if isinstance(bits, (bool, np.bool_)) or not isinstance(bits, (int, np.integer)) or bits < 0:
-                raise ModelError(f"{_who(what, None, idx)}: {field}={bits!r} must be a non-negative "
-                                 "integer (bits)")
-        core, radius = collision_core(kind, params, idx, name)
+                raise ModelError(f"{who}: {field}={_plain(bits)!r} must be a non-negative integer "
+                                 "(bits)")
+        core, radius = collision_core(kind, params, who)
         label = name or f"{self._bodies[bid]['name'] if bid >= 0 else 'world'}.{kind}{idx}"
         return dict(shape=idx, body=bid, kind=kind, core=core, radius=radius, mu=mu,
-                    restitution=e, category=int(category), mask=int(mask), label=label)
+                    restitution=e, category=int(category), mask=int(mask), label=label, who=who)
 
     def enable_collision(self, body_a, body_b):
         """Let two bodies of one mechanism (linked by pins, rods or actuators, which keeps them
@@ -268,11 +392,15 @@ class ModelBuilder:
     def _anchors(self, kind, name, idx, a, b, anchor_world, anchor_a, anchor_b):
         if anchor_world is not None:
             pw = _vec2(kind, name, idx, "anchor_world", anchor_world)
-            la = self._local(a, pw) if anchor_a is None else _vec2(kind, name, idx, "anchor_a", anchor_a)
-            lb = self._local(b, pw) if anchor_b is None else _vec2(kind, name, idx, "anchor_b", anchor_b)
+            la = (self._local(a, pw) if anchor_a is None
+                  else self._local_point(a, _vec2(kind, name, idx, "anchor_a", anchor_a)))
+            lb = (self._local(b, pw) if anchor_b is None
+                  else self._local_point(b, _vec2(kind, name, idx, "anchor_b", anchor_b)))
         else:
-            la = np.zeros(2) if anchor_a is None else _vec2(kind, name, idx, "anchor_a", anchor_a)
-            lb = np.zeros(2) if anchor_b is None else _vec2(kind, name, idx, "anchor_b", anchor_b)
+            la = self._local_point(a, np.zeros(2) if anchor_a is None
+                                   else _vec2(kind, name, idx, "anchor_a", anchor_a))
+            lb = self._local_point(b, np.zeros(2) if anchor_b is None
+                                   else _vec2(kind, name, idx, "anchor_b", anchor_b))
         for body, lp, f in ((a, la, "anchor_a"), (b, lb, "anchor_b")):
             if body >= 0 and self._bodies[body]["point"] and np.any(lp != 0.0):
                 if np.hypot(*lp) > 1e-12:
@@ -377,7 +505,7 @@ class ModelBuilder:
                       for i, x in enumerate(np.asarray(size, dtype=np.float64).reshape(3)))
         mu = _length(who, None, len(self._fluid), "viscosity", viscosity, zero_ok=True)
         rho = _length(who, None, len(self._fluid), "density", density, zero_ok=True)
-        c = _vec2(who, None, len(self._fluid), "local", local)
+        c = self._local_point(b, _vec2(who, None, len(self._fluid), "local", local))
         th = _scalar(who, None, len(self._fluid), "angle", angle)
         d = (l1 + l2 + ln) / 3.0
         self._fluid.append((b, (c[0], c[1], th, 3.0 * math.pi * d * mu, math.pi * d ** 3 * mu,
@@ -471,6 +599,13 @@ class ModelBuilder:
         return idx
 
     # contacts -------------------------------------------------------------------------------
+    def _needs_ground(self, method, name):
+        """ModelError naming the contact when the model has no ground (ground=None)."""
+        if not self.ground:
+            raise ModelError(f"contact {name!r} ({len(self._contacts)}): {method} touches only "
+                             "the ground, and this model has none (ModelBuilder(ground=None)); "
+                             "give the body a shape (add_shape) to touch other shapes")
+
     def _contact(self, name, body, kind, local, radius, span, mu, verts):
         idx = len(self._contacts)
         self._register("contact", name, idx)
@@ -478,8 +613,9 @@ class ModelBuilder:
         mu = _scalar("contact", name, idx, "mu", mu)
         if mu < 0:
             raise ModelError(f"contact {name!r} ({idx}): mu={mu} must be >= 0")
-        local = _vec2("contact", name, idx, "local", local)
-        verts = [_vec2("contact", name, idx, f"vertex[{i}]", v) for i, v in enumerate(verts)]
+        local = self._local_point(bid, _vec2("contact", name, idx, "local", local))
+        verts = [self._local_point(bid, _vec2("contact", name, idx, f"vertex[{i}]", v))
+                 for i, v in enumerate(verts)]
         point = self._bodies[bid]["point"]
         if point and (kind != CONTACT_POINT or np.hypot(*local) > 1e-12):
             raise ModelError(f"contact {name!r} ({idx}): a point mass can only carry a point contact at (0, 0)")
@@ -492,6 +628,7 @@ class ModelBuilder:
     def add_point_contact(self, name, body, local=(0.0, 0.0), mu=1.0) -> int:
         """A point of `body` (local [m]) that touches the ground; on a point mass it uses
         continuous collision detection."""
+        self._needs_ground("add_point_contact", name)
         return self._contact(name, body, CONTACT_POINT, local, 0.0, (0.0, 0.0), mu, [])
 
     def add_arc_contact(self, name, body, center, radius, span=(-math.pi, math.pi), vertices=(),
@@ -500,6 +637,7 @@ class ModelBuilder:
         directions from the centre to the sole (full circle by default). Where the sole's lowest
         point lies outside the span, the lowest of `vertices` (heel, toe, back; local [m]) is
         used instead, so a tipped foot rests on its corners. The foot rolls."""
+        self._needs_ground("add_arc_contact", name)
         idx = len(self._contacts)
         r = _scalar("contact", name, idx, "radius", radius)
         if not r > 0:
@@ -518,6 +656,7 @@ class ModelBuilder:
         """Four corner point contacts of a box (local centre [m], width x height [m]).
         Returns the four contact ids, named ``name/0..3``; also draws the box. width and
         height must be > 0."""
+        self._needs_ground("add_box_contacts", name)
         idx = len(self._contacts)
         c = _vec2("box", name, idx, "center", center)
         width = _length("box", name, idx, "width", width)
@@ -625,10 +764,10 @@ class ModelBuilder:
                         radius=radius, span=span, mu=mu, verts=[], ccd=0, other=other, pair=pair,
                         restitution=restitution)
 
-        curved = self.terrain.coef[2] != 0      # hills: a straight side can touch a crest
+        curved = self.ground and self.terrain.coef[2] != 0   # hills: a straight side can touch a crest
         for sh in self._collide:
-            if sh["body"] < 0 or not sh["ground"]:
-                continue        # world shapes meet bodies, not the ground
+            if sh["body"] < 0 or not sh["ground"] or not self.ground:
+                continue        # world shapes meet bodies, not the ground (nor, if none, any)
             common = dict(mu=sh["mu"], restitution=sh["restitution"])
             core = sh["core"]
             if sh["kind"] in ("box", "polygon"):
@@ -702,10 +841,18 @@ class ModelBuilder:
             raise ModelError(f"model: gravity={self.gravity!r} must be a pair (gx, gy)") from None
         if not np.all(np.isfinite(g)):
             raise ModelError(f"model: gravity={tuple(g)} must be finite")
-        if not isinstance(self.terrain, Terrain):
+        if self.ground and not isinstance(self.terrain, Terrain):
             raise ModelError(f"model: terrain={self.terrain!r} must be a planarsim.terrain.Terrain")
+        if not self.ground and self.terrain is not None:
+            raise ModelError(f"model: terrain={getattr(self.terrain, 'name', self.terrain)!r} set on "
+                             "a builder made with ground=None; a world without ground has no terrain")
         if not self._bodies:
             raise ModelError("model: no bodies; add at least one with add_body or add_point_mass")
+        for i, body in enumerate(self._bodies):
+            if not body["mass"] > 0:
+                raise ModelError(f"body {body['name']!r} ({i}): no mass: none of its shapes has a "
+                                 "density; give mass= and inertia=, or density= (the body's or a "
+                                 "shape's)")
         contacts = self._contacts + self._shape_contacts()
         nb, npin, nr, nc, na = (len(x) for x in (self._bodies, self._pins, self._rods, contacts, self._acts))
 
@@ -764,7 +911,7 @@ class ModelBuilder:
             act_range=ro([a["limit"] for a in self._acts] or np.zeros((0, 2))).reshape(na, 2),
             fluid_body=ro([b for b, _ in self._fluid], np.int64).reshape(len(self._fluid)),
             fluid_coef=ro([c for _, c in self._fluid] or np.zeros((0, 8))).reshape(len(self._fluid), 8),
-            terrain_coef=ro(self.terrain.coef),
+            terrain_coef=ro((self.terrain if self.ground else flat()).coef),  # no ground: no contact reads it
             **self._shape_arrays(ro),
         )
         q0 = np.array([b["q"] for b in self._bodies])
@@ -777,4 +924,5 @@ class ModelBuilder:
                        rod_names=tuple(r["name"] for r in self._rods),
                        contact_names=tuple(c["name"] for c in contacts),
                        act_names=tuple(a["name"] for a in self._acts),
-                       q0=q0, v0=v0, shapes=tuple(self._shapes), terrain=self.terrain, meta=dict(meta))
+                       q0=q0, v0=v0, shapes=tuple(self._shapes), terrain=self.terrain, meta=dict(meta),
+                       shape_names=tuple(sh["who"] for sh in self._collide))

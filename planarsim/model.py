@@ -115,8 +115,10 @@ class Model:
     q0: np.ndarray                  # (n_body, 3) initial positions [m, m, rad]
     v0: np.ndarray                  # (n_body, 3) initial velocities [m/s, m/s, rad/s]
     shapes: tuple = ()
-    terrain: object = None
+    terrain: object = None          # the ground's Terrain; None: no ground (ModelBuilder(ground=None))
     meta: dict = field(default_factory=dict)
+    shape_names: tuple = ()         # how messages name each colliding shape (its kind, index,
+                                    #   name= and body), in the order of shape_body
 
     # counts
     @property

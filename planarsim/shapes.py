@@ -30,8 +30,15 @@ SHAPE_KINDS = ("circle", "capsule", "box", "polygon")
 CORE_TOL = 1e-12
 
 
-def _who(idx, kind, name):
-    return f"{kind} shape {name!r} ({idx})" if name else f"{kind} shape ({idx})"
+def shape_who(kind, idx, name=None, body=False) -> str:
+    """How messages name a shape: its name= where it has one, its kind and index, its body:
+    "shape 'heel' (circle 0) of body 'shin_L'", "circle shape (3) of body 'shin_L'", "static
+    box shape (2)". body: the body's name, None for a static shape (fixed in the world), False
+    when not known (the shape's body is what is wrong)."""
+    who = f"shape {name!r} ({kind} {idx})" if name else f"{kind} shape ({idx})"
+    if body is False:
+        return who
+    return f"static {who}" if body is None else f"{who} of body {body!r}"
 
 
 def box_vertices(center, width, height, angle=0.0):
@@ -82,10 +89,10 @@ def convex_ccw(vertices, who):
     return v if sign > 0 else v[::-1].copy()
 
 
-def collision_core(kind, params, idx, name=None):
+def collision_core(kind, params, who):
     """(core (n, 2), radius) of a colliding shape's parameters, validated: radii > 0, box
-    sides > 0, a capsule's ends apart, a polygon convex with at least 3 distinct vertices."""
-    who = _who(idx, kind, name)
+    sides > 0, a capsule's ends apart, a polygon convex with at least 3 distinct vertices;
+    errors name `who` (shape_who)."""
     if kind == "circle":
         center, radius = params[0], float(params[1])
         if not radius > 0:
@@ -104,6 +111,86 @@ def collision_core(kind, params, idx, name=None):
     if kind == "polygon":
         return convex_ccw(params[0], who), 0.0
     raise ModelError(f"{who}: kind must be one of {', '.join(SHAPE_KINDS)}")
+
+
+# mass properties -----------------------------------------------------------------------------
+def shape_area(kind, params, who="shape") -> tuple:
+    """(area A [m^2], centroid (2,) [m], polar second moment of area about the centroid
+    J [m^4]) of a shape given as add_shape takes it (a solid of unit area density: its mass is
+    A, its moment of inertia J). Capsule: a rectangle of the segment's length L and width 2r
+    plus two half disks (Box2D's b2ComputeCapsuleMass); convex polygon: triangles from an
+    inner point."""
+    if kind == "circle":
+        r = float(params[1])
+        area = math.pi * r * r
+        return area, np.asarray(params[0], dtype=np.float64).reshape(2), 0.5 * area * r * r
+    if kind == "capsule":
+        p0 = np.asarray(params[0], dtype=np.float64).reshape(2)
+        p1 = np.asarray(params[1], dtype=np.float64).reshape(2)
+        r = float(params[2])
+        length = math.hypot(*(p1 - p0))
+        rect, disk = 2.0 * r * length, math.pi * r * r
+        arm = 4.0 * r / (3.0 * math.pi)     # a half disk's centroid from its flat side
+        # rectangle (L^2 + 4 r^2)/12; half disks: r^2/2 about their centre, shifted out by L/2
+        j = (rect * (length * length + 4.0 * r * r) / 12.0
+             + disk * (0.5 * r * r + 0.25 * length * length + length * arm))
+        return rect + disk, 0.5 * (p0 + p1), j
+    if kind == "box":
+        w, h = float(params[1]), float(params[2])
+        return w * h, np.asarray(params[0], dtype=np.float64).reshape(2), w * h * (w * w + h * h) / 12.0
+    if kind == "polygon":
+        v = convex_ccw(params[0], who)
+        o = v.mean(axis=0)                  # an inner point: the triangles' common vertex
+        e1, e2 = v - o, np.roll(v, -1, axis=0) - o
+        cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+        area = 0.5 * float(np.sum(cross))
+        c = np.sum(cross[:, None] * (e1 + e2), axis=0) / (6.0 * area)
+        j_o = float(np.sum(cross * (np.sum(e1 * e1, axis=1) + np.sum(e1 * e2, axis=1)
+                                    + np.sum(e2 * e2, axis=1)))) / 12.0
+        return area, o + c, j_o - area * float(c @ c)
+    raise ModelError(f"{who}: kind={kind!r} must be one of {', '.join(SHAPE_KINDS)}")
+
+
+def combine_masses(parts) -> tuple:
+    """(mass [kg], centre of mass (2,) [m], inertia about it [kg m^2]) of rigidly joined parts
+    (mass, centre (2,), inertia about that centre): the parallel-axis theorem."""
+    parts = list(parts)
+    mass = sum(m for m, _, _ in parts)
+    if not mass > 0:
+        return 0.0, np.zeros(2), 0.0
+    c = sum(m * np.asarray(p, dtype=np.float64) for m, p, _ in parts) / mass
+    inertia = sum(i + m * float((np.asarray(p) - c) @ (np.asarray(p) - c)) for m, p, i in parts)
+    return float(mass), c, float(inertia)
+
+
+def mass_properties(shapes, density) -> tuple:
+    """(mass [kg], centroid (2,) [m], moment of inertia about the centroid [kg m^2]) of solid
+    shapes of area density `density` [kg/m^2] (one number, or one per shape), as Box2D and
+    pymunk compute them. shapes: tuples (kind, *params) as ModelBuilder.add_shape takes them,
+    in one frame: ``mass_properties([("circle", (0, 0), 0.1)], 1000.0)`` is a disk of
+    m = 1000 pi 0.1^2 with I = m r^2 / 2."""
+    shapes = [tuple(s) for s in shapes]
+    rho = np.broadcast_to(np.asarray(density, dtype=np.float64), (len(shapes),))
+    if not np.all(np.isfinite(rho) & (rho > 0)):
+        raise ModelError(f"mass_properties: density={np.asarray(density).tolist()} must be finite "
+                         "and > 0")
+    parts = []
+    for k, (s, d) in enumerate(zip(shapes, rho)):
+        area, c, j = shape_area(s[0], s[1:], f"shape {k}")
+        parts.append((float(d) * area, c, float(d) * j))
+    return combine_masses(parts)
+
+
+def shifted(kind, params, d) -> tuple:
+    """A shape's parameters moved by -d [m] (the same shape seen from a frame whose origin is
+    at d)."""
+    d = np.asarray(d, dtype=np.float64)
+    if kind == "polygon":
+        return (tuple(tuple(np.asarray(v, dtype=np.float64) - d) for v in params[0]),)
+    if kind == "capsule":
+        return (tuple(np.asarray(params[0], float) - d), tuple(np.asarray(params[1], float) - d),
+                *params[2:])
+    return (tuple(np.asarray(params[0], float) - d),) + tuple(params[1:])     # circle, box
 
 
 def bounding_circle(core, radius):

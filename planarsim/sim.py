@@ -10,6 +10,8 @@ field, with the state at the start of the failed step.
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .errors import diverged
@@ -17,7 +19,7 @@ from .integrator import check_integrator
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
-from .start_check import check_start
+from .start_check import check_overlap, check_start, overlapping
 from .state import (State, Workspace, check_state, copy_arrays, forget_ground_queries, forget_pairs,
                     make_state, make_workspace)
 from .trajectory import Trajectory, check_recording, make_recorder, record_state
@@ -41,10 +43,13 @@ class Simulator:
     allow_below_ground : start even where a contact is more than START_TOLERANCE (1 mm) below
         the ground (the first step then moves it to the surface); by default that start is a
         ModelError naming the contact, its body and its depth (planarsim.start_check)
+    allow_overlap : start even where two shapes that may collide overlap by more than
+        START_TOLERANCE (the first step then pushes them apart, and a warning names the pair and
+        the depth); by default that start is a ModelError naming both shapes and the depth
     """
 
     def __init__(self, model: Model, options: StepOptions | None = None, state: State | None = None,
-                 allow_below_ground: bool = False):
+                 allow_below_ground: bool = False, allow_overlap: bool = False):
         if not isinstance(model, Model):
             raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
         self._model = model
@@ -54,6 +59,13 @@ class Simulator:
             self.state = state
         if not allow_below_ground:
             check_start(model, self._state)
+        if not allow_overlap:
+            check_overlap(model, self._state)
+        else:
+            count, said = overlapping(model, self._state)
+            if count:
+                warnings.warn(f"{said}; the first step pushes them apart (allow_overlap=True)",
+                              stacklevel=2)
         self._u0 = np.zeros(model.n_act)
         self._recorded_entry = None
         self._args = None

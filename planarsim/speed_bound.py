@@ -4,7 +4,8 @@ at once with the body named, long before the magnitude guard (1e10) would.
 
 The speeds the model explains [m/s]:
   fall      sqrt(2 |g| (H + L)): a fall from the highest body's height above the ground H plus
-            the model's size L (the span of its bodies and contact points, at least 1 m)
+            the model's size L (the span of its bodies and contact points, at least 1 m); a
+            model without ground (ModelBuilder(ground=None)) under gravity has no bound (0)
   start     the fastest body's speed, or turning speed |omega| r_g, at the start
   actuators each actuator's largest force or torque acting for one second on the lightest
             body it moves: F / m, or tau / (m r_g) (r_g = sqrt(I / m))
@@ -38,8 +39,10 @@ def speed_bound(model, v=None, q=None) -> float:
         points.append(q[a.contact_body, :2] + np.abs(a.contact_local).max())
     points = np.vstack(points)
     size = max(MIN_SIZE, float(np.ptp(points[:, 0])) + float(np.ptp(points[:, 1])))
-    height = max(0.0, float(np.max(q[:, 1] - model.terrain.height(q[:, 0]))))
     g = float(np.hypot(*a.gravity))
+    if model.terrain is None and g > 0.0:
+        return 0.0          # no ground: a body falls without end, no speed bounds it
+    height = 0.0 if model.terrain is None else max(0.0, float(np.max(q[:, 1] - model.terrain.height(q[:, 0]))))
     speeds = [MIN_SPEED, math.sqrt(2.0 * g * (height + size))]
     if len(v):
         speeds.append(float(np.max(np.hypot(v[:, 0], v[:, 1]))))

@@ -1,21 +1,27 @@
-"""Where a run starts: no body or contact may start below the ground.
+"""Where a run starts: no body or contact may start below the ground, no two colliding shapes
+inside each other.
 
 The step lifts a contact found below the ground onto it (the position projection), so a body
 built 1 m inside a hill would jump to the surface in the first step with no word. A simulator
 (planarsim.Simulator, a walker's run) refuses that start instead: a ModelError naming the
-contact, its body and how deep it is, unless the caller allows it.
+contact, its body and how deep it is, unless the caller allows it. Two shapes that may collide
+(their category and mask accept each other, their bodies are not of one mechanism) and start
+overlapping would likewise be pushed apart in the first step: a Simulator refuses that start
+too (a ModelError naming both shapes and the depth) unless allow_overlap=True.
 
 Depths are measured here in plain numpy from the model's terrain (not by the compiled
 contact search): a point's depth along the ground's normal at its x, an arc sole's and a
 straight side's deepest sample (every 0.5 degrees of arc, 200 points of a side), which is
-exact to far below the tolerance.
+exact to far below the tolerance. A pair of shapes' depth is exact: the separating axis test
+on their cores (every edge's normal, a segment's direction too) where the cores overlap, the
+distance between their closest features where they do not, less both radii (shape_gap).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .errors import ModelError
-from .kernels.codes import CONTACT_ARC, CONTACT_EDGE, CONTACT_POINT
+from .kernels.codes import CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
 from .terrain import from_coef
 
 START_TOLERANCE = 1e-3   # [m] a contact may start this far below the ground (rounding, a foot
@@ -66,6 +72,8 @@ def contact_depths(model, q, enabled=None) -> list:
     (n_body, 3): how far its deepest point is below the ground (negative: clear by that
     much) and where."""
     out = []
+    if model.terrain is None:
+        return out          # no ground (ModelBuilder(ground=None)): nothing to be below
     q = np.asarray(q, dtype=np.float64)
     ground = from_coef(model.arrays.terrain_coef, "ground")
     for i in range(model.n_contact):
@@ -103,3 +111,126 @@ def check_start(model, state, tolerance: float = START_TOLERANCE, who: str = "si
     if count:
         raise ModelError(f"{said}; the first step would move it to the surface. Build the body "
                          f"higher (its pos), or pass allow_below_ground=True to start it there")
+
+
+# shapes inside each other -------------------------------------------------------------------
+def _segments(core) -> tuple:
+    """(starts, ends) (m, 2) of a core's sides: a circle's one point (a segment of length 0),
+    a capsule's segment, a polygon's edges."""
+    if len(core) <= 2:
+        return core[:1], core[-1:]
+    return core, np.roll(core, -1, axis=0)
+
+
+def _point_segment_distance(p, a, b) -> np.ndarray:
+    """Distances [m] from points p (n, 2) to every segment a -> b (m, 2): (n, m)."""
+    ab = b - a
+    ap = p[:, None, :] - a[None, :, :]
+    len2 = np.sum(ab * ab, axis=1)
+    u = np.clip(np.sum(ap * ab[None], axis=2) / np.where(len2 > 0, len2, 1.0), 0.0, 1.0)
+    d = ap - u[:, :, None] * ab[None]
+    return np.hypot(d[..., 0], d[..., 1])
+
+
+def _axes(core_a, core_b) -> np.ndarray:
+    """Unit directions (k, 2) on which two convex cores, if apart, show a gap: every side's
+    normal, a segment's direction, and two points' joining line."""
+    out = []
+    for core in (core_a, core_b):
+        starts, ends = _segments(core)
+        e = ends - starts
+        out += [np.stack([e[:, 1], -e[:, 0]], axis=1)]
+        if len(core) == 2:
+            out.append(e)
+    if len(core_a) == 1 and len(core_b) == 1:
+        out.append(core_b - core_a)
+    axes = np.concatenate(out)
+    n = np.hypot(axes[:, 0], axes[:, 1])
+    return axes[n > 0] / n[n > 0, None]
+
+
+def shape_gap(core_a, radius_a, core_b, radius_b) -> float:
+    """Signed distance [m] between two rounded convex shapes given by their cores (n, 2) in
+    world coordinates and radii [m]: the gap between them, negative by the depth by which they
+    overlap (the shortest translation that separates them)."""
+    core_a = np.asarray(core_a, dtype=np.float64).reshape(-1, 2)
+    core_b = np.asarray(core_b, dtype=np.float64).reshape(-1, 2)
+    axes = _axes(core_a, core_b)
+    sep = 0.0               # two coincident points: cores touching
+    if len(axes):
+        pa, pb = core_a @ axes.T, core_b @ axes.T
+        sep = float(np.max(np.maximum(pb.min(axis=0) - pa.max(axis=0),
+                                      pa.min(axis=0) - pb.max(axis=0))))
+    if sep > 0.0:           # cores apart: the distance of their closest features
+        sa, sb = _segments(core_a), _segments(core_b)
+        sep = float(min(_point_segment_distance(core_a, *sb).min(),
+                        _point_segment_distance(core_b, *sa).min()))
+    return sep - radius_a - radius_b
+
+
+def _shape_world(model, q, i) -> np.ndarray:
+    """Core vertices (n, 2) [m] of colliding shape i in the world at configuration q."""
+    a = model.arrays
+    adr, num, b = int(a.shape_vert_adr[i]), int(a.shape_vert_num[i]), int(a.shape_body[i])
+    core = np.asarray(a.core_vert[adr:adr + num], dtype=np.float64)
+    return core if b < 0 else _world(q, b, core)
+
+
+def shape_overlaps(model, q, enabled=None) -> list:
+    """[(depth [m], shape i, shape j)] of every pair of shapes that may collide (an enabled pair
+    contact of the model) and overlap at configuration q (n_body, 3); depth > 0."""
+    a = model.arrays
+    q = np.asarray(q, dtype=np.float64)
+    pairs = {}
+    for c in np.flatnonzero(np.asarray(a.contact_kind) == CONTACT_PAIR):
+        if enabled is None or enabled[c]:
+            pairs[(int(a.contact_pair[c, 0]), int(a.contact_pair[c, 1]))] = True
+    if not pairs:
+        return []
+    ij = np.array(list(pairs), dtype=np.int64).reshape(-1, 2)
+    # bounding circles first: only the pairs whose circles overlap are measured
+    bound = np.asarray(a.shape_bound, dtype=np.float64)
+    body = np.asarray(a.shape_body)
+    pose = np.where(body[:, None] >= 0, q[np.maximum(body, 0)], 0.0)   # static: the world's
+    c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+    centre = pose[:, :2] + np.stack([c * bound[:, 0] - s * bound[:, 1],
+                                     s * bound[:, 0] + c * bound[:, 1]], axis=1)
+    dist = np.hypot(*(centre[ij[:, 0]] - centre[ij[:, 1]]).T)
+    out = []
+    for i, j in ij[dist < bound[ij[:, 0], 2] + bound[ij[:, 1], 2]]:
+        gap = shape_gap(_shape_world(model, q, i), float(a.shape_radius[i]),
+                        _shape_world(model, q, j), float(a.shape_radius[j]))
+        if gap < 0.0:
+            out.append((-gap, int(i), int(j)))
+    return out
+
+
+def _shape_who(model, i) -> str:
+    """How messages name colliding shape i (its body, and its name= where it has one)."""
+    names = getattr(model, "shape_names", ())
+    if i < len(names):
+        return names[i]
+    b = int(model.arrays.shape_body[i])
+    return f"shape ({i}) of " + ("the world (static)" if b < 0 else f"body {model.body_names[b]!r}")
+
+
+def overlapping(model, state, tolerance: float = START_TOLERANCE, who: str = "simulator"):
+    """(how many pairs of shapes that may collide overlap by more than `tolerance` [m] at
+    `state`, a sentence naming the deepest pair and its depth; '' when none)."""
+    deep = [o for o in shape_overlaps(model, state.q, state.contact_enabled) if o[0] > tolerance]
+    if not deep:
+        return 0, ""
+    depth, i, j = max(deep)
+    more = len(deep) - 1
+    others = f" (and {more} more pair{'s' if more > 1 else ''})" if more else ""
+    return len(deep), (f"{who}: {_shape_who(model, i)} and {_shape_who(model, j)} start "
+                       f"overlapping by {depth:.4g} m{others}, more than {tolerance:g} m")
+
+
+def check_overlap(model, state, tolerance: float = START_TOLERANCE, who: str = "simulator") -> None:
+    """ModelError naming the deepest pair of colliding shapes that start overlapping by more
+    than `tolerance` [m] at `state` (both shapes, their bodies, the depth), else nothing."""
+    count, said = overlapping(model, state, tolerance, who)
+    if count:
+        raise ModelError(f"{said}; the first step would push them apart. Build them apart, or "
+                         f"pass allow_overlap=True to start them there")

@@ -45,6 +45,8 @@ def terrain_info(model) -> dict:
     Trajectory records so that it reproduces its ground."""
     coef = np.asarray(model.arrays.terrain_coef, dtype=np.float64)
     ter = getattr(model, "terrain", None)
+    if ter is None:
+        return {"terrain": "none"}      # no ground (ModelBuilder(ground=None))
     return {"terrain": str(getattr(ter, "name", "terrain")), "terrain_coef": tuple(coef.tolist())}
 
 
@@ -141,7 +143,7 @@ class Trajectory:
 
     def terrain(self):
         """The planarsim.terrain.Terrain the run was on (from info's terrain_coef and
-        terrain), or None for a recording that did not keep it."""
+        terrain), or None for a world without ground or a recording that did not keep it."""
         from .terrain import from_coef
         coef = self.info.get("terrain_coef")
         if coef is None:

@@ -405,10 +405,15 @@ def refresh_contact(m, s, ws, i):
 def engage_contact(m, s, ws, i, vn, vt):
     """Bring free contact i into touch, approaching at normal velocity vn and tangential vt
     [m/s]: sliding along vt when |vt| > mu |vn| (an impact's friction impulse, at most mu
-    times its normal impulse, cannot stop that slip), else pinned. The checks after the solve
+    times its normal impulse, cannot stop that slip), else pinned; a frictionless contact
+    (mu = 0) always slides, with slip 0 and no friction. The checks after the solve
     then settle it: a pinned contact outside the friction cone slides, a sliding one whose slip
     reverses sticks, so an impact ends up sticking exactly when Coulomb's law says so."""
-    if abs(vt) > m.contact_mu[i] * abs(vn) and abs(vt) > 1e-9:
+    if m.contact_mu[i] == 0.0:
+        # frictionless: touching is sliding with no friction (slip 0; no tangent row)
+        s.contact_mode[i] = MODE_SLIDING
+        s.contact_slip[i] = 0.0
+    elif abs(vt) > m.contact_mu[i] * abs(vn) and abs(vt) > 1e-9:
         s.contact_mode[i] = MODE_SLIDING
         s.contact_slip[i] = 1.0 if vt > 0.0 else -1.0
     else:

@@ -31,6 +31,9 @@ LCP_INACCURATE = 3   # the path ended, but its basis gives no answer within ANSW
 # the rounding of a basis of condition up to 1e9 (a 16-box chain resting on its 32 corners has
 # 3e9: its fresh solve misses by 2e-9 max -q)
 ANSWER_TOL = 1e-7
+# the answer check's scale is at least this share of the problem's largest |q|: its basic
+# values carry rounding of every q (ANSWER_TOL times this, 1e-13 of max |q|, is ~500 eps)
+ROUNDING_SHARE = 1e-6
 GOLDEN = 0.6180339887498949
 # refinements of the final basis against M and q (rounding of the pivots, not the path): at
 # most this many, until the residual is rounding (REFINE_TARGET of max -q) or stops shrinking
@@ -313,12 +316,15 @@ def polish(M, q, m, T, basis, z, floor):
 def _basic_residual(M, q, m, T, basis, res):
     """res = q - B x for the basic values x (T's rhs column) of the basis; returns the
     largest -q_i (the fastest approach: rows with a large positive q, say a contact far
-    above the ground, must not loosen the tolerance of the others)."""
+    above the ground, must not loosen the tolerance of the others), at least ROUNDING_SHARE
+    of the largest |q_i|."""
     rhs = 2 * m + 1
     scale = 0.0
+    size = 0.0
     for i in range(m):
         res[i] = q[i]
         scale = max(scale, -q[i])
+        size = max(size, abs(q[i]))
     for i in range(m):
         b = basis[i]
         x = T[i, rhs]
@@ -328,7 +334,10 @@ def _basic_residual(M, q, m, T, basis, res):
             j = b - m                   # column of z_j: -M[:, j]
             for k in range(m):
                 res[k] += M[k, j] * x
-    return scale
+    # ... but the basic values are computed from every q: where the only approaches are
+    # rounding (touching bodies at rest beside an impact, -q ~ 1e-14) their rounding is that
+    # of the largest |q|, far below what an approach could be (ROUNDING_SHARE of it)
+    return max(scale, ROUNDING_SHARE * size)
 
 
 @kernel

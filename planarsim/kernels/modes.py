@@ -67,6 +67,8 @@ def check_contact(m, s, ws, i):
         if ln < 0.0:
             s.contact_mode[i] = MODE_FREE
             return 1
+        if m.contact_mu[i] == 0.0:
+            return 0        # frictionless: it slides whichever way it moves
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
         if vt * s.contact_slip[i] <= 0.0:
             s.contact_mode[i] = MODE_PINNED

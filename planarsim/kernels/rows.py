@@ -321,8 +321,9 @@ def build_rows(m, s, ws):
             jr += 1
         else:
             mode = s.contact_mode[ic]
+            # a frictionless contact (mu = 0) has no tangent row in any mode
             n = add_contact_rows(ws, n, ic, mode == MODE_PINNED or mode == MODE_SLIDING,
-                                 mode == MODE_PINNED)
+                                 mode == MODE_PINNED and m.contact_mu[ic] > 0.0)
             ic += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
@@ -335,9 +336,10 @@ def build_rows(m, s, ws):
             for k in range(3):
                 ws.row_F[r, e, k] = ws.row_J[r, e, k]
         o = ws.row_owner[r]
-        if ws.row_kind[r] == ROW_CONTACT_N and s.contact_mode[o] == MODE_SLIDING:
+        if (ws.row_kind[r] == ROW_CONTACT_N and s.contact_mode[o] == MODE_SLIDING
+                and m.contact_mu[o] * s.contact_slip[o] != 0.0):
             sliding += 1
-            # impulse lambda_n (n - mu s t): t = (n_y, -n_x)
+            # impulse lambda_n (n - mu s t): t = (n_y, -n_x); frictionless (mu s = 0): F = J
             b = ws.row_body[r, 1]
             nx = ws.contact_normal[o, 0]
             ny = ws.contact_normal[o, 1]

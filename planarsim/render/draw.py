@@ -297,6 +297,8 @@ class Scene:
 
     def _terrain(self, x0, x1):
         ter = self.model.terrain
+        if ter is None:         # no ground (ModelBuilder(ground=None)): nothing drawn
+            return np.zeros((0, 2)), np.zeros((0, 2, 2)), np.zeros(0, dtype=bool)
         xs = np.linspace(x0, x1, 121)      # 5 cm apart on a 5 m view: smooth for hills of 1 m and more
         line = np.column_stack([xs, ter.height(xs)])
         s = self.tick_spacing
@@ -336,6 +338,8 @@ class Scene:
                 continue
             if normals is not None and np.all(np.isfinite(normals[i])):
                 n = np.asarray(normals[i], float)
+            elif ter is None:
+                continue        # no normal recorded and no ground to take one from
             else:
                 n = ter.normal(points[i, 0]).reshape(2)
             t = np.array([n[1], -n[0]])
@@ -404,8 +408,10 @@ class Scene:
         x0, x1 = center[0] - 0.6 * self.view_width, center[0] + 0.6 * self.view_width
         line, ticks, major = self._terrain(x0, x1)
         self.terrain_line.set_data(line[:, 0], line[:, 1])
-        bottom = center[1] - 2.0 * self.view_height - abs(line[:, 1]).max()
-        self.ground_fill.set_xy(np.vstack([line, [[x1, bottom], [x0, bottom]]]))
+        self.ground_fill.set_visible(len(line) > 0)
+        if len(line):
+            bottom = center[1] - 2.0 * self.view_height - abs(line[:, 1]).max()
+            self.ground_fill.set_xy(np.vstack([line, [[x1, bottom], [x0, bottom]]]))
         self.ticks.set_segments(list(ticks))
         self._place_tick_labels(ticks, major, center[0])
         self.bodies.set_verts(self.body_polygons(q))

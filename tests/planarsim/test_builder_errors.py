@@ -108,3 +108,72 @@ def test_valid_model_compiles_and_is_read_only():
     assert m.n_body == 1
     with pytest.raises(ValueError):
         m.arrays.body_mass[0] = 2.0
+
+
+# shapes: every mistake names the shape's body and its name= -----------------------------------
+SQUARE = [(0.0, 0.0), (0.1, 0.0), (0.1, 0.1), (0.0, 0.1)]
+NP0 = np.float64(0.0)
+
+
+@pytest.mark.parametrize("kind, params, kw, words", [
+    ("circle", ((0.0, 0.0),), {}, r"params=\(\(0.0, 0.0\),\) must be \(center, radius\)"),
+    ("circle", ((0.0, 0.0), 0.1, 0.2), {}, r"must be \(center, radius\)"),
+    ("circle", ((NP0, NP0), NP0), {}, r"radius=0.0 must be > 0 for a shape that collides"),
+    ("circle", ((0.0, 0.0), -0.1), {}, r"radius=-0.1 must be >= 0"),
+    ("circle", ((0.0, 0.0), "big"), {}, r"radius='big' must be a number"),
+    ("circle", ((0.0, 0.0), math.inf), {}, r"radius=inf must be finite"),
+    ("circle", (NP0, 0.1), {}, r"center=0.0 must be a pair \(x, y\)"),
+    ("circle", ((NP0, math.nan), 0.1), {}, r"center=\[0.0, nan\] must be finite"),
+    ("capsule", ((0.0, 0.0), (0.0, 0.0), 0.05), {}, r"p0 and p1 coincide; use a circle"),
+    ("capsule", ((0.0, 0.0), (0.0, -0.3), 0.0), {}, r"radius=0.0 must be > 0 for a shape that collides"),
+    ("box", ((0.0, 0.0), NP0, 0.1), {}, r"width=0.0 must be > 0"),
+    ("box", ((0.0, 0.0), 0.1, -0.2), {}, r"height=-0.2 must be > 0"),
+    ("box", ((0.0, 0.0), 0.1, 0.2, math.nan), {}, r"angle=nan must be finite"),
+    ("box", ((0.0, 0.0), 0.1, 0.2, "flat"), {}, r"angle='flat' must be a number"),
+    ("polygon", (3,), {}, r"vertices=3 must be a list of \(x, y\) pairs"),
+    ("polygon", ([(0.0, 0.0), (1.0,), (1.0, 1.0)],), {}, r"vertices\[1\]=\(1.0,\) must be a pair"),
+    ("polygon", ([(0.0, 0.0), (1.0, math.nan), (1.0, 1.0)],), {}, r"vertices\[1\]=\[1.0, nan\] must be finite"),
+    ("polygon", ([(0.0, 0.0), (1.0, 0.0)],), {}, r"a polygon needs at least 3 vertices, got 2"),
+    ("polygon", ([(0.0, 0.0), (0.0, 0.0), (1.0, 1.0)],), {}, r"vertices 0 and 1 coincide"),
+    ("polygon", ([(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (1.0, 1.0)],), {}, r"lies on the line"),
+    ("polygon", ([(0.0, 0.0), (2.0, 0.0), (1.0, 0.2), (1.0, 1.0)],), {}, r"not convex"),
+    ("polygon", ([(math.cos(a), math.sin(a)) for a in np.arange(5) * 4 * math.pi / 5],), {},
+     r"winds around 2 times"),
+    ("blob", ((0.0, 0.0), 0.1), {}, r"kind='blob' must be one of"),
+    ("circle", ((0.0, 0.0), 0.1), dict(collide="yes"), r"collide='yes' must be True or False"),
+    ("circle", ((0.0, 0.0), 0.1), dict(ground=1), r"ground=1 must be True or False"),
+    ("circle", ((0.0, 0.0), 0.1), dict(mu=-0.5), r"mu=-0.5 must be >= 0"),
+    ("circle", ((0.0, 0.0), 0.1), dict(mu=math.nan), r"mu=nan must be finite"),
+    ("circle", ((0.0, 0.0), 0.1), dict(restitution=1.5), r"restitution=1.5 must be in \[0, 1\]"),
+    ("circle", ((0.0, 0.0), 0.1), dict(category=-1), r"category=-1 must be a non-negative integer"),
+    ("circle", ((0.0, 0.0), 0.1), dict(mask=np.float64(2.0)), r"mask=2.0 must be a non-negative integer"),
+])
+@pytest.mark.parametrize("name", [None, "heel"])
+def test_every_shape_mistake_names_its_body_and_name(kind, params, kw, words, name):
+    b = base()
+    b.add_body("shin_L", mass=1.0, inertia=0.1, pos=(0.0, 0.5))
+    with pytest.raises(ModelError, match=words) as err:
+        b.add_shape("shin_L", kind, *params, name=name, **kw)
+    said = str(err.value)
+    assert "np.float64" not in said
+    shape = f"shape 'heel' ({kind} 0)" if name else f"{kind} shape (0)"
+    assert said.startswith(f"{shape} of body 'shin_L': "), said
+    # the same shape given with add_body(shapes=...)
+    with pytest.raises(ModelError, match=words) as err:
+        base().add_body("shin_L", mass=1.0, inertia=0.1, shapes=[(kind, *params, dict(kw, name=name))])
+    assert str(err.value).startswith(f"{shape} of body 'shin_L': "), str(err.value)
+
+
+def test_static_shape_mistakes_say_static():
+    with pytest.raises(ModelError, match=r"^static shape 'ramp' \(box 0\): width=-1.0 must be > 0"):
+        base().add_shape(None, "box", (0.0, 0.0), -1.0, 0.1, name="ramp")
+    with pytest.raises(ModelError, match=r"^static circle shape \(0\): a static shape \(body None\) "
+                                         r"must collide"):
+        base().add_shape(None, "circle", (0.0, 0.0), 0.1, collide=False)
+
+
+def test_a_shape_on_a_missing_body_names_the_body_given():
+    with pytest.raises(ModelError, match=r"^shape 'heel' \(circle 0\): body='shin_L' names no body"):
+        base().add_shape("shin_L", "circle", (0.0, 0.0), 0.1, name="heel")
+    with pytest.raises(ModelError, match=r"^static circle shape \(0\): name=3 must be a non-empty"):
+        base().add_shape(None, "circle", (0.0, 0.0), 0.1, name=3)

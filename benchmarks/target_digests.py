@@ -1,0 +1,114 @@
+"""The same numbers on every machine: bit-level fingerprints of the shipped walkers
+(walker_digests.py) and of a fixed set of stress-corpus runs (contact_stress.py), computed in
+fresh processes with numba's code generated for this CPU, for a generic x86-64 target
+(NUMBA_CPU_NAME=generic: no AVX, no FMA; numba then sets NUMBA_CPU_FEATURES to none), and
+with 1 and 2 threads (NUMBA_NUM_THREADS, OPENBLAS_NUM_THREADS); every fingerprint must be
+identical across all four.
+
+    python benchmarks/target_digests.py                  # 3 s per walker, the corpus set
+    python benchmarks/target_digests.py --seconds 1      # quicker
+    python benchmarks/target_digests.py --print          # this process's fingerprints only
+
+Prints each setting's difference from the host's (none: "identical") and exits 1 if any.
+A first run of the generic target compiles every kernel for it (numba caches it beside the
+host's code, one cache entry per target).
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+#: (label, environment settings) of each run; the first is the reference
+SETTINGS = (("host", {}),
+            ("generic", {"NUMBA_CPU_NAME": "generic"}),
+            ("threads=1", {"NUMBA_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}),
+            ("threads=2", {"NUMBA_NUM_THREADS": "2", "OPENBLAS_NUM_THREADS": "2"}))
+
+#: stress-corpus runs fingerprinted: (family, seed), each for its family's whole run
+CORPUS = (("biped_stance", 0), ("biped_collapse", 1), ("chain_hills", 2), ("mass_ratio", 3),
+          ("shape_pile", 4), ("shape_hills", 5), ("loop_inertia", 36), ("loop_inertia", 162),
+          ("hills_fast", 7), ("ranger_loop", 2))
+
+
+def corpus_lines():
+    """One line per CORPUS run: a digest of every step's q and v [m, rad, m/s, rad/s] and how
+    the run ended (the error's text, or ok)."""
+    import numpy as np
+
+    import planarsim as ps
+    from benchmarks.contact_stress import MAX_STEPS, SECONDS, build, commands
+    from benchmarks.walker_digests import digest
+    for family, seed in CORPUS:
+        model, _, q0, v0 = build(family, seed)
+        n = min(int(round(SECONDS[family] / model.dt)), MAX_STEPS)
+        u = commands(family, seed, model, n)
+        sim = ps.Simulator(model, ps.make_options(), ps.make_state(model, q0, v0))
+        frames, end = [np.concatenate([q0, v0])], "ok"
+        try:
+            for k in range(n):
+                sim.step(None if u is None else u[k])
+                frames.append(np.concatenate([sim.state.q, sim.state.v]))
+        except ps.SimulationDiverged as exc:
+            end = str(exc).splitlines()[0]
+        yield f"{family:14s} {seed:4d} {digest(np.array(frames))} steps {len(frames) - 1} {end}"
+
+
+def fingerprints(seconds):
+    """This process's fingerprints: walker_digests' lines, then corpus_lines'."""
+    from benchmarks import walker_digests
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        walker_digests.main(["--seconds", str(seconds)])
+    return out.getvalue().splitlines() + list(corpus_lines())
+
+
+def run(settings, seconds):
+    """The fingerprints of a fresh process with `settings` in its environment."""
+    env = dict(os.environ, **settings)
+    for name in ("NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
+        if name not in settings:
+            env.pop(name, None)
+    done = subprocess.run([sys.executable, __file__, "--print", "--seconds", str(seconds)],
+                          env=env, cwd=ROOT, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"{' '.join(f'{k}={v}' for k, v in settings.items()) or 'host'}: "
+                         f"the fingerprints' run failed:\n{done.stderr}")
+    return done.stdout.splitlines()
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=3.0, help="simulated time per walker [s]")
+    ap.add_argument("--print", action="store_true", help="print this process's fingerprints")
+    a = ap.parse_args(argv)
+    if a.print:
+        print("\n".join(fingerprints(a.seconds)))
+        return 0
+    reference = None
+    differing = 0
+    for label, settings in SETTINGS:
+        lines = run(settings, a.seconds)
+        if reference is None:
+            reference = lines
+            print(f"{label}: {len(lines)} fingerprints")
+            continue
+        diff = [(x, y) for x, y in zip(reference, lines) if x != y]
+        if len(lines) != len(reference):
+            diff.append((f"{len(reference)} lines", f"{len(lines)} lines"))
+        differing += bool(diff)
+        print(f"{label}: " + ("identical" if not diff else f"{len(diff)} lines differ"))
+        for x, y in diff:
+            print(f"  host:   {x}\n  {label}: {y}")
+    return 1 if differing else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
