@@ -51,8 +51,9 @@ def _projectile(rng):
 
 
 def build_case(seed, target, dt):
-    """A shape thrown at a slab along x (normal +x, slab centred at x = 0, facing the shape on
-    its -x side): the model, the shape's core and radius, the slab's body (-1: static)."""
+    """A shape thrown at a slab (centred at (0, 10), tilted up to 0.3 rad, normal n), from its
+    -n side, 1-40 cm from it, within 57 deg of n: the model, the shape's core and radius, the
+    slab's body (-1: static)."""
     rng = np.random.default_rng(seed)
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0))
     tilt = rng.uniform(-0.3, 0.3)               # the slab's tilt [rad]
@@ -66,11 +67,14 @@ def build_case(seed, target, dt):
         slab = 0
     kind, params, core, radius, mass, inertia = _projectile(rng)
     speed = rng.uniform(100.0, 300.0)
-    heading = rng.uniform(-1.0, 1.0)            # within 57 deg of the slab's normal
-    distance = rng.uniform(0.1, 0.5)
-    pos = (-T / 2 - distance, 10.0 + rng.uniform(-0.3, 0.3))
-    b.add_body("shot", mass, inertia, pos=pos, angle=rng.uniform(0.0, 2.0 * math.pi),
-               vel=(speed * math.cos(heading), speed * math.sin(heading)),
+    heading = rng.uniform(-1.0, 1.0)            # [rad] from the slab's normal
+    distance = rng.uniform(0.01, 0.4)           # from the slab to the shape's bounding circle
+    reach = float(np.max(np.hypot(core[:, 0], core[:, 1]))) + radius
+    n = np.array([math.cos(tilt), math.sin(tilt)])          # the slab's normal
+    along = np.array([-n[1], n[0]])
+    pos = np.array([0.0, 10.0]) - (T / 2 + reach + distance) * n + rng.uniform(-0.3, 0.3) * along
+    b.add_body("shot", mass, inertia, pos=tuple(pos), angle=rng.uniform(0.0, 2.0 * math.pi),
+               vel=(speed * math.cos(tilt + heading), speed * math.sin(tilt + heading)),
                omega=rng.uniform(0.0, 300.0) * rng.choice([-1.0, 1.0]),
                shapes=[(kind, *params, {"ground": False})])
     return b.compile(), core, radius, slab
