@@ -127,12 +127,13 @@ def step_excess(q0, v0, q1, v1, h):
     return moved - h * speed
 
 
-def run_case(seed, strategy, seconds=0.3):
-    """Run case `seed` under `strategy` for `seconds` [s], judged at every step. Returns a dict:
+def run_case(seed, strategy, seconds=0.3, jump_limit=SLACK):
+    """Run case `seed` under `strategy` for `seconds` [s] with StepOptions.jump_limit (the
+    engine's own check; 0: off), judged at every step. Returns a dict:
     excess (the largest step_excess, [m]), step and body where it is, raised (an engine
     error's first line, '' if none), jump (excess > SLACK with no error raised)."""
     model, kind = build(seed)
-    sim = ps.Simulator(model, ps.make_options(strategy))
+    sim = ps.Simulator(model, ps.make_options(strategy, jump_limit=jump_limit))
     h = model.dt
     steps = max(1, int(round(seconds / h)))
     out = dict(seed=seed, strategy=strategy, kind=kind, dt=h, steps=steps, excess=-math.inf,
@@ -169,11 +170,13 @@ def main(argv=None) -> int:
     ap.add_argument("--strategy", choices=STRATEGIES + ("both",), default="both")
     ap.add_argument("--only", action="append", default=[], metavar="SEED:STRATEGY")
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
+    ap.add_argument("--jump-limit", type=float, default=SLACK,
+                    help=f"StepOptions.jump_limit [m] (default {SLACK}; 0: the engine's check off)")
     args = ap.parse_args(argv)
     strategies = STRATEGIES if args.strategy == "both" else (args.strategy,)
     cases = ([(int(t.split(":")[0]), t.split(":")[1]) for t in args.only] if args.only else
              [(s, st) for s in range(args.first, args.first + args.seeds) for st in strategies])
-    work = [(seed, st, args.seconds) for seed, st in cases]
+    work = [(seed, st, args.seconds, args.jump_limit) for seed, st in cases]
     t0 = time.perf_counter()
     run_case(0, "all", 0.01)                     # compile (or load) once, before forking
     if args.jobs > 1 and len(work) > 1:

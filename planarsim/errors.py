@@ -220,10 +220,11 @@ def jumped(model, ws, who="simulation"):
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): body {name!r} ({body}) moved {moved:.4g} m "
         f"in one step, farther than its velocities explain (h max(|v_start|, |v_end|) = "
-        f"{explained:.4g} m, {allowed:.3g} m allowed beyond it), with {touching}: the step's "
-        f"position correction moved it by more than the violation it corrected (a body "
-        f"turning by about a radian in one step, or a contact normal or a rod turned within "
-        f"it). Take a smaller dt (or raise StepOptions.jump_limit; 0: no check)",
+        f"{explained:.4g} m; {allowed:.3g} m allowed beyond it: StepOptions.jump_limit and the "
+        f"depth it started the step below the ground), with {touching}: the step's position "
+        f"correction moved it (a body turning by about a radian in one step, a contact normal "
+        f"or a rod turned within it, or a body driven into the ground within the step and "
+        f"pushed out). Take a smaller dt (or raise StepOptions.jump_limit; 0: no check)",
         step, t, name, "displacement", moved, _start_of_step(ws))
 
 

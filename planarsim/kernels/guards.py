@@ -2,7 +2,7 @@
 import math
 
 from ..compile import kernel
-from .codes import CONTACT_ARC, CONTACT_EDGE, CONTACT_POINT, MODE_FREE
+from .codes import CONTACT_ARC, CONTACT_POINT, MODE_FREE
 from .forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from .terrain import ground_point
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
@@ -124,17 +124,17 @@ def check_actuator_turns(m, ws, h, limit):
 
 
 @kernel
-def _start_depth(m, q, b):
+def start_depth(m, q, b):
     """How deep [m] body b's deepest ground contact (a point, an arc sole's circle or a
-    fallback vertex) was below the ground at configuration q (0: none below): the violation
-    the step's correction may lift the body out of (a start below the ground)."""
+    fallback vertex) is below the ground at configuration q (0: none below): at the step's
+    start, a violation the step's correction lifts the body out of (a start allowed below
+    the ground)."""
     c = math.cos(q[b, 2])
     sn = math.sin(q[b, 2])
     deepest = 0.0
     for i in range(m.contact_body.shape[0]):
         kind = m.contact_kind[i]
-        if m.contact_body[i] != b or not (kind == CONTACT_POINT or kind == CONTACT_ARC
-                                          or kind == CONTACT_EDGE):
+        if m.contact_body[i] != b or not (kind == CONTACT_POINT or kind == CONTACT_ARC):
             continue
         lx = m.contact_local[i, 0]
         ly = m.contact_local[i, 1]
@@ -171,14 +171,15 @@ def _touching_contact(m, s, ws, b):
 @kernel
 def check_displacements(m, s, ws, h, slack):
     """GUARD_JUMP if some body's centre of mass moved over the step of h [s] (from ws.prev,
-    the step's start) farther than h max(|v_start|, |v_end|) + slack [m], plus the depth its
-    ground contacts started the step at (a start below the ground is lifted out). Symplectic
-    Euler moves it by h |v_end|, a time-of-impact split by h times a speed between the two;
-    the rest is the position correction's, which closes violations of the order of the
-    step's motion: a move beyond that is a correction larger than the violation it corrects
-    (a body turning by h w ~ 1 rad in the step, a normal or a rod turned within it), not
-    motion. Recorded: body, a contact touching it (_touching_contact), the distance, what
-    its velocities explain, the allowance. O(bodies) per step."""
+    the step's start) farther than h max(|v_start|, |v_end|) + slack [m] (plus the depth its
+    ground contacts started the step below the ground: a start allowed there is lifted out;
+    start_depth). Symplectic Euler moves it by h |v_end|, a time-of-impact split by h times
+    a speed between the two; a longer move is the position correction's: a correction
+    larger than the violation it corrects (a body turning by h w ~ 1 rad in the step, a rod
+    or a normal that turned within it), or a body driven deep into the ground within the
+    step and pushed out (a shape turning through a hill). Recorded: body, a contact touching
+    it (_touching_contact), the distance, what its velocities explain, the allowance.
+    O(bodies) per step; depths are measured only for a body beyond the first bound."""
     for i in range(s.q.shape[0]):
         dx = s.q[i, 0] - ws.prev.q[i, 0]
         dy = s.q[i, 1] - ws.prev.q[i, 1]
@@ -187,7 +188,7 @@ def check_displacements(m, s, ws, h, slack):
                     math.sqrt(s.v[i, 0] * s.v[i, 0] + s.v[i, 1] * s.v[i, 1]))
         if not moved > h * speed + slack:
             continue
-        allowed = slack + _start_depth(m, ws.prev.q, i)
+        allowed = slack + start_depth(m, ws.prev.q, i)
         if moved > h * speed + allowed:
             ws.info[INFO_GUARD_BODY] = i
             ws.info[INFO_GUARD_FIELD] = _touching_contact(m, s, ws, i)

@@ -225,14 +225,14 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
     code = check_guards(s, ws, opt.guard_limit)
     if code == 0 and opt.speed_limit > 0.0:
         code = check_speeds(m, s, ws, opt.speed_limit)
-    if code == 0 and opt.jump_limit > 0.0 and not stage:
-        code = check_displacements(m, s, ws, step_length, opt.jump_limit)
     if code == 0 and opt.gross_limit > 0.0 and ws.audit_worst_value[0] > opt.gross_limit:
         return GUARD_GROSS
     if code == 0 and ws.energy_stop[0] == 1:
         return GUARD_ENERGY
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
+    if code == 0 and opt.jump_limit > 0.0 and not stage:
+        code = check_displacements(m, s, ws, step_length, opt.jump_limit)
     return code
 
 
