@@ -94,6 +94,10 @@ judged on each end-of-step state (and the start):
 - depth: the deepest box corner below the ground, target DEPTH_TOL = 1e-8 m (flat ground:
   metrics.lowest_point; hills: see clearance);
 - divergence: planarsim.SimulationDiverged, or a non-finite state;
+- jump: each step's path, not only its end: every body's centre of mass moves at most
+  h max(|v_start|, |v_end|) + JUMP_SLACK (1 cm) in a step of h (path_excess; a step that
+  ends on the surface after passing through a hill, or after a correction that pushed a body
+  metres along a turned normal, misses it);
 - audit: the engine's own violation counters sim.ws.audit (n/a where the engine has none).
 
 Each family's line also counts the runs the engine stopped with an error ('raise') and the
@@ -120,6 +124,7 @@ from planarsim import terrain  # noqa: E402
 from benchmarks.metrics import (energy, lowest_point, pin_separation,  # noqa: E402
                                      spec_from_model, world_points)
 from benchmarks.scenes import G, biped_collapse  # noqa: E402
+from benchmarks.displacement import SLACK as JUMP_SLACK, step_excess  # noqa: E402
 from planarsim.kernels.work import CONSTRAINT_SHARE  # noqa: E402
 
 FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio", "shape_pile",
@@ -767,7 +772,7 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
     sim = ps.Simulator(model, ps.make_options(strategy), ps.make_state(model, q0, v0))
     out = dict(family=family, seed=seed, strategy=strategy, dt=dt, steps=steps,
                e0=float(energy(spec, q0[None], v0[None])[0]), e_tol=energy_bound(spec, ground, q0, v0),
-               gain=math.nan, pin=math.nan, depth=math.nan, diverged="")
+               gain=math.nan, pin=math.nan, depth=math.nan, diverged="", jump=math.nan)
     try:
         traj = sim.run(n_steps=steps, record_every=1)   # frames: the start, then steps 1..steps
         q, v = traj.q, traj.v
@@ -779,6 +784,7 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
             low = (shape_clearance(model, q) if family in SHAPE_FAMILIES
                    else clearance(spec, ground, q))
             out["depth"] = max(0.0, -float(np.min(low)))
+            out["jump"] = path_excess(q, v, dt)
     except ps.SimulationDiverged as exc:
         out["diverged"] = str(exc).splitlines()[0][:160]
         out["raised"] = out["diverged"]
@@ -786,10 +792,21 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
     out["audit"] = None if counts is None else dict(zip(audit_names(len(counts)), (int(c) for c in counts)))
     out["failed"] = [name for name, bad in (
         ("energy", out["gain"] > out["e_tol"]), ("pin", out["pin"] > PIN_TOL),
-        ("depth", out["depth"] > DEPTH_TOL), ("diverged", bool(out["diverged"])),
+        ("depth", out["depth"] > DEPTH_TOL), ("jump", out["jump"] > JUMP_SLACK),
+        ("diverged", bool(out["diverged"])),
         ("audit", out["audit"] is not None and sum(out["audit"].values()) > 0)) if bad]
     out["wall"] = time.perf_counter() - t_start
     return out
+
+
+def path_excess(q, v, dt):
+    """The largest distance [m] any body's centre of mass moved in one step beyond
+    h max(|v_start|, |v_end|) over the frames q, v (K, n_body, 3) of steps of dt [s]
+    (displacement.step_excess); -inf for fewer than two frames."""
+    worst = -math.inf
+    for k in range(len(q) - 1):
+        worst = max(worst, float(np.max(step_excess(q[k], v[k], q[k + 1], v[k + 1], dt))))
+    return worst
 
 
 def ground_gap(ground, x, y):
@@ -979,7 +996,7 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
                e_tol=math.nan if u is not None else energy_bound(spec, ground, q0, v0),
                gain=math.nan, pin=math.nan, depth=math.nan, diverged="", raised="", speed=math.nan,
                speed_ratio=math.nan, step_gain=math.nan, step_k=-1, step_note="", tunnel=math.nan,
-               slide_leave_gain=math.nan, slide_leave_k=-1)
+               slide_leave_gain=math.nan, slide_leave_k=-1, jump=math.nan)
     nb, nc, npin = model.n_body, model.n_contact, model.n_pin
     q, v = np.empty((steps + 1, nb, 3)), np.empty((steps + 1, nb, 3))
     mode, limit = np.empty((steps + 1, nc), np.int64), np.empty((steps + 1, npin, 2), np.int64)
@@ -1010,6 +1027,7 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
         out["depth"] = max(0.0, -float(np.min(contact_clearance(model, q))))
         if family == "hills_fast" and n >= 2:
             out["tunnel"] = tunnel_depth(model, q, v, mode, dt)
+        out["jump"] = path_excess(q, v, dt)
         out["speed"] = float(np.max(np.hypot(v[..., 0], v[..., 1])))
         if u is not None:
             out["speed_ratio"] = motor_speed_ratio(model, spec, q, v, dt)
@@ -1043,7 +1061,8 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
     out["failed"] = [name for name, bad in (
         ("energy", out["gain"] > out["e_tol"]), ("step", out["step_gain"] > out["e_tol"]),
         ("pin", out["pin"] > PIN_TOL), ("depth", out["depth"] > DEPTH_TOL),
-        ("tunnel", out["tunnel"] > DEPTH_TOL), ("speed", out["speed_ratio"] > 1.0),
+        ("tunnel", out["tunnel"] > DEPTH_TOL), ("jump", out["jump"] > JUMP_SLACK),
+        ("speed", out["speed_ratio"] > 1.0),
         ("diverged", bool(out["diverged"])),
         ("audit", out["audit"] is not None and sum(out["audit"].values()) > 0)) if bad]
     out["wall"] = time.perf_counter() - t_start
@@ -1094,7 +1113,8 @@ def report(results, n_worst=8) -> bool:
     one ('silent'), ...), its silent misses by cause, its audit counts by rule, and the worst
     runs; True when every run meets every target."""
     print(f"targets: energy gained <= E_tol (energy_bound), pin gap <= {PIN_TOL:g} m, depth <= "
-          f"{DEPTH_TOL:g} m, no divergence, no audit violation"
+          f"{DEPTH_TOL:g} m, no step moving a body beyond h max|v| + {JUMP_SLACK:g} m, no "
+          f"divergence, no audit violation"
           + ("; stiff_motors: no energy target, speed ratio <= 1 (motor_speed_ratio)"
              if any(r["family"] == "stiff_motors" for r in results) else ""))
     head = (f"{'family':15s} {'runs':>4s} {'miss':>4s} {'>E0':>4s} {'worst gain J (of E0)':>21s} {'pin gap m':>9s} "
@@ -1119,9 +1139,13 @@ def report(results, n_worst=8) -> bool:
               f"{len(silent):6d} {audit:>6s}  {bound}")
         if silent:
             causes = {c: sum(c in r["failed"] for r in silent)
-                      for c in ("energy", "step", "pin", "depth", "tunnel", "speed", "diverged", "audit")}
+                      for c in ("energy", "step", "pin", "depth", "tunnel", "jump", "speed", "diverged",
+                                "audit")}
             print(f"{'':15s} silent misses by cause: "
                   + ", ".join(f"{c if c != 'diverged' else 'non-finite'} {n}" for c, n in causes.items()))
+        print(f"{'':15s} worst step path: a body moved {_worst(r['jump'] for r in rs):.3g} m beyond "
+              f"h max(|v_start|, |v_end|) ({sum('jump' in r['failed'] for r in rs)} runs beyond "
+              f"{JUMP_SLACK:g} m)")
         raised = [r for r in rs if r.get("raised")]
         if raised:
             kinds = {}

@@ -18,7 +18,7 @@ from .kernels.codes import INTEGRATOR_NAMES
 from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
                              UNSUPPORTED_SOFT)
 from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
-                             GUARD_ENERGY, GUARD_NONFINITE_COMMAND, GUARD_SPEED,
+                             GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_SPEED,
                              GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
 
 
@@ -206,6 +206,28 @@ def too_fast(model, ws, who="simulation"):
         step, t, name, field, speed, last)
 
 
+def jumped(model, ws, who="simulation"):
+    """The SimulationDiverged of a step that moved a body farther than its velocities explain
+    (guards.check_displacements, StepOptions.jump_limit)."""
+    body = int(ws.info[INFO_GUARD_BODY])
+    contact = int(ws.info[INFO_GUARD_FIELD])
+    moved, explained, allowed = (float(x) for x in ws.guard_value[:3])
+    step = int(ws.prev.step[0])
+    t = float(ws.prev.time[0])
+    name = _body_name(model, body)
+    touching = (f"contact {model.contact_names[contact]!r} ({contact}) touching it"
+                if contact >= 0 else "no contact touching it (its joints' correction moved it)")
+    return SimulationDiverged(
+        f"{who} stopped at step {step} (t={t:.6g} s): body {name!r} ({body}) moved {moved:.4g} m "
+        f"in one step, farther than its velocities explain (h max(|v_start|, |v_end|) = "
+        f"{explained:.4g} m; {allowed:.3g} m allowed beyond it: StepOptions.jump_limit and the "
+        f"depth it started the step below the ground), with {touching}: the step's position "
+        f"correction moved it (a body turning by about a radian in one step, a contact normal "
+        f"or a rod turned within it, or a body driven into the ground within the step and "
+        f"pushed out). Take a smaller dt (or raise StepOptions.jump_limit; 0: no check)",
+        step, t, name, "displacement", moved, _start_of_step(ws))
+
+
 def stiff_actuator(model, ws, who="simulation"):
     """The SimulationDiverged of a step not taken because a torque actuator's command would
     turn what it drives further in one step than the step resolves (guards.check_actuator_turns,
@@ -274,6 +296,8 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
         return too_fast(model, ws, who)
     if code == GUARD_ENERGY:
         return energy_from_nowhere(model, ws, who)
+    if code == GUARD_JUMP:
+        return jumped(model, ws, who)
     if code == GUARD_STIFF_ACTUATOR:
         return stiff_actuator(model, ws, who)
     if code == GUARD_UNSUPPORTED:

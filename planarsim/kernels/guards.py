@@ -2,7 +2,9 @@
 import math
 
 from ..compile import kernel
+from .codes import CONTACT_ARC, CONTACT_POINT, MODE_FREE
 from .forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
+from .terrain import ground_point
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 
 GUARD_OK = 0
@@ -22,6 +24,10 @@ FIELD_TURNING = 7         # ... of its turning speed |omega| r_g [m/s] (r_g its 
 GUARD_UNSUPPORTED = 8     # StepOptions.integrator cannot step this model (kernels/rattle.py
                           # unsupported; ws.info[INFO_GUARD_FIELD]: what, [INFO_GUARD_BODY]:
                           # which element); nothing is stepped
+GUARD_JUMP = 9           # a body moved in the step farther than its velocities explain
+                          # (check_displacements; ws.info[INFO_GUARD_BODY]: the body,
+                          # [INFO_GUARD_FIELD]: a contact touching it or -1, ws.guard_value:
+                          # the distance, what its velocities explain, the allowance [m])
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[INFO_COMMAND]:
                           # its length); negative, so that no walker's own return code clashes
 GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[INFO_COMMAND]: its index,
@@ -114,4 +120,80 @@ def check_actuator_turns(m, ws, h, limit):
             ws.guard_value[1] = kappa
             ws.guard_value[2] = limit
             return GUARD_STIFF_ACTUATOR
+    return GUARD_OK
+
+
+@kernel
+def start_depth(m, q, b):
+    """How deep [m] body b's deepest ground contact (a point, an arc sole's circle or a
+    fallback vertex) is below the ground at configuration q (0: none below): at the step's
+    start, a violation the step's correction lifts the body out of (a start allowed below
+    the ground)."""
+    c = math.cos(q[b, 2])
+    sn = math.sin(q[b, 2])
+    deepest = 0.0
+    for i in range(m.contact_body.shape[0]):
+        kind = m.contact_kind[i]
+        if m.contact_body[i] != b or not (kind == CONTACT_POINT or kind == CONTACT_ARC):
+            continue
+        lx = m.contact_local[i, 0]
+        ly = m.contact_local[i, 1]
+        gap = ground_point(m.terrain_coef, q[b, 0] + c * lx - sn * ly,
+                           q[b, 1] + sn * lx + c * ly)[4]
+        if kind == CONTACT_ARC:
+            gap -= m.contact_radius[i]
+        deepest = max(deepest, -gap)
+        adr = m.contact_vert_adr[i]
+        for k in range(adr, adr + m.contact_vert_num[i]):
+            lx = m.vert_local[k, 0]
+            ly = m.vert_local[k, 1]
+            gap = ground_point(m.terrain_coef, q[b, 0] + c * lx - sn * ly,
+                               q[b, 1] + sn * lx + c * ly)[4]
+            deepest = max(deepest, -gap)
+    return deepest
+
+
+@kernel
+def _touching_contact(m, s, ws, b):
+    """A contact on body b that touches at the end of the step (else one of its enabled
+    contacts; -1: it has none)."""
+    some = -1
+    for i in range(m.contact_body.shape[0]):
+        if ws.contact_bodies[i, 0] != b and ws.contact_bodies[i, 1] != b:
+            continue
+        if s.contact_enabled[i] == 1 and s.contact_mode[i] != MODE_FREE:
+            return i
+        if some < 0 and s.contact_enabled[i] == 1:
+            some = i
+    return some
+
+
+@kernel
+def check_displacements(m, s, ws, h, slack):
+    """GUARD_JUMP if some body's centre of mass moved over the step of h [s] (from ws.prev,
+    the step's start) farther than h max(|v_start|, |v_end|) + slack [m] (plus the depth its
+    ground contacts started the step below the ground: a start allowed there is lifted out;
+    start_depth). Symplectic Euler moves it by h |v_end|, a time-of-impact split by h times
+    a speed between the two; a longer move is the position correction's: a correction
+    larger than the violation it corrects (a body turning by h w ~ 1 rad in the step, a rod
+    or a normal that turned within it), or a body driven deep into the ground within the
+    step and pushed out (a shape turning through a hill). Recorded: body, a contact touching
+    it (_touching_contact), the distance, what its velocities explain, the allowance.
+    O(bodies) per step; depths are measured only for a body beyond the first bound."""
+    for i in range(s.q.shape[0]):
+        dx = s.q[i, 0] - ws.prev.q[i, 0]
+        dy = s.q[i, 1] - ws.prev.q[i, 1]
+        moved = math.sqrt(dx * dx + dy * dy)
+        speed = max(math.sqrt(ws.prev.v[i, 0] * ws.prev.v[i, 0] + ws.prev.v[i, 1] * ws.prev.v[i, 1]),
+                    math.sqrt(s.v[i, 0] * s.v[i, 0] + s.v[i, 1] * s.v[i, 1]))
+        if not moved > h * speed + slack:
+            continue
+        allowed = slack + start_depth(m, ws.prev.q, i)
+        if moved > h * speed + allowed:
+            ws.info[INFO_GUARD_BODY] = i
+            ws.info[INFO_GUARD_FIELD] = _touching_contact(m, s, ws, i)
+            ws.guard_value[0] = moved
+            ws.guard_value[1] = h * speed
+            ws.guard_value[2] = allowed
+            return GUARD_JUMP
     return GUARD_OK

@@ -20,8 +20,8 @@ from .codes import INTEGRATOR_EULER, MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_actuator_turns, check_guards,
-                     check_speeds)
+from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_actuator_turns,
+                     check_displacements, check_guards, check_speeds)
 from .info import INFO_SOLVES, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
@@ -234,6 +234,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         return GUARD_ENERGY
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
+    if code == 0 and opt.jump_limit > 0.0 and not stage:
+        code = check_displacements(m, s, ws, step_length, opt.jump_limit)
     return code
 
 
@@ -271,7 +273,10 @@ def accurate_step(m, s, ws, opt, u, step_length):
         rattle_end(m, s, ws, u, h, opt.pivot_tol, k == n - 1)
     s.time[0] = t0 + step_length
     s.step[0] = count + 1
-    return check_guards(s, ws, opt.guard_limit)
+    code = check_guards(s, ws, opt.guard_limit)
+    if code == 0 and opt.jump_limit > 0.0:
+        code = check_displacements(m, s, ws, step_length, opt.jump_limit)
+    return code
 
 
 @kernel(inline="always")
