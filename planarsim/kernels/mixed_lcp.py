@@ -43,8 +43,8 @@ CONE_EDGE_TOL = 1e-9
 # corpus 9 kept a regularised answer (polish failed), none broke an audit rule
 REGULARISATION = (1e-12, 1e-10, 1e-8, 1e-6)
 # a regularised answer that polish cannot make exact is kept where its contacts approach at
-# most this share of the problem's fastest approach (scaled units; StepInfo's lcp_eps says
-# which diagonal term a step kept)
+# most this share of the problem's fastest approach (scaled units; ws.lcp_eps[0] is the
+# largest diagonal term a step kept)
 SOFT_ANSWER_TOL = 1e-4
 
 
