@@ -194,20 +194,60 @@ def solve_contacts(m, s, ws, h, include_ccd):
 
 
 # contacts within this gap [m] of the ground take part in the position projection (their
-# row may become active as others move)
+# row may become active as others move); a ground contact also within the reach of the
+# projection's last move (_last_move)
 PROJECTION_MARGIN = 1e-6
+
+
+@kernel
+def _contact_lever(m, i):
+    """A bound [m] on the distance from its body's COM of any point ground contact i may
+    hold: its point, arc centre or edge start, and its fallback vertices (an edge's end),
+    plus its radius (a sole's, a capsule side's)."""
+    lever = math.hypot(m.contact_local[i, 0], m.contact_local[i, 1])
+    for k in range(m.contact_vert_adr[i], m.contact_vert_adr[i] + m.contact_vert_num[i]):
+        lever = max(lever, math.hypot(m.vert_local[k, 0], m.vert_local[k, 1]))
+    return lever + m.contact_radius[i]
+
+
+@kernel
+def _moved(dq, b, lever):
+    """|dx| + |dy| + |dtheta| lever [m]: a bound on how far move dq carried a point of body b
+    at that distance [m] from its COM (0 for the world, b < 0)."""
+    if b < 0:
+        return 0.0
+    return abs(dq[b, 0]) + abs(dq[b, 1]) + abs(dq[b, 2]) * lever
+
+
+@kernel
+def _last_move(m, ws, i):
+    """A bound [m] on how far the projection's last move (ws.dq_correction) can have closed
+    contact i: its point's move (_contact_lever), or for a shape pair the two shapes' moves
+    (each core's farthest vertex plus its radius)."""
+    dq = ws.dq_correction
+    if m.contact_kind[i] != CONTACT_PAIR:
+        return _moved(dq, m.contact_body[i], _contact_lever(m, i))
+    slot0 = i - m.contact_pair[i, 2]
+    sa = m.contact_pair[slot0, 0]
+    sb = m.contact_pair[slot0, 1]
+    return (_moved(dq, m.shape_body[sa], m.shape_bound[sa, 4] + m.shape_radius[sa])
+            + _moved(dq, m.shape_body[sb], m.shape_bound[sb, 4] + m.shape_radius[sb]))
 
 
 @kernel
 def _projection_contact(m, s, ws, n, i):
     """Append contact i's normal row at slot n if it is enabled and within PROJECTION_MARGIN
-    of the ground or of its pair's other shape (a ground contact is found again here first);
-    returns the next free slot."""
+    of the ground or of its pair's other shape, plus the reach of the projection's last
+    move (_last_move: a body that one row lifts by turning may bring its other corners, or a
+    shape on it, as far down; their rows then hold them in the next move, where a margin of
+    rounding alone let the moves cycle between the edge contact of a thin polygon rocking on
+    a hill, its corners and a ball rolling on it); a ground contact is found again here
+    first. Returns the next free slot."""
     if s.contact_enabled[i] == 0:
         return n
     if m.contact_kind[i] != CONTACT_PAIR:
         query_contact(m, s.q, ws, i)
-    if ws.contact_gap[i] < PROJECTION_MARGIN:
+    if ws.contact_gap[i] < PROJECTION_MARGIN + _last_move(m, ws, i):
         n = add_contact_rows(ws, n, i, True, False)
     return n
 
@@ -238,7 +278,7 @@ def _projection_rows(m, s, ws, h):
         for k in range(n_near):
             i = ws.sweep_pairs[k]
             if s.contact_enabled[i] == 1:
-                find_pair(m, s, ws, i, h, PROJECTION_MARGIN, True)
+                find_pair(m, s, ws, i, h, PROJECTION_MARGIN + _last_move(m, ws, i), True)
     # in the contacts' order: the ground contacts and the slots of the pairs within reach
     for k in range(merge_contacts(ws.ground_contacts, ws.sweep_pairs, n_near, ws.near_contacts)):
         n = _projection_contact(m, s, ws, n, ws.near_contacts[k])
@@ -269,6 +309,7 @@ def project_positions(m, s, ws, h, iters, tol):
     worst = 0.0
     best = math.inf         # the error where the last move started (q_keep)
     share = 1.0             # of the last move taken
+    ws.dq_correction[:] = 0.0   # no move yet (the rows' margin reads the last one)
     for it in range(iters + 1):
         n = _projection_rows(m, s, ws, h)
         worst = _largest_error(ws, n)
