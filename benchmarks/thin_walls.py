@@ -48,13 +48,15 @@ def family(seed) -> str:
     return _projectile(rng)[0]
 
 
-def run(seed, target, dt) -> dict:
-    """Run one case for RUN_TIME [s], judged after every step; returns its counts and worst
-    values (through, depth [m], gain [-], audit depth count, raised message, steps whose
-    splits ran out, fastest turn [rad/s])."""
+def run(seed, target, dt, max_splits=None) -> dict:
+    """Run one case for RUN_TIME [s] (StepOptions.max_ccd_splits = max_splits, None: the
+    default), judged after every step; returns its counts and worst values (through, depth
+    [m], gain [-], audit depth count, raised message, steps whose splits ran out, fastest
+    turn [rad/s])."""
     model, core, radius, slab = build_case(seed, target, dt)
     tilt0 = np.random.default_rng(seed).uniform(-0.3, 0.3)
-    sim = ps.Simulator(model)
+    options = ps.StepOptions() if max_splits is None else ps.StepOptions(max_ccd_splits=max_splits)
+    sim = ps.Simulator(model, options)
     e0 = kinetic_energy(model, sim.state.v)
     out = dict(seed=seed, target=target, dt=dt, family=family(seed), through=False, depth=0.0,
                gain=-math.inf, audit=0, raised="", split_out=0, omega=0.0, first_through=-1)
@@ -88,11 +90,13 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=600, help="seeds per target and dt (default 600)")
     ap.add_argument("--only", action="append", default=[], help="SEED:TARGET:DT (repeatable)")
+    ap.add_argument("--max-splits", type=int, default=None,
+                    help="StepOptions.max_ccd_splits (default: StepOptions' own, 16)")
     a = ap.parse_args(argv)
     todo = ([(int(s), t, float(d)) for s, t, d in (x.split(":") for x in a.only)] if a.only
             else list(cases(a.seeds)))
     t0 = time.perf_counter()
-    results = [run(*c) for c in todo]
+    results = [run(*c, max_splits=a.max_splits) for c in todo]
     wall = time.perf_counter() - t0
     print(f"{'family':9s} {'runs':>5s} {'through':>8s} {'overlap':>8s} {'gain':>5s} {'audit':>6s} "
           f"{'raised':>7s} {'split out':>10s}")

@@ -156,14 +156,24 @@ def time_of_impact(m, s, ws, h):
 def advance_to_impact(s, ws, h, tau, drift):
     """Move every body along its within-step path to tau: v = v0 + tau a, q += tau v; or
     (drift: a shape pair's impact, kernels/pair_toi.py) q += tau v1, the step's drift at its
-    solved velocity v1 = ws.v_new, whose path the pair's sweep followed (the velocity as
-    before: the step's forces and impulses for the time taken, the rest of the step adds
-    the rest)."""
+    solved velocity v1 = ws.v_new, whose path the pair's sweep followed, and
+        v = v1 - (1 - tau / h) (v* - v0)      (v* = ws.v_pred = v0 + h M^-1 f)
+    the forces for the time taken, the solve's impulses whole: an impact at the sub-step's
+    start is over at once, and a speculative contact's impulse leaves its pair closing no
+    faster than the rest of the sub-step can close its gap. (Taking the impulses by the
+    share tau / h left a pair the turn horizon split still approaching at nearly its speed
+    before the impact, to touch and be split again: a 6 mm polygon at 290 m/s spent the 16
+    splits of its first step so and went through a 5 cm slab, benchmarks/thin_walls.py
+    312:slab:0.01.)"""
     for i in range(s.q.shape[0]):
         for k in range(3):
-            vk = s.v[i, k] + tau * (ws.v_new[i, k] - s.v[i, k]) / h
-            s.v[i, k] = vk
-            s.q[i, k] += tau * (ws.v_new[i, k] if drift else vk)
+            if drift:
+                s.v[i, k] = ws.v_new[i, k] - (1.0 - tau / h) * (ws.v_pred[i, k] - s.v[i, k])
+                s.q[i, k] += tau * ws.v_new[i, k]
+            else:
+                vk = s.v[i, k] + tau * (ws.v_new[i, k] - s.v[i, k]) / h
+                s.v[i, k] = vk
+                s.q[i, k] += tau * vk
 
 
 @kernel
@@ -191,3 +201,4 @@ def split_at_impact(m, s, ws, h, splits_left):
         ws.contact_new[hit] = 2
     ws.info[INFO_CCD_SPLITS] += 1
     return tau
+
