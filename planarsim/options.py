@@ -32,7 +32,9 @@ class StepOptions(NamedTuple):
     refine_tol : stop refining when every constraint residual is below this [m or rad]
     max_ccd_splits : cap on time-of-impact splits of one step (a point mass reaching the
         ground, fast shapes touching or turning about a touching point: kernels/ccd.py,
-        kernels/pair_toi.py); the rest of a step beyond it is taken whole
+        kernels/pair_toi.py); the rest of a step beyond it is taken whole, but where a fast
+        shape pair would touch in it, or turn too far about a touching point, it ends there
+        (the rest of the step's time dropped; step_info 'ccd_stops'; ccd.stop_at_impact)
     guard_limit : any |q| or |v| component above this stops the run
     pivot_tol : relative pivot below which the guess solve treats a row as redundant (its
         answer is checked against every rule; one that breaks a rule goes to the

@@ -10,13 +10,16 @@ INFO_LCP_PIVOTS = 6        # Lemke pivots, velocity stage and projections
 INFO_PROJECTIONS = 7       # complementarity projections of the positions
 INFO_COMMAND = 8           # the command the guard names: index of a NaN / inf one
                            # (GUARD_NONFINITE_COMMAND), or how many were given (GUARD_BAD_COMMANDS)
-N_INFO = 9
+INFO_CCD_STOPS = 9         # a step that used up its splits was cut at a fast pair's time of
+                           # impact or turn horizon (ccd.stop_at_impact: the rest of its time
+                           # dropped)
+N_INFO = 10
 
 INFO_NAMES = ("solves", "ccd_splits", "guard_body", "guard_field", "lcp_solves",
-              "newton_taken_back", "lcp_pivots", "projections", "command")
+              "newton_taken_back", "lcp_pivots", "projections", "command", "ccd_stops")
 # counted afresh by every step (the guard slots keep the last failure)
 STEP_COUNTS = (INFO_SOLVES, INFO_CCD_SPLITS, INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK,
-               INFO_LCP_PIVOTS, INFO_PROJECTIONS)
+               INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS)
 
 
 def step_info(ws) -> dict:

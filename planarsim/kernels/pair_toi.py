@@ -169,11 +169,11 @@ def fast_before_solve(m, ws, sa, sb, h):
 
 @kernel(inline="never")
 def hold_off_fast_pairs(m, s, ws, h):
-    """Stage 2 while the step may still be split: a pair whose shapes are fast before the
-    solve (fast_before_solve) and farther apart than the touch target (its manifold's
-    smallest gap above TOUCH_SHARE of the thinner width) gets no speculative contact: both
-    slots are cleared (free, no features, no impulse, gap inf) and the sweep after the solve
-    (pair_impact_time) splits the step where the pair touches. A speculative contact's
+    """Stage 2: a pair whose shapes are fast before the solve (fast_before_solve) and farther
+    apart than the touch target (its manifold's smallest gap above TOUCH_SHARE of the
+    thinner width) gets no speculative contact: both slots are cleared (free, no features, no
+    impulse, gap inf) and the sweep after the solve (pair_impact_time) splits the step where
+    the pair touches, or, its splits used up, ends it there (ccd.stop_at_impact). A speculative contact's
     impulse would act from the step's start, at the features closest then: on a fast turning
     thin body it stops a point that would have missed, or turns the body through the wall."""
     for k in range(ws.n_live_pairs[0]):

@@ -15,7 +15,7 @@ five-stage composition (accurate_step; kernels/rattle.py).
 """
 from ..compile import kernel
 from .audit import audit_impulses, audit_total
-from .ccd import split_at_impact
+from .ccd import split_at_impact, stop_at_impact
 from .codes import INTEGRATOR_EULER, MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
@@ -203,7 +203,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         predict_configuration(m, s, ws, h)                  #    q + h v* (joints' drift)
         find_contacts(m, s, ws, h)                          # 2. contacts
         ccd_on = split < opt.max_ccd_splits
-        if ccd_on and m.n_shape_pair > 0:                   #    fast shape pairs apart: left
+        if m.n_shape_pair > 0:                              #    fast shape pairs apart: left
             hold_off_fast_pairs(m, s, ws, h)                #    to the sweep of stage 7
         for attempt in range(2):                            # 3-5. rows, impulses, modes
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
@@ -218,6 +218,10 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             if tau >= 0.0:                                  #    mid-step: the rest again
                 h -= tau
                 continue
+        else:                                               #    splits used up: the part
+            tau = stop_at_impact(m, s, ws, h)               #    ends at a fast pair's impact
+            if tau >= 0.0:                                  #    or turn horizon, the rest of
+                h = tau                                     #    the step's time dropped
         audit_impulses(m, s, ws, opt, h)                    # 9. the audit of the impulses
         position_stage(m, s, ws, opt, h, answered)          # 6. integrate, correct, settle
         break
