@@ -4,9 +4,16 @@ against the folded-loop test's rule: no step may gain more than 1 % of its kinet
 
     python benchmarks/folded_loops.py              # seeds 0-199
     python benchmarks/folded_loops.py 36 42 162    # these seeds
+    python benchmarks/folded_loops.py --explain $(seq 0 999)   # and where each miss comes from
 
 Prints, per seed missing the rule, its worst step (number, gain [J], kinetic energy [J]) and
-the largest pin impulse of the run [N s]; then how many seeds miss it.
+the largest pin impulse of the run [N s]; then how many seeds miss it. --explain adds, per
+miss, the worst step taken again: its gain split into the velocity stage's (integrated with
+the solve's velocity, ws.v_solved) and the position correction's, KE at its start, KE(v*)
+and KE of the solve's answer [J], whether the complementarity solve ran, the step's largest
+pin impulse [N s] and its vertical momentum at start and end [kg m/s] (a stage gaining
+(h / 2) g (p_start + p_end) is a loop whose upward motion the contacts stop: the rule's
+gravity term reads that momentum's change as gravity's).
 """
 from __future__ import annotations
 
@@ -50,7 +57,43 @@ def worst_step(seed):
     return k + 1, float(gains[k]), float(kinetic[k]), pin, raised
 
 
+def explain(seed, step):
+    """One line: where the gain of loop_inertia seed `seed`'s step `step` comes from."""
+    from planarsim.kernels.info import step_info
+    model, _, q0, v0 = build("loop_inertia", seed)
+    a = model.arrays
+    h = model.dt
+    sim = ps.Simulator(model, ps.make_options(), ps.make_state(model, q0, v0))
+    for _ in range(step - 1):
+        sim.step()
+    q, v = sim.state.q.copy(), sim.state.v.copy()
+    sim.step()
+    ws = sim.ws
+
+    def kinetic(vel):
+        return 0.5 * float(np.sum(a.body_mass * (vel[:, 0] ** 2 + vel[:, 1] ** 2)
+                                  + a.body_inertia * vel[:, 2] ** 2))
+
+    def momentum(vel):
+        return float(np.sum(a.body_mass * vel[:, 1]))
+
+    def gain(q1, v1):
+        return (kinetic(v1) - kinetic(v) + G * float(np.sum(a.body_mass * (q1[:, 1] - q[:, 1])))
+                - 0.5 * h * G * (momentum(v1) - momentum(v)))
+
+    total = gain(sim.state.q, sim.state.v)
+    solve = gain(ws.q_solved, ws.v_solved)
+    info = step_info(ws)
+    return (f"    dt {h:g}: velocity stage {solve:.3g} J, correction {total - solve:.3g} J; KE start "
+            f"{kinetic(v):.3g} v* {kinetic(ws.v_pred):.3g} answer {kinetic(ws.v_new):.3g} J; "
+            f"{'complementarity' if info['lcp_solves'] else 'linear'} solve; pin impulse "
+            f"{float(np.abs(sim.state.last_pin_impulse).max()):.3g} N s; p_y {momentum(v):.3g} -> "
+            f"{momentum(sim.state.v):.3g}")
+
+
 def main(argv):
+    detail = "--explain" in argv
+    argv = [s for s in argv if s != "--explain"]
     seeds = [int(s) for s in argv] or list(range(200))
     misses = 0
     for seed in seeds:
@@ -59,6 +102,8 @@ def main(argv):
             misses += 1
             print(f"seed {seed:3d}: step {step} gains {gain:.3g} J at {kinetic:.3g} J of motion; "
                   f"largest pin impulse {pin:.3g} N s{'; raised' if raised else ''}")
+            if detail:
+                print(explain(seed, step))
     print(f"{misses} of {len(seeds)} seeds miss the folded-loop rule")
     return 1 if misses else 0
 

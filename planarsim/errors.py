@@ -219,9 +219,10 @@ def jumped(model, ws, who="simulation"):
                 if contact >= 0 else "no contact touching it (its joints' correction moved it)")
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): body {name!r} ({body}) moved {moved:.4g} m "
-        f"in one step, farther than its velocities explain (h max(|v_start|, |v_end|) = "
-        f"{explained:.4g} m; {allowed:.3g} m allowed beyond it: StepOptions.jump_limit and the "
-        f"depth it started the step below the ground), with {touching}: the step's position "
+        f"in one step, farther than its velocities explain (h max(|v_start|, |v_end|), per "
+        f"part of a step split at an impact: {explained:.4g} m; {allowed:.3g} m allowed beyond "
+        f"it: StepOptions.jump_limit and the depth it or a body joined to it started the step "
+        f"below the ground or inside a shape), with {touching}: the step's position "
         f"correction moved it (a body turning by about a radian in one step, a contact normal "
         f"or a rod turned within it, or a body driven into the ground within the step and "
         f"pushed out). Take a smaller dt (or raise StepOptions.jump_limit; 0: no check)",

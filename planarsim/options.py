@@ -76,18 +76,15 @@ class StepOptions(NamedTuple):
         turns of about 2 * 0.1 rad (the position correction's regime, kernels/work.py); a
         bang-bang 100-1000 N m motor on a light link at dt 1e-2 turns it 0.3 to 100 rad.
         0: no check
-    jump_limit : [m] a body whose centre of mass moves in a step farther than
-        h max(|v_start|, |v_end|) + jump_limit (plus the depth its contacts started the
-        step below the ground) stops the run (SimulationDiverged naming the body, a contact
-        touching it, the step and the distance): the velocities explain the step's motion;
-        a longer move is the position correction's (a body turning by about a radian in
-        one step, a rod or a normal turned within it, a shape driven through a hill and
-        pushed out). 0 (default, for now): no check. 0.01 stops every such step of
-        benchmarks/displacement.py's corpus, but also steps that existing scenes take: a
-        point skimming crests at 200 m/s pulled 11 cm back onto the crest it hit, a rod
-        pinned at one end swinging its other end out of the ground along a circle nearly
-        tangent to it, shapes started inside each other or a capsule's side started in
-        the ground (depths it does not measure) moved out in the first step
+    jump_limit : [m] a body whose centre of mass moves in a step farther than its
+        velocities explain, h max(|v_start|, |v_end|) (a step split at a time of impact:
+        per part, its length times the largest speed in it, summed), plus jump_limit, plus
+        the depth it or a body joined to it started the step below the ground or inside
+        another shape, stops the run (SimulationDiverged naming the body, a contact
+        touching it, the step and the distance): a longer move is the position
+        correction's, in a step beyond what a step resolves (a body turning by about a
+        radian in it, a shape driven through a hill and pushed out). 0.01 (default);
+        0: no check
     integrator : 0 'euler' (default): symplectic Euler with SHAKE, energy error O(h);
         1 'rattle': RATTLE, the velocity of the instant kept on the joints' tangent space,
         energy error O(h^2) (bounded, no drift), pins closed as by the default step, 1.26
@@ -112,7 +109,7 @@ class StepOptions(NamedTuple):
     energy_limit: float = 0.0
     turn_limit: float = 0.2
     integrator: int = INTEGRATOR_EULER
-    jump_limit: float = 0.0
+    jump_limit: float = 0.01
 
 
 def make_options(strategy="alternating", refine=True, integrator="euler", **kw) -> StepOptions:

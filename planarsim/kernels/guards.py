@@ -128,7 +128,7 @@ def start_depth(m, q, b):
     """How deep [m] body b's deepest ground contact (a point, an arc sole's circle or a
     fallback vertex) is below the ground at configuration q (0: none below): at the step's
     start, a violation the step's correction lifts the body out of (a start allowed below
-    the ground)."""
+    the ground). Shapes' overlaps at the start: note_start_depths."""
     c = math.cos(q[b, 2])
     sn = math.sin(q[b, 2])
     deepest = 0.0
@@ -169,34 +169,112 @@ def _touching_contact(m, s, ws, b):
 
 
 @kernel
+def _speed(v, i):
+    """Body i's speed [m/s], its centre of mass's, from velocities v (n_body, 3)."""
+    return math.sqrt(v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1])
+
+
+@kernel
+def start_path(s, ws):
+    """A step starts: no path yet, each body's part starts at its speed, no depth known yet
+    (ws.path_explained)."""
+    for i in range(s.v.shape[0]):
+        ws.path_explained[i, 0] = 0.0
+        ws.path_explained[i, 1] = _speed(s.v, i)
+        ws.path_explained[i, 2] = 0.0
+
+
+@kernel
+def note_start_depths(ws):
+    """After the step's first contact search: each body's largest overlap [m] among the live
+    contacts found at the step's start (a shape started in the ground or inside another
+    shape, which the step's correction pushes out: ws.path_explained[:, 2])."""
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
+        depth = -ws.contact_gap[i]
+        if not depth > 0.0:
+            continue
+        for e in range(2):
+            b = ws.contact_bodies[i, e]
+            if b >= 0 and depth > ws.path_explained[b, 2]:
+                ws.path_explained[b, 2] = depth
+
+
+@kernel
+def add_part_path(s, ws, tau):
+    """A part of tau [s] ended at a time-of-impact split (ccd.advance_to_impact moved each body
+    by tau times its velocity at the split, s.v, or its part's solved velocity ws.v_new): add
+    tau max(|v_start|, |v_split|, |v_new|) to the path its velocities explain; the next part
+    starts at |v_split|."""
+    for i in range(s.v.shape[0]):
+        speed = _speed(s.v, i)
+        ws.path_explained[i, 0] += tau * max(ws.path_explained[i, 1], speed, _speed(ws.v_new, i))
+        ws.path_explained[i, 1] = speed
+
+
+@kernel
+def _join(ws, a, b):
+    """Mark bodies a and b joined (ws.path_explained[:, 3]) if either is; True if one was new."""
+    if a < 0 or b < 0 or ws.path_explained[a, 3] == ws.path_explained[b, 3]:
+        return False
+    ws.path_explained[a, 3] = 1.0
+    ws.path_explained[b, 3] = 1.0
+    return True
+
+
+@kernel
+def joined_start_depth(m, ws, i):
+    """The largest overlap [m] at the step's start (start_depth, note_start_depths) of body i
+    and of every body joined to it by pins and rods: a correction pushing one body out of
+    the ground moves the bodies joined to it as far. Only for a body beyond its first bound
+    (a walk over the joints, O(joints) per pass)."""
+    for b in range(ws.path_explained.shape[0]):
+        ws.path_explained[b, 3] = 0.0
+    ws.path_explained[i, 3] = 1.0
+    changed = True
+    while changed:
+        changed = False
+        for j in range(m.pin_body.shape[0]):
+            if _join(ws, m.pin_body[j, 0], m.pin_body[j, 1]):
+                changed = True
+        for j in range(m.rod_body.shape[0]):
+            if _join(ws, m.rod_body[j, 0], m.rod_body[j, 1]):
+                changed = True
+    depth = 0.0
+    for b in range(ws.path_explained.shape[0]):
+        if ws.path_explained[b, 3] == 1.0:
+            depth = max(depth, start_depth(m, ws.prev.q, b), ws.path_explained[b, 2])
+    return depth
+
+
+@kernel
 def check_displacements(m, s, ws, h, slack):
-    """GUARD_JUMP if some body's centre of mass moved over the step of h [s] (from ws.prev,
-    the step's start) farther than h max(|v_start|, |v_end|) + slack [m] (plus the depth its
-    ground contacts started the step below the ground: a start allowed there is lifted out;
-    start_depth). Symplectic Euler moves it by h |v_end|; a longer move is the position
-    correction's, or a time-of-impact split's, whose parts move it at their own velocities
-    (which may exceed both ends': a body struck and slowed again within the step, so a
-    split step may pass this bound legitimately; benchmarks/contact_stress.py's path judge
-    leaves split steps out). A correction
-    larger than the violation it corrects (a body turning by h w ~ 1 rad in the step, a rod
-    or a normal that turned within it), or a body driven deep into the ground within the
-    step and pushed out (a shape turning through a hill). Recorded: body, a contact touching
-    it (_touching_contact), the distance, what its velocities explain, the allowance.
-    O(bodies) per step; depths are measured only for a body beyond the first bound."""
+    """GUARD_JUMP if some body's centre of mass moved over the step (from ws.prev, the step's
+    start) farther than its velocities explain plus slack [m] (plus the depth its contacts,
+    or those of a body joined to it, started the step below the ground or inside another
+    shape, which the step pushes out: joined_start_depth). What they explain: h max(|v_start|, |v_end|) over the step's last part of
+    h [s] (the whole step unless it was split at a time of impact), plus, per earlier part,
+    its length times the largest speed the body had in it (ws.path_explained: start_path,
+    add_part_path). Symplectic Euler moves a body by h |v_end|; a longer move is the position
+    correction's: a correction larger than the violation it corrects (a body turning by
+    h w ~ 1 rad in the step, a rod or a normal that turned within it), or a body driven deep
+    into the ground within the step and pushed out (a shape turning through a hill).
+    Recorded: body, a contact touching it (_touching_contact), the distance, what its
+    velocities explain, the allowance. O(bodies) per step; depths are measured only for a
+    body beyond the first bound."""
     for i in range(s.q.shape[0]):
         dx = s.q[i, 0] - ws.prev.q[i, 0]
         dy = s.q[i, 1] - ws.prev.q[i, 1]
         moved = math.sqrt(dx * dx + dy * dy)
-        speed = max(math.sqrt(ws.prev.v[i, 0] * ws.prev.v[i, 0] + ws.prev.v[i, 1] * ws.prev.v[i, 1]),
-                    math.sqrt(s.v[i, 0] * s.v[i, 0] + s.v[i, 1] * s.v[i, 1]))
-        if not moved > h * speed + slack:
+        explained = ws.path_explained[i, 0] + h * max(ws.path_explained[i, 1], _speed(s.v, i))
+        if not moved > explained + slack:
             continue
-        allowed = slack + start_depth(m, ws.prev.q, i)
-        if moved > h * speed + allowed:
+        allowed = slack + joined_start_depth(m, ws, i)
+        if moved > explained + allowed:
             ws.info[INFO_GUARD_BODY] = i
             ws.info[INFO_GUARD_FIELD] = _touching_contact(m, s, ws, i)
             ws.guard_value[0] = moved
-            ws.guard_value[1] = h * speed
+            ws.guard_value[1] = explained
             ws.guard_value[2] = allowed
             return GUARD_JUMP
     return GUARD_OK

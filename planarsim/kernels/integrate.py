@@ -241,9 +241,64 @@ def rows_hold_within(m, s, ws, h, limit):
     return True
 
 
+@kernel
+def pull_allowance(m, s, ws, r, h):
+    """How far [m] the correction may pull the open unilateral row r (a touching contact's
+    normal) back onto its surface: the second-order motion of its points on bodies turning
+    by d = h w over the step of h [s], (d^2 / 2 + |d|^3 / 6) times their distance from the
+    COM (a pivoting foot's tip lifted by L (h w)^2 / 2, which the continuous motion keeps
+    on the ground: SHAKE holds it there), plus rounding. A contact open by more is leaving
+    its surface (a point that hit a crest flying on over it) and is not pulled back."""
+    allow = 0.0
+    for e in range(2):
+        b = ws.row_body[r, e]
+        if b < 0:
+            continue
+        lever = row_lever(m, ws, r, e)
+        if lever == math.inf:
+            return math.inf
+        d = abs(h * s.v[b, 2])
+        allow += (0.5 * d * d + d * d * d / 6.0) * lever
+        allow += ROUNDING * (1.0 + abs(s.q[b, 0]) + abs(s.q[b, 1]) + lever)
+    return allow
+
+
 @kernel(inline="never")
-def max_residual(m, s, ws):
-    """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs)."""
+def drop_leaving_rows(m, s, ws, h):
+    """Before the correction: drop the rows of each contact (its normal and a sticking
+    contact's tangent row) and limit that the configuration being corrected has opened by
+    more than the step's turning explains (pull_allowance): the body is leaving the
+    surface (a point that hit a crest flying on over it), and holding the row would pull it
+    back down. Evaluates the rows at s.q (ws.row_Jp, ws.rhs: scratch here); returns how
+    many rows were dropped."""
+    update_trig(s.q, ws.body_cs)
+    n = ws.n_row[0]
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_Jp, ws.rhs, n, False)
+    for r in range(n):
+        c = ws.rhs[r]
+        if c > 0.0 and is_unilateral(ws.row_kind[r]) and c > pull_allowance(m, s, ws, r, h):
+            ws.rhs[r] = math.nan        # leaving
+    k = 0
+    for r in range(n):
+        leaving = ws.rhs[r] != ws.rhs[r]
+        if (not leaving and is_tangent_row(ws.row_kind[r]) and r > 0
+                and is_normal_row(ws.row_kind[r - 1])
+                and ws.row_owner[r - 1] == ws.row_owner[r]):
+            leaving = ws.rhs[r - 1] != ws.rhs[r - 1]    # its contact's normal row leaves
+        if leaving:
+            continue
+        if k != r:
+            move_row(ws, k, r)
+        k += 1
+    ws.n_row[0] = k
+    return n - k
+
+
+@kernel(inline="never")
+def max_residual(m, s, ws, h):
+    """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs
+    with the correction's target -c). The rows of contacts leaving their surface were
+    dropped before the correction began (drop_leaving_rows); h [s]: the step's length."""
     update_trig(s.q, ws.body_cs)
     n = ws.n_row[0]
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_Jp, ws.rhs, n, False)
@@ -261,6 +316,10 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     """Newton-SHAKE; returns the final max residual [m or rad]. envelope_ready: the rows are
     those of the velocity solve's envelope (ws.row_first / row_reach): none was dropped since
     and no complementarity solve changed them."""
+    if ws.n_row[0] == 0:
+        return 0.0
+    if drop_leaving_rows(m, s, ws, h) > 0:
+        envelope_ready = False
     n = ws.n_row[0]
     if n == 0:
         return 0.0
@@ -268,7 +327,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         # the envelope of the rows as they are now (keep_correction_rows compacted them;
         # after a complementarity solve they are not the rows the guess's solve had)
         compute_envelope(ws, n, s.q.shape[0])
-    worst = max_residual(m, s, ws)
+    worst = max_residual(m, s, ws, h)
     ptol = pivot_tol
     for _ in range(iters):
         if worst <= tol:
@@ -306,7 +365,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 s.q[i, k] += ws.dq_correction[i, k]
                 s.v[i, k] += ws.dv_correction[i, k]
-        after = max_residual(m, s, ws)
+        after = max_residual(m, s, ws, h)
         if after <= STALLED_RATIO * worst:
             worst = after
             continue
@@ -324,7 +383,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 s.q[i, k] = ws.q_keep[i, k]
                 s.v[i, k] = ws.v_keep[i, k]
-        worst = max_residual(m, s, ws)
+        worst = max_residual(m, s, ws, h)
         ws.info[INFO_NEWTON_TAKEN_BACK] += 1
         if ptol >= LOOSE_PIVOT_TOL:
             break

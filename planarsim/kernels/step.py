@@ -21,7 +21,8 @@ from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_actuator_turns,
-                     check_displacements, check_guards, check_speeds)
+                     check_displacements, check_guards, check_speeds,
+                     add_part_path, note_start_depths, start_path)
 from .info import INFO_SOLVES, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
@@ -184,6 +185,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         return code
     if not stage:
         reset_counts(ws)            # (an accurate step counts over all its stages)
+        start_path(s, ws)           # (the path its velocities explain: check_displacements)
     ws.lcp_eps[0] = 0.0
     ws.audit_worst_value[0] = 0.0
     ws.first_order[0] = 0
@@ -202,6 +204,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         predict_velocity(m, s, ws, h)                       #    v* = v + h M^-1 f
         predict_configuration(m, s, ws, h)                  #    q + h v* (joints' drift)
         find_contacts(m, s, ws, h)                          # 2. contacts
+        if split == 0 and not stage:
+            note_start_depths(ws)                           #    (check_displacements)
         ccd_on = split < opt.max_ccd_splits
         if m.n_shape_pair > 0:                              #    fast shape pairs apart: left
             hold_off_fast_pairs(m, s, ws, h)                #    to the sweep of stage 7
@@ -216,6 +220,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         if ccd_on:
             tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 7. an impact
             if tau >= 0.0:                                  #    mid-step: the rest again
+                if not stage:
+                    add_part_path(s, ws, tau)
                 h -= tau
                 continue
         else:                                               #    splits used up: the part
@@ -239,7 +245,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
     if code == 0 and opt.jump_limit > 0.0 and not stage:
-        code = check_displacements(m, s, ws, step_length, opt.jump_limit)
+        code = check_displacements(m, s, ws, h, opt.jump_limit)    # h: the last part's
     return code
 
 
@@ -257,6 +263,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
         return code
     copy_state(s, ws.prev)
     reset_counts(ws)
+    start_path(s, ws)
     if opt.turn_limit > 0.0:
         update_trig(s.q, ws.body_cs)
         apply_forces(m, s, ws, u)

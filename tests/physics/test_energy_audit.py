@@ -94,10 +94,13 @@ def test_rods_thrown_at_hills_keep_their_energy(seed):
     """Point masses joined by rods, thrown at 1-200 m/s onto steep sine hills: a rod turning
     by a radian in a step once jumped from 1.2e4 J to 3.2e6 J (seed 79). The run's energy now
     never rises above its start by more than symplectic Euler's own oscillation under
-    gravity (the corpus's energy_bound)."""
+    gravity (the corpus's energy_bound). A rod turning by a radian in a step is beyond what
+    a step resolves: with the jump check on (the default) seed 9 stops at step 3, naming an
+    end the correction moved 12 cm farther than its velocities explain; the energy law is
+    checked here with the check off."""
     from benchmarks.contact_stress import build, energy_bound, shape_spec
     model, ground, q0, v0 = build("hills_fast", seed)
-    model, q, v, sim, error = corpus_run("hills_fast", seed)
+    model, q, v, sim, error = corpus_run("hills_fast", seed, jump_limit=0.0)
     assert error is None
     spec = shape_spec("hills_fast", model, 0.0)
     e = energy(model, q, v)

@@ -12,9 +12,10 @@ from planarsim.compiled import audit_counts
 R = 0.05        # ball radius [m]
 
 
-def cradle(n_row, gap, e, mass_ratio=1.0, strategy="alternating", speed=1.0):
+def cradle(n_row, gap, e, mass_ratio=1.0, strategy="alternating", speed=1.0, **options):
     """A 1 kg ball at `speed` [m/s] into a row of n_row balls of mass_ratio kg each, `gap` [m]
-    apart (0: touching), frictionless, no gravity."""
+    apart (0: touching), frictionless, no gravity; run 1 s at dt = 1 ms (options: StepOptions
+    fields)."""
     b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, 0.0))
     spec = {"restitution": e, "mu": 0.0}
     b.add_body("striker", 1.0, 0.5 * R * R, pos=(-0.3, 5.0), vel=(speed, 0.0),
@@ -22,7 +23,7 @@ def cradle(n_row, gap, e, mass_ratio=1.0, strategy="alternating", speed=1.0):
     for k in range(n_row):
         b.add_body(f"ball{k}", mass_ratio, 0.5 * mass_ratio * R * R,
                    pos=(k * (2 * R + gap), 5.0), shapes=[("circle", (0.0, 0.0), R, spec)])
-    sim = ps.Simulator(b.compile(), ps.make_options(strategy))
+    sim = ps.Simulator(b.compile(), ps.make_options(strategy, **options))
     sim.steps(1000)
     return sim
 
@@ -57,7 +58,20 @@ def test_a_cradle_with_gaps_passes_the_blow_along_the_row(strategy, gap):
 @pytest.mark.parametrize("gap", [0.0, 0.005])
 @pytest.mark.parametrize("speed", [0.01, 1.0, 30.0])
 def test_a_cradle_keeps_momentum_and_energy(gap, speed):
-    sim = cradle(4, gap, 1.0, 1.0, speed=speed)
+    """Momentum and (e = 1) energy kept, whatever the order the blow travels in; the jump
+    check is off (at 30 m/s with 5 mm gaps it stops the run: see the next test)."""
+    sim = cradle(4, gap, 1.0, 1.0, speed=speed, jump_limit=0.0)
     v = sim.state.v[:, 0]
     assert abs(v.sum() - speed) <= 1e-9 * speed
     assert abs(0.5 * np.sum(v * v) - 0.5 * speed ** 2) <= 1e-9 * speed ** 2
+
+
+@pytest.mark.xfail(strict=True, raises=ps.SimulationDiverged, reason=(
+    "known: a ball struck within a step (at rest at the split's time of impact) moves on at "
+    "30 m/s into a neighbour 5 mm away that the step's contact search, made at rest, did not "
+    "list; the correction pushes the neighbour out 1.1 cm at zero velocity, and the jump "
+    "check stops the run (step 7). The search would need the answer's velocities."))
+def test_a_ball_struck_within_a_step_meets_its_neighbour_within_it():
+    """30 m/s into four balls 5 mm apart at dt = 1 ms: every step's motion is what the
+    velocities of its parts explain (the default jump check raises nothing)."""
+    cradle(4, 0.005, 1.0, 1.0, speed=30.0)

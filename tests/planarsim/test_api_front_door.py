@@ -144,8 +144,11 @@ def test_a_start_on_the_ground_or_allowed_below_it_runs():
     assert deep.state.q[0, 1] == pytest.approx(0.3, abs=1e-6)   # lifted onto the ground, as asked
 
 
-def test_a_walker_that_starts_in_the_ground_says_so_in_its_summary():
-    """SIMBICON's feet start flat: on the default hills a sole's corner starts 3 cm inside."""
+def test_simbicon_starts_with_its_soles_on_the_ground_on_hills():
+    """SIMBICON's soles start on the highest ground under them: on the default hills no
+    corner starts inside (standing at the heel's height, the toe began 3 cm inside, and the
+    steps lifting it out moved the legs 2-3 cm farther than their velocities explain), and
+    nothing is said."""
     import warnings
 
     import walkers
@@ -153,7 +156,7 @@ def test_a_walker_that_starts_in_the_ground_says_so_in_its_summary():
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         _, raw, _ = mod.simulate(0.05, terrain="hills")
-    assert raw["audit"]["start_below_ground"] == 2
-    assert any("'right_sole/1'" in str(w.message) and "below the ground" in str(w.message) for w in said)
+    assert raw["audit"]["start_below_ground"] == 0
+    assert not any("below the ground" in str(w.message) for w in said)
     _, raw, _ = mod.simulate(0.05, terrain="flat")
     assert raw["audit"]["start_below_ground"] == 0

@@ -41,7 +41,8 @@ FOOT_BOX = (0.15, -1.2, 0.3, 0.15)   # MJCF foot box: centre x, z; width, height
 
 
 def build(params: SimbiconParams | None = None, terrain=None, dt: float = 1e-3):
-    """Model of the character standing on `terrain` (default flat) at x = 0.
+    """Model of the character standing on `terrain` (default flat) at x = 0, its soles on the
+    highest ground under them.
 
     Returns the compiled Model; ``model.meta`` holds the index maps the controller needs:
     torso, thigh[side], shin[side], foot[side], pin[side, joint], act[side, joint],
@@ -49,7 +50,10 @@ def build(params: SimbiconParams | None = None, terrain=None, dt: float = 1e-3):
     """
     p = params if params is not None else SimbiconParams()
     terrain = terrain if terrain is not None else flat()
-    ground = float(terrain.height(0.0))
+    # the soles rest on the highest ground under them (on hills the toe's ground may be
+    # higher than the heel's: started at the heel's, the toe would begin below the ground)
+    cx, _, w, _ = FOOT_BOX
+    ground = float(max(terrain.height(x) for x in np.linspace(cx - w / 2, cx + w / 2, 9)))
     b = ModelBuilder(dt=dt, terrain=terrain)
     char = load_mjcf(XML, builder=b, offset=(0.0, ground + SOLE_DEPTH), collide=COLLIDING_GEOMS)
     limits = {"hip": p.hip_torque_max, "knee": p.knee_torque_max, "ankle": p.ankle_torque_max}
