@@ -204,7 +204,6 @@ def split_at_impact(m, s, ws, h, splits_left):
     return tau
 
 
-
 # splits_left that gives pair_impact_time's turn horizon no floor (an even share of nothing)
 NO_SPLIT_FLOOR = 1 << 52
 

@@ -6,6 +6,7 @@ from .codes import CONTACT_ARC, CONTACT_POINT, MODE_FREE
 from .forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from .terrain import ground_point
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
+from .islands import _root
 
 GUARD_OK = 0
 GUARD_NONFINITE = 1
@@ -67,6 +68,12 @@ def check_commands(u, ws):
 
 
 @kernel
+def _speed(v, i):
+    """Body i's speed [m/s], its centre of mass's, from velocities v (n_body, 3)."""
+    return math.sqrt(v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1])
+
+
+@kernel
 def check_speeds(m, s, ws, bound):
     """GUARD_SPEED if some body's speed |v| or turning speed |omega| r_g (r_g = sqrt(I / m),
     its radius of gyration: the speed whose kinetic energy equals the body's turning energy)
@@ -74,7 +81,7 @@ def check_speeds(m, s, ws, bound):
     bound in ws.guard_value), else GUARD_OK. One bound for both: a body's kinetic energy is at
     most m bound^2."""
     for i in range(s.v.shape[0]):
-        speed = math.sqrt(s.v[i, 0] * s.v[i, 0] + s.v[i, 1] * s.v[i, 1])
+        speed = _speed(s.v, i)
         turning = abs(s.v[i, 2]) * math.sqrt(m.body_inertia[i] * m.body_inv_mass[i])
         if speed > bound or turning > bound:
             ws.info[INFO_GUARD_BODY] = i
@@ -169,12 +176,6 @@ def _touching_contact(m, s, ws, b):
 
 
 @kernel
-def _speed(v, i):
-    """Body i's speed [m/s], its centre of mass's, from velocities v (n_body, 3)."""
-    return math.sqrt(v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1])
-
-
-@kernel
 def start_path(s, ws):
     """A step starts: no path yet, each body's part starts at its speed, no depth known yet
     (ws.path_explained)."""
@@ -213,36 +214,29 @@ def add_part_path(s, ws, tau):
 
 
 @kernel
-def _join(ws, a, b):
-    """Mark bodies a and b joined (ws.path_explained[:, 3]) if either is; True if one was new."""
-    if a < 0 or b < 0 or ws.path_explained[a, 3] == ws.path_explained[b, 3]:
-        return False
-    ws.path_explained[a, 3] = 1.0
-    ws.path_explained[b, 3] = 1.0
-    return True
-
-
-@kernel
 def joined_start_depth(m, ws, i):
     """The largest overlap [m] at the step's start (start_depth, note_start_depths) of body i
     and of every body joined to it by pins and rods: a correction pushing one body out of
-    the ground moves the bodies joined to it as far. Only for a body beyond its first bound
-    (a walk over the joints, O(joints) per pass)."""
-    for b in range(ws.path_explained.shape[0]):
-        ws.path_explained[b, 3] = 0.0
-    ws.path_explained[i, 3] = 1.0
-    changed = True
-    while changed:
-        changed = False
-        for j in range(m.pin_body.shape[0]):
-            if _join(ws, m.pin_body[j, 0], m.pin_body[j, 1]):
-                changed = True
-        for j in range(m.rod_body.shape[0]):
-            if _join(ws, m.rod_body[j, 0], m.rod_body[j, 1]):
-                changed = True
+    the ground moves the bodies joined to it as far. Only for a body beyond its first bound:
+    a union-find over the joints (islands._root) in ws.island_parent, whose islands the
+    step's solve is done with."""
+    parent = ws.island_parent
+    for b in range(parent.shape[0]):
+        parent[b] = b
+    for j in range(m.pin_body.shape[0] + m.rod_body.shape[0]):
+        if j < m.pin_body.shape[0]:
+            a, b = m.pin_body[j, 0], m.pin_body[j, 1]
+        else:
+            a, b = m.rod_body[j - m.pin_body.shape[0], 0], m.rod_body[j - m.pin_body.shape[0], 1]
+        if a >= 0 and b >= 0:
+            ra = _root(parent, a)
+            rb = _root(parent, b)
+            if ra != rb:
+                parent[max(ra, rb)] = min(ra, rb)
+    ri = _root(parent, i)
     depth = 0.0
-    for b in range(ws.path_explained.shape[0]):
-        if ws.path_explained[b, 3] == 1.0:
+    for b in range(parent.shape[0]):
+        if _root(parent, b) == ri:
             depth = max(depth, start_depth(m, ws.prev.q, b), ws.path_explained[b, 2])
     return depth
 

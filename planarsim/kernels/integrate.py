@@ -294,14 +294,10 @@ def drop_leaving_rows(m, s, ws, h):
     return n - k
 
 
-@kernel(inline="never")
-def max_residual(m, s, ws, h):
-    """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs
-    with the correction's target -c). The rows of contacts leaving their surface were
-    dropped before the correction began (drop_leaving_rows); h [s]: the step's length."""
-    update_trig(s.q, ws.body_cs)
-    n = ws.n_row[0]
-    eval_rows(m, s.q, ws.body_cs, ws, ws.row_Jp, ws.rhs, n, False)
+@kernel
+def targets_of(ws, n):
+    """The correction's targets from the rows' errors c in ws.rhs (rows 0..n-1): ws.rhs <- -c;
+    returns the largest |c|."""
     worst = 0.0
     for r in range(n):
         c = ws.rhs[r]
@@ -311,6 +307,16 @@ def max_residual(m, s, ws, h):
     return worst
 
 
+@kernel(inline="never")
+def max_residual(m, s, ws):
+    """Largest |c| over the active rows at the current configuration (fills ws.row_Jp, ws.rhs
+    with the correction's target -c)."""
+    update_trig(s.q, ws.body_cs)
+    n = ws.n_row[0]
+    eval_rows(m, s.q, ws.body_cs, ws, ws.row_Jp, ws.rhs, n, False)
+    return targets_of(ws, n)
+
+
 @kernel(inline="always")
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     """Newton-SHAKE; returns the final max residual [m or rad]. envelope_ready: the rows are
@@ -318,16 +324,16 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     and no complementarity solve changed them."""
     if ws.n_row[0] == 0:
         return 0.0
-    if drop_leaving_rows(m, s, ws, h) > 0:
-        envelope_ready = False
+    dropped = drop_leaving_rows(m, s, ws, h)     # (evaluates the rows: c in ws.rhs)
     n = ws.n_row[0]
     if n == 0:
         return 0.0
-    if not envelope_ready:
-        # the envelope of the rows as they are now (keep_correction_rows compacted them;
-        # after a complementarity solve they are not the rows the guess's solve had)
+    if dropped > 0 or not envelope_ready:
+        # the envelope of the rows as they are now (keep_correction_rows or drop_leaving_rows
+        # compacted them; after a complementarity solve they are not the guess's rows)
         compute_envelope(ws, n, s.q.shape[0])
-    worst = max_residual(m, s, ws, h)
+    # the rows kept are as drop_leaving_rows evaluated them unless it moved some
+    worst = max_residual(m, s, ws) if dropped > 0 else targets_of(ws, n)
     ptol = pivot_tol
     for _ in range(iters):
         if worst <= tol:
@@ -365,7 +371,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 s.q[i, k] += ws.dq_correction[i, k]
                 s.v[i, k] += ws.dv_correction[i, k]
-        after = max_residual(m, s, ws, h)
+        after = max_residual(m, s, ws)
         if after <= STALLED_RATIO * worst:
             worst = after
             continue
@@ -383,7 +389,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 s.q[i, k] = ws.q_keep[i, k]
                 s.v[i, k] = ws.v_keep[i, k]
-        worst = max_residual(m, s, ws, h)
+        worst = max_residual(m, s, ws)
         ws.info[INFO_NEWTON_TAKEN_BACK] += 1
         if ptol >= LOOSE_PIVOT_TOL:
             break

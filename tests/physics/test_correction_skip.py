@@ -17,7 +17,7 @@ from planarsim.options import StepOptions
 def _bound_and_error(args, limit):
     """(rows_hold_within(limit), largest row error) right after a step without correction."""
     ok = rows_hold_within(args.m, args.s, args.ws, args.m.dt, limit)
-    return ok, max_residual(args.m, args.s, args.ws, args.m.dt)
+    return ok, max_residual(args.m, args.s, args.ws)
 
 
 def _scene(kind, slope_deg, y_offset):
