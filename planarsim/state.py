@@ -305,6 +305,9 @@ class Workspace(NamedTuple):
                                  #   the step's finished parts (time-of-impact splits), its speed
                                  #   [m/s] at the current part's start, its largest overlap [m]
                                  #   at the step's start (guards.check_displacements)
+    step_path: np.ndarray        # (n_body,) the path [m] each body's velocities explain over the
+                                 #   last whole step: per part (time-of-impact splits, turn
+                                 #   sub-steps) its length times the body's largest speed in it
     prev: State                  # the state at the start of the last step (for guard errors)
 
 
@@ -414,4 +417,5 @@ def make_workspace(model: Model) -> Workspace:
                      energy_stop=z(1, np.int64),
                      joint_gain=z(3), lcp_eps=z(1),
                      impact_time=z(1), audit_keep=z(N_AUDIT, np.int64), path_explained=z((nb, 3)),
+                     step_path=z(nb),
                      prev=make_state(model))
