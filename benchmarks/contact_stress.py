@@ -97,8 +97,9 @@ judged on each end-of-step state (and the start):
 - jump: each step's path, not only its end: every body's centre of mass moves at most
   h max(|v_start|, |v_end|) + JUMP_SLACK (1 cm) in a step of h (path_excess; a step that
   ends on the surface after passing through a hill, or after a correction that pushed a body
-  metres along a turned normal, misses it); a step the engine split at a time of impact is
-  not judged (inside it a body moves at its parts' velocities, which may exceed both ends');
+  metres along a turned normal, misses it); a step the engine took in parts (time-of-impact
+  splits, turn sub-steps) is judged part by part (inside it a body moves at its parts'
+  velocities, which may exceed both ends': displacement.parted_step_excess);
 - audit: the engine's own violation counters sim.ws.audit (n/a where the engine has none).
 
 Each family's line also counts the runs the engine stopped with an error ('raise') and the
@@ -125,9 +126,8 @@ from planarsim import terrain  # noqa: E402
 from benchmarks.metrics import (energy, lowest_point, pin_separation,  # noqa: E402
                                      spec_from_model, world_points)
 from benchmarks.scenes import G, biped_collapse  # noqa: E402
-from benchmarks.displacement import SLACK as JUMP_SLACK, step_excess  # noqa: E402
+from benchmarks.displacement import SLACK as JUMP_SLACK, parted, step_excess  # noqa: E402
 from planarsim.kernels.work import CONSTRAINT_SHARE  # noqa: E402
-from planarsim.kernels.info import INFO_CCD_SPLITS  # noqa: E402
 
 FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio", "shape_pile",
             "shape_hills")
@@ -776,14 +776,15 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
                e0=float(energy(spec, q0[None], v0[None])[0]), e_tol=energy_bound(spec, ground, q0, v0),
                gain=math.nan, pin=math.nan, depth=math.nan, diverged="", jump=math.nan)
     try:
-        # frames: the start, then steps 1..steps; which steps were split at a time of impact
+        # frames: the start, then steps 1..steps; the path explained in steps taken in parts
         q, v = np.empty((steps + 1, model.n_body, 3)), np.empty((steps + 1, model.n_body, 3))
-        split = np.zeros(steps, dtype=bool)
+        paths = np.full((steps, model.n_body), np.nan)
         q[0], v[0] = sim.state.q, sim.state.v
         for k in range(steps):
             sim.step()
             q[k + 1], v[k + 1] = sim.state.q, sim.state.v
-            split[k] = sim.ws.info[INFO_CCD_SPLITS] > 0
+            if parted(sim):
+                paths[k] = sim.ws.step_path
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
             out["diverged"] = "non-finite state"
         else:
@@ -792,7 +793,7 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
             low = (shape_clearance(model, q) if family in SHAPE_FAMILIES
                    else clearance(spec, ground, q))
             out["depth"] = max(0.0, -float(np.min(low)))
-            out["jump"] = path_excess(q, v, dt, split)
+            out["jump"] = path_excess(q, v, dt, paths)
     except ps.SimulationDiverged as exc:
         out["diverged"] = str(exc).splitlines()[0][:160]
         out["raised"] = out["diverged"]
@@ -807,18 +808,21 @@ def run_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) -> dict:
     return out
 
 
-def path_excess(q, v, dt, split=None):
+def path_excess(q, v, dt, paths=None):
     """The largest distance [m] any body's centre of mass moved in one step beyond
     h max(|v_start|, |v_end|) over the frames q, v (K, n_body, 3) of steps of dt [s]
-    (displacement.step_excess); -inf for fewer than two frames. split (K - 1,) marks the
-    steps the engine split at a time of impact: inside such a step a body moves at the
-    velocities of its parts, which may exceed both ends' (a body struck and stopped again
-    within the step), so the law does not bound it and the step is not judged."""
+    (displacement.step_excess); -inf for fewer than two frames. paths (K - 1, n_body): for a
+    step the engine took in parts (time-of-impact splits, turn sub-steps) the path its
+    velocities explain part by part (Workspace.step_path; displacement.parted_step_excess),
+    NaN for a whole step: inside a parted step a body moves at its parts' velocities, which
+    may exceed both ends' (a body struck and stopped again within the step)."""
     worst = -math.inf
     for k in range(len(q) - 1):
-        if split is not None and split[k]:
-            continue
-        worst = max(worst, float(np.max(step_excess(q[k], v[k], q[k + 1], v[k + 1], dt))))
+        if paths is not None and not np.isnan(paths[k, 0]):
+            moved = np.hypot(q[k + 1, :, 0] - q[k, :, 0], q[k + 1, :, 1] - q[k, :, 1])
+            worst = max(worst, float(np.max(moved - paths[k])))
+        else:
+            worst = max(worst, float(np.max(step_excess(q[k], v[k], q[k + 1], v[k + 1], dt))))
     return worst
 
 
@@ -1013,7 +1017,7 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
     nb, nc, npin = model.n_body, model.n_contact, model.n_pin
     q, v = np.empty((steps + 1, nb, 3)), np.empty((steps + 1, nb, 3))
     mode, limit = np.empty((steps + 1, nc), np.int64), np.empty((steps + 1, npin, 2), np.int64)
-    split = np.zeros(steps, dtype=bool)
+    paths = np.full((steps, model.n_body), np.nan)
     s = sim.state
     q[0], v[0], mode[0], limit[0] = s.q, s.v, s.contact_mode, s.limit_active
     n = steps + 1
@@ -1023,7 +1027,8 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
             sim.step(None if u is None else u[k - 1])
             s = sim.state
             q[k], v[k], mode[k], limit[k] = s.q, s.v, s.contact_mode, s.limit_active
-            split[k - 1] = sim.ws.info[INFO_CCD_SPLITS] > 0
+            if parted(sim):
+                paths[k - 1] = sim.ws.step_path
     except Exception as exc:          # an error of the engine's, naming why: raised, not silent
         if not type(exc).__module__.startswith("planarsim"):
             raise
@@ -1042,7 +1047,7 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
         out["depth"] = max(0.0, -float(np.min(contact_clearance(model, q))))
         if family == "hills_fast" and n >= 2:
             out["tunnel"] = tunnel_depth(model, q, v, mode, dt)
-        out["jump"] = path_excess(q, v, dt, split[:n - 1])
+        out["jump"] = path_excess(q, v, dt, paths[:n - 1])
         out["speed"] = float(np.max(np.hypot(v[..., 0], v[..., 1])))
         if u is not None:
             out["speed_ratio"] = motor_speed_ratio(model, spec, q, v, dt)

@@ -16,9 +16,9 @@ shapes (a box, a circle or a capsule, 2-40 cm, turning at up to 30 rad/s) in the
 The law (judge): over a step of h [s] every body's centre of mass moves
 |q_end - q_start| <= h max(|v_start|, |v_end|) + SLACK (symplectic Euler moves it by exactly
 h |v_end|; a position correction that moves it by more than that plus 1 cm is a jump), unless
-the run stopped with an error of the engine's. A step split at a time of impact is judged
-part by part: each part's length times the largest speed the body had in it, summed
-(split_step_excess).
+the run stopped with an error of the engine's. A step taken in parts (split at a time of
+impact, or in turn sub-steps) is judged part by part: each part's length times the largest
+speed the body had in it, summed (parted_step_excess).
 """
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
 from planarsim import terrain  # noqa: E402
-from planarsim.kernels.info import INFO_CCD_SPLITS  # noqa: E402
+from planarsim.kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS  # noqa: E402
 
 SLACK = 0.01                 # [m] a step's displacement allowed beyond h max(|v0|, |v1|)
 STRATEGIES = ("alternating", "all")
@@ -130,18 +130,26 @@ def step_excess(q0, v0, q1, v1, h):
     return moved - h * speed
 
 
-def split_step_excess(sim, t0, q0, q1, v1, h):
-    """(n_body,) step_excess of a step the engine split at a time of impact (its parts:
-    before each split, then the rest): each part moves a body at its own velocities, which
-    may exceed both ends' (a body struck and stopped again within the step), so the path
-    its velocities explain is the sum over the parts of each part's length times the
-    largest speed the body had in it; the engine records the finished parts' sum and the
-    last part's starting speed (Workspace.path_explained), the last part runs from the
-    last split (ws.impact_time) to the step's end."""
-    pe = sim.ws.path_explained
-    rest = h - (float(sim.ws.impact_time[0]) - t0)
+def parted(sim):
+    """True if the engine took its last step in parts (time-of-impact splits or turn
+    sub-steps): inside it a body moves at each part's velocities, which may exceed both
+    ends' (a body struck and stopped again within the step)."""
+    return sim.ws.info[INFO_CCD_SPLITS] > 0 or sim.ws.info[INFO_TURN_SUBSTEPS] > 1
+
+
+def parted_step_excess(sim, q0, q1):
+    """(n_body,) step_excess of a step the engine took in parts (parted): the path its
+    velocities explain is the sum over the parts of each part's length times the largest
+    speed the body had in it, which the engine records (Workspace.step_path)."""
     moved = np.hypot(q1[:, 0] - q0[:, 0], q1[:, 1] - q0[:, 1])
-    return moved - (pe[:, 0] + rest * np.maximum(pe[:, 1], np.hypot(v1[:, 0], v1[:, 1])))
+    return moved - sim.ws.step_path
+
+
+def judged_excess(sim, q0, v0, q1, v1, h):
+    """(n_body,) how far [m] each body moved in the last step of h [s] (from q0, v0 to q1, v1)
+    beyond what its velocities explain: step_excess, or parted_step_excess for a step taken
+    in parts."""
+    return parted_step_excess(sim, q0, q1) if parted(sim) else step_excess(q0, v0, q1, v1, h)
 
 
 def run_case(seed, strategy, seconds=0.3, jump_limit=SLACK):
@@ -157,7 +165,6 @@ def run_case(seed, strategy, seconds=0.3, jump_limit=SLACK):
                step=-1, body="", raised="", at=None)
     q0, v0 = sim.state.q.copy(), sim.state.v.copy()
     for k in range(steps):
-        t0 = float(sim.state.time[0])
         try:
             sim.step()
         except Exception as exc:     # an error of the engine's, naming why: raised, not silent
@@ -166,8 +173,7 @@ def run_case(seed, strategy, seconds=0.3, jump_limit=SLACK):
             out["raised"] = f"{type(exc).__name__}: {str(exc).splitlines()[0][:200]}"
             break
         q1, v1 = sim.state.q.copy(), sim.state.v.copy()
-        ex = (split_step_excess(sim, t0, q0, q1, v1, h) if sim.ws.info[INFO_CCD_SPLITS] > 0
-              else step_excess(q0, v0, q1, v1, h))
+        ex = judged_excess(sim, q0, v0, q1, v1, h)
         i = int(np.argmax(ex))
         if ex[i] > out["excess"]:
             out.update(excess=float(ex[i]), step=k, body=model.body_names[i],

@@ -77,8 +77,8 @@ class StepOptions(NamedTuple):
         bang-bang 100-1000 N m motor on a light link at dt 1e-2 turns it 0.3 to 100 rad.
         0: no check
     jump_limit : [m] a body whose centre of mass moves in a step farther than its
-        velocities explain, h max(|v_start|, |v_end|) (a step split at a time of impact:
-        per part, its length times the largest speed in it, summed), plus jump_limit, plus
+        velocities explain, h max(|v_start|, |v_end|) (a step split at a time of impact or
+        taken in sub-steps: per part, its length times the largest speed in it, summed), plus jump_limit, plus
         the depth it or a body joined to it started the step below the ground or inside
         another shape, stops the run (SimulationDiverged naming the body, a contact
         touching it, the step and the distance): a longer move is the position
@@ -94,6 +94,14 @@ class StepOptions(NamedTuple):
         ones take mechanisms of pins, sliders and rods under gravity, pushes and actuators
         only: a model with a contact, a joint limit, a joint spring, damper or armature or a
         fluid drag is refused (ModelError naming it; kernels/rattle.py)
+    max_substeps : cap on the equal sub-steps a default (Euler) step is taken in where a
+        pin's anchor or a touching ground contact's point would leave the motion its rows
+        linearise by more than 1 mm as its body turns, L (h w)^2 / 2 (L its lever [m], w
+        the body's turn rate [rad/s], at the step's start or at its answer, which then is
+        taken again: kernels/step.py turn_substeps; step_info 'turn_substeps'). Each
+        sub-step is a whole step (solve, positions, audit, guards) and the State counts
+        one; its last impulses are the last sub-step's (as a step split at a time of
+        impact keeps its last part's). 16 (default); 1: never
     """
     mode_strategy: int = MODES_ALTERNATING
     refine_iters: int = 4
@@ -110,6 +118,7 @@ class StepOptions(NamedTuple):
     turn_limit: float = 0.2
     integrator: int = INTEGRATOR_EULER
     jump_limit: float = 0.01
+    max_substeps: int = 16
 
 
 def make_options(strategy="alternating", refine=True, integrator="euler", **kw) -> StepOptions:
@@ -147,6 +156,7 @@ _OPTION_RULES = {
     "integrator": (int, lambda x: 0 <= x < len(INTEGRATOR_NAMES),
                    f"must be one of 0..{len(INTEGRATOR_NAMES) - 1} ({', '.join(INTEGRATOR_NAMES)})"),
     "jump_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0 [m]"),
+    "max_substeps": (int, lambda x: x >= 1, "must be an integer >= 1"),
     "speed_limit": (float, lambda x: x == -1.0 or (math.isfinite(x) and x >= 0.0),
                     "must be -1 (from the model), 0 (none) or a speed > 0 [m/s]"),
 }

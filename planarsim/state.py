@@ -299,10 +299,15 @@ class Workspace(NamedTuple):
     lcp_eps: np.ndarray          # (1,) largest diagonal term the complementarity solves of
                                  #   this step added (mixed_lcp.REGULARISATION; scaled units)
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
+    audit_keep: np.ndarray       # (N_AUDIT,) int the audit's counts before a step that may be
+                                 #   taken again in sub-steps (step._step)
     path_explained: np.ndarray   # (n_body, 3) the path [m] each body's velocities explain over
                                  #   the step's finished parts (time-of-impact splits), its speed
                                  #   [m/s] at the current part's start, its largest overlap [m]
                                  #   at the step's start (guards.check_displacements)
+    step_path: np.ndarray        # (n_body,) the path [m] each body's velocities explain over the
+                                 #   last whole step: per part (time-of-impact splits, turn
+                                 #   sub-steps) its length times the body's largest speed in it
     prev: State                  # the state at the start of the last step (for guard errors)
 
 
@@ -411,5 +416,6 @@ def make_workspace(model: Model) -> Workspace:
                      audit_worst=z(4, np.int64), audit_worst_value=z(1), first_order=z(1, np.int64),
                      energy_stop=z(1, np.int64),
                      joint_gain=z(3), lcp_eps=z(1),
-                     impact_time=z(1), path_explained=z((nb, 3)),
+                     impact_time=z(1), audit_keep=z(N_AUDIT, np.int64), path_explained=z((nb, 3)),
+                     step_path=z(nb),
                      prev=make_state(model))

@@ -214,6 +214,24 @@ def add_part_path(s, ws, tau):
 
 
 @kernel
+def finish_path(s, ws, h):
+    """The step's last part, of h [s], ended: add h max(|v_start|, |v_end|) to the path each
+    body's velocities explain (ws.path_explained[:, 0] then holds the whole step's)."""
+    for i in range(s.v.shape[0]):
+        speed = _speed(s.v, i)
+        ws.path_explained[i, 0] += h * max(ws.path_explained[i, 1], speed)
+        ws.path_explained[i, 1] = speed
+
+
+@kernel
+def keep_step_path(ws, add):
+    """The step's (add: a sub-step's) path, ws.path_explained[:, 0], into (added to)
+    ws.step_path."""
+    for i in range(ws.step_path.shape[0]):
+        ws.step_path[i] = ws.path_explained[i, 0] + (ws.step_path[i] if add else 0.0)
+
+
+@kernel
 def joined_start_depth(m, ws, i):
     """The largest overlap [m] at the step's start (start_depth, note_start_depths) of body i
     and of every body joined to it by pins and rods: a correction pushing one body out of
@@ -242,14 +260,14 @@ def joined_start_depth(m, ws, i):
 
 
 @kernel
-def check_displacements(m, s, ws, h, slack):
+def check_displacements(m, s, ws, slack):
     """GUARD_JUMP if some body's centre of mass moved over the step (from ws.prev, the step's
     start) farther than its velocities explain plus slack [m] (plus the depth its contacts,
     or those of a body joined to it, started the step below the ground or inside another
-    shape, which the step pushes out: joined_start_depth). What they explain: h max(|v_start|, |v_end|) over the step's last part of
-    h [s] (the whole step unless it was split at a time of impact), plus, per earlier part,
-    its length times the largest speed the body had in it (ws.path_explained: start_path,
-    add_part_path). Symplectic Euler moves a body by h |v_end|; a longer move is the position
+    shape, which the step pushes out: joined_start_depth). What they explain: per part of the
+    step (the whole step unless it was split at a time of impact), its length times the
+    largest speed the body had in it, max(|v_start|, |v_end|) for the last part
+    (ws.path_explained[:, 0]: start_path, add_part_path, finish_path). Symplectic Euler moves a body by h |v_end|; a longer move is the position
     correction's: a correction larger than the violation it corrects (a body turning by
     h w ~ 1 rad in the step, a rod or a normal that turned within it), or a body driven deep
     into the ground within the step and pushed out (a shape turning through a hill).
@@ -260,7 +278,7 @@ def check_displacements(m, s, ws, h, slack):
         dx = s.q[i, 0] - ws.prev.q[i, 0]
         dy = s.q[i, 1] - ws.prev.q[i, 1]
         moved = math.sqrt(dx * dx + dy * dy)
-        explained = ws.path_explained[i, 0] + h * max(ws.path_explained[i, 1], _speed(s.v, i))
+        explained = ws.path_explained[i, 0]
         if not moved > explained + slack:
             continue
         allowed = slack + joined_start_depth(m, ws, i)
