@@ -7,7 +7,9 @@ compiled step fires (non-finite or huge state); it carries the last finite state
 its own audit (kernels/audit.py); it names the step, time, rule, contact or pin and body.
 ``RecordingTooLarge`` is raised before a recording is allocated that would not fit in the
 machine's memory (a duration far too long for its frame interval); it names the frames and
-the memory they would need.
+the memory they would need. ``WorkspaceTooLarge`` is raised before a model's step workspace is
+allocated that would not fit (its solve matrices are sized by every pair of shapes that may
+touch); it names the sizes and what to change.
 """
 import math
 
@@ -45,6 +47,25 @@ class RecordingTooLarge(ValueError):
     def __reduce__(self):
         # picklable, so that a tuning worker's refusal reaches the command line intact
         return (type(self), (str(self), self.frames, self.nbytes, self.available))
+
+
+class WorkspaceTooLarge(MemoryError):
+    """A model whose step's workspace cannot fit in this machine's memory, refused before it
+    is allocated (state.check_workspace); it names what sizes it.
+
+    Attributes
+    ----------
+    nbytes : int      memory the workspace's dense solve matrices would need [bytes]
+    available : int   the machine's physical memory [bytes]
+    """
+
+    def __init__(self, message, nbytes=0, available=0):
+        super().__init__(message)
+        self.nbytes = int(nbytes)
+        self.available = int(available)
+
+    def __reduce__(self):
+        return (type(self), (str(self), self.nbytes, self.available))
 
 
 class SimulationDiverged(RuntimeError):

@@ -372,8 +372,37 @@ def _broad_phase_lists(model: Model) -> dict:
                 near_contacts=np.zeros(nc, np.int64))
 
 
+def dense_workspace_bytes(model: Model) -> int:
+    """Memory [bytes] of the workspace's dense solve matrices (make_workspace): four R x R
+    (A, lcp_B, lcp_G, lcp_S; R = max_rows) and L x L plus L x (2L + 2) (lcp_M, lcp_T; L =
+    max_lcp), sized by every contact slot the model holds, two per pair of shapes that may
+    touch; the rest of the workspace grows linearly and is left out."""
+    R, L = max_rows(model), max_lcp(model)
+    return 8 * (2 * R * R + 2 * R * (R + 1) + L * L + L * (2 * L + 2))
+
+
+def check_workspace(model: Model) -> None:
+    """Raise WorkspaceTooLarge, before anything is allocated, when the workspace's dense solve
+    matrices (dense_workspace_bytes) need more memory than the machine has."""
+    from .errors import WorkspaceTooLarge
+    from .trajectory import _gib, machine_memory
+    need = dense_workspace_bytes(model)
+    have = machine_memory()
+    if have and need > have:
+        n_pair = int(np.sum(model.arrays.contact_kind == CONTACT_PAIR)) // 2
+        raise WorkspaceTooLarge(
+            f"this model's step needs {_gib(need)} of memory, more than this machine's "
+            f"{_gib(have)}: its solve matrices are sized by every contact it could ever have "
+            f"({model.n_contact:,} contact slots: {n_pair:,} pairs of shapes that may touch, two "
+            f"each, of {model.n_shape:,} shapes on {model.n_body:,} bodies; "
+            f"{max_rows(model):,} rows). Fewer pairs fit: collide=False on shapes that never "
+            f"touch, or category= / mask= filter bits that keep apart the shapes that cannot "
+            f"meet (ModelBuilder.add_shape)", need, have)
+
+
 def make_workspace(model: Model) -> Workspace:
     from .kernels.audit import N_AUDIT
+    check_workspace(model)
     nb, nc, na = model.n_body, model.n_contact, model.n_act
     R = max_rows(model)
     L = max_lcp(model)
