@@ -607,12 +607,12 @@ class _Loader:
                         **self.contact_params(g, eff))
         size = self.floats(g, eff, "size", (1, 2, 3))
         if np.any(size <= 0):
-            self.fail(g, f"size={tuple(size)} must be > 0")
+            self.fail(g, f"size={tuple(float(x) for x in size)} must be > 0")
         need = {"sphere": 1, "capsule": 1 if "fromto" in eff else 2,
                 "cylinder": 1 if "fromto" in eff else 2, "box": 2 if "fromto" in eff else 3,
                 "ellipsoid": 2 if "fromto" in eff else 3}[kind]
         if size.size < need:
-            self.fail(g, f"{kind} size={tuple(size)} needs {need} number(s)")
+            self.fail(g, f"{kind} size={tuple(float(x) for x in size)} needs {need} number(s)")
         if "fromto" in eff and kind != "sphere":
             ft = self.floats(g, eff, "fromto", 6)
             p0, p1 = ft[:3], ft[3:]
@@ -1218,6 +1218,8 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
     was ignored). Raises ModelError naming the element and line for malformed or unsupported
     input.
     """
+    if isinstance(source, (str, Path)) and not str(source).strip():
+        raise ModelError("load_mjcf: the source is empty (give an MJCF file's path or its XML text)")
     if isinstance(source, (str, Path)) and not str(source).lstrip().startswith("<"):
         path = Path(source)
         try:

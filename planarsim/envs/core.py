@@ -191,6 +191,10 @@ class GeneralizedCoords:
         return qpos, qvel
 
 
+# keywords an environment passes on to planarsim.mjcf.load_mjcf (and its ModelBuilder)
+LOAD_KEYWORDS = frozenset({"offset", "collide", "drop", "dt", "gravity", "terrain", "ground"})
+
+
 class PlanarMujocoEnv(gymnasium.Env):
     """A gymnasium Env with MuJoCo's MujocoEnv interface (data.qpos / data.qvel, init_qpos,
     init_qvel, set_state, do_simulation, state_vector, dt = timestep * frame_skip) on planarsim.
@@ -207,6 +211,11 @@ class PlanarMujocoEnv(gymnasium.Env):
 
     def __init__(self, xml_file: str, frame_skip: int, observation_space=None,
                  render_mode: str | None = None, width: int = 480, height: int = 480, **load_kw):
+        unknown = sorted(set(load_kw) - LOAD_KEYWORDS)
+        if unknown:
+            raise TypeError(f"{type(self).__name__}: unknown keyword(s) {unknown}; it takes its "
+                            f"task's own (gymnasium's v5 names), render_mode, width, height and "
+                            f"the model loader's {sorted(LOAD_KEYWORDS)}")
         path = xml_file if os.path.isabs(xml_file) else gym_asset(xml_file)
         self.loaded = load_mjcf(path, **load_kw)
         self.sim_model = self.loaded.compile()
@@ -251,6 +260,11 @@ class PlanarMujocoEnv(gymnasium.Env):
         if qpos.shape != (self.model.nq,) or qvel.shape != (self.model.nv,):
             raise ValueError(f"set_state: qpos shape {qpos.shape} and qvel shape {qvel.shape} "
                              f"must be ({self.model.nq},) and ({self.model.nv},)")
+        for name, x in (("qpos", qpos), ("qvel", qvel)):
+            bad = np.flatnonzero(~np.isfinite(x))
+            if bad.size:
+                raise ValueError(f"set_state: {name}[{int(bad[0])}] = {x[bad[0]]} is not finite "
+                                 f"({bad.size} of {x.size} entries NaN or infinite)")
         q, v = self.coords.to_maximal(qpos, qvel)
         # as a new simulator: no contact modes, warm starts or ground queries carry over.
         # Like MuJoCo's set_state, any pose is accepted (one below the floor is pushed out by

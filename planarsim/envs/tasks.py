@@ -6,6 +6,8 @@ termination, reset noise and frame skip.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from gymnasium import utils
 from gymnasium.spaces import Box
@@ -265,7 +267,7 @@ class InvertedPendulum(_Task):
 def _site(path, name):
     """(MJCF body name, plane position at the file's pose) of site `name`, for files whose
     bodies carry positions only (local coordinates, no rotations)."""
-    root = parse_xml(open(path).read(), path)
+    root = parse_xml(Path(path).read_text(), path)
 
     def walk(node, pos, body):
         for ch in node.children:

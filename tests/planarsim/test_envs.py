@@ -217,3 +217,30 @@ def test_difference_from_mujoco_euler_halves_with_the_step(name, dq, dv, action,
     assert diffs[0] > 1e-4                       # a difference to watch shrink
     for a, b in zip(diffs, diffs[1:]):
         assert 0.4 < b / a < 0.6, diffs
+
+
+def test_bad_inputs_name_the_culprit():
+    """An unknown gym.make keyword names the environment and what it takes (not
+    ModelBuilder.__init__); set_state with a NaN names the entry (not 'joints hang from no
+    body'); the double pendulum's file is read and closed (no ResourceWarning)."""
+    import warnings
+    with pytest.raises(TypeError, match=r"Reacher: unknown keyword\(s\) \['bogus'\]"):
+        gym.make("planarsim/Reacher-v0", bogus=1)
+    env = gym.make("planarsim/Hopper-v0").unwrapped
+    env.reset(seed=0)
+    qpos = env.init_qpos.copy()
+    qpos[2] = np.nan
+    with pytest.raises(ValueError, match=r"qpos\[2\] = nan is not finite"):
+        env.set_state(qpos, env.init_qvel)
+    qvel = env.init_qvel.copy()
+    qvel[0] = np.inf
+    with pytest.raises(ValueError, match=r"qvel\[0\] = inf is not finite"):
+        env.set_state(env.init_qpos, qvel)
+    import gc
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ResourceWarning)
+        env = gym.make("planarsim/InvertedDoublePendulum-v0")
+        env.close()
+        del env
+        gc.collect()
+    assert not [w for w in caught if issubclass(w.category, ResourceWarning)]

@@ -194,3 +194,17 @@ def test_capsule_inertia_matches_closed_form_in_any_plane_direction(r, length, m
     m = load_mjcf(xml).compile()
     assert m.arrays.body_inertia[0] == pytest.approx(capsule_inertia(mass, r, length), rel=1e-9)
     assert tuple(m.q0[0, :2]) == pytest.approx((dx / 2, dz / 2), abs=1e-12)
+
+
+def test_empty_sources_and_zero_sizes_are_named_plainly():
+    """load_mjcf("") says the source is empty (not "'.': Is a directory"); a zero-size geom's
+    message prints its numbers, not numpy's reprs."""
+    with pytest.raises(ModelError, match="the source is empty"):
+        load_mjcf("")
+    with pytest.raises(ModelError, match="the source is empty"):
+        load_mjcf("   ")
+    xml = """<mujoco><worldbody><body name="b"><joint type="hinge" axis="0 1 0"/>
+             <geom type="capsule" size="0" fromto="0 0 0 0.1 0 0"/></body></worldbody></mujoco>"""
+    with pytest.raises(ModelError) as err:
+        load_mjcf(xml)
+    assert "size=(0.0,)" in str(err.value) and "np.float64" not in str(err.value)
