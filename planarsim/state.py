@@ -296,6 +296,10 @@ class Workspace(NamedTuple):
     joint_gain: np.ndarray       # (3,) the joints' energy gain of the step's answer beyond
                                  #   their allowance [J], its row, 1 where measured for the
                                  #   answer standing (work.joints_add_energy, computed once)
+    joint_pivot: np.ndarray      # (1,) the smallest share of its diagonal a joint row's pivot
+                                 #   kept in the factorisation of the step's answer (1: no
+                                 #   joint row; 0: one dropped as dependent): a loop at or
+                                 #   near a dependent configuration (work.joints_add_energy)
     lcp_eps: np.ndarray          # (1,) largest diagonal term the complementarity solves of
                                  #   this step added (mixed_lcp.REGULARISATION; scaled units)
     impact_time: np.ndarray      # (1,) time [s] of the last CCD impact (time-of-impact split)
@@ -444,7 +448,7 @@ def make_workspace(model: Model) -> Workspace:
                      audit_last=z(4, np.int64), audit_value=z(1),
                      audit_worst=z(4, np.int64), audit_worst_value=z(1), first_order=z(1, np.int64),
                      energy_stop=z(1, np.int64),
-                     joint_gain=z(3), lcp_eps=z(1),
+                     joint_gain=z(3), joint_pivot=np.ones(1), lcp_eps=z(1),
                      impact_time=z(1), audit_keep=z(N_AUDIT, np.int64), path_explained=z((nb, 3)),
                      step_path=z(nb),
                      prev=make_state(model))

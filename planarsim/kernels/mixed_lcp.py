@@ -98,7 +98,9 @@ def _factor_pivoted(B, nb, rows, scratch):
     rows' order, a loop's last row could keep as its pivot the rounding of far larger rows
     (measured: a folded four-bar with inertias 1e-4..1e4 kg m^2 kept a pivot of 2e-12 of its
     diagonal on a loop singular to 1e-15, and its pins took 2e5 N s). scratch (>= nb, 2):
-    the remaining pivots and the diagonals."""
+    the remaining pivots and the diagonals. Returns the smallest share of its diagonal that
+    a pivot kept (0 if a row was left out)."""
+    smallest = 1.0
     for i in range(nb):
         scratch[i, 0] = B[i, i]
         scratch[i, 1] = B[i, i]
@@ -123,7 +125,8 @@ def _factor_pivoted(B, nb, rows, scratch):
                 B[i, i] = 0.0
                 for j in range(i + 1, nb):
                     B[j, i] = 0.0
-            return
+            return 0.0
+        smallest = min(smallest, best)
         piv = B[k, k]
         for i in range(k + 1, nb):
             B[i, k] = B[i, k] / piv
@@ -137,6 +140,7 @@ def _factor_pivoted(B, nb, rows, scratch):
         for i in range(k + 1, nb):       # the remaining block full again, for the swaps
             for j in range(i + 1, nb):
                 B[i, j] = B[j, i]
+    return smallest
 
 
 @kernel
@@ -145,12 +149,14 @@ def _factor_joints(A, B, nb, rows, scratch):
     _factor_pivoted). In the rows' order where every pivot is at least PIVOTING_SHARE of its
     diagonal, far above rounding, so that the rows are certainly independent (a tree's
     joints); pivoted otherwise: a loop, at or near a dependent configuration, whose rows
-    left out must be the dependent ones whatever the rows' order."""
+    left out must be the dependent ones whatever the rows' order. Returns the smallest share
+    of its diagonal that a pivot kept (0 if a row was left out)."""
     _fill_joint_block(A, B, nb, rows)
-    if _factor_plain(B, nb) >= PIVOTING_SHARE:
-        return
+    smallest = _factor_plain(B, nb)
+    if smallest >= PIVOTING_SHARE:
+        return smallest
     _fill_joint_block(A, B, nb, rows)
-    _factor_pivoted(B, nb, rows, scratch)
+    return _factor_pivoted(B, nb, rows, scratch)
 
 
 @kernel
@@ -202,7 +208,8 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     # joints: B = A_bb factored; G = A_bb^-1 [A_bx, b_b]
     B = ws.lcp_B
     G = ws.lcp_G
-    _factor_joints(ws.A, B, nb, ws.lcp_rows, G)
+    if nb > 0:
+        ws.joint_pivot[0] = min(ws.joint_pivot[0], _factor_joints(ws.A, B, nb, ws.lcp_rows, G))
     for j in range(nx + 1):
         for i in range(nb):
             ri = ws.lcp_rows[i]

@@ -314,6 +314,20 @@ def add_compliance(ws, n):
             ws.A[r, r] += soft_compliance(ws, r)
 
 
+@kernel
+def joint_pivot_share(ws, n):
+    """Right after factor / factor_symmetric (ws.lam holding each row's diagonal before
+    elimination, ws.A the pivots on its diagonal): the smallest share of its diagonal that a
+    joint row's pivot kept (0: one dropped as dependent; 1: no joint row)."""
+    smallest = 1.0
+    for k in range(n):
+        kind = ws.row_kind[k]
+        if is_joint_row(kind) and not is_soft_row(kind):
+            share = abs(ws.A[k, k]) / ws.lam[k] if ws.lam[k] > 0.0 else 0.0
+            smallest = min(smallest, share)
+    return smallest
+
+
 @kernel(inline="always")
 def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
@@ -334,6 +348,7 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
         dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
     else:
         dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
+    ws.joint_pivot[0] = joint_pivot_share(ws, n)
     warm = start_impulses(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)

@@ -39,6 +39,12 @@ CONSTRAINT_SHARE = SHAKE_REGIME * SHAKE_REGIME
 # 6.7 %); energy from nowhere is orders beyond it (a folded loop's nearly dependent rows:
 # 1e4 times the energy in a step; a rod turning a radian in a step: 6e3 times)
 JOINT_WORK_SHARE = 0.25
+# a joint row whose pivot kept less than this share of its diagonal (ws.joint_pivot) belongs
+# to a loop at or near a dependent configuration (a four-bar folded flat: 1e-8 to 1e-6 at the
+# steps whose second-order target gained 1 % to 8 % of KE(v*); a tree's rows keep 1e-4 or more):
+# there the target's drift along the nearly dependent direction is carried by huge
+# impulses, not by motion, and only the constraints' share CONSTRAINT_SHARE is its own
+NEAR_DEPENDENT = 1e-3
 WORK_REL_TOL = 1e-7      # the accuracy the complementarity solve accepts (lcp.ANSWER_TOL)
 # [m/s] a contact velocity this small is the solve's rounding, not motion: it moves a point by
 # 1e-8 h m in a step, a hundredth of DEPTH_TOL or less (h <= 1e-2 s), below what the position
@@ -154,7 +160,8 @@ def joints_add_energy(m, s, ws, h):
     if rounding > CONSTRAINT_SHARE * kinetic:
         gain = gain_from_velocities(m, ws, h, kinetic)
     excess = max(work - CONSTRAINT_SHARE * kinetic - rounding, gain - CONSTRAINT_SHARE * kinetic)
-    if excess > 0.0 and prediction_turn(m, s, ws, h) <= SHAKE_REGIME:
+    if (excess > 0.0 and ws.joint_pivot[0] >= NEAR_DEPENDENT
+            and prediction_turn(m, s, ws, h) <= SHAKE_REGIME):
         excess = max(work - JOINT_WORK_SHARE * kinetic - rounding,
                      gain - JOINT_WORK_SHARE * kinetic)
     if excess > 0.0 and row < 0:
