@@ -147,9 +147,11 @@ def joints_add_energy(m, s, ws, h):
     about (h w)^2 of the energy of what turns, which a whip's tip concentrates (measured: 7 %
     of a 32-link chain's KE(v*) at a step, 0.02 % net over 10 s): only a gain beyond
     JOINT_WORK_SHARE of KE(v*) is energy from nowhere. Where the end turns further from the
-    prediction (an armature or stiff spring that the velocity solve, not v*, holds back; a
-    closed loop's nearly dependent rows whose huge impulses turn its bodies) the target
-    was linearized at the wrong place: beyond CONSTRAINT_SHARE of KE(v*) is from nowhere.
+    prediction (an armature or stiff spring that the velocity solve, not v*, holds back) the
+    target was linearized at the wrong place, and where the joint rows are nearly dependent
+    (ws.joint_pivot below NEAR_DEPENDENT: a closed loop at or near a dead point) its drift
+    along the direction they can hardly move is carried by huge impulses, not by motion:
+    beyond CONSTRAINT_SHARE of KE(v*) is from nowhere.
     Where the impulses are so large that their work's rounding exceeds that share, the
     velocities' lower bound of that work (gain_from_velocities) is judged too."""
     work, rounding, row = joint_work(m, ws, ws.v_new)
