@@ -157,14 +157,24 @@ def within_reach(ws, sa, sb, reach):
 
 
 @kernel
-def fast_before_solve(m, ws, sa, sb, h):
+def pair_gate(m, i):
+    """The share of the thinner width beyond which pair i's relative motion in a step is
+    swept: GATE_SHARE, or for a pair with restitution TOUCH_SHARE, so that a bouncing pair a
+    gap apart is struck at its own time of impact, not within the same solve as the contacts
+    already touching (a speculative contact's impulse would join their impact: a cradle's
+    balls 5 mm apart at 10 m/s took the blow together as if touching)."""
+    return TOUCH_SHARE if m.contact_restitution[i] > 0.0 else GATE_SHARE
+
+
+@kernel
+def fast_before_solve(m, ws, sa, sb, h, gate):
     """(fast, width): whether shapes sa and sb may move, relative to each other, more than
-    GATE_SHARE of the thinner one's width [m] (m.shape_bound[:, 3]) in the step of h [s], by
+    gate (pair_gate) of the thinner one's width [m] (m.shape_bound[:, 3]) in the step of h [s], by
     the speed bounds under the step's start and predicted velocities (ws.shape_reach, placed
     at the sub-step's start: the same answer at stage 2 and stage 7)."""
     width = min(m.shape_bound[sa, 3], m.shape_bound[sb, 3])
     reach = h * (ws.shape_reach[sa, 3] + ws.shape_reach[sb, 3])
-    return reach > GATE_SHARE * width and within_reach(ws, sa, sb, reach), width
+    return reach > gate * width and within_reach(ws, sa, sb, reach), width
 
 
 @kernel(inline="never")
@@ -178,22 +188,23 @@ def hold_off_fast_pairs(m, s, ws, h):
     thin body it stops a point that would have missed, or turns the body through the wall."""
     for k in range(ws.n_live_pairs[0]):
         i = ws.live_pairs[k]
-        fast, width = fast_before_solve(m, ws, m.contact_pair[i, 0], m.contact_pair[i, 1], h)
+        fast, width = fast_before_solve(m, ws, m.contact_pair[i, 0], m.contact_pair[i, 1], h,
+                                        pair_gate(m, i))
         if fast and min(ws.contact_gap[i], ws.contact_gap[i + 1]) > TOUCH_SHARE * width:
             clear_slot(s, ws, i)
             clear_slot(s, ws, i + 1)
 
 
 @kernel
-def pair_is_fast(m, ws, sa, sb, h):
+def pair_is_fast(m, ws, sa, sb, h, gate):
     """(fast, reach, width): whether shapes sa and sb must be swept over h [s]: they can move,
-    relative to each other, more than GATE_SHARE of the thinner one's width in their drift
+    relative to each other, more than gate (pair_gate) of the thinner width in their drift
     (reach [m]: that motion's bound), or they were fast before the solve (their speculative
     contact may have been held off), and their bounding circles are within the reach; and
     the thinner width [m]."""
     reach = h * (drift_speed(m, ws, sa) + drift_speed(m, ws, sb))
-    held, width = fast_before_solve(m, ws, sa, sb, h)
-    fast = (held or reach > GATE_SHARE * width) and reach > 0.0
+    held, width = fast_before_solve(m, ws, sa, sb, h, gate)
+    fast = (held or reach > gate * width) and reach > 0.0
     return fast and within_reach(ws, sa, sb, reach), reach, width
 
 
@@ -252,7 +263,7 @@ def pair_impact_time(m, s, ws, h, splits_left):
             continue
         sa = m.contact_pair[i, 0]
         sb = m.contact_pair[i, 1]
-        fast, reach, width = pair_is_fast(m, ws, sa, sb, h)
+        fast, reach, width = pair_is_fast(m, ws, sa, sb, h, pair_gate(m, i))
         if fast:
             target = TOUCH_SHARE * width
             best = min(best, turn_horizon(m, s, ws, i, sa, sb, h, splits_left, target))

@@ -17,6 +17,7 @@ import math
 
 from ..compile import kernel
 from .audit import audit_impulses, audit_total
+from .broad_phase import widen_for_answer
 from .ccd import split_at_impact, stop_at_impact
 from .codes import CONTACT_PAIR, INTEGRATOR_EULER, MODE_FREE, MODES_ALTERNATING
 from .complementarity import solve_contacts
@@ -31,6 +32,7 @@ from .integrate import predict_configuration
 from .math2d import update_trig
 from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
+from .pair import PAIR_MARGIN
 from .pair_toi import hold_off_fast_pairs
 from .position import position_stage
 from .rows import build_rows
@@ -220,6 +222,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
                 break
             ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
+        if ccd_on and m.n_shape_pair > 0:                   #    shapes the answer moves
+            widen_for_answer(m, s, ws, h, PAIR_MARGIN)      #    into, unlisted at stage 2
         if ccd_on:
             tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 7. an impact
             if tau >= 0.0:                                  #    mid-step: the rest again
