@@ -149,11 +149,11 @@ def widen_for_answer(m, s, ws, h, margin):
     """After a part's solve: a body the solve set moving faster than the sweep of its start
     assumed (a ball struck at rest within a step, then at 30 m/s) may meet shapes no listed
     pair holds. Where a shape's speed bound under the answer (ws.v_new) exceeds the one its
-    box was widened for, the shapes are swept again with boxes that also cover the answer,
-    and the pairs that join the list (apart: their slots free) are left to the sweep after
-    the solve (pair_toi.pair_impact_time), which splits the step where they touch. The
-    boxes only grow, so no listed pair leaves; ws.shape_reach is placed again as it was
-    (its speed bounds are the ones stage 2 judged the pairs by). Returns the pairs added."""
+    box was widened for, the pairs are listed again (update_live) with boxes that also cover
+    the answer; the pairs that join (apart: their slots free) are left to the sweep after the
+    solve (pair_toi.pair_impact_time), which splits the step where they touch. The boxes
+    only grow, so no listed pair leaves; ws.shape_reach is placed again as it was (its speed
+    bounds are the ones stage 2 judged the pairs by). Returns the pairs added."""
     grow = False
     for k in range(m.shape_body.shape[0]):
         if _speed_bound(m, ws.v_new, m.shape_body[k], k) > ws.shape_reach[k, 3]:
@@ -163,18 +163,7 @@ def widen_for_answer(m, s, ws, h, margin):
         return 0
     for k in range(m.shape_body.shape[0]):
         ws.shape_reach[k, 3] = max(ws.shape_reach[k, 3], _speed_bound(m, ws.v_new, m.shape_body[k], k))
-    n = sweep_pairs(ws, margin, h, ws.sweep_pairs)
-    added = 0
-    for k in range(n):
-        p = ws.sweep_pairs[k]
-        if ws.pair_flag[p] != FLAG_LIVE:
-            ws.pair_flag[p] = FLAG_LIVE
-            added += 1
-    if added > 0:
-        for k in range(n):
-            ws.live_pairs[k] = ws.sweep_pairs[k]
-            ws.last_pairs[k] = ws.sweep_pairs[k]
-        ws.n_live_pairs[0] = n
-        ws.n_live[0] = merge_contacts(ws.ground_contacts, ws.live_pairs, n, ws.live)
+    listed = ws.n_live_pairs[0]
+    added = update_live(m, s, ws, margin, h) - listed
     place_shapes(m, s.q, ws.body_cs, s.v, ws.v_pred, ws)
     return added

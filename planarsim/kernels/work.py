@@ -40,8 +40,9 @@ CONSTRAINT_SHARE = SHAKE_REGIME * SHAKE_REGIME
 # 1e4 times the energy in a step; a rod turning a radian in a step: 6e3 times)
 JOINT_WORK_SHARE = 0.25
 # a joint row whose pivot kept less than this share of its diagonal (ws.joint_pivot) belongs
-# to a loop at or near a dependent configuration (a four-bar folded flat: 1e-8 to 1e-6 at the
-# steps whose second-order target gained 1 % to 8 % of KE(v*); a tree's rows keep 1e-4 or more):
+# to a loop at or near a dependent configuration (a four-bar folded flat: 1e-8 to 3e-4 at the
+# steps whose second-order target gained 1 % to 8 % of KE(v*); no step of the shipped walkers
+# changed with it):
 # there the target's drift along the nearly dependent direction is carried by huge
 # impulses, not by motion, and only the constraints' share CONSTRAINT_SHARE is its own
 NEAR_DEPENDENT = 1e-3
