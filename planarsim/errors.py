@@ -20,7 +20,7 @@ from .kernels.codes import INTEGRATOR_NAMES
 from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
                              UNSUPPORTED_SOFT)
 from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
-                             GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_SPEED,
+                             GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_ROOM, GUARD_SPEED,
                              GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
 
 
@@ -296,6 +296,20 @@ def accurate_unsupported(model, what, index, integrator=None, who="simulation"):
         f"nothing was stepped")
 
 
+def out_of_room(model, ws, who):
+    """Step stopped by GUARD_ROOM where nothing grows the workspace: its rows did not fit."""
+    from .state import workspace_contacts
+    step = int(ws.prev.step[0])
+    t = float(ws.prev.time[0])
+    held = workspace_contacts(model, ws)
+    return SimulationDiverged(
+        f"{who}: step {step} (t={t:.6g} s) touches with more contacts than its workspace's "
+        f"solve holds ({held:,} of the model's {model.n_contact:,} contact slots); the state is "
+        f"left at that step's start. Simulator.step / steps / run grow the workspace and go "
+        f"on; a workspace of your own: make_workspace(model, contacts=...) with more",
+        step, t, "", "", float(held), _start_of_step(ws))
+
+
 def diverged(model, ws, code, guard_limit, who="simulation"):
     """The SimulationDiverged for guard `code` (1 non-finite, 2 too large) of the step that
     just failed on workspace ws: step, time, body, field and value from the guard's record,
@@ -322,6 +336,8 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
         return jumped(model, ws, who)
     if code == GUARD_STIFF_ACTUATOR:
         return stiff_actuator(model, ws, who)
+    if code == GUARD_ROOM:
+        return out_of_room(model, ws, who)
     if code == GUARD_UNSUPPORTED:
         return accurate_unsupported(model, int(ws.info[INFO_GUARD_FIELD]),
                                     int(ws.info[INFO_GUARD_BODY]), None, who)

@@ -20,8 +20,9 @@ from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
 from .start_check import check_overlap, check_start, overlapping
+from .kernels.guards import GUARD_ROOM
 from .state import (State, Workspace, check_state, copy_arrays, forget_ground_queries, forget_pairs,
-                    make_state, make_workspace)
+                    grow_workspace, make_state, make_workspace, workspace_contacts)
 from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
 
@@ -171,9 +172,20 @@ class Simulator:
         """One step of `dt` (the options' dt, else the model's) under actuator commands u
         (n_act,) [N or N m]."""
         entry = self._steps_entry or self._bind_steps()
-        code, done = entry(self._args, self._u0 if u is None else self._commands(u), 1)
+        u = self._u0 if u is None else self._commands(u)
+        code, done = entry(self._args, u, 1)
+        while code == GUARD_ROOM:
+            self._grow()
+            code, done = self._bind_steps()(self._args, u, 1)
         if code:
             self._raise(code)
+
+    def _grow(self):
+        """A step ran out of room for its rows (GUARD_ROOM: it was undone): the solve's
+        storage grown (state.grow_workspace) for the step to be taken again."""
+        self._ws = grow_workspace(self._model, self._ws)
+        self._fresh_ws = None
+        self._repack()
 
     def _bind_steps(self):
         """run_steps compiled (or loaded from the cache) for this simulator's handle, then
@@ -182,11 +194,19 @@ class Simulator:
         return self._steps_entry
 
     def _run_recorded(self, u, n, every, rec, k0):
-        """compile.link.run_recorded on this simulator (bound once: see _bind)."""
+        """compile.link.run_recorded on this simulator (bound once: see _bind); a step that
+        ran out of room (GUARD_ROOM) is taken again after the storage grows."""
         entry = self._recorded_entry
         if entry is None:
             entry = self._recorded_entry = self._bind(_link().run_recorded, (n, every, rec, k0))
-        return entry(self.model.arrays, self._state, self._ws, self._options, u, n, every, rec, k0)
+        total = 0
+        while True:
+            code, done, k0 = entry(self.model.arrays, self._state, self._ws, self._options, u,
+                                   n - total, every, rec, k0)
+            total += done
+            if code != GUARD_ROOM:
+                return code, total, k0
+            self._grow()
 
     def _bind(self, kernel, extra):
         """`kernel` compiled for this simulator's argument types (model, state, workspace,
@@ -202,7 +222,12 @@ class Simulator:
         if n < 0:
             raise ValueError(f"n={n} steps must be >= 0")
         entry = self._steps_entry or self._bind_steps()
-        code, done = entry(self._args, self._commands(u), n)
+        u = self._commands(u)
+        code, done = entry(self._args, u, n)
+        while code == GUARD_ROOM:
+            self._grow()
+            n -= done
+            code, done = self._bind_steps()(self._args, u, n)
         if code:
             self._raise(code)
 
@@ -279,7 +304,7 @@ class Simulator:
                 raise ValueError(f"start_over: {name} of body {self._model.body_names[bad[0]]!r} "
                                  f"({bad[0]}) is {a[bad[0]].tolist()}; it must be finite")
         if getattr(self, "_fresh_ws", None) is None:
-            self._fresh_ws = make_workspace(self._model)
+            self._fresh_ws = make_workspace(self._model, workspace_contacts(self._model, self._ws))
         copy_arrays(self._ws, self._fresh_ws)
         if getattr(self, "_speed_from_model", False):
             self.state = st          # the setter bounds the speeds again from this start

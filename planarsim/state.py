@@ -312,6 +312,16 @@ class Workspace(NamedTuple):
     step_path: np.ndarray        # (n_body,) the path [m] each body's velocities explain over the
                                  #   last whole step: per part (time-of-impact splits, turn
                                  #   sub-steps) its length times the body's largest speed in it
+    room: np.ndarray             # (2,) int [0] 1: a row or a complementarity variable did not
+                                 #   fit this step (its answer is discarded: the step returns
+                                 #   GUARD_ROOM from its start, and Simulator grows the solve's
+                                 #   storage, grow_workspace); [1] 1: the solve's storage holds
+                                 #   fewer contacts than the model has (so a step keeps its
+                                 #   pair list's start in start_pairs, to begin again from it)
+    start_pairs: np.ndarray      # (n_pair,) int the listed pairs at the step's start (room[1])
+    n_start_pairs: np.ndarray    # (1,) int how many
+    start: State                 # the step's start while it is taken in sub-steps (GUARD_ROOM
+                                 #   puts it back; kernels/step.py)
     prev: State                  # the state at the start of the last step (for guard errors)
 
 
@@ -341,15 +351,47 @@ def forget_pairs(ws: Workspace) -> None:
     ws.n_live_pairs[0] = slot0.size
 
 
-def max_rows(model: Model) -> int:
-    # a joint's two equalities, two limit sides and its soft row; a rod's; a contact's two
-    return max(1, 5 * model.n_pin + model.n_rod + 2 * model.n_contact)
+def max_rows(model: Model, contacts: int | None = None) -> int:
+    """Rows of the step's solve with room for `contacts` contacts in rows (default: every
+    contact slot the model has): a joint's two equalities, two limit sides and its soft row;
+    a rod's; a contact's normal and tangent."""
+    nc = model.n_contact if contacts is None else contacts
+    return max(1, 5 * model.n_pin + model.n_rod + 2 * nc)
 
 
-def max_lcp(model: Model) -> int:
-    """Variables of the largest complementarity problem: joint limits and contact normals one
-    each, a contact's friction three (beta+, beta-, gamma)."""
-    return max(1, 2 * model.n_pin + 4 * model.n_contact)
+def max_lcp(model: Model, contacts: int | None = None) -> int:
+    """Variables of the largest complementarity problem with room for `contacts` contacts
+    (default: all): joint limits and contact normals one each, a contact's friction three
+    (beta+, beta-, gamma)."""
+    nc = model.n_contact if contacts is None else contacts
+    return max(1, 2 * model.n_pin + 4 * nc)
+
+
+# [bytes] the dense solve storage (dense_workspace_bytes) a workspace is given for every
+# contact slot of its model, when that fits; beyond it, room for the contacts a step is
+# likely to hold (contact_capacity), grown by the Simulator when a step needs more
+DENSE_BUDGET = 64 * 2 ** 20
+
+# contacts per shape a first workspace holds when not every slot fits DENSE_BUDGET: a box
+# on two others with one beside it touches with 2-3 pairs of two slots each
+CONTACTS_PER_SHAPE = 6
+
+
+def contact_capacity(model: Model) -> int:
+    """Contacts the solve's storage of a new workspace holds: every contact slot of the model
+    where that fits DENSE_BUDGET (every walker, every model of tens of shapes), else the
+    ground contacts and CONTACTS_PER_SHAPE per shape; a step that needs more returns
+    GUARD_ROOM and the Simulator grows it (grow_workspace)."""
+    nc = model.n_contact
+    if dense_workspace_bytes(model, nc) <= DENSE_BUDGET:
+        return nc
+    n_ground = int(np.sum(model.arrays.contact_kind != CONTACT_PAIR))
+    return min(nc, n_ground + CONTACTS_PER_SHAPE * model.n_shape)
+
+
+def workspace_contacts(model: Model, ws) -> int:
+    """Contacts the solve's storage of workspace ws holds (the inverse of max_rows)."""
+    return (ws.A.shape[0] - 5 * model.n_pin - model.n_rod) // 2
 
 
 def _broad_phase_lists(model: Model) -> dict:
@@ -376,44 +418,81 @@ def _broad_phase_lists(model: Model) -> dict:
                 near_contacts=np.zeros(nc, np.int64))
 
 
-def dense_workspace_bytes(model: Model) -> int:
-    """Memory [bytes] of the workspace's dense solve matrices (make_workspace): four R x R
-    (A, lcp_B, lcp_G, lcp_S; R = max_rows) and L x L plus L x (2L + 2) (lcp_M, lcp_T; L =
-    max_lcp), sized by every contact slot the model holds, two per pair of shapes that may
-    touch; the rest of the workspace grows linearly and is left out."""
-    R, L = max_rows(model), max_lcp(model)
+def dense_workspace_bytes(model: Model, contacts: int | None = None) -> int:
+    """Memory [bytes] of the workspace's dense solve matrices with room for `contacts`
+    contacts (default: every contact slot, two per pair of shapes that may touch): four
+    R x R (A, lcp_B, lcp_G, lcp_S; R = max_rows) and L x L plus L x (2L + 2) (lcp_M, lcp_T;
+    L = max_lcp); the rest of the workspace grows linearly and is left out."""
+    R, L = max_rows(model, contacts), max_lcp(model, contacts)
     return 8 * (2 * R * R + 2 * R * (R + 1) + L * L + L * (2 * L + 2))
 
 
-def check_workspace(model: Model) -> None:
+def check_workspace(model: Model, contacts: int | None = None) -> None:
     """Raise WorkspaceTooLarge, before anything is allocated, when the workspace's dense solve
-    matrices (dense_workspace_bytes) need more memory than the machine has."""
+    matrices with room for `contacts` contacts (dense_workspace_bytes) need more memory than
+    the machine has."""
     from .errors import WorkspaceTooLarge
     from .trajectory import _gib, machine_memory
-    need = dense_workspace_bytes(model)
+    nc = model.n_contact if contacts is None else contacts
+    need = dense_workspace_bytes(model, nc)
     have = machine_memory()
     if have and need > have:
         n_pair = int(np.sum(model.arrays.contact_kind == CONTACT_PAIR)) // 2
         raise WorkspaceTooLarge(
             f"this model's step needs {_gib(need)} of memory, more than this machine's "
-            f"{_gib(have)}: its solve matrices are sized by every contact it could ever have "
-            f"({model.n_contact:,} contact slots: {n_pair:,} pairs of shapes that may touch, two "
-            f"each, of {model.n_shape:,} shapes on {model.n_body:,} bodies; "
-            f"{max_rows(model):,} rows). Fewer pairs fit: collide=False on shapes that never "
-            f"touch, or category= / mask= filter bits that keep apart the shapes that cannot "
-            f"meet (ModelBuilder.add_shape)", need, have)
+            f"{_gib(have)}: its solve matrices hold {nc:,} contacts in rows ({max_rows(model, nc):,} "
+            f"rows; the model has {model.n_contact:,} contact slots: {n_pair:,} pairs of shapes "
+            f"that may touch, two each, of {model.n_shape:,} shapes on {model.n_body:,} bodies). "
+            f"Fewer contacts fit: collide=False on shapes that never touch, or category= / "
+            f"mask= filter bits that keep apart the shapes that cannot meet "
+            f"(ModelBuilder.add_shape), or fewer bodies touching at once", need, have)
 
 
-def make_workspace(model: Model) -> Workspace:
-    from .kernels.audit import N_AUDIT
-    check_workspace(model)
-    nb, nc, na = model.n_body, model.n_contact, model.n_act
-    R = max_rows(model)
-    L = max_lcp(model)
+def _solve_arrays(model: Model, contacts: int) -> dict:
+    """The workspace's arrays sized by the solve's rows R and complementarity variables L
+    (max_rows, max_lcp with room for `contacts` contacts)."""
+    R, L = max_rows(model, contacts), max_lcp(model, contacts)
     z = np.zeros
+    return dict(row_first=z(R, np.int64), row_reach=z(R, np.int64), row_list=z(R, np.int64),
+                row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)), row_F=z((R, 2, 3)),
+                row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R), row_kind=z(R, np.int64),
+                row_owner=z(R, np.int64), A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R),
+                row_b=z(R), row_soft=z((R, 5)), lcp_rows=z(R, np.int64),
+                lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64), lcp_B=z((R, R)),
+                lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)), lcp_q=z(L),
+                lcp_z=z(L), lcp_scale=z(L), lcp_T=z((L, 2 * L + 2)), lcp_basis=z(L, np.int64),
+                row_slip=z(R), island_rows=z(R, np.int64), row_island=z(R, np.int64))
+
+
+def grow_workspace(model: Model, ws: Workspace) -> Workspace:
+    """ws with room for twice its contacts in its solve's storage (at most every slot of the
+    model), after a step returned GUARD_ROOM; its other arrays are ws's own (the same
+    objects). WorkspaceTooLarge if that does not fit the machine."""
+    have = workspace_contacts(model, ws)
+    contacts = min(model.n_contact, max(2 * have, have + 16))
+    check_workspace(model, contacts)
+    grown = _solve_arrays(model, contacts)
+    for name, array in grown.items():
+        old = getattr(ws, name)
+        array[tuple(slice(0, k) for k in old.shape)] = old
+    room = ws.room.copy()
+    room[0] = 0
+    room[1] = int(contacts < model.n_contact)
+    return ws._replace(room=room, **grown)
+
+
+def make_workspace(model: Model, contacts: int | None = None) -> Workspace:
+    """A model's workspace with room for `contacts` contacts in its solve's storage
+    (default: contact_capacity)."""
+    from .kernels.audit import N_AUDIT
+    contacts = contact_capacity(model) if contacts is None else min(int(contacts), model.n_contact)
+    check_workspace(model, contacts)
+    nb, nc, na = model.n_body, model.n_contact, model.n_act
+    z = np.zeros
+    lists = _broad_phase_lists(model)
+    n_pair = lists["live_pairs"].shape[0]
     return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan),
-                     body_first_row=z(nb, np.int64), row_first=z(R, np.int64),
-                     row_reach=z(R, np.int64), row_list=z(R, np.int64),
+                     body_first_row=z(nb, np.int64),
                      v_pred=z((nb, 3)), v_new=z((nb, 3)),
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),
@@ -429,20 +508,13 @@ def make_workspace(model: Model) -> Workspace:
                      contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
                      contact_refpt=z((nc, 4)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
-                     **_broad_phase_lists(model),
-                     row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)),
-                     row_F=z((R, 2, 3)), row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R),
-                     row_kind=z(R, np.int64), row_owner=z(R, np.int64), n_row=z(1, np.int64),
-                     A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R), act_u=z(na), act_power=z(na),
-                     info=z(N_INFO, np.int64), guard_value=z(3), row_b=z(R), row_soft=z((R, 5)),
+                     **lists, **_solve_arrays(model, contacts),
+                     n_row=z(1, np.int64), act_u=z(na), act_power=z(na),
+                     info=z(N_INFO, np.int64), guard_value=z(3),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
-                     lcp_rows=z(R, np.int64), lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64),
-                     lcp_B=z((R, R)), lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)),
-                     lcp_q=z(L), lcp_z=z(L), lcp_scale=z(L), lcp_T=z((L, 2 * L + 2)),
-                     lcp_basis=z(L, np.int64), row_slip=z(R), island_parent=z(nb, np.int64),
+                     island_parent=z(nb, np.int64),
                      island_label=z(nb, np.int64), island_start=z(nb + 2, np.int64),
-                     island_fill=z(nb + 1, np.int64), island_rows=z(R, np.int64),
-                     row_island=z(R, np.int64), island_failed=z(nb + 1, np.int64),
+                     island_fill=z(nb + 1, np.int64), island_failed=z(nb + 1, np.int64),
                      island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),
                      audit=z(N_AUDIT, np.int64),
                      audit_last=z(4, np.int64), audit_value=z(1),
@@ -451,4 +523,6 @@ def make_workspace(model: Model) -> Workspace:
                      joint_gain=z(3), joint_pivot=np.ones(1), lcp_eps=z(1),
                      impact_time=z(1), audit_keep=z(N_AUDIT, np.int64), path_explained=z((nb, 3)),
                      step_path=z(nb),
-                     prev=make_state(model))
+                     room=np.array([0, int(contacts < nc)], np.int64),
+                     start_pairs=z(n_pair, np.int64), n_start_pairs=z(1, np.int64),
+                     start=make_state(model), prev=make_state(model))

@@ -29,6 +29,9 @@ GUARD_JUMP = 9           # a body moved in the step farther than its velocities 
                           # (check_displacements; ws.info[INFO_GUARD_BODY]: the body,
                           # [INFO_GUARD_FIELD]: a contact touching it or -1, ws.guard_value:
                           # the distance, what its velocities explain, the allowance [m])
+GUARD_ROOM = 10          # a row or complementarity variable of the step did not fit the
+                          # workspace's storage (ws.room): the state is put back at the step's
+                          # start, and Simulator grows the storage and takes the step again
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[INFO_COMMAND]:
                           # its length); negative, so that no walker's own return code clashes
 GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[INFO_COMMAND]: its index,

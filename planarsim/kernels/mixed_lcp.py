@@ -232,6 +232,9 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
         ws.lcp_pos[i] = nv
         nv += 3 if is_tangent_row(ws.row_kind[r]) else 1
     Mx = ws.lcp_M
+    if nv > Mx.shape[0]:            # beyond the workspace's storage: the step begins again
+        ws.room[0] = 1              # with more (kernels/step.py, GUARD_ROOM)
+        return LCP_RAY, 0, 0.0
     qx = ws.lcp_q
     d = ws.lcp_scale
     for i in range(nv):

@@ -6,7 +6,12 @@ from ..compile import kernel
 
 @kernel
 def add_row(ws, n, kind, owner, a, b):
-    """Row slot n <- (kind, owner, bodies a and b); returns n + 1."""
+    """Row slot n <- (kind, owner, bodies a and b); returns n + 1. Where slot n is beyond
+    the workspace's storage, nothing is written, ws.room[0] is set (the step begins again
+    with more: kernels/step.py, GUARD_ROOM) and n is returned."""
+    if n >= ws.row_kind.shape[0]:
+        ws.room[0] = 1
+        return n
     ws.row_kind[n] = kind
     ws.row_owner[n] = owner
     ws.row_body[n, 0] = a

@@ -17,13 +17,13 @@ import math
 
 from ..compile import kernel
 from .audit import audit_impulses, audit_total
-from .broad_phase import widen_for_answer
+from .broad_phase import FLAG_LIVE, widen_for_answer
 from .ccd import split_at_impact, stop_at_impact
 from .codes import CONTACT_PAIR, INTEGRATOR_EULER, MODE_FREE, MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, check_actuator_turns,
+from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_ROOM, check_actuator_turns,
                      check_displacements, check_guards, check_speeds,
                      add_part_path, finish_path, keep_step_path, note_start_depths,
                      start_path)
@@ -175,6 +175,45 @@ def reset_counts(ws):
         ws.info[k] = 0
 
 
+@kernel
+def keep_pairs(ws):
+    """Keep the broad phase's pair list at the step's start (ws.room[1]: a workspace that may
+    run out of room), so that a step begun again (put_back) lists its pairs as the first
+    attempt did."""
+    if ws.room[1] == 0:
+        return
+    n = ws.n_live_pairs[0]
+    for k in range(n):
+        ws.start_pairs[k] = ws.last_pairs[k]
+    ws.n_start_pairs[0] = n
+
+
+@kernel
+def begin_step(ws):
+    """Before a step: the audit's counts and the broad phase's pair list kept (put_back
+    restores them), no shortage of room yet."""
+    for k in range(ws.audit.shape[0]):
+        ws.audit_keep[k] = ws.audit[k]
+    ws.room[0] = 0
+    keep_pairs(ws)
+
+
+@kernel
+def put_back(s, ws, start):
+    """A step that ran out of room (GUARD_ROOM) undone: the State at its start, the audit's
+    counts and the broad phase's pair list (keep_pairs) as they were."""
+    copy_state(start, s)
+    for k in range(ws.audit.shape[0]):
+        ws.audit[k] = ws.audit_keep[k]
+    for k in range(ws.n_live_pairs[0]):
+        ws.pair_flag[ws.last_pairs[k]] = 0
+    n = ws.n_start_pairs[0]
+    for k in range(n):
+        ws.last_pairs[k] = ws.start_pairs[k]
+        ws.pair_flag[ws.start_pairs[k]] = FLAG_LIVE
+    ws.n_live_pairs[0] = n
+
+
 @kernel(inline="never")
 def step_of_length(m, s, ws, opt, u, step_length, stage):
     """Advance s by one default step of step_length [s] under actuator commands u; return the
@@ -222,6 +261,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
                 break
             ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
+        if ws.room[0] == 1:                                 #    rows beyond the storage:
+            return GUARD_ROOM                               #    again with more (_step)
         if ccd_on and m.n_shape_pair > 0:                   #    shapes the answer moves
             widen_for_answer(m, s, ws, h, PAIR_MARGIN)      #    into, unlisted at stage 2
         if ccd_on:
@@ -238,6 +279,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         audit_impulses(m, s, ws, opt, h)                    # 9. the audit of the impulses
         position_stage(m, s, ws, opt, h, answered)          # 6. integrate, correct, settle
         break
+    if ws.room[0] == 1:
+        return GUARD_ROOM
     s.time[0] = ws.prev.time[0] + step_length
     s.step[0] += 1
     if m.contact_body.shape[0] > 0:
@@ -271,6 +314,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
     if code != 0:
         return code
     copy_state(s, ws.prev)
+    begin_step(ws)
     reset_counts(ws)
     start_path(s, ws)
     if opt.turn_limit > 0.0:
@@ -288,6 +332,8 @@ def accurate_step(m, s, ws, opt, u, step_length):
         s.step[0] = count                                   # an error names this step
         rattle_begin(m, s, ws, u, h)
         code = step_of_length(m, s, ws, opt, u, h, True)
+        if code == GUARD_ROOM:
+            put_back(s, ws, ws.prev)
         if code != 0:
             return code
         rattle_end(m, s, ws, u, h, opt.pivot_tol, k == n - 1)
@@ -347,12 +393,14 @@ def _step(m, s, ws, opt, u):
     StepOptions.integrator; return the guard code."""
     step_length = opt.dt if opt.dt > 0.0 else m.dt
     if opt.integrator == INTEGRATOR_EULER:
+        begin_step(ws)
         most = opt.max_substeps
         n = turn_substeps(m, s, step_length, most)
         if n == 1:
-            for k in range(ws.audit.shape[0]):
-                ws.audit_keep[k] = ws.audit[k]
             code = step_of_length(m, s, ws, opt, u, step_length, False)
+            if code == GUARD_ROOM:
+                put_back(s, ws, ws.prev)
+                return code
             # a body that began turning fast within the step (an impact spinning a light
             # link up) is judged at the step's answer: taken again, in sub-steps
             n = turn_substeps(m, s, step_length, most)
@@ -367,10 +415,14 @@ def _step(m, s, ws, opt, u):
         # count as one: an error names this step
         count = s.step[0]
         t0 = s.time[0]
+        if ws.room[1] == 1:
+            copy_state(s, ws.start)
         for k in range(n):
             s.step[0] = count
             code = step_of_length(m, s, ws, opt, u, step_length / n, False)
             keep_step_path(ws, k > 0)
+            if code == GUARD_ROOM:
+                put_back(s, ws, ws.start)
             if code != 0:
                 return code
         s.step[0] = count + 1

@@ -1,0 +1,134 @@
+"""Worlds of many boxes at rest: memory, the first step, the steps after it, how far a box
+moves, the audit. Each world runs in its own process (its peak memory is its own), stopped
+after --limit seconds (a first step that takes longer is reported as such).
+
+    python benchmarks/worlds.py                          # every world, 200 steps each
+    python benchmarks/worlds.py columns10x10 pyramid10 --steps 500 --limit 120
+
+Worlds: columns10x10 (ten columns of ten 0.2 m boxes, 0.4 m apart), pyramid10 (55 boxes),
+pyramid20 (210 boxes, each on two below), wall40x10 (400 bricks 0.4 x 0.2 m, staggered),
+pyramid45 (1,035 boxes). Prints per world: bodies, contact slots, the contacts the
+workspace's solve holds at the end, peak memory [MB], the first step [ms], mean and largest
+of the later steps [ms], the largest move of a box from its start [m] and the audit's total.
+"""
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import resource
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import planarsim as ps  # noqa: E402
+
+BOX = 0.2   # [m]
+
+
+def _box(b, name, x, y, w=BOX, h=BOX):
+    b.add_body(name, pos=(x, y), shapes=[("box", (0.0, 0.0), w, h, {"mu": 0.6})], density=100.0)
+
+
+def columns(n_columns=10, n_rows=10):
+    b = ps.ModelBuilder(dt=1e-3)
+    for c in range(n_columns):
+        for r in range(n_rows):
+            _box(b, f"box{c}_{r}", 2 * BOX * c, BOX / 2 + BOX * r)
+    return b.compile()
+
+
+def pyramid(rows):
+    """rows levels of 0.2 m boxes, each on two below (touching side by side)."""
+    b = ps.ModelBuilder(dt=1e-3)
+    for level in range(rows):
+        n = rows - level
+        for j in range(n):
+            _box(b, f"box{level}_{j}", (j - (n - 1) / 2) * BOX, BOX / 2 + level * BOX)
+    return b.compile()
+
+
+def wall(n_columns=40, n_rows=10):
+    """A staggered wall of 0.4 x 0.2 m bricks: odd rows shifted by half a brick."""
+    b = ps.ModelBuilder(dt=1e-3)
+    for r in range(n_rows):
+        for c in range(n_columns):
+            _box(b, f"brick{r}_{c}", 2 * BOX * c + (BOX if r % 2 else 0.0), BOX / 2 + BOX * r,
+                 w=2 * BOX)
+    return b.compile()
+
+
+WORLDS = {
+    "columns10x10": lambda: columns(10, 10),
+    "pyramid10": lambda: pyramid(10),
+    "pyramid20": lambda: pyramid(20),
+    "wall40x10": lambda: wall(40, 10),
+    "pyramid45": lambda: pyramid(45),
+}
+
+
+def _measure(name, steps, out):
+    from planarsim.compiled import audit_counts
+    from planarsim.state import workspace_contacts
+    model = WORLDS[name]()
+    sim = ps.Simulator(model)
+    q0 = sim.state.q.copy()
+    out.put(("built", model.n_body, model.n_contact))
+    t = time.perf_counter()
+    sim.step()
+    first = time.perf_counter() - t
+    out.put(("first", first))
+    times = np.zeros(max(steps - 1, 1))
+    for k in range(steps - 1):
+        t = time.perf_counter()
+        sim.step()
+        times[k] = time.perf_counter() - t
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    out.put(("done", workspace_contacts(model, sim.ws), rss, first, float(times.mean()),
+             float(times.max()), float(np.abs(sim.state.q - q0).max()),
+             int(sum(audit_counts(sim.ws).values()))))
+
+
+def run(name, steps, limit):
+    out = mp.Queue()
+    proc = mp.Process(target=_measure, args=(name, steps, out))
+    proc.start()
+    proc.join(limit)
+    said = {}
+    while not out.empty():
+        item = out.get()
+        said[item[0]] = item[1:]
+    if proc.is_alive():
+        proc.kill()
+        proc.join()
+    if "done" in said:
+        held, rss, first, mean, most, move, audit = said["done"]
+        n_body, n_contact = said["built"]
+        return (f"{name:13s} {n_body:5d} bodies {n_contact:8,d} slots  holds {held:6,d}  "
+                f"{rss:7.0f} MB  first {first * 1e3:9.1f} ms  then mean {mean * 1e3:7.3f} ms "
+                f"(largest {most * 1e3:7.2f})  moved {move:.1e} m  audit {audit}")
+    where = ("before its first step ended" if "first" not in said
+             else f"after a first step of {said['first'][0]:.1f} s")
+    built = said.get("built")
+    size = f"{built[0]} bodies {built[1]:,} slots, " if built else ""
+    return f"{name:13s} {size}stopped at the {limit:g} s limit {where}"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("worlds", nargs="*", default=list(WORLDS), help=f"of {list(WORLDS)}")
+    ap.add_argument("--steps", type=int, default=200)
+    ap.add_argument("--limit", type=float, default=120.0, help="seconds per world")
+    a = ap.parse_args(argv)
+    unknown = [w for w in a.worlds if w not in WORLDS]
+    if unknown:
+        ap.error(f"unknown world(s) {unknown}; the worlds are {list(WORLDS)}")
+    for name in a.worlds:
+        print(run(name, a.steps, a.limit), flush=True)
+
+
+if __name__ == "__main__":
+    main()
