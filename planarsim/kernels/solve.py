@@ -328,6 +328,55 @@ def joint_pivot_share(ws, n):
     return smallest
 
 
+# [-] the share of its own diagonal added to each row of a statically indeterminate set for
+# the least-change solve (least_change_impulses), and how many rounds of refinement it takes
+LEAST_CHANGE_SHARE = 1e-8
+LEAST_CHANGE_ROUNDS = 4
+# [-] how much more a friction row's change weighs in that least change than a normal's: the
+# load goes to the normals, friction takes only what they cannot (a box beside another leans
+# on it through friction only if nothing is below it)
+TANGENT_WEIGHT = 1e4
+
+
+@kernel
+def least_change_impulses(m, s, ws, h, tol, n):
+    """lambda of the rows (symmetric, some dependent: a box resting on two others) that
+    changes the start impulses (the last step's, warm_start.py) least, in the norm of
+    A's diagonal, and v_new = v* + W J^T lambda. Where the factorisation drops a dependent
+    row, the others carry its load in whatever split the elimination order gives (a box on
+    two boxes could hang from one of its four corners and press twice with another); the
+    least change spreads it over the set as the rows' geometry does. Iterated Tikhonov: A +
+    s D factored once (s = LEAST_CHANGE_SHARE, D = diag A: no pivot vanishes), then each round
+    solves for the equations' residual at the current answer; its limit is the least change
+    that meets the equations (the dependent directions are never entered), a friction row's
+    change weighing TANGENT_WEIGHT times a normal's."""
+    assemble(m, ws, ws.row_J, ws.row_F, n, True)
+    add_compliance(ws, n)
+    for r in range(n):
+        share = LEAST_CHANGE_SHARE
+        if is_tangent_row(ws.row_kind[r]):
+            share *= TANGENT_WEIGHT
+        ws.A[r, r] *= 1.0 + share
+    factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
+    for i in range(ws.v_new.shape[0]):
+        for k in range(3):
+            ws.v_new[i, k] = ws.v_pred[i, k]
+    if not start_impulses(s, ws, n, 1):
+        for r in range(n):
+            ws.lam_start[r] = 0.0
+    apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
+    for _ in range(LEAST_CHANGE_ROUNDS):
+        for r in range(n):
+            ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
+                          - row_dot(ws, r, ws.row_J, ws.v_pred))
+        substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+        apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
+        for r in range(n):
+            ws.lam_start[r] += ws.lam[r]
+    for r in range(n):
+        ws.lam[r] = ws.lam_start[r]
+
+
 @kernel(inline="always")
 def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
@@ -349,6 +398,9 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     else:
         dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
     ws.joint_pivot[0] = joint_pivot_share(ws, n)
+    if dropped > 0 and symmetric and ws.least_change[0] == 1:
+        least_change_impulses(m, s, ws, h, tol, n)
+        return dropped
     warm = start_impulses(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)

@@ -83,6 +83,7 @@ def build_and_solve(m, s, ws, opt, h):
     solves of solve_modes): its work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
     dropped = solve_impulses(m, s, ws, h, opt.pivot_tol, sliding == 0)
+    ws.least_change[1] = dropped
     return dropped > 0 or sliding > 0
 
 
@@ -94,6 +95,30 @@ def answer_check(m, s, ws, h, include_ccd, equalities):
     engaged = engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
         m, s, ws, h, ws.v_new)
     return breaks, engaged
+
+
+@kernel(inline="always")
+def solve_and_check(m, s, ws, opt, h, include_ccd):
+    """One linear solve under the modes as they stand and its check (answer_check); returns
+    (rule breaks, contacts and limits engaged, solves taken). An answer that breaks a rule
+    where the solve dropped dependent rows (a statically indeterminate pile, whose dropped
+    rows' load the elimination order split: a box on two hanging from one corner) is solved
+    again with the least change of impulses (solve.least_change_impulses). If that answer
+    keeps every rule it stands, and the step's later solves take the least change too;
+    otherwise the first answer is solved again and stands, as if never tried."""
+    equalities = build_and_solve(m, s, ws, opt, h)
+    breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
+    if breaks == 0 or ws.least_change[1] == 0 or ws.least_change[0] == 1:
+        return breaks, engaged, 1
+    ws.least_change[0] = 1
+    equalities = build_and_solve(m, s, ws, opt, h)
+    if rule_breaks(m, s, ws, h, equalities) == 0:
+        engaged += engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
+            m, s, ws, h, ws.v_new)
+        return 0, engaged, 2
+    ws.least_change[0] = 0
+    build_and_solve(m, s, ws, opt, h)
+    return breaks, engaged, 3
 
 
 @kernel(inline="always")
@@ -113,15 +138,13 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     True if a linear solve's answer stood (its rows, and their envelope where there are rows,
     are in ws), False if the complementarity solve replaced it."""
     ws.joint_gain[2] = 0.0      # a new answer: the joints' work is not known yet
+    ws.least_change[0] = 0
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
-    equalities = build_and_solve(m, s, ws, opt, h)
-    rounds = 1
-    breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
+    breaks, engaged, rounds = solve_and_check(m, s, ws, opt, h, include_ccd)
     while breaks == 0 and engaged > 0:
-        equalities = build_and_solve(m, s, ws, opt, h)
-        rounds += 1
-        breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
+        breaks, engaged, more = solve_and_check(m, s, ws, opt, h, include_ccd)
+        rounds += more
     ok = breaks == 0 and engaged == 0
     nc = m.contact_body.shape[0]
     if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
