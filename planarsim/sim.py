@@ -171,12 +171,17 @@ class Simulator:
     def step(self, u=None) -> None:
         """One step of `dt` (the options' dt, else the model's) under actuator commands u
         (n_act,) [N or N m]."""
+        self._run_steps(self._u0 if u is None else self._commands(u), 1)
+
+    def _run_steps(self, u, n):
+        """n compiled steps under commands u (checked); a step that ran out of room
+        (GUARD_ROOM: undone) is taken again after the storage grows (_grow)."""
         entry = self._steps_entry or self._bind_steps()
-        u = self._u0 if u is None else self._commands(u)
-        code, done = entry(self._args, u, 1)
+        code, done = entry(self._args, u, n)
         while code == GUARD_ROOM:
             self._grow()
-            code, done = self._bind_steps()(self._args, u, 1)
+            n -= done
+            code, done = self._bind_steps()(self._args, u, n)
         if code:
             self._raise(code)
 
@@ -221,15 +226,7 @@ class Simulator:
         n = int(n)
         if n < 0:
             raise ValueError(f"n={n} steps must be >= 0")
-        entry = self._steps_entry or self._bind_steps()
-        u = self._commands(u)
-        code, done = entry(self._args, u, n)
-        while code == GUARD_ROOM:
-            self._grow()
-            n -= done
-            code, done = self._bind_steps()(self._args, u, n)
-        if code:
-            self._raise(code)
+        self._run_steps(self._commands(u), n)
 
     def run(self, duration: float | None = None, u=None, controller=None, n_steps: int | None = None,
             record_every: int = 1, control_every: int = 1, labels=None) -> Trajectory:

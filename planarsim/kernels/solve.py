@@ -339,7 +339,16 @@ TANGENT_WEIGHT = 1e4
 
 
 @kernel
-def least_change_impulses(m, s, ws, h, tol, n):
+def residual_rhs(ws, n):
+    """ws.rhs = -w, w = A lam + b the rows' residual at the impulses already applied to
+    ws.v_new: b + J (v_new - v*)."""
+    for r in range(n):
+        ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
+                      - row_dot(ws, r, ws.row_J, ws.v_pred))
+
+
+@kernel
+def least_change_impulses(m, s, ws, tol, n):
     """lambda of the rows (symmetric, some dependent: a box resting on two others) that
     changes the start impulses (the last step's, warm_start.py) least, in the norm of
     A's diagonal, and v_new = v* + W J^T lambda. Where the factorisation drops a dependent
@@ -366,9 +375,7 @@ def least_change_impulses(m, s, ws, h, tol, n):
             ws.lam_start[r] = 0.0
     apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
     for _ in range(LEAST_CHANGE_ROUNDS):
-        for r in range(n):
-            ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
-                          - row_dot(ws, r, ws.row_J, ws.v_pred))
+        residual_rhs(ws, n)
         substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
         apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
         for r in range(n):
@@ -399,15 +406,12 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
         dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
     ws.joint_pivot[0] = joint_pivot_share(ws, n)
     if dropped > 0 and symmetric and ws.least_change[0] == 1:
-        least_change_impulses(m, s, ws, h, tol, n)
+        least_change_impulses(m, s, ws, tol, n)
         return dropped
     warm = start_impulses(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
-        for r in range(n):
-            # w = A lam + b at the start: b + J (v_new - v*)
-            ws.rhs[r] = -(ws.row_b[r] + row_dot(ws, r, ws.row_J, ws.v_new)
-                          - row_dot(ws, r, ws.row_J, ws.v_pred))
+        residual_rhs(ws, n)
     else:
         for r in range(n):
             ws.rhs[r] = -ws.row_b[r]

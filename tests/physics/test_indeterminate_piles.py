@@ -9,22 +9,11 @@ import numpy as np
 import pytest
 
 import planarsim as ps
+from benchmarks.worlds import pyramid   # 0.2 m boxes of 4 kg, each on two below
 from planarsim.compiled import audit_counts, step_info
 from planarsim.kernels.codes import CONTACT_PAIR
 
 G = 9.81
-BOX = 0.2
-
-
-def pyramid(rows):
-    """rows levels of 0.2 m boxes (4 kg), each on two below, touching side by side."""
-    b = ps.ModelBuilder(dt=1e-3)
-    for level in range(rows):
-        n = rows - level
-        for j in range(n):
-            b.add_body(f"box{level}_{j}", pos=((j - (n - 1) / 2) * BOX, BOX / 2 + level * BOX),
-                       shapes=[("box", (0.0, 0.0), BOX, BOX, {"mu": 0.6})], density=100.0)
-    return b.compile()
 
 
 @pytest.mark.parametrize("rows", [6, 8])
