@@ -113,21 +113,25 @@ def integrate_positions(s, ws, vel, h):
 @kernel
 def bound_correction_work(m, s, ws, h):
     """The position correction's velocity change dv = s.v - ws.v_solved (SHAKE: a joint's
-    correction / h) kept as far as the correction adds no energy beyond its allowance:
+    correction / h) kept as far as the step as a whole adds no energy beyond its allowance:
     v = v_solved + k dv with the largest k in [0, 1] such that
 
         KE(v) - KE(v_solved) - f . (q - q_solved) <= allowance
 
-    (kinetic energy gained less the applied forces' work along the correction's move; the move
-    itself is kept). Within SHAKE's regime, |dv| <= SHAKE_REGIME |v_solved| (mass-weighted),
-    the correction is a second-order term of a step that turns each body by h w << 1; it
-    keeps the integrator symplectic (energy oscillates, momenta are kept) and may move the
-    energy by CONSTRAINT_SHARE of the kinetic energy (work.py); beyond it the allowance is 0.
-    The move's own lift against the applied forces (a contact point pushed out of the ground)
-    is allowed up to that share plus the step's own error under the forces (h [s] the
-    integrated step's), in either regime. Returns the energy [J] the correction still adds
-    beyond its allowance and beyond what the step's velocity solve took out (only the move's
-    own work can leave some: k = 0 keeps no velocity change).
+    (kinetic energy gained plus the move's work against the applied forces f). Within
+    SHAKE's regime, |dv| <= SHAKE_REGIME |v_solved| (mass-weighted), the correction is a
+    second-order term of a step that turns each body by h w << 1; it keeps the integrator
+    symplectic (energy oscillates, momenta are kept), and the step's constraints (the velocity
+    solve and the correction together) may move the energy by CONSTRAINT_SHARE (work.py) of
+    the smaller of the step's kinetic energies at its start and after its solve: the
+    allowance is that share less what the velocity stage already gained
+    (velocity_stage_gain). Beyond the regime the allowance is 0. A move whose own lift against
+    the forces exceeds the allowance (a contact point pushed out of the ground by a turning
+    body's (h w)^2 r dip, a joint's drift closed through a contact) keeps the least kinetic
+    energy it can, and its lift is allowed up to the share plus the step's own error under
+    the forces (work.force_step_energy; h [s] the integrated step's). Returns the energy [J]
+    the correction still adds beyond that and beyond what the step's velocity solve took out
+    (only the move's own work can leave some: k = 0 keeps no velocity change).
 
     A body turning by h w ~ 1 in one step (a light body spinning after a hard impact)
     leaves first-order errors; Newton can then end on a far solution of the joint
@@ -153,16 +157,12 @@ def bound_correction_work(m, s, ws, h):
                           + inertia * ws.v_solved[i, 2] ** 2)
         momentum += mass * (abs(dx) + abs(dy) + abs(ws.v_solved[i, 0]) + abs(ws.v_solved[i, 1]))
     in_regime = b <= SHAKE_REGIME * SHAKE_REGIME * kinetic
-    # what the correction may gain: its share in the regime; the applied forces' work along
-    # its move (what the move takes from them), less what it gives them beyond that share
-    # (the move's own lift against gravity: a turning body's contact point pushed out of
-    # the ground by its (h w)^2 r dip, a joint's drift closed through a contact; also up to
-    # the step's own first-order error under the forces, work.force_step_energy); rounding
-    share = CONSTRAINT_SHARE * kinetic
+    start_kinetic, gained = velocity_stage_gain(m, ws, h)
+    # the step's share: of the smaller kinetic energy, less what its velocity stage gained
+    share = max(CONSTRAINT_SHARE * min(kinetic, start_kinetic) - max(gained, 0.0), 0.0)
     force_work = correction_force_work(s, ws)
-    lift = share + force_step_energy(m, ws, h)
-    room = (share if in_regime else 0.0) + force_work + min(max(-force_work, 0.0), lift)
-    room += correction_rounding(m, ws, momentum, kinetic + abs(a) + b)
+    rounding = correction_rounding(m, ws, momentum, kinetic + abs(a) + b)
+    room = (share if in_regime else 0.0) + force_work + rounding
     if a + b <= room or (in_regime and a + b <= 0.0):
         return 0.0
     if b <= 0.0:
@@ -178,11 +178,40 @@ def bound_correction_work(m, s, ws, h):
             s.v[i, c] = ws.v_solved[i, c] + k * (s.v[i, c] - ws.v_solved[i, c])
     if not short:
         return 0.0
-    # what is left is the move's own work. The velocity stage's loss in this step (contacts
-    # absorbing an approach, friction) pays for it first: a step whose velocity solve took out
-    # more than the move then puts back (a box pushed out of the overlap it hit) gains nothing
-    loss = kinetic_energy(m, ws.v_pred) - kinetic_energy(m, ws.v_solved)
-    return max(k * a + k * k * b - room - max(loss, 0.0), 0.0)
+    # what is left is the move's own work. Its lift against the forces is allowed up to the
+    # share plus the step's own error under them; the velocity stage's loss in this step
+    # (contacts absorbing an approach, friction) pays for the rest first: a step whose
+    # velocity solve took out more than the move then puts back (a box pushed out of the
+    # overlap it hit) gains nothing
+    lift = min(max(-force_work, 0.0), share + force_step_energy(m, ws, h))
+    loss = kinetic_energy(m, ws.v_pred) - kinetic
+    return max(k * a + k * k * b - room - lift - max(loss, 0.0), 0.0)
+
+
+@kernel
+def velocity_stage_gain(m, ws, h):
+    """(KE at the step's start [J], the energy [J] its velocity stage gained beyond the
+    applied forces' own symplectic Euler term): with v0 = v_pred - h M^-1 f the velocity at
+    the start of the integrated step of h [s] and v_solved, q_solved its solve's answer,
+
+        KE(v_solved) - KE(v0) - f . (q_solved - q0) + (h / 2) f . (v_solved - v0),
+
+    exactly 0 for a step without impulses under constant forces (a falling body's step moves
+    its energy by (h / 2) g dp_y) and for a body at rest on the ground."""
+    start = 0.0
+    end = 0.0
+    power = 0.0
+    for i in range(ws.v_solved.shape[0]):
+        for k in range(3):
+            inertia = m.body_mass[i] if k < 2 else m.body_inertia[i]
+            inverse = m.body_inv_mass[i] if k < 2 else m.body_inv_inertia[i]
+            v0 = ws.v_pred[i, k] - h * inverse * ws.force[i, k]
+            v1 = ws.v_solved[i, k]
+            start += inertia * v0 * v0
+            end += inertia * v1 * v1
+            # -f . (q_solved - q0) = -h f . v1
+            power += ws.force[i, k] * (-h * v1 + 0.5 * h * (v1 - v0))
+    return 0.5 * start, 0.5 * end - 0.5 * start + power
 
 
 @kernel

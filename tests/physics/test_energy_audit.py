@@ -7,12 +7,16 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numba import njit
 
 import planarsim as ps
 from planarsim.compile import options as compile_options
 from planarsim.compiled import audit_counts
 from planarsim.kernels.work import joints_add_energy
+
+from benchmarks.folded_loops import gravity_term, step_gains
 
 G = 9.81
 
@@ -44,14 +48,36 @@ def energy(model, q, v):
             + G * np.sum(a.body_mass * q[..., 1], axis=-1))
 
 
-def step_gains(model, q, v):
-    """Each step's energy change beyond its own gravity term, dE - (dt / 2) g dp_y [J] (the
-    exact change of a step without impulses), and each step's kinetic energy at its start."""
-    a = model.arrays
-    e = energy(model, q, v)
-    py = np.sum(a.body_mass * v[..., 1], axis=-1)
-    kinetic = 0.5 * np.sum(a.body_mass * (v[..., 0] ** 2 + v[..., 1] ** 2) + a.body_inertia * v[..., 2] ** 2, axis=-1)
-    return np.diff(e) - 0.5 * model.dt * G * np.diff(py), kinetic[:-1]
+@settings(max_examples=60, deadline=None)
+@given(dt=st.sampled_from([1e-3, 2e-3, 3e-3, 1e-2]), share=st.floats(0.01, 0.99),
+       mass=st.floats(0.1, 100.0))
+def test_a_ball_landing_within_its_step_owes_gravity_its_energy_not_h_g_dp(dt, share, mass):
+    """A ball on flat ground rising at a < g h lands within the step: its contact stops it
+    where it started, exactly as if it rose and fell back inside the step, and it loses its
+    kinetic energy m a^2 / 2. Symplectic Euler's free-flight term (h / 2) g dp reads the
+    momentum its contact took as gravity's and calls m a (g h - a) / 2 a gain; the rule's
+    gravity term (benchmarks/folded_loops.py gravity_term) owes gravity exactly the loss."""
+    a = share * G * dt
+    b = ps.ModelBuilder(dt=dt)
+    ball = b.add_point_mass("ball", mass, pos=(0.0, 0.0), vel=(0.0, a))
+    b.add_point_contact("foot", ball)
+    model = b.compile()
+    sim = ps.Simulator(model)
+    q0, v0 = sim.state.q.copy(), sim.state.v.copy()
+    sim.step()
+    q = np.array([q0, sim.state.q.copy()])
+    v = np.array([v0, sim.state.v.copy()])
+    assert abs(v[1, 0, 1]) <= 1e-15 and abs(q[1, 0, 1]) <= 1e-15    # (rounding)
+    de = float(np.diff(energy(model, q, v))[0])
+    assert de == pytest.approx(-0.5 * mass * a * a, rel=1e-9)
+    dp = -mass * a
+    free_flight_gain = de - 0.5 * dt * G * dp
+    assert free_flight_gain == pytest.approx(0.5 * mass * a * (G * dt - a), rel=1e-9)
+    gains, _ = step_gains(model, q, v)
+    assert abs(gains[0]) <= 1e-12 * mass * (G * dt) ** 2
+    # free flight and rest: the two terms agree
+    for dp in (-mass * G * dt, 0.0):
+        assert gravity_term(dt, dp, mass) == pytest.approx(0.5 * dt * G * dp, abs=1e-15)
 
 
 # Seed 162 once missed the rule on an AMD EPYC with AVX-512 (2.41e-6 J gained at step 527
@@ -61,12 +87,7 @@ def step_gains(model, q, v):
 # dropped. An answer that breaks a rule where rows were dropped is now solved again with the
 # least change of impulses (kernels/solve.py least_change_impulses), which never enters the
 # dependent directions: the self-stress is not made, and the seed passes on that machine.
-# benchmarks/folded_loops.py 0..999 finds 15 of 1000 seeds still missing this rule there: 7
-# loops nearly at rest whose ground contacts' friction does positive discrete work,
-# lambda_t t.(v0 + v1) / 2, as gravity turns them within the step (their energy falls; the
-# rule's gravity term credits the momentum the contacts take out); 7 position corrections
-# gaining 1.0-1.1 % of the kinetic energy, or lifting a loop out of the ground at dt = 10 ms;
-# one fold whose correction the jump check stops (seed 172).
+# benchmarks/folded_loops.py runs the rule over seeds 0-999.
 @pytest.mark.parametrize("seed", [22, 36, 42, 162])
 def test_a_folded_loop_gains_no_energy_from_its_nearly_dependent_pins(seed):
     """Four bars pinned in a closed loop, folding flat onto the ground: at the fold the pin
@@ -76,7 +97,7 @@ def test_a_folded_loop_gains_no_energy_from_its_nearly_dependent_pins(seed):
     a pivot of 2e-12 of its diagonal on a loop singular to 1e-15 (seed 36: 0.009 J gained in
     one step at 3e-5 J of motion; seed 162: 1.2e-3 J). No step may now gain
     more than the constraints' second-order share (1 % of its kinetic energy) beyond its
-    gravity term."""
+    gravity term (benchmarks/folded_loops.py step_gains)."""
     model, q, v, sim, error = corpus_run("loop_inertia", seed)
     assert error is None
     gains, kinetic = step_gains(model, q, v)
