@@ -83,8 +83,9 @@ class StepOptions(NamedTuple):
         another shape, stops the run (SimulationDiverged naming the body, a contact
         touching it, the step and the distance): a longer move is the position
         correction's, in a step beyond what a step resolves (a body turning by about a
-        radian in it, a shape driven through a hill and pushed out). 0.01 (default);
-        0: no check
+        radian in it, a shape driven through a hill and pushed out). Such a step is first
+        taken again in twice as many sub-steps, up to max_substeps; the error stands if
+        the last still jumps. 0.01 (default); 0: no check
     integrator : 0 'euler' (default): symplectic Euler with SHAKE, energy error O(h);
         1 'rattle': RATTLE, the velocity of the instant kept on the joints' tangent space,
         energy error O(h^2) (bounded, no drift), pins closed as by the default step, 1.26
@@ -98,7 +99,8 @@ class StepOptions(NamedTuple):
         pin's anchor or a touching ground contact's point would leave the motion its rows
         linearise by more than 1 mm as its body turns, L (h w)^2 / 2 (L its lever [m], w
         the body's turn rate [rad/s], at the step's start or at its answer, which then is
-        taken again: kernels/step.py turn_substeps; step_info 'turn_substeps'). Each
+        taken again: kernels/step.py turn_substeps; step_info 'turn_substeps'), and where
+        a body moves farther than its velocities explain (jump_limit). Each
         sub-step is a whole step (solve, positions, audit, guards) and the State counts
         one; its last impulses are the last sub-step's (as a step split at a time of
         impact keeps its last part's). 16 (default); 1: never

@@ -235,8 +235,8 @@ def keep_step_path(ws, add):
 
 
 @kernel
-def joined_start_depth(m, ws, i):
-    """The largest overlap [m] at the step's start (start_depth, note_start_depths) of body i
+def joined_start_depth(m, ws, start_q, i):
+    """The largest overlap [m] at the step's start (start_q: start_depth; note_start_depths) of body i
     and of every body joined to it by pins and rods: a correction pushing one body out of
     the ground moves the bodies joined to it as far. Only for a body beyond its first bound:
     a union-find over the joints (islands._root) in ws.island_parent, whose islands the
@@ -258,7 +258,7 @@ def joined_start_depth(m, ws, i):
     depth = 0.0
     for b in range(parent.shape[0]):
         if _root(parent, b) == ri:
-            depth = max(depth, start_depth(m, ws.prev.q, b), ws.path_explained[b, 2])
+            depth = max(depth, start_depth(m, start_q, b), ws.path_explained[b, 2])
     return depth
 
 
@@ -277,14 +277,22 @@ def check_displacements(m, s, ws, slack):
     Recorded: body, a contact touching it (_touching_contact), the distance, what its
     velocities explain, the allowance. O(bodies) per step; depths are measured only for a
     body beyond the first bound."""
+    return check_moves(m, s, ws, ws.prev.q, False, slack)
+
+
+@kernel
+def check_moves(m, s, ws, start_q, whole, slack):
+    """check_displacements from positions start_q: over the step's last part (whole False:
+    ws.path_explained[:, 0], from ws.prev) or over a step taken in sub-steps (whole True:
+    their summed paths, ws.step_path, from the step's start)."""
     for i in range(s.q.shape[0]):
-        dx = s.q[i, 0] - ws.prev.q[i, 0]
-        dy = s.q[i, 1] - ws.prev.q[i, 1]
+        dx = s.q[i, 0] - start_q[i, 0]
+        dy = s.q[i, 1] - start_q[i, 1]
         moved = math.sqrt(dx * dx + dy * dy)
-        explained = ws.path_explained[i, 0]
+        explained = ws.step_path[i] if whole else ws.path_explained[i, 0]
         if not moved > explained + slack:
             continue
-        allowed = slack + joined_start_depth(m, ws, i)
+        allowed = slack + joined_start_depth(m, ws, start_q, i)
         if moved > explained + allowed:
             ws.info[INFO_GUARD_BODY] = i
             ws.info[INFO_GUARD_FIELD] = _touching_contact(m, s, ws, i)

@@ -27,7 +27,7 @@ from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_n
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
-                   force_step_energy, kinetic_energy)
+                   gravity_work)
 
 
 # relative pivot below which the position correction drops a row after a Newton step diverged:
@@ -125,13 +125,12 @@ def bound_correction_work(m, s, ws, h):
     solve and the correction together) may move the energy by CONSTRAINT_SHARE (work.py) of
     the smaller of the step's kinetic energies at its start and after its solve: the
     allowance is that share less what the velocity stage already gained
-    (velocity_stage_gain). Beyond the regime the allowance is 0. A move whose own lift against
-    the forces exceeds the allowance (a contact point pushed out of the ground by a turning
-    body's (h w)^2 r dip, a joint's drift closed through a contact) keeps the least kinetic
-    energy it can, and its lift is allowed up to the share plus the step's own error under
-    the forces (work.force_step_energy; h [s] the integrated step's). Returns the energy [J]
-    the correction still adds beyond that and beyond what the step's velocity solve took out
-    (only the move's own work can leave some: k = 0 keeps no velocity change).
+    (velocity_stage_gain; h [s] the integrated step's). Beyond the regime the allowance is 0.
+    A move whose own lift against the forces exceeds the allowance even at the k of least
+    energy (a contact point pushed out of the ground by a turning body's (h w)^2 r dip, a
+    loop's pin gap closed at a dead point through its contacts) has the rest paid by the
+    velocity stage's loss, then by the motion (pay_from_motion). Returns the energy [J] the
+    correction still adds beyond all that (a motion too slow to pay for its lift).
 
     A body turning by h w ~ 1 in one step (a light body spinning after a hard impact)
     leaves first-order errors; Newton can then end on a far solution of the joint
@@ -157,59 +156,116 @@ def bound_correction_work(m, s, ws, h):
                           + inertia * ws.v_solved[i, 2] ** 2)
         momentum += mass * (abs(dx) + abs(dy) + abs(ws.v_solved[i, 0]) + abs(ws.v_solved[i, 1]))
     in_regime = b <= SHAKE_REGIME * SHAKE_REGIME * kinetic
-    start_kinetic, gained = velocity_stage_gain(m, ws, h)
+    start_kinetic, gained = velocity_stage_gain(m, ws, ws.v_solved, h)
     # the step's share: of the smaller kinetic energy, less what its velocity stage gained
     share = max(CONSTRAINT_SHARE * min(kinetic, start_kinetic) - max(gained, 0.0), 0.0)
     force_work = correction_force_work(s, ws)
-    rounding = correction_rounding(m, ws, momentum, kinetic + abs(a) + b)
-    room = (share if in_regime else 0.0) + force_work + rounding
-    if a + b <= room or (in_regime and a + b <= 0.0):
+    # what the correction may gain, k a + k^2 b - force_work (the move's lift against the
+    # forces counts against the same share), with k = 1 if it can
+    room = (share if in_regime else 0.0) + force_work + correction_rounding(
+        m, ws, momentum, kinetic + abs(a) + b)
+    if a + b <= room:
         return 0.0
-    if b <= 0.0:
-        return 0.0
-    # the largest k in [0, 1] with b k^2 + a k <= room (none: the k of least energy, -a / 2b)
+    # the largest k in [0, 1] with b k^2 + a k <= room; none: the k of least energy
     disc = a * a + 4.0 * b * room
-    k = (-a + math.sqrt(disc)) / (2.0 * b) if disc >= 0.0 else -a / (2.0 * b)
-    # room reached (up to the root's rounding) unless no k in [0, 1] reaches it
-    short = disc < 0.0 or k < 0.0
+    k = (-a + math.sqrt(disc)) / (2.0 * b) if disc >= 0.0 and b > 0.0 else -1.0
+    short = k < 0.0 or (disc >= 0.0 and b > 0.0 and -a - math.sqrt(disc) > 2.0 * b)
+    if short:
+        k = -a / (2.0 * b) if b > 0.0 else 1.0
     k = min(max(k, 0.0), 1.0)
     for i in range(s.v.shape[0]):
         for c in range(3):
             s.v[i, c] = ws.v_solved[i, c] + k * (s.v[i, c] - ws.v_solved[i, c])
     if not short:
         return 0.0
-    # what is left is the move's own work. Its lift against the forces is allowed up to the
-    # share plus the step's own error under them; the velocity stage's loss in this step
-    # (contacts absorbing an approach, friction) pays for the rest first: a step whose
-    # velocity solve took out more than the move then puts back (a box pushed out of the
-    # overlap it hit) gains nothing
-    lift = min(max(-force_work, 0.0), share + force_step_energy(m, ws, h))
-    loss = kinetic_energy(m, ws.v_pred) - kinetic
-    return max(k * a + k * k * b - room - lift - max(loss, 0.0), 0.0)
+    # what is left is the move's own lift against gravity. The velocity stage's loss in this
+    # step, as the step's energy measures it (velocity_stage_gain), pays for it first (a box
+    # pushed out of the overlap it hit gains nothing); a body's lift out of an overlap it
+    # began the step in is the start's (start_lift: a start below the ground, a terrain put
+    # in); the step's first-order error under the forces other than gravity is its own
+    # (actuation_step_energy: a motor's turn; gravity's is exact in the step's measure).
+    # The motion pays for the rest (pay_from_motion: a loop near a dead point, where a pin
+    # gap of 1e-8 m takes a move of 1e-4 m to close). The other forces' work along the
+    # move (a motor's torque) is no energy the step stores
+    left = (k * a + k * k * b - ((share if in_regime else 0.0) + gravity_work(m, s, ws))
+            - max(-gained, 0.0) - start_lift(ws) - actuation_step_energy(m, ws, h))
+    if left <= 0.0:
+        return 0.0
+    return pay_from_motion(m, s, left)
 
 
 @kernel
-def velocity_stage_gain(m, ws, h):
+def actuation_step_energy(m, ws, h):
+    """(h^2 / 2) f' . M^-1 f' [J] of the applied forces other than gravity, f' = ws.force -
+    m g: how far one step of h [s] under them moves the energy by itself (a motor's torque,
+    a spring's pull, a push; work.force_step_energy)."""
+    total = 0.0
+    for i in range(ws.force.shape[0]):
+        fx = ws.force[i, 0] - m.body_mass[i] * m.gravity[0]
+        fy = ws.force[i, 1] - m.body_mass[i] * m.gravity[1]
+        total += m.body_inv_mass[i] * (fx * fx + fy * fy)
+        total += m.body_inv_inertia[i] * ws.force[i, 2] ** 2
+    return 0.5 * h * h * total
+
+
+@kernel
+def start_lift(ws):
+    """An upper bound [J] of the work against the applied forces of moving each body out of
+    the overlap it began the step in (ws.path_explained[:, 2], guards.note_start_depths)."""
+    total = 0.0
+    for i in range(ws.force.shape[0]):
+        total += (abs(ws.force[i, 0]) + abs(ws.force[i, 1])) * ws.path_explained[i, 2]
+    return total
+
+
+@kernel
+def pay_from_motion(m, s, energy):
+    """Take energy [J] out of the bodies' motion relative to their centre of mass, keeping
+    their momentum: v <- v_c + alpha (v - v_c), w <- alpha w. Returns what it could not
+    take (the motion had less)."""
+    mass = 0.0
+    px = 0.0
+    py = 0.0
+    for i in range(s.v.shape[0]):
+        mass += m.body_mass[i]
+        px += m.body_mass[i] * s.v[i, 0]
+        py += m.body_mass[i] * s.v[i, 1]
+    vx = px / mass if mass > 0.0 else 0.0
+    vy = py / mass if mass > 0.0 else 0.0
+    internal = 0.0
+    for i in range(s.v.shape[0]):
+        internal += 0.5 * (m.body_mass[i] * ((s.v[i, 0] - vx) ** 2 + (s.v[i, 1] - vy) ** 2)
+                           + m.body_inertia[i] * s.v[i, 2] ** 2)
+    alpha = math.sqrt(1.0 - energy / internal) if internal > energy else 0.0
+    for i in range(s.v.shape[0]):
+        s.v[i, 0] = vx + alpha * (s.v[i, 0] - vx)
+        s.v[i, 1] = vy + alpha * (s.v[i, 1] - vy)
+        s.v[i, 2] *= alpha
+    return max(energy - internal, 0.0)
+
+
+@kernel
+def velocity_stage_gain(m, ws, vel, h):
     """(KE at the step's start [J], the energy [J] its velocity stage gained beyond the
     applied forces' own symplectic Euler term): with v0 = v_pred - h M^-1 f the velocity at
-    the start of the integrated step of h [s] and v_solved, q_solved its solve's answer,
+    the start of the integrated step of h [s] and vel its solve's answer (q1 = q0 + h vel),
 
-        KE(v_solved) - KE(v0) - f . (q_solved - q0) + (h / 2) f . (v_solved - v0),
+        KE(vel) - KE(v0) - f . (q1 - q0) + (h / 2) f . (vel - v0),
 
     exactly 0 for a step without impulses under constant forces (a falling body's step moves
     its energy by (h / 2) g dp_y) and for a body at rest on the ground."""
     start = 0.0
     end = 0.0
     power = 0.0
-    for i in range(ws.v_solved.shape[0]):
+    for i in range(vel.shape[0]):
         for k in range(3):
             inertia = m.body_mass[i] if k < 2 else m.body_inertia[i]
             inverse = m.body_inv_mass[i] if k < 2 else m.body_inv_inertia[i]
             v0 = ws.v_pred[i, k] - h * inverse * ws.force[i, k]
-            v1 = ws.v_solved[i, k]
+            v1 = vel[i, k]
             start += inertia * v0 * v0
             end += inertia * v1 * v1
-            # -f . (q_solved - q0) = -h f . v1
+            # -f . (q1 - q0) = -h f . v1
             power += ws.force[i, k] * (-h * v1 + 0.5 * h * (v1 - v0))
     return 0.5 * start, 0.5 * end - 0.5 * start + power
 

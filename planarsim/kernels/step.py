@@ -23,9 +23,9 @@ from .codes import CONTACT_PAIR, INTEGRATOR_EULER, MODE_FREE, MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
-from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_ROOM, check_actuator_turns,
-                     check_displacements, check_guards, check_speeds,
-                     add_part_path, finish_path, keep_step_path, note_start_depths,
+from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_ROOM,
+                     check_actuator_turns, check_displacements, check_guards, check_moves,
+                     check_speeds, add_part_path, finish_path, keep_step_path, note_start_depths,
                      start_path)
 from .info import INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
 from .integrate import predict_configuration
@@ -425,29 +425,51 @@ def _step(m, s, ws, opt, u):
                 put_back(s, ws, ws.prev)
                 return code
             # a body that began turning fast within the step (an impact spinning a light
-            # link up) is judged at the step's answer: taken again, in sub-steps
+            # link up) is judged at the step's answer: taken again, in sub-steps; so is a
+            # step whose correction moved a body farther than its velocities explain
             n = turn_substeps(m, s, step_length, most)
-            if n == 1:
+            if n == 1 and not (code == GUARD_JUMP and most > 1):
                 ws.info[INFO_TURN_SUBSTEPS] = 1
                 keep_step_path(ws, False)
                 return code
+            n = max(n, 2)
             copy_state(ws.prev, s)
             for k in range(ws.audit.shape[0]):
                 ws.audit[k] = ws.audit_keep[k]
         # sub-steps, each a whole step of its own (solve, positions, audit, guards), that
-        # count as one: an error names this step
+        # count as one: an error names this step. A sub-step whose correction moves a body
+        # farther than its velocities explain (a loop near a dead point closing its drift, a
+        # turn the count above did not foresee) has the step taken again in twice as many
+        # (at most max_substeps) before the error stands
         count = s.step[0]
         t0 = s.time[0]
-        if ws.room[1] == 1:
-            copy_state(s, ws.start)
-        for k in range(n):
-            s.step[0] = count
-            code = step_of_length(m, s, ws, opt, u, step_length / n, False)
-            keep_step_path(ws, k > 0)
-            if code == GUARD_ROOM:
-                put_back(s, ws, ws.start)
+        copy_state(s, ws.start)
+        while True:
+            for k in range(n):
+                s.step[0] = count
+                code = step_of_length(m, s, ws, opt, u, step_length / n, False)
+                keep_step_path(ws, k > 0)
+                if code == GUARD_ROOM:
+                    put_back(s, ws, ws.start)
+                if code != 0:
+                    break
+            # over the whole step too: the sub-steps' summed paths plus jump_limit once
+            if code == 0 and opt.jump_limit > 0.0:
+                code = check_moves(m, s, ws, ws.start.q, True, opt.jump_limit)
+                if code != 0:
+                    copy_state(ws.start, ws.prev)           # (the error names the step's start)
+            if code == GUARD_JUMP and n < most:
+                if ws.room[1] == 1:
+                    put_back(s, ws, ws.start)       # (the broad phase's pairs too)
+                else:
+                    copy_state(ws.start, s)
+                    for k in range(ws.audit.shape[0]):
+                        ws.audit[k] = ws.audit_keep[k]
+                n = min(2 * n, most)
+                continue
             if code != 0:
                 return code
+            break
         s.step[0] = count + 1
         s.time[0] = t0 + step_length
         ws.info[INFO_TURN_SUBSTEPS] = n

@@ -287,11 +287,18 @@ def judge_energy(m, ws, opt, h, excess):
 
 
 @kernel
-def gravity_lift(m, s, ws):
-    """The energy [J] the position correction's move gave the bodies against gravity,
-    max(0, -sum_i m_i g . (q_i - q_solved_i)): a body pushed out of the ground."""
+def gravity_work(m, s, ws):
+    """Gravity's work [J] along the position correction's and projection's move,
+    sum_i m_i g . (q_i - q_solved_i) (negative: the bodies were lifted)."""
     work = 0.0
     for i in range(s.q.shape[0]):
         work += m.body_mass[i] * (m.gravity[0] * (s.q[i, 0] - ws.q_solved[i, 0])
                                   + m.gravity[1] * (s.q[i, 1] - ws.q_solved[i, 1]))
-    return max(0.0, -work)
+    return work
+
+
+@kernel
+def gravity_lift(m, s, ws):
+    """The energy [J] the position correction's move gave the bodies against gravity,
+    max(0, -gravity_work): a body pushed out of the ground."""
+    return max(0.0, -gravity_work(m, s, ws))

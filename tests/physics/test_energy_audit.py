@@ -87,8 +87,14 @@ def test_a_ball_landing_within_its_step_owes_gravity_its_energy_not_h_g_dp(dt, s
 # dropped. An answer that breaks a rule where rows were dropped is now solved again with the
 # least change of impulses (kernels/solve.py least_change_impulses), which never enters the
 # dependent directions: the self-stress is not made, and the seed passes on that machine.
-# benchmarks/folded_loops.py runs the rule over seeds 0-999.
-@pytest.mark.parametrize("seed", [22, 36, 42, 162])
+# Seeds 172, 310, 319 and 357 once missed it at the position correction: 310 gained 1 % of
+# the kinetic energy after its solve, more than 1 % of the step's start (the share is now
+# of the smaller, less what the velocity stage gained); 319 and 357 lifted a loop near a
+# dead point out of the ground to close a pin gap of 1e-8 m (the motion now pays for a lift
+# beyond the share); 172's correction moved a bar 2.4 cm where its velocities explain 1.3
+# cm (the step is now taken again in more sub-steps). benchmarks/folded_loops.py runs the
+# rule over seeds 0-999.
+@pytest.mark.parametrize("seed", [22, 36, 42, 162, 172, 310, 319, 357])
 def test_a_folded_loop_gains_no_energy_from_its_nearly_dependent_pins(seed):
     """Four bars pinned in a closed loop, folding flat onto the ground: at the fold the pin
     rows are nearly dependent, and the second-order target of the velocity solve once turned

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 import planarsim as ps
 from planarsim import terrain
-from planarsim.kernels.info import INFO_CCD_SPLITS
+from planarsim.kernels.info import INFO_CCD_SPLITS, step_info
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
@@ -68,8 +68,9 @@ def _dumbbell_that_turns_too_far():
 
 
 def test_a_jump_is_a_simulation_diverged_naming_body_contact_step_and_distance():
+    """Taken whole (max_substeps 1), the dumbbell's step jumps: the run stops naming it."""
     model = _dumbbell_that_turns_too_far()
-    sim = ps.Simulator(model, ps.make_options(jump_limit=SLACK))
+    sim = ps.Simulator(model, ps.make_options(jump_limit=SLACK, max_substeps=1))
     with pytest.raises(ps.SimulationDiverged) as err:
         sim.steps(5)
     e = err.value
@@ -82,8 +83,25 @@ def test_a_jump_is_a_simulation_diverged_naming_body_contact_step_and_distance()
     assert f"step {e.step}" in str(e) and f"moved {moved:.4g} m" in str(e)
     assert "contact '" in str(e) and e.body in str(e)
     # the same run with the check off goes on, silently: what the check is for
-    quiet = ps.Simulator(model, ps.make_options(jump_limit=0.0))
+    quiet = ps.Simulator(model, ps.make_options(jump_limit=0.0, max_substeps=1))
     quiet.steps(5)
+
+
+def test_a_step_that_jumps_is_taken_again_in_sub_steps_that_do_not():
+    """By default the jumping step is taken again in twice as many sub-steps until none
+    jumps (up to max_substeps): the run goes on, its step taken in parts, and no body moves
+    in any step farther than its velocities explain (judged_excess: per part) plus the
+    slack."""
+    model = _dumbbell_that_turns_too_far()
+    sim = ps.Simulator(model, ps.make_options(jump_limit=SLACK))
+    parts = []
+    for _ in range(5):
+        q0, v0 = sim.state.q.copy(), sim.state.v.copy()
+        sim.step()
+        parts.append(step_info(sim.ws)["turn_substeps"])
+        excess = judged_excess(sim, q0, v0, sim.state.q, sim.state.v, model.dt)
+        assert excess.max() <= SLACK, (len(parts), excess)
+    assert max(parts) >= 2, parts
 
 
 def test_a_start_below_the_ground_is_lifted_without_a_stop():
