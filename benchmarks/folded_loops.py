@@ -99,7 +99,8 @@ def explain(seed, step):
         return float(np.sum(a.body_mass * vel[:, 1]))
 
     def gain(q1, v1):
-        return float(kinetic(v1) - kinetic(v) + G * float(np.sum(a.body_mass * (q1[:, 1] - q[:, 1])))
+        lift = G * float(np.sum(a.body_mass * (q1[:, 1] - q[:, 1])))
+        return float(kinetic(v1) - kinetic(v) + lift
                      - gravity_term(h, momentum(v1) - momentum(v), float(np.sum(a.body_mass))))
 
     total = gain(sim.state.q, sim.state.v)
