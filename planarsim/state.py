@@ -318,10 +318,11 @@ class Workspace(NamedTuple):
                                  #   storage, grow_workspace); [1] 1: the solve's storage holds
                                  #   fewer contacts than the model has (so a step keeps its
                                  #   pair list's start in start_pairs, to begin again from it)
-    least_change: np.ndarray     # (2,) int [0] 1: this step's solves take the least change of
+    least_change: np.ndarray     # (3,) int [0] 1: this step's solves take the least change of
                                  #   impulses where rows are dependent (solve.least_change_impulses;
                                  #   set once an answer broke a rule: step.solve_and_check);
-                                 #   [1] rows the last solve dropped as dependent
+                                 #   [1] rows the last solve dropped as dependent; [2] least-change
+                                 #   answers tried in this solve of the modes
     start_pairs: np.ndarray      # (n_pair,) int the listed pairs at the step's start (room[1])
     n_start_pairs: np.ndarray    # (1,) int how many
     start: State                 # the step's start while it is taken in sub-steps (GUARD_ROOM
@@ -527,6 +528,6 @@ def make_workspace(model: Model, contacts: int | None = None) -> Workspace:
                      joint_gain=z(3), joint_pivot=np.ones(1), lcp_eps=z(1),
                      impact_time=z(1), audit_keep=z(N_AUDIT, np.int64), path_explained=z((nb, 3)),
                      step_path=z(nb),
-                     room=np.array([0, int(contacts < nc)], np.int64), least_change=z(2, np.int64),
+                     room=np.array([0, int(contacts < nc)], np.int64), least_change=z(3, np.int64),
                      start_pairs=z(n_pair, np.int64), n_start_pairs=z(1, np.int64),
                      start=make_state(model), prev=make_state(model))

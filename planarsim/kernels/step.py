@@ -19,7 +19,7 @@ from ..compile import kernel
 from .audit import audit_impulses, audit_total
 from .broad_phase import FLAG_LIVE, widen_for_answer
 from .ccd import split_at_impact, stop_at_impact
-from .codes import CONTACT_PAIR, INTEGRATOR_EULER, MODE_FREE, MODES_ALTERNATING
+from .codes import CONTACT_PAIR, INTEGRATOR_EULER, MODE_FREE, MODE_PINNED, MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
@@ -97,28 +97,107 @@ def answer_check(m, s, ws, h, include_ccd, equalities):
     return breaks, engaged
 
 
+# least-change answers whose modes a step may correct by the contact rules before it gives up
+# on them (solve_and_check), and least-change answers a step may try: a contact released by
+# the rules that the answer's velocity engages again would otherwise cycle
+LEAST_CHANGE_MODE_ROUNDS = 4
+LEAST_CHANGE_CALLS = 16
+
+
+@kernel
+def keep_modes(s, ws):
+    """Each listed contact's mode and slip direction into ws.near_contacts (a scratch list
+    the projection fills later in the step)."""
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
+        ws.near_contacts[k] = s.contact_mode[i] + (3 if s.contact_slip[i] > 0.0 else 0)
+
+
+@kernel
+def restore_modes(s, ws):
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
+        code = ws.near_contacts[k]
+        s.contact_mode[i] = code % 3
+        s.contact_slip[i] = 1.0 if code >= 3 else -1.0
+
+
+# a contact whose least-change normal impulse is below this share of the largest carries a
+# load the least change spread over it, not one it must carry: its friction beyond the cone
+# releases it (a staggered wall's corner loaded with 1e-5 of a brick's weight and friction
+# 1.2 times that)
+LIGHT_LOAD = 1e-3
+
+
+@kernel
+def largest_normal_impulse(s, ws):
+    """The largest normal impulse [N s] of the listed contacts (ws.contact_impulse)."""
+    top = 0.0
+    for k in range(ws.n_live[0]):
+        top = max(top, ws.contact_impulse[ws.live[k], 0])
+    return top
+
+
+@kernel(inline="never")
+def least_change_answer(m, s, ws, opt, h, include_ccd):
+    """The step's answer solved again with the least change of impulses (the last solve
+    dropped dependent rows and broke a rule). Where it still breaks one (a box loaded off
+    its middle by the box above: the least change of a load spread over four corners can
+    pull at the far one), every listed contact that pulls, or that carries under LIGHT_LOAD
+    of the largest load with its friction beyond the cone, is released at once and it is
+    solved again, up to LEAST_CHANGE_MODE_ROUNDS times (friction beyond the cone of a loaded
+    contact is left to the complementarity solve). Returns (contacts and limits its velocity engages, or
+    -1 if no answer kept every rule: the modes are then put back as they were; solves)."""
+    ws.least_change[0] = 1
+    keep_modes(s, ws)
+    equalities = build_and_solve(m, s, ws, opt, h)
+    solves = 1
+    for attempt in range(LEAST_CHANGE_MODE_ROUNDS + 1):
+        if rule_breaks(m, s, ws, h, equalities) == 0:
+            return engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
+                m, s, ws, h, ws.v_new), solves
+        if attempt == LEAST_CHANGE_MODE_ROUNDS:
+            break
+        gather_contact_impulses(m, s, ws)
+        changed = 0
+        light = LIGHT_LOAD * largest_normal_impulse(s, ws)
+        for k in range(ws.n_live[0]):
+            i = ws.live[k]
+            if s.contact_mode[i] != MODE_PINNED:
+                continue
+            normal = ws.contact_impulse[i, 0]
+            if normal < 0.0 or (normal < light and abs(ws.contact_impulse[i, 1])
+                                > m.contact_mu[i] * normal):
+                s.contact_mode[i] = MODE_FREE
+                changed += 1
+        if changed == 0:
+            break
+        equalities = build_and_solve(m, s, ws, opt, h)
+        solves += 1
+    restore_modes(s, ws)
+    ws.least_change[0] = 0
+    return -1, solves
+
+
 @kernel(inline="always")
 def solve_and_check(m, s, ws, opt, h, include_ccd):
     """One linear solve under the modes as they stand and its check (answer_check); returns
     (rule breaks, contacts and limits engaged, solves taken). An answer that breaks a rule
     where the solve dropped dependent rows (a statically indeterminate pile, whose dropped
     rows' load the elimination order split: a box on two hanging from one corner) is solved
-    again with the least change of impulses (solve.least_change_impulses). If that answer
-    keeps every rule it stands, and the step's later solves take the least change too;
-    otherwise the first answer is solved again and stands, as if never tried."""
+    again with the least change of impulses (least_change_answer). If that answer, or one
+    the contact rules correct, keeps every rule it stands, and the step's later solves take
+    the least change too; otherwise the first answer is solved again and stands."""
     equalities = build_and_solve(m, s, ws, opt, h)
     breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
-    if breaks == 0 or ws.least_change[1] == 0 or ws.least_change[0] == 1:
+    if breaks == 0 or ws.least_change[1] == 0 or ws.least_change[2] >= LEAST_CHANGE_CALLS:
         return breaks, engaged, 1
-    ws.least_change[0] = 1
-    equalities = build_and_solve(m, s, ws, opt, h)
-    if rule_breaks(m, s, ws, h, equalities) == 0:
-        engaged += engage_contacts(m, s, ws, h, include_ccd, ws.v_new) + engage_limits(
-            m, s, ws, h, ws.v_new)
-        return 0, engaged, 2
-    ws.least_change[0] = 0
+    ws.least_change[2] += 1
+    more, solves = least_change_answer(m, s, ws, opt, h, include_ccd)
+    if more >= 0:
+        return 0, engaged + more, 1 + solves
     build_and_solve(m, s, ws, opt, h)
-    return breaks, engaged, 3
+    return breaks, engaged, 2 + solves
 
 
 @kernel(inline="always")
@@ -139,6 +218,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     are in ws), False if the complementarity solve replaced it."""
     ws.joint_gain[2] = 0.0      # a new answer: the joints' work is not known yet
     ws.least_change[0] = 0
+    ws.least_change[2] = 0
     engage_contacts(m, s, ws, h, include_ccd, ws.v_pred)
     engage_limits(m, s, ws, h, ws.v_pred)
     breaks, engaged, rounds = solve_and_check(m, s, ws, opt, h, include_ccd)
