@@ -71,6 +71,13 @@ WORLDS = {
 
 
 def _measure(name, steps, out):
+    try:
+        _measure_world(name, steps, out)
+    except Exception as exc:     # reported by run(), one line
+        out.put(("error", f"{type(exc).__name__}: {exc}"))
+
+
+def _measure_world(name, steps, out):
     from planarsim.compiled import audit_counts
     from planarsim.state import workspace_contacts
     ps.Simulator(columns(1, 1)).step()   # the compiled step loaded (once a process), not timed
@@ -102,9 +109,14 @@ def run(name, steps, limit):
     while not out.empty():
         item = out.get()
         said[item[0]] = item[1:]
-    if proc.is_alive():
+    stopped = proc.is_alive()
+    if stopped:
         proc.kill()
         proc.join()
+    if "error" in said:
+        return f"{name:13s} {said['error'][0]}"
+    if not stopped and "done" not in said:
+        return f"{name:13s} its process ended with exit code {proc.exitcode} and no figures"
     if "done" in said:
         held, rss, first, mean, most, move, audit = said["done"]
         n_body, n_contact = said["built"]
