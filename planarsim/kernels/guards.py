@@ -238,9 +238,10 @@ def keep_step_path(ws, add):
 def joined_start_depth(m, ws, start_q, i):
     """The largest overlap [m] at the step's start (positions start_q: start_depth;
     note_start_depths) of body i and of every body joined to it by pins and rods: a
-    correction pushing one body out of the ground moves the bodies joined to it as far. Only
-    for a body beyond its first bound: a union-find over the joints (islands._root) in ws.island_parent, whose islands the
-    step's solve is done with."""
+    correction pushing one body out of the ground moves the bodies joined to it as far (of a
+    step taken in sub-steps, the last one's shape overlaps). Only for a body beyond its
+    first bound: a union-find over the joints (islands._root) in ws.island_parent, whose
+    islands the step's solve is done with."""
     parent = ws.island_parent
     for b in range(parent.shape[0]):
         parent[b] = b

@@ -27,7 +27,7 @@ from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_n
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
-                   gravity_work)
+                   gravity_work, kinetic_energy)
 
 
 # relative pivot below which the position correction drops a row after a Newton step diverged:
@@ -220,28 +220,15 @@ def start_lift(ws):
 
 @kernel
 def pay_from_motion(m, s, energy):
-    """Take energy [J] out of the bodies' motion relative to their centre of mass, keeping
-    their momentum: v <- v_c + alpha (v - v_c), w <- alpha w. Returns what it could not
-    take (the motion had less)."""
-    mass = 0.0
-    px = 0.0
-    py = 0.0
+    """Take energy [J] out of the bodies' motion, v <- alpha v for every body: every
+    homogeneous velocity constraint (a pin to the world, a sticking contact, J v = 0) is kept
+    as it was. Returns what it could not take (the motion had less)."""
+    kinetic = kinetic_energy(m, s.v)
+    alpha = math.sqrt(1.0 - energy / kinetic) if kinetic > energy else 0.0
     for i in range(s.v.shape[0]):
-        mass += m.body_mass[i]
-        px += m.body_mass[i] * s.v[i, 0]
-        py += m.body_mass[i] * s.v[i, 1]
-    vx = px / mass if mass > 0.0 else 0.0
-    vy = py / mass if mass > 0.0 else 0.0
-    internal = 0.0
-    for i in range(s.v.shape[0]):
-        internal += 0.5 * (m.body_mass[i] * ((s.v[i, 0] - vx) ** 2 + (s.v[i, 1] - vy) ** 2)
-                           + m.body_inertia[i] * s.v[i, 2] ** 2)
-    alpha = math.sqrt(1.0 - energy / internal) if internal > energy else 0.0
-    for i in range(s.v.shape[0]):
-        s.v[i, 0] = vx + alpha * (s.v[i, 0] - vx)
-        s.v[i, 1] = vy + alpha * (s.v[i, 1] - vy)
-        s.v[i, 2] *= alpha
-    return max(energy - internal, 0.0)
+        for c in range(3):
+            s.v[i, c] *= alpha
+    return max(energy - kinetic, 0.0)
 
 
 @kernel

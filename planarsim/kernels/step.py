@@ -106,20 +106,23 @@ LEAST_CHANGE_CALLS = 16
 
 @kernel
 def keep_modes(s, ws):
-    """Each listed contact's mode and slip direction into ws.near_contacts (a scratch list
-    the projection fills later in the step)."""
+    """Each listed contact's mode and slip direction (-1, 0 or 1) into ws.near_contacts (a
+    scratch list the projection fills later in the step): mode + 3 (slip + 1)."""
     for k in range(ws.n_live[0]):
         i = ws.live[k]
-        ws.near_contacts[k] = s.contact_mode[i] + (3 if s.contact_slip[i] > 0.0 else 0)
+        slip = s.contact_slip[i]
+        sign = 2 if slip > 0.0 else (0 if slip < 0.0 else 1)
+        ws.near_contacts[k] = s.contact_mode[i] + 3 * sign
 
 
 @kernel
 def restore_modes(s, ws):
+    """The modes and slip directions keep_modes kept."""
     for k in range(ws.n_live[0]):
         i = ws.live[k]
         code = ws.near_contacts[k]
         s.contact_mode[i] = code % 3
-        s.contact_slip[i] = 1.0 if code >= 3 else -1.0
+        s.contact_slip[i] = float(code // 3 - 1)
 
 
 # a contact whose least-change normal impulse is below this share of the largest carries a
@@ -143,11 +146,13 @@ def least_change_answer(m, s, ws, opt, h, include_ccd):
     """The step's answer solved again with the least change of impulses (the last solve
     dropped dependent rows and broke a rule). Where it still breaks one (a box loaded off
     its middle by the box above: the least change of a load spread over four corners can
-    pull at the far one), every listed contact that pulls, or that carries under LIGHT_LOAD
-    of the largest load with its friction beyond the cone, is released at once and it is
-    solved again, up to LEAST_CHANGE_MODE_ROUNDS times (friction beyond the cone of a loaded
-    contact is left to the complementarity solve). Returns (contacts and limits its velocity engages, or
-    -1 if no answer kept every rule: the modes are then put back as they were; solves)."""
+    pull at the far one), every pinned listed contact that pulls, or that carries under
+    LIGHT_LOAD of the largest load with its friction beyond the cone, is released at once
+    and it is solved again, up to LEAST_CHANGE_MODE_ROUNDS times (friction beyond the cone of
+    a loaded contact is left to the complementarity solve). Returns (contacts and limits its
+    velocity engages, or -1 if no answer kept every rule: the modes and the least-change
+    switch are then put back as they were; solves)."""
+    was_on = ws.least_change[0]
     ws.least_change[0] = 1
     keep_modes(s, ws)
     equalities = build_and_solve(m, s, ws, opt, h)
@@ -175,7 +180,7 @@ def least_change_answer(m, s, ws, opt, h, include_ccd):
         equalities = build_and_solve(m, s, ws, opt, h)
         solves += 1
     restore_modes(s, ws)
-    ws.least_change[0] = 0
+    ws.least_change[0] = was_on
     return -1, solves
 
 
@@ -536,8 +541,6 @@ def _step(m, s, ws, opt, u):
             # over the whole step too: the sub-steps' summed paths plus jump_limit once
             if code == 0 and opt.jump_limit > 0.0:
                 code = check_moves(m, s, ws, ws.start.q, True, opt.jump_limit)
-                if code != 0:
-                    copy_state(ws.start, ws.prev)           # (the error names the step's start)
             if code == GUARD_JUMP and n < most:
                 if ws.room[1] == 1:
                     put_back(s, ws, ws.start)       # (the broad phase's pairs too)
@@ -548,6 +551,8 @@ def _step(m, s, ws, opt, u):
                 n = min(2 * n, most)
                 continue
             if code != 0:
+                if code != GUARD_ROOM:
+                    copy_state(ws.start, ws.prev)   # (the error names the step's start)
                 return code
             break
         s.step[0] = count + 1
