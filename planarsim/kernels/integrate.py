@@ -27,7 +27,7 @@ from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_n
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
-                   gravity_work, kinetic_energy)
+                   gravity_work, kinetic_energy, step_energy_of_forces)
 
 
 # relative pivot below which the position correction drops a row after a Newton step diverged:
@@ -183,29 +183,15 @@ def bound_correction_work(m, s, ws, h):
     # pushed out of the overlap it hit gains nothing); a body's lift out of an overlap it
     # began the step in is the start's (start_lift: a start below the ground, a terrain put
     # in); the step's first-order error under the forces other than gravity is its own
-    # (actuation_step_energy: a motor's turn; gravity's is exact in the step's measure).
+    # (work.step_energy_of_forces: a motor's turn; gravity's is exact in the step's measure).
     # The motion pays for the rest (pay_from_motion: a loop near a dead point, where a pin
     # gap of 1e-8 m takes a move of 1e-4 m to close). The other forces' work along the
     # move (a motor's torque) is no energy the step stores
     left = (k * a + k * k * b - ((share if in_regime else 0.0) + gravity_work(m, s, ws))
-            - max(-gained, 0.0) - start_lift(ws) - actuation_step_energy(m, ws, h))
+            - max(-gained, 0.0) - start_lift(ws) - step_energy_of_forces(m, ws, h, 0.0))
     if left <= 0.0:
         return 0.0
     return pay_from_motion(m, s, left)
-
-
-@kernel
-def actuation_step_energy(m, ws, h):
-    """(h^2 / 2) f' . M^-1 f' [J] of the applied forces other than gravity, f' = ws.force -
-    m g: how far one step of h [s] under them moves the energy by itself (a motor's torque,
-    a spring's pull, a push; work.force_step_energy)."""
-    total = 0.0
-    for i in range(ws.force.shape[0]):
-        fx = ws.force[i, 0] - m.body_mass[i] * m.gravity[0]
-        fy = ws.force[i, 1] - m.body_mass[i] * m.gravity[1]
-        total += m.body_inv_mass[i] * (fx * fx + fy * fy)
-        total += m.body_inv_inertia[i] * ws.force[i, 2] ** 2
-    return 0.5 * h * h * total
 
 
 @kernel

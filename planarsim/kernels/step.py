@@ -307,12 +307,19 @@ def begin_step(ws):
 
 
 @kernel
-def put_back(s, ws, start):
-    """A step that ran out of room (GUARD_ROOM) undone: the State at its start, the audit's
-    counts and the broad phase's pair list (keep_pairs) as they were."""
+def begin_again(s, ws, start):
+    """The State at the step's start and the audit's counts as they were, to take the step
+    again (in sub-steps)."""
     copy_state(start, s)
     for k in range(ws.audit.shape[0]):
         ws.audit[k] = ws.audit_keep[k]
+
+
+@kernel
+def put_back(s, ws, start):
+    """A step that ran out of room (GUARD_ROOM) undone: the State at its start, the audit's
+    counts and the broad phase's pair list (keep_pairs) as they were."""
+    begin_again(s, ws, start)
     for k in range(ws.n_live_pairs[0]):
         ws.pair_flag[ws.last_pairs[k]] = 0
     n = ws.n_start_pairs[0]
@@ -518,9 +525,7 @@ def _step(m, s, ws, opt, u):
                 keep_step_path(ws, False)
                 return code
             n = max(n, 2)
-            copy_state(ws.prev, s)
-            for k in range(ws.audit.shape[0]):
-                ws.audit[k] = ws.audit_keep[k]
+            begin_again(s, ws, ws.prev)
         # sub-steps, each a whole step of its own (solve, positions, audit, guards), that
         # count as one: an error names this step. A sub-step whose correction moves a body
         # farther than its velocities explain (a loop near a dead point closing its drift, a
@@ -545,9 +550,7 @@ def _step(m, s, ws, opt, u):
                 if ws.room[1] == 1:
                     put_back(s, ws, ws.start)       # (the broad phase's pairs too)
                 else:
-                    copy_state(ws.start, s)
-                    for k in range(ws.audit.shape[0]):
-                        ws.audit[k] = ws.audit_keep[k]
+                    begin_again(s, ws, ws.start)
                 n = min(2 * n, most)
                 continue
             if code != 0:

@@ -249,9 +249,18 @@ def force_step_energy(m, ws, h):
     forces ws.force moves the energy by itself (exactly, for constant forces: a falling body's
     step gains (h / 2) g dp_y); a position correction moving bodies by this step's own
     first-order error trades about this much energy with the forces."""
+    return step_energy_of_forces(m, ws, h, 1.0)
+
+
+@kernel
+def step_energy_of_forces(m, ws, h, gravity):
+    """force_step_energy of the applied forces less (1 - gravity) times gravity's: gravity
+    1.0 all of them, 0.0 those other than gravity (a motor's torque, a spring, a push)."""
     total = 0.0
     for i in range(ws.force.shape[0]):
-        total += m.body_inv_mass[i] * (ws.force[i, 0] ** 2 + ws.force[i, 1] ** 2)
+        fx = ws.force[i, 0] - (1.0 - gravity) * m.body_mass[i] * m.gravity[0]
+        fy = ws.force[i, 1] - (1.0 - gravity) * m.body_mass[i] * m.gravity[1]
+        total += m.body_inv_mass[i] * (fx * fx + fy * fy)
         total += m.body_inv_inertia[i] * ws.force[i, 2] ** 2
     return 0.5 * h * h * total
 
