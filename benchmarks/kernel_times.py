@@ -31,7 +31,8 @@ from planarsim.kernels.integrate import bound_correction_work, max_residual  # n
 from planarsim.kernels.math2d import update_trig  # noqa: E402
 from planarsim.kernels.modes import engage_limits, rule_breaks  # noqa: E402
 from planarsim.kernels.rows import build_rows  # noqa: E402
-from planarsim.kernels.solve import assemble, factor_solve, solve_impulses  # noqa: E402
+from planarsim.kernels.matrix import assemble, factor_solve  # noqa: E402
+from planarsim.kernels.solve import solve_impulses  # noqa: E402
 from planarsim.kernels.step import copy_state  # noqa: E402
 from planarsim.kernels.work import joints_add_energy  # noqa: E402
 

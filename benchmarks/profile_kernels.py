@@ -3,6 +3,7 @@
     python benchmarks/profile_kernels.py chain4                # a bench scene (Simulator.steps)
     python benchmarks/profile_kernels.py walker:simbicon       # a walker's simulate()
     python benchmarks/profile_kernels.py biped_collapse --seconds 20
+    python benchmarks/profile_kernels.py world:pyramid45 --seconds 0.2   # benchmarks/worlds.py
 
 numba's machine code has no symbols that perf can see, so this script writes perf's map file
 (/tmp/perf-<pid>.map: address, size, name of every compiled function the run links), samples
@@ -98,8 +99,9 @@ def _workload(target, seconds):
         return (lambda: mod.simulate(seconds)), list(disps.values())
     import planarsim as ps
     from benchmarks.scenes import SCENES
+    from benchmarks.worlds import WORLDS
     from planarsim.compile.link import run_steps
-    model = SCENES[target][0]()
+    model = WORLDS[target[6:]]() if target.startswith("world:") else SCENES[target][0]()
     sim = ps.Simulator(model)
     sim.steps(10)
     start = sim.state.copy()
@@ -113,7 +115,8 @@ def _workload(target, seconds):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("target", help="a bench scene (chain4, biped_collapse, ...) or walker:<name>")
+    ap.add_argument("target", help="a bench scene (chain4, biped_collapse, ...), walker:<name> or "
+                    "world:<name> (benchmarks/worlds.py)")
     ap.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--top", type=int, default=20)

@@ -5,11 +5,13 @@ after --limit seconds (a first step that takes longer is reported as such).
     python benchmarks/worlds.py                          # every world, 200 steps each
     python benchmarks/worlds.py columns10x10 pyramid10 --steps 500 --limit 120
 
-Worlds: columns10x10 (ten columns of ten 0.2 m boxes, 0.4 m apart), pyramid10 (55 boxes),
+Worlds: pyramid4 (10 boxes), columns10x10 (ten columns of ten 0.2 m boxes, 0.4 m apart), pyramid10 (55 boxes),
 pyramid20 (210 boxes, each on two below), wall40x10 (400 bricks 0.4 x 0.2 m, staggered),
 pyramid45 (1,035 boxes). Prints per world: bodies, contact slots, the contacts the
 workspace's solve holds at the end, peak memory [MB], the first step [ms], mean and largest
-of the later steps [ms], the largest move of a box from its start [m] and the audit's total.
+of the later steps [ms], the largest move of a box from its start [m], the deepest overlap of
+a listed contact before the last step [m] and the audit's total; then how the mean step at
+rest grows with the number of bodies, from the smallest world run to the largest.
 """
 from __future__ import annotations
 
@@ -62,6 +64,7 @@ def wall(n_columns=40, n_rows=10):
 
 
 WORLDS = {
+    "pyramid4": lambda: pyramid(4),
     "columns10x10": lambda: columns(10, 10),
     "pyramid10": lambda: pyramid(10),
     "pyramid20": lambda: pyramid(20),
@@ -95,9 +98,11 @@ def _measure_world(name, steps, out):
         sim.step()
         times[k] = time.perf_counter() - t
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    live = sim.ws.live[:sim.ws.n_live[0]]
+    deepest = max(0.0, -float(np.min(sim.ws.contact_gap[live]))) if live.size else 0.0
     out.put(("done", workspace_contacts(model, sim.ws), rss, first, float(times.mean()),
              float(times.max()), float(np.abs(sim.state.q - q0).max()),
-             int(sum(audit_counts(sim.ws).values()))))
+             int(sum(audit_counts(sim.ws).values())), deepest))
 
 
 def run(name, steps, limit):
@@ -114,20 +119,22 @@ def run(name, steps, limit):
         proc.kill()
         proc.join()
     if "error" in said:
-        return f"{name:13s} {said['error'][0]}"
+        return f"{name:13s} {said['error'][0]}", None
     if not stopped and "done" not in said:
-        return f"{name:13s} its process ended with exit code {proc.exitcode} and no figures"
+        return f"{name:13s} its process ended with exit code {proc.exitcode} and no figures", None
     if "done" in said:
-        held, rss, first, mean, most, move, audit = said["done"]
+        held, rss, first, mean, most, move, audit, deepest = said["done"]
         n_body, n_contact = said["built"]
-        return (f"{name:13s} {n_body:5d} bodies {n_contact:8,d} slots  holds {held:6,d}  "
+        line = (f"{name:13s} {n_body:5d} bodies {n_contact:9,d} slots  holds {held:6,d}  "
                 f"{rss:7.0f} MB  first {first * 1e3:9.1f} ms  then mean {mean * 1e3:7.3f} ms "
-                f"(largest {most * 1e3:7.2f})  moved {move:.1e} m  audit {audit}")
+                f"(largest {most * 1e3:7.2f})  moved {move:.1e} m  deepest {deepest:.1e} m  "
+                f"audit {audit}")
+        return line, (n_body, mean)
     where = ("before its first step ended" if "first" not in said
              else f"after a first step of {said['first'][0]:.1f} s")
     built = said.get("built")
     size = f"{built[0]} bodies {built[1]:,} slots, " if built else ""
-    return f"{name:13s} {size}stopped at the {limit:g} s limit {where}"
+    return f"{name:13s} {size}stopped at the {limit:g} s limit {where}", None
 
 
 def main(argv=None):
@@ -139,8 +146,18 @@ def main(argv=None):
     unknown = [w for w in a.worlds if w not in WORLDS]
     if unknown:
         ap.error(f"unknown world(s) {unknown}; the worlds are {list(WORLDS)}")
+    sizes = []
     for name in a.worlds:
-        print(run(name, a.steps, a.limit), flush=True)
+        line, size = run(name, a.steps, a.limit)
+        print(line, flush=True)
+        if size is not None:
+            sizes.append(size)
+    if len(sizes) >= 2:
+        (n0, t0), (n1, t1) = min(sizes), max(sizes)
+        if n1 > n0:
+            growth = np.log(t1 / t0) / np.log(n1 / n0)
+            print(f"a step at rest grows as N^{growth:.2f} from {n0} to {n1} bodies "
+                  f"({t0 * 1e3:.3f} ms to {t1 * 1e3:.3f} ms)")
 
 
 if __name__ == "__main__":

@@ -297,16 +297,28 @@ def accurate_unsupported(model, what, index, integrator=None, who="simulation"):
 
 
 def out_of_room(model, ws, who):
-    """Step stopped by GUARD_ROOM where nothing grows the workspace: its rows did not fit."""
-    from .state import workspace_contacts
+    """Step stopped by GUARD_ROOM where nothing grows the workspace: its rows, their matrix's
+    envelope or an island's complementarity problem did not fit."""
+    from .state import workspace_capacity
     step = int(ws.prev.step[0])
     t = float(ws.prev.time[0])
-    held = workspace_contacts(model, ws)
+    held, profile, lcp_rows = workspace_capacity(model, ws)
+    if ws.room[2] > profile:
+        what = (f"needs {int(ws.room[2]):,} entries of its rows' matrix, more than its "
+                f"workspace's solve holds ({profile:,})")
+        keyword = "profile"
+    elif ws.room[3] > lcp_rows:
+        what = (f"needs a complementarity problem of {int(ws.room[3]):,} rows, more than its "
+                f"workspace's solve holds ({lcp_rows:,})")
+        keyword = "lcp_rows"
+    else:
+        what = (f"touches with more contacts than its workspace's solve holds ({held:,} of the "
+                f"model's {model.n_contact:,} contact slots)")
+        keyword = "contacts"
     return SimulationDiverged(
-        f"{who}: step {step} (t={t:.6g} s) touches with more contacts than its workspace's "
-        f"solve holds ({held:,} of the model's {model.n_contact:,} contact slots); the state is "
-        f"left at that step's start. Simulator.step / steps / run grow the workspace and go "
-        f"on; a workspace of your own: make_workspace(model, contacts=...) with more",
+        f"{who}: step {step} (t={t:.6g} s) {what}; the state is left at that step's start. "
+        f"Simulator.step / steps / run grow the workspace and go on; a workspace of your own: "
+        f"make_workspace(model, {keyword}=...) with more",
         step, t, "", "", float(held), _start_of_step(ws))
 
 

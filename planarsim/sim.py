@@ -22,7 +22,7 @@ from .speed_bound import resolve_speed_limit
 from .start_check import check_overlap, check_start, overlapping
 from .kernels.guards import GUARD_ROOM
 from .state import (State, Workspace, check_state, copy_arrays, forget_ground_queries, forget_pairs,
-                    grow_workspace, make_state, make_workspace, workspace_contacts)
+                    grow_workspace, make_state, make_workspace, workspace_capacity)
 from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
 
@@ -301,7 +301,7 @@ class Simulator:
                 raise ValueError(f"start_over: {name} of body {self._model.body_names[bad[0]]!r} "
                                  f"({bad[0]}) is {a[bad[0]].tolist()}; it must be finite")
         if getattr(self, "_fresh_ws", None) is None:
-            self._fresh_ws = make_workspace(self._model, workspace_contacts(self._model, self._ws))
+            self._fresh_ws = make_workspace(self._model, *workspace_capacity(self._model, self._ws))
         copy_arrays(self._ws, self._fresh_ws)
         if getattr(self, "_speed_from_model", False):
             self.state = st          # the setter bounds the speeds again from this start

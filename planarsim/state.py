@@ -9,7 +9,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .kernels.info import N_INFO
-from .kernels.codes import CONTACT_PAIR
+from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
 from .model import Model
 
 
@@ -242,7 +242,41 @@ class Workspace(NamedTuple):
     row_kind: np.ndarray         # (R,) int ROW_*
     row_owner: np.ndarray        # (R,) int pin / rod / contact index
     n_row: np.ndarray            # (1,) int rows in use
-    A: np.ndarray                # (R, R) effective-mass matrix J M^-1 F^T
+    A_low: np.ndarray            # (P,) the effective-mass matrix J M^-1 F^T, its lower
+                                 #   triangle and diagonal inside the rows' envelope: entry
+                                 #   (i, j), row_first[i] <= j <= i, at row_start[i] + j -
+                                 #   row_first[i] (kernels/solve.py); P: profile capacity
+    A_up: np.ndarray             # (P,) its upper triangle the same way: entry (j, i), j < i,
+                                 #   at row_start[i] + j - row_first[i] (column i)
+    row_start: np.ndarray        # (R + 1,) int where each row's envelope begins in A_low / A_up
+    factor_kind: np.ndarray      # (1,) int which factorisation holds the rows (kernels/matrix.py:
+                                 #   0 the envelope, 1 sparse; then A_low / A_up hold the
+                                 #   factors' columns L and U, at L_index's rows)
+    L_index: np.ndarray          # (P,) int the sparse factors' row of each entry
+    sp_perm: np.ndarray          # (R,) int sparse order: place -> row (kernels/sparse_factor.py)
+    sp_iperm: np.ndarray         # (R,) int row -> place
+    sp_row_key: np.ndarray       # (R,) int each row's part in the nested dissection
+    sp_parent: np.ndarray        # (R,) int elimination tree (-1: a root)
+    sp_flag: np.ndarray          # (R,) int scratch marks
+    sp_pattern: np.ndarray       # (R,) int scratch: a row's pattern in the factor
+    sp_lcount: np.ndarray        # (R,) int entries of each factor column
+    sp_lstart: np.ndarray        # (R + 1,) int where each factor column begins
+    sp_pivot: np.ndarray         # (R,) pivots by place (0: dropped)
+    sp_diag: np.ndarray          # (R,) the matrix's diagonal by place
+    sp_x: np.ndarray             # (R,) scratch
+    sp_y: np.ndarray             # (R,) scratch
+    sp_start: np.ndarray         # (R + 1,) int where each place's lower neighbours begin
+    sp_index: np.ndarray         # (P,) int the lower neighbours' places
+    sp_low: np.ndarray           # (P,) A[k, i] of each (i < k)
+    sp_up: np.ndarray            # (P,) A[i, k] of each
+    sp_body_rows: np.ndarray     # (2 R,) int each body's rows by place (sp_body_start)
+    sp_body_start: np.ndarray    # (n_body + 1,) int
+    sp_body_fill: np.ndarray     # (n_body,) int scratch cursor
+    sp_bodies: np.ndarray        # (n_body,) int the bodies in nested-dissection order
+    sp_body_place: np.ndarray    # (n_body,) int each body's place in it
+    sp_key: np.ndarray           # (n_body,) scratch: the coordinate a part is split along [m]
+    sp_stack: np.ndarray         # (n_body + 2, 2) int the parts still to split
+    sp_count: np.ndarray         # ((n_body + 1) MAX_DEPTH + 1,) int counting sort of the rows
     rhs: np.ndarray              # (R,)
     lam_start: np.ndarray        # (R,) impulses the solve starts from (the last step's)
     lam: np.ndarray              # (R,) impulses [N s or N m s]
@@ -262,10 +296,14 @@ class Workspace(NamedTuple):
     lcp_rows: np.ndarray         # (R,) int rows: joints first, then the others
     lcp_var: np.ndarray          # (R,) int row -> first LCP variable (tangent rows: 3)
     lcp_pos: np.ndarray          # (R,) int non-joint row k -> its first LCP variable
-    lcp_B: np.ndarray            # (R, R) joint block A_bb, factored
-    lcp_G: np.ndarray            # (R, R + 1) A_bb^-1 [A_bx, b_b]
-    lcp_S: np.ndarray            # (R, R + 1) Schur complement [S, s]
-    lcp_M: np.ndarray            # (L, L) the LCP matrix (L: unilateral + 3 per friction row)
+    row_local: np.ndarray        # (R,) int a row's place in its island's dense matrix lcp_A
+    lcp_A: np.ndarray            # (C, C) an island's J M^-1 J^T in full (C: the island rows
+                                 #   the dense complementarity storage holds)
+    lcp_B: np.ndarray            # (C, C) joint block A_bb, factored
+    lcp_G: np.ndarray            # (C, C + 1) A_bb^-1 [A_bx, b_b]
+    lcp_S: np.ndarray            # (C, C + 1) Schur complement [S, s]
+    lcp_M: np.ndarray            # (L, L) the LCP matrix (L = 2 C: unilateral + 3 per friction
+                                 #   row, which follows its normal row)
     lcp_q: np.ndarray            # (L,)
     lcp_z: np.ndarray            # (L,) its solution
     lcp_scale: np.ndarray        # (L,) diagonal scaling of the variables
@@ -312,12 +350,17 @@ class Workspace(NamedTuple):
     step_path: np.ndarray        # (n_body,) the path [m] each body's velocities explain over the
                                  #   last whole step: per part (time-of-impact splits, turn
                                  #   sub-steps) its length times the body's largest speed in it
-    room: np.ndarray             # (2,) int [0] 1: a row or a complementarity variable did not
-                                 #   fit this step (its answer is discarded: the step returns
-                                 #   GUARD_ROOM from its start, and Simulator grows the solve's
-                                 #   storage, grow_workspace); [1] 1: the solve's storage holds
-                                 #   fewer contacts than the model has (so a step keeps its
-                                 #   pair list's start in start_pairs, to begin again from it)
+    room: np.ndarray             # (5,) int [0] 1: a row, the rows' envelope or an island's
+                                 #   complementarity problem did not fit this step (its answer
+                                 #   is discarded: the step returns GUARD_ROOM from its start,
+                                 #   and Simulator grows the solve's storage, grow_workspace);
+                                 #   [1] 1: the solve's storage holds fewer contacts than the
+                                 #   model has (so a step keeps its pair list's start in
+                                 #   start_pairs, to begin again from it); [2] the envelope
+                                 #   entries and [3] the island rows the step needed beyond
+                                 #   the storage (0: none); [4] the island rows the dense
+                                 #   complementarity storage may grow to (LCP_GROWTH_BUDGET:
+                                 #   a larger island's problem is not solved that way)
     least_change: np.ndarray     # (3,) int [0] 1: this step's solves take the least change of
                                  #   impulses where rows are dependent (solve.least_change_impulses;
                                  #   set once an answer broke a rule: step.solve_and_check);
@@ -364,39 +407,83 @@ def max_rows(model: Model, contacts: int | None = None) -> int:
     return max(1, 5 * model.n_pin + model.n_rod + 2 * nc)
 
 
-def max_lcp(model: Model, contacts: int | None = None) -> int:
-    """Variables of the largest complementarity problem with room for `contacts` contacts
-    (default: all): joint limits and contact normals one each, a contact's friction three
-    (beta+, beta-, gamma)."""
-    nc = model.n_contact if contacts is None else contacts
-    return max(1, 2 * model.n_pin + 4 * nc)
+# [bytes] the solve's storage a new workspace is given (solve_bytes): room in rows for every
+# contact slot of its model, the envelope of all those rows and a dense complementarity
+# problem over all of them where that fits (every walker, every model of tens of shapes);
+# beyond it, room for the contacts a step is likely to hold (contact_capacity), an envelope
+# of ENVELOPE_PER_ROW entries a row and complementarity problems of LCP_ROWS rows, each grown
+# by the Simulator when a step needs more
+SOLVE_BUDGET = 64 * 2 ** 20
 
-
-# [bytes] the dense solve storage (dense_workspace_bytes) a workspace is given for every
-# contact slot of its model, when that fits; beyond it, room for the contacts a step is
-# likely to hold (contact_capacity), grown by the Simulator when a step needs more
-DENSE_BUDGET = 64 * 2 ** 20
-
-# contacts per shape a first workspace holds when not every slot fits DENSE_BUDGET: a box
+# contacts per shape a first workspace holds when not every slot fits SOLVE_BUDGET: a box
 # on two others with one beside it touches with 2-3 pairs of two slots each
 CONTACTS_PER_SHAPE = 6
+# envelope entries per row a first workspace holds when the full envelope does not fit
+ENVELOPE_PER_ROW = 64
+# island rows a first workspace's dense complementarity storage holds when not all rows fit
+LCP_ROWS = 256
+# [bytes] the largest dense complementarity storage a workspace may grow to: an island with
+# more rows than fit is not solved as one complementarity problem (its contacts' modes are
+# found by the linear solves alone; where those fail the audit says so)
+LCP_GROWTH_BUDGET = 2 ** 30
+
+
+def profile_full(rows: int) -> int:
+    """Envelope entries of rows rows that all share a body: rows (rows + 1) / 2."""
+    return rows * (rows + 1) // 2
+
+
+def lcp_bytes(lcp_rows: int) -> int:
+    """Memory [bytes] of the dense complementarity storage for islands of lcp_rows rows:
+    four C x C (or C x (C + 1)) matrices and Lemke's L x L and L x (2L + 2), L = 2 C."""
+    C, L = lcp_rows, 2 * lcp_rows
+    return 8 * (2 * C * C + 2 * C * (C + 1) + L * L + L * (2 * L + 2))
+
+
+def lcp_rows_limit() -> int:
+    """The island rows whose dense complementarity storage fits LCP_GROWTH_BUDGET."""
+    C = int((LCP_GROWTH_BUDGET / 80.0) ** 0.5)
+    while lcp_bytes(C + 1) <= LCP_GROWTH_BUDGET:
+        C += 1
+    while C > 1 and lcp_bytes(C) > LCP_GROWTH_BUDGET:
+        C -= 1
+    return C
+
+
+def solve_bytes(model: Model, contacts: int, profile: int, lcp_rows: int) -> int:
+    """Memory [bytes] of the solve's storage with room for `contacts` contacts in rows,
+    `profile` envelope entries and islands of `lcp_rows` rows in the dense complementarity
+    storage (the arrays of _solve_arrays)."""
+    return sum(int(np.prod(shape)) * 8 for shape, _ in _solve_shapes(model, contacts, profile,
+                                                                     lcp_rows).values())
 
 
 def contact_capacity(model: Model) -> int:
     """Contacts the solve's storage of a new workspace holds: every contact slot of the model
-    where that fits DENSE_BUDGET (every walker, every model of tens of shapes), else the
-    ground contacts and CONTACTS_PER_SHAPE per shape; a step that needs more returns
+    where that, with their full envelope and complementarity storage, fits SOLVE_BUDGET, else
+    the ground contacts and CONTACTS_PER_SHAPE per shape; a step that needs more returns
     GUARD_ROOM and the Simulator grows it (grow_workspace)."""
     nc = model.n_contact
-    if dense_workspace_bytes(model, nc) <= DENSE_BUDGET:
+    R = max_rows(model, nc)
+    if solve_bytes(model, nc, profile_full(R), R) <= SOLVE_BUDGET:
         return nc
     n_ground = int(np.sum(model.arrays.contact_kind != CONTACT_PAIR))
     return min(nc, n_ground + CONTACTS_PER_SHAPE * model.n_shape)
 
 
+def first_capacity(model: Model, contacts: int) -> tuple[int, int]:
+    """(envelope entries, island rows of the dense complementarity storage) of a new
+    workspace holding `contacts` contacts: all its rows' where that fits SOLVE_BUDGET, else
+    ENVELOPE_PER_ROW a row and LCP_ROWS (grown when a step needs more)."""
+    R = max_rows(model, contacts)
+    if solve_bytes(model, contacts, profile_full(R), R) <= SOLVE_BUDGET:
+        return profile_full(R), R
+    return min(profile_full(R), ENVELOPE_PER_ROW * R), min(R, LCP_ROWS)
+
+
 def workspace_contacts(model: Model, ws) -> int:
     """Contacts the solve's storage of workspace ws holds (the inverse of max_rows)."""
-    return (ws.A.shape[0] - 5 * model.n_pin - model.n_rod) // 2
+    return (ws.row_kind.shape[0] - 5 * model.n_pin - model.n_rod) // 2
 
 
 def _broad_phase_lists(model: Model) -> dict:
@@ -423,75 +510,108 @@ def _broad_phase_lists(model: Model) -> dict:
                 near_contacts=np.zeros(nc, np.int64))
 
 
-def dense_workspace_bytes(model: Model, contacts: int | None = None) -> int:
-    """Memory [bytes] of the workspace's dense solve matrices with room for `contacts`
-    contacts (default: every contact slot, two per pair of shapes that may touch): four
-    R x R (A, lcp_B, lcp_G, lcp_S; R = max_rows) and L x L plus L x (2L + 2) (lcp_M, lcp_T;
-    L = max_lcp); the rest of the workspace grows linearly and is left out."""
-    R, L = max_rows(model, contacts), max_lcp(model, contacts)
-    return 8 * (2 * R * R + 2 * R * (R + 1) + L * L + L * (2 * L + 2))
-
-
-def check_workspace(model: Model, contacts: int | None = None) -> None:
-    """Raise WorkspaceTooLarge, before anything is allocated, when the workspace's dense solve
-    matrices with room for `contacts` contacts (dense_workspace_bytes) need more memory than
-    the machine has."""
+def check_workspace(model: Model, contacts: int, profile: int, lcp_rows: int) -> None:
+    """Raise WorkspaceTooLarge, before anything is allocated, when the solve's storage with
+    room for `contacts` contacts, `profile` envelope entries and islands of `lcp_rows` rows
+    (solve_bytes) needs more memory than the machine has."""
     from .errors import WorkspaceTooLarge
     from .trajectory import _gib, machine_memory
-    nc = model.n_contact if contacts is None else contacts
-    need = dense_workspace_bytes(model, nc)
+    need = solve_bytes(model, contacts, profile, lcp_rows)
     have = machine_memory()
     if have and need > have:
         n_pair = int(np.sum(model.arrays.contact_kind == CONTACT_PAIR)) // 2
         raise WorkspaceTooLarge(
             f"this model's step needs {_gib(need)} of memory, more than this machine's "
-            f"{_gib(have)}: its solve matrices hold {nc:,} contacts in rows ({max_rows(model, nc):,} "
-            f"rows; the model has {model.n_contact:,} contact slots: {n_pair:,} pairs of shapes "
-            f"that may touch, two each, of {model.n_shape:,} shapes on {model.n_body:,} bodies). "
-            f"Fewer contacts fit: collide=False on shapes that never touch, or category= / "
-            f"mask= filter bits that keep apart the shapes that cannot meet "
+            f"{_gib(have)}: its solve holds {contacts:,} contacts in rows "
+            f"({max_rows(model, contacts):,} rows, {profile:,} entries of their matrix, "
+            f"complementarity problems of {lcp_rows:,} rows; the model has "
+            f"{model.n_contact:,} contact slots: {n_pair:,} pairs of shapes that may touch, "
+            f"two each, of {model.n_shape:,} shapes on {model.n_body:,} bodies). Fewer "
+            f"contacts fit: collide=False on shapes that never touch, or category= / mask= "
+            f"filter bits that keep apart the shapes that cannot meet "
             f"(ModelBuilder.add_shape), or fewer bodies touching at once", need, have)
 
 
-def _solve_arrays(model: Model, contacts: int) -> dict:
-    """The workspace's arrays sized by the solve's rows R and complementarity variables L
-    (max_rows, max_lcp with room for `contacts` contacts)."""
-    R, L = max_rows(model, contacts), max_lcp(model, contacts)
-    z = np.zeros
-    return dict(row_first=z(R, np.int64), row_reach=z(R, np.int64), row_list=z(R, np.int64),
-                row_body=z((R, 2), np.int64), row_J=z((R, 2, 3)), row_F=z((R, 2, 3)),
-                row_Jp=z((R, 2, 3)), row_c=z(R), row_c_pred=z(R), row_kind=z(R, np.int64),
-                row_owner=z(R, np.int64), A=z((R, R)), rhs=z(R), lam_start=z(R), lam=z(R),
-                row_b=z(R), row_soft=z((R, 5)), lcp_rows=z(R, np.int64),
-                lcp_var=z(R, np.int64), lcp_pos=z(R, np.int64), lcp_B=z((R, R)),
-                lcp_G=z((R, R + 1)), lcp_S=z((R, R + 1)), lcp_M=z((L, L)), lcp_q=z(L),
-                lcp_z=z(L), lcp_scale=z(L), lcp_T=z((L, 2 * L + 2)), lcp_basis=z(L, np.int64),
-                row_slip=z(R), island_rows=z(R, np.int64), row_island=z(R, np.int64))
+def _solve_shapes(model: Model, contacts: int, profile: int, lcp_rows: int) -> dict:
+    """name -> (shape, dtype) of the workspace's arrays sized by the solve's rows R
+    (max_rows with room for `contacts` contacts), the envelope's entries P (`profile`) and
+    the dense complementarity storage's island rows C (`lcp_rows`; L = 2 C variables)."""
+    R, P, C = max_rows(model, contacts), max(1, profile), max(1, lcp_rows)
+    L = 2 * C
+    f, i = np.float64, np.int64
+    return dict(row_first=((R,), i), row_reach=((R,), i), row_list=((R,), i),
+                row_body=((R, 2), i), row_J=((R, 2, 3), f), row_F=((R, 2, 3), f),
+                row_Jp=((R, 2, 3), f), row_c=((R,), f), row_c_pred=((R,), f),
+                row_kind=((R,), i), row_owner=((R,), i), A_low=((P,), f), A_up=((P,), f),
+                row_start=((R + 1,), i), L_index=((P,), i), sp_perm=((R,), i),
+                sp_iperm=((R,), i), sp_row_key=((R,), i), sp_parent=((R,), i),
+                sp_flag=((R,), i), sp_pattern=((R,), i), sp_lcount=((R,), i),
+                sp_lstart=((R + 1,), i), sp_pivot=((R,), f), sp_diag=((R,), f),
+                sp_x=((R,), f), sp_y=((R,), f), sp_start=((R + 1,), i), sp_index=((P,), i),
+                sp_low=((P,), f), sp_up=((P,), f), sp_body_rows=((2 * R,), i), rhs=((R,), f), lam_start=((R,), f), lam=((R,), f),
+                row_b=((R,), f), row_soft=((R, 5), f), lcp_rows=((R,), i),
+                lcp_var=((R,), i), lcp_pos=((R,), i), row_local=((R,), i),
+                lcp_A=((C, C), f), lcp_B=((C, C), f), lcp_G=((C, C + 1), f),
+                lcp_S=((C, C + 1), f), lcp_M=((L, L), f), lcp_q=((L,), f), lcp_z=((L,), f),
+                lcp_scale=((L,), f), lcp_T=((L, 2 * L + 2), f), lcp_basis=((L,), i),
+                row_slip=((R,), f), island_rows=((R,), i), row_island=((R,), i))
+
+
+def _solve_arrays(model: Model, contacts: int, profile: int, lcp_rows: int) -> dict:
+    """The workspace's arrays of _solve_shapes, zeroed."""
+    return {name: np.zeros(shape, dtype)
+            for name, (shape, dtype) in _solve_shapes(model, contacts, profile, lcp_rows).items()}
+
+
+def workspace_capacity(model: Model, ws) -> tuple[int, int, int]:
+    """(contacts, envelope entries, island rows of the complementarity storage) that
+    workspace ws's solve holds."""
+    return workspace_contacts(model, ws), ws.A_low.shape[0], ws.lcp_A.shape[0]
 
 
 def grow_workspace(model: Model, ws: Workspace) -> Workspace:
-    """ws with room for twice its contacts in its solve's storage (at most every slot of the
-    model), after a step returned GUARD_ROOM; its other arrays are ws's own (the same
-    objects). WorkspaceTooLarge if that does not fit the machine."""
-    have = workspace_contacts(model, ws)
-    contacts = min(model.n_contact, max(2 * have, have + 16))
-    check_workspace(model, contacts)
-    grown = _solve_arrays(model, contacts)
+    """ws with more room in its solve's storage after a step returned GUARD_ROOM: twice the
+    envelope entries or the complementarity storage's island rows the step ran out of (at
+    least what it needed), else twice its contacts (at most every slot of the model); its
+    other arrays are ws's own (the same objects). WorkspaceTooLarge if that does not fit
+    the machine."""
+    contacts, profile, lcp_rows = workspace_capacity(model, ws)
+    need_profile, need_lcp = int(ws.room[2]), int(ws.room[3])
+    if need_profile > profile or need_lcp > lcp_rows:
+        if need_profile > profile:
+            profile = max(2 * profile, need_profile)
+        if need_lcp > lcp_rows:
+            lcp_rows = min(max(2 * lcp_rows, need_lcp), max(int(ws.room[4]), need_lcp))
+    else:
+        contacts = min(model.n_contact, max(2 * contacts, contacts + 16))
+    check_workspace(model, contacts, profile, lcp_rows)
+    grown = _solve_arrays(model, contacts, profile, lcp_rows)
     for name, array in grown.items():
         old = getattr(ws, name)
-        array[tuple(slice(0, k) for k in old.shape)] = old
+        if old.shape == array.shape:
+            grown[name] = old
+        else:
+            array[tuple(slice(0, min(k, g)) for k, g in zip(old.shape, array.shape))] = \
+                old[tuple(slice(0, min(k, g)) for k, g in zip(old.shape, array.shape))]
     room = ws.room.copy()
     room[0] = 0
     room[1] = int(contacts < model.n_contact)
+    room[2] = 0
+    room[3] = 0
     return ws._replace(room=room, **grown)
 
 
-def make_workspace(model: Model, contacts: int | None = None) -> Workspace:
+def make_workspace(model: Model, contacts: int | None = None, profile: int | None = None,
+                   lcp_rows: int | None = None) -> Workspace:
     """A model's workspace with room for `contacts` contacts in its solve's storage
-    (default: contact_capacity)."""
+    (default: contact_capacity), `profile` entries of their matrix's envelope and islands of
+    `lcp_rows` rows in its dense complementarity storage (defaults: first_capacity)."""
     from .kernels.audit import N_AUDIT
     contacts = contact_capacity(model) if contacts is None else min(int(contacts), model.n_contact)
-    check_workspace(model, contacts)
+    first_profile, first_lcp = first_capacity(model, contacts)
+    profile = first_profile if profile is None else int(profile)
+    lcp_rows = first_lcp if lcp_rows is None else int(lcp_rows)
+    check_workspace(model, contacts, profile, lcp_rows)
     nb, nc, na = model.n_body, model.n_contact, model.n_act
     z = np.zeros
     lists = _broad_phase_lists(model)
@@ -513,11 +633,15 @@ def make_workspace(model: Model, contacts: int | None = None) -> Workspace:
                      contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
                      contact_refpt=z((nc, 4)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
-                     **lists, **_solve_arrays(model, contacts),
+                     **lists, **_solve_arrays(model, contacts, profile, lcp_rows),
                      n_row=z(1, np.int64), act_u=z(na), act_power=z(na),
                      info=z(N_INFO, np.int64), guard_value=z(3),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
-                     island_parent=z(nb, np.int64),
+                     island_parent=z(nb, np.int64), factor_kind=z(1, np.int64),
+                     sp_body_start=z(nb + 1, np.int64), sp_body_fill=z(nb, np.int64),
+                     sp_bodies=z(nb, np.int64), sp_body_place=z(nb, np.int64), sp_key=z(nb),
+                     sp_stack=z((nb + 2, 2), np.int64),
+                     sp_count=z((nb + 1) * SPARSE_MAX_DEPTH + 1, np.int64),
                      island_label=z(nb, np.int64), island_start=z(nb + 2, np.int64),
                      island_fill=z(nb + 1, np.int64), island_failed=z(nb + 1, np.int64),
                      island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),
@@ -528,6 +652,6 @@ def make_workspace(model: Model, contacts: int | None = None) -> Workspace:
                      joint_gain=z(3), joint_pivot=np.ones(1), lcp_eps=z(1),
                      impact_time=z(1), audit_keep=z(N_AUDIT, np.int64), path_explained=z((nb, 3)),
                      step_path=z(nb),
-                     room=np.array([0, int(contacts < nc)], np.int64), least_change=z(3, np.int64),
+                     room=np.array([0, int(contacts < nc), 0, 0, lcp_rows_limit()], np.int64), least_change=z(3, np.int64),
                      start_pairs=z(n_pair, np.int64), n_start_pairs=z(1, np.int64),
                      start=make_state(model), prev=make_state(model))

@@ -40,3 +40,6 @@ INTEGRATOR_RATTLE = 1     # RATTLE, second order (kernels/rattle.py)
 INTEGRATOR_RATTLE4 = 2    # RATTLE composed in five stages (Suzuki), fourth order
 INTEGRATOR_RATTLE6 = 3    # RATTLE composed in seven stages (Yoshida), sixth order
 INTEGRATOR_NAMES = ("euler", "rattle", "rattle4", "rattle6")
+# nesting depth of the sparse factorisation's parts (kernels/sparse_factor.py; the workspace's
+# counting sort holds this many keys per body): parts deeper than this share a place
+SPARSE_MAX_DEPTH = 40

@@ -29,7 +29,7 @@ from .pair import PAIR_MARGIN, find_pair, place_shapes
 from .islands import group_rows
 from .lcp import LCP_SOLVED
 from .math2d import update_trig
-from .mixed_lcp import assemble_dense, solve_mixed_lcp
+from .mixed_lcp import assemble_dense, lcp_room, solve_mixed_lcp
 from .modes import engage_contacts, engage_limits, gather_contact_impulses, modes_from_solution
 from .limit import add_limit_rows
 from .rod import add_rod_row
@@ -68,9 +68,13 @@ def _solve_island(m, ws, k, vars_per_row, floor):
     """The complementarity problem of island k (kernels/islands.py, grouped), its answer
     checked at a scale of at least floor; Lemke's path capped at PIVOTS_PER_VARIABLE per
     possible variable (vars_per_row per row). Its own scale into ws.island_scale[k]. Returns
-    True if solved."""
+    True if solved; False too for an island beyond the dense storage (lcp_room: the step
+    begins again with more, or it has more rows than the storage may grow to hold)."""
     start = ws.island_start[k]
     count = ws.island_start[k + 1] - start
+    if not lcp_room(ws, count):
+        ws.island_scale[k] = 0.0
+        return False
     assemble_dense(m, ws, ws.island_rows, start, count)
     cap = PIVOTS_PER_VARIABLE * (vars_per_row * count + 10)
     status, pivots, scale = solve_mixed_lcp(m, ws, ws.island_rows, start, count, cap, floor)
@@ -111,7 +115,7 @@ def _solve_by_islands(m, ws, n, vars_per_row):
     grouped)."""
     n_island = group_rows(ws, n)
     failed = _solve_islands(m, ws, n_island, vars_per_row, False)
-    if failed == 0 or n_island == 1:
+    if failed == 0 or n_island == 1 or not lcp_room(ws, n):
         return n_island, failed
     for r in range(n):
         ws.island_rows[r] = r

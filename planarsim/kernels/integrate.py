@@ -25,7 +25,8 @@ from .limit import limit_side
 from .row_list import move_row
 from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_normal_row,
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
-from .solve import apply_impulses, assemble, compute_envelope, factor_solve, row_dot, substitute
+from .matrix import arrange, assemble, factor_solve, substitute_ws
+from .solve import apply_impulses, row_dot
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
                    gravity_work, kinetic_energy, step_energy_of_forces)
 
@@ -404,7 +405,8 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     if dropped > 0 or not envelope_ready:
         # the envelope of the rows as they are now (keep_correction_rows or drop_leaving_rows
         # compacted them; after a complementarity solve they are not the guess's rows)
-        compute_envelope(ws, n, s.q.shape[0])
+        if not arrange(s.q, ws, n, s.q.shape[0]):
+            return max_residual(m, s, ws)       # (no room: the step begins again with more)
     # the rows kept are as drop_leaving_rows evaluated them unless it moved some
     worst = max_residual(m, s, ws) if dropped > 0 else targets_of(ws, n)
     ptol = pivot_tol
@@ -438,7 +440,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             # (same matrix: its factors are reused)
             for r in range(n):
                 ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
-            substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+            substitute_ws(ws, ws.rhs, ws.lam, n, False)
             apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
         for i in range(s.q.shape[0]):
             for k in range(3):

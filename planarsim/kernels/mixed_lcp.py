@@ -1,6 +1,7 @@
 """The rows of a step as one mixed complementarity problem, solved by Lemke's method (lcp.py).
 
-Rows r with impulses x_r and residuals w = A x + b (A = J W J^T, dense here, b = ws.row_b):
+Rows r with impulses x_r and residuals w = A x + b (A = J W J^T, dense here: an island's in
+ws.lcp_A, b = ws.row_b):
   joints (pins x / y, rods):   x free,  w = 0
   unilateral (contact normals, joint limits):   x >= 0, w >= 0, x w = 0
   friction (a contact's tangent row t, after its normal row n):   |x_t| <= mu x_n, and
@@ -25,7 +26,7 @@ from .codes import CONTACT_PAIR
 from .contacts import pair_motion_scale
 from .rows import is_joint_row, is_soft_row, is_tangent_row
 from .soft import soft_compliance
-from .solve import _entry
+from .envelope import _entry
 
 # a joint-only loop: a pivot below this share of its row's diagonal belongs to a row that is
 # an exact combination of the others (consistent joints), left out with impulse 0
@@ -49,19 +50,40 @@ SOFT_ANSWER_TOL = 1e-4
 
 
 @kernel
+def lcp_room(ws, count):
+    """Do islands of `count` rows fit the dense complementarity storage? If not, and the
+    storage may grow to hold them (ws.room[4]), ws.room asks for it (the step begins again
+    with more: kernels/step.py, GUARD_ROOM). Returns True if they fit."""
+    if count <= ws.lcp_A.shape[0]:
+        return True
+    if count <= ws.room[4]:
+        ws.room[0] = 1
+        ws.room[3] = max(ws.room[3], count)
+    return False
+
+
+@kernel
 def assemble_dense(m, ws, rows, start, count):
-    """ws.A[r, s] = (J W J^T)[r, s] in full for the rows r, s in rows[start:start + count]
-    (an island's: kernels/islands.py; rows touching no common body give 0)."""
+    """ws.lcp_A = (J W J^T)[r, s] in full for the rows r, s in rows[start:start + count]
+    (an island's: kernels/islands.py; rows touching no common body give 0), row r at
+    ws.row_local[r]. The rows must fit (lcp_room)."""
     for i in range(count):
         ri = rows[start + i]
+        ws.row_local[ri] = i
         for j in range(i + 1):
             rj = rows[start + j]
             a = _entry(ws.row_J, ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia,
                        ri, rj)
             if j == i and is_soft_row(ws.row_kind[ri]):
                 a += soft_compliance(ws, ri)     # a joint's soft row (soft.py)
-            ws.A[ri, rj] = a
-            ws.A[rj, ri] = a
+            ws.lcp_A[i, j] = a
+            ws.lcp_A[j, i] = a
+
+
+@kernel(inline="always")
+def dense_entry(ws, r, c):
+    """(J W J^T)[r, c] of two rows of the island assemble_dense filled."""
+    return ws.lcp_A[ws.row_local[r], ws.row_local[c]]
 
 
 @kernel
@@ -144,27 +166,28 @@ def _factor_pivoted(B, nb, rows, scratch):
 
 
 @kernel
-def _factor_joints(A, B, nb, rows, scratch):
-    """B = L D L^T of the joint rows rows[:nb] of A (rows may be permuted; see
+def _factor_joints(A, local, B, nb, rows, scratch):
+    """B = L D L^T of the joint rows rows[:nb] of the island's A (row r at local[r]; rows may be permuted; see
     _factor_pivoted). In the rows' order where every pivot is at least PIVOTING_SHARE of its
     diagonal, far above rounding, so that the rows are certainly independent (a tree's
     joints); pivoted otherwise: a loop, at or near a dependent configuration, whose rows
     left out must be the dependent ones whatever the rows' order. Returns the smallest share
     of its diagonal that a pivot kept (0 if a row was left out)."""
-    _fill_joint_block(A, B, nb, rows)
+    _fill_joint_block(A, local, B, nb, rows)
     smallest = _factor_plain(B, nb)
     if smallest >= PIVOTING_SHARE:
         return smallest
-    _fill_joint_block(A, B, nb, rows)
+    _fill_joint_block(A, local, B, nb, rows)
     return _factor_pivoted(B, nb, rows, scratch)
 
 
 @kernel
-def _fill_joint_block(A, B, nb, rows):
-    """B[i, j] = A[rows[i], rows[j]] for i, j < nb."""
+def _fill_joint_block(A, local, B, nb, rows):
+    """B[i, j] = A[local[rows[i]], local[rows[j]]] for i, j < nb (A: the island's dense
+    matrix, assemble_dense; local: each row's place in it)."""
     for i in range(nb):
         for j in range(nb):
-            B[i, j] = A[rows[i], rows[j]]
+            B[i, j] = A[local[rows[i]], local[rows[j]]]
 
 
 @kernel
@@ -187,7 +210,7 @@ def _solve_joints(B, nb, G, col):
 @kernel(inline="never")
 def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     """Impulses ws.lam[r] of the rows r in rows[start:start + count] (an island's, in their
-    order: a tangent row follows its normal row; ws.A from assemble_dense, ws.row_b) that meet
+    order: a tangent row follows its normal row; ws.lcp_A from assemble_dense, ws.row_b) that meet
     the complementarity rules above; ws.row_slip[r] of a tangent row its slip speed gamma.
     floor: a lower bound of the answers' check scale (lcp.lemke; 0: this problem's own).
     Returns (status lcp.LCP_*, pivots, this problem's own scale: its largest approach -q in
@@ -209,20 +232,21 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     B = ws.lcp_B
     G = ws.lcp_G
     if nb > 0:
-        ws.joint_pivot[0] = min(ws.joint_pivot[0], _factor_joints(ws.A, B, nb, ws.lcp_rows, G))
+        ws.joint_pivot[0] = min(ws.joint_pivot[0], _factor_joints(ws.lcp_A, ws.row_local, B, nb,
+                                                               ws.lcp_rows, G))
     for j in range(nx + 1):
         for i in range(nb):
             ri = ws.lcp_rows[i]
-            G[i, j] = ws.A[ri, ws.lcp_rows[nb + j]] if j < nx else ws.row_b[ri]
+            G[i, j] = dense_entry(ws, ri, ws.lcp_rows[nb + j]) if j < nx else ws.row_b[ri]
         _solve_joints(B, nb, G, j)
     # Schur complement S = A_xx - A_xb G_x, s = b_x - A_xb G_b (S in lcp_S)
     S = ws.lcp_S
     for i in range(nx):
         ri = ws.lcp_rows[nb + i]
         for j in range(nx + 1):
-            acc = ws.A[ri, ws.lcp_rows[nb + j]] if j < nx else ws.row_b[ri]
+            acc = dense_entry(ws, ri, ws.lcp_rows[nb + j]) if j < nx else ws.row_b[ri]
             for k in range(nb):
-                acc -= ws.A[ri, ws.lcp_rows[k]] * G[k, j]
+                acc -= dense_entry(ws, ri, ws.lcp_rows[k]) * G[k, j]
             S[i, j] = acc
     # variables: a unilateral row one (x >= 0), a tangent row three (beta+, beta-, gamma)
     nv = 0
@@ -234,6 +258,7 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     Mx = ws.lcp_M
     if nv > Mx.shape[0]:            # beyond the workspace's storage: the step begins again
         ws.room[0] = 1              # with more (kernels/step.py, GUARD_ROOM)
+        ws.room[3] = max(ws.room[3], nv)
         return LCP_RAY, 0, 0.0
     qx = ws.lcp_q
     d = ws.lcp_scale

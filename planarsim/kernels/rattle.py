@@ -40,7 +40,8 @@ from .guards import GUARD_OK, GUARD_UNSUPPORTED
 from .info import INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .math2d import update_trig
 from .rows import eval_rows
-from .solve import apply_impulses, assemble, factor_symmetric, row_dot, substitute_symmetric
+from .matrix import assemble, factor_ws, substitute_ws
+from .solve import apply_impulses, row_dot
 
 # Suzuki's fourth-order fractal: stages of p h, p h, (1 - 4 p) h, p h, p h
 SUZUKI_P = 1.0 / (4.0 - 4.0 ** (1.0 / 3.0))
@@ -130,10 +131,10 @@ def project_velocities(m, s, ws, pivot_tol):
     update_trig(s.q, ws.body_cs)
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, False)
     assemble(m, ws, ws.row_J, ws.row_J, n, True)
-    factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, pivot_tol, ws.lam, ws.row_list)
+    factor_ws(ws, n, pivot_tol, True)
     for r in range(n):
         ws.rhs[r] = -row_dot(ws, r, ws.row_J, s.v)
-    substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+    substitute_ws(ws, ws.rhs, ws.lam, n, True)
     apply_impulses(m, ws, ws.row_J, ws.lam, n, s.v, 1.0)
 
 

@@ -302,15 +302,16 @@ def build_rows(m, s, ws):
     n = 0
     n_pin = m.pin_body.shape[0]
     n_rod = m.rod_body.shape[0]
-    n_con = m.contact_body.shape[0]
+    n_con = ws.n_live[0]            # (a contact off the broad phase's list is free)
     big = m.body_inv_mass.shape[0] + 1
     jp = 0
     jr = 0
-    ic = 0
-    while jp < n_pin or jr < n_rod or ic < n_con:
+    k = 0
+    while jp < n_pin or jr < n_rod or k < n_con:
+        ic = ws.live[k] if k < n_con else 0
         kp = _later_body(m.pin_body, jp) if jp < n_pin else big
         kr = _later_body(m.rod_body, jr) if jr < n_rod else big
-        kc = max(m.contact_body[ic], m.contact_other[ic]) if ic < n_con else big
+        kc = max(m.contact_body[ic], m.contact_other[ic]) if k < n_con else big
         if kp <= kr and kp <= kc:
             n = add_joint_rows(m, ws, n, jp)
             n = add_limit_rows(m, s, ws, n, jp)
@@ -320,11 +321,11 @@ def build_rows(m, s, ws):
             n = add_rod_row(m, ws, n, jr)
             jr += 1
         else:
+            k += 1
             mode = s.contact_mode[ic]
             # a frictionless contact (mu = 0) has no tangent row in any mode
             n = add_contact_rows(ws, n, ic, mode == MODE_PINNED or mode == MODE_SLIDING,
                                  mode == MODE_PINNED and m.contact_mu[ic] > 0.0)
-            ic += 1
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     predict_joint_errors(m, ws, n)

@@ -1,4 +1,4 @@
-"""Stage 5: position-level impulses, one dense solve.
+"""Stage 5: position-level impulses, one linear solve.
 
 Impulses lambda make every active row hold at the END of the step (symplectic Euler inside):
     c + h J (v* + W F^T lambda) = 0   =>   (J W F^T) lambda = -(c / h + J v*)
@@ -6,8 +6,10 @@ with W = M^-1 (diagonal: 1/m, 1/m, 1/I per body) and F = J except for sliding co
 Joint rows (pins, rods) use their exact error at the predicted end of the step instead,
 c(q + h v*) = c + h J v* + O(h^2 w^2 r): the drift of rotating anchors is then removed by the
 impulses too, and the position correction (integrate.py) starts from a far smaller residual.
-The matrix is assembled and eliminated only inside its envelope (rows touch at most two
-bodies, so a chain's matrix is banded): the cost grows linearly with the number of links.
+The matrix is assembled and eliminated only where it has entries (matrix.py): inside its
+envelope for chains and trees (rows touch at most two bodies, so a chain's matrix is banded:
+the cost grows linearly with the number of links), in a nested-dissection order for the
+many rows of piles and walls.
 Closed loops (Ranger in double stance, a box on two corners) make J W F^T singular: Gaussian
 elimination drops a row whose pivot falls below pivot_tol times its own diagonal, i.e. a row
 that is a combination of earlier ones; its impulse is zero and the rows it depends on carry
@@ -20,220 +22,11 @@ Without sliding contacts F = J and the matrix is symmetric: it is assembled in i
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ..compile import kernel
+from .matrix import (add_to_diagonal, arrange, assemble, diagonal_and_pivot, factor_ws,
+                     scale_diagonal, substitute_ws)
 from .rows import is_joint_row, is_normal_row, is_soft_row, is_tangent_row
 from .soft import soft_compliance, soft_row_b
 from .warm_start import start_impulses
-
-
-@kernel
-def compute_envelope(ws, n, n_body):
-    """row_first[r]: the first row sharing a body with row r; row_reach[k]: the last row whose
-    envelope reaches column k. Rows touch at most two bodies, so for rows ordered along a
-    chain or tree the envelope is narrow and elimination inside it costs O(n), not O(n^3)."""
-    for b in range(n_body):
-        ws.body_first_row[b] = -1
-    for r in range(n):
-        f = r
-        for e in range(2):
-            b = ws.row_body[r, e]
-            if b < 0:
-                continue
-            if ws.body_first_row[b] < 0:
-                ws.body_first_row[b] = r
-            elif ws.body_first_row[b] < f:
-                f = ws.body_first_row[b]
-        ws.row_first[r] = f
-        ws.row_reach[r] = r
-    for i in range(n):
-        for k in range(ws.row_first[i], i):
-            ws.row_reach[k] = i
-
-
-@kernel
-def _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j):
-    """(JL W JR^T)[i, j] over the bodies rows i and j share (each row touches at most two)."""
-    acc = 0.0
-    bj0 = row_body[j, 0]
-    bj1 = row_body[j, 1]
-    for ei in range(2):
-        bi = row_body[i, ei]
-        if bi < 0:
-            continue
-        im = inv_mass[bi]
-        ii = inv_inertia[bi]
-        if bj0 == bi:
-            acc += (JL[i, ei, 0] * JR[j, 0, 0] + JL[i, ei, 1] * JR[j, 0, 1]) * im
-            acc += JL[i, ei, 2] * JR[j, 0, 2] * ii
-        if bj1 == bi:
-            acc += (JL[i, ei, 0] * JR[j, 1, 0] + JL[i, ei, 1] * JR[j, 1, 1]) * im
-            acc += JL[i, ei, 2] * JR[j, 1, 2] * ii
-    return acc
-
-
-@kernel
-def assemble_rows(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetric):
-    """A = JL W JR^T inside the envelope (entries outside it are structurally zero); symmetric
-    (JL = JR): the lower triangle only (all that factor_symmetric reads). Takes the arrays
-    it needs as arguments, so the loops index them directly."""
-    for i in range(n):
-        for j in range(first[i], i + 1):
-            A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
-            if j != i and not symmetric:
-                A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
-
-
-@kernel
-def assemble(m, ws, JL, JR, n, symmetric):
-    """ws.A = JL W JR^T inside the envelope (symmetric: JL = JR, lower triangle only)."""
-    assemble_rows(JL, JR, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.row_first, ws.A,
-                  n, symmetric)
-
-
-@kernel
-def diagonal_scale(A, n, scale):
-    """scale[k] = |A[k, k]| before elimination: the yardstick of the pivot test."""
-    for k in range(n):
-        scale[k] = abs(A[k, k])
-
-
-@kernel
-def is_dependent(piv, scale, tol):
-    """A row whose pivot fell below tol times its own diagonal depends on earlier rows."""
-    return abs(piv) <= tol * scale or scale == 0.0
-
-
-@kernel
-def rows_below(first, reach, k, rows):
-    """rows[:count] = the rows below column k whose envelope reaches it (first[i] <= k),
-    ascending; returns count. Listed once per column, the elimination's double loop over them
-    tests nothing (in a tree the rows up to reach[k] include whole branches that do not)."""
-    count = 0
-    for i in range(k + 1, reach[k] + 1):
-        if first[i] <= k:
-            rows[count] = i
-            count += 1
-    return count
-
-
-@kernel
-def factor(A, first, reach, n, tol, scale, rows):
-    """LU factorisation of A in place, inside the envelope given by first / reach (see
-    compute_envelope): U on and above the diagonal, the multipliers L below it. `scale` (n,)
-    and `rows` (n,) int are scratch.
-
-    A row whose pivot falls below tol times its own diagonal depends on earlier rows (a
-    closed loop, a box on two corners): it is dropped (impulse 0), marked by a zero pivot.
-    Returns #dropped.
-    """
-    dropped = 0
-    diagonal_scale(A, n, scale)
-    for k in range(n):
-        piv = A[k, k]
-        count = rows_below(first, reach, k, rows)
-        if is_dependent(piv, scale[k], tol):
-            dropped += 1
-            for a in range(count):
-                j = rows[a]
-                A[k, j] = 0.0
-                A[j, k] = 0.0
-            A[k, k] = 0.0
-            continue
-        inv = 1.0 / piv
-        for a in range(count):
-            i = rows[a]
-            fct = A[i, k] * inv
-            A[i, k] = fct
-            if fct == 0.0:
-                continue
-            for b in range(count):
-                j = rows[b]
-                A[i, j] -= fct * A[k, j]
-    return dropped
-
-
-@kernel
-def forward_substitute(A, first, reach, rhs, n):
-    """rhs <- L^-1 rhs with the unit lower factor below the diagonal of A (both factorisations
-    store it there); dropped rows (zero pivot) get 0."""
-    for k in range(n):
-        if A[k, k] == 0.0:
-            rhs[k] = 0.0
-            continue
-        rk = rhs[k]
-        for i in range(k + 1, reach[k] + 1):
-            if first[i] <= k:
-                rhs[i] -= A[i, k] * rk
-
-
-@kernel
-def substitute(A, first, reach, rhs, x, n):
-    """x = A^-1 rhs from the factors of `factor` (rhs destroyed); dropped rows get x = 0."""
-    forward_substitute(A, first, reach, rhs, n)
-    for k in range(n - 1, -1, -1):
-        if A[k, k] == 0.0:
-            x[k] = 0.0
-            continue
-        acc = rhs[k]
-        for j in range(k + 1, reach[k] + 1):
-            if first[j] <= k:
-                acc -= A[k, j] * x[j]
-        x[k] = acc / A[k, k]
-
-
-@kernel
-def factor_symmetric(A, first, reach, n, tol, scale, rows):
-    """As `factor` for a symmetric A, in half the work: A = L D L^T with the multipliers L
-    below the diagonal and D on it; the upper triangle is neither read nor written. The same
-    pivot test drops dependent rows (zero pivot and multipliers). Returns #dropped."""
-    dropped = 0
-    diagonal_scale(A, n, scale)
-    for k in range(n):
-        piv = A[k, k]
-        count = rows_below(first, reach, k, rows)
-        if is_dependent(piv, scale[k], tol):
-            dropped += 1
-            for a in range(count):
-                A[rows[a], k] = 0.0
-            A[k, k] = 0.0
-            continue
-        inv = 1.0 / piv
-        # rows from the last up: the update of row i reads column k of the rows j <= i, which
-        # must still hold A[j, k] (not yet divided by the pivot)
-        for a in range(count - 1, -1, -1):
-            i = rows[a]
-            a_ik = A[i, k]
-            if a_ik == 0.0:
-                continue
-            fct = a_ik * inv
-            for b in range(a + 1):
-                j = rows[b]
-                A[i, j] -= fct * A[j, k]
-            A[i, k] = fct
-    return dropped
-
-
-@kernel
-def substitute_symmetric(A, first, reach, rhs, x, n):
-    """x = A^-1 rhs from the factors of `factor_symmetric` (rhs destroyed); dropped rows get
-    x = 0. Back substitution uses U = D L^T: x_k = y_k / d_k - sum_j L_jk x_j."""
-    forward_substitute(A, first, reach, rhs, n)
-    for k in range(n - 1, -1, -1):
-        if A[k, k] == 0.0:
-            x[k] = 0.0
-            continue
-        acc = rhs[k] / A[k, k]
-        for j in range(k + 1, reach[k] + 1):
-            if first[j] <= k:
-                acc -= A[j, k] * x[j]
-        x[k] = acc
-
-
-@kernel(inline="always")
-def factor_solve(ws, rhs, x, n, tol):
-    """Factor ws.A and solve A x = rhs; returns #dropped rows."""
-    dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, x, ws.row_list)
-    substitute(ws.A, ws.row_first, ws.row_reach, rhs, x, n)
-    return dropped
 
 
 @kernel
@@ -311,19 +104,20 @@ def add_compliance(ws, n):
     """A[r, r] += gamma of each soft row (soft.py; after fill_row_b, which sets gamma)."""
     for r in range(n):
         if is_soft_row(ws.row_kind[r]):
-            ws.A[r, r] += soft_compliance(ws, r)
+            add_to_diagonal(ws, r, soft_compliance(ws, r))
 
 
 @kernel
 def joint_pivot_share(ws, n):
     """Right after factor / factor_symmetric (ws.lam holding each row's diagonal before
-    elimination, ws.A the pivots on its diagonal): the smallest share of its diagonal that a
+    elimination, matrix.diagonal_and_pivot): the smallest share of its diagonal that a
     joint row's pivot kept (0: one dropped as dependent; 1: no joint row)."""
     smallest = 1.0
     for k in range(n):
         kind = ws.row_kind[k]
         if is_joint_row(kind) and not is_soft_row(kind):
-            share = abs(ws.A[k, k]) / ws.lam[k] if ws.lam[k] > 0.0 else 0.0
+            scale, pivot = diagonal_and_pivot(ws, k)
+            share = abs(pivot) / scale if scale > 0.0 else 0.0
             smallest = min(smallest, share)
     return smallest
 
@@ -365,8 +159,8 @@ def least_change_impulses(m, s, ws, tol, n):
         share = LEAST_CHANGE_SHARE
         if is_tangent_row(ws.row_kind[r]):
             share *= TANGENT_WEIGHT
-        ws.A[r, r] *= 1.0 + share
-    factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
+        scale_diagonal(ws, r, 1.0 + share)
+    factor_ws(ws, n, tol, True)
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
             ws.v_new[i, k] = ws.v_pred[i, k]
@@ -376,7 +170,7 @@ def least_change_impulses(m, s, ws, tol, n):
     apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
     for _ in range(LEAST_CHANGE_ROUNDS):
         residual_rhs(ws, n)
-        substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+        substitute_ws(ws, ws.rhs, ws.lam, n, True)
         apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
         for r in range(n):
             ws.lam_start[r] += ws.lam[r]
@@ -396,14 +190,14 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
             ws.v_new[i, k] = ws.v_pred[i, k]
     if n == 0:
         return 0
-    compute_envelope(ws, n, ws.v_new.shape[0])
+    if not arrange(s.q, ws, n, ws.v_new.shape[0]):
+        for r in range(n):
+            ws.lam[r] = 0.0
+        return 0                    # (no room: the step begins again with more)
     assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     fill_row_b(ws, h, n)
     add_compliance(ws, n)
-    if symmetric:
-        dropped = factor_symmetric(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
-    else:
-        dropped = factor(ws.A, ws.row_first, ws.row_reach, n, tol, ws.lam, ws.row_list)
+    dropped = factor_ws(ws, n, tol, symmetric)
     ws.joint_pivot[0] = joint_pivot_share(ws, n)
     if dropped > 0 and symmetric and ws.least_change[0] == 1:
         least_change_impulses(m, s, ws, tol, n)
@@ -415,10 +209,7 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     else:
         for r in range(n):
             ws.rhs[r] = -ws.row_b[r]
-    if symmetric:
-        substitute_symmetric(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
-    else:
-        substitute(ws.A, ws.row_first, ws.row_reach, ws.rhs, ws.lam, n)
+    substitute_ws(ws, ws.rhs, ws.lam, n, symmetric)
     apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
     if warm:
         for r in range(n):

@@ -194,6 +194,8 @@ def solve_and_check(m, s, ws, opt, h, include_ccd):
     the contact rules correct, keeps every rule it stands, and the step's later solves take
     the least change too; otherwise the first answer is solved again and stands."""
     equalities = build_and_solve(m, s, ws, opt, h)
+    if ws.room[0] == 1:
+        return 0, 0, 1          # (no room: the step begins again with more)
     breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
     if breaks == 0 or ws.least_change[1] == 0 or ws.least_change[2] >= LEAST_CHANGE_CALLS:
         return breaks, engaged, 1
@@ -231,6 +233,8 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         breaks, engaged, more = solve_and_check(m, s, ws, opt, h, include_ccd)
         rounds += more
     ok = breaks == 0 and engaged == 0
+    if ws.room[0] == 1:
+        return True             # (no room: the step begins again with more)
     nc = m.contact_body.shape[0]
     if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
         seed_rule(m, s, ws, s.mode_cursor[0] % nc)

@@ -14,9 +14,9 @@ jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit
-def _factor_solve(A, b, rows, B, G, x):
+def _factor_solve(A, b, rows, B, G, x, local):
     n = b.shape[0]
-    _factor_joints(A, B, n, rows, G)
+    _factor_joints(A, local, B, n, rows, G)
     for i in range(n):
         G[i, 0] = b[rows[i]]
     _solve_joints(B, n, G, 0)
@@ -32,7 +32,7 @@ def _solve(A, b, rows):
     """(impulses x, rows left out) of A x = b."""
     n = len(b)
     x = np.zeros(n)
-    dropped = _factor_solve(A, b, rows, np.zeros((n, n)), np.zeros((n, 2)), x)
+    dropped = _factor_solve(A, b, rows, np.zeros((n, n)), np.zeros((n, 2)), x, np.arange(n))
     return x, dropped
 
 

@@ -113,7 +113,7 @@ def test_rows_and_jacobians_match_the_constraint_functions(n_body, slope, seed):
         assert np.allclose(J[r], ref.jacobian(f, q)[0], atol=1e-8), (kind, o)
     # the effective-mass matrix
     A = ref.delassus(J, ref.inverse_mass(a))
-    assert np.allclose(ws.A[:n, :n], A, rtol=1e-12, atol=1e-12 * np.abs(A).max())
+    assert np.allclose(ws.lcp_A[:n, :n], A, rtol=1e-12, atol=1e-12 * np.abs(A).max())
 
 
 @settings(max_examples=300, deadline=None)
@@ -132,7 +132,7 @@ def test_mixed_complementarity_solve_meets_coulomb_and_matches_the_enumeration(n
     J = _dense(ws, n, model.n_body)
     b = J @ rng.normal(0.0, 1.0, J.shape[1])
     ws.row_b[:n] = b
-    A = ws.A[:n, :n].copy()
+    A = ws.lcp_A[:n, :n].copy()
     kinds = [int(k) for k in ws.row_kind[:n]]
     mu_of_row = np.array([a.contact_mu[o] if k >= ref.CONTACT_N else 0.0 for k, o in zip(kinds, ws.row_owner[:n])])
     status, pivots = _solve(a, ws, n)

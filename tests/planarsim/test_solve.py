@@ -7,8 +7,8 @@ from hypothesis import given, settings, strategies as st
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.solve import (compute_envelope, factor, factor_symmetric, substitute,
-                                     substitute_symmetric)
+from planarsim.kernels.envelope import (compute_envelope, factor, factor_symmetric, substitute,
+                                        substitute_symmetric)
 
 TOL = 1e-11
 # not cached: numba checks a cached function against its own file only, and these wrappers
@@ -16,23 +16,69 @@ TOL = 1e-11
 jit = njit(**dict(compile_options(), cache=False))
 
 
+def _start(first):
+    """Where each row's envelope begins in the envelope storage (envelope.compute_envelope)."""
+    n = len(first)
+    return np.concatenate([[0], np.cumsum(np.arange(n) - np.asarray(first) + 1)]).astype(np.int64)
+
+
+def _pack(A, first):
+    """(low, up, start): dense A in the envelope storage (lower triangle and diagonal by row;
+    the upper triangle by column, in the same places)."""
+    n = A.shape[0]
+    start = _start(first)
+    low = np.zeros(max(1, start[n]))
+    up = np.zeros(max(1, start[n]))
+    for i in range(n):
+        for j in range(first[i], i + 1):
+            low[start[i] + j - first[i]] = A[i, j]
+            up[start[i] + j - first[i]] = A[j, i]
+    return low, up, start
+
+
+def _unpack(low, up, start, first, n, symmetric):
+    """The dense matrix of the envelope storage (zeros outside the envelope)."""
+    A = np.zeros((n, n))
+    for i in range(n):
+        for j in range(first[i], i + 1):
+            A[i, j] = low[start[i] + j - first[i]]
+            if j < i and not symmetric:
+                A[j, i] = up[start[i] + j - first[i]]
+    return A
+
+
 @jit
+def _lu_packed(low, up, start, first, reach, rhs, x, scale, tol, rows):
+    n = rhs.shape[0]
+    dropped = factor(low, up, start, first, reach, n, tol, scale, rows)
+    substitute(low, up, start, first, reach, rhs, x, n)
+    return dropped
+
+
+@jit
+def _ldl_packed(low, start, first, reach, rhs, x, scale, tol, rows):
+    n = rhs.shape[0]
+    dropped = factor_symmetric(low, start, first, reach, n, tol, scale, rows)
+    substitute_symmetric(low, start, first, reach, rhs, x, n)
+    return dropped
+
+
 def _lu(A, first, reach, rhs, x, scale, tol, rows):
-    dropped = factor(A, first, reach, A.shape[0], tol, scale, rows)
-    substitute(A, first, reach, rhs, x, A.shape[0])
-    return dropped
+    low, up, start = _pack(A, first)
+    return _lu_packed(low, up, start, np.asarray(first, np.int64), np.asarray(reach, np.int64),
+                      rhs, x, scale, tol, rows)
 
 
-@jit
 def _ldl(A, first, reach, rhs, x, scale, tol, rows):
-    dropped = factor_symmetric(A, first, reach, A.shape[0], tol, scale, rows)
-    substitute_symmetric(A, first, reach, rhs, x, A.shape[0])
-    return dropped
+    """(The upper triangle is not packed: the symmetric factorisation must not need it.)"""
+    low, _, start = _pack(np.tril(A), first)
+    return _ldl_packed(low, start, np.asarray(first, np.int64), np.asarray(reach, np.int64),
+                       rhs, x, scale, tol, rows)
 
 
 def _envelope(row_body, n_body):
     """first[r]: first row sharing a body with r; reach[k]: last row whose envelope holds k
-    (the definition of kernels.solve.compute_envelope)."""
+    (the definition of kernels.envelope.compute_envelope)."""
     n = len(row_body)
     seen = [-1] * n_body
     first = np.arange(n)
@@ -94,10 +140,8 @@ def test_symmetric_factor_gives_the_velocity_change_of_lu_and_reads_only_the_low
     first, reach = _envelope(row_body, n_body)
     x_lu = np.zeros(n)
     _lu(A.copy(), first, reach, rhs.copy(), x_lu, np.zeros(n), TOL, np.zeros(n, np.int64))
-    A_ldl = A.copy()
-    A_ldl[np.triu_indices(n, 1)] = np.nan      # must never be read
     x_ldl = np.zeros(n)
-    _ldl(A_ldl, first, reach, rhs.copy(), x_ldl, np.zeros(n), TOL, np.zeros(n, np.int64))
+    _ldl(A.copy(), first, reach, rhs.copy(), x_ldl, np.zeros(n), TOL, np.zeros(n, np.int64))
     assert np.all(np.isfinite(x_ldl))
     dv_lu = w * (J.T @ x_lu)
     dv_ldl = w * (J.T @ x_ldl)
@@ -159,18 +203,28 @@ def _reference_elimination(A, first, reach, n, tol, symmetric):
 
 
 @jit
-def _factor_only(A, first, reach, tol, symmetric, scale, rows):
-    n = A.shape[0]
+def _factor_packed(low, up, start, first, reach, n, tol, symmetric, scale, rows):
     if symmetric:
-        return factor_symmetric(A, first, reach, n, tol, scale, rows)
-    return factor(A, first, reach, n, tol, scale, rows)
+        return factor_symmetric(low, start, first, reach, n, tol, scale, rows)
+    return factor(low, up, start, first, reach, n, tol, scale, rows)
+
+
+def _factor_only(A, first, reach, tol, symmetric, scale, rows):
+    """Factor A in the envelope storage; A (n x n) gets the factors back inside the envelope."""
+    n = A.shape[0]
+    first = np.asarray(first, np.int64)
+    low, up, start = _pack(A, first)
+    dropped = _factor_packed(low, up, start, first, np.asarray(reach, np.int64), n, tol,
+                             symmetric, scale, rows)
+    A[...] = _unpack(low, up, start, first, n, symmetric)
+    return dropped
 
 
 @settings(max_examples=200, deadline=None)
 @given(systems(), st.sampled_from([TOL, 1e-3, 0.0]), st.booleans())
 def test_the_factorisations_keep_the_operations_of_the_envelope_elimination_bit_for_bit(
         system, tol, unordered):
-    """Each column's rows are listed once (solve.rows_below) instead of tested in every loop:
+    """Each column's rows are listed once (envelope.rows_below) instead of tested in every loop:
     the factors, dropped rows and all, must be those of the elimination as first written, to
     the bit (signed zeros included), for rows in build order and out of it; a non-symmetric
     matrix (the position correction's) goes through the LU."""

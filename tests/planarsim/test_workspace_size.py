@@ -34,21 +34,27 @@ def tumbling_boxes():
     return b.compile()
 
 
-def test_the_dense_matrices_counted_are_the_ones_allocated():
+def test_the_solve_storage_counted_is_the_storage_allocated():
     model = columns(2, 3)
     ws = ps.Simulator(model).ws
-    allocated = sum(getattr(ws, f).nbytes for f in ("A", "lcp_B", "lcp_G", "lcp_S", "lcp_M", "lcp_T"))
-    held = state_module.workspace_contacts(model, ws)
-    assert held == model.n_contact      # a small model has room for every slot
-    assert state_module.dense_workspace_bytes(model, held) == allocated
+    names = state_module._solve_shapes(model, 1, 1, 1)
+    allocated = sum(getattr(ws, f).nbytes for f in names)
+    held, profile, lcp_rows = state_module.workspace_capacity(model, ws)
+    rows = state_module.max_rows(model)
+    assert held == model.n_contact      # a small model has room for every slot,
+    assert profile == rows * (rows + 1) // 2     # their full envelope
+    assert lcp_rows == rows             # and one complementarity problem of them all
+    assert state_module.solve_bytes(model, held, profile, lcp_rows) == allocated
 
 
 def test_ten_columns_of_ten_boxes_stand_in_a_workspace_sized_by_their_contacts():
     """4,950 pairs of shapes, 10,300 contact slots: room for all of them in dense matrices
     would be about 50 GiB. The workspace holds room for the contacts the boxes touch with,
-    and the columns stand: no box moves more than 1e-9 m, every audit count 0."""
+    the envelope of their rows and complementarity problems of a few hundred rows, and the
+    columns stand: no box moves more than 1e-9 m, every audit count 0."""
     model = columns(10, 10)
-    assert state_module.dense_workspace_bytes(model) > 40 * 2 ** 30
+    rows = state_module.max_rows(model)
+    assert state_module.solve_bytes(model, model.n_contact, rows * (rows + 1) // 2, rows) > 40 * 2 ** 30
     sim = ps.Simulator(model)
     held = state_module.workspace_contacts(model, sim.ws)
     assert held < model.n_contact // 10
@@ -56,7 +62,7 @@ def test_ten_columns_of_ten_boxes_stand_in_a_workspace_sized_by_their_contacts()
     sim.steps(20)
     assert np.max(np.abs(sim.state.q - q0)) <= 1e-9
     assert sum(audit_counts(sim.ws).values()) == 0
-    assert state_module.dense_workspace_bytes(model, state_module.workspace_contacts(model, sim.ws)) < 2 ** 30
+    assert state_module.solve_bytes(model, *state_module.workspace_capacity(model, sim.ws)) < 2 ** 27
 
 
 @pytest.mark.parametrize("how", ["step", "steps", "run"])
@@ -115,18 +121,21 @@ def test_a_workspace_nothing_grows_stops_saying_so():
 
 
 def test_growth_beyond_the_machine_is_refused_before_allocating(monkeypatch):
-    """On a machine said to have 1 GiB, room for every slot of ten columns of ten boxes
-    (about 50 GiB) is refused with a WorkspaceTooLarge (a MemoryError) naming the memory,
-    the contacts, the slots and the pairs, and what to change."""
+    """On a machine said to have 1 GiB, room for one complementarity problem of every slot of
+    ten columns of ten boxes (about 50 GiB) is refused with a WorkspaceTooLarge (a
+    MemoryError) naming the memory, the contacts, the slots and the pairs, and what to
+    change."""
     import planarsim.trajectory as trajectory
     monkeypatch.setattr(trajectory, "machine_memory", lambda: 2 ** 30)
     model = columns(10, 10)
+    rows = state_module.max_rows(model)
     with pytest.raises(ps.WorkspaceTooLarge) as err:
-        state_module.make_workspace(model, contacts=model.n_contact)
+        state_module.make_workspace(model, contacts=model.n_contact, lcp_rows=rows)
     text = str(err.value)
     assert "GiB" in text and "10,300 contact slots" in text and "4,950 pairs" in text
     assert "collide=False" in text
-    assert err.value.nbytes == state_module.dense_workspace_bytes(model) > 2 ** 30
+    profile = state_module.first_capacity(model, model.n_contact)[0]
+    assert err.value.nbytes == state_module.solve_bytes(model, model.n_contact, profile, rows) > 2 ** 30
     assert isinstance(err.value, MemoryError)
     again = pickle.loads(pickle.dumps(err.value))
     assert again.nbytes == err.value.nbytes and str(again) == text
@@ -136,7 +145,9 @@ def test_growth_beyond_the_machine_is_refused_before_allocating(monkeypatch):
 def test_a_model_that_fits_is_not_refused(monkeypatch):
     import planarsim.trajectory as trajectory
     model = columns(2, 3)
-    monkeypatch.setattr(trajectory, "machine_memory", lambda: state_module.dense_workspace_bytes(model))
+    held = state_module.contact_capacity(model)
+    need = state_module.solve_bytes(model, held, *state_module.first_capacity(model, held))
+    monkeypatch.setattr(trajectory, "machine_memory", lambda: need)
     sim = ps.Simulator(model)
     sim.steps(5)
     assert np.all(np.isfinite(sim.state.q))

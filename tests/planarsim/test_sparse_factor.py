@@ -1,0 +1,182 @@
+"""The sparse factorisation (kernels/sparse_factor.py) that serves piles and walls: on random
+rows between bodies scattered in the plane (each row touching one or two bodies, as the
+engine's), some exactly dependent (closed loops, redundant contacts), its answers must solve
+A x = rhs and give the velocity change W J^T x of the envelope elimination; on
+independent rows, the one answer. The order it finds must be a permutation, and its
+factors must fit the room analyse asked for."""
+import numpy as np
+from hypothesis import given, settings, strategies as st
+from numba import njit
+
+import planarsim as ps
+from planarsim import state as state_module
+from planarsim.compile import options as compile_options
+from planarsim.kernels import matrix
+from planarsim.kernels import sparse_factor as sf
+
+TOL = 1e-11
+jit = njit(**dict(compile_options(), cache=False))
+
+
+@jit
+def _sparse_solve(m, q, ws, n, n_body, rhs, x, symmetric):
+    sf.order_rows(q, ws, n)
+    if not sf.analyse(ws, n, n_body):
+        return -1
+    ws.factor_kind[0] = matrix.SPARSE
+    matrix.assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
+    dropped = matrix.factor_ws(ws, n, TOL, symmetric)
+    matrix.substitute_ws(ws, rhs, x, n, symmetric)
+    return dropped
+
+
+@jit
+def _envelope_solve(m, q, ws, n, n_body, rhs, x, symmetric):
+    ws.factor_kind[0] = matrix.ENVELOPE
+    matrix.arrange(q, ws, n, n_body)          # (fewer rows than SPARSE_MIN_ROWS)
+    matrix.assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
+    dropped = matrix.factor_ws(ws, n, TOL, symmetric)
+    matrix.substitute_ws(ws, rhs, x, n, symmetric)
+    return dropped
+
+
+def _bodies(n_body, rng):
+    """A model of n_body free bodies of random masses and inertias, scattered in the plane."""
+    b = ps.ModelBuilder(dt=1e-3)
+    for i in range(n_body):
+        b.add_body(f"b{i}", mass=float(rng.uniform(0.2, 5.0)), inertia=float(rng.uniform(0.01, 2.0)),
+                   pos=(float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3))))
+    return b.compile()
+
+
+@st.composite
+def systems(draw):
+    n_body = draw(st.integers(1, 40))
+    n_row = draw(st.integers(1, min(4 * n_body + 4, ps.kernels.sparse_factor.SPARSE_MIN_ROWS - 1)))
+    dependent = draw(st.floats(0.0, 0.5))
+    seed = draw(st.integers(0, 2 ** 32 - 1))
+    return n_body, n_row, dependent, seed
+
+
+def _workspace(model, n_row):
+    """A workspace with room for n_row rows and every entry their factors could need."""
+    ws = state_module.make_workspace(model)
+    arrays = state_module._solve_arrays(model, n_row, n_row * (n_row + 1) // 2 + 1, 1)
+    return ws._replace(**arrays)
+
+
+def _rows(model, n_row, dependent, rng):
+    """row_body (n, 2), row_J (n, 2, 3) and the dense J (n, 3 n_body): rows on one body (the
+    other -1) or two, a share of them exact multiples of earlier ones."""
+    n_body = model.n_body
+    row_body = np.full((n_row, 2), -1, np.int64)
+    row_J = np.zeros((n_row, 2, 3))
+    for r in range(n_row):
+        if r > 0 and rng.random() < dependent:
+            k = int(rng.integers(0, r))
+            row_body[r] = row_body[k]
+            row_J[r] = rng.uniform(0.5, 2.0) * row_J[k]
+            continue
+        a = int(rng.integers(0, n_body))
+        b = int(rng.integers(0, n_body)) if rng.random() < 0.7 else -1
+        if b == a:
+            b = -1
+        row_body[r] = (b, a)
+        row_J[r, 1] = rng.normal(size=3)
+        if b >= 0:
+            row_J[r, 0] = rng.normal(size=3)
+    J = np.zeros((n_row, 3 * n_body))
+    for r in range(n_row):
+        for e in range(2):
+            body = row_body[r, e]
+            if body >= 0:
+                J[r, 3 * body:3 * body + 3] += row_J[r, e]
+    return row_body, row_J, J
+
+
+def _weights(model):
+    a = model.arrays
+    return np.repeat(np.stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia], 1).ravel()
+                     .reshape(-1, 3), 1, 0).ravel()
+
+
+@settings(max_examples=150, deadline=None)
+@given(systems())
+def test_the_sparse_factorisation_solves_what_the_envelope_solves(system):
+    n_body, n_row, dependent, seed = system
+    rng = np.random.default_rng(seed)
+    model = _bodies(n_body, rng)
+    row_body, row_J, J = _rows(model, n_row, dependent, rng)
+    w = _weights(model)
+    A = (J * w) @ J.T
+    rhs = A @ rng.normal(size=n_row)          # consistent, as the engine's
+    q = np.array(model.q0, dtype=float)
+    answers = []
+    for solve in (_sparse_solve, _envelope_solve):
+        ws = _workspace(model, n_row)
+        ws.row_body[:n_row] = row_body
+        ws.row_J[:n_row] = row_J
+        ws.row_F[:n_row] = row_J
+        x = np.zeros(n_row)
+        dropped = solve(model.arrays, q, ws, n_row, n_body, rhs.copy(), x, True)
+        assert dropped >= 0
+        assert np.all(np.isfinite(x))
+        assert np.abs(A @ x - rhs).max() <= 1e-7 * (1.0 + np.abs(rhs).max())
+        answers.append((x, dropped, ws))
+    (xs, ds, ws), (xe, de, _) = answers
+    perm = ws.sp_perm[:n_row]
+    assert sorted(perm) == list(range(n_row))
+    assert np.array_equal(ws.sp_iperm[perm], np.arange(n_row))
+    # impulses of dependent rows are not unique (a row whose pivot is rounding near the
+    # threshold may be kept by one order and dropped by the other); the velocity change is
+    dv_s, dv_e = w * (J.T @ xs), w * (J.T @ xe)
+    assert np.abs(dv_s - dv_e).max() <= 1e-6 * (1.0 + np.abs(dv_e).max())
+
+
+@settings(max_examples=100, deadline=None)
+@given(systems())
+def test_the_sparse_lu_of_a_matrix_that_is_not_symmetric_gives_its_one_answer(system):
+    """J W F^T with F != J (sliding contacts, the position correction's J(q+) W J(q)^T):
+    independent rows, the answer of a dense solve."""
+    n_body, n_row, _, seed = system
+    rng = np.random.default_rng(seed)
+    model = _bodies(n_body, rng)
+    row_body, row_J, J = _rows(model, n_row, 0.0, rng)
+    if np.linalg.matrix_rank(J) < n_row:
+        return
+    row_F = row_J + 0.05 * rng.normal(size=row_J.shape) * (row_J != 0.0)
+    F = np.zeros_like(J)
+    for r in range(n_row):
+        for e in range(2):
+            body = row_body[r, e]
+            if body >= 0:
+                F[r, 3 * body:3 * body + 3] += row_F[r, e]
+    w = _weights(model)
+    A = (J * w) @ F.T
+    if np.linalg.cond(A) > 1e8:
+        return
+    rhs = rng.normal(size=n_row)
+    ws = _workspace(model, n_row)
+    ws.row_body[:n_row] = row_body
+    ws.row_J[:n_row] = row_J
+    ws.row_F[:n_row] = row_F
+    x = np.zeros(n_row)
+    assert _sparse_solve(model.arrays, np.array(model.q0, float), ws, n_row, n_body, rhs.copy(),
+                         x, False) == 0
+    assert np.allclose(x, np.linalg.solve(A, rhs), rtol=1e-8, atol=1e-8 * np.abs(x).max())
+
+
+def test_a_pile_too_large_for_the_storage_asks_for_room():
+    """analyse finds the entries the factors need before writing any: a workspace with too
+    few asks for them (ws.room) and returns False."""
+    rng = np.random.default_rng(3)
+    model = _bodies(30, rng)
+    row_body, row_J, J = _rows(model, 100, 0.2, rng)
+    ws = state_module.make_workspace(model)._replace(
+        **state_module._solve_arrays(model, 100, 10, 1))
+    ws.row_body[:100] = row_body
+    ws.row_J[:100] = row_J
+    x = np.zeros(100)
+    assert _sparse_solve(model.arrays, np.array(model.q0, float), ws, 100, 30, np.ones(100), x,
+                         True) == -1
+    assert ws.room[0] == 1 and ws.room[2] > 10
