@@ -58,10 +58,11 @@ def step_times(sim, n) -> np.ndarray:
     return out
 
 
-def measure(name, peers, repeats=3, seconds=None) -> dict:
-    """Figures of scene `name` (module docstring) against peers {name: module}."""
+def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
+    """Figures of scene `name` (module docstring) against peers {name: module} over `steps`
+    steps, or `seconds` [s], or the scene's seconds."""
     scene = STRESS_SCENES[name]
-    n = max(1, int(round((seconds or scene.seconds) / scene.dt)))
+    n = int(steps) if steps else max(1, int(round((seconds or scene.seconds) / scene.dt)))
     model = build_model(scene)
     sim = ps.Simulator(model)
     start = sim.snapshot()
@@ -127,12 +128,14 @@ def print_rows(rows, peer_names):
           "peers: at its end)")
 
 
-def run(names, peer_names, repeats=3, seconds=None):
-    """Measure and print the scenes `names`; returns the rows."""
+def run(names, peer_names, repeats=3, seconds=None, steps=None):
+    """Measure and print the scenes `names` (against the installed peers among `peer_names`);
+    returns the rows."""
     peers = available(peer_names)
+    print(f"stress scenes against {', '.join(peers) or 'no peer'}: {repeats} repeats", flush=True)
     rows = []
     for name in names:
-        rows.append(measure(name, peers, repeats, seconds))
+        rows.append(measure(name, peers, repeats, seconds, steps))
         print(f"measured {name}", file=sys.stderr, flush=True)
     print_rows(rows, list(peers))
     return rows
