@@ -6,7 +6,8 @@ planarsim and in the peers built from the same description, with planarsim's acc
     planarsim bench --parts stress                     # the same from the bench command
 
 Per scene: planarsim's mean step [ms] (the compiled Simulator.steps(n) over the run) and its
-mean and largest single step [ms] (a Python loop of Simulator.step(), each step timed), each
+mean and largest single step [ms] (a Python loop of Simulator.step(), each step timed in
+`repeats` runs and its median taken, so that a step the machine preempted does not count), each
 peer's mean step [ms] (its ShapeWorld.run: peers/box2d_peer.py, pymunk_peer.py,
 mujoco_peer.py) and planarsim's mean over the peer's (> 1: planarsim is slower). Runs start
 from the scene's start state (rebuilding is not timed), one warm-up each, then `repeats`
@@ -80,8 +81,11 @@ def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
             run(n)
             times[key].append((time.perf_counter() - t0) / n)
     mean = {key: statistics.median(t[1:]) for key, t in times.items()}
-    sim.restore(start)
-    single = step_times(sim, n)
+    loops = []
+    for _ in range(repeats):
+        sim.restore(start)
+        loops.append(step_times(sim, n))
+    single = np.median(loops, axis=0)       # each step's median: a preempted step is not its cost
     sim.restore(start)
     traj = sim.run(n_steps=n, record_every=1)
     row = dict(scene=name, bodies=scene.n_body, steps=n, first_call_s=first, mean_ms=1e3 * mean["planarsim"],
@@ -107,7 +111,7 @@ def _fmt(x, spec=".2e"):
 def print_rows(rows, peer_names):
     """The table of measure() rows."""
     head = (f"{'scene':<12}{'bodies':>7}{'steps':>6}{'mean ms':>9}{'loop ms':>9}{'max ms':>9}"
-            + "".join(f"{p + ' ms':>12}{'ratio':>7}" for p in peer_names)
+            + "".join(f"{p + ' ms':>12}{'ratio':>8}" for p in peer_names)
             + f"{'pin gap m':>11}{'overlap m':>11}{'drift m':>11}"
             + "".join(f"{p + ' drift':>13}" for p in peer_names))
     print(head)
@@ -116,14 +120,14 @@ def print_rows(rows, peer_names):
                 f"{r['max_ms']:>9.3f}")
         for p in peer_names:
             pr = r["peers"].get(p)
-            line += f"{_fmt(pr and pr['mean_ms'], '.3f'):>12}{_fmt(pr and pr['ratio'], '.2f'):>7}"
+            line += f"{_fmt(pr and pr['mean_ms'], '.3f'):>12}{_fmt(pr and pr['ratio'], '.2f'):>8}"
         line += f"{_fmt(r['pin_gap_m']):>11}{_fmt(r['overlap_m']):>11}{_fmt(r['rest_drift_m']):>11}"
         for p in peer_names:
             pr = r["peers"].get(p)
             line += f"{_fmt(pr and pr['drift_m']):>13}"
         print(line, flush=True)
     print("mean ms: compiled Simulator.steps(n) per step; loop ms / max ms: a Python loop of step(), "
-          "mean and largest step; ratio: planarsim's mean over the peer's (> 1: planarsim slower); "
+          "mean and largest step (each step's median over the repeats); ratio: planarsim's mean over the peer's (> 1: planarsim slower); "
           "drift: largest distance of a body from its start in a resting scene (planarsim: over the run; "
           "peers: at its end)")
 
