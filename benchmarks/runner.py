@@ -35,10 +35,9 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
 - stress: Box2D's classic stress scenes and the contact-rich scenes (stress_scenes.py: the
   160-plank bridge (sagging, and Box2D's taut one), the chain holding a 100x ball, the card
   house, the 100:1 boxes, the 20-box stack, 20 dominoes, 50 shapes poured into a U, the
-  55-box pyramid) built in
-  planarsim and in every installed --peers: mean and largest step, each peer's mean step and
-  the ratio, planarsim's pin gap, overlap and rest drift (stress.py; --steps sets the run,
-  default each scene's 1 s).
+  55-box pyramid) built in planarsim and in every installed --peers: mean and largest step,
+  each peer's mean step and the ratio, planarsim's pin gap, overlap and rest drift
+  (stress.py; --steps sets the run, default each scene's 1 s).
 Then a table of every benchmark target with the measured figure, met or not met. Targets are
 measured here, never asserted by the tests.
 """
