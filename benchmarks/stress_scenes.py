@@ -18,8 +18,8 @@ Stress scenes (planarsim must hold them exactly: pins <= 1e-9 m, overlaps <= 1e-
 Contact-rich scenes:
 - dominoes20: 20 dominoes 0.02 x 0.2 m, 0.1 kg, 0.1 m apart; the first tipping forward at
   4 rad/s about its front foot.
-- pour50: 50 circles (r 5 cm) and capsules (0.1 m + 2 x 4 cm), 0.2 kg each, in a 5 x 10 grid above a static
-  U of three boxes (no ground), falling into it from rest.
+- pour50: 50 circles (r 5 cm) and capsules (0.1 m + 2 x 4 cm), 0.2 kg each, in a 5 x 10
+  grid above a static U of three boxes (no ground), falling into it from rest.
 - pyramid55: 55 cubes 0.2 m in 10 rows (2 cm apart in a row, each row on the one below), from
   rest on flat ground.
 
