@@ -2,7 +2,7 @@
 
     planarsim bench                        # everything (same as: python benchmarks/run.py)
     planarsim bench chain4 rod_drop        # only these scenes and their peer comparison
-    planarsim bench --parts scenes,peers   # parts: scenes, peers, walkers, batch, startup, envs
+    planarsim bench --parts scenes,peers   # parts: scenes, peers, walkers, batch, startup, envs, stress
     planarsim bench --peers pymunk,box2d   # peers to compare (default: all; 'none' skips)
     planarsim bench --no-cold              # skip the cold-cache start-up (about half a minute)
     planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
@@ -32,6 +32,12 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
   vectorised (PlanarVectorEnv, --env-copies copies on 2 processes), beside gymnasium's MuJoCo
   environment of the same name in the same run (env_speed.py; needs gymnasium, and mujoco
   for the MuJoCo figures).
+- stress: Box2D's classic stress scenes and the contact-rich scenes (stress_scenes.py: the
+  160-plank bridge (sagging, and Box2D's taut one), the chain holding a 100x ball, the card
+  house, the 100:1 boxes, the 20-box stack, 20 dominoes, 50 shapes poured into a U, the
+  55-box pyramid) built in planarsim and in every installed --peers: mean and largest step,
+  each peer's mean step and the ratio, planarsim's pin gap, overlap and rest drift
+  (stress.py; --steps sets the run, default each scene's 1 s).
 Then a table of every benchmark target with the measured figure, met or not met. Targets are
 measured here, never asserted by the tests.
 """
@@ -55,7 +61,7 @@ from benchmarks.report import (plot_chain_scaling, print_peers, print_scenes, pr
                            print_walkers, targets)
 from benchmarks.scenes import SCENES
 
-PARTS = ("scenes", "peers", "pareto", "walkers", "batch", "startup", "envs")
+PARTS = ("scenes", "peers", "pareto", "walkers", "batch", "startup", "envs", "stress")
 
 
 def machine_name() -> str:
@@ -246,6 +252,11 @@ def main(argv=None):
         results["envs"] = env_rows
         rows += env_rows
         print_envs(env_rows)
+    if "stress" in parts:
+        from benchmarks.stress import run as run_stress
+        from benchmarks.stress_scenes import STRESS_SCENES
+        results["stress"] = run_stress(list(STRESS_SCENES), args.peers, args.repeats, steps=args.steps)
+        print()
     if "startup" in parts:
         from benchmarks.startup import measure_startup
         results["startup"] = measure_startup(cold=not args.no_cold)

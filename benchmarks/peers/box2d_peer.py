@@ -92,3 +92,79 @@ class World:
                 step(h, vi, pi)
             self.pose(q, v, k)
         return q, v
+
+
+class ShapeWorld:
+    """A Box2D world of a stress scene (benchmarks/stress_scenes.Scene: boxes, circles and
+    capsules, static boxes, pins) with run(n) (timed), reset() and positions().
+
+    Each body has the scene's mass and inertia (mass data set after its fixtures); a capsule is
+    a polygon box between two circles (Box2D 2.3 has no capsule); static boxes are fixtures of
+    one static body; flat ground is a static edge at y = 0; pins are revolute joints at their
+    world anchors; pinned bodies share groupIndex -1 (they collide with nothing there).
+    Friction the scene's mu, restitution 0, VELOCITY_ITERATIONS / POSITION_ITERATIONS, doSleep
+    False. Box2D keeps a skin of b2_polygonRadius (1 cm) around every polygon, so each box
+    half-extent is made smaller by it (the outline then is the scene's, with rounded corners),
+    but never below a quarter of itself: a 4 mm card or a 2 cm domino stays thicker than in
+    the scene."""
+
+    def __init__(self, scene, velocity_iterations: int = VELOCITY_ITERATIONS,
+                 position_iterations: int = POSITION_ITERATIONS):
+        import Box2D
+        self.b2, self.scene = Box2D, scene
+        self.iterations = int(velocity_iterations), int(position_iterations)
+        self.timing = (f"Python loop of world.Step ({self.iterations[0]} velocity, {self.iterations[1]} "
+                       "position iterations)")
+        self.reset()
+
+    def _inside(self, half):
+        """A box half-extent [m] less Box2D's polygon skin (at least a quarter of it)."""
+        return max(half - self.b2.b2_polygonRadius, 0.25 * half)
+
+    def _fixtures(self, body, shape, mu, group):
+        b2 = self.b2
+        common = dict(density=1.0, friction=mu, restitution=0.0, groupIndex=group)
+        if shape[0] == "box":
+            body.CreatePolygonFixture(box=(self._inside(shape[1] / 2), self._inside(shape[2] / 2)), **common)
+        elif shape[0] == "circle":
+            body.CreateCircleFixture(radius=shape[1], pos=(0.0, 0.0), **common)
+        else:
+            half, r = shape[1], shape[2]
+            body.CreatePolygonFixture(shape=b2.b2PolygonShape(box=(half, self._inside(r))), **common)
+            for x in (-half, half):
+                body.CreateCircleFixture(radius=r, pos=(x, 0.0), **common)
+
+    def reset(self):
+        b2, scene = self.b2, self.scene
+        world = b2.b2World(gravity=(0.0, -9.81), doSleep=False)
+        static = world.CreateStaticBody(position=(0.0, 0.0))
+        if scene.ground:
+            static.CreateEdgeFixture(vertices=[(-100.0, 0.0), (100.0, 0.0)], friction=scene.mu, restitution=0.0)
+        for center, w, h in scene.statics:
+            static.CreateFixture(shape=b2.b2PolygonShape(box=(self._inside(w / 2), self._inside(h / 2),
+                                                              tuple(center), 0.0)),
+                                 friction=scene.mu, restitution=0.0)
+        pinned = scene.pinned
+        bodies = []
+        for k, (part, inertia) in enumerate(zip(scene.parts, scene.inertias)):
+            body = world.CreateDynamicBody(position=tuple(part.pos), angle=float(part.angle))
+            self._fixtures(body, part.shape, scene.mu, -1 if k in pinned else 0)
+            md = b2.b2MassData()
+            md.mass, md.center, md.I = float(part.mass), (0.0, 0.0), float(inertia)
+            body.massData = md
+            body.linearVelocity, body.angularVelocity = tuple(part.vel), float(part.omega)
+            bodies.append(body)
+        for a, b, anchor in scene.pins:
+            world.CreateRevoluteJoint(bodyA=static if a < 0 else bodies[a], bodyB=static if b < 0 else bodies[b],
+                                      anchor=tuple(anchor), collideConnected=False)
+        self.world, self.bodies = world, bodies
+
+    def run(self, n: int):
+        step, h = self.world.Step, self.scene.dt
+        vi, pi = self.iterations
+        for _ in range(n):
+            step(h, vi, pi)
+
+    def positions(self) -> np.ndarray:
+        """(n_body, 2) COM positions [m] now."""
+        return np.array([tuple(b.worldCenter) for b in self.bodies])

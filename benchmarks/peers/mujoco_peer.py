@@ -183,3 +183,98 @@ class World:
         finally:
             mj.set_mju_user_warning(previous)
         return q, v
+
+
+def _geom(shape, extra):
+    """The MJCF geom of a stress scene's shape (x-z plane; 0.1 m deep boxes, a circle a sphere,
+    a capsule a capsule along the body's x axis)."""
+    if shape[0] == "box":
+        return f'<geom type="box" size="{shape[1] / 2:.17g} 0.05 {shape[2] / 2:.17g}" {extra}/>'
+    if shape[0] == "circle":
+        return f'<geom type="sphere" size="{shape[1]:.17g}" {extra}/>'
+    return (f'<geom type="capsule" fromto="{-shape[1]:.17g} 0 0 {shape[1]:.17g} 0 0" '
+            f'size="{shape[2]:.17g}" {extra}/>')
+
+
+def shape_mjcf(scene) -> str:
+    """The MJCF text of a stress scene (benchmarks/stress_scenes.Scene): every body free in the
+    plane (slide x, slide z, hinge about -y) at its centre of mass with the scene's mass and
+    inertia; pins are `connect` equality constraints at their anchors (MuJoCo's soft
+    equality: the bridge is a closed loop, no tree); pinned bodies' geoms collide with
+    nothing (contype 0); static boxes are world geoms, flat ground a plane."""
+    friction = f'friction="{scene.mu:.17g} 0.005 0.0001"'
+    world = []
+    if scene.ground:
+        world.append(f'    <geom type="plane" size="100 1 0.1" {friction}/>')
+    for (cx, cy), w, h in scene.statics:
+        world.append(f'    <geom type="box" pos="{cx:.17g} 0 {cy:.17g}" size="{w / 2:.17g} 0.05 {h / 2:.17g}" '
+                     f'{friction}/>')
+    pinned = scene.pinned
+    for k, (part, inertia) in enumerate(zip(scene.parts, scene.inertias)):
+        extra = friction + (' contype="0" conaffinity="0"' if k in pinned else "") + ' mass="0"'
+        world += [f'    <body name="b{k}" pos="{part.pos[0]:.17g} 0 {part.pos[1]:.17g}" '
+                  f'axisangle="0 -1 0 {part.angle:.17g}">',
+                  f'      <inertial pos="0 0 0" mass="{part.mass:.17g}" '
+                  f'diaginertia="{inertia:.17g} {inertia:.17g} {inertia:.17g}"/>',
+                  '      <joint type="slide" axis="1 0 0"/>', '      <joint type="slide" axis="0 0 1"/>',
+                  '      <joint type="hinge" axis="0 -1 0"/>',
+                  f"      {_geom(part.shape, extra)}", "    </body>"]
+    equality = []
+    for j, (a, b, anchor) in enumerate(scene.pins):
+        body, other = (b, a) if a < 0 else (a, b)      # body1 a body; body2 the world or a body
+        part = scene.parts[body]
+        c, s = np.cos(part.angle), np.sin(part.angle)
+        dx, dy = anchor[0] - part.pos[0], anchor[1] - part.pos[1]
+        lx, ly = c * dx + s * dy, -s * dx + c * dy
+        second = f' body2="b{other}"' if other >= 0 else ""
+        equality.append(f'    <connect body1="b{body}"{second} anchor="{lx:.17g} 0 {ly:.17g}"/>')
+    return "\n".join([
+        '<mujoco model="planarsim-stress">',
+        '  <compiler angle="radian" inertiafromgeom="false"/>',
+        f'  <option timestep="{scene.dt:.17g}" gravity="0 0 {-9.81:.17g}" integrator="Euler"/>',
+        "  <worldbody>", *world, "  </worldbody>",
+        *(["  <equality>", *equality, "  </equality>"] if equality else []), "</mujoco>"])
+
+
+class ShapeWorld:
+    """A MuJoCo model of a stress scene (shape_mjcf) with run(n) (timed: one single-threaded
+    rollout call from the start state, as World), reset() and positions()."""
+
+    def __init__(self, scene):
+        import mujoco
+        try:
+            from mujoco import rollout
+        except ImportError:  # MuJoCo < 3.1: no rollout module
+            rollout = None
+        self.mj, self._rollout, self.scene = mujoco, rollout, scene
+        self.timing = ("mujoco.rollout, one thread" if rollout is not None
+                       else "Python loop of mj_step (this MuJoCo has no rollout module)")
+        self.model = mujoco.MjModel.from_xml_string(shape_mjcf(scene))
+        self.data = mujoco.MjData(self.model)
+        self.reset()
+        self.kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        self.x0 = np.zeros(mujoco.mj_stateSize(self.model, self.kind))
+        mujoco.mj_getState(self.model, self.data, self.x0, self.kind)
+        self._out = {}
+
+    def reset(self):
+        self.mj.mj_resetData(self.model, self.data)
+        for k, part in enumerate(self.scene.parts):
+            self.data.qvel[3 * k:3 * k + 3] = part.vel[0], part.vel[1], part.omega
+
+    def run(self, n: int):
+        """n steps from the start state: one rollout call (or an mj_step loop after reset())."""
+        if self._rollout is None:
+            step, m, d = self.mj.mj_step, self.model, self.data
+            for _ in range(n):
+                step(m, d)
+            return
+        if n not in self._out:
+            self._out[n] = np.zeros((1, n, len(self.x0)))
+        self._rollout.rollout(self.model, self.data, self.x0[None, :], nstep=n, state=self._out[n])
+        self.mj.mj_setState(self.model, self.data, self._out[n][0, -1], self.kind)
+
+    def positions(self) -> np.ndarray:
+        """(n_body, 2) COM positions [m] now."""
+        self.mj.mj_kinematics(self.model, self.data)
+        return np.array([(self.data.xpos[k + 1][0], self.data.xpos[k + 1][2]) for k in range(self.scene.n_body)])

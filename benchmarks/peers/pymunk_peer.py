@@ -95,3 +95,70 @@ class World:
                 step(h)
             self.pose(q, v, k)
         return q, v
+
+
+class ShapeWorld:
+    """A pymunk space of a stress scene (benchmarks/stress_scenes.Scene: boxes, circles and
+    capsules, static boxes, pins) with run(n) (timed), reset() and positions().
+
+    Bodies with the scene's mass and inertia (shapes without mass); boxes are Poly boxes, a
+    circle a Circle, a capsule a Segment with its radius; static boxes are Polys of the static
+    body; flat ground a static Segment at y = 0; pins PivotJoints at their world anchors;
+    pinned bodies in one ShapeFilter group (they collide with nothing there). Friction the
+    scene's mu, elasticity 0, `iterations` solver iterations (default 10), collision_slop
+    COLLISION_SLOP, sleeping off."""
+
+    def __init__(self, scene, iterations: int = 10):
+        import pymunk
+        self.pm, self.scene, self.iterations = pymunk, scene, int(iterations)
+        self.timing = f"Python loop of space.step ({self.iterations} iterations)"
+        self.reset()
+
+    def _shape(self, body, shape):
+        pm = self.pm
+        if shape[0] == "box":
+            return pm.Poly.create_box(body, (shape[1], shape[2]), radius=0.0)
+        if shape[0] == "circle":
+            return pm.Circle(body, shape[1])
+        return pm.Segment(body, (-shape[1], 0.0), (shape[1], 0.0), shape[2])
+
+    def reset(self):
+        pm, scene = self.pm, self.scene
+        space = pm.Space()
+        space.gravity = (0.0, -9.81)
+        space.collision_slop = COLLISION_SLOP
+        space.iterations = self.iterations
+        statics = []
+        if scene.ground:
+            statics.append(pm.Segment(space.static_body, (-100.0, 0.0), (100.0, 0.0), 0.0))
+        for (cx, cy), w, h in scene.statics:
+            statics.append(pm.Poly(space.static_body, [(cx - w / 2, cy - h / 2), (cx + w / 2, cy - h / 2),
+                                                       (cx + w / 2, cy + h / 2), (cx - w / 2, cy + h / 2)]))
+        for s in statics:
+            s.friction, s.elasticity = scene.mu, 0.0
+        space.add(*statics)
+        pinned = scene.pinned
+        bodies = []
+        for k, (part, inertia) in enumerate(zip(scene.parts, scene.inertias)):
+            body = pm.Body(float(part.mass), float(inertia))
+            body.position, body.angle = tuple(part.pos), float(part.angle)
+            body.velocity, body.angular_velocity = tuple(part.vel), float(part.omega)
+            shape = self._shape(body, part.shape)
+            shape.friction, shape.elasticity = scene.mu, 0.0
+            if k in pinned:
+                shape.filter = pm.ShapeFilter(group=1)
+            space.add(body, shape)
+            bodies.append(body)
+        for a, b, anchor in scene.pins:
+            space.add(pm.PivotJoint(space.static_body if a < 0 else bodies[a],
+                                    space.static_body if b < 0 else bodies[b], tuple(anchor)))
+        self.space, self.bodies = space, bodies
+
+    def run(self, n: int):
+        step, h = self.space.step, self.scene.dt
+        for _ in range(n):
+            step(h)
+
+    def positions(self) -> np.ndarray:
+        """(n_body, 2) COM positions [m] now."""
+        return np.array([tuple(b.position) for b in self.bodies])

@@ -106,3 +106,14 @@ def test_box_columns_report_their_cost_growth_and_peer_ratio(capsys):
     assert "slope" in line and ("met" in line or "NOT MET" in line)
     for name in available_peers()[0]:
         assert f"box_column10    {name}" in out
+
+
+def test_stress_part_prints_every_stress_scene(capsys):
+    """`planarsim bench --parts stress` on 5 steps: a row per stress scene, a column per peer."""
+    from benchmarks.stress_scenes import STRESS_SCENES
+    assert bench.main(["--parts", "stress", "--repeats", "1", "--steps", "5"]) == 0
+    out = capsys.readouterr().out
+    for name in STRESS_SCENES:
+        assert f"\n{name} " in out, name
+    for name in available_peers()[0]:
+        assert f"{name} ms" in out
