@@ -59,157 +59,247 @@ INV_INERTIA = 1.0 / INERTIA
 DT = 1e-3          # [s]
 TOL = ps.StepOptions().refine_tol          # [m] the engine's default
 MAX_ITERS = ps.StepOptions().refine_iters  # the engine's default
-BAND = 3           # rows of pin k couple to those of pins k - 1 and k + 1
+
+
+HALF = 0.5 * LENGTH
+RESYNC = 64        # steps between resyncs of the carried (cos, sin) from theta
+TAYLOR_MAX = 0.1   # [rad] increments up to this turn (cos, sin) by the series below
 
 
 @jit
-def _trig(q, cs):
-    for k in range(q.shape[0]):
-        cs[k, 0] = math.cos(q[k, 2])
-        cs[k, 1] = math.sin(q[k, 2])
+def _turn(c, s, d):
+    """(cos, sin) of theta + d from those of theta: Taylor series of cos d and sin d to
+    d^8 and d^9 (error below 3e-17 for |d| <= 0.1)."""
+    d2 = d * d
+    cd = 1.0 - d2 * (1.0 / 2 - d2 * (1.0 / 24 - d2 * (1.0 / 720 - d2 * (1.0 / 40320))))
+    sd = d * (1.0 - d2 * (1.0 / 6 - d2 * (1.0 / 120 - d2 * (1.0 / 5040 - d2 * (1.0 / 362880)))))
+    return c * cd - s * sd, s * cd + c * sd
 
 
 @jit
-def _pins(q, cs, J, c):
-    """Pin k joins the right end of link k - 1 (the world origin for k = 0) to the left end
-    of link k: rows 2k (x) and 2k + 1 (y); J[r, 0:3] on link k - 1, J[r, 3:6] on link k."""
-    half = 0.5 * LENGTH
-    for k in range(q.shape[0]):
-        rbx = -half * cs[k, 0]
-        rby = -half * cs[k, 1]
-        rax = 0.0
-        ray = 0.0
-        ax = 0.0
-        ay = 0.0
-        if k > 0:
-            rax = half * cs[k - 1, 0]
-            ray = half * cs[k - 1, 1]
-            ax = q[k - 1, 0] + rax
-            ay = q[k - 1, 1] + ray
-        x = 2 * k
-        J[x, 0] = -1.0
-        J[x, 1] = 0.0
-        J[x, 2] = ray
-        J[x, 3] = 1.0
-        J[x, 4] = 0.0
-        J[x, 5] = -rby
-        J[x + 1, 0] = 0.0
-        J[x + 1, 1] = -1.0
-        J[x + 1, 2] = -rax
-        J[x + 1, 3] = 0.0
-        J[x + 1, 4] = 1.0
-        J[x + 1, 5] = rbx
-        c[x] = q[k, 0] + rbx - ax
-        c[x + 1] = q[k, 1] + rby - ay
+def run_chain(q, v, cs, hist, count, n_steps):
+    """n_steps of the dedicated chain step on q, v (N, 3) in place.
 
-
-@jit
-def _dot(JL, i, si, JR, j, sj):
-    """The mass-weighted product of row i's block on slot si (0: link k - 1, 1: link k) with
-    row j's block on slot sj: J W J^T of one shared link."""
-    a = 3 * si
-    b = 3 * sj
-    return ((JL[i, a] * JR[j, b] + JL[i, a + 1] * JR[j, b + 1]) * INV_MASS
-            + JL[i, a + 2] * JR[j, b + 2] * INV_INERTIA)
-
-
-@jit
-def _solve(JL, JR, A, rhs, x):
-    """x = (JL W JR^T)^-1 rhs by a banded LU (rhs destroyed). Rows of pin k touch links k - 1
-    and k, so A couples them to pins k - 1 and k + 1 only: a band of 3 on either side."""
-    n = rhs.shape[0]
-    for i in range(n):
-        pin = i // 2
-        for j in range(2 * pin, i + 1):             # rows of the same pin: links pin - 1, pin
-            A[i, j] = _dot(JL, i, 1, JR, j, 1)
-            if pin > 0:
-                A[i, j] += _dot(JL, i, 0, JR, j, 0)
-            if j != i:
-                A[j, i] = _dot(JL, j, 1, JR, i, 1)
-                if pin > 0:
-                    A[j, i] += _dot(JL, j, 0, JR, i, 0)
-        if pin > 0:
-            for j in range(2 * pin - 2, 2 * pin):   # rows of the pin before: link pin - 1
-                A[i, j] = _dot(JL, i, 0, JR, j, 1)
-                A[j, i] = _dot(JL, j, 1, JR, i, 0)
-    for k in range(n):
-        inv = 1.0 / A[k, k]
-        last = min(n, k + BAND + 1)
-        for i in range(k + 1, last):
-            f = A[i, k] * inv
-            A[i, k] = f
-            for j in range(k + 1, last):
-                A[i, j] -= f * A[k, j]
-            rhs[i] -= f * rhs[k]
-    for k in range(n - 1, -1, -1):
-        acc = rhs[k]
-        for j in range(k + 1, min(n, k + BAND + 1)):
-            acc -= A[k, j] * x[j]
-        x[k] = acc / A[k, k]
-
-
-@jit
-def _apply(J, lam, dv, scale):
-    """dv += scale W J^T lam."""
-    for k in range(dv.shape[0]):
-        for r in (2 * k, 2 * k + 1):
-            l = lam[r] * scale
-            if k > 0:
-                dv[k - 1, 0] += J[r, 0] * l * INV_MASS
-                dv[k - 1, 1] += J[r, 1] * l * INV_MASS
-                dv[k - 1, 2] += J[r, 2] * l * INV_INERTIA
-            dv[k, 0] += J[r, 3] * l * INV_MASS
-            dv[k, 1] += J[r, 4] * l * INV_MASS
-            dv[k, 2] += J[r, 5] * l * INV_INERTIA
-
-
-@jit
-def run_chain(q, v, n_steps, light):
-    """n_steps of the dedicated chain step (light: see the module docstring) on q, v
-    (N, 3) in place."""
+    cs (N, 2): cos, sin of q[:, 2] carried from step to step (turned by each increment,
+    resynced from theta every RESYNC steps and at count[0] == 0); hist (3, 2, N + 1): the last
+    three steps' multipliers (ring buffer, newest at count[1] % 3; column N stays 0);
+    count: [steps taken, steps of history]. The state of a run is (q, v, cs, hist, count);
+    reset it with fresh_state.
+    """
     N = q.shape[0]
-    n = 2 * N
-    J0 = np.zeros((n, 6))
-    J1 = np.zeros((n, 6))
-    c = np.zeros(n)
-    A = np.zeros((n, n))
-    rhs = np.zeros(n)
-    lam = np.zeros(n)
-    cs = np.zeros((N, 2))
-    dv = np.zeros((N, 3))
-    qp = np.zeros((N, 3))
+    h = DT
+    im = INV_MASS
+    ii = INV_INERTIA
+    # the bodies, one array per coordinate (loops over bodies vectorise)
+    X = q[:, 0].copy()
+    Y = q[:, 1].copy()
+    T = q[:, 2].copy()
+    VX = v[:, 0].copy()
+    VY = v[:, 1].copy()
+    VW = v[:, 2].copy()
+    C = cs[:, 0].copy()
+    S = cs[:, 1].copy()
+    QX = np.empty(N)        # the iterate q* + W J0^T mu
+    QY = np.empty(N)
+    QT = np.empty(N)
+    CN = np.empty(N)        # its (cos, sin)
+    SN = np.empty(N)
+    U0X = np.empty(N)       # u0 = (L/2)(sin, -cos) at the step's start: J0's angle column
+    U0Y = np.empty(N)
+    GX = np.zeros(N + 1)    # mu (pin k: x, y; GX[N] = GY[N] = 0)
+    GY = np.zeros(N + 1)
+    # the factorisation: per pin, S_k^-1, M_k = S_k^-1 B_k and B_{k-1}; z the forward sweep
+    FS = np.empty((N, 4))
+    FM = np.empty((N, 4))
+    FB = np.empty((N, 4))
+    ZX = np.empty(N)
+    ZY = np.empty(N)
     for _ in range(n_steps):
-        _trig(q, cs)
-        _pins(q, cs, J0, c)
-        for k in range(N):
-            v[k, 1] -= G * DT
-            for d in range(3):
-                qp[k, d] = q[k, d] + DT * v[k, d]
-        _trig(qp, cs)
-        _pins(qp, cs, J1, rhs)
-        for r in range(n):
-            rhs[r] = -rhs[r] / DT
-        _solve(J1 if light else J0, J0, A, rhs, lam)
-        _apply(J0, lam, v, 1.0)
-        for k in range(N):
-            for d in range(3):
-                q[k, d] += DT * v[k, d]
-        for it in range(1 if light else MAX_ITERS + 1):
-            _trig(q, cs)
-            _pins(q, cs, J1, c)
-            worst = 0.0
-            for r in range(n):
-                worst = max(worst, abs(c[r]))
-                rhs[r] = -c[r]
-            if not light and (worst <= TOL or it == MAX_ITERS):
-                break
-            _solve(J1, J0, A, rhs, lam)
-            dv[:] = 0.0
-            _apply(J0, lam, dv, 1.0)
+        if count[0] % RESYNC == 0:
             for k in range(N):
-                for d in range(3):
-                    q[k, d] += dv[k, d]
-                    v[k, d] += dv[k, d] / DT
+                C[k] = math.cos(T[k])
+                S[k] = math.sin(T[k])
+        # first guess of mu: quadratic extrapolation of the last steps' (fewer at the start)
+        nh = count[1]
+        a0, a1, a2 = 0.0, 0.0, 0.0
+        if nh >= 3:
+            a0, a1, a2 = 3.0, -3.0, 1.0
+        elif nh == 2:
+            a0, a1 = 2.0, -1.0
+        elif nh == 1:
+            a0 = 1.0
+        i0 = (nh + 2) % 3   # entry e of the history sits at e % 3: newest nh - 1
+        i1 = (nh + 1) % 3
+        i2 = nh % 3
+        H0X = hist[i0, 0]
+        H0Y = hist[i0, 1]
+        H1X = hist[i1, 0]
+        H1Y = hist[i1, 1]
+        H2X = hist[i2, 0]
+        H2Y = hist[i2, 1]
+        for k in range(N):
+            GX[k] = a0 * H0X[k] + a1 * H1X[k] + a2 * H2X[k]
+            GY[k] = a0 * H0Y[k] + a1 * H1Y[k] + a2 * H2Y[k]
+        # gravity, and the prediction q + h v* + W J0^T mu
+        big = 0
+        for k in range(N):
+            VY[k] -= G * h
+            u0x = HALF * S[k]
+            u0y = -HALF * C[k]
+            U0X[k] = u0x
+            U0Y[k] = u0y
+            dx = h * VX[k] + (GX[k] - GX[k + 1]) * im
+            dy = h * VY[k] + (GY[k] - GY[k + 1]) * im
+            dt = h * VW[k] + (u0x * (GX[k] + GX[k + 1]) + u0y * (GY[k] + GY[k + 1])) * ii
+            QX[k] = X[k] + dx
+            QY[k] = Y[k] + dy
+            QT[k] = T[k] + dt
+            CN[k], SN[k] = _turn(C[k], S[k], dt)
+            big |= abs(dt) > TAYLOR_MAX
+        if big:
+            for k in range(N):
+                if abs(QT[k] - T[k]) > TAYLOR_MAX:
+                    CN[k] = math.cos(QT[k])
+                    SN[k] = math.sin(QT[k])
+        # Newton on C(q* + W J0^T mu) = 0: the first pass factors J(q) W J0^T at the
+        # iterate, later passes reuse it; stop at the first pass with every gap <= TOL
+        for it in range(MAX_ITERS + 2):
+            worst = 0.0
+            px = 0.0             # right end of the link before (the world anchor for pin 0)
+            py = 0.0
+            zx = 0.0
+            zy = 0.0
+            if it == 0:
+                m00, m01, m10, m11 = 0.0, 0.0, 0.0, 0.0
+                p00, p01, p10, p11 = 0.0, 0.0, 0.0, 0.0   # R_{k-1}
+                for k in range(N):
+                    hc = HALF * CN[k]
+                    hs = HALF * SN[k]
+                    cx = QX[k] - hc - px
+                    cy = QY[k] - hs - py
+                    px = QX[k] + hc
+                    py = QY[k] + hs
+                    worst = max(worst, cx * cx + cy * cy)
+                    # R_k = W_theta un u0^T, un = (L/2)(sin, -cos) at the iterate
+                    u0x = U0X[k]
+                    u0y = U0Y[k]
+                    r00 = hs * u0x * ii
+                    r01 = hs * u0y * ii
+                    r10 = -hc * u0x * ii
+                    r11 = -hc * u0y * ii
+                    # B_{k-1} = R_{k-1} - I/m couples pins k-1 and k both ways
+                    b00 = p00 - im
+                    b01 = p01
+                    b10 = p10
+                    b11 = p11 - im
+                    s00 = im + r00
+                    s01 = r01
+                    s10 = r10
+                    s11 = im + r11
+                    yx = -cx
+                    yy = -cy
+                    if k > 0:
+                        s00 += im + p00 - (b00 * m00 + b01 * m10)
+                        s01 += p01 - (b00 * m01 + b01 * m11)
+                        s10 += p10 - (b10 * m00 + b11 * m10)
+                        s11 += im + p11 - (b10 * m01 + b11 * m11)
+                        yx -= b00 * zx + b01 * zy
+                        yy -= b10 * zx + b11 * zy
+                    inv = 1.0 / (s00 * s11 - s01 * s10)
+                    i00 = s11 * inv
+                    i01 = -s01 * inv
+                    i10 = -s10 * inv
+                    i11 = s00 * inv
+                    zx = i00 * yx + i01 * yy
+                    zy = i10 * yx + i11 * yy
+                    # M_k = S_k^-1 B_k, B_k = R_k - I/m
+                    n00 = r00 - im
+                    n11 = r11 - im
+                    m00 = i00 * n00 + i01 * r10
+                    m01 = i00 * r01 + i01 * n11
+                    m10 = i10 * n00 + i11 * r10
+                    m11 = i10 * r01 + i11 * n11
+                    FS[k, 0] = i00
+                    FS[k, 1] = i01
+                    FS[k, 2] = i10
+                    FS[k, 3] = i11
+                    FM[k, 0] = m00
+                    FM[k, 1] = m01
+                    FM[k, 2] = m10
+                    FM[k, 3] = m11
+                    FB[k, 0] = b00
+                    FB[k, 1] = b01
+                    FB[k, 2] = b10
+                    FB[k, 3] = b11
+                    ZX[k] = zx
+                    ZY[k] = zy
+                    p00, p01, p10, p11 = r00, r01, r10, r11
+            else:
+                for k in range(N):
+                    hc = HALF * CN[k]
+                    hs = HALF * SN[k]
+                    cx = QX[k] - hc - px
+                    cy = QY[k] - hs - py
+                    px = QX[k] + hc
+                    py = QY[k] + hs
+                    worst = max(worst, cx * cx + cy * cy)
+                    yx = -cx - (FB[k, 0] * zx + FB[k, 1] * zy)
+                    yy = -cy - (FB[k, 2] * zx + FB[k, 3] * zy)
+                    zx = FS[k, 0] * yx + FS[k, 1] * yy
+                    zy = FS[k, 2] * yx + FS[k, 3] * yy
+                    ZX[k] = zx
+                    ZY[k] = zy
+                count[2] += 1
+                if worst <= TOL * TOL or it == MAX_ITERS + 1:
+                    break
+            # back substitution, the correction applied as it comes
+            xx = 0.0
+            xy = 0.0
+            for k in range(N - 1, -1, -1):
+                nx = ZX[k] - (FM[k, 0] * xx + FM[k, 1] * xy)
+                ny = ZY[k] - (FM[k, 2] * xx + FM[k, 3] * xy)
+                dt = (U0X[k] * (nx + xx) + U0Y[k] * (ny + xy)) * ii
+                QX[k] += (nx - xx) * im
+                QY[k] += (ny - xy) * im
+                QT[k] += dt
+                CN[k], SN[k] = _turn(CN[k], SN[k], dt)
+                GX[k] += nx
+                GY[k] += ny
+                xx = nx
+                xy = ny
+        # v = v* + W J0^T mu / h; the step's end is the iterate
+        for k in range(N):
+            VX[k] += (GX[k] - GX[k + 1]) * (im / h)
+            VY[k] += (GY[k] - GY[k + 1]) * (im / h)
+            VW[k] += (U0X[k] * (GX[k] + GX[k + 1]) + U0Y[k] * (GY[k] + GY[k + 1])) * (ii / h)
+            X[k] = QX[k]
+            Y[k] = QY[k]
+            T[k] = QT[k]
+            C[k] = CN[k]
+            S[k] = SN[k]
+        j = nh % 3
+        for k in range(N):
+            hist[j, 0, k] = GX[k]
+            hist[j, 1, k] = GY[k]
+        count[0] += 1
+        count[1] = nh + 1
+    for k in range(N):
+        q[k, 0] = X[k]
+        q[k, 1] = Y[k]
+        q[k, 2] = T[k]
+        v[k, 0] = VX[k]
+        v[k, 1] = VY[k]
+        v[k, 2] = VW[k]
+        cs[k, 0] = C[k]
+        cs[k, 1] = S[k]
+
+
+def fresh_state(model):
+    """(q, v, cs, hist, count) of a dedicated run from the model's start, at rest."""
+    q = model.q0.copy()
+    n = q.shape[0]
+    return (q, np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((3, 2, n + 1)),
+            np.zeros(3, np.int64))
 
 
 def _print_row(n_links, key, rates, spec, poses, start, end):
