@@ -64,6 +64,9 @@ MAX_ITERS = ps.StepOptions().refine_iters  # the engine's default
 HALF = 0.5 * LENGTH
 RESYNC = 64        # steps between resyncs of the carried (cos, sin) from theta
 TAYLOR_MAX = 0.1   # [rad] increments up to this turn (cos, sin) by the series below
+TOL2 = TOL * TOL
+FAR = 1e-9         # [m] gaps above this after a correction: factor again (else reuse)
+FAR2 = FAR * FAR
 
 
 @jit
@@ -114,6 +117,8 @@ def run_chain(q, v, cs, hist, count, n_steps):
     FB = np.empty((N, 4))
     ZX = np.empty(N)
     ZY = np.empty(N)
+    RX = np.empty(N)        # the gaps at the iterate
+    RY = np.empty(N)
     for _ in range(n_steps):
         if count[0] % RESYNC == 0:
             for k in range(N):
@@ -161,97 +166,109 @@ def run_chain(q, v, cs, hist, count, n_steps):
                 if abs(QT[k] - T[k]) > TAYLOR_MAX:
                     CN[k] = math.cos(QT[k])
                     SN[k] = math.sin(QT[k])
-        # Newton on C(q* + W J0^T mu) = 0: the first pass factors J(q) W J0^T at the
-        # iterate, later passes reuse it; stop at the first pass with every gap <= TOL
+        # Newton on C(q* + W J0^T mu) = 0. A pass: the gaps at the iterate (every pin's at
+        # once); stop when all are <= TOL (after the first pass); else factor J(q) W J0^T at
+        # the iterate (the first pass, or when the gaps are still far from closed) or reuse
+        # the last factorisation, solve, and apply the correction.
         for it in range(MAX_ITERS + 2):
-            worst = 0.0
-            px = 0.0             # right end of the link before (the world anchor for pin 0)
-            py = 0.0
-            zx = 0.0
-            zy = 0.0
-            if it == 0:
-                m00, m01, m10, m11 = 0.0, 0.0, 0.0, 0.0
-                p00, p01, p10, p11 = 0.0, 0.0, 0.0, 0.0   # R_{k-1}
+            # pin k: left end of link k minus right end of link k - 1 (the origin for k = 0)
+            rx = QX[0] - HALF * CN[0]
+            ry = QY[0] - HALF * SN[0]
+            RX[0] = rx
+            RY[0] = ry
+            g = rx * rx + ry * ry
+            bad = g > TOL2
+            far = g > FAR2
+            for k in range(1, N):
+                rx = (QX[k] - HALF * CN[k]) - (QX[k - 1] + HALF * CN[k - 1])
+                ry = (QY[k] - HALF * SN[k]) - (QY[k - 1] + HALF * SN[k - 1])
+                RX[k] = rx
+                RY[k] = ry
+                g = rx * rx + ry * ry
+                bad |= g > TOL2
+                far |= g > FAR2
+            if it > 0:
+                count[2] += 1
+                if not bad or it == MAX_ITERS + 1:
+                    break
+            if it == 0 or far:
+                count[3] += 1
+                # block LU of A = J W J0^T: diagonal blocks D_k = I/m + R_k (+ I/m + R_{k-1}),
+                # off-diagonal B_{k-1} = R_{k-1} - I/m both ways, R_k = (1/I) un_k u0_k^T
+                # (un at the iterate). Pivots S_k = D_k - B_{k-1} S_{k-1}^-1 B_{k-1}, the
+                # inverse as adj(S) / det so that the division is off the products' path.
+                s00, s01, s10, s11, inv = 1.0, 0.0, 0.0, 1.0, 0.0
+                b00, b01, b10, b11 = 0.0, 0.0, 0.0, 0.0
+                zx = 0.0
+                zy = 0.0
                 for k in range(N):
-                    hc = HALF * CN[k]
-                    hs = HALF * SN[k]
-                    cx = QX[k] - hc - px
-                    cy = QY[k] - hs - py
-                    px = QX[k] + hc
-                    py = QY[k] + hs
-                    worst = max(worst, cx * cx + cy * cy)
-                    # R_k = W_theta un u0^T, un = (L/2)(sin, -cos) at the iterate
                     u0x = U0X[k]
                     u0y = U0Y[k]
-                    r00 = hs * u0x * ii
-                    r01 = hs * u0y * ii
-                    r10 = -hc * u0x * ii
-                    r11 = -hc * u0y * ii
-                    # B_{k-1} = R_{k-1} - I/m couples pins k-1 and k both ways
-                    b00 = p00 - im
-                    b01 = p01
-                    b10 = p10
-                    b11 = p11 - im
-                    s00 = im + r00
-                    s01 = r01
-                    s10 = r10
-                    s11 = im + r11
-                    yx = -cx
-                    yy = -cy
+                    hs = HALF * SN[k] * ii
+                    hc = -HALF * CN[k] * ii
+                    r00 = hs * u0x
+                    r01 = hs * u0y
+                    r10 = hc * u0x
+                    r11 = hc * u0y
+                    # B_{k-1} adj(S_{k-1}) B_{k-1}
+                    t00 = b00 * s11 - b01 * s10
+                    t01 = b01 * s00 - b00 * s01
+                    t10 = b10 * s11 - b11 * s10
+                    t11 = b11 * s00 - b10 * s01
+                    p00 = t00 * b00 + t01 * b10
+                    p01 = t00 * b01 + t01 * b11
+                    p10 = t10 * b00 + t11 * b10
+                    p11 = t10 * b01 + t11 * b11
+                    e00 = im + r00
+                    e11 = im + r11
+                    e01 = r01
+                    e10 = r10
                     if k > 0:
-                        s00 += im + p00 - (b00 * m00 + b01 * m10)
-                        s01 += p01 - (b00 * m01 + b01 * m11)
-                        s10 += p10 - (b10 * m00 + b11 * m10)
-                        s11 += im + p11 - (b10 * m01 + b11 * m11)
-                        yx -= b00 * zx + b01 * zy
-                        yy -= b10 * zx + b11 * zy
+                        e00 += b00 + 2.0 * im      # I/m + R_{k-1} = B_{k-1} + 2 I/m
+                        e11 += b11 + 2.0 * im
+                        e01 += b01
+                        e10 += b10
+                    s00 = e00 - p00 * inv
+                    s01 = e01 - p01 * inv
+                    s10 = e10 - p10 * inv
+                    s11 = e11 - p11 * inv
                     inv = 1.0 / (s00 * s11 - s01 * s10)
                     i00 = s11 * inv
                     i01 = -s01 * inv
                     i10 = -s10 * inv
                     i11 = s00 * inv
-                    zx = i00 * yx + i01 * yy
-                    zy = i10 * yx + i11 * yy
-                    # M_k = S_k^-1 B_k, B_k = R_k - I/m
-                    n00 = r00 - im
-                    n11 = r11 - im
-                    m00 = i00 * n00 + i01 * r10
-                    m01 = i00 * r01 + i01 * n11
-                    m10 = i10 * n00 + i11 * r10
-                    m11 = i10 * r01 + i11 * n11
-                    FS[k, 0] = i00
-                    FS[k, 1] = i01
-                    FS[k, 2] = i10
-                    FS[k, 3] = i11
-                    FM[k, 0] = m00
-                    FM[k, 1] = m01
-                    FM[k, 2] = m10
-                    FM[k, 3] = m11
+                    yx = RX[k] + b00 * zx + b01 * zy     # -(the right-hand side)
+                    yy = RY[k] + b10 * zx + b11 * zy
+                    zx = -(i00 * yx + i01 * yy)
+                    zy = -(i10 * yx + i11 * yy)
                     FB[k, 0] = b00
                     FB[k, 1] = b01
                     FB[k, 2] = b10
                     FB[k, 3] = b11
+                    b00 = r00 - im
+                    b01 = r01
+                    b10 = r10
+                    b11 = r11 - im
+                    FS[k, 0] = i00
+                    FS[k, 1] = i01
+                    FS[k, 2] = i10
+                    FS[k, 3] = i11
+                    FM[k, 0] = i00 * b00 + i01 * b10     # S_k^-1 B_k
+                    FM[k, 1] = i00 * b01 + i01 * b11
+                    FM[k, 2] = i10 * b00 + i11 * b10
+                    FM[k, 3] = i10 * b01 + i11 * b11
                     ZX[k] = zx
                     ZY[k] = zy
-                    p00, p01, p10, p11 = r00, r01, r10, r11
             else:
+                zx = 0.0
+                zy = 0.0
                 for k in range(N):
-                    hc = HALF * CN[k]
-                    hs = HALF * SN[k]
-                    cx = QX[k] - hc - px
-                    cy = QY[k] - hs - py
-                    px = QX[k] + hc
-                    py = QY[k] + hs
-                    worst = max(worst, cx * cx + cy * cy)
-                    yx = -cx - (FB[k, 0] * zx + FB[k, 1] * zy)
-                    yy = -cy - (FB[k, 2] * zx + FB[k, 3] * zy)
-                    zx = FS[k, 0] * yx + FS[k, 1] * yy
-                    zy = FS[k, 2] * yx + FS[k, 3] * yy
+                    yx = RX[k] + FB[k, 0] * zx + FB[k, 1] * zy
+                    yy = RY[k] + FB[k, 2] * zx + FB[k, 3] * zy
+                    zx = -(FS[k, 0] * yx + FS[k, 1] * yy)
+                    zy = -(FS[k, 2] * yx + FS[k, 3] * yy)
                     ZX[k] = zx
                     ZY[k] = zy
-                count[2] += 1
-                if worst <= TOL * TOL or it == MAX_ITERS + 1:
-                    break
             # back substitution, the correction applied as it comes
             xx = 0.0
             xy = 0.0
@@ -299,31 +316,34 @@ def fresh_state(model):
     q = model.q0.copy()
     n = q.shape[0]
     return (q, np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((3, 2, n + 1)),
-            np.zeros(3, np.int64))
+            np.zeros(4, np.int64))
 
 
-def _print_row(n_links, key, rates, spec, poses, start, end):
-    """One runner's or peer's line: steps/s, ratio to the engine, largest pin gap over the
-    sampled poses, energy change from start (q, v) to end (q, v) as a share of the scale."""
+def _print_row(n_links, key, rates, best, spec, poses, start, end):
+    """One runner's or peer's line: us/step, steps/s, ratio to the engine and to the fastest
+    peer, largest pin gap over the sampled poses, energy change from start (q, v) to end
+    (q, v) as a share of the scale."""
     drift = (energy(spec, *end) - energy(spec, *start)) / spec.energy_scale
-    print(f"{n_links:3d}  {key:10s} {rates[key] / 1e3:8.0f}k  "
-          f"{rates[key] / rates['engine']:8.2f}  "
-          f"{pin_separation(spec, poses):15.1e}  {drift:+21.2%}")
+    peer = f"{rates[key] / rates[best]:7.2f}" if best else f"{'-':>7s}"
+    print(f"{n_links:3d}  {key:10s} {1e6 / rates[key]:8.3f}  {rates[key] / 1e3:8.0f}k  "
+          f"{rates[key] / rates['engine']:8.2f}  {peer}  "
+          f"{pin_separation(spec, poses):15.1e}  {drift:+21.3%}")
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--links", type=int, nargs="+", default=[4, 32])
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--peers", default="none",
-                    help="comma-separated peers timed alongside (mujoco, pymunk, box2d; 'all')")
+    ap.add_argument("--peers", nargs="+", default=["none"],
+                    help="peers timed alongside (mujoco pymunk box2d, or comma-separated; 'all')")
     args = ap.parse_args(argv)
     if any(n < 1 for n in args.links):
         ap.error("--links: every chain needs at least one link")
+    asked = [x.strip() for arg in args.peers for x in arg.split(",") if x.strip()]
     peers = {}
-    if args.peers != "none":
+    if asked and asked != ["none"]:
         from benchmarks.peers import PEER_MODULES, available_peers
-        names = None if args.peers == "all" else [x.strip() for x in args.peers.split(",")]
+        names = None if "all" in asked else asked
         unknown = [x for x in names or () if x not in PEER_MODULES]
         if unknown:
             ap.error(f"--peers: unknown {', '.join(unknown)}; "
@@ -335,8 +355,8 @@ def main(argv=None) -> int:
             print("chain_floor: no peer to time (see above)", file=sys.stderr)
             return 1
     n_steps, n_accuracy = 5000, 10000      # 5 s timing episode, 10 s accuracy run (the bench's)
-    print(f"{'N':>3s}  {'runner':10s} {'steps/s':>9s}  {'x engine':>8s}  {'largest pin gap':>15s}  "
-          f"{'energy change / scale':>21s}")
+    print(f"{'N':>3s}  {'runner':10s} {'us/step':>8s}  {'steps/s':>9s}  {'x engine':>8s}  "
+          f"{'x peer':>7s}  {'largest pin gap':>15s}  {'energy change / scale':>21s}")
     for n_links in args.links:
         model = chain(n_links, dt=DT, length=LENGTH, mass=MASS)
         spec = spec_from_model(f"chain{n_links}", model, n_accuracy * DT)
@@ -346,21 +366,20 @@ def main(argv=None) -> int:
             box["sim"] = ps.Simulator(model)
 
         def reset_dedicated():
-            box["q"], box["v"] = model.q0.copy(), np.zeros((n_links, 3))
+            box["state"] = fresh_state(model)
         # runner: (run n steps, reset to the start (not timed), current (q, v))
         runners = {
             "engine": (lambda n: box["sim"].steps(n), reset_engine,
                        lambda: (box["sim"].state.q, box["sim"].state.v)),
-            "dedicated": (lambda n: run_chain(box["q"], box["v"], n, False), reset_dedicated,
-                          lambda: (box["q"], box["v"])),
-            "light": (lambda n: run_chain(box["q"], box["v"], n, True), reset_dedicated,
-                      lambda: (box["q"], box["v"])),
+            "dedicated": (lambda n: run_chain(*box["state"], n), reset_dedicated,
+                          lambda: box["state"][:2]),
         }
         worlds = {key: mod.World(spec) for key, mod in peers.items()}
         engines = {key: r[:2] for key, r in runners.items()}
         engines.update({key: (w.run, w.reset) for key, w in worlds.items()})
         timed = _rates(engines, n_steps, args.repeats)
         rates = {key: statistics.median(r) for key, r in timed.items()}
+        best = max(worlds, key=lambda k: rates[k]) if worlds else None
         for key, (run, reset, pose) in runners.items():
             # accuracy: poses sampled every 100 steps (0.1 s) over the 10 s run
             reset()
@@ -369,12 +388,11 @@ def main(argv=None) -> int:
             for _ in range(n_accuracy // 100):
                 run(100)
                 poses.append(pose()[0].copy())
-            _print_row(n_links, key, rates, spec, np.array(poses), (q0, v0), pose())
+            _print_row(n_links, key, rates, best, spec, np.array(poses), (q0, v0), pose())
         for key, world in worlds.items():
             q, v = world.record(n_accuracy)      # every step: sampled as the runners'
-            _print_row(n_links, key, rates, spec, q[::100], (q[0], v[0]), (q[-1], v[-1]))
+            _print_row(n_links, key, rates, best, spec, q[::100], (q[0], v[0]), (q[-1], v[-1]))
         if worlds:
-            best = max(worlds, key=lambda k: rates[k])
             print(f"{n_links:3d}  dedicated / fastest peer ({best}): "
                   f"{rates['dedicated'] / rates[best]:.2f}x; engine / {best}: "
                   f"{rates['engine'] / rates[best]:.2f}x")
