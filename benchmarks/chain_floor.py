@@ -65,17 +65,32 @@ HALF = 0.5 * LENGTH
 RESYNC = 64        # steps between resyncs of the carried (cos, sin) from theta
 TAYLOR_MAX = 0.1   # [rad] increments up to this turn (cos, sin) by the series below
 TOL2 = TOL * TOL
+NUDGE_MAX = 1e-4   # [rad] corrections up to this turn (cos, sin) by the shorter series
 FAR = 1e-9         # [m] gaps above this after a correction: factor again (else reuse)
 FAR2 = FAR * FAR
 
 
-@jit
+@njit(inline="always")
 def _turn(c, s, d):
     """(cos, sin) of theta + d from those of theta: Taylor series of cos d and sin d to
-    d^8 and d^9 (error below 3e-17 for |d| <= 0.1)."""
+    d^8 and d^9 (error below 3e-17 for |d| <= TAYLOR_MAX), summed in Estrin's order (a
+    shorter chain of dependent products than Horner's)."""
     d2 = d * d
-    cd = 1.0 - d2 * (1.0 / 2 - d2 * (1.0 / 24 - d2 * (1.0 / 720 - d2 * (1.0 / 40320))))
-    sd = d * (1.0 - d2 * (1.0 / 6 - d2 * (1.0 / 120 - d2 * (1.0 / 5040 - d2 * (1.0 / 362880)))))
+    d4 = d2 * d2
+    d8 = d4 * d4
+    cd = (1.0 - d2 * (1.0 / 2)) + d4 * (1.0 / 24 - d2 * (1.0 / 720)) + d8 * (1.0 / 40320)
+    sd = d * ((1.0 - d2 * (1.0 / 6)) + d4 * (1.0 / 120 - d2 * (1.0 / 5040))
+              + d8 * (1.0 / 362880))
+    return c * cd - s * sd, s * cd + c * sd
+
+
+@njit(inline="always")
+def _nudge(c, s, d):
+    """_turn for |d| <= NUDGE_MAX: cos d = 1 - d^2 / 2, sin d = d - d^3 / 6 (error below
+    5e-18)."""
+    d2 = d * d
+    cd = 1.0 - d2 * (1.0 / 2)
+    sd = d - d * d2 * (1.0 / 6)
     return c * cd - s * sd, s * cd + c * sd
 
 
@@ -117,6 +132,9 @@ def run_chain(q, v, cs, hist, count, n_steps):
     FB = np.empty((N, 4))
     ZX = np.empty(N)
     ZY = np.empty(N)
+    DX = np.zeros(N + 1)    # a correction of mu (DX[N] = DY[N] = 0)
+    DY = np.zeros(N + 1)
+    DT_ = np.empty(N)       # the angle increments of the prediction
     RX = np.empty(N)        # the gaps at the iterate
     RY = np.empty(N)
     for _ in range(n_steps):
@@ -159,11 +177,14 @@ def run_chain(q, v, cs, hist, count, n_steps):
             QX[k] = X[k] + dx
             QY[k] = Y[k] + dy
             QT[k] = T[k] + dt
-            CN[k], SN[k] = _turn(C[k], S[k], dt)
-            big |= abs(dt) > TAYLOR_MAX
+            DT_[k] = dt
+            big += abs(dt) > TAYLOR_MAX
+        for k in range(N):
+            CN[k], SN[k] = _turn(C[k], S[k], DT_[k])
+            # CN[k] = c * cd - s * sd
         if big:
             for k in range(N):
-                if abs(QT[k] - T[k]) > TAYLOR_MAX:
+                if abs(DT_[k]) > TAYLOR_MAX:
                     CN[k] = math.cos(QT[k])
                     SN[k] = math.sin(QT[k])
         # Newton on C(q* + W J0^T mu) = 0. A pass: the gaps at the iterate (every pin's at
@@ -269,21 +290,42 @@ def run_chain(q, v, cs, hist, count, n_steps):
                     zy = -(FS[k, 2] * yx + FS[k, 3] * yy)
                     ZX[k] = zx
                     ZY[k] = zy
-            # back substitution, the correction applied as it comes
+            # back substitution, then the correction applied to every body at once
             xx = 0.0
             xy = 0.0
             for k in range(N - 1, -1, -1):
                 nx = ZX[k] - (FM[k, 0] * xx + FM[k, 1] * xy)
-                ny = ZY[k] - (FM[k, 2] * xx + FM[k, 3] * xy)
+                xy = ZY[k] - (FM[k, 2] * xx + FM[k, 3] * xy)
+                xx = nx
+                DX[k] = xx
+                DY[k] = xy
+            nudge = 0
+            big = 0
+            for k in range(N):
+                nx = DX[k]
+                ny = DY[k]
+                xx = DX[k + 1]
+                xy = DY[k + 1]
                 dt = (U0X[k] * (nx + xx) + U0Y[k] * (ny + xy)) * ii
                 QX[k] += (nx - xx) * im
                 QY[k] += (ny - xy) * im
                 QT[k] += dt
-                CN[k], SN[k] = _turn(CN[k], SN[k], dt)
+                DT_[k] = dt
                 GX[k] += nx
                 GY[k] += ny
-                xx = nx
-                xy = ny
+                nudge += abs(dt) > NUDGE_MAX
+                big += abs(dt) > TAYLOR_MAX
+            if nudge:
+                for k in range(N):
+                    CN[k], SN[k] = _turn(CN[k], SN[k], DT_[k])
+            else:
+                for k in range(N):
+                    CN[k], SN[k] = _nudge(CN[k], SN[k], DT_[k])
+            if big:
+                for k in range(N):
+                    if abs(DT_[k]) > TAYLOR_MAX:
+                        CN[k] = math.cos(QT[k])
+                        SN[k] = math.sin(QT[k])
         # v = v* + W J0^T mu / h; the step's end is the iterate
         for k in range(N):
             VX[k] += (GX[k] - GX[k + 1]) * (im / h)
