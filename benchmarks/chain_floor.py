@@ -94,6 +94,30 @@ def _nudge(c, s, d):
     return c * cd - s * sd, s * cd + c * sd
 
 
+@njit(inline="always")
+def _pivot(s00, s01, s10, s11, inv, b00, b01, b10, b11, e00, e01, e10, e11):
+    """(P, 1 / det P) of the pivot P = E - B S^-1 B that eliminating a pin whose pivot is S
+    (inv = 1 / det S) leaves on its neighbour (coupling B, diagonal block E): S^-1 as
+    adj(S) / det S, the division off the path of the products."""
+    p00, p01, p10, p11 = _schur(s00, s01, s10, s11, inv, b00, b01, b10, b11,
+                                e00, e01, e10, e11)
+    return p00, p01, p10, p11, 1.0 / (p00 * p11 - p01 * p10)
+
+
+@njit(inline="always")
+def _schur(s00, s01, s10, s11, inv, b00, b01, b10, b11, e00, e01, e10, e11):
+    """E - B S^-1 B (see _pivot)."""
+    t00 = b00 * s11 - b01 * s10
+    t01 = b01 * s00 - b00 * s01
+    t10 = b10 * s11 - b11 * s10
+    t11 = b11 * s00 - b10 * s01
+    p00 = e00 - (t00 * b00 + t01 * b10) * inv
+    p01 = e01 - (t00 * b01 + t01 * b11) * inv
+    p10 = e10 - (t10 * b00 + t11 * b10) * inv
+    p11 = e11 - (t10 * b01 + t11 * b11) * inv
+    return p00, p01, p10, p11
+
+
 @jit
 def run_chain(q, v, cs, hist, count, n_steps):
     """n_steps of the dedicated chain step on q, v (N, 3) in place.
@@ -135,6 +159,12 @@ def run_chain(q, v, cs, hist, count, n_steps):
     DX = np.zeros(N + 1)    # a correction of mu (DX[N] = DY[N] = 0)
     DY = np.zeros(N + 1)
     DT_ = np.empty(N)       # the angle increments of the prediction
+    R00 = np.empty(N)       # R_k = (1/I) un_k u0_k^T of link k
+    R01 = np.empty(N)
+    R10 = np.empty(N)
+    R11 = np.empty(N)
+    mid = N // 2            # the pin where the two eliminations meet
+    nbot = N - 1 - mid      # pins eliminated from the bottom
     RX = np.empty(N)        # the gaps at the iterate
     RY = np.empty(N)
     for _ in range(n_steps):
@@ -215,90 +245,169 @@ def run_chain(q, v, cs, hist, count, n_steps):
             if it == 0 or far:
                 count[3] += 1
                 # block LU of A = J W J0^T: diagonal blocks D_k = I/m + R_k (+ I/m + R_{k-1}),
-                # off-diagonal B_{k-1} = R_{k-1} - I/m both ways, R_k = (1/I) un_k u0_k^T
-                # (un at the iterate). Pivots S_k = D_k - B_{k-1} S_{k-1}^-1 B_{k-1}, the
-                # inverse as adj(S) / det so that the division is off the products' path.
-                s00, s01, s10, s11, inv = 1.0, 0.0, 0.0, 1.0, 0.0
-                b00, b01, b10, b11 = 0.0, 0.0, 0.0, 0.0
-                zx = 0.0
-                zy = 0.0
+                # B_k = R_k - I/m between pins k and k + 1 both ways, R_k = (1/I) un_k u0_k^T
+                # (un at the iterate). Twisted: pivots eliminated from both ends at once (two
+                # independent chains of half the length) until they meet at pin mid.
                 for k in range(N):
-                    u0x = U0X[k]
-                    u0y = U0Y[k]
                     hs = HALF * SN[k] * ii
                     hc = -HALF * CN[k] * ii
-                    r00 = hs * u0x
-                    r01 = hs * u0y
-                    r10 = hc * u0x
-                    r11 = hc * u0y
-                    # B_{k-1} adj(S_{k-1}) B_{k-1}
-                    t00 = b00 * s11 - b01 * s10
-                    t01 = b01 * s00 - b00 * s01
-                    t10 = b10 * s11 - b11 * s10
-                    t11 = b11 * s00 - b10 * s01
-                    p00 = t00 * b00 + t01 * b10
-                    p01 = t00 * b01 + t01 * b11
-                    p10 = t10 * b00 + t11 * b10
-                    p11 = t10 * b01 + t11 * b11
-                    e00 = im + r00
-                    e11 = im + r11
-                    e01 = r01
-                    e10 = r10
+                    R00[k] = hs * U0X[k]
+                    R01[k] = hs * U0Y[k]
+                    R10[k] = hc * U0X[k]
+                    R11[k] = hc * U0Y[k]
+                # top: pins 0, 1, ..., mid - 1, S_k = D_k - B_{k-1} S_{k-1}^-1 B_{k-1}
+                ts00, ts01, ts10, ts11, tinv = 1.0, 0.0, 0.0, 1.0, 0.0
+                tb00, tb01, tb10, tb11 = 0.0, 0.0, 0.0, 0.0
+                tzx, tzy = 0.0, 0.0
+                # bottom: pins N - 1, ..., mid + 1, S_k = D_k - B_k S_{k+1}^-1 B_k
+                bs00, bs01, bs10, bs11, binv = 1.0, 0.0, 0.0, 1.0, 0.0
+                bb00, bb01, bb10, bb11 = 0.0, 0.0, 0.0, 0.0
+                bzx, bzy = 0.0, 0.0
+                for i in range(mid):
+                    k = i
+                    e00 = im + R00[k]
+                    e01 = R01[k]
+                    e10 = R10[k]
+                    e11 = im + R11[k]
                     if k > 0:
-                        e00 += b00 + 2.0 * im      # I/m + R_{k-1} = B_{k-1} + 2 I/m
-                        e11 += b11 + 2.0 * im
-                        e01 += b01
-                        e10 += b10
-                    s00 = e00 - p00 * inv
-                    s01 = e01 - p01 * inv
-                    s10 = e10 - p10 * inv
-                    s11 = e11 - p11 * inv
-                    inv = 1.0 / (s00 * s11 - s01 * s10)
-                    i00 = s11 * inv
-                    i01 = -s01 * inv
-                    i10 = -s10 * inv
-                    i11 = s00 * inv
-                    yx = RX[k] + b00 * zx + b01 * zy     # -(the right-hand side)
-                    yy = RY[k] + b10 * zx + b11 * zy
-                    zx = -(i00 * yx + i01 * yy)
-                    zy = -(i10 * yx + i11 * yy)
-                    FB[k, 0] = b00
-                    FB[k, 1] = b01
-                    FB[k, 2] = b10
-                    FB[k, 3] = b11
-                    b00 = r00 - im
-                    b01 = r01
-                    b10 = r10
-                    b11 = r11 - im
+                        e00 += tb00 + 2.0 * im      # I/m + R_{k-1} = B_{k-1} + 2 I/m
+                        e01 += tb01
+                        e10 += tb10
+                        e11 += tb11 + 2.0 * im
+                    ts00, ts01, ts10, ts11, tinv = _pivot(ts00, ts01, ts10, ts11, tinv,
+                                                          tb00, tb01, tb10, tb11,
+                                                          e00, e01, e10, e11)
+                    i00 = ts11 * tinv
+                    i01 = -ts01 * tinv
+                    i10 = -ts10 * tinv
+                    i11 = ts00 * tinv
+                    yx = RX[k] + tb00 * tzx + tb01 * tzy     # -(the right-hand side)
+                    yy = RY[k] + tb10 * tzx + tb11 * tzy
+                    tzx = -(i00 * yx + i01 * yy)
+                    tzy = -(i10 * yx + i11 * yy)
+                    FB[k, 0] = tb00
+                    FB[k, 1] = tb01
+                    FB[k, 2] = tb10
+                    FB[k, 3] = tb11
+                    tb00 = R00[k] - im                      # B_k, towards the middle
+                    tb01 = R01[k]
+                    tb10 = R10[k]
+                    tb11 = R11[k] - im
                     FS[k, 0] = i00
                     FS[k, 1] = i01
                     FS[k, 2] = i10
                     FS[k, 3] = i11
-                    FM[k, 0] = i00 * b00 + i01 * b10     # S_k^-1 B_k
-                    FM[k, 1] = i00 * b01 + i01 * b11
-                    FM[k, 2] = i10 * b00 + i11 * b10
-                    FM[k, 3] = i10 * b01 + i11 * b11
-                    ZX[k] = zx
-                    ZY[k] = zy
+                    FM[k, 0] = i00 * tb00 + i01 * tb10     # S_k^-1 B_k
+                    FM[k, 1] = i00 * tb01 + i01 * tb11
+                    FM[k, 2] = i10 * tb00 + i11 * tb10
+                    FM[k, 3] = i10 * tb01 + i11 * tb11
+                    ZX[k] = tzx
+                    ZY[k] = tzy
+                    if i < nbot:
+                        k = N - 1 - i
+                        c00 = R00[k - 1] - im               # B_{k-1}, towards the middle
+                        c01 = R01[k - 1]
+                        c10 = R10[k - 1]
+                        c11 = R11[k - 1] - im
+                        e00 = (im + R00[k]) + (c00 + 2.0 * im)
+                        e01 = R01[k] + c01
+                        e10 = R10[k] + c10
+                        e11 = (im + R11[k]) + (c11 + 2.0 * im)
+                        bs00, bs01, bs10, bs11, binv = _pivot(bs00, bs01, bs10, bs11, binv,
+                                                              bb00, bb01, bb10, bb11,
+                                                              e00, e01, e10, e11)
+                        i00 = bs11 * binv
+                        i01 = -bs01 * binv
+                        i10 = -bs10 * binv
+                        i11 = bs00 * binv
+                        yx = RX[k] + bb00 * bzx + bb01 * bzy
+                        yy = RY[k] + bb10 * bzx + bb11 * bzy
+                        bzx = -(i00 * yx + i01 * yy)
+                        bzy = -(i10 * yx + i11 * yy)
+                        FB[k, 0] = bb00
+                        FB[k, 1] = bb01
+                        FB[k, 2] = bb10
+                        FB[k, 3] = bb11
+                        bb00, bb01, bb10, bb11 = c00, c01, c10, c11
+                        FS[k, 0] = i00
+                        FS[k, 1] = i01
+                        FS[k, 2] = i10
+                        FS[k, 3] = i11
+                        FM[k, 0] = i00 * c00 + i01 * c10    # S_k^-1 B_{k-1}
+                        FM[k, 1] = i00 * c01 + i01 * c11
+                        FM[k, 2] = i10 * c00 + i11 * c10
+                        FM[k, 3] = i10 * c01 + i11 * c11
+                        ZX[k] = bzx
+                        ZY[k] = bzy
+                # pin mid: both neighbours' eliminations (tb: B_{mid-1}, bb: B_mid)
+                k = mid
+                e00 = im + R00[k]
+                e01 = R01[k]
+                e10 = R10[k]
+                e11 = im + R11[k]
+                if k > 0:
+                    e00 += tb00 + 2.0 * im
+                    e01 += tb01
+                    e10 += tb10
+                    e11 += tb11 + 2.0 * im
+                e00, e01, e10, e11 = _schur(bs00, bs01, bs10, bs11, binv,
+                                            bb00, bb01, bb10, bb11, e00, e01, e10, e11)
+                ts00, ts01, ts10, ts11, tinv = _pivot(ts00, ts01, ts10, ts11, tinv,
+                                                      tb00, tb01, tb10, tb11,
+                                                      e00, e01, e10, e11)
+                FS[k, 0] = ts11 * tinv
+                FS[k, 1] = -ts01 * tinv
+                FS[k, 2] = -ts10 * tinv
+                FS[k, 3] = ts00 * tinv
+                FB[k, 0] = tb00
+                FB[k, 1] = tb01
+                FB[k, 2] = tb10
+                FB[k, 3] = tb11
+                FM[k, 0] = bb00                             # the middle keeps B_mid here
+                FM[k, 1] = bb01
+                FM[k, 2] = bb10
+                FM[k, 3] = bb11
             else:
-                zx = 0.0
-                zy = 0.0
-                for k in range(N):
-                    yx = RX[k] + FB[k, 0] * zx + FB[k, 1] * zy
-                    yy = RY[k] + FB[k, 2] * zx + FB[k, 3] * zy
-                    zx = -(FS[k, 0] * yx + FS[k, 1] * yy)
-                    zy = -(FS[k, 2] * yx + FS[k, 3] * yy)
-                    ZX[k] = zx
-                    ZY[k] = zy
-            # back substitution, then the correction applied to every body at once
-            xx = 0.0
-            xy = 0.0
-            for k in range(N - 1, -1, -1):
-                nx = ZX[k] - (FM[k, 0] * xx + FM[k, 1] * xy)
-                xy = ZY[k] - (FM[k, 2] * xx + FM[k, 3] * xy)
-                xx = nx
-                DX[k] = xx
-                DY[k] = xy
+                tzx, tzy, bzx, bzy = 0.0, 0.0, 0.0, 0.0
+                for i in range(mid):
+                    k = i
+                    yx = RX[k] + FB[k, 0] * tzx + FB[k, 1] * tzy
+                    yy = RY[k] + FB[k, 2] * tzx + FB[k, 3] * tzy
+                    tzx = -(FS[k, 0] * yx + FS[k, 1] * yy)
+                    tzy = -(FS[k, 2] * yx + FS[k, 3] * yy)
+                    ZX[k] = tzx
+                    ZY[k] = tzy
+                    if i < nbot:
+                        k = N - 1 - i
+                        yx = RX[k] + FB[k, 0] * bzx + FB[k, 1] * bzy
+                        yy = RY[k] + FB[k, 2] * bzx + FB[k, 3] * bzy
+                        bzx = -(FS[k, 0] * yx + FS[k, 1] * yy)
+                        bzy = -(FS[k, 2] * yx + FS[k, 3] * yy)
+                        ZX[k] = bzx
+                        ZY[k] = bzy
+            # the middle pin's unknown, then back substitution outwards from it
+            k = mid
+            yx = RX[k] + FB[k, 0] * tzx + FB[k, 1] * tzy + FM[k, 0] * bzx + FM[k, 1] * bzy
+            yy = RY[k] + FB[k, 2] * tzx + FB[k, 3] * tzy + FM[k, 2] * bzx + FM[k, 3] * bzy
+            mx = -(FS[k, 0] * yx + FS[k, 1] * yy)
+            my = -(FS[k, 2] * yx + FS[k, 3] * yy)
+            DX[k] = mx
+            DY[k] = my
+            txx, txy, bxx, bxy = mx, my, mx, my
+            for i in range(1, mid + 1):
+                k = mid - i
+                nx = ZX[k] - (FM[k, 0] * txx + FM[k, 1] * txy)
+                txy = ZY[k] - (FM[k, 2] * txx + FM[k, 3] * txy)
+                txx = nx
+                DX[k] = txx
+                DY[k] = txy
+                if i <= nbot:
+                    k = mid + i
+                    nx = ZX[k] - (FM[k, 0] * bxx + FM[k, 1] * bxy)
+                    bxy = ZY[k] - (FM[k, 2] * bxx + FM[k, 3] * bxy)
+                    bxx = nx
+                    DX[k] = bxx
+                    DY[k] = bxy
             nudge = 0
             big = 0
             for k in range(N):
