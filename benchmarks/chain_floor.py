@@ -1,34 +1,49 @@
 """How fast the engine's algorithm can run the pendulum chains at all (not a test).
 
     python benchmarks/chain_floor.py                 # N = 4 and 32, median of 5 runs each
-    python benchmarks/chain_floor.py --links 4 8 16 32 64
-    python benchmarks/chain_floor.py --peers pymunk  # and a peer's step, timed in the same run
+    python benchmarks/chain_floor.py --links 2 4 8 16 32 64 --peers pymunk box2d mujoco
 
-Times the engine on the bench chains (scenes.chain: 0.5 m, 1 kg thin rods, horizontal
-at rest, dt = 1 ms) next to two dedicated chain steps written for this one model, in the
-same process:
+Times the engine on the bench chains (scenes.chain: 0.5 m, 1 kg thin rods pinned end to end,
+link 0 to the world, horizontal at rest, dt = 1 ms) next to "dedicated", a step written for
+this one model, in the same process.
 
-- "dedicated": the engine's algorithm with nothing general left. Gravity, a velocity solve
-  of the pins aimed at their errors at q + h v* (Jacobian at the step's start), symplectic
-  Euler, then Newton-SHAKE corrections along the start-of-step directions until every pin
-  holds to 1e-12 m (at most 4). Fixed row layout (pin k: rows 2k, 2k+1 on links k-1, k),
-  one banded LU (bandwidth 3) for both solves (the engine factors the symmetric velocity
-  solve as L D L^T, half the work), no row kinds, contacts, modes, guards or state copies.
-- "light": the scheme of a throwaway prototype: the velocity solve
-  linearised at q + h v* (a first Newton-SHAKE step) and one correction, with no residual
-  checks at all.
+"dedicated" is the engine's scheme with nothing general left: symplectic Euler with the pins
+enforced at the step's end, i.e. gravity, then q+ = q + h v* + W J0^T mu with mu such that
+every pin holds at q+ to 1e-12 m (J0: the pins' Jacobian at the step's start, W the inverse
+masses), v+ = v* + W J0^T mu / h. The same answer as the engine's (a velocity solve aimed at
+the gaps at q + h v*, then Newton corrections along J0 to 1e-12 m) to rounding, computed as:
 
-The first shows what the engine's generality costs; the second what a lighter scheme gains
-and what it gives up (its residual and energy columns). All three are judged alike: the
-largest pin gap over a 10 s run (sampled every 0.1 s), and the energy change over it as a
-share of the bench's scale m g L sum(i + 1/2).
+- Newton on C(q + h v* + W J0^T mu) = 0, the first pass (the velocity solve) linearised at
+  the prediction, started from mu extrapolated from the last three steps' (3 mu1 - 3 mu2 +
+  mu3); later passes reuse the first pass's factorisation (a fresh one only while some gap is
+  still above 1e-9 m), and the corrections stop at the first pass whose gaps are all within
+  1e-12 m (at most the engine's 4 corrections);
+- J W J0^T is block tridiagonal with 2x2 blocks (pin k couples to pins k - 1 and k + 1
+  through links k - 1 and k): a block LU, twisted (pivots eliminated from both ends of the
+  chain at once, two independent chains of dependent products half as long, meeting at the
+  middle pin), each pivot's inverse as adj / det so that the division is off the products'
+  path;
+- (cos, sin) of every angle carried from step to step and turned by each increment with its
+  Taylor series (Estrin's order; two terms for corrections under 1e-4 rad, math.cos/sin above
+  0.1 rad), resynced from theta every 64 steps;
+- one array per coordinate, so the loops over bodies (prediction, gaps, corrections,
+  velocities) vectorise; the multipliers' history, the carried (cos, sin) and the counters are
+  part of the state (fresh_state), so a run split into calls anywhere gives the same bits.
+No row kinds, contacts, modes, guards or state copies; fastmath stays off, as in the engine
+(it would change the bits). The "light" runner of earlier versions (a velocity solve
+linearised at the prediction and one unchecked correction) is gone: the dedicated step now
+takes that linearisation and still checks every gap.
 
---peers (mujoco, pymunk, box2d; `pip install planarsim[compare]`): the peers' steps of the
-same chains (benchmarks/peers, as `planarsim bench` times them) go round with the three
-above, and each N ends with the dedicated step's ratio to the fastest of them: how fast the
-engine could be against the peers with nothing general left. The fastest is the one with the
-most steps/s, whatever its accuracy (the bench's raw ratio); the peers are judged the same
-way as the runners above (pin gaps sampled every 0.1 s, energy change over the 10 s).
+Both runners are judged alike: the largest pin gap over a 10 s run (sampled every 0.1 s), and
+the energy change over it as a share of the bench's scale m g L sum(i + 1/2).
+
+--peers (mujoco, pymunk, box2d, apart or comma-separated, or all; `pip install
+planarsim[compare]`): the peers' steps of the same chains (benchmarks/peers, as `planarsim
+bench` times them) go round with the two above, and each N ends with the dedicated step's
+ratio to the fastest of them (the "x peer" column): how fast the engine's scheme can be
+against the peers with nothing general left. The fastest is the one with the most steps/s,
+whatever its accuracy (the bench's raw ratio); the peers are judged the same way as the
+runners above (pin gaps sampled every 0.1 s, energy change over the 10 s).
 """
 from __future__ import annotations
 
@@ -59,8 +74,6 @@ INV_INERTIA = 1.0 / INERTIA
 DT = 1e-3          # [s]
 TOL = ps.StepOptions().refine_tol          # [m] the engine's default
 MAX_ITERS = ps.StepOptions().refine_iters  # the engine's default
-
-
 HALF = 0.5 * LENGTH
 RESYNC = 64        # steps between resyncs of the carried (cos, sin) from theta
 TAYLOR_MAX = 0.1   # [rad] increments up to this turn (cos, sin) by the series below
@@ -124,9 +137,9 @@ def run_chain(q, v, cs, hist, count, n_steps):
 
     cs (N, 2): cos, sin of q[:, 2] carried from step to step (turned by each increment,
     resynced from theta every RESYNC steps and at count[0] == 0); hist (3, 2, N + 1): the last
-    three steps' multipliers (ring buffer, newest at count[1] % 3; column N stays 0);
-    count: [steps taken, steps of history]. The state of a run is (q, v, cs, hist, count);
-    reset it with fresh_state.
+    three steps' multipliers (ring buffer: step e's at e % 3; column N stays 0); count: [steps
+    taken, steps of history, correction passes checked, factorisations]. The state of a run
+    is (q, v, cs, hist, count); fresh_state makes one.
     """
     N = q.shape[0]
     h = DT
@@ -150,7 +163,9 @@ def run_chain(q, v, cs, hist, count, n_steps):
     U0Y = np.empty(N)
     GX = np.zeros(N + 1)    # mu (pin k: x, y; GX[N] = GY[N] = 0)
     GY = np.zeros(N + 1)
-    # the factorisation: per pin, S_k^-1, M_k = S_k^-1 B_k and B_{k-1}; z the forward sweep
+    # the factorisation, per pin: FS the pivot's inverse S_k^-1, FM = S_k^-1 (coupling to
+    # the next pin of its sweep), FB the coupling to the one before (the middle pin: FB to
+    # mid - 1, FM to mid + 1); Z the forward sweeps' unknowns
     FS = np.empty((N, 4))
     FM = np.empty((N, 4))
     FB = np.empty((N, 4))
@@ -158,7 +173,7 @@ def run_chain(q, v, cs, hist, count, n_steps):
     ZY = np.empty(N)
     DX = np.zeros(N + 1)    # a correction of mu (DX[N] = DY[N] = 0)
     DY = np.zeros(N + 1)
-    DT_ = np.empty(N)       # the angle increments of the prediction
+    DT_ = np.empty(N)       # the angle increments of the prediction or a correction
     R00 = np.empty(N)       # R_k = (1/I) un_k u0_k^T of link k
     R01 = np.empty(N)
     R10 = np.empty(N)
