@@ -79,6 +79,7 @@ RESYNC = 64        # steps between resyncs of the carried (cos, sin) from theta
 TAYLOR_MAX = 0.1   # [rad] increments up to this turn (cos, sin) by the series below
 TOL2 = TOL * TOL
 NUDGE_MAX = 1e-4   # [rad] corrections up to this turn (cos, sin) by the shorter series
+CLOSED_TURN = math.sqrt(TOL / (4 * HALF))   # [rad] see the end of a Newton pass
 FAR = 1e-9         # [m] gaps above this after a correction: factor again (else reuse)
 FAR2 = FAR * FAR
 
@@ -257,7 +258,8 @@ def run_chain(q, v, cs, hist, count, n_steps):
                 count[2] += 1
                 if not bad or it == MAX_ITERS + 1:
                     break
-            if it == 0 or far:
+            newton = it == 0 or far
+            if newton:
                 count[3] += 1
                 # block LU of A = J W J0^T: diagonal blocks D_k = I/m + R_k (+ I/m + R_{k-1}),
                 # B_k = R_k - I/m between pins k and k + 1 both ways, R_k = (1/I) un_k u0_k^T
@@ -425,6 +427,7 @@ def run_chain(q, v, cs, hist, count, n_steps):
                     DY[k] = bxy
             nudge = 0
             big = 0
+            coarse = 0
             for k in range(N):
                 nx = DX[k]
                 ny = DY[k]
@@ -439,6 +442,7 @@ def run_chain(q, v, cs, hist, count, n_steps):
                 GY[k] += ny
                 nudge += abs(dt) > NUDGE_MAX
                 big += abs(dt) > TAYLOR_MAX
+                coarse += abs(dt) > CLOSED_TURN
             if nudge:
                 for k in range(N):
                     CN[k], SN[k] = _turn(CN[k], SN[k], DT_[k])
@@ -450,6 +454,12 @@ def run_chain(q, v, cs, hist, count, n_steps):
                     if abs(DT_[k]) > TAYLOR_MAX:
                         CN[k] = math.cos(QT[k])
                         SN[k] = math.sin(QT[k])
+            # after a Newton pass (the Jacobian of the iterate's own gaps) the new gaps are
+            # the turns' second-order terms, at most (L/2) max dtheta^2 (the translations are
+            # linear): with every turn within CLOSED_TURN every gap is within TOL / 4, closed
+            # without measuring them again
+            if newton and not coarse:
+                break
         # v = v* + W J0^T mu / h; the step's end is the iterate
         for k in range(N):
             VX[k] += (GX[k] - GX[k + 1]) * (im / h)
