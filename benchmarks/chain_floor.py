@@ -133,124 +133,138 @@ def _schur(s00, s01, s10, s11, inv, b00, b01, b10, b11, e00, e01, e10, e11):
 
 
 @jit
-def run_chain(q, v, cs, hist, count, n_steps):
-    """n_steps of the dedicated chain step on q, v (N, 3) in place.
+def _coefficients(nh):
+    """Weights of the newest, the one before and the oldest of nh steps' multipliers in the
+    next step's first guess: quadratic extrapolation (linear, constant, none at the start)."""
+    if nh >= 3:
+        return 3.0, -3.0, 1.0
+    if nh == 2:
+        return 2.0, -1.0, 0.0
+    if nh == 1:
+        return 1.0, 0.0, 0.0
+    return 0.0, 0.0, 0.0
 
-    cs (N, 2): cos, sin of q[:, 2] carried from step to step (turned by each increment,
-    resynced from theta every RESYNC steps and at count[0] == 0); hist (3, 2, N + 1): the last
-    three steps' multipliers (ring buffer: step e's at e % 3; column N stays 0); count: [steps
-    taken, steps of history, correction passes checked, factorisations]. The state of a run
-    is (q, v, cs, hist, count); fresh_state makes one.
-    """
+
+@njit(inline="always")
+def _run(q, v, cs, hist, count, n_steps, NM):
+    """run_chain's kernel. Every per-body or per-pin quantity is a row of one flat array W at
+    stride NM. Inlined where NM is a constant (_run40, ...), the compiler sees that the rows
+    are disjoint and vectorises the loops over bodies without runtime checks of overlap
+    (which cost more than the loops themselves at 8 to 32 links)."""
     N = q.shape[0]
     h = DT
     im = INV_MASS
     ii = INV_INERTIA
-    # the bodies, one array per coordinate (loops over bodies vectorise)
-    X = q[:, 0].copy()
-    Y = q[:, 1].copy()
-    T = q[:, 2].copy()
-    VX = v[:, 0].copy()
-    VY = v[:, 1].copy()
-    VW = v[:, 2].copy()
-    C = cs[:, 0].copy()
-    S = cs[:, 1].copy()
-    QX = np.empty(N)        # the iterate q* + W J0^T mu
-    QY = np.empty(N)
-    QT = np.empty(N)
-    CN = np.empty(N)        # its (cos, sin)
-    SN = np.empty(N)
-    U0X = np.empty(N)       # u0 = (L/2)(sin, -cos) at the step's start: J0's angle column
-    U0Y = np.empty(N)
-    GX = np.zeros(N + 1)    # mu (pin k: x, y; GX[N] = GY[N] = 0)
-    GY = np.zeros(N + 1)
+    X_ = 0 * NM
+    Y_ = 1 * NM
+    T_ = 2 * NM
+    VX_ = 3 * NM
+    VY_ = 4 * NM
+    VW_ = 5 * NM
+    C_ = 6 * NM
+    S_ = 7 * NM
+    QX_ = 8 * NM
+    QY_ = 9 * NM
+    QT_ = 10 * NM
+    CN_ = 11 * NM
+    SN_ = 12 * NM
+    U0X_ = 13 * NM
+    U0Y_ = 14 * NM
+    GX_ = 15 * NM
+    GY_ = 16 * NM
+    DX_ = 17 * NM
+    DY_ = 18 * NM
+    DT__ = 19 * NM
+    R00_ = 20 * NM
+    R01_ = 21 * NM
+    R10_ = 22 * NM
+    R11_ = 23 * NM
+    RX_ = 24 * NM
+    RY_ = 25 * NM
+    ZX_ = 26 * NM
+    ZY_ = 27 * NM
+    H0X_ = 28 * NM
+    H0Y_ = 29 * NM
+    H1X_ = 30 * NM
+    H1Y_ = 31 * NM
+    H2X_ = 32 * NM
+    H2Y_ = 33 * NM
+    W = np.zeros(34 * NM)
+    for k in range(N):
+        W[X_ + k] = q[k, 0]
+        W[Y_ + k] = q[k, 1]
+        W[T_ + k] = q[k, 2]
+        W[VX_ + k] = v[k, 0]
+        W[VY_ + k] = v[k, 1]
+        W[VW_ + k] = v[k, 2]
+        W[C_ + k] = cs[k, 0]
+        W[S_ + k] = cs[k, 1]
+        W[H0X_ + k] = hist[0, 0, k]
+        W[H0Y_ + k] = hist[0, 1, k]
+        W[H1X_ + k] = hist[1, 0, k]
+        W[H1Y_ + k] = hist[1, 1, k]
+        W[H2X_ + k] = hist[2, 0, k]
+        W[H2Y_ + k] = hist[2, 1, k]
     # the factorisation, per pin: FS the pivot's inverse S_k^-1, FM = S_k^-1 (coupling to
     # the next pin of its sweep), FB the coupling to the one before (the middle pin: FB to
     # mid - 1, FM to mid + 1); Z the forward sweeps' unknowns
     FS = np.empty((N, 4))
     FM = np.empty((N, 4))
     FB = np.empty((N, 4))
-    ZX = np.empty(N)
-    ZY = np.empty(N)
-    DX = np.zeros(N + 1)    # a correction of mu (DX[N] = DY[N] = 0)
-    DY = np.zeros(N + 1)
-    DT_ = np.empty(N)       # the angle increments of the prediction or a correction
-    R00 = np.empty(N)       # R_k = (1/I) un_k u0_k^T of link k
-    R01 = np.empty(N)
-    R10 = np.empty(N)
-    R11 = np.empty(N)
     mid = N // 2            # the pin where the two eliminations meet
     nbot = N - 1 - mid      # pins eliminated from the bottom
-    RX = np.empty(N)        # the gaps at the iterate
-    RY = np.empty(N)
+    # the first guess of mu: extrapolated from the history (newest first)
+    a0, a1, a2 = _coefficients(count[1])
+    for k in range(N):
+        W[GX_ + k] = a0 * W[H0X_ + k] + a1 * W[H1X_ + k] + a2 * W[H2X_ + k]
+        W[GY_ + k] = a0 * W[H0Y_ + k] + a1 * W[H1Y_ + k] + a2 * W[H2Y_ + k]
     for _ in range(n_steps):
         if count[0] % RESYNC == 0:
             for k in range(N):
-                C[k] = math.cos(T[k])
-                S[k] = math.sin(T[k])
-        # first guess of mu: quadratic extrapolation of the last steps' (fewer at the start)
-        nh = count[1]
-        a0, a1, a2 = 0.0, 0.0, 0.0
-        if nh >= 3:
-            a0, a1, a2 = 3.0, -3.0, 1.0
-        elif nh == 2:
-            a0, a1 = 2.0, -1.0
-        elif nh == 1:
-            a0 = 1.0
-        i0 = (nh + 2) % 3   # entry e of the history sits at e % 3: newest nh - 1
-        i1 = (nh + 1) % 3
-        i2 = nh % 3
-        H0X = hist[i0, 0]
-        H0Y = hist[i0, 1]
-        H1X = hist[i1, 0]
-        H1Y = hist[i1, 1]
-        H2X = hist[i2, 0]
-        H2Y = hist[i2, 1]
-        for k in range(N):
-            GX[k] = a0 * H0X[k] + a1 * H1X[k] + a2 * H2X[k]
-            GY[k] = a0 * H0Y[k] + a1 * H1Y[k] + a2 * H2Y[k]
+                W[C_ + k] = math.cos(W[T_ + k])
+                W[S_ + k] = math.sin(W[T_ + k])
         # gravity, and the prediction q + h v* + W J0^T mu
         big = 0
         for k in range(N):
-            VY[k] -= G * h
-            u0x = HALF * S[k]
-            u0y = -HALF * C[k]
-            U0X[k] = u0x
-            U0Y[k] = u0y
-            dx = h * VX[k] + (GX[k] - GX[k + 1]) * im
-            dy = h * VY[k] + (GY[k] - GY[k + 1]) * im
-            dt = h * VW[k] + (u0x * (GX[k] + GX[k + 1]) + u0y * (GY[k] + GY[k + 1])) * ii
-            QX[k] = X[k] + dx
-            QY[k] = Y[k] + dy
-            QT[k] = T[k] + dt
-            DT_[k] = dt
+            W[VY_ + k] -= G * h
+            u0x = HALF * W[S_ + k]
+            u0y = -HALF * W[C_ + k]
+            W[U0X_ + k] = u0x
+            W[U0Y_ + k] = u0y
+            dx = h * W[VX_ + k] + (W[GX_ + k] - W[GX_ + k + 1]) * im
+            dy = h * W[VY_ + k] + (W[GY_ + k] - W[GY_ + k + 1]) * im
+            dt = h * W[VW_ + k] + (u0x * (W[GX_ + k] + W[GX_ + k + 1]) + u0y * (W[GY_ + k] + W[GY_ + k + 1])) * ii
+            W[QX_ + k] = W[X_ + k] + dx
+            W[QY_ + k] = W[Y_ + k] + dy
+            W[QT_ + k] = W[T_ + k] + dt
+            W[DT__ + k] = dt
             big += abs(dt) > TAYLOR_MAX
         for k in range(N):
-            CN[k], SN[k] = _turn(C[k], S[k], DT_[k])
-            # CN[k] = c * cd - s * sd
+            W[CN_ + k], W[SN_ + k] = _turn(W[C_ + k], W[S_ + k], W[DT__ + k])
+            # W[CN_ + k] = c * cd - s * sd
         if big:
             for k in range(N):
-                if abs(DT_[k]) > TAYLOR_MAX:
-                    CN[k] = math.cos(QT[k])
-                    SN[k] = math.sin(QT[k])
+                if abs(W[DT__ + k]) > TAYLOR_MAX:
+                    W[CN_ + k] = math.cos(W[QT_ + k])
+                    W[SN_ + k] = math.sin(W[QT_ + k])
         # Newton on C(q* + W J0^T mu) = 0. A pass: the gaps at the iterate (every pin's at
         # once); stop when all are <= TOL (after the first pass); else factor J(q) W J0^T at
         # the iterate (the first pass, or when the gaps are still far from closed) or reuse
         # the last factorisation, solve, and apply the correction.
         for it in range(MAX_ITERS + 2):
             # pin k: left end of link k minus right end of link k - 1 (the origin for k = 0)
-            rx = QX[0] - HALF * CN[0]
-            ry = QY[0] - HALF * SN[0]
-            RX[0] = rx
-            RY[0] = ry
+            rx = W[QX_ + 0] - HALF * W[CN_ + 0]
+            ry = W[QY_ + 0] - HALF * W[SN_ + 0]
+            W[RX_ + 0] = rx
+            W[RY_ + 0] = ry
             g = rx * rx + ry * ry
             bad = g > TOL2
             far = g > FAR2
             for k in range(1, N):
-                rx = (QX[k] - HALF * CN[k]) - (QX[k - 1] + HALF * CN[k - 1])
-                ry = (QY[k] - HALF * SN[k]) - (QY[k - 1] + HALF * SN[k - 1])
-                RX[k] = rx
-                RY[k] = ry
+                rx = (W[QX_ + k] - HALF * W[CN_ + k]) - (W[QX_ + k - 1] + HALF * W[CN_ + k - 1])
+                ry = (W[QY_ + k] - HALF * W[SN_ + k]) - (W[QY_ + k - 1] + HALF * W[SN_ + k - 1])
+                W[RX_ + k] = rx
+                W[RY_ + k] = ry
                 g = rx * rx + ry * ry
                 bad |= g > TOL2
                 far |= g > FAR2
@@ -266,12 +280,12 @@ def run_chain(q, v, cs, hist, count, n_steps):
                 # (un at the iterate). Twisted: pivots eliminated from both ends at once (two
                 # independent chains of half the length) until they meet at pin mid.
                 for k in range(N):
-                    hs = HALF * SN[k] * ii
-                    hc = -HALF * CN[k] * ii
-                    R00[k] = hs * U0X[k]
-                    R01[k] = hs * U0Y[k]
-                    R10[k] = hc * U0X[k]
-                    R11[k] = hc * U0Y[k]
+                    hs = HALF * W[SN_ + k] * ii
+                    hc = -HALF * W[CN_ + k] * ii
+                    W[R00_ + k] = hs * W[U0X_ + k]
+                    W[R01_ + k] = hs * W[U0Y_ + k]
+                    W[R10_ + k] = hc * W[U0X_ + k]
+                    W[R11_ + k] = hc * W[U0Y_ + k]
                 # top: pins 0, 1, ..., mid - 1, S_k = D_k - B_{k-1} S_{k-1}^-1 B_{k-1}
                 ts00, ts01, ts10, ts11, tinv = 1.0, 0.0, 0.0, 1.0, 0.0
                 tb00, tb01, tb10, tb11 = 0.0, 0.0, 0.0, 0.0
@@ -282,10 +296,10 @@ def run_chain(q, v, cs, hist, count, n_steps):
                 bzx, bzy = 0.0, 0.0
                 for i in range(mid):
                     k = i
-                    e00 = im + R00[k]
-                    e01 = R01[k]
-                    e10 = R10[k]
-                    e11 = im + R11[k]
+                    e00 = im + W[R00_ + k]
+                    e01 = W[R01_ + k]
+                    e10 = W[R10_ + k]
+                    e11 = im + W[R11_ + k]
                     if k > 0:
                         e00 += tb00 + 2.0 * im      # I/m + R_{k-1} = B_{k-1} + 2 I/m
                         e01 += tb01
@@ -298,18 +312,18 @@ def run_chain(q, v, cs, hist, count, n_steps):
                     i01 = -ts01 * tinv
                     i10 = -ts10 * tinv
                     i11 = ts00 * tinv
-                    yx = RX[k] + tb00 * tzx + tb01 * tzy     # -(the right-hand side)
-                    yy = RY[k] + tb10 * tzx + tb11 * tzy
+                    yx = W[RX_ + k] + tb00 * tzx + tb01 * tzy     # -(the right-hand side)
+                    yy = W[RY_ + k] + tb10 * tzx + tb11 * tzy
                     tzx = -(i00 * yx + i01 * yy)
                     tzy = -(i10 * yx + i11 * yy)
                     FB[k, 0] = tb00
                     FB[k, 1] = tb01
                     FB[k, 2] = tb10
                     FB[k, 3] = tb11
-                    tb00 = R00[k] - im                      # B_k, towards the middle
-                    tb01 = R01[k]
-                    tb10 = R10[k]
-                    tb11 = R11[k] - im
+                    tb00 = W[R00_ + k] - im                      # B_k, towards the middle
+                    tb01 = W[R01_ + k]
+                    tb10 = W[R10_ + k]
+                    tb11 = W[R11_ + k] - im
                     FS[k, 0] = i00
                     FS[k, 1] = i01
                     FS[k, 2] = i10
@@ -318,18 +332,18 @@ def run_chain(q, v, cs, hist, count, n_steps):
                     FM[k, 1] = i00 * tb01 + i01 * tb11
                     FM[k, 2] = i10 * tb00 + i11 * tb10
                     FM[k, 3] = i10 * tb01 + i11 * tb11
-                    ZX[k] = tzx
-                    ZY[k] = tzy
+                    W[ZX_ + k] = tzx
+                    W[ZY_ + k] = tzy
                     if i < nbot:
                         k = N - 1 - i
-                        c00 = R00[k - 1] - im               # B_{k-1}, towards the middle
-                        c01 = R01[k - 1]
-                        c10 = R10[k - 1]
-                        c11 = R11[k - 1] - im
-                        e00 = (im + R00[k]) + (c00 + 2.0 * im)
-                        e01 = R01[k] + c01
-                        e10 = R10[k] + c10
-                        e11 = (im + R11[k]) + (c11 + 2.0 * im)
+                        c00 = W[R00_ + k - 1] - im               # B_{k-1}, towards the middle
+                        c01 = W[R01_ + k - 1]
+                        c10 = W[R10_ + k - 1]
+                        c11 = W[R11_ + k - 1] - im
+                        e00 = (im + W[R00_ + k]) + (c00 + 2.0 * im)
+                        e01 = W[R01_ + k] + c01
+                        e10 = W[R10_ + k] + c10
+                        e11 = (im + W[R11_ + k]) + (c11 + 2.0 * im)
                         bs00, bs01, bs10, bs11, binv = _pivot(bs00, bs01, bs10, bs11, binv,
                                                               bb00, bb01, bb10, bb11,
                                                               e00, e01, e10, e11)
@@ -337,8 +351,8 @@ def run_chain(q, v, cs, hist, count, n_steps):
                         i01 = -bs01 * binv
                         i10 = -bs10 * binv
                         i11 = bs00 * binv
-                        yx = RX[k] + bb00 * bzx + bb01 * bzy
-                        yy = RY[k] + bb10 * bzx + bb11 * bzy
+                        yx = W[RX_ + k] + bb00 * bzx + bb01 * bzy
+                        yy = W[RY_ + k] + bb10 * bzx + bb11 * bzy
                         bzx = -(i00 * yx + i01 * yy)
                         bzy = -(i10 * yx + i11 * yy)
                         FB[k, 0] = bb00
@@ -354,14 +368,14 @@ def run_chain(q, v, cs, hist, count, n_steps):
                         FM[k, 1] = i00 * c01 + i01 * c11
                         FM[k, 2] = i10 * c00 + i11 * c10
                         FM[k, 3] = i10 * c01 + i11 * c11
-                        ZX[k] = bzx
-                        ZY[k] = bzy
+                        W[ZX_ + k] = bzx
+                        W[ZY_ + k] = bzy
                 # pin mid: both neighbours' eliminations (tb: B_{mid-1}, bb: B_mid)
                 k = mid
-                e00 = im + R00[k]
-                e01 = R01[k]
-                e10 = R10[k]
-                e11 = im + R11[k]
+                e00 = im + W[R00_ + k]
+                e01 = W[R01_ + k]
+                e10 = W[R10_ + k]
+                e11 = im + W[R11_ + k]
                 if k > 0:
                     e00 += tb00 + 2.0 * im
                     e01 += tb01
@@ -388,103 +402,160 @@ def run_chain(q, v, cs, hist, count, n_steps):
                 tzx, tzy, bzx, bzy = 0.0, 0.0, 0.0, 0.0
                 for i in range(mid):
                     k = i
-                    yx = RX[k] + FB[k, 0] * tzx + FB[k, 1] * tzy
-                    yy = RY[k] + FB[k, 2] * tzx + FB[k, 3] * tzy
+                    yx = W[RX_ + k] + FB[k, 0] * tzx + FB[k, 1] * tzy
+                    yy = W[RY_ + k] + FB[k, 2] * tzx + FB[k, 3] * tzy
                     tzx = -(FS[k, 0] * yx + FS[k, 1] * yy)
                     tzy = -(FS[k, 2] * yx + FS[k, 3] * yy)
-                    ZX[k] = tzx
-                    ZY[k] = tzy
+                    W[ZX_ + k] = tzx
+                    W[ZY_ + k] = tzy
                     if i < nbot:
                         k = N - 1 - i
-                        yx = RX[k] + FB[k, 0] * bzx + FB[k, 1] * bzy
-                        yy = RY[k] + FB[k, 2] * bzx + FB[k, 3] * bzy
+                        yx = W[RX_ + k] + FB[k, 0] * bzx + FB[k, 1] * bzy
+                        yy = W[RY_ + k] + FB[k, 2] * bzx + FB[k, 3] * bzy
                         bzx = -(FS[k, 0] * yx + FS[k, 1] * yy)
                         bzy = -(FS[k, 2] * yx + FS[k, 3] * yy)
-                        ZX[k] = bzx
-                        ZY[k] = bzy
+                        W[ZX_ + k] = bzx
+                        W[ZY_ + k] = bzy
             # the middle pin's unknown, then back substitution outwards from it
             k = mid
-            yx = RX[k] + FB[k, 0] * tzx + FB[k, 1] * tzy + FM[k, 0] * bzx + FM[k, 1] * bzy
-            yy = RY[k] + FB[k, 2] * tzx + FB[k, 3] * tzy + FM[k, 2] * bzx + FM[k, 3] * bzy
+            yx = W[RX_ + k] + FB[k, 0] * tzx + FB[k, 1] * tzy + FM[k, 0] * bzx + FM[k, 1] * bzy
+            yy = W[RY_ + k] + FB[k, 2] * tzx + FB[k, 3] * tzy + FM[k, 2] * bzx + FM[k, 3] * bzy
             mx = -(FS[k, 0] * yx + FS[k, 1] * yy)
             my = -(FS[k, 2] * yx + FS[k, 3] * yy)
-            DX[k] = mx
-            DY[k] = my
+            W[DX_ + k] = mx
+            W[DY_ + k] = my
             txx, txy, bxx, bxy = mx, my, mx, my
             for i in range(1, mid + 1):
                 k = mid - i
-                nx = ZX[k] - (FM[k, 0] * txx + FM[k, 1] * txy)
-                txy = ZY[k] - (FM[k, 2] * txx + FM[k, 3] * txy)
+                nx = W[ZX_ + k] - (FM[k, 0] * txx + FM[k, 1] * txy)
+                txy = W[ZY_ + k] - (FM[k, 2] * txx + FM[k, 3] * txy)
                 txx = nx
-                DX[k] = txx
-                DY[k] = txy
+                W[DX_ + k] = txx
+                W[DY_ + k] = txy
                 if i <= nbot:
                     k = mid + i
-                    nx = ZX[k] - (FM[k, 0] * bxx + FM[k, 1] * bxy)
-                    bxy = ZY[k] - (FM[k, 2] * bxx + FM[k, 3] * bxy)
+                    nx = W[ZX_ + k] - (FM[k, 0] * bxx + FM[k, 1] * bxy)
+                    bxy = W[ZY_ + k] - (FM[k, 2] * bxx + FM[k, 3] * bxy)
                     bxx = nx
-                    DX[k] = bxx
-                    DY[k] = bxy
+                    W[DX_ + k] = bxx
+                    W[DY_ + k] = bxy
             nudge = 0
             big = 0
             coarse = 0
             for k in range(N):
-                nx = DX[k]
-                ny = DY[k]
-                xx = DX[k + 1]
-                xy = DY[k + 1]
-                dt = (U0X[k] * (nx + xx) + U0Y[k] * (ny + xy)) * ii
-                QX[k] += (nx - xx) * im
-                QY[k] += (ny - xy) * im
-                QT[k] += dt
-                DT_[k] = dt
-                GX[k] += nx
-                GY[k] += ny
+                nx = W[DX_ + k]
+                ny = W[DY_ + k]
+                xx = W[DX_ + k + 1]
+                xy = W[DY_ + k + 1]
+                dt = (W[U0X_ + k] * (nx + xx) + W[U0Y_ + k] * (ny + xy)) * ii
+                W[QX_ + k] += (nx - xx) * im
+                W[QY_ + k] += (ny - xy) * im
+                W[QT_ + k] += dt
+                W[DT__ + k] = dt
+                W[GX_ + k] += nx
+                W[GY_ + k] += ny
                 nudge += abs(dt) > NUDGE_MAX
                 big += abs(dt) > TAYLOR_MAX
                 coarse += abs(dt) > CLOSED_TURN
             if nudge:
                 for k in range(N):
-                    CN[k], SN[k] = _turn(CN[k], SN[k], DT_[k])
+                    W[CN_ + k], W[SN_ + k] = _turn(W[CN_ + k], W[SN_ + k], W[DT__ + k])
             else:
                 for k in range(N):
-                    CN[k], SN[k] = _nudge(CN[k], SN[k], DT_[k])
+                    W[CN_ + k], W[SN_ + k] = _nudge(W[CN_ + k], W[SN_ + k], W[DT__ + k])
             if big:
                 for k in range(N):
-                    if abs(DT_[k]) > TAYLOR_MAX:
-                        CN[k] = math.cos(QT[k])
-                        SN[k] = math.sin(QT[k])
+                    if abs(W[DT__ + k]) > TAYLOR_MAX:
+                        W[CN_ + k] = math.cos(W[QT_ + k])
+                        W[SN_ + k] = math.sin(W[QT_ + k])
             # after a Newton pass (the Jacobian of the iterate's own gaps) the new gaps are
             # the turns' second-order terms, at most (L/2) max dtheta^2 (the translations are
             # linear): with every turn within CLOSED_TURN every gap is within TOL / 4, closed
             # without measuring them again
             if newton and not coarse:
                 break
-        # v = v* + W J0^T mu / h; the step's end is the iterate
+        # v = v* + W J0^T mu / h; the step's end is the iterate; mu into the history and the
+        # next step's first guess (quadratic extrapolation of the last three steps' mu)
+        nh = min(count[1] + 1, 3)
+        a0, a1, a2 = _coefficients(nh)
         for k in range(N):
-            VX[k] += (GX[k] - GX[k + 1]) * (im / h)
-            VY[k] += (GY[k] - GY[k + 1]) * (im / h)
-            VW[k] += (U0X[k] * (GX[k] + GX[k + 1]) + U0Y[k] * (GY[k] + GY[k + 1])) * (ii / h)
-            X[k] = QX[k]
-            Y[k] = QY[k]
-            T[k] = QT[k]
-            C[k] = CN[k]
-            S[k] = SN[k]
-        j = nh % 3
+            gx = W[GX_ + k]
+            gy = W[GY_ + k]
+            gx1 = W[GX_ + k + 1]
+            gy1 = W[GY_ + k + 1]
+            W[VX_ + k] += (gx - gx1) * (im / h)
+            W[VY_ + k] += (gy - gy1) * (im / h)
+            W[VW_ + k] += (W[U0X_ + k] * (gx + gx1) + W[U0Y_ + k] * (gy + gy1)) * (ii / h)
+            W[X_ + k] = W[QX_ + k]
+            W[Y_ + k] = W[QY_ + k]
+            W[T_ + k] = W[QT_ + k]
+            W[C_ + k] = W[CN_ + k]
+            W[S_ + k] = W[SN_ + k]
+            W[H2X_ + k] = W[H1X_ + k]
+            W[H2Y_ + k] = W[H1Y_ + k]
+            W[H1X_ + k] = W[H0X_ + k]
+            W[H1Y_ + k] = W[H0Y_ + k]
+            W[H0X_ + k] = gx
+            W[H0Y_ + k] = gy
         for k in range(N):
-            hist[j, 0, k] = GX[k]
-            hist[j, 1, k] = GY[k]
+            W[GX_ + k] = a0 * W[H0X_ + k] + a1 * W[H1X_ + k] + a2 * W[H2X_ + k]
+            W[GY_ + k] = a0 * W[H0Y_ + k] + a1 * W[H1Y_ + k] + a2 * W[H2Y_ + k]
         count[0] += 1
-        count[1] = nh + 1
+        count[1] = nh
     for k in range(N):
-        q[k, 0] = X[k]
-        q[k, 1] = Y[k]
-        q[k, 2] = T[k]
-        v[k, 0] = VX[k]
-        v[k, 1] = VY[k]
-        v[k, 2] = VW[k]
-        cs[k, 0] = C[k]
-        cs[k, 1] = S[k]
+        q[k, 0] = W[X_ + k]
+        q[k, 1] = W[Y_ + k]
+        q[k, 2] = W[T_ + k]
+        v[k, 0] = W[VX_ + k]
+        v[k, 1] = W[VY_ + k]
+        v[k, 2] = W[VW_ + k]
+        cs[k, 0] = W[C_ + k]
+        cs[k, 1] = W[S_ + k]
+        hist[0, 0, k] = W[H0X_ + k]
+        hist[0, 1, k] = W[H0Y_ + k]
+        hist[1, 0, k] = W[H1X_ + k]
+        hist[1, 1, k] = W[H1Y_ + k]
+        hist[2, 0, k] = W[H2X_ + k]
+        hist[2, 1, k] = W[H2Y_ + k]
+
+
+@jit
+def _run_short(q, v, cs, hist, count, n_steps):
+    _run(q, v, cs, hist, count, n_steps, 40)
+
+
+@jit
+def _run_long(q, v, cs, hist, count, n_steps):
+    _run(q, v, cs, hist, count, n_steps, 264)
+
+
+@jit
+def _run_any(q, v, cs, hist, count, n_steps):
+    _run(q, v, cs, hist, count, n_steps, q.shape[0] + 1)
+
+
+#: (most links, kernel) of the kernels with a constant row stride (40 and 264 numbers, at
+#: least N + 1). Measured (2 to 64 links): at 264 every loop over bodies vectorises, at 40
+#: to 136 some do not (the compiler's dependence analysis gives up on them); 40 is a little
+#: faster up to 7 links. Longer chains than 263 links take _run_any (stride N + 1, the
+#: overlap checked at run time).
+KERNELS = ((7, _run_short), (263, _run_long))
+
+
+def run_chain(q, v, cs, hist, count, n_steps):
+    """n_steps of the dedicated chain step on q, v (N, 3) in place.
+
+    cs (N, 2): cos, sin of q[:, 2] carried from step to step (turned by each increment,
+    resynced from theta every RESYNC steps and at count[0] == 0); hist (3, 2, N + 1): the last
+    three steps' multipliers, newest first (column N stays 0); count: [steps taken, steps of
+    history (at most 3), correction passes checked, factorisations]. The state of a run is
+    (q, v, cs, hist, count); fresh_state makes one.
+    """
+    for most, kernel in KERNELS:
+        if q.shape[0] <= most:
+            kernel(q, v, cs, hist, count, n_steps)
+            return
+    _run_any(q, v, cs, hist, count, n_steps)
 
 
 def fresh_state(model):
