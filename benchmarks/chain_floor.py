@@ -17,7 +17,9 @@ the gaps at q + h v*, then Newton corrections along J0 to 1e-12 m) to rounding, 
   the prediction, started from mu extrapolated from the last three steps' (3 mu1 - 3 mu2 +
   mu3); later passes reuse the first pass's factorisation (a fresh one only while some gap is
   still above 1e-9 m), and the corrections stop at the first pass whose gaps are all within
-  1e-12 m (at most the engine's 4 corrections);
+  1e-12 m (at most the engine's 4 corrections). A Newton pass that turned no link by more
+  than 1e-6 rad needs no measuring: its gaps are the turns' second-order terms, within
+  (L/2) dtheta^2 <= 1e-12 m / 4;
 - J W J0^T is block tridiagonal with 2x2 blocks (pin k couples to pins k - 1 and k + 1
   through links k - 1 and k): a block LU, twisted (pivots eliminated from both ends of the
   chain at once, two independent chains of dependent products half as long, meeting at the
@@ -26,9 +28,13 @@ the gaps at q + h v*, then Newton corrections along J0 to 1e-12 m) to rounding, 
 - (cos, sin) of every angle carried from step to step and turned by each increment with its
   Taylor series (Estrin's order; two terms for corrections under 1e-4 rad, math.cos/sin above
   0.1 rad), resynced from theta every 64 steps;
-- one array per coordinate, so the loops over bodies (prediction, gaps, corrections,
-  velocities) vectorise; the multipliers' history, the carried (cos, sin) and the counters are
-  part of the state (fresh_state), so a run split into calls anywhere gives the same bits.
+- every per-body (or per-pin) quantity a row of one work array at a row stride that is a
+  compile-time constant (kernels for up to 7 and up to 263 links; longer chains take a
+  kernel with the stride known at run time only), so the compiler sees the rows disjoint and
+  the loops over bodies (prediction, gaps, corrections, velocities) vectorise without
+  runtime overlap checks; the multipliers' history, the carried (cos, sin) and the counters
+  are part of the state (fresh_state), so a run split into calls anywhere gives the same
+  bits.
 No row kinds, contacts, modes, guards or state copies; fastmath stays off, as in the engine
 (it would change the bits). The "light" runner of earlier versions (a velocity solve
 linearised at the prediction and one unchecked correction) is gone: the dedicated step now
@@ -148,9 +154,9 @@ def _coefficients(nh):
 @njit(inline="always")
 def _run(q, v, cs, hist, count, n_steps, NM):
     """run_chain's kernel. Every per-body or per-pin quantity is a row of one flat array W at
-    stride NM. Inlined where NM is a constant (_run40, ...), the compiler sees that the rows
-    are disjoint and vectorises the loops over bodies without runtime checks of overlap
-    (which cost more than the loops themselves at 8 to 32 links)."""
+    stride NM. Inlined where NM is a constant (_run_short, _run_long), the compiler sees
+    that the rows are disjoint and vectorises the loops over bodies without runtime checks
+    of overlap (which cost more than the loops themselves at 8 to 32 links)."""
     N = q.shape[0]
     h = DT
     im = INV_MASS
@@ -231,9 +237,13 @@ def _run(q, v, cs, hist, count, n_steps, NM):
             u0y = -HALF * W[C_ + k]
             W[U0X_ + k] = u0x
             W[U0Y_ + k] = u0y
-            dx = h * W[VX_ + k] + (W[GX_ + k] - W[GX_ + k + 1]) * im
-            dy = h * W[VY_ + k] + (W[GY_ + k] - W[GY_ + k + 1]) * im
-            dt = h * W[VW_ + k] + (u0x * (W[GX_ + k] + W[GX_ + k + 1]) + u0y * (W[GY_ + k] + W[GY_ + k + 1])) * ii
+            gx = W[GX_ + k]
+            gy = W[GY_ + k]
+            gx1 = W[GX_ + k + 1]
+            gy1 = W[GY_ + k + 1]
+            dx = h * W[VX_ + k] + (gx - gx1) * im
+            dy = h * W[VY_ + k] + (gy - gy1) * im
+            dt = h * W[VW_ + k] + (u0x * (gx + gx1) + u0y * (gy + gy1)) * ii
             W[QX_ + k] = W[X_ + k] + dx
             W[QY_ + k] = W[Y_ + k] + dy
             W[QT_ + k] = W[T_ + k] + dt
