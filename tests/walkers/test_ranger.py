@@ -220,7 +220,10 @@ def test_estimator_switches_once_per_touchdown():
         for i in on:
             prior = td[td <= i]
             assert len(prior) and (i - prior[-1]) * dtf < 0.06, f"foot {s}: 'on' at {traj.t[i]} s"
-    assert raw_bounces >= 0
+    # the raw contact signal does chatter (111 re-engagements within 50 ms of a release over
+    # this run's 60 touchdowns, measured): the one estimator switch per touchdown above is the
+    # filter's work, not a clean signal's; with no bounce that check would filter nothing
+    assert raw_bounces > 0
     # eq. 17 frame by frame: positive, and its power-weighted mean is the whole-run figure
     cot = ranger.instantaneous_cot(traj, rs.model)
     ok = np.isfinite(cot)
