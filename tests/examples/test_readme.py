@@ -63,10 +63,37 @@ def test_readme_api_section_gives_what_a_model_builder_needs():
         assert (f"`{code}` {meaning}" in api) or (meaning.endswith("marks") and meaning in api)
 
 
-def test_readme_gives_the_expected_time_of_both_commands():
+def test_readme_gives_the_expected_time_of_both_commands(monkeypatch, capsys):
+    """README's expected times agree with the figures they come from: each 'about N minutes'
+    is its measured seconds rounded, command 2's parts add up to its total, the first compile's
+    quiet-machine figure is the one the program quotes (compiled.TYPICAL_COMPILE_S), the
+    program's message reads as README quotes it, and tests/README.md gives the same time for
+    the test run. (The times themselves are measured by hand: benchmarks/startup.py.)"""
+    from planarsim import compiled
+    from walkers import cli
     text = README.read_text()
     part = " ".join(text[text.index("## Two commands"):text.index("## The command line")].split())
-    assert re.search(r"command 1: about \d+ minutes?", part)
-    assert re.search(r"command 2: about \d+ minutes?", part)
-    assert "first compile: measured N s on this machine" in part
+    minutes = {}
+    for k in (1, 2):
+        about, unit, measured = re.search(rf"command {k}: about (\d+) (minutes?) \((\d+) s measured\)", part).groups()
+        assert int(about) == round(int(measured) / 60), (k, about, measured)
+        assert unit == ("minute" if int(about) == 1 else "minutes"), (k, unit)
+        minutes[k] = int(about)
+    # command 2: the install and the tests add up to the measured total (README rounds each)
+    total, install, tests = map(int, re.search(
+        r"command 2: about \d+ minutes \((\d+) s measured\): the install with the test extras about (\d+) s, "
+        r"then the tests (\d+) s", part).groups())
+    assert abs(install + tests - total) <= 5, (install, tests, total)
+    # the first compile on a quiet machine: what the program says where it has measured none
+    quiet = float(re.search(r"first compile of the engine \(about (\d+) s on a quiet machine", part).group(1))
+    assert quiet == compiled.TYPICAL_COMPILE_S
+    # the program's message after a first compile, as README quotes it (N: the seconds)
+    monkeypatch.setattr(compiled, "record_compile", lambda seconds: None)   # keep this machine's record
+    cli._said_compiled(37.4)
+    quoted = re.search(r"\(`(first compile: [^`]*)`\)", part).group(1)
+    assert quoted.replace("N", "37") in capsys.readouterr().err, quoted
+    # tests/README.md states the test run's time in words: the same minutes as command 2's
+    words = {"five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}
+    said = re.search(r"runs everything \(about (\w+) minutes", (README.parent / "tests" / "README.md").read_text())
+    assert words.get(said.group(1), said.group(1)) in (minutes[2], str(minutes[2])), said.group(0)
     assert "about half a minute" not in text
