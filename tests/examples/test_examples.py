@@ -62,11 +62,12 @@ def test_period_doubling_example_runs_small(tmp_path, capsys):
         assert (tmp_path / name).stat().st_size > 100
 
 
-def test_the_dog_pushes_a_box_two_metres():
+def test_the_dog_pushes_a_box_3_3_metres():
+    """README: 'pushes the box 3.3 m in 12 s without falling' (3.37 m measured)."""
     ex = load("push_box")
     travel, summary = ex.main(duration=12.0)
     assert not summary["fell"]
-    assert travel >= 2.0
+    assert travel >= 3.3, travel
     assert all(v == 0 for v in summary["audit"].values()), summary["audit"]
 
 
@@ -97,20 +98,21 @@ def test_new_examples_run_as_scripts(name):
 
 
 def test_random_search_learns_to_swim(tmp_path):
-    """A short run of examples/learn_swimmer.py (8 iterations of 4 directions, 300-step
-    episodes): the learned linear policy swims farther than doing nothing from the same
-    starts, the iterations' mean return grows, a seed fixes the result, and the GIF is written."""
+    """README's claim at its bound: examples/learn_swimmer.py with its own settings (8
+    directions, the 4 best, 1000-step episodes), 12 iterations, returns at least 300 on unseen
+    starts (322 measured, 14 s of learning on two shared cores; README: 'a return of at least
+    300 within 2 minutes'). The iterations' mean return grows, a seed fixes the result (on a
+    short run), and the GIF is written."""
     pytest.importorskip("gymnasium")
     ex = load("learn_swimmer")
-    kw = dict(iterations=8, directions=4, top=2, horizon=300, workers=2, eval_episodes=2,
-              progress=False)
-    out = ex.learn(**kw)
-    still = ex.evaluate(np.zeros_like(out["policy"]), 2, horizon=300, workers=2)
-    assert out["eval_return"] > still.mean() + 20.0, (out["eval_returns"], still)
+    out = ex.learn(iterations=12, workers=2, progress=False)
+    assert out["eval_return"] >= 300.0, out["eval_returns"]
+    assert out["seconds"] < 120.0, out["seconds"]
     means = [m for _, m, _ in out["history"]]
-    assert np.mean(means[-3:]) > np.mean(means[:3]) + 10.0, means
-    again = ex.learn(**kw)
-    assert np.array_equal(again["policy"], out["policy"])
+    assert np.mean(means[-3:]) > np.mean(means[:3]) + 100.0, means
+    kw = dict(iterations=3, directions=2, top=1, horizon=100, workers=2, eval_episodes=1, progress=False)
+    once, again = ex.learn(**kw), ex.learn(**kw)
+    assert np.array_equal(again["policy"], once["policy"]) and np.any(once["policy"] != 0.0)
     gif = tmp_path / "swim.gif"
     ex.record_gif(out["policy"], gif, seconds=2.0)
     with Image.open(gif) as im:
