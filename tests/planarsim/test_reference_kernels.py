@@ -46,24 +46,42 @@ def _solve(m, ws, n):
     return status, pivots
 
 
-def _mechanism(n_body, slope_deg, seed):
-    """A chain of n_body boxes (pins with limits; per seed the first pinned to the world, a rod
-    across three or more) with point contacts at some bodies' lower corners, on a slope: some
-    seeds give independent rows, others closed loops with redundant ones."""
-    rng = np.random.default_rng(seed)
+@st.composite
+def mechanisms(draw, max_bodies):
+    """What _mechanism builds, drawn (so a failing case shrinks to fewer bodies, equal
+    masses, no rod, ...): a chain of 1..max_bodies boxes (pins with limits; perhaps the first
+    pinned to the world, a rod across three or more) with point contacts at some bodies'
+    lower corners (always the first's), on a slope: some independent rows, others closed
+    loops with redundant ones."""
+    n_body = draw(st.integers(1, max_bodies))
+
+    def each(strategy, n=n_body):
+        return draw(st.lists(strategy, min_size=n, max_size=n))
+    return dict(slope_deg=draw(st.floats(-20.0, 20.0)), world_pin=draw(st.booleans()),
+                mass=each(st.floats(0.1, 10.0)), inertia=each(st.floats(0.01, 1.0)),
+                contact=[True] + each(st.booleans(), n_body - 1), mu=each(st.floats(0.2, 1.2)),
+                rod=n_body >= 3 and draw(st.booleans()))
+
+
+def offsets(n_body, scale):
+    """(n_body, 3) draws in [-scale, scale] (a pose's or a velocity's)."""
+    return st.lists(st.floats(-scale, scale), min_size=3 * n_body, max_size=3 * n_body).map(
+        lambda x: np.reshape(x, (n_body, 3)))
+
+
+def _mechanism(slope_deg, world_pin, mass, inertia, contact, mu, rod):
     b = ps.ModelBuilder(terrain=ps.terrain.slope(slope_deg))
-    world_pin = rng.uniform() < 0.5
+    n_body = len(mass)
     prev = None
     for k in range(n_body):
-        body = b.add_body(f"b{k}", mass=float(rng.uniform(0.1, 10.0)), inertia=float(rng.uniform(0.01, 1.0)),
-                          pos=(0.4 * k, 0.3))
+        body = b.add_body(f"b{k}", mass=mass[k], inertia=inertia[k], pos=(0.4 * k, 0.3))
         if prev is not None or world_pin:
             b.add_pin(f"p{k}", prev, body, anchor_world=(0.4 * k - 0.2, 0.3),
                       limit=(-0.5, 0.5) if prev is not None else None)
-        if k == 0 or rng.uniform() < 0.6:
-            b.add_point_contact(f"c{k}", body, local=(0.1, -0.15), mu=float(rng.uniform(0.2, 1.2)))
+        if contact[k]:
+            b.add_point_contact(f"c{k}", body, local=(0.1, -0.15), mu=mu[k])
         prev = body
-    if n_body >= 3 and rng.uniform() < 0.5:
+    if rod:
         b.add_rod("r", 0, n_body - 1, anchor_a=(0.0, 0.1), anchor_b=(0.0, 0.1))
     return b.compile()
 
@@ -80,12 +98,11 @@ def _dense(ws, n, n_body):
 
 
 @settings(max_examples=40, deadline=None)
-@given(n_body=st.integers(1, 4), slope=st.floats(-20.0, 20.0), seed=st.integers(0, 10_000))
-def test_rows_and_jacobians_match_the_constraint_functions(n_body, slope, seed):
-    model = _mechanism(n_body, slope, seed)
+@given(data=st.data(), mechanism=mechanisms(4))
+def test_rows_and_jacobians_match_the_constraint_functions(data, mechanism):
+    model = _mechanism(**mechanism)
     a = model.arrays
-    rng = np.random.default_rng(seed + 1)
-    q = model.q0 + rng.normal(0.0, 0.05, model.q0.shape)
+    q = model.q0 + data.draw(offsets(model.n_body, 0.15), label="pose offset")
     state = ps.make_state(model, q=q)
     state.contact_mode[:] = 1          # pinned: a normal and a tangent row each
     state.limit_active[:] = np.isfinite(a.pin_limit)   # both limit rows of every limited pin
@@ -117,20 +134,21 @@ def test_rows_and_jacobians_match_the_constraint_functions(n_body, slope, seed):
 
 
 @settings(max_examples=300, deadline=None)
-@given(n_body=st.integers(1, 3), slope=st.floats(-20.0, 20.0), seed=st.integers(0, 1_000_000))
-def test_mixed_complementarity_solve_meets_coulomb_and_matches_the_enumeration(n_body, slope, seed):
-    """Problems of the engine's own rows (random mechanisms: pins, limits, a rod, a pinned
-    contact per body, so closed loops and redundant rows), b from random velocities."""
-    model = _mechanism(n_body, slope, seed)
+@given(data=st.data(), mechanism=mechanisms(3))
+def test_mixed_complementarity_solve_meets_coulomb_and_matches_the_enumeration(data, mechanism):
+    """Problems of the engine's own rows (drawn mechanisms: pins, limits, a rod, a pinned
+    contact per body, so closed loops and redundant rows), b from drawn velocities."""
+    model = _mechanism(**mechanism)
     a = model.arrays
-    rng = np.random.default_rng(seed + 2)
-    state = ps.make_state(model, q=model.q0 + rng.normal(0.0, 0.05, model.q0.shape))
+    state = ps.make_state(model, q=model.q0 + data.draw(offsets(model.n_body, 0.15), label="pose offset"))
     state.contact_mode[:] = 1
-    state.limit_active[:] = np.isfinite(a.pin_limit) & (rng.uniform(size=a.pin_limit.shape) < 0.3)
+    active = data.draw(st.lists(st.booleans(), min_size=a.pin_limit.size, max_size=a.pin_limit.size),
+                       label="limit rows active")
+    state.limit_active[:] = np.isfinite(a.pin_limit) & np.reshape(active, a.pin_limit.shape).astype(bool)
     ws = make_workspace(model)
     n = _rows_at(a, state, ws)
     J = _dense(ws, n, model.n_body)
-    b = J @ rng.normal(0.0, 1.0, J.shape[1])
+    b = J @ data.draw(offsets(model.n_body, 3.0), label="velocity").ravel()
     ws.row_b[:n] = b
     A = ws.lcp_A[:n, :n].copy()
     kinds = [int(k) for k in ws.row_kind[:n]]
@@ -142,11 +160,11 @@ def test_mixed_complementarity_solve_meets_coulomb_and_matches_the_enumeration(n
     if status != LCP_SOLVED:
         # the engine then uses its frictionless rule; Lemke's path must not miss the one
         # answer of a problem without redundant rows
-        assert not (full_rank and len(solutions) == 1), (seed, status)
+        assert not (full_rank and len(solutions) == 1), status
         return
     x = ws.lam[:n].copy()
     assert ref.coulomb_violations(A, b, kinds, mu_of_row, x, scale) <= 1e-7 * scale * (1 + np.abs(x).max())
     if full_rank:
         # without redundant rows Coulomb's problem here has this one answer
         assert len(solutions) >= 1
-        assert any(np.allclose(x, s_, rtol=1e-7, atol=1e-9 * scale) for s_ in solutions), seed
+        assert any(np.allclose(x, s_, rtol=1e-7, atol=1e-9 * scale) for s_ in solutions), (x, solutions)
