@@ -101,13 +101,14 @@ def test_random_search_learns_to_swim(tmp_path):
     """README's claim at its bound: examples/learn_swimmer.py with its own settings (8
     directions, the 4 best, 1000-step episodes), 12 iterations, returns at least 300 on unseen
     starts (322 measured, 14 s of learning on two shared cores; README: 'a return of at least
-    300 within 2 minutes'). The iterations' mean return grows, a seed fixes the result (on a
+    300 within 2 minutes'; the time is not asserted). The iterations' mean return grows, a seed fixes the result (on a
     short run), and the GIF is written."""
     pytest.importorskip("gymnasium")
     ex = load("learn_swimmer")
     out = ex.learn(iterations=12, workers=2, progress=False)
     assert out["eval_return"] >= 300.0, out["eval_returns"]
-    assert out["seconds"] < 120.0, out["seconds"]
+    # (its 2 minutes are a time, measured by the run and printed, never asserted here: the
+    # machines that run the tests are shared)
     means = [m for _, m, _ in out["history"]]
     assert np.mean(means[-3:]) > np.mean(means[:3]) + 100.0, means
     kw = dict(iterations=3, directions=2, top=1, horizon=100, workers=2, eval_episodes=1, progress=False)
