@@ -30,7 +30,7 @@ from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_R
 from .info import INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
 from .integrate import predict_configuration
 from .math2d import update_trig
-from .modes import (engage_contacts, engage_limits, gather_contact_impulses,
+from .modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .pair import PAIR_MARGIN
 from .pair_toi import hold_off_fast_pairs
@@ -207,6 +207,61 @@ def solve_and_check(m, s, ws, opt, h, include_ccd):
     return breaks, engaged, 2 + solves
 
 
+# rounds of the simultaneous check (switch_rounds) a step tries after the guess and the
+# alternating check, before the complementarity solve; rounds without fewer broken rules
+# after which only the first contact that breaks one is switched (Murty's least index)
+SWITCH_ROUNDS = 48
+SWITCH_STALL = 3
+
+
+@kernel
+def switch_contacts(m, s, ws, only_first):
+    """Listed contacts re-examined by the rules (modes.check_contact: release if it pulls,
+    slide if its friction leaves the cone, stick if its slip reversed): every one at once,
+    or only_first the first in the list that changes; returns how many changed."""
+    gather_contact_impulses(m, s, ws)
+    changed = 0
+    for k in range(ws.n_live[0]):
+        changed += check_contact(m, s, ws, ws.live[k])
+        if only_first and changed > 0:
+            break
+    return changed
+
+
+@kernel(inline="never")
+def switch_rounds(m, s, ws, opt, h, include_ccd):
+    """After the guess and the alternating check broke a rule: the contacts that break one
+    switched by the rules and solved again, up to SWITCH_ROUNDS times: every one at once
+    (block principal pivoting, Judice and Pires 1994), and once SWITCH_STALL rounds in a row
+    did not lower the number of broken rules, one at a time, the first in the list (Murty's
+    least-index rule, which cannot cycle where the problem is a P-matrix's). An answer that
+    breaks none but pushes further contacts into touch is solved again with them, as in
+    solve_modes. A pile settling with many contacts that start or stop sliding in one step
+    (a pour of 50 shapes) finds its modes in linear solves, where the complementarity solve
+    over its island took thousands of pivots. Where no round's answer keeps every rule, the
+    modes are put back as they were (the complementarity solve starts from them). Returns
+    (an answer stands, solves)."""
+    keep_modes(s, ws)
+    solves = 0
+    breaks = 1
+    fewest = 1 << 62
+    stall = 0
+    for _ in range(SWITCH_ROUNDS):
+        if breaks > 0 and switch_contacts(m, s, ws, stall >= SWITCH_STALL) == 0:
+            break
+        breaks, engaged, more = solve_and_check(m, s, ws, opt, h, include_ccd)
+        solves += more
+        if ws.room[0] == 1 or (breaks == 0 and engaged == 0):
+            return True, solves
+        if breaks < fewest:
+            fewest = breaks
+            stall = 0
+        else:
+            stall += 1
+    restore_modes(s, ws)
+    return False, solves
+
+
 @kernel(inline="always")
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 4-6: impulses and contact modes that meet every rule (modes.rule_breaks).
@@ -218,9 +273,10 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     solve engages more (at most once per contact and limit: a stack landing or settling
     engages one level per solve, each solve linear in its size). Alternating strategy: an
     answer that breaks a rule has the contact under the cursor re-examined by the
-    alternating rule and is solved once more. An answer that still breaks a rule goes to the
-    complementarity solve, which ends at a consistent answer (complementarity.solve_contacts).
-    No other rounds, no cap: at most 2 linear solves plus one per contact and limit. Returns
+    alternating rule and is solved once more; one that still breaks a rule has every contact
+    that breaks one switched at once, up to SWITCH_ROUNDS times (switch_rounds). An answer
+    that still breaks a rule goes to the complementarity solve, which ends at a consistent
+    answer (complementarity.solve_contacts). Returns
     True if a linear solve's answer stood (its rows, and their envelope where there are rows,
     are in ws), False if the complementarity solve replaced it."""
     ws.joint_gain[2] = 0.0      # a new answer: the joints' work is not known yet
@@ -242,6 +298,9 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         rounds += 1
         breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
         ok = breaks == 0 and engaged == 0
+    if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
+        ok, more = switch_rounds(m, s, ws, opt, h, include_ccd)
+        rounds += more
     if ok:
         gather_contact_impulses(m, s, ws)
     else:
