@@ -99,6 +99,22 @@ def mjcf(spec, integrator: str = "Euler", timestep: float | None = None) -> str:
         "  <worldbody>", *world, "  </worldbody>", "</mujoco>"])
 
 
+def _roll(peer, n: int) -> bool:
+    """n MuJoCo steps of peer (model, data, x0, _rollout, _out) from its start state in one
+    single-threaded rollout call; where mujoco.rollout is missing, an mj_step loop from
+    where the data is (after reset()). Returns True if rolled out (the last state is in
+    peer._out[n][0, -1])."""
+    if peer._rollout is None:
+        step, m, d = peer.mj.mj_step, peer.model, peer.data
+        for _ in range(n):
+            step(m, d)
+        return False
+    if n not in peer._out:
+        peer._out[n] = np.zeros((1, n, len(peer.x0)))
+    peer._rollout.rollout(peer.model, peer.data, peer.x0[None, :], nstep=n, state=peer._out[n])
+    return True
+
+
 class World:
     """A MuJoCo model of the scene with run(n) (timed), reset() and record(n)."""
 
@@ -130,15 +146,7 @@ class World:
         """n frames of the scene's dt (n * substeps steps) from the start state in one
         single-threaded rollout call (or an mj_step loop after reset() where mujoco.rollout is
         missing)."""
-        n = n * self.substeps
-        if self._rollout is None:
-            step, m, d = self.mj.mj_step, self.model, self.data
-            for _ in range(n):
-                step(m, d)
-            return
-        if n not in self._out:
-            self._out[n] = np.zeros((1, n, len(self.x0)))
-        self._rollout.rollout(self.model, self.data, self.x0[None, :], nstep=n, state=self._out[n])
+        _roll(self, n * self.substeps)
 
     def _kinematics(self):
         """Poses and COM velocities of the current state (mj_step leaves those of the step's
@@ -264,15 +272,8 @@ class ShapeWorld:
 
     def run(self, n: int):
         """n steps from the start state: one rollout call (or an mj_step loop after reset())."""
-        if self._rollout is None:
-            step, m, d = self.mj.mj_step, self.model, self.data
-            for _ in range(n):
-                step(m, d)
-            return
-        if n not in self._out:
-            self._out[n] = np.zeros((1, n, len(self.x0)))
-        self._rollout.rollout(self.model, self.data, self.x0[None, :], nstep=n, state=self._out[n])
-        self.mj.mj_setState(self.model, self.data, self._out[n][0, -1], self.kind)
+        if _roll(self, n):
+            self.mj.mj_setState(self.model, self.data, self._out[n][0, -1], self.kind)
 
     def positions(self) -> np.ndarray:
         """(n_body, 2) COM positions [m] now."""
