@@ -99,6 +99,13 @@ def assemble(m, ws, JL, JR, n, symmetric):
 
 
 @kernel
+def diagonal_scale(low, start, first, n, scale):
+    """scale[k] = |A[k, k]| before elimination: the yardstick of the pivot test."""
+    for k in range(n):
+        scale[k] = abs(low[at(start, first, k, k)])
+
+
+@kernel
 def is_dependent(piv, scale, tol):
     """A row whose pivot fell below tol times its own diagonal depends on earlier rows."""
     return abs(piv) <= tol * scale or scale == 0.0
@@ -128,8 +135,7 @@ def factor(low, up, start, first, reach, n, tol, scale, rows):
     Returns #dropped.
     """
     dropped = 0
-    for k in range(n):
-        scale[k] = abs(low[at(start, first, k, k)])
+    diagonal_scale(low, start, first, n, scale)
     for k in range(n):
         dk = at(start, first, k, k)
         piv = low[dk]
@@ -197,8 +203,7 @@ def factor_symmetric(low, start, first, reach, n, tol, scale, rows):
     written. The same pivot test drops dependent rows (zero pivot and multipliers).
     Returns #dropped."""
     dropped = 0
-    for k in range(n):
-        scale[k] = abs(low[at(start, first, k, k)])
+    diagonal_scale(low, start, first, n, scale)
     for k in range(n):
         dk = at(start, first, k, k)
         piv = low[dk]
