@@ -14,15 +14,19 @@ import planarsim as ps
 from benchmarks.worlds import pyramid, wall   # 0.2 m boxes of 4 kg, each on two below
 from planarsim.compiled import audit_counts, step_info
 from planarsim.kernels.codes import CONTACT_PAIR
+from planarsim.kernels.matrix import ENVELOPE, SPARSE
+from planarsim.kernels.sparse_factor import SPARSE_MIN_ROWS
 
 G = 9.81
 
 
-@pytest.mark.parametrize("pile", ["pyramid6", "pyramid8", "pyramid10", "wall2x8", "wall8x8"])
+@pytest.mark.parametrize("pile", ["pyramid6", "pyramid8", "pyramid10", "pyramid20", "wall2x8",
+                                  "wall8x8"])
 def test_a_pile_from_rest_takes_its_first_step_with_linear_solves_and_stands(pile):
-    """Pyramids of 21 to 55 boxes and staggered walls of 16 and 64 bricks (half a brick
+    """Pyramids of 21 to 210 boxes and staggered walls of 16 and 64 bricks (half a brick
     over each joint below; 8 rows once sent the first step to Lemke: 634 pivots for 16
-    bricks, 3,869 and 94 s for 160)."""
+    bricks, 3,869 and 94 s for 160). The 210-box pyramid's 1,568 rows go through the sparse
+    factorisation (kernels/sparse_factor.py), the others' through the envelope."""
     if pile.startswith("pyramid"):
         rows = int(pile[len("pyramid"):])
         model = pyramid(rows)
@@ -44,3 +48,6 @@ def test_a_pile_from_rest_takes_its_first_step_with_linear_solves_and_stands(pil
     sim.steps(200)
     assert np.max(np.abs(sim.state.q - q0)) <= 1e-9
     assert sum(audit_counts(sim.ws).values()) == 0
+    sparse = sim.ws.n_row[0] >= SPARSE_MIN_ROWS
+    assert sparse == (pile == "pyramid20")
+    assert sim.ws.factor_kind[0] == (SPARSE if sparse else ENVELOPE)
