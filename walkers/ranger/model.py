@@ -32,10 +32,7 @@ DRAWN = {"collide": False}
 OUTER, INNER = 0, 1
 LEG = (0, 1)             # body of the leg of side s
 FOOT = (2, 3)            # body of the foot of side s
-HIP_PIN = 0
 ANKLE_PIN = (1, 2)       # pin of the ankle of side s
-HIP_MOTOR = 0
-ANKLE_MOTOR = (1, 2)     # actuator of the ankle of side s
 
 
 def foot_inertia_com(p: RangerParams) -> float:
