@@ -1,4 +1,4 @@
-"""Compiled Ranger rollout, its run class (``RangerSim``, a walkers.base.WalkerRun) and the
+"""Compiled Ranger rollout, its run class (``Run``, a walkers.base.WalkerRun) and the
 uniform ``simulate(...)`` entry point.
 
 ``rollout_ranger`` runs physics + controller + recording without returning to Python; it stops
@@ -64,13 +64,13 @@ def step_options(strategy: str = "alternating") -> ps.StepOptions:
     return ps.make_options(strategy)
 
 
-class RangerSim(WalkerRun):
+class Run(WalkerRun):
     """Ranger in the world (a WalkerRun) with its Controller (tables, memory, gait switches).
 
     The model starts at rest in the STAND pose for every gait; WALK starts from it through the
     controller's START phase. ``options`` overrides Ranger's StepOptions (step_options()).
 
-    >>> rs = RangerSim(gait="stand")          # doctest: +SKIP
+    >>> rs = Run(gait="stand")                # doctest: +SKIP
     >>> traj = rs.run(5.0); rs.set_gait("walk"); traj2 = rs.run(10.0)
     """
 
@@ -143,8 +143,7 @@ class RangerSim(WalkerRun):
         return out
 
 
-Run = RangerSim
-simulate = simulation(RangerSim)
+simulate = simulation(Run)
 
 
 def instantaneous_cot(traj: Trajectory, model, overhead_power: float = 4.5, min_speed: float = 0.05):
@@ -162,7 +161,7 @@ def live(gait: str = "walk", terrain=None, params: RangerParams | None = None,
     """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and the
     Python-path Controller; keys w / s / g for WALK / STAND / GUI; sliders for the GUI joint
     targets [rad] (Kelly 2014, 6.1: the GUI mode sets joint targets and gains)."""
-    rs = RangerSim(params, terrain, gait=gait, strategy=strategy)
+    rs = Run(params, terrain, gait=gait, strategy=strategy)
     sim = ps.Simulator(rs.model, rs.options, rs.state)
     ctrl, mem, gui = rs.controller, rs.memory, rs.tables.gui
 

@@ -1,4 +1,4 @@
-"""Compiled rollout of the SIMBICON biped, its run class (``SimbiconRun``, a
+"""Compiled rollout of the SIMBICON biped, its run class (``Run``, a
 walkers.base.WalkerRun), ``simulate`` and the tuning entry point ``run``.
 
 ``rollout_simbicon`` runs physics + controller + recording + a torso push without returning to
@@ -76,7 +76,7 @@ def _push_array(push):
     return arr
 
 
-class SimbiconRun(WalkerRun):
+class Run(WalkerRun):
     """The SIMBICON biped in the world (a WalkerRun), from the standing start pose.
 
     Parameters
@@ -149,17 +149,16 @@ class SimbiconRun(WalkerRun):
         return out
 
 
-Run = SimbiconRun
-simulate = simulation(SimbiconRun)
+simulate = simulation(Run)
 
 
 def run(params: SimbiconParams, duration: float, terrain=None, dt=1e-3, push=None,
         record_every: int = 10, model=None, record: bool = True, strategy: str = STRATEGY,
         glitch_ok: bool = True):
-    """A SimbiconRun of `duration` [s] (tuning's entry point; record=False records nothing).
-    Returns (Trajectory or None, summary dict, model); see SimbiconRun.numbers for the keys."""
-    r = SimbiconRun(params, terrain, dt, push=push, record_every=record_every if record else 0,
-                    strategy=strategy, glitch_ok=glitch_ok, model=model)
+    """A SIMBICON Run of `duration` [s] (tuning's entry point; record=False records nothing).
+    Returns (Trajectory or None, summary dict, model); see Run.numbers for the keys."""
+    r = Run(params, terrain, dt, push=push, record_every=record_every if record else 0,
+            strategy=strategy, glitch_ok=glitch_ok, model=model)
     r.run(duration)
     return (r.trajectory() if record else None), r.summary(), r.model
 
