@@ -59,6 +59,11 @@ def rollout_ranger(m, s, ws, opt, tab, mem, u, n, every, rec, lab, lab_idx, k0):
     return 0, n, kf
 
 
+def _gravity(model) -> float:
+    """The model's gravity [m/s^2] (its magnitude)."""
+    return float(np.hypot(*model.arrays.gravity))
+
+
 def step_options(strategy: str = "alternating") -> ps.StepOptions:
     """Ranger's StepOptions: the engine defaults with the chosen contact-mode strategy."""
     return ps.make_options(strategy)
@@ -88,7 +93,7 @@ class Run(WalkerRun):
             raise ValueError(f"Ranger gait {gait!r} unknown; use one of {GAITS}")
         params = params if params is not None else RangerParams()
         model = build(params, terrain_of(terrain), dt=dt, suspended=suspended)
-        self.controller = Controller(params, dt, max_steps=max_steps)
+        self.controller = Controller(params, dt, max_steps=max_steps, gravity=_gravity(model))
         self.controller.reset(gait)
         super().__init__(model, params, self.controller.tables, self.controller.mem,
                          options=options if options is not None else step_options(strategy),
@@ -114,7 +119,7 @@ class Run(WalkerRun):
         mem, model, p = self.memory, self.model, self.params
         n = int(mem[C.MEM.steps])
         log = self.tables.steplog[:min(n, len(self.tables.steplog))]
-        weight = 9.81 * float(model.arrays.body_mass.sum())
+        weight = _gravity(model) * float(model.arrays.body_mass.sum())
         out = {"steps": n, "fell": self.fell, "time": self.time,
                "distance": float(self.state.q[0, 0] - model.q0[0, 0])}
         out["mean_speed"] = out["distance"] / out["time"] if out["time"] > 0 else 0.0
@@ -151,7 +156,7 @@ def instantaneous_cot(traj: Trajectory, model, overhead_power: float = 4.5, min_
     speed); NaN where the forward COM speed is below min_speed [m/s]."""
     power = sum(np.maximum(traj.labels[k], 0.0) for k in ("power_hip", "power_outer_ankle", "power_inner_ankle"))
     speed = traj.com_velocity(model)[:, 0]
-    weight = 9.81 * float(model.arrays.body_mass.sum())
+    weight = _gravity(model) * float(model.arrays.body_mass.sum())
     cot = (power + overhead_power) / (weight * np.where(speed > min_speed, speed, np.nan))
     return cot
 
