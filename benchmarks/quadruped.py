@@ -27,7 +27,7 @@ from walkers import quadruped as qd  # noqa: E402
 
 
 def one_run(seconds, gait, speed, strategy):
-    dog = qd.Quadruped(gait=gait, speed=speed, strategy=strategy)
+    dog = qd.Run(gait=gait, speed=speed, strategy=strategy)
     t0 = time.perf_counter()
     dog.run(seconds)
     wall = time.perf_counter() - t0
@@ -42,7 +42,7 @@ def largest_push(params, speed, sign, forces=range(20, 201, 20)):
     """Largest force [N] of a 0.2 s push survived (4 s without a fall), pushing in direction sign."""
     best = 0
     for f in forces:
-        dog = qd.Quadruped(params=params, gait="walk", speed=speed)
+        dog = qd.Run(params=params, gait="walk", speed=speed)
         dog.run(10.0)
         dog.state.ext_force[0, 0] = sign * f
         dog.run(0.2)
@@ -60,7 +60,7 @@ def ablation(speed):
         fwd, back = largest_push(p, speed, 1), largest_push(p, speed, -1)
         runs = []
         for v in (0.5, 0.6, -0.4, -0.5):
-            dog = qd.Quadruped(params=p, gait="walk", speed=v)
+            dog = qd.Run(params=p, gait="walk", speed=v)
             dog.run(20.0)
             s = dog.summary()
             runs.append(f"{v:+.1f}: " + (f"fell at {s['time']:.1f} s" if s["fell"] else f"{s['mean_speed']:+.3f} m/s"))

@@ -17,11 +17,11 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from walkers.ranger import RangerSim  # noqa: E402
+from walkers.ranger import Run  # noqa: E402
 
 
 def one_run(seconds, strategy, record_every=10):
-    rs = RangerSim(gait="walk", strategy=strategy, record_every=record_every)
+    rs = Run(gait="walk", strategy=strategy, record_every=record_every)
     t0 = time.perf_counter()
     rs.run(seconds)
     return time.perf_counter() - t0, rs
@@ -59,7 +59,7 @@ def main(argv=None):
               f"{n / w:,.0f} steps/s")
         print("   ", figures(rs))
         if args.steps:
-            rs = RangerSim(gait="walk", strategy=strategy, record_every=1000)
+            rs = Run(gait="walk", strategy=strategy, record_every=1000)
             t1 = time.perf_counter()
             while rs.steps < args.steps and not rs.fell and rs.time < 10.0 * args.steps:
                 rs.run(50.0)

@@ -20,7 +20,7 @@ from walkers import simple_biped as sb  # noqa: E402
 
 
 def one_run(seconds, speed, terrain):
-    w = sb.Walker(gait="walk", speed=speed, terrain=terrain)
+    w = sb.Run(gait="walk", speed=speed, terrain=terrain)
     t0 = time.perf_counter()
     w.run(seconds)
     wall = time.perf_counter() - t0

@@ -2,17 +2,18 @@
 __version__ = "0.1.0"
 
 from .builder import ModelBuilder
-from .errors import ModelError, SimulationDiverged, WorkspaceTooLarge
+from .errors import AuditViolation, ModelError, SimulationDiverged, WorkspaceTooLarge
 from .model import Model
 from .options import ContactMode, ModeStrategy, StepOptions, make_options
 from .sim import Simulator
-from .state import State, make_state
+from .state import State, make_state, make_workspace
 from . import batch, measure, terrain
 from .energy import kinetic_energy, potential_energy, total_energy
 from .snapshot import load_snapshot, save_snapshot
 from .trajectory import Trajectory
 
-__all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "WorkspaceTooLarge", "Simulator", "State",
-           "StepOptions", "batch", "measure", "ContactMode", "ModeStrategy", "make_options", "make_state", "terrain",
+__all__ = ["ModelBuilder", "Model", "ModelError", "SimulationDiverged", "AuditViolation", "WorkspaceTooLarge",
+           "Simulator", "State", "StepOptions", "batch", "measure", "ContactMode", "ModeStrategy", "make_options",
+           "make_state", "make_workspace", "terrain",
            "kinetic_energy", "potential_energy", "total_energy", "save_snapshot", "load_snapshot",
            "Trajectory", "__version__"]

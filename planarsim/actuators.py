@@ -96,15 +96,3 @@ def motor_power(current, rate, mp):
     i0 = mp[MOTOR_CURRENT_SMOOTH]
     abs_i = current * current / math.sqrt(current * current + i0 * i0)
     return current * current * mp[MOTOR_RESISTANCE] + mp[MOTOR_CONTACT_V] * abs_i + gk * rate * current
-
-
-@jit
-def current_for_torque(torque, mp):
-    """Ideal current [A] for a joint torque [N m] (T / (G K), friction not compensated)."""
-    return torque / (mp[MOTOR_GEAR] * mp[MOTOR_TORQUE_CONST])
-
-
-@jit
-def reflected_inertia(mp):
-    """Rotor inertia seen at the joint, G^2 Jm [kg m^2]."""
-    return mp[MOTOR_GEAR] * mp[MOTOR_GEAR] * mp[MOTOR_ROTOR_INERTIA]

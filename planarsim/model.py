@@ -19,8 +19,6 @@ ACT_HIP_TORQUE = 2   # torque between two point-mass legs about a hip point mass
 ACT_BODY_FORCE = 3   # force along a fixed world direction at the body origin [N]
 ACT_BODY_TORQUE = 4  # torque on one body [N m]
 ACT_SLIDER_FORCE = 5  # force along a slider's axis: +f on body b, -f on body a [N]
-ACT_KIND_NAMES = ("pin_torque", "axial", "hip_torque", "body_force", "body_torque",
-                  "slider_force")
 from .kernels.codes import (JOINT_FREE_BIT, JOINT_FREE_HINGE, JOINT_FREE_SLIDE,  # noqa: E402,F401
                            JOINT_HINGE, JOINT_SLIDE_BIT, JOINT_SLIDER)  # (pin_kind)
 

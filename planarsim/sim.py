@@ -2,7 +2,7 @@
 
 >>> sim = Simulator(model)            # doctest: +SKIP
 >>> sim.step(u)                       # one step under commands u (n_act,)
->>> traj = sim.run(1000, u, record_every=10)
+>>> traj = sim.run(2.0, u, record_every=10)   # 2 s, a frame every 10 steps
 
 The state lives in ``sim.state`` (a State of numpy arrays, mutated in place); ``snapshot()`` and
 ``restore()`` copy it. A guard failure raises SimulationDiverged naming step, time, body and

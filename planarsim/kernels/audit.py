@@ -1,4 +1,5 @@
-"""The step audits its own answer and counts what breaks the rules (ws.audit).
+"""Stage 7: the step audits its own answer and counts what breaks the rules (ws.audit); the
+positions' rules at the end of stage 8.
 
 After the velocity stage (impulses as applied):
   pull      a contact's normal impulse pulls (lambda_n < 0)

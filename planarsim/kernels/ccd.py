@@ -1,4 +1,4 @@
-"""Stage 8: continuous collision detection for point masses (and the split at a shape pair's
+"""Stage 6: continuous collision detection for point masses (and the split at a shape pair's
 time of impact, found by kernels/pair_toi.py).
 
 Within-step path model of a free point (the motion a sub-step of length tau would produce,

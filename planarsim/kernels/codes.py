@@ -36,7 +36,7 @@ ROW_SLIDE_ANGLE = 8    # a slider's relative angle held (slider.py)
 ROW_JOINT_SOFT = 9     # a joint coordinate's armature and implicit spring-damper (soft.py)
 
 INTEGRATOR_EULER = 0      # StepOptions.integrator: the default step, symplectic Euler with SHAKE
-INTEGRATOR_RATTLE = 1     # RATTLE, second order (kernels/rattle.py)
+# 1: RATTLE, second order (kernels/rattle.py)
 INTEGRATOR_RATTLE4 = 2    # RATTLE composed in five stages (Suzuki), fourth order
 INTEGRATOR_RATTLE6 = 3    # RATTLE composed in seven stages (Yoshida), sixth order
 INTEGRATOR_NAMES = ("euler", "rattle", "rattle4", "rattle6")

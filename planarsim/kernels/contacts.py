@@ -1,4 +1,4 @@
-"""Stage 3: the contact point of every foot, recomputed at the start of each step.
+"""Stage 2: the contact point of every foot, recomputed at the start of each step.
 
 Point contact: the material point itself. Arc contact (curved sole): the circle point closest
 to the ground, c - r n, where n is the ground normal at the ground point closest to the arc
@@ -473,7 +473,7 @@ def bounce_of(m, s, ws, i):
 
 @kernel
 def find_contacts(m, s, ws, h):
-    """Stage 3 for every contact (a free point contact surely clear of the ground is left
+    """Stage 2 for every contact (a free point contact surely clear of the ground is left
     unqueried: see the module's docstring; a shape pair's two slots by kernels/pair.py); a
     disabled contact is forced free. A contact that a time-of-impact split brought into touch
     (contact_new == 2) is engaged here, where its ground normal is known."""

@@ -1,4 +1,4 @@
-"""Stage 1-2: applied forces (gravity, actuators, pushes) and v* = v + h M^-1 f.
+"""Stage 1: applied forces (gravity, actuators, pushes) and v* = v + h M^-1 f.
 
 Actuator kinds (see planarsim/model.py): pin torque, axial force between anchors, hip torque
 between point-mass legs (as perpendicular forces), body force along a world direction, body

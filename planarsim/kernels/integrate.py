@@ -1,4 +1,4 @@
-"""Stages 7 and 7b: integrate positions, then Newton-SHAKE position correction.
+"""Stage 8 (position.py): integrate positions, then Newton-SHAKE position correction.
 
 integrate:  v = v_new,  q = q + h v  (symplectic Euler).
 correct_positions: the linearised rows leave a residual O(h^2 w^2 r). Newton on the SHAKE

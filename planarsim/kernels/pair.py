@@ -183,7 +183,7 @@ def clear_slot(s, ws, c):
 
 @part("model", "state", "workspace", "int64", "float64", "float64", "boolean")
 def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
-    """Stage 3 for the pair whose slot 0 is contact i, at s.q (ws.body_cs current, the
+    """Stage 2 for the pair whose slot 0 is contact i, at s.q (ws.body_cs current, the
     shapes placed there: place_shapes): the
     manifold within the step's reach (PAIR_MARGIN, or margin_floor if larger, plus what
     SPECULATIVE_FACTOR times the bodies' speed bounds can close in h) and its points given to

@@ -1,4 +1,4 @@
-"""Stage 8 for shape pairs: the time of impact of two shapes' swept motion (translation and
+"""Stage 6 for shape pairs: the time of impact of two shapes' swept motion (translation and
 rotation) by conservative advancement on their distances.
 
 A pair's speculative contact (kernels/pair.py) linearises the step's motion at its start: the
@@ -171,7 +171,7 @@ def fast_before_solve(m, ws, sa, sb, h, gate):
     """(fast, width): whether shapes sa and sb may move, relative to each other, more than
     gate (pair_gate) of the thinner one's width [m] (m.shape_bound[:, 3]) in the step of h [s], by
     the speed bounds under the step's start and predicted velocities (ws.shape_reach, placed
-    at the sub-step's start: the same answer at stage 2 and stage 7)."""
+    at the sub-step's start: the same answer at stage 2 and stage 6)."""
     width = min(m.shape_bound[sa, 3], m.shape_bound[sb, 3])
     reach = h * (ws.shape_reach[sa, 3] + ws.shape_reach[sb, 3])
     return reach > gate * width and within_reach(ws, sa, sb, reach), width

@@ -1,4 +1,4 @@
-"""Stage 6: the positions at the end of the step: integrate, correct, settle.
+"""Stage 8: the positions at the end of the step: integrate, correct, settle.
 
 position_stage(m, s, ws, opt, h, answered):
   1. integrate q += h v with the solve's velocity (integrate.integrate_positions);
@@ -63,7 +63,7 @@ def _settle_measured(m, s, ws, h, opt, rows_held):
 
 @kernel(inline="always")
 def position_stage(m, s, ws, opt, h, answered):
-    """Stage 6 (the module's docstring) after a velocity solve over a step of h [s];
+    """Stage 8 (the module's docstring) after a velocity solve over a step of h [s];
     answered: a linear solve's answer stood (its rows' envelope in ws is reused)."""
     integrate_positions(s, ws, ws.v_new, h)
     kept_all = keep_correction_rows(s, ws) == 0

@@ -1,31 +1,27 @@
-"""Stage 4: constraint rows J (Jacobian blocks on bodies a, b) and position errors c.
+"""Stage 3: the active rows (constraint rows J and position errors c), and the one dispatch on
+a row's kind.
 
 Row kinds: pin x / y (p_b - p_a = 0), slider (n.(p_b - p_a) = 0 and theta_b - theta_a - ref
 = 0), rod (|p_b - p_a| - L = 0), joint limit (coordinate - lower >= 0, upper - coordinate >= 0),
-a joint's soft row (armature and implicit spring-damper, a compliant equality), contact normal (n.(p - g) = 0) and tangent (t.(p - g) = 0); a shape
-pair's contact rows act on both its bodies (kernels/pair.py). For a
-point p on a body with COM x, J = (d_x, d_y, (p - x) x d) for a row along unit direction d.
-A contact's normal row uses the exact gap (a rolling sole: the gap of its centre minus r, which
-rotation leaves unchanged); its tangent row holds the material point at the ground point found
-at the start of the step (no slip).
-Sliding contacts keep only the normal row; their impulse direction F = n - mu s t carries the
-Coulomb friction -mu lambda_n s along the tangent t.
-"""
-"""Stage 3: the active rows, and the one dispatch on a row's kind.
+a joint's soft row (armature and implicit spring-damper, a compliant equality), contact normal
+(n.(p - g) = 0) and tangent (t.(p - g) = 0); a shape pair's contact rows act on both its bodies.
 
 Each kind of constraint has its own module that evaluates its rows: pin.py (two equalities,
 ROW_PIN_X / ROW_PIN_Y), slider.py (ROW_SLIDE_PERP / ROW_SLIDE_ANGLE), rod.py (ROW_ROD),
 limit.py (ROW_LIMIT_LO / ROW_LIMIT_HI, inequalities on a joint's coordinate: a hinge's angle,
 a slider's slide), soft.py (ROW_JOINT_SOFT, a joint coordinate's armature and implicit
 spring-damper: an equality with a compliance), contacts.py (a ground contact's normal and
-tangent rows) and pair.py (a shape pair's, acting on both bodies). This module is the one place that dispatches on the
-kind (eval_row, row_lever, last_impulse, store_impulse) and names the kinds' classes
-(is_joint_row, is_mode_row, is_unilateral, ...): nothing else compares row codes or relies on
-their order. Adding a kind = its module, one arm in each dispatch here, a builder method.
+tangent rows) and pair.py (a shape pair's, acting on both bodies). This module is the one place
+that dispatches on the kind (eval_row, row_lever, last_impulse, store_joint_impulse) and names
+the kinds' classes (is_joint_row, is_mode_row, is_unilateral, ...): nothing else compares row
+codes or relies on their order. Adding a kind = its module, one arm in each dispatch here, a
+builder method.
 
 A row along unit direction d at point p of a body with COM x has J = (d_x, d_y, (p - x) x d).
-Sliding contacts keep only the normal row; their impulse direction F = n - mu s t carries the
-Coulomb friction -mu lambda_n s along the tangent t.
+A contact's normal row uses the exact gap (a rolling sole: the gap of its centre minus r, which
+rotation leaves unchanged); its tangent row holds the material point at the ground point found
+at the start of the step (no slip). Sliding contacts keep only the normal row; their impulse
+direction F = n - mu s t carries the Coulomb friction -mu lambda_n s along the tangent t.
 """
 import math
 

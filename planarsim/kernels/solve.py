@@ -1,4 +1,4 @@
-"""Stage 5: position-level impulses, one linear solve.
+"""Stage 4: position-level impulses, one linear solve.
 
 Impulses lambda make every active row hold at the END of the step (symplectic Euler inside):
     c + h J (v* + W F^T lambda) = 0   =>   (J W F^T) lambda = -(c / h + J v*)

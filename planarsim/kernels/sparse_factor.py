@@ -1,4 +1,4 @@
-"""Stage 5's factorisation for large systems: a sparse L U in an order of little fill.
+"""Stage 4's factorisation for large systems: a sparse L U in an order of little fill.
 
 The envelope elimination (solve.py) is linear for chains and trees, but a pile or a wall
 couples every row of a level with the level above: its envelope is as wide as a level, and

@@ -77,7 +77,7 @@ def copy_state(src, dst):
 
 @kernel(inline="never")
 def build_and_solve(m, s, ws, opt, h):
-    """Stages 4-5: the active rows at the current configuration and their impulses under the
+    """Stages 3-4: the active rows at the current configuration and their impulses under the
     modes as they stand. Returns True if the answer's equations need checking (a dependent
     row was dropped, or the system was not symmetric). A call (one copy of its code for both
     solves of solve_modes): its work is microseconds, the call a few nanoseconds."""
@@ -264,7 +264,7 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
 
 @kernel(inline="always")
 def solve_modes(m, s, ws, opt, h, include_ccd):
-    """Stages 4-6: impulses and contact modes that meet every rule (modes.rule_breaks).
+    """Stages 3-5: rows, impulses and contact modes that meet every rule (modes.rule_breaks).
 
     The modes carried over from the last step (plus contacts and limits the free motion would
     push into the ground or past their limit) are a guess: one linear solve, then its answer
@@ -430,7 +430,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             note_start_depths(ws)                           #    (check_displacements)
         ccd_on = split < opt.max_ccd_splits
         if m.n_shape_pair > 0:                              #    fast shape pairs apart: left
-            hold_off_fast_pairs(m, s, ws, h)                #    to the sweep of stage 7
+            hold_off_fast_pairs(m, s, ws, h)                #    to the sweep of stage 6
         for attempt in range(2):                            # 3-5. rows, impulses, modes
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
             if attempt == 1 or ws.first_order[0] == 1 or opt.integrator != INTEGRATOR_EULER:
@@ -444,7 +444,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         if ccd_on and m.n_shape_pair > 0:                   #    shapes the answer moves
             widen_for_answer(m, s, ws, h, PAIR_MARGIN)      #    into, unlisted at stage 2
         if ccd_on:
-            tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 7. an impact
+            tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 6. an impact
             if tau >= 0.0:                                  #    mid-step: the rest again
                 if not stage:
                     add_part_path(s, ws, tau)
@@ -454,8 +454,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             tau = stop_at_impact(m, s, ws, h)               #    ends at a fast pair's impact
             if tau >= 0.0:                                  #    or turn horizon, the rest of
                 h = tau                                     #    the step's time dropped
-        audit_impulses(m, s, ws, opt, h)                    # 9. the audit of the impulses
-        position_stage(m, s, ws, opt, h, answered)          # 6. integrate, correct, settle
+        audit_impulses(m, s, ws, opt, h)                    # 7. the audit of the impulses
+        position_stage(m, s, ws, opt, h, answered)          # 8. integrate, correct, settle
         break
     if ws.room[0] == 1:
         return GUARD_ROOM
@@ -463,7 +463,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
     s.step[0] += 1
     if m.contact_body.shape[0] > 0:
         s.mode_cursor[0] = (s.mode_cursor[0] + 1) % m.contact_body.shape[0]
-    code = check_guards(s, ws, opt.guard_limit)
+    code = check_guards(s, ws, opt.guard_limit)             # 9. guards
     if code == 0 and opt.speed_limit > 0.0:
         code = check_speeds(m, s, ws, opt.speed_limit)
     if code == 0 and opt.gross_limit > 0.0 and ws.audit_worst_value[0] > opt.gross_limit:

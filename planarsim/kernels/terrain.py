@@ -44,14 +44,6 @@ def height_derivs(coef, x):
     return h, dh, ddh
 
 
-@jit
-def normal_at(coef, x):
-    """Unit normal (nx, ny) of the ground at x, pointing up (out of the ground)."""
-    h, dh, ddh = height_derivs(coef, x)
-    inv = 1.0 / math.sqrt(1.0 + dh * dh)
-    return -dh * inv, inv
-
-
 @jit(inline="force")
 def max_curvature(coef):
     """Upper bound on |h''| [1/m]: sum_k A_k (2 pi / L_k)^2."""

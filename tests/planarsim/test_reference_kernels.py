@@ -25,7 +25,8 @@ jit = njit(**dict(compile_options(), cache=False))
 
 @jit
 def _rows_at(m, s, ws):
-    """Stages 3-4 at s.q with every contact pinned: the rows, their errors and Jacobians."""
+    """Stages 2-3 at s.q with every contact pinned: the contacts, the rows, their errors and
+    Jacobians."""
     update_trig(s.q, ws.body_cs)
     for i in range(s.q.shape[0]):
         for k in range(3):

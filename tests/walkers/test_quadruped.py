@@ -135,7 +135,7 @@ def test_registry_interface_and_model():
 
 
 def test_python_controller_path_matches_compiled_rollout():
-    dog = qd.Quadruped(gait="walk", record_every=1)
+    dog = qd.Run(gait="walk", record_every=1)
     traj_c = dog.run(0.8)
     model = dog.model
     sim = ps.Simulator(model, ps.make_options("all"))
@@ -149,7 +149,7 @@ def test_python_controller_path_matches_compiled_rollout():
 def test_piaffe_60s():
     """Trot in place for 60 s: no fall, pitch within 10 deg, drift under 0.5 m, and the feet
     really step (every foot leaves the ground, the pairs alternate)."""
-    dog = qd.Quadruped(gait="piaffe", record_every=10)
+    dog = qd.Run(gait="piaffe", record_every=10)
     traj = dog.run(60.0)
     s = dog.summary()
     assert not s["fell"] and traj.t[-1] > 59.99
@@ -171,7 +171,7 @@ def test_piaffe_60s():
 
 def test_walk_forward_20m():
     """Commanded 0.3 m/s: 20 m without falling, mean speed within 20 % of the command."""
-    dog = qd.Quadruped(gait="walk", speed=0.3, record_every=20)
+    dog = qd.Run(gait="walk", speed=0.3, record_every=20)
     traj = dog.run(70.0)
     s = dog.summary()
     assert not s["fell"], s
@@ -186,7 +186,7 @@ def test_walk_forward_20m():
 
 
 def test_walk_backward():
-    dog = qd.Quadruped(gait="walk", speed=-0.3, record_every=20)
+    dog = qd.Run(gait="walk", speed=-0.3, record_every=20)
     traj = dog.run(12.0)
     s = dog.summary()
     assert not s["fell"], s
@@ -197,7 +197,7 @@ def test_walk_backward():
 
 def test_gait_switch_at_run_time():
     """Stand, then trot in place, then walk, then stand again, in one run."""
-    dog = qd.Quadruped(gait="stand")
+    dog = qd.Run(gait="stand")
     dog.run(1.0)
     assert dog.summary()["steps"] == 0
     dog.set_gait("piaffe")
@@ -231,7 +231,7 @@ def test_live_hook_for_the_viewer():
 @pytest.mark.parametrize("spec", ["hills", "slope:5", "slope:-5"])
 def test_walk_on_uneven_ground(spec):
     """Foot goals follow the terrain (plant height r / cos(slope) above the ground)."""
-    dog = qd.Quadruped(gait="walk", speed=0.3, terrain=spec, record_every=50)
+    dog = qd.Run(gait="walk", speed=0.3, terrain=spec, record_every=50)
     traj = dog.run(15.0)
     s = dog.summary()
     assert not s["fell"], s
@@ -245,7 +245,7 @@ def test_no_foot_pulls_under_either_strategy():
     feet pinned and pulling for up to 3 steps), and the step's own audit counts nothing."""
     pulls = {}
     for strategy in ("all", "alternating"):
-        dog = qd.Quadruped(gait="walk", speed=0.3, strategy=strategy, record_every=1)
+        dog = qd.Run(gait="walk", speed=0.3, strategy=strategy, record_every=1)
         traj = dog.run(8.0)
         assert not dog.fell
         normal = traj.contact_impulse[1:, :, 0]

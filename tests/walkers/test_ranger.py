@@ -14,7 +14,7 @@ from planarsim.actuators import (MOTOR_GEAR, MOTOR_TORQUE_CONST, make_motor, mot
                                  motor_torque, saturate_current)
 from walkers import WALKERS
 from walkers import ranger
-from walkers.ranger import RangerParams, RangerSim
+from walkers.ranger import RangerParams, Run
 from walkers.ranger import tables as T
 from walkers.ranger.estimator import butterworth2, filter_signal
 from walkers.ranger.model import foot_inertia_com
@@ -67,7 +67,7 @@ def test_double_stance_closed_loop(strategy):
     foot-ground. Pin residuals stay below 1e-9 m and the impulses carry exactly the weight.
     (With rolling arc soles the 10 rows are independent, rank 10 of 12 coordinates: each foot
     can still rock about its contact; the solver's dropped-row path is not needed here.)"""
-    rs = RangerSim(gait="stand", strategy=strategy, record_every=1)
+    rs = Run(gait="stand", strategy=strategy, record_every=1)
     traj = rs.run(3.0)
     ws = rs.ws
     J = np.zeros((ws.n_row[0], 3 * rs.model.n_body))
@@ -88,7 +88,7 @@ def test_double_stance_closed_loop(strategy):
 
 
 def test_stand_holds_30s():
-    rs = RangerSim(gait="stand", record_every=100)
+    rs = Run(gait="stand", record_every=100)
     h0 = hip_height(rs.state.q)
     traj = rs.run(30.0)
     assert not rs.fell and traj.t[-1] >= 30.0 - 1e-9
@@ -102,7 +102,7 @@ def test_stand_holds_30s():
 def walk_1000():
     """STAND for 2 s, then WALK through the Python API (the START phase) until 1000 steps (or a
     fall)."""
-    rs = RangerSim(gait="stand", record_every=1000)
+    rs = Run(gait="stand", record_every=1000)
     stand_q = rs.state.q.copy()
     rs.run(2.0)
     assert not rs.fell and np.abs(rs.state.v).max() < 1e-3 and np.abs(rs.state.q - stand_q).max() < 0.03
@@ -138,7 +138,7 @@ def test_gui_tracks_targets_against_static_equilibrium():
     Python API. The settled joint angles must match the static equilibrium of PD current
     torque + parallel springs + gravity, solved here independently by Newton's method."""
     p = RangerParams()
-    rs = RangerSim(p, gait="gui", suspended=True, record_every=1000)
+    rs = Run(p, gait="gui", suspended=True, record_every=1000)
     c = rs.controller
     targets = (0.5, 0.3, -0.4)
     gains = ((15.0, 3.0), (4.0, 0.3), (6.0, 0.3))
@@ -198,9 +198,9 @@ def touchdowns(mode, dt_frame, quiet=0.05):
 def test_estimator_switches_once_per_touchdown():
     """On a recorded walk the filtered estimator turns a foot 'on' at most once between two
     real touchdowns, and every 'on' follows a real touchdown within 60 ms."""
-    rs = RangerSim(gait="walk", record_every=1)
+    rs = Run(gait="walk", record_every=1)
     # a fresh WALK run starts at rest in the STAND pose (and gets going through START)
-    assert np.array_equal(rs.state.q, RangerSim(gait="stand").state.q)
+    assert np.array_equal(rs.state.q, Run(gait="stand").state.q)
     assert np.all(rs.state.v == 0.0)
     traj = rs.run(30.0)
     assert not rs.fell and rs.steps > 30
@@ -350,7 +350,7 @@ def test_the_efficient_set_meets_its_acceptance():
     from walkers.ranger.gait_map import RangerGaitMap
     values = load_values(Path(ranger.__file__).parent / "efficient.json", RangerParams)
     params = dataclasses.replace(RangerParams(), **values)
-    rs = RangerSim(params, gait="walk", record_every=1000)
+    rs = Run(params, gait="walk", record_every=1000)
     while rs.steps < 1000 and not rs.fell and rs.time < 1000.0:
         rs.run(50.0)
     s = rs.summary()

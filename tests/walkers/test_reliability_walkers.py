@@ -147,13 +147,13 @@ def test_walker_snapshot_with_controller_memory_continues_bit_for_bit(tmp_path):
     """Snapshot the Simple Biped mid-walk (engine state + controller memory) to disk, restore
     it into a fresh walker, and continue 1e3 steps: every recorded step hashes the same."""
     import planarsim as ps
-    from walkers.simple_biped import Walker
-    ref = Walker(record_every=1)
+    from walkers.simple_biped import Run
+    ref = Run(record_every=1)
     ref.run(3.0)
     path = ps.save_snapshot(tmp_path / "walk.npz", ref.state, memory={"controller": ref.memory})
     expected = frame_hashes(ref.run(1.0))
     state, memory = ps.load_snapshot(path)
-    again = Walker(record_every=1)
+    again = Run(record_every=1)
     again.state.restore(state)
     again.memory[:] = memory["controller"]
     cont = again.run(1.0)
@@ -165,8 +165,8 @@ def test_a_walker_divergence_names_the_body_and_field():
     """A huge push on the Simple Biped's hip: the walker's own rollout raises the engine's
     error naming step, body and field, with the state at the start of the failed step."""
     import planarsim as ps
-    from walkers.simple_biped import Walker
-    w = Walker(record_every=1)
+    from walkers.simple_biped import Run
+    w = Run(record_every=1)
     w.run(0.2)
     w.state.ext_force[0, 0] = 1e16     # N: the hip's velocity leaves the guard's bound
     with pytest.raises(ps.SimulationDiverged, match=r"simple-biped diverged at step 200 .*body 'hip' \(0\) vx=") as e:

@@ -50,7 +50,7 @@ def speed_over_last(traj, distance):
 
 @pytest.mark.parametrize("speed", [0.5, 1.0, 1.5])
 def test_walks_100m_on_flat_ground_at_the_target_speed(speed):
-    w = sb.Walker(gait="walk", speed=speed)
+    w = sb.Run(gait="walk", speed=speed)
     traj = walk_until(w, 100.0, t_max=100.0 / speed * 2 + 20)
     assert_walked(w, traj, 100.0)
     v = speed_over_last(traj, 50.0)
@@ -74,13 +74,13 @@ def test_hills_terrain_is_as_steep_as_the_seed_claims():
 @pytest.mark.parametrize("terrain", [steep_hills(), T.slope(5.0), T.slope(-5.0)],
                          ids=["hills-12deg", "up-5deg", "down-5deg"])
 def test_walks_100m_over_hills_and_slopes_from_rest(terrain, speed):
-    w = sb.Walker(gait="walk", terrain=terrain, speed=speed)
+    w = sb.Run(gait="walk", terrain=terrain, speed=speed)
     traj = walk_until(w, 100.0, t_max=100.0 / speed * 2 + 20)
     assert_walked(w, traj, 100.0)
 
 
 def test_stands_30s_with_the_hip_at_its_set_height():
-    w = sb.Walker(gait="stand")
+    w = sb.Run(gait="stand")
     traj = w.run(30.0)
     assert not w.fell
     settled = traj.t > 2.0
@@ -99,7 +99,7 @@ def flights(traj, model, min_gap=0.01):
 
 
 def test_jumps_then_walks_then_stands_switched_at_run_time():
-    w = sb.Walker(gait="stand")
+    w = sb.Run(gait="stand")
     w.run(1.0)
     w.set_gait("jump")
     jumps = w.run(9.0)
@@ -141,7 +141,7 @@ def test_simulate_returns_trajectory_summary_and_model():
 
 
 def test_compiled_rollout_and_python_controller_give_the_same_run():
-    w = sb.Walker(gait="walk", record_every=1)
+    w = sb.Run(gait="walk", record_every=1)
     fast = w.run(3.0)
     sim = ps.Simulator(w.model)
     ctrl = Controller(PARAMS, gait=sb.Gait.WALK)
@@ -152,7 +152,7 @@ def test_compiled_rollout_and_python_controller_give_the_same_run():
 
 def test_leg_actuators_and_hip_torque_are_internal_forces():
     # in free fall (no ground below), actuators cannot move the centre of mass off its parabola
-    w = sb.Walker(gait="jump", record_every=1)
+    w = sb.Run(gait="jump", record_every=1)
     w.state.q[:, 1] += 50.0  # lift the standing walker high above the ground
     com0 = w.model.arrays.body_mass @ w.state.q[:, :2] / w.model.total_mass
     traj = w.run(0.5)
@@ -166,6 +166,6 @@ def test_leg_actuators_and_hip_torque_are_internal_forces():
 
 def test_bad_gait_and_parameters_are_rejected_by_name():
     with pytest.raises(ValueError, match="hop"):
-        sb.Walker(gait="hop")
+        sb.Run(gait="hop")
     with pytest.raises(ValueError, match="stand_height"):
         sb.SimpleBipedParams(stand_height=math.nan)

@@ -37,7 +37,7 @@ def test_parameter_slots_read_the_fields_of_to_array(cls, layout):
 
 
 def test_memories_and_tables_have_their_layouts_size():
-    assert len(biped_rollout.Walker(gait="walk").memory) == size(biped.MEM)
+    assert len(biped_rollout.Run(gait="walk").memory) == size(biped.MEM)
     assert len(ranger.make_memory()) == size(ranger.MEM)
     assert len(simbicon.make_memory()) == size(simbicon.MEM)
     tables = ranger.make_tables(ranger.RangerParams(), 1e-3, max_steps=4)

@@ -3,7 +3,7 @@ inverse-kinematics puppet, trotting with diagonal pairs (STAND / PIAFFE / WALK).
 
 >>> from walkers import quadruped as qd                       # doctest: +SKIP
 >>> traj, summary, model = qd.simulate(20.0, gait="walk", speed=0.3)
->>> dog = qd.Quadruped(gait="piaffe"); dog.run(5.0); dog.set_gait("walk", 0.3); dog.run(10.0)
+>>> dog = qd.Run(gait="piaffe"); dog.run(5.0); dog.set_gait("walk", 0.3); dog.run(10.0)
 """
 from planarsim.compiled import drop_stale_caches
 
@@ -13,7 +13,7 @@ from .controller import Controller, FootState, Gait  # noqa: E402
 from .model import LEG_NAMES, PAIR, build  # noqa: E402
 from .params import QuadrupedParams  # noqa: E402
 from .puppet import leg_fk, leg_ik, puppet_pose  # noqa: E402
-from .rollout import GAITS, Quadruped, Run, live, rollout_quadruped, simulate  # noqa: E402
+from .rollout import GAITS, Run, live, rollout_quadruped, simulate  # noqa: E402
 
 NAME = "quadruped"
 FEET = (("FL_foot", "RR_foot"), ("FR_foot", "RL_foot"))   # a trot: diagonal pairs land together
@@ -32,6 +32,6 @@ GAIT_DOCS = {
 }
 Params = QuadrupedParams   # the walker's parameters (planarsim params quadruped)
 
-__all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "Quadruped", "QuadrupedParams", "Controller", "Gait",
+__all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "QuadrupedParams", "Controller", "Gait",
            "FootState", "build", "leg_fk", "leg_ik", "puppet_pose", "rollout_quadruped",
            "LEG_NAMES", "PAIR", "live"]

@@ -1,4 +1,4 @@
-"""Compiled rollout of the quadruped and its run class (``Quadruped``, a walkers.base.WalkerRun;
+"""Compiled rollout of the quadruped and its run class (``Run``, a walkers.base.WalkerRun;
 ``simulate``).
 
 ``rollout_quadruped`` runs physics + controller + recording + fall monitor without returning
@@ -52,7 +52,7 @@ def rollout_quadruped(m, s, ws, opt, p, mem, u, n, every, rec, lab, slots, k0):
     return 0, n, k
 
 
-class Quadruped(WalkerRun):
+class Run(WalkerRun):
     """The robot dog in the world (a WalkerRun): model, state, controller memory, chunks. Its
     controller table is the parameter vector (params.to_array(), indices I_<FIELD>).
 
@@ -116,8 +116,7 @@ class Quadruped(WalkerRun):
                 "speed_command": float(C.command_speed(self.memory))}
 
 
-Run = Quadruped
-simulate = simulation(Quadruped)
+simulate = simulation(Run)
 
 
 def live(gait="walk", terrain=None, speed=None, params=None, strategy="all") -> dict:

@@ -5,7 +5,7 @@ model, FSM WALK / STAND / GUI with a step-to-step push-off feedback, cost of tra
 >>> traj, summary, model = ranger.simulate(10.0, gait="walk")   # doctest: +SKIP
 
 Choices (numbers in params.py, each with its reason):
-- Contact-mode strategy: Kelly's "alternating" by default (RangerSim(strategy=...)); "all"
+- Contact-mode strategy: Kelly's "alternating" by default (Run(strategy=...)); "all"
   also walks 1000 steps, fresh or after 0.3 s / 2 s of STAND (measured on a6cac2a).
 - Rotor inertia: the ankle rotor's G^2 Jm is added to the foot body (armature), and ankle
   currents on a foot in the air are capped (free_foot_max_accel), see model.py/controller.py.
@@ -52,7 +52,7 @@ from .params import RangerParams  # noqa: E402
 from .model import build  # noqa: E402
 from .controller import Controller  # noqa: E402
 from .tables import Gait, Phase, Program, Tables, make_tables  # noqa: E402
-from .rollout import GAITS, RangerSim, Run, instantaneous_cot, live, simulate  # noqa: E402
+from .rollout import GAITS, Run, instantaneous_cot, live, simulate  # noqa: E402
 
 NAME = "ranger"
 SUMMARY_EXTRAS = {
@@ -74,4 +74,4 @@ GAIT_DOCS = {
 Params = RangerParams   # the walker's parameters (planarsim params ranger)
 
 __all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "RangerParams", "build", "Controller", "Tables", "make_tables", "Gait", "Phase",
-           "Program", "RangerSim", "instantaneous_cot", "live"]
+           "Program", "instantaneous_cot", "live"]

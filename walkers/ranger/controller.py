@@ -38,6 +38,7 @@ from planarsim.compiled import jit_inline, kernel, pin_angle_rate, height as ter
 
 from .estimator import filter_step, hysteresis
 from .motor import drive_motor, torque_constant
+from .model import GRAVITY
 from .params import RangerParams
 
 
@@ -307,7 +308,7 @@ def height_below(m, x):
 class Controller:
     """Python-side holder of the compiled controller's tables and memory.
 
-    ``Controller(params, dt)``; ``set_gait("walk"|"stand"|"gui")``; ``set_gui(joint, target,
+    ``Controller(params, dt, gravity=model's [m/s^2])``; ``set_gait("walk"|"stand"|"gui")``; ``set_gui(joint, target,
     kp, kd)`` (joint 0 hip, 1 outer ankle, 2 inner ankle; REL pin angles [rad], gains [A/rad],
     [A s/rad]); ``__call__(sim) -> u`` runs one control step on a Simulator (the Python path).
     ``reset`` refills the memory in place (a run holding it sees the new values).
@@ -315,9 +316,10 @@ class Controller:
 
     GAITS = {"walk": GAIT_WALK, "stand": GAIT_STAND, "gui": GAIT_GUI}
 
-    def __init__(self, params: RangerParams | None = None, dt: float = 1e-3, max_steps: int = 20000):
+    def __init__(self, params: RangerParams | None = None, dt: float = 1e-3, max_steps: int = 20000,
+                 gravity: float = GRAVITY):
         self.params = params if params is not None else RangerParams()
-        self.tables = make_tables(self.params, dt, max_steps)
+        self.tables = make_tables(self.params, dt, max_steps, gravity)
         self.mem = make_memory()
         self.reset()
 

@@ -52,7 +52,7 @@ from planarsim.compiled import (RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, 
 from walkers.common.section import GaitMapMixin, chain_poses, chain_velocities, copy_tuple, restore_tuple
 
 from . import controller as C, tables as T
-from .rollout import RangerSim
+from .rollout import Run
 
 NAMES = ("stance_foot_angle", "swing_leg_angle", "swing_foot_angle", "stance_leg_rate",
          "swing_leg_rate", "stance_foot_rate", "swing_foot_rate",
@@ -110,7 +110,7 @@ class RangerGaitMap(GaitMapMixin):
 
     def __init__(self, settle: float = SETTLE, dt: float = DT, params=None, stance: int = 0):
         self.dt, self.settle = float(dt), float(settle)
-        self.rs = rs = RangerSim(params, dt=dt, gait="walk", max_steps=16)
+        self.rs = rs = Run(params, dt=dt, gait="walk", max_steps=16)
         self.model = rs.model
         self.m = rs.model.arrays
         self.tables = rs.tables._replace(steplog=np.zeros((16, T.N_LOG)))

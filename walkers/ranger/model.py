@@ -28,14 +28,14 @@ from .params import RangerParams
 
 # the shapes only draw the walker: its feet are its contacts
 DRAWN = {"collide": False}
+# [m/s^2] the model's gravity, straight down (the controller's tables are made with the
+# model's: Run passes model.arrays.gravity's magnitude)
+GRAVITY = 9.81
 
 OUTER, INNER = 0, 1
 LEG = (0, 1)             # body of the leg of side s
 FOOT = (2, 3)            # body of the foot of side s
-HIP_PIN = 0
 ANKLE_PIN = (1, 2)       # pin of the ankle of side s
-HIP_MOTOR = 0
-ANKLE_MOTOR = (1, 2)     # actuator of the ankle of side s
 
 
 def foot_inertia_com(p: RangerParams) -> float:
@@ -90,7 +90,7 @@ def build(p: RangerParams | None = None, terrain=None, dt: float = 1e-3, suspend
     """
     p = p if p is not None else RangerParams()
     terrain = terrain if terrain is not None else flat()
-    b = ps.ModelBuilder(dt=dt, gravity=(0.0, -9.81), terrain=terrain)
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, -GRAVITY), terrain=terrain)
     hip, angles, foot_angles = standing_pose(p, terrain)
     if suspended:
         hip = hip + np.array([0.0, 0.3])       # on the test stand the feet hang 0.3 m up

@@ -9,7 +9,7 @@ towards +x, so a stance leg goes from positive (foot ahead) to negative (foot be
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from walkers.common.params import WalkerParams, param
 
@@ -104,7 +104,3 @@ class RangerParams(WalkerParams):
             raise ValueError(f"RangerParams.est_off={self.est_off} must be below est_on={self.est_on}")
         if self.sole_span_front <= self.sole_span_back:
             raise ValueError("RangerParams.sole_span_front must exceed sole_span_back")
-
-
-PARAM_NAMES = tuple(f.name for f in fields(RangerParams))
-PARAM_INDEX = {n: i for i, n in enumerate(PARAM_NAMES)}

@@ -1,4 +1,4 @@
-"""Compiled Ranger rollout, its run class (``RangerSim``, a walkers.base.WalkerRun) and the
+"""Compiled Ranger rollout, its run class (``Run``, a walkers.base.WalkerRun) and the
 uniform ``simulate(...)`` entry point.
 
 ``rollout_ranger`` runs physics + controller + recording without returning to Python; it stops
@@ -59,18 +59,23 @@ def rollout_ranger(m, s, ws, opt, tab, mem, u, n, every, rec, lab, lab_idx, k0):
     return 0, n, kf
 
 
+def _gravity(model) -> float:
+    """The model's gravity [m/s^2] (its magnitude)."""
+    return float(np.hypot(*model.arrays.gravity))
+
+
 def step_options(strategy: str = "alternating") -> ps.StepOptions:
     """Ranger's StepOptions: the engine defaults with the chosen contact-mode strategy."""
     return ps.make_options(strategy)
 
 
-class RangerSim(WalkerRun):
+class Run(WalkerRun):
     """Ranger in the world (a WalkerRun) with its Controller (tables, memory, gait switches).
 
     The model starts at rest in the STAND pose for every gait; WALK starts from it through the
     controller's START phase. ``options`` overrides Ranger's StepOptions (step_options()).
 
-    >>> rs = RangerSim(gait="stand")          # doctest: +SKIP
+    >>> rs = Run(gait="stand")                # doctest: +SKIP
     >>> traj = rs.run(5.0); rs.set_gait("walk"); traj2 = rs.run(10.0)
     """
 
@@ -88,7 +93,7 @@ class RangerSim(WalkerRun):
             raise ValueError(f"Ranger gait {gait!r} unknown; use one of {GAITS}")
         params = params if params is not None else RangerParams()
         model = build(params, terrain_of(terrain), dt=dt, suspended=suspended)
-        self.controller = Controller(params, dt, max_steps=max_steps)
+        self.controller = Controller(params, dt, max_steps=max_steps, gravity=_gravity(model))
         self.controller.reset(gait)
         super().__init__(model, params, self.controller.tables, self.controller.mem,
                          options=options if options is not None else step_options(strategy),
@@ -114,7 +119,7 @@ class RangerSim(WalkerRun):
         mem, model, p = self.memory, self.model, self.params
         n = int(mem[C.MEM.steps])
         log = self.tables.steplog[:min(n, len(self.tables.steplog))]
-        weight = 9.81 * float(model.arrays.body_mass.sum())
+        weight = _gravity(model) * float(model.arrays.body_mass.sum())
         out = {"steps": n, "fell": self.fell, "time": self.time,
                "distance": float(self.state.q[0, 0] - model.q0[0, 0])}
         out["mean_speed"] = out["distance"] / out["time"] if out["time"] > 0 else 0.0
@@ -143,8 +148,7 @@ class RangerSim(WalkerRun):
         return out
 
 
-Run = RangerSim
-simulate = simulation(RangerSim)
+simulate = simulation(Run)
 
 
 def instantaneous_cot(traj: Trajectory, model, overhead_power: float = 4.5, min_speed: float = 0.05):
@@ -152,7 +156,7 @@ def instantaneous_cot(traj: Trajectory, model, overhead_power: float = 4.5, min_
     speed); NaN where the forward COM speed is below min_speed [m/s]."""
     power = sum(np.maximum(traj.labels[k], 0.0) for k in ("power_hip", "power_outer_ankle", "power_inner_ankle"))
     speed = traj.com_velocity(model)[:, 0]
-    weight = 9.81 * float(model.arrays.body_mass.sum())
+    weight = _gravity(model) * float(model.arrays.body_mass.sum())
     cot = (power + overhead_power) / (weight * np.where(speed > min_speed, speed, np.nan))
     return cot
 
@@ -162,7 +166,7 @@ def live(gait: str = "walk", terrain=None, params: RangerParams | None = None,
     """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and the
     Python-path Controller; keys w / s / g for WALK / STAND / GUI; sliders for the GUI joint
     targets [rad] (Kelly 2014, 6.1: the GUI mode sets joint targets and gains)."""
-    rs = RangerSim(params, terrain, gait=gait, strategy=strategy)
+    rs = Run(params, terrain, gait=gait, strategy=strategy)
     sim = ps.Simulator(rs.model, rs.options, rs.state)
     ctrl, mem, gui = rs.controller, rs.memory, rs.tables.gui
 

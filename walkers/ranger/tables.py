@@ -13,7 +13,7 @@ import numpy as np
 from walkers.common.slots import size, slots
 
 from .estimator import butterworth2
-from .model import foot_inertia_com
+from .model import GRAVITY, foot_inertia_com
 from .motor import motor_table
 from .params import RangerParams
 
@@ -88,10 +88,12 @@ LOG = slots("StepLogColumns", (
 N_LOG = size(LOG)
 
 
-def make_constants(p: RangerParams, dt: float) -> np.ndarray:
+def make_constants(p: RangerParams, dt: float, gravity: float = GRAVITY) -> np.ndarray:
+    """(N_K,) constants, slots CONST, of RangerParams, the step dt [s] and the model's gravity
+    [m/s^2] (its magnitude)."""
     k = np.zeros(N_K)
     k[CONST.dt] = dt
-    k[CONST.weight] = 9.81 * (2 * p.leg_mass + 2 * p.foot_mass)
+    k[CONST.weight] = gravity * (2 * p.leg_mass + 2 * p.foot_mass)
     k[CONST.est_on], k[CONST.est_off] = p.est_on, p.est_off
     k[CONST.b0:CONST.b0 + 5] = butterworth2(p.est_cutoff, dt)
     k[CONST.foot_i] = foot_inertia_com(p) + p.foot_mass * (p.foot_com_x ** 2 + p.foot_com_y ** 2)
@@ -100,7 +102,7 @@ def make_constants(p: RangerParams, dt: float) -> np.ndarray:
     k[CONST.scissor], k[CONST.scissor_off] = p.scissor_gain, p.scissor_offset
     k[CONST.land_leg], k[CONST.push_leg] = p.land_leg_angle, p.push_leg_angle
     k[CONST.push_i0], k[CONST.push_gain], k[CONST.v_target], k[CONST.imax] = p.push_current, p.push_gain, p.target_speed, p.current_max
-    k[CONST.leg_com], k[CONST.fall_h], k[CONST.grav] = p.leg_com, p.fall_height, 9.81
+    k[CONST.leg_com], k[CONST.fall_h], k[CONST.grav] = p.leg_com, p.fall_height, gravity
     k[CONST.ds_time] = p.ds_time
     k[CONST.start_i], k[CONST.start_leg] = p.start_push_current, p.start_leg_angle
     return k
@@ -164,7 +166,9 @@ class Tables(NamedTuple):
     steplog: np.ndarray   # (max_steps, N_LOG) one row per heel strike (columns LOG), written by the controller
 
 
-def make_tables(p: RangerParams, dt: float, max_steps: int = 20000) -> Tables:
-    """RangerParams and the step length dt [s] -> Tables, with room to log max_steps steps."""
-    return Tables(k=make_constants(p, dt), prog=make_programs(p), motor=motor_table(p),
+def make_tables(p: RangerParams, dt: float, max_steps: int = 20000,
+                gravity: float = GRAVITY) -> Tables:
+    """RangerParams, the step length dt [s] and the model's gravity [m/s^2] (its magnitude) ->
+    Tables, with room to log max_steps steps."""
+    return Tables(k=make_constants(p, dt, gravity), prog=make_programs(p), motor=motor_table(p),
                   gui=make_gui(p), steplog=np.zeros((int(max_steps), N_LOG)))

@@ -8,7 +8,7 @@ drop_stale_caches(__path__[0])
 from .params import SimbiconParams, THESIS  # noqa: E402
 from .model import build  # noqa: E402
 from .controller import Controller, Phase  # noqa: E402
-from .rollout import GAITS, Run, SimbiconRun, live, run, simulate  # noqa: E402
+from .rollout import GAITS, Run, live, run, simulate  # noqa: E402
 
 NAME = "simbicon"
 SUMMARY_EXTRAS = {
@@ -23,4 +23,4 @@ GAIT_DOCS = {"walk": "walks with SIMBICON's four-state machine: PD joints, torso
                      "stance hip, swing-hip balance feedback"}
 Params = SimbiconParams   # the walker's parameters (planarsim params simbicon)
 
-__all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "SimbiconRun", "run", "live", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]
+__all__ = ["NAME", "GAITS", "GAIT_DOCS", "simulate", "Run", "run", "live", "build", "Controller", "Phase", "SimbiconParams", "THESIS"]

@@ -1,4 +1,4 @@
-"""Compiled rollout of the SIMBICON biped, its run class (``SimbiconRun``, a
+"""Compiled rollout of the SIMBICON biped, its run class (``Run``, a
 walkers.base.WalkerRun), ``simulate`` and the tuning entry point ``run``.
 
 ``rollout_simbicon`` runs physics + controller + recording + a torso push without returning to
@@ -76,7 +76,7 @@ def _push_array(push):
     return arr
 
 
-class SimbiconRun(WalkerRun):
+class Run(WalkerRun):
     """The SIMBICON biped in the world (a WalkerRun), from the standing start pose.
 
     Parameters
@@ -90,7 +90,10 @@ class SimbiconRun(WalkerRun):
     seed : accepted for the common interface (the walker is deterministic)
     record_every : steps between recorded frames (0: none, and no min_clearance)
     strategy : engine contact-mode strategy
-    glitch_ok : an engine divergence ends the run as a glitch (a fall) instead of raising
+    glitch_ok : an engine divergence (a non-finite or too large state) ends the run as a glitch
+           (a fall) instead of raising; off by default, so a divergence raises as in every
+           walker (tuning's objective turns it on: a parameter set the engine cannot run
+           loses its run)
     model : a model built already (build(params, terrain, dt)), to skip the build
     """
 
@@ -99,7 +102,7 @@ class SimbiconRun(WalkerRun):
     LABEL_SLOTS = np.zeros(0, np.int64)   # no per-frame labels
 
     def __init__(self, params: SimbiconParams | None = None, terrain=None, dt=1e-3, gait="walk",
-                 push=None, seed=0, record_every=10, strategy: str = STRATEGY, glitch_ok: bool = True,
+                 push=None, seed=0, record_every=10, strategy: str = STRATEGY, glitch_ok: bool = False,
                  model=None):
         if gait not in GAITS:
             raise ValueError(f"simbicon gait {gait!r} unknown; gaits: {GAITS}")
@@ -149,17 +152,16 @@ class SimbiconRun(WalkerRun):
         return out
 
 
-Run = SimbiconRun
-simulate = simulation(SimbiconRun)
+simulate = simulation(Run)
 
 
 def run(params: SimbiconParams, duration: float, terrain=None, dt=1e-3, push=None,
         record_every: int = 10, model=None, record: bool = True, strategy: str = STRATEGY,
-        glitch_ok: bool = True):
-    """A SimbiconRun of `duration` [s] (tuning's entry point; record=False records nothing).
-    Returns (Trajectory or None, summary dict, model); see SimbiconRun.numbers for the keys."""
-    r = SimbiconRun(params, terrain, dt, push=push, record_every=record_every if record else 0,
-                    strategy=strategy, glitch_ok=glitch_ok, model=model)
+        glitch_ok: bool = False):
+    """A SIMBICON Run of `duration` [s] (tuning's entry point; record=False records nothing).
+    Returns (Trajectory or None, summary dict, model); see Run.numbers for the keys."""
+    r = Run(params, terrain, dt, push=push, record_every=record_every if record else 0,
+            strategy=strategy, glitch_ok=glitch_ok, model=model)
     r.run(duration)
     return (r.trajectory() if record else None), r.summary(), r.model
 

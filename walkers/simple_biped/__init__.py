@@ -2,7 +2,7 @@
 
 >>> from walkers import simple_biped as sb              # doctest: +SKIP
 >>> traj, summary, model = sb.simulate(20.0, gait="walk", speed=1.0)
->>> w = sb.Walker(gait="stand"); w.run(2.0); w.set_gait("jump"); w.run(5.0)
+>>> w = sb.Run(gait="stand"); w.run(2.0); w.set_gait("jump"); w.run(5.0)
 """
 from planarsim.compiled import drop_stale_caches
 
@@ -11,7 +11,7 @@ drop_stale_caches(__path__[0])
 from .controller import Gait, State, Tables, make_tables  # noqa: E402
 from .model import build  # noqa: E402
 from .params import SimpleBipedParams  # noqa: E402
-from .rollout import Run, Walker, live, rollout_simple_biped, simulate  # noqa: E402
+from .rollout import Run, live, rollout_simple_biped, simulate  # noqa: E402
 
 NAME = "simple-biped"
 SUMMARY_EXTRAS = {
@@ -31,5 +31,5 @@ GAIT_DOCS = {
     "jump": "jumps in place again and again: crouch, thrust, flight with both feet up, landing",
 }
 
-__all__ = ["NAME", "GAITS", "GAIT_DOCS", "Gait", "State", "Tables", "make_tables", "SimpleBipedParams", "Run", "Walker", "build", "simulate", "live",
+__all__ = ["NAME", "GAITS", "GAIT_DOCS", "Gait", "State", "Tables", "make_tables", "SimpleBipedParams", "Run", "build", "simulate", "live",
            "rollout_simple_biped"]

@@ -27,7 +27,7 @@ from walkers.common.section import GaitMapMixin, copy_tuple, restore_tuple
 
 from . import controller as C
 from .params import FIELD
-from .rollout import Walker, _longest_leg
+from .rollout import Run, _longest_leg
 
 NAMES = ("hip_dx", "hip_dy", "hip_vx", "hip_vy", "rear_dx", "v_top")
 DT = 1e-4       # [s] analysis step: the controller switches at step boundaries, which makes the
@@ -71,7 +71,7 @@ class SimpleBipedGaitMap(GaitMapMixin):
 
     def __init__(self, settle: float = SETTLE, speed=None, params=None, dt: float = DT, stance: int = 0):
         self.dt, self.settle = float(dt), float(settle)
-        self.walker = w = Walker(params, dt=dt, gait="walk", speed=speed, record_every=10 ** 9)
+        self.walker = w = Run(params, dt=dt, gait="walk", speed=speed, record_every=10 ** 9)
         self.m = w.model.arrays
         self.max_steps = int(round(4.0 / dt))
         code, _ = rollout_to_touchdown(self.m, w.state, w.ws, w.options, w.tables, w.memory, w.u, 10 ** 9,

@@ -19,9 +19,6 @@ from planarsim.terrain import Terrain
 
 from .params import SimpleBipedParams
 
-BODY_HIP, BODY_FOOT0, BODY_FOOT1 = 0, 1, 2
-ACT_LEG0, ACT_LEG1, ACT_HIP = 0, 1, 2
-
 
 # [l0] radius of the feet's disks against shapes (the ground meets the foot's centre)
 FOOT_RADIUS = 0.01

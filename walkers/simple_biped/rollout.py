@@ -1,8 +1,8 @@
-"""Compiled rollout of the Simple Biped and its run class (``Walker``, a walkers.base.WalkerRun;
+"""Compiled rollout of the Simple Biped and its run class (``Run``, a walkers.base.WalkerRun;
 ``simulate``).
 
 ``rollout_simple_biped`` runs physics + controller + recording + fall monitor without returning
-to Python. ``Walker`` keeps model, state and controller memory between chunks, so the gait (and
+to Python. ``Run`` keeps model, state and controller memory between chunks, so the gait (and
 the target speed) can be switched at run time: ``w.set_gait("jump"); w.run(5.0)``.
 Per recorded frame, ``Trajectory.labels`` holds the controller's ``gait``, ``state`` (see
 controller.State), ``stance`` foot, ``phase``, ``steps`` and ``jumps``.
@@ -69,7 +69,7 @@ def _gait_id(gait) -> int:
     return int(C.Gait(gait))
 
 
-class Walker(WalkerRun):
+class Run(WalkerRun):
     """A Simple Biped in the world (a WalkerRun): model, state, controller memory, chunks.
 
     Parameters
@@ -137,15 +137,14 @@ class Walker(WalkerRun):
                 "gait": self.gait, "state": C.State(int(self.memory[C.MEM.state])).name.lower()}
 
 
-Run = Walker
-simulate = simulation(Walker)
+simulate = simulation(Run)
 
 
 def live(gait="walk", terrain=None, params=None, speed=None) -> dict:
     """Hook for the interactive viewer (planarsim.render.viewer.view_walker): a Simulator and the
     compiled controller called from Python each step; keys s / w / j for STAND / WALK / JUMP,
     a slider for the target walking speed [m/s]."""
-    w = Walker(params, terrain, gait=gait, speed=speed)
+    w = Run(params, terrain, gait=gait, speed=speed)
     sim = ps.Simulator(w.model, w.options, w.state)
     m, tab, mem, u = w.model.arrays, w.tables, w.memory, w.u
 
