@@ -111,3 +111,24 @@ def test_break_in_needs_python_mode_and_names_an_unknown_stage():
     assert out.returncode == 0, out.stderr[-2000:]
     lines = out.stdout.splitlines()
     assert lines[0] == "1" and "no function 'no_such_stage' in planarsim/kernels/solve.py" in lines[1]
+
+
+def test_ci_runs_in_the_mode_its_switches_ask_for():
+    """In CI (.ci/run sets CI) the process runs in the mode its switches ask for: fast unless
+    PLANARSIM_PLAIN_NUMBA=1 or NUMBA_DISABLE_JIT=1 say otherwise. Elsewhere a numba release
+    without the fast mode's internals falls back to plain numba with a warning (a slower
+    first compile, the same numbers); in CI that fallback would skip the fast mode's own test
+    modules and still pass, so there it fails here instead."""
+    from numba import config
+    if os.environ.get("CI", "") in ("", "0"):
+        pytest.skip("not in CI: a fallback to plain numba is a warning there, not a failure")
+    asked = mode.choose_mode(os.environ, bool(config.DISABLE_JIT), lambda: ())
+    assert planarsim.compile.MODE == asked, (
+        f"CI runs in the {planarsim.compile.MODE!r} mode where its switches ask for {asked!r}: "
+        f"numba lacks {mode_missing()} that the fast mode builds on")
+
+
+def mode_missing():
+    """The numba internals the fast mode lacks in this process (numba_check.py)."""
+    from planarsim.compile.numba_check import changed_internals
+    return ", ".join(changed_internals()) or "nothing"
