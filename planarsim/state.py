@@ -4,6 +4,7 @@ Both are NamedTuples of numpy arrays so that compiled kernels take them directly
 """
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -441,13 +442,10 @@ def lcp_bytes(lcp_rows: int) -> int:
 
 
 def lcp_rows_limit() -> int:
-    """The island rows whose dense complementarity storage fits LCP_GROWTH_BUDGET."""
-    C = int((LCP_GROWTH_BUDGET / 80.0) ** 0.5)
-    while lcp_bytes(C + 1) <= LCP_GROWTH_BUDGET:
-        C += 1
-    while C > 1 and lcp_bytes(C) > LCP_GROWTH_BUDGET:
-        C -= 1
-    return C
+    """The most island rows whose dense complementarity storage fits LCP_GROWTH_BUDGET
+    (lcp_bytes(C) = 128 C^2 + 48 C, solved for C)."""
+    C = int((-48.0 + math.sqrt(48.0 ** 2 + 512.0 * LCP_GROWTH_BUDGET)) / 256.0)
+    return C - 1 if lcp_bytes(C) > LCP_GROWTH_BUDGET else C
 
 
 def solve_bytes(model: Model, contacts: int, profile: int, lcp_rows: int) -> int:
@@ -585,14 +583,14 @@ def grow_workspace(model: Model, ws: Workspace) -> Workspace:
     else:
         contacts = min(model.n_contact, max(2 * contacts, contacts + 16))
     check_workspace(model, contacts, profile, lcp_rows)
-    grown = _solve_arrays(model, contacts, profile, lcp_rows)
-    for name, array in grown.items():
+    grown = {}
+    for name, (shape, dtype) in _solve_shapes(model, contacts, profile, lcp_rows).items():
         old = getattr(ws, name)
-        if old.shape == array.shape:
-            grown[name] = old
-        else:
-            array[tuple(slice(0, min(k, g)) for k, g in zip(old.shape, array.shape))] = \
-                old[tuple(slice(0, min(k, g)) for k, g in zip(old.shape, array.shape))]
+        if old.shape != shape:
+            array = np.zeros(shape, dtype)
+            kept = tuple(slice(0, min(k, g)) for k, g in zip(old.shape, shape))
+            array[kept] = old[kept]
+            grown[name] = array
     room = ws.room.copy()
     room[0] = 0
     room[1] = int(contacts < model.n_contact)
