@@ -167,12 +167,12 @@ def _factor_pivoted(B, nb, rows, scratch):
 
 @kernel
 def _factor_joints(A, local, B, nb, rows, scratch):
-    """B = L D L^T of the joint rows rows[:nb] of the island's A (row r at local[r]; rows may be permuted; see
-    _factor_pivoted). In the rows' order where every pivot is at least PIVOTING_SHARE of its
-    diagonal, far above rounding, so that the rows are certainly independent (a tree's
-    joints); pivoted otherwise: a loop, at or near a dependent configuration, whose rows
-    left out must be the dependent ones whatever the rows' order. Returns the smallest share
-    of its diagonal that a pivot kept (0 if a row was left out)."""
+    """B = L D L^T of the joint rows rows[:nb] of the island's A (row r at local[r]; rows
+    may be permuted; see _factor_pivoted). In the rows' order where every pivot is at least
+    PIVOTING_SHARE of its diagonal, far above rounding, so that the rows are certainly
+    independent (a tree's joints); pivoted otherwise: a loop, at or near a dependent
+    configuration, whose rows left out must be the dependent ones whatever the rows' order.
+    Returns the smallest share of its diagonal that a pivot kept (0 if a row was left out)."""
     _fill_joint_block(A, local, B, nb, rows)
     smallest = _factor_plain(B, nb)
     if smallest >= PIVOTING_SHARE:
