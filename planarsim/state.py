@@ -8,6 +8,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from .kernels.info import N_INFO
 from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
@@ -385,14 +386,50 @@ class Workspace(NamedTuple):
     prev: State                  # the state at the start of the last step (for guard errors)
 
 
-def copy_arrays(dst, src) -> None:
-    """Copy a NamedTuple of arrays (nested ones too: Workspace.prev) into one of the same
-    shapes, in place."""
+def array_pairs(dst, src) -> list:
+    """[(a, b)]: the arrays of two NamedTuples of the same shapes (nested ones too), paired."""
+    pairs = []
     for a, b in zip(dst, src):
         if isinstance(a, tuple):
-            copy_arrays(a, b)
+            pairs.extend(array_pairs(a, b))
         else:
-            a[...] = b
+            pairs.append((a, b))
+    return pairs
+
+
+@njit(cache=True)
+def _copy_flat(dst, src):
+    for k in range(len(dst)):
+        d = dst[k]
+        s = src[k]
+        for i in range(d.shape[0]):
+            d[i] = s[i]
+
+
+class ArrayCopier:
+    """Copies the second array of each (dst, src) pair into the first, in place, in one
+    compiled call per dtype (float64, int64; any other array in Python): a Simulator's reset
+    copies a fresh workspace's few hundred arrays, whose copy one by one from Python cost
+    more than the environment's step."""
+
+    def __init__(self, pairs):
+        from numba.typed import List
+        self.lists = {}
+        self.others = []
+        for dst, src in pairs:
+            if (dst.dtype in (np.float64, np.int64) and dst.dtype == src.dtype
+                    and dst.shape == src.shape and dst.flags.c_contiguous and src.flags.c_contiguous):
+                lists = self.lists.setdefault(dst.dtype.str, (List(), List()))
+                lists[0].append(dst.reshape(-1))
+                lists[1].append(src.reshape(-1))
+            else:
+                self.others.append((dst, src))
+
+    def copy(self) -> None:
+        for dst, src in self.lists.values():
+            _copy_flat(dst, src)
+        for dst, src in self.others:
+            dst[...] = src
 
 
 def forget_ground_queries(ws: Workspace) -> None:
