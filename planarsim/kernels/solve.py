@@ -66,9 +66,12 @@ def row_dot(ws, r, J, vel):
 @kernel
 def fill_row_b(ws, h, n):
     """ws.row_b: each row's end-of-step residual without impulses [m/s], w = A lam + b."""
-    soft = False        # soft rows: the joints' target is linearized at v_lin, not at v*
-    for r in range(n):
-        soft = soft or is_soft_row(ws.row_kind[r])
+    # the joints' target is linearized at v_lin: v* but where soft rows or a second
+    # linearization (step.relinearize) moved it
+    moved = False
+    for i in range(ws.v_lin.shape[0]):
+        for k in range(3):
+            moved = moved or ws.v_lin[i, k] != ws.v_pred[i, k]
     for r in range(n):
         if is_soft_row(ws.row_kind[r]):
             # armature and implicit spring-damper (soft.py); its compliance is set here
@@ -85,7 +88,7 @@ def fill_row_b(ws, h, n):
             if ws.first_order[0] == 0:
                 # linearized at q + h v_lin: c(q_pred) + h J (v_new - v_lin) = 0
                 ws.row_b[r] = ws.row_c_pred[r] / h
-                if soft:
+                if moved:
                     ws.row_b[r] += (row_dot(ws, r, ws.row_J, ws.v_pred)
                                     - row_dot(ws, r, ws.row_J, ws.v_lin))
             else:

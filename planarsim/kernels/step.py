@@ -41,7 +41,7 @@ from .solve import solve_impulses
 from .rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
                      unsupported)
 from .warm_start import remember_impulses
-from .work import joints_add_energy
+from .work import NEAR_DEPENDENT, joints_add_energy, prediction_turn
 
 
 @kernel
@@ -340,6 +340,39 @@ def second_order_gains(m, s, ws, h):
     return excess > 0.0
 
 
+# a step's end this far [rad] from where the joints' target was linearized (work.
+# prediction_turn) is linearized again at it before the target is given up
+RELINEARIZE_TURN = 1e-3
+
+
+@kernel
+def relinearize(m, s, ws, h):
+    """The joints' second-order target added energy (second_order_gains) while linearized
+    at q + h v_lin (soft rows moved it from v*; without them the projection stands, as
+    validated on the stress corpus) RELINEARIZE_TURN or more from the answer's end, with
+    joint rows that are not nearly dependent (ws.joint_pivot; a loop near a dead point gets
+    its projection):
+    the target is linearized again at the answer, v_lin = v_new, for one more solve. A light
+    link between heavy rotors ends far from where the soft rows alone predicted (the pins
+    move it too); the projection (J v = 0) would leave its drift to the position
+    correction, whose velocity change weighs the bodies without their rotors. Returns True
+    if it did."""
+    if ws.joint_pivot[0] < NEAR_DEPENDENT or prediction_turn(m, s, ws, h) < RELINEARIZE_TURN:
+        return False
+    moved = False           # (without soft rows, v* is the prediction: projection as before)
+    for i in range(s.v.shape[0]):
+        for k in range(3):
+            moved = moved or ws.v_lin[i, k] != ws.v_pred[i, k]
+    if not moved:
+        return False
+    for i in range(s.v.shape[0]):
+        for k in range(3):
+            ws.v_lin[i, k] = ws.v_new[i, k]
+    predict_configuration(m, s, ws, h)
+    forget_impulses(s)
+    return True
+
+
 @kernel
 def reset_counts(ws):
     """Zero the counts of what a step did (info.STEP_COUNTS; step_info reads them)."""
@@ -433,13 +466,15 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         ccd_on = split < opt.max_ccd_splits
         if m.n_shape_pair > 0:                              #    fast shape pairs apart: left
             hold_off_fast_pairs(m, s, ws, h)                #    to the sweep of stage 6
-        for attempt in range(2):                            # 3-5. rows, impulses, modes
+        for attempt in range(3):                            # 3-5. rows, impulses, modes
             answered = solve_modes(m, s, ws, opt, h, not ccd_on)
-            if attempt == 1 or ws.first_order[0] == 1 or opt.integrator != INTEGRATOR_EULER:
+            if attempt == 2 or ws.first_order[0] == 1 or opt.integrator != INTEGRATOR_EULER:
                 break                                       #    (RATTLE keeps its target)
             if not second_order_gains(m, s, ws, h):
                 break
-            ws.first_order[0] = 1                           #    again, joint rows at J v = 0,
+            if attempt == 0 and relinearize(m, s, ws, h):   #    again, the target at the
+                continue                                    #    answer's end (once), or
+            ws.first_order[0] = 1                           #    with joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
         if ws.room[0] == 1:                                 #    rows beyond the storage:
             return GUARD_ROOM                               #    again with more (_step)

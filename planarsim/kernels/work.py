@@ -157,16 +157,21 @@ def joints_add_energy(m, s, ws, h):
     velocities' lower bound of that work (gain_from_velocities) is judged too."""
     work, rounding, row = joint_work(m, ws, ws.v_new)
     kinetic = kinetic_energy(m, ws.v_pred)
+    # the shares are of the energy of the motion the target was linearized at: KE(v*), but
+    # KE(v_lin) where soft rows moved it (v* lets the applied torques spin a light link
+    # that its rotors hold back: a yardstick 5x too large passed a target that kicked such
+    # a link by 2.7 rad/s a step) or a second linearization did (step.relinearize)
+    scale = kinetic_energy(m, ws.v_lin)
     # impulses so large that their work's rounding alone hides the share (a folded loop's
     # self-stress of 1e5 N s at 1e-5 J of motion): the velocities bound what they added
     gain = -math.inf
-    if rounding > CONSTRAINT_SHARE * kinetic:
+    if rounding > CONSTRAINT_SHARE * scale:
         gain = gain_from_velocities(m, ws, h, kinetic)
-    excess = max(work - CONSTRAINT_SHARE * kinetic - rounding, gain - CONSTRAINT_SHARE * kinetic)
+    excess = max(work - CONSTRAINT_SHARE * scale - rounding, gain - CONSTRAINT_SHARE * scale)
     if (excess > 0.0 and ws.joint_pivot[0] >= NEAR_DEPENDENT
             and prediction_turn(m, s, ws, h) <= SHAKE_REGIME):
-        excess = max(work - JOINT_WORK_SHARE * kinetic - rounding,
-                     gain - JOINT_WORK_SHARE * kinetic)
+        excess = max(work - JOINT_WORK_SHARE * scale - rounding,
+                     gain - JOINT_WORK_SHARE * scale)
     if excess > 0.0 and row < 0:
         row = largest_joint_impulse(ws)
     return excess, row
