@@ -126,3 +126,29 @@ def test_pages_name_no_file_outside_the_repository():
         text = page.read_text()
         assert "../shared" not in text and "shared/" not in text, page
         assert not re.search(r"\bissues?\b #?\d|/issues\b|\bissue tracker\b", text, re.I), page
+
+
+def test_docstrings_keep_their_layout_in_the_api_reference():
+    """docs/hooks/plain_docstrings.py (the API reference's griffe extension): a `>>>` session
+    becomes a Python console block, an aligned `name : meaning` table and an indented
+    continuation keep their lines in a text block, a dashed section title turns bold, and
+    running prose stays Markdown."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("plain_docstrings", DOCS / "hooks" / "plain_docstrings.py")
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+    text = inspect.cleandoc('''Prose that wraps
+        onto a second line.
+
+        >>> 1 + 1
+        2
+
+        Parameters
+        ----------
+        q : (n_body, 3) [m]     positions
+        v : (n_body, 3) [m/s]   velocities, continued
+            on an indented line''')
+    md = hook.to_markdown(text)
+    assert md.startswith("Prose that wraps\nonto a second line.\n\n```pycon\n>>> 1 + 1\n2\n```")
+    assert "**Parameters**\n\n```text\nq : (n_body, 3) [m]     positions\n" in md
+    assert md.endswith("    on an indented line\n```")
