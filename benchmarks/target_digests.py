@@ -8,8 +8,15 @@ identical across all four.
     python benchmarks/target_digests.py                  # 3 s per walker, the corpus set
     python benchmarks/target_digests.py --seconds 1      # quicker
     python benchmarks/target_digests.py --print          # this process's fingerprints only
+    python benchmarks/target_digests.py --write-baseline # commit what the numbers are now
 
 Prints each setting's difference from the host's (none: "identical") and exits 1 if any.
+The committed baseline (benchmarks/results/digests-<machine>-<system>.txt, this platform's,
+at BASELINE_SECONDS per walker; tests/planarsim/test_digests_baseline.py compares a fresh
+run with it) is what the numbers were when it was last written: a change of physics that
+moves them writes it again, and its commit says which lines moved and why. Across x86-64
+CPUs the numbers are the same (the settings above); another architecture or C library may
+differ in the last bits of sin / cos, hence a file per platform.
 A first run of the generic target compiles every kernel for it (numba caches it beside the
 host's code, one cache entry per target).
 """
@@ -36,6 +43,16 @@ SETTINGS = (("host", {}),
 CORPUS = (("biped_stance", 0), ("biped_collapse", 1), ("chain_hills", 2), ("mass_ratio", 3),
           ("shape_pile", 4), ("shape_hills", 5), ("loop_inertia", 36), ("loop_inertia", 162),
           ("hills_fast", 7), ("ranger_loop", 2))
+
+
+#: simulated time per walker [s] of the committed baseline
+BASELINE_SECONDS = 1.0
+
+
+def baseline_path() -> Path:
+    """This platform's committed fingerprints."""
+    import platform
+    return ROOT / "benchmarks" / "results" / f"digests-{platform.machine()}-{sys.platform}.txt"
 
 
 def corpus_lines():
@@ -88,9 +105,17 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=3.0, help="simulated time per walker [s]")
     ap.add_argument("--print", action="store_true", help="print this process's fingerprints")
+    ap.add_argument("--write-baseline", action="store_true",
+                    help=f"write this platform's baseline ({BASELINE_SECONDS} s per walker)")
     a = ap.parse_args(argv)
     if a.print:
         print("\n".join(fingerprints(a.seconds)))
+        return 0
+    if a.write_baseline:
+        path = baseline_path()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("\n".join(run({}, BASELINE_SECONDS)) + "\n")
+        print(f"wrote {path.relative_to(ROOT)}")
         return 0
     reference = None
     differing = 0

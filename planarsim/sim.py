@@ -21,7 +21,7 @@ from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
 from .start_check import check_overlap, check_start, overlapping
 from .kernels.guards import GUARD_ROOM
-from .state import (State, Workspace, check_state, copy_arrays, forget_ground_queries, forget_pairs,
+from .state import (ArrayCopier, State, Workspace, array_pairs, check_state, forget_ground_queries, forget_pairs,
                     grow_workspace, make_state, make_workspace, workspace_capacity)
 from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
@@ -300,9 +300,12 @@ class Simulator:
             if bad.size:
                 raise ValueError(f"start_over: {name} of body {self._model.body_names[bad[0]]!r} "
                                  f"({bad[0]}) is {a[bad[0]].tolist()}; it must be finite")
-        if getattr(self, "_fresh_ws", None) is None:
-            self._fresh_ws = make_workspace(self._model, *workspace_capacity(self._model, self._ws))
-        copy_arrays(self._ws, self._fresh_ws)
+        fresh = getattr(self, "_fresh_ws", None)
+        if fresh is None or fresh[0] is not self._ws:
+            # a fresh workspace's arrays and this one's, paired once: a reset copies them all
+            made = make_workspace(self._model, *workspace_capacity(self._model, self._ws))
+            self._fresh_ws = fresh = (self._ws, ArrayCopier(array_pairs(self._ws, made)))
+        fresh[1].copy()
         if getattr(self, "_speed_from_model", False):
             self.state = st          # the setter bounds the speeds again from this start
         else:                        # made by make_state: shapes and codes right already

@@ -8,6 +8,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from .kernels.info import N_INFO
 from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
@@ -178,6 +179,17 @@ class Workspace(NamedTuple):
     row_list: np.ndarray         # (R,) int scratch: the rows a column's elimination updates
     v_pred: np.ndarray           # (n_body, 3) unconstrained velocity v + h M^-1 f
     v_new: np.ndarray            # (n_body, 3) constrained velocity of the current solve
+    v_lin: np.ndarray            # (n_body, 3) velocity the joints' second-order target is
+                                 #   linearized at: v_pred and the soft rows' own answer
+                                 #   (soft.soft_prediction)
+    soft_joint: np.ndarray       # (n_pin,) int the joints with a soft row, in order
+    soft_body: np.ndarray        # (n_pin, 2) int their bodies (-1: the world)
+    soft_J: np.ndarray           # (n_pin, 2, 3) their rate rows g at the step's start
+    soft_first: np.ndarray       # (n_pin,) int first soft row sharing a body with each (envelope)
+    soft_start: np.ndarray       # (n_pin,) int where each row's envelope begins in soft_env
+    soft_env: np.ndarray         # (soft_envelope_size,) L D L^T of G W G^T + Gamma, row by row
+    soft_rhs: np.ndarray         # (n_pin,) its right-hand side, then the soft rows' impulses
+    soft_mark: np.ndarray        # (n_body,) int first soft row touching each body (scratch)
     q_pred: np.ndarray           # (n_body, 3) predicted end-of-step configuration q + h v_pred
     cs_pred: np.ndarray          # (n_body, 3) cos, sin, angle of q_pred (as body_cs)
     q_keep: np.ndarray           # (n_body, 3) q and v before a Newton step of the position
@@ -290,8 +302,8 @@ class Workspace(NamedTuple):
                                  #   inverse inertia and limit (GUARD_STIFF_ACTUATOR)
     row_b: np.ndarray            # (R,) residual of each row without impulses: w = A lam + b
                                  #   [m/s] (velocity stage) or [m, rad] (position projection)
-    row_soft: np.ndarray         # (R, 5) a soft row's armature, stiffness, damping, joint rate
-                                 #   at the step's start, compliance (kernels/soft.py)
+    row_soft: np.ndarray         # (R, 6) a soft row's armature, stiffness, damping, joint rate
+                                 #   at the step's start, compliance, g W g^T (kernels/soft.py)
     contact_candidate: np.ndarray  # (n_contact,) int 1: in the complementarity problem
     limit_candidate: np.ndarray  # (n_pin, 2) int 1: in the complementarity problem
     lcp_rows: np.ndarray         # (R,) int rows: joints first, then the others
@@ -374,14 +386,50 @@ class Workspace(NamedTuple):
     prev: State                  # the state at the start of the last step (for guard errors)
 
 
-def copy_arrays(dst, src) -> None:
-    """Copy a NamedTuple of arrays (nested ones too: Workspace.prev) into one of the same
-    shapes, in place."""
+def array_pairs(dst, src) -> list:
+    """[(a, b)]: the arrays of two NamedTuples of the same shapes (nested ones too), paired."""
+    pairs = []
     for a, b in zip(dst, src):
         if isinstance(a, tuple):
-            copy_arrays(a, b)
+            pairs.extend(array_pairs(a, b))
         else:
-            a[...] = b
+            pairs.append((a, b))
+    return pairs
+
+
+@njit(cache=True)
+def _copy_flat(dst, src):
+    for k in range(len(dst)):
+        d = dst[k]
+        s = src[k]
+        for i in range(d.shape[0]):
+            d[i] = s[i]
+
+
+class ArrayCopier:
+    """Copies the second array of each (dst, src) pair into the first, in place, in one
+    compiled call per dtype (float64, int64; any other array in Python): a Simulator's reset
+    copies a fresh workspace's few hundred arrays, whose copy one by one from Python cost
+    more than the environment's step."""
+
+    def __init__(self, pairs):
+        from numba.typed import List
+        self.lists = {}
+        self.others = []
+        for dst, src in pairs:
+            if (dst.dtype in (np.float64, np.int64) and dst.dtype == src.dtype
+                    and dst.shape == src.shape and dst.flags.c_contiguous and src.flags.c_contiguous):
+                lists = self.lists.setdefault(dst.dtype.str, (List(), List()))
+                lists[0].append(dst.reshape(-1))
+                lists[1].append(src.reshape(-1))
+            else:
+                self.others.append((dst, src))
+
+    def copy(self) -> None:
+        for dst, src in self.lists.values():
+            _copy_flat(dst, src)
+        for dst, src in self.others:
+            dst[...] = src
 
 
 def forget_ground_queries(ws: Workspace) -> None:
@@ -547,7 +595,7 @@ def _solve_shapes(model: Model, contacts: int, profile: int, lcp_rows: int) -> d
                 sp_lstart=((R + 1,), i), sp_pivot=((R,), f), sp_diag=((R,), f),
                 sp_x=((R,), f), sp_y=((R,), f), sp_start=((R + 1,), i), sp_index=((P,), i),
                 sp_low=((P,), f), sp_up=((P,), f), sp_body_rows=((2 * R,), i), rhs=((R,), f), lam_start=((R,), f), lam=((R,), f),
-                row_b=((R,), f), row_soft=((R, 5), f), lcp_rows=((R,), i),
+                row_b=((R,), f), row_soft=((R, 6), f), lcp_rows=((R,), i),
                 lcp_var=((R,), i), lcp_pos=((R,), i), row_local=((R,), i),
                 lcp_A=((C, C), f), lcp_B=((C, C), f), lcp_G=((C, C + 1), f),
                 lcp_S=((C, C + 1), f), lcp_M=((L, L), f), lcp_q=((L,), f), lcp_z=((L,), f),
@@ -599,6 +647,20 @@ def grow_workspace(model: Model, ws: Workspace) -> Workspace:
     return ws._replace(room=room, **grown)
 
 
+def soft_envelope_size(model: Model) -> int:
+    """Entries of the soft prediction's envelope (kernels/soft.soft_prediction) were every
+    joint to have a soft row: row t holds columns from the first joint sharing a body with t."""
+    first_at = {}
+    size = 0
+    for t, bodies in enumerate(np.asarray(model.arrays.pin_body).reshape(-1, 2)):
+        first = t
+        for b in bodies:
+            if b >= 0:
+                first = min(first, first_at.setdefault(int(b), t))
+        size += t - first + 1
+    return size
+
+
 def make_workspace(model: Model, contacts: int | None = None, profile: int | None = None,
                    lcp_rows: int | None = None) -> Workspace:
     """A model's workspace with room for `contacts` contacts in its solve's storage
@@ -611,12 +673,17 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
     lcp_rows = first_lcp if lcp_rows is None else int(lcp_rows)
     check_workspace(model, contacts, profile, lcp_rows)
     nb, nc, na = model.n_body, model.n_contact, model.n_act
+    npin = model.n_pin
     z = np.zeros
     lists = _broad_phase_lists(model)
     n_pair = lists["live_pairs"].shape[0]
     return Workspace(force=z((nb, 3)), body_cs=np.full((nb, 3), np.nan),
                      body_first_row=z(nb, np.int64),
-                     v_pred=z((nb, 3)), v_new=z((nb, 3)),
+                     v_pred=z((nb, 3)), v_new=z((nb, 3)), v_lin=z((nb, 3)),
+                     soft_joint=z(npin, np.int64), soft_body=z((npin, 2), np.int64),
+                     soft_J=z((npin, 2, 3)), soft_first=z(npin, np.int64),
+                     soft_start=z(npin, np.int64), soft_env=z(soft_envelope_size(model)),
+                     soft_rhs=z(npin), soft_mark=z(nb, np.int64),
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),
                      q_solved=z((nb, 3)), v_solved=z((nb, 3)),

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections import namedtuple
 from types import SimpleNamespace
 
 import numpy as np
@@ -34,6 +35,12 @@ from ..state import make_state
 def gym_asset(name: str) -> str:
     """Path of gymnasium's MJCF file `name` (gymnasium ships them without mujoco)."""
     return os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets", name)
+
+
+# the pin table's columns joint_values reads: handing numba these five arrays instead of the
+# model's whole table (a hundred arrays, each typed at every call) makes the call about 10x
+# cheaper, which an environment pays at every step
+JointTable = namedtuple("JointTable", "pin_kind pin_body pin_axis pin_anchor pin_ref")
 
 
 def _rot(a):
@@ -57,6 +64,64 @@ def joint_values(m, q, v, cs, pins, sign, ref, qpos, qvel):
         x, rate = joint_position_rate(m, q, cs, v, pins[i])
         qpos[i] = ref[i] + sign[i] * x
         qvel[i] = sign[i] * rate
+
+
+@jit
+def set_commands(ctrl, lo, hi, gear, act_id, u):
+    """u[act_id[k]] = gear[k] * ctrl[k] clamped to [lo[k], hi[k]]; False (u untouched) if an
+    entry of ctrl is not finite."""
+    for k in range(ctrl.shape[0]):
+        if not math.isfinite(ctrl[k]):
+            return False
+    for k in range(ctrl.shape[0]):
+        u[act_id[k]] = gear[k] * min(max(ctrl[k], lo[k]), hi[k])
+    return True
+
+
+@jit
+def place_links(order, ref, sign, pin_body, pin_anchor, pin_ref, pin_kind, pin_axis, qpos, qvel,
+                q, v):
+    """q, v of each joint's body b from its body a (placed before it in `order`: rows of (MJCF
+    joint index, pin index)) and the joint's qpos, qvel (a hinge: angle ref + sign x, a slide
+    along the pin's axis turning with body a)."""
+    for k in range(order.shape[0]):
+        i = order[k, 0]
+        j = order[k, 1]
+        a = pin_body[j, 0]
+        b = pin_body[j, 1]
+        xa = q[a, 0] if a >= 0 else 0.0
+        ya = q[a, 1] if a >= 0 else 0.0
+        ta = q[a, 2] if a >= 0 else 0.0
+        vxa = v[a, 0] if a >= 0 else 0.0
+        vya = v[a, 1] if a >= 0 else 0.0
+        wa = v[a, 2] if a >= 0 else 0.0
+        c, s = math.cos(ta), math.sin(ta)
+        px = xa + c * pin_anchor[j, 0, 0] - s * pin_anchor[j, 0, 1]
+        py = ya + s * pin_anchor[j, 0, 0] + c * pin_anchor[j, 0, 1]
+        vpx = vxa - wa * (py - ya)
+        vpy = vya + wa * (px - xa)
+        if pin_kind[j] & JOINT_SLIDE_BIT:
+            th = ta + pin_ref[j]
+            dx = c * pin_axis[j, 0] - s * pin_axis[j, 1]
+            dy = s * pin_axis[j, 0] + c * pin_axis[j, 1]
+            d = qpos[i] - ref[i]
+            vpx += -wa * dy * d + dx * qvel[i]
+            vpy += wa * dx * d + dy * qvel[i]
+            px += dx * d
+            py += dy * d
+            w = wa
+        else:
+            th = ta + pin_ref[j] + sign[i] * (qpos[i] - ref[i])
+            w = wa + sign[i] * qvel[i]
+        cb, sb = math.cos(th), math.sin(th)
+        cx = px - (cb * pin_anchor[j, 1, 0] - sb * pin_anchor[j, 1, 1])
+        cy = py - (sb * pin_anchor[j, 1, 0] + cb * pin_anchor[j, 1, 1])
+        q[b, 0] = cx
+        q[b, 1] = cy
+        q[b, 2] = th
+        v[b, 0] = vpx - w * (cy - py)
+        v[b, 1] = vpy + w * (cx - px)
+        v[b, 2] = w
 
 
 class GeneralizedCoords:
@@ -87,7 +152,8 @@ class GeneralizedCoords:
         self.sign = np.array([jm.sign for jm in self.jm], float)
         self.ref = np.array([jm.ref for jm in self.jm], float)
         self._cs = np.full((self.n_body, 3), np.nan)
-        self._arrays = model.arrays
+        a = model.arrays
+        self._arrays = JointTable(a.pin_kind, a.pin_body, a.pin_axis, a.pin_anchor, a.pin_ref)
 
     def values(self, q, v, qpos=None, qvel=None):
         """The same as from_maximal, compiled (into qpos, qvel if given)."""
@@ -102,6 +168,27 @@ class GeneralizedCoords:
         slides, (h,) = self.free[body]
         A = np.array([self.jm[i].axis for i in slides], float).T
         return slides, h, A, np.array(self.jm[slides[0]].anchor, float)
+
+    def _link_order(self):
+        """The non-free joints (their indices) in an order in which each one's body a is
+        placed before it (the world, a free root or an earlier joint's body b), made once."""
+        order = getattr(self, "_order", None)
+        if order is not None:
+            return order
+        placed = set(self.free) | {-1}
+        pending, order = list(self.links), []
+        while pending:
+            ready = [i for i in pending if self.pin_body[self.jm[i].id][0] in placed]
+            if not ready:
+                raise RuntimeError(f"joints {[self.names[i] for i in pending]} hang from no body")
+            for i in ready:
+                order.append(i)
+                placed.add(int(self.pin_body[self.jm[i].id][1]))
+                pending.remove(i)
+        self._order = np.array([(i, self.jm[i].id) for i in order], np.int64).reshape(-1, 2)
+        self._link_ref = np.array([jm.ref for jm in self.jm], float)
+        self._link_sign = np.array([jm.sign for jm in self.jm], float)
+        return self._order
 
     def to_maximal(self, qpos, qvel):
         """(nq,), (nv,) MuJoCo values -> q, v (n_body, 3)."""
@@ -118,39 +205,9 @@ class GeneralizedCoords:
             q[body] = (c[0], c[1], self.q0[body, 2] + phi)
             v[body, :2] = A @ np.array([qvel[i] for i in slides]) + _cross(w, c - anchor)
             v[body, 2] = w
-        pending = list(self.links)
-        while pending:
-            progressed = False
-            for i in list(pending):
-                jm = self.jm[i]
-                a, b = self.pin_body[jm.id]
-                if a >= 0 and np.isnan(q[a, 0]):
-                    continue
-                qa = q[a] if a >= 0 else np.zeros(3)
-                va = v[a] if a >= 0 else np.zeros(3)
-                la, lb = self.pin_anchor[jm.id]
-                Ra = _rot(qa[2])
-                Pa = qa[:2] + Ra @ la
-                vPa = va[:2] + _cross(va[2], Pa - qa[:2])
-                if self.pin_kind[jm.id] & JOINT_SLIDE_BIT:
-                    th = qa[2] + self.pin_ref[jm.id]
-                    dw = Ra @ self.pin_axis[jm.id]
-                    s = qpos[i] - jm.ref
-                    P = Pa + dw * s
-                    vP = vPa + _cross(va[2], dw * s) + dw * qvel[i]
-                    w = va[2]
-                else:
-                    th = qa[2] + self.pin_ref[jm.id] + jm.sign * (qpos[i] - jm.ref)
-                    P, vP = Pa, vPa
-                    w = va[2] + jm.sign * qvel[i]
-                c = P - _rot(th) @ lb
-                q[b] = (c[0], c[1], th)
-                v[b, :2] = vP + _cross(w, c - P)
-                v[b, 2] = w
-                pending.remove(i)
-                progressed = True
-            if not progressed:
-                raise RuntimeError(f"joints {[self.names[i] for i in pending]} hang from no body")
+        order = self._link_order()
+        place_links(order, self._link_ref, self._link_sign, self.pin_body, self.pin_anchor,
+                    self.pin_ref, self.pin_kind, self.pin_axis, qpos, qvel, q, v)
         return q, v
 
     def from_maximal(self, q, v):
@@ -283,9 +340,12 @@ class PlanarMujocoEnv(gymnasium.Env):
         return a
 
     def do_simulation(self, ctrl, n_frames):
-        ctrl = self.check_action(ctrl)
-        # MuJoCo clamps ctrl to ctrlrange; the actuator's input is gear * ctrl
-        self._u[self._act_id] = self._act_gear * np.clip(ctrl, self._act_lo, self._act_hi)
+        a = np.asarray(ctrl, dtype=np.float64)
+        # MuJoCo clamps ctrl to ctrlrange; the actuator's input is gear * ctrl (one compiled
+        # call, which also says whether every entry was finite)
+        if a.shape != self.action_space.shape or not set_commands(
+                a, self._act_lo, self._act_hi, self._act_gear, self._act_id, self._u):
+            self.check_action(a)        # (raises, naming what is wrong)
         self.sim.steps(int(n_frames), self._u)
         self._sync()
 
@@ -312,9 +372,11 @@ class PlanarMujocoEnv(gymnasium.Env):
         """World (plane) position of a point fixed in MJCF body `body`, given at the file's
         pose in the plane's coordinates (e.g. a site's position)."""
         bid = self.loaded.body[body]
-        q = self.sim.state.q[bid]
-        off = np.asarray(local_mjcf, float) - self.sim_model.q0[bid, :2]
-        return q[:2] + _rot(q[2] - self.sim_model.q0[bid, 2]) @ off
+        x, y, angle = self.sim.state.q[bid]
+        q0 = self.sim_model.q0[bid]
+        dx, dy = float(local_mjcf[0]) - q0[0], float(local_mjcf[1]) - q0[1]
+        c, s = math.cos(angle - q0[2]), math.sin(angle - q0[2])
+        return np.array([x + c * dx - s * dy, y + s * dx + c * dy])
 
     # rendering ----------------------------------------------------------------------------
     def render(self):

@@ -6,6 +6,7 @@ termination, reset noise and frame skip.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -208,16 +209,19 @@ class Reacher(_Task):
     def obs_size(self):
         return 10
 
-    def _get_rew(self, action):
-        vec = self.body_com("fingertip") - self.body_com("target")
-        reward_dist = -np.linalg.norm(vec) * self._reward_dist_weight
+    def _get_rew(self, action, vec=None):
+        """(reward, its terms); vec: fingertip - target [m] if already measured."""
+        if vec is None:
+            vec = self.body_com("fingertip") - self.body_com("target")
+        reward_dist = -math.hypot(vec[0], vec[1]) * self._reward_dist_weight
         reward_ctrl = -np.square(action).sum() * self._reward_control_weight
         return reward_dist + reward_ctrl, {"reward_dist": reward_dist, "reward_ctrl": reward_ctrl}
 
     def step(self, action):
         self.do_simulation(action, self.frame_skip)
-        observation = self._get_obs()
-        reward, info = self._get_rew(action)
+        vec = self.body_com("fingertip") - self.body_com("target")
+        observation = self._get_obs(vec)
+        reward, info = self._get_rew(action, vec)
         return observation, reward, False, False, info
 
     def reset_model(self):
@@ -232,11 +236,12 @@ class Reacher(_Task):
         self.set_state(qpos, qvel)
         return self._get_obs()
 
-    def _get_obs(self):
-        theta = self.data.qpos.flatten()[:2]
-        return np.concatenate([np.cos(theta), np.sin(theta), self.data.qpos.flatten()[2:],
-                               self.data.qvel.flatten()[:2],
-                               self.body_com("fingertip") - self.body_com("target")])
+    def _get_obs(self, vec=None):
+        if vec is None:
+            vec = self.body_com("fingertip") - self.body_com("target")
+        theta = self.data.qpos[:2]
+        return np.concatenate([np.cos(theta), np.sin(theta), self.data.qpos[2:],
+                               self.data.qvel[:2], vec])
 
 
 class InvertedPendulum(_Task):

@@ -261,13 +261,14 @@ def velocity_stage_gain(m, ws, vel, h):
 
 @kernel
 def predict_configuration(m, s, ws, h):
-    """ws.q_pred = q + h v_pred (the end of the step without constraint impulses) and its
-    cos / sin: the joints' errors there give the velocity solve its second-order term."""
+    """ws.q_pred = q + h v_lin (the end of the step without constraint impulses but the soft
+    rows', soft.soft_prediction) and its cos / sin: the joints' errors there give the velocity
+    solve its second-order term."""
     if m.pin_body.shape[0] + m.rod_body.shape[0] == 0:
         return
     for i in range(s.q.shape[0]):
         for k in range(3):
-            ws.q_pred[i, k] = s.q[i, k] + h * ws.v_pred[i, k]
+            ws.q_pred[i, k] = s.q[i, k] + h * ws.v_lin[i, k]
     update_trig(ws.q_pred, ws.cs_pred)
 
 

@@ -66,6 +66,9 @@ def row_dot(ws, r, J, vel):
 @kernel
 def fill_row_b(ws, h, n):
     """ws.row_b: each row's end-of-step residual without impulses [m/s], w = A lam + b."""
+    soft = False        # soft rows: the joints' target is linearized at v_lin, not at v*
+    for r in range(n):
+        soft = soft or is_soft_row(ws.row_kind[r])
     for r in range(n):
         if is_soft_row(ws.row_kind[r]):
             # armature and implicit spring-damper (soft.py); its compliance is set here
@@ -80,7 +83,11 @@ def fill_row_b(ws, h, n):
             # closes the joints' errors (c / h as velocity would be energy from nowhere
             # after a time-of-impact split moved the bodies off their joints)
             if ws.first_order[0] == 0:
+                # linearized at q + h v_lin: c(q_pred) + h J (v_new - v_lin) = 0
                 ws.row_b[r] = ws.row_c_pred[r] / h
+                if soft:
+                    ws.row_b[r] += (row_dot(ws, r, ws.row_J, ws.v_pred)
+                                    - row_dot(ws, r, ws.row_J, ws.v_lin))
             else:
                 ws.row_b[r] = row_dot(ws, r, ws.row_J, ws.v_pred)
             continue

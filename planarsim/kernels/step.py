@@ -36,6 +36,7 @@ from .pair import PAIR_MARGIN
 from .pair_toi import hold_off_fast_pairs
 from .position import position_stage
 from .rows import build_rows
+from .soft import soft_prediction
 from .solve import solve_impulses
 from .rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
                      unsupported)
@@ -424,7 +425,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             if code != 0:
                 return code
         predict_velocity(m, s, ws, h)                       #    v* = v + h M^-1 f
-        predict_configuration(m, s, ws, h)                  #    q + h v* (joints' drift)
+        soft_prediction(m, s, ws, h)                        #    v_lin: v* and soft rows
+        predict_configuration(m, s, ws, h)                  #    q + h v_lin (joints' drift)
         find_contacts(m, s, ws, h)                          # 2. contacts
         if split == 0 and not stage:
             note_start_depths(ws)                           #    (check_displacements)

@@ -117,14 +117,14 @@ def _rod_rate(s, v, a, b, ax, ay, bx, by):
 @kernel
 def prediction_turn(m, s, ws, h):
     """The largest angle [rad] by which the step's end, integrated with the solve's velocity
-    ws.v_new, turns away from the predicted end q + h v* at which the joints' second-order
-    target was linearized (ws.q_pred): h |w - w*| of a body, and for a rod, h |dv_perp| / L
+    ws.v_new, turns away from the predicted end q + h v_lin at which the joints' second-order
+    target was linearized (ws.q_pred, soft.soft_prediction): h |w - w_lin| of a body, and for a rod, h |dv_perp| / L
     of the change of its anchors' relative velocity across it. A pin's or rod's error is
     nonlinear in these turns only (linear in translations), so the target's error is of
     order (this turn) x (the drift it aims at)."""
     top = 0.0
     for i in range(s.v.shape[0]):
-        top = max(top, abs(h) * abs(ws.v_new[i, 2] - ws.v_pred[i, 2]))
+        top = max(top, abs(h) * abs(ws.v_new[i, 2] - ws.v_lin[i, 2]))
     for j in range(m.rod_body.shape[0]):
         a = m.rod_body[j, 0]
         b = m.rod_body[j, 1]
@@ -133,7 +133,7 @@ def prediction_turn(m, s, ws, h):
         length2 = (bx - ax) ** 2 + (by - ay) ** 2
         if length2 > 0.0:
             change = (_rod_rate(s, ws.v_new, a, b, ax, ay, bx, by)
-                      - _rod_rate(s, ws.v_pred, a, b, ax, ay, bx, by))
+                      - _rod_rate(s, ws.v_lin, a, b, ax, ay, bx, by))
             top = max(top, abs(h) * abs(change) / length2)
     return top
 
