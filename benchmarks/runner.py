@@ -131,7 +131,26 @@ class _Tee(io.TextIOBase):
         self.out.flush()
 
     def isatty(self):
-        return self.out.isatty()
+        try:
+            return self.out.isatty()
+        except ValueError:      # asked after the stream it wrote to was closed (an atexit hook)
+            return False
+
+
+def _git_commit():
+    """The checkout's commit (short hash, '+' when files differ from it), or None outside git."""
+    import subprocess
+    root = Path(__file__).resolve().parents[1]
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
+                              text=True, timeout=10)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
+                               capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if head.returncode != 0:
+        return None
+    return head.stdout.strip() + ("+" if dirty.stdout.strip() else "")
 
 
 def markdown_report(results, printed, argv, when=None) -> str:
@@ -139,8 +158,10 @@ def markdown_report(results, printed, argv, when=None) -> str:
     the figures were made, the targets as a Markdown table, then the run's printed output."""
     when = when or datetime.datetime.now(datetime.timezone.utc)
     command = " ".join(["planarsim bench", *argv])
+    commit = _git_commit()
     lines = [f"## Measured on `{machine_name()}`", "",
-             f"Written by `{command}` on {when:%Y-%m-%d %H:%M} UTC ({os.cpu_count()} cores, load "
+             f"Written by `{command}` on {when:%Y-%m-%d %H:%M} UTC"
+             + (f" at commit {commit}" if commit else "") + f" ({os.cpu_count()} cores, load "
              f"average {os.getloadavg()[0]:.1f} at the end). Timings on a shared machine vary from run "
              f"to run; compare figures within one run.", "",
              "| benchmark target | measured | status |", "|---|---|---|"]

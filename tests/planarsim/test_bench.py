@@ -152,6 +152,8 @@ def test_md_writes_the_machines_results_page(tmp_path, capsys):
     assert f"wrote {tmp_path / bench.machine_name()}.md" in out
     assert page.startswith(f"## Measured on `{bench.machine_name()}`")
     assert f"`planarsim bench {' '.join(argv)}`" in page
+    commit = bench._git_commit()          # the checkout's commit, where there is one
+    assert (f" at commit {commit} (" in page) if commit else ("at commit" not in page)
     table = [line for line in page.splitlines() if line.startswith("| ")]
     assert table[0] == "| benchmark target | measured | status |"
     targets = out[out.index("benchmark targets (measured in this run)"):].splitlines()[1:]
