@@ -446,7 +446,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         if ccd_on and m.n_shape_pair > 0:                   #    shapes the answer moves
             widen_for_answer(m, s, ws, h, PAIR_MARGIN)      #    into, unlisted at stage 2
         if ccd_on:
-            tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 6. an impact
+            tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 6. impact
             if tau >= 0.0:                                  #    mid-step: the rest again
                 if not stage:
                     add_part_path(s, ws, tau)
@@ -456,9 +456,9 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             tau = stop_at_impact(m, s, ws, h)               #    ends at a fast pair's impact
             if tau >= 0.0:                                  #    or turn horizon, the rest of
                 h = tau                                     #    the step's time dropped
-        audit_impulses(m, s, ws, opt, h)                    # 7. the audit of the impulses
-        position_stage(m, s, ws, opt, h, answered)          # 8. integrate, correct, settle
-        break
+        audit_impulses(m, s, ws, opt, h)                    # 7. audit of the impulses
+        position_stage(m, s, ws, opt, h, answered)          # 8. positions: integrate,
+        break                                               #    correct, settle
     if ws.room[0] == 1:
         return GUARD_ROOM
     s.time[0] = ws.prev.time[0] + step_length
