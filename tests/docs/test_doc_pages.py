@@ -152,3 +152,14 @@ def test_docstrings_keep_their_layout_in_the_api_reference():
     assert md.startswith("Prose that wraps\nonto a second line.\n\n```pycon\n>>> 1 + 1\n2\n```")
     assert "**Parameters**\n\n```text\nq : (n_body, 3) [m]     positions\n" in md
     assert md.endswith("    on an indented line\n```")
+
+
+def test_the_stage_table_is_the_codes_own():
+    """docs/engine.md takes its table of the step's stages from planarsim/kernels/stages.py (the
+    hook docs/hooks/stage_table.py puts stage_table() where the marker stands) and keeps no
+    hand-written copy of it."""
+    text = (DOCS / "engine.md").read_text()
+    assert text.count("<!-- stage-table -->") == 1
+    assert "| stage |" not in text
+    hooks = (DOCS.parent / "mkdocs.yml").read_text()
+    assert "docs/hooks/stage_table.py" in hooks

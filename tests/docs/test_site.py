@@ -53,6 +53,13 @@ def test_the_site_builds_strict_with_every_page_and_this_machines_benchmarks(sit
     for path in results:
         heading = path.read_text().splitlines()[0].removeprefix("## Measured on ").strip("`")
         assert heading in page, path.name
+    # the engine page's table of the stages is the one planarsim/kernels/stages.py writes
+    from planarsim.kernels.stages import STAGES
+    engine = html.unescape(re.sub(r"<[^>]+>", "", (site / "engine" / "index.html").read_text()))
+    assert "stage-table" not in engine
+    for k, (name, what, modules, functions) in enumerate(STAGES):
+        assert f"{k + 1}. {name}" in engine and " ".join(what.split()) in " ".join(engine.split()), name
+        assert all(f in engine for f in functions), (name, functions)
     # the two commands come from README.md itself (its section between the snippet markers)
     readme = (ROOT / "README.md").read_text()
     section = readme[readme.index("--8<-- [start:two-commands]"):readme.index("--8<-- [end:two-commands]")]
