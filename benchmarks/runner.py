@@ -6,6 +6,7 @@
     planarsim bench --peers pymunk,box2d   # peers to compare (default: all; 'none' skips)
     planarsim bench --no-cold              # skip the cold-cache start-up (about half a minute)
     planarsim bench --csv DIR              # also write DIR/<machine>/<scene>.csv
+    planarsim bench --md benchmarks/results   # also write what it prints to DIR/<machine>.md
     planarsim bench chain32 --parts pareto --pareto-out out/pareto   # accuracy-matched comparison
 
 Parts (each warm after compilation; steps/s = median and min-max of --repeats runs):
@@ -39,12 +40,17 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
   each peer's mean step and the ratio, planarsim's pin gap, overlap and rest drift
   (stress.py; --steps sets the run, default each scene's 1 s).
 Then a table of every benchmark target with the measured figure, met or not met. Targets are
-measured here, never asserted by the tests.
+measured here, never asserted by the tests. With --md DIR the run also writes DIR/<machine>.md:
+the machine, the date, the command line, the targets as a Markdown table and everything the
+run printed (the documentation's benchmarks page shows benchmarks/results/*.md).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
+import datetime
+import io
 import math
 import os
 import platform
@@ -111,6 +117,70 @@ def write_csv(results, folder) -> Path:
     return out
 
 
+class _Tee(io.TextIOBase):
+    """A stream that writes to the real stdout and keeps a copy (for --md)."""
+
+    def __init__(self, out):
+        self.out, self.copy = out, io.StringIO()
+
+    def write(self, text):
+        self.copy.write(text)
+        return self.out.write(text)
+
+    def flush(self):
+        self.out.flush()
+
+    def isatty(self):
+        try:
+            return self.out.isatty()
+        except ValueError:      # asked after the stream it wrote to was closed (an atexit hook)
+            return False
+
+
+def _git_commit():
+    """The checkout's commit (short hash, '+' when files differ from it), or None outside git."""
+    import subprocess
+    root = Path(__file__).resolve().parents[1]
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
+                              text=True, timeout=10)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
+                               capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if head.returncode != 0:
+        return None
+    return head.stdout.strip() + ("+" if dirty.stdout.strip() else "")
+
+
+def markdown_report(results, printed, argv, when=None) -> str:
+    """The text of benchmarks/results/<machine>.md: a heading naming the machine, how and when
+    the figures were made, the targets as a Markdown table, then the run's printed output."""
+    when = when or datetime.datetime.now(datetime.timezone.utc)
+    command = " ".join(["planarsim bench", *argv])
+    commit = _git_commit()
+    lines = [f"## Measured on `{machine_name()}`", "",
+             f"Written by `{command}` on {when:%Y-%m-%d %H:%M} UTC"
+             + (f" at commit {commit}" if commit else "") + f" ({os.cpu_count()} cores, load "
+             f"average {os.getloadavg()[0]:.1f} at the end). Timings on a shared machine vary from run "
+             f"to run; compare figures within one run.", "",
+             "| benchmark target | measured | status |", "|---|---|---|"]
+    for target, measured, status in results["targets"]:
+        cells = [str(c).replace("|", "\\|") for c in (target, measured, status)]
+        lines.append("| " + " | ".join(cells) + " |")
+    lines += ["", "Everything the run printed:", "", "```text", printed.rstrip("\n"), "```", ""]
+    return "\n".join(lines)
+
+
+def write_markdown(results, printed, argv, folder) -> Path:
+    """Write DIR/<machine>.md (see markdown_report) and return its path."""
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{machine_name()}.md"
+    path.write_text(markdown_report(results, printed, argv))
+    return path
+
+
 def run_pareto(args, peers):
     """Rows of the accuracy-matched comparison of args.pareto_scenes; prints the tables and
     writes one Pareto plot per scene and pareto.csv to args.pareto_out."""
@@ -171,6 +241,9 @@ def parse_args(argv):
     ap.add_argument("--env-copies", type=int, default=16, help="copies in the vectorised env figure (16)")
     ap.add_argument("--no-cold", action="store_true", help="skip the cold-cache start-up measurement")
     ap.add_argument("--csv", metavar="DIR", default=None, help="write DIR/<machine>/<scene>.csv")
+    ap.add_argument("--md", metavar="DIR", default=None,
+                    help="write DIR/<machine>.md: the targets as a table and all the run printed "
+                         "(the documentation shows benchmarks/results/*.md)")
     ap.add_argument("--pareto-out", metavar="DIR", default=None,
                     help="folder of the Pareto plots and pareto.csv (default out/pareto/<machine>)")
     ap.add_argument("--quick", action="store_true", help="pareto: short ladder (first configuration, k = 1, 2)")
@@ -195,7 +268,21 @@ def parse_args(argv):
 
 
 def main(argv=None):
+    argv = list(sys.argv[1:] if argv is None else argv)
     args = parse_args(argv)
+    if args.md is None:
+        _run(args)
+        return 0
+    tee = _Tee(sys.stdout)
+    with contextlib.redirect_stdout(tee):
+        results = _run(args)
+    path = write_markdown(results, tee.copy.getvalue(), argv, args.md)
+    print(f"wrote {path}")
+    return 0
+
+
+def _run(args):
+    """Run the parts args asks for, print their figures; returns the results dictionary."""
     import numba
     print(f"planarsim bench on {machine_name()} ({os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}): "
           f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
@@ -268,7 +355,7 @@ def main(argv=None):
         folder = write_csv(results, args.csv)
         plot_chain_scaling(results, folder / "chain_scaling.png")
         print(f"wrote {folder}")
-    return 0
+    return results
 
 
 if __name__ == "__main__":

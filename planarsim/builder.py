@@ -175,8 +175,8 @@ class ModelBuilder:
                  omega=0.0, shapes=(), density=None) -> int:
         """Rigid body: mass [kg] > 0 and inertia about its centre of mass (COM) [kg m^2] > 0,
         pos [m] and angle [rad] the pose of its COM; vel [m/s] and omega [rad/s] its start
-        velocity (the State's v at time 0: the velocity over the step before it, see README's
-        "How the engine works"). shapes: tuples (kind, *params) as add_shape takes them, each
+        velocity (the State's v at time 0: the velocity over the step before it, see "How the
+        engine works" in the documentation, docs/engine.md). shapes: tuples (kind, *params) as add_shape takes them, each
         optionally ending with a dict of add_shape's keywords, e.g.
         ``("box", (0, 0), 0.2, 0.1, {"mu": 0.5})``; they collide unless that dict says
         ``"collide": False``.

@@ -290,7 +290,7 @@ class Scene:
                            world_points(q, bodies[j, 1], anchors[j, 1])]) for j in range(len(bodies))]
 
     def terrain_geometry(self, x0, x1):
-        """(terrain polyline (N, 2), tick segments (M, 2, 2)) over [x0, x1] [m]; ticks at
+        """(terrain polyline (N, 2), tick segments (M, 2, 2)) for x0 <= x <= x1 [m]; ticks at
         multiples of label_spacing are 1.8x longer."""
         line, ticks, _ = self._terrain(x0, x1)
         return line, ticks

@@ -63,7 +63,7 @@ def test_period_doubling_example_runs_small(tmp_path, capsys):
 
 
 def test_the_dog_pushes_a_box_3_3_metres():
-    """README: 'pushes the box 3.3 m in 12 s without falling' (3.37 m measured)."""
+    """docs/shapes.md: 'pushes the box 3.3 m in 12 s without falling' (3.37 m measured)."""
     ex = load("push_box")
     travel, summary = ex.main(duration=12.0)
     assert not summary["fell"]
@@ -98,9 +98,9 @@ def test_new_examples_run_as_scripts(name):
 
 
 def test_random_search_learns_to_swim(tmp_path):
-    """README's claim at its bound: examples/learn_swimmer.py with its own settings (8
+    """docs/mjcf-gymnasium.md's claim at its bound: examples/learn_swimmer.py with its own settings (8
     directions, the 4 best, 1000-step episodes), 12 iterations, returns at least 300 on unseen
-    starts (322 measured, 14 s of learning on two shared cores; README: 'a return of at least
+    starts (322 measured, 14 s of learning on two shared cores; the page: 'a return of at least
     300 within 2 minutes'; the time is not asserted). The iterations' mean return grows, a seed fixes the result (on a
     short run), and the GIF is written."""
     pytest.importorskip("gymnasium")
@@ -121,7 +121,7 @@ def test_random_search_learns_to_swim(tmp_path):
 
 
 def test_debug_step_stops_in_the_contact_solve_under_numba_disable_jit():
-    """README's debugging paragraph as written: pdb stops in solve_impulses of Ranger's step."""
+    """docs/debugging.md's example as written: pdb stops in solve_impulses of Ranger's step."""
     import os
     import subprocess
     root = EXAMPLES.parent

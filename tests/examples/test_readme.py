@@ -1,5 +1,6 @@
-"""README's Python code runs as written (the tour, then the compiled controller, which reuses
-the tour's model), in a temporary folder."""
+"""README's Python code runs as written (the rolling disk, then a Ranger walk), in a temporary
+folder, and gives what README says it gives; README's two commands and their expected times.
+The documentation pages' blocks: tests/docs/test_doc_pages.py."""
 import math
 import re
 import runpy
@@ -11,56 +12,51 @@ README = Path(__file__).resolve().parents[2] / "README.md"
 
 
 def test_readme_python_blocks_run_in_order(tmp_path, monkeypatch):
-    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
+    blocks = re.findall(r"^```python\n(.*?)^```", README.read_text(), re.S | re.M)
     assert len(blocks) >= 2
     monkeypatch.chdir(tmp_path)
     # one script file, as a reader would paste it (numba caches a function by its file)
     script = tmp_path / "readme_blocks.py"
     script.write_text("\n".join(blocks))
     namespace = runpy.run_path(str(script), run_name="readme")
-    assert (tmp_path / "tour.gif").stat().st_size > 0
-    assert (tmp_path / "tour.png").stat().st_size > 0
-    assert namespace["code"] == 0 and namespace["traj"].t.shape[0] == namespace["k"]
-    # the accurate integrator's double pendulum: the energy error README's comment gives
-    swing, tr = namespace["swing"], namespace["swing_traj"]
-    e = ps.total_energy(swing.model, tr.q, tr.v)
-    assert abs(float(max(abs(e - e[0]))) - 1.0e-4) < 0.05e-4
-    # the gait analysis example's doubling is located, where README's text puts it
-    pd = namespace["pd"]
-    assert pd.located and abs(pd.p - 0.014935) < 5e-7, (pd.p, pd.located, pd.note)
-    # the tour's torso and leg are shapes that collide: whatever the controller does, no corner
-    # of the torso's box ends up inside the hill (it used to fall 0.5 m into it)
-    model, traj = namespace["model"], namespace["traj"]
-    ground = model.terrain
-    torso = model.body("torso")
-    for frame in traj.q:
-        x, y, th = frame[torso]
-        for dx in (-0.1, 0.1):
-            for dy in (-0.25, 0.25):
-                px = x + math.cos(th) * dx - math.sin(th) * dy
-                py = y + math.sin(th) * dx + math.cos(th) * dy
-                assert py - ground.height(px) > -1e-6
+    # the rolling disk: the textbook's (2/3) g sin(slope) t^2 / 2 along the slope, as README says
+    # (0.6849 m against 0.6846 m: the step's first-order error at dt = 1 ms), rolling, not sliding
+    slope = namespace["slope"]
+    theory = (2 / 3) * 9.81 * math.sin(slope) * 2.0 ** 2 / 2
+    assert abs(namespace["travel"] - theory) < 2e-3 * theory, (namespace["travel"], theory)
+    assert list(namespace["traj"].contact_mode[-1]) == [ps.ContactMode.PINNED]
+    from planarsim.compiled import audit_counts
+    assert not any(audit_counts(namespace["sim"].ws).values())
+    # Ranger walks and its audit is all 0, as the comment says
+    numbers = namespace["numbers"]
+    assert numbers["distance"] > 0.5 and not numbers["fell"]
+    assert numbers["audit"] and not any(numbers["audit"].values()), numbers["audit"]
 
 
-def test_readme_api_section_gives_what_a_model_builder_needs():
-    """Without reading the source: the angle convention, the shape tuples, add_box_contacts'
-    arguments, terrain.slope's unit and what each contact_mode code means."""
+TWO_COMMANDS = [
+    "python3 -m venv .venv && .venv/bin/pip install -q -e . && .venv/bin/planarsim run simple-biped",
+    "python3 -m venv .venv && .venv/bin/pip install -q -e '.[test]' && .venv/bin/python -m pytest -q",
+]
+
+
+def two_commands_section(text):
+    """README's two commands and their times: the part the documentation's Getting started page
+    includes (pymdownx.snippets' section markers)."""
+    return text[text.index("--8<-- [start:two-commands]"):text.index("--8<-- [end:two-commands]")]
+
+
+def test_readme_gives_the_two_commands_and_ci_runs_the_second():
+    """The two commands, exactly: one installs and runs the main job, one installs and runs the
+    tests; .ci/run runs the second as it stands (the documentation includes this section)."""
     text = README.read_text()
-    api = text[text.index("## A five-minute tour of the API"):text.index("## Shapes that collide")]
-    api = " ".join(api.split())
-    assert "counter-clockwise from the world's x axis" in api
-    for shape in ('("circle", center, r)', '("capsule", p0, p1, r)',
-                  '("box", center, width, height[, angle])', '("polygon", [(x, y), ...])'):
-        assert shape in api
-    import inspect
-
-    signature = str(inspect.signature(ps.ModelBuilder.add_box_contacts)).replace("self, ", "")
-    assert f"add_box_contacts{signature.split(' ->')[0]}" in api
-    assert "`terrain.slope(angle_deg, height=0.0)` takes degrees" in api
-    from planarsim.kernels import codes
-    for code, meaning in ((codes.MODE_FREE, "free"), (codes.MODE_PINNED, "pinned"),
-                          (codes.MODE_SLIDING, "sliding"), (-1, "in a recording `-1` marks")):
-        assert (f"`{code}` {meaning}" in api) or (meaning.endswith("marks") and meaning in api)
+    part = two_commands_section(text)
+    assert re.findall(r"^python3 -m venv .*$", part, re.M) == TWO_COMMANDS
+    assert text.index("## Two commands") < text.index("--8<-- [start:two-commands]")
+    ci = (README.parent / ".ci" / "run").read_text()
+    assert re.search(r"^python3 -m venv .venv && .venv/bin/pip install -q -e '\.\[test\]' && "
+                     r"\.venv/bin/python -m pytest -q$", ci, re.M)
+    getting_started = (README.parent / "docs" / "getting-started.md").read_text()
+    assert '--8<-- "README.md:two-commands"' in getting_started
 
 
 def test_readme_gives_the_expected_time_of_both_commands(monkeypatch, capsys):
@@ -72,7 +68,7 @@ def test_readme_gives_the_expected_time_of_both_commands(monkeypatch, capsys):
     from planarsim import compiled
     from walkers import cli
     text = README.read_text()
-    part = " ".join(text[text.index("## Two commands"):text.index("## The command line")].split())
+    part = " ".join(two_commands_section(text).split())
     minutes = {}
     for k in (1, 2):
         about, unit, measured = re.search(rf"command {k}: about (\d+) (minutes?) \((\d+) s measured\)", part).groups()

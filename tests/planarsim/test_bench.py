@@ -139,3 +139,27 @@ def test_stress_part_prints_every_stress_scene(capsys):
         assert f"\n{name} " in out, name
     for name in available_peers()[0]:
         assert f"{name} ms" in out
+
+
+def test_md_writes_the_machines_results_page(tmp_path, capsys):
+    """--md DIR writes DIR/<machine>.md (the documentation's benchmarks page shows
+    benchmarks/results/*.md): the command line, the targets as a Markdown table with one row per
+    target, and the figures the run printed."""
+    argv = ["chain2", "--parts", "scenes", "--md", str(tmp_path), *TINY]
+    assert bench.main(argv) == 0
+    out = capsys.readouterr().out
+    page = (tmp_path / f"{bench.machine_name()}.md").read_text()
+    assert f"wrote {tmp_path / bench.machine_name()}.md" in out
+    assert page.startswith(f"## Measured on `{bench.machine_name()}`")
+    assert f"`planarsim bench {' '.join(argv)}`" in page
+    commit = bench._git_commit()          # the checkout's commit, where there is one
+    assert (f" at commit {commit} (" in page) if commit else ("at commit" not in page)
+    table = [line for line in page.splitlines() if line.startswith("| ")]
+    assert table[0] == "| benchmark target | measured | status |"
+    targets = out[out.index("benchmark targets (measured in this run)"):].splitlines()[1:]
+    assert len(table) - 1 == len([t for t in targets if t.startswith("  ")]) > 0
+    assert any("(chain2)" in row and row.endswith(("| met |", "| NOT MET |")) for row in table)
+    # the printed figures, verbatim, in a text block
+    printed = page[page.index("```text\n") + 8:page.rindex("```")]
+    assert "planarsim scenes" in printed and "chain2 " in printed
+    assert printed.strip() in out

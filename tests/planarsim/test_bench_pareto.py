@@ -31,7 +31,7 @@ def test_quick_ladder_prints_tables_plot_and_csv(tmp_path, capsys):
     assert curves == expected
     for r in rows:
         assert float(r["cost_s_per_s"]) > 0 and float(r["energy_err_max"]) >= 0
-    # planarsim's pins hold at every step of its ladder (physics, not timing): README's
+    # planarsim's pins hold at every step of its ladder (physics, not timing): docs/benchmarks.md's
     # 'within 2e-12 m on every curve'
     assert all(float(r["pin_error_m"]) <= 2e-12 for r in rows if r["engine"] == "planarsim")
     assert "pareto chain2: cost = wall s per simulated s" in out
@@ -99,7 +99,7 @@ def test_contact_scene_is_matched_on_contact_error_not_energy():
     assert figures(rows) == ["contact_error_m"]
     for r in rows:
         assert r["contact_error_m"] == max(r["penetration_m"], abs(r["rest_gap_m"]))
-        # planarsim's contacts neither sink nor hover: README's 'contact error below 1e-9 m
+        # planarsim's contacts neither sink nor hover: docs/benchmarks.md's 'contact error below 1e-9 m
         # at every step of its ladder' (4.3e-13 m measured on the full ladder)
         assert r["contact_error_m"] < 1e-9
 

@@ -322,7 +322,7 @@ def test_the_efficient_set_walks_further_for_less():
 
 
 def test_cost_of_transport_sweep_smoke(tmp_path, capsys):
-    """benchmarks/ranger_cot.py (README's plot of cost of transport against speed), two
+    """benchmarks/ranger_cot.py (docs/walkers.md's plot of cost of transport against speed), two
     target speeds per gait over 6 s walks: every walk reported, the tuned gait at its own
     target walks faster and cheaper than the default at the same target, the PNG written."""
     from benchmarks.ranger_cot import main as cot_main

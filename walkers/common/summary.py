@@ -18,7 +18,7 @@ Common keys, the same for every walker, units in their names:
   wall_time_s       {"compile": numba compile or cache load and model build, "run": the
                     simulation, "output": files written}
   extras            the walker's own numbers, named with units in its module's SUMMARY_EXTRAS
-                    (README lists them)
+                    (docs/walkers.md lists them)
 """
 from __future__ import annotations
 
