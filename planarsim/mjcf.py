@@ -1218,7 +1218,8 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
               drop=(), assets=None, **builder_kw) -> MJCFModel:
     """Load a planar MJCF model (see the module's docstring for what is read).
 
-    source : path to an .xml file, or the XML text itself (a string starting with '<')
+    source : path to an .xml file, or the XML text itself (a string starting with '<', or
+        UTF-8 bytes)
     builder : add to this ModelBuilder (it keeps its dt, gravity and terrain); default: a new
         one with the file's timestep [s], in-plane gravity [m/s^2] and ground plane (flat
         terrain), overridden by ``builder_kw`` (dt, gravity, terrain)
@@ -1235,6 +1236,8 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
     was ignored). Raises ModelError naming the element and line for malformed or unsupported
     input.
     """
+    if isinstance(source, (bytes, bytearray)):   # hook: XML text as bytes (dm_control's swimmer)
+        source = mjcf_include.decode(source, "load_mjcf: the XML source")
     if isinstance(source, (str, Path)) and not str(source).strip():
         raise ModelError("load_mjcf: the source is empty (give an MJCF file's path or its XML text)")
     if isinstance(source, (str, Path)) and not str(source).lstrip().startswith("<"):

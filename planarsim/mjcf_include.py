@@ -31,12 +31,17 @@ def _norm(name: str) -> str:
     return posixpath.normpath(str(name).replace("\\", "/"))
 
 
+def decode(data, what) -> str:
+    """UTF-8 bytes -> str, or a ModelError naming what they are."""
+    try:
+        return bytes(data).decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ModelError(f"{what} is not UTF-8 text: {e}") from None
+
+
 def _text(data, name) -> str:
     if isinstance(data, (bytes, bytearray)):
-        try:
-            return bytes(data).decode("utf-8")
-        except UnicodeDecodeError as e:
-            raise ModelError(f"included file {name!r} (from assets) is not UTF-8 text: {e}") from None
+        return decode(data, f"included file {name!r} (from assets)")
     if isinstance(data, str):
         return data
     raise ModelError(f"assets[{name!r}] must be bytes or str, got {type(data).__name__}")
