@@ -4,11 +4,12 @@ include element's place, wherever it stands (as MuJoCo does).
 Where an included file is looked for, in order:
 
 * ``assets`` (a dict: name -> bytes or str, as ``mujoco.MjModel.from_xml_string(xml,
-  assets)`` takes it): the name as the including file gives it, next to the including
-  file, then as given; names compare after normalisation ("./common/skybox.xml" and
-  "common/skybox.xml" are one name);
-* on disk: next to the including file, then next to the main file (for XML text given as a
-  string: the current directory).
+  assets)`` takes it): the name as given, then joined to the including asset's directory;
+  names compare after normalisation ("./common/skybox.xml" and "common/skybox.xml" are one
+  name);
+* on disk: next to the main file (for XML text given as a string: the current directory),
+  then next to the including file. This is MuJoCo's order (checked with MuJoCo 4.0): where
+  both directories hold the name, the main file's directory wins.
 
 Included files may include others (a file that includes itself, directly or not, is a
 ModelError naming the chain). Every node read from an included file remembers it
@@ -118,16 +119,15 @@ def _find(fname, source, own_dir, main_dir, assets, where):
     """(text, name for messages, directory for its own includes) of an included file."""
     tried = []
     if assets:
-        keys = []
+        keys = [_norm(fname)]
         if isinstance(own_dir, str):
             keys.append(_norm(posixpath.join(own_dir, fname)))
-        keys.append(_norm(fname))
         for key in keys:
             if key in assets:
                 orig, data = assets[key]
                 return _text(data, orig), orig, posixpath.dirname(key)
         tried.append(f"assets {sorted(set(keys))} (assets has {sorted(k for k, _ in assets.values())})")
-    dirs = [d for d in (own_dir if isinstance(own_dir, Path) else None, main_dir) if d is not None]
+    dirs = [d for d in (main_dir, own_dir if isinstance(own_dir, Path) else None) if d is not None]
     for d in dict.fromkeys(dirs):
         path = Path(d) / fname if not os.path.isabs(fname) else Path(fname)
         tried.append(str(path))
