@@ -1149,12 +1149,21 @@ class _Loader:
         does not (bodies linked by joints never collide here)."""
         if self.collide is not None:
             return
+
+        def tree_of(b):               # the first body below the world (or what is welded to it)
+            while b.parent is not None and b.parent.rid is not None:
+                b = b.parent
+            return b.name
         parent = {b.rid: (b.parent.rid if b.parent is not None else None)
                   for b in self.bodies if b.joints}
         geoms = [(rid, p[5]) for rid, rb in enumerate(self.rigid) for p in rb.parts if p[3] is not None]
+        # fix: bodies of separate trees (joined only through the world) do collide in planarsim
+        tree = {b.rid: tree_of(b) for b in self.bodies if b.rid is not None}
         for i, (ra, ga) in enumerate(geoms):
             for rb_, gb in geoms[i + 1:]:
                 if ra == rb_ or parent.get(ra) == rb_ or parent.get(rb_) == ra:
+                    continue
+                if tree[ra] != tree[rb_]:
                     continue
                 if _mj_pair(ga, gb):
                     self.report.note(f"geoms {ga['name'] or ga['node'].line!r} and "

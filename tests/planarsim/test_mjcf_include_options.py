@@ -303,3 +303,19 @@ def test_geoms_directly_under_worldbody_collide():
     _, ours, theirs = settle(xml, 1.0)
     assert abs(ours[1] - 0.7) <= 1e-6, ours
     assert abs(1.0 + theirs[1] - 0.7) <= 5e-3, theirs
+
+
+def test_separate_trees_collide_and_are_not_noted_as_missed_self_collisions():
+    """finger's layout: two trees hinged to the world (a finger and a spinner) collide in
+    planarsim as in MuJoCo, so the report does not list them among the pairs it misses."""
+    xml = ("<mujoco><worldbody>"
+           "<body name='a' pos='-0.2 0 1'><joint name='ja' type='hinge' axis='0 1 0'/>"
+           "<geom name='ga' type='capsule' fromto='0 0 0 0.2 0 0' size='0.05'/></body>"
+           "<body name='b' pos='0.2 0 1'><joint name='jb' type='hinge' axis='0 1 0'/>"
+           "<geom name='gb' type='capsule' fromto='0 0 0 -0.2 0 0' size='0.05'/>"
+           "<body name='c' pos='0 0 0.3'><joint name='jc' type='hinge' axis='0 1 0'/>"
+           "<geom name='gc' type='sphere' size='0.05'/></body></body></worldbody></mujoco>")
+    loaded = load_mjcf(xml)
+    model = loaded.compile()
+    assert model.arrays.n_shape_pair == 2               # a-b and a-c (b-c: parent and child)
+    assert not any("may touch" in n for n in loaded.report.notes)
