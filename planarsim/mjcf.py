@@ -32,6 +32,11 @@ What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
   (a body torque or force on a free root's joints) whose torque input [N m] is
   ``gear * ctrl`` in the pin's sign (``MJCFModel.actuator[name].gear``), saturated to
   gear * ctrlrange.
+* ``<include file>`` (planarsim.mjcf_include: on disk or from ``assets``), ``<option><flag>``
+  (planarsim.mjcf_options: gravity, contact, limit, constraint, spring, damper, frictionloss
+  honoured; flags without physics reported; the rest a ModelError), planes whose normal lies
+  in the plane of motion as static walls and the plane of motion of a slides-only model
+  (planarsim.mjcf_plane).
 
 Purely visual or solver-tuning elements and attributes (rgba, material, asset, visual, light,
 camera, site, solref, margin, integrator, ...) are ignored and listed in ``MJCFModel.report``;
