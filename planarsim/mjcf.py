@@ -1243,8 +1243,8 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
         collide (with the ground and other bodies' shapes), the others drawn only
     drop : physics to load without instead of a ModelError: "armature", "fluid" (reported)
     assets : dict file name -> bytes or str, as mujoco.MjModel.from_xml_string takes it:
-        where ``<include file=...>`` looks first (then next to the including file on disk;
-        see planarsim.mjcf_include)
+        where ``<include file=...>`` looks first (then on disk: next to the main file, then
+        next to the including file, as MuJoCo; see planarsim.mjcf_include)
 
     Returns an MJCFModel (builder, name maps, per-body mass properties, ``report`` of what
     was ignored). Raises ModelError naming the element and line for malformed or unsupported
