@@ -32,6 +32,11 @@ What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
   (a body torque or force on a free root's joints) whose torque input [N m] is
   ``gear * ctrl`` in the pin's sign (``MJCFModel.actuator[name].gear``), saturated to
   gear * ctrlrange.
+* ``<include file>`` (planarsim.mjcf_include: on disk or from ``assets``), ``<option><flag>``
+  (planarsim.mjcf_options: gravity, contact, limit, constraint, spring, damper, frictionloss
+  honoured; flags without physics reported; the rest a ModelError), planes whose normal lies
+  in the plane of motion as static walls and the plane of motion of a slides-only model
+  (planarsim.mjcf_plane).
 
 Purely visual or solver-tuning elements and attributes (rgba, material, asset, visual, light,
 camera, site, solref, margin, integrator, ...) are ignored and listed in ``MJCFModel.report``;
@@ -62,6 +67,7 @@ import numpy as np
 from .builder import ModelBuilder
 from .errors import ModelError
 from . import mjcf_frames as F
+from . import mjcf_include, mjcf_options, mjcf_plane   # hooks: includes, <option><flag>, plane
 from .terrain import flat
 
 DEFAULT_DENSITY = 1000.0  # [kg/m^3] MuJoCo's default geom density
@@ -97,10 +103,10 @@ ATTRIBUTES = {
                  default={"mocap": "false", "gravcomp": "0"}),
     "joint": dict(
         use={"name", "class", "type", "pos", "axis", "range", "limited", "stiffness", "damping",
-             "armature", "ref", "springref"},
+             "armature", "ref", "springref", "frictionloss"},
         ignore={"group", "margin", "solreflimit", "solimplimit", "solreffriction",
                 "solimpfriction", "user"},
-        default={"frictionloss": "0", "springdamper": "0 0", "actuatorfrclimited": "auto",
+        default={"springdamper": "0 0", "actuatorfrclimited": "auto",
                  "actuatorgravcomp": "false"}),
     "geom": dict(
         use={"name", "class", "type", "size", "pos", "fromto", "mass", "density", "friction",
@@ -325,6 +331,7 @@ class _Loader:
         self.classes = {"main": {}}           # class -> tag -> attributes
         self.report = LoadReport()
         self.free_bodies = []                 # bodies with a free root's slides and hinge
+        self.flags = mjcf_options.Flags()     # hook: <option><flag> (mjcf_options.read_flags)
         bad = sorted(set(drop) - set(DROPPABLE))
         if bad:
             raise ModelError(f"load_mjcf: drop={sorted(drop)} names {bad}; it may name {DROPPABLE}")
@@ -332,7 +339,8 @@ class _Loader:
 
     # errors and attributes --------------------------------------------------------------------
     def fail(self, node, msg):
-        raise ModelError(f"{self.src}:{node.line}: <{node.tag}"
+        src = getattr(node, "file", None) or self.src     # hook: a node from an included file
+        raise ModelError(f"{src}:{node.line}: <{node.tag}"
                          f"{' name=' + repr(node.attrib['name']) if 'name' in node.attrib else ''}> "
                          f"(line {node.line}): {msg}")
 
@@ -355,7 +363,7 @@ class _Loader:
             if key in use:
                 continue
             if key in ignore:
-                self.report.ignore(f"{node.tag} {key}", node.line)
+                self.report.ignore(f"{node.tag} {key}{mjcf_include.origin(node)}", node.line)
             elif key in default:
                 if not self.same(eff[key], default[key]):
                     self.fail(node, f"{key}={eff[key]!r} changes physics this loader does not "
@@ -461,8 +469,11 @@ class _Loader:
         self.choose_plane()
         self.world = world
         self.collide = None if collide is None else frozenset(collide)
+        if not self.flags.contact:            # hook: <flag contact|constraint="disable">
+            self.collide = frozenset()
         b = self.builder(builder_kw, builder)
         out = self.emit(b, root.attrib.get("model", "mjcf"))
+        mjcf_options.check_filterparent(self)   # hook: <flag filterparent="disable">
         for node in actuators:
             self.actuators(node, out)
         return out
@@ -471,7 +482,8 @@ class _Loader:
         """An element the loader does not read: ignored and reported when it only draws,
         senses or tunes; otherwise a ModelError naming it."""
         if node.tag in _IGNORED_ELEMENTS:
-            self.report.ignore(f"<{node.tag}>", node.line)
+            # hook: an included file's elements are reported with its name
+            self.report.ignore(f"<{node.tag}>{mjcf_include.origin(node)}", node.line)
             return
         if node.tag in _EMPTY_ONLY:
             kids = [c for c in node.children if not (node.tag == "contact" and c.tag == "exclude")]
@@ -512,8 +524,6 @@ class _Loader:
     def options(self, node):
         eff = dict(node.attrib)
         self.vet(node, eff)
-        for c in node.children:
-            self.fail(c, f"<{c.tag}> inside <option> is not supported (flags change physics)")
         self.option["timestep"] = self.scalar(node, eff, "timestep", DEFAULT_TIMESTEP)
         if not self.option["timestep"] > 0:
             self.fail(node, f"timestep={self.option['timestep']} must be > 0")
@@ -529,6 +539,7 @@ class _Loader:
             else:
                 self.option["fluid"] = fluid
         self.option_line = node.line
+        mjcf_options.read_flags(self, node)   # hook: <flag> children (gravity, contact, ...)
 
     def defaults(self, node, parent, top=False):
         """<default class=...>: attributes per element tag, inherited by nested classes."""
@@ -593,6 +604,7 @@ class _Loader:
         p = self.floats(j, eff, "pos", 3, default=(0.0, 0.0, 0.0))
         if not self.global_coords:
             a, p = body.R @ a, body.pos + body.R @ p
+        mjcf_options.check_frictionloss(self, j, eff)   # hook: 0, or a ModelError naming it
         return dict(node=j, eff=eff, type=kind, axis=a, pos=p,
                     name=eff.get("name") or f"joint@{j.line}")
 
@@ -679,9 +691,8 @@ class _Loader:
         hinge must be normal to it and every slide in it."""
         joints = [j for b in self.bodies for j in b.joints]
         hinges = [j for j in joints if j["type"] == "hinge"]
-        normal = 1
-        if hinges and abs(abs(hinges[0]["axis"][2]) - 1) <= AXIS_TOL:
-            normal = 2
+        # hook: from the hinges, else from the slides (a point mass on x and y slides)
+        normal = mjcf_plane.normal_from_joints(hinges, [j for j in joints if j["type"] == "slide"])
         self.i1, self.i2 = (0, 2) if normal == 1 else (0, 1)
         self.normal = normal
         self.plane_name = "x-z" if normal == 1 else "x-y"
@@ -742,6 +753,8 @@ class _Loader:
             n = g["R"][:, 2]
             if abs(abs(n[self.normal]) - 1) <= AXIS_TOL:
                 self.report.ignore("geom plane parallel to the plane of motion", g["node"].line)
+                continue
+            if mjcf_plane.is_wall(self, g):   # hook: a wall, a static box (parts())
                 continue
             if abs(n[self.i2] - 1) > AXIS_TOL:
                 self.fail(g["node"], f"a plane whose normal {_vec(n)} is not the "
@@ -811,6 +824,8 @@ class _Loader:
         self.free_bodies.append(b)
 
     def limited(self, j):
+        if not self.flags.limit:              # hook: <flag limit|constraint="disable">
+            return False
         v = self.flag(j["node"], j["eff"], "limited")
         return v == "true" or (v == "auto" and "range" in j["eff"])
 
@@ -828,7 +843,9 @@ class _Loader:
         every geom (and <inertial>) of every rigid body; static geoms go to self.static."""
         n = np.eye(3)[self.normal]
         self.static = []
-        for b in self.bodies:
+        # hook: the world's own geoms too (they were left out: a static geom directly under
+        # <worldbody> never collided)
+        for b in [self.world] + self.bodies:
             use_inertial = self.uses_inertial(b)
             if self.inertiafromgeom == "true":
                 for i in b.inertials:
@@ -849,6 +866,7 @@ class _Loader:
                 for i in b.inertials:
                     self.rigid[b.rid].parts.append((i["mass"], self.plane(i["pos"]),
                                                     float(n @ i["tensor"] @ n), None, "", i))
+        self.static += mjcf_plane.wall_shapes(self)   # hook: planes that are walls
 
     def own_inertia(self, g, n) -> float:
         """Inertia per unit mass [m^2] about the normal through the geom's centre."""
@@ -987,6 +1005,7 @@ class _Loader:
         c = self.scalar(node, eff, "damping", 0.0)
         if k < 0 or c < 0:
             self.fail(node, f"stiffness={k} and damping={c} must be >= 0")
+        k, c = self.flags.passive(k, c)       # hook: <flag spring|damper="disable">
         rest = sign * (self.scalar(node, eff, "springref", 0.0) * s - ref) + 0.0   # no -0.0
         return limit, k, c, rest
 
@@ -1135,12 +1154,21 @@ class _Loader:
         does not (bodies linked by joints never collide here)."""
         if self.collide is not None:
             return
+
+        def tree_of(b):               # the first body below the world (or what is welded to it)
+            while b.parent is not None and b.parent.rid is not None:
+                b = b.parent
+            return b.name
         parent = {b.rid: (b.parent.rid if b.parent is not None else None)
                   for b in self.bodies if b.joints}
         geoms = [(rid, p[5]) for rid, rb in enumerate(self.rigid) for p in rb.parts if p[3] is not None]
+        # fix: bodies of separate trees (joined only through the world) do collide in planarsim
+        tree = {b.rid: tree_of(b) for b in self.bodies if b.rid is not None}
         for i, (ra, ga) in enumerate(geoms):
             for rb_, gb in geoms[i + 1:]:
                 if ra == rb_ or parent.get(ra) == rb_ or parent.get(rb_) == ra:
+                    continue
+                if tree[ra] != tree[rb_]:
                     continue
                 if _mj_pair(ga, gb):
                     self.report.note(f"geoms {ga['name'] or ga['node'].line!r} and "
@@ -1201,10 +1229,11 @@ def _hull(points) -> list:
 
 
 def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), collide=None,
-              drop=(), **builder_kw) -> MJCFModel:
+              drop=(), assets=None, **builder_kw) -> MJCFModel:
     """Load a planar MJCF model (see the module's docstring for what is read).
 
-    source : path to an .xml file, or the XML text itself (a string starting with '<')
+    source : path to an .xml file, or the XML text itself (a string starting with '<', or
+        UTF-8 bytes)
     builder : add to this ModelBuilder (it keeps its dt, gravity and terrain); default: a new
         one with the file's timestep [s], in-plane gravity [m/s^2] and ground plane (flat
         terrain), overridden by ``builder_kw`` (dt, gravity, terrain)
@@ -1213,11 +1242,16 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
     collide : None: geoms collide by MuJoCo's contype/conaffinity; or names of the geoms that
         collide (with the ground and other bodies' shapes), the others drawn only
     drop : physics to load without instead of a ModelError: "armature", "fluid" (reported)
+    assets : dict file name -> bytes or str, as mujoco.MjModel.from_xml_string takes it:
+        where ``<include file=...>`` looks first (then on disk: next to the main file, then
+        next to the including file, as MuJoCo; see planarsim.mjcf_include)
 
     Returns an MJCFModel (builder, name maps, per-body mass properties, ``report`` of what
     was ignored). Raises ModelError naming the element and line for malformed or unsupported
     input.
     """
+    if isinstance(source, (bytes, bytearray)):   # hook: XML text as bytes (dm_control's swimmer)
+        source = mjcf_include.decode(source, "load_mjcf: the XML source")
     if isinstance(source, (str, Path)) and not str(source).strip():
         raise ModelError("load_mjcf: the source is empty (give an MJCF file's path or its XML text)")
     if isinstance(source, (str, Path)) and not str(source).lstrip().startswith("<"):
@@ -1226,10 +1260,12 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
             text = path.read_text()
         except OSError as e:
             raise ModelError(f"cannot read MJCF file {str(path)!r}: {e.strerror}") from None
-        name = str(path)
+        name, base_dir = str(path), path.parent
     else:
-        text, name = str(source), "<string>"
+        text, name, base_dir = str(source), "<string>", None
     root = parse_xml(text, name)
+    # hook: <include file=...> replaced by the included files' elements
+    root = mjcf_include.resolve_includes(root, name, base_dir, assets, parse_xml)
     loader = _Loader(root, name, drop)
     out = loader.load(builder_kw, builder, offset, collide)
     if collide is not None:
