@@ -1,4 +1,4 @@
-"""The compiled step: a table of contents of the stages (README, "How the engine works").
+"""The compiled step: a table of contents of the stages (docs/engine.md, "How the engine works").
 
 step(m, s, ws, opt, u) advances State s in place by one step of opt.dt (0: the model's m.dt)
 and returns a guard code (0 ok, 1 non-finite, 2 too large). Model, state, workspace and
@@ -8,7 +8,7 @@ complementarity solve, the skip test of the correction, the measured end-of-step
 compiled once per machine and called by address from every compiled caller (a walker's
 rollout, run_steps; compile/link.py). A time-of-impact split (CCD) repeats
 stages 1-5 for the remainder of the step with the new contact pinned. Each stage lives in its
-module (README's table "How the engine works" names them); this file only orders them, and
+module (kernels/stages.py lists them); this file only orders them, and
 solve_modes, the guess-check-solve of stages 3-5. StepOptions.integrator other than the default
 wraps the same stages (step_of_length) in RATTLE's half kicks and projection, or in its
 five-stage composition (accurate_step; kernels/rattle.py).
