@@ -39,6 +39,11 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
   55-box pyramid) built in planarsim and in every installed --peers: mean and largest step,
   each peer's mean step and the ratio, planarsim's pin gap, overlap and rest drift
   (stress.py; --steps sets the run, default each scene's 1 s).
+- worlds: boxes at rest, 10 to 1,035 of them (a 4-row pyramid, ten columns of ten, 20- and
+  45-row pyramids, a 40 x 10 staggered brick wall; stress_scenes.WORLD_SCENES), in planarsim
+  and every installed --peers, as the stress scenes; then the log-log growth of planarsim's
+  step at rest with the bodies against its target, N^1.3 (peak memory per world, each in its
+  own process: benchmarks/worlds.py).
 Then a table of every benchmark target with the measured figure, met or not met. Targets are
 measured here, never asserted by the tests. With --md DIR the run also writes DIR/<machine>.md:
 the machine, the date, the command line, the targets as a Markdown table and everything the
@@ -67,7 +72,7 @@ from benchmarks.report import (plot_chain_scaling, print_peers, print_scenes, pr
                            print_walkers, targets)
 from benchmarks.scenes import SCENES
 
-PARTS = ("scenes", "peers", "pareto", "walkers", "batch", "startup", "envs", "stress")
+PARTS = ("scenes", "peers", "pareto", "walkers", "batch", "startup", "envs", "stress", "worlds")
 
 
 def machine_name() -> str:
@@ -343,6 +348,10 @@ def _run(args):
         from benchmarks.stress import run as run_stress
         from benchmarks.stress_scenes import STRESS_SCENES
         results["stress"] = run_stress(list(STRESS_SCENES), args.peers, args.repeats, steps=args.steps)
+        print()
+    if "worlds" in parts:
+        from benchmarks.stress import run_worlds
+        results["worlds"] = run_worlds(args.peers, args.repeats, steps=args.steps)
         print()
     if "startup" in parts:
         from benchmarks.startup import measure_startup

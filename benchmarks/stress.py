@@ -28,7 +28,7 @@ import time
 import numpy as np
 
 import planarsim as ps
-from benchmarks.stress_scenes import STRESS_SCENES, accuracy, build_model
+from benchmarks.stress_scenes import ALL_SCENES, STRESS_SCENES, accuracy, build_model
 
 PEERS = {"box2d": "benchmarks.peers.box2d_peer", "pymunk": "benchmarks.peers.pymunk_peer",
          "mujoco": "benchmarks.peers.mujoco_peer"}
@@ -92,7 +92,7 @@ def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
     steps, or `seconds` [s], or the scene's seconds. A run planarsim stops with an error of its
     own (SimulationDiverged: a pin it cannot hold) gives its message under "error" and no
     planarsim figures; the peers are timed all the same."""
-    scene = STRESS_SCENES[name]
+    scene = ALL_SCENES[name]
     n = int(steps) if steps else max(1, int(round((seconds or scene.seconds) / scene.dt)))
     model = build_model(scene)
     sim = ps.Simulator(model)
@@ -118,7 +118,7 @@ def measure(name, peers, repeats=3, seconds=None, steps=None) -> dict:
     sim.restore(start)
     traj = sim.run(n_steps=n, record_every=1)
     row.update(mean_ms=1e3 * mean["planarsim"], loop_mean_ms=1e3 * float(np.mean(single)),
-               max_ms=1e3 * float(np.max(single)))
+               max_ms=1e3 * float(np.max(single)), median_ms=1e3 * float(np.median(single)))
     row.update(accuracy(scene, model, traj.q))
     row["peers"] = peer_rows(scene, worlds, mean, n, mean["planarsim"])
     return row
@@ -165,6 +165,31 @@ def run(names, peer_names, repeats=3, seconds=None, steps=None):
         rows.append(measure(name, peers, repeats, seconds, steps))
         print(f"measured {name}", file=sys.stderr, flush=True)
     print_rows(rows, list(peers))
+    return rows
+
+
+def growth(rows) -> tuple | None:
+    """(exponent, (bodies, ms), (bodies, ms)): how planarsim's median step (a step at rest: the
+    first step, which finds every contact and mode, excluded by the median) grows with the
+    bodies from the smallest measured scene to the largest (log-log), or None."""
+    sizes = sorted((r["bodies"], r["median_ms"]) for r in rows if "median_ms" in r)
+    if len(sizes) < 2 or sizes[-1][0] == sizes[0][0]:
+        return None
+    (n0, t0), (n1, t1) = sizes[0], sizes[-1]
+    return math.log(t1 / t0) / math.log(n1 / n0), (n0, t0), (n1, t1)
+
+
+def run_worlds(peer_names, repeats=3, steps=None):
+    """The worlds at rest (stress_scenes.WORLD_SCENES) against the peers, then how a step at
+    rest grows with the bodies; returns the rows."""
+    from benchmarks.stress_scenes import WORLD_SCENES
+    rows = run(list(WORLD_SCENES), peer_names, repeats, steps=steps)
+    found = growth(rows)
+    if found is not None:
+        k, (n0, t0), (n1, t1) = found
+        print(f"worlds: a step at rest (median) grows as N^{k:.2f} from {n0} to {n1} bodies "
+              f"({t0:.3f} ms to {t1:.3f} ms; target N^1.3: {'met' if k <= 1.3 else 'NOT MET'}); "
+              "peak memory per world: python benchmarks/worlds.py", flush=True)
     return rows
 
 

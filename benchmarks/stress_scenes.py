@@ -268,6 +268,41 @@ STRESS_SCENES = {s.name: s for s in (bridge(), bridge(sag=0.0), chain_ball(), ca
                                      dominoes(), pour(), pyramid())}
 
 
+# ---- worlds of many boxes at rest (benchmarks/worlds.py's, as scenes the peers build) -------
+WORLD_BOX = 0.2      # [m]
+WORLD_MASS = 4.0     # [kg] a 0.2 m box of density 100 kg/m^2 (a brick 0.4 m: twice)
+
+
+def columns(n_columns=10, n_rows=10):
+    """n_columns columns of n_rows boxes, 0.4 m apart."""
+    parts = [Part(f"box{c}_{r}", (2 * WORLD_BOX * c, WORLD_BOX / 2 + WORLD_BOX * r),
+                  ("box", WORLD_BOX, WORLD_BOX), WORLD_MASS)
+             for c in range(n_columns) for r in range(n_rows)]
+    return Scene(f"columns{n_columns}x{n_rows}", tuple(parts), resting=True, seconds=0.05)
+
+
+def box_pyramid(rows):
+    """rows levels of boxes touching side by side, each on two below."""
+    return Scene(f"world_pyramid{rows}",
+                 tuple(resting_grid(range(rows, 0, -1), WORLD_BOX, WORLD_MASS, 0.0)),
+                 resting=True, seconds=0.05)
+
+
+def brick_wall(n_columns=40, n_rows=10):
+    """A staggered wall of 0.4 x 0.2 m bricks: odd rows shifted by half a brick."""
+    parts = [Part(f"brick{r}_{c}", (2 * WORLD_BOX * c + (WORLD_BOX if r % 2 else 0.0),
+                                    WORLD_BOX / 2 + WORLD_BOX * r),
+                  ("box", 2 * WORLD_BOX, WORLD_BOX), 2 * WORLD_MASS)
+             for r in range(n_rows) for c in range(n_columns)]
+    return Scene(f"wall{n_columns}x{n_rows}", tuple(parts), resting=True, seconds=0.05)
+
+
+#: the worlds of `planarsim bench --parts worlds`, smallest first (10 to 1,035 bodies)
+WORLD_SCENES = {s.name: s for s in (box_pyramid(4), columns(10, 10), box_pyramid(20),
+                                    brick_wall(40, 10), box_pyramid(45))}
+ALL_SCENES = {**STRESS_SCENES, **WORLD_SCENES}
+
+
 # ---- planarsim ----------------------------------------------------------------------------
 def build_model(scene: Scene):
     """The planarsim Model of the scene."""

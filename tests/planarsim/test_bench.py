@@ -163,3 +163,17 @@ def test_md_writes_the_machines_results_page(tmp_path, capsys):
     printed = page[page.index("```text\n") + 8:page.rindex("```")]
     assert "planarsim scenes" in printed and "chain2 " in printed
     assert printed.strip() in out
+
+
+def test_worlds_growth_is_the_log_log_slope_of_the_median_step():
+    """stress.growth: from the smallest world to the largest, log(t1 / t0) / log(n1 / n0) of
+    the median steps; rows without a median (planarsim stopped) are left out."""
+    from benchmarks.stress import growth
+    from benchmarks.stress_scenes import WORLD_SCENES
+    rows = [dict(bodies=10, median_ms=0.02), dict(bodies=1000, median_ms=2.0 * 100 ** 1.3 * 0.01),
+            dict(bodies=100, median_ms=0.5), dict(bodies=5000)]
+    k, (n0, t0), (n1, t1) = growth(rows)
+    assert (n0, n1) == (10, 1000)
+    assert k == pytest.approx(math.log(t1 / t0) / math.log(100.0))
+    assert growth(rows[:1]) is None
+    assert [s.n_body for s in WORLD_SCENES.values()] == [10, 100, 210, 400, 1035]
