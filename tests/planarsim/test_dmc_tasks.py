@@ -248,3 +248,24 @@ def test_cross_entropy_learns_cartpole_balance():
     assert ex.episode_return(env, np.zeros(len(ex.FEATURES)), 10_000, 300) < 280.0
     means = [m for _, m, _ in out["history"]]
     assert means[-1] > means[0], means
+
+
+def test_vector_env_steps_a_dmc_task_as_sync_vector_env_does():
+    """PlanarVectorEnv (two processes) and gymnasium's SyncVectorEnv give walker-walk's
+    copies the same episodes bit for bit."""
+    from gymnasium.vector import AutoresetMode, SyncVectorEnv
+    from planarsim.envs.vector import PlanarVectorEnv
+    eid = dmc.env_id("walker-walk")
+    ours = PlanarVectorEnv(eid, num_envs=4, workers=2)
+    sync = SyncVectorEnv([lambda: gym.make(eid) for _ in range(4)],
+                         autoreset_mode=AutoresetMode.NEXT_STEP)
+    try:
+        assert np.array_equal(ours.reset(seed=3)[0], sync.reset(seed=3)[0])
+        rng = np.random.default_rng(0)
+        for _ in range(10):
+            act = rng.uniform(-1, 1, (4, 6))
+            a, b = ours.step(act), sync.step(act)
+            assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    finally:
+        ours.close()
+        sync.close()
