@@ -150,8 +150,8 @@ def test_reset_draws_dm_controls_initial_state(task):
 
 def perturbed_states(task, theirs, n, rng):
     """n (qpos, qvel, ctrl) near dm_control's reset state: joints turned, speeds set, the
-    root's forward speed spread over the task's reward ramp; walkers lifted clear of the
-    floor (no contact: hopper's touch sensors read 0 in both)."""
+    root's forward speed spread over the task's reward ramp; hopper lifted clear of the floor
+    (its touch sensors, contact forces, then read 0 in both)."""
     m = theirs.physics.model
     names = [m.id2name(j, "joint") for j in range(m.njnt)]
     base_q, out = theirs.physics.data.qpos.copy(), []
@@ -162,7 +162,8 @@ def perturbed_states(task, theirs, n, rng):
         if "rootx" in names and task.split("-")[0] in ("cheetah", "walker", "hopper"):
             top = {"cheetah-run": 12, "walker-run": 9, "hopper-hop": 2.5}.get(task, 1.5)
             qvel[names.index("rootx")] = rng.uniform(0, top)
-            qpos[names.index("rootz")] += 0.5 if task.startswith("walker") is False else 0.0
+        if task.startswith("hopper"):
+            qpos[names.index("rootz")] += 0.5     # in the air: no contact force in either
         if task == "pendulum-swingup" and k % 2:
             qpos[:] = rng.normal(0, 0.1, 1)                 # upright: reward 1
         out.append((qpos, qvel, ctrl))
