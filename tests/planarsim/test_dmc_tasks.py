@@ -146,6 +146,11 @@ def test_reset_draws_dm_controls_initial_state(task):
     assert np.allclose(obs[:n], want[:n], rtol=0, atol=1e-9), np.abs(obs[:n] - want[:n]).max()
     if env.target is not None:
         assert np.allclose(env.target[:2], theirs.physics.named.model.geom_pos["target"][:2])
+    # the next episode (no seed) continues the same draws, as dm_control's task does
+    theirs.reset()
+    env.reset()
+    assert np.allclose(env.qpos, theirs.physics.data.qpos, rtol=0, atol=1e-12)
+    assert np.allclose(env.qvel, theirs.physics.data.qvel, rtol=0, atol=1e-12)
 
 
 def perturbed_states(task, theirs, n, rng):
