@@ -170,7 +170,7 @@ class FileFrames:
 def randomize_limited_and_rotational_joints(env, random, qpos):
     """dm_control.suite.utils.randomizers' rule, joint by joint in file order: a limited
     hinge or slide uniform in its range, an unlimited hinge uniform in [-pi, pi]."""
-    for i, name in enumerate(env.coords.names):
+    for i in range(len(env.coords.names)):
         lo, hi = env.joint_range[i]
         if env.joint_limited[i]:
             qpos[i] = random.uniform(lo, hi)
