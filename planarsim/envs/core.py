@@ -249,7 +249,8 @@ class GeneralizedCoords:
 
 
 # keywords an environment passes on to planarsim.mjcf.load_mjcf (and its ModelBuilder)
-LOAD_KEYWORDS = frozenset({"offset", "collide", "drop", "dt", "gravity", "terrain", "ground"})
+LOAD_KEYWORDS = frozenset({"offset", "collide", "drop", "dt", "gravity", "terrain", "ground",
+                           "assets"})
 
 
 class PlanarMujocoEnv(gymnasium.Env):
@@ -273,7 +274,9 @@ class PlanarMujocoEnv(gymnasium.Env):
             raise TypeError(f"{type(self).__name__}: unknown keyword(s) {unknown}; it takes its "
                             f"task's own (gymnasium's v5 names), render_mode, width, height and "
                             f"the model loader's {sorted(LOAD_KEYWORDS)}")
-        path = xml_file if os.path.isabs(xml_file) else gym_asset(xml_file)
+        # an absolute path, the XML text itself, or the name of one of gymnasium's files
+        path = (xml_file if os.path.isabs(xml_file) or xml_file.lstrip().startswith("<")
+                else gym_asset(xml_file))
         self.loaded = load_mjcf(path, **load_kw)
         self.sim_model = self.loaded.compile()
         self.coords = GeneralizedCoords(self.loaded, self.sim_model)

@@ -1,0 +1,700 @@
+"""The DeepMind Control Suite's planar tasks as gymnasium environments on planarsim, with
+dm_control's semantics: its model files (read from the installed dm_control package, which
+is not imported), its rewards (``rewards.tolerance``, reimplemented), its observations (the
+task's ``get_observation`` entries, each raveled, concatenated in order), its control step
+(``_CONTROL_TIMESTEP`` where the domain sets one, else the model's timestep; the physics
+steps n_sub_steps = control step / timestep times per action), its time limits (episode
+steps = ceil(time limit / control step)) and its episode initialisation (the same draws from
+a ``numpy.random.RandomState(seed)``, so that a seed starts the same state as
+``suite.load(domain, task, task_kwargs={"random": seed})``; cheetah then settles 200 physics
+steps on planarsim's engine).
+
+One class, :class:`DMCEnv`; each domain is a few functions (its initialisation, observation
+and reward, written as dm_control's ``Physics`` / ``Task`` methods are), each task a row of
+``TASKS`` (its domain and parameters: walker stand / walk / run differ by a target speed).
+The quantities dm_control reads from MuJoCo's data (body frames ``xpos`` / ``xmat``, body
+centres of mass ``xipos``, site and geom positions, the sensors ``subtreelinvel``,
+``velocimeter``, ``gyro``, ``touch``) are computed from planarsim's body poses and
+velocities and the file's frames (:class:`FileFrames`).
+
+What differs from dm_control: the motion (planarsim's hard contacts and its integrator, not
+MuJoCo's soft contacts and Euler / RK4), hence episodes beyond their first steps; and hopper's
+touch sensors, which here are the normal force of planarsim's contacts in the site's sphere
+over the last physics step (impulse / timestep), not MuJoCo's soft contact force of the
+current state (0 right after a reset). As in dm_control, the reward's control terms read the
+action as given, the motors the action clamped to ctrlrange. pendulum and reacher run with
+StepOptions.turn_limit 0 (see DOMAINS: the check's bound is far above their motors' turns).
+"""
+from __future__ import annotations
+
+import collections
+import importlib.util
+import math
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+
+import numpy as np
+from gymnasium import spaces
+
+from ..mjcf import parse_xml
+from .core import PlanarMujocoEnv
+from .rewards import tolerance
+
+INF = float("inf")
+
+
+# --- the suite's files --------------------------------------------------------------------
+
+def find_suite_dir() -> str:
+    """Directory of dm_control's suite model files (found without importing dm_control)."""
+    spec = importlib.util.find_spec("dm_control")
+    if spec is None or not spec.submodule_search_locations:
+        raise ImportError("the DeepMind Control Suite's model files come with dm_control, which "
+                          "is not installed (pip install dm_control); planarsim does not ship "
+                          "them")
+    return os.path.join(list(spec.submodule_search_locations)[0], "suite")
+
+
+def common_assets(directory: str) -> dict:
+    """The ./common/*.xml files the suite's models include, as load_mjcf's assets."""
+    common = os.path.join(directory, "common")
+    return {f"./common/{f}": open(os.path.join(common, f), "rb").read()
+            for f in sorted(os.listdir(common)) if f.endswith(".xml")}
+
+
+def swimmer_xml(directory: str, n_bodies: int) -> str:
+    """dm_control's swimmer with n_bodies bodies (suite/swimmer.py's _make_model, with the
+    standard library's ElementTree)."""
+    if n_bodies < 3:
+        raise ValueError(f"swimmer: at least 3 bodies required, got {n_bodies}")
+    mjcf = ET.fromstring(open(os.path.join(directory, "swimmer.xml")).read())
+    head_body = mjcf.find("./worldbody/body")
+    actuator = ET.SubElement(mjcf, "actuator")
+    sensor = ET.SubElement(mjcf, "sensor")
+    parent = head_body
+    for i in range(n_bodies - 1):
+        child = ET.Element("body", name=f"segment_{i}")
+        child.set("pos", "0 .1 0")
+        ET.SubElement(child, "geom", {"class": "visual", "name": f"visual_{i}"})
+        ET.SubElement(child, "geom", {"class": "inertial", "name": f"inertial_{i}"})
+        child.append(ET.Element("site", name=f"site_{i}"))
+        limit = 360.0 / n_bodies
+        child.append(ET.Element("joint", {"name": f"joint_{i}", "range": f"{-limit} {limit}"}))
+        actuator.append(ET.Element("motor", name=f"motor_{i}", joint=f"joint_{i}"))
+        sensor.append(ET.Element("velocimeter", name=f"velocimeter_{i}", site=f"site_{i}"))
+        sensor.append(ET.Element("gyro", name=f"gyro_{i}", site=f"site_{i}"))
+        parent.append(child)
+        parent = child
+    return ET.tostring(mjcf, encoding="unicode")
+
+
+def _vec(text, n=3):
+    v = [float(x) for x in text.split()]
+    return np.array(v + [0.0] * (n - len(v)))
+
+
+_ROTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
+
+
+class FileFrames:
+    """Frames of an MJCF file at its own pose (qpos0), for files whose bodies and sites carry
+    positions only: each body's origin and parent, each site's and named geom's body,
+    position and size (class defaults and childclass applied to sizes), the sensors in order
+    (type, name, attributes). Positions are 3D world coordinates [m]."""
+
+    def __init__(self, text: str, source: str):
+        root = parse_xml(text, source)
+        self.source = source
+        self.body = collections.OrderedDict()       # name -> (parent name or None, pos)
+        self.site, self.geom = {}, {}               # name -> (body or None, pos, size)
+        self.sensors = []                           # (type, name, attrib)
+        self._defaults = {}
+        for node in root.children:
+            if node.tag == "default":
+                self._read_defaults(node, "main", {})
+        for node in root.children:
+            if node.tag == "worldbody":
+                self._walk(node, None, np.zeros(3), "main")
+            elif node.tag == "sensor":
+                self.sensors += [(s.tag, s.attrib.get("name", ""), s.attrib) for s in node.children]
+
+    def _read_defaults(self, node, name, inherited):
+        own = {tag: dict(a) for tag, a in inherited.items()}
+        for ch in node.children:
+            if ch.tag != "default":
+                own.setdefault(ch.tag, {}).update(ch.attrib)
+        self._defaults[name] = own
+        for ch in node.children:
+            if ch.tag == "default":
+                self._read_defaults(ch, ch.attrib.get("class", name), own)
+
+    def _attr(self, node, cls, key, default):
+        if key in node.attrib:
+            return node.attrib[key]
+        return self._defaults.get(node.attrib.get("class", cls), {}).get(node.tag, {}).get(key, default)
+
+    def _walk(self, node, body, pos, cls):
+        for ch in node.children:
+            if ch.tag == "body":
+                name = ch.attrib.get("name")
+                rot = sorted(set(ch.attrib) & set(_ROTATIONS))
+                if rot:
+                    raise NotImplementedError(f"{self.source}:{ch.line}: body {name!r} is rotated "
+                                              f"({rot}); planarsim's dm_control tasks read frames "
+                                              f"of unrotated bodies only")
+                p = pos + _vec(ch.attrib.get("pos", "0 0 0"))
+                self.body[name] = (body, p)
+                self._walk(ch, name, p, ch.attrib.get("childclass", cls))
+            elif ch.tag in ("site", "geom") and "name" in ch.attrib:
+                if "fromto" in ch.attrib:
+                    ft = _vec(ch.attrib["fromto"], 6)
+                    local = (ft[:3] + ft[3:]) / 2
+                else:
+                    local = _vec(ch.attrib.get("pos", "0 0 0"))
+                size = _vec(self._attr(ch, cls, "size", "0.005" if ch.tag == "site" else "0"))
+                table = self.site if ch.tag == "site" else self.geom
+                table[ch.attrib["name"]] = (body, pos + local, size)
+
+    def subtree(self, name) -> list:
+        """MJCF bodies in body `name`'s subtree (itself first)."""
+        out = [name]
+        for b, (parent, _) in self.body.items():
+            if parent in out:
+                out.append(b)
+        return out
+
+
+# --- the domains: dm_control's Physics / Task methods on planarsim ----------------------
+
+def randomize_limited_and_rotational_joints(env, random, qpos):
+    """dm_control.suite.utils.randomizers' rule, joint by joint in file order: a limited
+    hinge or slide uniform in its range, an unlimited hinge uniform in [-pi, pi]."""
+    for i in range(len(env.coords.names)):
+        lo, hi = env.joint_range[i]
+        if env.joint_limited[i]:
+            qpos[i] = random.uniform(lo, hi)
+        elif env.joint_angular[i]:
+            qpos[i] = random.uniform(-np.pi, np.pi)
+
+
+def _init_randomized(env, random, qpos, qvel, params):
+    randomize_limited_and_rotational_joints(env, random, qpos)
+
+
+def _init_cheetah(env, random, qpos, qvel, params):
+    limited = env.joint_limited
+    lower, upper = env.joint_range[limited].T
+    qpos[limited] = random.uniform(lower, upper)
+    env.settle = 200                   # physics steps without control before the episode
+
+
+def _init_acrobot(env, random, qpos, qvel, params):
+    qpos[[env.qindex("shoulder"), env.qindex("elbow")]] = random.uniform(-np.pi, np.pi, 2)
+
+
+def _init_cartpole(env, random, qpos, qvel, params):
+    nv = len(qvel)
+    if params["swing_up"]:
+        qpos[env.qindex("slider")] = .01 * random.randn()
+        qpos[env.qindex("hinge_1")] = np.pi + .01 * random.randn()
+        qpos[2:] = .1 * random.randn(nv - 2)
+    else:
+        qpos[env.qindex("slider")] = random.uniform(-.1, .1)
+        qpos[1:] = random.uniform(-.034, .034, nv - 1)
+    qvel[:] = 0.01 * random.randn(nv)
+
+
+def _init_pendulum(env, random, qpos, qvel, params):
+    qpos[env.qindex("hinge")] = random.uniform(-np.pi, np.pi)
+
+
+def _init_reacher(env, random, qpos, qvel, params):
+    env.geom_size_override["target"] = params["target_size"]
+    randomize_limited_and_rotational_joints(env, random, qpos)
+    angle = random.uniform(0, 2 * np.pi)
+    radius = random.uniform(.05, .20)
+    env.set_target(radius * np.sin(angle), radius * np.cos(angle))
+
+
+def _init_swimmer(env, random, qpos, qvel, params):
+    randomize_limited_and_rotational_joints(env, random, qpos)
+    close_target = random.rand() < .2
+    target_box = .3 if close_target else 2
+    xpos, ypos = random.uniform(-target_box, target_box, size=2)
+    env.set_target(xpos, ypos)
+
+
+def _obs_position_velocity(env):
+    return collections.OrderedDict(position=env.qpos[1:].copy(), velocity=env.qvel.copy())
+
+
+def _obs_walker(env):
+    return collections.OrderedDict(
+        orientations=np.array([[env.xmat(b)[0, 0], env.xmat(b)[0, 2]] for b in env.frames.body]).ravel(),
+        height=np.array(env.xpos("torso")[2]), velocity=env.qvel.copy())
+
+
+def _touch(env):
+    return np.log1p([env.sensor("touch_toe"), env.sensor("touch_heel")])
+
+
+def _obs_hopper(env):
+    obs = _obs_position_velocity(env)
+    obs["touch"] = _touch(env)
+    return obs
+
+
+def _obs_acrobot(env):
+    arms = ("upper_arm", "lower_arm")
+    return collections.OrderedDict(
+        orientations=np.array([env.xmat(b)[0, 2] for b in arms] + [env.xmat(b)[2, 2] for b in arms]),
+        velocity=env.qvel.copy())
+
+
+def _poles(env):
+    return list(env.frames.body)[1:]        # dm_control's xmat[2:]: the bodies after the cart
+
+
+def _obs_cartpole(env):
+    pos = [env.qpos[env.qindex("slider")]]
+    for b in _poles(env):
+        pos += [env.xmat(b)[2, 2], env.xmat(b)[0, 2]]
+    return collections.OrderedDict(position=np.array(pos), velocity=env.qvel.copy())
+
+
+def _obs_pendulum(env):
+    R = env.xmat("pole")
+    return collections.OrderedDict(orientation=np.array([R[2, 2], R[0, 2]]),
+                                   velocity=env.qvel[[env.qindex("hinge")]].copy())
+
+
+def _finger_to_target(env):
+    return env.geom_xpos("target")[:2] - env.geom_xpos("finger")[:2]
+
+
+def _obs_reacher(env):
+    return collections.OrderedDict(position=env.qpos.copy(), to_target=_finger_to_target(env),
+                                   velocity=env.qvel.copy())
+
+
+def _nose_to_target(env):
+    return (env.geom_xpos("target") - env.geom_xpos("nose")).dot(env.xmat("head"))[:2]
+
+
+def _obs_swimmer(env):
+    vel = []
+    for kind, name, attrib in env.frames.sensors:     # dm_control: sensordata[12:], (vx, vy, wz)
+        if kind == "velocimeter":
+            vel += list(env.sensor(name)[:2])
+        elif kind == "gyro":
+            vel.append(env.sensor(name)[2])
+    return collections.OrderedDict(joints=env.qpos[3:].copy(), to_target=_nose_to_target(env),
+                                   body_velocities=np.array(vel))
+
+
+def _reward_cheetah(env, p):
+    return tolerance(env.sensor("torso_subtreelinvel")[0], bounds=(p["run_speed"], INF),
+                     margin=p["run_speed"], value_at_margin=0, sigmoid="linear")
+
+
+def _reward_walker(env, p):
+    standing = tolerance(env.xpos("torso")[2], bounds=(p["stand_height"], INF),
+                         margin=p["stand_height"] / 2)
+    upright = (1 + env.xmat("torso")[2, 2]) / 2
+    stand_reward = (3 * standing + upright) / 4
+    if p["move_speed"] == 0:
+        return stand_reward
+    move_reward = tolerance(env.sensor("torso_subtreelinvel")[0], bounds=(p["move_speed"], INF),
+                            margin=p["move_speed"] / 2, value_at_margin=0.5, sigmoid="linear")
+    return stand_reward * (5 * move_reward + 1) / 6
+
+
+def _reward_hopper(env, p):
+    height = env.xipos("torso")[2] - env.xipos("foot")[2]
+    standing = tolerance(height, (p["stand_height"], 2))
+    if p["hop_speed"]:
+        hopping = tolerance(env.sensor("torso_subtreelinvel")[0], bounds=(p["hop_speed"], INF),
+                            margin=p["hop_speed"] / 2, value_at_margin=0.5, sigmoid="linear")
+        return standing * hopping
+    small_control = tolerance(env.control(), margin=1, value_at_margin=0,
+                              sigmoid="quadratic").mean()
+    return standing * (small_control + 4) / 5
+
+
+def _reward_acrobot(env, p):
+    dist = np.linalg.norm(env.site_xpos("target") - env.site_xpos("tip"))
+    return tolerance(dist, bounds=(0, env.frames.site["target"][2][0]), margin=1)
+
+
+def _reward_cartpole(env, p):
+    cosines = np.array([env.xmat(b)[2, 2] for b in _poles(env)])
+    upright = (cosines + 1) / 2
+    centered = (1 + tolerance(env.qpos[env.qindex("slider")], margin=2)) / 2
+    small_control = tolerance(env.control(), margin=1, value_at_margin=0, sigmoid="quadratic")[0]
+    small_control = (4 + small_control) / 5
+    small_velocity = (1 + tolerance(env.qvel[1:], margin=5).min()) / 2
+    return upright.mean() * small_control * small_velocity * centered
+
+
+def _reward_pendulum(env, p):
+    return tolerance(env.xmat("pole")[2, 2], (np.cos(np.deg2rad(p["angle_bound"])), 1))
+
+
+def _reward_reacher(env, p):
+    radii = env.geom_size("target")[0] + env.geom_size("finger")[0]
+    return tolerance(np.linalg.norm(_finger_to_target(env)), (0, radii))
+
+
+def _reward_swimmer(env, p):
+    target_size = env.geom_size("target")[0]
+    return tolerance(np.linalg.norm(_nose_to_target(env)), bounds=(0, target_size),
+                     margin=5 * target_size, sigmoid="long_tail")
+
+
+@dataclass(frozen=True)
+class Domain:
+    """A suite domain: its file, MuJoCo timestep [s] (the file's; checked at load),
+    _DEFAULT_TIME_LIMIT [s], _CONTROL_TIMESTEP [s] (None: the timestep), and its functions
+    init(env, random, qpos, qvel, params), observe(env) -> OrderedDict, reward(env, params);
+    defaults: the task parameters its module sets as constants; step_options: StepOptions
+    fields the domain's simulator takes."""
+    xml: str
+    timestep: float
+    time_limit: float
+    control_timestep: float | None
+    init: callable
+    observe: callable
+    reward: callable
+    defaults: dict = field(default_factory=dict)
+    step_options: dict = field(default_factory=dict)
+
+    @property
+    def n_sub_steps(self) -> int:
+        """dm_control.rl.control.compute_n_steps."""
+        if self.control_timestep is None:
+            return 1
+        n = self.control_timestep / self.timestep
+        if self.control_timestep < self.timestep or abs(n - round(n)) > 1e-8:
+            raise ValueError(f"{self.xml}: control timestep {self.control_timestep} is not a whole "
+                             f"multiple of the physics timestep {self.timestep}")
+        return int(round(n))
+
+    @property
+    def episode_steps(self) -> int:
+        """Steps until dm_control's step count reaches time_limit / control step."""
+        return int(math.ceil(self.time_limit / (self.timestep * self.n_sub_steps)))
+
+
+DOMAINS = {
+    "cheetah": Domain("cheetah.xml", 0.01, 10, None, _init_cheetah, _obs_position_velocity,
+                      _reward_cheetah, dict(run_speed=10)),
+    "walker": Domain("walker.xml", 0.0025, 25, .025, _init_randomized, _obs_walker,
+                     _reward_walker, dict(stand_height=1.2)),
+    "hopper": Domain("hopper.xml", 0.005, 20, .02, _init_randomized, _obs_hopper, _reward_hopper,
+                     dict(stand_height=0.6)),
+    "acrobot": Domain("acrobot.xml", 0.01, 10, None, _init_acrobot, _obs_acrobot, _reward_acrobot),
+    "cartpole": Domain("cartpole.xml", 0.01, 10, None, _init_cartpole, _obs_cartpole,
+                       _reward_cartpole),
+    "pendulum": Domain("pendulum.xml", 0.02, 20, None, _init_pendulum, _obs_pendulum,
+                       _reward_pendulum, dict(angle_bound=8),
+                       # StepOptions.turn_limit's check bounds a motor's turn by the inertia
+                       # its bodies would have free (the bob about its centre: 1e-3 kg m^2,
+                       # 0.4 rad a step at full torque) and would stop the run; on its hinge
+                       # the pole has 0.251 kg m^2 and turns 0.002 rad a step
+                       step_options=dict(turn_limit=0.0)),
+    "reacher": Domain("reacher.xml", 0.02, 20, None, _init_reacher, _obs_reacher, _reward_reacher,
+                      # the turn check bounds the wrist motor's turn by the two links'
+                      # inertia as free bodies (3e-5 kg m^2: 0.66 rad a step at full torque)
+                      # and would stop the run; the hand (1.9e-4 kg m^2 about the wrist)
+                      # turns ~0.1 rad a step with the arm held, as in MuJoCo's model
+                      step_options=dict(turn_limit=0.0)),
+    "swimmer": Domain("swimmer.xml", 0.002, 30, .03, _init_swimmer, _obs_swimmer,
+                      _reward_swimmer),
+}
+
+# task -> (domain, parameters): dm_control's task functions' arguments
+TASKS = {
+    "cheetah-run": ("cheetah", {}),
+    "walker-stand": ("walker", dict(move_speed=0)),
+    "walker-walk": ("walker", dict(move_speed=1)),
+    "walker-run": ("walker", dict(move_speed=8)),
+    "hopper-stand": ("hopper", dict(hop_speed=0)),
+    "hopper-hop": ("hopper", dict(hop_speed=2)),
+    "acrobot-swingup": ("acrobot", {}),
+    "cartpole-balance": ("cartpole", dict(swing_up=False)),
+    "cartpole-swingup": ("cartpole", dict(swing_up=True)),
+    "pendulum-swingup": ("pendulum", {}),
+    "reacher-easy": ("reacher", dict(target_size=.05)),
+    "reacher-hard": ("reacher", dict(target_size=.015)),
+    "swimmer-swimmer6": ("swimmer", dict(n_bodies=6)),
+}
+
+# the suite's other planar tasks, and why planarsim cannot run them
+UNSUPPORTED = {
+    "finger-spin": "finger's spinner hinge has joint friction (frictionloss), which planarsim's "
+                   "engine does not model",
+    "finger-turn_easy": "finger's spinner hinge has joint friction (frictionloss), which "
+                        "planarsim's engine does not model",
+    "finger-turn_hard": "finger's spinner hinge has joint friction (frictionloss), which "
+                        "planarsim's engine does not model",
+    "point_mass-easy": "point_mass is driven through fixed tendons, which planarsim's engine does "
+                       "not model",
+}
+
+
+def env_id(task: str) -> str:
+    return f"planarsim/dmc-{task}-v0"
+
+
+# --- the environment -----------------------------------------------------------------------
+
+class DMCEnv(PlanarMujocoEnv):
+    """A DeepMind Control Suite task (a key of TASKS, e.g. "walker-walk") on planarsim.
+
+    obs: the task's observation entries flattened in dm_control's order (float64, unbounded);
+    action: one control per actuator in its ctrlrange (float64, as dm_control's action_spec);
+    reward: dm_control's ``get_reward`` of the state after the step; never terminates (the
+    registered ids truncate at dm_control's time limit). reset(seed=s) draws the initial
+    state as dm_control's task does from numpy.random.RandomState(s).
+
+    ``suite_dir``: where the suite's files are (default: the installed dm_control's);
+    remaining keywords go to PlanarMujocoEnv (render_mode, width, height, load_mjcf's).
+    """
+
+    def __init__(self, task: str, suite_dir: str | None = None, **kw):
+        if task in UNSUPPORTED:
+            raise NotImplementedError(f"dm_control task {task!r} cannot run on planarsim: "
+                                      f"{UNSUPPORTED[task]}")
+        if task not in TASKS:
+            raise ValueError(f"unknown dm_control task {task!r}; planarsim runs {sorted(TASKS)}")
+        self.task = task
+        domain_name, params = TASKS[task]
+        self.domain = DOMAINS[domain_name]
+        self.params = {**self.domain.defaults, **params}
+        directory = suite_dir or find_suite_dir()
+        if domain_name == "swimmer":
+            text = swimmer_xml(directory, self.params["n_bodies"])
+            source = f"swimmer({self.params['n_bodies']})"
+        else:
+            source = os.path.join(directory, self.domain.xml)
+            text = open(source).read()
+        self.frames = FileFrames(text, source)
+        kw.setdefault("assets", common_assets(directory))
+        PlanarMujocoEnv.__init__(self, text, self.domain.n_sub_steps, **kw)
+        if abs(self.timestep - self.domain.timestep) > 1e-12:
+            raise ValueError(f"{source}: the file's timestep is {self.timestep} s, planarsim's "
+                             f"table of dm_control domains says {self.domain.timestep} s")
+        if self.domain.step_options:
+            self.sim.options = self.sim.options._replace(**self.domain.step_options)
+        self.metadata = {"render_modes": ["rgb_array"], "render_fps": int(round(1.0 / self.dt))}
+        self.action_space = spaces.Box(low=self._act_lo.copy(), high=self._act_hi.copy(),
+                                       dtype=np.float64)
+        self._setup_geometry()
+        self._random = None
+        self.settle = 0
+        self._ctrl = np.zeros(len(self._act))
+        self._reset_state(np.random.RandomState(0))
+        n = self._get_obs().size
+        self.observation_space = spaces.Box(-np.inf, np.inf, (n,), np.float64)
+
+    # the model's data as dm_control reads it --------------------------------------------
+    @property
+    def qpos(self):
+        """MuJoCo's qpos of the current state."""
+        return self.data.qpos
+
+    @property
+    def qvel(self):
+        """MuJoCo's qvel of the current state."""
+        return self.data.qvel
+
+    def _setup_geometry(self):
+        loaded, model = self.loaded, self.sim_model
+        self.plane_axes = (0, 2) if loaded.plane == "x-z" else (0, 1)
+        self.normal_axis = 1 if loaded.plane == "x-z" else 2
+        # the plane's counter-clockwise rotation axis in 3D: -y for x-z, +z for x-y
+        self.ccw_sign = -1.0 if loaded.plane == "x-z" else 1.0
+        self.qindex = {n: i for i, n in enumerate(self.coords.names)}.__getitem__
+        rng = []
+        for jm in self.coords.jm:
+            lim = model.arrays.pin_limit[jm.coordinate]
+            rng.append(sorted(jm.ref + jm.sign * x for x in lim))
+        self.joint_range = np.array(rng, float)
+        self.joint_limited = np.isfinite(self.joint_range).all(axis=1)
+        self.joint_angular = np.array([jm.angular for jm in self.coords.jm])
+        self.geom_size_override = {}
+        self.target = None
+        self._mass = np.asarray(model.arrays.body_mass, float)
+
+    def _rigid(self, body):
+        if body not in self.loaded.body:
+            raise KeyError(f"{self.task}: MJCF body {body!r} does not move (welded to the world) "
+                           f"or is not in the file; moving bodies: {sorted(self.loaded.body)}")
+        return self.loaded.body[body]
+
+    def _to3(self, p2, file_point):
+        out = np.array(file_point, float).copy()
+        out[self.plane_axes[0]], out[self.plane_axes[1]] = p2
+        return out
+
+    def pos3(self, body, file_point):
+        """World 3D position of a point fixed in MJCF body `body` (None: the world), given at
+        the file's pose (its out-of-plane coordinate stays the file's)."""
+        if body is None:
+            return np.array(file_point, float)
+        a, b = self.plane_axes
+        return self._to3(self.point(body, (file_point[a], file_point[b])), file_point)
+
+    def xpos(self, body):
+        """MuJoCo's xpos: the body frame's origin."""
+        return self.pos3(body, self.frames.body[body][1])
+
+    def xipos(self, body):
+        """MuJoCo's xipos: the body's own centre of mass."""
+        com = self.loaded.com[body]
+        p = self.frames.body[body][1].copy()
+        p[self.plane_axes[0]], p[self.plane_axes[1]] = com
+        return self.pos3(body, p)
+
+    def angle(self, body):
+        """The body's rotation from the file's pose, counter-clockwise in the plane [rad]."""
+        b = self._rigid(body)
+        return float(self.sim.state.q[b, 2] - self.sim_model.q0[b, 2])
+
+    def xmat(self, body):
+        """MuJoCo's xmat (3x3) of a body (its frame unrotated in the file)."""
+        phi = self.ccw_sign * self.angle(body)
+        c, s = math.cos(phi), math.sin(phi)
+        if self.normal_axis == 1:        # rotation about +y by phi
+            return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+        return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+    def site_xpos(self, name):
+        body, p, _ = self.frames.site[name]
+        return self.pos3(body, p)
+
+    def geom_xpos(self, name):
+        body, p, _ = self.frames.geom[name]
+        if body is None and self.target is not None and name == "target":
+            p = self.target
+        return self.pos3(body, p)
+
+    def geom_size(self, name):
+        size = self.frames.geom[name][2].copy()
+        if name in self.geom_size_override:
+            size[0] = self.geom_size_override[name]
+        return size
+
+    def set_target(self, x, y):
+        """Move the world geom 'target' (reacher, swimmer) to (x, y) in the x-y plane, as
+        dm_control's tasks set model.geom_pos."""
+        p = self.frames.geom["target"][1].copy()
+        p[0], p[1] = x, y
+        self.target = p
+
+    def set_control(self, action):
+        """Set the control the reward reads (dm_control's physics.set_control), without
+        stepping."""
+        self._ctrl = np.array(action, dtype=np.float64).reshape(len(self._act))
+
+    def control(self):
+        """dm_control's physics.control(): the last action as given (before the clamp)."""
+        return self._ctrl
+
+    def _velocity_at(self, body, file_point):
+        b = self._rigid(body)
+        p = self.pos3(body, file_point)
+        a0, a1 = self.plane_axes
+        q, v = self.sim.state.q[b], self.sim.state.v[b]
+        w = v[2]
+        r = (p[a0] - q[0], p[a1] - q[1])
+        out = np.zeros(3)
+        out[a0], out[a1] = v[0] - w * r[1], v[1] + w * r[0]
+        return out
+
+    def sensor(self, name):
+        """A sensor of the file's <sensor> section, by name: subtreelinvel, velocimeter, gyro
+        (3D, as MuJoCo's), touch (a float)."""
+        for kind, sname, attrib in self.frames.sensors:
+            if sname == name:
+                break
+        else:
+            raise KeyError(f"{self.task}: no sensor {name!r} in the file; it has "
+                           f"{[s[1] for s in self.frames.sensors]}")
+        if kind == "subtreelinvel":
+            ids = sorted({self.loaded.body[b] for b in self.frames.subtree(attrib["body"])
+                          if b in self.loaded.body})
+            m = self._mass[ids]
+            v2 = (m[:, None] * self.sim.state.v[ids, :2]).sum(0) / m.sum()
+            out = np.zeros(3)
+            out[self.plane_axes[0]], out[self.plane_axes[1]] = v2
+            return out
+        if kind in ("velocimeter", "gyro"):
+            body, p, _ = self.frames.site[attrib["site"]]
+            if kind == "gyro":
+                w = np.zeros(3)
+                w[self.normal_axis] = self.ccw_sign * self.sim.state.v[self._rigid(body), 2]
+                return self.xmat(body).T @ w
+            return self.xmat(body).T @ self._velocity_at(body, p)
+        if kind == "touch":
+            return self._touch(attrib["site"])
+        raise NotImplementedError(f"{self.task}: sensor {name!r} of type <{kind}> is not computed")
+
+    def _touch(self, site):
+        """Normal force [N] of the contacts of the site's body inside its sphere over the last
+        physics step (impulse / timestep); a contact on an arc counts at its lowest point."""
+        body, p, size = self.frames.site[site]
+        centre = self.point(body, (p[self.plane_axes[0]], p[self.plane_axes[1]]))
+        b = self._rigid(body)
+        a = self.sim_model.arrays
+        st = self.sim.state
+        total = 0.0
+        c, s = math.cos(st.q[b, 2]), math.sin(st.q[b, 2])
+        for k in np.flatnonzero(np.asarray(a.contact_body) == b):
+            lx, ly = a.contact_local[k]
+            x = st.q[b, 0] + c * lx - s * ly
+            y = st.q[b, 1] + s * lx + c * ly - a.contact_radius[k]
+            if math.hypot(x - centre[0], y - centre[1]) <= size[0]:
+                total += max(st.last_contact_impulse[k, 0], 0.0) / self.timestep
+        return total
+
+    # gymnasium -----------------------------------------------------------------------------
+    def observation(self) -> collections.OrderedDict:
+        """The task's observation entries (dm_control's get_observation)."""
+        return self.domain.observe(self)
+
+    def _get_obs(self):
+        return np.concatenate([np.asarray(x, float).ravel() for x in self.observation().values()])
+
+    def reward(self) -> float:
+        """dm_control's get_reward of the current state (and last control)."""
+        return float(self.domain.reward(self, self.params))
+
+    def _reset_state(self, random):
+        qpos, qvel = self.init_qpos.copy(), np.zeros(self.model.nv)
+        self.settle = 0
+        self.geom_size_override = {}
+        self.domain.init(self, random, qpos, qvel, self.params)
+        self._ctrl = np.zeros(len(self._act))
+        self.set_state(qpos, qvel)
+        if self.settle:
+            self.sim.steps(self.settle, np.zeros(self.sim_model.n_act))
+            self._sync()
+
+    def reset_model(self):
+        if self._random is None:
+            self._random = np.random.RandomState(int(self.np_random.integers(2 ** 31)))
+        self._reset_state(self._random)
+        return self._get_obs()
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        if seed is not None:
+            self._random = np.random.RandomState(seed)
+        return super().reset(seed=seed, options=options)
+
+    def step(self, action):
+        a = self.check_action(action)
+        self._ctrl = a.copy()
+        self.do_simulation(a, self.frame_skip)
+        return self._get_obs(), self.reward(), False, False, {}

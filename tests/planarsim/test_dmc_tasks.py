@@ -1,0 +1,277 @@
+"""planarsim.envs.dmc: the DeepMind Control Suite's planar tasks on planarsim, against
+dm_control (the oracle: it is not imported by planarsim itself).
+
+For every registered task: the observation and action spaces and the episode length equal
+dm_control's ``suite.load(domain, task)``; gymnasium's env checker passes; a seed gives one
+episode bit for bit; reset(seed=s) starts from dm_control's initial state for random=s (the
+same draws; cheetah then settles on each engine, so only its draws are compared); and from
+the same physical state (dm_control's reset state perturbed, put in both), reward and
+observation equal dm_control's to 1e-9, over states whose rewards are not all saturated.
+"""
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium", reason="gymnasium is not installed (pip install -e '.[gym]')")
+suite = pytest.importorskip("dm_control.suite",
+                            reason="dm_control is not installed (pip install dm_control): it is "
+                                   "the oracle and ships the suite's model files")
+
+mujoco = pytest.importorskip("mujoco", reason="mujoco is not installed (pip install -e '.[test]')")
+
+
+def _dm_control_index_compat():
+    """dm_control 1.0.50's named indexers list MjModel / MjData fields newer MuJoCo releases
+    dropped (mujoco 4.0: flex_vertedge, ...); every ``physics.named`` (which the suite's tasks
+    read) then raises AttributeError. Drop the fields this mujoco does not have."""
+    from dm_control.mujoco.wrapper.mjbindings import sizes
+    for struct, cls in (("mjmodel", mujoco.MjModel), ("mjdata", mujoco.MjData)):
+        table = sizes.array_sizes[struct]
+        for name in [f for f in table if not hasattr(cls, f)]:
+            del table[name]
+
+
+_dm_control_index_compat()
+
+import planarsim.envs  # noqa: E402,F401  (registers the environments)
+from planarsim.envs import dmc  # noqa: E402
+from planarsim.envs.rewards import tolerance  # noqa: E402
+
+TASKS = list(dmc.TASKS)
+TOL = 1e-9
+# tasks whose reward is an indicator (tolerance with margin 0): 0 or 1 only
+BINARY = {"pendulum-swingup", "reacher-easy", "reacher-hard"}
+
+
+def dm_load(task, seed=0):
+    domain, name = task.split("-", 1)
+    return suite.load(domain, name, task_kwargs={"random": seed})
+
+
+def flat(obs):
+    return np.concatenate([np.asarray(v, float).ravel() for v in obs.values()])
+
+
+def test_every_task_is_registered_and_the_unsupported_are_refused():
+    assert set(dmc.TASKS) == {"cheetah-run", "walker-stand", "walker-walk", "walker-run",
+                              "hopper-stand", "hopper-hop", "acrobot-swingup", "cartpole-balance",
+                              "cartpole-swingup", "pendulum-swingup", "reacher-easy",
+                              "reacher-hard", "swimmer-swimmer6"}
+    for task in dmc.TASKS:
+        assert f"planarsim/dmc-{task}-v0" in gym.registry
+    for task, why in (("finger-spin", "frictionloss"), ("point_mass-easy", "tendons")):
+        assert f"planarsim/dmc-{task}-v0" not in gym.registry
+        with pytest.raises(NotImplementedError, match=why):
+            dmc.DMCEnv(task)
+    with pytest.raises(ValueError, match="unknown dm_control task 'walker-fly'"):
+        dmc.DMCEnv("walker-fly")
+
+
+@pytest.mark.parametrize("kind, margin, value", [
+    ("gaussian", 1.0, 0.1), ("hyperbolic", 0.5, 0.3), ("long_tail", 0.5, 0.1),
+    ("reciprocal", 2.0, 0.2), ("cosine", 1.0, 0.0), ("linear", 10.0, 0.0), ("linear", 0.5, 0.5),
+    ("quadratic", 1.0, 0.0), ("tanh_squared", 1.5, 0.4)])
+def test_tolerance_is_dm_controls(kind, margin, value):
+    from dm_control.utils import rewards
+    x = np.linspace(-4, 4, 301)
+    for bounds in ((0.0, 0.0), (-0.5, 1.0), (1.0, np.inf)):
+        ours = tolerance(x, bounds, margin, kind, value)
+        theirs = rewards.tolerance(x, bounds, margin, kind, value)
+        assert np.array_equal(ours, theirs), (kind, bounds)
+        assert tolerance(0.7, bounds, margin, kind, value) == rewards.tolerance(0.7, bounds, margin, kind, value)
+    with pytest.raises(ValueError, match="lower bound 1 > upper bound 0"):
+        tolerance(0.0, (1, 0))
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_spaces_and_time_limit_are_dm_controls(task):
+    theirs = dm_load(task)
+    env = gym.make(dmc.env_id(task))
+    aspec = theirs.action_spec()
+    assert env.action_space.shape == aspec.shape and env.action_space.dtype == aspec.dtype
+    assert np.array_equal(env.action_space.low, aspec.minimum)
+    assert np.array_equal(env.action_space.high, aspec.maximum)
+    n_obs = sum(int(np.prod(s.shape)) for s in theirs.observation_spec().values())
+    assert env.observation_space.shape == (n_obs,)
+    assert np.all(env.observation_space.low == -np.inf) and np.all(env.observation_space.high == np.inf)
+    # dm_control's episode: steps until its count reaches time limit / control step
+    assert env.spec.max_episode_steps == int(np.ceil(theirs._step_limit))
+    u = env.unwrapped
+    assert u.frame_skip == theirs._n_sub_steps
+    assert u.dt == pytest.approx(theirs.control_timestep(), rel=1e-12)
+    assert u.timestep == theirs.physics.timestep()
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_env_checker_passes(task):
+    from gymnasium.utils.env_checker import check_env
+    check_env(gym.make(dmc.env_id(task)).unwrapped, skip_render_check=True)
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_same_seed_same_episode(task):
+    def episode():
+        env = gym.make(dmc.env_id(task))
+        out = [env.reset(seed=11)[0]]
+        env.action_space.seed(3)
+        for _ in range(20):
+            obs, r, term, trunc, _ = env.step(env.action_space.sample())
+            out.append(np.append(obs, r))
+        return out
+    a, b = episode(), episode()
+    assert all(np.array_equal(x, y) for x, y in zip(a, b))
+    env = gym.make(dmc.env_id(task))
+    assert not np.array_equal(env.reset(seed=1)[0], env.reset(seed=2)[0])
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_reset_draws_dm_controls_initial_state(task):
+    theirs = dm_load(task, seed=5)
+    ts = theirs.reset()
+    env = dmc.DMCEnv(task)
+    obs, _ = env.reset(seed=5)
+    if task == "cheetah-run":
+        # the draws match; the 200 settling steps run on each engine: compare before them
+        env.settle, qpos = 0, env.init_qpos.copy()
+        dmc._init_cheetah(env, np.random.RandomState(5), qpos, np.zeros(env.model.nv), {})
+        fresh = theirs.physics.model.qpos0.copy()
+        rs = np.random.RandomState(5)
+        limited = theirs.physics.model.jnt_limited == 1
+        fresh[limited] = rs.uniform(*theirs.physics.model.jnt_range[limited].T)
+        assert np.allclose(qpos, fresh, rtol=0, atol=1e-12)
+        return
+    q, v = theirs.physics.data.qpos, theirs.physics.data.qvel
+    assert np.allclose(env.qpos, q, rtol=0, atol=1e-12) and np.allclose(env.qvel, v, rtol=0, atol=1e-12)
+    want = flat(ts.observation)
+    n = len(want) - (2 if task.startswith("hopper") else 0)   # hopper's touch: contact forces
+    assert np.allclose(obs[:n], want[:n], rtol=0, atol=1e-9), np.abs(obs[:n] - want[:n]).max()
+    if env.target is not None:
+        assert np.allclose(env.target[:2], theirs.physics.named.model.geom_pos["target"][:2])
+    # the next episode (no seed) continues the same draws, as dm_control's task does
+    theirs.reset()
+    env.reset()
+    assert np.allclose(env.qpos, theirs.physics.data.qpos, rtol=0, atol=1e-12)
+    assert np.allclose(env.qvel, theirs.physics.data.qvel, rtol=0, atol=1e-12)
+
+
+def perturbed_states(task, theirs, n, rng):
+    """n (qpos, qvel, ctrl) near dm_control's reset state: joints turned, speeds set, the
+    root's forward speed spread over the task's reward ramp; hopper lifted clear of the floor
+    (its touch sensors, contact forces, then read 0 in both)."""
+    m = theirs.physics.model
+    names = [m.id2name(j, "joint") for j in range(m.njnt)]
+    base_q, out = theirs.physics.data.qpos.copy(), []
+    for k in range(n):
+        qpos = base_q + rng.normal(0, 0.3, m.nq)
+        qvel = rng.normal(0, 1.0, m.nv)
+        ctrl = rng.uniform(-1.2, 1.2, m.nu)
+        if "rootx" in names and task.split("-")[0] in ("cheetah", "walker", "hopper"):
+            top = {"cheetah-run": 12, "walker-run": 9, "hopper-hop": 2.5}.get(task, 1.5)
+            qvel[names.index("rootx")] = rng.uniform(0, top)
+        if task.startswith("hopper"):
+            qpos[names.index("rootz")] += 0.5     # in the air: no contact force in either
+        if task == "pendulum-swingup" and k % 2:
+            qpos[:] = rng.normal(0, 0.1, 1)                 # upright: reward 1
+        out.append((qpos, qvel, ctrl))
+    return out
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_reward_and_observation_equal_dm_controls_from_the_same_state(task):
+    rng = np.random.default_rng(2024)
+    rewards, worst_r, worst_o = [], 0.0, 0.0
+    for seed in (0, 1, 2):
+        theirs = dm_load(task, seed)
+        theirs.reset()
+        env = dmc.DMCEnv(task)
+        env.reset(seed=seed)
+        physics = theirs.physics
+        for i, (qpos, qvel, ctrl) in enumerate(perturbed_states(task, theirs, 4, rng)):
+            physics.data.qpos[:], physics.data.qvel[:] = qpos, qvel
+            physics.set_control(ctrl)
+            physics.forward()
+            if task.startswith("reacher") and i % 2:
+                # the target on the finger (+- a little): reward 1 in the indicator
+                tip = physics.named.data.geom_xpos["finger", :2] + rng.normal(0, 0.003, 2)
+                physics.named.model.geom_pos["target", :2] = tip
+                physics.forward()
+            if env.target is not None:
+                env.set_target(*physics.named.model.geom_pos["target", :2])
+            env.set_state(qpos, qvel)
+            env.set_control(ctrl)
+            r_dm = theirs.task.get_reward(physics)
+            r = env.reward()
+            o_dm, o = flat(theirs.task.get_observation(physics)), env._get_obs()
+            worst_r = max(worst_r, abs(r - r_dm))
+            worst_o = max(worst_o, float(np.abs(o - o_dm).max()))
+            rewards.append(r_dm)
+    print(f"{task}: reward max |diff| {worst_r:.3g}, observation {worst_o:.3g}")
+    assert worst_r <= TOL and worst_o <= TOL, (worst_r, worst_o)
+    rewards = np.array(rewards)
+    if task in BINARY:
+        assert set(rewards) == {0.0, 1.0}, rewards
+    else:
+        assert np.any((rewards > 0.01) & (rewards < 0.99)), rewards
+
+
+def test_hopper_touch_sensors_carry_its_weight_on_the_floor_and_read_zero_in_the_air():
+    """hopper's touch (log1p of the toe's and heel's normal force): standing straight on its
+    foot, the two carry its weight (within 5 %) at the first step, the toe's share the
+    one nearer the centre of mass's side; lifted, both are 0."""
+    env = dmc.DMCEnv("hopper-stand")
+    env.reset(seed=0)
+    qpos, qvel = env.init_qpos.copy(), np.zeros(env.model.nv)
+    env.set_state(qpos, qvel)
+    qpos[env.qindex("rootz")] -= env.xpos("foot")[2] - 0.04     # the capsule on the floor
+    env.set_state(qpos, qvel)
+    env.do_simulation(np.zeros(4), 1)
+    toe, heel = np.expm1(env._get_obs()[-2:])
+    weight = env._mass.sum() * 9.81
+    assert toe > 0 and heel > 0 and abs(toe + heel - weight) <= 0.05 * weight, (toe, heel, weight)
+    # the heel (x = -0.08) is nearer the centre of mass (x ~ 0) than the toe (x = 0.17)
+    assert heel > toe
+    qpos[env.qindex("rootz")] += 0.5
+    env.set_state(qpos, qvel)
+    env.do_simulation(np.zeros(4), 1)
+    assert np.array_equal(env._get_obs()[-2:], [0.0, 0.0])
+
+
+def test_cross_entropy_learns_cartpole_balance():
+    """examples/learn_dmc_cartpole.py on a small budget (3 iterations of 12 policies over
+    200-step episodes, ~2 s): the learned linear policy returns at least 280 of 300 on unseen
+    300-step episodes; random actions (105-207 measured) and no action (~215) do not."""
+    import importlib
+    import sys
+    from pathlib import Path
+    examples = str(Path(__file__).resolve().parents[2] / "examples")
+    if examples not in sys.path:
+        sys.path.insert(0, examples)
+    ex = importlib.import_module("learn_dmc_cartpole")
+    out = ex.learn(iterations=3, population=12, elite=4, horizon=200, eval_episodes=2,
+                   eval_horizon=300, progress=False)
+    assert min(out["eval_returns"]) >= 280.0, out["eval_returns"]
+    assert ex.random_return(episodes=3, horizon=300) < 280.0
+    env = gym.make(ex.ENV)
+    assert ex.episode_return(env, np.zeros(len(ex.FEATURES)), 10_000, 300) < 280.0
+    means = [m for _, m, _ in out["history"]]
+    assert means[-1] > means[0], means
+
+
+def test_vector_env_steps_a_dmc_task_as_sync_vector_env_does():
+    """PlanarVectorEnv (two processes) and gymnasium's SyncVectorEnv give walker-walk's
+    copies the same episodes bit for bit."""
+    from gymnasium.vector import AutoresetMode, SyncVectorEnv
+    from planarsim.envs.vector import PlanarVectorEnv
+    eid = dmc.env_id("walker-walk")
+    ours = PlanarVectorEnv(eid, num_envs=4, workers=2)
+    sync = SyncVectorEnv([lambda: gym.make(eid) for _ in range(4)],
+                         autoreset_mode=AutoresetMode.NEXT_STEP)
+    try:
+        assert np.array_equal(ours.reset(seed=3)[0], sync.reset(seed=3)[0])
+        rng = np.random.default_rng(0)
+        for _ in range(10):
+            act = rng.uniform(-1, 1, (4, 6))
+            a, b = ours.step(act), sync.step(act)
+            assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    finally:
+        ours.close()
+        sync.close()
