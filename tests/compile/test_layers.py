@@ -1,12 +1,13 @@
 """planarsim's layers, read from its sources with ast: no import circle of more than two
-modules (imports inside functions counted too), and a compiler layer (planarsim/compile)
-that imports nothing from the rest of planarsim."""
+modules (imports inside functions counted too), a compiler layer (planarsim/compile) that
+imports nothing from the rest of planarsim, and numba's classes left as they are."""
 import ast
 from pathlib import Path
 
 import planarsim
 
 PACKAGE = Path(planarsim.__file__).resolve().parent
+REPOSITORY = PACKAGE.parent
 
 
 def _modules(package: Path) -> dict:
@@ -144,3 +145,69 @@ def test_the_compiler_layer_imports_nothing_from_the_rest_of_planarsim():
                 name = node.value
                 assert not (name.startswith("planarsim.") and not name.startswith("planarsim.compile")), (
                     f"{path.name} names {name}")
+
+
+def _numba_names(tree) -> set:
+    """Names bound to numba objects in a module: ``from numba... import X`` and ``import
+    numba...`` (as their alias)."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "numba":
+            names |= {alias.asname or alias.name for alias in node.names}
+        elif isinstance(node, ast.Import):
+            names |= {(alias.asname or alias.name).split(".")[0] for alias in node.names
+                      if alias.name.split(".")[0] == "numba"}
+    return names
+
+
+def _root(node):
+    while isinstance(node, ast.Attribute):
+        node = node.value
+    return node.id if isinstance(node, ast.Name) else None
+
+
+def numba_assignments(tree) -> list:
+    """(line, name) of each assignment to an attribute of a numba object in module `tree`:
+    ``name.attr = ...`` (or augmented, or annotated) and ``setattr(name, ...)``, name bound
+    by an import from numba."""
+    numba = _numba_names(tree)
+    found = []
+    for node in ast.walk(tree):
+        targets = []
+        if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+              and node.func.id == "setattr" and node.args):
+            targets = [ast.Attribute(value=node.args[0], attr="?")]
+        for target in targets:
+            if isinstance(target, ast.Attribute) and _root(target) in numba:
+                found.append((node.lineno, _root(target)))
+    return found
+
+
+def test_the_numba_assignment_reader_finds_each_form():
+    source = ("from numba.core.targetconfig import TargetConfig\n"
+              "import numba.core.codegen as cg\n"
+              "from numba.core import caching\n"
+              "TargetConfig.__hash__ = lambda self: 0\n"
+              "cg.JITCodeLibrary.finalize = None\n"
+              "setattr(caching, 'Cache', None)\n"
+              "mine = object()\n"
+              "mine.x = 1\n")
+    assert numba_assignments(ast.parse(source)) == [(4, "TargetConfig"), (5, "cg"), (6, "caching")]
+
+
+def test_no_attribute_of_numba_is_assigned_anywhere_in_the_repository():
+    """planarsim changes none of numba's classes or modules for the whole process: no
+    ``numba_thing.attr = ...`` and no setattr(numba_thing, ...) in any source (tests may
+    monkeypatch numba's config through pytest, which puts it back)."""
+    checked = 0
+    for path in REPOSITORY.rglob("*.py"):
+        if ".venv" in path.parts or "site-packages" in path.parts:
+            continue
+        tree = ast.parse(path.read_text(), str(path))
+        if _numba_names(tree):
+            checked += 1
+        found = numba_assignments(tree)
+        assert not found, f"{path.relative_to(REPOSITORY)} assigns attributes of numba's {found}"
+    assert checked > 10
