@@ -21,10 +21,16 @@ from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
 from .start_check import check_overlap, check_start, overlapping
 from .kernels.guards import GUARD_ROOM
-from .link import step as linked   # (its compiled functions publish the step before their first call)
 from .state import (State, Workspace, check_state, copy_arrays, forget_ground_queries, forget_pairs,
                     grow_workspace, make_state, make_workspace, workspace_capacity)
 from .trajectory import Trajectory, check_recording, make_recorder, record_state
+
+
+def _link():
+    """link/step.py, imported with the first Simulator (its compiled functions publish the
+    step before their first call: from the numba cache, or its first-ever compile)."""
+    from .link import step   # (imported here for start-up time: about 0.1 s of import planarsim)
+    return step
 
 
 
@@ -118,9 +124,9 @@ class Simulator:
 
     def _repack(self):
         """The table that Simulator.step / steps hand to the compiled run_steps."""
-        args = linked.StepArgs(self._model.arrays, self._state, self._ws, self._options)
+        args = _link().StepArgs(self._model.arrays, self._state, self._ws, self._options)
         if self._args is None:
-            self._args = linked.Handle(args)
+            self._args = _link().Handle(args)
         else:
             self._args.repack(args)
         self._steps_entry = None  # bound on the first step (_bind_steps)
@@ -190,7 +196,7 @@ class Simulator:
     def _bind_steps(self):
         """run_steps compiled (or loaded from the cache) for this simulator's handle, then
         called directly: numba's type dispatch is skipped (the handle's type never changes)."""
-        self._steps_entry = linked.bind_steps(self._args)
+        self._steps_entry = _link().bind_steps(self._args)
         return self._steps_entry
 
     def _run_recorded(self, u, n, every, rec, k0):
@@ -198,7 +204,7 @@ class Simulator:
         ran out of room (GUARD_ROOM) is taken again after the storage grows."""
         entry = self._recorded_entry
         if entry is None:
-            entry = self._recorded_entry = self._bind(linked.run_recorded, (n, every, rec, k0))
+            entry = self._recorded_entry = self._bind(_link().run_recorded, (n, every, rec, k0))
         total = 0
         while True:
             code, done, k0 = entry(self.model.arrays, self._state, self._ws, self._options, u,
@@ -214,7 +220,7 @@ class Simulator:
         recorder's arrays would be typed again on every call); the simulator owns its arrays,
         so their types cannot change."""
         args = (self.model.arrays, self._state, self.ws, self.options, self._u0) + tuple(extra)
-        return linked.bind(kernel, args)
+        return _link().bind(kernel, args)
 
     def steps(self, n: int, u=None) -> None:
         """n steps under constant commands, compiled as one loop."""

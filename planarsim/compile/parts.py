@@ -79,6 +79,7 @@ def _check_listed(name):
         raise ValueError(f"part {name} has no slot: add it to the parts' names "
                          "(planarsim/link/fast_step.py PART_NAMES)")
 
+
 # the parts' C function's address (kept alive for the process: compiled code reads it)
 _TABLE = np.zeros(1, np.uint64)
 _PARTS = {}          # name -> Part
