@@ -9,16 +9,19 @@ chain, one step of the Simple Biped) with a profiler installed, and prints:
 - the phases: import, the engine's first step, the walker's first step [s];
 - the CPU time by kind of work, exclusive (a compile nested in another is not counted twice):
   numba's typing (type inference, including the typing of functions numba inlines into it),
-  numba's other passes (bytecode, IR rewrites, numba-level inlining, lowering to LLVM IR),
-  LLVM's per-function passes, LLVM's module optimisation (O3) and LLVM's machine code
-  emission, the numba cache's writes;
-- per compiled function: its compiles (one per specialisation: argument types), its
-  exclusive time in each kind of work, and for each module LLVM optimises, the size of its
-  IR (instructions) before and after optimisation.
+  numba's lowering to LLVM IR, numba's other passes (bytecode, IR rewrites, numba-level
+  inlining) and LLVM (every call into LLVM: parsing, linking, optimisation, machine code);
+- per compiled function: its compiles (one per specialisation: argument types) and its
+  exclusive time in each kind of work;
+- LLVM's own pass timers (numba's NUMBA_LLVM_PASS_TIMINGS, set in the child) per code library
+  LLVM optimised in this process (the step's parts compile in a child process of their own):
+  per-function passes, module optimisation (O3) and machine code, and the size of its
+  optimised IR (instructions). Those timers run on the wall clock: on a busy machine they
+  count the time LLVM waits for a core too.
 
 numba's own events drive it (``numba.core.event``: "numba:run_pass" around each compiler pass
-of each function); the LLVM stages are timed by wrapping numba's code-library methods in the
-child only. The profiler adds a little time of its own (counting IR instructions).
+of each function, "numba:llvm_lock" around each call into LLVM, "numba:compile" naming each
+dispatcher compiled); nothing of numba is replaced, in the child or anywhere.
 """
 from __future__ import annotations
 
@@ -40,8 +43,10 @@ PASS_KIND = {
 }
 # the profile's clock: this process's CPU time (the work, whatever else the machine runs)
 CLOCK = time.process_time
-KINDS = ("typing", "lowering", "numba other", "llvm function passes", "llvm module O3",
-         "llvm machine code", "llvm link", "cache write")
+KINDS = ("typing", "lowering", "numba other", "llvm")
+# LLVM's pass timers' records (numba's code libraries name them) by stage
+LLVM_STAGES = (("Function passes", "llvm function passes"), ("Module passes", "llvm module O3"),
+               ("Finalize object", "llvm machine code"))
 
 
 class Profiler:
@@ -52,8 +57,8 @@ class Profiler:
         self.stack = []                       # [kind, function, start, children's time]
         self.own = defaultdict(float)         # (kind, function) -> s
         self.compiles = defaultdict(list)     # function -> [argument types] of each compile
-        self.sizes = []                       # (function, IR instructions before, after O3)
         self.passes = defaultdict(float)      # numba pass name -> exclusive s
+        self.dispatchers = []                 # every dispatcher compiled (their libraries)
 
     def push(self, kind, function, name=None):
         self.stack.append([kind, function, CLOCK(), 0.0, name])
@@ -67,17 +72,9 @@ class Profiler:
         if self.stack:
             self.stack[-1][3] += total
 
-    def timed(self, kind, name_of):
-        """Decorator wrapping a method: its call is a region of `kind`, for name_of(self)."""
-        def wrap(method):
-            def wrapper(obj, *args, **kwargs):
-                self.push(kind, name_of(obj))
-                try:
-                    return method(obj, *args, **kwargs)
-                finally:
-                    self.pop()
-            return wrapper
-        return wrap
+    def function(self):
+        """The function whose compiler pass is running (the innermost open region's)."""
+        return self.stack[-1][1] if self.stack else "(outside a compiler pass)"
 
 
 def _instructions(module) -> int:
@@ -85,8 +82,8 @@ def _instructions(module) -> int:
 
 
 def install(profiler: Profiler) -> None:
-    """Listen to numba's pass events and wrap its code libraries' LLVM stages (this process)."""
-    from numba.core import caching, codegen, event
+    """Listen to numba's events: its compiler passes, its calls into LLVM and its compiles."""
+    from numba.core import event
 
     class Passes(event.Listener):
         def on_start(self, ev):
@@ -99,27 +96,57 @@ def install(profiler: Profiler) -> None:
         def on_end(self, ev):
             profiler.pop()
 
-    event.register("numba:run_pass", Passes())
-    lib_name = lambda lib: lib.name                      # noqa: E731
-    cpu = codegen.CPUCodeLibrary
-    cpu._optimize_functions = profiler.timed("llvm function passes", lib_name)(cpu._optimize_functions)
-    plain_o3 = cpu._optimize_final_module
+    class LLVM(event.Listener):
+        def on_start(self, ev):
+            profiler.push("llvm", profiler.function())
 
-    def o3(lib):
-        before = _instructions(lib._final_module)
-        plain_o3(lib)
-        profiler.sizes.append((lib.name, before, _instructions(lib._final_module)))
-    cpu._optimize_final_module = profiler.timed("llvm module O3", lib_name)(o3)
-    jit_lib = codegen.JITCodeLibrary
-    jit_lib._finalize_specific = profiler.timed("llvm machine code", lib_name)(jit_lib._finalize_specific)
-    cpu.finalize = profiler.timed("llvm link", lib_name)(cpu.finalize)
+        def on_end(self, ev):
+            profiler.pop()
+
+    class Compiles(event.Listener):
+        def on_start(self, ev):
+            pass
+
+        def on_end(self, ev):
+            dispatcher = (ev.data or {}).get("dispatcher")
+            if dispatcher is not None:
+                profiler.dispatchers.append(dispatcher)
+
+    event.register("numba:run_pass", Passes())
+    event.register("numba:llvm_lock", LLVM())
+    event.register("numba:compile", Compiles())
+
+
+def _libraries(profiler: Profiler) -> list:
+    """The code libraries LLVM optimised: every compiled dispatcher's, the step's and its
+    parts' C functions'."""
+    found = [cres.library for d in profiler.dispatchers
+             for cres in getattr(d, "overloads", {}).values()]
     try:
-        from planarsim.compile.fast import KernelCodeLibrary
-        KernelCodeLibrary.finalize = profiler.timed("llvm link", lib_name)(KernelCodeLibrary.finalize)
-    except ImportError:
+        from planarsim.compile.parts import PARTS
+        from planarsim.link.step import _ENGINE
+        found += [c._library for c in (_ENGINE.get("cfunc"), PARTS.cfunc) if c is not None]
+    except (ImportError, AttributeError):
         pass
-    caching.Cache.save_overload = profiler.timed(
-        "cache write", lambda cache: cache._name)(caching.Cache.save_overload)
+    return [lib for lib in dict.fromkeys(found) if getattr(lib, "_finalized", False)]
+
+
+def _llvm_timings(libraries) -> list:
+    """[name, {stage: s}, IR instructions after O3] per library (LLVM's own pass timers)."""
+    rows = []
+    for lib in libraries:
+        stages = dict.fromkeys((stage for _, stage in LLVM_STAGES), 0.0)
+        for record in getattr(lib, "_recorded_timings", ()):
+            for prefix, stage in LLVM_STAGES:
+                if record.name.startswith(prefix):
+                    stages[stage] += record.timings.get_total_time() or 0.0
+        try:
+            size = _instructions(lib._final_module)
+        except Exception:   # a library whose module numba has since dropped
+            size = 0
+        if any(stages.values()):
+            rows.append([lib.name, stages, size])
+    return sorted(rows, key=lambda r: -sum(r[1].values()))
 
 
 def child(top: int) -> dict:
@@ -137,10 +164,7 @@ def child(top: int) -> dict:
     for (kind, function), seconds in profiler.own.items():
         by_kind[kind] += seconds
         by_function[function][kind] += seconds
-    size = {}
-    for name, before, after in profiler.sizes:
-        b, a = size.get(name, (0, 0))
-        size[name] = (b + before, a + after)
+    llvm = _llvm_timings(_libraries(profiler))
     rows = sorted(by_function.items(), key=lambda kv: -sum(kv[1].values()))
     return dict(
         phases=dict(**phases,
@@ -153,14 +177,15 @@ def child(top: int) -> dict:
         specialisations={name: args for name, args in profiler.compiles.items() if len(args) > 1},
         compiled_functions=len(profiler.compiles),
         compiles=sum(len(a) for a in profiler.compiles.values()),
-        ir_sizes=sorted(([n, b, a] for n, (b, a) in size.items()), key=lambda r: -r[2])[:top],
+        llvm_stages={stage: sum(r[1][stage] for r in llvm) for _, stage in LLVM_STAGES},
+        llvm_libraries=llvm[:top],
     )
 
 
 def measure(top=20, timeout=1800) -> dict:
     """Run the profiled cold start in a child with a fresh, empty numba cache directory."""
     tmp = tempfile.mkdtemp(prefix="planarsim-cold-profile-")
-    env = {**os.environ, "NUMBA_CACHE_DIR": tmp}
+    env = {**os.environ, "NUMBA_CACHE_DIR": tmp, "NUMBA_LLVM_PASS_TIMINGS": "1"}
     try:
         t0 = time.perf_counter()
         proc = subprocess.run([sys.executable, "-m", "benchmarks.compile_profile", "--child",
@@ -190,8 +215,7 @@ def report(out: dict) -> str:
         s = out["by_kind"].get(kind, 0.0)
         lines.append(f"  {kind:22s} {s:7.2f}  {100 * s / total:5.1f} %")
     lines.append(f"  {'all':22s} {total:7.2f}")
-    short = ["typing", "lowering", "numba other", "llvm function passes", "llvm module O3",
-             "llvm machine code"]
+    short = list(KINDS)
     lines += ["", "numba's passes, all functions (exclusive CPU) [s]:"]
     for name, s in out["passes"].items():
         lines.append(f"  {name:40s} {s:7.2f}")
@@ -200,9 +224,15 @@ def report(out: dict) -> str:
     for row in out["functions"]:
         lines.append(f"  {row['name'][:44]:44s} {row['compiles']:3d} {row['total_s']:6.2f} "
                      + " ".join(f"{row[k]:9.2f}" for k in short))
-    lines += ["", "LLVM IR instructions of the modules optimised (before -> after O3):"]
-    for name, before, after in out["ir_sizes"]:
-        lines.append(f"  {name[:60]:60s} {before:8d} -> {after:8d}")
+    stages = [stage for _, stage in LLVM_STAGES]
+    lines += ["", "LLVM's own pass timers, all libraries [s]:"]
+    for stage in stages:
+        lines.append(f"  {stage:22s} {out['llvm_stages'][stage]:7.2f}")
+    lines += ["", "per code library LLVM optimised (LLVM's pass timers [s], IR instructions after O3):",
+              f"  {'library':44s} " + " ".join(f"{k[5:14]:>9s}" for k in stages) + f" {'IR':>8s}"]
+    for name, times, size in out["llvm_libraries"]:
+        lines.append(f"  {name[:44]:44s} " + " ".join(f"{times[k]:9.2f}" for k in stages)
+                     + f" {size:8d}")
     if out["specialisations"]:
         lines += ["", "functions typed more than once (argument types of each):"]
         for name, args in sorted(out["specialisations"].items()):

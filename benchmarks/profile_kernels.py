@@ -41,7 +41,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 def _compiled_functions(dispatchers):
     """{address: symbol} of every function in the libraries of the dispatchers' overloads."""
-    from planarsim.compile.link import _ENGINE, load_step
+    from planarsim.link.step import _ENGINE, load_step
     from planarsim.compile.parts import PARTS
     load_step()
     libraries = [cres.library for disp in dispatchers for cres in disp.overloads.values()]
@@ -100,7 +100,7 @@ def _workload(target, seconds):
     import planarsim as ps
     from benchmarks.scenes import SCENES
     from benchmarks.worlds import WORLDS
-    from planarsim.compile.link import run_steps
+    from planarsim.link.step import run_steps
     model = WORLDS[target[6:]]() if target.startswith("world:") else SCENES[target][0]()
     sim = ps.Simulator(model)
     sim.steps(10)

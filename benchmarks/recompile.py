@@ -40,7 +40,7 @@ class Compiles(event.Listener):
             f = d["dispatcher"].py_func
             compiled.append([f.__module__ + "." + f.__qualname__, type(d["dispatcher"]).__name__])
         elif ev.data["name"].startswith("nopython_type_inference") and d["qualname"] == "_step_c":
-            compiled.append(["planarsim.compile.fast_step._step_c", "cfunc"])
+            compiled.append(["planarsim.link.fast_step._step_c", "cfunc"])
     def on_end(self, ev):
         pass
 

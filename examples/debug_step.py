@@ -12,7 +12,7 @@ import sys
 
 import walkers
 from planarsim.compile import MODE, PYTHON
-from planarsim.compile.debug import break_in
+from planarsim.link.debug import break_in
 
 
 def main(seconds=0.3):

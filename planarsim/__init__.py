@@ -1,6 +1,7 @@
 """planarsim: an exact, fast planar physics engine for walking machines."""
 __version__ = "0.1.0"
 
+from .link import caches as _caches   # noqa: F401  (planarsim's stale numba caches cleared first)
 from .builder import ModelBuilder
 from .errors import AuditViolation, ModelError, SimulationDiverged, WorkspaceTooLarge
 from .model import Model

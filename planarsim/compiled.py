@@ -17,7 +17,7 @@ Engine, from compiled code:
                                              The step is one C function, compiled once per
                                              machine and loaded before the first jit function
                                              runs; every caller calls it by address (the
-                                             linkage is all in planarsim/compile/link.py).
+                                             linkage is all in planarsim/link/step.py).
                                              Decorate callers with jit, not numba.njit
     record_frame(s, ws, rec, k)              write frame k of a Recorder (make_recorder)
     height(coef, x), height_derivs(coef, x)  the ground h(x) [m] and (h, h', h'')
@@ -42,9 +42,14 @@ RUN_NONFINITE_COMMAND (nothing stepped). A rollout adds its own reasons to stop 
 RUN_WALKER up (RUN_FELL, RUN_NO_EVENT, or more of its own), so that one test,
 ``engine_failed(code)``, tells the two apart everywhere.
 """
+import os
+from pathlib import Path
+
 from .errors import diverged
-from .compile import drop_stale_caches, jit, jit_inline, kernel
-from .compile.link import step, step_from_python
+from .compile import jit, jit_inline, kernel
+from .compile.caches import cache_folder
+from .link import caches as _caches
+from .link.step import step, step_from_python
 from .kernels.audit import audit_counts
 from .kernels.forces import pin_angle_rate
 from .kernels.pair import shape_contact_mode
@@ -69,11 +74,7 @@ RUN_NO_EVENT = 101      # a step map found no section event (touchdown, mid-stan
 def kernel_cache():
     """(folder, sorted index files) of the engine kernels' numba cache: no files means the next
     run compiles (measured_compile() says how long that took on this machine last time)."""
-    from pathlib import Path
-
-    from . import compile as layer
-    from .compile.caches import cache_folder
-    folder = cache_folder(Path(layer.__file__).parent)     # NUMBA_CACHE_DIR's, where set
+    folder = cache_folder(Path(_caches.__file__).parent)     # NUMBA_CACHE_DIR's, where set
     # (not the step's parts, which a child process caches while the step still compiles)
     return folder, sorted(f for f in folder.glob("*.nbi") if not f.name.startswith("parts."))
 
@@ -99,7 +100,6 @@ def measured_compile():
 def record_compile(seconds: float) -> None:
     """Keep `seconds` [s], a first compile just measured, beside the cache (numba's cache
     clearing leaves it); nothing where the install is read-only."""
-    import os
     folder = kernel_cache()[0]
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -108,6 +108,32 @@ def record_compile(seconds: float) -> None:
         os.replace(tmp, folder / COMPILE_RECORD)
     except OSError:
         pass
+
+
+def _exported_kernels(names=None) -> set:
+    """Kernel modules (short names) of the compiled functions this module exports (`names` of
+    them; None: all)."""
+    found = set()
+    for name in __all__ if names is None else names:
+        fn = globals().get(name)
+        module = getattr(getattr(fn, "py_func", None), "__module__", "") or ""
+        if module.startswith("planarsim.kernels."):
+            found.add(module[len("planarsim.kernels."):])
+    return found
+
+
+def caller_sources(folder) -> tuple:
+    """(kernel modules, other files) that compiled code below `folder` may inline besides its
+    own files (planarsim/link/caches.py caller_sources), for what it imports from here too."""
+    return _caches.caller_sources(folder, _exported_kernels)
+
+
+def drop_stale_caches(folder, clear=None) -> None:
+    """Clear the numba caches below `clear` (default `folder`) when the sources below `folder`,
+    or the engine sources its compiled code can inline (planarsim/link/caches.py), changed
+    since the last call: numba checks a cached function against its own file only. A package
+    with compiled code (a walker) calls it on import with its own folder."""
+    _caches.drop_stale_caches(folder, clear, _exported_kernels)
 
 
 def engine_failed(code) -> bool:

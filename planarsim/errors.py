@@ -13,6 +13,7 @@ touch); it names the sizes and what to change.
 """
 import math
 
+from .capacity import workspace_capacity
 from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_WORK,
                             AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
@@ -299,7 +300,6 @@ def accurate_unsupported(model, what, index, integrator=None, who="simulation"):
 def out_of_room(model, ws, who):
     """Step stopped by GUARD_ROOM where nothing grows the workspace: its rows, their matrix's
     envelope or an island's complementarity problem did not fit."""
-    from .state import workspace_capacity
     step = int(ws.prev.step[0])
     t = float(ws.prev.time[0])
     held, profile, lcp_rows = workspace_capacity(model, ws)

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from .analysis import StepEvents, step_events, step_summary
+from .analysis import StepEvents, foot_groups, step_events, step_summary
 from .energy import joint_position_rate
 from .model import ACT_AXIAL
 
@@ -65,7 +65,6 @@ def summary(traj, model, feet=None, min_air=0.05, together=0.05, min_stride=MIN_
     from where it lifted (a model that stands, rocks or hops in place makes none); feet
     landing within `together` [s] of each other land once. Adds distance [m] and mean_speed
     [m/s] of the centre of mass over the whole recording."""
-    from .analysis import foot_groups
     feet = foot_groups(traj.contact_names) if feet is None else feet
     out = step_summary(traj, model, feet=feet, min_air=min_air, together=together,
                        min_stride=min_stride)

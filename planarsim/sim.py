@@ -27,10 +27,11 @@ from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
 
 def _link():
-    """compile.link, imported with the first Simulator (its compiled functions publish the
+    """link/step.py, imported with the first Simulator (its compiled functions publish the
     step before their first call: from the numba cache, or its first-ever compile)."""
-    from .compile import link
-    return link
+    from .link import step   # (imported here for start-up time: about 0.1 s of import planarsim)
+    return step
+
 
 
 class Simulator:
@@ -199,7 +200,7 @@ class Simulator:
         return self._steps_entry
 
     def _run_recorded(self, u, n, every, rec, k0):
-        """compile.link.run_recorded on this simulator (bound once: see _bind); a step that
+        """link.step.run_recorded on this simulator (bound once: see _bind); a step that
         ran out of room (GUARD_ROOM) is taken again after the storage grows."""
         entry = self._recorded_entry
         if entry is None:

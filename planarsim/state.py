@@ -10,6 +10,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from . import memory
+from .capacity import workspace_capacity, workspace_contacts  # noqa: F401  (public here too)
+from .errors import WorkspaceTooLarge
+from .kernels.audit import N_AUDIT
 from .kernels.info import N_INFO
 from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
 from .model import Model
@@ -527,11 +531,6 @@ def first_capacity(model: Model, contacts: int) -> tuple[int, int]:
     return min(profile_full(R), ENVELOPE_PER_ROW * R), min(R, LCP_ROWS)
 
 
-def workspace_contacts(model: Model, ws) -> int:
-    """Contacts the solve's storage of workspace ws holds (the inverse of max_rows)."""
-    return (ws.row_kind.shape[0] - 5 * model.n_pin - model.n_rod) // 2
-
-
 def _broad_phase_lists(model: Model) -> dict:
     """The broad phase's tables and lists (kernels/broad_phase.py): the pair table of the
     shapes, every ground contact, and the live list, which holds every contact until the
@@ -560,15 +559,13 @@ def check_workspace(model: Model, contacts: int, profile: int, lcp_rows: int) ->
     """Raise WorkspaceTooLarge, before anything is allocated, when the solve's storage with
     room for `contacts` contacts, `profile` envelope entries and islands of `lcp_rows` rows
     (solve_bytes) needs more memory than the machine has."""
-    from .errors import WorkspaceTooLarge
-    from .trajectory import _gib, machine_memory
     need = solve_bytes(model, contacts, profile, lcp_rows)
-    have = machine_memory()
+    have = memory.machine_memory()
     if have and need > have:
         n_pair = int(np.sum(model.arrays.contact_kind == CONTACT_PAIR)) // 2
         raise WorkspaceTooLarge(
-            f"this model's step needs {_gib(need)} of memory, more than this machine's "
-            f"{_gib(have)}: its solve holds {contacts:,} contacts in rows "
+            f"this model's step needs {memory.gib(need)} of memory, more than this machine's "
+            f"{memory.gib(have)}: its solve holds {contacts:,} contacts in rows "
             f"({max_rows(model, contacts):,} rows, {profile:,} entries of their matrix, "
             f"complementarity problems of {lcp_rows:,} rows; the model has "
             f"{model.n_contact:,} contact slots: {n_pair:,} pairs of shapes that may touch, "
@@ -607,12 +604,6 @@ def _solve_arrays(model: Model, contacts: int, profile: int, lcp_rows: int) -> d
     """The workspace's arrays of _solve_shapes, zeroed."""
     return {name: np.zeros(shape, dtype)
             for name, (shape, dtype) in _solve_shapes(model, contacts, profile, lcp_rows).items()}
-
-
-def workspace_capacity(model: Model, ws) -> tuple[int, int, int]:
-    """(contacts, envelope entries, island rows of the complementarity storage) that
-    workspace ws's solve holds."""
-    return workspace_contacts(model, ws), ws.A_low.shape[0], ws.lcp_A.shape[0]
 
 
 def grow_workspace(model: Model, ws: Workspace) -> Workspace:
@@ -666,7 +657,6 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
     """A model's workspace with room for `contacts` contacts in its solve's storage
     (default: contact_capacity), `profile` entries of their matrix's envelope and islands of
     `lcp_rows` rows in its dense complementarity storage (defaults: first_capacity)."""
-    from .kernels.audit import N_AUDIT
     contacts = contact_capacity(model) if contacts is None else min(int(contacts), model.n_contact)
     first_profile, first_lcp = first_capacity(model, contacts)
     profile = first_profile if profile is None else int(profile)

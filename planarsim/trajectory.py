@@ -15,8 +15,12 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import memory
+from .energy import kinetic_energy, potential_energy
+from .errors import RecordingTooLarge
 from .files import discard, publish, staging_file
 from .state import check_shapes
+from .terrain import from_coef
 
 FORMAT_VERSION = 1
 
@@ -62,29 +66,16 @@ def frame_bytes(model, extra_columns: int = 0) -> int:
     return 8 * (items + int(extra_columns))   # every recorded dtype is 8 bytes
 
 
-def machine_memory() -> int:
-    """This machine's physical memory [bytes]; 0 where the system does not say."""
-    try:
-        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
-    except (AttributeError, OSError, ValueError):
-        return 0
-
-
-def _gib(nbytes) -> str:
-    return f"{nbytes / 2 ** 30:.3g} GiB"
-
-
 def check_recording(model, n_frames, what: str = "", extra_columns: int = 0) -> None:
     """Raise RecordingTooLarge, before anything is allocated, when `n_frames` frames of
     `model` (frame_bytes) need more memory than the machine has (machine_memory). `what`
     says what asked for them (a run's duration, say)."""
-    from .errors import RecordingTooLarge
     need = int(n_frames) * frame_bytes(model, extra_columns)
-    have = machine_memory()
+    have = memory.machine_memory()
     if have and need > have:
         raise RecordingTooLarge(
             f"{what + ': ' if what else ''}recording {int(n_frames):,} frames needs "
-            f"{_gib(need)} of memory, more than this machine's {_gib(have)}; record fewer frames "
+            f"{memory.gib(need)} of memory, more than this machine's {memory.gib(have)}; record fewer frames "
             f"(a shorter run, or a frame every more steps)", n_frames, need, have)
 
 
@@ -144,7 +135,6 @@ class Trajectory:
     def terrain(self):
         """The planarsim.terrain.Terrain the run was on (from info's terrain_coef and
         terrain), or None for a world without ground or a recording that did not keep it."""
-        from .terrain import from_coef
         coef = self.info.get("terrain_coef")
         if coef is None:
             return None
@@ -181,7 +171,6 @@ class Trajectory:
 
     def energy(self, model) -> dict:
         """Kinetic, potential and total energy per frame [J]."""
-        from .energy import kinetic_energy, potential_energy
         ke = kinetic_energy(model, self.q, self.v)
         pe = potential_energy(model, self.q)
         return {"kinetic": ke, "potential": pe, "total": ke + pe}

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..trajectory import atomic_write
 from .parallel import MapPool
 from .stepmap import (FIT_POINTS, FIT_WINDOW, StepMapError, central_jacobian, central_points,
                       map_noise, multipliers_by_fit, noise_tolerance)
@@ -120,7 +121,6 @@ class Branch:
 
 def write_csv(path, rows):
     """Rows (dicts with the same keys) as CSV, atomically."""
-    from ..trajectory import atomic_write
     rows = list(rows)
 
     def write(f):

@@ -10,13 +10,13 @@ import math
 
 import numpy as np
 
+from ..trajectory import Trajectory
 from .events import step_events
 
 
 def frame_from_state(model, state, ws=None):
     """A one-frame Trajectory of a State (the frame record_frame would write; contacts that
     are disabled get mode -1)."""
-    from ..trajectory import Trajectory
     s = state
     mode = np.where(np.asarray(s.contact_enabled) != 0, s.contact_mode, -1)[None, :].astype(np.int64)
     nc, na = model.n_contact, model.n_act

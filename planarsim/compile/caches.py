@@ -1,17 +1,13 @@
 """Stale numba caches: numba checks a cached function against its own file only.
 
-A kernel that calls into another file would keep stale machine code after that file changes.
-``drop_stale_caches`` hashes a folder's sources with the engine sources its compiled code is
-built from, and clears the folder's numba caches when the hash changes. planarsim's own
-caches (the step among them) follow all engine sources: kernels/ and compile/, and the mode.
-A package of compiled callers (a walker) follows compile/ and only the kernel modules its
-compiled code can inline: those it imports (from planarsim.compiled or planarsim.kernels)
-and the modules they import in turn; and the other sources it can inline: planarsim's modules
-with compiled code that it imports, and the modules of its own top-level package outside its
-folder (a walker's shared helpers), with what they import. In the fast mode its code
-reaches the step by address, so an edit of a kernel only the step uses (the contact solve,
-say) recompiles the step and leaves the walkers' rollouts cached; in the other modes the step
-is inlined into every caller, which then follows all engine sources.
+A compiled function that calls into another file would keep stale machine code after that
+file changes. This is the machinery to find and clear such caches: a hash of a folder's
+sources (``sources_hash``), the modules a source file imports (``imported_modules``, read
+from its text: lazy imports inside functions too), the folders numba keeps a source folder's
+caches in (``cache_folder``: its __pycache__, NUMBA_CACHE_DIR's or numba's user-wide folder)
+and ``clear_if_stale``, which clears them when the hash of what their code is built from
+changes. Which sources a package's compiled code is built from is the business of the layer
+that knows the engine (planarsim/link/caches.py).
 """
 from __future__ import annotations
 
@@ -22,12 +18,8 @@ import re
 import tempfile
 from pathlib import Path
 
-from .mode import FAST, MODE, PYTHON
 
-_PLANARSIM = Path(__file__).resolve().parent.parent
-
-
-def _sources_hash(folder: Path, extra: str = "", files=None) -> str:
+def sources_hash(folder: Path, extra: str = "", files=None) -> str:
     """Hash of the .py files below `folder` (or of `files`, paths below it) and `extra`."""
     digest = hashlib.blake2b(extra.encode(), digest_size=16)
     for path in sorted(folder.rglob("*.py") if files is None else files):
@@ -36,22 +28,7 @@ def _sources_hash(folder: Path, extra: str = "", files=None) -> str:
     return digest.hexdigest()
 
 
-def _mode_tag() -> str:
-    if MODE != FAST:
-        return MODE
-    from .fast import KERNEL_CALLS   # the kernels compile differently with it: a switch clears
-    return "calls" if KERNEL_CALLS else ""
-
-
-# the engine's compiled code changes with its kernels, this compiler layer and the mode
-ENGINE_HASH = _sources_hash(_PLANARSIM / "compile",
-                            _sources_hash(_PLANARSIM / "kernels", _mode_tag()))
-_KERNELS = "planarsim.kernels"
-# parts.py hands its child the hash it compiles the step from (the child compares its own)
-CHILD_HASH = "PLANARSIM_CHILD_ENGINE_HASH"
-
-
-def _imported_modules(path: Path):
+def imported_modules(path: Path):
     """(module, names) of each import statement of source file `path`: absolute module names
     (relative imports resolved by the file's folders, up to `level` packages), names None for
     ``import module``."""
@@ -82,7 +59,7 @@ def _parse_imports(path: Path):
         names = [n.split()[0] for n in names.strip("()").replace("\\", " ").split(",")
                  if n.split()]
         if level:
-            package = _dotted(path.parent)
+            package = dotted(path.parent)
             if package is None:
                 continue
             parts = package.split(".")
@@ -96,7 +73,7 @@ def _parse_imports(path: Path):
                 yield m.split()[0], None
 
 
-def _dotted(folder: Path):
+def dotted(folder: Path):
     """Dotted name of the package in `folder` (None if it is not one)."""
     parts = []
     while (folder / "__init__.py").exists():
@@ -105,103 +82,13 @@ def _dotted(folder: Path):
     return ".".join(parts) or None
 
 
-def _module_file(module: str, roots):
+def module_file(module: str, roots):
     base = [root.joinpath(*module.split(".")) for root in roots]
     for b in base:
         for candidate in (b.with_suffix(".py"), b / "__init__.py"):
             if candidate.is_file():
                 return candidate
     return None
-
-
-def _exported_kernels(names=None) -> set:
-    """Kernel modules (short names) of the compiled functions planarsim.compiled exports
-    (`names` of them; None: all)."""
-    from .. import compiled
-    found = set()
-    for name in compiled.__all__ if names is None else names:
-        fn = getattr(compiled, name, None)
-        module = getattr(getattr(fn, "py_func", None), "__module__", "") or ""
-        if module.startswith(_KERNELS + "."):
-            found.add(module[len(_KERNELS) + 1:])
-    return found
-
-
-def _has_compiled_code(path: Path) -> bool:
-    text = path.read_text()
-    return "@jit" in text or "@kernel" in text or "@part" in text
-
-
-def caller_sources(folder) -> tuple:
-    """(kernel modules, other files) that compiled functions of the .py files below `folder`
-    may inline, besides the folder's own files (fast mode: the step itself is reached by
-    address). Kernel modules (short names: "terrain"): those imported from planarsim.kernels
-    or through planarsim.compiled, or by planarsim's modules with compiled code that are
-    imported (planarsim/half_step.py: forces), and in turn every kernel module those import.
-    Other files: planarsim's modules with compiled code that are imported
-    (planarsim/actuators.py), and the modules of the folder's own top-level package outside
-    it (walkers/common/pd.py for a walker) with, in turn, what those import."""
-    folder = Path(folder).resolve()
-    root = folder
-    while (root / "__init__.py").exists():
-        root = root.parent
-    roots = (root, _PLANARSIM.parent)
-    kernels, files = set(), set()
-    todo = list(folder.rglob("*.py"))
-    seen = set(todo)
-    while todo:
-        for module, names in _imported_modules(todo.pop()):
-            if module == "planarsim.compiled":
-                kernels |= _exported_kernels(names)
-            elif module == "planarsim" and names and "compiled" in names:
-                kernels |= _exported_kernels()
-            elif module == _KERNELS:
-                kernels |= set(names or ())
-            elif module.startswith(_KERNELS + "."):
-                kernels.add(module[len(_KERNELS) + 1:].split(".")[0])
-            elif module == "planarsim" or module.startswith("planarsim.compile"):
-                continue       # the package's front (everything) / the compiler (hashed whole)
-            else:
-                path = _module_file(module, roots)
-                if path is None or path in seen or folder in path.parents:
-                    continue
-                seen.add(path)
-                if _PLANARSIM in path.parents:
-                    if _has_compiled_code(path):
-                        files.add(path)         # and the kernels its compiled code inlines
-                        todo.append(path)
-                else:
-                    files.add(path)
-                    todo.append(path)
-    todo, closure = list(kernels), set()
-    while todo:
-        name = todo.pop()
-        path = _PLANARSIM / "kernels" / f"{name}.py"
-        if name in closure or not path.exists():
-            continue
-        closure.add(name)
-        for module, names in _imported_modules(path):
-            if module == _KERNELS:
-                todo += list(names or ())
-            elif module.startswith(_KERNELS + "."):
-                todo.append(module[len(_KERNELS) + 1:].split(".")[0])
-    return closure, files
-
-
-def _caller_engine_hash(folder: Path) -> str:
-    """ENGINE_HASH as it matters to the compiled callers below `folder` (module docstring),
-    with the other files they may inline (caller_sources)."""
-    kernel_names, files = caller_sources(folder)
-    others = hashlib.blake2b(digest_size=16)
-    for path in sorted(files):
-        others.update(f"{path.parent.name}/{path.name}".encode())   # a moved checkout keeps it
-        others.update(path.read_bytes())
-    if MODE != FAST:
-        return ENGINE_HASH + others.hexdigest()
-    kernels = _PLANARSIM / "kernels"
-    inlined = [kernels / f"{name}.py" for name in sorted(kernel_names)]
-    return _sources_hash(_PLANARSIM / "compile",
-                         _sources_hash(kernels, _mode_tag() + others.hexdigest(), inlined))
 
 
 def cache_folder(source_folder) -> Path:
@@ -319,33 +206,16 @@ def _clear_if_changed(stamp: Path, new: str, folders, recursive: bool) -> None:
         pass  # read-only install: its sources cannot change either
 
 
-def drop_stale_caches(folder, clear=None) -> None:
-    """Clear the numba caches below `clear` (default `folder`) when the sources of `folder`
-    or the engine sources its compiled code is built from changed since the caches were
-    written (the module's docstring; nothing under NUMBA_DISABLE_JIT=1, which neither reads
-    nor writes them). With NUMBA_CACHE_DIR set (or, for a read-only install, in its user-wide
-    cache folder) numba keeps those caches there instead, one folder per source folder and
-    per path it was imported by: each such folder (for the
-    resolved path and the one given) holds a stamp of its own (numba checks each function
-    against its own file only, so without this a kernel's edit, or a new planarsim release,
-    would run the step's stale machine code from there).
-
-    Walker packages call this on import with their own folder, since their rollouts inline
-    their controller files and the engine kernels they import.
-    """
-    if MODE == PYTHON or os.environ.get(CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
-        return   # (a child compiling the step's parts for sources since edited: parts.py)
+def clear_if_stale(folder, engine: str, clear=None) -> None:
+    """Clear numba's caches of the sources below `clear` (default `folder`) unless the hash of
+    `folder`'s sources with `engine` (a hash of the other sources their compiled code is
+    built from) is the one recorded at the last clearing; then record it. The record is kept
+    in folder's __pycache__ and, for caches outside the source tree, in each of their
+    folders (named after the path the sources were imported by, so each keeps its own)."""
     given = Path(os.path.abspath(folder if clear is None else clear))
     folder = Path(folder).resolve()
     clear = folder if clear is None else Path(clear).resolve()
-    engine = ENGINE_HASH if clear == _PLANARSIM else _caller_engine_hash(folder)
-    new = _sources_hash(folder, engine)
+    new = sources_hash(folder, engine)
     _clear_if_changed(folder / "__pycache__" / "numba_sources.hash", new, [clear], True)
-    # one stamp in each of NUMBA_CACHE_DIR's folders: a folder is named after the path the
-    # sources were imported by, so each keeps its own record of the sources its code is of
     for cache in _user_cache_folders(clear, {clear, given}):
         _clear_if_changed(cache / "planarsim_sources.hash", new, [cache], False)
-
-
-_COMPILE = Path(os.path.abspath(__file__)).parent     # as imported (a link is not resolved)
-drop_stale_caches(_COMPILE, clear=_COMPILE.parent)

@@ -27,7 +27,16 @@ Under NUMBA_DISABLE_JIT=1 each returns the function itself (its `py_func` is its
 """
 from __future__ import annotations
 
+import numba
+
 from .mode import FAST, MODE, PYTHON, TABLES
+from .part_types import PART_ARGS
+
+# the fast mode's compiler and the tables use numba internals that the other modes may lack
+if MODE == FAST:
+    from . import fast, parts
+if TABLES:
+    from . import refs
 
 # plain numba: documented options only
 PLAIN_OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy")
@@ -36,8 +45,7 @@ PLAIN_OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy"
 def options():
     """numba.njit keywords of this mode's compiled code (tests compile helpers with them)."""
     if MODE == FAST:
-        from .fast import _OPTIONS
-        return dict(_OPTIONS)
+        return dict(fast._OPTIONS)
     return dict(PLAIN_OPTIONS)
 
 
@@ -57,10 +65,8 @@ def _decorator(who, allowed, fn, inline):
     if MODE == PYTHON:
         decorate = _python
     elif MODE == FAST:
-        from . import fast
         decorate = getattr(fast, who)(inline)
     else:
-        import numba
         decorate = numba.njit(**dict(PLAIN_OPTIONS, **({"inline": "always"} if inline == "always" else {})))
     return decorate if fn is None else decorate(fn)
 
@@ -87,8 +93,8 @@ def part(*args, returns=None):
     each argument, "model", "state", "workspace", "options", "float64", "int64" or "boolean";
     returns: "float64", "int64", or None. Elsewhere than the fast mode, kernel(inline="never")."""
     for a in args:
-        if a not in _PART_ARGS:
-            raise ValueError(f"part: argument type {a!r} is none of {', '.join(_PART_ARGS)}")
+        if a not in PART_ARGS:
+            raise ValueError(f"part: argument type {a!r} is none of {', '.join(PART_ARGS)}")
     if returns not in (None, "float64", "int64"):
         raise ValueError(f"part: returns {returns!r}; a part returns float64, int64 or None")
 
@@ -96,15 +102,8 @@ def part(*args, returns=None):
         dispatcher = kernel(fn, inline="never")
         if MODE != FAST:
             return dispatcher
-        from . import parts
         return parts.register(fn, dispatcher, args, returns)
     return decorate
-
-
-# a part's argument types: the engine's tables, then the scalars (parts.py reads both)
-PART_TABLES = ("model", "state", "workspace", "options")
-PART_SCALARS = ("float64", "int64", "boolean")
-_PART_ARGS = PART_TABLES + PART_SCALARS
 
 
 def register(cls=None, *, readonly=False):
@@ -115,6 +114,5 @@ def register(cls=None, *, readonly=False):
     if cls is None:
         return lambda c: register(c, readonly=readonly)
     if TABLES:
-        from . import refs
         return refs.register(cls, readonly=readonly)
     return cls

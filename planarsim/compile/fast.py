@@ -25,11 +25,9 @@ from numba.core.codegen import JITCodeLibrary
 from numba.core.compiler_lock import global_compiler_lock, require_global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
-from . import flags
+from .flags import quick_compiler
 
 _OPTIONS = dict(cache=True, fastmath=False, nogil=True, error_model="numpy", _nrt=False)
-
-flags.install()   # numba's compile flags hashed and compared without rebuilding them (flags.py)
 
 
 # LLVM's code layout while planarsim's machine code is emitted: every function and every block
@@ -75,31 +73,42 @@ def code_layout():
                     llvm.set_option("planarsim", option)
 
 
+# what runs before a `jit` function's machine code is compiled or loaded from the cache: the
+# layer above publishes there the symbols that code may name (planarsim/link/fast_step.py:
+# the compiled step's)
+_BEFORE_COMPILE = []
+
+
+def before_compile(hook):
+    """Run hook() before any `jit` function compiles or loads its machine code, and before a
+    compiled caller of a part is typed (compile/parts.py); once registered, it runs each time
+    (returns hook)."""
+    if hook not in _BEFORE_COMPILE:
+        _BEFORE_COMPILE.append(hook)
+    return hook
+
+
+def prepare_compile():
+    """Run the before_compile hooks."""
+    for hook in _BEFORE_COMPILE:
+        hook()
+
+
 class CallerDispatcher(CPUDispatcher):
-    """Dispatcher of a `jit` function. Its machine code may call the compiled step by a
-    symbol that LLVM resolves when the code is compiled or loaded from the cache; so before
-    either, the step is published (compile/fast_step.py: loaded from the cache, or compiled the
-    first time ever). Importing a module of compiled code therefore compiles nothing: a
-    command that only lists walkers or parameters never waits for the step."""
+    """Dispatcher of a `jit` function. Its machine code may call code by a symbol that LLVM
+    resolves when the code is compiled or loaded from the cache (the compiled step's); so
+    before either, the before_compile hooks publish those symbols. Importing a module of
+    compiled code therefore compiles nothing: a command that only lists walkers or
+    parameters never waits for the step. Compiles with planarsim's flags (flags.py)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._compiler = quick_compiler(self._compiler)
 
     def compile(self, sig):
-        link_step()
+        prepare_compile()
         with code_layout():
             return super().compile(sig)
-
-
-_LINKED = []     # the step is published in this process
-
-
-def link_step():
-    """Publish the compiled step's symbol (compile/fast_step.py load_step, which waits under
-    numba's compiler lock while another thread publishes it), once per process."""
-    if _LINKED:
-        return
-    from . import fast_step
-    fast_step.load_step()
-    if "cfunc" in fast_step._ENGINE:
-        _LINKED.append(True)
 
 
 class FastFunctionCache(FunctionCache):
@@ -143,7 +152,12 @@ KERNEL_CALLS = os.environ.get("PLANARSIM_KERNEL_CALLS") == "1"
 # Anything called from Python (rollouts, run_recorded, step_entry, terrain queries) keeps `jit`.
 class KernelDispatcher(CPUDispatcher):
     """Dispatcher of a kernel. Compiled code calls it directly; a call from Python is refused
-    with a clear error (numba would jump into the Python wrapper that was never built)."""
+    with a clear error (numba would jump into the Python wrapper that was never built).
+    Compiles with planarsim's flags (flags.py)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._compiler = quick_compiler(self._compiler)
 
     def __call__(self, *args, **kwargs):
         name = self.py_func.__qualname__

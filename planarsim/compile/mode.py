@@ -19,6 +19,8 @@ from __future__ import annotations
 import os
 import warnings
 
+from .numba_check import changed_internals, changed_tables
+
 FAST, PLAIN, PYTHON = "fast", "plain", "python"
 PLAIN_SWITCH = "PLANARSIM_PLAIN_NUMBA"
 
@@ -43,7 +45,6 @@ def choose_mode(environ, jit_disabled: bool, missing) -> str:
 
 def _mode() -> str:
     from numba import config
-    from .numba_check import changed_internals
     return choose_mode(os.environ, bool(config.DISABLE_JIT), changed_internals)
 
 
@@ -52,7 +53,6 @@ def _tables(mode) -> bool:
         return False
     if mode == FAST:
         return True
-    from .numba_check import changed_tables
     changed = changed_tables()
     if changed:
         warnings.warn(f"numba lacks {', '.join(changed)}: planarsim passes its NamedTuples to "

@@ -1,11 +1,12 @@
 """The numba internals planarsim's fast mode builds on, checked when planarsim is imported.
 
 Beyond numba's documented extension API (numba.extending), compile/fast.py lowers kernels into
-its own code library (numba.core.codegen, numba.core.compiler), and compile/refs.py and
-compile/link.py build arrays and calls in LLVM IR (numba.core.cgutils, numba.np.arrayobj).
+its own code library (numba.core.codegen, numba.core.compiler) and compiles with flags of its
+own (flags.py: numba's function compilers subclassed), and compile/refs.py and
+planarsim/link/fast_step.py build arrays and calls in LLVM IR (numba.core.cgutils).
 A numba release that renames or drops one of them is found here, before anything compiles,
 and planarsim runs on plain numba instead (compile/mode.py), warning with the numba version
-and each changed internal (flags.py reads numba's compile flags). Checked with numba 0.59 to 0.68.
+and each changed internal. Checked with numba 0.59 to 0.68.
 """
 import importlib
 import inspect
@@ -20,11 +21,13 @@ NEEDED = {
                           "JITCodeLibrary._raise_if_finalized JITCodeLibrary._get_module_for_linking "
                           "JITCPUCodegen.set_env",
     "numba.core.caching": "FunctionCache IndexDataCacheFile",
-    "numba.core.ccallback": "CFunc CFunc.compile CFunc.enable_caching CFunc._targetdescr",  # parts.py
-    "numba.core.compiler": "Compiler.compile_extra",
+    "numba.core.ccallback": "CFunc CFunc.compile CFunc.enable_caching CFunc._targetdescr "
+                            "_CFuncCompiler._customize_flags",  # parts.py, flags.py
+    "numba.core.dispatcher": "_FunctionCompiler _FunctionCompiler._customize_flags",  # flags.py
     "numba.core.compiler_lock": "require_global_compiler_lock global_compiler_lock",
     "numba.core.registry": "CPUDispatcher CPUDispatcher.compile CPUDispatcher.enable_caching "
                            "CPUDispatcher.get_call_template",
+    "numba.core.compiler": "Compiler.compile_extra Flags",
     "numba.core.targetconfig": "TargetConfig.options TargetConfig.__slots__",   # flags.py
 }
 # numba's low-level extension API as refs.py uses it (numba.extending and the helpers its
@@ -43,8 +46,14 @@ NEEDED_TABLES = {
 ARRAY_FIELDS = ("meminfo", "parent", "nitems", "itemsize", "data", "shape", "strides")
 # fields of a code library that KernelCodeLibrary.finalize reads and sets
 LIBRARY_FIELDS = ("_linking_libraries", "_final_module", "_finalized", "_codegen")
+# fields of a dispatcher's (and a C function's) compiler that flags.quick_compiler reads
+COMPILER_FIELDS = ("py_func", "targetdescr", "targetoptions", "locals", "pipeline_class")
 # keyword arguments of the dispatcher's constructor that fast.py passes
 DISPATCHER_ARGS = ("py_func", "locals", "targetoptions", "pipeline_class")
+
+
+def _probe():
+    return 0
 
 
 def _has(module, path):
@@ -81,6 +90,8 @@ def changed_internals():
     """The internals of the fast mode (as 'module.attribute' text) missing from numba."""
     missing = _missing(NEEDED) + changed_tables()
     try:
+        from numba.core import ccallback as numba_ccallback
+        from numba.core import types
         from numba.core.registry import CPUDispatcher, cpu_target
         params = inspect.signature(CPUDispatcher.__init__).parameters
         missing += [f"numba.core.registry.CPUDispatcher(..., {a}=)" for a in DISPATCHER_ARGS
@@ -91,6 +102,11 @@ def changed_internals():
         from numba.core.targetconfig import TargetConfig
         if "_values" not in TargetConfig.__slots__:   # flags.py compares the set options
             missing.append("numba.core.targetconfig.TargetConfig._values")
+        for owner in (CPUDispatcher(py_func=_probe, locals={}, targetoptions={}),
+                      numba_ccallback.CFunc(_probe, ((), types.int64), {}, {})):
+            compiler = getattr(owner, "_compiler", None)   # flags.py replaces each one's own
+            if compiler is None or not all(hasattr(compiler, a) for a in COMPILER_FIELDS):
+                missing.append(f"{type(owner).__name__}()._compiler ({', '.join(COMPILER_FIELDS)})")
     except Exception as exc:   # any change in how these are made counts as a change
         missing.append(f"numba.core.registry (making a code library: {type(exc).__name__}: {exc})")
     return missing

@@ -1,24 +1,23 @@
-"""The step's parts (fast mode): long kernels, most of them rarely run, compiled into a C
-function of their own that the step calls through a table of addresses, so that a first-ever
-start compiles them in a child process while this one compiles the rest of the step
-(compile/fast_step.py load_step).
+"""Parts (fast mode): long kernels, most of them rarely run, compiled into a C function of
+their own that compiled code calls through a table of addresses, so that a first-ever start
+can compile them in a child process while this one compiles the rest of the code that calls
+them (planarsim/link/fast_step.py: the step's parts beside the step).
 
-A part is declared with compile/decorators.py's ``part``: its argument types ("model",
-"state", "workspace", "options" or a numba scalar type's name) and its return type (a scalar
-type's name, or None). The parts are compiled into one C function (Parts: a numba cfunc
-cached on disk like the step, its callees inlined into it as into the step) that runs the
-part its first argument names. Callers call it by address, read from a table at the call (a
-load and an indirect call: nanoseconds; the contact solve's parts run rarely, the shape
-pairs' search once a step per pair in reach); the table is published under one symbol
-(table_symbol()) and filled, by load_step, before any code that calls a part is compiled or
-loaded (a part's caller, when typed, calls load_step as the step's does).
+A part is declared with compile/decorators.py's ``part``: its argument types (the names of
+the tables the layer above binds, "model", "state", "workspace", "options", or a numba scalar
+type's name) and its return type (a scalar type's name, or None). The parts are compiled into
+one C function (Parts: a numba cfunc cached on disk, its callees inlined into it) that runs
+the part its first argument names. Callers call it by address, read from a table at the call
+(a load and an indirect call: nanoseconds); the table is published under one symbol
+(table_symbol()) and filled before any code that calls a part is compiled or loaded (a
+part's caller, when typed, runs the before_compile hooks of compile/fast.py, where the layer
+above loads or compiles the parts).
 
-Why: numba's typing, lowering and LLVM's optimisation run on one core. With the contact
-solve's complementarity parts compiled beside the step's core on a second core, the first-ever
-compile takes the longer of the two, not their sum (README: "The first compile").
-
-PART_NAMES fixes each part's number: both processes, and every cached caller, agree on it
-whatever order the kernel modules are imported in.
+This module knows no part and no table type: the layer above binds them (``bind``: every
+part's name in a fixed order, which numbers them, the numba types of the tables and the
+module whose ``child_main`` a child process runs). Why a child: numba's typing, lowering and
+LLVM's optimisation run on one core; with the parts compiled beside the rest on a second
+core, the first-ever compile takes the longer of the two, not their sum.
 """
 from __future__ import annotations
 
@@ -32,20 +31,55 @@ import llvmlite.binding as ll
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.core.ccallback import CFunc
 from numba.core.errors import TypingError
 from numba.core.typeconv import Conversion
 from numba.extending import intrinsic
 
-from .decorators import PART_SCALARS, PART_TABLES
+from .fast import KERNEL_OPTIONS, prepare_compile
+from .flags import QuickCFunc
+from .part_types import PART_SCALARS, PART_TABLES
 
-# every part, by module and name: its index is its number (parts_c's `which`)
-PART_NAMES = (
-    "planarsim.kernels.complementarity.solve_contacts",
-    "planarsim.kernels.complementarity.project_positions",
-    "planarsim.kernels.position._settle_measured",
-    "planarsim.kernels.pair.find_pair",
-)
+
+class Binding:
+    """What the layer above binds the parts to: `names` ("module.function" of every part, in
+    an order that numbers them: both processes, and every cached caller, agree on it whatever
+    order the modules are imported in), `table_types()` (the numba types of PART_TABLES, in
+    order), `child_module` (its child_main() compiles the parts in a child process) and
+    `child_env()` (environment variables the child is started with)."""
+
+    def __init__(self, names, table_types, child_module, child_env=dict):
+        self.names = tuple(names)
+        self.table_types = table_types
+        self.child_module = child_module
+        self.child_env = child_env
+
+
+_BINDING = []
+
+
+def bind(binding: Binding):
+    """Bind the parts to `binding` (once per process; the parts already registered must be
+    among its names)."""
+    if _BINDING and _BINDING[0].names != binding.names:
+        raise ValueError("parts: bound twice, to different parts")
+    _BINDING[:] = [binding]
+    for name in _PARTS:
+        _check_listed(name)
+
+
+def binding() -> Binding:
+    if not _BINDING:
+        raise RuntimeError("parts: nothing bound them (planarsim/link/fast_step.py binds the "
+                           "step's parts on import)")
+    return _BINDING[0]
+
+
+def _check_listed(name):
+    if _BINDING and name not in _BINDING[0].names:
+        raise ValueError(f"part {name} has no slot: add it to the parts' names "
+                         "(planarsim/link/fast_step.py PART_NAMES)")
+
+
 # the parts' C function's address (kept alive for the process: compiled code reads it)
 _TABLE = np.zeros(1, np.uint64)
 _PARTS = {}          # name -> Part
@@ -68,12 +102,15 @@ class Part:
         self.dispatcher = dispatcher
         self.args = tuple(args)
         self.returns = returns
-        self.index = PART_NAMES.index(name)
+
+    @property
+    def index(self):
+        """Its number (parts_c's `which`): its place among the bound names."""
+        return binding().names.index(self.name)
 
     def types(self):
         """The numba types (args, return) of the kernel as declared."""
-        from .fast_step import engine_types
-        engine = dict(zip(PART_TABLES, engine_types()))
+        engine = dict(zip(PART_TABLES, binding().table_types()))
         args = tuple(engine[a] if a in engine else getattr(types, a) for a in self.args)
         return args, (types.none if self.returns is None else getattr(types, self.returns))
 
@@ -99,7 +136,7 @@ def slot_counts():
 
 class Parts:
     """The parts' one C function: parts_c(which, model, state, workspace, options, float64...,
-    int64..., boolean...) -> float64 runs part `which` (PART_NAMES' order) on the arguments
+    int64..., boolean...) -> float64 runs part `which` (the bound names' order) on the arguments
     it takes and returns its result as a float64 (0 for none; an int64's counts are exact).
     One C function, so that LLVM optimises and emits the kernels the parts share once."""
 
@@ -109,10 +146,9 @@ class Parts:
         self._wrapper = None
 
     def signature(self):
-        from .fast_step import engine_types
         width = slot_counts()
         scalars = [getattr(types, x) for x in PART_SCALARS for _ in range(width[x])]
-        return (types.int64, *engine_types(), *scalars), types.float64
+        return (types.int64, *binding().table_types(), *scalars), types.float64
 
     def wrapper(self):
         """The Python function the C function is compiled from (a function of this file, so
@@ -159,8 +195,7 @@ PARTS = Parts()
 
 def new_cfunc(pyfunc, args, ret):
     """numba's C function of pyfunc for numba types args -> ret, cached, not yet compiled."""
-    from .fast import KERNEL_OPTIONS
-    c = CFunc(pyfunc, (args, ret), {}, dict(KERNEL_OPTIONS))
+    c = QuickCFunc(pyfunc, (args, ret), {}, dict(KERNEL_OPTIONS))
     c.enable_caching()
     return c
 
@@ -202,12 +237,12 @@ def publish_table():
 
 
 def all_parts():
-    """Every Part, in PART_NAMES' order (their kernel modules imported)."""
-    import importlib
-    for name in PART_NAMES:
-        if name not in _PARTS:
-            importlib.import_module(name.rsplit(".", 1)[0])
-    return [_PARTS[name] for name in PART_NAMES]
+    """Every Part, in the bound names' order (the layer above imports their modules)."""
+    names = binding().names
+    missing = [name for name in names if name not in _PARTS]
+    if missing:
+        raise RuntimeError(f"parts: {', '.join(missing)} bound but never declared with part()")
+    return [_PARTS[name] for name in names]
 
 
 def _caller(p: Part):
@@ -216,8 +251,7 @@ def _caller(p: Part):
     names = [f"a{i}" for i in range(len(p.args))]
 
     def typer(typingctx, *given):
-        from .fast_step import load_step
-        load_step()     # the table published and filled before code that reads it links
+        prepare_compile()   # the table published and filled before code that reads it links
         want, ret = p.types()
         for k, (have, need) in enumerate(zip(given, want)):
             conversion = typingctx.can_convert(have, need)
@@ -254,8 +288,7 @@ def register(fn, dispatcher, args, returns):
     """The callable compiled code calls part `fn` by (its kernel `dispatcher`; args and
     returns as decorators.part checked them); see the module's docstring."""
     name = f"{fn.__module__}.{fn.__qualname__}"
-    if name not in PART_NAMES:
-        raise ValueError(f"part {name} has no slot: add it to compile/parts.py PART_NAMES")
+    _check_listed(name)
     p = Part(name, dispatcher, args, returns)
     _PARTS[name] = p
     caller = _caller(p)
@@ -286,17 +319,20 @@ def start_child(parts):
     """Start a child process compiling `parts` (PARTS, or None: nothing to do) into numba's
     cache; None where that cannot help: switched off, one CPU, no interpreter to start (a
     frozen app), numba's cache not readable as planarsim reads it, or an error starting it.
-    The child imports from this process's sys.path, in its order."""
+    The child imports from this process's sys.path, in its order, and runs the bound
+    child_module's child_main()."""
     if (parts is None or os.environ.get(CHILD_SWITCH, "") == "0" or _cores() < 2
             or not sys.executable or getattr(sys, "frozen", False) or _PROBE_FAILED):
         return None
-    from .caches import CHILD_HASH, ENGINE_HASH
     try:
+        bound = binding()
         env = dict(os.environ, PYTHONSAFEPATH="1")   # not the working folder first: sys.path's
+        env.update(bound.child_env())
         env[CHILD_SWITCH] = "0"          # the child compiles, it does not start one of its own
         env[_CHILD_PATH] = json.dumps([p for p in sys.path if isinstance(p, str)])
-        env[CHILD_HASH] = ENGINE_HASH   # the sources this process compiles the step from
-        return subprocess.Popen([sys.executable, "-c", _CHILD_CODE], env=env,
+        code = (f"import json, os, sys; sys.path[:] = json.loads(os.environ['{_CHILD_PATH}']); "
+                f"from {bound.child_module} import child_main; child_main()")
+        return subprocess.Popen([sys.executable, "-c", code], env=env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
     except Exception:
@@ -304,8 +340,6 @@ def start_child(parts):
 
 
 _CHILD_PATH = "PLANARSIM_CHILD_SYS_PATH"
-_CHILD_CODE = ("import json, os, sys; sys.path[:] = json.loads(os.environ['" + _CHILD_PATH + "']); "
-               "from planarsim.compile.parts import child_main; child_main()")
 
 
 def finish(parts, child, waited=0.0):
@@ -328,18 +362,3 @@ def stop_child(child):
     if child is not None and child.poll() is None:
         child.kill()
         child.wait()
-
-
-def child_main():
-    """The child process: compile the parts' C function into numba's cache, from the sources
-    its parent compiles the step from (an engine edited meanwhile: exit 3, and the parent
-    compiles them; caches.py leaves the caches alone in such a child)."""
-    from .caches import CHILD_HASH, ENGINE_HASH
-    if os.environ.get(CHILD_HASH, ENGINE_HASH) != ENGINE_HASH:
-        raise SystemExit(3)
-    from . import fast_step
-    from .fast import code_layout
-    fast_step._LOADING.append(True)    # the parts never call the step: do not compile it here
-    publish_table()
-    with code_layout():
-        PARTS.compile()

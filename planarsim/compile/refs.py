@@ -1,4 +1,5 @@
-"""Model, state, workspace and options reach compiled code as one pointer each.
+"""NamedTuples of arrays reach compiled code as one pointer each (the engine's model, state,
+workspace and options: planarsim/link/engine.py registers them).
 
 numba passes a NamedTuple of arrays to a compiled function field by field: every array is a
 struct of 7-9 machine words, so a call with the model, state and workspace (about 80 arrays)
@@ -350,18 +351,6 @@ def _getattr(context, builder, typ, value, attr):
     shape = [_load_slot(builder, base, offset + 1 + d) for d in range(ndim)]
     ary = _c_array(context, builder, arrty, data, shape)
     return impl_ret_borrowed(context, builder, arrty, ary)
-
-
-def _register_engine_types():
-    from ..model import ModelArrays
-    from ..options import StepOptions
-    from ..state import State, Workspace
-    register(ModelArrays, readonly=True)
-    for cls in (State, Workspace, StepOptions):
-        register(cls)
-
-
-_register_engine_types()
 
 
 @intrinsic

@@ -386,6 +386,7 @@ class PlanarMujocoEnv(gymnasium.Env):
         if self.render_mode is None:
             gymnasium.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
             return None
+        # (imported here for start-up time: matplotlib only where an env renders)
         from ..render.draw import render_state
         import matplotlib.pyplot as plt
         dpi = 100

@@ -29,9 +29,11 @@ import gymnasium
 from gymnasium.vector import AutoresetMode, SyncVectorEnv, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from .registry import register_all
+
 
 def _make_sync(env_id, n, kwargs):
-    import planarsim.envs  # noqa: F401  (registers the ids in a fresh process)
+    register_all()   # the ids, in a fresh process
     return SyncVectorEnv([lambda: gymnasium.make(env_id, **kwargs) for _ in range(n)],
                          autoreset_mode=AutoresetMode.NEXT_STEP)
 

@@ -6,7 +6,7 @@ options arrive as one pointer each (compile/refs.py). The stages are compiled in
 function (inlined, but for a few long or rarely run parts kept as calls: build_and_solve, the
 complementarity solve, the skip test of the correction, the measured end-of-step audit),
 compiled once per machine and called by address from every compiled caller (a walker's
-rollout, run_steps; compile/link.py). A time-of-impact split (CCD) repeats
+rollout, run_steps; link/step.py). A time-of-impact split (CCD) repeats
 stages 1-5 for the remainder of the step with the new contact pinned. Each stage lives in its
 module (kernels/stages.py lists them); this file only orders them, and
 solve_modes, the guess-check-solve of stages 3-5. StepOptions.integrator other than the default

@@ -23,6 +23,7 @@ from ..progress import TextProgress, progress_for  # noqa: F401  (TextProgress: 
 from .camera import Camera
 from .frames import FrameRenderer, frame_indices, frame_times, map_frames, usable_cores  # noqa: F401
 from .html import player_fragment, self_contained  # noqa: F401
+from .writers import GifWriter, HtmlWriter, Mp4Writer
 
 VIDEO_FORMATS = {".gif": "gif", ".mp4": "mp4", ".html": "html", ".htm": "html"}
 PARALLEL_MIN_FRAMES = 40    # fewer frames: forking costs more than it saves
@@ -65,13 +66,10 @@ def _samples(renderer, n: int = 5) -> list:
 
 def _make_writer(fmt, tmp, renderer, fps, bitrate, embed_limit_mb, colors, page):
     if fmt == "gif":
-        from .writers import GifWriter
         return GifWriter(tmp, len(renderer), fps, _samples(renderer), colors)
     if fmt == "mp4":
-        from .writers import Mp4Writer
         ffmpeg_exe()
         return Mp4Writer(tmp, renderer.pixel_size, fps, bitrate)
-    from .writers import HtmlWriter
     return HtmlWriter(tmp, fps, _samples(renderer), max(colors, 128), embed_limit_mb, page)
 
 
@@ -138,7 +136,6 @@ def animation_html(traj, model, fps: float = 30.0, speed: float = 1.0, progress=
     frame slider): what a Jupyter notebook shows inline. Arguments as export_animation."""
     import tempfile
 
-    from .writers import HtmlWriter
     renderer = FrameRenderer(traj, model, fps, speed, start, duration, size, dpi, camera, **scene_kw)
     report = progress_for(progress, len(renderer), "frames")
     with tempfile.TemporaryDirectory() as d:

@@ -24,7 +24,8 @@ from matplotlib.patches import Polygon
 
 from ..model import ACT_AXIAL, JOINT_FREE_BIT
 from .sides import SIDE_ORDER, model_sides, side_index
-from .legend import legend_bitmap
+from .legend import com_marker, legend_bitmap
+from .plots import save_figure
 from .stamps import ImageStamp, TextStamp
 
 
@@ -449,13 +450,6 @@ class Scene:
                                contact_normal=None if traj.contact_normal is None else traj.contact_normal[k])
 
 
-def com_marker():
-    """The centre-of-mass mark: a ring with a cross through it (one marker path)."""
-    from matplotlib.path import Path
-    cross = Path([(-1, 0), (1, 0), (0, -1), (0, 1)], [Path.MOVETO, Path.LINETO, Path.MOVETO, Path.LINETO])
-    return Path.make_compound_path(Path.unit_circle(), cross)
-
-
 def distance_label(x: float) -> str:
     """'2 m', '0.5 m', '-1 m' for a tick at x [m] (no '-0', no rounding noise)."""
     x = round(float(x), 6)
@@ -481,6 +475,5 @@ def render_state(model, q, path=None, size=(6.4, 3.6), dpi=100, center=None, **s
     scene = Scene(model, ax, **scene_kw)
     scene.draw_state(q, center=center)
     if path is not None:
-        from .plots import save_figure
         save_figure(fig, path)
     return fig, scene

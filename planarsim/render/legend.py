@@ -22,7 +22,6 @@ def legend_bitmap(entries, dpi: float, style) -> np.ndarray | None:
         elif kind == "arrow":
             handles.append(Line2D([], [], color=color, lw=1.6, marker=">", ms=5, markevery=[1]))
         else:   # the scene's mark: a ring with a cross
-            from .draw import com_marker
             handles.append(Line2D([], [], ls="none", marker=com_marker(), ms=8, mfc="white", mec=color, mew=1.2))
     labels = [label for label, _, _ in entries]
     fig = matplotlib.figure.Figure(figsize=(4, 2), dpi=dpi)
@@ -37,3 +36,10 @@ def legend_bitmap(entries, dpi: float, style) -> np.ndarray | None:
     x0, x1 = int(math.floor(box.x0)), int(math.ceil(box.x1))
     y0, y1 = h - int(math.ceil(box.y1)), h - int(math.floor(box.y0))
     return np.ascontiguousarray(img[max(0, y0):y1, max(0, x0):x1])
+
+
+def com_marker():
+    """The centre-of-mass mark: a ring with a cross through it (one marker path)."""
+    from matplotlib.path import Path
+    cross = Path([(-1, 0), (1, 0), (0, -1), (0, 1)], [Path.MOVETO, Path.LINETO, Path.MOVETO, Path.LINETO])
+    return Path.make_compound_path(Path.unit_circle(), cross)

@@ -31,6 +31,7 @@ import time
 
 import numpy as np
 
+from ..errors import SimulationDiverged
 from .camera import Camera
 from .draw import Scene
 
@@ -244,7 +245,6 @@ class Viewer:
     def advance(self, sim_seconds: float) -> int:
         """Step the simulation by `sim_seconds` [s] (whole steps; the remainder carries over).
         Returns the number of steps taken. A diverged simulation pauses with a message."""
-        from ..errors import SimulationDiverged
         dt = self.sim.dt
         want = self._carry + sim_seconds / dt
         n = int(math.floor(want + 1e-9))

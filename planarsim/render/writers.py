@@ -12,6 +12,7 @@ import io
 
 from PIL import Image
 
+from .html import player_page
 from .gif import FrameEncoder, GifStream, palette_from, quantize
 
 
@@ -85,7 +86,6 @@ class HtmlWriter:
         self.frames.append(encoded)
 
     def close(self) -> None:
-        from .html import player_page
         with open(self.path, "w", encoding="utf-8") as f:
             f.write(player_page(self.frames, self.fps, **self.page))
 

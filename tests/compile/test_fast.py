@@ -1,4 +1,4 @@
-"""The fast mode (planarsim/compile/fast.py, fast_step.py): its check of numba's internals,
+"""The fast mode (planarsim/compile/fast.py, planarsim/link/fast_step.py): its check of numba's internals,
 kernels' own code library, the step's linkage across processes and the cache invalidation
 after a kernel's source changes."""
 import os
@@ -282,7 +282,7 @@ def test_planarsim_compiles_its_step_and_callers_under_code_layout():
         real = llvm.set_option
         llvm.set_option = lambda name, option: (calls.append(option), real(name, option))[1]
         from planarsim.compile.fast import LLVM_DEFAULTS, PLANARSIM_LLVM
-        from planarsim.compile.link import load_step
+        from planarsim.link.step import load_step
         load_step()
         step_calls = list(calls)
         del calls[:]
@@ -306,7 +306,7 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
     hashes too the modules of its own top-level package outside it that it imports (a shared
     helper: walkers/common for a walker) and planarsim's modules with compiled code, with the
     kernels those import (planarsim/half_step.py inlines kernels/forces.py)."""
-    from planarsim.compile.caches import caller_sources
+    from planarsim.compiled import caller_sources
     top = tmp_path / "top"
     own, shared = top / "own", top / "shared"
     for package in (top, own, shared):
@@ -356,8 +356,8 @@ def test_the_kernels_cache_folder_is_numbas_own_with_numba_cache_dir_set(tmp_pat
     clearing look where numba writes: NUMBA_CACHE_DIR's folder for the step's source, if set."""
     from numba.core import caching, config
 
-    from planarsim.compile import fast_step
     from planarsim.compile.caches import cache_folder
+    from planarsim.link import fast_step
     source = Path(fast_step.__file__)
     if not config.CACHE_DIR:
         assert cache_folder(source.parent) == Path(os.path.abspath(source.parent)) / "__pycache__"
@@ -375,7 +375,8 @@ def test_a_numba_cache_dir_that_cannot_be_written_is_named_and_numbas_fallback_u
     in the unusable folder), and a RuntimeWarning names the folder."""
     from numba.core import caching, config
 
-    from planarsim.compile import caches, fast_step
+    from planarsim.compile import caches
+    from planarsim.link import fast_step
     source = Path(fast_step.__file__)
     if blocked == "the folder":
         blocker = tmp_path / "a_file"
@@ -412,6 +413,7 @@ def test_a_read_only_installs_stale_caches_in_numbas_user_wide_folder_are_cleare
     after a change of the sources only."""
     from numba.core import caching, config
 
+    from planarsim import compiled
     from planarsim.compile import caches
     monkeypatch.setattr(config, "CACHE_DIR", "")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user_cache"))
@@ -425,11 +427,11 @@ def test_a_read_only_installs_stale_caches_in_numbas_user_wide_folder_are_cleare
     exec(compile(source.read_text(), str(source), "exec"), namespace)
     numbas = Path(caching.UserWideCacheLocator(namespace["f"], str(source)).get_cache_path())
     assert caches.cache_folder(pkg) == numbas
-    caches.drop_stale_caches(pkg)
+    compiled.drop_stale_caches(pkg)
     stale = numbas / "a.f-1.py311.nbi"
     stale.write_text("machine code of the sources as they were")
-    caches.drop_stale_caches(pkg)            # the same sources: kept
+    compiled.drop_stale_caches(pkg)            # the same sources: kept
     assert stale.exists()
     source.write_text("def f(x):\n    return x + 1\n")
-    caches.drop_stale_caches(pkg)            # changed: cleared
+    compiled.drop_stale_caches(pkg)            # changed: cleared
     assert not stale.exists()

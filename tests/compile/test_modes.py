@@ -60,7 +60,8 @@ def test_numba_disable_jit_runs_every_kernel_as_python_with_the_compiled_numbers
 def test_under_numba_disable_jit_the_step_is_python_that_pdb_can_enter():
     code = textwrap.dedent("""
         import inspect
-        from planarsim.compile import MODE, link
+        from planarsim.compile import MODE
+        from planarsim.link import step as link
         from planarsim.kernels import solve, step
         print(MODE, inspect.isfunction(step._step), inspect.isfunction(solve.solve_impulses),
               inspect.isfunction(link.step))
@@ -99,11 +100,11 @@ def test_three_decorators_and_their_options():
 
 
 def test_break_in_needs_python_mode_and_names_an_unknown_stage():
-    from planarsim.compile import debug
+    from planarsim.link import debug
     if mode.PYTHON != planarsim.compile.MODE:
         with pytest.raises(RuntimeError, match="NUMBA_DISABLE_JIT=1"):
             debug.break_in("solve.solve_impulses")
-    code = ("from planarsim.compile.debug import break_in\n"
+    code = ("from planarsim.link.debug import break_in\n"
             "d = break_in('solve.solve_impulses'); print(len(d.get_all_breaks()))\n"
             "try:\n    break_in('solve.no_such_stage')\nexcept ValueError as e:\n    print(e)\n")
     env = dict(os.environ, PYTHONPATH=os.getcwd(), NUMBA_DISABLE_JIT="1")

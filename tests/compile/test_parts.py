@@ -15,6 +15,7 @@ if MODE != FAST:
     pytest.skip("parts are plain kernels outside the fast mode", allow_module_level=True)
 
 from planarsim.compile import options, parts  # noqa: E402
+from planarsim.link.fast_step import PART_NAMES  # noqa: E402
 
 
 def _stepped():
@@ -28,7 +29,7 @@ def _stepped():
 
 def test_the_parts_are_loaded_into_the_table_before_the_step_runs():
     _stepped()
-    assert [p.name for p in parts.all_parts()] == list(parts.PART_NAMES)
+    assert [p.name for p in parts.all_parts()] == list(PART_NAMES)
     assert parts.PARTS.cfunc is not None and parts.PARTS.cfunc.address != 0
     assert parts._TABLE[0] == parts.PARTS.cfunc.address
 
@@ -133,7 +134,7 @@ def test_the_child_imports_from_this_process_path_and_leaves_edited_sources_to_i
     this process's (an edit meanwhile): it exits 3 and leaves the caches alone."""
     monkeypatch.setattr(sys, "path", [*sys.path, tmp_path])          # a Path entry
     monkeypatch.setattr(parts, "_cores", lambda: 2)
-    import planarsim.compile.caches as caches
+    import planarsim.link.caches as caches
     monkeypatch.setattr(caches, "ENGINE_HASH", "edited-since")        # what the child is told
     monkeypatch.delenv(parts.CHILD_SWITCH, raising=False)
     child = parts.start_child(parts.PARTS)

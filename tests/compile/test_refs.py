@@ -15,7 +15,7 @@ if not TABLES:
     pytest.skip("NamedTuples reach compiled code as they are in this mode", allow_module_level=True)
 
 from planarsim.compile import refs  # noqa: E402
-from planarsim.compile.link import step_entry  # noqa: E402
+from planarsim.link.step import step_entry  # noqa: E402
 
 
 @refs.register

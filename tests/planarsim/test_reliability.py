@@ -129,7 +129,7 @@ def test_a_second_process_loads_the_step_kernel_from_the_cache():
     sim.run(n_steps=2)
     code = textwrap.dedent("""
         import planarsim as ps
-        from planarsim.compile.link import _ENGINE, run_recorded, run_steps
+        from planarsim.link.step import _ENGINE, run_recorded, run_steps
         from tests.planarsim.test_reliability import two_link_on_hills
         sim = ps.Simulator(two_link_on_hills())
         sim.step()            # the Python step path (run_steps, which calls the step)

@@ -125,8 +125,8 @@ def test_growth_beyond_the_machine_is_refused_before_allocating(monkeypatch):
     ten columns of ten boxes (about 50 GiB) is refused with a WorkspaceTooLarge (a
     MemoryError) naming the memory, the contacts, the slots and the pairs, and what to
     change."""
-    import planarsim.trajectory as trajectory
-    monkeypatch.setattr(trajectory, "machine_memory", lambda: 2 ** 30)
+    import planarsim.memory as memory
+    monkeypatch.setattr(memory, "machine_memory", lambda: 2 ** 30)
     model = columns(10, 10)
     rows = state_module.max_rows(model)
     with pytest.raises(ps.WorkspaceTooLarge) as err:
@@ -143,11 +143,11 @@ def test_growth_beyond_the_machine_is_refused_before_allocating(monkeypatch):
 
 
 def test_a_model_that_fits_is_not_refused(monkeypatch):
-    import planarsim.trajectory as trajectory
+    import planarsim.memory as memory
     model = columns(2, 3)
     held = state_module.contact_capacity(model)
     need = state_module.solve_bytes(model, held, *state_module.first_capacity(model, held))
-    monkeypatch.setattr(trajectory, "machine_memory", lambda: need)
+    monkeypatch.setattr(memory, "machine_memory", lambda: need)
     sim = ps.Simulator(model)
     sim.steps(5)
     assert np.all(np.isfinite(sim.state.q))

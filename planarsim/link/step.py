@@ -2,7 +2,7 @@
 (compile/mode.py).
 
 ``step(m, s, ws, opt, u)`` advances a State by one step. In the fast mode it is one C function
-compiled once and called by address (compile/fast_step.py); on plain numba and under
+compiled once and called by address (link/fast_step.py); on plain numba and under
 NUMBA_DISABLE_JIT=1 it is an ordinary kernel (in Python, a function pdb can step into).
 run_steps, step_entry and run_recorded call it from a loop; step_from_python and the Simulator
 reach those through a handle bound once (bind_steps, bind).
@@ -11,7 +11,10 @@ import threading
 from typing import NamedTuple
 
 import numpy as np
+from numba import types
+from numba.extending import overload
 
+from ..compile import FAST, MODE, PYTHON, TABLES, jit, kernel, register
 from ..kernels.guards import GUARD_BAD_COMMANDS, check_commands
 from ..kernels.info import INFO_COMMAND
 from ..kernels.record import record_frame
@@ -19,18 +22,14 @@ from ..kernels.step import _step
 from ..model import ModelArrays
 from ..options import StepOptions, check_options
 from ..state import State, Workspace, forget_ground_queries
-from .decorators import jit, kernel, register
-from .mode import FAST, MODE, PYTHON, TABLES
+from .engine import check_step_types, engine_types
 
-if MODE == FAST:
-    from numba import types
-
+if TABLES:     # (compile/refs.py uses numba's extension API, which TABLES says is there)
+    from ..compile.refs import TableHandle
+if MODE == FAST:   # (the fast mode's step uses numba internals the other modes may lack)
     from .fast_step import _ENGINE, load_step, step   # noqa: F401  (re-exported)
-    from .refs import TableHandle as Handle
+    Handle = TableHandle
 else:
-    from numba.extending import overload
-
-    from .engine import check_step_types
     _ENGINE = {}
 
     def load_step():
@@ -61,24 +60,11 @@ else:
         @overload(step)
         def _step_typed(m, s, ws, opt, u):
             """Name a wrong argument when a caller is typed (as the fast mode's intrinsic)."""
-            check_step_types((m, s, ws, opt, u), _expected_types())
+            check_step_types((m, s, ws, opt, u), engine_types())
             return lambda m, s, ws, opt, u: _step_checked(m, s, ws, opt, u)
 
-        _EXPECTED = []
-
-        def _expected_types():
-            if not _EXPECTED:
-                import numba
-                from .engine import samples
-                if TABLES:
-                    from .refs import TableRef, layout_of
-                    _EXPECTED.append(tuple(TableRef(layout_of(x)) for x in samples()))
-                else:
-                    _EXPECTED.append(tuple(numba.typeof(x) for x in samples()))
-            return _EXPECTED[0]
-
     if TABLES:
-        from .refs import TableHandle as Handle
+        Handle = TableHandle
     else:
         class Handle:
             """The StepArgs a loop is called with (packed into a table where TABLES)."""

@@ -5,15 +5,16 @@ The step (kernels/step.py) is compiled once, as a C function (a numba cfunc, cac
 and every compiled caller (run_steps, run_recorded, step_entry, each walker's rollout, your
 own) calls it by address through the intrinsic ``step``. A plain numba call would link the
 step's code into each caller, where LLVM optimises and compiles it again: that was most of
-the first-ever start-up (about 15 s per rollout). The step's long parts (most run rarely) are
-a C function of their own that it calls through a table (compile/parts.py): a first-ever start
-compiles them in a child process while this one compiles the rest (_load_or_compile).
+the first-ever start-up (about 15 s per rollout). The step's long parts (most run rarely,
+PART_NAMES) are a C function of their own that it calls through a table (compile/parts.py,
+bound here): a first-ever start compiles them in a child process while this one compiles the
+rest (_load_or_compile).
 
 A caller's machine code names the step by a symbol (``planarsim_step_<hash of the engine
 types>``) that LLVM resolves when the caller is compiled or loaded from the numba cache. The
 symbol is therefore published (load_step) before any such code exists in a process: by the
-dispatcher of every `jit` function before it compiles or loads code (fast.CallerDispatcher),
-and by the intrinsic when a caller is typed. Loading takes about 0.1 s from the cache plus
+dispatcher of every `jit` function before it compiles or loads code (load_step is a
+before_compile hook of compile/fast.py), and by the intrinsic when a caller is typed. Loading takes about 0.1 s from the cache plus
 numba's own set-up on the first compile of a process; the first-ever compile takes most of
 the cold start. Importing this module compiles nothing, so a command that only imports
 walkers (to list them, say) is quick. Decorate your own code that calls ``step`` with
@@ -21,6 +22,7 @@ planarsim.compiled.jit: a plain numba.njit(cache=True) function loaded from the 
 new process would name a symbol nothing has published yet.
 """
 import hashlib
+import os
 import time
 
 import llvmlite.binding as ll
@@ -30,25 +32,43 @@ from numba.core import cgutils
 from numba.core.compiler_lock import global_compiler_lock
 from numba.extending import intrinsic
 
+from ..compile import parts, refs
+from ..compile.fast import before_compile, code_layout
+from ..kernels import complementarity, pair, position   # noqa: F401  (the parts' modules)
 from ..kernels.guards import GUARD_BAD_COMMANDS, check_commands
 from ..kernels.info import INFO_COMMAND
 from ..kernels.step import _step
-from . import parts, refs
-from .engine import check_step_types, samples
-from .fast import code_layout
+from . import caches
+from .engine import check_step_types
+from .engine import engine_types as _engine_types
 
 _ENGINE = {}
 _LOADING = []     # this thread is compiling the step (see load_step)
+
+# the step's parts, by module and name: its index is its number (compile/parts.py)
+PART_NAMES = (
+    "planarsim.kernels.complementarity.solve_contacts",
+    "planarsim.kernels.complementarity.project_positions",
+    "planarsim.kernels.position._settle_measured",
+    "planarsim.kernels.pair.find_pair",
+)
 
 
 def engine_types():
     """(model, state, workspace, options) numba types the step is compiled for."""
     if "types" not in _ENGINE:
-        found = tuple(refs.TableRef(refs.layout_of(x)) for x in samples())
+        found = _engine_types()
         text = "|".join(t.name for t in found)
         symbol = "planarsim_step_" + hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
         _ENGINE.update(symbol=symbol, types=found)     # one update: another thread sees both or none
     return _ENGINE["types"]
+
+
+def _child_env():
+    return {caches.CHILD_HASH: caches.ENGINE_HASH}   # the sources this process compiles from
+
+
+parts.bind(parts.Binding(PART_NAMES, engine_types, __name__, _child_env))
 
 
 def _step_c(m, s, ws, opt, u_data, n_u):
@@ -62,6 +82,7 @@ def _step_c(m, s, ws, opt, u_data, n_u):
     return _step(m, s, ws, opt, u)
 
 
+@before_compile
 def load_step():
     """Compile the step's C function (or load it from the cache) and publish its address
     under the symbol returned (once per process; see the module's docstring). Under numba's
@@ -124,3 +145,16 @@ def step(typingctx, m, s, ws, opt, u):
         n_u = cgutils.unpack_tuple(builder, commands.shape)[0]
         return builder.call(fn, list(args[:4]) + [commands.data, n_u])
     return types.int64(m, s, ws, opt, u), codegen
+
+
+def child_main():
+    """The child process of compile/parts.py: compile the parts' C function into numba's
+    cache, from the sources its parent compiles the step from (an engine edited meanwhile:
+    exit 3, and the parent compiles them; caches.py leaves the caches alone in such a
+    child)."""
+    if os.environ.get(caches.CHILD_HASH, caches.ENGINE_HASH) != caches.ENGINE_HASH:
+        raise SystemExit(3)
+    _LOADING.append(True)    # the parts never call the step: do not compile it here
+    parts.publish_table()
+    with code_layout():
+        parts.PARTS.compile()

@@ -23,7 +23,7 @@ import os
 import posixpath
 from pathlib import Path
 
-from .errors import ModelError
+from ..errors import ModelError
 
 MAX_DEPTH = 32      # includes within includes; deeper is a cycle MuJoCo would refuse too
 

@@ -1,15 +1,27 @@
-"""The step's argument types: those of a sample model's arrays, State, Workspace and StepOptions,
-and the check that names a wrong argument when compiled code that calls the step is typed."""
+"""The step's argument types: the model's arrays, State, Workspace and StepOptions registered
+with the compiler layer (one pointer each in compiled code: compile/refs.py), those of a
+sample model, and the check that names a wrong argument when compiled code that calls the
+step is typed."""
+import numba
 from numba import types
 from numba.core.errors import TypingError
 
+from ..builder import ModelBuilder
+from ..compile import TABLES, register
+from ..model import ModelArrays
 from ..options import StepOptions
+from ..state import State, Workspace, make_state, make_workspace
+
+if TABLES:     # (compile/refs.py uses numba's extension API, which TABLES says is there)
+    from ..compile.refs import TableRef, layout_of
+
+register(ModelArrays, readonly=True)
+for _cls in (State, Workspace, StepOptions):
+    register(_cls)
 
 
 def samples():
     """(model arrays, State, Workspace, StepOptions) of a small model with every kind of array."""
-    from ..builder import ModelBuilder
-    from ..state import make_state, make_workspace
     b = ModelBuilder()
     body = b.add_body("b", 1.0, 1.0)
     b.add_pin("p", None, body, anchor_world=(0.0, 0.0))
@@ -17,6 +29,21 @@ def samples():
     b.add_pin_motor("m", "p")
     model = b.compile()
     return model.arrays, make_state(model), make_workspace(model), StepOptions()
+
+
+_TYPES = []
+
+
+def engine_types():
+    """(model, state, workspace, options) numba types the step is compiled for: those of
+    samples() (a TableRef each where TABLES, else numba's types of the NamedTuples)."""
+    if not _TYPES:
+        if TABLES:
+            found = tuple(TableRef(layout_of(x)) for x in samples())
+        else:
+            found = tuple(numba.typeof(x) for x in samples())
+        _TYPES.append(found)
+    return _TYPES[0]
 
 
 def check_step_types(got, expected):

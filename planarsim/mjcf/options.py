@@ -73,7 +73,8 @@ class Flags:
 
 
 def read_flags(loader, option_node):
-    """Read the <flag> children of <option> into loader.flags (ModelError for any other child,
+    """Read the <flag> children of <option> into loader.flags (loader: the Reader; its flags,
+    option, report, fail()) (ModelError for any other child,
     an unknown flag, a value other than enable/disable, or a flag planarsim cannot honour);
     apply the ones that change what <option> set: gravity (zeroed) and the fluid (dropped
     with both spring and damper disabled)."""
@@ -126,7 +127,7 @@ def read_flags(loader, option_node):
 
 
 def check_frictionloss(loader, node, eff):
-    """A joint's frictionloss: 0, or ignored (reported) where <flag frictionloss> or
+    """(loader: the Reader) A joint's frictionloss: 0, or ignored (reported) where <flag frictionloss> or
     <flag constraint> is disabled; otherwise a ModelError naming the joint."""
     raw = eff.get("frictionloss")
     if raw is None:
@@ -147,7 +148,8 @@ def check_frictionloss(loader, node, eff):
 
 
 def check_filterparent(loader):
-    """<flag filterparent='disable'>: MuJoCo then lets a parent and child body collide;
+    """(loader: the Emitter, after its bodies and joints; its flags, collide, rigid, bodies,
+    report, fail()) <flag filterparent='disable'>: MuJoCo then lets a parent and child body collide;
     planarsim never collides bodies linked by a joint: a ModelError where such a pair's
     geoms may touch (contype/conaffinity), else nothing changes."""
     if loader.flags.filterparent or not loader.flags.contact or loader.collide is not None:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import importlib
 import pdb
 
-from .mode import MODE, PYTHON
+from ..compile.mode import MODE, PYTHON
 
 
 def break_in(where: str, debugger: pdb.Pdb | None = None) -> pdb.Pdb:
