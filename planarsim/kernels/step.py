@@ -323,9 +323,10 @@ def forget_impulses(s):
 
 @kernel
 def second_order_gains(m, s, ws, h):
-    """The joints' second-order target (solve.fill_row_b) made their impulses add energy
-    beyond what it may (work.joints_add_energy): a closed loop near a dead point, whose
-    nearly dependent rows turn an inconsistent drift into huge impulses, a rod turning by
+    """The joints' second-order target (solve.fill_row_b, linearized at q + h v_lin) made
+    their impulses add energy beyond what it may (work.joints_add_energy, against
+    KE(v_lin)): a closed loop near a dead point, whose nearly dependent rows turn an
+    inconsistent drift into huge impulses, a rod turning by
     a radian in the step, or an armature whose velocity solve ends far from q + h v*. The
     step then solves again with the joints aimed at J v = 0 (a projection, which cannot add
     energy) and leaves the drift to the position correction, whose work is bounded
@@ -474,6 +475,9 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
                 break
             if attempt == 0 and relinearize(m, s, ws, h):   #    again, the target at the
                 continue                                    #    answer's end (once), or
+            if attempt == 1:                                #    (the soft rows' prediction
+                soft_prediction(m, s, ws, h)                #    back: the audit measures
+                predict_configuration(m, s, ws, h)          #    the projection against it)
             ws.first_order[0] = 1                           #    with joint rows at J v = 0,
             forget_impulses(s)                              #    from zero impulses
         if ws.room[0] == 1:                                 #    rows beyond the storage:

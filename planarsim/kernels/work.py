@@ -118,8 +118,8 @@ def _rod_rate(s, v, a, b, ax, ay, bx, by):
 def prediction_turn(m, s, ws, h):
     """The largest angle [rad] by which the step's end, integrated with the solve's velocity
     ws.v_new, turns away from the predicted end q + h v_lin at which the joints' second-order
-    target was linearized (ws.q_pred, soft.soft_prediction): h |w - w_lin| of a body, and for a rod, h |dv_perp| / L
-    of the change of its anchors' relative velocity across it. A pin's or rod's error is
+    target was linearized (ws.q_pred, soft.soft_prediction): h |w - w_lin| of a body, and
+    for a rod, h |dv_perp| / L of the change of its anchors' relative velocity across it. A pin's or rod's error is
     nonlinear in these turns only (linear in translations), so the target's error is of
     order (this turn) x (the drift it aims at)."""
     top = 0.0
@@ -143,7 +143,8 @@ def joints_add_energy(m, s, ws, h):
     """The joints' impulses of the velocity solve (a step of h [s]) added more kinetic energy
     than their second-order target can, beyond rounding: returns the excess [J] (<= 0: none)
     and the row doing the most work. The target aims each row at its drift at the predicted
-    end q + h v*; where the step ends near it (prediction_turn within SHAKE_REGIME) the
+    end q + h v_lin (v* but where soft rows or step.relinearize moved it), and the shares
+    below are of KE(v_lin); where the step ends near it (prediction_turn within SHAKE_REGIME) the
     target is right to third order and its work is the drift's own, an oscillation of
     about (h w)^2 of the energy of what turns, which a whip's tip concentrates (measured: 7 %
     of a 32-link chain's KE(v*) at a step, 0.02 % net over 10 s): only a gain beyond
