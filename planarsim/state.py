@@ -639,11 +639,15 @@ def grow_workspace(model: Model, ws: Workspace) -> Workspace:
 
 
 def soft_envelope_size(model: Model) -> int:
-    """Entries of the soft prediction's envelope (kernels/soft.soft_prediction) were every
-    joint to have a soft row: row t holds columns from the first joint sharing a body with t."""
+    """Entries of the soft prediction's envelope (kernels/soft.soft_prediction): its rows are
+    the joints with a soft row (armature, stiffness or damping; soft.has_soft_row), in order,
+    and row t holds columns from the first of them sharing a body with t."""
+    a = model.arrays
+    soft = (np.asarray(a.pin_armature) > 0) | (np.asarray(a.pin_stiffness) > 0) | (
+        np.asarray(a.pin_damping) > 0)
     first_at = {}
     size = 0
-    for t, bodies in enumerate(np.asarray(model.arrays.pin_body).reshape(-1, 2)):
+    for t, bodies in enumerate(np.asarray(a.pin_body).reshape(-1, 2)[soft]):
         first = t
         for b in bodies:
             if b >= 0:
