@@ -48,12 +48,19 @@ CURVES = {
     "planarsim": [("planarsim", {}), ("planarsim-rattle", {"integrator": "rattle"}),
                   ("planarsim-rattle4", {"integrator": "rattle4"}),
                   ("planarsim-rattle6", {"integrator": "rattle6"})],
-    "pymunk": [("pymunk it10", {"iterations": 10}), ("pymunk it40", {"iterations": 40})],
+    "pymunk": [("pymunk it10", {"iterations": 10}), ("pymunk it40", {"iterations": 40}),
+               ("pymunk it40 stiff", {"iterations": 40, "slop": 0.0, "bias": 1e-12})],
     "box2d": [("box2d it8/3", {"velocity_iterations": 8, "position_iterations": 3}),
-              ("box2d it30/10", {"velocity_iterations": 30, "position_iterations": 10})],
+              ("box2d it30/10", {"velocity_iterations": 30, "position_iterations": 10}),
+              ("box2d it30/10 skin", {"velocity_iterations": 30, "position_iterations": 10, "skin": "compensated"})],
     "mujoco": [("mujoco Euler", {"integrator": "Euler"}), ("mujoco implicitfast", {"integrator": "implicitfast"}),
-               ("mujoco RK4", {"integrator": "RK4"})],
+               ("mujoco RK4", {"integrator": "RK4"}),
+               ("mujoco Euler stiff", {"integrator": "Euler", "contact": "stiff"}),
+               ("mujoco RK4 stiff", {"integrator": "RK4", "contact": "stiff"})],
 }
+#: keywords of the curves that set a peer's contact softness (pymunk's slop and bias, Box2D's
+#: skin, MuJoCo's solref/solimp); those curves run on scenes with a ground only
+CONTACT_KEYWORDS = frozenset({"slop", "bias", "skin", "contact"})
 
 
 def ladder(engine, quick=False):
@@ -121,6 +128,8 @@ def measure_scene(name, peers, quick=False, repeats=3, timing_seconds=1.0, accur
     accurate_ok = unsupported_feature(build_model(name, dt)) is None
     for engine in ("planarsim", *peers):
         for label, kw, k in ladder(engine, quick):
+            if CONTACT_KEYWORDS & set(kw) and not spec.ground:
+                continue    # contact softness: nothing to vary without contacts
             m, sub = frames(k)
             if engine == "planarsim":
                 if kw.get("integrator", "euler") != "euler" and not accurate_ok:

@@ -66,13 +66,19 @@ def print_peers(res):
         for r in [res["scenes"][scene]] + peers:
             timing.setdefault(f"{r['engine']} {r['version']}", r["timing"])
     print("timed as: " + "; ".join(f"{k}: {v}" for k, v in timing.items()))
-    print(f"{'scene':15s} {'engine':9s} {'version':8s} {'steps/s median (min-max)':>26s} {'ratio':>6s} "
+    empty = {r["engine"]: r["empty_step_s"] for peers in res["peers"].values() for r in peers
+             if "empty_step_s" in r}
+    if empty:
+        print("an empty world's step by the same call: " + ", ".join(f"{e} {t * 1e6:.2f} us" for e, t in empty.items())
+              + "; 'net' = the ratio with that taken off every peer step (planarsim's own call is one per run)")
+    print(f"{'scene':15s} {'engine':9s} {'version':8s} {'steps/s median (min-max)':>26s} {'ratio':>6s} {'net':>6s} "
           f"{'pin error':>10s} {'E drift':>8s} {'|dE| max':>8s} {'penetration':>11s} {'rest gap':>9s}")
     for scene, peers in res["peers"].items():
         ps_row = res["scenes"][scene]
         for r in [ps_row] + peers:
             ratio = "-" if r is ps_row else f"{ps_row['steps_per_s'] / r['steps_per_s']:.2f}x"
-            line = (f"{scene:15s} {r['engine']:9s} {r['version']:8s} {_spread(r):>26s} {ratio:>6s} "
+            net = f"{ps_row['steps_per_s'] / r['steps_per_s_net']:.2f}x" if "steps_per_s_net" in r else "-"
+            line = (f"{scene:15s} {r['engine']:9s} {r['version']:8s} {_spread(r):>26s} {ratio:>6s} {net:>6s} "
                     f"{_len(r.get('pin_error_m')):>10s} {_pct(r['energy_drift'])} "
                     f"{_pct(r['energy_err_max'])} {_len(r.get('penetration_m')):>11s} "
                     f"{_len(r.get('rest_gap_m')):>9s}")

@@ -94,6 +94,21 @@ def call_floor_s(calls=20000) -> float:
     return statistics.median(times)
 
 
+_EMPTY = {}
+
+
+def net_rate(mod, steps_per_s):
+    """{empty_step_s, steps_per_s_net} of a peer module at `steps_per_s`: the wall time of one
+    step of an empty world by the same call path (measured once per process), and the rate
+    with that time taken off every step: the scene's own cost, what the peer would reach
+    with no call around its step."""
+    if mod.ENGINE not in _EMPTY:
+        _EMPTY[mod.ENGINE] = mod.empty_step_s()
+    empty = _EMPTY[mod.ENGINE]
+    own = 1.0 / steps_per_s - empty
+    return dict(empty_step_s=empty, steps_per_s_net=1.0 / own if own > 0 else float("inf"))
+
+
 def measure_scene(name, peers=None, repeats=5, n_steps=None, accuracy_seconds=None):
     """(planarsim row, [peer rows]) of scene `name`: timing interleaved over planarsim and
     the peers {name: module} (peers/mujoco_peer, pymunk_peer, box2d_peer), and for the peer
@@ -143,6 +158,7 @@ def measure_scene(name, peers=None, repeats=5, n_steps=None, accuracy_seconds=No
         mod = peers[key]
         r = dict(scene=name, engine=mod.ENGINE, version=mod.version(), bodies=spec.n_body, timing=world.timing)
         r.update(_summary(rates[key], spec.dt))
+        r.update(net_rate(mod, r["steps_per_s"]))
         r.update(accuracy(spec, *world.record(k)))
         warnings = getattr(world, "warnings", [])
         if warnings:

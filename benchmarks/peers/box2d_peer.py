@@ -8,7 +8,14 @@ character's own bodies), then the mass data set explicitly (centre at the body o
 are revolute joints at the local anchors; the ground is a static edge at y = 0. Friction 1,
 restitution 0, gravity 9.81, dt 1 ms, doSleep False, 8 velocity and 3 position iterations (the
 Box2D manual's recommendation). Effort (the accuracy ladder of pareto.py): the iteration
-counts and `substeps` world.Step(dt / substeps) calls per frame of the scene's dt. Timing: a Python loop of world.Step from a freshly built world.
+counts and `substeps` world.Step(dt / substeps) calls per frame of the scene's dt. Contact
+softness: `skin="compensated"` makes every box smaller by its skin less a quarter of Box2D's
+linear slop (b2_polygonRadius - b2_linearSlop / 4 = 8.75 mm a side) and lowers the ground edge
+by as much. Box2D leaves a resting contact anywhere from two skins to two skins less one slop
+apart (it corrects overlaps deeper than the slop only), so the outlines then rest within half a
+slop (2.5 mm) of touching, either way: the best Box2D 2.3 allows (its slop is compiled in). Timing: a Python loop of world.Step (pybox2d's SWIG call; no
+lower-level path) from a freshly built world; `empty_step_s` measures that call on an empty
+world.
 """
 from __future__ import annotations
 
@@ -17,6 +24,23 @@ import numpy as np
 ENGINE = "box2d"
 PACKAGE = "Box2D"
 VELOCITY_ITERATIONS, POSITION_ITERATIONS = 8, 3
+SKINS = ("box2d", "compensated")
+
+
+def empty_step_s(calls: int = 20000) -> float:
+    """Wall time of one world.Step of an empty world [s] (median of 5): the part of every
+    timed step that is the call, not the scene."""
+    import statistics
+    import time
+    import Box2D
+    step = Box2D.b2World(gravity=(0.0, -9.81), doSleep=False).Step
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            step(1e-3, VELOCITY_ITERATIONS, POSITION_ITERATIONS)
+        times.append((time.perf_counter() - t0) / calls)
+    return statistics.median(times)
 
 
 def version() -> str:
@@ -28,12 +52,16 @@ class World:
     """A Box2D world of the scene with run(n) (timed), reset() and record(n)."""
 
     def __init__(self, spec, velocity_iterations: int = VELOCITY_ITERATIONS,
-                 position_iterations: int = POSITION_ITERATIONS, substeps: int = 1):
+                 position_iterations: int = POSITION_ITERATIONS, substeps: int = 1, skin: str = "box2d"):
         import Box2D
         if min(int(velocity_iterations), int(position_iterations), int(substeps)) < 1:
             raise ValueError(f"Box2D peer: velocity_iterations {velocity_iterations}, position_iterations "
                              f"{position_iterations} and substeps {substeps} must be >= 1")
+        if skin not in SKINS:
+            raise ValueError(f"Box2D peer: skin {skin!r}; choose from {SKINS}")
         self.b2, self.spec = Box2D, spec
+        #: how much smaller every box is a side, and how much lower the ground [m]
+        self.inset = Box2D.b2_polygonRadius - Box2D.b2_linearSlop / 4 if skin == "compensated" else 0.0
         self.iterations = int(velocity_iterations), int(position_iterations)
         self.substeps = int(substeps)
         self.timing = (f"Python loop of world.Step ({self.iterations[0]} velocity, {self.iterations[1]} "
@@ -45,14 +73,16 @@ class World:
         world = b2.b2World(gravity=(0.0, -9.81), doSleep=False)
         ground = world.CreateStaticBody(position=(0.0, 0.0))
         if spec.ground:
-            ground.CreateEdgeFixture(vertices=[(-100.0, 0.0), (100.0, 0.0)], friction=1.0, restitution=0.0)
+            y = -self.inset
+            ground.CreateEdgeFixture(vertices=[(-100.0, y), (100.0, y)], friction=1.0, restitution=0.0)
         bodies = []
         for b in range(spec.n_body):
             body = world.CreateDynamicBody(position=(float(spec.q0[b, 0]), float(spec.q0[b, 1])),
                                            angle=float(spec.q0[b, 2]))
             w, h = spec.box[b]
             if not np.isnan(w):
-                body.CreatePolygonFixture(box=(float(w) / 2, float(h) / 2), density=1.0, friction=1.0,
+                body.CreatePolygonFixture(box=(float(w) / 2 - self.inset, float(h) / 2 - self.inset),
+                                          density=1.0, friction=1.0,
                                           restitution=0.0,
                                           groupIndex=0 if spec.bodies_collide else -1)
             md = b2.b2MassData()

@@ -42,11 +42,26 @@ def _parents(spec):
 INTEGRATORS = ("Euler", "implicitfast", "implicit", "RK4")
 
 
-def mjcf(spec, integrator: str = "Euler", timestep: float | None = None) -> str:
-    """The MJCF text of the scene (timestep: default the scene's dt) [s]."""
+#: contact softness: MuJoCo's default, or as stiff as its safety clamp allows at the step (solref
+#: time constant 2 h, critically damped, the clamp's bound; solimp impedance 0.99-0.9999 over
+#: 1 mm, where the default is 0.9-0.95)
+CONTACTS = ("default", "stiff")
+
+
+def _contact_xml(contact, timestep):
+    if contact not in CONTACTS:
+        raise ValueError(f"MuJoCo peer: contact {contact!r}; choose from {CONTACTS}")
+    if contact == "default":
+        return ""
+    return f' solref="{2 * timestep:.17g} 1" solimp="0.99 0.9999 0.001 0.5 2"'
+
+
+def mjcf(spec, integrator: str = "Euler", timestep: float | None = None, contact: str = "default") -> str:
+    """The MJCF text of the scene (timestep: default the scene's dt [s]; contact: CONTACTS)."""
     if integrator not in INTEGRATORS:
         raise ValueError(f"MuJoCo peer: integrator {integrator!r}; choose from {INTEGRATORS}")
     timestep = spec.dt if timestep is None else float(timestep)
+    soft = _contact_xml(contact, timestep)
     parent = _parents(spec)
     children = {}
     for b, (j, a) in parent.items():
@@ -81,7 +96,7 @@ def mjcf(spec, integrator: str = "Euler", timestep: float | None = None) -> str:
             ct = 3 if spec.bodies_collide else 2
             ca = 3 if spec.bodies_collide else 1
             lines.append(f'{pad}  <geom type="box" size="{w / 2:.17g} 0.05 {h / 2:.17g}" contype="{ct}" '
-                         f'conaffinity="{ca}" friction="1 0.005 0.0001" mass="0"/>')
+                         f'conaffinity="{ca}" friction="1 0.005 0.0001" mass="0"{soft}/>')
         for child in children.get(b, []):
             lines += body_xml(child, indent + 2)
         lines.append(f"{pad}</body>")
@@ -89,7 +104,8 @@ def mjcf(spec, integrator: str = "Euler", timestep: float | None = None) -> str:
 
     world = []
     if spec.ground:
-        world.append('    <geom type="plane" size="100 1 0.1" contype="1" conaffinity="2" friction="1 0.005 0.0001"/>')
+        world.append('    <geom type="plane" size="100 1 0.1" contype="1" conaffinity="2" '
+                     f'friction="1 0.005 0.0001"{soft}/>')
     for b in roots + children.get(-1, []):
         world += body_xml(b, 4)
     return "\n".join([
@@ -97,6 +113,30 @@ def mjcf(spec, integrator: str = "Euler", timestep: float | None = None) -> str:
         '  <compiler angle="radian" inertiafromgeom="false"/>',
         f'  <option timestep="{timestep:.17g}" gravity="0 0 {-9.81:.17g}" integrator="{integrator}"/>',
         "  <worldbody>", *world, "  </worldbody>", "</mujoco>"])
+
+
+def empty_step_s(steps: int = 20000) -> float:
+    """Wall time of one step of an empty model by the timed call path (a rollout of `steps`
+    steps in one call) [s] (median of 5): MuJoCo's fixed cost of a step, not the scene's."""
+    import statistics
+    import time
+    from types import SimpleNamespace
+    import mujoco
+    try:
+        from mujoco import rollout
+    except ImportError:
+        rollout = None
+    model = mujoco.MjModel.from_xml_string('<mujoco><worldbody/></mujoco>')
+    data = mujoco.MjData(model)
+    kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    x0 = np.zeros(mujoco.mj_stateSize(model, kind))
+    peer = SimpleNamespace(mj=mujoco, model=model, data=data, x0=x0, _rollout=rollout, _out={})
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        _roll(peer, steps)
+        times.append((time.perf_counter() - t0) / steps)
+    return statistics.median(times)
 
 
 def _roll(peer, n: int) -> bool:
@@ -118,7 +158,7 @@ def _roll(peer, n: int) -> bool:
 class World:
     """A MuJoCo model of the scene with run(n) (timed), reset() and record(n)."""
 
-    def __init__(self, spec, integrator: str = "Euler", substeps: int = 1):
+    def __init__(self, spec, integrator: str = "Euler", substeps: int = 1, contact: str = "default"):
         import mujoco
         if int(substeps) < 1:
             raise ValueError(f"MuJoCo peer: substeps {substeps} must be >= 1")
@@ -130,7 +170,7 @@ class World:
         self.mj, self._rollout, self.spec = mujoco, rollout, spec
         self.timing = ("mujoco.rollout, one thread" if rollout is not None
                        else "Python loop of mj_step (this MuJoCo has no rollout module)")
-        self.model = mujoco.MjModel.from_xml_string(mjcf(spec, integrator, spec.dt / self.substeps))
+        self.model = mujoco.MjModel.from_xml_string(mjcf(spec, integrator, spec.dt / self.substeps, contact))
         self.data = mujoco.MjData(self.model)
         self.kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
         self.x0 = np.zeros(mujoco.mj_stateSize(self.model, self.kind))

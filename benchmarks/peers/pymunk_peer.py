@@ -7,8 +7,13 @@ static Segment at y = 0. Friction 1, elasticity 0, gravity 9.81, dt 1 ms, sleepi
 (pymunk's default sleep_time_threshold = inf), default 10 solver iterations. pymunk's default
 collision_slop (0.1) is meant for pixel units; for metres it is set to 0.5 mm here.
 Effort (the accuracy ladder of pareto.py): `iterations` solver iterations and `substeps`
-space.step(dt / substeps) calls per frame of the scene's dt.
-Timing: a Python loop of space.step from a freshly built space (build not timed).
+space.step(dt / substeps) calls per frame of the scene's dt; contact softness: `slop` (the
+overlap pymunk leaves uncorrected) [m] and `bias` (the fraction of an overlap left after one
+second of correction; pymunk's default 0.9^60 = 0.0018).
+Timing: a Python loop of chipmunk's cpSpaceStep called through cffi (pymunk's own Space.step
+adds 1-1.5 us of Python per call around the same C call: its post-step callbacks, none here),
+from a freshly built space (build not timed); `empty_step_s` measures that loop's cost per step
+on an empty space.
 """
 from __future__ import annotations
 
@@ -17,6 +22,32 @@ import numpy as np
 ENGINE = "pymunk"
 PACKAGE = "pymunk"
 COLLISION_SLOP = 5e-4  # [m]
+COLLISION_BIAS = (1.0 - 0.1) ** 60   # pymunk's default
+
+
+def _stepper(space):
+    """f(h): one chipmunk step of `space` by h [s] through cffi, without pymunk's Python
+    wrapper (pymunk's Space.step makes the same C call and then runs its post-step callbacks,
+    which these scenes do not use)."""
+    from pymunk._chipmunk_cffi import lib
+    step, ptr = lib.cpSpaceStep, space._space
+    return lambda h: step(ptr, h)
+
+
+def empty_step_s(calls: int = 20000) -> float:
+    """Wall time of one step of an empty space by the timed call path [s] (median of 5): the
+    part of every timed step that is the call, not the scene."""
+    import pymunk
+    import statistics
+    import time
+    step = _stepper(pymunk.Space())
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            step(1e-3)
+        times.append((time.perf_counter() - t0) / calls)
+    return statistics.median(times)
 
 
 def version() -> str:
@@ -27,20 +58,24 @@ def version() -> str:
 class World:
     """A pymunk space of the scene with run(n) (timed), reset() and record(n)."""
 
-    def __init__(self, spec, iterations: int = 10, substeps: int = 1):
+    def __init__(self, spec, iterations: int = 10, substeps: int = 1, slop: float = COLLISION_SLOP,
+                 bias: float = COLLISION_BIAS):
         import pymunk
         if int(iterations) < 1 or int(substeps) < 1:
             raise ValueError(f"pymunk peer: iterations {iterations} and substeps {substeps} must be >= 1")
+        if not (slop >= 0.0 and 0.0 <= bias < 1.0):
+            raise ValueError(f"pymunk peer: slop {slop} m must be >= 0 and bias {bias} in [0, 1)")
         self.pm, self.spec = pymunk, spec
         self.iterations, self.substeps = int(iterations), int(substeps)
-        self.timing = "Python loop of space.step"
+        self.slop, self.bias = float(slop), float(bias)
+        self.timing = "Python loop of cpSpaceStep (cffi)"
         self.reset()
 
     def reset(self):
         pm, spec = self.pm, self.spec
         space = pm.Space()
         space.gravity = (0.0, -9.81)
-        space.collision_slop = COLLISION_SLOP
+        space.collision_slop, space.collision_bias = self.slop, self.bias
         space.iterations = self.iterations
         bodies = []
         # one group: the character's own bodies do not collide; a stack's boxes do
@@ -70,10 +105,11 @@ class World:
             ground.friction, ground.elasticity = 1.0, 0.0
             space.add(ground)
         self.space, self.bodies = space, bodies
+        self.step = _stepper(space)
 
     def run(self, n: int):
         """n frames of the scene's dt (n * substeps steps)."""
-        step, h = self.space.step, self.spec.dt / self.substeps
+        step, h = self.step, self.spec.dt / self.substeps
         for _ in range(n * self.substeps):
             step(h)
 
@@ -89,7 +125,7 @@ class World:
         q = np.zeros((n + 1, self.spec.n_body, 3))
         v = np.zeros_like(q)
         self.pose(q, v, 0)
-        step, h, sub = self.space.step, self.spec.dt / self.substeps, self.substeps
+        step, h, sub = self.step, self.spec.dt / self.substeps, self.substeps
         for k in range(1, n + 1):
             for _ in range(sub):
                 step(h)
@@ -111,7 +147,7 @@ class ShapeWorld:
     def __init__(self, scene, iterations: int = 10):
         import pymunk
         self.pm, self.scene, self.iterations = pymunk, scene, int(iterations)
-        self.timing = f"Python loop of space.step ({self.iterations} iterations)"
+        self.timing = f"Python loop of cpSpaceStep (cffi; {self.iterations} iterations)"
         self.reset()
 
     def _shape(self, body, shape):
@@ -153,9 +189,10 @@ class ShapeWorld:
             space.add(pm.PivotJoint(space.static_body if a < 0 else bodies[a],
                                     space.static_body if b < 0 else bodies[b], tuple(anchor)))
         self.space, self.bodies = space, bodies
+        self.step = _stepper(space)
 
     def run(self, n: int):
-        step, h = self.space.step, self.scene.dt
+        step, h = self.step, self.scene.dt
         for _ in range(n):
             step(h)
 
