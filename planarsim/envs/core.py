@@ -26,6 +26,7 @@ from gymnasium import spaces
 from ..compiled import jit
 from ..kernels.joints import joint_position_rate
 from ..kernels.math2d import update_trig
+from ..link.step import bind
 from ..mjcf import load_mjcf
 from ..model import JOINT_SLIDE_BIT
 from ..sim import Simulator
@@ -161,6 +162,14 @@ class GeneralizedCoords:
         qvel = np.empty(self.nq) if qvel is None else qvel
         joint_values(self._arrays, q, v, self._cs, self.pins, self.sign, self.ref, qpos, qvel)
         return qpos, qvel
+
+    def values_into(self, q, v, qpos, qvel):
+        """A callable of no arguments that writes values(q, v) into qpos, qvel: the compiled
+        map bound once to these arrays (no type dispatch per call where the compile mode
+        allows it; for arrays that stay the same objects, as a simulator's state does)."""
+        args = (self._arrays, q, v, self._cs, self.pins, self.sign, self.ref, qpos, qvel)
+        entry = bind(joint_values, args)
+        return lambda: entry(*args)
 
     def _free_parts(self, body):
         """(slide indices, hinge index or None, (2, 2) slide axes as columns, anchor at the
@@ -311,9 +320,20 @@ class PlanarMujocoEnv(gymnasium.Env):
         return self.timestep * self.frame_skip
 
     # MuJoCo's MujocoEnv interface -------------------------------------------------------
+    #: (state, callable): data.qpos, data.qvel written from that state (values_into)
+    _sync_bound = (None, None)
+
     def _sync(self):
+        """data.qpos and data.qvel from the simulator's state, written in place (as MuJoCo's
+        MjData fields are) by one compiled call bound to the state's arrays."""
         st = self.sim.state
-        self.data.qpos, self.data.qvel = self.coords.values(st.q, st.v)
+        bound, call = self._sync_bound
+        if bound is not st:
+            d = self.data
+            d.qpos, d.qvel = np.array(d.qpos, float), np.array(d.qvel, float)   # arrays of our own
+            call = self.coords.values_into(st.q, st.v, d.qpos, d.qvel)
+            self._sync_bound = (st, call)
+        call()
 
     def set_state(self, qpos, qvel):
         qpos, qvel = np.asarray(qpos, float), np.asarray(qvel, float)
