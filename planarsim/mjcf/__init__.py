@@ -74,7 +74,7 @@ from pathlib import Path
 
 from ..builder import ModelBuilder
 from ..errors import ModelError
-from .description import Body3D, Description, Motor
+from .description import Body3D, Description, Motor, Tendon
 from .emitter import Emitter
 from .include import decode, resolve_includes
 from .reader import Reader
@@ -84,7 +84,8 @@ from .schema import (ATTRIBUTES, AXIS_TOL, COLLIDES, DEFAULT_DENSITY, DEFAULT_FR
 from .xml_tree import Node, parse_xml
 
 __all__ = ["load_mjcf", "MJCFModel", "JointMap", "ActuatorMap", "LoadReport", "RigidBody", "Body3D",
-           "Description", "Motor", "Node", "parse_xml", "Reader", "Emitter", "ATTRIBUTES", "AXIS_TOL",
+           "Description", "Motor", "Tendon", "Node", "parse_xml", "Reader", "Emitter", "ATTRIBUTES",
+           "AXIS_TOL",
            "COLLIDES", "DEFAULT_DENSITY", "DEFAULT_FRICTION", "DEFAULT_GRAVITY", "DEFAULT_TIMESTEP",
            "DRAWN", "DROPPABLE", "SUPPORTED_GEOMS"]
 
