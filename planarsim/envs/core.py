@@ -68,14 +68,16 @@ def joint_values(m, q, v, cs, pins, sign, ref, qpos, qvel):
 
 
 @jit
-def set_commands(ctrl, lo, hi, gear, act_id, u):
-    """u[act_id[k]] = gear[k] * ctrl[k] clamped to [lo[k], hi[k]]; False (u untouched) if an
-    entry of ctrl is not finite."""
+def set_commands(ctrl, lo, hi, entry, act_id, gain, u):
+    """Each drive e (a planarsim actuator of action entry[e]): u[act_id[e]] = gain[e] * c,
+    c = ctrl[entry[e]] clamped to [lo, hi] of that entry; False (u untouched) if an entry of
+    ctrl is not finite."""
     for k in range(ctrl.shape[0]):
         if not math.isfinite(ctrl[k]):
             return False
-    for k in range(ctrl.shape[0]):
-        u[act_id[k]] = gear[k] * min(max(ctrl[k], lo[k]), hi[k])
+    for e in range(act_id.shape[0]):
+        k = entry[e]
+        u[act_id[e]] = gain[e] * min(max(ctrl[k], lo[k]), hi[k])
     return True
 
 
@@ -301,8 +303,10 @@ class PlanarMujocoEnv(gymnasium.Env):
         self.init_qpos, self.init_qvel = self.coords.from_maximal(self.sim_model.q0, self.sim_model.v0)
         self.data = SimpleNamespace(qpos=self.init_qpos.copy(), qvel=self.init_qvel.copy())
         self._u = np.zeros(self.sim_model.n_act)
-        self._act_id = np.array([a.id for a in self._act], np.int64)
-        self._act_gear = np.array([a.gear for a in self._act], float)
+        # the drives: each planarsim actuator, its action entry and its gain gear * coef
+        self._drive_entry = np.array([k for k, a in enumerate(self._act) for _ in a.ids], np.int64)
+        self._drive_id = np.array([i for a in self._act for i in a.ids], np.int64)
+        self._drive_gain = np.array([g for a in self._act for g in a.gains], float)
         self._act_lo = np.array([a.ctrlrange[0] for a in self._act], float)
         self._act_hi = np.array([a.ctrlrange[1] for a in self._act], float)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -357,17 +361,18 @@ class PlanarMujocoEnv(gymnasium.Env):
         if a.shape != self.action_space.shape:
             raise ValueError(f"action has shape {a.shape}; {type(self).__name__} takes shape "
                              f"{self.action_space.shape} (one control per actuator: "
-                             f"{[x.joint for x in self._act]})")
+                             f"{[x.target for x in self._act]})")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"action {a.tolist()} has NaN or infinite entries")
         return a
 
     def do_simulation(self, ctrl, n_frames):
         a = np.asarray(ctrl, dtype=np.float64)
-        # MuJoCo clamps ctrl to ctrlrange; the actuator's input is gear * ctrl (one compiled
-        # call, which also says whether every entry was finite)
+        # MuJoCo clamps ctrl to ctrlrange; each actuator's input is gear * coef * ctrl (one
+        # compiled call, which also says whether every entry was finite)
         if a.shape != self.action_space.shape or not set_commands(
-                a, self._act_lo, self._act_hi, self._act_gear, self._act_id, self._u):
+                a, self._act_lo, self._act_hi, self._drive_entry, self._drive_id,
+                self._drive_gain, self._u):
             self.check_action(a)        # (raises, naming what is wrong)
         self.sim.steps(int(n_frames), self._u)
         self._sync()

@@ -229,6 +229,11 @@ def _obs_position_velocity(env):
     return collections.OrderedDict(position=env.qpos[1:].copy(), velocity=env.qvel.copy())
 
 
+def _obs_state(env):
+    """physics.position() and physics.velocity(): the whole qpos and qvel."""
+    return collections.OrderedDict(position=env.qpos.copy(), velocity=env.qvel.copy())
+
+
 def _obs_walker(env):
     return collections.OrderedDict(
         orientations=np.array([[env.xmat(b)[0, 0], env.xmat(b)[0, 2]] for b in env.frames.body]).ravel(),
@@ -346,6 +351,16 @@ def _reward_reacher(env, p):
     return tolerance(np.linalg.norm(_finger_to_target(env)), (0, radii))
 
 
+def _reward_point_mass(env, p):
+    target_size = env.geom_size("target")[0]
+    dist = np.linalg.norm(env.geom_xpos("target") - env.geom_xpos("pointmass"))
+    near_target = tolerance(dist, bounds=(0, target_size), margin=target_size)
+    control_reward = tolerance(env.control(), margin=1, value_at_margin=0,
+                               sigmoid="quadratic").mean()
+    small_control = (control_reward + 4) / 5
+    return near_target * small_control
+
+
 def _reward_swimmer(env, p):
     target_size = env.geom_size("target")[0]
     return tolerance(np.linalg.norm(_nose_to_target(env)), bounds=(0, target_size),
@@ -411,6 +426,9 @@ DOMAINS = {
                       step_options=dict(turn_limit=0.0)),
     "swimmer": Domain("swimmer.xml", 0.002, 30, .03, _init_swimmer, _obs_swimmer,
                       _reward_swimmer),
+    # a mass on two limited, damped slides, each pulled by a motor on a fixed tendon
+    "point_mass": Domain("point_mass.xml", 0.02, 20, None, _init_randomized, _obs_state,
+                         _reward_point_mass),
 }
 
 # task -> (domain, parameters): dm_control's task functions' arguments
@@ -428,6 +446,7 @@ TASKS = {
     "reacher-easy": ("reacher", dict(target_size=.05)),
     "reacher-hard": ("reacher", dict(target_size=.015)),
     "swimmer-swimmer6": ("swimmer", dict(n_bodies=6)),
+    "point_mass-easy": ("point_mass", {}),
 }
 
 # the suite's other planar tasks, and why planarsim cannot run them
@@ -438,8 +457,6 @@ UNSUPPORTED = {
                         "planarsim's engine does not model",
     "finger-turn_hard": "finger's spinner hinge has joint friction (frictionloss), which "
                         "planarsim's engine does not model",
-    "point_mass-easy": "point_mass is driven through fixed tendons, which planarsim's engine does "
-                       "not model",
 }
 
 

@@ -32,6 +32,11 @@ What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
   (a body torque or force on a free root's joints) whose torque input [N m] is
   ``gear * ctrl`` in the pin's sign (``MJCFModel.actuator[name].gear``), saturated to
   gear * ctrlrange.
+* ``<tendon><fixed><joint joint coef>`` and ``<motor tendon>``: a fixed tendon's length is
+  sum coef_i q_i; a motor on it drives each joint whose coef is not 0 with gear * coef *
+  ctrl (one planarsim motor each: ``MJCFModel.actuator[name].ids / joints / gains``). The
+  tendon's limits, spring, damper, friction and armature, and spatial tendons, are
+  ModelErrors.
 * ``<include file>`` (include.py: on disk or from ``assets``), ``<option><flag>``
   (options.py: gravity, contact, limit, constraint, spring, damper, frictionloss
   honoured; flags without physics reported; the rest a ModelError), planes whose normal lies
@@ -40,7 +45,7 @@ What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
 
 Purely visual or solver-tuning elements and attributes (rgba, material, asset, visual, light,
 camera, site, solref, margin, integrator, ...) are ignored and listed in ``MJCFModel.report``;
-anything else that changes physics and is not supported (tendons, equality constraints, a
+anything else that changes physics and is not supported (spatial tendons, equality constraints, a
 joint leaving the plane) is a ModelError naming the element and its line.
 
 Plane mapping. The plane of motion is the one normal to the hinges: MJCF y (x-z plane, the
@@ -69,7 +74,7 @@ from pathlib import Path
 
 from ..builder import ModelBuilder
 from ..errors import ModelError
-from .description import Body3D, Description, Motor
+from .description import Body3D, Description, Motor, Tendon
 from .emitter import Emitter
 from .include import decode, resolve_includes
 from .reader import Reader
@@ -79,7 +84,8 @@ from .schema import (ATTRIBUTES, AXIS_TOL, COLLIDES, DEFAULT_DENSITY, DEFAULT_FR
 from .xml_tree import Node, parse_xml
 
 __all__ = ["load_mjcf", "MJCFModel", "JointMap", "ActuatorMap", "LoadReport", "RigidBody", "Body3D",
-           "Description", "Motor", "Node", "parse_xml", "Reader", "Emitter", "ATTRIBUTES", "AXIS_TOL",
+           "Description", "Motor", "Tendon", "Node", "parse_xml", "Reader", "Emitter", "ATTRIBUTES",
+           "AXIS_TOL",
            "COLLIDES", "DEFAULT_DENSITY", "DEFAULT_FRICTION", "DEFAULT_GRAVITY", "DEFAULT_TIMESTEP",
            "DRAWN", "DROPPABLE", "SUPPORTED_GEOMS"]
 

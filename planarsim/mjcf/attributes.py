@@ -46,8 +46,10 @@ class ElementReader:
         self.vet(node, eff)
         return eff
 
-    def vet(self, node, eff):
-        rules = ATTRIBUTES[node.tag]
+    def vet(self, node, eff, kind=None):
+        """Each attribute in eff read, ignored (reported) or at its default, by the rules of
+        ATTRIBUTES[kind] (default: the node's tag); else a ModelError naming it."""
+        rules = ATTRIBUTES[kind or node.tag]
         use, ignore, default = rules.get("use", set()), rules.get("ignore", set()), rules.get("default", {})
         for key in sorted(eff):
             if key in use:

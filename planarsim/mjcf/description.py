@@ -41,14 +41,27 @@ class Body3D:
 
 
 @dataclass
-class Motor:
-    """A <motor>: its name (its joint's where it has none), joint, gear (the first component)
-    and the range (lo, hi) its control is saturated to (ctrlrange and forcerange)."""
+class Tendon:
+    """A fixed tendon: its length L = sum coef * q over its joints [m or rad], `path` the
+    (joint name, coef) pairs in file order."""
     node: Node
     name: str
-    joint: str
+    path: tuple
+
+
+@dataclass
+class Motor:
+    """A <motor>: its name (its joint's or tendon's where it has none), gear (the first
+    component), the range (lo, hi) its control is saturated to (ctrlrange and forcerange),
+    and its transmission: `moment`, the (joint name, coef) pairs its force gear * ctrl acts
+    on as generalized force coef * gear * ctrl (((joint, 1.0),) for a motor on a joint; a
+    fixed tendon's path for one on a tendon, named by `tendon`)."""
+    node: Node
+    name: str
+    moment: tuple
     gear: float
     ctrl: tuple
+    tendon: str | None = None
 
 
 @dataclass
@@ -59,6 +72,7 @@ class Description:
         density; gravity zeroed and fluid dropped as <option><flag> says); inertiafromgeom:
         "true", "false" or "auto"; settotalmass [kg] or None
     flags: what <option><flag> switched off (options.Flags)
+    tendons: name -> Tendon (the fixed tendons, read for the motors on them)
     world: the world body (its geoms, and its child bodies); bodies: every other body, in
         file order (a parent before its children)
     """
@@ -73,3 +87,4 @@ class Description:
     settotalmass: float | None
     report: LoadReport
     flags: Flags = field(default_factory=Flags)
+    tendons: dict = field(default_factory=dict)

@@ -280,13 +280,22 @@ class Emitter:
 
     # actuators --------------------------------------------------------------------------------
     def motor(self, motor, out: MJCFModel):
-        """A <motor> -> a pin (or slider) motor whose input is gear * ctrl in the joint's
-        sign, saturated to gear * its range."""
-        jm = out.joint[motor.joint]
-        signed = motor.gear * jm.sign
+        """A <motor> -> a pin (or slider) motor on each joint of its transmission whose
+        coefficient is not 0, its input gear * coef * ctrl in the joint's sign, saturated to
+        that gain times its range (named the motor's name, or "motor:joint" where it drives
+        several)."""
         lo, hi = motor.ctrl
-        limit = tuple(sorted((signed * lo, signed * hi))) if math.isfinite(lo) else (-math.inf, math.inf)
         b = out.builder
-        add_motor = b.add_pin_motor if jm.angular else b.add_slider_motor
-        aid = add_motor(motor.name, jm.coordinate, limit=limit)
-        out.actuator[motor.name] = ActuatorMap(aid, motor.joint, signed, motor.ctrl)
+        drives = [(j, c) for j, c in motor.moment if c != 0.0]
+        ids, gains = [], []
+        for joint, coef in drives:
+            jm = out.joint[joint]
+            gain = motor.gear * coef * jm.sign
+            limit = (tuple(sorted((gain * lo, gain * hi))) if math.isfinite(lo)
+                     else (-math.inf, math.inf))
+            add_motor = b.add_pin_motor if jm.angular else b.add_slider_motor
+            name = motor.name if len(drives) == 1 else f"{motor.name}:{joint}"
+            ids.append(add_motor(name, jm.coordinate, limit=limit))
+            gains.append(gain)
+        out.actuator[motor.name] = ActuatorMap(tuple(ids), tuple(j for j, _ in drives),
+                                               tuple(gains), motor.ctrl, motor.tendon)

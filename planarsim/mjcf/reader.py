@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ..errors import ModelError
-from .description import Body3D, Description, Motor
+from .description import Body3D, Description, Motor, Tendon
 from .geoms import BodyPartsReader
 from .include import origin
 from .options import Flags, check_frictionloss, read_flags
@@ -42,7 +42,7 @@ class Reader(BodyPartsReader):
         if root.tag != "mujoco":
             self.fail(root, "the root element must be <mujoco>")
         self.vet(root, root.attrib)
-        worldbody, actuators = None, []
+        worldbody, actuators, tendons = None, [], []
         for node in root.children:      # compiler first: it sets the angle unit for the rest
             if node.tag == "compiler":
                 self.compiler(node)
@@ -59,6 +59,8 @@ class Reader(BodyPartsReader):
                 worldbody = node
             elif node.tag == "actuator":
                 actuators.append(node)
+            elif node.tag == "tendon":
+                tendons.append(node)
             else:
                 self.elsewhere(node, "mujoco")
         if worldbody is None:
@@ -67,10 +69,13 @@ class Reader(BodyPartsReader):
         self.bodies = []
         self.walk_children(worldbody, world, "main")
         joints = {j["name"] for b in self.bodies for j in b.joints}
+        self.tendons = {}
+        for node in tendons:
+            self.tendon_section(node, joints)
         motors = [m for node in actuators for m in self.motors(node, joints)]
         return Description(self.src, root, root.attrib.get("model", "mjcf"), world, self.bodies,
                            motors, self.option, self.inertiafromgeom, self.settotalmass,
-                           self.report, self.flags)
+                           self.report, self.flags, self.tendons)
 
     def elsewhere(self, node, parent):
         """An element the loader does not read: ignored and reported when it only draws,
@@ -149,7 +154,7 @@ class Reader(BodyPartsReader):
         for c in node.children:
             if c.tag == "default":
                 self.defaults(c, name)
-            elif c.tag in ("joint", "geom", "inertial"):
+            elif c.tag in ("joint", "geom", "inertial", "tendon"):
                 table.setdefault(c.tag, {}).update(c.attrib)
             elif c.tag in ("motor", "general"):
                 table.setdefault("motor", {}).update(c.attrib)
@@ -224,9 +229,51 @@ class Reader(BodyPartsReader):
         return dict(ref=ref, range=rng, stiffness=k, damping=c, springref=springref,
                     armature=0.0 if dropped else armature, armature_dropped=dropped)
 
+    # tendons ----------------------------------------------------------------------------------
+    def tendon_section(self, node, joints):
+        """A <tendon> section's fixed tendons into self.tendons (each joint one of `joints`);
+        a spatial tendon, or a fixed one whose limits, spring, damper, friction or armature
+        would act, is a ModelError."""
+        self.vet(node, node.attrib)
+        if not node.children:
+            self.report.ignore("<tendon> (empty)", node.line)
+        for t in node.children:
+            if t.tag == "spatial":
+                self.fail(t, "spatial tendons (routed through sites and wrapping geoms) are not "
+                             "supported; a fixed tendon (a sum of joint values) is")
+            if t.tag != "fixed":
+                self.elsewhere(t, "tendon")
+                continue
+            eff = self.effective(t, tag="tendon")      # (checked against ATTRIBUTES["fixed"])
+            v = self.flag(t, eff, "limited") if self.flags.limit else "false"
+            if v == "true" or (v == "auto" and "range" in eff):
+                self.fail(t, f"limited={eff.get('limited', 'auto')!r} with range="
+                             f"{eff.get('range', '0 0')!r}: tendon limits are not supported")
+            if "range" in eff:
+                self.report.ignore("fixed range (not limited)", t.line)
+            name = eff.get("name") or f"tendon@{t.line}"
+            if name in self.tendons:
+                self.fail(t, f"duplicate tendon name {name!r}")
+            path = []
+            for j in t.children:
+                if j.tag != "joint":
+                    self.elsewhere(j, "fixed")
+                    continue
+                self.vet(j, j.attrib, "tendon joint")
+                jname = j.attrib.get("joint")
+                if jname not in joints:
+                    self.fail(j, f"joint={jname!r} names no joint of the model")
+                if any(jname == p[0] for p in path):
+                    self.fail(j, f"joint={jname!r} is already in tendon {name!r}")
+                path.append((jname, float(self.floats(j, j.attrib, "coef", 1)[0])))
+            if not path:
+                self.fail(t, f"tendon {name!r} has no <joint>: its path cannot be empty")
+            self.tendons[name] = Tendon(t, name, tuple(path))
+
     # actuators --------------------------------------------------------------------------------
     def motors(self, node, joints):
-        """The <motor>s of an <actuator> (on one of `joints` each); others are ModelErrors."""
+        """The <motor>s of an <actuator> (each on one of `joints` or on a fixed tendon);
+        others are ModelErrors."""
         out = []
         for a in node.children:
             if a.tag != "motor":
@@ -235,11 +282,17 @@ class Reader(BodyPartsReader):
                 self.elsewhere(a, "actuator")
                 continue
             eff = self.effective(a, tag="motor")
-            for key in ("tendon", "site", "body", "jointinparent"):
+            for key in ("site", "body", "jointinparent"):
                 if key in eff:
-                    self.fail(a, f"a motor on a {key} is not supported (only joint=)")
+                    self.fail(a, f"a motor on a {key} is not supported (only joint= or tendon=)")
+            if ("joint" in eff) == ("tendon" in eff):
+                self.fail(a, "a motor needs exactly one of joint= and tendon=")
+            tname = eff.get("tendon")
+            if tname is not None and tname not in self.tendons:
+                self.fail(a, f"tendon={tname!r} names no fixed tendon of the model "
+                             f"({sorted(self.tendons)})")
             jname = eff.get("joint")
-            if jname is None or jname not in joints:
+            if tname is None and jname not in joints:
                 self.fail(a, f"joint={jname!r} names no joint of the model")
             gear = self.floats(a, eff, "gear", (1, 6), default=(1.0,))
             if np.any(gear[1:] != 0):
@@ -252,5 +305,7 @@ class Reader(BodyPartsReader):
                     if r[0] > r[1]:
                         self.fail(a, f"{rng}={tuple(r)} has lower > upper")
                     lo, hi = max(lo, r[0]), min(hi, r[1])
-            out.append(Motor(a, eff.get("name") or jname, jname, float(gear[0]), (lo, hi)))
+            moment = self.tendons[tname].path if tname is not None else ((jname, 1.0),)
+            out.append(Motor(a, eff.get("name") or tname or jname, moment, float(gear[0]),
+                             (lo, hi), tname))
         return out

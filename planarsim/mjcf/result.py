@@ -50,12 +50,39 @@ class JointMap:
 
 @dataclass
 class ActuatorMap:
-    """A <motor>: planarsim actuator id, its MJCF joint, and gear: the actuator's input
-    [N m or N] is ``gear * ctrl`` (the pin's sign included), saturated to ctrlrange * gear."""
-    id: int
-    joint: str
-    gear: float
+    """An MJCF <motor>, one entry of an environment's action: the planarsim actuators it
+    drives, one per joint its transmission moves (its joint, or each joint of its fixed
+    tendon whose coefficient is not 0). Actuator ids[k] on MJCF joint joints[k] takes the
+    input gains[k] * ctrl [N m or N] (gain = gear * coef, the pin's sign included), ctrl
+    clamped to ctrlrange first. id, joint and gear: those of its only actuator."""
+    ids: tuple
+    joints: tuple
+    gains: tuple
     ctrlrange: tuple = (-math.inf, math.inf)
+    tendon: str | None = None
+
+    def _only(self, what):
+        if len(self.ids) != 1:
+            raise ValueError(f"the motor on tendon {self.tendon!r} drives {len(self.ids)} "
+                             f"joints {list(self.joints)}: read ids, joints and gains, not {what}")
+        return 0
+
+    @property
+    def id(self) -> int:
+        return self.ids[self._only("id")]
+
+    @property
+    def joint(self) -> str:
+        return self.joints[self._only("joint")]
+
+    @property
+    def gear(self) -> float:
+        return self.gains[self._only("gear")]
+
+    @property
+    def target(self) -> str:
+        """What it pulls on, for messages: its joint's name or "tendon 'name'"."""
+        return f"tendon {self.tendon!r}" if self.tendon is not None else self.joints[0]
 
 
 @dataclass
@@ -106,7 +133,8 @@ class MJCFModel:
     root    : planarsim id of the first root body
     free_joints : names of the root's planar joints (slides + hinge) that became "free"
     joint   : MJCF joint name -> JointMap (kind, id, sign, ref)
-    actuator : MJCF motor name (or its joint's) -> ActuatorMap (id, joint, gear, ctrlrange)
+    actuator : MJCF motor name (or its joint's or tendon's) -> ActuatorMap (ids, joints,
+              gains, ctrlrange, tendon)
     plane   : "x-z" or "x-y": the MJCF plane the model moves in
     report  : LoadReport: what was ignored, dropped or approximated
     com     : MJCF body name -> its own centre of mass in the plane at the file's pose [m]

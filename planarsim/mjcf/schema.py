@@ -48,22 +48,36 @@ ATTRIBUTES = {
         default={"shellinertia": "false", "fluidshape": "none", "fitscale": "1"}),
     "inertial": dict(use={"pos", "mass", "diaginertia", "fullinertia"} | ORIENT),
     "motor": dict(
-        use={"name", "class", "joint", "gear", "ctrlrange", "ctrllimited", "forcerange",
+        use={"name", "class", "joint", "tendon", "gear", "ctrlrange", "ctrllimited", "forcerange",
              "forcelimited"},
         ignore={"group", "user", "lengthrange", "actdim"},
         default={"actlimited": "auto", "actrange": "0 0"}),
+    # a fixed tendon: L = sum coef_i q_i, read for the motors that pull on it; its own
+    # physics (limits, spring, damper, friction, armature) only at MuJoCo's defaults, which
+    # do nothing; rgba, width and material reach it from <default><tendon> (spatial ones')
+    "fixed": dict(
+        use={"name", "class", "limited", "range"},
+        ignore={"group", "user", "rgba", "width", "material", "solreflimit", "solimplimit",
+                "solreffriction", "solimpfriction"},
+        default={"stiffness": "0", "damping": "0", "frictionloss": "0", "springlength": "-1 -1",
+                 "margin": "0", "armature": "0", "actuatorfrclimited": "auto",
+                 "actuatorfrcrange": "0 0"}),
+    "tendon": dict(),
+    "tendon joint": dict(use={"joint", "coef"}),
 }
 # elements read by the loader, per parent
 CHILDREN = {
-    "mujoco": {"compiler", "option", "default", "worldbody", "actuator"},
+    "mujoco": {"compiler", "option", "default", "worldbody", "actuator", "tendon"},
     "worldbody": {"body", "geom"},
     "body": {"body", "geom", "joint", "inertial"},
     "actuator": {"motor"},
+    "tendon": {"fixed"},
+    "fixed": {"joint"},
 }
 # elements ignored (and reported) wherever they appear: drawing, cameras, sensing, bookkeeping
 IGNORED_ELEMENTS = {"size", "visual", "statistic", "custom", "asset", "keyframe", "sensor",
                      "light", "camera", "site", "extension", "exclude"}
 # elements that are ignored when empty (a declaration with nothing in it) and a ModelError
 # otherwise: each changes physics this loader does not model
-EMPTY_ONLY = {"tendon": "tendons", "equality": "equality constraints", "contact": "explicit contact pairs"}
+EMPTY_ONLY = {"equality": "equality constraints", "contact": "explicit contact pairs"}
 SUPPORTED_GEOMS = ("sphere", "capsule", "cylinder", "box", "ellipsoid", "plane")

@@ -55,10 +55,10 @@ def test_every_task_is_registered_and_the_unsupported_are_refused():
     assert set(dmc.TASKS) == {"cheetah-run", "walker-stand", "walker-walk", "walker-run",
                               "hopper-stand", "hopper-hop", "acrobot-swingup", "cartpole-balance",
                               "cartpole-swingup", "pendulum-swingup", "reacher-easy",
-                              "reacher-hard", "swimmer-swimmer6"}
+                              "reacher-hard", "swimmer-swimmer6", "point_mass-easy"}
     for task in dmc.TASKS:
         assert f"planarsim/dmc-{task}-v0" in gym.registry
-    for task, why in (("finger-spin", "frictionloss"), ("point_mass-easy", "tendons")):
+    for task, why in (("finger-spin", "frictionloss"),):
         assert f"planarsim/dmc-{task}-v0" not in gym.registry
         with pytest.raises(NotImplementedError, match=why):
             dmc.DMCEnv(task)
@@ -171,6 +171,8 @@ def perturbed_states(task, theirs, n, rng):
             qpos[names.index("rootz")] += 0.5     # in the air: no contact force in either
         if task == "pendulum-swingup" and k % 2:
             qpos[:] = rng.normal(0, 0.1, 1)                 # upright: reward 1
+        if task == "point_mass-easy" and k % 2:
+            qpos[:] = rng.normal(0, 0.015, 2)               # near the target: reward > 0
         out.append((qpos, qvel, ctrl))
     return out
 
@@ -211,6 +213,25 @@ def test_reward_and_observation_equal_dm_controls_from_the_same_state(task):
         assert set(rewards) == {0.0, 1.0}, rewards
     else:
         assert np.any((rewards > 0.01) & (rewards < 0.99)), rewards
+
+
+def test_point_mass_episode_is_dm_controls_until_a_slide_reaches_its_limit():
+    """point_mass-easy has no contacts and moves linearly (a damped mass under constant
+    forces): planarsim's step is MuJoCo's Euler step, so an episode away from the slides'
+    limits (+-0.29 m; MuJoCo's are soft, planarsim's hard) equals dm_control's to 1e-12."""
+    theirs = dm_load("point_mass-easy", 3)
+    ts = theirs.reset()
+    env = dmc.DMCEnv("point_mass-easy")
+    obs, _ = env.reset(seed=3)
+    rng = np.random.default_rng(3)
+    assert np.allclose(obs, flat(ts.observation), rtol=0, atol=1e-12)
+    for _ in range(200):
+        action = rng.uniform(-0.3, 0.3, 2)
+        ts = theirs.step(action)
+        obs, reward, *_ = env.step(action)
+        assert not env.sim.state.limit_active.any()
+        assert np.allclose(obs, flat(ts.observation), rtol=0, atol=1e-12)
+        assert abs(reward - ts.reward) <= 1e-12
 
 
 def test_hopper_touch_sensors_carry_its_weight_on_the_floor_and_read_zero_in_the_air():

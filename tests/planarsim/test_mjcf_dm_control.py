@@ -3,12 +3,13 @@ against MuJoCo.
 
 The ten planar domains load as shipped, from the file's path (their <include>s of
 ./common/*.xml next to them), swimmer from its generated XML with its assets dict, except
-the two that need constraint rows planarsim does not have: finger (the spinner's joint
-frictionloss) and point_mass (its fixed tendons): those are ModelErrors naming the joint
-and the tendon.
+finger, which needs a constraint row planarsim does not have (the spinner's joint
+frictionloss): a ModelError naming the joint. point_mass's motors pull on fixed tendons
+(test_mjcf_tendons.py compares its motion under them with MuJoCo's).
 
 For each model that loads: every rigid body's mass and inertia about the plane's normal
-equal MuJoCo's compiled model (1e-9 relative); and a passive motion (no control; from
+equal MuJoCo's compiled model (1e-9 relative; point_mass's body only translates: the
+inertia its geoms assemble, which no motion uses); and a passive motion (no control; from
 qpos0 with every limited joint at 35 % or 65 % of its range, free hinges turned 0.3 rad,
 joint speeds 0.4-0.7 rad/s or m/s, the walkers lifted 0.5 m so that nothing touches) over
 SPAN = 0.06 s at the file's dt is compared with MuJoCo's RK4 at dt 1e-5 (the exact motion,
@@ -19,7 +20,8 @@ is 1e-5 against 1.5e-3 in position); both engines are first order, so ours at dt
 errs at least 5x less than the first-order error at dt (ours or MuJoCo's Euler's; cheetah
 at its dt 0.01 is not yet asymptotic in either engine). Measured ratios (position, velocity): cheetah 0.27,
 0.15; walker 0.99, 3.65; hopper 1.00, 15.6; acrobot 0.99, 1.62; cartpole 1.00, 1.01;
-pendulum 1.00, 1.00; reacher 1.04, 0.96; swimmer (6 links) 0.99, 1.18."""
+pendulum 1.00, 1.00; reacher 1.04, 0.96; swimmer (6 links) 0.99, 1.18; point_mass 1.00,
+1.00."""
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +39,8 @@ from planarsim.mjcf import load_mjcf  # noqa: E402
 from planarsim.state import make_state  # noqa: E402
 
 SUITE = Path(suite.__file__).resolve().parent
-LOADS = ["cheetah", "walker", "hopper", "acrobot", "cartpole", "pendulum", "reacher", "swimmer"]
+LOADS = ["cheetah", "walker", "hopper", "acrobot", "cartpole", "pendulum", "reacher", "swimmer",
+         "point_mass"]
 WALKERS = ("cheetah", "walker", "hopper")      # a free root: lifted off the floor
 SPAN = 0.06                                   # [s] a whole number of every file's dt
 REL = 1e-9
@@ -80,7 +83,9 @@ def test_suite_model_masses_and_inertias_match_mujoco(name):
             d = md.xipos[i] - com
             inertia += n @ R @ np.diag(mm.body_inertia[i]) @ R.T @ n + m_i * (d[i1] ** 2 + d[i2] ** 2)
         assert abs(model.arrays.body_mass[bid] - masses.sum()) <= REL * masses.sum(), rb.name
-        assert abs(model.arrays.body_inertia[bid] - inertia) <= REL * inertia, rb.name
+        # (a body that only translates is a point mass: no inertia in the model)
+        ours = rb.inertia if model.is_point(bid) else model.arrays.body_inertia[bid]
+        assert abs(ours - inertia) <= REL * inertia, rb.name
         assert np.allclose(model.q0[bid, :2], (com[i1], com[i2]), rtol=0, atol=REL), rb.name
 
 
@@ -161,36 +166,21 @@ def test_finger_is_refused_naming_the_spinners_frictionloss():
         load_mjcf(SUITE / "finger.xml")
 
 
-def test_point_mass_is_refused_naming_its_tendon():
-    with pytest.raises(ModelError, match=r"point_mass\.xml:35: <fixed name='t1'> \(line 35\): "
-                                         r"<fixed> inside <tendon>: tendons change physics"):
-        load_mjcf(SUITE / "point_mass.xml")
-
-
-def test_point_mass_without_its_tendons_moves_in_x_y_like_mujoco():
-    """point_mass's body on two slides (no hinge) chooses the x-y plane; with its tendons
-    and their motors cut out it loads as a point mass whose limited, damped slides follow
-    MuJoCo (the ones the suite's tendons drive)."""
-    text = (SUITE / "point_mass.xml").read_text()
-    text = text[:text.index("<tendon>")] + text[text.index("</actuator>") + len("</actuator>"):]
-    assets = {f"./common/{f}": (SUITE / "common" / f).read_bytes()
-              for f in ("skybox.xml", "visual.xml", "materials.xml")}
-    loaded = load_mjcf(text, assets=assets)
-    mm = mujoco.MjModel.from_xml_string(text, assets)
+def test_point_mass_loads_in_x_y_with_limited_damped_slides_and_tendon_motors():
+    """point_mass's body on two slides (no hinge) chooses the x-y plane and becomes a point
+    mass on two limited, damped slides, each pulled by a motor on a fixed tendon (t1: root_x,
+    t2: root_y; the other joint's coef 0 drives nothing)."""
+    loaded = load_mjcf(SUITE / "point_mass.xml")
+    mm = mujoco.MjModel.from_xml_path(str(SUITE / "point_mass.xml"))
     assert loaded.plane == "x-y" and list(loaded.joint) == ["root_x", "root_y"]
     model = loaded.compile()
     bid = loaded.body["pointmass"]
     assert model.is_point(bid) and model.arrays.body_mass[bid] == pytest.approx(mm.body_mass[1], rel=REL)
-    assert tuple(model.arrays.pin_limit[loaded.joint["root_x"].coordinate]) == (-0.29, 0.29)
-    assert model.arrays.pin_damping[loaded.joint["root_y"].coordinate] == 1.0
-    pytest.importorskip("gymnasium", reason="planarsim.envs (the joint coordinates) needs gymnasium")
-    qp, qv = np.array([0.05, -0.1]), np.array([0.4, -0.3])
-    exact_p, exact_v, rows = mujoco_motion(mm, qp, qv, 1e-5, mujoco.mjtIntegrator.mjINT_RK4)
-    euler_p, euler_v, _ = mujoco_motion(mm, qp, qv, 0.02, mujoco.mjtIntegrator.mjINT_EULER)
-    p, v, touched = our_motion(loaded, qp, qv, 0.02)
-    assert rows == 0 and not touched
-    assert np.abs(p - exact_p).max() <= RATIO * np.abs(euler_p - exact_p).max()
-    assert np.abs(v - exact_v).max() <= RATIO * np.abs(euler_v - exact_v).max()
+    for j in ("root_x", "root_y"):
+        assert tuple(model.arrays.pin_limit[loaded.joint[j].coordinate]) == (-0.29, 0.29)
+        assert model.arrays.pin_damping[loaded.joint[j].coordinate] == 1.0
+    assert [(a.tendon, a.joints, a.gains) for a in loaded.actuator.values()] == [
+        ("t1", ("root_x",), (0.1,)), ("t2", ("root_y",), (0.1,))]
 
 
 @pytest.mark.parametrize("name, ignored", [
