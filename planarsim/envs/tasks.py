@@ -33,6 +33,37 @@ def joined_finite(a, b, out):
     return finite
 
 
+@jit
+def reacher_obs(q, q0, bodies, local, qpos, qvel, out):
+    """Reacher's observation into out (cos and sin of the two arm angles, the target's qpos,
+    the arm's qvel, fingertip - target); returns fingertip - target (x, y) [m]. bodies: the
+    fingertip's and the target's body; local: their centres of mass at the file's pose."""
+    vx = 0.0
+    vy = 0.0
+    for k in range(2):
+        b = bodies[k]
+        dx = local[k, 0] - q0[b, 0]
+        dy = local[k, 1] - q0[b, 1]
+        c = math.cos(q[b, 2] - q0[b, 2])
+        s = math.sin(q[b, 2] - q0[b, 2])
+        sign = 1.0 if k == 0 else -1.0            # the fingertip less the target
+        vx += sign * (q[b, 0] + c * dx - s * dy)
+        vy += sign * (q[b, 1] + s * dx + c * dy)
+    out[0] = math.cos(qpos[0])
+    out[1] = math.cos(qpos[1])
+    out[2] = math.sin(qpos[0])
+    out[3] = math.sin(qpos[1])
+    n = 4
+    for i in range(2, qpos.shape[0]):
+        out[n] = qpos[i]
+        n += 1
+    out[n] = qvel[0]
+    out[n + 1] = qvel[1]
+    out[n + 2] = vx
+    out[n + 3] = vy
+    return vx, vy
+
+
 class _Task(PlanarMujocoEnv, utils.EzPickle):
     """A task's keyword arguments and their defaults are its class's DEFAULTS (gymnasium's
     v5 defaults), each kept as the attribute "_" + name; any other keyword goes to
@@ -221,6 +252,10 @@ class Reacher(_Task):
     def __init__(self, **kw):
         _Task.__init__(self, **kw)
         self.goal = self.init_qpos[-2:].copy()
+        # the fingertip's and the target's bodies and centres of mass, for reacher_obs
+        self._ends = np.array([self.loaded.body[b] for b in ("fingertip", "target")], np.int64)
+        self._ends_com = np.array([self.loaded.com[b][:2] for b in ("fingertip", "target")], float)
+        self._q0 = np.ascontiguousarray(self.sim_model.q0, float).reshape(-1, 3)
 
     def obs_size(self):
         return 10
@@ -235,8 +270,9 @@ class Reacher(_Task):
 
     def step(self, action):
         self.do_simulation(action, self.frame_skip)
-        vec = self.body_com("fingertip") - self.body_com("target")
-        observation = self._get_obs(vec)
+        observation = np.empty(10)
+        vec = reacher_obs(self.sim.state.q, self._q0, self._ends, self._ends_com, self.data.qpos,
+                          self.data.qvel, observation)
         reward, info = self._get_rew(action, vec)
         return observation, reward, False, False, info
 

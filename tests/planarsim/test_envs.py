@@ -244,3 +244,20 @@ def test_bad_inputs_name_the_culprit():
         del env
         gc.collect()
     assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
+
+
+@pytest.mark.parametrize("name", ["InvertedPendulum", "Reacher"])
+def test_compiled_step_observation_is_the_tasks_own_to_the_bit(name):
+    """The compiled observations of step() (tasks.joined_finite, tasks.reacher_obs) give the
+    task's _get_obs() and reward to the bit, over random actions."""
+    env = gym.make(f"planarsim/{name}-v0").unwrapped
+    env.reset(seed=3)
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        a = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+        obs, reward, terminated, *_ = env.step(a)
+        assert np.array_equal(obs, env._get_obs())
+        if name == "Reacher":
+            assert reward == env._get_rew(a)[0]
+        if terminated:
+            env.reset(seed=4)
