@@ -1013,6 +1013,7 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
                e_tol=math.nan if u is not None else energy_bound(spec, ground, q0, v0),
                gain=math.nan, pin=math.nan, depth=math.nan, diverged="", raised="", speed=math.nan,
                speed_ratio=math.nan, step_gain=math.nan, step_k=-1, step_note="", tunnel=math.nan,
+               turn_steps=0, turn_max=0.0,
                slide_leave_gain=math.nan, slide_leave_k=-1, jump=math.nan)
     nb, nc, npin = model.n_body, model.n_contact, model.n_pin
     q, v = np.empty((steps + 1, nb, 3)), np.empty((steps + 1, nb, 3))
@@ -1061,6 +1062,12 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
             kinetic = 0.5 * np.sum(spec.mass * (v[:-1, :, 0] ** 2 + v[:-1, :, 1] ** 2)
                                    + spec.inertia * v[:-1, :, 2] ** 2, axis=-1)
             turn = dt * fastest_turn(model, q[:-1], v[:-1])
+            # the steps that pass only by the turn term: beyond the flat share (and E_tol)
+            # but within (h w)^2 of the kinetic energy (their count and largest h w, printed)
+            needs = ((excess - CONSTRAINT_SHARE * kinetic > out["e_tol"])
+                     & (excess - np.maximum(CONSTRAINT_SHARE, turn ** 2) * kinetic <= out["e_tol"]))
+            out["turn_steps"] = int(np.count_nonzero(needs))
+            out["turn_max"] = float(np.max(turn[needs])) if out["turn_steps"] else 0.0
             excess = excess - np.maximum(CONSTRAINT_SHARE, turn ** 2) * kinetic
         k = int(np.argmax(excess))
         out["step_gain"], out["step_k"] = float(excess[k]), k + 1
@@ -1176,6 +1183,11 @@ def report(results, n_worst=8) -> bool:
         if audits:
             kinds = {k: sum(a[k] for a in audits) for k in audits[0]}
             print(f"{'':15s} audit by rule: " + ", ".join(f"{k} {n}" for k, n in kinds.items()))
+        turned = [r for r in rs if r.get("turn_steps", 0)]
+        print(f"{'':15s} steps within the step allowance only by its (h w)^2 term (beyond "
+              f"{CONSTRAINT_SHARE:.0%} of KE + E_tol): "
+              + (f"{sum(r['turn_steps'] for r in turned)} in {len(turned)} runs, largest h w "
+                 f"{max(r['turn_max'] for r in turned):.3g} rad" if turned else "none"))
         if family in EXTREME_FAMILIES:
             step = max(rs, key=lambda r: -math.inf if math.isnan(r["step_gain"]) else r["step_gain"])
             line = (f"worst speed {_worst(r['speed'] for r in rs):.3g} m/s; worst single-step gain "

@@ -149,3 +149,21 @@ def coulomb_solutions(A, b, kinds, mu_of_row, tol=1e-9):
         if coulomb_violations(A, b, kinds, mu_of_row, x, scale) <= tol * scale * (1.0 + np.abs(x).max()):
             found.append(x)
     return found
+
+
+def hinge_turn_gain(a, q, j):
+    """1 / [kg m^2]: how fast a torque on hinge j turns its angle (theta_b - theta_a) from rest,
+    with the hinge's own pin holding its two bodies and each body's hinges to the world
+    holding it, nothing else: the Schur complement g W g^T - g W G^T (G W G^T)^+ G W g^T,
+    G those pins' rows (by differences of pin_error), g the angle's row."""
+    W = inverse_mass(a)
+    ba, bb = (int(b) for b in a.pin_body[j])
+    pins = [j] + [p for p in range(len(a.pin_kind)) if p != j and a.pin_kind[p] == 0
+                  and min(a.pin_body[p]) < 0 and max(a.pin_body[p]) in (ba, bb)]
+    G = np.vstack([jacobian(lambda x, p=p: pin_error(a, x.reshape(q.shape), p), q) for p in pins])
+    g = np.zeros(q.size)
+    g[3 * bb + 2] = 1.0
+    if ba >= 0:
+        g[3 * ba + 2] = -1.0
+    c = G @ W @ g
+    return float(g @ W @ g - c @ np.linalg.pinv(G @ W @ G.T, rcond=1e-10) @ c)

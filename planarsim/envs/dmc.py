@@ -22,8 +22,7 @@ MuJoCo's soft contacts and Euler / RK4), hence episodes beyond their first steps
 touch sensors, which here are the normal force of planarsim's contacts in the site's sphere
 over the last physics step (impulse / timestep), not MuJoCo's soft contact force of the
 current state (0 right after a reset). As in dm_control, the reward's control terms read the
-action as given, the motors the action clamped to ctrlrange. pendulum and reacher run with
-StepOptions.turn_limit 0 (see DOMAINS: the check's bound is far above their motors' turns).
+action as given, the motors the action clamped to ctrlrange.
 """
 from __future__ import annotations
 
@@ -412,18 +411,8 @@ DOMAINS = {
     "cartpole": Domain("cartpole.xml", 0.01, 10, None, _init_cartpole, _obs_cartpole,
                        _reward_cartpole),
     "pendulum": Domain("pendulum.xml", 0.02, 20, None, _init_pendulum, _obs_pendulum,
-                       _reward_pendulum, dict(angle_bound=8),
-                       # StepOptions.turn_limit's check bounds a motor's turn by the inertia
-                       # its bodies would have free (the bob about its centre: 1e-3 kg m^2,
-                       # 0.4 rad a step at full torque) and would stop the run; on its hinge
-                       # the pole has 0.251 kg m^2 and turns 0.002 rad a step
-                       step_options=dict(turn_limit=0.0)),
-    "reacher": Domain("reacher.xml", 0.02, 20, None, _init_reacher, _obs_reacher, _reward_reacher,
-                      # the turn check bounds the wrist motor's turn by the two links'
-                      # inertia as free bodies (3e-5 kg m^2: 0.66 rad a step at full torque)
-                      # and would stop the run; the hand (1.9e-4 kg m^2 about the wrist)
-                      # turns ~0.1 rad a step with the arm held, as in MuJoCo's model
-                      step_options=dict(turn_limit=0.0)),
+                       _reward_pendulum, dict(angle_bound=8)),
+    "reacher": Domain("reacher.xml", 0.02, 20, None, _init_reacher, _obs_reacher, _reward_reacher),
     "swimmer": Domain("swimmer.xml", 0.002, 30, .03, _init_swimmer, _obs_swimmer,
                       _reward_swimmer),
     # a mass on two limited, damped slides, each pulled by a motor on a fixed tendon

@@ -2,7 +2,7 @@
 import math
 
 from ..compile import kernel
-from .codes import CONTACT_ARC, CONTACT_POINT, MODE_FREE
+from .codes import CONTACT_ARC, CONTACT_POINT, JOINT_HINGE, MODE_FREE
 from .forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from .terrain import ground_point
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
@@ -96,11 +96,97 @@ def check_speeds(m, s, ws, bound):
 
 
 @kernel
-def turn_gain(m, k):
-    """1 / [kg m^2]: how fast torque actuator k turns what it drives, from rest, on free bodies:
-    g M^-1 g^T of its joint coordinate (1/I_a + 1/I_b; a joint's armature a gives
-    kappa / (1 + a kappa)) or of its body's angle (1/I); 0 for the actuators that push (forces,
-    point-mass hips, sliders). Joints and contacts only slow the turn: an upper bound."""
+def _pin_arm(m, ws, j, e):
+    """(x, y) [m] of pin j's anchor on its body e (0: a, 1: b) from that body's centre of mass,
+    in the world frame (ws.body_cs: the angles' cos and sin); (0, 0) for the world."""
+    body = m.pin_body[j, e]
+    if body < 0:
+        return 0.0, 0.0
+    lx = m.pin_anchor[j, e, 0]
+    ly = m.pin_anchor[j, e, 1]
+    c = ws.body_cs[body, 0]
+    sn = ws.body_cs[body, 1]
+    return c * lx - sn * ly, sn * lx + c * ly
+
+
+@kernel
+def _held_mobility(m, ws, body, skip):
+    """(W00, W01, W02, W11, W12, W22): body's mobility M^-1 [1/kg, 1/(kg m), 1/(kg m^2)] in
+    (x, y, angle) with its hinges to the world (other than pin `skip`) holding it: W - B S^-1
+    B^T over the first such pin (B = W G^T, S = G W G^T of its two rows), all zeros with two
+    or more (the body cannot move)."""
+    w = m.body_inv_mass[body]
+    i = m.body_inv_inertia[body]
+    held = -1
+    for p in range(m.pin_body.shape[0]):
+        if p == skip or m.pin_kind[p] != JOINT_HINGE:
+            continue
+        if (m.pin_body[p, 0] == body and m.pin_body[p, 1] < 0) or (
+                m.pin_body[p, 1] == body and m.pin_body[p, 0] < 0):
+            if held >= 0:
+                return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            held = p
+    if held < 0:
+        return w, 0.0, 0.0, w, 0.0, i
+    sx, sy = _pin_arm(m, ws, held, 0 if m.pin_body[held, 0] == body else 1)
+    det = w * w + w * i * (sx * sx + sy * sy)
+    if not det > 0.0:
+        return w, 0.0, 0.0, w, 0.0, i
+    s00 = (w + sx * sx * i) / det
+    s01 = sx * sy * i / det
+    s11 = (w + sy * sy * i) / det
+    # B's rows (x, y, angle): (w, 0), (0, w), (-sy i, sx i)
+    b20 = -sy * i
+    b21 = sx * i
+    return (w - w * s00 * w, -w * s01 * w, -w * (s00 * b20 + s01 * b21), w - w * s11 * w,
+            -w * (s01 * b20 + s11 * b21),
+            i - (b20 * (s00 * b20 + s01 * b21) + b21 * (s01 * b20 + s11 * b21)))
+
+
+@kernel
+def hinge_turn_gain(m, ws, j):
+    """1 / [kg m^2]: g M_c^-1 g^T of hinge j's angle (g: the rate of theta_b - theta_a) with
+    the hinge's own pin holding its two bodies, each body also held by its hinge to the world
+    if it has one (_held_mobility), and nothing else acting: g W g^T - c^T A^-1 c,
+    A = G W G^T of the pin's two rows, c = G W g^T. A link hinged to the world turns as about
+    its hinge, 1 / (I + m d^2). The model's other joints and contacts only add constraints,
+    which lower it: an upper bound of the turn. 1/I_a + 1/I_b where the pin's rows are
+    degenerate (point masses)."""
+    ggt = 0.0
+    c1 = 0.0
+    c2 = 0.0
+    a11 = 0.0
+    a12 = 0.0
+    a22 = 0.0
+    free = 0.0
+    for e in range(2):
+        body = m.pin_body[j, e]
+        if body < 0:
+            continue
+        free += m.body_inv_inertia[body]
+        p, q, r, s, t, u = _held_mobility(m, ws, body, j)
+        rx, ry = _pin_arm(m, ws, j, e)
+        ggt += u
+        # G_e = +-[[1, 0, -ry], [0, 1, rx]], g_e = -+(0, 0, 1): c_e = -(r - ry u, t + rx u)
+        c1 -= r - ry * u
+        c2 -= t + rx * u
+        a11 += p - 2.0 * ry * r + ry * ry * u
+        a22 += s + 2.0 * rx * t + rx * rx * u
+        a12 += q - ry * t + rx * r - rx * ry * u
+    det = a11 * a22 - a12 * a12
+    if not det > 1e-12 * (a11 * a22) or not math.isfinite(det):
+        return free
+    held = (a22 * c1 * c1 - 2.0 * a12 * c1 * c2 + a11 * c2 * c2) / det
+    return max(ggt - held, 0.0)
+
+
+@kernel
+def turn_gain(m, ws, k):
+    """1 / [kg m^2]: how fast torque actuator k turns what it drives, from rest: of its
+    hinge's angle with that hinge's pin holding its two bodies (hinge_turn_gain; a joint's
+    armature a gives kappa / (1 + a kappa)), or of its body's angle (1/I); 0 for the
+    actuators that push (forces, point-mass hips, sliders). The other joints and contacts
+    only slow the turn: an upper bound."""
     kind = m.act_kind[k]
     if kind == ACT_BODY_TORQUE:
         return m.body_inv_inertia[m.act_body[k, 0]]
@@ -108,9 +194,12 @@ def turn_gain(m, k):
         return 0.0
     j = m.act_ref[k]
     kappa = 0.0
-    for e in range(2):
-        if m.pin_body[j, e] >= 0:
-            kappa += m.body_inv_inertia[m.pin_body[j, e]]
+    if m.pin_kind[j] == JOINT_HINGE:
+        kappa = hinge_turn_gain(m, ws, j)
+    else:
+        for e in range(2):
+            if m.pin_body[j, e] >= 0:
+                kappa += m.body_inv_inertia[m.pin_body[j, e]]
     return kappa / (1.0 + m.pin_armature[j] * kappa)
 
 
@@ -122,7 +211,7 @@ def check_actuator_turns(m, ws, h, limit):
     joints' and contacts' corrections hold only turns of a few tenths of a radian per step).
     Recorded: the actuator (ws.info[INFO_COMMAND]), the turn, kappa and limit (ws.guard_value)."""
     for k in range(m.act_kind.shape[0]):
-        kappa = turn_gain(m, k)
+        kappa = turn_gain(m, ws, k)
         turn = h * h * abs(ws.act_u[k]) * kappa
         if turn > limit:
             ws.info[INFO_COMMAND] = k
