@@ -39,12 +39,14 @@ def matrices(rows, cols, lo, hi):
 
 
 @st.composite
-def full_rank(draw, rows, cols, lo=-3.0, hi=3.0, max_condition=1e3):
+def full_rank(draw, rows, cols, lo=-3.0, hi=3.0, max_condition=1e3, min_row_norm=0.1):
     """A rows x cols matrix of entries in [lo, hi] (a clipped normal draw's range), of full rank
-    min(rows, cols) with condition number at most max_condition: a normal draw's structure
-    (its condition number is nearly always far below), without the exact degeneracies a
-    shrink heads for (a zero or repeated column)."""
+    min(rows, cols) with condition number at most max_condition and no row shorter than
+    min_row_norm: a normal draw's structure (its condition number is nearly always far below,
+    its rows nearly always longer), without the exact degeneracies a shrink heads for (a zero
+    row or column, a repeated column)."""
     m = draw(matrices(rows, cols, lo, hi))
+    assume(np.linalg.norm(m, axis=1).min() >= min_row_norm)
     assume(np.linalg.cond(m) <= max_condition)
     return m
 
