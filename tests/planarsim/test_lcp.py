@@ -3,12 +3,15 @@ of contact shape: M = J J^T with more rows than degrees of freedom (redundant co
 sharing a load, so M and the answer's basis are singular) and q built around a known
 answer, so that every problem has one."""
 import numpy as np
-from hypothesis import given, settings, strategies as st
+import pytest
+from hypothesis import assume, given, settings, strategies as st
+from hypothesis.extra.numpy import arrays
 
 from numba import njit
 
 from planarsim.compile import options as compile_options
 from planarsim.kernels.lcp import ANSWER_TOL, LCP_INACCURATE, LCP_SOLVED, lemke, polish
+from strategies import full_rank, vectors
 
 # not cached: numba checks a cached function against its own file only, and this wrapper
 # must follow the kernels it calls
@@ -54,30 +57,44 @@ def _nearly_singular(M, z, eps):
     return lam.min() < 100 * eps
 
 
+def _problem(J, loaded, load, slack):
+    """(M, q) of contact rows J (k x d) with a known answer: z = load on the `loaded` rows
+    (w = 0 there), w = slack on the others (z = 0 there)."""
+    M = J @ J.T
+    z_star = np.where(loaded, load, 0.0)
+    w_star = np.where(loaded, 0.0, slack)
+    return M, w_star - M @ z_star
+
+
 def _seeded_problem(d, k, seed):
     """(M, q) of k contact rows on d degrees of freedom from numpy seed `seed`, with a known
     answer: about half of the rows loaded in it."""
     rng = np.random.default_rng(seed)
     J = rng.normal(size=(k, d))
-    M = J @ J.T
     loaded = rng.random(k) < 0.5
-    z_star = np.where(loaded, rng.uniform(0.1, 1.0, k), 0.0)
-    w_star = np.where(loaded, 0.0, rng.uniform(0.0, 1.0, k))
-    return M, w_star - M @ z_star
+    return _problem(J, loaded, rng.uniform(0.1, 1.0, k), rng.uniform(0.0, 1.0, k))
 
 
 @st.composite
 def redundant_contacts(draw):
-    """(M, q): k contact rows on d < k degrees of freedom, half of them loaded in the answer."""
+    """(M, q): k contact rows on d < k degrees of freedom (J of rank d, entries drawn in
+    [-3, 3], no two rows parallel), each loaded in the answer with chance 1/2 (its load z in [0.1, 1]), else its
+    slack w in [0, 1]."""
     d = draw(st.integers(2, 6))
     k = draw(st.integers(d + 1, 2 * d + 2))
-    return _seeded_problem(d, k, draw(st.integers(0, 2**31 - 1)))
+    loaded = draw(arrays(np.bool_, k, elements=st.booleans(), fill=st.nothing()))
+    J = draw(full_rank(k, d))
+    # no two rows parallel, as in a normal draw (exactly parallel rows with a slack below the
+    # regularisation: test_polish_of_two_identical_contacts_pushed_a_hair_apart_is_exact)
+    unit = J / np.linalg.norm(J, axis=1, keepdims=True)
+    assume(np.abs(np.triu(unit @ unit.T, 1)).max() < 1.0 - 1e-9)
+    return _problem(J, loaded, draw(vectors(k, 0.1, 1.0)),
+                    draw(vectors(k, 0.0, 1.0)))
 
 
-@settings(max_examples=150, deadline=None)
-@given(redundant_contacts())
-def test_polish_turns_a_regularised_answer_into_an_exact_one(problem):
-    M, q = problem
+def _check_polish(M, q):
+    """lemke solves M + 1e-6 I; polish then solves M to 1e-9 of max |q| (ANSWER_TOL where the
+    loaded rows are nearly singular) or says it could not and leaves the regularised answer."""
     if q.min() >= 0.0:          # nothing pushes: z = 0, no path, nothing to polish
         return
     z_reg = np.zeros(len(q))
@@ -99,6 +116,23 @@ def test_polish_turns_a_regularised_answer_into_an_exact_one(problem):
     assert _miss(M, q, z) < 1e-9
     # the regularised answer itself misses by about eps z: polish did the work
     assert _miss(M, q, z_reg) > 10 * _miss(M, q, z) or _miss(M, q, z_reg) < 1e-9
+
+
+@settings(max_examples=150, deadline=None)
+@given(redundant_contacts())
+def test_polish_turns_a_regularised_answer_into_an_exact_one(problem):
+    _check_polish(*problem)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "engine: two identical contact rows, one pushed 1e-7 less than the other (exact answer "
+    "z = (0, 1, 0)); polish reports LCP_SOLVED with z = (0.3, 0.7, 0), missing by 5e-8 of "
+    "max |q| (bound 1e-9); redundant_contacts leaves out parallel rows until this is mended"))
+def test_polish_of_two_identical_contacts_pushed_a_hair_apart_is_exact():
+    """Contacts 0 and 1 on the same direction (a redundant pair): contact 1 carries the load
+    (z = 1), contact 0 is 1e-7 short of touching (w = 1e-7), below the regularisation 1e-6."""
+    J = np.array([[1.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    _check_polish(*_problem(J, np.array([False, True, False]), np.ones(3), np.array([1e-7, 0.0, 0.0])))
 
 
 def test_polish_solves_a_seeded_corpus_and_a_failure_would_say_so():
