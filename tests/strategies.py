@@ -65,6 +65,7 @@ def body_rows(draw, n_body, n_row, dependent, chain):
     `dependent` a row is an exact multiple (0.5 to 2) of an earlier row (a closed loop, a
     redundant contact). With chance 0.7 a row joins a second body: the next one if `chain`
     (the world past the last body), else any other (the world if it draws a itself)."""
+    block = st.tuples(*[reals(-LEVER, LEVER)] * 3)
     rows = []
     for r in range(n_row):
         if r > 0 and draw(chance(dependent)):
@@ -78,8 +79,8 @@ def body_rows(draw, n_body, n_row, dependent, chain):
             b = a + 1 if chain else draw(st.integers(0, n_body - 1))
             if b == a or b >= n_body:
                 b = -1
-        ja = draw(vectors(3, -LEVER, LEVER))
-        jb = draw(vectors(3, -LEVER, LEVER)) if b >= 0 else np.zeros(3)
+        ja = np.array(draw(block))
+        jb = np.array(draw(block)) if b >= 0 else np.zeros(3)
         rows.append((a, b, ja, jb))
     return rows
 
