@@ -155,10 +155,9 @@ def test_polish_solves_a_seeded_corpus_and_a_failure_would_say_so():
     """Over a seeded corpus of contact problems of redundant_contacts' family (_seeded_problem:
     normal J, uniform loads and slacks; every d, k it draws, 600 seeds each: 17 731 that
     push), polish solves every one exactly; a failure would return LCP_INACCURATE with the
-    regularised answer left as it was. Before lcp._swap_to_answer
-    two failed (d = 4, k = 9, seed 565; d = 6, k = 7, seed 90: the nearby problem's eps put
-    a row with a nearly zero share on the wrong side, and its basis's answer for M missed
-    by 3e-7 of max |q|)."""
+    regularised answer left as it was. Before lcp._swap_to_answer two failed (d = 4, k = 9,
+    seed 565; d = 6, k = 7, seed 90: the nearby problem's eps put a row with a nearly zero
+    share on the wrong side, and its basis's answer for M missed by 3e-7 of max |q|)."""
     failed = solved = 0
     for d in range(2, 7):
         for k in range(d + 1, 2 * d + 3):
