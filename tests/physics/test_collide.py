@@ -206,18 +206,19 @@ def close(a, b, scale=1.0):
 # ---------------------------------------------------------------- hypothesis strategies
 
 @st.composite
-def shapes(draw, kinds=("circle", "capsule", "box", "polygon", "rounded_box"), size=(5e-4, 5.0),
-           off=1.0, radius=(1e-3, 2.0)):
-    """(core, r): one of `kinds` of size in `size` [m]; a circle's or capsule's centre within
-    `off` [m] of the origin, a capsule's radius in `radius` [m] and its angle, a box's aspect
-    (0.05 to 1) and a rounded box's radius (1 mm to 0.5 m), a polygon's vertices drawn."""
+def shapes(draw, kinds=("circle", "capsule", "box", "polygon", "rounded_box"), sizes=(5e-4, 5.0),
+           offset=1.0, radii=(1e-3, 2.0)):
+    """(core, r): one of `kinds` of size in `sizes` [m]; a circle's or capsule's centre within
+    `offset` [m] of the origin along each axis, a capsule's radius in `radii` [m] and its angle,
+    a box's aspect (0.05 to 1) and a rounded box's radius (1 mm to 0.5 m), a polygon's
+    vertices drawn."""
     kind = draw(st.sampled_from(kinds))
-    size = draw(reals(*size))
-    off = draw(st.tuples(reals(-off, off), reals(-off, off)))
+    size = draw(reals(*sizes))
+    off = draw(st.tuples(reals(-offset, offset), reals(-offset, offset)))
     if kind == "circle":
         return circle(size, off[0], off[1])
     if kind == "capsule":
-        return capsule(size, draw(reals(*radius)), draw(angles()), off[0], off[1])
+        return capsule(size, draw(reals(*radii)), draw(angles()), off[0], off[1])
     if kind in ("box", "rounded_box"):
         aspect = draw(reals(0.05, 1.0))
         r = draw(reals(1e-3, 0.5)) if kind == "rounded_box" else 0.0
@@ -349,8 +350,8 @@ def test_gaps_do_not_depend_on_where_the_pair_stands(pair, tx, ty, turn):
 
 def generic_shapes():
     """Shapes of 1 cm to 3 m, centres within 0.5 m, capsule radii 1 cm to 1 m, no rounded box."""
-    return shapes(kinds=("circle", "capsule", "box", "polygon"), size=(0.01, 3.0), off=0.5,
-                  radius=(0.01, 1.0))
+    return shapes(kinds=("circle", "capsule", "box", "polygon"), sizes=(0.01, 3.0), offset=0.5,
+                  radii=(0.01, 1.0))
 
 
 @settings(max_examples=300, deadline=None)
