@@ -5,11 +5,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 from numba import njit
 from numba.core.errors import TypingError
 
 import planarsim as ps
 from planarsim.compile import TABLES
+from strategies import reals, vectors
 
 if not TABLES:
     pytest.skip("NamedTuples reach compiled code as they are in this mode", allow_module_level=True)
@@ -71,11 +73,22 @@ def _expected(o):
     return o.scale * (o.grid.sum() + o.inner.a.sum()) + o.count + o.inner.k.sum()
 
 
+@st.composite
+def outers(draw):
+    """An Outer of drawn fields: a scale in [-2, 2], a count in [-5, 4], a grid of 0 to 4 x 0 to
+    4 x 0 to 4 floats, inner.a of 0 to 6 floats (in [-3, 3]), inner.k of 0 to 3 ints in [-9, 8]."""
+    grid_shape = draw(st.tuples(st.integers(0, 4), st.integers(0, 4), st.integers(0, 4)))
+    a = draw(vectors(draw(st.integers(0, 6)), -3.0, 3.0))
+    k = draw(arrays(np.int64, draw(st.integers(0, 3)), elements=st.integers(-9, 8), fill=st.nothing()))
+    return Outer(scale=draw(reals(-2.0, 2.0)), count=draw(st.integers(-5, 4)),
+                 grid=draw(arrays(np.float64, grid_shape, elements=reals(-3.0, 3.0), fill=st.nothing())),
+                 inner=Inner(a, k))
+
+
 @settings(max_examples=40, deadline=None)
-@given(st.tuples(st.integers(0, 4), st.integers(0, 4), st.integers(0, 4)), st.integers(0, 6),
-       st.integers(0, 3), st.integers(0, 2 ** 31))
-def test_fields_read_and_write_the_numpy_arrays(grid_shape, n_a, n_k, seed):
-    o = _outer(grid_shape, n_a, n_k, seed)
+@given(outers())
+def test_fields_read_and_write_the_numpy_arrays(o):
+    n_k = len(o.inner.k)
     want = _expected(o)
     k0 = o.inner.k.copy()
     assert _total(o) == pytest.approx(want, rel=1e-12, abs=1e-12)

@@ -9,6 +9,7 @@ from numba import njit
 
 from planarsim.compile import options as compile_options
 from planarsim.kernels.mixed_lcp import _factor_joints, _solve_joints
+from strategies import full_rank, vectors
 
 jit = njit(**dict(compile_options(), cache=False))
 
@@ -39,18 +40,16 @@ def _solve(A, b, rows):
 @st.composite
 def dependent_joints(draw):
     """(A, b, d): n joint rows on d < n degrees of freedom whose inverse masses and inertias
-    are 10^U(-4, 4) apart (A = J W J^T, singular by n - d; J's entries lever arms of order
-    1), each row in units of its own (scaled by 10^U(-2, 2)) and in random order; b = A y
-    for some impulses y (a consistent drift)."""
+    are 10^U(-4, 4) apart (A = J W J^T, singular by n - d; J of full rank d, its entries lever
+    arms of order 1 drawn in [-3, 3]), each row in units of its own (scaled by 10^U(-2, 2));
+    b = A y for drawn impulses y in [-3, 3] (a consistent drift)."""
     n = draw(st.integers(2, 10))
     d = draw(st.integers(max(1, n - 3), n - 1))
-    seed = draw(st.integers(0, 2**31 - 1))
-    rng = np.random.default_rng(seed)
-    J = rng.normal(size=(n, d)) * 10.0 ** rng.uniform(-2, 2, size=(n, 1))
-    J = J[rng.permutation(n)]
-    W = 10.0 ** rng.uniform(-4, 4, size=d)
+    row_scale = 10.0 ** draw(vectors(n, -2.0, 2.0))
+    J = draw(full_rank(n, d)) * row_scale[:, None]
+    W = 10.0 ** draw(vectors(d, -4.0, 4.0))
     A = (J * W) @ J.T
-    return A, A @ rng.normal(size=n), d
+    return A, A @ draw(vectors(n, -3.0, 3.0)), d
 
 
 def _scaled_least(A, b):

@@ -9,6 +9,7 @@ from numba import njit
 from planarsim.compile import options as compile_options
 from planarsim.kernels.envelope import (compute_envelope, factor, factor_symmetric, substitute,
                                         substitute_symmetric)
+from strategies import body_rows, dense_jacobian, vectors
 
 TOL = 1e-11
 # not cached: numba checks a cached function against its own file only, and these wrappers
@@ -97,35 +98,20 @@ def _envelope(row_body, n_body):
 
 @st.composite
 def systems(draw):
-    """Rows on a chain of bodies (a row joins body a to a + 1 or to the world), an inverse
-    mass matrix, and a right-hand side in the range of A (consistent, as the engine's)."""
+    """Rows on a chain of bodies (a row joins body a to a + 1 or to the world; a fifth of them
+    exact multiples of earlier ones), in body order as build_rows emits them; inverse masses
+    [1/kg] drawn in [0.2, 5] (inverse inertias 3 times those, 1/(kg m^2)); a right-hand side
+    A y, y drawn in [-3, 3], in the range of A (consistent, as the engine's)."""
     n_body = draw(st.integers(1, 6))
     n_row = draw(st.integers(1, 3 * n_body + 3))
-    seed = draw(st.integers(0, 2 ** 32 - 1))
-    rng = np.random.default_rng(seed)
-    J = np.zeros((n_row, 3 * n_body))
-    row_body = []
-    for r in range(n_row):
-        if r > 0 and rng.random() < 0.2:
-            # an exact copy of an earlier row, scaled: a dependent row (a closed loop)
-            k = int(rng.integers(0, r))
-            J[r] = rng.uniform(0.5, 2.0) * J[k]
-            row_body.append(row_body[k])
-            continue
-        a = int(rng.integers(0, n_body))
-        b = a + 1 if (a + 1 < n_body and rng.random() < 0.7) else -1
-        for body in (a, b):
-            if body >= 0:
-                J[r, 3 * body:3 * body + 3] = rng.normal(size=3)
-        row_body.append((a, b))
-    # rows in body order, as build_rows emits them
-    order = sorted(range(n_row), key=lambda r: max(row_body[r]))
-    J = J[order]
-    row_body = [row_body[r] for r in order]
-    w = np.repeat(rng.uniform(0.2, 5.0, n_body), 3) * np.tile([1.0, 1.0, 3.0], n_body)
+    rows = draw(body_rows(n_body, n_row, dependent=0.2, chain=True))
+    rows.sort(key=lambda row: max(row[0], row[1]))
+    row_body = [(a, b) for a, b, _, _ in rows]
+    J = dense_jacobian(rows, n_body)
+    w = np.repeat(draw(vectors(n_body, 0.2, 5.0)), 3) * np.tile([1.0, 1.0, 3.0], n_body)
     A = (J * w) @ J.T
     A = 0.5 * (A + A.T)
-    rhs = A @ rng.normal(size=n_row)
+    rhs = A @ draw(vectors(n_row, -3.0, 3.0))
     return A, rhs, row_body, n_body, J, w
 
 
@@ -221,17 +207,17 @@ def _factor_only(A, first, reach, tol, symmetric, scale, rows):
 
 
 @settings(max_examples=200, deadline=None)
-@given(systems(), st.sampled_from([TOL, 1e-3, 0.0]), st.booleans())
+@given(systems(), st.sampled_from([TOL, 1e-3, 0.0]), st.data())
 def test_the_factorisations_keep_the_operations_of_the_envelope_elimination_bit_for_bit(
-        system, tol, unordered):
+        system, tol, data):
     """Each column's rows are listed once (envelope.rows_below) instead of tested in every loop:
     the factors, dropped rows and all, must be those of the elimination as first written, to
     the bit (signed zeros included), for rows in build order and out of it; a non-symmetric
     matrix (the position correction's) goes through the LU."""
     A, rhs, row_body, n_body, J, w = system
     n = len(rhs)
-    if unordered:
-        order = np.random.default_rng(n).permutation(n)
+    if data.draw(st.booleans(), label="out of build order"):
+        order = data.draw(st.permutations(range(n)), label="order")
         A, row_body = A[np.ix_(order, order)], [row_body[r] for r in order]
     first, reach = _envelope(row_body, n_body)
     skew = A + 1e-3 * np.tril(np.ones((n, n)), -1) * A        # as J(q+) W J(q)^T: not symmetric
@@ -254,11 +240,12 @@ def _compute_envelope(ws, n, n_body):
 
 
 @settings(max_examples=100, deadline=None)
-@given(st.integers(0, 2 ** 32 - 1))
-def test_the_envelope_kernel_gives_each_rows_first_row_and_each_columns_reach(seed):
+@given(st.data())
+def test_the_envelope_kernel_gives_each_rows_first_row_and_each_columns_reach(data):
     """compute_envelope's first rows and reaches (what the factorisations and substitutions
-    loop within) against their definitions (_envelope), for random rows in the order
-    build_rows makes (body by body) and out of it, up to the workspace's room for rows."""
+    loop within) against their definitions (_envelope), for drawn rows (each a body or the
+    world, and a body) in the order build_rows makes (body by body) and out of it, up to the
+    workspace's room for rows."""
     import planarsim as ps
     from planarsim.state import make_workspace
     builder = ps.ModelBuilder(dt=1e-3)
@@ -269,10 +256,11 @@ def test_the_envelope_kernel_gives_each_rows_first_row_and_each_columns_reach(se
         prev = link
     model = builder.compile()
     ws = make_workspace(model)
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(0, ws.row_first.shape[0] + 1))
-    bodies = np.stack([rng.integers(-1, model.n_body, n), rng.integers(0, model.n_body, n)], 1)
-    if rng.random() < 0.5:
+    pairs = st.tuples(st.integers(-1, model.n_body - 1), st.integers(0, model.n_body - 1))
+    bodies = np.array(data.draw(st.lists(pairs, max_size=ws.row_first.shape[0]), label="rows"),
+                      np.int64).reshape(-1, 2)
+    n = len(bodies)
+    if data.draw(st.booleans(), label="in build order"):
         bodies = bodies[np.argsort(bodies.max(axis=1), kind="stable")]
     ws.row_body[:n] = bodies
     _compute_envelope(ws, n, model.n_body)
