@@ -12,20 +12,22 @@ checked here, and a result file is its own backing). Digits inside a name are no
 (`chain4`, `rattle4`, `float64`, `MP4`, `V1`: preceded by a letter), nor an exponent after `^`
 (`dt^2`: the formula's base is). The allow-rules, all of them:
 
-- the numbering of an ordered list or a heading (`1. Its rows ...`, `### 8. Positions`);
+- the numbering of an ordered list or a heading (`1. Its rows ...`, `### 8. Positions`), and
+  a reference to the engine's numbered stages (`stage 7`, `stages 4 and 5`, `stages 1-9`);
 - a year: a four-digit integer from 1900 to 2099 (`Kelly 2014`, `IJRR 1998`);
 - the names in NAMES (`2D`, `x86-64`), which carry digits but are not figures.
 
 Every other number, however small, needs an entry: a count of walkers in digits, a dt in an
 example, a version, a measured time. An entry names its page, the figure as written (`number`,
 with a few words around it where the same figure stands on the page with another meaning) or a
-whole table (`table`: its header row; every number in its rows), a short `what`, and exactly one
+whole table (`table`: its header row; every number in the rows below it), a short `what`, and exactly one
 backing: `test` (a test function, path::name, that asserts the figure at the stated bound or
-tighter), `result` (a committed file written by a benchmark that contains every number the entry
-covers, and `command`, the command that writes it), or `kind`: "definition" or "input" (a
-number that is set, not measured: a parameter, a default, a dt, a version, a count of things
-named) or "measured-once" (a figure from one run by hand, which its page says was measured,
-with `command` and `measured`: when and where).
+tighter), `result` (a committed file written by a benchmark that holds every number the
+entry covers, as written or rounded as the page prints it, and `command`, the command that
+writes it), or `kind`: "definition" or "input" (a number that is set, not measured: a
+parameter, a default, a dt, a version, a count of things named, a date), "cited" (a figure
+from a paper, with `source`) or "measured-once" (a figure from one run by hand, which its page
+says was measured, with `command` and `measured`: when and where).
 
 The test fails naming page, line and number for a number without an entry, for an entry whose
 figure is no longer on its page, for a test that does not exist and for a result file that does
@@ -41,9 +43,9 @@ ROOT = Path(__file__).resolve().parents[2]
 TABLE = ROOT / "docs" / "claims.toml"
 PAGES = ["README.md"] + sorted(f"docs/{p.name}" for p in (ROOT / "docs").glob("*.md"))
 NAMES = ("2D", "x86-64")
-KINDS = {"definition", "input", "measured-once"}
+KINDS = {"definition", "input", "cited", "measured-once"}
 # pages whose entries are still being written: their numbers are not enforced yet
-PENDING: set[str] = {"docs/walkers.md", "docs/shapes.md", "docs/engine.md", "docs/benchmarks.md",
+PENDING: set[str] = {"docs/benchmarks.md",
                      "docs/mjcf-gymnasium.md", "docs/gait-analysis.md", "docs/cli.md",
                      "docs/controllers.md", "docs/debugging.md", "docs/testing.md",
                      "docs/references.md"}
@@ -76,6 +78,8 @@ def allowed(text, m):
     before = text[line_start:m.start()]
     if re.fullmatch(r" *(#+ +)?", before) and text[m.end():m.end() + 2] == ". ":
         return True
+    if re.search(r"\bstages? (\d+(-| and ))?$", text[max(0, m.start() - 20):m.start()], re.I):
+        return True
     return re.fullmatch(r"(19|20)\d\d", m.group()) is not None
 
 
@@ -95,12 +99,13 @@ def load():
 
 def spans(clean, entry):
     """Where an entry's figure (or table) stands in the page's prose: (start, end) pairs."""
-    if "table" in entry:
+    if "table" in entry:                    # the rows under the header and its |---| line
         at = clean.find(entry["table"])
         if at < 0:
             return []
+        rows = clean.find("\n", clean.find("\n", at) + 1) + 1
         end = clean.find("\n\n", at)
-        return [(at, len(clean) if end < 0 else end)]
+        return [(rows, len(clean) if end < 0 else end)]
     words = [re.escape(w) for w in entry["number"].split()]
     pattern = r"(?<![\w.])" + r"\s+".join(words) + r"(?![\w]|[.,]\d)"
     return [(m.start(), m.end()) for m in re.finditer(pattern, clean)]
@@ -124,6 +129,8 @@ def test_the_claims_table_reads_and_every_entry_has_one_backing():
             problems.append(f"{name}: kind {e['kind']!r} is not one of {sorted(KINDS)}")
         if ("result" in e or e.get("kind") == "measured-once") and not e.get("command"):
             problems.append(f"{name}: a measured figure needs the `command` that measures it")
+        if e.get("kind") == "cited" and not e.get("source"):
+            problems.append(f"{name}: a cited figure needs its `source`")
         if e.get("kind") == "measured-once" and not e.get("measured"):
             problems.append(f"{name}: a figure measured once needs `measured` (when, where)")
         key = (e.get("page"), e.get("number", e.get("table")))
@@ -172,6 +179,20 @@ def test_a_figure_measured_once_says_so_on_its_page():
     assert not quiet, "measured once, but the page does not say so:\n" + "\n".join(quiet)
 
 
+def _as_printed(token, figure):
+    """Whether `figure` (a number in a result file) is `token` (a number on a page) as the page
+    prints it: equal, or rounded to the token's decimals (significant figures for 1.4e-12)."""
+    token, figure = token.replace(",", ""), figure.replace(",", "")
+    if token == figure:
+        return True
+    mantissa, _, exponent = token.lower().partition("e")
+    if exponent:
+        digits = len(mantissa.replace(".", "").lstrip("0")) - 1
+        return f"{float(figure):.{digits}e}" == f"{float(token):.{digits}e}"
+    decimals = len(mantissa.partition(".")[2])
+    return f"{float(figure):.{decimals}f}" == token
+
+
 def _functions(path):
     return {n.name for n in ast.walk(ast.parse(path.read_text()))
             if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))}
@@ -179,7 +200,8 @@ def _functions(path):
 
 def test_every_backing_exists():
     """A `test` names a test function that exists; a `result` file exists and holds every number
-    the entry covers (or `in_result`, the figure as the file writes it)."""
+    the entry covers, as written or as the page rounds it (0.51 for 0.510, 1.4e-12 for
+    1.39e-12), or `in_result`, the figure as the file writes it."""
     problems = []
     for e in load():
         label = f"{e['page']}: {e.get('number', e.get('table'))!r}"
@@ -191,19 +213,21 @@ def test_every_backing_exists():
                 elif not func.startswith("test") or func not in _functions(ROOT / path):
                     problems.append(f"{label}: no test function {func} in {path}")
         if "result" in e:
-            result = ROOT / e["result"]
-            if not result.is_file():
-                problems.append(f"{label}: no result file {e['result']}")
+            files = [e["result"]] if isinstance(e["result"], str) else e["result"]
+            missing = [f for f in files if not (ROOT / f).is_file()]
+            if missing:
+                problems.append(f"{label}: no result file {missing}")
                 continue
-            held = set(NUMBER.findall(result.read_text()))
+            written = "\n".join((ROOT / f).read_text() for f in files)
+            held = set(NUMBER.findall(written))
             if "in_result" in e:
-                if e["in_result"] not in result.read_text():
+                if e["in_result"] not in written:
                     problems.append(f"{label}: {e['in_result']!r} is not in {e['result']}")
                 continue
             text = (ROOT / e["page"]).read_text()
             clean, found = numbers(text)
             for s, t in spans(clean, e):
                 for a, b, tok in found:
-                    if s <= a and b <= t and tok not in held:
+                    if s <= a and b <= t and not any(_as_printed(tok, f) for f in held):
                         problems.append(f"{label}: {tok} is not in {e['result']}")
     assert not problems, "\n".join(problems)
