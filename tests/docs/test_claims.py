@@ -15,7 +15,7 @@ checked here, and a result file is its own backing). Digits inside a name are no
 - the numbering of an ordered list or a heading (`1. Its rows ...`, `### 8. Positions`), and
   a reference to the engine's numbered stages (`stage 7`, `stages 4 and 5`, `stages 1-9`);
 - a year: a four-digit integer from 1900 to 2099 (`Kelly 2014`, `IJRR 1998`);
-- the names in NAMES (`2D`, `x86-64`), which carry digits but are not figures.
+- the names in NAMES (`2D`, `2-D`, `x86-64`), which carry digits but are not figures.
 
 Every other number, however small, needs an entry: a count of walkers in digits, a dt in an
 example, a version, a measured time. An entry names its page, the figure as written (`number`,
@@ -43,12 +43,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 TABLE = ROOT / "docs" / "claims.toml"
 PAGES = ["README.md"] + sorted(f"docs/{p.name}" for p in (ROOT / "docs").glob("*.md"))
-NAMES = ("2D", "x86-64")
+NAMES = ("2D", "2-D", "x86-64")
 KINDS = {"definition", "input", "cited", "measured-once"}
 # pages whose entries are still being written: their numbers are not enforced yet
-PENDING: set[str] = {"docs/gait-analysis.md", "docs/cli.md",
-                     "docs/controllers.md", "docs/debugging.md", "docs/testing.md",
-                     "docs/references.md"}
+PENDING: set[str] = {"docs/gait-analysis.md"}
 
 NUMBER = re.compile(r"(?<![\w.^])\d+(?:,\d{3})*(?:\.\d+)?(?:[eE][-+]?\d+)?")
 

@@ -88,6 +88,7 @@ def test_simplest_walker_step_map_is_second_order_in_dt():
         periods.append(abs(w.last_period - period))
     print("step map error, step period error [s] at dt 1e-3, 5e-4, 2.5e-4:", errs, periods)
     assert errs[0] < 1e-5 and periods[0] < 1e-5
+    assert f"{errs[0]:.1e}" == "4.3e-06", errs[0]        # docs/gait-analysis.md: "error 4.3e-6 at dt 1e-3 s"
     for big, small in ((errs[0], errs[1]), (errs[1], errs[2]), (periods[0], periods[1]),
                        (periods[1], periods[2])):
         assert 3.0 < big / small < 5.5
