@@ -273,7 +273,7 @@ def test_runs_shorter_than_one_recording_interval(name):
 @pytest.mark.parametrize("name", ["simplest-walker", "compass-gait", "rimless-wheel"])
 def test_cost_of_transport_is_sin_slope_whatever_the_duration(name):
     """Energy lost per weight and distance along the slope, over whole steps (touchdown to
-    touchdown), is sin(slope) on a steady gait: within 1% for runs that end anywhere in a
+    touchdown), is sin(slope) on a steady gait: within 0.6% for runs that end anywhere in a
     step (the end-of-run version gave 0.0074-0.0083 for the simplest walker's 0.009)."""
     import walkers
     mod = walkers.load(name)
@@ -286,7 +286,7 @@ def test_cost_of_transport_is_sin_slope_whatever_the_duration(name):
     slope = {"simplest-walker": SimplestParams().slope, "compass-gait": CompassParams().slope,
              "rimless-wheel": RimlessParams().slope}[name]
     print(name, cots, math.sin(slope))
-    assert np.all(np.abs(np.array(cots) / math.sin(slope) - 1) < 0.01)
+    assert np.all(np.abs(np.array(cots) / math.sin(slope) - 1) < 0.006)   # docs/gait-analysis.md: 0.6%
 
 
 def test_compass_fixed_point_converges_to_the_map_noise():
