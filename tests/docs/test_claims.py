@@ -153,7 +153,7 @@ def test_every_number_on_the_page_has_an_entry(page):
     missing = [f"{page}:{line_of(text, a)}: {tok!r} in "
                f"{' '.join(text.splitlines()[line_of(text, a) - 1].split())[:100]!r}"
                for a, b, tok in found if not any(s <= a and b <= t for s, t in covered)]
-    assert not missing, (f"{len(missing)} numbers of {page} have no entry in docs/claims.toml:\n"
+    assert not missing, (f"{len(missing)} number(s) of {page} without an entry in docs/claims.toml:\n"
                          + "\n".join(missing))
 
 
