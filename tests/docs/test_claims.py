@@ -29,9 +29,13 @@ parameter, a default, a dt, a version, a count of things named, a date), "cited"
 from a paper, with `source`) or "measured-once" (a figure from one run by hand, which its page
 says was measured, with `command` and `measured`: when and where).
 
+An entry covers every number inside each place its text stands on its page (words matched
+across line breaks, inline code ignored); one entry per figure and page.
+
 The test fails naming page, line and number for a number without an entry, for an entry whose
-figure is no longer on its page, for a test that does not exist and for a result file that does
-not hold the figure. It runs no physics."""
+figure is no longer on its page, for a test that does not exist, for a result file that does
+not hold the figure, and for a figure "measured-once" whose paragraph does not say it was
+measured. It runs no physics."""
 import ast
 import functools
 import re
@@ -72,7 +76,7 @@ def prose(text):
 
 
 def allowed(text, m):
-    """The allow-rules: ordered-list and heading numbering, years."""
+    """The allow-rules: ordered-list and heading numbering, the engine's stage numbers, years."""
     line_start = text.rfind("\n", 0, m.start()) + 1
     before = text[line_start:m.start()]
     if re.fullmatch(r" *(#+ +)?", before) and text[m.end():m.end() + 2] == ". ":
