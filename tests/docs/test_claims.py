@@ -65,7 +65,7 @@ def prose(text):
     for pattern in (r"(?s)^ *```.*?^ *```[^\n]*$",        # fenced code blocks
                     r"(?s)<!--.*?-->",                      # HTML comments (and the stage table's marker)
                     r"^.*--8<--.*$",                        # snippet markers and includes
-                    r"``[^\n]+?``|`[^`\n]+`",              # inline code spans
+                    r"``(?:[^\n]|\n(?!\n))+?``|`(?:[^`\n]|\n(?!\n))+`",   # inline code (may wrap a line)
                     r"\]\([^)\s]*\)",                       # link targets and image paths
                     r"https?://\S+"):                       # bare URLs
         for m in reversed(list(re.finditer(pattern, text, re.M))):
