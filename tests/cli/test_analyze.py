@@ -51,7 +51,10 @@ def reference_doublings():
     model's 0.0150883, 0.0176692)."""
     from walkers.passive import SimplestParams
     from walkers.passive.reference import simplest_feet_doublings
-    return simplest_feet_doublings(SimplestParams().foot_mass_ratio)
+    doublings = simplest_feet_doublings(SimplestParams().foot_mass_ratio)
+    # as docs/gait-analysis.md prints them
+    assert [f"{p:.10f}" for p in doublings[:2]] == ["0.0149350876", "0.0175182649"], doublings
+    return doublings
 
 
 def _doublings(dt, rng, points, follow, capsys):

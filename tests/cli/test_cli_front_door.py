@@ -79,6 +79,15 @@ def test_the_summary_file_lists_the_files_the_run_wrote(tmp_path, monkeypatch, c
     assert all((tmp_path / f).exists() for f in saved["files"])
 
 
+def test_a_10_s_walk_at_the_default_size_is_under_1_mb(tmp_path, monkeypatch, capsys):
+    """docs/cli.md: 'out/WALKER.gif (640x360, 20 fps: a 10 s walk is under 1 MB)' (the Simple
+    Biped's: 0.75 MB measured)."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, "run", "simple-biped")
+    assert code == 0, err
+    assert (tmp_path / "out" / "simple-biped.gif").stat().st_size < 1_000_000
+
+
 # progress goes to a terminal only ---------------------------------------------------------------
 def test_analyze_writes_no_progress_bar_into_a_pipe(capsys):
     code, out, err = run_cli(capsys, "analyze", "simplest-walker", "--param", "slope",

@@ -74,6 +74,35 @@ def test_energy_error_shrinks_with_the_order_on_a_double_pendulum(integrator, ra
     assert ratio / 1.3 < coarse / fine < ratio * 1.3, (coarse, fine)
 
 
+def test_the_engine_pages_energy_table_is_what_the_double_pendulum_gives():
+    """docs/engine.md's table of the largest |E - E0| [J] over 1 s of the double pendulum (two
+    0.5 m, 1 kg links released horizontal), read from the page: every cell as it is printed there
+    (two significant figures), a cell marked (rounding) below 1e-12 J, and each row's 'per
+    halving' ratio."""
+    import re
+    from pathlib import Path
+    page = (Path(__file__).resolve().parents[2] / "docs" / "engine.md").read_text()
+    table = page[page.index("| integrator | dt 2 ms |"):]
+    table = table[:table.index("\n\n")].splitlines()[2:]
+    for row in table:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        integrator, printed, halving = cells[0], cells[1:4], cells[4]
+        errors = [energy_error(2, integrator, dt, 1.0) for dt in (2e-3, 1e-3, 5e-4)]
+        for got, want in zip(errors, printed):
+            if want.endswith("(rounding)"):
+                assert got < 1e-12, (integrator, got)
+                continue
+            mantissa, exponent = want.split("e")
+            assert f"{got:.1e}" == f"{float(mantissa):.1f}e{int(exponent):+03d}", (integrator, got, want)
+        ratios = [a / b for a, b in zip(errors, errors[1:]) if a > 1e-12]      # not into rounding
+        low, high = (float(x) for x in re.match(r"([\d.]+)(?:-([\d.]+))?x", halving).groups("0"))
+        low, high = (low * 0.95, low * 1.05) if high == 0 else (low * 0.95, high * 1.05)
+        assert all(low <= r <= high for r in ratios), (integrator, ratios, halving)
+        if integrator == "rattle6":       # "(3.1e-9 at 4 ms)": the top of its range from 4 ms
+            at4 = energy_error(2, integrator, 4e-3, 1.0)
+            assert f"{at4:.1e}" == "3.1e-09" and low <= at4 / errors[0] <= high, (at4, errors[0])
+
+
 def test_rattle_trajectory_converges_at_second_order_to_a_fine_reference():
     # reference: the fourth-order composition at 0.125 ms (its own error is far below RATTLE's)
     ref = run(make_chain(2, dt=1.25e-4), "rattle4", 1.0)[1].q[-1]
@@ -225,6 +254,11 @@ def test_rattle4_follows_mujoco_rk4_on_a_four_link_chain():
     _, tr1 = run(model, "euler", 1.0)
     err1 = np.max(np.abs(tr1.q[:, :, :2] - q_mj[:, :, :2]))
     assert err2 < err1 / 10
+    # docs/engine.md: "the largest position error over 1 s at dt 1 ms is 3.9e-3 m (euler),
+    # 1.7e-5 m (rattle) and 3.3e-10 m (rattle4)"
+    err4 = np.max(np.abs(tr.q[:, :, :2] - q_mj[:, :, :2]))
+    print(f"position errors against RK4: {err1:.2e} {err2:.2e} {err4:.2e}")
+    assert (f"{err1:.1e}", f"{err2:.1e}", f"{err4:.1e}") == ("3.9e-03", "1.7e-05", "3.3e-10"), (err1, err2, err4)
 
 
 def _with_limit():
