@@ -9,7 +9,10 @@ runs them: ``python benchmarks/contact_stress.py --quick`` prints the same cases
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+import planarsim as ps
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
@@ -23,3 +26,38 @@ def test_contact_stress_case_meets_targets(family, seed, strategy):
         f"{family}:{seed}:{strategy} (dt={r['dt']:g} s x {r['steps']}) misses {r['failed']}: "
         f"energy gained {r['gain']:.3g} J (bound {r['e_tol']:.3g} J), pin gap {r['pin']:.3g} m, "
         f"depth {r['depth']:.3g} m, audit {r['audit']}, diverged {r['diverged']!r}")
+
+
+@pytest.mark.parametrize("h_w", [0.05, 0.1, 0.2])
+def test_a_spinning_rods_own_step_gain_is_a_quarter_of_h_w_squared(h_w):
+    """The corpus judge's yardstick for a step beyond the flat share (contact_free_gain): the
+    integrator's own energy change from the step's state with no ground. For two point masses
+    (1 and 2 kg) on a 1 m rod spinning freely at w, one step of 10 ms gains (h w)^2 / 4 of
+    the kinetic energy (the rod's projection of a turn by h w), to 1 %: the step allowance is
+    measured per step, not (h w)^2 of the kinetic energy for every step (4 times this)."""
+    from benchmarks.contact_stress import contact_free_gain
+    dt = 1e-2
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0))
+    b.add_point_mass("a", 1.0, pos=(-0.5, 0.0))
+    b.add_point_mass("b", 2.0, pos=(0.5, 0.0))
+    b.add_rod("rod", "a", "b")
+    model = b.compile()
+    w = h_w / dt
+    centre = (1.0 * -0.5 + 2.0 * 0.5) / 3.0
+    q = np.array(model.q0, float).reshape(-1, 3)[:2].copy()
+    v = np.zeros((2, 3))
+    v[0, 1], v[1, 1] = w * (-0.5 - centre), w * (0.5 - centre)
+    kinetic = 0.5 * (1.0 * v[0, 1] ** 2 + 2.0 * v[1, 1] ** 2)
+    assert contact_free_gain(model, q, v) / kinetic == pytest.approx(h_w ** 2 / 4.0, rel=0.01)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "engine: a 150 m/s rod turning 0.62 rad per step (dt 10 ms) gains 3.5 % of its kinetic "
+    "energy in the step that meets a hill (245 J beyond 1 % of it and E_tol), where the same "
+    "step with no ground gains nothing; the step's own audit counts nothing (the run's "
+    "energy ends within E_tol). Found when the judge's (h w)^2 allowance became the measured "
+    "contact-free gain"))
+def test_no_step_gains_more_than_the_integrator_alone_explains_hills_fast_29():
+    from benchmarks.contact_stress import run_case
+    r = run_case("hills_fast", 29, "alternating")
+    assert "step" not in r["failed"], (r["step_gain"], r["step_k"], r["e_tol"])
