@@ -306,7 +306,8 @@ def test_integrator_option_is_checked_by_name():
 
 def test_a_torque_too_strong_for_the_longest_stage_stops_before_the_step():
     """rattle6's stages are up to 1.32 steps long: a torque that the default step resolves
-    (0.16 rad in one step of 10 ms, under the 0.2 rad turn limit) is too strong for them.
+    (0.16 rad in one step of 10 ms for a 1 m rod turning about its end, inverse inertia
+    1 / (1/12 + 1/4) = 3 / (kg m^2), under the 0.2 rad turn limit) is too strong for them.
     The step stops before its first stage: the state is as it was, and the error reports
     the step's start (step 0, t = 0, last_state bit for bit), not a stage's."""
     b = ps.ModelBuilder(dt=1e-2)
@@ -314,7 +315,7 @@ def test_a_torque_too_strong_for_the_longest_stage_stops_before_the_step():
     b.add_pin("pivot", None, rod, anchor_world=(0.0, 0.0))
     b.add_pin_motor("motor", "pivot")
     model = b.compile()
-    u = np.array([130.0])
+    u = np.array([520.0])
     for integrator in ("euler", "rattle", "rattle4"):
         sim = ps.Simulator(model, options=ps.make_options(integrator=integrator))
         sim.step(u)
