@@ -356,3 +356,35 @@ def test_finger_pushing_its_frictional_spinner_keeps_every_rule(strategy):
         assert sim.ws.audit.sum() == 0
     if strategy == "all":
         assert lcp_solves > 0
+
+
+def test_a_negative_frictionloss_and_an_accurate_integrator_are_refused_naming_the_joint():
+    b = ps.ModelBuilder(dt=DT)
+    rod = b.add_body("rod", mass=M, inertia=I, pos=(0.0, -L / 2))
+    with pytest.raises(ps.ModelError, match=r"pin 'hinge' \(0\): frictionloss=-0.1 must be >= 0"):
+        b.add_pin("hinge", None, rod, anchor_world=(0.0, 0.0), frictionloss=-0.1)
+    with pytest.raises(ps.ModelError, match=r"joint friction \(frictionloss\).*'hinge'|'hinge'.*"
+                                            r"joint friction \(frictionloss\)"):
+        ps.Simulator(pendulum(0.3, 0.1), ps.make_options(integrator="rattle"))
+
+
+@pytest.mark.parametrize("friction, w0", [(0.2, 0.0), (0.2, -3.0), (5.0, -3.0)])
+def test_a_frictional_hinge_at_its_limit_keeps_every_rule(friction, w0):
+    """The limit's row and the stuck friction row share one Jacobian (dependent rows): a rod
+    falling onto its lower limit (friction below gravity's torque) rests there, one stopped by
+    friction first (F 5 N m) stays where it stopped; no audit rule breaks on any step."""
+    b = ps.ModelBuilder(dt=DT)
+    th = 0.5
+    rod = b.add_body("rod", mass=M, inertia=I, pos=(L / 2 * math.sin(th), -L / 2 * math.cos(th)),
+                     angle=th, omega=w0)
+    b.add_pin("hinge", None, rod, anchor_world=(0.0, 0.0), ref_angle=0.0, limit=(0.2, 1.0),
+              frictionloss=friction)
+    sim = ps.Simulator(b.compile(), ps.make_options(audit_raise=1))
+    for _ in range(3000):
+        sim.step()
+    assert abs(sim.state.v[0, 2]) <= 1e-12
+    if friction < abs(gravity_torque(0.2)):
+        assert sim.state.q[0, 2] == pytest.approx(0.2, abs=1e-9)
+    else:
+        assert 0.2 < sim.state.q[0, 2] < th
+    assert sim.ws.audit.sum() == 0
