@@ -388,3 +388,28 @@ def test_a_frictional_hinge_at_its_limit_keeps_every_rule(friction, w0):
     else:
         assert 0.2 < sim.state.q[0, 2] < th
     assert sim.ws.audit.sum() == 0
+
+
+def test_a_double_pendulum_with_friction_in_both_hinges_comes_to_rest_keeping_every_rule():
+    """Two coupled frictional hinges (their modes switched together, friction_rounds, or by
+    the complementarity solve): the chain swings down, loses its energy to friction and
+    stops, both hinges stuck at exactly rest, no audit rule broken on any step."""
+    b = ps.ModelBuilder(dt=DT)
+    a1, a2 = 1.2, 2.0
+    p1 = np.array([L / 2 * math.sin(a1), -L / 2 * math.cos(a1)])
+    elbow = 2 * p1
+    p2 = elbow + [L / 2 * math.sin(a2), -L / 2 * math.cos(a2)]
+    l1 = b.add_body("l1", mass=M, inertia=I, pos=p1, angle=a1)
+    l2 = b.add_body("l2", mass=M, inertia=I, pos=p2, angle=a2)
+    b.add_pin("shoulder", None, l1, anchor_world=(0.0, 0.0), ref_angle=0.0, frictionloss=2.0)
+    b.add_pin("elbow", l1, l2, anchor_world=elbow, frictionloss=0.5)
+    sim = ps.Simulator(b.compile(), ps.make_options(audit_raise=1))
+    E = lambda s: (0.5 * M * (s.v[:, :2] ** 2).sum() + 0.5 * I * (s.v[:, 2] ** 2).sum()  # noqa: E731
+                   + M * G * s.q[:, 1].sum())
+    e0 = E(sim.state)
+    for _ in range(10000):
+        sim.step()
+        assert E(sim.state) <= e0 + 1e-3 * M * G * L
+    assert np.abs(sim.state.v[:, 2]).max() <= 1e-12
+    assert E(sim.state) < e0 - 0.5
+    assert sim.ws.audit.sum() == 0
