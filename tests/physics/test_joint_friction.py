@@ -50,16 +50,22 @@ def test_a_pendulum_whose_gravity_torque_is_below_its_friction_stays_exactly_at_
 
 
 def test_a_pendulum_whose_gravity_torque_exceeds_its_friction_turns_at_torque_less_friction():
+    """Each step's rate increment equals h (torque - F) / I_pivot (torque at the step's start
+    angle) to 1e-9 of itself over the first 12 steps (measured 5.7e-13 at the first, from
+    rest, rising to 9.3e-10 at the 12th); beyond, the pinned rod's own second-order drift
+    term (present without friction too: the pin's target at q + h v) grows as its rate does
+    (measured 2.5e-7 of the increment at 0.8 rad/s, h = 1 ms), as does the increment's
+    difference from a frictionless step's from the same state."""
     theta = 0.3
     friction = 0.5 * abs(gravity_torque(theta))
     sim = ps.Simulator(pendulum(theta, friction))
     worst = 0.0
-    for _ in range(20):
+    for _ in range(12):
         th, w = sim.state.q[0, 2], sim.state.v[0, 2]
         sim.step()
         # slipping towards theta = 0: friction +F opposes it
-        expected = w + DT * (gravity_torque(th) + friction) / IP
-        worst = max(worst, abs(sim.state.v[0, 2] - expected) / abs(expected))
+        increment = DT * (gravity_torque(th) + friction) / IP
+        worst = max(worst, abs((sim.state.v[0, 2] - w) / increment - 1.0))
     assert worst <= 1e-9, worst
     assert sim.ws.audit.sum() == 0
 
