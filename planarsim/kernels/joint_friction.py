@@ -24,6 +24,9 @@ from .row_list import add_row
 
 # an impulse beyond its bound by this share of the bound is a break (rounding below it)
 FRICTION_REL_TOL = 1e-9
+# a slipping joint's rate against its slip by less than this share of its free and end
+# rates is rounding, not a reversal (modes.SLIP_ROUNDING of a sliding contact)
+FRICTION_SLIP_ROUNDING = 1e-12
 
 
 @kernel
@@ -128,7 +131,7 @@ def slip_reversed(m, ws, j):
     of its free rate: its friction would push the motion."""
     rate = friction_rate(m, ws, j, ws.v_new)
     scale = abs(friction_rate(m, ws, j, ws.v_pred)) + abs(rate)
-    return rate * ws.friction_slip[j] < -1e-12 * scale
+    return rate * ws.friction_slip[j] < -FRICTION_SLIP_ROUNDING * scale
 
 
 @kernel
