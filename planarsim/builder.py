@@ -411,7 +411,7 @@ class ModelBuilder:
     # joints ---------------------------------------------------------------------------------
     def add_pin(self, name, body_a, body_b, anchor_world=None, anchor_a=None, anchor_b=None,
                 limit=None, stiffness=0.0, damping=0.0, rest_angle=0.0, ref_angle=None,
-                armature=0.0) -> int:
+                armature=0.0, frictionloss=0.0) -> int:
         """Pin joint between body_a and body_b (None: the world).
 
         Anchors: give ``anchor_world`` (a point both bodies share at the build pose), or local
@@ -420,7 +420,9 @@ class ModelBuilder:
         ``limit=(lower, upper)`` [rad] adds unilateral limits; stiffness [N m/rad] and
         damping [N m s/rad] add a passive spring-damper toward ``rest_angle`` (implicit in the
         velocity solve, kernels/soft.py); armature [kg m^2] a reflected rotor inertia on the
-        pin angle (M_joint += armature, as MuJoCo's).
+        pin angle (M_joint += armature, as MuJoCo's); frictionloss [N m] a dry friction on the
+        pin angle (MuJoCo's frictionloss: the joint sticks while the torque holding it stays
+        within it, else slips against it; kernels/joint_friction.py).
         """
         idx, a, b = self._joint_bodies("pin", name, body_a, body_b, world_b=True)
         if a < 0 and b < 0:
@@ -436,9 +438,10 @@ class ModelBuilder:
         ref = self._angle(b) - self._angle(a) if ref_angle is None else _scalar("pin", name, idx, "ref_angle", ref_angle)
         lo, hi = self._joint_limit("pin", name, idx, limit)
         k, c, arm = self._joint_passive("pin", name, idx, stiffness, damping, armature)
+        fl = self._joint_friction("pin", name, idx, frictionloss)
         self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=ref, limit=(lo, hi),
                                k=k, c=c, rest=_scalar("pin", name, idx, "rest_angle", rest_angle),
-                               kind=JOINT_HINGE, axis=(0.0, 0.0), armature=arm))
+                               kind=JOINT_HINGE, axis=(0.0, 0.0), armature=arm, frictionloss=fl))
         return idx
 
     def _joint_bodies(self, kind, name, body_a, body_b, world_b):
@@ -453,7 +456,8 @@ class ModelBuilder:
         return idx, a, b
 
     def add_free_coordinate(self, name, body, kind="slide", axis=(1.0, 0.0), anchor_world=None,
-                            limit=None, stiffness=0.0, damping=0.0, rest=0.0, armature=0.0) -> int:
+                            limit=None, stiffness=0.0, damping=0.0, rest=0.0, armature=0.0,
+                            frictionloss=0.0) -> int:
         """One coordinate of a body otherwise free in the plane, measured from the world and
         holding nothing (no constraint rows): what acts on it acts as on a joint's coordinate.
 
@@ -462,7 +466,8 @@ class ModelBuilder:
         pose; kind "hinge": the body's turn theta - theta0 [rad] (anchor_world is only drawn).
         ``limit`` [m or rad] adds unilateral limits, stiffness / damping a passive implicit
         spring-damper toward ``rest``, armature [kg or kg m^2] a reflected inertia on the
-        coordinate (as MuJoCo's on a free root's slide or hinge: M_joint += armature), and
+        coordinate (as MuJoCo's on a free root's slide or hinge: M_joint += armature),
+        frictionloss [N or N m] a dry friction on it (kernels/joint_friction.py), and
         add_slider_motor / add_pin_motor a force [N] along the axis at the anchor / a torque
         [N m]. An MJCF free root (two slides and a hinge) is three of these on one body.
         It shares the pins' table with kind JOINT_FREE_SLIDE or JOINT_FREE_HINGE.
@@ -485,11 +490,12 @@ class ModelBuilder:
             d = tuple(d / norm)
         lo, hi = self._joint_limit("free coordinate", name, idx, limit)
         k, c, arm = self._joint_passive("free coordinate", name, idx, stiffness, damping, armature)
+        fl = self._joint_friction("free coordinate", name, idx, frictionloss)
         self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=self._angle(b),
                                limit=(lo, hi), k=k, c=c,
                                rest=_scalar("free coordinate", name, idx, "rest", rest),
                                kind=JOINT_FREE_SLIDE if kind == "slide" else JOINT_FREE_HINGE,
-                               axis=d, armature=arm))
+                               axis=d, armature=arm, frictionloss=fl))
         return idx
 
     def add_fluid_box(self, body, size, viscosity=0.0, density=0.0, local=(0.0, 0.0),
@@ -535,9 +541,16 @@ class ModelBuilder:
             raise ModelError(f"{kind} {name!r} ({idx}): armature={arm} must be >= 0")
         return k, c, arm
 
+    @staticmethod
+    def _joint_friction(kind, name, idx, frictionloss):
+        fl = _scalar(kind, name, idx, "frictionloss", frictionloss)
+        if fl < 0:
+            raise ModelError(f"{kind} {name!r} ({idx}): frictionloss={fl} must be >= 0")
+        return fl
+
     def add_slider(self, name, body_a, body_b, axis=(1.0, 0.0), anchor_world=None, anchor_a=None,
                    anchor_b=None, limit=None, stiffness=0.0, damping=0.0, rest=0.0,
-                   ref_angle=None, armature=0.0) -> int:
+                   ref_angle=None, armature=0.0, frictionloss=0.0) -> int:
         """Slider (prismatic) joint: body_b moves along ``axis`` of body_a (None: the world)
         and keeps its angle relative to body_a.
 
@@ -548,7 +561,8 @@ class ModelBuilder:
         slide s = d.(p_b - p_a) [m] (d the axis in the world) is the joint's coordinate:
         ``limit=(lower, upper)`` [m] adds unilateral limits on it, stiffness [N/m] and damping
         [N s/m] a passive spring-damper toward ``rest`` [m] (implicit, kernels/soft.py),
-        armature [kg] a reflected rotor inertia on it. The relative angle held is
+        armature [kg] a reflected rotor inertia on it, frictionloss [N] a dry friction on it
+        (MuJoCo's frictionloss; kernels/joint_friction.py). The relative angle held is
         theta_b - theta_a = ref_angle [rad] (default: as at the build pose). The slider shares
         the pins' table (names, State.limit_active, State.last_pin_impulse: perpendicular,
         angle, lower, upper impulse) with kind JOINT_SLIDER.
@@ -577,9 +591,10 @@ class ModelBuilder:
                else _scalar("slider", name, idx, "ref_angle", ref_angle))
         lo, hi = self._joint_limit("slider", name, idx, limit)
         k, c, arm = self._joint_passive("slider", name, idx, stiffness, damping, armature)
+        fl = self._joint_friction("slider", name, idx, frictionloss)
         self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=ref, limit=(lo, hi),
                                k=k, c=c, rest=_scalar("slider", name, idx, "rest", rest),
-                               kind=JOINT_SLIDER, axis=tuple(d), armature=arm))
+                               kind=JOINT_SLIDER, axis=tuple(d), armature=arm, frictionloss=fl))
         return idx
 
     def add_rod(self, name, body_a, body_b, anchor_a=(0.0, 0.0), anchor_b=(0.0, 0.0), length=None) -> int:
@@ -884,6 +899,7 @@ class ModelBuilder:
             pin_kind=ro([p["kind"] for p in self._pins], np.int64).reshape(npin),
             pin_axis=ro([p["axis"] for p in self._pins] or np.zeros((0, 2))).reshape(npin, 2),
             pin_armature=ro([p["armature"] for p in self._pins]).reshape(npin),
+            pin_frictionloss=ro([p["frictionloss"] for p in self._pins]).reshape(npin),
             rod_body=ro([r["body"] for r in self._rods] or np.zeros((0, 2)), np.int64).reshape(nr, 2),
             rod_anchor=ro([r["anchor"] for r in self._rods] or np.zeros((0, 2, 2))).reshape(nr, 2, 2),
             rod_length=ro([r["length"] for r in self._rods]).reshape(nr),

@@ -14,12 +14,13 @@ touch); it names the sizes and what to change.
 import math
 
 from .capacity import workspace_capacity
-from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_WORK,
+from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_FRICTION,
+                            AUDIT_JOINT_WORK,
                             AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.codes import INTEGRATOR_NAMES
 from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
-                             UNSUPPORTED_SOFT)
+                             UNSUPPORTED_FRICTION, UNSUPPORTED_SOFT)
 from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
                              GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_ROOM, GUARD_SPEED,
                              GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
@@ -128,6 +129,8 @@ _AUDIT_TEXT = {
                   "a projection (J v = 0)",
     "limit_work": "a joint limit's impulse does positive work ({v:.3g} J)",
     "correction_work": "the position correction added {v:.3g} J beyond its allowance",
+    "joint_friction": "a joint's dry friction outside its bound or pushing the motion "
+                      "({v:.3g} N s beyond its bound, or J of positive work)",
 }
 
 
@@ -159,7 +162,8 @@ def _body_name(model, body) -> str:
 def _element_name(model, kind, element):
     """'pin NAME (j)', 'rod NAME (j)', 'contact NAME (i)' or what else an audit record of rule
     `kind` names."""
-    if kind in (AUDIT_PIN_GAP, AUDIT_JOINT_WORK, AUDIT_LIMIT_WORK) and element < len(model.pin_names):
+    if kind in (AUDIT_PIN_GAP, AUDIT_JOINT_WORK, AUDIT_LIMIT_WORK,
+                AUDIT_JOINT_FRICTION) and element < len(model.pin_names):
         return f"pin {model.pin_names[element]!r} ({element})"
     if kind in (AUDIT_PIN_GAP, AUDIT_JOINT_WORK):
         rod = element - len(model.pin_names)
@@ -275,6 +279,7 @@ def stiff_actuator(model, ws, who="simulation"):
 # what the accurate integrators cannot step, by kernels/rattle.py's UNSUPPORTED_* code
 _UNSUPPORTED = {UNSUPPORTED_CONTACT: "contact", UNSUPPORTED_LIMIT: "joint limit",
                 UNSUPPORTED_SOFT: "joint spring, damper or armature",
+                UNSUPPORTED_FRICTION: "joint friction (frictionloss)",
                 UNSUPPORTED_FLUID: "fluid drag"}
 
 

@@ -10,13 +10,13 @@ import numpy as np
 
 from .errors import accurate_unsupported
 from .kernels.codes import INTEGRATOR_EULER
-from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
-                             UNSUPPORTED_SOFT)
+from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_FRICTION,
+                             UNSUPPORTED_LIMIT, UNSUPPORTED_SOFT)
 
 
 def unsupported_feature(model):
     """(what, index) of the first element an accurate integrator cannot step (a contact, a
-    joint limit, a joint's spring, damper or armature, a fluid drag), or None."""
+    joint limit, a joint's spring, damper, armature or friction, a fluid drag), or None."""
     a = model.arrays
     if len(a.contact_body):
         return UNSUPPORTED_CONTACT, 0
@@ -25,6 +25,8 @@ def unsupported_feature(model):
             return UNSUPPORTED_LIMIT, j
         if a.pin_armature[j] > 0.0 or a.pin_stiffness[j] > 0.0 or a.pin_damping[j] > 0.0:
             return UNSUPPORTED_SOFT, j
+        if a.pin_frictionloss[j] > 0.0:
+            return UNSUPPORTED_FRICTION, j
     if len(a.fluid_body):
         return UNSUPPORTED_FLUID, 0
     return None

@@ -51,6 +51,9 @@ class ModelArrays(NamedTuple):
                                     #   if a = -1); (0, 0) for a hinge
     pin_armature: np.ndarray        # (n_pin,) reflected rotor inertia on the joint coordinate
                                     #   [kg m^2 hinge, kg slider] (kernels/soft.py)
+    pin_frictionloss: np.ndarray    # (n_pin,) dry friction on the joint coordinate, MuJoCo's
+                                    #   frictionloss [N m hinge, N slider]
+                                    #   (kernels/joint_friction.py)
     rod_body: np.ndarray            # (n_rod, 2) int
     rod_anchor: np.ndarray          # (n_rod, 2, 2) local anchors [m]
     rod_length: np.ndarray          # (n_rod,) [m]

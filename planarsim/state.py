@@ -193,6 +193,11 @@ class Workspace(NamedTuple):
     soft_start: np.ndarray       # (n_pin,) int where each row's envelope begins in soft_env
     soft_env: np.ndarray         # (soft_envelope_size,) L D L^T of G W G^T + Gamma, row by row
     soft_rhs: np.ndarray         # (n_pin,) its right-hand side, then the soft rows' impulses
+    friction_slip: np.ndarray    # (n_pin,) a frictional joint's mode this step: 0 stuck (its
+                                 #   row in the solve), +-1 slipping that way (its friction
+                                 #   -F h slip in v_pred) (kernels/joint_friction.py)
+    friction_bound: np.ndarray   # (n_pin,) F h [N m s or N s]: its impulse's bound this step
+    friction_J: np.ndarray       # (n_pin, 2, 3) its rate row g at the step's start
     soft_mark: np.ndarray        # (n_body,) int first soft row touching each body (scratch)
     q_pred: np.ndarray           # (n_body, 3) predicted end-of-step configuration q + h v_pred
     cs_pred: np.ndarray          # (n_body, 3) cos, sin, angle of q_pred (as body_cs)
@@ -678,6 +683,7 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      soft_J=z((npin, 2, 3)), soft_first=z(npin, np.int64),
                      soft_start=z(npin, np.int64), soft_env=z(soft_envelope_size(model)),
                      soft_rhs=z(npin), soft_mark=z(nb, np.int64),
+                     friction_slip=z(npin), friction_bound=z(npin), friction_J=z((npin, 2, 3)),
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),
                      q_solved=z((nb, 3)), v_solved=z((nb, 3)),

@@ -440,12 +440,12 @@ TASKS = {
 
 # the suite's other planar tasks, and why planarsim cannot run them
 UNSUPPORTED = {
-    "finger-spin": "finger's spinner hinge has joint friction (frictionloss), which planarsim's "
-                   "engine does not model",
-    "finger-turn_easy": "finger's spinner hinge has joint friction (frictionloss), which "
-                        "planarsim's engine does not model",
-    "finger-turn_hard": "finger's spinner hinge has joint friction (frictionloss), which "
-                        "planarsim's engine does not model",
+    "finger-spin": "finger's task is not ported yet (its model, with the spinner hinge's joint "
+                   "friction, frictionloss, loads: planarsim.mjcf.load_mjcf)",
+    "finger-turn_easy": "finger's task is not ported yet (its model, with the spinner hinge's "
+                        "joint friction, frictionloss, loads: planarsim.mjcf.load_mjcf)",
+    "finger-turn_hard": "finger's task is not ported yet (its model, with the spinner hinge's "
+                        "joint friction, frictionloss, loads: planarsim.mjcf.load_mjcf)",
 }
 
 

@@ -16,6 +16,9 @@ After the velocity stage (impulses as applied):
             terms may (kernels/work.joints_add_energy), even after the step
             aimed them at J v = 0 (the step's own remedy, kernels/step.py)
   limit_work  a joint limit's impulse does positive work at the end velocity beyond rounding
+  joint_friction  a joint's dry friction outside its bound (|p| > F h) or pushing the motion
+            (p g v_new > 0, or a slipping joint's rate reversed against its friction) beyond
+            rounding (kernels/joint_friction.py)
 After the position stage (the configuration the step ends at):
   pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
   depth     a contact point below the ground, or two shapes overlapping, by more than
@@ -42,6 +45,8 @@ from .math2d import world_point
 from .broad_phase import sweep_pairs
 from .pair import pair_gap_now, place_shapes
 from .rows import is_limit_row, is_normal_row
+from .joint_friction import (FRICTION_REL_TOL, friction_rate, is_joint_friction_row,
+                             slip_reversed)
 from .joints import is_free_joint, is_slider
 from .slider import slider_gap
 from .terrain import ground_point
@@ -58,9 +63,10 @@ AUDIT_UNSOLVED = 6
 AUDIT_JOINT_WORK = 7
 AUDIT_LIMIT_WORK = 8
 AUDIT_CORRECTION_WORK = 9
-N_AUDIT = 10
+AUDIT_JOINT_FRICTION = 10
+N_AUDIT = 11
 AUDIT_NAMES = ("pull", "cone", "work", "pin_gap", "depth", "fallback", "unsolved",
-               "joint_work", "limit_work", "correction_work")
+               "joint_work", "limit_work", "correction_work", "joint_friction")
 
 PIN_GAP_TOL = 1e-9       # [m]
 DEPTH_TOL = 1e-8         # [m]
@@ -173,10 +179,41 @@ def joint_element(m, ws, r):
 
 
 @kernel
+def audit_joint_friction(m, s, ws):
+    """Joints' dry friction outside its bound F h, or pushing the motion at the end velocity
+    (a stuck row's impulse doing positive work beyond rounding, a slipping joint's rate
+    reversed against its friction); returns how many."""
+    found = 0
+    step = s.step[0]
+    for r in range(ws.n_row[0]):
+        if not is_joint_friction_row(ws.row_kind[r]):
+            continue
+        j = ws.row_owner[r]
+        bound = ws.friction_bound[j]
+        lam = ws.lam[r]
+        rate = friction_rate(m, ws, j, ws.v_new)
+        free = friction_rate(m, ws, j, ws.v_pred)
+        over = abs(lam) - bound
+        work = lam * rate
+        if over > FRICTION_REL_TOL * bound:
+            note(ws, step, AUDIT_JOINT_FRICTION, j, m.pin_body[j, 1], over)
+            found += 1
+        elif work > abs(lam) * (WORK_REL_TOL * (abs(rate) + abs(free)) + VELOCITY_FLOOR):
+            note(ws, step, AUDIT_JOINT_FRICTION, j, m.pin_body[j, 1], work)
+            found += 1
+    for j in range(m.pin_body.shape[0]):
+        if ws.friction_slip[j] != 0.0 and slip_reversed(m, ws, j):
+            note(ws, step, AUDIT_JOINT_FRICTION, j, m.pin_body[j, 1],
+                 ws.friction_bound[j] * abs(friction_rate(m, ws, j, ws.v_new)))
+            found += 1
+    return found
+
+
+@kernel
 def audit_joints(m, s, ws, opt, h):
     """Joint limits whose impulse does positive work at the end velocity, and joints whose
     impulses added energy (work.joints_add_energy), beyond rounding; returns how many."""
-    found = 0
+    found = audit_joint_friction(m, s, ws)
     step = s.step[0]
     speed = -1.0
     for r in range(ws.n_row[0]):

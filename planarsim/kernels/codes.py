@@ -34,6 +34,7 @@ ROW_CONTACT_T = 6
 ROW_SLIDE_PERP = 7     # a slider's anchor b held on its axis line (slider.py)
 ROW_SLIDE_ANGLE = 8    # a slider's relative angle held (slider.py)
 ROW_JOINT_SOFT = 9     # a joint coordinate's armature and implicit spring-damper (soft.py)
+ROW_JOINT_FRICTION = 10  # a stuck joint's dry friction: its rate held, |impulse| <= F h (joint_friction.py)
 
 INTEGRATOR_EULER = 0      # StepOptions.integrator: the default step, symplectic Euler with SHAKE
 # 1: RATTLE, second order (kernels/rattle.py)

@@ -23,6 +23,7 @@ from .info import INFO_NEWTON_TAKEN_BACK
 from .math2d import update_trig
 from .limit import limit_side
 from .row_list import move_row
+from .joint_friction import is_joint_friction_row
 from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_normal_row,
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .matrix import arrange, assemble, factor_solve, substitute_ws
@@ -64,8 +65,8 @@ def keep_correction_rows(s, ws):
             continue    # rebounding (restitution): it leaves the surface, not held to it
         if is_limit_row(kind) and s.limit_active[o, limit_side(kind)] == 0:
             continue
-        if is_soft_row(kind):
-            continue    # a joint's armature / spring-damper row: no position error to hold
+        if is_soft_row(kind) or is_joint_friction_row(kind):
+            continue    # a joint's armature / spring-damper / friction row: no position error
         if k != r:
             move_row(ws, k, r)
         k += 1

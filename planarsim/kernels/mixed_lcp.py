@@ -5,7 +5,8 @@ ws.lcp_A, b = ws.row_b):
   joints (pins x / y, rods):   x free,  w = 0
   unilateral (contact normals, joint limits):   x >= 0, w >= 0, x w = 0
   friction (a contact's tangent row t, after its normal row n):   |x_t| <= mu x_n, and
-      w_t = 0 inside the cone (sticking) or x_t = -mu x_n sign(w_t) (sliding)
+      w_t = 0 inside the cone (sticking) or x_t = -mu x_n sign(w_t) (sliding); a joint's
+      friction row (joint_friction.py) the same with the constant bound F h for mu x_n
 The joints are eliminated first (Schur complement: x_b = -A_bb^-1 (b_b + A_bx x_x); the joint
 rows of a tree are independent, so A_bb is positive definite; a row of a joint-only loop that
 depends exactly on others is consistent and is left out there, impulse 0; which rows those
@@ -25,6 +26,7 @@ from .lcp import LCP_INACCURATE, LCP_RAY, LCP_SOLVED, lemke, polish
 from .codes import CONTACT_PAIR
 from .contacts import pair_motion_scale
 from .rows import is_joint_row, is_soft_row, is_tangent_row
+from .joint_friction import is_joint_friction_row
 from .soft import soft_compliance
 from .envelope import _entry
 
@@ -207,6 +209,22 @@ def _solve_joints(B, nb, G, col):
         G[i, col] = acc
 
 
+@kernel
+def is_boxed_row(kind):
+    """A friction row (three variables beta+, beta-, gamma): a contact's tangent row (bound
+    mu x_n) or a stuck joint's friction row (bound F h, joint_friction.py)."""
+    return is_tangent_row(kind) or is_joint_friction_row(kind)
+
+
+@kernel
+def friction_bound_of(m, ws, r):
+    """The bound [N s or N m s] of friction row r's impulse as solved: mu x_n of a contact's
+    (its normal row r - 1), F h of a joint's."""
+    if is_joint_friction_row(ws.row_kind[r]):
+        return ws.friction_bound[ws.row_owner[r]]
+    return m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1]
+
+
 @kernel(inline="never")
 def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     """Impulses ws.lam[r] of the rows r in rows[start:start + count] (an island's, in their
@@ -254,7 +272,7 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
         r = ws.lcp_rows[nb + i]
         ws.lcp_var[r] = nv
         ws.lcp_pos[i] = nv
-        nv += 3 if is_tangent_row(ws.row_kind[r]) else 1
+        nv += 3 if is_boxed_row(ws.row_kind[r]) else 1
     Mx = ws.lcp_M
     if nv > Mx.shape[0]:            # beyond the workspace's storage: the step begins again
         ws.room[0] = 1              # with more (kernels/step.py, GUARD_ROOM)
@@ -274,18 +292,18 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
         sii = S[i, i]
         sc = 1.0 / math.sqrt(sii) if sii > 0.0 else 1.0
         d[p] = sc
-        if is_tangent_row(ws.row_kind[r]):
+        if is_boxed_row(ws.row_kind[r]):
             d[p + 1] = sc
             d[p + 2] = 1.0 / sc
     for i in range(nx):
         ri = ws.lcp_rows[nb + i]
         pi = ws.lcp_pos[i]
-        ti = is_tangent_row(ws.row_kind[ri])
+        ti = is_boxed_row(ws.row_kind[ri])
         for j in range(nx):
             rj = ws.lcp_rows[nb + j]
             pj = ws.lcp_pos[j]
             sij = S[i, j]
-            if is_tangent_row(ws.row_kind[rj]):
+            if is_boxed_row(ws.row_kind[rj]):
                 Mx[pi, pj] = sij
                 Mx[pi, pj + 1] = -sij
                 if ti:
@@ -300,10 +318,13 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
             qx[pi + 1] = -S[i, nx]
             Mx[pi, pi + 2] = 1.0
             Mx[pi + 1, pi + 2] = 1.0
-            # gamma's row: mu x_n - beta+ - beta-, x_n the normal row just before this one
+            # gamma's row: mu x_n - beta+ - beta-, x_n the normal row just before this one;
+            # a joint's friction: F h - beta+ - beta- (a constant bound)
             o = ws.row_owner[ri]
-            pn = ws.lcp_var[ri - 1]
-            Mx[pi + 2, pn] = m.contact_mu[o]
+            if is_joint_friction_row(ws.row_kind[ri]):
+                qx[pi + 2] = ws.friction_bound[o]
+            else:
+                Mx[pi + 2, ws.lcp_var[ri - 1]] = m.contact_mu[o]
             Mx[pi + 2, pi] = -1.0
             Mx[pi + 2, pi + 1] = -1.0
     for i in range(nv):
@@ -365,13 +386,13 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     for i in range(nx):
         r = ws.lcp_rows[nb + i]
         p = ws.lcp_pos[i]
-        if is_tangent_row(ws.row_kind[r]):
+        if is_boxed_row(ws.row_kind[r]):
             ws.row_slip[r] = ws.lcp_z[p + 2]
             ws.lam[r] = ws.lcp_z[p] - ws.lcp_z[p + 1]
             # rounding (or a regularised answer polish could not mend) may leave |x_t| a
-            # hair above mu x_n: clip to the cone (the clip changes other rows' velocities
-            # by as much; the audit judges the result)
-            bound = m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1]
+            # hair above mu x_n (F h): clip to the cone (the clip changes other rows'
+            # velocities by as much; the audit judges the result)
+            bound = friction_bound_of(m, ws, r)
             if ws.lam[r] > bound:
                 ws.lam[r] = bound
             elif ws.lam[r] < -bound:

@@ -8,6 +8,8 @@ meets for every contact and limit at once:
            slip does not reverse within the step
   free     no impulse, and the point does not end the step below the ground
   limits   a limit's impulse pushes; an inactive limit is not passed
+  joint friction  a stuck joint's impulse within F h; a slipping joint's rate not reversed
+           (joint_friction.py)
 rule_breaks checks a guess's answer (the modes carried over); engage_* bring contacts and
 limits the motion would push through into the problem; seed_rule is the alternating
 strategy's one-contact re-examination (release if it pulls, slide outside the cone, stick on
@@ -23,6 +25,7 @@ from .audit import IMPULSE_FLOOR
 from .mixed_lcp import is_sliding_solution
 from .limit import limit_side
 from .joints import is_slider, joint_position_rate
+from .joint_friction import friction_breaks
 from .rows import has_mode_rows, is_limit_row, is_normal_row, is_soft_row, is_tangent_row
 from .soft import soft_compliance
 from .solve import row_dot
@@ -173,8 +176,11 @@ def rule_breaks(m, s, ws, h, equalities):
     check every row's equation (needed where the solve dropped a dependent row or had no
     symmetric factorisation; a backward-stable L D L^T of all rows meets them to rounding)."""
     n = ws.n_row[0]
+    # a frictional joint's rule (joint_friction.py): a stuck one's impulse within F h, a
+    # slipping one's rate not reversed (a slipping joint has no row)
+    friction = friction_breaks(m, ws)
     if not equalities and not has_mode_rows(ws, n):
-        return 0        # joints only, their equations met by the solve: no rule to break
+        return friction     # joints only, their equations met by the solve
     big_lam = 0.0
     big_b = 0.0
     big_normal = 0.0
@@ -187,7 +193,7 @@ def rule_breaks(m, s, ws, h, equalities):
     # rounding of a contact that carries no load (statically indeterminate: a box on two)
     floor = IMPULSE_FLOOR * big_normal
     tol_w = SOLVE_REL_TOL * (big_b + 1.0)
-    breaks = 0
+    breaks = friction
     for r in range(n):
         kind = ws.row_kind[r]
         o = ws.row_owner[r]

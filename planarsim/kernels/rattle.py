@@ -58,6 +58,7 @@ YOSHIDA6_W0 = 1.0 - 2.0 * (YOSHIDA6_W1 + YOSHIDA6_W2 + YOSHIDA6_W3)
 UNSUPPORTED_CONTACT = 0   # a contact (index: the contact)
 UNSUPPORTED_LIMIT = 1     # a joint limit (index: the joint)
 UNSUPPORTED_SOFT = 2      # a joint's spring, damper or armature (index: the joint)
+UNSUPPORTED_FRICTION = 4  # a joint's dry friction, frictionloss (index: the joint)
 UNSUPPORTED_FLUID = 3     # a body under fluid drag (index: the fluid entry)
 
 
@@ -113,6 +114,8 @@ def unsupported(m, ws):
             return _refuse(ws, UNSUPPORTED_LIMIT, j)
         if m.pin_armature[j] > 0.0 or m.pin_stiffness[j] > 0.0 or m.pin_damping[j] > 0.0:
             return _refuse(ws, UNSUPPORTED_SOFT, j)
+        if m.pin_frictionloss[j] > 0.0:
+            return _refuse(ws, UNSUPPORTED_FRICTION, j)
     if m.fluid_body.shape[0] > 0:
         return _refuse(ws, UNSUPPORTED_FLUID, 0)
     return GUARD_OK

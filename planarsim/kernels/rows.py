@@ -9,7 +9,8 @@ a joint's soft row (armature and implicit spring-damper, a compliant equality), 
 Each kind of constraint has its own module that evaluates its rows: pin.py (two equalities,
 ROW_PIN_X / ROW_PIN_Y), slider.py (ROW_SLIDE_PERP / ROW_SLIDE_ANGLE), rod.py (ROW_ROD),
 limit.py (ROW_LIMIT_LO / ROW_LIMIT_HI, inequalities on a joint's coordinate: a hinge's angle,
-a slider's slide), soft.py (ROW_JOINT_SOFT, a joint coordinate's armature and implicit
+a slider's slide), joint_friction.py (ROW_JOINT_FRICTION, a stuck joint's dry friction: its
+rate held, its impulse within +-F h), soft.py (ROW_JOINT_SOFT, a joint coordinate's armature and implicit
 spring-damper: an equality with a compliance), contacts.py (a ground contact's normal and
 tangent rows) and pair.py (a shape pair's, acting on both bodies). This module is the one place
 that dispatches on the kind (eval_row, row_lever, last_impulse, store_joint_impulse) and names
@@ -30,6 +31,7 @@ from .codes import (CONTACT_PAIR, MODE_PINNED, MODE_SLIDING, ROW_CONTACT_N, ROW_
                     ROW_JOINT_SOFT, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
                     ROW_SLIDE_ANGLE, ROW_SLIDE_PERP)
 from .joints import is_free_joint, is_slider, joint_rate_row
+from .joint_friction import add_friction_row, friction_row, is_joint_friction_row
 from .contacts import ground_lever, ground_row
 from .limit import add_limit_rows, limit_row, limit_side
 from .math2d import set_dir, world_point
@@ -133,6 +135,8 @@ def eval_row(m, q, cs, ws, r, J, found):
         return slider_angle_row(m, q, o, a, b, J)
     if kind == ROW_JOINT_SOFT:
         return soft_row(m, q, cs, o, J)
+    if is_joint_friction_row(kind):
+        return friction_row(m, q, cs, o, J)
     if is_limit_row(kind):
         if is_slider(m, o):
             return slide_limit_row(m, q, cs, o, limit_side(kind), J)
@@ -169,7 +173,7 @@ def row_lever(m, ws, r, e):
         return 0.0
     if kind == ROW_SLIDE_PERP:
         return slider_lever(m, o, e)
-    if is_limit_row(kind):
+    if is_limit_row(kind) or is_joint_friction_row(kind):
         return slider_lever(m, o, e) if is_slider(m, o) else 0.0
     if is_contact_row(kind):
         if m.contact_kind[o] == CONTACT_PAIR:
@@ -312,6 +316,7 @@ def build_rows(m, s, ws):
             n = add_joint_rows(m, ws, n, jp)
             n = add_limit_rows(m, s, ws, n, jp)
             n = add_soft_row(m, ws, n, jp)
+            n = add_friction_row(m, ws, n, jp)
             jp += 1
         elif kr <= kc:
             n = add_rod_row(m, ws, n, jr)

@@ -29,6 +29,7 @@ from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_R
                      start_path)
 from .info import INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
 from .integrate import predict_configuration
+from .joint_friction import start_joint_friction, stick_all, switch_joint_friction
 from .math2d import update_trig
 from .modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
@@ -208,6 +209,41 @@ def solve_and_check(m, s, ws, opt, h, include_ccd):
     return breaks, engaged, 2 + solves
 
 
+# rounds of the joints' friction rule (friction_rounds) a step tries before the contacts'
+# strategies and the complementarity solve
+FRICTION_ROUNDS = 8
+
+
+@kernel
+def refresh_prediction(m, s, ws, h):
+    """v_lin and the predicted configuration again from v* (a joint's friction mode moved it;
+    joint_friction.py): the answer is then the one a right guess would have given."""
+    soft_prediction(m, s, ws, h)
+    predict_configuration(m, s, ws, h)
+
+
+@kernel(inline="never")
+def friction_rounds(m, s, ws, opt, h, include_ccd):
+    """After an answer that broke a rule: every frictional joint that breaks its own
+    (joint_friction.switch_joint_friction: stuck beyond F h slips, a reversed slip sticks)
+    switched and the step solved again (with the contacts and limits its answer engages), up
+    to FRICTION_ROUNDS times, while a switch is left to make. Returns (an answer stands,
+    solves)."""
+    solves = 0
+    for _ in range(FRICTION_ROUNDS):
+        if switch_joint_friction(m, ws) == 0:
+            break
+        refresh_prediction(m, s, ws, h)
+        breaks, engaged, more = solve_and_check(m, s, ws, opt, h, include_ccd)
+        solves += more
+        while breaks == 0 and engaged > 0 and ws.room[0] == 0:
+            breaks, engaged, more = solve_and_check(m, s, ws, opt, h, include_ccd)
+            solves += more
+        if ws.room[0] == 1 or (breaks == 0 and engaged == 0):
+            return True, solves
+    return False, solves
+
+
 # rounds of the simultaneous check (switch_rounds) a step tries after the guess and the
 # alternating check, before the complementarity solve; rounds without fewer broken rules
 # after which only the first contact that breaks one is switched (Murty's least index)
@@ -276,7 +312,9 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     answer that breaks a rule has the contact under the cursor re-examined by the
     alternating rule and is solved once more; one that still breaks a rule has every contact
     that breaks one switched at once, up to SWITCH_ROUNDS times (switch_rounds). An answer
-    that still breaks a rule goes to the complementarity solve, which ends at a consistent
+    that still breaks a rule has its frictional joints switched by their rule (friction_rounds),
+    then the contacts' strategies; one that still breaks a rule goes to the complementarity
+    solve, which ends at a consistent
     answer (complementarity.solve_contacts). Returns
     True if a linear solve's answer stood (its rows, and their envelope where there are rows,
     are in ws), False if the complementarity solve replaced it."""
@@ -292,6 +330,11 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     ok = breaks == 0 and engaged == 0
     if ws.room[0] == 1:
         return True             # (no room: the step begins again with more)
+    if not ok:
+        ok, more = friction_rounds(m, s, ws, opt, h, include_ccd)
+        rounds += more
+        if ws.room[0] == 1:
+            return True
     nc = m.contact_body.shape[0]
     if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
         seed_rule(m, s, ws, s.mode_cursor[0] % nc)
@@ -305,6 +348,8 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     if ok:
         gather_contact_impulses(m, s, ws)
     else:
+        if stick_all(m, ws) > 0:        # frictional joints enter as box rows
+            refresh_prediction(m, s, ws, h)
         solve_contacts(m, s, ws, h, include_ccd)
     remember_impulses(s, ws)
     ws.info[INFO_SOLVES] += rounds
@@ -459,6 +504,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             if code != 0:
                 return code
         predict_velocity(m, s, ws, h)                       #    v* = v + h M^-1 f
+        start_joint_friction(m, s, ws, h)                   #    slipping joints' friction
         soft_prediction(m, s, ws, h)                        #    v_lin: v* and soft rows
         predict_configuration(m, s, ws, h)                  #    q + h v_lin (joints' drift)
         find_contacts(m, s, ws, h)                          # 2. contacts

@@ -209,20 +209,21 @@ class Emitter:
 
     def add_pin(self, builder, j, a, b):
         """A hinge -> ModelBuilder.add_pin at the joint's world position (armature [kg m^2]
-        to add_pin(armature=...))."""
+        to add_pin(armature=...), frictionloss [N m] to add_pin(frictionloss=...))."""
         limit, k, c, rest = self.joint_terms(j)
         return builder.add_pin(j["name"], a, b, anchor_world=tuple(self.map.plane(j["pos"])),
                                limit=limit, stiffness=k, damping=c, rest_angle=rest,
-                               armature=self.armature(j))
+                               armature=self.armature(j), frictionloss=j["frictionloss"])
 
     def add_slider(self, builder, j, a, b):
         """A slide between bodies -> ModelBuilder.add_slider (axis: unit in-plane direction;
-        limit [m]; stiffness [N/m], damping [N s/m]; armature [kg])."""
+        limit [m]; stiffness [N/m], damping [N s/m]; armature [kg]; frictionloss [N])."""
         limit, k, c, rest = self.joint_terms(j)
         ax = j["axis"]
         return builder.add_slider(j["name"], a, b, axis=(ax[self.map.i1], ax[self.map.i2]),
                                   anchor_world=tuple(self.map.plane(j["pos"])), limit=limit,
-                                  stiffness=k, damping=c, rest=rest, armature=self.armature(j))
+                                  stiffness=k, damping=c, rest=rest, armature=self.armature(j),
+                                  frictionloss=j["frictionloss"])
 
     def free_coordinates(self, builder, b, body, out):
         """A free root's joints -> ModelBuilder.add_free_coordinate, each about the hinge's
@@ -236,7 +237,7 @@ class Emitter:
             pid = builder.add_free_coordinate(
                 j["name"], body, kind=kind, axis=(1.0, 0.0) if kind == "hinge" else axis,
                 anchor_world=anchor, limit=limit, stiffness=k, damping=c, rest=rest,
-                armature=self.armature(j))
+                armature=self.armature(j), frictionloss=j["frictionloss"])
             out.joint[j["name"]] = JointMap("free", body,
                                             self.map.sign(j) if kind == "hinge" else 1.0,
                                             j["ref"], axis, anchor, pin=pid)

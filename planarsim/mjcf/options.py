@@ -8,7 +8,7 @@ contact        no geom collides: every shape is drawn only (the ground and walls
 limit          joint ranges are not enforced (the joints load without limits)
 constraint     all of contact, limit and frictionloss (planarsim's joints themselves
                are its coordinates, not constraints, as MuJoCo's are)
-frictionloss   joints' frictionloss is not applied (so a non-zero one loads)
+frictionloss   joints' frictionloss is not applied (their dry friction rows are left out)
 spring         joint stiffness is zero
 damper         joint damping is zero (with spring also disabled: the fluid forces too,
                as MuJoCo's passive forces)
@@ -126,25 +126,25 @@ def read_flags(loader, option_node):
         loader.report.note("fluid forces are off (<option><flag spring and damper='disable'>)")
 
 
-def check_frictionloss(loader, node, eff):
-    """(loader: the Reader) A joint's frictionloss: 0, or ignored (reported) where <flag frictionloss> or
-    <flag constraint> is disabled; otherwise a ModelError naming the joint."""
+def joint_frictionloss(loader, node, eff):
+    """(loader: the Reader) A hinge's or slide's frictionloss [N m or N] (MuJoCo's dry joint
+    friction; planarsim's exact friction row, kernels/joint_friction.py); 0, reported as
+    ignored, where <flag frictionloss> or <flag constraint> is disabled; a negative one is a
+    ModelError naming the joint."""
     raw = eff.get("frictionloss")
     if raw is None:
-        return
+        return 0.0
     value = loader.scalar(node, eff, "frictionloss", 0.0)
     if value == 0.0:
-        return
+        return 0.0
     if value < 0:
-        loader.fail(node, f"frictionloss={value} must be >= 0")
+        name = eff.get("name") or f"joint@{node.line}"
+        loader.fail(node, f"joint {name!r} has frictionloss={value}: it must be >= 0")
     if not loader.flags.frictionloss:
         loader.report.ignore("joint frictionloss (<flag frictionloss or constraint='disable'>)",
                              node.line)
-        return
-    name = eff.get("name") or f"joint@{node.line}"
-    loader.fail(node, f"joint {name!r} has frictionloss={value} (dry friction in the joint): "
-                      f"not supported (planarsim has no joint friction rows); only "
-                      f"frictionloss=0 loads")
+        return 0.0
+    return value
 
 
 def check_filterparent(loader):

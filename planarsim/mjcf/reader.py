@@ -12,7 +12,7 @@ from ..errors import ModelError
 from .description import Body3D, Description, Motor, Tendon
 from .geoms import BodyPartsReader
 from .include import origin
-from .options import Flags, check_frictionloss, read_flags
+from .options import Flags, joint_frictionloss, read_flags
 from .schema import CHILDREN, DEFAULT_GRAVITY, DEFAULT_TIMESTEP, DROPPABLE, EMPTY_ONLY, IGNORED_ELEMENTS
 from .xml_tree import Node
 
@@ -202,8 +202,8 @@ class Reader(BodyPartsReader):
         p = self.floats(j, eff, "pos", 3, default=(0.0, 0.0, 0.0))
         if not self.global_coords:
             a, p = body.R @ a, body.pos + body.R @ p
-        check_frictionloss(self, j, eff)      # 0, or a ModelError naming it
-        return dict(node=j, eff=eff, type=kind, axis=a, pos=p,
+        friction = joint_frictionloss(self, j, eff)   # [N m or N]; 0 where off
+        return dict(node=j, eff=eff, type=kind, axis=a, pos=p, frictionloss=friction,
                     name=eff.get("name") or f"joint@{j.line}", **self.joint_values(j, eff, kind))
 
     def joint_values(self, node, eff, kind):

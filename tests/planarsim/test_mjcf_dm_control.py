@@ -2,9 +2,9 @@
 against MuJoCo.
 
 The ten planar domains load as shipped, from the file's path (their <include>s of
-./common/*.xml next to them), swimmer from its generated XML with its assets dict, except
-finger, which needs a constraint row planarsim does not have (the spinner's joint
-frictionloss): a ModelError naming the joint. point_mass's motors pull on fixed tendons
+./common/*.xml next to them), swimmer from its generated XML with its assets dict; finger
+with its spinner's joint frictionloss (planarsim's exact friction row; its motion against
+MuJoCo's: tests/physics/test_joint_friction.py). point_mass's motors pull on fixed tendons
 (test_mjcf_tendons.py compares its motion under them with MuJoCo's).
 
 For each model that loads: every rigid body's mass and inertia about the plane's normal
@@ -160,10 +160,14 @@ def test_suite_model_passive_motion_matches_mujoco(name):
     assert 5.0 * err(fine_v, exact_v) <= max(err(v, exact_v), err(euler_v, exact_v))
 
 
-def test_finger_is_refused_naming_the_spinners_frictionloss():
-    with pytest.raises(ModelError, match=r"finger\.xml:40: <joint name='hinge'> \(line 40\): joint "
-                                         r"'hinge' has frictionloss=0\.1 .*not supported"):
-        load_mjcf(SUITE / "finger.xml")
+def test_finger_loads_with_the_spinners_frictionloss():
+    loaded = load_mjcf(SUITE / "finger.xml")
+    model = loaded.compile()
+    hinge = loaded.joint["hinge"].coordinate
+    assert model.arrays.pin_frictionloss[hinge] == 0.1
+    assert model.arrays.pin_damping[hinge] == 0.5
+    assert all(model.arrays.pin_frictionloss[loaded.joint[j].coordinate] == 0.0
+               for j in ("proximal", "distal"))
 
 
 def test_point_mass_loads_in_x_y_with_limited_damped_slides_and_tendon_motors():

@@ -196,17 +196,19 @@ def test_override_loads_where_contacts_are_off():
     assert "option flag override='enable' (contacts are off)" in rep.ignored
 
 
-def test_frictionloss_is_an_error_naming_the_joint_unless_zero_or_switched_off():
+def test_frictionloss_loads_onto_the_joint_unless_switched_off_and_a_negative_one_is_an_error():
     xml = PENDULUM.format(dt=0.01, flags="{f}", range="-20 20").replace(
         "damping='0.4'", "damping='0.4'\nfrictionloss='{v}'")
+    loaded = load_mjcf(xml.format(f="", v="0.25"))
+    assert loaded.compile().arrays.pin_frictionloss[loaded.joint["j"].coordinate] == 0.25
+    assert load_mjcf(xml.format(f="", v="0")).compile().arrays.pin_frictionloss.max() == 0.0
     with pytest.raises(ModelError, match=r"<string>:1: <joint name='j'> \(line 1\): joint 'j' has "
-                                         r"frictionloss=0.25 \(dry friction in the joint\): not "
-                                         r"supported"):
-        load_mjcf(xml.format(f="", v="0.25"))
-    load_mjcf(xml.format(f="", v="0"))
+                                         r"frictionloss=-0.25: it must be >= 0"):
+        load_mjcf(xml.format(f="", v="-0.25"))
     for off in ("frictionloss='disable'", "constraint='disable'"):
-        rep = load_mjcf(xml.format(f=off, v="0.25")).report
-        assert any(k.startswith("joint frictionloss") for k in rep.ignored)
+        loaded = load_mjcf(xml.format(f=off, v="0.25"))
+        assert any(k.startswith("joint frictionloss") for k in loaded.report.ignored)
+        assert loaded.compile().arrays.pin_frictionloss.max() == 0.0
 
 
 def test_filterparent_disabled_is_an_error_where_parent_and_child_may_touch():
