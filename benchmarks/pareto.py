@@ -96,22 +96,41 @@ def frames(k):
 
 class _Planarsim:
     """planarsim at frame_dt / k steps per frame, with the peers' World interface; options:
-    make_options keywords (integrator='rattle', say)."""
+    make_options keywords (integrator='rattle', say). A run the engine stops (a
+    SimulationDiverged: a chain whipping faster than a long step resolves, say) keeps its
+    message in `warnings` as (frame, text), as a peer's warning: it is not on the front."""
 
     def __init__(self, name, frame_dt, k, **options):
         self.sim = ps.Simulator(build_model(name, frame_dt / k), options=ps.make_options(**options))
         self.start, self.k = self.sim.snapshot(), k
+        self.warnings = []
 
     def reset(self):
         self.sim.restore(self.start)
 
     def run(self, n):
-        self.sim.steps(n * self.k)
+        try:
+            self.sim.steps(n * self.k)
+        except ps.SimulationDiverged as err:
+            self.warnings = self.warnings or [(-1, str(err).split(":")[0])]
 
     def record(self, n):
+        """Poses and velocities (n + 1, n_body, 3) of an n-frame run from the start state, or
+        the frames before the engine stopped it."""
         self.reset()
-        traj = self.sim.run(n_steps=n * self.k, record_every=self.k)
-        return traj.q[:n + 1], traj.v[:n + 1]
+        self.warnings = []
+        nb = self.sim.model.n_body
+        q = np.zeros((n + 1, nb, 3))
+        v = np.zeros_like(q)
+        q[0], v[0] = self.sim.state.q[:nb], self.sim.state.v[:nb]
+        for f in range(1, n + 1):
+            try:
+                self.sim.steps(self.k)
+            except ps.SimulationDiverged as err:
+                self.warnings = [(f, str(err).split(":")[0])]
+                return q[:f], v[:f]
+            q[f], v[f] = self.sim.state.q[:nb], self.sim.state.v[:nb]
+        return q, v
 
 
 def measure_scene(name, peers, quick=False, repeats=3, timing_seconds=1.0, accuracy_seconds=None):

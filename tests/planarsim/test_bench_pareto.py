@@ -214,3 +214,17 @@ def test_each_peer_times_its_empty_step_by_the_call_it_is_timed_with(monkeypatch
     monkeypatch.setattr(mod, "_stepper", lambda space: space.step)     # pymunk's own Space.step
     q_slow, _ = mod.World(spec).record(200)
     assert np.array_equal(q_fast, q_slow)
+
+
+def test_a_planarsim_run_the_engine_stops_is_reported_as_a_peers_warning():
+    """chain8 under RATTLE at 8 ms steps whips faster than a step resolves: the engine stops
+    it (its jump check) at 6.3 s. The ladder keeps the frames before it and the message as a
+    warning (off the front), as it does for a peer that diverges, instead of failing."""
+    from benchmarks.pareto import _Planarsim
+    world = _Planarsim("chain8", 8e-3, 1, integrator="rattle")
+    q, v = world.record(1250)                      # 10 s of 8 ms frames
+    assert world.warnings and len(q) == world.warnings[0][0] < 1251
+    assert "stopped" in world.warnings[0][1]
+    world.reset()
+    world.run(1250)                                # the timed run: no error either
+    assert world.warnings
