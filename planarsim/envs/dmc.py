@@ -7,22 +7,26 @@ steps n_sub_steps = control step / timestep times per action), its time limits (
 steps = ceil(time limit / control step)) and its episode initialisation (the same draws from
 a ``numpy.random.RandomState(seed)``, so that a seed starts the same state as
 ``suite.load(domain, task, task_kwargs={"random": seed})``; cheetah then settles 200 physics
-steps on planarsim's engine).
+steps on planarsim's engine; finger draws its joint angles again while two of planarsim's
+colliding shapes overlap, where dm_control asks MuJoCo for a contact: the same geometry, so
+the same draws, and a start that never overlaps).
 
 One class, :class:`DMCEnv`; each domain is a few functions (its initialisation, observation
 and reward, written as dm_control's ``Physics`` / ``Task`` methods are), each task a row of
 ``TASKS`` (its domain and parameters: walker stand / walk / run differ by a target speed).
 The quantities dm_control reads from MuJoCo's data (body frames ``xpos`` / ``xmat``, body
 centres of mass ``xipos``, site and geom positions, the sensors ``subtreelinvel``,
-``velocimeter``, ``gyro``, ``touch``) are computed from planarsim's body poses and
-velocities and the file's frames (:class:`FileFrames`).
+``velocimeter``, ``gyro``, ``framepos``, ``jointpos``, ``jointvel``, ``touch``) are
+computed from planarsim's body poses and velocities and the file's frames
+(:class:`FileFrames`).
 
 What differs from dm_control: the motion (planarsim's hard contacts and its integrator, not
-MuJoCo's soft contacts and Euler / RK4), hence episodes beyond their first steps; and hopper's
-touch sensors, which here are the normal force of planarsim's contacts in the site's sphere
-over the last physics step (impulse / timestep), not MuJoCo's soft contact force of the
-current state (0 right after a reset). As in dm_control, the reward's control terms read the
-action as given, the motors the action clamped to ctrlrange.
+MuJoCo's soft contacts and Euler / RK4), hence episodes beyond their first steps; and the
+touch sensors (hopper's, finger's), which here are the normal force of planarsim's contacts
+in the site's sphere or ellipsoid over the last physics step (impulse / timestep), not
+MuJoCo's soft contact force of the current state (0 right after a reset). As in dm_control,
+the reward's control terms read the action as given, the motors the action clamped to
+ctrlrange.
 """
 from __future__ import annotations
 
@@ -37,6 +41,8 @@ import numpy as np
 from gymnasium import spaces
 
 from ..mjcf import parse_xml
+from ..kernels.codes import CONTACT_PAIR
+from ..start_check import shape_overlaps
 from .core import PlanarMujocoEnv
 from .rewards import tolerance
 
@@ -60,6 +66,18 @@ def common_assets(directory: str) -> dict:
     common = os.path.join(directory, "common")
     return {f"./common/{f}": open(os.path.join(common, f), "rb").read()
             for f in sorted(os.listdir(common)) if f.endswith(".xml")}
+
+
+def with_joint_damping(text: str, damping: dict) -> str:
+    """The model text with the named joints' damping [N m s/rad] replaced (as dm_control's
+    tasks set model.dof_damping before their episodes)."""
+    mjcf = ET.fromstring(text)
+    for name, value in damping.items():
+        joints = [j for j in mjcf.iter("joint") if j.get("name") == name]
+        if len(joints) != 1:
+            raise ValueError(f"joint damping: the model has {len(joints)} joints named {name!r}")
+        joints[0].set("damping", repr(float(value)))
+    return ET.tostring(mjcf, encoding="unicode")
 
 
 def swimmer_xml(directory: str, n_bodies: int) -> str:
@@ -107,6 +125,7 @@ class FileFrames:
         self.source = source
         self.body = collections.OrderedDict()       # name -> (parent name or None, pos)
         self.site, self.geom = {}, {}               # name -> (body or None, pos, size)
+        self.site_type = {}                         # site name -> "sphere", "ellipsoid", ...
         self.sensors = []                           # (type, name, attrib)
         self._defaults = {}
         for node in root.children:
@@ -154,6 +173,8 @@ class FileFrames:
                 size = _vec(self._attr(ch, cls, "size", "0.005" if ch.tag == "site" else "0"))
                 table = self.site if ch.tag == "site" else self.geom
                 table[ch.attrib["name"]] = (body, pos + local, size)
+                if ch.tag == "site":
+                    self.site_type[ch.attrib["name"]] = self._attr(ch, cls, "type", "sphere")
 
     def subtree(self, name) -> list:
         """MJCF bodies in body `name`'s subtree (itself first)."""
@@ -224,6 +245,31 @@ def _init_swimmer(env, random, qpos, qvel, params):
     env.set_target(xpos, ypos)
 
 
+def set_random_joint_angles(env, random, qpos, max_attempts=1000):
+    """dm_control finger's _set_random_joint_angles: the randomizers' draws, again until no
+    two colliding shapes overlap (MuJoCo: no contact after the reset). The test is planarsim's
+    exact gap of its colliding shapes (start_check.shape_overlaps: capsules and discs, the
+    file's geoms in the plane), so the start is never inside the spinner and the draws are
+    dm_control's."""
+    zero = np.zeros(len(qpos))
+    for _ in range(max_attempts):
+        randomize_limited_and_rotational_joints(env, random, qpos)
+        q, _ = env.coords.to_maximal(qpos, zero)
+        if not shape_overlaps(env.sim_model, q):
+            return
+    raise RuntimeError(f"{env.task}: no collision-free joint angles in {max_attempts} draws")
+
+
+def _init_finger(env, random, qpos, qvel, params):
+    if params["target_radius"] is not None:        # turn: a target on the spinner's circle
+        angle = random.uniform(-np.pi, np.pi)
+        hinge = env.xpos("spinner")
+        radius = env.geom_size("cap1").sum()
+        env.set_target(hinge[0] + radius * np.sin(angle), hinge[2] + radius * np.cos(angle))
+        env.site_size_override["target"] = params["target_radius"]
+    set_random_joint_angles(env, random, qpos)
+
+
 def _obs_position_velocity(env):
     return collections.OrderedDict(position=env.qpos[1:].copy(), velocity=env.qvel.copy())
 
@@ -284,6 +330,33 @@ def _obs_reacher(env):
 
 def _nose_to_target(env):
     return (env.geom_xpos("target") - env.geom_xpos("nose")).dot(env.xmat("head"))[:2]
+
+
+def _tip_position(env):
+    """The spinner's tip relative to its hinge, (x, z) [m] (sensors tip - spinner)."""
+    return env.sensor("tip")[[0, 2]] - env.sensor("spinner")[[0, 2]]
+
+
+def _target_position(env):
+    return env.sensor("target")[[0, 2]] - env.sensor("spinner")[[0, 2]]
+
+
+def _dist_to_target(env):
+    """Signed distance [m] of the tip to the target's surface (negative: inside)."""
+    return (np.linalg.norm(_target_position(env) - _tip_position(env))
+            - env.site_size("target")[0])
+
+
+def _obs_finger(env):
+    s = env.sensor
+    obs = collections.OrderedDict(
+        position=np.hstack(([s("proximal"), s("distal")], _tip_position(env))),
+        velocity=np.array([s("proximal_velocity"), s("distal_velocity"), s("hinge_velocity")]),
+        touch=np.log1p([s("touchtop"), s("touchbottom")]))
+    if env.params["target_radius"] is not None:
+        obs["target_position"] = _target_position(env)
+        obs["dist_to_target"] = np.array(_dist_to_target(env))
+    return obs
 
 
 def _obs_swimmer(env):
@@ -366,6 +439,12 @@ def _reward_swimmer(env, p):
                      margin=5 * target_size, sigmoid="long_tail")
 
 
+def _reward_finger(env, p):
+    if p["target_radius"] is None:          # spin: the hinge turning fast enough [rad/s]
+        return float(env.sensor("hinge_velocity") <= -p["spin_velocity"])
+    return float(_dist_to_target(env) <= 0)
+
+
 @dataclass(frozen=True)
 class Domain:
     """A suite domain: its file, MuJoCo timestep [s] (the file's; checked at load),
@@ -418,6 +497,12 @@ DOMAINS = {
     # a mass on two limited, damped slides, each pulled by a motor on a fixed tendon
     "point_mass": Domain("point_mass.xml", 0.02, 20, None, _init_randomized, _obs_state,
                          _reward_point_mass),
+    # a two-link finger and a spinner on a hinge with dry friction, no gravity. The motors
+    # alone (30 N m on 0.0068 kg m^2) would turn the proximal link 0.44 rad in a step from
+    # rest; its damping (2.5 N m s/rad, implicit as in MuJoCo's Euler) holds that to 0.09 rad:
+    # the motor guard, which leaves damping out, is off
+    "finger": Domain("finger.xml", 0.01, 20, .02, _init_finger, _obs_finger, _reward_finger,
+                     dict(target_radius=None, spin_velocity=15.0), dict(turn_limit=0.0)),
 }
 
 # task -> (domain, parameters): dm_control's task functions' arguments
@@ -436,17 +521,13 @@ TASKS = {
     "reacher-hard": ("reacher", dict(target_size=.015)),
     "swimmer-swimmer6": ("swimmer", dict(n_bodies=6)),
     "point_mass-easy": ("point_mass", {}),
+    "finger-spin": ("finger", dict(joint_damping={"hinge": .03})),
+    "finger-turn_easy": ("finger", dict(target_radius=.07)),
+    "finger-turn_hard": ("finger", dict(target_radius=.03)),
 }
 
-# the suite's other planar tasks, and why planarsim cannot run them
-UNSUPPORTED = {
-    "finger-spin": "finger's task is not ported yet (its model, with the spinner hinge's joint "
-                   "friction, frictionloss, loads: planarsim.mjcf.load_mjcf)",
-    "finger-turn_easy": "finger's task is not ported yet (its model, with the spinner hinge's "
-                        "joint friction, frictionloss, loads: planarsim.mjcf.load_mjcf)",
-    "finger-turn_hard": "finger's task is not ported yet (its model, with the spinner hinge's "
-                        "joint friction, frictionloss, loads: planarsim.mjcf.load_mjcf)",
-}
+# the suite's other planar tasks, and why planarsim cannot run them (none left)
+UNSUPPORTED = {}
 
 
 def env_id(task: str) -> str:
@@ -485,6 +566,8 @@ class DMCEnv(PlanarMujocoEnv):
         else:
             source = os.path.join(directory, self.domain.xml)
             text = open(source).read()
+        if self.params.get("joint_damping"):
+            text = with_joint_damping(text, self.params["joint_damping"])
         self.frames = FileFrames(text, source)
         kw.setdefault("assets", common_assets(directory))
         PlanarMujocoEnv.__init__(self, text, self.domain.n_sub_steps, **kw)
@@ -529,7 +612,7 @@ class DMCEnv(PlanarMujocoEnv):
         self.joint_range = np.array(rng, float)
         self.joint_limited = np.isfinite(self.joint_range).all(axis=1)
         self.joint_angular = np.array([jm.angular for jm in self.coords.jm])
-        self.geom_size_override = {}
+        self.geom_size_override, self.site_size_override = {}, {}
         self.target = None
         self._mass = np.asarray(model.arrays.body_mass, float)
 
@@ -578,7 +661,15 @@ class DMCEnv(PlanarMujocoEnv):
 
     def site_xpos(self, name):
         body, p, _ = self.frames.site[name]
+        if body is None and self.target is not None and name == "target":
+            p = self.target
         return self.pos3(body, p)
+
+    def site_size(self, name):
+        size = self.frames.site[name][2].copy()
+        if name in self.site_size_override:
+            size[0] = self.site_size_override[name]
+        return size
 
     def geom_xpos(self, name):
         body, p, _ = self.frames.geom[name]
@@ -593,10 +684,11 @@ class DMCEnv(PlanarMujocoEnv):
         return size
 
     def set_target(self, x, y):
-        """Move the world geom 'target' (reacher, swimmer) to (x, y) in the x-y plane, as
-        dm_control's tasks set model.geom_pos."""
-        p = self.frames.geom["target"][1].copy()
-        p[0], p[1] = x, y
+        """Move the world's 'target' (reacher's and swimmer's geom, finger's site) to (x, y)
+        [m] in the model's plane, as dm_control's tasks set model.geom_pos / site_pos."""
+        table = self.frames.geom if "target" in self.frames.geom else self.frames.site
+        p = table["target"][1].copy()
+        p[self.plane_axes[0]], p[self.plane_axes[1]] = x, y
         self.target = p
 
     def set_control(self, action):
@@ -620,8 +712,9 @@ class DMCEnv(PlanarMujocoEnv):
         return out
 
     def sensor(self, name):
-        """A sensor of the file's <sensor> section, by name: subtreelinvel, velocimeter, gyro
-        (3D, as MuJoCo's), touch (a float)."""
+        """A sensor of the file's <sensor> section, by name: subtreelinvel, velocimeter, gyro,
+        framepos of a site or body frame (3D, as MuJoCo's), jointpos, jointvel, touch (a
+        float)."""
         for kind, sname, attrib in self.frames.sensors:
             if sname == name:
                 break
@@ -645,24 +738,48 @@ class DMCEnv(PlanarMujocoEnv):
             return self.xmat(body).T @ self._velocity_at(body, p)
         if kind == "touch":
             return self._touch(attrib["site"])
+        if kind in ("jointpos", "jointvel"):
+            values = self.qpos if kind == "jointpos" else self.qvel
+            return float(values[self.qindex(attrib["joint"])])
+        if kind == "framepos" and attrib.get("objtype") in ("site", "xbody", "body"):
+            obj = attrib["objname"]
+            return self.site_xpos(obj) if attrib["objtype"] == "site" else self.xpos(obj)
         raise NotImplementedError(f"{self.task}: sensor {name!r} of type <{kind}> is not computed")
 
     def _touch(self, site):
-        """Normal force [N] of the contacts of the site's body inside its sphere over the last
-        physics step (impulse / timestep); a contact on an arc counts at its lowest point."""
+        """Normal force [N] of the site body's contacts whose point lies in the site's sphere
+        or ellipsoid, over the last physics step (impulse / timestep). A ground contact's
+        point: on an arc, its lowest point; a contact of two shapes': the surface point on
+        the site's body where the step's contact acted."""
         body, p, size = self.frames.site[site]
-        centre = self.point(body, (p[self.plane_axes[0]], p[self.plane_axes[1]]))
+        a0, a1 = self.plane_axes
+        centre = self.point(body, (p[a0], p[a1]))
+        sphere = self.frames.site_type[site] == "sphere"
+        radii = (size[0], size[0]) if sphere else (size[a0], size[a1])
         b = self._rigid(body)
-        a = self.sim_model.arrays
-        st = self.sim.state
-        total = 0.0
+        a, st, ws = self.sim_model.arrays, self.sim.state, self.sim.ws
+        phi = self.angle(body)
         c, s = math.cos(st.q[b, 2]), math.sin(st.q[b, 2])
-        for k in np.flatnonzero(np.asarray(a.contact_body) == b):
-            lx, ly = a.contact_local[k]
-            x = st.q[b, 0] + c * lx - s * ly
-            y = st.q[b, 1] + s * lx + c * ly - a.contact_radius[k]
-            if math.hypot(x - centre[0], y - centre[1]) <= size[0]:
-                total += max(st.last_contact_impulse[k, 0], 0.0) / self.timestep
+        cr, sr = math.cos(phi), math.sin(phi)
+        total = 0.0
+        for k in np.flatnonzero(st.last_contact_impulse[:, 0] > 0.0):
+            if a.contact_kind[k] == CONTACT_PAIR:
+                side = [i for i in (0, 1) if ws.contact_bodies[k, i] == b]
+                if not side:
+                    continue
+                lx, ly = ws.contact_refpt[k, 2 * side[0]:2 * side[0] + 2]
+                drop = 0.0
+            elif a.contact_body[k] == b:
+                lx, ly = a.contact_local[k]
+                drop = a.contact_radius[k]
+            else:
+                continue
+            dx = st.q[b, 0] + c * lx - s * ly - centre[0]
+            dy = st.q[b, 1] + s * lx + c * ly - drop - centre[1]
+            # the offset in the site's frame (the body's at the file's pose)
+            u, w = cr * dx + sr * dy, -sr * dx + cr * dy
+            if (u / radii[0]) ** 2 + (w / radii[1]) ** 2 <= 1.0:
+                total += st.last_contact_impulse[k, 0] / self.timestep
         return total
 
     # gymnasium -----------------------------------------------------------------------------
@@ -680,7 +797,7 @@ class DMCEnv(PlanarMujocoEnv):
     def _reset_state(self, random):
         qpos, qvel = self.init_qpos.copy(), np.zeros(self.model.nv)
         self.settle = 0
-        self.geom_size_override = {}
+        self.geom_size_override, self.site_size_override = {}, {}
         self.domain.init(self, random, qpos, qvel, self.params)
         self._ctrl = np.zeros(len(self._act))
         self.set_state(qpos, qvel)

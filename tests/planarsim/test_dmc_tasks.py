@@ -39,7 +39,8 @@ from planarsim.envs.rewards import tolerance  # noqa: E402
 TASKS = list(dmc.TASKS)
 TOL = 1e-9
 # tasks whose reward is an indicator (tolerance with margin 0): 0 or 1 only
-BINARY = {"pendulum-swingup", "reacher-easy", "reacher-hard"}
+BINARY = {"pendulum-swingup", "reacher-easy", "reacher-hard", "finger-spin", "finger-turn_easy",
+          "finger-turn_hard"}
 
 
 def dm_load(task, seed=0):
@@ -51,17 +52,25 @@ def flat(obs):
     return np.concatenate([np.asarray(v, float).ravel() for v in obs.values()])
 
 
-def test_every_task_is_registered_and_the_unsupported_are_refused():
+def dm_target(physics, env):
+    """dm_control's target (reacher's and swimmer's geom, finger's site) in env's plane [m]."""
+    model = physics.named.model
+    pos = model.geom_pos if "target" in env.frames.geom else model.site_pos
+    return pos["target"][list(env.plane_axes)]
+
+
+def test_every_task_is_registered_and_the_unsupported_are_refused(monkeypatch):
     assert set(dmc.TASKS) == {"cheetah-run", "walker-stand", "walker-walk", "walker-run",
                               "hopper-stand", "hopper-hop", "acrobot-swingup", "cartpole-balance",
                               "cartpole-swingup", "pendulum-swingup", "reacher-easy",
-                              "reacher-hard", "swimmer-swimmer6", "point_mass-easy"}
+                              "reacher-hard", "swimmer-swimmer6", "point_mass-easy",
+                              "finger-spin", "finger-turn_easy", "finger-turn_hard"}
     for task in dmc.TASKS:
         assert f"planarsim/dmc-{task}-v0" in gym.registry
-    for task, why in (("finger-spin", "frictionloss"),):
-        assert f"planarsim/dmc-{task}-v0" not in gym.registry
-        with pytest.raises(NotImplementedError, match=why):
-            dmc.DMCEnv(task)
+    assert dmc.UNSUPPORTED == {}       # the suite's planar tasks all run
+    monkeypatch.setitem(dmc.UNSUPPORTED, "finger-spin", "its joint friction is not modelled")
+    with pytest.raises(NotImplementedError, match="'finger-spin' cannot run.*joint friction"):
+        dmc.DMCEnv("finger-spin")
     with pytest.raises(ValueError, match="unknown dm_control task 'walker-fly'"):
         dmc.DMCEnv("walker-fly")
 
@@ -142,10 +151,12 @@ def test_reset_draws_dm_controls_initial_state(task):
     q, v = theirs.physics.data.qpos, theirs.physics.data.qvel
     assert np.allclose(env.qpos, q, rtol=0, atol=1e-12) and np.allclose(env.qvel, v, rtol=0, atol=1e-12)
     want = flat(ts.observation)
-    n = len(want) - (2 if task.startswith("hopper") else 0)   # hopper's touch: contact forces
+    # hopper's touch: contact forces (MuJoCo's of the state, planarsim's of the last step);
+    # finger starts with no contact (drawn so), its touch 0 in both: compared
+    n = len(want) - (2 if task.startswith("hopper") else 0)
     assert np.allclose(obs[:n], want[:n], rtol=0, atol=1e-9), np.abs(obs[:n] - want[:n]).max()
     if env.target is not None:
-        assert np.allclose(env.target[:2], theirs.physics.named.model.geom_pos["target"][:2])
+        assert np.allclose(env.target[list(env.plane_axes)], dm_target(theirs.physics, env))
     # the next episode (no seed) continues the same draws, as dm_control's task does
     theirs.reset()
     env.reset()
@@ -156,13 +167,30 @@ def test_reset_draws_dm_controls_initial_state(task):
 def perturbed_states(task, theirs, n, rng):
     """n (qpos, qvel, ctrl) near dm_control's reset state: joints turned, speeds set, the
     root's forward speed spread over the task's reward ramp; hopper lifted clear of the floor
-    (its touch sensors, contact forces, then read 0 in both)."""
+    and finger's drawn again until MuJoCo finds no contact (their touch sensors, contact
+    forces, then read 0 in both: planarsim's is the force of its last step, none after
+    set_state); finger's spinner every other state spun past spin's threshold or turned to
+    the target (reward 1)."""
     m = theirs.physics.model
+    physics = theirs.physics
     names = [m.id2name(j, "joint") for j in range(m.njnt)]
-    base_q, out = theirs.physics.data.qpos.copy(), []
+    base_q, out = physics.data.qpos.copy(), []
     for k in range(n):
         qpos = base_q + rng.normal(0, 0.3, m.nq)
         qvel = rng.normal(0, 1.0, m.nv)
+        if task.startswith("finger"):
+            hinge = names.index("hinge")
+            if k % 2 and task == "finger-spin":
+                qvel[hinge] = -rng.uniform(15, 30)
+            elif k % 2:
+                tx, tz = physics.target_position()
+                qpos[hinge] = -np.arctan2(tx, tz) + rng.normal(0, 0.05)
+            while True:
+                physics.data.qpos[:] = qpos
+                physics.forward()
+                if physics.data.ncon == 0:
+                    break
+                qpos[:hinge] = base_q[:hinge] + rng.normal(0, 0.3, hinge)
         ctrl = rng.uniform(-1.2, 1.2, m.nu)
         if "rootx" in names and task.split("-")[0] in ("cheetah", "walker", "hopper"):
             top = {"cheetah-run": 12, "walker-run": 9, "hopper-hop": 2.5}.get(task, 1.5)
@@ -197,7 +225,7 @@ def test_reward_and_observation_equal_dm_controls_from_the_same_state(task):
                 physics.named.model.geom_pos["target", :2] = tip
                 physics.forward()
             if env.target is not None:
-                env.set_target(*physics.named.model.geom_pos["target", :2])
+                env.set_target(*dm_target(physics, env))
             env.set_state(qpos, qvel)
             env.set_control(ctrl)
             r_dm = theirs.task.get_reward(physics)
@@ -296,3 +324,64 @@ def test_vector_env_steps_a_dmc_task_as_sync_vector_env_does():
     finally:
         ours.close()
         sync.close()
+
+
+@pytest.mark.parametrize("task", ["finger-spin", "finger-turn_hard"])
+def test_finger_reset_redraws_as_dm_control_until_no_contact(task):
+    """finger's start: dm_control draws the joint angles again while MuJoCo finds a contact;
+    planarsim redraws while two of its colliding shapes overlap (their exact gap). Over 40
+    seeds the starts equal dm_control's, some of them after a redraw, and none overlaps."""
+    from planarsim.start_check import shape_overlaps
+    env = dmc.DMCEnv(task)
+    redrawn = 0
+    for seed in range(40):
+        theirs = dm_load(task, seed)
+        theirs.reset()
+        env.reset(seed=seed)
+        assert np.allclose(env.qpos, theirs.physics.data.qpos, rtol=0, atol=1e-12), seed
+        assert theirs.physics.data.ncon == 0
+        assert not shape_overlaps(env.sim_model, env.sim.state.q), seed
+        rs = np.random.RandomState(seed)
+        if task != "finger-spin":
+            rs.uniform(-np.pi, np.pi)                  # the target's angle
+        lo, hi = theirs.physics.model.jnt_range[:2].T
+        first = [rs.uniform(lo[0], hi[0]), rs.uniform(lo[1], hi[1]), rs.uniform(-np.pi, np.pi)]
+        redrawn += not np.array_equal(first, env.qpos)
+    assert redrawn >= 2, redrawn
+
+
+def test_finger_touch_reads_the_fingertips_push_on_the_spinner():
+    """finger's touch (log1p of the normal force [N] in each fingertip site): the fingertip's
+    end set on the spinner's flat side level with its hinge (the force's line through the
+    proximal joint and the hinge: the spinner stays), the distal motor pressing with a
+    torque of 20 N times the distal joint's lever arm: after 2 s touchtop reads that force
+    within 1 % and touchbottom, whose site the contact is outside, 0; pulled back, both 0."""
+    from scipy.optimize import least_squares
+    env = dmc.DMCEnv("finger-turn_easy")
+    env.reset(seed=0)
+    qpos, qvel = env.init_qpos.copy(), np.zeros(env.model.nv)
+    tip_end = (-0.2, 0.4 - 0.18 - 0.161)         # the fingertip capsule's end, file pose [m]
+    face = 0.2 - 0.02 - 0.04                     # cap2's flat side at hinge angle 0 [m]
+    goal = np.array([face - 0.03 - 1e-4, 0.4])   # its sphere 0.1 mm clear of the side
+
+    def miss(x):
+        qpos[:2] = x
+        env.set_state(qpos, qvel)
+        return env.point("distal", tip_end) - goal
+    qpos[:2] = least_squares(miss, [0.5, -0.5]).x
+    assert np.abs(miss(qpos[:2])).max() < 1e-6     # [m], against the 0.1 mm clearance
+    force = 20.0
+    arm = env.xpos("distal")[2] - goal[1]         # the distal joint above the force's line
+    press = force * arm / 15.0                    # the distal motor's gear: 15 N m
+    env.set_state(qpos, qvel)
+    for _ in range(100):
+        obs = env.step(np.array([0.0, press]))[0]
+    top, bottom = np.expm1(obs[7:9])
+    print(f"finger touch: top {top:.4f} N for {force} N, bottom {bottom}, "
+          f"hinge {env.qvel[2]:.2g} rad/s")
+    assert abs(top - force) <= 0.01 * force and bottom == 0.0, (top, bottom)
+    assert abs(env.qvel[env.qindex("hinge")]) < 1e-3
+    env.set_state(qpos, qvel)
+    for _ in range(20):
+        obs = env.step(np.array([0.0, -press]))[0]
+    assert np.array_equal(obs[7:9], [0.0, 0.0])
