@@ -228,3 +228,32 @@ def test_a_planarsim_run_the_engine_stops_is_reported_as_a_peers_warning():
     world.reset()
     world.run(1250)                                # the timed run: no error either
     assert world.warnings
+
+
+def test_pareto_tables_from_a_known_ladder(tmp_path, capsys):
+    """benchmarks/pareto_tables.py on a written pareto.csv: RK4's cost on its front at our
+    error over our cost, and the fronts' ratio at each error, for ladders whose answer is
+    known (ours first order, cost 1 / error 1e-3 at k = 1; RK4 fourth order at 4x the cost
+    per k)."""
+    from benchmarks import pareto_tables
+    rows = []
+    for label, engine, cost0, err0, p in (("planarsim", "planarsim", 1e-3, 1e-3, 1),
+                                          ("planarsim-rattle", "planarsim", 1.2e-3, 5e-4, 2),
+                                          ("planarsim-rattle4", "planarsim", 5e-3, 1e-6, 4),
+                                          ("mujoco RK4", "mujoco", 4e-3, 1e-3, 4)):
+        for k in (1, 2, 4, 8):
+            rows.append(dict(scene="chain4", engine=engine, curve=label, k=k, dt=1e-3 / k,
+                             cost_s_per_s=cost0 * k, energy_err_max=err0 / k ** p, pin_error_m=1e-12))
+    path = tmp_path / "pareto.csv"
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    assert pareto_tables.main([str(path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    first = next(line for line in out if line.startswith("| 4 | 1, 1.0e-03"))
+    # RK4 reaches 1e-3 at its cheapest point (cost 4e-3): 4x our cost at dt; orders 1 and 4
+    assert "| 4x / " in first and first.endswith("| 1.0 / 2.0 / 4.0 / 4.0 |")
+    default = next(line for line in out if line.startswith("| 4 | default only |"))
+    assert default.split(" | ")[2:4] == ["4x", "4x"]          # at 1e-2 and 1e-3: both cheapest
+    assert pareto_tables.main([]) == 2
