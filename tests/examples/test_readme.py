@@ -81,7 +81,7 @@ def test_readme_gives_the_expected_time_of_both_commands(monkeypatch, capsys):
         r"then the tests (\d+) s", part).groups())
     assert abs(install + tests - total) <= 5, (install, tests, total)
     # the first compile on a quiet machine: what the program says where it has measured none
-    quiet = float(re.search(r"first compile of the engine \(about (\d+) s on a quiet machine", part).group(1))
+    quiet = float(re.search(r"the program's estimate for a quiet\s+machine, about (\d+) s", part).group(1))
     assert quiet == compiled.TYPICAL_COMPILE_S
     # the program's message after a first compile, as README quotes it (N: the seconds)
     monkeypatch.setattr(compiled, "record_compile", lambda seconds: None)   # keep this machine's record
