@@ -3,6 +3,7 @@ import math
 
 from ..compile import kernel
 from .codes import CONTACT_ARC, CONTACT_POINT, JOINT_HINGE, MODE_FREE
+from .math2d import rotate
 from .forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from .terrain import ground_point
 from .info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
@@ -102,11 +103,7 @@ def _pin_arm(m, ws, j, e):
     body = m.pin_body[j, e]
     if body < 0:
         return 0.0, 0.0
-    lx = m.pin_anchor[j, e, 0]
-    ly = m.pin_anchor[j, e, 1]
-    c = ws.body_cs[body, 0]
-    sn = ws.body_cs[body, 1]
-    return c * lx - sn * ly, sn * lx + c * ly
+    return rotate(ws.body_cs[body, 0], ws.body_cs[body, 1], m.pin_anchor[j, e, 0], m.pin_anchor[j, e, 1])
 
 
 @kernel
@@ -181,12 +178,13 @@ def hinge_turn_gain(m, ws, j):
 
 
 @kernel
-def turn_gain(m, ws, k):
+def turn_gain(m, ws, k, held):
     """1 / [kg m^2]: how fast torque actuator k turns what it drives, from rest: of its
-    hinge's angle with that hinge's pin holding its two bodies (hinge_turn_gain; a joint's
-    armature a gives kappa / (1 + a kappa)), or of its body's angle (1/I); 0 for the
-    actuators that push (forces, point-mass hips, sliders). The other joints and contacts
-    only slow the turn: an upper bound."""
+    hinge's angle with that hinge's pin holding its two bodies where `held` (hinge_turn_gain),
+    else as if they were free (1/I_a + 1/I_b: larger, and cheap); a joint's armature a gives
+    kappa / (1 + a kappa); of its body's angle (1/I); 0 for the actuators that push (forces,
+    point-mass hips, sliders). The other joints and contacts only slow the turn: an upper
+    bound."""
     kind = m.act_kind[k]
     if kind == ACT_BODY_TORQUE:
         return m.body_inv_inertia[m.act_body[k, 0]]
@@ -194,7 +192,7 @@ def turn_gain(m, ws, k):
         return 0.0
     j = m.act_ref[k]
     kappa = 0.0
-    if m.pin_kind[j] == JOINT_HINGE:
+    if held and m.pin_kind[j] == JOINT_HINGE:
         kappa = hinge_turn_gain(m, ws, j)
     else:
         for e in range(2):
@@ -209,9 +207,13 @@ def check_actuator_turns(m, ws, h, limit):
     turn what it drives by more than `limit` [rad] in one step of h [s] from rest,
     h^2 |u| kappa (turn_gain): a torque that acts faster than the step can resolve (the
     joints' and contacts' corrections hold only turns of a few tenths of a radian per step).
-    Recorded: the actuator (ws.info[INFO_COMMAND]), the turn, kappa and limit (ws.guard_value)."""
+    Recorded: the actuator (ws.info[INFO_COMMAND]), the turn, kappa and limit (ws.guard_value).
+    The free bodies' gain bounds the held one: only a command that passes the limit by it pays
+    for the held one (hinge_turn_gain scans the pins)."""
     for k in range(m.act_kind.shape[0]):
-        kappa = turn_gain(m, ws, k)
+        if h * h * abs(ws.act_u[k]) * turn_gain(m, ws, k, False) <= limit:
+            continue
+        kappa = turn_gain(m, ws, k, True)
         turn = h * h * abs(ws.act_u[k]) * kappa
         if turn > limit:
             ws.info[INFO_COMMAND] = k

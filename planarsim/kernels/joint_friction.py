@@ -19,7 +19,7 @@ position correction leaves the row out (friction acts on velocities only).
 """
 from ..compile import kernel
 from .codes import ROW_JOINT_FRICTION
-from .joints import joint_rate_row
+from .joints import joint_rate_row, rate_along
 from .row_list import add_row
 
 # an impulse beyond its bound by this share of the bound is a break (rounding below it)
@@ -60,14 +60,7 @@ def friction_row(m, q, cs, o, J):
 @kernel
 def friction_rate(m, ws, j, vel):
     """Joint j's rate g vel [rad/s or m/s] along its row at the step's start (ws.friction_J)."""
-    rate = 0.0
-    for e in range(2):
-        b = m.pin_body[j, e]
-        if b < 0:
-            continue
-        for k in range(3):
-            rate += ws.friction_J[j, e, k] * vel[b, k]
-    return rate
+    return rate_along(m.pin_body[j], ws.friction_J[j], vel)
 
 
 @kernel

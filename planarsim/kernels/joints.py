@@ -40,3 +40,16 @@ def joint_rate_row(m, q, cs, j, J):
         return slide_row(m, q, cs, j, a, b, J)
     return slider_angle_row(m, q, j, a, b, J)     # the same relative angle as a hinge's
 
+
+@kernel
+def rate_along(bodies, J, v):
+    """g v [rad/s or m/s] of a row g with blocks J (2, 3) on bodies (2,) at velocities v
+    (a joint's rate along its soft or friction row)."""
+    rate = 0.0
+    for e in range(2):
+        b = bodies[e]
+        if b < 0:
+            continue
+        for k in range(3):
+            rate += J[e, k] * v[b, k]
+    return rate

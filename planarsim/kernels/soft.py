@@ -39,7 +39,7 @@ c / h) and its kinetic-energy bound weigh the bodies' masses only, without the r
 """
 from ..compile import kernel
 from .codes import ROW_JOINT_SOFT
-from .joints import joint_rate_row
+from .joints import joint_rate_row, rate_along
 from .row_list import add_row
 
 SOFT_ARMATURE = 0
@@ -83,19 +83,6 @@ def soft_row(m, q, cs, o, J):
 
 
 @kernel
-def _rate(bodies, J, v):
-    """g v [rad/s or m/s] of a row g with blocks J (2, 3) on bodies (2,) at velocities v."""
-    rate = 0.0
-    for e in range(2):
-        b = bodies[e]
-        if b < 0:
-            continue
-        for k in range(3):
-            rate += J[e, k] * v[b, k]
-    return rate
-
-
-@kernel
 def _inverse_inertia_along(m, bodies, J):
     """g W g^T [1 / (kg m^2) or 1 / kg] of a row g with blocks J (2, 3) on bodies (2,)."""
     acc = 0.0
@@ -115,7 +102,7 @@ def start_soft_row(m, s, ws, r):
     ws.row_soft[r, SOFT_ARMATURE] = m.pin_armature[o]
     ws.row_soft[r, SOFT_STIFFNESS] = m.pin_stiffness[o]
     ws.row_soft[r, SOFT_DAMPING] = m.pin_damping[o]
-    ws.row_soft[r, SOFT_RATE] = _rate(ws.row_body[r], ws.row_J[r], s.v)
+    ws.row_soft[r, SOFT_RATE] = rate_along(ws.row_body[r], ws.row_J[r], s.v)
     ws.row_soft[r, SOFT_GAMMA] = 0.0
     ws.row_soft[r, SOFT_KAPPA] = _inverse_inertia_along(m, ws.row_body[r], ws.row_J[r])
 
@@ -204,8 +191,8 @@ def soft_prediction(m, s, ws, h):
     for t in range(n):
         j = ws.soft_joint[t]
         stretch = joint_rate_row(m, s.q, ws.body_cs, j, ws.soft_J[t])
-        rate = _rate(ws.soft_body[t], ws.soft_J[t], s.v)
-        rate_pred = _rate(ws.soft_body[t], ws.soft_J[t], ws.v_pred)
+        rate = rate_along(ws.soft_body[t], ws.soft_J[t], s.v)
+        rate_pred = rate_along(ws.soft_body[t], ws.soft_J[t], ws.v_pred)
         a = m.pin_armature[j]
         stiff = m.pin_stiffness[j]
         gamma = soft_gamma(a, stiff, m.pin_damping[j], _soft_entry(m, ws, t, t), h)
