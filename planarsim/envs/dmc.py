@@ -281,7 +281,7 @@ def _obs_state(env):
 
 def _obs_walker(env):
     return collections.OrderedDict(
-        orientations=np.array([[env.xmat(b)[0, 0], env.xmat(b)[0, 2]] for b in env.frames.body]).ravel(),
+        orientations=np.array([env.xmat(b)[0, [0, 2]] for b in env.frames.body]).ravel(),
         height=np.array(env.xpos("torso")[2]), velocity=env.qvel.copy())
 
 
@@ -659,29 +659,33 @@ class DMCEnv(PlanarMujocoEnv):
             return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
-    def site_xpos(self, name):
-        body, p, _ = self.frames.site[name]
+    def _xpos(self, table, name):
+        """World position (3,) [m] of site or geom `name` of `table` (frames.site or
+        frames.geom); the world's 'target' where the task moved it (set_target)."""
+        body, p, _ = table[name]
         if body is None and self.target is not None and name == "target":
             p = self.target
         return self.pos3(body, p)
+
+    @staticmethod
+    def _size(table, override, name):
+        """The size of site or geom `name` of `table`, its first entry as the task set it."""
+        size = table[name][2].copy()
+        if name in override:
+            size[0] = override[name]
+        return size
+
+    def site_xpos(self, name):
+        return self._xpos(self.frames.site, name)
 
     def site_size(self, name):
-        size = self.frames.site[name][2].copy()
-        if name in self.site_size_override:
-            size[0] = self.site_size_override[name]
-        return size
+        return self._size(self.frames.site, self.site_size_override, name)
 
     def geom_xpos(self, name):
-        body, p, _ = self.frames.geom[name]
-        if body is None and self.target is not None and name == "target":
-            p = self.target
-        return self.pos3(body, p)
+        return self._xpos(self.frames.geom, name)
 
     def geom_size(self, name):
-        size = self.frames.geom[name][2].copy()
-        if name in self.geom_size_override:
-            size[0] = self.geom_size_override[name]
-        return size
+        return self._size(self.frames.geom, self.geom_size_override, name)
 
     def set_target(self, x, y):
         """Move the world's 'target' (reacher's and swimmer's geom, finger's site) to (x, y)

@@ -288,9 +288,8 @@ class Reacher(_Task):
         self.set_state(qpos, qvel)
         return self._get_obs()
 
-    def _get_obs(self, vec=None):
-        if vec is None:
-            vec = self.body_com("fingertip") - self.body_com("target")
+    def _get_obs(self):
+        vec = self.body_com("fingertip") - self.body_com("target")
         theta = self.data.qpos[:2]
         return np.concatenate([np.cos(theta), np.sin(theta), self.data.qpos[2:],
                                self.data.qvel[:2], vec])
