@@ -76,8 +76,8 @@ without impulses; see energy_bound) and the motors' work, against the run's whol
 (contacts only take energy out), less the joints' second-order share of the step's kinetic
 energy (CONSTRAINT_SHARE, kernels/work.py: an oscillation the energy target bounds over the
 run; or, where more, what the same step gains with no ground, contact_free_gain: a rod
-spinning at w gains (h w)^2 / 4 of its kinetic energy a step by the integrator alone); tunnel (hills_fast) above DEPTH_TOL,
-beyond rod_sag for a point on a rod; speed (stiff_motors). A run the engine stops with an
+spinning at w gains (h w)^2 / 4 of its kinetic energy a step by the integrator alone);
+tunnel (hills_fast) above DEPTH_TOL, beyond rod_sag for a point on a rod; speed (stiff_motors). A run the engine stops with an
 error of its own (planarsim's SimulationDiverged or any planarsim error, naming why) is
 "raised"; a run missing a target without one is "silent" (an audit count alone is silent:
 nothing stopped the run). The summary gives both per family, the silent misses by cause and
@@ -124,7 +124,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
 from planarsim import terrain  # noqa: E402
-from benchmarks.metrics import (energy, lowest_point, pin_separation,  # noqa: E402
+from benchmarks.metrics import (energy, kinetic, lowest_point, pin_separation,  # noqa: E402
                                      spec_from_model, world_points)
 from benchmarks.scenes import G, biped_collapse  # noqa: E402
 from benchmarks.displacement import SLACK as JUMP_SLACK, parted, step_excess  # noqa: E402
@@ -933,13 +933,11 @@ def contact_free_gain(model, q, v, u=None):
     except ps.SimulationDiverged:
         return 0.0
     q1, v1 = sim.state.q[:model.n_body], sim.state.v[:model.n_body]
-    m, inertia = a.body_mass, a.body_inertia
-
-    def kinetic(x):
-        return 0.5 * float(np.sum(m * (x[:, 0] ** 2 + x[:, 1] ** 2) + inertia * x[:, 2] ** 2))
+    m = a.body_mass
     gravity = G * float(np.sum(m * (q1[:, 1] - lifted[:, 1])))
     dp = float(np.sum(m * (v1[:, 1] - v[:, 1])))
-    return kinetic(v1) - kinetic(v) + gravity - 0.5 * model.dt * G * dp
+    return (float(kinetic(m, a.body_inertia, v1)) - float(kinetic(m, a.body_inertia, v)) + gravity
+            - 0.5 * model.dt * G * dp)
 
 
 def fastest_turn(model, q, v):
@@ -1093,15 +1091,14 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
             # integrator itself gains from its start state with nothing to touch
             # (contact_free_gain: a rod spinning at w gains (h w)^2 / 4 of it); a gain the
             # contacts add beyond it is a miss
-            kinetic = 0.5 * np.sum(spec.mass * (v[:-1, :, 0] ** 2 + v[:-1, :, 1] ** 2)
-                                   + spec.inertia * v[:-1, :, 2] ** 2, axis=-1)
-            allowance = CONSTRAINT_SHARE * kinetic
+            ke = kinetic(spec.mass, spec.inertia, v[:-1])
+            allowance = CONSTRAINT_SHARE * ke
             beyond = np.nonzero(excess - allowance > out["e_tol"])[0]
             for k in beyond[:MAX_FREE_STEPS]:
                 own = contact_free_gain(model, q[k], v[k], None if u is None else u[k])
                 if own > allowance[k]:
-                    allowance[k] = own * (1.0 + 1e-9) + 1e-12 * kinetic[k]
-            needs = (excess - CONSTRAINT_SHARE * kinetic > out["e_tol"]) & (excess - allowance <= out["e_tol"])
+                    allowance[k] = own * (1.0 + 1e-9) + 1e-12 * ke[k]
+            needs = (excess - CONSTRAINT_SHARE * ke > out["e_tol"]) & (excess - allowance <= out["e_tol"])
             out["turn_steps"] = int(np.count_nonzero(needs))
             turn = dt * fastest_turn(model, q[:-1], v[:-1])
             out["turn_max"] = float(np.max(turn[needs])) if out["turn_steps"] else 0.0

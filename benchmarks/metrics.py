@@ -133,11 +133,15 @@ def lowest_point(spec: SceneSpec, q) -> np.ndarray:
     return low
 
 
+def kinetic(mass, inertia, v) -> np.ndarray:
+    """(K,) kinetic energy [J] of velocities v (K, n_body, 3) (or () of one frame (n_body, 3))
+    of bodies of `mass` [kg] and `inertia` [kg m^2] (n_body,)."""
+    return 0.5 * np.sum(mass * (v[..., 0] ** 2 + v[..., 1] ** 2) + inertia * v[..., 2] ** 2, axis=-1)
+
+
 def energy(spec: SceneSpec, q, v) -> np.ndarray:
     """(K,) kinetic + gravitational potential energy [J]."""
-    m, inertia = spec.mass, spec.inertia
-    ke = 0.5 * np.sum(m * (v[..., 0] ** 2 + v[..., 1] ** 2) + inertia * v[..., 2] ** 2, axis=-1)
-    return ke + G * np.sum(m * q[..., 1], axis=-1)
+    return kinetic(spec.mass, spec.inertia, v) + G * np.sum(spec.mass * q[..., 1], axis=-1)
 
 
 def accuracy(spec: SceneSpec, q, v) -> dict:

@@ -82,16 +82,22 @@ def _empty_kernel():
     return 0
 
 
-def call_floor_s(calls=20000) -> float:
-    """Wall time of one call of an empty compiled function from Python [s] (median of 5)."""
-    _empty_kernel()
+def median_call_s(fn, args=(), calls=20000, per_call=1) -> float:
+    """Wall time [s] of one call of fn(*args) (divided by `per_call`: the steps one call takes),
+    the median of 5 timed loops of `calls` calls, after one call to warm up."""
+    fn(*args)
     times = []
     for _ in range(5):
         t0 = time.perf_counter()
         for _ in range(calls):
-            _empty_kernel()
-        times.append((time.perf_counter() - t0) / calls)
+            fn(*args)
+        times.append((time.perf_counter() - t0) / (calls * per_call))
     return statistics.median(times)
+
+
+def call_floor_s(calls=20000) -> float:
+    """Wall time of one call of an empty compiled function from Python [s] (median of 5)."""
+    return median_call_s(_empty_kernel, calls=calls)
 
 
 _EMPTY = {}

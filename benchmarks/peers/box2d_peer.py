@@ -30,17 +30,10 @@ SKINS = ("box2d", "compensated")
 def empty_step_s(calls: int = 20000) -> float:
     """Wall time of one world.Step of an empty world [s] (median of 5): the part of every
     timed step that is the call, not the scene."""
-    import statistics
-    import time
     import Box2D
+    from benchmarks.peers import median_call_s
     step = Box2D.b2World(gravity=(0.0, -9.81), doSleep=False).Step
-    times = []
-    for _ in range(5):
-        t0 = time.perf_counter()
-        for _ in range(calls):
-            step(1e-3, VELOCITY_ITERATIONS, POSITION_ITERATIONS)
-        times.append((time.perf_counter() - t0) / calls)
-    return statistics.median(times)
+    return median_call_s(step, (1e-3, VELOCITY_ITERATIONS, POSITION_ITERATIONS), calls)
 
 
 def version() -> str:

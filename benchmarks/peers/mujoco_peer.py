@@ -118,10 +118,9 @@ def mjcf(spec, integrator: str = "Euler", timestep: float | None = None, contact
 def empty_step_s(steps: int = 20000) -> float:
     """Wall time of one step of an empty model by the timed call path (a rollout of `steps`
     steps in one call) [s] (median of 5): MuJoCo's fixed cost of a step, not the scene's."""
-    import statistics
-    import time
     from types import SimpleNamespace
     import mujoco
+    from benchmarks.peers import median_call_s
     try:
         from mujoco import rollout
     except ImportError:
@@ -131,12 +130,7 @@ def empty_step_s(steps: int = 20000) -> float:
     kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
     x0 = np.zeros(mujoco.mj_stateSize(model, kind))
     peer = SimpleNamespace(mj=mujoco, model=model, data=data, x0=x0, _rollout=rollout, _out={})
-    times = []
-    for _ in range(5):
-        t0 = time.perf_counter()
-        _roll(peer, steps)
-        times.append((time.perf_counter() - t0) / steps)
-    return statistics.median(times)
+    return median_call_s(_roll, (peer, steps), calls=1, per_call=steps)
 
 
 def _roll(peer, n: int) -> bool:

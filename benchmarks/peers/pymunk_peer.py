@@ -38,16 +38,8 @@ def empty_step_s(calls: int = 20000) -> float:
     """Wall time of one step of an empty space by the timed call path [s] (median of 5): the
     part of every timed step that is the call, not the scene."""
     import pymunk
-    import statistics
-    import time
-    step = _stepper(pymunk.Space())
-    times = []
-    for _ in range(5):
-        t0 = time.perf_counter()
-        for _ in range(calls):
-            step(1e-3)
-        times.append((time.perf_counter() - t0) / calls)
-    return statistics.median(times)
+    from benchmarks.peers import median_call_s
+    return median_call_s(_stepper(pymunk.Space()), (1e-3,), calls)
 
 
 def version() -> str:
