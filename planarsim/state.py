@@ -17,6 +17,7 @@ from .kernels.audit import N_AUDIT
 from .kernels.info import N_INFO
 from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
 from .model import Model
+from .pin_chains import pin_chain_order
 
 
 class State(NamedTuple):
@@ -390,6 +391,16 @@ class Workspace(NamedTuple):
                                  #   answers tried in this solve of the modes
     start_pairs: np.ndarray      # (n_pair,) int the listed pairs at the step's start (room[1])
     n_start_pairs: np.ndarray    # (1,) int how many
+    chain_on: np.ndarray         # (1,) int 1: the model's pins form open chains and are its only
+                                 #   rows: the step tries its pin-chain path (kernels/pin_chain.py;
+                                 #   planarsim/pin_chains.py)
+    chain_pin: np.ndarray        # (n_pin,) int the pins chain by chain (pin_chain_order)
+    chain_end: np.ndarray        # (n_pin, 2) int the ends of pins k and k - 1 at the body they
+                                 #   share (-1: a chain starts at k)
+    chain_factor: np.ndarray     # (n_pin, 12) the block elimination of the pins' matrix at
+                                 #   place k: its pivot's inverse, A[k, k - 1], A[k - 1, k]
+                                 #   (2 x 2 each, row-major)
+    chain_y: np.ndarray          # (n_pin, 2) scratch of the block substitution
     start: State                 # the step's start while it is taken in sub-steps (GUARD_ROOM
                                  #   puts it back; kernels/step.py)
     prev: State                  # the state at the start of the last step (for guard errors)
@@ -719,4 +730,14 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      step_path=z(nb),
                      room=np.array([0, int(contacts < nc), 0, 0, lcp_rows_limit()], np.int64), least_change=z(3, np.int64),
                      start_pairs=z(n_pair, np.int64), n_start_pairs=z(1, np.int64),
-                     start=make_state(model), prev=make_state(model))
+                     **_chain_arrays(model), start=make_state(model), prev=make_state(model))
+
+
+def _chain_arrays(model: Model) -> dict:
+    """The pin-chain path's arrays (Workspace.chain_*; planarsim/pin_chains.py)."""
+    npin = model.n_pin
+    found = pin_chain_order(model)
+    order, ends = found if found is not None else (np.zeros(npin, np.int64),
+                                                    np.full((npin, 2), -1, np.int64))
+    return dict(chain_on=np.array([int(found is not None)], np.int64), chain_pin=order,
+                chain_end=ends, chain_factor=np.zeros((npin, 12)), chain_y=np.zeros((npin, 2)))

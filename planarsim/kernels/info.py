@@ -15,11 +15,13 @@ INFO_CCD_STOPS = 9         # a step that used up its splits was cut at a fast pa
                            # dropped)
 INFO_TURN_SUBSTEPS = 10    # sub-steps the step was taken in (1: whole; step.turn_substeps: a
                            # joint's anchor or a touching contact's point turning too far)
-N_INFO = 11
+INFO_CHAIN_PATH = 11       # 1: the step was taken by the pin-chain path (step.chain_step), 0:
+                           # by the general stages
+N_INFO = 12
 
 INFO_NAMES = ("solves", "ccd_splits", "guard_body", "guard_field", "lcp_solves",
               "newton_taken_back", "lcp_pivots", "projections", "command", "ccd_stops",
-              "turn_substeps")
+              "turn_substeps", "chain_path")
 # counted afresh by every step (the guard slots keep the last failure)
 STEP_COUNTS = (INFO_SOLVES, INFO_CCD_SPLITS, INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK,
                INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS)

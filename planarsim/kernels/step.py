@@ -16,7 +16,7 @@ five-stage composition (accurate_step; kernels/rattle.py).
 import math
 
 from ..compile import kernel
-from .audit import audit_impulses, audit_total
+from .audit import PIN_GAP_TOL, audit_impulses, audit_total
 from .broad_phase import FLAG_LIVE, widen_for_answer
 from .ccd import split_at_impact, stop_at_impact
 from .codes import CONTACT_PAIR, INTEGRATOR_EULER, MODE_FREE, MODE_PINNED, MODES_ALTERNATING
@@ -27,15 +27,17 @@ from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_R
                      check_actuator_turns, check_displacements, check_guards, check_moves,
                      check_speeds, add_part_path, finish_path, keep_step_path, note_start_depths,
                      start_path)
-from .info import INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
-from .integrate import predict_configuration
+from .info import INFO_CHAIN_PATH, INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
+from .integrate import (bound_correction_work, integrate_positions, predict_configuration,
+                        rows_hold_within)
 from .joint_friction import start_joint_friction, stick_all, switch_joint_friction
 from .math2d import update_trig
 from .modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .pair import PAIR_MARGIN
+from .pin_chain import chain_correct, chain_velocity_solve
 from .pair_toi import hold_off_fast_pairs
-from .position import position_stage
+from .position import ROWS_HELD_SHARE, position_stage
 from .rows import build_rows
 from .soft import soft_prediction
 from .solve import solve_impulses
@@ -652,13 +654,128 @@ def turn_substeps(m, s, h, most):
     return max(1, min(n, most))
 
 
+# chain_part's answers besides 0: the part cannot be taken by the chain path, from its start
+# as it is (CHAIN_GENERAL) or after putting it back (CHAIN_AGAIN, from ws.prev)
+CHAIN_GENERAL = -100
+CHAIN_AGAIN = -101
+
+
+@kernel(inline="never")
+def chain_part(m, s, ws, opt, u, h):
+    """One part of h [s] (the step, or a turn sub-step) of a model whose only rows are the
+    pins of open chains (ws.chain_on; planarsim/pin_chains.py): the stages step_of_length
+    runs for such a model, in its order, with the velocity solve and the correction by block
+    elimination along the chains (kernels/pin_chain.py) and every check of the general
+    step. Where the general step would do more than this (a nearly dependent pivot, the
+    joints' energy check or the correction's energy bound taking effect, a correction that
+    stalls or ends above refine_tol, a guard, an audit) it returns CHAIN_GENERAL or
+    CHAIN_AGAIN; else 0."""
+    copy_state(s, ws.prev)
+    if check_guards(s, ws, opt.guard_limit) != 0:
+        return CHAIN_GENERAL
+    reset_counts(ws)
+    start_path(s, ws)
+    ws.lcp_eps[0] = 0.0
+    ws.audit_worst_value[0] = 0.0
+    ws.first_order[0] = 0
+    ws.energy_stop[0] = 0
+    audited = audit_total(ws)
+    update_trig(s.q, ws.body_cs)
+    apply_forces(m, s, ws, u)                               # 1. forces
+    if opt.turn_limit > 0.0 and check_actuator_turns(m, ws, h, opt.turn_limit) != 0:
+        return CHAIN_GENERAL
+    predict_velocity(m, s, ws, h)
+    soft_prediction(m, s, ws, h)                            #    (v_lin = v*)
+    predict_configuration(m, s, ws, h)
+    ws.joint_gain[2] = 0.0                                  # 3-4. rows and impulses
+    ws.least_change[0] = 0
+    ws.least_change[1] = 0
+    ws.least_change[2] = 0
+    build_rows(m, s, ws)
+    ws.joint_pivot[0] = chain_velocity_solve(m, ws, h)
+    ws.info[INFO_SOLVES] += 1
+    if ws.joint_pivot[0] < max(opt.pivot_tol, NEAR_DEPENDENT):
+        return CHAIN_GENERAL
+    if second_order_gains(m, s, ws, h):
+        return CHAIN_GENERAL
+    remember_impulses(s, ws)
+    if audit_impulses(m, s, ws, opt, h) > 0:                # 7. audit
+        return CHAIN_AGAIN
+    integrate_positions(s, ws, ws.v_new, h)                 # 8. positions
+    if not rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol):
+        worst = chain_correct(m, s, ws, h, opt.refine_iters, opt.refine_tol)
+        if not (worst >= 0.0 and worst <= opt.refine_tol):
+            return CHAIN_AGAIN
+        if bound_correction_work(m, s, ws, h) > 0.0:
+            return CHAIN_AGAIN
+    s.time[0] = ws.prev.time[0] + h
+    s.step[0] += 1
+    code = check_guards(s, ws, opt.guard_limit)             # 9. guards
+    if code == 0 and opt.speed_limit > 0.0:
+        code = check_speeds(m, s, ws, opt.speed_limit)
+    if code != 0 or audit_total(ws) > audited:
+        return CHAIN_AGAIN
+    finish_path(s, ws, h)
+    if opt.jump_limit > 0.0 and check_displacements(m, s, ws, opt.jump_limit) != 0:
+        return CHAIN_AGAIN
+    return 0
+
+
+@kernel(inline="never")
+def chain_step(m, s, ws, opt, u, step_length):
+    """_step for a model of pin chains (ws.chain_on): the whole step, or the turn sub-steps
+    _step would take it in, by chain_part. Returns 0, or CHAIN_GENERAL with s as it was at
+    the step's start (the general stages then take the step: their answer differs from
+    this path's by rounding only, their checks are the same)."""
+    if opt.refine_iters == 0 or not 0.0 < opt.refine_tol <= ROWS_HELD_SHARE * PIN_GAP_TOL:
+        return CHAIN_GENERAL
+    most = opt.max_substeps
+    n = turn_substeps(m, s, step_length, most)
+    if n == 1:
+        code = chain_part(m, s, ws, opt, u, step_length)
+        if code != 0:
+            if code == CHAIN_AGAIN:
+                begin_again(s, ws, ws.prev)
+            return CHAIN_GENERAL
+        n = turn_substeps(m, s, step_length, most)
+        if n == 1:
+            ws.info[INFO_TURN_SUBSTEPS] = 1
+            keep_step_path(ws, False)
+            return 0
+        n = max(n, 2)
+        begin_again(s, ws, ws.prev)
+    count = s.step[0]
+    t0 = s.time[0]
+    copy_state(s, ws.start)
+    code = 0
+    for k in range(n):
+        s.step[0] = count
+        code = chain_part(m, s, ws, opt, u, step_length / n)
+        if code != 0:
+            break
+        keep_step_path(ws, k > 0)
+    if code == 0 and opt.jump_limit > 0.0:
+        code = check_moves(m, s, ws, ws.start.q, True, opt.jump_limit)
+    if code != 0:
+        begin_again(s, ws, ws.start)
+        return CHAIN_GENERAL
+    s.step[0] = count + 1
+    s.time[0] = t0 + step_length
+    ws.info[INFO_TURN_SUBSTEPS] = n
+    return 0
+
+
 @kernel(inline="always")
 def _step(m, s, ws, opt, u):
     """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u with
     StepOptions.integrator; return the guard code."""
     step_length = opt.dt if opt.dt > 0.0 else m.dt
+    ws.info[INFO_CHAIN_PATH] = 0
     if opt.integrator == INTEGRATOR_EULER:
         begin_step(ws)
+        if ws.chain_on[0] == 1 and chain_step(m, s, ws, opt, u, step_length) == 0:
+            ws.info[INFO_CHAIN_PATH] = 1
+            return 0
         most = opt.max_substeps
         n = turn_substeps(m, s, step_length, most)
         if n == 1:

@@ -1,0 +1,185 @@
+"""Stages 4 and 8 for a model whose only rows are the pins of open chains
+(planarsim/pin_chains.py says which models; step.chain_step runs them): the velocity solve and
+the Newton-SHAKE correction by block elimination along each chain.
+
+Pin j owns rows 2j (x) and 2j + 1 (y) (rows.build_rows makes them in that order when pins are
+a model's only rows). Along a chain (Workspace.chain_pin: place k holds a pin, place k - 1 the
+pin it shares a body with) the matrix A = J_L W J_R^T couples a pin only to its neighbours,
+through the body they share: block tridiagonal in 2 x 2 blocks. Its block LU, pivot by pivot,
+
+    P_k = A[k, k] - A[k, k-1] P_{k-1}^-1 A[k-1, k],
+
+costs a few dozen flops a link and fills nothing (Baraff 1996 orders a tree's rows the same
+way). The velocity solve is the general solve's (solve.solve_impulses: J W J^T lam =
+-c(q + h v*) / h with J at the step's start); the correction is integrate.correct_positions'
+Newton-SHAKE (q moved along the start's rows, J(q+) W J(q0)^T mu = -c(q+)), whose later
+passes reuse the factorisation of an earlier one once every row is within CHORD_TOL (a chord
+step: the rows moved by less than that since, so each pass still removes all but a share of
+that order of the error). Both end where the general stages end, to rounding.
+"""
+from ..compile import kernel
+from .integrate import STALLED_RATIO, max_residual
+from .solve import add_impulses
+
+# [m] every row within this after a correction pass: the next reuses the factorisation
+CHORD_TOL = 1e-9
+
+
+@kernel(inline="always")
+def _body_share(m, JL, JR, rl, el, rr, er, b):
+    """Body b's share of A[rl:rl + 2, rr:rr + 2] = JL W JR^T (JL's rows rl, rl + 1 at their
+    end el, JR's rows rr, rr + 1 at their end er), row-major."""
+    wm = m.body_inv_mass[b]
+    wi = m.body_inv_inertia[b]
+    a00 = wm * (JL[rl, el, 0] * JR[rr, er, 0] + JL[rl, el, 1] * JR[rr, er, 1]) + (
+        wi * JL[rl, el, 2] * JR[rr, er, 2])
+    a01 = wm * (JL[rl, el, 0] * JR[rr + 1, er, 0] + JL[rl, el, 1] * JR[rr + 1, er, 1]) + (
+        wi * JL[rl, el, 2] * JR[rr + 1, er, 2])
+    a10 = wm * (JL[rl + 1, el, 0] * JR[rr, er, 0] + JL[rl + 1, el, 1] * JR[rr, er, 1]) + (
+        wi * JL[rl + 1, el, 2] * JR[rr, er, 2])
+    a11 = wm * (JL[rl + 1, el, 0] * JR[rr + 1, er, 0] + JL[rl + 1, el, 1] * JR[rr + 1, er, 1]) + (
+        wi * JL[rl + 1, el, 2] * JR[rr + 1, er, 2])
+    return a00, a01, a10, a11
+
+
+@kernel
+def chain_factor(m, ws, JL, JR):
+    """The block LU of A = JL W JR^T along the chains into ws.chain_factor; returns the
+    smallest share of its own diagonal that a row's pivot kept (each 2 x 2 pivot eliminated
+    x row first, as the general L D L^T does; 0: a pivot vanished, the rows are dependent)."""
+    f = ws.chain_factor
+    smallest = 1.0
+    for k in range(ws.chain_pin.shape[0]):
+        j = ws.chain_pin[k]
+        r = 2 * j
+        d00 = 0.0
+        d01 = 0.0
+        d10 = 0.0
+        d11 = 0.0
+        for e in range(2):
+            b = m.pin_body[j, e]
+            if b >= 0:
+                a00, a01, a10, a11 = _body_share(m, JL, JR, r, e, r, e, b)
+                d00 += a00
+                d01 += a01
+                d10 += a10
+                d11 += a11
+        p00 = d00
+        p01 = d01
+        p10 = d10
+        p11 = d11
+        ej = ws.chain_end[k, 0]
+        if ej >= 0:
+            ei = ws.chain_end[k, 1]
+            ri = 2 * ws.chain_pin[k - 1]
+            b = m.pin_body[j, ej]
+            e00, e01, e10, e11 = _body_share(m, JL, JR, r, ej, ri, ei, b)     # A[k, k-1]
+            u00, u01, u10, u11 = _body_share(m, JL, JR, ri, ei, r, ej, b)     # A[k-1, k]
+            # G = A[k, k-1] P_{k-1}^-1, then P -= G A[k-1, k]
+            g00 = e00 * f[k - 1, 0] + e01 * f[k - 1, 2]
+            g01 = e00 * f[k - 1, 1] + e01 * f[k - 1, 3]
+            g10 = e10 * f[k - 1, 0] + e11 * f[k - 1, 2]
+            g11 = e10 * f[k - 1, 1] + e11 * f[k - 1, 3]
+            p00 -= g00 * u00 + g01 * u10
+            p01 -= g00 * u01 + g01 * u11
+            p10 -= g10 * u00 + g11 * u10
+            p11 -= g10 * u01 + g11 * u11
+            f[k, 4] = e00
+            f[k, 5] = e01
+            f[k, 6] = e10
+            f[k, 7] = e11
+            f[k, 8] = u00
+            f[k, 9] = u01
+            f[k, 10] = u10
+            f[k, 11] = u11
+        second = p11 - p10 * p01 / p00 if p00 != 0.0 else 0.0
+        share0 = abs(p00) / d00 if d00 > 0.0 else 0.0
+        share1 = abs(second) / d11 if d11 > 0.0 else 0.0
+        smallest = min(smallest, share0, share1)
+        det = p00 * p11 - p01 * p10
+        if det == 0.0:
+            for c in range(4):
+                f[k, c] = 0.0
+            smallest = 0.0
+            continue
+        f[k, 0] = p11 / det
+        f[k, 1] = -p01 / det
+        f[k, 2] = -p10 / det
+        f[k, 3] = p00 / det
+    return smallest
+
+
+@kernel
+def chain_solve(ws, rhs, x):
+    """x = A^-1 rhs by the factors of chain_factor (rows 2j, 2j + 1 of pin j in both)."""
+    f = ws.chain_factor
+    y = ws.chain_y
+    n = ws.chain_pin.shape[0]
+    for k in range(n):
+        r = 2 * ws.chain_pin[k]
+        y0 = rhs[r]
+        y1 = rhs[r + 1]
+        if ws.chain_end[k, 0] >= 0:
+            # y_k -= A[k, k-1] P_{k-1}^-1 y_{k-1}
+            z0 = f[k - 1, 0] * y[k - 1, 0] + f[k - 1, 1] * y[k - 1, 1]
+            z1 = f[k - 1, 2] * y[k - 1, 0] + f[k - 1, 3] * y[k - 1, 1]
+            y0 -= f[k, 4] * z0 + f[k, 5] * z1
+            y1 -= f[k, 6] * z0 + f[k, 7] * z1
+        y[k, 0] = y0
+        y[k, 1] = y1
+    for k in range(n - 1, -1, -1):
+        r = 2 * ws.chain_pin[k]
+        t0 = y[k, 0]
+        t1 = y[k, 1]
+        if k + 1 < n and ws.chain_end[k + 1, 0] >= 0:
+            # t -= A[k, k+1] x_{k+1}
+            rn = 2 * ws.chain_pin[k + 1]
+            t0 -= f[k + 1, 8] * x[rn] + f[k + 1, 9] * x[rn + 1]
+            t1 -= f[k + 1, 10] * x[rn] + f[k + 1, 11] * x[rn + 1]
+        x[r] = f[k, 0] * t0 + f[k, 1] * t1
+        x[r + 1] = f[k, 2] * t0 + f[k, 3] * t1
+
+
+@kernel
+def chain_velocity_solve(m, ws, h):
+    """Stage 4 on the chains: lam with J W J^T lam = -c(q_pred) / h (J and W at the step's
+    start, c(q_pred) the pins' gaps at the predicted end, rows.build_rows) and v_new = v* +
+    W J^T lam. Returns the smallest pivot share (chain_factor)."""
+    n = ws.n_row[0]
+    share = chain_factor(m, ws, ws.row_J, ws.row_J)
+    for r in range(n):
+        ws.rhs[r] = -ws.row_c_pred[r] / h
+    chain_solve(ws, ws.rhs, ws.lam)
+    for i in range(ws.v_new.shape[0]):
+        for k in range(3):
+            ws.v_new[i, k] = ws.v_pred[i, k]
+    add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                 ws.v_new, 1.0)
+    return share
+
+
+@kernel
+def chain_correct(m, s, ws, h, iters, tol):
+    """Stage 8's Newton-SHAKE on the chains: up to iters passes of J(q) W J(q0)^T mu = -c(q),
+    q += W J(q0)^T mu, v += W J(q0)^T mu / h, until every row is within tol [m]. Returns the
+    largest row error left, or -1 where a pass removed less than half of it (the general
+    correction's safeguards then decide: the step is taken by the general stages)."""
+    n = ws.n_row[0]
+    worst = max_residual(m, s, ws)          # row_Jp at q, ws.rhs = -c
+    fresh = True
+    for _ in range(iters):
+        if worst <= tol:
+            break
+        if fresh:
+            chain_factor(m, ws, ws.row_Jp, ws.row_J)
+        chain_solve(ws, ws.rhs, ws.lam)
+        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                     s.q, 1.0)
+        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                     s.v, 1.0 / h)
+        after = max_residual(m, s, ws)
+        if after > STALLED_RATIO * worst:
+            return -1.0
+        fresh = after > CHORD_TOL
+        worst = after
+    return worst
