@@ -398,7 +398,7 @@ class Workspace(NamedTuple):
     chain_end: np.ndarray        # (n_pin, 2) int the ends of pins k and k - 1 at the body they
                                  #   share (-1: a chain starts at k)
     chain_factor: np.ndarray     # (n_pin, 12) the block elimination of the pins' matrix at
-                                 #   place k: its pivot's inverse, A[k, k - 1], A[k - 1, k]
+                                 #   place k: its pivot's inverse, A[k, k - 1] P_{k-1}^-1, A[k - 1, k]
                                  #   (2 x 2 each, row-major)
     chain_y: np.ndarray          # (n_pin, 2) scratch of the block substitution
     start: State                 # the step's start while it is taken in sub-steps (GUARD_ROOM

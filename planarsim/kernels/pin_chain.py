@@ -28,25 +28,24 @@ CHORD_TOL = 1e-9
 @kernel(inline="always")
 def _body_share(m, JL, JR, rl, el, rr, er, b):
     """Body b's share of A[rl:rl + 2, rr:rr + 2] = JL W JR^T (JL's rows rl, rl + 1 at their
-    end el, JR's rows rr, rr + 1 at their end er), row-major."""
+    end el, JR's rows rr, rr + 1 at their end er: pins' x and y rows, whose x row has no y
+    entry and y row no x entry; the products with those zeros are left out), row-major."""
     wm = m.body_inv_mass[b]
     wi = m.body_inv_inertia[b]
-    a00 = wm * (JL[rl, el, 0] * JR[rr, er, 0] + JL[rl, el, 1] * JR[rr, er, 1]) + (
-        wi * JL[rl, el, 2] * JR[rr, er, 2])
-    a01 = wm * (JL[rl, el, 0] * JR[rr + 1, er, 0] + JL[rl, el, 1] * JR[rr + 1, er, 1]) + (
-        wi * JL[rl, el, 2] * JR[rr + 1, er, 2])
-    a10 = wm * (JL[rl + 1, el, 0] * JR[rr, er, 0] + JL[rl + 1, el, 1] * JR[rr, er, 1]) + (
-        wi * JL[rl + 1, el, 2] * JR[rr, er, 2])
-    a11 = wm * (JL[rl + 1, el, 0] * JR[rr + 1, er, 0] + JL[rl + 1, el, 1] * JR[rr + 1, er, 1]) + (
-        wi * JL[rl + 1, el, 2] * JR[rr + 1, er, 2])
-    return a00, a01, a10, a11
+    lx = JL[rl, el, 2]
+    ly = JL[rl + 1, el, 2]
+    rx = JR[rr, er, 2]
+    ry = JR[rr + 1, er, 2]
+    return (wm * (JL[rl, el, 0] * JR[rr, er, 0]) + wi * lx * rx, wi * lx * ry, wi * ly * rx,
+            wm * (JL[rl + 1, el, 1] * JR[rr + 1, er, 1]) + wi * ly * ry)
 
 
 @kernel
-def chain_factor(m, ws, JL, JR):
-    """The block LU of A = JL W JR^T along the chains into ws.chain_factor; returns the
-    smallest share of its own diagonal that a row's pivot kept (each 2 x 2 pivot eliminated
-    x row first, as the general L D L^T does; 0: a pivot vanished, the rows are dependent)."""
+def chain_factor(m, ws, JL, JR, symmetric):
+    """The block LU of A = JL W JR^T along the chains into ws.chain_factor (symmetric: JL is
+    JR, so A[k-1, k] is A[k, k-1]^T); returns the smallest share of its own diagonal that a
+    row's pivot kept (each 2 x 2 pivot eliminated x row first, as the general L D L^T does;
+    0: a pivot vanished, the rows are dependent)."""
     f = ws.chain_factor
     smallest = 1.0
     for k in range(ws.chain_pin.shape[0]):
@@ -74,7 +73,10 @@ def chain_factor(m, ws, JL, JR):
             ri = 2 * ws.chain_pin[k - 1]
             b = m.pin_body[j, ej]
             e00, e01, e10, e11 = _body_share(m, JL, JR, r, ej, ri, ei, b)     # A[k, k-1]
-            u00, u01, u10, u11 = _body_share(m, JL, JR, ri, ei, r, ej, b)     # A[k-1, k]
+            if symmetric:
+                u00, u01, u10, u11 = e00, e10, e01, e11
+            else:
+                u00, u01, u10, u11 = _body_share(m, JL, JR, ri, ei, r, ej, b)  # A[k-1, k]
             # G = A[k, k-1] P_{k-1}^-1, then P -= G A[k-1, k]
             g00 = e00 * f[k - 1, 0] + e01 * f[k - 1, 2]
             g01 = e00 * f[k - 1, 1] + e01 * f[k - 1, 3]
@@ -84,10 +86,10 @@ def chain_factor(m, ws, JL, JR):
             p01 -= g00 * u01 + g01 * u11
             p10 -= g10 * u00 + g11 * u10
             p11 -= g10 * u01 + g11 * u11
-            f[k, 4] = e00
-            f[k, 5] = e01
-            f[k, 6] = e10
-            f[k, 7] = e11
+            f[k, 4] = g00
+            f[k, 5] = g01
+            f[k, 6] = g10
+            f[k, 7] = g11
             f[k, 8] = u00
             f[k, 9] = u01
             f[k, 10] = u10
@@ -120,11 +122,9 @@ def chain_solve(ws, rhs, x):
         y0 = rhs[r]
         y1 = rhs[r + 1]
         if ws.chain_end[k, 0] >= 0:
-            # y_k -= A[k, k-1] P_{k-1}^-1 y_{k-1}
-            z0 = f[k - 1, 0] * y[k - 1, 0] + f[k - 1, 1] * y[k - 1, 1]
-            z1 = f[k - 1, 2] * y[k - 1, 0] + f[k - 1, 3] * y[k - 1, 1]
-            y0 -= f[k, 4] * z0 + f[k, 5] * z1
-            y1 -= f[k, 6] * z0 + f[k, 7] * z1
+            # y_k -= G_k y_{k-1}, G_k = A[k, k-1] P_{k-1}^-1
+            y0 -= f[k, 4] * y[k - 1, 0] + f[k, 5] * y[k - 1, 1]
+            y1 -= f[k, 6] * y[k - 1, 0] + f[k, 7] * y[k - 1, 1]
         y[k, 0] = y0
         y[k, 1] = y1
     for k in range(n - 1, -1, -1):
@@ -146,7 +146,7 @@ def chain_velocity_solve(m, ws, h):
     start, c(q_pred) the pins' gaps at the predicted end, rows.build_rows) and v_new = v* +
     W J^T lam. Returns the smallest pivot share (chain_factor)."""
     n = ws.n_row[0]
-    share = chain_factor(m, ws, ws.row_J, ws.row_J)
+    share = chain_factor(m, ws, ws.row_J, ws.row_J, True)
     for r in range(n):
         ws.rhs[r] = -ws.row_c_pred[r] / h
     chain_solve(ws, ws.rhs, ws.lam)
@@ -171,7 +171,7 @@ def chain_correct(m, s, ws, h, iters, tol):
         if worst <= tol:
             break
         if fresh:
-            chain_factor(m, ws, ws.row_Jp, ws.row_J)
+            chain_factor(m, ws, ws.row_Jp, ws.row_J, False)
         chain_solve(ws, ws.rhs, ws.lam)
         add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
                      s.q, 1.0)

@@ -687,7 +687,7 @@ def chain_part(m, s, ws, opt, u, h):
     predict_velocity(m, s, ws, h)
     soft_prediction(m, s, ws, h)                            #    (v_lin = v*)
     predict_configuration(m, s, ws, h)
-    ws.joint_gain[2] = 0.0                                  # 3-4. rows and impulses
+    ws.joint_gain[2] = 0.0                                  # 3-4. rows, impulses
     ws.least_change[0] = 0
     ws.least_change[1] = 0
     ws.least_change[2] = 0
