@@ -44,8 +44,9 @@ def _body_share(m, JL, JR, rl, el, rr, er, b):
 def chain_factor(m, ws, JL, JR, symmetric):
     """The block LU of A = JL W JR^T along the chains into ws.chain_factor (symmetric: JL is
     JR, so A[k-1, k] is A[k, k-1]^T); returns the smallest share of its own diagonal that a
-    row's pivot kept (each 2 x 2 pivot eliminated x row first, as the general L D L^T does;
-    0: a pivot vanished, the rows are dependent)."""
+    row's pivot kept (each 2 x 2 pivot eliminated x row first, as the general L D L^T does,
+    in the chains' order, which is the rows' where the model lists its pins along its
+    chains; 0: a pivot vanished, the rows are dependent)."""
     f = ws.chain_factor
     smallest = 1.0
     for k in range(ws.chain_pin.shape[0]):

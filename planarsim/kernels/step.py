@@ -666,8 +666,8 @@ def chain_part(m, s, ws, opt, u, h):
     pins of open chains (ws.chain_on; planarsim/pin_chains.py): the stages step_of_length
     runs for such a model, in its order, with the velocity solve and the correction by block
     elimination along the chains (kernels/pin_chain.py) and every check of the general
-    step. Where the general step would do more than this (a nearly dependent pivot, the
-    joints' energy check or the correction's energy bound taking effect, a correction that
+    step. Where the general step would do more than this (a row its solve would drop as
+    dependent, the joints' energy check or the correction's energy bound taking effect, a correction that
     stalls or ends above refine_tol, a guard, an audit) it returns CHAIN_GENERAL or
     CHAIN_AGAIN; else 0."""
     copy_state(s, ws.prev)
@@ -694,7 +694,7 @@ def chain_part(m, s, ws, opt, u, h):
     build_rows(m, s, ws)
     ws.joint_pivot[0] = chain_velocity_solve(m, ws, h)
     ws.info[INFO_SOLVES] += 1
-    if ws.joint_pivot[0] < max(opt.pivot_tol, NEAR_DEPENDENT):
+    if ws.joint_pivot[0] < opt.pivot_tol:           # (a row the general solve would drop)
         return CHAIN_GENERAL
     if second_order_gains(m, s, ws, h):
         return CHAIN_GENERAL
