@@ -34,6 +34,15 @@ def pin_rows(q, cs, anchor, o, a, b, J, c, r):
     c[r + 1] = (bx - ax) * 0.0 + (by - ay) * 1.0
 
 
+@kernel(inline="always")
+def pin_gap(q, cs, anchor, o, a, b):
+    """(x, y) [m] of pin o's gap p_b - p_a between bodies a and b: its rows' errors (pin_rows'
+    c, without their Jacobian blocks)."""
+    ax, ay = world_point(q, cs, a, anchor[o, 0, 0], anchor[o, 0, 1])
+    bx, by = world_point(q, cs, b, anchor[o, 1, 0], anchor[o, 1, 1])
+    return bx - ax, by - ay
+
+
 @kernel
 def pin_axis(kind):
     """0 for a pin's x row, 1 for its y row (its impulse's slot in State.last_pin_impulse)."""

@@ -18,7 +18,10 @@ step: the rows moved by less than that since, so each pass still removes all but
 that order of the error). Both end where the general stages end, to rounding.
 """
 from ..compile import kernel
-from .integrate import STALLED_RATIO, max_residual
+from .codes import ROW_PIN_X, ROW_PIN_Y
+from .integrate import STALLED_RATIO
+from .math2d import turn_trig, update_trig
+from .pin import pin_gap, pin_rows
 from .solve import add_impulses
 
 # [m] every row within this after a correction pass: the next reuses the factorisation
@@ -142,6 +145,53 @@ def chain_solve(ws, rhs, x):
 
 
 @kernel
+def chain_rows(m, s, ws):
+    """Stage 3 on the chains: pin j's rows 2j (x) and 2j + 1 (y), their Jacobian blocks and
+    errors at q (ws.body_cs its cos / sin) and their errors at q_pred (ws.cs_pred): the rows
+    rows.build_rows makes for such a model (but row_F, which this path does not read)."""
+    n_pin = m.pin_body.shape[0]
+    for j in range(n_pin):
+        r = 2 * j
+        a = m.pin_body[j, 0]
+        b = m.pin_body[j, 1]
+        ws.row_kind[r] = ROW_PIN_X
+        ws.row_kind[r + 1] = ROW_PIN_Y
+        ws.row_owner[r] = j
+        ws.row_owner[r + 1] = j
+        ws.row_body[r, 0] = a
+        ws.row_body[r, 1] = b
+        ws.row_body[r + 1, 0] = a
+        ws.row_body[r + 1, 1] = b
+        pin_rows(s.q, ws.body_cs, m.pin_anchor, j, a, b, ws.row_J, ws.row_c, r)
+        gx, gy = pin_gap(ws.q_pred, ws.cs_pred, m.pin_anchor, j, a, b)
+        ws.row_c_pred[r] = gx
+        ws.row_c_pred[r + 1] = gy
+    ws.n_row[0] = 2 * n_pin
+
+
+@kernel
+def chain_residual(m, s, ws, jacobian):
+    """The pins' errors c at q as the correction's targets, ws.rhs = -c (and, jacobian, their
+    rows' Jacobian blocks into ws.row_Jp); returns the largest |c| [m]. ws.body_cs must hold
+    q's cos / sin."""
+    worst = 0.0
+    for j in range(m.pin_body.shape[0]):
+        r = 2 * j
+        a = m.pin_body[j, 0]
+        b = m.pin_body[j, 1]
+        if jacobian:
+            pin_rows(s.q, ws.body_cs, m.pin_anchor, j, a, b, ws.row_Jp, ws.rhs, r)
+            gx = ws.rhs[r]
+            gy = ws.rhs[r + 1]
+        else:
+            gx, gy = pin_gap(s.q, ws.body_cs, m.pin_anchor, j, a, b)
+        ws.rhs[r] = -gx
+        ws.rhs[r + 1] = -gy
+        worst = max(worst, abs(gx), abs(gy))
+    return worst
+
+
+@kernel
 def chain_velocity_solve(m, ws, h):
     """Stage 4 on the chains: lam with J W J^T lam = -c(q_pred) / h (J and W at the step's
     start, c(q_pred) the pins' gaps at the predicted end, rows.build_rows) and v_new = v* +
@@ -162,11 +212,14 @@ def chain_velocity_solve(m, ws, h):
 @kernel
 def chain_correct(m, s, ws, h, iters, tol):
     """Stage 8's Newton-SHAKE on the chains: up to iters passes of J(q) W J(q0)^T mu = -c(q),
-    q += W J(q0)^T mu, v += W J(q0)^T mu / h, until every row is within tol [m]. Returns the
-    largest row error left, or -1 where a pass removed less than half of it (the general
+    q += W J(q0)^T mu, v += W J(q0)^T mu / h, until every row is within tol [m]; a pass
+    after one that left every row within CHORD_TOL reuses its factorisation. The angles'
+    cos / sin after a pass are turned by its few nanoradians (math2d.turn_trig). Returns
+    the largest row error left, or -1 where a pass removed less than half of it (the general
     correction's safeguards then decide: the step is taken by the general stages)."""
     n = ws.n_row[0]
-    worst = max_residual(m, s, ws)          # row_Jp at q, ws.rhs = -c
+    update_trig(s.q, ws.body_cs)
+    worst = chain_residual(m, s, ws, True)
     fresh = True
     for _ in range(iters):
         if worst <= tol:
@@ -178,9 +231,12 @@ def chain_correct(m, s, ws, h, iters, tol):
                      s.q, 1.0)
         add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
                      s.v, 1.0 / h)
-        after = max_residual(m, s, ws)
+        turn_trig(s.q, ws.body_cs)
+        after = chain_residual(m, s, ws, False)
         if after > STALLED_RATIO * worst:
             return -1.0
         fresh = after > CHORD_TOL
+        if fresh and after > tol:
+            chain_residual(m, s, ws, True)      # (the next pass factors J at this q)
         worst = after
     return worst

@@ -35,7 +35,7 @@ from .math2d import update_trig
 from .modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .pair import PAIR_MARGIN
-from .pin_chain import chain_correct, chain_velocity_solve
+from .pin_chain import chain_correct, chain_rows, chain_velocity_solve
 from .pair_toi import hold_off_fast_pairs
 from .position import ROWS_HELD_SHARE, position_stage
 from .rows import build_rows
@@ -691,7 +691,7 @@ def chain_part(m, s, ws, opt, u, h):
     ws.least_change[0] = 0
     ws.least_change[1] = 0
     ws.least_change[2] = 0
-    build_rows(m, s, ws)
+    chain_rows(m, s, ws)
     ws.joint_pivot[0] = chain_velocity_solve(m, ws, h)
     ws.info[INFO_SOLVES] += 1
     if ws.joint_pivot[0] < opt.pivot_tol:           # (a row the general solve would drop)
