@@ -300,6 +300,11 @@ class Workspace(NamedTuple):
     sp_key: np.ndarray           # (n_body,) scratch: the coordinate a part is split along [m]
     sp_stack: np.ndarray         # (n_body + 2, 2) int the parts still to split
     sp_count: np.ndarray         # ((n_body + 1) MAX_DEPTH + 1,) int counting sort of the rows
+    sp_kept_rows: np.ndarray     # (R, 4) int the rows whose factors the sparse storage holds:
+                                 #   kind, owner, bodies (solve.reuse_factors)
+    sp_kept: np.ndarray          # (3,) int [0] 1: the sparse storage holds the velocity solve's
+                                 #   factors of the rows in sp_kept_rows, [1] how many, [2] how
+                                 #   many it dropped as dependent (0: no factors kept)
     rhs: np.ndarray              # (R,)
     lam_start: np.ndarray        # (R,) impulses the solve starts from (the last step's)
     lam: np.ndarray              # (R,) impulses [N s or N m s]
@@ -607,7 +612,8 @@ def _solve_shapes(model: Model, contacts: int, profile: int, lcp_rows: int) -> d
                 sp_flag=((R,), i), sp_pattern=((R,), i), sp_lcount=((R,), i),
                 sp_lstart=((R + 1,), i), sp_pivot=((R,), f), sp_diag=((R,), f),
                 sp_x=((R,), f), sp_y=((R,), f), sp_start=((R + 1,), i), sp_index=((P,), i),
-                sp_low=((P,), f), sp_up=((P,), f), sp_body_rows=((2 * R,), i), rhs=((R,), f), lam_start=((R,), f), lam=((R,), f),
+                sp_low=((P,), f), sp_up=((P,), f), sp_body_rows=((2 * R,), i),
+                sp_kept_rows=((R, 4), i), rhs=((R,), f), lam_start=((R,), f), lam=((R,), f),
                 row_b=((R,), f), row_soft=((R, 6), f), lcp_rows=((R,), i),
                 lcp_var=((R,), i), lcp_pos=((R,), i), row_local=((R,), i),
                 lcp_A=((C, C), f), lcp_B=((C, C), f), lcp_G=((C, C + 1), f),
@@ -646,6 +652,7 @@ def grow_workspace(model: Model, ws: Workspace) -> Workspace:
             kept = tuple(slice(0, min(k, g)) for k, g in zip(old.shape, shape))
             array[kept] = old[kept]
             grown[name] = array
+    ws.sp_kept[0] = 0           # (factors of the old storage's rows: not kept)
     room = ws.room.copy()
     room[0] = 0
     room[1] = int(contacts < model.n_contact)
@@ -718,6 +725,7 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      sp_bodies=z(nb, np.int64), sp_body_place=z(nb, np.int64), sp_key=z(nb),
                      sp_stack=z((nb + 2, 2), np.int64),
                      sp_count=z((nb + 1) * SPARSE_MAX_DEPTH + 1, np.int64),
+                     sp_kept=z(3, np.int64),
                      island_label=z(nb, np.int64), island_start=z(nb + 2, np.int64),
                      island_fill=z(nb + 1, np.int64), island_failed=z(nb + 1, np.int64),
                      island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),

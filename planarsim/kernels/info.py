@@ -17,14 +17,16 @@ INFO_TURN_SUBSTEPS = 10    # sub-steps the step was taken in (1: whole; step.tur
                            # joint's anchor or a touching contact's point turning too far)
 INFO_CHAIN_PATH = 11       # 1: the step was taken by the pin-chain path (step.chain_step), 0:
                            # by the general stages
-N_INFO = 12
+INFO_KEPT_FACTORS = 12     # velocity solves on the factors kept from an earlier step's
+                           # (solve.refine_on_kept_factors: a pile at rest)
+N_INFO = 13
 
 INFO_NAMES = ("solves", "ccd_splits", "guard_body", "guard_field", "lcp_solves",
               "newton_taken_back", "lcp_pivots", "projections", "command", "ccd_stops",
-              "turn_substeps", "chain_path")
+              "turn_substeps", "chain_path", "kept_factors")
 # counted afresh by every step (the guard slots keep the last failure)
 STEP_COUNTS = (INFO_SOLVES, INFO_CCD_SPLITS, INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK,
-               INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS)
+               INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS, INFO_KEPT_FACTORS)
 
 
 def step_info(ws) -> dict:

@@ -22,8 +22,9 @@ Without sliding contacts F = J and the matrix is symmetric: it is assembled in i
 triangle only and factored as L D L^T (half the work of LU, the same pivot test).
 """
 from ..compile import kernel
-from .matrix import (add_to_diagonal, arrange, assemble, diagonal_and_pivot, factor_ws,
-                     scale_diagonal, substitute_ws)
+from .matrix import (SPARSE, add_to_diagonal, arrange, assemble, diagonal_and_pivot,
+                     factor_ws, scale_diagonal, substitute_ws)
+from .info import INFO_KEPT_FACTORS
 from .rows import is_joint_row, is_normal_row, is_soft_row, is_tangent_row
 from .soft import soft_compliance, soft_row_b
 from .warm_start import start_impulses
@@ -188,18 +189,106 @@ def least_change_impulses(m, s, ws, tol, n):
         ws.lam[r] = ws.lam_start[r]
 
 
+# refinement rounds a solve on kept factors may take (refine_on_kept_factors), and how small
+# each kept row's residual must end: REFINE_TOL (|b| + 1) [m/s], 1e-4 of the tolerance the
+# rules check every equation to (modes.SOLVE_REL_TOL (|b| + 1))
+REFINE_ROUNDS = 4
+REFINE_TOL = 1e-13
+
+
+@kernel
+def same_rows_factored(ws, n):
+    """True if the sparse storage holds the velocity solve's factors of exactly rows 0..n-1
+    (kind, owner and bodies; ws.sp_kept_rows)."""
+    if ws.sp_kept[0] == 0 or ws.sp_kept[1] != n or ws.factor_kind[0] != SPARSE:
+        return False
+    for r in range(n):
+        if (ws.sp_kept_rows[r, 0] != ws.row_kind[r] or ws.sp_kept_rows[r, 1] != ws.row_owner[r]
+                or ws.sp_kept_rows[r, 2] != ws.row_body[r, 0]
+                or ws.sp_kept_rows[r, 3] != ws.row_body[r, 1]):
+            return False
+    return True
+
+
+@kernel
+def keep_factors(ws, n, dropped):
+    """Mark the sparse factors just made of rows 0..n-1 as the velocity solve's, for reuse;
+    not where a row is soft (its compliance is not in the matrix-free residual that
+    refine_on_kept_factors measures)."""
+    for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            return
+    for r in range(n):
+        ws.sp_kept_rows[r, 0] = ws.row_kind[r]
+        ws.sp_kept_rows[r, 1] = ws.row_owner[r]
+        ws.sp_kept_rows[r, 2] = ws.row_body[r, 0]
+        ws.sp_kept_rows[r, 3] = ws.row_body[r, 1]
+    ws.sp_kept[0] = 1
+    ws.sp_kept[1] = n
+    ws.sp_kept[2] = dropped
+
+
+@kernel
+def refine_on_kept_factors(m, ws, n):
+    """Iterative refinement of the answer in ws.lam, v_new against this step's matrix (its
+    residual b + J (v_new - v*) is matrix-free) with the kept factors of last step's: up to
+    REFINE_ROUNDS corrections. Returns True if every row the factors keep (not dropped as
+    dependent) ends within REFINE_TOL (|b| + 1)."""
+    big_b = 0.0
+    for r in range(n):
+        big_b = max(big_b, abs(ws.row_b[r]))
+    tol = REFINE_TOL * (big_b + 1.0)
+    for rounds in range(REFINE_ROUNDS + 1):
+        residual_rhs(ws, n)
+        worst = 0.0
+        for r in range(n):
+            if ws.sp_pivot[ws.sp_iperm[r]] != 0.0:
+                worst = max(worst, abs(ws.rhs[r]))
+        if worst <= tol:
+            return True
+        if rounds == REFINE_ROUNDS:
+            break
+        substitute_ws(ws, ws.rhs, ws.lam_start, n, True)
+        apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
+        for r in range(n):
+            ws.lam[r] += ws.lam_start[r]
+    return False
+
+
 @kernel(inline="always")
 def solve_impulses(m, s, ws, h, tol, symmetric):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
     Where a row is dropped as dependent, the solve finds the change from the last step's
     impulses (ws.lam_start; warm_start.py), so the dropped row keeps its impulse.
-    symmetric: F = J (no sliding contact), so J W F^T is symmetric (L D L^T on its lower half)."""
+    symmetric: F = J (no sliding contact), so J W F^T is symmetric (L D L^T on its lower half).
+    A pile at rest keeps its rows from step to step, and its matrix changes by rounding:
+    where the sparse storage holds the factors of this step's very rows (same_rows_factored),
+    they are reused and the answer refined against this step's matrix to rounding
+    (refine_on_kept_factors; where it does not converge, the rows are factored afresh)."""
     n = ws.n_row[0]
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
             ws.v_new[i, k] = ws.v_pred[i, k]
     if n == 0:
         return 0
+    reuse = symmetric and ws.least_change[0] == 0 and same_rows_factored(ws, n)
+    if reuse:
+        fill_row_b(ws, h, n)
+        dropped = ws.sp_kept[2]
+        warm = start_impulses(s, ws, n, dropped)
+        if warm:
+            for r in range(n):
+                ws.lam[r] = ws.lam_start[r]
+        else:
+            for r in range(n):
+                ws.lam[r] = 0.0
+        apply_impulses(m, ws, ws.row_F, ws.lam, n, ws.v_new, 1.0)
+        if refine_on_kept_factors(m, ws, n):
+            ws.info[INFO_KEPT_FACTORS] += 1
+            return dropped
+        for i in range(ws.v_new.shape[0]):
+            for k in range(3):
+                ws.v_new[i, k] = ws.v_pred[i, k]
     if not arrange(s.q, ws, n, ws.v_new.shape[0]):
         for r in range(n):
             ws.lam[r] = 0.0
@@ -212,6 +301,8 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     if dropped > 0 and symmetric and ws.least_change[0] == 1:
         least_change_impulses(m, s, ws, tol, n)
         return dropped
+    if symmetric and ws.factor_kind[0] == SPARSE:
+        keep_factors(ws, n, dropped)
     warm = start_impulses(s, ws, n, dropped)
     if warm:
         apply_impulses(m, ws, ws.row_F, ws.lam_start, n, ws.v_new, 1.0)
