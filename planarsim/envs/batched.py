@@ -1,0 +1,153 @@
+"""Many copies of one planarsim environment in this process, their physics advanced by one
+compiled call per vector step: ``BatchedVectorEnv``, the environments' gymnasium
+``vector_entry_point`` (``gymnasium.make_vec(id, num_envs=N)``).
+
+A vector step has three phases. (1) Each copy that steps (not one being autoreset) turns its
+action into actuator commands (PlanarMujocoEnv.load_commands), written into its row of one
+(num_envs, n_act) array. (2) One compiled call (``run_steps_batch``) runs frame_skip physics
+steps of every such copy, in copy order, each on its own Simulator's state (the same compiled
+loop as Simulator.steps). (3) gymnasium's ``SyncVectorEnv.step`` steps the copies as it does
+for any environment: each copy's ``step`` finds its physics already advanced
+(PlanarMujocoEnv.do_simulation only reads qpos, qvel), and computes its observation, reward,
+termination and info in Python; autoreset (NEXT_STEP), seeding and info batching are
+gymnasium's own. The episodes are therefore bit for bit those of ``SyncVectorEnv`` over the
+same environment (a test).
+
+Where the compile mode has no table handles (plain numba, NUMBA_DISABLE_JIT) phase (2) steps
+the copies one after another from Python, with the same numbers. A copy whose step runs out
+of solver storage (GUARD_ROOM) or diverges is finished or reported from Python as
+Simulator.steps does; an error is raised after every copy's physics has run (SyncVectorEnv
+raises it with the copies after it not yet stepped).
+
+>>> import gymnasium, planarsim.envs
+>>> envs = gymnasium.make_vec("planarsim/Hopper-v0", num_envs=64)     # doctest: +SKIP
+>>> obs, info = envs.reset(seed=0)                                    # doctest: +SKIP
+>>> obs, rew, term, trunc, info = envs.step(envs.action_space.sample())  # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import functools
+import numbers
+
+import numpy as np
+import gymnasium
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
+from gymnasium.vector.utils import iterate
+
+from ..compile import MODE, FAST
+from ..compiled import jit
+from ..kernels.guards import GUARD_ROOM
+from ..link.step import run_steps
+
+
+@jit
+def run_steps_batch(handles, active, u, n, codes, done):
+    """n physics steps of every copy i with active[i] (handles: one Simulator's StepArgs
+    handle per copy, all of one type; u: (copies, n_act) commands), in copy order; the
+    guard code and steps completed of each into codes[i], done[i] (0, n for a copy left
+    alone)."""
+    for i in range(len(handles)):
+        codes[i] = 0
+        done[i] = n
+        if active[i]:
+            codes[i], done[i] = run_steps(handles[i], u[i], n)
+
+
+def check_num_envs(num_envs) -> int:
+    """num_envs as an int; a ValueError naming it unless it is a positive integer."""
+    if isinstance(num_envs, bool) or not isinstance(num_envs, numbers.Integral) or num_envs < 1:
+        raise ValueError(f"num_envs={num_envs!r} must be a positive integer (the number of "
+                         f"copies of the environment)")
+    return int(num_envs)
+
+
+class BatchedVectorEnv(SyncVectorEnv):
+    """``num_envs`` copies of ``gymnasium.make(env_id, **kwargs)`` (each with gymnasium's
+    usual wrappers: TimeLimit at max_episode_steps, order enforcing, the passive checker), a
+    gymnasium SyncVectorEnv whose copies' physics for a step run in one compiled call (see
+    the module's docstring). Autoreset: gymnasium's NEXT_STEP (a copy that ended is reset by
+    the next step, which ignores its action and returns its first observation, reward 0)."""
+
+    def __init__(self, env_id: str, num_envs: int = 1, max_episode_steps: int | None = None,
+                 **kwargs):
+        num_envs = check_num_envs(num_envs)
+        if max_episode_steps is not None:
+            kwargs["max_episode_steps"] = max_episode_steps
+        super().__init__([functools.partial(gymnasium.make, env_id, **kwargs)] * num_envs,
+                         autoreset_mode=AutoresetMode.NEXT_STEP)
+        self.env_id = env_id
+        self._copies = [env.unwrapped for env in self.envs]
+        sims = [c.sim for c in self._copies]
+        n_act = sims[0].model.n_act
+        # each copy's commands are its row of one array (the compiled loop reads rows)
+        self._commands = np.zeros((num_envs, n_act))
+        for c, row in zip(self._copies, self._commands):
+            c._u = row
+        self._frames = self._copies[0].frame_skip
+        self._handles = tuple(s._args for s in sims)
+        self._active = np.zeros(num_envs, np.bool_)
+        self._codes = np.zeros(num_envs, np.int64)
+        self._done = np.zeros(num_envs, np.int64)
+        self._was_reset = False
+
+    def reset(self, *, seed=None, options=None):
+        out = super().reset(seed=seed, options=options)
+        self._was_reset = True
+        return out
+
+    def step(self, actions):
+        """One step of every copy (gymnasium's SyncVectorEnv.step, after the copies' physics
+        have advanced together)."""
+        if self._was_reset and self._load_actions(actions):
+            self._advance_physics()
+        return super().step(actions)
+
+    def _load_actions(self, actions) -> bool:
+        """Phase 1: each copy that steps loads its action's commands; False (nothing
+        loaded to run) if an action is malformed: the copies then step one by one and the
+        copy's own step names what is wrong."""
+        self._active[:] = ~np.asarray(self._autoreset_envs, bool)
+        try:
+            rows = list(iterate(self.action_space, actions))
+        except (TypeError, ValueError, IndexError, AssertionError):
+            return False
+        if len(rows) != self.num_envs:
+            return False
+        for i in np.flatnonzero(self._active):
+            if not self._copies[i].load_commands(rows[i]):
+                return False
+        return True
+
+    def _advance_physics(self):
+        """Phase 2: frame_skip physics steps of every active copy, then each told that its
+        next do_simulation finds them done."""
+        n = self._frames
+        if MODE == FAST:
+            run_steps_batch(self._handles, self._active, self._commands, n, self._codes,
+                            self._done)
+        else:
+            for i in np.flatnonzero(self._active):
+                self._copies[i].sim.steps(n, self._commands[i])
+            self._codes[:] = 0
+        for i in np.flatnonzero(self._active):
+            self._copies[i]._advanced = n
+        for i in np.flatnonzero(self._codes):
+            self._finish(i, int(self._codes[i]), int(self._done[i]), n)
+
+    def _finish(self, i, code, done, n):
+        """A copy whose batched steps stopped (guard code `code` after `done` of n steps): on
+        GUARD_ROOM (the step undone) its storage grows and the rest run as Simulator.steps
+        runs them; another code raises SimulationDiverged."""
+        sim = self._copies[i].sim
+        if code != GUARD_ROOM:
+            for c in self._copies:
+                c._advanced = None
+            sim._raise(code)
+        sim._grow()
+        sim._run_steps(self._commands[i], n - done)
+
+
+def make_batched(env_id: str, num_envs: int = 1, **kwargs) -> BatchedVectorEnv:
+    """The vector entry point of planarsim's environment `env_id` (registry.py): gymnasium's
+    make_vec calls it with num_envs, max_episode_steps and the environment's keywords."""
+    return BatchedVectorEnv(env_id, num_envs=num_envs, **kwargs)
