@@ -83,7 +83,6 @@ class BatchedVectorEnv(SyncVectorEnv):
         self._commands = np.zeros((num_envs, n_act))
         for c, row in zip(self._copies, self._commands):
             c._u = row
-        self._frames = self._copies[0].frame_skip
         self._handles = tuple(s._args for s in sims)
         self._active = np.zeros(num_envs, np.bool_)
         self._codes = np.zeros(num_envs, np.int64)
@@ -104,8 +103,9 @@ class BatchedVectorEnv(SyncVectorEnv):
 
     def _load_actions(self, actions) -> bool:
         """Phase 1: each copy that steps loads its action's commands; False (nothing
-        loaded to run) if an action is malformed: the copies then step one by one and the
-        copy's own step names what is wrong."""
+        loaded to run) if an action is malformed (the copies then step one by one and the
+        copy's own step names what is wrong), if no copy steps, or if the copies' frame_skip
+        differ (set_attr)."""
         self._active[:] = ~np.asarray(self._autoreset_envs, bool)
         try:
             rows = list(iterate(self.action_space, actions))
@@ -113,10 +113,13 @@ class BatchedVectorEnv(SyncVectorEnv):
             return False
         if len(rows) != self.num_envs:
             return False
+        frames = set()
         for i in np.flatnonzero(self._active):
             if not self._copies[i].load_commands(rows[i]):
                 return False
-        return True
+            frames.add(self._copies[i].frame_skip)
+        self._frames = frames.pop() if len(frames) == 1 else None
+        return self._frames is not None
 
     def _advance_physics(self):
         """Phase 2: frame_skip physics steps of every active copy, then each told that its
