@@ -32,25 +32,30 @@ import numbers
 import numpy as np
 import gymnasium
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
-from gymnasium.vector.utils import iterate
 
 from ..compile import MODE, FAST
 from ..compiled import jit
 from ..kernels.guards import GUARD_ROOM
-from ..link.step import run_steps
+from ..link.step import bind, run_steps
+from .core import set_commands
 
 
 @jit
-def run_steps_batch(handles, active, u, n, codes, done):
-    """n physics steps of every copy i with active[i] (handles: one Simulator's StepArgs
-    handle per copy, all of one type; u: (copies, n_act) commands), in copy order; the
-    guard code and steps completed of each into codes[i], done[i] (0, n for a copy left
-    alone)."""
+def step_batch(handles, active, ctrl, lo, hi, entry, act_id, gain, u, n, codes, done):
+    """Every copy i with active[i] (handles: one Simulator's StepArgs handle per copy, all of
+    one type): its commands u[i] from its action ctrl[i] (core.set_commands; lo, hi, entry,
+    act_id, gain: the copies' common drives), then n physics steps, in copy order; the guard
+    code and steps completed of each into codes[i], done[i] (0, n for a copy left alone).
+    False, with no copy stepped, if an active copy's action has a NaN or infinite entry."""
+    for i in range(len(handles)):
+        if active[i] and not set_commands(ctrl[i], lo, hi, entry, act_id, gain, u[i]):
+            return False
     for i in range(len(handles)):
         codes[i] = 0
         done[i] = n
         if active[i]:
             codes[i], done[i] = run_steps(handles[i], u[i], n)
+    return True
 
 
 def check_num_envs(num_envs) -> int:
@@ -78,15 +83,23 @@ class BatchedVectorEnv(SyncVectorEnv):
         self.env_id = env_id
         self._copies = [env.unwrapped for env in self.envs]
         sims = [c.sim for c in self._copies]
+        first = self._copies[0]
         n_act = sims[0].model.n_act
         # each copy's commands are its row of one array (the compiled loop reads rows)
         self._commands = np.zeros((num_envs, n_act))
         for c, row in zip(self._copies, self._commands):
             c._u = row
-        self._handles = tuple(s._args for s in sims)
+        self._actions = np.zeros(self.action_space.shape)
         self._active = np.zeros(num_envs, np.bool_)
         self._codes = np.zeros(num_envs, np.int64)
         self._done = np.zeros(num_envs, np.int64)
+        self._frames = np.int64(first.frame_skip)
+        self._batch_args = (tuple(s._args for s in sims), self._active, self._actions,
+                            first._act_lo, first._act_hi, first._drive_entry, first._drive_id,
+                            first._drive_gain, self._commands, self._frames, self._codes,
+                            self._done)
+        # compiled once for these arguments' types and called without numba's type dispatch
+        self._step_batch = bind(step_batch, self._batch_args) if MODE == FAST else None
         self._was_reset = False
 
     def reset(self, *, seed=None, options=None):
@@ -102,38 +115,38 @@ class BatchedVectorEnv(SyncVectorEnv):
         return super().step(actions)
 
     def _load_actions(self, actions) -> bool:
-        """Phase 1: each copy that steps loads its action's commands; False (nothing
-        loaded to run) if an action is malformed (the copies then step one by one and the
-        copy's own step names what is wrong), if no copy steps, or if the copies' frame_skip
-        differ (set_attr)."""
-        self._active[:] = ~np.asarray(self._autoreset_envs, bool)
+        """Phase 1: the actions as float64 (as each copy converts its own) and the copies
+        that step (not being autoreset); False (nothing to run: the copies then step one by
+        one and a copy's own step names what is wrong) for actions of the wrong shape or
+        kind, if no copy steps, or if a copy's frame_skip was changed (set_attr)."""
+        np.logical_not(self._autoreset_envs, out=self._active)
         try:
-            rows = list(iterate(self.action_space, actions))
-        except (TypeError, ValueError, IndexError, AssertionError):
-            return False
-        if len(rows) != self.num_envs:
-            return False
-        frames = set()
-        for i in np.flatnonzero(self._active):
-            if not self._copies[i].load_commands(rows[i]):
+            actions = np.asarray(actions)
+            if actions.shape != self._actions.shape or actions.dtype.kind not in "fiub":
                 return False
-            frames.add(self._copies[i].frame_skip)
-        self._frames = frames.pop() if len(frames) == 1 else None
-        return self._frames is not None
+            np.copyto(self._actions, actions, casting="unsafe")
+        except (TypeError, ValueError):
+            return False
+        return bool(self._active.any()) and all(c.frame_skip == self._frames for c in self._copies)
 
     def _advance_physics(self):
-        """Phase 2: frame_skip physics steps of every active copy, then each told that its
-        next do_simulation finds them done."""
-        n = self._frames
-        if MODE == FAST:
-            run_steps_batch(self._handles, self._active, self._commands, n, self._codes,
-                            self._done)
+        """Phase 2: every active copy's commands and frame_skip physics steps (one compiled
+        call), then each told that its next do_simulation finds them done."""
+        n = int(self._frames)
+        if self._step_batch is not None:
+            if not self._step_batch(*self._batch_args):
+                return                     # a non-finite action: the copies' steps raise
         else:
+            for i in np.flatnonzero(self._active):
+                c = self._copies[i]
+                if not c.load_commands(self._actions[i]):
+                    return
             for i in np.flatnonzero(self._active):
                 self._copies[i].sim.steps(n, self._commands[i])
             self._codes[:] = 0
-        for i in np.flatnonzero(self._active):
-            self._copies[i]._advanced = n
+        for c, active in zip(self._copies, self._active):
+            if active:
+                c._advanced = n
         for i in np.flatnonzero(self._codes):
             self._finish(i, int(self._codes[i]), int(self._done[i]), n)
 

@@ -376,15 +376,15 @@ class PlanarMujocoEnv(gymnasium.Env):
             a, self._act_lo, self._act_hi, self._drive_entry, self._drive_id, self._drive_gain,
             self._u)
 
-    #: frames the simulator has already advanced under the commands of the next
-    #: do_simulation (a batched vector step: planarsim.envs.batched), or None
+    #: frames the simulator has already advanced, under commands loaded from the action the
+    #: next do_simulation is given (a batched vector step: planarsim.envs.batched), or None
     _advanced = None
 
     def do_simulation(self, ctrl, n_frames):
-        if not self.load_commands(ctrl):
-            self.check_action(ctrl)        # (raises, naming what is wrong)
         advanced, self._advanced = self._advanced, None
         if advanced is None:
+            if not self.load_commands(ctrl):
+                self.check_action(ctrl)        # (raises, naming what is wrong)
             self.sim.steps(int(n_frames), self._u)
         elif advanced != int(n_frames):
             raise RuntimeError(f"do_simulation({int(n_frames)} frames) after a batched step of "
