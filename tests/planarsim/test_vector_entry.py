@@ -117,3 +117,44 @@ def test_bad_action_is_the_copies_error_and_the_copies_stay_in_step():
 def test_bad_num_envs_is_named(num_envs):
     with pytest.raises(ValueError, match=f"num_envs={num_envs!r} must be a positive integer"):
         gym.make_vec("planarsim/Hopper-v0", num_envs=num_envs, vectorization_mode="vector_entry_point")
+
+
+def test_a_copy_whose_step_runs_out_of_room_grows_and_keeps_the_bits(monkeypatch):
+    """Workspaces made with room for one contact: a copy's batched step that needs more is
+    undone, its storage grows and its steps finish from Python (as Simulator.steps does),
+    with the bits of SyncVectorEnv's copies that grow alike."""
+    from planarsim import state as state_module
+    monkeypatch.setattr(state_module, "contact_capacity", lambda m: 1)
+    finished = []
+    finish = BatchedVectorEnv._finish
+    monkeypatch.setattr(BatchedVectorEnv, "_finish",
+                        lambda self, *a: finished.append(a) or finish(self, *a))
+    ours, ref = make_pair("planarsim/HalfCheetah-v0")      # feet and shins land: more than one
+    try:
+        assert_same(ours.reset(seed=2), ref.reset(seed=2))
+        rng = np.random.default_rng(1)
+        for _ in range(40):
+            a = rng.uniform(-1, 1, size=ours.action_space.shape).astype(np.float32)
+            assert_same(ours.step(a), ref.step(a))
+        grown = [state_module.workspace_capacity(c.sim_model, c.sim.ws)[0] for c in ours._copies]
+        assert max(grown) > 1
+        if MODE == FAST:
+            assert finished                # (grown after a batched step ran out of room)
+    finally:
+        ours.close()
+        ref.close()
+
+
+def test_a_diverging_copy_raises_as_in_sync_vector_env():
+    from planarsim.errors import SimulationDiverged
+    ours, ref = make_pair("planarsim/InvertedPendulum-v0")
+    try:
+        for envs in (ours, ref):
+            envs.reset(seed=0)
+            copy = envs.envs[1].unwrapped
+            copy.set_state(copy.init_qpos, np.full(copy.model.nv, 1e200))
+            with pytest.raises(SimulationDiverged):
+                envs.step(np.zeros(envs.action_space.shape, np.float32))
+    finally:
+        ours.close()
+        ref.close()
