@@ -158,3 +158,38 @@ def test_a_diverging_copy_raises_as_in_sync_vector_env():
     finally:
         ours.close()
         ref.close()
+
+
+PARITY_SCRIPT = """
+import numpy as np, gymnasium, planarsim.envs
+from planarsim.envs import batched
+ours, ref = (gymnasium.make_vec("planarsim/InvertedPendulum-v0", num_envs=3,
+                                vectorization_mode=mode) for mode in ("vector_entry_point", "sync"))
+assert batched.MODE == "python" and ours._step_batch is None
+assert np.array_equal(ours.reset(seed=1)[0], ref.reset(seed=1)[0])
+rng = np.random.default_rng(0)
+ended = 0
+for _ in range(20):
+    a = rng.uniform(-3, 3, size=ours.action_space.shape).astype(np.float32)
+    r1, r2 = ours.step(a), ref.step(a)
+    assert all(np.array_equal(x, y) for x, y in zip(r1[:4], r2[:4]))
+    ended += int(r1[2].sum())
+assert ended > 0
+print("same")
+"""
+
+
+def test_without_the_fast_mode_the_copies_step_one_by_one_with_the_same_bits():
+    """Under NUMBA_DISABLE_JIT (a process of its own) the copies' physics run from Python,
+    one after another: the same episodes as SyncVectorEnv's."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = str(Path(__file__).resolve().parents[2])          # this checkout's planarsim
+    env = {**os.environ, "NUMBA_DISABLE_JIT": "1",
+           "PYTHONPATH": os.pathsep.join([root, os.environ.get("PYTHONPATH", "")])}
+    out = subprocess.run([sys.executable, "-c", PARITY_SCRIPT], env=env, capture_output=True,
+                         text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().endswith("same")
