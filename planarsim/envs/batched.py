@@ -2,22 +2,25 @@
 compiled call per vector step: ``BatchedVectorEnv``, the environments' gymnasium
 ``vector_entry_point`` (``gymnasium.make_vec(id, num_envs=N)``).
 
-A vector step has three phases. (1) Each copy that steps (not one being autoreset) turns its
-action into actuator commands (PlanarMujocoEnv.load_commands), written into its row of one
-(num_envs, n_act) array. (2) One compiled call (``run_steps_batch``) runs frame_skip physics
-steps of every such copy, in copy order, each on its own Simulator's state (the same compiled
-loop as Simulator.steps). (3) gymnasium's ``SyncVectorEnv.step`` steps the copies as it does
-for any environment: each copy's ``step`` finds its physics already advanced
-(PlanarMujocoEnv.do_simulation only reads qpos, qvel), and computes its observation, reward,
-termination and info in Python; autoreset (NEXT_STEP), seeding and info batching are
-gymnasium's own. The episodes are therefore bit for bit those of ``SyncVectorEnv`` over the
-same environment (a test).
+A vector step has three phases. (1) Each copy that steps (not one being autoreset) is
+marked, and the actions are taken as float64 (as each copy converts its own). (2) One
+compiled call (``step_batch``) turns every such copy's action into its actuator commands
+(core.set_commands, into its row of one (num_envs, n_act) array) and runs frame_skip physics
+steps of it on its own Simulator's state (run_steps, the loop Simulator.steps runs), copy
+after copy. (3) gymnasium's ``SyncVectorEnv.step`` steps the copies as it does for any
+environment: each copy's ``step`` finds its physics already advanced (PlanarMujocoEnv.
+do_simulation only reads qpos, qvel) and computes its observation, reward, termination and
+info in Python; autoreset (NEXT_STEP), seeding and info batching are gymnasium's own. The
+episodes are therefore bit for bit those of ``SyncVectorEnv`` over the same environment (a
+test). ``step_batch`` is compiled once per number of copies (the handles are a tuple) and
+bound, so a step pays no numba type dispatch.
 
-Where the compile mode has no table handles (plain numba, NUMBA_DISABLE_JIT) phase (2) steps
-the copies one after another from Python, with the same numbers. A copy whose step runs out
-of solver storage (GUARD_ROOM) or diverges is finished or reported from Python as
-Simulator.steps does; an error is raised after every copy's physics has run (SyncVectorEnv
-raises it with the copies after it not yet stepped).
+Outside the fast compile mode (plain numba, NUMBA_DISABLE_JIT) phase (2) steps the copies
+one after another from Python, with the same numbers. An action with a NaN or infinite
+entry, or of the wrong shape, sends the step to SyncVectorEnv's own loop (whose copy raises,
+naming it). A copy whose step runs out of solve storage (GUARD_ROOM) or diverges is
+finished or reported from Python as Simulator.steps does; a divergence is raised after
+every copy's physics has run (SyncVectorEnv raises it before the copies after it step).
 
 >>> import gymnasium, planarsim.envs
 >>> envs = gymnasium.make_vec("planarsim/Hopper-v0", num_envs=64)     # doctest: +SKIP
