@@ -49,16 +49,19 @@ def step_batch(handles, active, ctrl, lo, hi, entry, act_id, gain, u, n, codes, 
     one type): its commands u[i] from its action ctrl[i] (core.set_commands; lo, hi, entry,
     act_id, gain: the copies' common drives), then n physics steps, in copy order; the guard
     code and steps completed of each into codes[i], done[i] (0, n for a copy left alone).
-    False, with no copy stepped, if an active copy's action has a NaN or infinite entry."""
+    Returns how many copies' steps stopped (a nonzero code), or -1, with no copy stepped, if
+    an active copy's action has a NaN or infinite entry."""
     for i in range(len(handles)):
         if active[i] and not set_commands(ctrl[i], lo, hi, entry, act_id, gain, u[i]):
-            return False
+            return -1
+    stopped = 0
     for i in range(len(handles)):
         codes[i] = 0
         done[i] = n
         if active[i]:
             codes[i], done[i] = run_steps(handles[i], u[i], n)
-    return True
+            stopped += codes[i] != 0
+    return stopped
 
 
 def check_num_envs(num_envs) -> int:
@@ -121,7 +124,7 @@ class BatchedVectorEnv(SyncVectorEnv):
         """Phase 1: the actions as float64 (as each copy converts its own) and the copies
         that step (not being autoreset); False (nothing to run: the copies then step one by
         one and a copy's own step names what is wrong) for actions of the wrong shape or
-        kind, if no copy steps, or if a copy's frame_skip was changed (set_attr)."""
+        kind, or if a copy's frame_skip was changed (set_attr)."""
         np.logical_not(self._autoreset_envs, out=self._active)
         try:
             actions = np.asarray(actions)
@@ -130,28 +133,38 @@ class BatchedVectorEnv(SyncVectorEnv):
             np.copyto(self._actions, actions, casting="unsafe")
         except (TypeError, ValueError):
             return False
-        return bool(self._active.any()) and all(c.frame_skip == self._frames for c in self._copies)
+        frames = self._frames
+        return all([c.frame_skip == frames for c in self._copies])
 
     def _advance_physics(self):
         """Phase 2: every active copy's commands and frame_skip physics steps (one compiled
         call), then each told that its next do_simulation finds them done."""
         n = int(self._frames)
         if self._step_batch is not None:
-            if not self._step_batch(*self._batch_args):
+            stopped = self._step_batch(*self._batch_args)
+            if stopped < 0:
                 return                     # a non-finite action: the copies' steps raise
         else:
-            for i in np.flatnonzero(self._active):
-                c = self._copies[i]
-                if not c.load_commands(self._actions[i]):
-                    return
-            for i in np.flatnonzero(self._active):
-                self._copies[i].sim.steps(n, self._commands[i])
-            self._codes[:] = 0
-        for c, active in zip(self._copies, self._active):
+            stopped = self._steps_one_by_one(n)
+            if stopped < 0:
+                return
+        for c, active in zip(self._copies, self._active.tolist()):
             if active:
                 c._advanced = n
-        for i in np.flatnonzero(self._codes):
-            self._finish(i, int(self._codes[i]), int(self._done[i]), n)
+        if stopped:
+            for i in np.flatnonzero(self._codes):
+                self._finish(i, int(self._codes[i]), int(self._done[i]), n)
+
+    def _steps_one_by_one(self, n) -> int:
+        """Phase 2 from Python (no fast compile mode): step_batch's work, copy by copy, with
+        its return (Simulator.steps finishes or raises a stopped step itself: 0 stopped)."""
+        active = np.flatnonzero(self._active)
+        for i in active:
+            if not self._copies[i].load_commands(self._actions[i]):
+                return -1
+        for i in active:
+            self._copies[i].sim.steps(n, self._commands[i])
+        return 0
 
     def _finish(self, i, code, done, n):
         """A copy whose batched steps stopped (guard code `code` after `done` of n steps): on
