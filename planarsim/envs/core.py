@@ -366,15 +366,29 @@ class PlanarMujocoEnv(gymnasium.Env):
             raise ValueError(f"action {a.tolist()} has NaN or infinite entries")
         return a
 
-    def do_simulation(self, ctrl, n_frames):
+    def load_commands(self, ctrl) -> bool:
+        """The actuators' commands self._u from action `ctrl`: MuJoCo clamps ctrl to
+        ctrlrange; each actuator's input is gear * coef * ctrl (one compiled call, which also
+        says whether every entry was finite). False (self._u untouched) for an action of the
+        wrong shape or with a NaN or infinite entry."""
         a = np.asarray(ctrl, dtype=np.float64)
-        # MuJoCo clamps ctrl to ctrlrange; each actuator's input is gear * coef * ctrl (one
-        # compiled call, which also says whether every entry was finite)
-        if a.shape != self.action_space.shape or not set_commands(
-                a, self._act_lo, self._act_hi, self._drive_entry, self._drive_id,
-                self._drive_gain, self._u):
-            self.check_action(a)        # (raises, naming what is wrong)
-        self.sim.steps(int(n_frames), self._u)
+        return a.shape == self.action_space.shape and set_commands(
+            a, self._act_lo, self._act_hi, self._drive_entry, self._drive_id, self._drive_gain,
+            self._u)
+
+    #: frames the simulator has already advanced, under commands loaded from the action the
+    #: next do_simulation is given (a batched vector step: planarsim.envs.batched), or None
+    _advanced = None
+
+    def do_simulation(self, ctrl, n_frames):
+        advanced, self._advanced = self._advanced, None
+        if advanced is None:
+            if not self.load_commands(ctrl):
+                self.check_action(ctrl)        # (raises, naming what is wrong)
+            self.sim.steps(int(n_frames), self._u)
+        elif advanced != int(n_frames):
+            raise RuntimeError(f"do_simulation({int(n_frames)} frames) after a batched step of "
+                               f"{advanced} frames")
         self._sync()
 
     def state_vector(self):

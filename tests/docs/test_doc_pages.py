@@ -55,6 +55,8 @@ def check_shapes(ns, folder):
 
 def check_mjcf_gymnasium(ns, folder):
     assert ns["obs"].shape == (4, 8)                # "(4, 8)", as the vector env's comment says
+    assert ns["hopper_obs"].shape == (8, 11)        # "(8, 11)": the vector entry point's
+    assert type(ns["hoppers"]).__name__ == "BatchedVectorEnv"
     assert ns["model"].dt == 0.002                  # "dt 0.002 s"
     assert ns["torque"] == ns["hopper"].actuator["thigh_joint"].gear * 0.5 > 0
 
