@@ -19,7 +19,7 @@ from ..compile import kernel
 from .audit import PIN_GAP_TOL, audit_impulses, audit_total
 from .broad_phase import FLAG_LIVE, widen_for_answer
 from .ccd import split_at_impact, stop_at_impact
-from .codes import CONTACT_PAIR, INTEGRATOR_EULER, MODE_FREE, MODE_PINNED, MODES_ALTERNATING
+from .codes import INTEGRATOR_EULER, MODE_FREE, MODE_PINNED, MODES_ALTERNATING
 from .complementarity import solve_contacts
 from .contacts import find_contacts
 from .forces import apply_forces, predict_velocity
@@ -621,7 +621,7 @@ TURN_TARGET = 1e-3
 
 
 @kernel
-def turn_substeps(m, s, h, most):
+def turn_substeps(m, s, ws, h, most):
     """How many equal sub-steps the step of h [s] is taken in (1..most): a point at lever L
     [m] on a body turning at w [rad/s] leaves the motion its rows linearise by at most
     L (h w)^2 / 2, so where a pin's anchors or a touching (not free) ground contact's point
@@ -639,9 +639,8 @@ def turn_substeps(m, s, h, most):
                 w = s.v[b, 2]
                 c += (abs(m.pin_anchor[j, e, 0]) + abs(m.pin_anchor[j, e, 1])) * w * w
         curve = max(curve, c)
-    for i in range(m.contact_body.shape[0]):
-        if m.contact_kind[i] == CONTACT_PAIR:
-            continue
+    for k in range(ws.ground_contacts.shape[0]):
+        i = ws.ground_contacts[k]      # (a shape pair's contacts are not judged here)
         # touching (a contact that touches within the step is seen when the step's answer
         # is judged: _step); its lever bounded by |x| + |y|
         if s.contact_mode[i] == MODE_FREE:
@@ -730,14 +729,14 @@ def chain_step(m, s, ws, opt, u, step_length):
     if opt.refine_iters == 0 or not 0.0 < opt.refine_tol <= ROWS_HELD_SHARE * PIN_GAP_TOL:
         return CHAIN_GENERAL
     most = opt.max_substeps
-    n = turn_substeps(m, s, step_length, most)
+    n = turn_substeps(m, s, ws, step_length, most)
     if n == 1:
         code = chain_part(m, s, ws, opt, u, step_length)
         if code != 0:
             if code == CHAIN_AGAIN:
                 begin_again(s, ws, ws.prev)
             return CHAIN_GENERAL
-        n = turn_substeps(m, s, step_length, most)
+        n = turn_substeps(m, s, ws, step_length, most)
         if n == 1:
             ws.info[INFO_TURN_SUBSTEPS] = 1
             keep_step_path(ws, False)
@@ -777,7 +776,7 @@ def _step(m, s, ws, opt, u):
             ws.info[INFO_CHAIN_PATH] = 1
             return 0
         most = opt.max_substeps
-        n = turn_substeps(m, s, step_length, most)
+        n = turn_substeps(m, s, ws, step_length, most)
         if n == 1:
             code = step_of_length(m, s, ws, opt, u, step_length, False)
             if code == GUARD_ROOM:
@@ -786,7 +785,7 @@ def _step(m, s, ws, opt, u):
             # a body that began turning fast within the step (an impact spinning a light
             # link up) is judged at the step's answer: taken again, in sub-steps; so is a
             # step whose correction moved a body farther than its velocities explain
-            n = turn_substeps(m, s, step_length, most)
+            n = turn_substeps(m, s, ws, step_length, most)
             if n == 1 and not (code == GUARD_JUMP and most > 1):
                 ws.info[INFO_TURN_SUBSTEPS] = 1
                 keep_step_path(ws, False)
