@@ -4,7 +4,6 @@ fresh factorisation's to rounding; where the rows change or the refinement does 
 converge, the rows are factored afresh."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
 
 import planarsim as ps
 from planarsim.kernels.info import step_info
@@ -50,14 +49,14 @@ def test_a_pile_at_rest_reuses_its_factors_and_gets_the_fresh_answer(pyramid20):
     assert np.array_equal(kept.ws.audit, fresh.ws.audit)
 
 
-@settings(max_examples=8, deadline=None)
-@given(fx=st.floats(-10, 10), fy=st.floats(0, 150))
+@pytest.mark.parametrize("fx, fy", [(5.0, 0.0), (0.0, 60.0), (0.0, 150.0), (9.0, 100.0)])
 def test_a_pushed_pile_moves_as_with_fresh_factors(pyramid20, fx, fy):
     """A push on the top box from the 10th step (sideways within its friction; upward beyond
     its weight of 39 N it lifts off, and its contacts' rows go): the factors are made afresh
-    where the rows change, and the motion is the fresh factorisation's. (A push that makes
-    the pile slide is left out: its complementarity problem over 1,568 rows takes minutes
-    either way.)"""
+    where the rows change, and the motion is the fresh factorisation's. (Not a push that
+    sets some of its contacts sliding while the others stick, 8 N sideways with 20 N up:
+    its complementarity problem over the pile's 1,568 rows runs for minutes, with fresh
+    factors as with kept ones.)"""
     model, start = pyramid20
     kept, _ = run(model, start, 30, True, (209, (fx, fy)))
     fresh, _ = run(model, start, 30, False, (209, (fx, fy)))
