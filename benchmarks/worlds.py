@@ -4,6 +4,7 @@ after --limit seconds (a first step that takes longer is reported as such).
 
     python benchmarks/worlds.py                          # every world, 200 steps each
     python benchmarks/worlds.py columns10x10 pyramid10 --steps 500 --limit 120
+    python benchmarks/worlds.py --keep-factors         # StepOptions(keep_factors=1)
 
 Worlds: pyramid4 (10 boxes), columns10x10 (ten columns of ten 0.2 m boxes, 0.4 m apart), pyramid10 (55 boxes),
 pyramid20 (210 boxes, each on two below), wall40x10 (400 bricks 0.4 x 0.2 m, staggered),
@@ -73,19 +74,19 @@ WORLDS = {
 }
 
 
-def _measure(name, steps, out):
+def _measure(name, steps, out, keep_factors):
     try:
-        _measure_world(name, steps, out)
+        _measure_world(name, steps, out, keep_factors)
     except Exception as exc:     # reported by run(), one line
         out.put(("error", f"{type(exc).__name__}: {exc}"))
 
 
-def _measure_world(name, steps, out):
+def _measure_world(name, steps, out, keep_factors=0):
     from planarsim.compiled import audit_counts
     from planarsim.state import workspace_contacts
     ps.Simulator(columns(1, 1)).step()   # the compiled step loaded (once a process), not timed
     model = WORLDS[name]()
-    sim = ps.Simulator(model)
+    sim = ps.Simulator(model, options=ps.StepOptions(keep_factors=keep_factors))
     q0 = sim.state.q.copy()
     out.put(("built", model.n_body, model.n_contact))
     t = time.perf_counter()
@@ -105,9 +106,9 @@ def _measure_world(name, steps, out):
              int(sum(audit_counts(sim.ws).values())), deepest))
 
 
-def run(name, steps, limit):
+def run(name, steps, limit, keep_factors=0):
     out = mp.Queue()
-    proc = mp.Process(target=_measure, args=(name, steps, out))
+    proc = mp.Process(target=_measure, args=(name, steps, out, keep_factors))
     proc.start()
     proc.join(limit)
     said = {}
@@ -142,13 +143,15 @@ def main(argv=None):
     ap.add_argument("worlds", nargs="*", default=list(WORLDS), help=f"of {list(WORLDS)}")
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--limit", type=float, default=120.0, help="seconds per world")
+    ap.add_argument("--keep-factors", action="store_true",
+                    help="StepOptions(keep_factors=1): a pile at rest keeps its factors")
     a = ap.parse_args(argv)
     unknown = [w for w in a.worlds if w not in WORLDS]
     if unknown:
         ap.error(f"unknown world(s) {unknown}; the worlds are {list(WORLDS)}")
     sizes = []
     for name in a.worlds:
-        line, size = run(name, a.steps, a.limit)
+        line, size = run(name, a.steps, a.limit, int(a.keep_factors))
         print(line, flush=True)
         if size is not None:
             sizes.append(size)

@@ -105,6 +105,13 @@ class StepOptions(NamedTuple):
         sub-step is a whole step (solve, positions, audit, guards) and the State counts
         one; its last impulses are the last sub-step's (as a step split at a time of
         impact keeps its last part's). 16 (default); 1: never
+    keep_factors : 1: a pile at rest (1,024 rows or more, the sparse factorisation) keeps
+        its velocity solve's factors from step to step while its rows stay the same, and
+        each step's answer is refined against its own matrix to rounding (kernels/solve.py
+        refine_on_kept_factors; a 1,035-box pyramid at rest about 4x faster). The answer then
+        depends, at rounding, on the step the factors were made at, which the State does not
+        hold: a restored State continues to rounding, not bit for bit. 0 (default): every
+        solve factors afresh
     """
     mode_strategy: int = MODES_ALTERNATING
     refine_iters: int = 4
@@ -122,6 +129,7 @@ class StepOptions(NamedTuple):
     integrator: int = INTEGRATOR_EULER
     jump_limit: float = 0.01
     max_substeps: int = 16
+    keep_factors: int = 0
 
 
 def make_options(strategy="alternating", refine=True, integrator="euler", **kw) -> StepOptions:
@@ -160,6 +168,7 @@ _OPTION_RULES = {
                    f"must be one of 0..{len(INTEGRATOR_NAMES) - 1} ({', '.join(INTEGRATOR_NAMES)})"),
     "jump_limit": (float, lambda x: math.isfinite(x) and x >= 0.0, "must be finite and >= 0 [m]"),
     "max_substeps": (int, lambda x: x >= 1, "must be an integer >= 1"),
+    "keep_factors": (int, lambda x: x in (0, 1), "must be 0 or 1"),
     "speed_limit": (float, lambda x: x == -1.0 or (math.isfinite(x) and x >= 0.0),
                     "must be -1 (from the model), 0 (none) or a speed > 0 [m/s]"),
 }

@@ -3,8 +3,11 @@
 A model qualifies when its only constraint rows are the x and y rows of plain hinge pins
 (no rods, sliders, joint limits, springs, dampers, armature or joint friction, no contacts)
 and its pins form open chains: every body carries at most two pins, two pins share at most
-one body, and no ring of bodies closes on itself. A pin to the world ends a chain (a chain
-may hang from the world at one end, or at both: a bridge). Along such a chain the pins'
+one body, and no ring of bodies closes on itself; a chain's pins are listed in the model in
+their order along it (either way), and there are fewer than SPARSE_MIN_ROWS / 2 pins, so that
+the path eliminates the rows in the general solve's order (the same pivots, and the same
+decisions taken on them). A pin to the world ends a chain (a chain may hang from the world
+at one end, or at both: a bridge). Along such a chain the pins'
 effective-mass matrix J W J^T is block tridiagonal in 2 x 2 blocks (a pin couples only to its
 neighbours, through the body they share), so the solve is a block elimination linear in the
 number of links with no fill.
@@ -14,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels.codes import JOINT_HINGE
+from .kernels.sparse_factor import SPARSE_MIN_ROWS
 
 
 def _plain_hinges(a) -> bool:
@@ -34,8 +38,8 @@ def pin_chain_order(model) -> tuple[np.ndarray, np.ndarray] | None:
     and of pin order[k - 1] at the body they share, (-1, -1) where a chain starts."""
     a = model.arrays
     n_pin = int(np.asarray(a.pin_body).shape[0])
-    if (n_pin == 0 or np.asarray(a.rod_body).shape[0] or np.asarray(a.contact_body).shape[0]
-            or a.terrain_coef[2] != 0.0 or not _plain_hinges(a)):
+    if (n_pin == 0 or 2 * n_pin >= SPARSE_MIN_ROWS or np.asarray(a.rod_body).shape[0]
+            or np.asarray(a.contact_body).shape[0] or not _plain_hinges(a)):
         return None
     pin_body = np.asarray(a.pin_body).reshape(-1, 2)
     pins_of: dict[int, list[int]] = {}
@@ -80,4 +84,9 @@ def pin_chain_order(model) -> tuple[np.ndarray, np.ndarray] | None:
             prev, j = j, (nxt[0] if nxt else -1)
     if not seen.all():
         return None                     # a ring of bodies: every pin has two neighbours
+    # each chain walked from its lowest pin: the path repeats the general solve's
+    # elimination (rows in pin order) where its pins' indices increase along it
+    if any(ends[k][0] >= 0 and order[k] < order[k - 1] for k in range(n_pin)):
+        return None
     return np.asarray(order, np.int64), np.asarray(ends, np.int64).reshape(n_pin, 2)
+

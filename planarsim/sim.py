@@ -21,8 +21,9 @@ from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
 from .start_check import check_overlap, check_start, overlapping
 from .kernels.guards import GUARD_ROOM
-from .state import (ArrayCopier, State, Workspace, array_pairs, check_state, forget_ground_queries, forget_pairs,
-                    grow_workspace, make_state, make_workspace, workspace_capacity)
+from .state import (ArrayCopier, State, Workspace, array_pairs, check_state, forget_ground_queries,
+                    forget_kept_factors, forget_pairs, grow_workspace, make_state, make_workspace,
+                    refresh_chains, workspace_capacity)
 from .trajectory import Trajectory, check_recording, make_recorder, record_state
 
 
@@ -94,6 +95,8 @@ class Simulator:
         # the ground queries' references belong to the old terrain and contact points
         forget_ground_queries(self._ws)
         forget_pairs(self._ws)
+        forget_kept_factors(self._ws)
+        refresh_chains(value, self._ws)
         self._repack()
         self._recorded_entry = None
 
@@ -120,6 +123,7 @@ class Simulator:
         check_integrator(self._model, value)
         self._speed_from_model = value.speed_limit == -1.0
         self._options = resolve_speed_limit(value, self._model, self._state.v, self._state.q)
+        forget_kept_factors(self._ws)
         self._repack()
 
     def _repack(self):
@@ -146,6 +150,7 @@ class Simulator:
         check_state(value, self._model)
         self._state.restore(value)
         forget_pairs(self._ws)
+        forget_kept_factors(self._ws)
         if getattr(self, "_speed_from_model", False):
             self._options = resolve_speed_limit(self._options._replace(speed_limit=-1.0),
                                                 self._model, self._state.v, self._state.q)

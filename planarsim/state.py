@@ -301,12 +301,14 @@ class Workspace(NamedTuple):
     sp_stack: np.ndarray         # (n_body + 2, 2) int the parts still to split
     sp_count: np.ndarray         # ((n_body + 1) MAX_DEPTH + 1,) int counting sort of the rows
     sp_kept_rows: np.ndarray     # (R, 4) int the rows whose factors the sparse storage holds:
-                                 #   kind, owner, bodies (solve.reuse_factors)
+                                 #   kind, owner, bodies (solve.same_rows_factored)
     sp_kept: np.ndarray          # (3,) int [0] 1: the sparse storage holds the velocity solve's
-                                 #   factors of the rows in sp_kept_rows, [1] how many, [2] how
-                                 #   many it dropped as dependent (0: no factors kept)
+                                 #   factors of the rows in sp_kept_rows (0: none kept), [1] how
+                                 #   many rows, [2] how many it dropped as dependent
+    sp_kept_pivot: np.ndarray    # (1,) their joint rows' smallest pivot share (ws.joint_pivot)
     rhs: np.ndarray              # (R,)
-    lam_start: np.ndarray        # (R,) impulses the solve starts from (the last step's)
+    lam_start: np.ndarray        # (R,) impulses the solve starts from (the last step's);
+                                 #   scratch of the refinement on kept factors
     lam: np.ndarray              # (R,) impulses [N s or N m s]
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
     act_power: np.ndarray        # (n_act,) mechanical power [W]
@@ -471,6 +473,19 @@ def forget_pairs(ws: Workspace) -> None:
     slot0 = np.unique(ws.shape_pair_slot[ws.shape_pair_slot >= 0])
     ws.last_pairs[:] = slot0
     ws.n_live_pairs[0] = slot0.size
+
+
+def forget_kept_factors(ws: Workspace) -> None:
+    """The velocity solve's kept factors (StepOptions.keep_factors) not to be reused: a state,
+    model or options put in from outside."""
+    ws.sp_kept[0] = 0
+
+
+def refresh_chains(model: Model, ws: Workspace) -> None:
+    """ws's pin-chain arrays for `model` (a model swapped in: its pins' limits, springs or
+    armature decide whether the pin-chain path may take its steps)."""
+    for name, value in _chain_arrays(model).items():
+        getattr(ws, name)[...] = value
 
 
 def max_rows(model: Model, contacts: int | None = None) -> int:
@@ -725,7 +740,7 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      sp_bodies=z(nb, np.int64), sp_body_place=z(nb, np.int64), sp_key=z(nb),
                      sp_stack=z((nb + 2, 2), np.int64),
                      sp_count=z((nb + 1) * SPARSE_MAX_DEPTH + 1, np.int64),
-                     sp_kept=z(3, np.int64),
+                     sp_kept=z(3, np.int64), sp_kept_pivot=np.ones(1),
                      island_label=z(nb, np.int64), island_start=z(nb + 2, np.int64),
                      island_fill=z(nb + 1, np.int64), island_failed=z(nb + 1, np.int64),
                      island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),

@@ -30,38 +30,6 @@ def update_trig(q, cs):
         cs[i, 2] = th
 
 
-# [rad] a body's angle that changed by at most this since its (cos, sin) were computed has
-# them turned by the change's series (turn_trig): cos d - (1 - d^2/2 + d^4/24) and
-# sin d - d (1 - d^2/6 + d^4/120) are below d^6/720 ~ 1e-21 there, far below rounding
-SERIES_TURN = 1e-3
-
-
-@kernel
-def turn_trig(q, cs):
-    """update_trig for angles that moved by a correction (a few nanoradians): (cos, sin) of a
-    body whose angle changed by d with |d| <= SERIES_TURN turned by d's series, exact to
-    rounding, instead of computed afresh; others as update_trig. Each call turns the last
-    (cos, sin) again, so it is for a few corrections after a fresh update_trig, not for a
-    run of steps (rounding would add up)."""
-    for i in range(q.shape[0]):
-        th = q[i, 2]
-        d = th - cs[i, 2]
-        if d == 0.0 and math.copysign(1.0, th) == math.copysign(1.0, cs[i, 2]):
-            continue
-        if abs(d) <= SERIES_TURN:
-            d2 = d * d
-            cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0))
-            sd = d * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0)))
-            c = cs[i, 0]
-            s = cs[i, 1]
-            cs[i, 0] = c * cd - s * sd
-            cs[i, 1] = s * cd + c * sd
-        else:
-            cs[i, 0] = math.cos(th)
-            cs[i, 1] = math.sin(th)
-        cs[i, 2] = th
-
-
 @kernel
 def world_point(q, cs, body, lx, ly):
     """World position [m] of the point (lx, ly) fixed in `body` (cs: cached cos/sin of the

@@ -22,7 +22,7 @@ def arrange(q, ws, n, n_body):
     """The structure of rows 0..n-1 (bodies at q): their envelope, or their sparse order and
     elimination tree. Returns False (ws.room set) if it does not fit the workspace's storage:
     the step begins again with more (kernels/step.py, GUARD_ROOM). Factors kept for reuse
-    (solve.reuse_factors) are forgotten."""
+    (solve.same_rows_factored) are forgotten."""
     ws.sp_kept[0] = 0
     if n >= SPARSE_MIN_ROWS:
         ws.factor_kind[0] = SPARSE
@@ -80,7 +80,7 @@ def diagonal_and_pivot(ws, r):
 @kernel(inline="always")
 def factor_ws(ws, n, tol, symmetric):
     """Factor the assembled matrix (ws.lam holds each row's diagonal before elimination
-    afterwards); returns #dropped rows. Factors kept for reuse (solve.reuse_factors) are
+    afterwards); returns #dropped rows. Factors kept for reuse (solve.same_rows_factored) are
     replaced, so forgotten."""
     ws.sp_kept[0] = 0
     if ws.factor_kind[0] == SPARSE:

@@ -20,7 +20,7 @@ that order of the error). Both end where the general stages end, to rounding.
 from ..compile import kernel
 from .codes import ROW_PIN_X, ROW_PIN_Y
 from .integrate import STALLED_RATIO
-from .math2d import turn_trig, update_trig
+from .math2d import update_trig
 from .pin import pin_gap, pin_rows
 from .solve import add_impulses
 
@@ -229,13 +229,14 @@ def move_along_rows(m, s, ws, n, rate):
 
 
 @kernel
-def chain_correct(m, s, ws, h, iters, tol):
+def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
     """Stage 8's Newton-SHAKE on the chains: up to iters passes of J(q) W J(q0)^T mu = -c(q),
     q += W J(q0)^T mu, v += W J(q0)^T mu / h, until every row is within tol [m]; a pass
-    after one that left every row within CHORD_TOL reuses its factorisation. The angles'
-    cos / sin after a pass are turned by its few nanoradians (math2d.turn_trig). Returns
-    the largest row error left, or -1 where a pass removed less than half of it (the general
-    correction's safeguards then decide: the step is taken by the general stages)."""
+    after one that left every row within CHORD_TOL reuses its factorisation. Returns
+    the largest row error left, or -1 where a pass removed less than half of it or a
+    factorisation kept a pivot share at or below pivot_tol (StepOptions.refine_pivot_tol:
+    the general correction would drop that row; its safeguards then decide, the step is
+    taken by the general stages)."""
     n = ws.n_row[0]
     update_trig(s.q, ws.body_cs)
     worst = chain_residual(m, s, ws, True)
@@ -243,11 +244,11 @@ def chain_correct(m, s, ws, h, iters, tol):
     for _ in range(iters):
         if worst <= tol:
             break
-        if fresh:
-            chain_factor(m, ws, ws.row_Jp, ws.row_J, False)
+        if fresh and chain_factor(m, ws, ws.row_Jp, ws.row_J, False) <= pivot_tol:
+            return -1.0
         chain_solve(ws, ws.rhs, ws.lam)
         move_along_rows(m, s, ws, n, 1.0 / h)
-        turn_trig(s.q, ws.body_cs)
+        update_trig(s.q, ws.body_cs)
         after = chain_residual(m, s, ws, False)
         if after > STALLED_RATIO * worst:
             return -1.0

@@ -226,6 +226,7 @@ def keep_factors(ws, n, dropped):
     ws.sp_kept[0] = 1
     ws.sp_kept[1] = n
     ws.sp_kept[2] = dropped
+    ws.sp_kept_pivot[0] = ws.joint_pivot[0]
 
 
 @kernel
@@ -256,25 +257,27 @@ def refine_on_kept_factors(m, ws, n):
 
 
 @kernel(inline="always")
-def solve_impulses(m, s, ws, h, tol, symmetric):
+def solve_impulses(m, s, ws, h, tol, symmetric, keep):
     """lambda for the active rows and v_new = v* + W F^T lambda; returns #dropped rows.
     Where a row is dropped as dependent, the solve finds the change from the last step's
     impulses (ws.lam_start; warm_start.py), so the dropped row keeps its impulse.
     symmetric: F = J (no sliding contact), so J W F^T is symmetric (L D L^T on its lower half).
-    A pile at rest keeps its rows from step to step, and its matrix changes by rounding:
-    where the sparse storage holds the factors of this step's very rows (same_rows_factored),
-    they are reused and the answer refined against this step's matrix to rounding
-    (refine_on_kept_factors; where it does not converge, the rows are factored afresh)."""
+    keep (StepOptions.keep_factors): a pile at rest keeps its rows from step to step, and
+    its matrix changes by rounding: where the sparse storage holds the factors of this
+    step's very rows (same_rows_factored), they are reused and the answer refined against
+    this step's matrix to rounding (refine_on_kept_factors; where it does not converge, the
+    rows are factored afresh)."""
     n = ws.n_row[0]
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
             ws.v_new[i, k] = ws.v_pred[i, k]
     if n == 0:
         return 0
-    reuse = symmetric and ws.least_change[0] == 0 and same_rows_factored(ws, n)
+    reuse = keep and symmetric and ws.least_change[0] == 0 and same_rows_factored(ws, n)
     if reuse:
         fill_row_b(ws, h, n)
         dropped = ws.sp_kept[2]
+        ws.joint_pivot[0] = ws.sp_kept_pivot[0]
         warm = start_impulses(s, ws, n, dropped)
         if warm:
             for r in range(n):
@@ -301,7 +304,7 @@ def solve_impulses(m, s, ws, h, tol, symmetric):
     if dropped > 0 and symmetric and ws.least_change[0] == 1:
         least_change_impulses(m, s, ws, tol, n)
         return dropped
-    if symmetric and ws.factor_kind[0] == SPARSE:
+    if keep and symmetric and ws.factor_kind[0] == SPARSE:
         keep_factors(ws, n, dropped)
     warm = start_impulses(s, ws, n, dropped)
     if warm:

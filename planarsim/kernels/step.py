@@ -86,7 +86,7 @@ def build_and_solve(m, s, ws, opt, h):
     row was dropped, or the system was not symmetric). A call (one copy of its code for both
     solves of solve_modes): its work is microseconds, the call a few nanoseconds."""
     sliding = build_rows(m, s, ws)
-    dropped = solve_impulses(m, s, ws, h, opt.pivot_tol, sliding == 0)
+    dropped = solve_impulses(m, s, ws, h, opt.pivot_tol, sliding == 0, opt.keep_factors == 1)
     ws.least_change[1] = dropped
     return dropped > 0 or sliding > 0
 
@@ -693,7 +693,7 @@ def chain_part(m, s, ws, opt, u, h):
     chain_rows(m, s, ws)
     ws.joint_pivot[0] = chain_velocity_solve(m, ws, h)
     ws.info[INFO_SOLVES] += 1
-    if ws.joint_pivot[0] < opt.pivot_tol:           # (a row the general solve would drop)
+    if ws.joint_pivot[0] <= opt.pivot_tol:          # (a row the general solve would drop)
         return CHAIN_GENERAL
     if second_order_gains(m, s, ws, h):
         return CHAIN_GENERAL
@@ -702,7 +702,8 @@ def chain_part(m, s, ws, opt, u, h):
         return CHAIN_AGAIN
     integrate_positions(s, ws, ws.v_new, h)                 # 8. positions
     if not rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol):
-        worst = chain_correct(m, s, ws, h, opt.refine_iters, opt.refine_tol)
+        worst = chain_correct(m, s, ws, h, opt.refine_iters, opt.refine_tol,
+                              opt.refine_pivot_tol)
         if not (worst >= 0.0 and worst <= opt.refine_tol):
             return CHAIN_AGAIN
         if bound_correction_work(m, s, ws, h) > 0.0:

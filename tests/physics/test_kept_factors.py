@@ -1,7 +1,8 @@
-"""A pile at rest keeps its sparse factors from step to step (solve.same_rows_factored,
-refine_on_kept_factors): the answer is refined against each step's own matrix, so it is the
-fresh factorisation's to rounding; where the rows change or the refinement does not
-converge, the rows are factored afresh."""
+"""StepOptions.keep_factors: a pile at rest keeps its sparse factors from step to step
+(solve.same_rows_factored, refine_on_kept_factors): the answer is refined against each
+step's own matrix, so it is the fresh factorisation's to rounding; where the rows change or
+the refinement does not converge, the rows are factored afresh. Off by default: then a
+restored State continues bit for bit."""
 import numpy as np
 import pytest
 
@@ -21,17 +22,14 @@ def pyramid20():
 
 
 def run(model, state, steps, keep, push=None):
-    """A Simulator from `state` after `steps` steps, kept factors allowed or forgotten before
-    every step; push: (body, force [N]) applied from the 10th step on. Returns it and how many
+    """A Simulator from `state` after `steps` steps, with kept factors or without; push: (body, force [N]) applied from the 10th step on. Returns it and how many
     of its solves used kept factors."""
-    sim = ps.Simulator(model)
+    sim = ps.Simulator(model, options=ps.StepOptions(keep_factors=int(keep)))
     sim.state = state
     kept = 0
     for k in range(steps):
         if push is not None and k == 10:
             sim.state.ext_force[push[0], :2] = push[1]
-        if not keep:
-            sim.ws.sp_kept[0] = 0
         sim.step()
         kept += step_info(sim.ws)["kept_factors"]
     return sim, kept
@@ -64,3 +62,13 @@ def test_a_pushed_pile_moves_as_with_fresh_factors(pyramid20, fx, fy):
     assert np.abs(kept.state.q - fresh.state.q).max() < 1e-9 * scale
     assert np.abs(kept.state.v - fresh.state.v).max() < 1e-7 * scale
     assert np.array_equal(kept.ws.audit, fresh.ws.audit)
+
+
+def test_by_default_a_restored_pile_continues_bit_for_bit(pyramid20):
+    """Without kept factors nothing but the State carries over from step to step."""
+    model, start = pyramid20
+    whole, _ = run(model, start, 20, False)
+    half, _ = run(model, start, 10, False)
+    rest, _ = run(model, half.state.copy(), 10, False)
+    assert whole.state.q.tobytes() == rest.state.q.tobytes()
+    assert whole.state.v.tobytes() == rest.state.v.tobytes()
