@@ -31,6 +31,11 @@ from .terrain import Terrain, flat
 PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
 
 
+
+def _shown(values) -> tuple:
+    """A vector as a message prints it: plain floats, (0.5, 0.0) (not np.float64(0.5))."""
+    return tuple(float(x) for x in np.ravel(values))
+
 def _who(kind, name, idx):
     """How errors name an element: "pin 'knee' (2)", or "fluid box (3)" for unnamed ones; idx
     None: `kind` is the whole description already (a shape's: shapes.shape_who)."""
@@ -404,7 +409,7 @@ class ModelBuilder:
         for body, lp, f in ((a, la, "anchor_a"), (b, lb, "anchor_b")):
             if body >= 0 and self._bodies[body]["point"] and np.any(lp != 0.0):
                 if np.hypot(*lp) > 1e-12:
-                    raise ModelError(f"{kind} {name!r} ({idx}): {f}={tuple(lp)} must be (0, 0) on "
+                    raise ModelError(f"{kind} {name!r} ({idx}): {f}={_shown(lp)} must be (0, 0) on "
                                      f"point mass {self._bodies[body]['name']!r}")
         return la, lb
 
@@ -485,7 +490,7 @@ class ModelBuilder:
             d = _vec2("free coordinate", name, idx, "axis", axis)
             norm = float(np.hypot(*d))
             if not norm > 1e-12:
-                raise ModelError(f"free coordinate {name!r} ({idx}): axis={tuple(map(float, d))} "
+                raise ModelError(f"free coordinate {name!r} ({idx}): axis={_shown(d)} "
                                  f"must not be zero")
             d = tuple(d / norm)
         lo, hi = self._joint_limit("free coordinate", name, idx, limit)
@@ -574,7 +579,7 @@ class ModelBuilder:
         d = _vec2("slider", name, idx, "axis", axis)
         norm = float(np.hypot(*d))
         if not norm > 1e-12:
-            raise ModelError(f"slider {name!r} ({idx}): axis={tuple(d)} must not be zero")
+            raise ModelError(f"slider {name!r} ({idx}): axis={_shown(d)} must not be zero")
         d = d / norm
         if anchor_world is None and anchor_a is None and anchor_b is None:
             anchor_world = self._world(b, np.zeros(2))
@@ -756,7 +761,7 @@ class ModelBuilder:
         d = _vec2("actuator", name, idx, "direction", direction)
         n = np.hypot(*d)
         if not n > 0:
-            raise ModelError(f"actuator {name!r} ({idx}): direction={tuple(d)} must be non-zero")
+            raise ModelError(f"actuator {name!r} ({idx}): direction={_shown(d)} must be non-zero")
         return self._act(name, M.ACT_BODY_FORCE, (bid, -1, -1), direction=d / n, limit=limit)
 
     def add_body_torque(self, name, body, limit=(-math.inf, math.inf)) -> int:
@@ -855,7 +860,7 @@ class ModelBuilder:
         except (TypeError, ValueError):
             raise ModelError(f"model: gravity={self.gravity!r} must be a pair (gx, gy)") from None
         if not np.all(np.isfinite(g)):
-            raise ModelError(f"model: gravity={tuple(g)} must be finite")
+            raise ModelError(f"model: gravity={_shown(g)} must be finite")
         if self.ground and not isinstance(self.terrain, Terrain):
             raise ModelError(f"model: terrain={self.terrain!r} must be a planarsim.terrain.Terrain")
         if not self.ground and self.terrain is not None:

@@ -177,3 +177,14 @@ def test_a_shape_on_a_missing_body_names_the_body_given():
         base().add_shape("shin_L", "circle", (0.0, 0.0), 0.1, name="heel")
     with pytest.raises(ModelError, match=r"^static circle shape \(0\): name=3 must be a non-empty"):
         base().add_shape(None, "circle", (0.0, 0.0), 0.1, name=3)
+
+
+def test_vectors_in_messages_are_plain_numbers():
+    """A vector the message quotes reads (0.5, 0.0), not (np.float64(0.5), np.float64(0.0))."""
+    b = ps.ModelBuilder()
+    p = b.add_point_mass("p", 1.0, pos=(0.0, 0.0))
+    q = b.add_body("q", mass=1.0, inertia=0.1, pos=(1.0, 0.0))
+    with pytest.raises(ModelError, match=r"anchor_a=\(0\.5, 0\.0\) must be \(0, 0\) on point mass 'p'"):
+        b.add_pin("x", p, q, anchor_world=(0.5, 0.0))
+    with pytest.raises(ModelError, match=r"axis=\(0\.0, 0\.0\) must not be zero"):
+        b.add_slider("s", None, q, axis=(0.0, 0.0))
