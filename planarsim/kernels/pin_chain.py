@@ -210,25 +210,6 @@ def chain_velocity_solve(m, ws, h):
 
 
 @kernel
-def move_along_rows(m, s, ws, n, rate):
-    """q += W J0^T mu and v += rate W J0^T mu (mu in ws.lam, J0 the rows at the step's
-    start, ws.row_J): solve.add_impulses into both in one pass."""
-    for r in range(n):
-        mu = ws.lam[r]
-        if mu == 0.0:
-            continue
-        for e in range(2):
-            b = ws.row_body[r, e]
-            if b < 0:
-                continue
-            for k in range(3):
-                w = m.body_inv_mass[b] if k < 2 else m.body_inv_inertia[b]
-                d = w * ws.row_J[r, e, k] * mu
-                s.q[b, k] += d
-                s.v[b, k] += d * rate
-
-
-@kernel
 def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
     """Stage 8's Newton-SHAKE on the chains: up to iters passes of J(q) W J(q0)^T mu = -c(q),
     q += W J(q0)^T mu, v += W J(q0)^T mu / h, until every row is within tol [m]; a pass
@@ -247,7 +228,10 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
         if fresh and chain_factor(m, ws, ws.row_Jp, ws.row_J, False) <= pivot_tol:
             return -1.0
         chain_solve(ws, ws.rhs, ws.lam)
-        move_along_rows(m, s, ws, n, 1.0 / h)
+        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                     s.q, 1.0)
+        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                     s.v, 1.0 / h)
         update_trig(s.q, ws.body_cs)
         after = chain_residual(m, s, ws, False)
         if after > STALLED_RATIO * worst:
