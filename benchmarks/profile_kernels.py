@@ -77,7 +77,7 @@ def _short(symbol):
     return ".".join(names) or symbol
 
 
-def _workload(target, seconds):
+def _workload(target, seconds, skip=0):
     """(callable running the workload once, [dispatchers whose code it runs])."""
     from numba.core.registry import CPUDispatcher
     if target.startswith("walker:"):
@@ -101,9 +101,15 @@ def _workload(target, seconds):
     from benchmarks.scenes import SCENES
     from benchmarks.worlds import WORLDS
     from planarsim.link.step import run_steps
-    model = WORLDS[target[6:]]() if target.startswith("world:") else SCENES[target][0]()
+    from benchmarks.stress_scenes import ALL_SCENES, build_model
+    if target.startswith("world:"):
+        model = WORLDS[target[6:]]()
+    elif target.startswith("stress:"):
+        model = build_model(ALL_SCENES[target[7:]])
+    else:
+        model = SCENES[target][0]()
     sim = ps.Simulator(model)
-    sim.steps(10)
+    sim.steps(max(skip, 10))
     start = sim.state.copy()
     n = int(round(seconds / model.dt))
 
@@ -116,14 +122,17 @@ def _workload(target, seconds):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("target", help="a bench scene (chain4, biped_collapse, ...), walker:<name> or "
-                    "world:<name> (benchmarks/worlds.py)")
+                    "world:<name> (benchmarks/worlds.py) or stress:<name> "
+                    "(benchmarks/stress_scenes.py)")
+    ap.add_argument("--skip", type=int, default=0,
+                    help="steps taken before the timed runs start (the scene's later part)")
     ap.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--top", type=int, default=20)
     args = ap.parse_args(argv)
     if shutil.which("perf") is None:
         sys.exit("perf is not installed (Debian: apt-get install linux-perf)")
-    run, disps = _workload(args.target, args.seconds)
+    run, disps = _workload(args.target, args.seconds, args.skip)
     funcs = _compiled_functions(disps)
     addrs = sorted(funcs)
     map_path = Path(f"/tmp/perf-{os.getpid()}.map")

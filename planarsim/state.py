@@ -341,6 +341,7 @@ class Workspace(NamedTuple):
     lcp_basis: np.ndarray        # (L,) int
     row_slip: np.ndarray         # (R,) slip speed gamma of a tangent row in the last
                                  #   complementarity solve [m/s] (mixed_lcp.solve_mixed_lcp)
+    lcp_nz: np.ndarray           # (L,) int scratch: a column's non-zero rows (lcp.lemke_revised)
     island_parent: np.ndarray    # (n_body,) int union-find of the bodies (kernels/islands.py)
     island_label: np.ndarray     # (n_body,) int island of a representative body (-1: none)
     island_start: np.ndarray     # (n_body + 2,) int first entry of each island in island_rows
@@ -634,7 +635,8 @@ def _solve_shapes(model: Model, contacts: int, profile: int, lcp_rows: int) -> d
                 lcp_A=((C, C), f), lcp_B=((C, C), f), lcp_G=((C, C + 1), f),
                 lcp_S=((C, C + 1), f), lcp_M=((L, L), f), lcp_q=((L,), f), lcp_z=((L,), f),
                 lcp_scale=((L,), f), lcp_T=((L, 2 * L + 2), f), lcp_basis=((L,), i),
-                row_slip=((R,), f), island_rows=((R,), i), row_island=((R,), i))
+                row_slip=((R,), f), lcp_nz=((L,), i), island_rows=((R,), i),
+                row_island=((R,), i))
 
 
 def _solve_arrays(model: Model, contacts: int, profile: int, lcp_rows: int) -> dict:
