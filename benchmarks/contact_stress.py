@@ -123,7 +123,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
-from planarsim import terrain  # noqa: E402
+from planarsim import dense, terrain  # noqa: E402
 from benchmarks.metrics import (energy, kinetic, lowest_point, pin_separation,  # noqa: E402
                                      spec_from_model, world_points)
 from benchmarks.scenes import G, biped_collapse  # noqa: E402
@@ -393,7 +393,8 @@ def loop_velocity(model, q, v):
         rows.append(row)
     jac = np.vstack(rows)
     flat = v.reshape(-1)
-    flat = flat - jac.T @ np.linalg.solve(jac @ jac.T, jac @ flat)
+    # (planarsim.dense: the same bits on every CPU, where numpy's BLAS kernels differ)
+    flat = flat - dense.matmul(jac.T, dense.solve(dense.matmul(jac, jac.T), dense.matmul(jac, flat)))
     return flat.reshape(v.shape)
 
 

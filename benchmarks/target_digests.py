@@ -2,8 +2,8 @@
 (walker_digests.py) and of a fixed set of stress-corpus runs (contact_stress.py), computed in
 fresh processes with numba's code generated for this CPU, for a generic x86-64 target
 (NUMBA_CPU_NAME=generic: no AVX, no FMA; numba then sets NUMBA_CPU_FEATURES to none), and
-with 1 and 2 threads (NUMBA_NUM_THREADS, OPENBLAS_NUM_THREADS); every fingerprint must be
-identical across all four.
+with 1 and 2 threads (NUMBA_NUM_THREADS, OPENBLAS_NUM_THREADS), and with numpy's BLAS on its
+SSE3 kernels (OPENBLAS_CORETYPE); every fingerprint must be identical across all five.
 
     python benchmarks/target_digests.py                  # 3 s per walker, the corpus set
     python benchmarks/target_digests.py --seconds 1      # quicker
@@ -37,7 +37,11 @@ sys.path.insert(0, str(ROOT))
 SETTINGS = (("host", {}),
             ("generic", {"NUMBA_CPU_NAME": "generic"}),
             ("threads=1", {"NUMBA_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}),
-            ("threads=2", {"NUMBA_NUM_THREADS": "2", "OPENBLAS_NUM_THREADS": "2"}))
+            ("threads=2", {"NUMBA_NUM_THREADS": "2", "OPENBLAS_NUM_THREADS": "2"}),
+            # OpenBLAS's SSE3 kernels in place of the host's (numpy's BLAS picks its kernels per
+            # CPU; a set-up that ran through it gave other bits on an AVX-512 machine than on an
+            # AVX2 one: planarsim.dense)
+            ("blas=sse3", {"OPENBLAS_CORETYPE": "Prescott"}))
 
 #: stress-corpus runs fingerprinted: (family, seed), each for its family's whole run
 CORPUS = (("biped_stance", 0), ("biped_collapse", 1), ("chain_hills", 2), ("mass_ratio", 3),

@@ -26,6 +26,7 @@ import math
 
 import numpy as np
 
+from . import dense
 from .errors import ModelError
 from .compile import jit
 from .kernels.codes import JOINT_FREE_BIT, JOINT_SLIDER
@@ -101,7 +102,7 @@ def project_velocities(model, q, v, pinned=()) -> np.ndarray:
         Ja, pa = point(ba, la) if ba >= 0 else (np.zeros((2, 3 * nb)), la)
         Jb, pb = point(bb, lb) if bb >= 0 else (np.zeros((2, 3 * nb)), lb)
         e = (pb - pa) / np.hypot(*(pb - pa))
-        rows.append(e @ (Jb - Ja))
+        rows.append(dense.matmul((Jb - Ja).T, e))
     for j in range(model.n_pin):
         if a.pin_kind[j] & JOINT_FREE_BIT:
             continue        # a free body's coordinate: measured, holds nothing
@@ -115,6 +116,7 @@ def project_velocities(model, q, v, pinned=()) -> np.ndarray:
         return v.copy()
     J = np.array(rows)
     x = v.ravel()
-    A = (J * w) @ J.T
-    mu = np.linalg.lstsq(A, J @ x, rcond=1e-12)[0]
-    return (x - w * (J.T @ mu)).reshape(nb, 3)
+    # (planarsim.dense: the same bits on every CPU, where numpy's BLAS kernels differ)
+    A = dense.matmul(J * w, J.T)
+    mu = dense.solve_psd(A, dense.matmul(J, x), 1e-12)
+    return (x - w * dense.matmul(J.T, mu)).reshape(nb, 3)

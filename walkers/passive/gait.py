@@ -37,6 +37,12 @@ def _cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
 
 
+def _dot(a, b):
+    """a . b of two plane vectors, written out: numpy's `@` runs in a BLAS kernel chosen per
+    CPU, whose last bits differ between machines (planarsim.dense)."""
+    return a[0] * b[0] + a[1] * b[1]
+
+
 def _dup(theta):
     """d leg_up / d theta in slope coordinates (t, n): (-cos theta, -sin theta)."""
     return np.array([-math.cos(theta), -math.sin(theta)])
@@ -109,7 +115,7 @@ class PassiveWalker:
         stance = self.feet[self.memory[0]] if stance is None else int(stance)
         ps_, vs = self.foot_point(stance, q, v)
         r, rd = q[self.hip, :2] - ps_, v[self.hip, :2] - vs
-        return math.atan2(-(r @ self.t_hat), r @ self.n_hat), _cross(r, rd) / (r @ r)
+        return math.atan2(-_dot(r, self.t_hat), _dot(r, self.n_hat)), _cross(r, rd) / _dot(r, r)
 
     def coords(self, q=None, v=None, stance=None) -> np.ndarray:
         """Section coordinates of the state (default: the simulator's) with stance contact
@@ -124,8 +130,8 @@ class PassiveWalker:
         swing = self.feet[1] if stance == self.feet[0] else self.feet[0]
         pw, vw = self.foot_point(swing, q, v)
         d, dd = pw - hp, vw - hv
-        psi = math.atan2(d @ self.t_hat, -(d @ self.n_hat))
-        psi_dot = _cross(d, dd) / (d @ d)
+        psi = math.atan2(_dot(d, self.t_hat), -_dot(d, self.n_hat))
+        psi_dot = _cross(d, dd) / _dot(d, d)
         k = self.rate_scale
         return np.array([theta, theta_dot / k, theta - psi, (theta_dot - psi_dot) / k])
 
@@ -136,14 +142,17 @@ class PassiveWalker:
         s = self.sim.state
         s.restore(ps.make_state(self.model))
         t, n = self.t_hat, self.n_hat
-        basis = np.stack([t, n], axis=1)   # slope (t, n) coordinates -> world
+
+        def basis(d):                      # slope (t, n) coordinates -> world
+            return t * d[0] + n * d[1]
+
         if self.kind == "rimless":
             p = self.params
             alpha = p.half_angle
             up = leg_up(alpha, self.gamma)
             s.q[0, :2] = p.spoke_length * up
             s.q[0, 2] = math.atan2(-up[0], up[1])
-            s.v[0, :2] = p.spoke_length * x[0] * (basis @ _dup(alpha))
+            s.v[0, :2] = p.spoke_length * x[0] * basis(_dup(alpha))
             s.v[0, 2] = x[0]
         else:
             k = self.rate_scale
@@ -152,22 +161,22 @@ class PassiveWalker:
             l = self.length
             up_s, up_w = leg_up(th, self.gamma), leg_up(psi, self.gamma)
             hip = l * up_s
-            vhip = l * thd * (basis @ _dup(th))
+            vhip = l * thd * basis(_dup(th))
             s.q[self.hip, :2], s.v[self.hip, :2] = hip, vhip
             if self.kind == "simplest":
                 fb = self.model.body("foot_b")
                 s.q[fb, :2] = hip - l * up_w
-                s.v[fb, :2] = vhip - l * psid * (basis @ _dup(psi))
+                s.v[fb, :2] = vhip - l * psid * basis(_dup(psi))
             else:
                 a = self.params.com_from_foot
                 for name, up, ang, rate, sgn in (("leg_a", up_s, th, thd, 1.0), ("leg_b", up_w, psi, psid, -1.0)):
                     b = self.model.body(name)
                     if sgn > 0:
                         s.q[b, :2] = a * up
-                        s.v[b, :2] = a * rate * (basis @ _dup(ang))
+                        s.v[b, :2] = a * rate * basis(_dup(ang))
                     else:
                         s.q[b, :2] = hip - (l - a) * up
-                        s.v[b, :2] = vhip - (l - a) * rate * (basis @ _dup(ang))
+                        s.v[b, :2] = vhip - (l - a) * rate * basis(_dup(ang))
                     s.q[b, 2] = math.atan2(-up[0], up[1])
                     s.v[b, 2] = rate
         s.contact_mode[self.feet[0]] = 1
@@ -299,7 +308,7 @@ class PassiveWalker:
         self.sim.state.contact_enabled[self.feet[old]] = 0
         self.last_period = float(self.sim.state.time[0])
         end = self.foot_point(self.feet[self.memory[0]])[0]
-        self.last_length = float((end - start) @ self.t_hat)
+        self.last_length = float(_dot(end - start, self.t_hat))
         return self.coords()
 
     def step_map(self) -> StepMap:
