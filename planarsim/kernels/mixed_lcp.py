@@ -22,7 +22,7 @@ The velocity stage calls this with b = c / h + J v*; the position projection wit
 import math
 
 from ..compile import kernel
-from .lcp import LCP_INACCURATE, LCP_RAY, LCP_SOLVED, REVISED_SIZE, lemke, lemke_revised, polish
+from .lcp import LCP_INACCURATE, LCP_RAY, LCP_SOLVED, REVISED_SIZE, lemke, lemke_large, polish
 from .codes import CONTACT_PAIR
 from .contacts import pair_motion_scale
 from .rows import is_joint_row, is_soft_row, is_tangent_row
@@ -352,8 +352,8 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
                 Mx[i, i] += target - eps
             eps = target
             if nv >= REVISED_SIZE:      # a large problem: the path in revised form
-                status, more = lemke_revised(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z,
-                                             ws.lcp_nz, max_pivots, cover, floor)
+                status, more = lemke_large(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z,
+                                           ws.lcp_nz, max_pivots, cover, floor)
             else:
                 status, more = lemke(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, max_pivots,
                                      cover, floor)

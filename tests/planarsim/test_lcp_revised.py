@@ -9,8 +9,9 @@ import pytest
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.lcp import (LCP_CAP, LCP_SOLVED, REVISED_SIZE, _basis_key, _seen_before,
-                                   lemke, lemke_revised)
+from planarsim.kernels.lcp import (ANSWER_TOL, LCP_CAP, LCP_INACCURATE, LCP_SOLVED,
+                                   REVISED_SIZE, _basis_key, _seen_before, lemke, lemke_large,
+                                   lemke_revised)
 
 # not cached: numba checks a cached function against its own file only, and this wrapper
 # must follow the kernels it calls
@@ -18,18 +19,21 @@ jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit
-def _solve_in(M, q, revised, z, T, basis, nz):
+def _solve_in(M, q, form, z, T, basis, nz):
     m = q.shape[0]
-    if revised:
+    if form == 2:
+        return lemke_large(M, q, m, T, basis, z, nz, 40 * m + 10, 0, 0.0)
+    if form == 1:
         return lemke_revised(M, q, m, T, basis, z, nz, 40 * m + 10, 0, 0.0)
     return lemke(M, q, m, T, basis, z, 40 * m + 10, 0, 0.0)
 
 
-def _solve(M, q, revised):
-    """(status, pivots, z) of one path (covering vector 0) of the tableau or revised form."""
+def _solve(M, q, form):
+    """(status, pivots, z) of one path (covering vector 0): form 0 the tableau (lemke), 1 the
+    revised form (lemke_revised), 2 the large problems' (lemke_large)."""
     m = len(q)
     z = np.zeros(m)
-    status, pivots = _solve_in(M, q, revised, z, np.zeros((m, 2 * m + 2)),
+    status, pivots = _solve_in(M, q, form, z, np.zeros((m, 2 * m + 2)),
                                np.zeros(m, np.int64), np.zeros(m, np.int64))
     return status, pivots, z
 
@@ -103,24 +107,42 @@ CORPUS = ([("frictionless", k, d, seed) for k, d in ((100, 40), (160, 60)) for s
           + [("friction", c, d, seed) for c, d in ((25, 60), (40, 100)) for seed in range(20)])
 
 
+def _problem(family, size, d, seed):
+    return _frictionless(size, d, seed) if family == "frictionless" else \
+        _with_friction(size, d, 0.5, seed)
+
+
 @pytest.mark.parametrize("family,size,d,seed", CORPUS)
-def test_revised_form_follows_the_tableaus_path(family, size, d, seed):
-    """On problems of REVISED_SIZE variables and more, the revised form ends where the tableau
-    does (the same status, the same pivots: the same path in exact arithmetic, rounding
-    apart), and its answer meets the complementarity rules to 1e-9 of max |q|."""
-    if family == "frictionless":
-        M, q = _frictionless(size, d, seed)
-    else:
-        M, q = _with_friction(size, d, 0.5, seed)
+def test_large_problems_solve_where_the_tableau_does(family, size, d, seed):
+    """On problems of REVISED_SIZE variables and more, lemke_large (the revised form, then
+    the tableau where the revised path failed) solves wherever the tableau does, its answer
+    within the engine's check (ANSWER_TOL of max |q|). (Not the same pivots: these problems'
+    ties are decided by B^-1's last bits, which the two forms round apart.)"""
+    M, q = _problem(family, size, d, seed)
     assert len(q) >= REVISED_SIZE
-    status_t, pivots_t, z_t = _solve(M.copy(), q, False)
-    status_r, pivots_r, z_r = _solve(M.copy(), q, True)
-    assert status_r == status_t
+    status_t, _, _ = _solve(M.copy(), q, 0)
+    status_l, _, z_l = _solve(M.copy(), q, 2)
     if status_t != LCP_SOLVED:
-        return
-    assert abs(pivots_r - pivots_t) <= max(2, pivots_t // 50), (pivots_r, pivots_t)
-    assert _miss(M, q, z_r) < 1e-9
-    assert _miss(M, q, z_t) < 1e-9
+        return          # (8 of the 40 singular frictionless problems: the check's figure below)
+    assert status_l == LCP_SOLVED
+    assert _miss(M, q, z_l) < ANSWER_TOL
+
+
+def test_the_revised_path_alone_solves_most_and_says_so_where_it_does_not():
+    """The revised form alone solves all 40 frictional problems and at least 25 of the 40
+    singular frictionless ones (measured: 27; the tableau alone 32); where it does not, it
+    says so (LCP_CAP: rounding brought it back to a basis, long before the cap;
+    LCP_INACCURATE: its final basis's answer fails the check) and leaves no answer."""
+    solved = {"frictionless": 0, "friction": 0}
+    for family, size, d, seed in CORPUS:
+        M, q = _problem(family, size, d, seed)
+        status, pivots, z = _solve(M.copy(), q, 1)
+        if status == LCP_SOLVED:
+            assert _miss(M, q, z) < ANSWER_TOL
+            solved[family] += 1
+        else:
+            assert status in (LCP_CAP, LCP_INACCURATE) and pivots < 4 * len(q) and not z.any()
+    assert solved["frictionless"] >= 25 and solved["friction"] == 40, solved
 
 
 @jit
@@ -140,10 +162,10 @@ def test_a_capped_path_says_so_and_leaves_no_answer():
 
 
 @jit
-def _walk(keys_of_path, m):
-    """The revised path's record of basis keys (lcp._seen_before) over a walk of bases, each
-    given as its variables' list: returns the first step whose basis was seen before, or -1."""
-    T = np.zeros((m, 2 * m + 2))
+def _walk(keys_of_path, m, T):
+    """The revised path's record of basis keys (lcp._seen_before; T (m, 2m + 2) scratch) over
+    a walk of bases, each given as its variables' list: returns the first step whose basis
+    was seen before, or -1."""
     for step in range(keys_of_path.shape[0]):
         key = 0
         for v in keys_of_path[step]:
@@ -161,6 +183,6 @@ def test_a_basis_seen_before_is_recognised_whatever_the_order_of_its_variables()
     bases = [np.sort(rng.choice(2 * m + 1, m, replace=False)) for _ in range(2_000)]
     assert len({tuple(b) for b in bases}) == len(bases)
     path = np.array(bases)
-    assert _walk(path, m) == -1
+    assert _walk(path, m, np.zeros((m, 2 * m + 2))) == -1
     again = np.vstack([path[:700], rng.permutation(path[345])[None, :], path[700:]])
-    assert _walk(again, m) == 700
+    assert _walk(again, m, np.zeros((m, 2 * m + 2))) == 700
