@@ -127,6 +127,19 @@ def covering(i, m, cover):
     return 1.0 + 0.5 * ((i * GOLDEN) % 1.0)
 
 
+@kernel
+def _first_leaving(q, m, cover):
+    """The row where the artificial variable enters: the most negative q_i / d_i, d the
+    covering vector; -1 where q >= 0 (z = 0 is the answer) or m == 0."""
+    if m == 0:
+        return -1
+    lowest = 0
+    for i in range(m):
+        if q[i] / covering(i, m, cover) < q[lowest] / covering(lowest, m, cover):
+            lowest = i
+    return lowest if q[lowest] < 0.0 else -1
+
+
 @kernel(inline="never")
 def lemke(M, q, m, T, basis, z, max_pivots, cover, floor):
     """Solve LCP(M[:m, :m], q[:m]) into z[:m] along the path of covering vector `cover`
@@ -135,13 +148,8 @@ def lemke(M, q, m, T, basis, z, max_pivots, cover, floor):
     pivots)."""
     for i in range(m):
         z[i] = 0.0
-    if m == 0:
-        return LCP_SOLVED, 0
-    lowest = 0
-    for i in range(m):
-        if q[i] / covering(i, m, cover) < q[lowest] / covering(lowest, m, cover):
-            lowest = i
-    if q[lowest] >= 0.0:
+    lowest = _first_leaving(q, m, cover)
+    if lowest < 0:
         return LCP_SOLVED, 0
     z0 = 2 * m
     for i in range(m):
@@ -280,13 +288,8 @@ def lemke_revised(M, q, m, T, basis, z, nz, max_pivots, cover, floor):
     (>= m, int scratch)."""
     for i in range(m):
         z[i] = 0.0
-    if m == 0:
-        return LCP_SOLVED, 0
-    lowest = 0
-    for i in range(m):
-        if q[i] / covering(i, m, cover) < q[lowest] / covering(lowest, m, cover):
-            lowest = i
-    if q[lowest] >= 0.0:
+    lowest = _first_leaving(q, m, cover)
+    if lowest < 0:
         return LCP_SOLVED, 0
     rhs = 2 * m + 1
     z0 = 2 * m
