@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from planarsim import dense
 from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
@@ -35,12 +36,6 @@ IMPACT_DT = 1e-6   # [s] the step that resolves an impact at the section (refine
 
 def _cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
-
-
-def _dot(a, b):
-    """a . b of two plane vectors, written out: numpy's `@` runs in a BLAS kernel chosen per
-    CPU, whose last bits differ between machines (planarsim.dense)."""
-    return a[0] * b[0] + a[1] * b[1]
 
 
 def _dup(theta):
@@ -115,7 +110,7 @@ class PassiveWalker:
         stance = self.feet[self.memory[0]] if stance is None else int(stance)
         ps_, vs = self.foot_point(stance, q, v)
         r, rd = q[self.hip, :2] - ps_, v[self.hip, :2] - vs
-        return math.atan2(-_dot(r, self.t_hat), _dot(r, self.n_hat)), _cross(r, rd) / _dot(r, r)
+        return math.atan2(-dense.dot(r, self.t_hat), dense.dot(r, self.n_hat)), _cross(r, rd) / dense.dot(r, r)
 
     def coords(self, q=None, v=None, stance=None) -> np.ndarray:
         """Section coordinates of the state (default: the simulator's) with stance contact
@@ -130,8 +125,8 @@ class PassiveWalker:
         swing = self.feet[1] if stance == self.feet[0] else self.feet[0]
         pw, vw = self.foot_point(swing, q, v)
         d, dd = pw - hp, vw - hv
-        psi = math.atan2(_dot(d, self.t_hat), -_dot(d, self.n_hat))
-        psi_dot = _cross(d, dd) / _dot(d, d)
+        psi = math.atan2(dense.dot(d, self.t_hat), -dense.dot(d, self.n_hat))
+        psi_dot = _cross(d, dd) / dense.dot(d, d)
         k = self.rate_scale
         return np.array([theta, theta_dot / k, theta - psi, (theta_dot - psi_dot) / k])
 
@@ -308,7 +303,7 @@ class PassiveWalker:
         self.sim.state.contact_enabled[self.feet[old]] = 0
         self.last_period = float(self.sim.state.time[0])
         end = self.foot_point(self.feet[self.memory[0]])[0]
-        self.last_length = float(_dot(end - start, self.t_hat))
+        self.last_length = float(dense.dot(end - start, self.t_hat))
         return self.coords()
 
     def step_map(self) -> StepMap:

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from planarsim import dense
 from planarsim.analysis import step_summary
 
 from walkers.base import WalkerRun, terrain_of
@@ -150,8 +151,7 @@ class PassiveRun(WalkerRun):
         cost_of_transport (energy lost per weight and distance along the slope: sin(slope) on
         a steady gait)."""
         w = self.walker
-        d = self.state.q[w.hip, :2] - self.hip0
-        distance = float(d[0] * w.t_hat[0] + d[1] * w.t_hat[1])
+        distance = dense.dot(self.state.q[w.hip, :2] - self.hip0, w.t_hat)
         t_end = self.time
         whole = dict(whole_steps=0, step_period=math.nan, step_length=math.nan, speed=math.nan,
                      cost_of_transport=math.nan)
