@@ -4,7 +4,8 @@ integrate:  v = v_new,  q = q + h v  (symplectic Euler).
 correct_positions: the linearised rows leave a residual O(h^2 w^2 r). Newton on the SHAKE
 equation moves q along the START-of-step constraint directions J(q0):
     (J(q+) W J(q0)^T) mu = -c(q+),   q += W J(q0)^T mu,   v += W J(q0)^T mu / h
-(correcting along J(q+) instead would dissipate energy every step); on hills a point
+(correcting along J(q+) instead would dissipate energy every step); W with the joints'
+rotors (an armature's row takes part with compliance 1 / a: correction_compliance); on hills a point
 mass's ground contact row, which moves positions only, along its normal at q+ (normals_now).
 Safeguards: a Newton step that raises the largest error tenfold (nearly dependent rows of a
 closed loop through the ground) is taken back and tried once more with such rows dropped;
@@ -26,7 +27,8 @@ from .row_list import move_row
 from .joint_friction import is_joint_friction_row
 from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_normal_row,
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
-from .matrix import arrange, assemble, factor_solve, substitute_ws
+from .matrix import add_to_diagonal, arrange, assemble, factor_solve, substitute_ws
+from .soft import SOFT_ARMATURE
 from .solve import apply_impulses, row_dot
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
                    gravity_work, kinetic_energy, step_energy_of_forces)
@@ -49,9 +51,12 @@ def keep_correction_rows(s, ws):
     """Keep the rows the Newton correction holds: joints, active limits, the normal row of
     every touching contact and the tangent row of every sticking one (a sticking foot does
     not creep along the ground while the correction closes the joints). Rows of contacts the
-    solve set free or that rebound (restitution), the tangent rows of sliding ones, and the
-    joints' soft rows (soft.py: armature and spring-damper, no position error), are
-    dropped. Returns how many were
+    solve set free or that rebound (restitution), the tangent rows of sliding ones, the
+    joints' dry friction rows and the soft rows of joints without armature (a spring-damper
+    has no position error) are dropped. A joint's armature row stays: it has no error of
+    its own either (its target is 0), but its rotor turns with the joint, so the correction
+    moves the bodies and the rotors by (M + A)^-1 J^T mu, A the rotors' inertia
+    (correction_compliance), as the solve moves their velocities. Returns how many were
     dropped."""
     k = 0
     for r in range(ws.n_row[0]):
@@ -65,8 +70,10 @@ def keep_correction_rows(s, ws):
             continue    # rebounding (restitution): it leaves the surface, not held to it
         if is_limit_row(kind) and s.limit_active[o, limit_side(kind)] == 0:
             continue
-        if is_soft_row(kind) or is_joint_friction_row(kind):
-            continue    # a joint's armature / spring-damper / friction row: no position error
+        if is_soft_row(kind) and ws.row_soft[r, SOFT_ARMATURE] == 0.0:
+            continue    # a joint's spring-damper: no position error and no inertia
+        if is_joint_friction_row(kind):
+            continue    # a joint's dry friction: no position error
         if k != r:
             move_row(ws, k, r)
         k += 1
@@ -293,10 +300,15 @@ def rows_hold_within(m, s, ws, h, limit):
         return False
     n = ws.n_row[0]
     for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            ws.rhs[r] = 0.0         # an armature's row: no error of its own
+            continue
         ws.rhs[r] = abs(ws.row_c[r] + h * row_dot(ws, r, ws.row_J, s.v))
         if ws.rhs[r] > limit:
             return False
     for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            continue
         err = ws.rhs[r]
         angular = is_angular_row(m, ws, r)
         for e in range(2):
@@ -373,14 +385,30 @@ def drop_leaving_rows(m, s, ws, h):
 @kernel
 def targets_of(ws, n):
     """The correction's targets from the rows' errors c in ws.rhs (rows 0..n-1): ws.rhs <- -c;
-    returns the largest |c|."""
+    returns the largest |c|. An armature's row (keep_correction_rows) has target 0 and no
+    error: its rotor only shares the move."""
     worst = 0.0
     for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            ws.rhs[r] = 0.0
+            continue
         c = ws.rhs[r]
         ws.rhs[r] = -c
         if abs(c) > worst:
             worst = abs(c)
     return worst
+
+
+@kernel
+def correction_compliance(ws, n):
+    """A[r, r] += 1 / a for each armature row r (a: its rotor's inertia [kg m^2 or kg]) of
+    the correction's matrix: the row's impulse nu moves the rotor by -nu / a and the bodies
+    by W g^T nu, and its target g dq + nu / a = 0 turns the rotor with the joint, so the
+    bodies and rotors move together by (M + A)^-1 J^T mu (A = sum a g^T g), the inertia the
+    velocity solve gives them (soft.py)."""
+    for r in range(n):
+        if is_soft_row(ws.row_kind[r]):
+            add_to_diagonal(ws, r, 1.0 / ws.row_soft[r, SOFT_ARMATURE])
 
 
 @kernel(inline="never")
@@ -425,6 +453,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             unilateral += is_unilateral(ws.row_kind[r])
         normals_now(m, ws, n)
         assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
+        correction_compliance(ws, n)
         factor_solve(ws, ws.rhs, ws.lam, n, ptol)
         # move positions by the correction
         for i in range(ws.dq_correction.shape[0]):
