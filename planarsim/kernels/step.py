@@ -402,9 +402,8 @@ def relinearize(m, s, ws, h):
     its projection):
     the target is linearized again at the answer, v_lin = v_new, for one more solve. A light
     link between heavy rotors ends far from where the soft rows alone predicted (the pins
-    move it too); the projection (J v = 0) would leave its drift to the position
-    correction, whose velocity change weighs the bodies without their rotors. Returns True
-    if it did."""
+    move it too); the projection (J v = 0) would leave its first-order drift to the position
+    correction. Returns True if it did."""
     if ws.joint_pivot[0] < NEAR_DEPENDENT or prediction_turn(m, s, ws, h) < RELINEARIZE_TURN:
         return False
     moved = False           # (without soft rows, v* is the prediction: projection as before)

@@ -1,0 +1,230 @@
+"""Exact derivatives of one step: step_jacobian(sim, u).
+
+The default step (symplectic Euler with SHAKE, docs/engine.md) of a mechanism held by hinges
+ends at
+
+    v* = v + h W f(u),   q1 = q + h v* + W P^T L,   c(q1) = 0,   v1 = (q1 - q) / h,
+
+with W the bodies' inverse masses, P = dc/dq at the step's start and L the step's total
+impulse of the hinges' rows (the velocity solve's and the position correction's together:
+both act along W P^T, and the Newton correction ends where c(q1) = 0). Within its modes the
+step is smooth, and the implicit function theorem on c(q1) = 0 gives its derivative
+exactly:
+
+    dq1 = (I - W P^T S G) (dq + h dv + h^2 W F du + W H dq),   S = (G W P^T)^-1,
+    dv1 = (dq1 - dq) / h,
+
+with G = dc/dq at q1, F = df/du and H = d(P^T L)/dq (the hinges' curvature under the
+step's impulse: the anchors turn with their bodies). L is read back from the step's own
+answer (the engine's step is taken once, on a snapshot, and `sim` is restored); a step that
+did not end as that equation says (sub-steps, a correction held back by the energy bound)
+raises instead of giving a derivative of a different map.
+
+Covered so far: bodies and point masses held by hinges (pins) to each other and the world,
+under gravity, constant pushes and pin torques, body forces and body torques. Refused with a
+NotImplementedError naming the feature: sliders, rods, joint limits, springs, dampers,
+armature and dry friction, contacts and shape pairs that touch in the step, fluid drag, the
+other actuator kinds, the accurate integrators.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .kernels.codes import INTEGRATOR_EULER, JOINT_HINGE, MODE_FREE
+from .kernels.forces import ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_PIN_TORQUE
+from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
+
+#: the step's end must satisfy q1 = q + h v* + W P^T L to this share of |q1 - q| (plus
+#: rounding) for its derivative to be this map's
+FIT_TOL = 1e-9
+
+_LINEAR_ACTUATORS = {ACT_PIN_TORQUE: "pin torque", ACT_BODY_FORCE: "body force",
+                     ACT_BODY_TORQUE: "body torque"}
+
+
+@dataclass(frozen=True)
+class StepJacobian:
+    """The derivative of one step x -> x1, x = (q.ravel(), v.ravel()) [m, rad, m/s, rad/s].
+
+    A : (n_x, n_x) d x1 / d x
+    B : (n_x, n_u) d x1 / d u (u: the actuators' commands [N or N m])
+    modes_changed : True where an infinitesimal change of x or u would change a mode of the
+        step (here: a command exactly at its saturation bound; B then holds the derivative
+        from inside the range)
+    x1 : the state after the step, in the same layout
+    """
+    A: np.ndarray
+    B: np.ndarray
+    modes_changed: bool
+    x1: np.ndarray
+
+
+def _not_covered(what):
+    return NotImplementedError(
+        f"step_jacobian covers mechanisms of hinges under gravity, pushes and pin / body "
+        f"torques and body forces so far; this step has {what}")
+
+
+def check_covered(model, options) -> None:
+    """Raise NotImplementedError naming the first feature of `model` or `options` that
+    step_jacobian does not cover yet (module docstring)."""
+    a = model.arrays
+    if options.integrator != INTEGRATOR_EULER:
+        raise _not_covered(f"the accurate integrator {options.integrator!r}")
+    if model.n_rod:
+        raise _not_covered(f"rods ({model.rod_names[0]!r}, ...)")
+    if a.fluid_body.shape[0]:
+        raise _not_covered("fluid drag")
+    for j, name in enumerate(model.pin_names):
+        if a.pin_kind[j] != JOINT_HINGE:
+            raise _not_covered(f"joint {name!r}, which is not a hinge (kind {int(a.pin_kind[j])})")
+        for field, label in (("pin_stiffness", "a spring"), ("pin_damping", "a damper"),
+                             ("pin_armature", "armature"), ("pin_frictionloss", "dry friction")):
+            if getattr(a, field)[j] != 0.0:
+                raise _not_covered(f"{label} on joint {name!r}")
+    for k, name in enumerate(model.act_names):
+        if int(a.act_kind[k]) not in _LINEAR_ACTUATORS:
+            raise _not_covered(f"actuator {name!r} of kind {int(a.act_kind[k])}")
+
+
+def hinge_terms(model, q, impulse=None):
+    """The hinges' errors c (2 n_pin,) [m] and Jacobian J (2 n_pin, 3 n_body) at q (n_body, 3)
+    (rows x and y of each pin: anchor b minus anchor a, as kernels/pin.py); with `impulse`
+    (2 n_pin,) [N s] also H (3 n_body, 3 n_body) = d (J^T impulse) / dq."""
+    a = model.arrays
+    n, p = q.shape[0], model.n_pin
+    c = np.zeros(2 * p)
+    J = np.zeros((2 * p, 3 * n))
+    H = np.zeros((3 * n, 3 * n)) if impulse is not None else None
+    rows = np.arange(p)
+    for e, sign in ((0, -1.0), (1, 1.0)):
+        body = a.pin_body[:, e]
+        ax, ay = a.pin_anchor[:, e, 0], a.pin_anchor[:, e, 1]
+        moving = body >= 0
+        b = np.where(moving, body, 0)
+        th = np.where(moving, q[b, 2], 0.0)
+        cs, sn = np.cos(th), np.sin(th)
+        rx = np.where(moving, cs * ax - sn * ay, 0.0)   # the anchor's arm in the world [m]
+        ry = np.where(moving, sn * ax + cs * ay, 0.0)
+        px = np.where(moving, q[b, 0] + rx, ax)         # a world anchor's own coordinates
+        py = np.where(moving, q[b, 1] + ry, ay)
+        c[2 * rows] += sign * px
+        c[2 * rows + 1] += sign * py
+        m = rows[moving]
+        bm = b[moving]
+        np.add.at(J, (2 * m, 3 * bm), sign)
+        np.add.at(J, (2 * m + 1, 3 * bm + 1), sign)
+        np.add.at(J, (2 * m, 3 * bm + 2), -sign * ry[moving])
+        np.add.at(J, (2 * m + 1, 3 * bm + 2), sign * rx[moving])
+        if H is not None:
+            lx, ly = impulse[2 * m], impulse[2 * m + 1]
+            np.add.at(H, (3 * bm + 2, 3 * bm + 2),
+                      -sign * (rx[moving] * lx + ry[moving] * ly))
+    return c, J, H
+
+
+def force_terms(model, state, u):
+    """(f (3 n_body,) [N, N m] the applied forces under commands u, F (3 n_body, n_act) their
+    derivative with respect to u (0 for a command at or past a bound: from inside the range),
+    at_bound: a bool per actuator, its command exactly at a bound)."""
+    a = model.arrays
+    n = model.n_body
+    f = np.zeros((n, 3))
+    f[:, 0] = a.body_mass * a.gravity[0] + state.ext_force[:, 0]
+    f[:, 1] = a.body_mass * a.gravity[1] + state.ext_force[:, 1]
+    f[:, 2] = np.where(a.body_inv_inertia > 0.0, state.ext_force[:, 2], 0.0)
+    F = np.zeros((n, 3, model.n_act))
+    lo, hi = a.act_range[:, 0], a.act_range[:, 1]
+    inside = (u > lo) & (u < hi)
+    at_bound = (u == lo) | (u == hi)
+    u_sat = np.clip(u, lo, hi)
+    for k in range(model.n_act):
+        kind = int(a.act_kind[k])
+        if kind == ACT_PIN_TORQUE:
+            j = a.act_ref[k]
+            F[a.pin_body[j, 1], 2, k] += 1.0
+            if a.pin_body[j, 0] >= 0:
+                F[a.pin_body[j, 0], 2, k] -= 1.0
+        elif kind == ACT_BODY_FORCE:
+            F[a.act_body[k, 0], :2, k] = a.act_dir[k]
+        elif kind == ACT_BODY_TORQUE and a.body_inv_inertia[a.act_body[k, 0]] > 0.0:
+            F[a.act_body[k, 0], 2, k] = 1.0
+    f += F @ u_sat
+    F = F * inside                       # a saturated command moves nothing (from inside)
+    return f.ravel(), F.reshape(3 * n, model.n_act), at_bound
+
+
+def step_jacobian(sim, u=None) -> StepJacobian:
+    """The exact derivative of one step of `sim` (as `sim.step(u)` would take it) with respect
+    to the state x = (q.ravel(), v.ravel()) and the commands u (module docstring). `sim` is
+    left as it was. Raises NotImplementedError for a model, option or step outside what is
+    covered, naming it."""
+    model = sim.model
+    check_covered(model, sim.options)
+    u = np.zeros(model.n_act) if u is None else np.asarray(u, dtype=float)
+    if u.shape != (model.n_act,) or not np.all(np.isfinite(u)):
+        raise ValueError(f"commands u must be {model.n_act} finite numbers, got {u!r}")
+    h = float(sim.dt)
+    start = sim.snapshot()
+    q0 = start.q.copy()
+    v0 = start.v.copy()
+    try:
+        sim.step(u)
+        end = sim.state
+        q1, v1 = end.q.copy(), end.v.copy()
+        touching = bool((end.contact_mode != MODE_FREE).any())
+        substeps = int(sim.ws.info[INFO_TURN_SUBSTEPS])
+        splits = int(sim.ws.info[INFO_CCD_SPLITS])
+        limits = bool(end.limit_active.any())
+    finally:
+        sim.restore(start)
+    if touching:
+        raise _not_covered("a contact that touches in the step")
+    if limits:
+        raise _not_covered("a joint limit reached in the step")
+    if substeps > 1 or splits > 0:
+        raise _not_covered(f"a step taken in {max(substeps, 1)} sub-steps / {splits} "
+                           f"time-of-impact splits")
+    n = model.n_body
+    a = model.arrays
+    w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
+    f, F, saturated = force_terms(model, start, u)
+    v_star = v0.ravel() + h * w * f
+    _, P, _ = hinge_terms(model, q0)
+    # the step's total impulse L from its answer: W P^T L = q1 - q - h v* (least squares over
+    # the bodies' masses; P has full row rank where the hinges are independent)
+    move = q1.ravel() - q0.ravel() - h * v_star
+    WPt = w[:, None] * P.T
+    if P.shape[0]:
+        L, *_ = np.linalg.lstsq(WPt, move, rcond=None)
+    else:
+        L = np.zeros(0)
+    scale = np.abs(q1.ravel() - q0.ravel()).max() + np.abs(q0).max() * 1e-15 + 1e-300
+    if np.abs(WPt @ L - move).max() > FIT_TOL * scale:
+        raise _not_covered("an end that is not the hinges' SHAKE step (the position "
+                           "correction's velocity change held back by its energy bound?)")
+    if np.abs(v1.ravel() - (q1.ravel() - q0.ravel()) / h).max() > FIT_TOL * scale / h:
+        raise _not_covered("an end velocity other than (q1 - q) / h")
+    _, _, H = hinge_terms(model, q0, L)
+    _, G, _ = hinge_terms(model, q1)
+    nq = 3 * n
+    eye = np.eye(nq)
+    if G.shape[0]:
+        S = np.linalg.solve(G @ WPt, G)            # (G W P^T)^-1 G
+        proj = eye - WPt @ S
+    else:
+        proj = eye
+    # d(q + h v* + W H dq ...) with respect to q, v and u
+    dq_dq = proj @ (eye + w[:, None] * H)
+    dq_dv = proj * h
+    dq_du = proj @ (h * h * w[:, None] * F)
+    A = np.zeros((2 * nq, 2 * nq))
+    A[:nq, :nq] = dq_dq
+    A[:nq, nq:] = dq_dv
+    A[nq:, :nq] = (dq_dq - eye) / h
+    A[nq:, nq:] = dq_dv / h
+    B = np.vstack([dq_du, dq_du / h])
+    return StepJacobian(A=A, B=B, modes_changed=bool(saturated.any()),
+                        x1=np.concatenate([q1.ravel(), v1.ravel()]))
