@@ -1,4 +1,4 @@
-"""Exact derivatives of one step: step_jacobian(sim, u).
+"""Exact derivatives of one step: step_jacobian(sim, u); along a rollout: rollout_jacobians.
 
 The default step (symplectic Euler with SHAKE, docs/engine.md) of a mechanism held by hinges
 ends at
@@ -228,3 +228,18 @@ def step_jacobian(sim, u=None) -> StepJacobian:
     B = np.vstack([dq_du, dq_du / h])
     return StepJacobian(A=A, B=B, modes_changed=bool(saturated.any()),
                         x1=np.concatenate([q1.ravel(), v1.ravel()]))
+
+
+def rollout_jacobians(sim, us) -> list:
+    """Step `sim` under each command vector of `us` (n_steps, n_act) in turn and return the
+    StepJacobian of each step (taken at the state it started from); `sim` ends after the
+    last step, as `for u in us: sim.step(u)` leaves it. The derivative of the whole rollout
+    is the product of the A's (the last one on the left)."""
+    us = np.asarray(us, dtype=float)
+    if us.ndim != 2 or us.shape[1] != sim.model.n_act:
+        raise ValueError(f"us must have shape (n_steps, {sim.model.n_act}), got {us.shape}")
+    out = []
+    for u in us:
+        out.append(step_jacobian(sim, u))
+        sim.step(u)
+    return out

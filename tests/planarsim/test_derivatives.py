@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import planarsim as ps
-from planarsim.derivatives import step_jacobian
+from planarsim.derivatives import rollout_jacobians, step_jacobian
 
 REL_TOL = 1e-6      # the issue's bound on the relative error against finite differences
 EPS_X = 1e-6        # [m, rad, m/s, rad/s] the state's finite-difference step
@@ -162,3 +162,59 @@ def test_what_is_not_covered_yet_is_named():
         step_jacobian(ps.Simulator(b.compile()))
     with pytest.raises(ValueError, match="finite"):
         step_jacobian(ps.Simulator(chain([1.0], [0.5])), np.array([np.nan]))
+
+
+def test_a_rollouts_derivative_is_the_product_of_its_steps():
+    """Ten steps of a three-link chain under changing torques: the product of the steps' A
+    (and the chain rule for the first command) against differences of the ten-step map."""
+    model = chain([1.0, 0.5, 2.0], [0.4, 0.6, 0.3])
+    sim = ps.Simulator(model)
+    rng = np.random.default_rng(3)
+    moved_state(sim, rng, 0.5)
+    us = rng.uniform(-0.5, 0.5, (10, model.n_act))
+    start = sim.snapshot()
+    jacs = rollout_jacobians(sim, us)
+    end = sim.snapshot()
+    sim.restore(start)
+    for u in us:
+        sim.step(u)
+    assert np.array_equal(sim.state.q, end.q)          # as plain steps leave it
+    total = np.eye(jacs[0].A.shape[0])
+    for j in jacs:
+        total = j.A @ total
+    n = model.n_body
+    x0 = np.concatenate([start.q.ravel(), start.v.ravel()])
+
+    def rollout(x):
+        s = start.copy()
+        s.q[:] = x[:3 * n].reshape(n, 3)
+        s.v[:] = x[3 * n:].reshape(n, 3)
+        sim.restore(s)
+        for u in us:
+            sim.step(u)
+        return np.concatenate([sim.state.q.ravel(), sim.state.v.ravel()])
+
+    fd = np.empty_like(total)
+    for i in range(x0.size):
+        e = np.zeros_like(x0)
+        e[i] = EPS_X
+        fd[:, i] = (rollout(x0 + e) - rollout(x0 - e)) / (2 * EPS_X)
+    assert relative_error(total, fd) <= REL_TOL, relative_error(total, fd)
+    # d x_10 / d u_0 = A_9 ... A_1 B_0
+    chained = jacs[0].B
+    for j in jacs[1:]:
+        chained = j.A @ chained
+    k = 1
+    bumped = [us.copy(), us.copy()]
+    bumped[0][0, k] += EPS_U
+    bumped[1][0, k] -= EPS_U
+    ends = []
+    for seq in bumped:
+        sim.restore(start)
+        for u in seq:
+            sim.step(u)
+        ends.append(np.concatenate([sim.state.q.ravel(), sim.state.v.ravel()]))
+    fd_u = (ends[0] - ends[1]) / (2 * EPS_U)
+    assert relative_error(chained[:, k:k + 1], fd_u[:, None]) <= REL_TOL
+    with pytest.raises(ValueError, match="us must have shape"):
+        rollout_jacobians(sim, np.zeros(3))
