@@ -3,28 +3,30 @@
 The default step (symplectic Euler with SHAKE, docs/engine.md) of a mechanism held by hinges
 ends at
 
-    v* = v + h W f(u),   q1 = q + h v* + W P^T L,   c(q1) = 0,   v1 = (q1 - q) / h,
+    q1 = q + h v + h^2 W f(q, u) + W P^T L,   c(q1) = 0,   v1 = (q1 - q) / h,
 
-with W the bodies' inverse masses, P = dc/dq at the step's start and L the step's total
+with W the inverse of the bodies' masses and the hinges' rotors (M + A, A = sum a g^T g over
+the joints' armature a and rate rows g), P = dc/dq at the step's start and L the step's total
 impulse of the hinges' rows (the velocity solve's and the position correction's together:
 both act along W P^T, and the Newton correction ends where c(q1) = 0). Within its modes the
 step is smooth, and the implicit function theorem on c(q1) = 0 gives its derivative
 exactly:
 
-    dq1 = (I - W P^T S G) (dq + h dv + h^2 W F du + W H dq),   S = (G W P^T)^-1,
+    dq1 = (I - W P^T S G) (dq + h dv + h^2 W (K dq + F du) + W H dq),   S = (G W P^T)^-1,
     dv1 = (dq1 - dq) / h,
 
-with G = dc/dq at q1, F = df/du and H = d(P^T L)/dq (the hinges' curvature under the
-step's impulse: the anchors turn with their bodies). L is read back from the step's own
-answer (the engine's step is taken once, on a snapshot, and `sim` is restored); a step that
-did not end as that equation says (sub-steps, a correction held back by the energy bound)
-raises instead of giving a derivative of a different map.
+with G = dc/dq at q1, K = df/dq (the joints' springs), F = df/du and H = d(P^T L)/dq (the
+hinges' curvature under the step's impulse: the anchors turn with their bodies). L is read
+back from the step's own answer (the engine's step is taken once, on a snapshot, and `sim`
+is restored); a step that did not end as that equation says (sub-steps, a correction held
+back by the energy bound) raises instead of giving a derivative of a different map.
 
-Covered so far: bodies and point masses held by hinges (pins) to each other and the world,
-under gravity, constant pushes and pin torques, body forces and body torques. Refused with a
-NotImplementedError naming the feature: sliders, rods, joint limits, springs, dampers,
-armature and dry friction, contacts and shape pairs that touch in the step, fluid drag, the
-other actuator kinds, the accurate integrators.
+Covered so far: bodies held by hinges (pins) to each other and the world, with armature and
+springs the step resolves (kernels/soft.py: taken at the step's start), under gravity,
+constant pushes and pin torques, body forces and body torques. Refused with a
+NotImplementedError naming the feature: sliders, rods, joint limits, dampers, dry friction,
+springs too stiff for the step or without a rotor, contacts and shape pairs that touch in
+the step, fluid drag, the other actuator kinds, the accurate integrators.
 """
 from __future__ import annotations
 
@@ -80,13 +82,53 @@ def check_covered(model, options) -> None:
     for j, name in enumerate(model.pin_names):
         if a.pin_kind[j] != JOINT_HINGE:
             raise _not_covered(f"joint {name!r}, which is not a hinge (kind {int(a.pin_kind[j])})")
-        for field, label in (("pin_stiffness", "a spring"), ("pin_damping", "a damper"),
-                             ("pin_armature", "armature"), ("pin_frictionloss", "dry friction")):
+        for field, label in (("pin_damping", "a damper"), ("pin_frictionloss", "dry friction")):
             if getattr(a, field)[j] != 0.0:
                 raise _not_covered(f"{label} on joint {name!r}")
+        if a.pin_limit[j, 0] > -np.inf or a.pin_limit[j, 1] < np.inf:
+            raise _not_covered(f"limits on joint {name!r}")
+        k, arm = a.pin_stiffness[j], a.pin_armature[j]
+        if k > 0.0:
+            kappa = sum(a.body_inv_inertia[b] for b in a.pin_body[j] if b >= 0)
+            resolved = options_dt(model, options) ** 2 * k * kappa / (1.0 + arm * kappa)
+            if arm == 0.0 or resolved > 0.5:
+                raise _not_covered(f"a spring on joint {name!r} that the step takes at its end "
+                                   f"(without a rotor, or too stiff for the step)")
     for k, name in enumerate(model.act_names):
         if int(a.act_kind[k]) not in _LINEAR_ACTUATORS:
             raise _not_covered(f"actuator {name!r} of kind {int(a.act_kind[k])}")
+
+
+def options_dt(model, options) -> float:
+    """The step [s] the options give (their dt, else the model's)."""
+    dt = getattr(options, "dt", 0.0)
+    return float(dt) if dt and dt > 0.0 else float(model.arrays.dt)
+
+
+def rotor_terms(model, q):
+    """(W (3 n_body, 3 n_body): the inverse of the bodies' masses and the joints' rotors
+    (M + A)^-1, f_spring (3 n_body,) [N m] the joints' springs at q, K = d f_spring / dq)."""
+    a = model.arrays
+    n = model.n_body
+    w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
+    A = np.zeros((3 * n, 3 * n))
+    K = np.zeros((3 * n, 3 * n))
+    f = np.zeros(3 * n)
+    for j in range(model.n_pin):
+        g = np.zeros(3 * n)
+        for e, sign in ((0, -1.0), (1, 1.0)):
+            b = a.pin_body[j, e]
+            if b >= 0:
+                g[3 * b + 2] = sign
+        A += a.pin_armature[j] * np.outer(g, g)
+        k = a.pin_stiffness[j]
+        if k > 0.0:
+            stretch = g @ q.ravel() - a.pin_ref[j] - a.pin_rest[j]
+            f -= k * stretch * g
+            K -= k * np.outer(g, g)
+    # (M + A)^-1 = (I + W A)^-1 W, which holds where W has zeros (a point mass's turn)
+    W = np.linalg.solve(np.eye(3 * n) + w[:, None] * A, np.diag(w))
+    return W, f, K
 
 
 def hinge_terms(model, q, impulse=None):
@@ -188,15 +230,14 @@ def step_jacobian(sim, u=None) -> StepJacobian:
         raise _not_covered(f"a step taken in {max(substeps, 1)} sub-steps / {splits} "
                            f"time-of-impact splits")
     n = model.n_body
-    a = model.arrays
-    w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
     f, F, saturated = force_terms(model, start, u)
-    v_star = v0.ravel() + h * w * f
+    W, f_spring, K = rotor_terms(model, q0)
+    free = q0.ravel() + h * v0.ravel() + h * h * (W @ (f + f_spring))
     _, P, _ = hinge_terms(model, q0)
-    # the step's total impulse L from its answer: W P^T L = q1 - q - h v* (least squares over
-    # the bodies' masses; P has full row rank where the hinges are independent)
-    move = q1.ravel() - q0.ravel() - h * v_star
-    WPt = w[:, None] * P.T
+    # the step's total impulse L from its answer: W P^T L = q1 - free (least squares; P has
+    # full row rank where the hinges are independent)
+    move = q1.ravel() - free
+    WPt = W @ P.T
     if P.shape[0]:
         L, *_ = np.linalg.lstsq(WPt, move, rcond=None)
     else:
@@ -216,10 +257,10 @@ def step_jacobian(sim, u=None) -> StepJacobian:
         proj = eye - WPt @ S
     else:
         proj = eye
-    # d(q + h v* + W H dq ...) with respect to q, v and u
-    dq_dq = proj @ (eye + w[:, None] * H)
+    # d(q + h v + h^2 W f + W P^T L) with respect to q, v and u
+    dq_dq = proj @ (eye + W @ (H + h * h * K))
     dq_dv = proj * h
-    dq_du = proj @ (h * h * w[:, None] * F)
+    dq_du = proj @ (h * h * (W @ F))
     A = np.zeros((2 * nq, 2 * nq))
     A[:nq, :nq] = dq_dq
     A[:nq, nq:] = dq_dv

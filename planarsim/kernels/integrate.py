@@ -25,6 +25,7 @@ from .math2d import update_trig
 from .limit import limit_side
 from .row_list import move_row
 from .joint_friction import is_joint_friction_row
+from .joints import joint_position_rate
 from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_normal_row,
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
 from .matrix import add_to_diagonal, arrange, assemble, factor_solve, substitute_ws
@@ -148,7 +149,8 @@ def bound_correction_work(m, s, ws, h):
     closed loop of bodies whose inertias differ by 1e8 the correction's impulses, set by the
     light bodies' drift, turn a heavy body: a small dv of large momentum (measured: +8 J of
     1136 J in one 10 ms step).
-    KE(v_solved + k dv) - KE(v_solved) = k a + k^2 b (a = v_solved . M dv, b = dv . M dv / 2)."""
+    KE(v_solved + k dv) - KE(v_solved) = k a + k^2 b (a = v_solved . M dv, b = dv . M dv / 2,
+    M the bodies' masses and the joints' rotors: a a g^T g term per joint with armature a)."""
     a = 0.0
     b = 0.0
     kinetic = 0.0
@@ -164,6 +166,17 @@ def bound_correction_work(m, s, ws, h):
         kinetic += 0.5 * (mass * (ws.v_solved[i, 0] ** 2 + ws.v_solved[i, 1] ** 2)
                           + inertia * ws.v_solved[i, 2] ** 2)
         momentum += mass * (abs(dx) + abs(dy) + abs(ws.v_solved[i, 0]) + abs(ws.v_solved[i, 1]))
+    # the joints' rotors (armature): they share the correction's move (correction_compliance)
+    # and their kinetic energy a (g v)^2 / 2 is the system's
+    for j in range(m.pin_armature.shape[0]):
+        arm = m.pin_armature[j]
+        if arm == 0.0:
+            continue
+        rate = joint_position_rate(m, s.q, ws.body_cs, ws.v_solved, j)[1]
+        d = joint_position_rate(m, s.q, ws.body_cs, s.v, j)[1] - rate
+        a += arm * rate * d
+        b += 0.5 * arm * d * d
+        kinetic += 0.5 * arm * rate * rate
     in_regime = b <= SHAKE_REGIME * SHAKE_REGIME * kinetic
     start_kinetic, gained = velocity_stage_gain(m, ws, ws.v_solved, h)
     # the step's share: of the smaller kinetic energy, less what its velocity stage gained

@@ -38,8 +38,8 @@ In the position correction (integrate.py) a joint with armature keeps this row w
 and compliance 1 / a: the Newton-SHAKE move and its velocity change c / h are shared by the
 bodies and the rotors, (M + A)^-1 J^T mu, as in the solve (without it a light link next to a
 heavy rotor took the whole change: HalfCheetah's feet under torque erred up to 4.2x MuJoCo's
-Euler, 1.2x with it). Not covered: the correction's kinetic-energy bound
-(bound_correction_work) weighs the bodies' masses only, without the rotors'.
+Euler, 1.2x with it); its kinetic-energy bound (bound_correction_work) counts the rotors'
+energy with the bodies'.
 """
 from ..compile import kernel
 from .codes import ROW_JOINT_SOFT

@@ -7,7 +7,7 @@ implicit function theorem on the step's own answer, so they agree to the differe
 error (measured: 1e-10 of the largest entry)."""
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import planarsim as ps
@@ -18,14 +18,16 @@ EPS_X = 1e-6        # [m, rad, m/s, rad/s] the state's finite-difference step
 EPS_U = 1e-2        # [N m] the commands' (the step is linear in them but for the curvature)
 
 
-def chain(masses, lengths, dt=1e-3):
+def chain(masses, lengths, dt=1e-3, armature=None, stiffness=None):
     """Links hinged end to end from a world pin (each with a pin motor, the last pushed by a
     body force and turned by a body torque), horizontal at the build."""
     b = ps.ModelBuilder(dt=dt)
     prev, x = None, 0.0
     for i, (m, L) in enumerate(zip(masses, lengths)):
         body = b.add_body(f"link{i}", mass=m, inertia=m * L * L / 12, pos=(x + L / 2, 0.0))
-        b.add_pin(f"pin{i}", prev, body, anchor_world=(x, 0.0))
+        b.add_pin(f"pin{i}", prev, body, anchor_world=(x, 0.0),
+                  armature=0.0 if armature is None else armature[i],
+                  stiffness=0.0 if stiffness is None else stiffness[i], rest_angle=0.3)
         b.add_pin_motor(f"motor{i}", f"pin{i}")
         prev, x = body, x + L
     b.add_body_force("push", prev, direction=(0.6, 0.8))
@@ -74,6 +76,30 @@ def relative_error(exact, approx):
     return worst
 
 
+#: the refusals that depend on the step taken, not on the model
+NOT_COVERED_STEPS = ("sub-steps", "end velocity other than", "not the hinges' SHAKE step")
+
+
+def rotor_chain(masses, lengths, dt, rng):
+    """(armature, stiffness) of a chain's hinges: armature 1e-3 to 1e2 times the link's
+    inertia and a spring the step resolves (a twentieth of the stiffness at which the step
+    would take it at its end, kernels/soft.py)."""
+    inertia = masses * lengths ** 2 / 12
+    armature = inertia * 10 ** rng.uniform(-3, 2, masses.size)
+    kappa = 1.0 / inertia + np.concatenate([[0.0], 1.0 / inertia[:-1]])
+    return armature, 0.05 * 0.5 * (1.0 + armature * kappa) / (dt * dt * kappa)
+
+
+def random_case(masses, lengths, dt, armature, stiffness, rng):
+    """(sim moved to a random state, commands u): commands of a third of the lightest link's
+    weight times its length, for 20-60 steps (the links swing at up to about 15 rad/s)."""
+    model = chain(masses, lengths, dt=dt, armature=armature, stiffness=stiffness)
+    sim = ps.Simulator(model)
+    swing = 0.3 * masses.min() * 9.81 * lengths.min()
+    moved_state(sim, rng, swing)
+    return sim, rng.uniform(-1.0, 1.0, model.n_act) * swing
+
+
 def moved_state(sim, rng, swing):
     """Run the mechanism from its build pose under random torques for a while: a state with
     the links turned and moving (swing [N m] of the commands)."""
@@ -82,26 +108,51 @@ def moved_state(sim, rng, swing):
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(links=st.integers(1, 5), seed=st.integers(0, 2 ** 31 - 1),
-       mass_decades=st.floats(0.0, 3.0), dt=st.sampled_from([1e-3, 5e-3]))
-def test_step_jacobian_is_the_steps_derivative(links, seed, mass_decades, dt):
+       mass_decades=st.floats(0.0, 3.0), dt=st.sampled_from([1e-3, 5e-3]), rotors=st.booleans())
+def test_step_jacobian_is_the_steps_derivative(links, seed, mass_decades, dt, rotors):
+    """rotors: each hinge with armature of 1e-3 to 1e2 times its link's inertia and a spring
+    the step resolves (a twentieth of the stiffness whose step angle would need the spring at the
+    step's end)."""
     rng = np.random.default_rng(seed)
     masses = 10 ** rng.uniform(-mass_decades / 2, mass_decades / 2, links)
     lengths = rng.uniform(0.2, 0.8, links)
-    model = chain(masses, lengths, dt=dt)
-    sim = ps.Simulator(model)
-    # commands of a third of the lightest link's weight times its length, for 20-60 steps:
-    # the links swing at up to about 15 rad/s, each step resolving its turn (no sub-steps,
-    # which are not covered yet)
-    swing = 0.3 * masses.min() * 9.81 * lengths.min()
-    moved_state(sim, rng, swing)
-    u = rng.uniform(-1.0, 1.0, model.n_act) * swing
+    armature, stiffness = rotor_chain(masses, lengths, dt, rng) if rotors else (None, None)
+    sim, u = random_case(masses, lengths, dt, armature, stiffness, rng)
     before = sim.snapshot()
-    jac = step_jacobian(sim, u)
+    try:
+        jac = step_jacobian(sim, u)
+    except NotImplementedError as exc:
+        # a step the engine took in sub-steps or whose correction its energy bound held
+        # back: not covered yet (test_most_random_chains_are_covered counts them)
+        assume(not any(why in str(exc) for why in NOT_COVERED_STEPS))
+        raise
     assert np.array_equal(sim.state.q, before.q) and np.array_equal(sim.state.v, before.v)
     A, B = finite_differences(sim, u)
     assert relative_error(jac.A, A) <= REL_TOL, relative_error(jac.A, A)
     assert relative_error(jac.B, B) <= REL_TOL, relative_error(jac.B, B)
     assert not jac.modes_changed
+
+
+@pytest.mark.parametrize("rotors, covered", [(False, 60), (True, 50)])
+def test_most_random_chains_are_covered(rotors, covered):
+    """Of 60 seeded chains (1-5 links, masses over three decades, dt 1 or 5 ms) step_jacobian
+    covers every step without rotors and at least 50 with them (measured 53: 4 steps taken in
+    sub-steps, 3 whose correction's velocity change the energy bound held back; each refused
+    by name, never a derivative of another map)."""
+    count = 0
+    for seed in range(60):
+        rng = np.random.default_rng(seed)
+        links, decades, dt = int(rng.integers(1, 6)), rng.uniform(0, 3), (1e-3, 5e-3)[seed % 2]
+        masses = 10 ** rng.uniform(-decades / 2, decades / 2, links)
+        lengths = rng.uniform(0.2, 0.8, links)
+        armature, stiffness = rotor_chain(masses, lengths, dt, rng) if rotors else (None, None)
+        sim, u = random_case(masses, lengths, dt, armature, stiffness, rng)
+        try:
+            step_jacobian(sim, u)
+            count += 1
+        except NotImplementedError as exc:
+            assert any(why in str(exc) for why in NOT_COVERED_STEPS), exc
+    assert count >= covered, count
 
 
 def test_a_closed_loop_and_the_sim_continues_as_if_never_asked():
