@@ -63,10 +63,19 @@ class StepJacobian:
     x1: np.ndarray
 
 
+#: [m] the hinges' gap at the step's end below which the step counts as closing them (the
+#: derivative assumes c(q1) = 0; the default correction ends near 1e-15 m)
+PINS_CLOSED_TOL = 1e-10
+#: (G W P^T)'s condition number above which the hinges count as dependent (an over-
+#: constrained loop: the step is not smooth there)
+DEPENDENT_COND = 1e10
+
+
 def _not_covered(what):
     return NotImplementedError(
-        f"step_jacobian covers mechanisms of hinges under gravity, pushes and pin / body "
-        f"torques and body forces so far; this step has {what}")
+        f"step_jacobian covers mechanisms of hinges (with armature and springs the step "
+        f"resolves) under gravity, pushes and pin / body torques and body forces so far; this "
+        f"step has {what}")
 
 
 def check_covered(model, options) -> None:
@@ -75,6 +84,8 @@ def check_covered(model, options) -> None:
     a = model.arrays
     if options.integrator != INTEGRATOR_EULER:
         raise _not_covered(f"the accurate integrator {options.integrator!r}")
+    if options.refine_iters <= 0:
+        raise _not_covered("no position correction (refine_iters = 0): its pins stay open")
     if model.n_rod:
         raise _not_covered(f"rods ({model.rod_names[0]!r}, ...)")
     if a.fluid_body.shape[0]:
@@ -198,11 +209,11 @@ def force_terms(model, state, u):
     return f.ravel(), F.reshape(3 * n, model.n_act), at_bound
 
 
-def step_jacobian(sim, u=None) -> StepJacobian:
+def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     """The exact derivative of one step of `sim` (as `sim.step(u)` would take it) with respect
     to the state x = (q.ravel(), v.ravel()) and the commands u (module docstring). `sim` is
-    left as it was. Raises NotImplementedError for a model, option or step outside what is
-    covered, naming it."""
+    left as it was (its state, options, audit and counters). Raises NotImplementedError for a
+    model, option or step outside what is covered, naming it."""
     model = sim.model
     check_covered(model, sim.options)
     u = np.zeros(model.n_act) if u is None else np.asarray(u, dtype=float)
@@ -210,10 +221,14 @@ def step_jacobian(sim, u=None) -> StepJacobian:
         raise ValueError(f"commands u must be {model.n_act} finite numbers, got {u!r}")
     h = float(sim.dt)
     start = sim.snapshot()
+    options = sim.options
+    audit, info = sim.ws.audit.copy(), sim.ws.info.copy()
     q0 = start.q.copy()
     v0 = start.v.copy()
+    ended = False
     try:
         sim.step(u)
+        ended = True
         end = sim.state
         q1, v1 = end.q.copy(), end.v.copy()
         touching = bool((end.contact_mode != MODE_FREE).any())
@@ -221,7 +236,13 @@ def step_jacobian(sim, u=None) -> StepJacobian:
         splits = int(sim.ws.info[INFO_CCD_SPLITS])
         limits = bool(end.limit_active.any())
     finally:
-        sim.restore(start)
+        if not (_keep_end and ended):
+            sim.restore(start)
+            if sim.options is not options:     # (the state setter resolves the speed bound)
+                sim._options = options
+                sim._repack()
+            sim.ws.audit[:] = audit
+            sim.ws.info[:] = info
     if touching:
         raise _not_covered("a contact that touches in the step")
     if limits:
@@ -229,31 +250,44 @@ def step_jacobian(sim, u=None) -> StepJacobian:
     if substeps > 1 or splits > 0:
         raise _not_covered(f"a step taken in {max(substeps, 1)} sub-steps / {splits} "
                            f"time-of-impact splits")
+    gap = np.abs(hinge_terms(model, q1)[0]).max(initial=0.0)
+    if gap > PINS_CLOSED_TOL:
+        raise _not_covered(f"hinges left open by {gap:.3g} m at its end (the position "
+                           f"correction's refine_tol or a stalled correction)")
     n = model.n_body
     f, F, saturated = force_terms(model, start, u)
     W, f_spring, K = rotor_terms(model, q0)
     free = q0.ravel() + h * v0.ravel() + h * h * (W @ (f + f_spring))
     _, P, _ = hinge_terms(model, q0)
     # the step's total impulse L from its answer: W P^T L = q1 - free (least squares; P has
-    # full row rank where the hinges are independent)
+    # full row rank where the hinges are independent, checked below)
     move = q1.ravel() - free
     WPt = W @ P.T
     if P.shape[0]:
         L, *_ = np.linalg.lstsq(WPt, move, rcond=None)
     else:
         L = np.zeros(0)
-    scale = np.abs(q1.ravel() - q0.ravel()).max() + np.abs(q0).max() * 1e-15 + 1e-300
-    if np.abs(WPt @ L - move).max() > FIT_TOL * scale:
-        raise _not_covered("an end that is not the hinges' SHAKE step (the position "
-                           "correction's velocity change held back by its energy bound?)")
-    if np.abs(v1.ravel() - (q1.ravel() - q0.ravel()) / h).max() > FIT_TOL * scale / h:
-        raise _not_covered("an end velocity other than (q1 - q) / h")
+    eps = np.finfo(float).eps
+    scale = max(np.abs(move).max(initial=0.0), np.abs(q1 - q0).max(), h * np.abs(v0).max())
+    rounding = 64 * eps * (np.abs(q0).max() + np.abs(move).max(initial=0.0))
+    if np.abs(WPt @ L - move).max(initial=0.0) > FIT_TOL * scale + rounding:
+        raise _not_covered("an end that is not the hinges' SHAKE step q + h v + h^2 W f "
+                           "+ W P^T L")
+    secant = (q1.ravel() - q0.ravel()) / h
+    if np.abs(v1.ravel() - secant).max() > FIT_TOL * (np.abs(secant).max() + np.abs(v0).max()) \
+            + rounding / h:
+        raise _not_covered("an end velocity other than (q1 - q) / h (the position "
+                           "correction's velocity change held back by its energy bound)")
     _, _, H = hinge_terms(model, q0, L)
     _, G, _ = hinge_terms(model, q1)
     nq = 3 * n
     eye = np.eye(nq)
     if G.shape[0]:
-        S = np.linalg.solve(G @ WPt, G)            # (G W P^T)^-1 G
+        GWP = G @ WPt
+        if np.linalg.cond(GWP) > DEPENDENT_COND:
+            raise _not_covered("dependent hinges (an over-constrained loop): the step is not "
+                               "smooth there")
+        S = np.linalg.solve(GWP, G)                # (G W P^T)^-1 G
         proj = eye - WPt @ S
     else:
         proj = eye
@@ -274,13 +308,13 @@ def step_jacobian(sim, u=None) -> StepJacobian:
 def rollout_jacobians(sim, us) -> list:
     """Step `sim` under each command vector of `us` (n_steps, n_act) in turn and return the
     StepJacobian of each step (taken at the state it started from); `sim` ends after the
-    last step, as `for u in us: sim.step(u)` leaves it. The derivative of the whole rollout
-    is the product of the A's (the last one on the left)."""
+    last step, as `for u in us: sim.step(u)` leaves it (each step taken once). The
+    derivative of the whole rollout is the product of the A's (the last one on the left). A
+    step it does not cover raises NotImplementedError, `sim` left after that step."""
     us = np.asarray(us, dtype=float)
     if us.ndim != 2 or us.shape[1] != sim.model.n_act:
         raise ValueError(f"us must have shape (n_steps, {sim.model.n_act}), got {us.shape}")
     out = []
     for u in us:
-        out.append(step_jacobian(sim, u))
-        sim.step(u)
+        out.append(step_jacobian(sim, u, _keep_end=True))   # (the step taken once)
     return out

@@ -269,3 +269,44 @@ def test_a_rollouts_derivative_is_the_product_of_its_steps():
     assert relative_error(chained[:, k:k + 1], fd_u[:, None]) <= REL_TOL
     with pytest.raises(ValueError, match="us must have shape"):
         rollout_jacobians(sim, np.zeros(3))
+
+
+def test_at_rest_and_held_still_and_the_simulator_keeps_its_options_and_counters():
+    """Equilibria (a pendulum hanging at rest, one held level by its motor) are covered, and
+    asking leaves the simulator's speed bound, audit and counters as they were."""
+    b = ps.ModelBuilder(dt=1e-3)
+    link = b.add_body("link", mass=1.0, inertia=1.0 / 12, pos=(0.0, -0.5), angle=-np.pi / 2)
+    b.add_pin("hinge", None, link, anchor_world=(0.0, 0.0))
+    b.add_pin_motor("motor", "hinge", limit=(-20.0, 20.0))
+    sim = ps.Simulator(b.compile())
+    jac = step_jacobian(sim)
+    A, B = finite_differences(sim, np.zeros(1))
+    assert relative_error(jac.A, A) <= REL_TOL and relative_error(jac.B, B) <= REL_TOL
+    level = ps.Simulator(chain([1.0], [0.5]))
+    hold = np.array([9.81 * 0.25, 0.0, 0.0])       # the motor holds the link's weight
+    sim.steps(7, np.array([3.0]))
+    options, audit, info = sim.options, sim.ws.audit.copy(), sim.ws.info.copy()
+    step_jacobian(sim, np.array([19.0]))
+    assert sim.options is options
+    assert np.array_equal(sim.ws.audit, audit) and np.array_equal(sim.ws.info, info)
+    jac = step_jacobian(level, hold)
+    A, B = finite_differences(level, hold)
+    assert relative_error(jac.A, A) <= REL_TOL and relative_error(jac.B, B) <= REL_TOL
+
+
+def test_open_pins_and_dependent_hinges_are_refused():
+    sim = ps.Simulator(chain([1.0, 2.0], [0.5, 0.5]), ps.StepOptions(refine_iters=0))
+    with pytest.raises(NotImplementedError, match="no position correction"):
+        step_jacobian(sim)
+    # a parallelogram with a third, redundant link: its hinges' rows are dependent
+    b = ps.ModelBuilder(dt=1e-3)
+    bodies = [b.add_body(f"bar{i}", mass=1.0, inertia=1.0 / 48, pos=(x, -0.25),
+                         angle=-np.pi / 2) for i, x in enumerate((0.0, 0.5, 1.0))]
+    top = b.add_body("top", mass=1.0, inertia=1.0 / 12, pos=(0.5, -0.5))
+    for i, x in enumerate((0.0, 0.5, 1.0)):
+        b.add_pin(f"world{i}", None, bodies[i], anchor_world=(x, 0.0))
+        b.add_pin(f"top{i}", bodies[i], top, anchor_world=(x, -0.5))
+    sim = ps.Simulator(b.compile())
+    sim.steps(5)
+    with pytest.raises(NotImplementedError, match="dependent hinges"):
+        step_jacobian(sim)
