@@ -106,7 +106,7 @@ def moved_state(sim, rng, swing):
     sim.steps(int(rng.integers(20, 60)), rng.uniform(-swing, swing, sim.model.n_act))
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(links=st.integers(1, 5), seed=st.integers(0, 2 ** 31 - 1),
        mass_decades=st.floats(0.0, 3.0), dt=st.sampled_from([1e-3, 5e-3]), rotors=st.booleans())
 def test_step_jacobian_is_the_steps_derivative(links, seed, mass_decades, dt, rotors):
