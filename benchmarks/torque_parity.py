@@ -29,13 +29,46 @@ WALKERS = ("Hopper", "Walker2d", "HalfCheetah")
 SPAN = 0.02     # [s]
 
 
+def start_state(ref, fractions, speeds, lift):
+    """(qpos, qvel) of gymnasium env `ref` (its MuJoCo model): each limited joint at
+    `fractions` of its range, each free hinge offset by fractions - 0.5 rad; qvel = speeds
+    [rad/s or m/s]; the root raised by lift [m]."""
+    import mujoco
+    m = ref.model
+    qp = ref.init_qpos.copy()
+    for j in range(m.njnt):
+        a = m.jnt_qposadr[j]
+        if m.jnt_limited[j]:
+            lo, hi = m.jnt_range[j]
+            qp[a] = lo + fractions[j] * (hi - lo)
+        elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
+            qp[a] += fractions[j] - 0.5
+    qp[1] += lift
+    return qp, np.asarray(speeds[:m.nv], float)
+
+
+def our_qvel(name, qp, qv, u, dt):
+    """(planarsim's joint velocities after SPAN at step dt from (qp, qv) under commands u,
+    whether a contact or a joint limit acted at any of its steps, the audit's count)."""
+    import gymnasium as gym
+    import planarsim.envs  # noqa: F401  (registers the environments)
+    from planarsim.kernels.codes import MODE_FREE
+    env = gym.make(f"planarsim/{name}-v0", dt=dt, frame_skip=1).unwrapped
+    env.reset(seed=0)
+    env.set_state(qp, qv)
+    touched = False
+    for _ in range(int(round(SPAN / dt))):
+        env.do_simulation(u, 1)
+        state = env.sim.state
+        touched |= bool(state.limit_active.any() or (state.contact_mode != MODE_FREE).any())
+    return env.data.qvel.copy(), touched, int(env.sim.ws.audit.sum())
+
+
 def ratios(name, states, seed=0):
     """Our error over MuJoCo Euler's on `states` random states of gymnasium's `name` file."""
     import gymnasium as gym
     import mujoco
-    import planarsim.envs  # noqa: F401  (registers the environments)
     from mujoco_oracle import mujoco_qvel
-    from planarsim.kernels.codes import MODE_FREE
 
     ref = gym.make(f"{name}-v5").unwrapped
     m, dt = ref.model, float(ref.model.opt.timestep)
@@ -44,32 +77,16 @@ def ratios(name, states, seed=0):
     for _ in range(states):
         fractions, speeds = rng.uniform(0.3, 0.7, 12), rng.uniform(-1.0, 1.0, 12)
         level, signs = rng.choice([0.3, 1.0]), rng.choice([-1.0, 1.0], 6)
-        qp = ref.init_qpos.copy()
-        for j in range(m.njnt):
-            a = m.jnt_qposadr[j]
-            if m.jnt_limited[j]:
-                lo, hi = m.jnt_range[j]
-                qp[a] = lo + fractions[j] * (hi - lo)
-            elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
-                qp[a] += fractions[j] - 0.5
-        qp[1] += 1.0 if name in WALKERS else 0.0
-        qv = speeds[:m.nv].copy()
+        qp, qv = start_state(ref, fractions, speeds, 1.0 if name in WALKERS else 0.0)
         u = level * signs[:m.nu]
         exact, rows = mujoco_qvel(mujoco, m, qp, qv, u, 1e-5, mujoco.mjtIntegrator.mjINT_RK4,
                                   SPAN, data=ref.data)
         euler, more = mujoco_qvel(mujoco, m, qp, qv, u, dt, mujoco.mjtIntegrator.mjINT_EULER,
                                   SPAN, data=ref.data)
-        env = gym.make(f"planarsim/{name}-v0", dt=dt, frame_skip=1).unwrapped
-        env.reset(seed=0)
-        env.set_state(qp, qv)
-        touched = False
-        for _ in range(int(round(SPAN / dt))):
-            env.do_simulation(u, 1)
-            st = env.sim.state
-            touched |= bool(st.limit_active.any() or (st.contact_mode != MODE_FREE).any())
+        ours, touched, _ = our_qvel(name, qp, qv, u, dt)
         if rows + more or touched:
             continue
-        out.append(np.abs(env.data.qvel - exact).max() / np.abs(euler - exact).max())
+        out.append(np.abs(ours - exact).max() / np.abs(euler - exact).max())
     return np.array(out)
 
 

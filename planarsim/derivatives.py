@@ -78,9 +78,9 @@ def _not_covered(what):
         f"step has {what}")
 
 
-def check_covered(model, options) -> None:
-    """Raise NotImplementedError naming the first feature of `model` or `options` that
-    step_jacobian does not cover yet (module docstring)."""
+def check_covered(model, options, h) -> None:
+    """Raise NotImplementedError naming the first feature of `model` or `options` (for steps
+    of h [s]) that step_jacobian does not cover yet (module docstring)."""
     a = model.arrays
     if options.integrator != INTEGRATOR_EULER:
         raise _not_covered(f"the accurate integrator {options.integrator!r}")
@@ -101,19 +101,13 @@ def check_covered(model, options) -> None:
         k, arm = a.pin_stiffness[j], a.pin_armature[j]
         if k > 0.0:
             kappa = sum(a.body_inv_inertia[b] for b in a.pin_body[j] if b >= 0)
-            resolved = options_dt(model, options) ** 2 * k * kappa / (1.0 + arm * kappa)
+            resolved = h * h * k * kappa / (1.0 + arm * kappa)
             if arm == 0.0 or resolved > 0.5:
                 raise _not_covered(f"a spring on joint {name!r} that the step takes at its end "
                                    f"(without a rotor, or too stiff for the step)")
     for k, name in enumerate(model.act_names):
         if int(a.act_kind[k]) not in _LINEAR_ACTUATORS:
             raise _not_covered(f"actuator {name!r} of kind {int(a.act_kind[k])}")
-
-
-def options_dt(model, options) -> float:
-    """The step [s] the options give (their dt, else the model's)."""
-    dt = getattr(options, "dt", 0.0)
-    return float(dt) if dt and dt > 0.0 else float(model.arrays.dt)
 
 
 def rotor_terms(model, q):
@@ -215,11 +209,11 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     left as it was (its state, options, audit and counters). Raises NotImplementedError for a
     model, option or step outside what is covered, naming it."""
     model = sim.model
-    check_covered(model, sim.options)
+    h = float(sim.dt)
+    check_covered(model, sim.options, h)
     u = np.zeros(model.n_act) if u is None else np.asarray(u, dtype=float)
     if u.shape != (model.n_act,) or not np.all(np.isfinite(u)):
         raise ValueError(f"commands u must be {model.n_act} finite numbers, got {u!r}")
-    h = float(sim.dt)
     start = sim.snapshot()
     options = sim.options
     audit, info = sim.ws.audit.copy(), sim.ws.info.copy()

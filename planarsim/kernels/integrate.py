@@ -314,8 +314,7 @@ def rows_hold_within(m, s, ws, h, limit):
     n = ws.n_row[0]
     for r in range(n):
         if is_soft_row(ws.row_kind[r]):
-            ws.rhs[r] = 0.0         # an armature's row: no error of its own
-            continue
+            continue                # an armature's row: no error of its own
         ws.rhs[r] = abs(ws.row_c[r] + h * row_dot(ws, r, ws.row_J, s.v))
         if ws.rhs[r] > limit:
             return False

@@ -31,14 +31,14 @@ velocity solve, w = A mu + b with
     A_rr = g W g^T + gamma,   gamma = 1 / D   (its compliance),
     b = g v* - gamma (a (g v) - h k (x - x0)),
 and w = 0. The row is an equality (joints.py's class: its impulse is free) with a positive
-compliance, so it never depends on the others and is never dropped; the position correction
-leaves it out (it has no position error to remove).
+compliance, so it never depends on the others and is never dropped. It has no position error
+to remove: the position correction leaves it out, but for its armature (below).
 ws.row_soft[r] holds (a, k, c, g v at the step's start, gamma of the last fill_row_b, kappa).
 In the position correction (integrate.py) a joint with armature keeps this row with target 0
 and compliance 1 / a: the Newton-SHAKE move and its velocity change c / h are shared by the
 bodies and the rotors, (M + A)^-1 J^T mu, as in the solve (without it a light link next to a
-heavy rotor took the whole change: HalfCheetah's feet under torque erred up to 4.2x MuJoCo's
-Euler, 1.2x with it); its kinetic-energy bound (bound_correction_work) counts the rotors'
+heavy rotor took the whole change: HalfCheetah's feet under torque erred up to 6.0x MuJoCo's
+Euler, 1.23x with it); its kinetic-energy bound (bound_correction_work) counts the rotors'
 energy with the bodies'.
 """
 from ..compile import kernel

@@ -39,7 +39,7 @@ gym = pytest.importorskip("gymnasium", reason="gymnasium is not installed (pip i
 mujoco = pytest.importorskip("mujoco", reason="mujoco is not installed")
 sys.modules.setdefault("imageio", types.ModuleType("imageio"))   # (its video recorder only)
 import planarsim.envs  # noqa: E402,F401  (registers the environments)
-from planarsim.kernels.codes import MODE_FREE  # noqa: E402
+from benchmarks.torque_parity import our_qvel as parity_qvel, start_state  # noqa: E402
 
 NAMES = ["Hopper", "Walker2d", "HalfCheetah", "InvertedPendulum", "InvertedDoublePendulum",
          "Reacher", "Swimmer"]
@@ -57,22 +57,6 @@ def reference(name):
     return REFERENCES[name]
 
 
-def start_state(ref, fractions, speeds, lift):
-    """qpos: each limited joint at `fractions` of its range, each free hinge offset by
-    fractions - 0.5 rad; qvel = speeds [rad/s or m/s]; the root raised by lift [m]."""
-    m = ref.model
-    qp = ref.init_qpos.copy()
-    for j in range(m.njnt):
-        a = m.jnt_qposadr[j]
-        if m.jnt_limited[j]:
-            lo, hi = m.jnt_range[j]
-            qp[a] = lo + fractions[j] * (hi - lo)
-        elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
-            qp[a] += fractions[j] - 0.5
-    qp[1] += lift
-    return qp, np.asarray(speeds[:m.nv], float)
-
-
 def mujoco_qvel(ref, qp, qv, u, dt, integrator):
     """MuJoCo's joint velocities after SPAN at step dt; and how many constraint rows it met."""
     from mujoco_oracle import mujoco_qvel as oracle
@@ -81,17 +65,10 @@ def mujoco_qvel(ref, qp, qv, u, dt, integrator):
 
 def our_qvel(name, qp, qv, u, dt):
     """planarsim's joint velocities after SPAN at step dt; and whether a contact or a joint
-    limit acted at any of its steps."""
-    env = gym.make(f"planarsim/{name}-v0", dt=dt, frame_skip=1).unwrapped
-    env.reset(seed=0)
-    env.set_state(qp, qv)
-    touched = False
-    for _ in range(int(round(SPAN / dt))):
-        env.do_simulation(u, 1)
-        state = env.sim.state
-        touched |= bool(state.limit_active.any() or (state.contact_mode != MODE_FREE).any())
-    assert env.sim.ws.audit.sum() == 0
-    return env.data.qvel.copy(), touched
+    limit acted at any of its steps (benchmarks.torque_parity.our_qvel, its audit 0)."""
+    qvel, touched, audit = parity_qvel(name, qp, qv, u, dt)
+    assert audit == 0
+    return qvel, touched
 
 
 @pytest.mark.parametrize("name", NAMES)
