@@ -4,14 +4,15 @@ Actuator kinds (see planarsim/model.py): pin torque, axial force between anchors
 between point-mass legs (as perpendicular forces), body force along a world direction, body
 torque, force along a slider's axis. Commands are saturated to act_range; act_power records
 the mechanical power [W]. Joint springs, dampers and armature are not forces here: they act
-implicitly in the velocity solve (soft.py).
+implicitly in the velocity solve (soft.py); but a slider's rotor, whose row turns with the
+rail, adds its velocity-product forces here (slider.add_rotor_forces).
 """
 import math
 
 from ..compile import kernel
 from .fluid import apply_fluid
 from .math2d import cross2, update_trig, world_point
-from .slider import slide_position_rate, slider_frame
+from .slider import add_rotor_forces, slide_position_rate, slider_frame
 
 ACT_PIN_TORQUE = 0
 ACT_AXIAL = 1
@@ -132,8 +133,9 @@ def apply_actuator(m, q, cs, v, f, k, u):
 
 @kernel
 def apply_forces(m, s, ws, u):
-    """f = m g + pushes + fluid drag + saturated actuator commands u (joint springs and
-    dampers: soft.py)."""
+    """f = m g + pushes + fluid drag + the velocity-product forces of sliders' rotors
+    (slider.add_rotor_forces) + saturated actuator commands u (joint springs, dampers and
+    the rotors' inertia: soft.py)."""
     q = s.q
     v = s.v
     f = ws.force
@@ -143,6 +145,7 @@ def apply_forces(m, s, ws, u):
         f[i, 2] = s.ext_force[i, 2] if m.body_inv_inertia[i] > 0.0 else 0.0
     if m.fluid_body.shape[0] > 0:
         apply_fluid(m, q, ws.body_cs, v, f)
+    add_rotor_forces(m, q, ws.body_cs, v, f)
     # actuators, saturated
     for k in range(m.act_kind.shape[0]):
         uk = u[k]
