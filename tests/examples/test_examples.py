@@ -100,7 +100,7 @@ def test_new_examples_run_as_scripts(name):
 def test_random_search_learns_to_swim(tmp_path):
     """docs/mjcf-gymnasium.md's claim at its bound: examples/learn_swimmer.py with its own settings (8
     directions, the 4 best, 1000-step episodes), 12 iterations, returns at least 300 on unseen
-    starts (332.5 measured, 30 s of learning on two cores shared with other jobs:
+    starts (304.0 measured, 25 s of learning on two cores shared with other jobs:
     benchmarks/results/learn-swimmer.txt; the time is not asserted). The iterations' mean
     return grows, a seed fixes the result (on a short run), and the GIF is written."""
     pytest.importorskip("gymnasium")
