@@ -102,9 +102,9 @@ def check_covered(model, options, h) -> None:
         if k > 0.0:
             kappa = sum(a.body_inv_inertia[b] for b in a.pin_body[j] if b >= 0)
             resolved = h * h * k * kappa / (1.0 + arm * kappa)
-            if arm == 0.0 or resolved > 0.5:
+            if resolved > 0.5:
                 raise _not_covered(f"a spring on joint {name!r} that the step takes at its end "
-                                   f"(without a rotor, or too stiff for the step)")
+                                   f"(too stiff for the step)")
     for k, name in enumerate(model.act_names):
         if int(a.act_kind[k]) not in _LINEAR_ACTUATORS:
             raise _not_covered(f"actuator {name!r} of kind {int(a.act_kind[k])}")

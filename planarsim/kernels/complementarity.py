@@ -155,7 +155,7 @@ def _lcp_once(m, s, ws, h):
     for j in range(m.pin_body.shape[0]):
         ws.limit_candidate[j, 0] = s.limit_active[j, 0]
         ws.limit_candidate[j, 1] = s.limit_active[j, 1]
-    build_rows(m, s, ws)
+    build_rows(m, s, ws, h)
     n = ws.n_row[0]
     fill_row_b(ws, h, n)
     ws.info[INFO_LCP_SOLVES] += 1

@@ -85,7 +85,7 @@ def build_and_solve(m, s, ws, opt, h):
     modes as they stand. Returns True if the answer's equations need checking (a dependent
     row was dropped, or the system was not symmetric). A call (one copy of its code for both
     solves of solve_modes): its work is microseconds, the call a few nanoseconds."""
-    sliding = build_rows(m, s, ws)
+    sliding = build_rows(m, s, ws, h)
     dropped = solve_impulses(m, s, ws, h, opt.pivot_tol, sliding == 0, opt.keep_factors == 1)
     ws.least_change[1] = dropped
     return dropped > 0 or sliding > 0
@@ -499,7 +499,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
     h = step_length
     for split in range(opt.max_ccd_splits + 1):
         update_trig(s.q, ws.body_cs)                        # cos / sin of the angles
-        apply_forces(m, s, ws, u)                           # 1. forces
+        apply_forces(m, s, ws, u, h)                        # 1. forces
         if split == 0 and opt.turn_limit > 0.0 and not stage:  # a torque the step cannot
             code = check_actuator_turns(m, ws, h, opt.turn_limit)   # resolve: stop before it
             if code != 0:
@@ -585,7 +585,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
     start_path(s, ws)
     if opt.turn_limit > 0.0:
         update_trig(s.q, ws.body_cs)
-        apply_forces(m, s, ws, u)
+        apply_forces(m, s, ws, u, step_length)
         code = check_actuator_turns(m, ws, longest_stage(opt.integrator) * step_length,
                                     opt.turn_limit)
         if code != 0:
@@ -679,7 +679,7 @@ def chain_part(m, s, ws, opt, u, h):
     ws.energy_stop[0] = 0
     audited = audit_total(ws)
     update_trig(s.q, ws.body_cs)
-    apply_forces(m, s, ws, u)                               # 1. forces
+    apply_forces(m, s, ws, u, h)                            # 1. forces
     if opt.turn_limit > 0.0 and check_actuator_turns(m, ws, h, opt.turn_limit) != 0:
         return CHAIN_GENERAL
     predict_velocity(m, s, ws, h)
