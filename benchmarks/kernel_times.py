@@ -65,9 +65,9 @@ def _run(m, s, ws, opt, u, which, calls):
         if which == 1:
             acc += step(m, s, ws, opt, u)
         elif which == 2:
-            acc += build_rows(m, s, ws)
+            acc += build_rows(m, s, ws, h)
         elif which == 3:
-            acc += solve_impulses(m, s, ws, h, opt.pivot_tol, True)
+            acc += solve_impulses(m, s, ws, h, opt.pivot_tol, True, False)
         elif which == 4:
             for r in range(n):
                 ws.rhs[r] = 1.0

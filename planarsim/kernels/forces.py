@@ -5,7 +5,7 @@ between point-mass legs (as perpendicular forces), body force along a world dire
 torque, force along a slider's axis. Commands are saturated to act_range; act_power records
 the mechanical power [W]. Joint springs, dampers and armature are not forces here: they act
 implicitly in the velocity solve (soft.py); but a slider's rotor, whose row turns with the
-rail, adds its velocity-product forces here (slider.add_rotor_forces), and a hinge's spring
+rail, adds its velocity-product forces here (slider.add_rotor_forces), and a joint's spring
 without rotor or damper that the step resolves is a force here (spring_as_force).
 """
 import math
@@ -65,37 +65,61 @@ def pin_angle_rate(m, q, v, j):
 
 
 @kernel
-def spring_as_force(m, j, h):
-    """Joint j's spring acts as an explicit force in a step of h [s] (add_spring_torques):
-    a hinge's spring with neither rotor nor damper that the step resolves, h^2 k kappa <= 1/2
-    (kappa = 1 / I_a + 1 / I_b, its bodies' inverse inertias: the soft row's theta would be
-    0). Symplectic Euler's own spring, as MuJoCo's Euler takes it; kept at the step's end
-    (theta = 1, backward Euler) it was damped by the scheme (a random MJCF tree's hinge
-    spring of h w = 0.05 erred 43x MuJoCo Euler's after 0.2 s, 1.0x with a damper of 1e-9)."""
-    k = m.pin_stiffness[j]
-    if (k == 0.0 or m.pin_armature[j] > 0.0 or m.pin_damping[j] > 0.0
-            or (m.pin_kind[j] & JOINT_SLIDE_BIT) != 0):
-        return False
+def joint_kappa(m, q, cs, j):
+    """g W g^T [1 / (kg m^2) or 1 / kg] of joint j's coordinate row g at q (cs its cos / sin):
+    a hinge's 1 / I_a + 1 / I_b, a slider's along its slide (blocks at anchor b: slider.py)."""
+    a = m.pin_body[j, 0]
+    b = m.pin_body[j, 1]
+    if (m.pin_kind[j] & JOINT_SLIDE_BIT) == 0:
+        kappa = m.body_inv_inertia[b]
+        if a >= 0:
+            kappa += m.body_inv_inertia[a]
+        return kappa
+    dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, a, b)
     kappa = 0.0
     for e in range(2):
-        b = m.pin_body[j, e]
-        if b >= 0:
-            kappa += m.body_inv_inertia[b]
-    return h * h * k * kappa <= 0.5
+        body = a if e == 0 else b
+        if body >= 0:
+            lever = cross2(bx - q[body, 0], by - q[body, 1], dx, dy)
+            kappa += (dx * dx + dy * dy) * m.body_inv_mass[body] + lever * lever * m.body_inv_inertia[body]
+    return kappa
 
 
 @kernel
-def add_spring_torques(m, q, f, h):
-    """Add to f [N m] the torques of the hinges' springs that are forces in a step of h [s]
-    (spring_as_force): -k (angle - rest) on body b, the opposite on body a."""
+def spring_as_force(m, q, cs, j, h):
+    """Joint j's spring acts as an explicit force in a step of h [s] from q (add_spring_forces):
+    a spring with neither rotor nor damper that the step resolves, h^2 k kappa <= 1/2 (kappa =
+    joint_kappa: the soft row's theta would be 0). Symplectic Euler's own spring, as MuJoCo's
+    Euler takes it; kept at the step's end (theta = 1, backward Euler) it was damped by the
+    scheme (a random MJCF tree's hinge spring of h w = 0.05 erred 43x MuJoCo Euler's after
+    0.2 s, 1.0x with a damper of 1e-9)."""
+    k = m.pin_stiffness[j]
+    if k == 0.0 or m.pin_armature[j] > 0.0 or m.pin_damping[j] > 0.0:
+        return False
+    return h * h * k * joint_kappa(m, q, cs, j) <= 0.5
+
+
+@kernel
+def add_spring_forces(m, q, cs, f, h):
+    """Add to f [N, N m] the forces of the joints' springs that are forces in a step of h [s]
+    (spring_as_force): -k (x - rest) along the coordinate's row (a hinge's torque on body b
+    and its opposite on body a; a slider's force along its axis at anchor b, as a slider
+    motor's)."""
     for j in range(m.pin_stiffness.shape[0]):
-        if not spring_as_force(m, j, h):
+        if not spring_as_force(m, q, cs, j, h):
             continue
-        torque = -m.pin_stiffness[j] * (pin_angle(m, q, j) - m.pin_rest[j])
-        f[m.pin_body[j, 1], 2] += torque
         a = m.pin_body[j, 0]
-        if a >= 0:
-            f[a, 2] -= torque
+        b = m.pin_body[j, 1]
+        if (m.pin_kind[j] & JOINT_SLIDE_BIT) == 0:
+            torque = -m.pin_stiffness[j] * (pin_angle(m, q, j) - m.pin_rest[j])
+            f[b, 2] += torque
+            if a >= 0:
+                f[a, 2] -= torque
+            continue
+        dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, a, b)
+        push = -m.pin_stiffness[j] * (dx * (bx - ax) + dy * (by - ay) - m.pin_rest[j])
+        add_point_force(q, f, b, bx, by, push * dx, push * dy)
+        add_point_force(q, f, a, bx, by, -push * dx, -push * dy)
 
 
 @kernel(inline="always")
@@ -170,7 +194,7 @@ def apply_actuator(m, q, cs, v, f, k, u):
 @kernel
 def apply_forces(m, s, ws, u, h):
     """f = m g + pushes + fluid drag + the velocity-product forces of sliders' rotors
-    (slider.add_rotor_forces) + the hinge springs a step of h [s] takes as forces
+    (slider.add_rotor_forces) + the joint springs a step of h [s] takes as forces
     (spring_as_force) + saturated actuator commands u (the other joint springs, dampers and
     the rotors' inertia: soft.py)."""
     q = s.q
@@ -183,7 +207,7 @@ def apply_forces(m, s, ws, u, h):
     if m.fluid_body.shape[0] > 0:
         apply_fluid(m, q, ws.body_cs, v, f)
     add_rotor_forces(m, q, ws.body_cs, v, f)
-    add_spring_torques(m, q, f, h)
+    add_spring_forces(m, q, ws.body_cs, f, h)
     # actuators, saturated
     for k in range(m.act_kind.shape[0]):
         uk = u[k]
@@ -200,7 +224,7 @@ def kick(m, s, ws, u, h):
     """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s.q under commands u (h may be
     negative; a half kick of the step-to-instant conversions and of RATTLE). Uses ws's force
     scratch (the next step computes it again) and leaves ws.act_power at the velocity it was
-    called with. A hinge spring is a force here where a step of |h| resolves it
+    called with. A spring is a force here where a step of |h| resolves it
     (spring_as_force)."""
     update_trig(s.q, ws.body_cs)
     apply_forces(m, s, ws, u, abs(h))

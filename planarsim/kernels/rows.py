@@ -290,7 +290,7 @@ def _later_body(bodies, j):
 @kernel(inline="never")
 def build_rows(m, s, ws, h):
     """Fill the active rows at the current configuration for a step of h [s] (a joint's spring
-    may be a force instead of a row: soft.spring_as_force): J, F (impulse directions) and c;
+    may be a force instead of a row: forces.spring_as_force): J, F (impulse directions) and c;
     return how many are sliding-contact rows (F != J there; none: J W F^T is symmetric).
 
     Rows go body by body: a pin's or slider's (and its limits' and soft row's) and a rod's
@@ -316,7 +316,7 @@ def build_rows(m, s, ws, h):
         if kp <= kr and kp <= kc:
             n = add_joint_rows(m, ws, n, jp)
             n = add_limit_rows(m, s, ws, n, jp)
-            n = add_soft_row(m, ws, n, jp, h)
+            n = add_soft_row(m, s, ws, n, jp, h)
             n = add_friction_row(m, ws, n, jp)
             jp += 1
         elif kr <= kc:

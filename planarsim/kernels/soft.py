@@ -24,9 +24,8 @@ N s/m] and rest x0 gets one row along g whose impulse mu [N m s or N s] is the s
     (1/2 - theta) h^2 k (g v_new)^2: symplectic Euler's bounded exchange with the motion at
     theta = 0, none at 1/2; the damper only removes. A hinge's spring without rotor or
     damper (a = c = 0) has no row where theta = 0 (D = 0): it is then an explicit force of
-    stage 1 (spring_as_force; forces.add_spring_torques), as in MuJoCo's Euler. Where the
-    step does not resolve it, and on a slider, it keeps the stretch at the step's end
-    (theta = 1).
+    stage 1 (forces.spring_as_force, add_spring_forces), as in MuJoCo's Euler. Where the
+    step does not resolve it, it keeps the stretch at the step's end (theta = 1).
 Together: D (g v_new) + mu = a (g v) - h k (x - x0), D = a + h (theta h k + c). As a row of the
 velocity solve, w = A mu + b with
     A_rr = g W g^T + gamma,   gamma = 1 / D   (its compliance),
@@ -69,18 +68,18 @@ def soft_gamma(a, k, c, kappa, h):
 
 
 @kernel
-def has_soft_row(m, j, h):
+def has_soft_row(m, q, cs, j, h):
     """Joint j has an armature, a damper, or a spring that is not a force in a step of h [s]
-    (spring_as_force)."""
+    from q (cs its cos / sin; forces.spring_as_force)."""
     return (m.pin_armature[j] > 0.0 or m.pin_damping[j] > 0.0
-            or (m.pin_stiffness[j] > 0.0 and not spring_as_force(m, j, h)))
+            or (m.pin_stiffness[j] > 0.0 and not spring_as_force(m, q, cs, j, h)))
 
 
 @kernel
-def add_soft_row(m, ws, n, j, h):
-    """Append joint j's soft row at slot n if it has one in a step of h [s]; returns the next
-    free slot."""
-    if has_soft_row(m, j, h):
+def add_soft_row(m, s, ws, n, j, h):
+    """Append joint j's soft row at slot n if it has one in a step of h [s] from s.q; returns
+    the next free slot."""
+    if has_soft_row(m, s.q, ws.body_cs, j, h):
         n = add_row(ws, n, ROW_JOINT_SOFT, j, m.pin_body[j, 0], m.pin_body[j, 1])
     return n
 
@@ -172,7 +171,7 @@ def soft_prediction(m, s, ws, h):
             ws.v_lin[i, k] = ws.v_pred[i, k]
     n = 0
     for j in range(m.pin_body.shape[0]):
-        if has_soft_row(m, j, h):
+        if has_soft_row(m, s.q, ws.body_cs, j, h):
             ws.soft_joint[n] = j
             n += 1
     if n == 0:

@@ -60,6 +60,32 @@ def test_implicit_spring_damper_matches_closed_form_to_first_order():
     assert 0.4 < err[1e-3] / err[2e-3] < 0.6
 
 
+@pytest.mark.parametrize("slide", [False, True], ids=["hinge", "slider"])
+def test_a_spring_without_damper_or_rotor_keeps_its_energy(slide):
+    """A spring alone (no damper, no rotor) that the step resolves is symplectic Euler's
+    explicit force, as MuJoCo's Euler takes it: over 20 s (about 32 periods) of a 10 rad/s
+    oscillator at dt 1e-3 its energy oscillates within h w of its start (measured 0.50 %) and
+    does not drift. Kept at the step's end (backward Euler, an added damping h k) it would
+    lose 1 - exp(-h k T / I) = 86 % of it."""
+    k, inertia, theta0, dt = 2.0, 0.02, 0.5, 1e-3
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0))
+    if slide:
+        w = b.add_body("cart", mass=inertia, inertia=1.0, pos=(theta0, 0.0))
+        b.add_slider("rail", None, w, axis=(1.0, 0.0), anchor_world=(theta0, 0.0),
+                     stiffness=k, rest=-theta0)
+    else:
+        w = b.add_body("wheel", mass=1.0, inertia=inertia, angle=theta0)
+        b.add_pin("axle", None, w, anchor_world=(0.0, 0.0), stiffness=k, ref_angle=0.0)
+    model = b.compile()
+    traj = ps.Simulator(model).run(20.0, record_every=10)
+    energy = np.array([total_energy(model, q, v) for q, v in zip(traj.q, traj.v)])
+    start = 0.5 * k * theta0 ** 2
+    assert abs(energy[0] - start) <= 1e-12 * start
+    assert np.max(np.abs(energy - start)) <= dt * math.sqrt(k / inertia) * start
+    late = energy[len(energy) // 2:]
+    assert abs(late.mean() - energy[:len(energy) // 2].mean()) <= 1e-3 * start
+
+
 def light_link(dt, k=240.0, c=6.0, theta0=0.5, length=0.1):
     """A 1 kg rod of `length` [m] pinned at its end to the world, spring k and damper c toward
     hanging down, released at rest theta0 [rad] from hanging."""

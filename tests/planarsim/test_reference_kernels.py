@@ -33,7 +33,7 @@ def _rows_at(m, s, ws):
             ws.q_pred[i, k] = s.q[i, k]
     update_trig(ws.q_pred, ws.cs_pred)
     find_contacts(m, s, ws, m.dt)
-    build_rows(m, s, ws)
+    build_rows(m, s, ws, m.dt)
     n = ws.n_row[0]
     for r in range(n):
         ws.island_rows[r] = r
