@@ -424,7 +424,8 @@ class ModelBuilder:
         ref_angle defaults to the relative angle at the build pose (pin angle 0 there).
         ``limit=(lower, upper)`` [rad] adds unilateral limits; stiffness [N m/rad] and
         damping [N m s/rad] add a passive spring-damper toward ``rest_angle`` (implicit in the
-        velocity solve, kernels/soft.py); armature [kg m^2] a reflected rotor inertia on the
+        velocity solve, kernels/soft.py; a spring alone that the step resolves is an
+        explicit force, kernels/forces.py spring_as_force); armature [kg m^2] a reflected rotor inertia on the
         pin angle (M_joint += armature, as MuJoCo's); frictionloss [N m] a dry friction on the
         pin angle (MuJoCo's frictionloss: the joint sticks while the torque holding it stays
         within it, else slips against it; kernels/joint_friction.py).
@@ -469,8 +470,9 @@ class ModelBuilder:
         kind "slide": s = d.(p - p0) [m], the displacement along the world axis ``axis`` of
         the body's point at ``anchor_world`` (default its COM) from where it is at the build
         pose; kind "hinge": the body's turn theta - theta0 [rad] (anchor_world is only drawn).
-        ``limit`` [m or rad] adds unilateral limits, stiffness / damping a passive implicit
-        spring-damper toward ``rest``, armature [kg or kg m^2] a reflected inertia on the
+        ``limit`` [m or rad] adds unilateral limits, stiffness / damping a passive
+        spring-damper toward ``rest`` (implicit; a spring alone that the step resolves is an
+        explicit force), armature [kg or kg m^2] a reflected inertia on the
         coordinate (as MuJoCo's on a free root's slide or hinge: M_joint += armature),
         frictionloss [N or N m] a dry friction on it (kernels/joint_friction.py), and
         add_slider_motor / add_pin_motor a force [N] along the axis at the anchor / a torque
@@ -565,7 +567,8 @@ class ModelBuilder:
         Anchor b must lie on the line through anchor a along the axis (within 1e-6 m). The
         slide s = d.(p_b - p_a) [m] (d the axis in the world) is the joint's coordinate:
         ``limit=(lower, upper)`` [m] adds unilateral limits on it, stiffness [N/m] and damping
-        [N s/m] a passive spring-damper toward ``rest`` [m] (implicit, kernels/soft.py),
+        [N s/m] a passive spring-damper toward ``rest`` [m] (implicit, kernels/soft.py; a
+        spring alone that the step resolves is an explicit force: spring_as_force),
         armature [kg] a reflected rotor inertia on it, frictionloss [N] a dry friction on it
         (MuJoCo's frictionloss; kernels/joint_friction.py). The relative angle held is
         theta_b - theta_a = ref_angle [rad] (default: as at the build pose). The slider shares

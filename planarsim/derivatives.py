@@ -22,11 +22,12 @@ is restored); a step that did not end as that equation says (sub-steps, a correc
 back by the energy bound) raises instead of giving a derivative of a different map.
 
 Covered so far: bodies held by hinges (pins) to each other and the world, with armature and
-springs the step resolves (kernels/soft.py: taken at the step's start), under gravity,
-constant pushes and pin torques, body forces and body torques. Refused with a
-NotImplementedError naming the feature: sliders, rods, joint limits, dampers, dry friction,
-springs too stiff for the step or without a rotor, contacts and shape pairs that touch in
-the step, fluid drag, the other actuator kinds, the accurate integrators.
+springs the step resolves (taken at the step's start: kernels/soft.py with a rotor,
+kernels/forces.py spring_as_force without), under gravity, constant pushes and pin torques,
+body forces and body torques. Refused with a NotImplementedError naming the feature:
+sliders, rods, joint limits, dampers, dry friction, springs too stiff for the step,
+contacts and shape pairs that touch in the step, fluid drag, the other actuator kinds, the
+accurate integrators.
 """
 from __future__ import annotations
 

@@ -17,8 +17,10 @@ to_step_velocity    v(t_n) -> the velocity the next step expects, v - h/2 M^-1 f
 to_instant_velocity the velocity over the last step -> v(t_n): v + h/2 M^-1 f, projected onto
                     the constraints at q_n (project_velocities), which removes the reactions'
                     half kick.
-Applied forces: gravity, pushes (State.ext_force) and actuator commands u (saturated), as the
-step applies them; joint springs and dampers (solved implicitly) are not included.
+Applied forces: gravity, pushes (State.ext_force), actuator commands u (saturated), a slider
+rotor's velocity-product forces and the springs a step of h takes as forces, as the step
+applies them (kernels/forces.apply_forces); the joint springs and dampers it solves
+implicitly are not included.
 """
 from __future__ import annotations
 
@@ -34,10 +36,10 @@ from .kernels.forces import kick as forces_kick
 
 
 @jit
-def kick(m, s, ws, u, h):
-    """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s (kernels/forces.kick),
-    callable from Python."""
-    forces_kick(m, s, ws, u, h)
+def kick(m, s, ws, u, h, step):
+    """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s that a step of `step` [s]
+    applies (kernels/forces.kick), callable from Python."""
+    forces_kick(m, s, ws, u, h, step)
 
 
 def _commands(model, u):
@@ -58,14 +60,14 @@ def _no_sliders(model, who):
 def to_step_velocity(model, state, ws, h: float, u=None) -> None:
     """State's velocity known at its instant -> the velocity the next step of h [s] expects
     (in place): v - h/2 M^-1 f (module docstring)."""
-    kick(model.arrays, state, ws, _commands(model, u), -0.5 * float(h))
+    kick(model.arrays, state, ws, _commands(model, u), -0.5 * float(h), float(h))
 
 
 def to_instant_velocity(model, state, ws, h: float, u=None, pinned=()) -> None:
     """State's velocity over the last step of h [s] -> its velocity at its instant (in place):
     v + h/2 M^-1 f, projected onto the rods, pins and the contacts in `pinned` at its q."""
     _no_sliders(model, "to_instant_velocity")
-    kick(model.arrays, state, ws, _commands(model, u), 0.5 * float(h))
+    kick(model.arrays, state, ws, _commands(model, u), 0.5 * float(h), float(h))
     state.v[...] = project_velocities(model, state.q, state.v, pinned)
 
 

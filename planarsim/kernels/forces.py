@@ -220,14 +220,14 @@ def apply_forces(m, s, ws, u, h):
 
 
 @kernel
-def kick(m, s, ws, u, h):
+def kick(m, s, ws, u, h, step):
     """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s.q under commands u (h may be
     negative; a half kick of the step-to-instant conversions and of RATTLE). Uses ws's force
     scratch (the next step computes it again) and leaves ws.act_power at the velocity it was
-    called with. A spring is a force here where a step of |h| resolves it
-    (spring_as_force)."""
+    called with. step [s]: the length of the step whose forces these are (a spring is a
+    force here where that step takes it as one: spring_as_force)."""
     update_trig(s.q, ws.body_cs)
-    apply_forces(m, s, ws, u, abs(h))
+    apply_forces(m, s, ws, u, step)
     for i in range(s.v.shape[0]):
         s.v[i, 0] += h * m.body_inv_mass[i] * ws.force[i, 0]
         s.v[i, 1] += h * m.body_inv_mass[i] * ws.force[i, 1]

@@ -145,7 +145,7 @@ def project_velocities(m, s, ws, pivot_tol):
 def rattle_begin(m, s, ws, u, h):
     """Before a default step of h [s]: the half kick back (the step's full kick then gives
     RATTLE's first half kick)."""
-    kick(m, s, ws, u, -0.5 * h)
+    kick(m, s, ws, u, -0.5 * h, h)
 
 
 @kernel
@@ -153,6 +153,6 @@ def rattle_end(m, s, ws, u, h, pivot_tol, project):
     """After a default step of h [s]: RATTLE's second half kick at the new configuration and,
     if `project`, the projection onto the joints' tangent space there (between stages of a
     composition it is left out: the next stage's SHAKE solve absorbs that component)."""
-    kick(m, s, ws, u, 0.5 * h)
+    kick(m, s, ws, u, 0.5 * h, h)
     if project:
         project_velocities(m, s, ws, pivot_tol)

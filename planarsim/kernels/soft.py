@@ -22,10 +22,11 @@ N s/m] and rest x0 gets one row along g whose impulse mu [N m s or N s] is the s
     margin enough for the rest of the system (which only adds inertia to a joint) and for
     neighbouring springs. The spring's work over the step is its energy's fall plus
     (1/2 - theta) h^2 k (g v_new)^2: symplectic Euler's bounded exchange with the motion at
-    theta = 0, none at 1/2; the damper only removes. A hinge's spring without rotor or
+    theta = 0, none at 1/2; the damper only removes. A joint's spring without rotor or
     damper (a = c = 0) has no row where theta = 0 (D = 0): it is then an explicit force of
-    stage 1 (forces.spring_as_force, add_spring_forces), as in MuJoCo's Euler. Where the
-    step does not resolve it, it keeps the stretch at the step's end (theta = 1).
+    stage 1 (forces.spring_as_force, add_spring_forces), as in MuJoCo's Euler; where the step
+    does not resolve it, theta rises from 0 as for the others (D = theta h^2 k > 0), so the
+    scheme is continuous in the step.
 Together: D (g v_new) + mu = a (g v) - h k (x - x0), D = a + h (theta h k + c). As a row of the
 velocity solve, w = A mu + b with
     A_rr = g W g^T + gamma,   gamma = 1 / D   (its compliance),
@@ -60,10 +61,8 @@ def soft_gamma(a, k, c, kappa, h):
     """A soft row's compliance 1 / D [1 / (kg m^2) or 1 / kg] for a step of h [s]: armature a,
     stiffness k, damping c, kappa = g W g^T of its bodies (the spring's theta: module
     docstring)."""
-    theta = 1.0         # a spring alone: no row without some implicit stretch (D > 0)
-    if a + h * c > 0.0:
-        resolved = h * h * k * kappa / (1.0 + a * kappa)
-        theta = max(0.0, 0.5 - 0.25 / resolved) if resolved > 0.0 else 0.0
+    resolved = h * h * k * kappa / (1.0 + a * kappa)
+    theta = max(0.0, 0.5 - 0.25 / resolved) if resolved > 0.0 else 0.0
     return 1.0 / (a + h * (theta * h * k + c))
 
 

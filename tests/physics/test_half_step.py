@@ -101,7 +101,7 @@ def test_kick_applies_actuator_commands_saturated():
     b.add_pin_motor("motor", "axle", limit=(-1.0, 1.0))
     model = b.compile()
     sim = ps.Simulator(model)
-    kick(model.arrays, sim.state, sim.ws, np.array([5.0]), 0.1)      # saturated to 1 N m
+    kick(model.arrays, sim.state, sim.ws, np.array([5.0]), 0.1, 0.1)  # saturated to 1 N m
     assert sim.state.v[0, 2] == pytest.approx(0.1 * 1.0 / 0.5)
 
 

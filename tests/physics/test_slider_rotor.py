@@ -122,3 +122,62 @@ def test_a_slider_rotor_moves_as_mujocos(xml, arm):
         fine, _ = _errors(xml, arm, qp, qv, u, 2e-3 / 16)
         assert ours <= RATIO * euler, (ours, euler)
         assert fine <= ours / 8.0, (ours, fine)
+
+
+def test_the_rotor_forces_are_built_from_the_rates_derivatives():
+    """_rotor_blocks' g, g' = D_q g [v] and grad_q (g v) against centred differences of the
+    slide rate phi(q, v) = g(q) v (slider.slide_position_rate) at random q, v: a slider
+    between two bodies and a free slide off its body's centre of mass (relative error
+    <= 1e-6)."""
+    from planarsim.compile import jit
+    from planarsim.kernels.slider import _rotor_blocks, slide_position_rate, slider_frame
+
+    @jit
+    def parts(m, q, cs, v, j):
+        a = m.pin_body[j, 0]
+        b = m.pin_body[j, 1]
+        dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, a, b)
+        return _rotor_blocks(q, v, a, b, dx, dy, bx, by)
+
+    @jit
+    def rate(m, q, cs, v, j):
+        return slide_position_rate(m, q, cs, v, j)[1]
+
+    def trig(q):
+        return np.column_stack([np.cos(q[:, 2]), np.sin(q[:, 2]), q[:, 2]])
+
+    for free in (False, True):
+        b = ps.ModelBuilder(gravity=(0.0, 0.0), dt=1e-3)
+        b.add_body("rail", mass=1.0, inertia=0.1, pos=(0.1, 0.2), angle=0.3)
+        b.add_body("cart", mass=0.5, inertia=0.01, pos=(0.6, 0.4), angle=0.7)
+        if free:
+            b.add_free_coordinate("x", "cart", kind="slide", axis=(0.6, 0.8),
+                                  anchor_world=(0.7, 0.45), armature=1.0)
+        else:
+            b.add_slider("s", "rail", "cart", axis=(1.0, 0.3), anchor_world=(0.65, 0.42),
+                         armature=1.0)
+        m = b.compile().arrays
+        bodies = [int(x) for x in m.pin_body[0]]
+        rng = np.random.default_rng(3)
+        eps = 1e-6
+        for _ in range(4):
+            q, v = rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
+            phi, g, gd, grad = parts(m, q, trig(q), v, 0)
+            assert abs(phi - rate(m, q, trig(q), v, 0)) <= 1e-14
+            gp = np.array(parts(m, q + eps * v, trig(q + eps * v), v, 0)[1])
+            gm = np.array(parts(m, q - eps * v, trig(q - eps * v), v, 0)[1])
+            gd_num = (gp - gm) / (2 * eps)
+            for e, body in enumerate(bodies):
+                if body < 0:
+                    continue
+                for k in range(3):
+                    dv = np.zeros((2, 3))
+                    dv[body, k] = eps
+                    g_num = (rate(m, q, trig(q), v + dv, 0) - rate(m, q, trig(q), v - dv, 0)) / (2 * eps)
+                    grad_num = (rate(m, q + dv, trig(q + dv), v, 0)
+                                - rate(m, q - dv, trig(q - dv), v, 0)) / (2 * eps)
+                    i = 3 * e + k
+                    scale = 1.0 + abs(phi)
+                    assert abs(g[i] - g_num) <= 1e-6 * scale, (free, i, g[i], g_num)
+                    assert abs(grad[i] - grad_num) <= 1e-6 * scale, (free, i, grad[i], grad_num)
+                    assert abs(gd[i] - gd_num[i]) <= 1e-6 * scale, (free, i, gd[i], gd_num[i])

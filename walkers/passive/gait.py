@@ -272,7 +272,7 @@ class PassiveWalker:
             # the step of IMPACT_DT, less that step's kick of the applied forces (else the
             # section state is that of IMPACT_DT later: theta off by theta_dot IMPACT_DT)
             s.q[...] = touch
-            kick(m, s, ws, self.u0, -IMPACT_DT)
+            kick(m, s, ws, self.u0, -IMPACT_DT, IMPACT_DT)
             s.v[...] = project_velocities(self.model, s.q, s.v, [c])
         s.time[0] = prev.time[0] + tau
         return tau
