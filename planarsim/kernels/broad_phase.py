@@ -58,15 +58,30 @@ def _sort_by_left(ws):
 
 
 @kernel
+def _sift_down(a, root, end):
+    """Restore the max-heap a[:end] below root (heap_sort)."""
+    while True:
+        child = 2 * root + 1
+        if child >= end:
+            return
+        if child + 1 < end and a[child + 1] > a[child]:
+            child += 1
+        if a[root] >= a[child]:
+            return
+        a[root], a[child] = a[child], a[root]
+        root = child
+
+
+@kernel
 def _sort_ints(a, n):
-    """a[:n] ascending (insertion sort; the lists here are short or nearly sorted)."""
-    for i in range(1, n):
-        x = a[i]
-        j = i - 1
-        while j >= 0 and a[j] > x:
-            a[j + 1] = a[j]
-            j -= 1
-        a[j + 1] = x
+    """a[:n] ascending, in place (heap sort: O(n log n) whatever the order; the sweep emits
+    the pairs of a pile or a wall in the order of its boxes' left ends, far from their slots'
+    order, where an insertion sort took O(n^2))."""
+    for root in range(n // 2 - 1, -1, -1):
+        _sift_down(a, root, n)
+    for end in range(n - 1, 0, -1):
+        a[0], a[end] = a[end], a[0]
+        _sift_down(a, 0, end)
 
 
 @kernel
