@@ -74,6 +74,10 @@ WORLDS = {
 }
 
 
+def _load_step():
+    ps.Simulator(columns(1, 1)).step()
+
+
 def _measure(name, steps, out, keep_factors):
     try:
         _measure_world(name, steps, out, keep_factors)
@@ -149,19 +153,35 @@ def main(argv=None):
     unknown = [w for w in a.worlds if w not in WORLDS]
     if unknown:
         ap.error(f"unknown world(s) {unknown}; the worlds are {list(WORLDS)}")
+    # the compiled step compiled (minutes on a fresh clone) or loaded once, in a process of its
+    # own and without a time limit, so that no world's limit holds the compile: each world's
+    # process then loads it from the cache, and this one stays as light as it was (its
+    # children's peak memory is theirs)
+    t = time.perf_counter()
+    warm = mp.Process(target=_load_step)
+    warm.start()
+    warm.join()
+    print(f"(the compiled step made ready in {time.perf_counter() - t:.1f} s; not timed below)",
+          flush=True)
     sizes = []
+    failed = 0
     for name in a.worlds:
         line, size = run(name, a.steps, a.limit, int(a.keep_factors))
         print(line, flush=True)
         if size is not None:
             sizes.append(size)
+        else:
+            failed += 1
     if len(sizes) >= 2:
         (n0, t0), (n1, t1) = min(sizes), max(sizes)
         if n1 > n0:
             growth = np.log(t1 / t0) / np.log(n1 / n0)
             print(f"a step at rest grows as N^{growth:.2f} from {n0} to {n1} bodies "
                   f"({t0 * 1e3:.3f} ms to {t1 * 1e3:.3f} ms)")
+    if failed:
+        print(f"{failed} of {len(a.worlds)} worlds gave no figures (above)")
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())
