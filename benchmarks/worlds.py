@@ -75,6 +75,7 @@ WORLDS = {
 
 
 def _load_step():
+    """The compiled step compiled or loaded into this process (one step of one box)."""
     ps.Simulator(columns(1, 1)).step()
 
 
@@ -88,7 +89,7 @@ def _measure(name, steps, out, keep_factors):
 def _measure_world(name, steps, out, keep_factors=0):
     from planarsim.compiled import audit_counts
     from planarsim.state import workspace_contacts
-    ps.Simulator(columns(1, 1)).step()   # the compiled step loaded (once a process), not timed
+    _load_step()                         # the compiled step loaded (once a process), not timed
     model = WORLDS[name]()
     sim = ps.Simulator(model, options=ps.StepOptions(keep_factors=keep_factors))
     q0 = sim.state.q.copy()

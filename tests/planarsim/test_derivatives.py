@@ -54,19 +54,19 @@ def _stepper(sim):
     return x0, step
 
 
-def finite_differences(sim, u, eps_x=EPS_X, eps_u=EPS_U):
+def finite_differences(sim, u):
     """(A, B) of one step by centred differences, sim restored after each step."""
     x0, step = _stepper(sim)
     A = np.empty((x0.size, x0.size))
     for i in range(x0.size):
         e = np.zeros_like(x0)
-        e[i] = eps_x
-        A[:, i] = (step(x0 + e, u) - step(x0 - e, u)) / (2 * eps_x)
+        e[i] = EPS_X
+        A[:, i] = (step(x0 + e, u) - step(x0 - e, u)) / (2 * EPS_X)
     B = np.empty((x0.size, u.size))
     for k in range(u.size):
         e = np.zeros_like(u)
-        e[k] = eps_u
-        B[:, k] = (step(x0, u + e) - step(x0, u - e)) / (2 * eps_u)
+        e[k] = EPS_U
+        B[:, k] = (step(x0, u + e) - step(x0, u - e)) / (2 * EPS_U)
     return A, B
 
 
