@@ -34,7 +34,7 @@ PIVOT_TOL = ps.StepOptions().pivot_tol
 
 @jit
 def _arrange(q, ws, n):
-    return arrange(q, ws, n, q.shape[0])
+    return arrange(q, ws, n, q.shape[0], ws.start.contact_dependent, False)
 
 
 @jit

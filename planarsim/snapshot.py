@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .state import State, check_state
+from .state import State, check_state, with_defaults
 from .trajectory import atomic_write, read_npz
 
 SNAPSHOT_VERSION = 2   # 2: the State holds the last step's impulses
@@ -40,10 +40,11 @@ def load_snapshot(path, model=None):
     if version != SNAPSHOT_VERSION:
         raise ValueError(f"{path}: snapshot format version {version}; this planarsim reads version "
                          f"{SNAPSHOT_VERSION}")
-    missing = [k for k in State._fields if f"state__{k}" not in data]
+    arrays = with_defaults({k[7:]: v for k, v in data.items() if k.startswith("state__")})
+    missing = [k for k in State._fields if k not in arrays]
     if missing:
         raise ValueError(f"{path}: snapshot is missing state arrays {missing}")
-    state = State(*(np.array(data[f"state__{k}"]) for k in State._fields))
+    state = State(*(np.array(arrays[k]) for k in State._fields))
     check_state(state, model, what=f"{path}: snapshot state")
     memory = {k[8:]: v for k, v in data.items() if k.startswith("memory__")}
     return state, memory

@@ -41,6 +41,11 @@ class State(NamedTuple):
     contact_feature : (n_contact,) int    the features a shape pair's slot touched with in the
                                           last step (-1: none; kernels/pair.py): a slot keeps its
                                           mode and impulse while they stay the same
+    contact_dependent : (n_contact,) int  the contact's rows that the last step's sparse velocity
+                                          solve dropped as dependent on the others (bit 1: the
+                                          normal row, bit 2: the friction row; a pile at rest):
+                                          the next step factors the others only and checks
+                                          these rows' equations (kernels/sparse_factor.py)
     """
     q: np.ndarray
     v: np.ndarray
@@ -56,6 +61,7 @@ class State(NamedTuple):
     last_pin_impulse: np.ndarray
     last_rod_impulse: np.ndarray
     contact_feature: np.ndarray
+    contact_dependent: np.ndarray
 
     @property
     def t(self) -> float:
@@ -74,27 +80,42 @@ class State(NamedTuple):
 
     @classmethod
     def from_dict(cls, d) -> "State":
+        """The State of a dict of its arrays (as_dict); one saved before contact_dependent
+        existed starts with none known dependent."""
+        d = with_defaults(d)
         return cls(*(np.array(d[name]) for name in cls._fields))
+
+
+def with_defaults(d) -> dict:
+    """d (name -> array) with the fields that only steer the solve's work filled in where
+    missing: contact_dependent zeros (no row known dependent)."""
+    d = dict(d)
+    if "contact_dependent" not in d and "contact_mode" in d:
+        d["contact_dependent"] = np.zeros(np.shape(d["contact_mode"]), np.int64)
+    return d
 
 
 STATE_DIMS = dict(  # shape of each State array; strings are the model's sizes
     q=("n_body", 3), v=("n_body", 3), time=(1,), step=(1,), contact_mode=("n_contact",),
     contact_slip=("n_contact",), contact_enabled=("n_contact",), limit_active=("n_pin", 2),
     mode_cursor=(1,), ext_force=("n_body", 3), last_contact_impulse=("n_contact", 2),
-    last_pin_impulse=("n_pin", 4), last_rod_impulse=("n_rod",), contact_feature=("n_contact",))
+    last_pin_impulse=("n_pin", 4), last_rod_impulse=("n_rod",), contact_feature=("n_contact",),
+    contact_dependent=("n_contact",))
 
 # fields holding codes, not quantities: the values each may take and the rule's words
 _STATE_CODES = dict(
     contact_mode=((0, 1, 2), "must be 0 (free), 1 (pinned) or 2 (sliding)"),
     contact_enabled=((0, 1), "must be 0 or 1"),
     limit_active=((0, 1), "must be 0 or 1"),
+    contact_dependent=((0, 1, 2, 3), "must be 0..3 (bit 1: normal row, bit 2: friction row)"),
     contact_slip=((-1, 0, 1), "must be -1 or +1 (0: sliding solved without friction)"))
 
 # the element that index 0 of a field counts (named in errors when the model is known)
 _STATE_ELEMENT = dict(q="body", v="body", ext_force="body", contact_mode="contact",
                       contact_slip="contact", contact_enabled="contact",
                       last_contact_impulse="contact", limit_active="pin", last_pin_impulse="pin",
-                      last_rod_impulse="rod", contact_feature="contact")
+                      last_rod_impulse="rod", contact_feature="contact",
+                      contact_dependent="contact")
 
 
 def check_shapes(arrays, dims, what, sizes=None) -> dict:
@@ -163,7 +184,8 @@ def make_state(model: Model, q=None, v=None) -> State:
                  mode_cursor=np.zeros(1, np.int64), ext_force=np.zeros((nb, 3)),
                  last_contact_impulse=np.zeros((nc, 2)), last_pin_impulse=np.zeros((npin, 4)),
                  last_rod_impulse=np.zeros(model.n_rod),
-                 contact_feature=np.full(nc, -1, np.int64))
+                 contact_feature=np.full(nc, -1, np.int64),
+                 contact_dependent=np.zeros(nc, np.int64))
 
 
 class Workspace(NamedTuple):
@@ -306,6 +328,8 @@ class Workspace(NamedTuple):
                                  #   factors of the rows in sp_kept_rows (0: none kept), [1] how
                                  #   many rows, [2] how many it dropped as dependent
     sp_kept_pivot: np.ndarray    # (1,) their joint rows' smallest pivot share (ws.joint_pivot)
+    sp_factored: np.ndarray      # (1,) int the places the sparse factors hold; later ones are
+                                 #   rows left out as dependent (sparse_factor.order_rows)
     rhs: np.ndarray              # (R,)
     lam_start: np.ndarray        # (R,) impulses the solve starts from (the last step's);
                                  #   scratch of the refinement on kept factors
@@ -743,6 +767,7 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      sp_stack=z((nb + 2, 2), np.int64),
                      sp_count=z((nb + 1) * SPARSE_MAX_DEPTH + 1, np.int64),
                      sp_kept=z(3, np.int64), sp_kept_pivot=np.ones(1),
+                     sp_factored=z(1, np.int64),
                      island_label=z(nb, np.int64), island_start=z(nb + 2, np.int64),
                      island_fill=z(nb + 1, np.int64), island_failed=z(nb + 1, np.int64),
                      island_fallback=z(nb + 1, np.int64), island_scale=z(nb + 1),

@@ -447,14 +447,22 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     if dropped > 0 or not envelope_ready:
         # the envelope of the rows as they are now (keep_correction_rows or drop_leaving_rows
         # compacted them; after a complementarity solve they are not the guess's rows)
-        if not arrange(s.q, ws, n, s.q.shape[0]):
+        if not arrange(s.q, ws, n, s.q.shape[0], s.contact_dependent, False):
             return max_residual(m, s, ws)       # (no room: the step begins again with more)
+    # the velocity solve's sparse factors left out rows the last step dropped as dependent
+    # (solve.excluded_rows_hold checked their velocity equations); a correction factors
+    # every row, so their gaps are closed too, if it takes place at all
+    partial = ws.sp_factored[0] < n
     # the rows kept are as drop_leaving_rows evaluated them unless it moved some
     worst = max_residual(m, s, ws) if dropped > 0 else targets_of(ws, n)
     ptol = pivot_tol
     for _ in range(iters):
         if worst <= tol:
             break
+        if partial:
+            if not arrange(s.q, ws, n, s.q.shape[0], s.contact_dependent, False):
+                return worst                    # (no room: the step begins again with more)
+            partial = False
         for i in range(s.q.shape[0]):
             for k in range(3):
                 ws.q_keep[i, k] = s.q[i, k]

@@ -18,15 +18,18 @@ SPARSE = 1
 
 
 @kernel
-def arrange(q, ws, n, n_body):
+def arrange(q, ws, n, n_body, dependent, exclude):
     """The structure of rows 0..n-1 (bodies at q): their envelope, or their sparse order and
-    elimination tree. Returns False (ws.room set) if it does not fit the workspace's storage:
-    the step begins again with more (kernels/step.py, GUARD_ROOM). Factors kept for reuse
-    (solve.same_rows_factored) are forgotten."""
+    elimination tree; there, if `exclude`, without the contact rows the last step dropped as
+    dependent (dependent: State.contact_dependent; sparse_factor.order_rows). Returns False
+    (ws.room set) if it does not fit the workspace's storage: the step begins again with
+    more (kernels/step.py, GUARD_ROOM). Factors kept for reuse (solve.same_rows_factored)
+    are forgotten."""
     ws.sp_kept[0] = 0
+    ws.sp_factored[0] = n
     if n >= SPARSE_MIN_ROWS:
         ws.factor_kind[0] = SPARSE
-        order_rows(q, ws, n)
+        order_rows(q, ws, n, dependent, exclude)
         return analyse(ws, n, n_body)
     ws.factor_kind[0] = ENVELOPE
     return compute_envelope(ws, n, n_body)

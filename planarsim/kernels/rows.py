@@ -182,6 +182,17 @@ def row_lever(m, ws, r, e):
     return math.inf
 
 
+@kernel(inline="always")
+def dependent_bit(kind):
+    """The bit of State.contact_dependent that a row of `kind` stands for: 1 a contact's
+    normal row, 2 its friction row, 0 any other row."""
+    if kind == ROW_CONTACT_N:
+        return 1
+    if kind == ROW_CONTACT_T:
+        return 2
+    return 0
+
+
 @kernel
 def last_impulse(s, ws, r):
     """Row r's impulse in the last step (State.last_*_impulse; 0 where it had none). A sliding

@@ -18,6 +18,13 @@ U = D L^T and only L is computed (half the work). A row whose pivot falls below 
 own diagonal depends on earlier rows and is dropped, as in the envelope elimination: its
 pivot and multipliers are zero, its impulse 0.
 
+A pile at rest drops most of its rows as dependent (a 1,035-box pyramid: 4,710 of 7,816),
+and those rows make most of the work: they sit in the separators, and every row after them
+reaches through them. So the rows the last step dropped (State.contact_dependent) are left
+out: they come last in the order (ws.sp_factored: the places factored), take no part in the
+pattern, the elimination tree or the factors, and count as dropped (pivot 0). The solve then
+checks their equations (solve.excluded_rows_hold) and factors every row where one fails.
+
 Storage (the workspace's): the order (sp_perm: place -> row, sp_iperm: row -> place), the
 matrix's lower pattern by place (sp_start, sp_index; values sp_low = A[k, i], sp_up =
 A[i, k], i < k; diagonal sp_diag), and the factors' columns (sp_lstart, ws.L_index; values
@@ -26,6 +33,7 @@ ws.A_low = L, ws.A_up = U; pivots sp_pivot).
 from ..compile import kernel
 from .codes import SPARSE_MAX_DEPTH as MAX_DEPTH
 from .envelope import _entry, is_dependent
+from .rows import dependent_bit
 
 # a system of at least this many rows is factored sparse (fewer: the envelope elimination,
 # which is exact as well and has no ordering to find)
@@ -128,10 +136,20 @@ def _part_key(count, p0, p1):
     return hi * MAX_DEPTH + (MAX_DEPTH - 1 - min(depth, MAX_DEPTH - 1))
 
 
+@kernel(inline="always")
+def is_excluded(ws, r, dependent):
+    """Row r is a contact's row that the last step dropped as dependent (dependent:
+    State.contact_dependent)."""
+    bit = dependent_bit(ws.row_kind[r])
+    return bit != 0 and (dependent[ws.row_owner[r]] & bit) != 0
+
+
 @kernel
-def order_rows(q, ws, n):
+def order_rows(q, ws, n, dependent, exclude):
     """ws.sp_perm / sp_iperm: rows 0..n-1 in nested-dissection order of their bodies
-    (positions q). Rows of one part keep their own order (a counting sort, stable)."""
+    (positions q). Rows of one part keep their own order (a counting sort, stable). exclude:
+    the rows the last step dropped as dependent (is_excluded) come after all others, in
+    their own order; ws.sp_factored[0] = the places before them."""
     count = 0
     for r in range(n):
         for e in range(2):
@@ -150,6 +168,9 @@ def order_rows(q, ws, n):
     for k in range(n_key + 1):
         ws.sp_count[k] = 0
     for r in range(n):
+        if exclude and is_excluded(ws, r, dependent):
+            ws.sp_row_key[r] = -1
+            continue
         b0 = ws.row_body[r, 0]
         b1 = ws.row_body[r, 1]
         p0 = ws.sp_body_place[b1] if b1 >= 0 else ws.sp_body_place[b0]
@@ -159,18 +180,26 @@ def order_rows(q, ws, n):
         ws.sp_count[key + 1] += 1
     for k in range(n_key):
         ws.sp_count[k + 1] += ws.sp_count[k]
+    factored = ws.sp_count[n_key]
+    last = factored
     for r in range(n):
         key = ws.sp_row_key[r]
-        k = ws.sp_count[key]
-        ws.sp_count[key] += 1
+        if key < 0:
+            k = last
+            last += 1
+        else:
+            k = ws.sp_count[key]
+            ws.sp_count[key] += 1
         ws.sp_perm[k] = r
         ws.sp_iperm[r] = k
+    ws.sp_factored[0] = factored
 
 
 @kernel
 def analyse(ws, n, n_body):
-    """The matrix's lower pattern by place (rows meet where they share a body), the
-    elimination tree (sp_parent) and the factors' column starts (sp_lstart). Returns False
+    """The matrix's lower pattern by place (rows meet where they share a body; the places
+    from ws.sp_factored[0] on have none), the elimination tree (sp_parent) and the factors'
+    column starts (sp_lstart). Returns False
     (ws.room set, with the entries needed) if the pattern or the factors do not fit the
     workspace's storage."""
     # each body's rows, by place (ascending)
@@ -195,11 +224,14 @@ def analyse(ws, n, n_body):
     # the lower pattern: column k's neighbours i < k
     cap = ws.sp_index.shape[0]
     fill = 0
+    factored = ws.sp_factored[0]
     for k in range(n):
         ws.sp_flag[k] = -1
     for k in range(n):
         ws.sp_start[k] = fill
         ws.sp_flag[k] = k
+        if k >= factored:
+            continue
         r = ws.sp_perm[k]
         for e in range(2):
             b = ws.row_body[r, e]
@@ -341,17 +373,23 @@ def _eliminate(x, y, L, U, Li, lstart, count, pivot, pattern, top, k, d):
 def factor_sparse(ws, n, tol, symmetric, scale):
     """L U (symmetric: L D L^T) of the matrix assemble_sparse filled, up-looking along the
     elimination tree; scale[r] (by row) the diagonal before elimination. Dropped rows (pivot
-    below tol times their diagonal) get zero pivots and multipliers. Returns #dropped."""
+    below tol times their diagonal) get zero pivots and multipliers, as do the places from
+    ws.sp_factored[0] on (left out by order_rows). Returns #dropped."""
     dropped = 0
     for k in range(n):
         ws.sp_y[k] = 0.0
         ws.sp_x[k] = 0.0
         ws.sp_lcount[k] = 0
     pattern = ws.sp_pattern
+    factored = ws.sp_factored[0]
     for k in range(n):
-        top = _row_pattern(ws, k, symmetric)
         d = ws.sp_diag[k]
         scale[ws.sp_perm[k]] = abs(d)
+        if k >= factored:           # left out (order_rows): dropped
+            ws.sp_pivot[k] = 0.0
+            dropped += 1
+            continue
+        top = _row_pattern(ws, k, symmetric)
         if symmetric:
             d = _eliminate_symmetric(ws.sp_y, ws.A_low, ws.L_index, ws.sp_lstart, ws.sp_lcount,
                                      ws.sp_pivot, pattern, top, k, d)

@@ -77,6 +77,7 @@ def copy_state(src, dst):
     _copy2(src.last_pin_impulse, dst.last_pin_impulse)
     _copy1(src.last_rod_impulse, dst.last_rod_impulse)
     _copy1(src.contact_feature, dst.contact_feature)
+    _copy1(src.contact_dependent, dst.contact_dependent)
 
 
 @kernel(inline="never")

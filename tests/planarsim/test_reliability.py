@@ -94,6 +94,25 @@ def test_snapshot_restore_continues_bit_for_bit(tmp_path):
         assert state_hash(again.state) == hashes[k]
 
 
+def test_a_snapshot_saved_before_contact_dependent_existed_loads_with_none_dependent(tmp_path):
+    """A snapshot without State.contact_dependent (written before the field existed) loads,
+    with no contact row known dependent, and steps as a state that has the field."""
+    model = two_link_on_hills()
+    ref = ps.Simulator(model)
+    ref.steps(50)
+    path = ps.save_snapshot(tmp_path / "snap.npz", ref.state)
+    with np.load(path) as data:
+        old = {k: data[k] for k in data.files if k != "state__contact_dependent"}
+    np.savez(tmp_path / "old.npz", **old)
+    state, _ = ps.load_snapshot(tmp_path / "old.npz", model)
+    assert state.contact_dependent.shape == (model.n_contact,)
+    assert not state.contact_dependent.any()
+    again = ps.Simulator(model, state=state)
+    again.steps(20)
+    ref.steps(20)
+    assert state_hash(again.state) == state_hash(ref.state)
+
+
 def test_two_runs_hash_alike_in_process_and_in_a_fresh_process():
     model = two_link_on_hills()
 

@@ -14,6 +14,7 @@ from planarsim import state as state_module
 from planarsim.compile import options as compile_options
 from planarsim.kernels import matrix
 from planarsim.kernels import sparse_factor as sf
+from planarsim.kernels.codes import ROW_CONTACT_N
 from strategies import INERTIA, MASS, body_rows, dense_jacobian, reals, vectors
 
 TOL = 1e-11
@@ -21,8 +22,10 @@ jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit
-def _sparse_solve(m, q, ws, n, n_body, rhs, x, symmetric):
-    sf.order_rows(q, ws, n)
+def _sparse_solve_marked(m, q, ws, n, n_body, rhs, x, symmetric, dependent, exclude):
+    """Order (with the rows marked in `dependent` left out if `exclude`: order_rows), analyse,
+    assemble, factor and solve rows 0..n-1 sparse; returns #dropped (-1: no room)."""
+    sf.order_rows(q, ws, n, dependent, exclude)
     if not sf.analyse(ws, n, n_body):
         return -1
     ws.factor_kind[0] = matrix.SPARSE
@@ -32,10 +35,15 @@ def _sparse_solve(m, q, ws, n, n_body, rhs, x, symmetric):
     return dropped
 
 
+def _sparse_solve(m, q, ws, n, n_body, rhs, x, symmetric):
+    return _sparse_solve_marked(m, q, ws, n, n_body, rhs, x, symmetric, np.zeros(1, np.int64),
+                                False)
+
+
 @jit
 def _envelope_solve(m, q, ws, n, n_body, rhs, x, symmetric):
     ws.factor_kind[0] = matrix.ENVELOPE
-    matrix.arrange(q, ws, n, n_body)          # (fewer rows than SPARSE_MIN_ROWS)
+    matrix.arrange(q, ws, n, n_body, ws.start.contact_dependent, False)  # (< SPARSE_MIN_ROWS)
     matrix.assemble(m, ws, ws.row_J, ws.row_F, n, symmetric)
     dropped = matrix.factor_ws(ws, n, TOL, symmetric)
     matrix.substitute_ws(ws, rhs, x, n, symmetric)
@@ -116,6 +124,27 @@ def _weights(model):
                      .reshape(-1, 3), 1, 0).ravel()
 
 
+def _consistent_system(model, rows, data):
+    """(J, the weights W, A = J W J^T, a consistent right-hand side A y with y drawn in
+    [-3, 3], the bodies' positions) of body_rows' rows."""
+    _, _, J = _stack(rows, model.n_body)
+    w = _weights(model)
+    A = (J * w) @ J.T
+    rhs = A @ data.draw(vectors(len(rows), -3.0, 3.0), label="y")
+    return J, w, A, rhs, np.array(model.q0, dtype=float)
+
+
+def _filled_workspace(model, rows):
+    """_workspace for the rows, their bodies and Jacobians (F = J) filled in."""
+    n_row = len(rows)
+    row_body, row_J, _ = _stack(rows, model.n_body)
+    ws = _workspace(model, n_row)
+    ws.row_body[:n_row] = row_body
+    ws.row_J[:n_row] = row_J
+    ws.row_F[:n_row] = row_J
+    return ws
+
+
 @settings(max_examples=100, deadline=None)        # 150 with a seed: drawing the rows is slower
 @given(piles(dependent=reals(0.0, 0.5)), st.data())
 def test_the_sparse_factorisation_solves_what_the_envelope_solves(pile, data):
@@ -123,17 +152,10 @@ def test_the_sparse_factorisation_solves_what_the_envelope_solves(pile, data):
     [-3, 3], as the engine's)."""
     model, rows = pile
     n_body, n_row = model.n_body, len(rows)
-    row_body, row_J, J = _stack(rows, n_body)
-    w = _weights(model)
-    A = (J * w) @ J.T
-    rhs = A @ data.draw(vectors(n_row, -3.0, 3.0), label="y")
-    q = np.array(model.q0, dtype=float)
+    J, w, A, rhs, q = _consistent_system(model, rows, data)
     answers = []
     for solve in (_sparse_solve, _envelope_solve):
-        ws = _workspace(model, n_row)
-        ws.row_body[:n_row] = row_body
-        ws.row_J[:n_row] = row_J
-        ws.row_F[:n_row] = row_J
+        ws = _filled_workspace(model, rows)
         x = np.zeros(n_row)
         dropped = solve(model.arrays, q, ws, n_row, n_body, rhs.copy(), x, True)
         assert dropped >= 0
@@ -199,3 +221,39 @@ def test_a_pile_too_large_for_the_storage_asks_for_room():
     assert _sparse_solve(model.arrays, np.array(model.q0, float), ws, 100, 30, np.ones(100), x,
                          True) == -1
     assert ws.room[0] == 1 and ws.room[2] > 10
+
+
+@settings(max_examples=60, deadline=None)
+@given(piles(dependent=reals(0.0, 0.5)), st.data())
+def test_rows_left_out_as_dependent_come_last_and_the_others_solve_as_alone(pile, data):
+    """Rows marked as dropped by the last step (State.contact_dependent: here the rows the
+    full factorisation drops, and some drawn others) are ordered after all the rest, in
+    their own order, are dropped without elimination, and the remaining rows' answer solves
+    their own equations; where only truly dependent rows are left out, it solves them all
+    (a consistent right-hand side A y)."""
+    model, rows = pile
+    n_body, n_row = model.n_body, len(rows)
+    J, w, A, rhs, q = _consistent_system(model, rows, data)
+    ws = _filled_workspace(model, rows)
+    ws.row_kind[:n_row] = ROW_CONTACT_N
+    ws.row_owner[:n_row] = np.arange(n_row)
+    x = np.zeros(n_row)
+    assert _sparse_solve(model.arrays, q, ws, n_row, n_body, rhs.copy(), x, True) >= 0
+    dropped_rows = ws.sp_pivot[ws.sp_iperm[:n_row]] == 0.0
+    extra = data.draw(arrays(np.bool_, n_row), label="also left out") & data.draw(st.booleans())
+    out = dropped_rows | extra
+    dependent = out.astype(np.int64)          # bit 1: a normal row
+    dropped = _sparse_solve_marked(model.arrays, q, ws, n_row, n_body, rhs.copy(), x, True,
+                                   dependent, True)
+    factored = int(ws.sp_factored[0])
+    assert factored == n_row - out.sum()
+    perm = ws.sp_perm[:n_row]
+    assert sorted(perm) == list(range(n_row))
+    assert list(perm[factored:]) == list(np.flatnonzero(out))
+    assert np.all(ws.sp_pivot[factored:n_row] == 0.0) and dropped >= out.sum()
+    assert np.all(x[out] == 0.0)
+    keep = ~out
+    scale = 1e-7 * (1.0 + np.abs(rhs).max())
+    assert np.abs(A[np.ix_(keep, keep)] @ x[keep] - rhs[keep]).max(initial=0.0) <= scale
+    if not extra.any():
+        assert np.abs(A @ x - rhs).max() <= scale
