@@ -108,7 +108,7 @@ class StepOptions(NamedTuple):
     keep_factors : 1: a pile at rest (1,024 rows or more, the sparse factorisation) keeps
         its velocity solve's factors from step to step while its rows stay the same, and
         each step's answer is refined against its own matrix to rounding (kernels/solve.py
-        refine_on_kept_factors; a 1,035-box pyramid at rest about 4x faster). The answer then
+        refine_on_kept_factors; a 1,035-box pyramid at rest about 1.3x faster). The answer then
         depends, at rounding, on the step the factors were made at, which the State does not
         hold: a restored State continues to rounding, not bit for bit. 0 (default): every
         solve factors afresh

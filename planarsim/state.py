@@ -41,11 +41,13 @@ class State(NamedTuple):
     contact_feature : (n_contact,) int    the features a shape pair's slot touched with in the
                                           last step (-1: none; kernels/pair.py): a slot keeps its
                                           mode and impulse while they stay the same
-    contact_dependent : (n_contact,) int  the contact's rows that the last step's sparse velocity
-                                          solve dropped as dependent on the others (bit 1: the
+    contact_dependent : (n_contact,) int  the contact's rows that the last sparse velocity solve
+                                          (of this step or an earlier one) dropped as dependent
+                                          on the others, or left out and found held (bit 1: the
                                           normal row, bit 2: the friction row; a pile at rest):
-                                          the next step factors the others only and checks
-                                          these rows' equations (kernels/sparse_factor.py)
+                                          the next sparse solve factors the others only and
+                                          checks these rows' equations (kernels/sparse_factor.py;
+                                          a contact without rows keeps its bits)
     """
     q: np.ndarray
     v: np.ndarray
@@ -87,8 +89,9 @@ class State(NamedTuple):
 
 
 def with_defaults(d) -> dict:
-    """d (name -> array) with the fields that only steer the solve's work filled in where
-    missing: contact_dependent zeros (no row known dependent)."""
+    """d (name -> array) with contact_dependent filled in where missing: zeros (no row known
+    dependent; the first sparse solve factors every row, as a step always did before the
+    field existed)."""
     d = dict(d)
     if "contact_dependent" not in d and "contact_mode" in d:
         d["contact_dependent"] = np.zeros(np.shape(d["contact_mode"]), np.int64)
