@@ -5,6 +5,7 @@ after --limit seconds (a first step that takes longer is reported as such).
     python benchmarks/worlds.py                          # every world, 200 steps each
     python benchmarks/worlds.py columns10x10 pyramid10 --steps 500 --limit 120
     python benchmarks/worlds.py --keep-factors         # StepOptions(keep_factors=1)
+    python benchmarks/worlds.py --struck --steps 20 --limit 300   # piles struck after settling
 
 Worlds: pyramid4 (10 boxes), columns10x10 (ten columns of ten 0.2 m boxes, 0.4 m apart), pyramid10 (55 boxes),
 pyramid20 (210 boxes, each on two below), wall40x10 (400 bricks 0.4 x 0.2 m, staggered),
@@ -13,6 +14,12 @@ workspace's solve holds at the end, peak memory [MB], the first step [ms], mean 
 of the later steps [ms], the largest move of a box from its start [m], the deepest overlap of
 a listed contact before the last step [m] and the audit's total; then how the mean step at
 rest grows with the number of bodies, from the smallest world run to the largest.
+
+Struck piles (--struck): a world that settles for SETTLE steps, then one box is set moving,
+and the steps from there are timed as above ('first' is the step that meets the blow):
+pyramid20_thrown (the top box thrown up at 0.3 m/s: it leaves and lands about 60 ms later),
+pyramid20_pushed (the middle box of the third level pushed sideways at 0.5 m/s, into its
+neighbours). No growth is fitted.
 """
 from __future__ import annotations
 
@@ -74,6 +81,29 @@ WORLDS = {
 }
 
 
+# steps a struck world settles before its blow
+SETTLE = 5
+
+
+def _throw_top(q, v):
+    """The top box thrown up at 0.3 m/s."""
+    v[int(np.argmax(q[:, 1])), 1] = 0.3
+
+
+def _push_third_level(q, v):
+    """The middle box of the third level pushed sideways at 0.5 m/s."""
+    levels = np.unique(q[:, 1].round(6))
+    third = np.flatnonzero(np.abs(q[:, 1] - levels[2]) < 1e-3)
+    v[third[third.size // 2], 0] = 0.5
+
+
+# name -> (world, blow(q, v) applied after SETTLE steps)
+STRUCK = {
+    "pyramid20_thrown": (lambda: pyramid(20), _throw_top),
+    "pyramid20_pushed": (lambda: pyramid(20), _push_third_level),
+}
+
+
 def _load_step():
     """The compiled step compiled or loaded into this process (one step of one box)."""
     ps.Simulator(columns(1, 1)).step()
@@ -90,8 +120,11 @@ def _measure_world(name, steps, out, keep_factors=0):
     from planarsim.compiled import audit_counts
     from planarsim.state import workspace_contacts
     _load_step()                         # the compiled step loaded (once a process), not timed
-    model = WORLDS[name]()
+    model = WORLDS[name]() if name in WORLDS else STRUCK[name][0]()
     sim = ps.Simulator(model, options=ps.StepOptions(keep_factors=keep_factors))
+    if name in STRUCK:
+        sim.steps(SETTLE)
+        STRUCK[name][1](sim.state.q, sim.state.v)
     q0 = sim.state.q.copy()
     out.put(("built", model.n_body, model.n_contact))
     t = time.perf_counter()
@@ -145,15 +178,21 @@ def run(name, steps, limit, keep_factors=0):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("worlds", nargs="*", default=list(WORLDS), help=f"of {list(WORLDS)}")
+    ap.add_argument("worlds", nargs="*", help=f"of {list(WORLDS)} (default: all), or with "
+                    f"--struck of {list(STRUCK)}")
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--limit", type=float, default=120.0, help="seconds per world")
     ap.add_argument("--keep-factors", action="store_true",
                     help="StepOptions(keep_factors=1): a pile at rest keeps its factors")
+    ap.add_argument("--struck", action="store_true",
+                    help="the struck piles (STRUCK): settled, then one box set moving")
     a = ap.parse_args(argv)
-    unknown = [w for w in a.worlds if w not in WORLDS]
+    known = STRUCK if a.struck else WORLDS
+    a.worlds = a.worlds or list(known)
+    unknown = [w for w in a.worlds if w not in known]
     if unknown:
-        ap.error(f"unknown world(s) {unknown}; the worlds are {list(WORLDS)}")
+        ap.error(f"unknown world(s) {unknown}; the {'struck piles' if a.struck else 'worlds'} "
+                 f"are {list(known)}")
     # the compiled step compiled (minutes on a fresh clone) or loaded once, in a process of its
     # own and without a time limit, so that no world's limit holds the compile: each world's
     # process then loads it from the cache, and this one stays as light as it was (its
@@ -173,7 +212,7 @@ def main(argv=None):
             sizes.append(size)
         else:
             failed += 1
-    if len(sizes) >= 2:
+    if len(sizes) >= 2 and not a.struck:
         (n0, t0), (n1, t1) = min(sizes), max(sizes)
         if n1 > n0:
             growth = np.log(t1 / t0) / np.log(n1 / n0)
