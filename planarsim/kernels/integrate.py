@@ -28,7 +28,7 @@ from .joint_friction import is_joint_friction_row
 from .joints import joint_position_rate
 from .rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row, is_normal_row,
                    is_soft_row, is_tangent_row, is_unilateral, row_lever)
-from .matrix import add_to_diagonal, arrange, assemble, factor_solve, substitute_ws
+from .matrix import add_to_diagonal, arrange, assemble, factor_ws, substitute_ws
 from .soft import SOFT_ARMATURE
 from .solve import apply_impulses, row_dot
 from .work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work, correction_rounding,
@@ -434,6 +434,35 @@ def max_residual(m, s, ws):
 
 
 @kernel(inline="always")
+def move_by_correction(m, s, ws, h, n, unilateral):
+    """Move the bodies by the correction whose matrix ws holds factored and whose targets -c
+    are in ws.rhs (ws.row_c: a copy of them): positions by W J^T lam, velocities by the same
+    over h (bilateral rows) or by -c / h on the bilateral rows only (with unilateral ones)."""
+    substitute_ws(ws, ws.rhs, ws.lam, n, False)
+    for i in range(ws.dq_correction.shape[0]):
+        for k in range(3):
+            ws.dq_correction[i, k] = 0.0
+            ws.dv_correction[i, k] = 0.0
+    apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
+    if unilateral == 0:
+        # velocities by the same correction / h
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
+    else:
+        # velocities: bilateral rows change by -c / h, unilateral rows not at all (a
+        # separate solve: zeroing the unilateral impulses of the position solve instead
+        # leaves a pinned foot, held by its contact against a rod, moving at rod-fix / h)
+        # (same matrix: its factors are reused)
+        for r in range(n):
+            ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
+        substitute_ws(ws, ws.rhs, ws.lam, n, False)
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            s.q[i, k] += ws.dq_correction[i, k]
+            s.v[i, k] += ws.dv_correction[i, k]
+
+
+@kernel(inline="always")
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     """Newton-SHAKE; returns the final max residual [m or rad]. envelope_ready: the rows are
     those of the velocity solve's envelope (ws.row_first / row_reach): none was dropped since
@@ -456,6 +485,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     # the rows kept are as drop_leaving_rows evaluated them unless it moved some
     worst = max_residual(m, s, ws) if dropped > 0 else targets_of(ws, n)
     ptol = pivot_tol
+    newton = 0        # corrections taken while Newton converged (0: none, or it did not)
     for _ in range(iters):
         if worst <= tol:
             break
@@ -474,33 +504,14 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         normals_now(m, ws, n)
         assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
         correction_compliance(ws, n)
-        factor_solve(ws, ws.rhs, ws.lam, n, ptol)
-        # move positions by the correction
-        for i in range(ws.dq_correction.shape[0]):
-            for k in range(3):
-                ws.dq_correction[i, k] = 0.0
-                ws.dv_correction[i, k] = 0.0
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
-        if unilateral == 0:
-            # velocities by the same correction / h
-            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
-        else:
-            # velocities: bilateral rows change by -c / h, unilateral rows not at all (a
-            # separate solve: zeroing the unilateral impulses of the position solve instead
-            # leaves a pinned foot, held by its contact against a rod, moving at rod-fix / h)
-            # (same matrix: its factors are reused)
-            for r in range(n):
-                ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
-            substitute_ws(ws, ws.rhs, ws.lam, n, False)
-            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
-        for i in range(s.q.shape[0]):
-            for k in range(3):
-                s.q[i, k] += ws.dq_correction[i, k]
-                s.v[i, k] += ws.dv_correction[i, k]
+        factor_ws(ws, n, ptol, False)
+        move_by_correction(m, s, ws, h, n, unilateral)
         after = max_residual(m, s, ws)
         if after <= STALLED_RATIO * worst:
             worst = after
+            newton += 1
             continue
+        newton = 0
         if after <= DIVERGED_GROWTH * worst:
             # stalled: the largest error belongs to a row dropped as dependent (a closed loop
             # through the ground) whose error the others cannot remove; more steps would
@@ -520,4 +531,19 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         if ptol >= LOOSE_PIVOT_TOL:
             break
         ptol = LOOSE_PIVOT_TOL
+    if newton > 0 and 0.0 < worst <= tol:
+        # one more step on the last factors (no new matrix, a substitution): the end moves
+        # by about the residual left (below tol), and its derivative becomes the converged
+        # correction's. Newton's last step was taken at a residual r of about sqrt(tol);
+        # the end's derivative with respect to the step's start and commands is off by
+        # about r / (the bodies' size) after it (1e-6 at tol 1e-12: what
+        # derivatives.step_jacobian, exact for the converged correction, would disagree by)
+        # and by about the square of that after this one. The residual returned is the one
+        # before this step (it only shrinks).
+        unilateral = 0
+        for r in range(n):
+            ws.row_c[r] = ws.rhs[r]
+            unilateral += is_unilateral(ws.row_kind[r])
+        move_by_correction(m, s, ws, h, n, unilateral)
+        update_trig(s.q, ws.body_cs)
     return worst

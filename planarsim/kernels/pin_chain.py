@@ -222,6 +222,7 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
     update_trig(s.q, ws.body_cs)
     worst = chain_residual(m, s, ws, True)
     fresh = True
+    passes = 0
     for _ in range(iters):
         if worst <= tol:
             break
@@ -240,4 +241,14 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
         if fresh and after > tol:
             chain_residual(m, s, ws, True)      # (the next pass factors J at this q)
         worst = after
+        passes += 1
+    if passes > 0 and 0.0 < worst <= tol:
+        # one more pass on the last factorisation, as integrate.correct_positions takes it
+        # (it says why: the end's derivative becomes the converged correction's)
+        chain_solve(ws, ws.rhs, ws.lam)
+        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                     s.q, 1.0)
+        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                     s.v, 1.0 / h)
+        update_trig(s.q, ws.body_cs)
     return worst
