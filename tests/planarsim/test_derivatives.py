@@ -7,7 +7,7 @@ implicit function theorem on the step's own answer, so they agree to the differe
 error (measured: 1e-10 of the largest entry)."""
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 import planarsim as ps
@@ -145,6 +145,10 @@ def moved_state(sim, rng, swing):
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(links=st.integers(1, 5), seed=st.integers(0, 2 ** 31 - 1),
        mass_decades=st.floats(0.0, 3.0), dt=st.sampled_from([1e-3, 5e-3]), rotors=st.booleans())
+# found by the search: Newton's last step taken at a residual of ~1e-6 m left the end's
+# derivative 1.1e-6 off the converged correction's (until the correction ended with one more
+# step on its last factors)
+@example(links=4, seed=386, mass_decades=2.5, dt=5e-3, rotors=False)
 def test_step_jacobian_is_the_steps_derivative(links, seed, mass_decades, dt, rotors):
     """rotors: each hinge with armature of 1e-3 to 1e2 times its link's inertia and a spring
     the step resolves (a twentieth of the stiffness whose step angle would need the spring at the
