@@ -426,6 +426,15 @@ class Workspace(NamedTuple):
                                  #   answers tried in this solve of the modes
     start_pairs: np.ndarray      # (n_pair,) int the listed pairs at the step's start (room[1])
     n_start_pairs: np.ndarray    # (1,) int how many
+    prev_whole: np.ndarray       # (1,) int 1: the next copy of the State into prev copies every
+                                 #   contact slot (a state put in or handed out, a copy beside
+                                 #   prev's); 0: only the ground contacts' and sync_pairs' slots
+                                 #   (kernels/prev_copy.py)
+    sync_pairs: np.ndarray       # (n_pair,) int the pairs (slot-0 contacts) listed at the last
+                                 #   copy into prev and those listed since: the only pairs whose
+                                 #   slots the State can have changed since (each once)
+    n_sync_pairs: np.ndarray     # (1,) int how many
+    pair_synced: np.ndarray      # (n_contact,) int a pair's slot 0: 1 while in sync_pairs
     chain_on: np.ndarray         # (1,) int 1: the model's pins form open chains and are its only
                                  #   rows: the step tries its pin-chain path (kernels/pin_chain.py;
                                  #   planarsim/pin_chains.py)
@@ -501,6 +510,7 @@ def forget_pairs(ws: Workspace) -> None:
     slot0 = np.unique(ws.shape_pair_slot[ws.shape_pair_slot >= 0])
     ws.last_pairs[:] = slot0
     ws.n_live_pairs[0] = slot0.size
+    ws.prev_whole[0] = 1        # (the next sweep may clear any pair's slots)
 
 
 def forget_kept_factors(ws: Workspace) -> None:
@@ -783,6 +793,8 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      step_path=z(nb),
                      room=np.array([0, int(contacts < nc), 0, 0, lcp_rows_limit()], np.int64), least_change=z(3, np.int64),
                      start_pairs=z(n_pair, np.int64), n_start_pairs=z(1, np.int64),
+                     prev_whole=np.ones(1, np.int64), sync_pairs=z(n_pair, np.int64),
+                     n_sync_pairs=z(1, np.int64), pair_synced=z(nc, np.int64),
                      **_chain_arrays(model), start=make_state(model), prev=make_state(model))
 
 

@@ -19,6 +19,7 @@ shapes has every contact in the list, once (make_workspace), and never calls thi
 """
 from ..compile import kernel
 from .pair import SPECULATIVE_FACTOR, _speed_bound, clear_slot, place_shapes
+from .prev_copy import add_synced
 
 # relative widening of a shape's box [-] and its absolute floor [m]: the rounding of the box's
 # ends, so that the sweep never skips a pair the exact test would keep
@@ -141,6 +142,7 @@ def update_live(m, s, ws, margin, h):
     n = sweep_pairs(ws, margin, h, ws.live_pairs)
     for k in range(n):
         ws.pair_flag[ws.live_pairs[k]] = FLAG_LIVE
+        add_synced(ws, ws.live_pairs[k])     # (its slots may change: prev_copy.py)
     for k in range(ws.n_live_pairs[0]):
         p = ws.last_pairs[k]
         if ws.pair_flag[p] == FLAG_WAS_LIVE:

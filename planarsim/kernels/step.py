@@ -36,6 +36,7 @@ from .modes import (check_contact, engage_contacts, engage_limits, gather_contac
                     rule_breaks, seed_rule)
 from .pair import PAIR_MARGIN
 from .pin_chain import chain_correct, chain_rows, chain_velocity_solve
+from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev
 from .pair_toi import hold_off_fast_pairs
 from .position import ROWS_HELD_SHARE, position_stage
 from .rows import build_rows
@@ -45,39 +46,6 @@ from .rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage
                      unsupported)
 from .warm_start import remember_impulses
 from .work import NEAR_DEPENDENT, joints_add_energy, prediction_turn
-
-
-@kernel
-def _copy1(src, dst):
-    for i in range(src.shape[0]):
-        dst[i] = src[i]
-
-
-@kernel
-def _copy2(src, dst):
-    for i in range(src.shape[0]):
-        for k in range(src.shape[1]):
-            dst[i, k] = src[i, k]
-
-
-@kernel(inline="always")
-def copy_state(src, dst):
-    """dst <- src, array by array (dst is a State of the same shapes; no allocation)."""
-    _copy2(src.q, dst.q)
-    _copy2(src.v, dst.v)
-    _copy1(src.time, dst.time)
-    _copy1(src.step, dst.step)
-    _copy1(src.contact_mode, dst.contact_mode)
-    _copy1(src.contact_slip, dst.contact_slip)
-    _copy1(src.contact_enabled, dst.contact_enabled)
-    _copy2(src.limit_active, dst.limit_active)
-    _copy1(src.mode_cursor, dst.mode_cursor)
-    _copy2(src.ext_force, dst.ext_force)
-    _copy2(src.last_contact_impulse, dst.last_contact_impulse)
-    _copy2(src.last_pin_impulse, dst.last_pin_impulse)
-    _copy1(src.last_rod_impulse, dst.last_rod_impulse)
-    _copy1(src.contact_feature, dst.contact_feature)
-    _copy1(src.contact_dependent, dst.contact_dependent)
 
 
 @kernel(inline="never")
@@ -360,13 +328,14 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
 
 
 @kernel
-def forget_impulses(s):
+def forget_impulses(s, ws):
     """Zero the State's last impulses: a solve repeated with the joints aimed at J v = 0
     starts from zero, so that a row dropped as dependent keeps none (the first solve's
     impulses, or an earlier step's, could do work at this step's velocities)."""
     s.last_contact_impulse[:] = 0.0
     s.last_pin_impulse[:] = 0.0
     s.last_rod_impulse[:] = 0.0
+    ws.prev_whole[0] = 1        # (every slot changed: prev_copy.py)
 
 
 @kernel
@@ -417,7 +386,7 @@ def relinearize(m, s, ws, h):
         for k in range(3):
             ws.v_lin[i, k] = ws.v_new[i, k]
     predict_configuration(m, s, ws, h)
-    forget_impulses(s)
+    forget_impulses(s, ws)
     return True
 
 
@@ -452,26 +421,55 @@ def begin_step(ws):
 
 
 @kernel
-def begin_again(s, ws, start):
-    """The State at the step's start and the audit's counts as they were, to take the step
-    again (in sub-steps)."""
-    copy_state(start, s)
+def _audit_back(ws):
+    """The audit's counts as they were at the step's start (begin_step)."""
     for k in range(ws.audit.shape[0]):
         ws.audit[k] = ws.audit_keep[k]
 
 
 @kernel
-def put_back(s, ws, start):
-    """A step that ran out of room (GUARD_ROOM) undone: the State at its start, the audit's
-    counts and the broad phase's pair list (keep_pairs) as they were."""
-    begin_again(s, ws, start)
+def begin_again(s, ws):
+    """The State at the step's start (ws.prev) and the audit's counts as they were, to take
+    the step again (in sub-steps)."""
+    back_to_prev(s, ws)
+    _audit_back(ws)
+
+
+@kernel
+def begin_again_from(s, ws, start):
+    """begin_again from `start` (ws.start: the start of a step taken in sub-steps); the
+    State then differs from ws.prev beyond the listed pairs (prev_copy.py)."""
+    copy_state(start, s)
+    ws.prev_whole[0] = 1
+    _audit_back(ws)
+
+
+@kernel
+def _pairs_back(ws):
+    """The broad phase's pair list as it was at the step's start (keep_pairs)."""
     for k in range(ws.n_live_pairs[0]):
         ws.pair_flag[ws.last_pairs[k]] = 0
     n = ws.n_start_pairs[0]
     for k in range(n):
         ws.last_pairs[k] = ws.start_pairs[k]
         ws.pair_flag[ws.start_pairs[k]] = FLAG_LIVE
+        add_synced(ws, ws.start_pairs[k])
     ws.n_live_pairs[0] = n
+
+
+@kernel
+def put_back(s, ws):
+    """A step that ran out of room (GUARD_ROOM) undone: the State at its start (ws.prev),
+    the audit's counts and the broad phase's pair list (keep_pairs) as they were."""
+    begin_again(s, ws)
+    _pairs_back(ws)
+
+
+@kernel
+def put_back_from(s, ws, start):
+    """put_back from `start` (ws.start: the start of a step taken in sub-steps)."""
+    begin_again_from(s, ws, start)
+    _pairs_back(ws)
 
 
 @kernel(inline="never")
@@ -482,7 +480,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
     the step's start in ws.prev, has checked the actuators' turns for all its stages and
     counts what they all did (step_info)."""
     if not stage:
-        copy_state(s, ws.prev)
+        keep_prev(s, ws)
     # a state handed in from outside (restored, edited) is checked before it is used
     code = check_guards(s, ws, opt.guard_limit)
     if code != 0:
@@ -527,7 +525,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
                 soft_prediction(m, s, ws, h)                #    back: the audit measures
                 predict_configuration(m, s, ws, h)          #    the projection against it)
             ws.first_order[0] = 1                           #    with joint rows at J v = 0,
-            forget_impulses(s)                              #    from zero impulses
+            forget_impulses(s, ws)                              #    from zero impulses
         if ws.room[0] == 1:                                 #    rows beyond the storage:
             return GUARD_ROOM                               #    again with more (_step)
         if ccd_on and m.n_shape_pair > 0:                   #    shapes the answer moves
@@ -580,7 +578,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
     code = unsupported(m, ws)
     if code != 0:
         return code
-    copy_state(s, ws.prev)
+    keep_prev(s, ws)
     begin_step(ws)
     reset_counts(ws)
     start_path(s, ws)
@@ -600,7 +598,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
         rattle_begin(m, s, ws, u, h)
         code = step_of_length(m, s, ws, opt, u, h, True)
         if code == GUARD_ROOM:
-            put_back(s, ws, ws.prev)
+            put_back(s, ws)
         if code != 0:
             return code
         rattle_end(m, s, ws, u, h, opt.pivot_tol, k == n - 1)
@@ -669,7 +667,7 @@ def chain_part(m, s, ws, opt, u, h):
     dependent, the joints' energy check or the correction's energy bound taking effect, a correction that
     stalls or ends above refine_tol, a guard, an audit) it returns CHAIN_GENERAL or
     CHAIN_AGAIN; else 0."""
-    copy_state(s, ws.prev)
+    keep_prev(s, ws)
     if check_guards(s, ws, opt.guard_limit) != 0:
         return CHAIN_GENERAL
     reset_counts(ws)
@@ -735,7 +733,7 @@ def chain_step(m, s, ws, opt, u, step_length):
         code = chain_part(m, s, ws, opt, u, step_length)
         if code != 0:
             if code == CHAIN_AGAIN:
-                begin_again(s, ws, ws.prev)
+                begin_again(s, ws)
             return CHAIN_GENERAL
         n = turn_substeps(m, s, ws, step_length, most)
         if n == 1:
@@ -743,7 +741,7 @@ def chain_step(m, s, ws, opt, u, step_length):
             keep_step_path(ws, False)
             return 0
         n = max(n, 2)
-        begin_again(s, ws, ws.prev)
+        begin_again(s, ws)
     count = s.step[0]
     t0 = s.time[0]
     copy_state(s, ws.start)
@@ -757,7 +755,7 @@ def chain_step(m, s, ws, opt, u, step_length):
     if code == 0 and opt.jump_limit > 0.0:
         code = check_moves(m, s, ws, ws.start.q, True, opt.jump_limit)
     if code != 0:
-        begin_again(s, ws, ws.start)
+        begin_again_from(s, ws, ws.start)
         return CHAIN_GENERAL
     s.step[0] = count + 1
     s.time[0] = t0 + step_length
@@ -781,7 +779,7 @@ def _step(m, s, ws, opt, u):
         if n == 1:
             code = step_of_length(m, s, ws, opt, u, step_length, False)
             if code == GUARD_ROOM:
-                put_back(s, ws, ws.prev)
+                put_back(s, ws)
                 return code
             # a body that began turning fast within the step (an impact spinning a light
             # link up) is judged at the step's answer: taken again, in sub-steps; so is a
@@ -792,7 +790,7 @@ def _step(m, s, ws, opt, u):
                 keep_step_path(ws, False)
                 return code
             n = max(n, 2)
-            begin_again(s, ws, ws.prev)
+            begin_again(s, ws)
         # sub-steps, each a whole step of its own (solve, positions, audit, guards), that
         # count as one: an error names this step. A sub-step whose correction moves a body
         # farther than its velocities explain (a loop near a dead point closing its drift, a
@@ -807,7 +805,7 @@ def _step(m, s, ws, opt, u):
                 code = step_of_length(m, s, ws, opt, u, step_length / n, False)
                 keep_step_path(ws, k > 0)
                 if code == GUARD_ROOM:
-                    put_back(s, ws, ws.start)
+                    put_back_from(s, ws, ws.start)
                 if code != 0:
                     break
             # over the whole step too: the sub-steps' summed paths plus jump_limit once
@@ -815,14 +813,15 @@ def _step(m, s, ws, opt, u):
                 code = check_moves(m, s, ws, ws.start.q, True, opt.jump_limit)
             if code == GUARD_JUMP and n < most:
                 if ws.room[1] == 1:
-                    put_back(s, ws, ws.start)       # (the broad phase's pairs too)
+                    put_back_from(s, ws, ws.start)       # (the broad phase's pairs too)
                 else:
-                    begin_again(s, ws, ws.start)
+                    begin_again_from(s, ws, ws.start)
                 n = min(2 * n, most)
                 continue
             if code != 0:
                 if code != GUARD_ROOM:
                     copy_state(ws.start, ws.prev)   # (the error names the step's start)
+                    ws.prev_whole[0] = 1
                 return code
             break
         s.step[0] = count + 1
