@@ -139,9 +139,6 @@ class Simulator:
     @property
     def state(self) -> State:
         """The current State (numpy arrays, mutated in place by stepping)."""
-        # handed out, it may be changed in place: the next step keeps all of it as its start
-        # (kernels/prev_copy.py)
-        self._ws.prev_whole[0] = 1
         return self._state
 
     @state.setter

@@ -142,7 +142,7 @@ def update_live(m, s, ws, margin, h):
     n = sweep_pairs(ws, margin, h, ws.live_pairs)
     for k in range(n):
         ws.pair_flag[ws.live_pairs[k]] = FLAG_LIVE
-        add_synced(ws, ws.live_pairs[k])     # (its slots may change: prev_copy.py)
+        add_synced(s, ws, ws.live_pairs[k])     # (its slots may change: prev_copy.py)
     for k in range(ws.n_live_pairs[0]):
         p = ws.last_pairs[k]
         if ws.pair_flag[p] == FLAG_WAS_LIVE:

@@ -15,8 +15,15 @@ ws.prev:
   since (ws.sync_pairs: update_live adds each pair it lists that is not there yet).
 
 Whatever changes the State otherwise sets ws.prev_whole, and the next copy takes every slot:
-a state put in or handed out by Simulator (its `state` and the pairs forgotten, state.py), a
-step begun again from ws.start, the step's impulses forgotten (step.forget_impulses).
+each call from Python (link/step.py: run_steps and run_recorded set it as they begin and
+as they return, step_entry as it returns: the State may be put in or changed in place
+between calls), a step begun again from ws.start, the step's
+impulses forgotten (step.forget_impulses). So within one call of Simulator.steps(n) the steps
+after the first copy only the listed slots; Simulator.step() copies them all. A pair that
+joins the list has its slots copied into ws.prev as they are then (add_synced): a compiled
+loop of one's own that changes the State between its calls of `step` thus still begins a
+step again from what it put in; only ws.prev's pairs never listed since (an error's
+last_state) may miss such a change, unless the loop sets ws.prev_whole[0] = 1.
 """
 from ..compile import kernel
 
@@ -102,12 +109,16 @@ def list_synced(ws):
 
 
 @kernel
-def add_synced(ws, p):
-    """Pair p (its slot-0 contact) listed: into ws.sync_pairs unless there already."""
+def add_synced(s, ws, p):
+    """Pair p (its slot-0 contact) listed: into ws.sync_pairs unless there already, its slots
+    copied into ws.prev as they are (the step has not changed them since its start: a change
+    put in from outside between steps is then kept if the step begins again)."""
     if ws.pair_synced[p] == 0:
         ws.pair_synced[p] = 1
         ws.sync_pairs[ws.n_sync_pairs[0]] = p
         ws.n_sync_pairs[0] += 1
+        _copy_slot(s, ws.prev, p)
+        _copy_slot(s, ws.prev, p + 1)
 
 
 @kernel

@@ -445,7 +445,7 @@ def begin_again_from(s, ws, start):
 
 
 @kernel
-def _pairs_back(ws):
+def _pairs_back(s, ws):
     """The broad phase's pair list as it was at the step's start (keep_pairs)."""
     for k in range(ws.n_live_pairs[0]):
         ws.pair_flag[ws.last_pairs[k]] = 0
@@ -453,7 +453,7 @@ def _pairs_back(ws):
     for k in range(n):
         ws.last_pairs[k] = ws.start_pairs[k]
         ws.pair_flag[ws.start_pairs[k]] = FLAG_LIVE
-        add_synced(ws, ws.start_pairs[k])
+        add_synced(s, ws, ws.start_pairs[k])
     ws.n_live_pairs[0] = n
 
 
@@ -462,14 +462,14 @@ def put_back(s, ws):
     """A step that ran out of room (GUARD_ROOM) undone: the State at its start (ws.prev),
     the audit's counts and the broad phase's pair list (keep_pairs) as they were."""
     begin_again(s, ws)
-    _pairs_back(ws)
+    _pairs_back(s, ws)
 
 
 @kernel
 def put_back_from(s, ws, start):
     """put_back from `start` (ws.start: the start of a step taken in sub-steps)."""
     begin_again_from(s, ws, start)
-    _pairs_back(ws)
+    _pairs_back(s, ws)
 
 
 @kernel(inline="never")

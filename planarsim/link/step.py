@@ -92,17 +92,25 @@ class StepArgs(NamedTuple):
 @jit
 def run_steps(args, u, n):
     """n steps of StepArgs args under commands u; returns (guard code, steps completed)."""
+    # each call's first step keeps every contact slot as its start, and so does the step
+    # after it returns: the State may be changed in place between calls (prev_copy.py)
+    args.ws.prev_whole[0] = 1
+    code, done = 0, n
     for k in range(n):
         code = step(args.m, args.s, args.ws, args.opt, u)
         if code != 0:
-            return code, k
-    return 0, n
+            done = k
+            break
+    args.ws.prev_whole[0] = 1
+    return code, done
 
 
 @jit
 def step_entry(m, s, ws, opt, u):
     """`step` callable from Python (step itself is an intrinsic that only compiled code calls)."""
-    return step(m, s, ws, opt, u)
+    code = step(m, s, ws, opt, u)
+    ws.prev_whole[0] = 1           # (the State may be changed before the next: prev_copy.py)
+    return code
 
 
 # step_from_python's bound entries, by the identity of (model arrays, state, workspace):
@@ -156,13 +164,16 @@ def run_recorded(m, s, ws, opt, u, n, every, rec, k0):
     """n steps under constant u, recording every `every`-th step into rec from frame k0.
     Returns (guard code, steps completed, next frame index)."""
     k = k0
+    ws.prev_whole[0] = 1           # (as run_steps: the State may be changed between calls)
     for i in range(n):
         code = step(m, s, ws, opt, u)
         if code != 0:
+            ws.prev_whole[0] = 1
             return code, i, k
         if (s.step[0] % every) == 0 and k < rec.t.shape[0]:
             record_frame(s, ws, rec, k)
             k += 1
+    ws.prev_whole[0] = 1
     return 0, n, k
 
 
