@@ -209,6 +209,18 @@ def chain_velocity_solve(m, ws, h):
     return share
 
 
+@kernel(inline="always")
+def _chain_pass(m, s, ws, n, h):
+    """One correction pass on the factors in ws: mu from the targets in ws.rhs, q += W J(q0)^T
+    mu, v += W J(q0)^T mu / h, the bodies' cos / sin at the new q."""
+    chain_solve(ws, ws.rhs, ws.lam)
+    add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                 s.q, 1.0)
+    add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
+                 s.v, 1.0 / h)
+    update_trig(s.q, ws.body_cs)
+
+
 @kernel
 def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
     """Stage 8's Newton-SHAKE on the chains: up to iters passes of J(q) W J(q0)^T mu = -c(q),
@@ -228,12 +240,7 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
             break
         if fresh and chain_factor(m, ws, ws.row_Jp, ws.row_J, False) <= pivot_tol:
             return -1.0
-        chain_solve(ws, ws.rhs, ws.lam)
-        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
-                     s.q, 1.0)
-        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
-                     s.v, 1.0 / h)
-        update_trig(s.q, ws.body_cs)
+        _chain_pass(m, s, ws, n, h)
         after = chain_residual(m, s, ws, False)
         if after > STALLED_RATIO * worst:
             return -1.0
@@ -245,10 +252,5 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
     if passes > 0 and 0.0 < worst <= tol:
         # one more pass on the last factorisation, as integrate.correct_positions takes it
         # (it says why: the end's derivative becomes the converged correction's)
-        chain_solve(ws, ws.rhs, ws.lam)
-        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
-                     s.q, 1.0)
-        add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
-                     s.v, 1.0 / h)
-        update_trig(s.q, ws.body_cs)
+        _chain_pass(m, s, ws, n, h)
     return worst
