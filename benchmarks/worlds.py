@@ -19,7 +19,8 @@ Struck piles (--struck): a world that settles for SETTLE steps, then one box is 
 and the steps from there are timed as above ('first' is the step that meets the blow):
 pyramid20_thrown (the top box thrown up at 0.3 m/s: it leaves and lands about 60 ms later),
 pyramid20_pushed (the middle box of the third level pushed sideways at 0.5 m/s, into its
-neighbours). No growth is fitted.
+neighbours), and the same push on the 21- and 36-box pyramids (pyramid6_pushed,
+pyramid8_pushed). No growth is fitted.
 """
 from __future__ import annotations
 
@@ -103,6 +104,8 @@ def _push_third_level(q, v):
 
 # name -> (world, blow(q, v) applied after SETTLE steps)
 STRUCK = {
+    "pyramid6_pushed": (lambda: pyramid(6), _push_third_level),
+    "pyramid8_pushed": (lambda: pyramid(8), _push_third_level),
     "pyramid20_thrown": (lambda: pyramid(20), _throw_top),
     "pyramid20_pushed": (lambda: pyramid(20), _push_third_level),
 }
