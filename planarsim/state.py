@@ -427,9 +427,9 @@ class Workspace(NamedTuple):
     start_pairs: np.ndarray      # (n_pair,) int the listed pairs at the step's start (room[1])
     n_start_pairs: np.ndarray    # (1,) int how many
     prev_whole: np.ndarray       # (1,) int 1: the next copy of the State into prev copies every
-                                 #   contact slot (a state put in or handed out, a copy beside
-                                 #   prev's); 0: only the ground contacts' and sync_pairs' slots
-                                 #   (kernels/prev_copy.py)
+                                 #   contact slot (each call from Python begins and ends with
+                                 #   it set; a state put in; a step begun again from ws.start);
+                                 #   0: the ground contacts' and sync_pairs' slots (prev_copy.py)
     sync_pairs: np.ndarray       # (n_pair,) int the pairs (slot-0 contacts) listed at the last
                                  #   copy into prev and those listed since: the only pairs whose
                                  #   slots the State can have changed since (each once)

@@ -434,6 +434,17 @@ def max_residual(m, s, ws):
 
 
 @kernel(inline="always")
+def keep_targets(ws, n):
+    """ws.row_c <- the correction's targets -c in ws.rhs (rows 0..n-1; row_c is free then),
+    kept for its velocity solve; returns how many rows are unilateral."""
+    unilateral = 0
+    for r in range(n):
+        ws.row_c[r] = ws.rhs[r]
+        unilateral += is_unilateral(ws.row_kind[r])
+    return unilateral
+
+
+@kernel(inline="always")
 def move_by_correction(m, s, ws, h, n, unilateral):
     """Move the bodies by the correction whose matrix ws holds factored and whose targets -c
     are in ws.rhs (ws.row_c: a copy of them): positions by W J^T lam, velocities by the same
@@ -497,10 +508,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 ws.q_keep[i, k] = s.q[i, k]
                 ws.v_keep[i, k] = s.v[i, k]
-        unilateral = 0
-        for r in range(n):
-            ws.row_c[r] = ws.rhs[r]   # -c(q+), kept for the velocity solve (row_c is free now)
-            unilateral += is_unilateral(ws.row_kind[r])
+        unilateral = keep_targets(ws, n)
         normals_now(m, ws, n)
         assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
         correction_compliance(ws, n)
@@ -540,10 +548,6 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         # derivatives.step_jacobian, exact for the converged correction, would disagree by)
         # and by about the square of that after this one. The residual returned is the one
         # before this step (it only shrinks).
-        unilateral = 0
-        for r in range(n):
-            ws.row_c[r] = ws.rhs[r]
-            unilateral += is_unilateral(ws.row_kind[r])
-        move_by_correction(m, s, ws, h, n, unilateral)
+        move_by_correction(m, s, ws, h, n, keep_targets(ws, n))
         update_trig(s.q, ws.body_cs)
     return worst

@@ -41,22 +41,28 @@ def _copy2(src, dst):
             dst[i, k] = src[i, k]
 
 
-@kernel(inline="always")
-def copy_state(src, dst):
-    """dst <- src, array by array (dst is a State of the same shapes; no allocation)."""
+@kernel
+def _copy_all_but_slots(src, dst):
+    """dst <- src on every array but the contact slots' (bodies, time, joints, forces)."""
     _copy2(src.q, dst.q)
     _copy2(src.v, dst.v)
     _copy1(src.time, dst.time)
     _copy1(src.step, dst.step)
-    _copy1(src.contact_mode, dst.contact_mode)
-    _copy1(src.contact_slip, dst.contact_slip)
-    _copy1(src.contact_enabled, dst.contact_enabled)
     _copy2(src.limit_active, dst.limit_active)
     _copy1(src.mode_cursor, dst.mode_cursor)
     _copy2(src.ext_force, dst.ext_force)
-    _copy2(src.last_contact_impulse, dst.last_contact_impulse)
     _copy2(src.last_pin_impulse, dst.last_pin_impulse)
     _copy1(src.last_rod_impulse, dst.last_rod_impulse)
+
+
+@kernel(inline="always")
+def copy_state(src, dst):
+    """dst <- src, array by array (dst is a State of the same shapes; no allocation)."""
+    _copy_all_but_slots(src, dst)
+    _copy1(src.contact_mode, dst.contact_mode)
+    _copy1(src.contact_slip, dst.contact_slip)
+    _copy1(src.contact_enabled, dst.contact_enabled)
+    _copy2(src.last_contact_impulse, dst.last_contact_impulse)
     _copy1(src.contact_feature, dst.contact_feature)
     _copy1(src.contact_dependent, dst.contact_dependent)
 
@@ -77,15 +83,7 @@ def _copy_slot(src, dst, c):
 def _copy_listed(src, dst, ws):
     """dst <- src where they can differ (the module's docstring): every array but the
     contact slots, which are copied at the ground contacts and the slots of ws.sync_pairs."""
-    _copy2(src.q, dst.q)
-    _copy2(src.v, dst.v)
-    _copy1(src.time, dst.time)
-    _copy1(src.step, dst.step)
-    _copy2(src.limit_active, dst.limit_active)
-    _copy1(src.mode_cursor, dst.mode_cursor)
-    _copy2(src.ext_force, dst.ext_force)
-    _copy2(src.last_pin_impulse, dst.last_pin_impulse)
-    _copy1(src.last_rod_impulse, dst.last_rod_impulse)
+    _copy_all_but_slots(src, dst)
     for k in range(ws.ground_contacts.shape[0]):
         _copy_slot(src, dst, ws.ground_contacts[k])
     for k in range(ws.n_sync_pairs[0]):
