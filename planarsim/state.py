@@ -445,6 +445,8 @@ class Workspace(NamedTuple):
                                  #   place k: its pivot's inverse, A[k, k - 1] P_{k-1}^-1, A[k - 1, k]
                                  #   (2 x 2 each, row-major)
     chain_y: np.ndarray          # (n_pin, 2) scratch of the block substitution
+    chain_cs: np.ndarray         # (n_body, 3) cos, sin, angle carried through the path's step
+                                 #   (pin_chain.carry_trig; read within a step only)
     start: State                 # the step's start while it is taken in sub-steps (GUARD_ROOM
                                  #   puts it back; kernels/step.py)
     prev: State                  # the state at the start of the last step (for guard errors)
@@ -805,4 +807,5 @@ def _chain_arrays(model: Model) -> dict:
     order, ends = found if found is not None else (np.zeros(npin, np.int64),
                                                     np.full((npin, 2), -1, np.int64))
     return dict(chain_on=np.array([int(found is not None)], np.int64), chain_pin=order,
-                chain_end=ends, chain_factor=np.zeros((npin, 12)), chain_y=np.zeros((npin, 2)))
+                chain_end=ends, chain_factor=np.zeros((npin, 12)), chain_y=np.zeros((npin, 2)),
+                chain_cs=np.full((model.n_body, 3), np.nan))

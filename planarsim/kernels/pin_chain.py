@@ -16,7 +16,14 @@ Newton-SHAKE (q moved along the start's rows, J(q+) W J(q0)^T mu = -c(q+)), whos
 passes reuse the factorisation of an earlier one once every row is within CHORD_TOL (a chord
 step: the rows moved by less than that since, so each pass still removes all but a share of
 that order of the error). Both end where the general stages end, to rounding.
+
+Within a step the bodies' (cos, sin) are carried from the step's start through each turn
+(carry_trig, in Workspace.chain_cs) rather than computed afresh at every configuration; the
+step ends with them computed afresh at its end (update_trig), so that a step depends on the
+State alone.
 """
+import math
+
 from ..compile import kernel
 from .codes import ROW_PIN_X, ROW_PIN_Y
 from .integrate import STALLED_RATIO
@@ -26,6 +33,48 @@ from .solve import add_impulses
 
 # [m] every row within this after a correction pass: the next reuses the factorisation
 CHORD_TOL = 1e-9
+# [rad] a body's (cos, sin) is carried through a turn of at most this by turn_by (the series'
+# first left-out terms, d^9 / 9! and d^10 / 10!, are below 1e-21); beyond, computed afresh
+SERIES_TURN = 0.02
+
+
+@kernel(inline="always")
+def turn_by(c, s, d):
+    """(cos, sin) of an angle with cosine c and sine s turned by d [rad] (|d| <= SERIES_TURN):
+    each less its change, 1 - cos d and sin d by their Taylor series to d^8 and d^7
+    (multiplications only: the loops over bodies vectorise)."""
+    d2 = d * d
+    one_less_cos = 0.5 * d2 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (
+        1.0 - d2 * (1.0 / 56.0))))
+    sin_d = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))))
+    return c - (c * one_less_cos + s * sin_d), s - (s * one_less_cos - c * sin_d)
+
+
+@kernel
+def carry_trig(q, cs_from, cs_to):
+    """cs_to[i] = (cos, sin, angle) of q[i, 2], carried from cs_from[i] (the same of a nearby
+    angle; cs_to may be cs_from) by turn_by, or computed afresh for a turn beyond SERIES_TURN
+    (or a NaN): one loop without calls, then the few far turns. Within a step only: the
+    carried values differ from math.cos / sin in the last bits, so the step ends with
+    update_trig's (the next step must not depend on them)."""
+    far = 0
+    for i in range(q.shape[0]):
+        th = q[i, 2]
+        d = th - cs_from[i, 2]
+        c, sn = turn_by(cs_from[i, 0], cs_from[i, 1], d)
+        near = abs(d) <= SERIES_TURN
+        far += not near
+        cs_to[i, 0] = c
+        cs_to[i, 1] = sn
+        cs_to[i, 2] = th if near else math.nan
+    if far == 0:
+        return
+    for i in range(q.shape[0]):
+        if not cs_to[i, 2] == q[i, 2]:
+            th = q[i, 2]
+            cs_to[i, 0] = math.cos(th)
+            cs_to[i, 1] = math.sin(th)
+            cs_to[i, 2] = th
 
 
 @kernel(inline="always")
@@ -147,7 +196,7 @@ def chain_solve(ws, rhs, x):
 @kernel
 def chain_rows(m, s, ws):
     """Stage 3 on the chains: pin j's rows 2j (x) and 2j + 1 (y), their Jacobian blocks and
-    errors at q (ws.body_cs its cos / sin) and their errors at q_pred (ws.cs_pred): the rows
+    errors at q (ws.body_cs its cos / sin) and their errors at q_pred (ws.chain_cs): the rows
     rows.build_rows makes for such a model (but row_F, which this path does not read)."""
     n_pin = m.pin_body.shape[0]
     for j in range(n_pin):
@@ -163,16 +212,26 @@ def chain_rows(m, s, ws):
         ws.row_body[r + 1, 0] = a
         ws.row_body[r + 1, 1] = b
         pin_rows(s.q, ws.body_cs, m.pin_anchor, j, a, b, ws.row_J, ws.row_c, r)
-        gx, gy = pin_gap(ws.q_pred, ws.cs_pred, m.pin_anchor, j, a, b)
+        gx, gy = pin_gap(ws.q_pred, ws.chain_cs, m.pin_anchor, j, a, b)
         ws.row_c_pred[r] = gx
         ws.row_c_pred[r + 1] = gy
     ws.n_row[0] = 2 * n_pin
 
 
 @kernel
+def chain_prediction(s, ws, h):
+    """ws.q_pred = q + h v_lin (integrate.predict_configuration) and its cos / sin carried from
+    q's (ws.body_cs) into ws.chain_cs."""
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            ws.q_pred[i, k] = s.q[i, k] + h * ws.v_lin[i, k]
+    carry_trig(ws.q_pred, ws.body_cs, ws.chain_cs)
+
+
+@kernel
 def chain_residual(m, s, ws, jacobian):
     """The pins' errors c at q as the correction's targets, ws.rhs = -c (and, jacobian, their
-    rows' Jacobian blocks into ws.row_Jp); returns the largest |c| [m]. ws.body_cs must hold
+    rows' Jacobian blocks into ws.row_Jp); returns the largest |c| [m]. ws.chain_cs must hold
     q's cos / sin."""
     worst = 0.0
     for j in range(m.pin_body.shape[0]):
@@ -180,11 +239,11 @@ def chain_residual(m, s, ws, jacobian):
         a = m.pin_body[j, 0]
         b = m.pin_body[j, 1]
         if jacobian:
-            pin_rows(s.q, ws.body_cs, m.pin_anchor, j, a, b, ws.row_Jp, ws.rhs, r)
+            pin_rows(s.q, ws.chain_cs, m.pin_anchor, j, a, b, ws.row_Jp, ws.rhs, r)
             gx = ws.rhs[r]
             gy = ws.rhs[r + 1]
         else:
-            gx, gy = pin_gap(s.q, ws.body_cs, m.pin_anchor, j, a, b)
+            gx, gy = pin_gap(s.q, ws.chain_cs, m.pin_anchor, j, a, b)
         ws.rhs[r] = -gx
         ws.rhs[r + 1] = -gy
         worst = max(worst, abs(gx), abs(gy))
@@ -212,13 +271,13 @@ def chain_velocity_solve(m, ws, h):
 @kernel(inline="always")
 def _chain_pass(m, s, ws, n, h):
     """One correction pass on the factors in ws: mu from the targets in ws.rhs, q += W J(q0)^T
-    mu, v += W J(q0)^T mu / h, the bodies' cos / sin at the new q."""
+    mu, v += W J(q0)^T mu / h, the bodies' cos / sin at the new q carried (ws.chain_cs)."""
     chain_solve(ws, ws.rhs, ws.lam)
     add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
                  s.q, 1.0)
     add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
                  s.v, 1.0 / h)
-    update_trig(s.q, ws.body_cs)
+    carry_trig(s.q, ws.chain_cs, ws.chain_cs)
 
 
 @kernel
@@ -229,9 +288,10 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
     the largest row error left, or -1 where a pass removed less than half of it or a
     factorisation kept a pivot share at or below pivot_tol (StepOptions.refine_pivot_tol:
     the general correction would drop that row; its safeguards then decide, the step is
-    taken by the general stages)."""
+    taken by the general stages). ws.body_cs holds the cos / sin of the step's start on entry,
+    of q on return."""
     n = ws.n_row[0]
-    update_trig(s.q, ws.body_cs)
+    carry_trig(s.q, ws.body_cs, ws.chain_cs)
     worst = chain_residual(m, s, ws, True)
     fresh = True
     passes = 0
@@ -253,4 +313,5 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
         # one more pass on the last factorisation, as integrate.correct_positions takes it
         # (it says why: the end's derivative becomes the converged correction's)
         _chain_pass(m, s, ws, n, h)
+    update_trig(s.q, ws.body_cs)
     return worst

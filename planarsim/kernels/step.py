@@ -35,7 +35,7 @@ from .math2d import update_trig
 from .modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .pair import PAIR_MARGIN
-from .pin_chain import chain_correct, chain_rows, chain_velocity_solve
+from .pin_chain import chain_correct, chain_prediction, chain_rows, chain_velocity_solve
 from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev
 from .pair_toi import hold_off_fast_pairs
 from .position import ROWS_HELD_SHARE, position_stage
@@ -683,7 +683,7 @@ def chain_part(m, s, ws, opt, u, h):
         return CHAIN_GENERAL
     predict_velocity(m, s, ws, h)
     soft_prediction(m, s, ws, h)                            #    (v_lin = v*)
-    predict_configuration(m, s, ws, h)
+    chain_prediction(s, ws, h)
     ws.joint_gain[2] = 0.0                                  # 3-4. rows, impulses
     ws.least_change[0] = 0
     ws.least_change[1] = 0
