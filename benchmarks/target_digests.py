@@ -1,5 +1,6 @@
 """The same numbers on every machine: bit-level fingerprints of the shipped walkers
-(walker_digests.py) and of a fixed set of stress-corpus runs (contact_stress.py), computed in
+(walker_digests.py), of a fixed set of stress-corpus runs (contact_stress.py) and of two pin
+chains (the step's pin-chain path), computed in
 fresh processes with numba's code generated for this CPU, for a generic x86-64 target
 (NUMBA_CPU_NAME=generic: no AVX, no FMA; numba then sets NUMBA_CPU_FEATURES to none), and
 with 1 and 2 threads (NUMBA_NUM_THREADS, OPENBLAS_NUM_THREADS), and with numpy's BLAS on its
@@ -48,6 +49,10 @@ CORPUS = (("biped_stance", 0), ("biped_collapse", 1), ("chain_hills", 2), ("mass
           ("shape_pile", 4), ("shape_hills", 5), ("loop_inertia", 36), ("loop_inertia", 162),
           ("hills_fast", 7), ("ranger_loop", 2))
 
+#: pin chains fingerprinted (benchmarks.scenes.chain: links, steps), whose steps the pin-chain
+#: path takes (kernels/pin_chain.py; the walkers and the corpus runs all have contacts)
+CHAINS = ((4, 2000), (16, 2000))
+
 
 #: simulated time per walker [s] of the committed baseline
 BASELINE_SECONDS = 1.0
@@ -82,13 +87,33 @@ def corpus_lines():
         yield f"{family:14s} {seed:4d} {digest(np.array(frames))} steps {len(frames) - 1} {end}"
 
 
+def chain_lines():
+    """One line per CHAINS run: a digest of every step's q and v and how many steps the
+    pin-chain path took."""
+    import numpy as np
+
+    import planarsim as ps
+    from benchmarks.scenes import chain
+    from benchmarks.walker_digests import digest
+    from planarsim.compiled import step_info
+    for links, steps in CHAINS:
+        sim = ps.Simulator(chain(links))
+        frames, taken = [np.concatenate([sim.state.q, sim.state.v])], 0
+        for _ in range(steps):
+            sim.step()
+            taken += step_info(sim.ws)["chain_path"]
+            frames.append(np.concatenate([sim.state.q, sim.state.v]))
+        yield f"chain{links:<13d} {digest(np.array(frames))} steps {steps} chain path {taken}"
+
+
 def fingerprints(seconds):
-    """This process's fingerprints: walker_digests' lines, then corpus_lines'."""
+    """This process's fingerprints: walker_digests' lines, then corpus_lines', then
+    chain_lines'."""
     from benchmarks import walker_digests
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         walker_digests.main(["--seconds", str(seconds)])
-    return out.getvalue().splitlines() + list(corpus_lines())
+    return out.getvalue().splitlines() + list(corpus_lines()) + list(chain_lines())
 
 
 def run(settings, seconds):

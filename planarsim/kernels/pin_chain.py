@@ -34,7 +34,8 @@ from .solve import add_impulses
 # [m] every row within this after a correction pass: the next reuses the factorisation
 CHORD_TOL = 1e-9
 # [rad] a body's (cos, sin) is carried through a turn of at most this by turn_by (the series'
-# first left-out terms, d^9 / 9! and d^10 / 10!, are below 1e-21); beyond, computed afresh
+# first left-out terms, d^9 / 9! and d^10 / 10!, are at most 1.4e-21; each carry's rounding,
+# about an ulp, is what remains); beyond, computed afresh
 SERIES_TURN = 0.02
 
 
@@ -269,14 +270,38 @@ def chain_velocity_solve(m, ws, h):
 
 
 @kernel(inline="always")
+def _move_by(m, ws, n, q, v, inv_h):
+    """q += W J(q0)^T mu and v += W J(q0)^T mu / h (mu in ws.lam, J(q0) ws.row_J) in one sweep
+    of the rows: solve.add_impulses' arithmetic for each, the same bits."""
+    for r in range(n):
+        mu = ws.lam[r]
+        if mu == 0.0:
+            continue
+        rate = mu * inv_h
+        for e in range(2):
+            b = ws.row_body[r, e]
+            if b < 0:
+                continue
+            wm = m.body_inv_mass[b]
+            wi = m.body_inv_inertia[b]
+            dx = wm * ws.row_J[r, e, 0]
+            dy = wm * ws.row_J[r, e, 1]
+            dt = wi * ws.row_J[r, e, 2]
+            q[b, 0] += dx * mu
+            q[b, 1] += dy * mu
+            q[b, 2] += dt * mu
+            if rate != 0.0:     # (as add_impulses skips a row whose scaled impulse is 0)
+                v[b, 0] += dx * rate
+                v[b, 1] += dy * rate
+                v[b, 2] += dt * rate
+
+
+@kernel(inline="always")
 def _chain_pass(m, s, ws, n, h):
     """One correction pass on the factors in ws: mu from the targets in ws.rhs, q += W J(q0)^T
     mu, v += W J(q0)^T mu / h, the bodies' cos / sin at the new q carried (ws.chain_cs)."""
     chain_solve(ws, ws.rhs, ws.lam)
-    add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
-                 s.q, 1.0)
-    add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
-                 s.v, 1.0 / h)
+    _move_by(m, ws, n, s.q, s.v, 1.0 / h)
     carry_trig(s.q, ws.chain_cs, ws.chain_cs)
 
 
@@ -289,7 +314,7 @@ def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
     factorisation kept a pivot share at or below pivot_tol (StepOptions.refine_pivot_tol:
     the general correction would drop that row; its safeguards then decide, the step is
     taken by the general stages). ws.body_cs holds the cos / sin of the step's start on entry,
-    of q on return."""
+    of q on a return >= 0 (on -1, still the start's)."""
     n = ws.n_row[0]
     carry_trig(s.q, ws.body_cs, ws.chain_cs)
     worst = chain_residual(m, s, ws, True)
