@@ -1,33 +1,35 @@
 """Exact derivatives of one step: step_jacobian(sim, u); along a rollout: rollout_jacobians.
 
 The default step (symplectic Euler with SHAKE, docs/engine.md) of a mechanism held by hinges
-ends at
+and sliders ends at
 
     q1 = q + h v + h^2 W f(q, u) + W P^T L,   c(q1) = 0,   v1 = (q1 - q) / h,
 
 with W the inverse of the bodies' masses and the hinges' rotors (M + A, A = sum a g^T g over
-the joints' armature a and rate rows g), P = dc/dq at the step's start and L the step's total
-impulse of the hinges' rows (the velocity solve's and the position correction's together:
-both act along W P^T, and the Newton correction ends where c(q1) = 0). Within its modes the
-step is smooth, and the implicit function theorem on c(q1) = 0 gives its derivative
-exactly:
+the joints' armature a and rate rows g), c the joints' equality rows (a hinge's x and y, a
+slider's perpendicular and angle rows), P = dc/dq at the step's start and L the step's total
+impulse of those rows (the velocity solve's and the position correction's together: both act
+along W P^T, and the Newton correction ends where c(q1) = 0). Within its modes the step is
+smooth, and the implicit function theorem on c(q1) = 0 gives its derivative exactly:
 
     dq1 = (I - W P^T S G) (dq + h dv + h^2 W (K dq + F du) + W H dq),   S = (G W P^T)^-1,
     dv1 = (dq1 - dq) / h,
 
 with G = dc/dq at q1, K = df/dq (the joints' springs), F = df/du and H = d(P^T L)/dq (the
-hinges' curvature under the step's impulse: the anchors turn with their bodies). L is read
-back from the step's own answer (the engine's step is taken once, on a snapshot, and `sim`
-is restored); a step that did not end as that equation says (sub-steps, a correction held
-back by the energy bound) raises instead of giving a derivative of a different map.
+rows' curvature under the step's impulse: the anchors turn with their bodies, a slider's axis
+with its body a). L is read back from the step's own answer (the engine's step is taken once,
+on a snapshot, and `sim` is restored); a step that did not end as that equation says
+(sub-steps, a correction held back by the energy bound) raises instead of giving a derivative
+of a different map.
 
-Covered so far: bodies held by hinges (pins) to each other and the world, with armature and
-springs the step resolves (taken at the step's start: kernels/soft.py with a rotor,
-kernels/forces.py spring_as_force without), under gravity, constant pushes and pin torques,
-body forces and body torques. Refused with a NotImplementedError naming the feature:
-sliders, rods, joint limits, dampers, dry friction, springs too stiff for the step,
-contacts and shape pairs that touch in the step, fluid drag, the other actuator kinds, the
-accurate integrators.
+Covered so far: bodies held by hinges (pins) and sliders to each other and the world, with
+joint limits the step does not reach, the hinges' armature and springs the step resolves
+(taken at the step's start: kernels/soft.py with a rotor, kernels/forces.py spring_as_force
+without), under gravity, constant pushes and pin torques, body forces and body torques.
+Refused with a NotImplementedError naming the feature: a slider's armature or spring (its
+rate row turns with body a), rods, a limit reached in the step, dampers, dry friction,
+springs too stiff for the step, contacts and shape pairs that touch in the step, fluid drag,
+the other actuator kinds (slider forces among them), the accurate integrators.
 """
 from __future__ import annotations
 
@@ -35,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kernels.codes import INTEGRATOR_EULER, JOINT_HINGE, MODE_FREE
+from .kernels.codes import INTEGRATOR_EULER, JOINT_HINGE, JOINT_SLIDER, MODE_FREE
 from .kernels.forces import ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
 
@@ -64,10 +66,10 @@ class StepJacobian:
     x1: np.ndarray
 
 
-#: [m] the hinges' gap at the step's end below which the step counts as closing them (the
+#: [m, rad] the joints' gap at the step's end below which the step counts as closing them (the
 #: derivative assumes c(q1) = 0; the default correction ends near 1e-15 m)
 PINS_CLOSED_TOL = 1e-10
-#: (G W P^T)'s condition number above which the hinges count as dependent (an over-
+#: (G W P^T)'s condition number above which the joints count as dependent (an over-
 #: constrained loop: the step is not smooth there)
 DEPENDENT_COND = 1e10
 
@@ -75,8 +77,8 @@ DEPENDENT_COND = 1e10
 def _not_covered(what):
     return NotImplementedError(
         f"step_jacobian covers mechanisms of hinges (with armature and springs the step "
-        f"resolves) under gravity, pushes and pin / body torques and body forces so far; this "
-        f"step has {what}")
+        f"resolves) and sliders (without), with limits the step does not reach, under "
+        f"gravity, pushes and pin / body torques and body forces so far; this step has {what}")
 
 
 def check_covered(model, options, h) -> None:
@@ -92,14 +94,20 @@ def check_covered(model, options, h) -> None:
     if a.fluid_body.shape[0]:
         raise _not_covered("fluid drag")
     for j, name in enumerate(model.pin_names):
-        if a.pin_kind[j] != JOINT_HINGE:
-            raise _not_covered(f"joint {name!r}, which is not a hinge (kind {int(a.pin_kind[j])})")
+        kind = int(a.pin_kind[j])
+        if kind not in (JOINT_HINGE, JOINT_SLIDER):
+            raise _not_covered(f"joint {name!r}, which is neither a hinge nor a slider (kind "
+                               f"{kind}: a free body's coordinate)")
         for field, label in (("pin_damping", "a damper"), ("pin_frictionloss", "dry friction")):
             if getattr(a, field)[j] != 0.0:
                 raise _not_covered(f"{label} on joint {name!r}")
-        if a.pin_limit[j, 0] > -np.inf or a.pin_limit[j, 1] < np.inf:
-            raise _not_covered(f"limits on joint {name!r}")
         k, arm = a.pin_stiffness[j], a.pin_armature[j]
+        if kind == JOINT_SLIDER:
+            # (its rate row turns with body a: the rotor and the spring would depend on q)
+            if k != 0.0 or arm != 0.0:
+                raise _not_covered(f"{'a spring' if k != 0.0 else 'armature'} on slider "
+                                   f"{name!r}")
+            continue
         if k > 0.0:
             kappa = sum(a.body_inv_inertia[b] for b in a.pin_body[j] if b >= 0)
             resolved = h * h * k * kappa / (1.0 + arm * kappa)
@@ -121,6 +129,8 @@ def rotor_terms(model, q):
     K = np.zeros((3 * n, 3 * n))
     f = np.zeros(3 * n)
     for j in range(model.n_pin):
+        if a.pin_kind[j] != JOINT_HINGE:
+            continue                    # (a slider without rotor or spring: check_covered)
         g = np.zeros(3 * n)
         for e, sign in ((0, -1.0), (1, 1.0)):
             b = a.pin_body[j, e]
@@ -137,19 +147,29 @@ def rotor_terms(model, q):
     return W, f, K
 
 
-def hinge_terms(model, q, impulse=None):
-    """The hinges' errors c (2 n_pin,) [m] and Jacobian J (2 n_pin, 3 n_body) at q (n_body, 3)
-    (rows x and y of each pin: anchor b minus anchor a, as kernels/pin.py); with `impulse`
-    (2 n_pin,) [N s] also H (3 n_body, 3 n_body) = d (J^T impulse) / dq."""
+def joint_terms(model, q, impulse=None):
+    """The joints' errors c (2 n_pin,) [m, rad] and Jacobian J (2 n_pin, 3 n_body) at q
+    (n_body, 3): rows 2j and 2j + 1 of joint j, a hinge's x and y (anchor b minus anchor a,
+    as kernels/pin.py), a slider's perpendicular and angle rows (kernels/slider.py); with
+    `impulse` (2 n_pin,) [N s, N m s] also H (3 n_body, 3 n_body) = d (J^T impulse) / dq, the
+    rows' curvature (J is each row's gradient, so H is the impulse-weighted sum of their
+    Hessians)."""
     a = model.arrays
-    n, p = q.shape[0], model.n_pin
-    c = np.zeros(2 * p)
-    J = np.zeros((2 * p, 3 * n))
+    n = q.shape[0]
+    c = np.zeros(2 * model.n_pin)
+    J = np.zeros((2 * model.n_pin, 3 * n))
     H = np.zeros((3 * n, 3 * n)) if impulse is not None else None
-    rows = np.arange(p)
+    _joint_terms(a, q, np.flatnonzero(a.pin_kind == JOINT_HINGE), c, J, H, impulse)
+    for j in np.flatnonzero(a.pin_kind == JOINT_SLIDER):
+        _slider_terms(a, q, int(j), c, J, H, impulse)
+    return c, J, H
+
+
+def _joint_terms(a, q, rows, c, J, H, impulse):
+    """joint_terms' rows of the hinges `rows` (vectorised over them)."""
     for e, sign in ((0, -1.0), (1, 1.0)):
-        body = a.pin_body[:, e]
-        ax, ay = a.pin_anchor[:, e, 0], a.pin_anchor[:, e, 1]
+        body = a.pin_body[rows, e]
+        ax, ay = a.pin_anchor[rows, e, 0], a.pin_anchor[rows, e, 1]
         moving = body >= 0
         b = np.where(moving, body, 0)
         th = np.where(moving, q[b, 2], 0.0)
@@ -170,7 +190,57 @@ def hinge_terms(model, q, impulse=None):
             lx, ly = impulse[2 * m], impulse[2 * m + 1]
             np.add.at(H, (3 * bm + 2, 3 * bm + 2),
                       -sign * (rx[moving] * lx + ry[moving] * ly))
-    return c, J, H
+
+
+def _turned(theta, x, y):
+    """(x, y) turned by theta [rad]."""
+    cs, sn = np.cos(theta), np.sin(theta)
+    return np.array([cs * x - sn * y, sn * x + cs * y])
+
+
+def _slider_terms(a, q, j, c, J, H, impulse):
+    """joint_terms' rows of slider j: c_perp = n.(p_b - p_a) with d = R(theta_a) d0, n = (-d_y,
+    d_x), and c_angle = theta_b - theta_a - ref. n.R(theta_a) r_a is constant, so c_perp =
+    n.(x_b - x_a) + n.R(theta_b) r_b + const: its Hessian has the terms theta_a theta_a
+    -n.(p_b - x_a), theta_a x_b -d, theta_a x_a +d, theta_a theta_b -d.perp(R r_b), theta_b
+    theta_b -n.R r_b (dn / dtheta_a = -d); the angle row is linear."""
+    ba, bb = int(a.pin_body[j, 0]), int(a.pin_body[j, 1])
+    r = 2 * j
+    if ba >= 0:
+        d = _turned(q[ba, 2], *a.pin_axis[j])
+        pa = q[ba, :2] + _turned(q[ba, 2], *a.pin_anchor[j, 0])
+    else:
+        d = np.asarray(a.pin_axis[j], dtype=float)
+        pa = np.asarray(a.pin_anchor[j, 0], dtype=float)
+    nrm = np.array([-d[1], d[0]])
+    arm_b = _turned(q[bb, 2], *a.pin_anchor[j, 1])
+    pb = q[bb, :2] + arm_b
+    c[r] = nrm @ (pb - pa)
+    c[r + 1] = q[bb, 2] - a.pin_ref[j] - (q[ba, 2] if ba >= 0 else 0.0)
+
+    def cross(u, w):
+        return u[0] * w[1] - u[1] * w[0]
+    J[r, 3 * bb:3 * bb + 2] += nrm
+    J[r, 3 * bb + 2] += cross(pb - q[bb, :2], nrm)
+    J[r + 1, 3 * bb + 2] += 1.0
+    if ba >= 0:
+        J[r, 3 * ba:3 * ba + 2] -= nrm
+        J[r, 3 * ba + 2] -= cross(pb - q[ba, :2], nrm)
+        J[r + 1, 3 * ba + 2] -= 1.0
+    if H is None:
+        return
+    lam = impulse[r]
+    tb = 3 * bb + 2
+    H[tb, tb] -= lam * (nrm @ arm_b)
+    if ba >= 0:
+        ta = 3 * ba + 2
+        H[ta, ta] -= lam * (nrm @ (pb - q[ba, :2]))
+        perp_b = np.array([-arm_b[1], arm_b[0]])
+        mixed = [(3 * bb, -d[0]), (3 * bb + 1, -d[1]), (3 * ba, d[0]), (3 * ba + 1, d[1]),
+                 (tb, -(d @ perp_b))]
+        for k, value in mixed:
+            H[ta, k] += lam * value
+            H[k, ta] += lam * value
 
 
 def force_terms(model, state, u):
@@ -245,17 +315,17 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     if substeps > 1 or splits > 0:
         raise _not_covered(f"a step taken in {max(substeps, 1)} sub-steps / {splits} "
                            f"time-of-impact splits")
-    gap = np.abs(hinge_terms(model, q1)[0]).max(initial=0.0)
+    gap = np.abs(joint_terms(model, q1)[0]).max(initial=0.0)
     if gap > PINS_CLOSED_TOL:
-        raise _not_covered(f"hinges left open by {gap:.3g} m at its end (the position "
+        raise _not_covered(f"joints left open by {gap:.3g} m at its end (the position "
                            f"correction's refine_tol or a stalled correction)")
     n = model.n_body
     f, F, saturated = force_terms(model, start, u)
     W, f_spring, K = rotor_terms(model, q0)
     free = q0.ravel() + h * v0.ravel() + h * h * (W @ (f + f_spring))
-    _, P, _ = hinge_terms(model, q0)
+    _, P, _ = joint_terms(model, q0)
     # the step's total impulse L from its answer: W P^T L = q1 - free (least squares; P has
-    # full row rank where the hinges are independent, checked below)
+    # full row rank where the joints are independent, checked below)
     move = q1.ravel() - free
     WPt = W @ P.T
     if P.shape[0]:
@@ -266,21 +336,21 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     scale = max(np.abs(move).max(initial=0.0), np.abs(q1 - q0).max(), h * np.abs(v0).max())
     rounding = 64 * eps * (np.abs(q0).max() + np.abs(move).max(initial=0.0))
     if np.abs(WPt @ L - move).max(initial=0.0) > FIT_TOL * scale + rounding:
-        raise _not_covered("an end that is not the hinges' SHAKE step q + h v + h^2 W f "
+        raise _not_covered("an end that is not the joints' SHAKE step q + h v + h^2 W f "
                            "+ W P^T L")
     secant = (q1.ravel() - q0.ravel()) / h
     if np.abs(v1.ravel() - secant).max() > FIT_TOL * (np.abs(secant).max() + np.abs(v0).max()) \
             + rounding / h:
         raise _not_covered("an end velocity other than (q1 - q) / h (the position "
                            "correction's velocity change held back by its energy bound)")
-    _, _, H = hinge_terms(model, q0, L)
-    _, G, _ = hinge_terms(model, q1)
+    _, _, H = joint_terms(model, q0, L)
+    _, G, _ = joint_terms(model, q1)
     nq = 3 * n
     eye = np.eye(nq)
     if G.shape[0]:
         GWP = G @ WPt
         if np.linalg.cond(GWP) > DEPENDENT_COND:
-            raise _not_covered("dependent hinges (an over-constrained loop): the step is not "
+            raise _not_covered("dependent joints (an over-constrained loop): the step is not "
                                "smooth there")
         S = np.linalg.solve(GWP, G)                # (G W P^T)^-1 G
         proj = eye - WPt @ S

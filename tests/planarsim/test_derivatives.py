@@ -113,7 +113,7 @@ def relative_error(exact, approx):
 
 
 #: the refusals that depend on the step taken, not on the model
-NOT_COVERED_STEPS = ("sub-steps", "end velocity other than", "not the hinges' SHAKE step")
+NOT_COVERED_STEPS = ("sub-steps", "end velocity other than", "not the joints' SHAKE step")
 
 
 def rotor_chain(masses, lengths, dt, rng):
@@ -195,6 +195,54 @@ def test_most_random_chains_are_covered(rotors, covered):
     assert count >= covered, count
 
 
+def slider_mechanism(masses, tilt, dt, armature):
+    """A cart on a world rail tilted by `tilt` [rad] (limits +-5 m), an arm hinged to it (with
+    armature, a pin motor), a block sliding along the arm in a groove that turns with it
+    (limits +-1 m) and hinged to it a pendulum (a body force and a body torque on it): both
+    kinds of slider, their limits out of reach, under gravity."""
+    b = ps.ModelBuilder(dt=dt)
+    m0, m1, m2, m3 = masses
+    cart = b.add_body("cart", mass=m0, inertia=m0 * 0.02, pos=(0.0, 0.0))
+    b.add_slider("rail", None, cart, axis=(np.cos(tilt), np.sin(tilt)), limit=(-5.0, 5.0))
+    arm = b.add_body("arm", mass=m1, inertia=m1 * 0.36 / 12, pos=(0.3, 0.0))
+    b.add_pin("shoulder", cart, arm, anchor_world=(0.0, 0.0), armature=armature)
+    b.add_pin_motor("motor", "shoulder")
+    block = b.add_body("block", mass=m2, inertia=m2 * 0.01, pos=(0.45, 0.05))
+    b.add_slider("groove", arm, block, axis=(1.0, 0.0), anchor_world=(0.45, 0.0),
+                 limit=(-1.0, 1.0))
+    bob = b.add_body("bob", mass=m3, inertia=m3 * 0.09 / 12, pos=(0.6, 0.05))
+    b.add_pin("elbow", block, bob, anchor_world=(0.45, 0.05))
+    b.add_body_force("push", bob, direction=(0.6, 0.8))
+    b.add_body_torque("twist", bob)
+    return b.compile()
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2 ** 31 - 1), mass_decades=st.floats(0.0, 2.0),
+       tilt=st.floats(-0.6, 0.6), dt=st.sampled_from([1e-3, 5e-3]))
+def test_a_slider_mechanisms_step_jacobian_is_its_derivative(seed, mass_decades, tilt, dt):
+    """Sliders on the world and on a turning arm (their axis, and so their perpendicular row,
+    turns with it), with limits out of reach and a hinge with armature."""
+    rng = np.random.default_rng(seed)
+    masses = 10 ** rng.uniform(-mass_decades / 2, mass_decades / 2, 4)
+    model = slider_mechanism(masses, tilt, dt, armature=0.05 * masses[1])
+    sim = ps.Simulator(model)
+    swing = 0.3 * masses.min() * 9.81 * 0.3
+    moved_state(sim, rng, swing)
+    u = rng.uniform(-1.0, 1.0, model.n_act) * swing
+    before = sim.snapshot()
+    try:
+        jac = step_jacobian(sim, u)
+    except NotImplementedError as exc:
+        assume(not any(why in str(exc) for why in NOT_COVERED_STEPS + ("limit reached",)))
+        raise
+    assert np.array_equal(sim.state.q, before.q) and np.array_equal(sim.state.v, before.v)
+    assert np.abs(sim.state.v[[0, 2], :2]).max() > 0.0     # (the sliders slide)
+    error_A, error_B = differences_agree(jac, sim, u)
+    assert error_A <= REL_TOL, error_A
+    assert error_B <= REL_TOL, error_B
+
+
 def test_a_closed_loop_and_the_sim_continues_as_if_never_asked():
     """A four-bar loop (its last link pinned to the world too): the derivative holds, and a
     run asked for it continues bit for bit as one that was not."""
@@ -236,9 +284,22 @@ def test_a_saturated_command_moves_nothing_and_one_at_its_bound_is_a_mode_change
 def test_what_is_not_covered_yet_is_named():
     b = ps.ModelBuilder(dt=1e-3)
     cart = b.add_body("cart", mass=1.0, inertia=0.1, pos=(0.0, 0.0))
-    b.add_slider("rail", None, cart, axis=(1.0, 0.0), anchor_world=(0.0, 0.0))
-    with pytest.raises(NotImplementedError, match="'rail', which is not a hinge"):
+    b.add_slider("rail", None, cart, axis=(1.0, 0.0), anchor_world=(0.0, 0.0), armature=0.5)
+    with pytest.raises(NotImplementedError, match="armature on slider 'rail'"):
         step_jacobian(ps.Simulator(b.compile()))
+    b = ps.ModelBuilder(dt=1e-3)
+    cart = b.add_body("cart", mass=1.0, inertia=0.1, pos=(0.0, 0.0))
+    b.add_slider("rail", None, cart, axis=(1.0, 0.0), anchor_world=(0.0, 0.0))
+    b.add_slider_motor("drive", "rail")
+    with pytest.raises(NotImplementedError, match="actuator 'drive'"):
+        step_jacobian(ps.Simulator(b.compile()))
+    b = ps.ModelBuilder(dt=1e-3)
+    cart = b.add_body("cart", mass=1.0, inertia=0.1, pos=(0.0, 0.0))
+    b.add_slider("rail", None, cart, axis=(1.0, 0.0), anchor_world=(0.0, 0.0),
+                 limit=(-0.1, 0.0))
+    b.add_body_force("push", cart, direction=(1.0, 0.0))
+    with pytest.raises(NotImplementedError, match="a joint limit reached in the step"):
+        step_jacobian(ps.Simulator(b.compile()), np.array([50.0]))
     b = ps.ModelBuilder(dt=1e-3)
     box = b.add_body("box", mass=1.0, inertia=0.1, pos=(0.0, 0.1))
     b.add_box_contacts("feet", box, (0.0, 0.0), 0.2, 0.2)
@@ -348,7 +409,7 @@ def test_open_pins_and_dependent_hinges_are_refused():
         b.add_pin(f"top{i}", bodies[i], top, anchor_world=(x, -0.5))
     sim = ps.Simulator(b.compile())
     sim.steps(5)
-    with pytest.raises(NotImplementedError, match="dependent hinges"):
+    with pytest.raises(NotImplementedError, match="dependent joints"):
         step_jacobian(sim)
 
 
