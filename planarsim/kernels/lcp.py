@@ -12,7 +12,8 @@ Anitescu-Potra (1997) show the ray cannot happen when some motion lifts every co
 ground while keeping every joint, which a height-field ground always allows (move everything
 up). So in exact arithmetic it ends at a solution for our problems; in floating point
 rounding can spoil a long path, so lemke refines and checks its final basis (_refine_basis)
-and reports LCP_INACCURATE when that fails.
+and reports LCP_INACCURATE when that fails, and rounding can bring a path back to a basis it
+has visited, which ends it (LCP_CAP: the caller's next path runs).
 
 The tableau holds B^-1 [I, -M, -d, q] for the basis B (columns: w 0..m-1, z m..2m-1, the
 artificial z0 at 2m, the right-hand side at 2m+1); basis[i] is the variable of row i.
@@ -144,8 +145,10 @@ def _first_leaving(q, m, cover):
 def lemke(M, q, m, T, basis, z, max_pivots, cover, floor):
     """Solve LCP(M[:m, :m], q[:m]) into z[:m] along the path of covering vector `cover`
     (see covering); T (>= m, >= 2m + 2) and basis (>= m) are scratch. floor: a lower bound
-    of the answer check's scale (_is_answer; 0: this problem's own). Returns (status LCP_*,
-    pivots)."""
+    of the answer check's scale (_is_answer; 0: this problem's own). A path that comes back
+    to one of its last m bases (rounding: the exact path never does) ends as the cap would
+    (LCP_CAP): a 36-box pyramid set sliding cycled from pivot 1,882 to the cap of 29,160,
+    nine tenths of its step. Returns (status LCP_*, pivots)."""
     for i in range(m):
         z[i] = 0.0
     lowest = _first_leaving(q, m, cover)
@@ -166,6 +169,10 @@ def lemke(M, q, m, T, basis, z, max_pivots, cover, floor):
     leaving = basis[lowest]
     basis[lowest] = z0
     pivots = 1
+    key = 0
+    for i in range(m):
+        key ^= _basis_key(basis[i])
+    _seen_lately(z, m, key, 0)
     status = LCP_CAP
     while pivots < max_pivots:
         entering = leaving + m if leaving < m else leaving - m
@@ -180,6 +187,11 @@ def lemke(M, q, m, T, basis, z, max_pivots, cover, floor):
         if leaving == z0:
             status = LCP_SOLVED
             break
+        key ^= _basis_key(leaving) ^ _basis_key(entering)
+        if _seen_lately(z, m, key, pivots - 1):
+            break
+    for i in range(m):
+        z[i] = 0.0
     if status == LCP_SOLVED:
         status = _refine_basis(M, q, m, T, basis, z, floor)
     if status == LCP_SOLVED:
@@ -257,6 +269,19 @@ def _basis_key(var):
     """A 52-bit key of variable var (exact as a float); a basis's key is the XOR of its
     variables'."""
     return (_mix31(var, 0x2545F491, 0x2C1B3C6D) << 21) ^ _mix31(var, 0x1B873593, 0x27D4EB2F)
+
+
+@kernel
+def _seen_lately(keys, m, key, count):
+    """Record basis key `key` as the path's basis number `count` in keys[:m] (a ring of the
+    last m bases' keys, as floats; lemke's z, free while the path runs) and return True if one
+    of the last m bases had it: a cycle of up to m pivots, which rounding alone can make."""
+    mark = float(key)
+    for p in range(min(count, m)):
+        if keys[p] == mark:
+            return True
+    keys[count % m] = mark
+    return False
 
 
 @kernel
@@ -342,7 +367,8 @@ def lemke_revised(M, q, m, T, basis, z, nz, max_pivots, cover, floor):
 def lemke_large(M, q, m, T, basis, z, nz, max_pivots, cover, floor):
     """A large problem's path: lemke_revised, and where it came back to a basis, met the cap
     or ended at a basis whose answer fails the check, lemke's tableau on the same covering
-    vector. Measured on seeded singular frictionless problems (100-160 contacts on 40-60
+    vector (which ends too where it comes back to a recent basis). Measured on seeded
+    singular frictionless problems (100-160 contacts on 40-60
     degrees of freedom; tests/planarsim/test_lcp_revised.py): the revised path's rounding
     failed 11 of 40 (4 back to a basis, 7 at a basis whose answer fails), of which the
     tableau solved 10; on Stewart and Trinkle's frictional problems of the same sizes both
