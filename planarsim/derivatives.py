@@ -159,13 +159,13 @@ def joint_terms(model, q, impulse=None):
     c = np.zeros(2 * model.n_pin)
     J = np.zeros((2 * model.n_pin, 3 * n))
     H = np.zeros((3 * n, 3 * n)) if impulse is not None else None
-    _joint_terms(a, q, np.flatnonzero(a.pin_kind == JOINT_HINGE), c, J, H, impulse)
+    _hinge_terms(a, q, np.flatnonzero(a.pin_kind == JOINT_HINGE), c, J, H, impulse)
     for j in np.flatnonzero(a.pin_kind == JOINT_SLIDER):
         _slider_terms(a, q, int(j), c, J, H, impulse)
     return c, J, H
 
 
-def _joint_terms(a, q, rows, c, J, H, impulse):
+def _hinge_terms(a, q, rows, c, J, H, impulse):
     """joint_terms' rows of the hinges `rows` (vectorised over them)."""
     for e, sign in ((0, -1.0), (1, 1.0)):
         body = a.pin_body[rows, e]
@@ -198,6 +198,11 @@ def _turned(theta, x, y):
     return np.array([cs * x - sn * y, sn * x + cs * y])
 
 
+def _cross(u, w):
+    """z of u x w (2-vectors)."""
+    return u[0] * w[1] - u[1] * w[0]
+
+
 def _slider_terms(a, q, j, c, J, H, impulse):
     """joint_terms' rows of slider j: c_perp = n.(p_b - p_a) with d = R(theta_a) d0, n = (-d_y,
     d_x), and c_angle = theta_b - theta_a - ref. n.R(theta_a) r_a is constant, so c_perp =
@@ -217,15 +222,12 @@ def _slider_terms(a, q, j, c, J, H, impulse):
     pb = q[bb, :2] + arm_b
     c[r] = nrm @ (pb - pa)
     c[r + 1] = q[bb, 2] - a.pin_ref[j] - (q[ba, 2] if ba >= 0 else 0.0)
-
-    def cross(u, w):
-        return u[0] * w[1] - u[1] * w[0]
     J[r, 3 * bb:3 * bb + 2] += nrm
-    J[r, 3 * bb + 2] += cross(pb - q[bb, :2], nrm)
+    J[r, 3 * bb + 2] += _cross(pb - q[bb, :2], nrm)
     J[r + 1, 3 * bb + 2] += 1.0
     if ba >= 0:
         J[r, 3 * ba:3 * ba + 2] -= nrm
-        J[r, 3 * ba + 2] -= cross(pb - q[ba, :2], nrm)
+        J[r, 3 * ba + 2] -= _cross(pb - q[ba, :2], nrm)
         J[r + 1, 3 * ba + 2] -= 1.0
     if H is None:
         return
