@@ -3,33 +3,38 @@
 The default step (symplectic Euler with SHAKE, docs/engine.md) of a mechanism held by hinges
 and sliders ends at
 
-    q1 = q + h v + h^2 W f(q, u) + W P^T L,   c(q1) = 0,   v1 = (q1 - q) / h,
+    v_lin = W_D (E_A v + h f(q, u)),          q_pred = q + h v_lin,
+    (P W_D P^T) lam = -c(q_pred) / h,          v_new = v_lin + W_D P^T lam,
+    q1 = q + h v_new + W_A P^T mu,   c(q1) = 0,   v1 = (q1 - q) / h,
 
-with W the inverse of the bodies' masses and the hinges' rotors (M + A, A = sum a g^T g over
-the joints' armature a and rate rows g), c the joints' equality rows (a hinge's x and y, a
-slider's perpendicular and angle rows), P = dc/dq at the step's start and L the step's total
-impulse of those rows (the velocity solve's and the position correction's together: both act
-along W P^T, and the Newton correction ends where c(q1) = 0). Within its modes the step is
-smooth, and the implicit function theorem on c(q1) = 0 gives its derivative exactly:
+with c the joints' equality rows (a hinge's x and y, a slider's perpendicular and angle
+rows), P = dc/dq at the step's start, lam the velocity solve's impulses and mu the Newton
+correction's. E_A = M + A is the bodies' masses with the joints' rotors (A = sum a g g^T over
+the joints' armature a and rate rows g), E_D = M + sum (a + h c) g g^T the same with the
+dampers c taken implicitly (kernels/soft.py: the soft rows, solved with the pins and alone
+for the linearisation v_lin); W_A = E_A^-1 and W_D = E_D^-1. f holds gravity, pushes, the
+actuators' commands and the joints' springs, taken at the step's start. Without dampers W_D =
+W_A and only lam h + mu matters; with them the velocity solve and the correction move along
+different directions, so lam is the velocity solve's own (computed here from the equation
+above and checked against the step's answer). Within its modes the step is smooth and the
+implicit function theorem on c(q1) = 0 and on the velocity solve gives its derivative
+exactly: the joints' Jacobians at the start, at q_pred and at q1, and their curvature (each
+row's Hessian) under lam, mu and W_D P^T lam. The step is taken once, on a snapshot (`sim`
+is restored). A step taken in sub-steps (a body turning fast: step.turn_substeps) is the
+chain rule through them, each a step of h / n; a step that did not end as those equations
+say (a correction held back by the energy bound, a velocity solve that fell back to its
+first-order target) raises instead of giving a derivative of a different map.
 
-    dq1 = (I - W P^T S G) (dq + h dv + h^2 W (K dq + F du) + W H dq),   S = (G W P^T)^-1,
-    dv1 = (dq1 - dq) / h,
-
-with G = dc/dq at q1, K = df/dq (the joints' springs), F = df/du and H = d(P^T L)/dq (the
-rows' curvature under the step's impulse: the anchors turn with their bodies, a slider's axis
-with its body a). L is read back from the step's own answer (the engine's step is taken once,
-on a snapshot, and `sim` is restored); a step that did not end as that equation says
-(sub-steps, a correction held back by the energy bound) raises instead of giving a derivative
-of a different map.
-
-Covered so far: bodies held by hinges (pins) and sliders to each other and the world, with
-joint limits the step does not reach, the hinges' armature and springs the step resolves
-(taken at the step's start: kernels/soft.py with a rotor, kernels/forces.py spring_as_force
-without), under gravity, constant pushes and pin torques, body forces and body torques.
-Refused with a NotImplementedError naming the feature: a slider's armature or spring (its
-rate row turns with body a), rods, a limit reached in the step, dampers, dry friction,
-springs too stiff for the step, contacts and shape pairs that touch in the step, fluid drag,
-the other actuator kinds (slider forces among them), the accurate integrators.
+Covered so far: bodies held by hinges (pins) and sliders to each other and the world, free
+bodies' coordinates (an MJCF root's slides and hinge), with joint limits the step does not
+reach; armature, dampers and the springs the step resolves on every joint whose rate row g is
+constant (hinges, and slides along a world axis whose anchor is their body's centre of mass:
+MJCF roots, a cart on a rail); under gravity, constant pushes, pin torques, body forces and
+torques and forces along such slides. Refused with a NotImplementedError naming the feature:
+armature, dampers or springs on a slider whose rate row turns with its bodies (its rotor adds
+velocity-product forces), rods, a limit reached in the step, dry friction, springs too stiff
+for the step, contacts and shape pairs that touch in the step, fluid drag, the other
+actuator kinds, the accurate integrators.
 """
 from __future__ import annotations
 
@@ -37,8 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kernels.codes import INTEGRATOR_EULER, JOINT_HINGE, JOINT_SLIDER, MODE_FREE
-from .kernels.forces import ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_PIN_TORQUE
+from .kernels.codes import (INTEGRATOR_EULER, JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDE_BIT,
+                            JOINT_SLIDER, MODE_FREE)
+from .kernels.forces import ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_PIN_TORQUE, ACT_SLIDER_FORCE
 from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
 
 #: the step's end must satisfy q1 = q + h v* + W P^T L to this share of |q1 - q| (plus
@@ -46,7 +52,7 @@ from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
 FIT_TOL = 1e-9
 
 _LINEAR_ACTUATORS = {ACT_PIN_TORQUE: "pin torque", ACT_BODY_FORCE: "body force",
-                     ACT_BODY_TORQUE: "body torque"}
+                     ACT_BODY_TORQUE: "body torque", ACT_SLIDER_FORCE: "slider force"}
 
 
 @dataclass(frozen=True)
@@ -76,9 +82,40 @@ DEPENDENT_COND = 1e10
 
 def _not_covered(what):
     return NotImplementedError(
-        f"step_jacobian covers mechanisms of hinges (with armature and springs the step "
-        f"resolves) and sliders (without), with limits the step does not reach, under "
-        f"gravity, pushes and pin / body torques and body forces so far; this step has {what}")
+        f"step_jacobian covers mechanisms of hinges, sliders and free bodies' coordinates "
+        f"(armature, dampers and the springs the step resolves on joints whose rate row is "
+        f"constant), with limits the step does not reach, under gravity, pushes, pin and "
+        f"body torques, body forces and forces along such slides so far; this step has {what}")
+
+
+def _constant_rate_row(a, j) -> bool:
+    """Joint j's rate row g is the same at every q: a hinge's (theta_b - theta_a), a free
+    hinge's, or a slide's along a world axis (body a the world) whose anchor on body b is its
+    centre of mass."""
+    if not a.pin_kind[j] & JOINT_SLIDE_BIT:
+        return True
+    return a.pin_body[j, 0] < 0 and not np.any(a.pin_anchor[j, 1])
+
+
+def rate_row(a, j, n) -> np.ndarray:
+    """Joint j's rate row g (3 n,): its coordinate's rate is g v. Only for a constant row
+    (_constant_rate_row): a hinge's -1 / +1 on its bodies' angles, a world slide's axis on
+    its body's x and y."""
+    g = np.zeros(3 * n)
+    ba, bb = a.pin_body[j]
+    if a.pin_kind[j] & JOINT_SLIDE_BIT:
+        g[3 * bb:3 * bb + 2] = a.pin_axis[j]
+        return g
+    g[3 * bb + 2] = 1.0
+    if ba >= 0:
+        g[3 * ba + 2] = -1.0
+    return g
+
+
+def _soft_joints(a):
+    """The joints with armature, a damper or a spring."""
+    return np.flatnonzero((a.pin_armature > 0.0) | (a.pin_damping > 0.0)
+                          | (a.pin_stiffness > 0.0))
 
 
 def check_covered(model, options, h) -> None:
@@ -93,58 +130,72 @@ def check_covered(model, options, h) -> None:
         raise _not_covered(f"rods ({model.rod_names[0]!r}, ...)")
     if a.fluid_body.shape[0]:
         raise _not_covered("fluid drag")
+    w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
     for j, name in enumerate(model.pin_names):
         kind = int(a.pin_kind[j])
-        if kind not in (JOINT_HINGE, JOINT_SLIDER):
-            raise _not_covered(f"joint {name!r}, which is neither a hinge nor a slider (kind "
-                               f"{kind}: a free body's coordinate)")
-        for field, label in (("pin_damping", "a damper"), ("pin_frictionloss", "dry friction")):
-            if getattr(a, field)[j] != 0.0:
-                raise _not_covered(f"{label} on joint {name!r}")
-        k, arm = a.pin_stiffness[j], a.pin_armature[j]
-        if kind == JOINT_SLIDER:
-            # (its rate row turns with body a: the rotor and the spring would depend on q)
-            if k != 0.0 or arm != 0.0:
-                raise _not_covered(f"{'a spring' if k != 0.0 else 'armature'} on slider "
-                                   f"{name!r}")
+        if kind & ~(JOINT_SLIDE_BIT | JOINT_FREE_BIT):
+            raise _not_covered(f"joint {name!r} of kind {kind}")
+        if a.pin_frictionloss[j] != 0.0:
+            raise _not_covered(f"dry friction on joint {name!r}")
+        k, arm, damp = a.pin_stiffness[j], a.pin_armature[j], a.pin_damping[j]
+        if k == 0.0 and arm == 0.0 and damp == 0.0:
             continue
+        if not _constant_rate_row(a, j):
+            # (its rate row turns with its bodies: the rotor adds velocity-product forces,
+            # and the rotor, damper and spring depend on q)
+            feature = "armature" if arm else "a damper" if damp else "a spring"
+            raise _not_covered(f"{feature} on slider {name!r}, whose rate row turns with its "
+                               f"bodies")
         if k > 0.0:
-            kappa = sum(a.body_inv_inertia[b] for b in a.pin_body[j] if b >= 0)
+            g = rate_row(a, j, model.n_body)
+            kappa = float(g @ (w * g))
             resolved = h * h * k * kappa / (1.0 + arm * kappa)
             if resolved > 0.5:
                 raise _not_covered(f"a spring on joint {name!r} that the step takes at its end "
                                    f"(too stiff for the step)")
     for k, name in enumerate(model.act_names):
-        if int(a.act_kind[k]) not in _LINEAR_ACTUATORS:
-            raise _not_covered(f"actuator {name!r} of kind {int(a.act_kind[k])}")
+        kind = int(a.act_kind[k])
+        if kind not in _LINEAR_ACTUATORS:
+            raise _not_covered(f"actuator {name!r} of kind {kind}")
+        if kind == ACT_SLIDER_FORCE and not _constant_rate_row(a, a.act_ref[k]):
+            raise _not_covered(f"actuator {name!r}, a force along a slider whose axis or "
+                               f"anchor turns with its bodies")
 
 
-def rotor_terms(model, q):
-    """(W (3 n_body, 3 n_body): the inverse of the bodies' masses and the joints' rotors
-    (M + A)^-1, f_spring (3 n_body,) [N m] the joints' springs at q, K = d f_spring / dq)."""
+def rotor_terms(model, q, h):
+    """The bodies' inverse masses with the joints' rotors and dampers (module docstring), for a
+    step of h [s] from q (n_body, 3): (W_A = (M + A)^-1, W_D = (M + A + h C)^-1, R = W_D (M + A),
+    each (3 n_body, 3 n_body); f_spring (3 n_body,) [N, N m] the joints' springs at q, K =
+    d f_spring / dq). Every joint with armature, a damper or a spring has a constant rate row
+    (check_covered)."""
     a = model.arrays
     n = model.n_body
     w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
     A = np.zeros((3 * n, 3 * n))
+    D = np.zeros((3 * n, 3 * n))
     K = np.zeros((3 * n, 3 * n))
     f = np.zeros(3 * n)
-    for j in range(model.n_pin):
-        if a.pin_kind[j] != JOINT_HINGE:
-            continue                    # (a slider without rotor or spring: check_covered)
-        g = np.zeros(3 * n)
-        for e, sign in ((0, -1.0), (1, 1.0)):
-            b = a.pin_body[j, e]
-            if b >= 0:
-                g[3 * b + 2] = sign
-        A += a.pin_armature[j] * np.outer(g, g)
+    for j in _soft_joints(a):
+        g = rate_row(a, j, n)
+        gg = np.outer(g, g)
+        A += a.pin_armature[j] * gg
+        D += (a.pin_armature[j] + h * a.pin_damping[j]) * gg
         k = a.pin_stiffness[j]
         if k > 0.0:
-            stretch = g @ q.ravel() - a.pin_ref[j] - a.pin_rest[j]
-            f -= k * stretch * g
-            K -= k * np.outer(g, g)
-    # (M + A)^-1 = (I + W A)^-1 W, which holds where W has zeros (a point mass's turn)
-    W = np.linalg.solve(np.eye(3 * n) + w[:, None] * A, np.diag(w))
-    return W, f, K
+            coordinate = g @ q.ravel()
+            if a.pin_kind[j] & JOINT_SLIDE_BIT:
+                coordinate -= a.pin_axis[j] @ a.pin_anchor[j, 0]   # (anchor a in the world)
+            else:
+                coordinate -= a.pin_ref[j]
+            f -= k * (coordinate - a.pin_rest[j]) * g
+            K -= k * gg
+    # (M + X)^-1 = (I + W X)^-1 W, which holds where W has zeros (a point mass's turn); and
+    # (M + D)^-1 (M + A) = (I + W D)^-1 (I + W A)
+    eye = np.eye(3 * n)
+    W_A = np.linalg.solve(eye + w[:, None] * A, np.diag(w))
+    W_D = np.linalg.solve(eye + w[:, None] * D, np.diag(w))
+    R = np.linalg.solve(eye + w[:, None] * D, eye + w[:, None] * A)
+    return W_A, W_D, R, f, K
 
 
 def joint_terms(model, q, impulse=None):
@@ -163,6 +214,18 @@ def joint_terms(model, q, impulse=None):
     for j in np.flatnonzero(a.pin_kind == JOINT_SLIDER):
         _slider_terms(a, q, int(j), c, J, H, impulse)
     return c, J, H
+
+
+def joint_hessians(model, q):
+    """T (2 n_pin, 3 n_body, 3 n_body): the Hessian of each of the joints' rows at q
+    (joint_terms' H for a unit impulse on that row alone)."""
+    rows = 2 * model.n_pin
+    T = np.zeros((rows, 3 * q.shape[0], 3 * q.shape[0]))
+    for i in range(rows):
+        unit = np.zeros(rows)
+        unit[i] = 1.0
+        T[i] = joint_terms(model, q, unit)[2]
+    return T
 
 
 def _hinge_terms(a, q, rows, c, J, H, impulse):
@@ -271,6 +334,9 @@ def force_terms(model, state, u):
             F[a.act_body[k, 0], :2, k] = a.act_dir[k]
         elif kind == ACT_BODY_TORQUE and a.body_inv_inertia[a.act_body[k, 0]] > 0.0:
             F[a.act_body[k, 0], 2, k] = 1.0
+        elif kind == ACT_SLIDER_FORCE:
+            # along a world slide's axis at its body's centre of mass (check_covered)
+            F[:, :, k] = rate_row(a, a.act_ref[k], n).reshape(n, 3)
     f += F @ u_sat
     F = F * inside                       # a saturated command moves nothing (from inside)
     return f.ravel(), F.reshape(3 * n, model.n_act), at_bound
@@ -314,62 +380,122 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         raise _not_covered("a contact that touches in the step")
     if limits:
         raise _not_covered("a joint limit reached in the step")
-    if substeps > 1 or splits > 0:
-        raise _not_covered(f"a step taken in {max(substeps, 1)} sub-steps / {splits} "
-                           f"time-of-impact splits")
+    if splits > 0:
+        raise _not_covered(f"a step taken in {splits} time-of-impact splits")
+    if substeps > 1:
+        return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end)
     gap = np.abs(joint_terms(model, q1)[0]).max(initial=0.0)
     if gap > PINS_CLOSED_TOL:
         raise _not_covered(f"joints left open by {gap:.3g} m at its end (the position "
                            f"correction's refine_tol or a stalled correction)")
     n = model.n_body
+    nq = 3 * n
     f, F, saturated = force_terms(model, start, u)
-    W, f_spring, K = rotor_terms(model, q0)
-    free = q0.ravel() + h * v0.ravel() + h * h * (W @ (f + f_spring))
-    _, P, _ = joint_terms(model, q0)
-    # the step's total impulse L from its answer: W P^T L = q1 - free (least squares; P has
-    # full row rank where the joints are independent, checked below)
-    move = q1.ravel() - free
-    WPt = W @ P.T
+    W_A, W_D, R, f_spring, K = rotor_terms(model, q0, h)
+    # the rows of the joints that hold something (a free body's coordinate has none)
+    held = np.flatnonzero(np.repeat((model.arrays.pin_kind & JOINT_FREE_BIT) == 0, 2))
+    P = joint_terms(model, q0)[1][held]
+    # the velocity solve (module docstring): its linearisation, target and impulses
+    v_lin = R @ v0.ravel() + h * (W_D @ (f + f_spring))
+    q_pred = q0.ravel() + h * v_lin
+    c_pred, P_pred, _ = joint_terms(model, q_pred.reshape(n, 3))
+    c_pred, P_pred = c_pred[held], P_pred[held]
+    WdPt = W_D @ P.T
+    WaPt = W_A @ P.T
     if P.shape[0]:
-        L, *_ = np.linalg.lstsq(WPt, move, rcond=None)
+        N = P @ WdPt
+        if np.linalg.cond(N) > DEPENDENT_COND:
+            raise _not_covered("dependent joints (an over-constrained loop): the step is not "
+                               "smooth there")
+        lam = -np.linalg.solve(N, c_pred) / h
     else:
-        L = np.zeros(0)
+        lam = np.zeros(0)
+    v_new = v_lin + WdPt @ lam
+    # the correction's total impulse mu from the step's answer: W_A P^T mu = q1 - q - h v_new
+    # (least squares; P has full row rank where the joints are independent, checked above)
+    move = q1.ravel() - q0.ravel() - h * v_new
+    mu = np.linalg.lstsq(WaPt, move, rcond=None)[0] if P.shape[0] else np.zeros(0)
     eps = np.finfo(float).eps
     scale = max(np.abs(move).max(initial=0.0), np.abs(q1 - q0).max(), h * np.abs(v0).max())
     rounding = 64 * eps * (np.abs(q0).max() + np.abs(move).max(initial=0.0))
-    if np.abs(WPt @ L - move).max(initial=0.0) > FIT_TOL * scale + rounding:
-        raise _not_covered("an end that is not the joints' SHAKE step q + h v + h^2 W f "
-                           "+ W P^T L")
+    if np.abs(WaPt @ mu - move).max(initial=0.0) > FIT_TOL * scale + rounding:
+        raise _not_covered("an end that is not the joints' SHAKE step q + h v_new + W P^T mu "
+                           "(a velocity solve that took its first-order target)")
     secant = (q1.ravel() - q0.ravel()) / h
     if np.abs(v1.ravel() - secant).max() > FIT_TOL * (np.abs(secant).max() + np.abs(v0).max()) \
             + rounding / h:
         raise _not_covered("an end velocity other than (q1 - q) / h (the position "
                            "correction's velocity change held back by its energy bound)")
-    _, _, H = joint_terms(model, q0, L)
-    _, G, _ = joint_terms(model, q1)
-    nq = 3 * n
+    # differentials as linear maps of (dq, dv, du): matrices of 2 nq + n_act columns
+    nu = model.n_act
     eye = np.eye(nq)
-    if G.shape[0]:
-        GWP = G @ WPt
+    zero_v = np.zeros((nq, nq + nu))
+    d_q = np.hstack([eye, zero_v])                          # dq itself
+    dv_lin = np.hstack([h * (W_D @ K), R, h * (W_D @ F)])
+    dq_pred = d_q + h * dv_lin
+    dv_new = dv_lin
+    base = d_q
+    if P.shape[0]:
+        T = joint_hessians(model, q0)[held]                # each row's Hessian at q
+        H_lam = np.tensordot(lam, T, axes=1)               # d (P^T lam) / dq
+        H_mu = np.tensordot(mu, T, axes=1)
+        T_x = T @ (WdPt @ lam)                             # d (P x) / dq, x = W_D P^T lam
+        # N lam = -c(q_pred) / h, differentiated (W_D constant: check_covered)
+        rhs = P_pred @ dq_pred / h
+        rhs[:, :nq] += T_x + P @ (W_D @ H_lam)
+        d_lam = -np.linalg.solve(N, rhs)
+        dv_new = dv_lin + WdPt @ d_lam
+        dv_new[:, :nq] += W_D @ H_lam
+        base = d_q + W_A @ np.hstack([H_mu, zero_v])
+        G = joint_terms(model, q1)[1][held]
+        GWP = G @ WaPt
         if np.linalg.cond(GWP) > DEPENDENT_COND:
             raise _not_covered("dependent joints (an over-constrained loop): the step is not "
                                "smooth there")
-        S = np.linalg.solve(GWP, G)                # (G W P^T)^-1 G
-        proj = eye - WPt @ S
+        proj = eye - WaPt @ np.linalg.solve(GWP, G)
     else:
         proj = eye
-    # d(q + h v + h^2 W f + W P^T L) with respect to q, v and u
-    dq_dq = proj @ (eye + W @ (H + h * h * K))
-    dq_dv = proj * h
-    dq_du = proj @ (h * h * (W @ F))
-    A = np.zeros((2 * nq, 2 * nq))
-    A[:nq, :nq] = dq_dq
-    A[:nq, nq:] = dq_dv
-    A[nq:, :nq] = (dq_dq - eye) / h
-    A[nq:, nq:] = dq_dv / h
-    B = np.vstack([dq_du, dq_du / h])
+    dq1 = proj @ (base + h * dv_new)
+    dv1 = (dq1 - d_q) / h
+    A = np.vstack([dq1[:, :2 * nq], dv1[:, :2 * nq]])
+    B = np.vstack([dq1[:, 2 * nq:], dv1[:, 2 * nq:]])
     return StepJacobian(A=A, B=B, modes_changed=bool(saturated.any()),
                         x1=np.concatenate([q1.ravel(), v1.ravel()]))
+
+
+#: the sub-steps taken one by one must end where the whole step ended, to this share of the
+#: state's size (they are the same arithmetic: the same bits, measured)
+SUBSTEPS_TOL = 1e-12
+
+
+def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end) -> StepJacobian:
+    """The derivative of a step the engine took in n equal sub-steps (step.turn_substeps: a
+    body turning fast), each a whole step of h / n of its own: the chain rule through them,
+    A = A_n ... A_1 and B = sum_k A_n ... A_(k+1) B_k, each sub-step's from step_jacobian at
+    StepOptions.dt = h / n. `sim` ends as step_jacobian leaves it; raises where the sub-steps
+    do not end where the step did."""
+    options = sim.options
+    audit, info = sim.ws.audit.copy(), sim.ws.info.copy()
+    try:
+        sim.restore(start)
+        sim._options = options._replace(dt=sim.dt / n)
+        sim._repack()
+        parts = [step_jacobian(sim, u, _keep_end=True) for _ in range(n)]
+    finally:
+        sim.restore(start)
+        sim._options = options
+        sim._repack()
+        sim.ws.audit[:] = audit
+        sim.ws.info[:] = info
+    x1 = np.concatenate([q1.ravel(), v1.ravel()])
+    if np.abs(parts[-1].x1 - x1).max() > SUBSTEPS_TOL * max(np.abs(x1).max(), 1.0):
+        raise _not_covered(f"{n} sub-steps that end elsewhere than steps of h / {n}")
+    A, B = parts[0].A, parts[0].B
+    for part in parts[1:]:
+        A, B = part.A @ A, part.A @ B + part.B
+    if keep_end:
+        sim.step(u)
+    return StepJacobian(A=A, B=B, modes_changed=any(p.modes_changed for p in parts), x1=x1)
 
 
 def rollout_jacobians(sim, us) -> list:
