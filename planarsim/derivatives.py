@@ -373,7 +373,7 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
             sim.restore(start)
             if sim.options is not options:     # (the state setter resolves the speed bound)
                 sim._options = options
-                sim._repack()
+                sim._new_options()
             sim.ws.audit[:] = audit
             sim.ws.info[:] = info
     if touching:
@@ -479,12 +479,12 @@ def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end) -> StepJacobian:
     try:
         sim.restore(start)
         sim._options = options._replace(dt=sim.dt / n)
-        sim._repack()
+        sim._new_options()
         parts = [step_jacobian(sim, u, _keep_end=True) for _ in range(n)]
     finally:
         sim.restore(start)
         sim._options = options
-        sim._repack()
+        sim._new_options()
         sim.ws.audit[:] = audit
         sim.ws.info[:] = info
     x1 = np.concatenate([q1.ravel(), v1.ravel()])

@@ -124,7 +124,16 @@ class Simulator:
         self._speed_from_model = value.speed_limit == -1.0
         self._options = resolve_speed_limit(value, self._model, self._state.v, self._state.q)
         forget_kept_factors(self._ws)
-        self._repack()
+        self._new_options()
+
+    def _new_options(self):
+        """Point the step's table at self._options: its few slots rewritten, the rest of the
+        table (the model's, the state's and the workspace's arrays) and the bound step kept."""
+        if self._args is None:
+            self._repack()
+            return
+        self._args.refill(_link().StepArgs(self._model.arrays, self._state, self._ws,
+                                           self._options), "opt")
 
     def _repack(self):
         """The table that Simulator.step / steps hand to the compiled run_steps."""
@@ -154,7 +163,7 @@ class Simulator:
         if getattr(self, "_speed_from_model", False):
             self._options = resolve_speed_limit(self._options._replace(speed_limit=-1.0),
                                                 self._model, self._state.v, self._state.q)
-            self._repack()
+            self._new_options()
 
     # commands -------------------------------------------------------------------------------
     def _commands(self, u):

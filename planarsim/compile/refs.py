@@ -35,6 +35,16 @@ from numba.extending import (NativeValue, infer_getattr, intrinsic, lower_getatt
 
 SLOTS_PER_ARRAY = 4  # address, shape[0], shape[1], shape[2]
 _DTYPES = {"float64": types.float64, "int64": types.int64}
+# the names of those dtypes by dtype (numpy's dtype.name is built afresh on every read: a
+# workspace of hundreds of arrays spent milliseconds there each time a state was put in)
+_DTYPE_NAMES = {np.dtype(name): name for name in _DTYPES}
+
+
+def _dtype_name(value):
+    """The name of ndarray `value`'s dtype if compiled code takes it ("float64" or "int64"),
+    else its own name."""
+    name = _DTYPE_NAMES.get(value.dtype)
+    return value.dtype.name if name is None else name
 
 
 class Layout:
@@ -105,10 +115,11 @@ def layout_of(obj) -> Layout:
     for name in cls._fields:
         value = getattr(obj, name)
         if isinstance(value, np.ndarray):
-            if value.dtype.name not in _DTYPES or value.ndim > 3:
+            dtype = _dtype_name(value)
+            if dtype not in _DTYPES or value.ndim > 3:
                 raise TypeError(f"{cls.__name__}.{name} is a {value.ndim}-d {value.dtype} array; "
                                 "compiled code takes float64 or int64 arrays of at most 3 dimensions")
-            fields.append((name, "array", value.dtype.name, value.ndim, spec["readonly"], offset, None))
+            fields.append((name, "array", dtype, value.ndim, spec["readonly"], offset, None))
             offset += SLOTS_PER_ARRAY
         elif type(value) in _REGISTERED:
             sub = layout_of(value)
@@ -130,8 +141,8 @@ def fill(obj, layout, table, base):
         value = getattr(obj, name)
         k = base + offset
         if kind == "array":
-            if (not isinstance(value, np.ndarray) or value.dtype.name != dtype or value.ndim != ndim
-                    or not value.flags.c_contiguous):
+            if (not isinstance(value, np.ndarray) or _dtype_name(value) != dtype
+                    or value.ndim != ndim or not value.flags.c_contiguous):
                 raise TypeError(f"{type(obj).__name__}.{name} must be a C-contiguous {ndim}-d {dtype} "
                                 f"array, got {_describe(value)}")
             if not readonly and not value.flags.writeable:
