@@ -21,8 +21,11 @@ implicit function theorem on c(q1) = 0 and on the velocity solve gives its deriv
 exactly: the joints' Jacobians at the start, at q_pred and at q1, and their curvature (each
 row's Hessian) under lam, mu and W_D P^T lam. The step is taken once, on a snapshot (`sim`
 is restored). A step taken in sub-steps (a body turning fast: step.turn_substeps) is the
-chain rule through them, each a step of h / n; a step that did not end as those equations
-say (a correction held back by the energy bound, a velocity solve that fell back to its
+chain rule through them, each a step of h / n. Where the correction's energy bound
+(kernels/integrate.py bound_correction_work) kept only a share k of the correction's velocity
+change, v1 = v_new + k (q1 - q - h v_new) / h with k the bound's own root, differentiated with
+the energies it weighs (_energy_bound). A step that did not end as those equations say (the
+bound taking energy from the motion as well, a velocity solve that fell back to its
 first-order target) raises instead of giving a derivative of a different map.
 
 Covered so far: bodies held by hinges (pins) and sliders to each other and the world, free
@@ -46,6 +49,8 @@ from .kernels.codes import (INTEGRATOR_EULER, JOINT_FREE_BIT, JOINT_HINGE, JOINT
                             JOINT_SLIDER, MODE_FREE)
 from .kernels.forces import ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_PIN_TORQUE, ACT_SLIDER_FORCE
 from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
+from .kernels.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
+                           SHAKE_REGIME, VELOCITY_FLOOR)
 
 #: the step's end must satisfy q1 = q + h v* + W P^T L to this share of |q1 - q| (plus
 #: rounding) for its derivative to be this map's
@@ -166,8 +171,9 @@ def rotor_terms(model, q, h):
     """The bodies' inverse masses with the joints' rotors and dampers (module docstring), for a
     step of h [s] from q (n_body, 3): (W_A = (M + A)^-1, W_D = (M + A + h C)^-1, R = W_D (M + A),
     each (3 n_body, 3 n_body); f_spring (3 n_body,) [N, N m] the joints' springs at q, K =
-    d f_spring / dq). Every joint with armature, a damper or a spring has a constant rate row
-    (check_covered)."""
+    d f_spring / dq; the rotors' inertia A; the springs without rotor or damper alone, which
+    the step applies as forces (f_alone, K_alone)). Every joint with armature, a damper or a
+    spring has a constant rate row (check_covered)."""
     a = model.arrays
     n = model.n_body
     w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
@@ -175,6 +181,8 @@ def rotor_terms(model, q, h):
     D = np.zeros((3 * n, 3 * n))
     K = np.zeros((3 * n, 3 * n))
     f = np.zeros(3 * n)
+    f_alone = np.zeros(3 * n)
+    K_alone = np.zeros((3 * n, 3 * n))
     for j in _soft_joints(a):
         g = rate_row(a, j, n)
         gg = np.outer(g, g)
@@ -189,13 +197,17 @@ def rotor_terms(model, q, h):
                 coordinate -= a.pin_ref[j]
             f -= k * (coordinate - a.pin_rest[j]) * g
             K -= k * gg
+            if a.pin_armature[j] == 0.0 and a.pin_damping[j] == 0.0:
+                # a spring alone is a force of stage 1 (kernels/forces.py spring_as_force)
+                f_alone -= k * (coordinate - a.pin_rest[j]) * g
+                K_alone -= k * gg
     # (M + X)^-1 = (I + W X)^-1 W, which holds where W has zeros (a point mass's turn); and
     # (M + D)^-1 (M + A) = (I + W D)^-1 (I + W A)
     eye = np.eye(3 * n)
     W_A = np.linalg.solve(eye + w[:, None] * A, np.diag(w))
     W_D = np.linalg.solve(eye + w[:, None] * D, np.diag(w))
     R = np.linalg.solve(eye + w[:, None] * D, eye + w[:, None] * A)
-    return W_A, W_D, R, f, K
+    return W_A, W_D, R, f, K, A, f_alone, K_alone
 
 
 def joint_terms(model, q, impulse=None):
@@ -218,13 +230,30 @@ def joint_terms(model, q, impulse=None):
 
 def joint_hessians(model, q):
     """T (2 n_pin, 3 n_body, 3 n_body): the Hessian of each of the joints' rows at q
-    (joint_terms' H for a unit impulse on that row alone)."""
-    rows = 2 * model.n_pin
-    T = np.zeros((rows, 3 * q.shape[0], 3 * q.shape[0]))
-    for i in range(rows):
-        unit = np.zeros(rows)
-        unit[i] = 1.0
-        T[i] = joint_terms(model, q, unit)[2]
+    (joint_terms' H for a unit impulse on that row alone): a hinge's x and y rows bend only
+    in their bodies' angles, d^2 (R(theta) r) / dtheta^2 = -R(theta) r; a slider's
+    perpendicular row as _slider_terms says, its angle row not at all."""
+    a = model.arrays
+    n = q.shape[0]
+    T = np.zeros((2 * model.n_pin, 3 * n, 3 * n))
+    hinges = np.flatnonzero(a.pin_kind == JOINT_HINGE)
+    for e, sign in ((0, -1.0), (1, 1.0)):
+        body = a.pin_body[hinges, e]
+        moving = body >= 0
+        j, b = hinges[moving], body[moving]
+        th = q[b, 2]
+        ax, ay = a.pin_anchor[j, e, 0], a.pin_anchor[j, e, 1]
+        rx = np.cos(th) * ax - np.sin(th) * ay
+        ry = np.sin(th) * ax + np.cos(th) * ay
+        T[2 * j, 3 * b + 2, 3 * b + 2] -= sign * rx
+        T[2 * j + 1, 3 * b + 2, 3 * b + 2] -= sign * ry
+    for j in np.flatnonzero(a.pin_kind == JOINT_SLIDER):
+        unit = np.zeros(2 * model.n_pin)
+        unit[2 * j] = 1.0
+        H = np.zeros((3 * n, 3 * n))
+        _slider_terms(a, q, int(j), np.zeros(2 * model.n_pin),
+                      np.zeros((2 * model.n_pin, 3 * n)), H, unit)
+        T[2 * j] = H
     return T
 
 
@@ -310,8 +339,9 @@ def _slider_terms(a, q, j, c, J, H, impulse):
 
 def force_terms(model, state, u):
     """(f (3 n_body,) [N, N m] the applied forces under commands u, F (3 n_body, n_act) their
-    derivative with respect to u (0 for a command at or past a bound: from inside the range),
-    at_bound: a bool per actuator, its command exactly at a bound)."""
+    derivative with respect to u (0 for a command past a bound; for one exactly at a bound,
+    the derivative from inside the range), at_bound: a bool per actuator, its command exactly
+    at a bound)."""
     a = model.arrays
     n = model.n_body
     f = np.zeros((n, 3))
@@ -338,8 +368,123 @@ def force_terms(model, state, u):
             # along a world slide's axis at its body's centre of mass (check_covered)
             F[:, :, k] = rate_row(a, a.act_ref[k], n).reshape(n, 3)
     f += F @ u_sat
-    F = F * inside                       # a saturated command moves nothing (from inside)
+    # a command past a bound moves nothing; one exactly at a bound: the derivative from inside
+    # the range (StepJacobian.modes_changed says so)
+    F = F * (inside | at_bound)
     return f.ravel(), F.reshape(3 * n, model.n_act), at_bound
+
+
+def _energy_bound(model, h, q0, v0, v_s, dv, move, f, rotors):
+    """The share k of the position correction's velocity change dv [m/s, rad/s] that its
+    energy bound keeps (kernels/integrate.py bound_correction_work, its arithmetic in exact
+    terms) after a velocity solve that ended at v_s, for a step of h [s] from (q0, v0) whose
+    correction moved the positions by `move` under the applied forces f (ws.force); rotors:
+    the joints' rotors' inertia A. Returns (k, the partial derivatives of k with respect to
+    the bound's inputs, for _bound_derivative), or None where the bound took more than the
+    correction's velocity change (the motion paid: not covered)."""
+    a_ = model.arrays
+    n = model.n_body
+    Mb = np.column_stack([a_.body_mass, a_.body_mass, a_.body_inertia]).ravel()
+    E = np.diag(Mb) + rotors                # the bodies' and the rotors' kinetic energy
+    Ev, Edv = E @ v_s, E @ dv
+    a = v_s @ Edv
+    b = 0.5 * dv @ Edv
+    kinetic = 0.5 * v_s @ Ev
+    # velocity_stage_gain: the start's kinetic energy and the energy the solve gained
+    gravity = np.asarray(a_.gravity, dtype=float)
+    g = float(np.hypot(*gravity))
+    up = -gravity / g if g > 0.0 else np.zeros(2)
+    f_g = np.zeros(3 * n)
+    f_g[0::3] = a_.body_mass * gravity[0]
+    f_g[1::3] = a_.body_mass * gravity[1]
+    other = f - f_g
+    start = 0.5 * v0 @ (Mb * v0)
+    Up = np.zeros(3 * n)
+    Up[0::3] = a_.body_mass * up[0]
+    Up[1::3] = a_.body_mass * up[1]
+    dp = Up @ (v_s - v0)
+    total_mass = float(a_.body_mass.sum())
+    lift = 0.5 * h * g * dp
+    sink = -dp * dp / (2.0 * total_mass) if total_mass > 0.0 else 0.0
+    owed = max(lift, sink) if total_mass > 0.0 else 0.0
+    gained = (0.5 * v_s @ (Mb * v_s) - start - h * f @ v_s + 0.5 * h * other @ (v_s - v0)
+              - owed)
+    in_regime = b <= SHAKE_REGIME * SHAKE_REGIME * kinetic
+    smaller = min(kinetic, start)
+    share = max(CONSTRAINT_SHARE * smaller - max(gained, 0.0), 0.0)
+    force_work = f @ move
+    dvx = np.abs(dv).reshape(n, 3)[:, :2]
+    vsx = np.abs(v_s).reshape(n, 3)[:, :2]
+    momentum = float(a_.body_mass @ (dvx.sum(axis=1) + vsx.sum(axis=1)))
+    forces = float(np.abs(f.reshape(n, 3)[:, :2]).sum())
+    rounding = (VELOCITY_FLOOR * momentum + CORRECTION_MOVE_FLOOR * forces
+                + RELATIVE_ROUNDING * (kinetic + abs(a) + b))
+    room = (share if in_regime else 0.0) + force_work + rounding
+    if a + b <= room:
+        return 1.0, None
+    if not b > 0.0:
+        return None
+    disc = a * a + 4.0 * b * room
+    root = np.sqrt(disc) if disc >= 0.0 else -1.0
+    k = (-a + root) / (2.0 * b) if disc >= 0.0 else -1.0
+    if k < 0.0 or (disc >= 0.0 and -a - root > 2.0 * b):
+        # no k in [0, 1] keeps the energy within room: the k of least energy, -a / (2 b) in
+        # [0, 1] (the kernel then pays what is left from the motion, which the caller's check
+        # of the end velocity refuses)
+        k = -a / (2.0 * b)
+        if not 0.0 < k < 1.0:
+            return min(max(k, 0.0), 1.0), None      # (clipped: the same k nearby)
+        k_a, k_b, k_room = -1.0 / (2.0 * b), a / (2.0 * b * b), 0.0
+    elif k > 1.0:
+        return None
+    else:
+        # partial derivatives of k = (-a + sqrt(a^2 + 4 b room)) / (2 b)
+        k_a = (-1.0 + a / root) / (2.0 * b)
+        k_b = room / (b * root) - k / b
+        k_room = 1.0 / root
+    grads = dict(k_a=k_a, k_b=k_b, k_room=k_room, E=E, Mb=Mb, v_s=v_s, dv=dv, v0=v0, f=f,
+                 other=other, f_g=f_g, Up=Up, h=h, move=move, in_regime=in_regime,
+                 share_on=in_regime and CONSTRAINT_SHARE * smaller - max(gained, 0.0) > 0.0,
+                 smaller_is_kinetic=kinetic <= start, gained_on=gained > 0.0,
+                 owed_lift=lift >= sink, dp=dp, total_mass=total_mass, g=g,
+                 sign_a=np.sign(a), n=n)
+    return k, grads
+
+
+def _bound_derivative(grads, dv_s, d_dv, d_move, df, d_v0):
+    """dk (a row over the columns of the differentials) of _energy_bound's k from the
+    differentials of its inputs: dv_s of the solve's answer, d_dv of the correction's velocity
+    change, d_move of its move, df of the applied forces, d_v0 of the start's velocity."""
+    if grads is None:                   # (k = 0 or 1 held for every nearby input)
+        return np.zeros(dv_s.shape[1])
+    G = grads
+    E, Mb, v_s, dv, h, n = G["E"], G["Mb"], G["v_s"], G["dv"], G["h"], G["n"]
+    d_a = (E @ dv) @ dv_s + (E @ v_s) @ d_dv
+    d_b = (E @ dv) @ d_dv
+    d_kin = (E @ v_s) @ dv_s
+    d_room = np.zeros_like(d_a)
+    if G["share_on"]:
+        d_start = (Mb * G["v0"]) @ d_v0
+        d_small = d_kin if G["smaller_is_kinetic"] else d_start
+        d_share = CONSTRAINT_SHARE * d_small
+        if G["gained_on"]:
+            d_dp = G["Up"] @ (dv_s - d_v0)
+            d_owed = (0.5 * h * G["g"] * d_dp if G["owed_lift"]
+                      else -G["dp"] / G["total_mass"] * d_dp)
+            d_other = df - 0.0          # (gravity's forces do not move)
+            d_gained = ((Mb * v_s) @ dv_s - d_start - h * (G["f"] @ dv_s + v_s @ df)
+                        + 0.5 * h * (G["other"] @ (dv_s - d_v0) + (v_s - G["v0"]) @ d_other)
+                        - d_owed)
+            d_share = d_share - d_gained
+        d_room = d_room + d_share
+    d_room = d_room + G["f"] @ d_move + G["move"] @ df
+    mass = np.repeat(np.asarray(Mb).reshape(n, 3)[:, 0], 3)
+    planar = np.tile([1.0, 1.0, 0.0], n)
+    d_room = d_room + VELOCITY_FLOOR * ((mass * planar * np.sign(dv)) @ d_dv
+                                        + (mass * planar * np.sign(v_s)) @ dv_s)
+    d_room = d_room + CORRECTION_MOVE_FLOOR * ((planar * np.sign(G["f"])) @ df)
+    d_room = d_room + RELATIVE_ROUNDING * (d_kin + G["sign_a"] * d_a + d_b)
+    return G["k_a"] * d_a + G["k_b"] * d_b + G["k_room"] * d_room
 
 
 def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
@@ -391,7 +536,7 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     n = model.n_body
     nq = 3 * n
     f, F, saturated = force_terms(model, start, u)
-    W_A, W_D, R, f_spring, K = rotor_terms(model, q0, h)
+    W_A, W_D, R, f_spring, K, rotors, f_alone, K_alone = rotor_terms(model, q0, h)
     # the rows of the joints that hold something (a free body's coordinate has none)
     held = np.flatnonzero(np.repeat((model.arrays.pin_kind & JOINT_FREE_BIT) == 0, 2))
     P = joint_terms(model, q0)[1][held]
@@ -422,10 +567,17 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         raise _not_covered("an end that is not the joints' SHAKE step q + h v_new + W P^T mu "
                            "(a velocity solve that took its first-order target)")
     secant = (q1.ravel() - q0.ravel()) / h
-    if np.abs(v1.ravel() - secant).max() > FIT_TOL * (np.abs(secant).max() + np.abs(v0).max()) \
-            + rounding / h:
-        raise _not_covered("an end velocity other than (q1 - q) / h (the position "
-                           "correction's velocity change held back by its energy bound)")
+    speed_tol = FIT_TOL * (np.abs(secant).max() + np.abs(v0).max()) + rounding / h
+    dv_move = secant - v_new            # the correction's velocity change, move / h
+    bounded = np.abs(v1.ravel() - secant).max() > speed_tol
+    if bounded:
+        # the correction's energy bound kept v_new + k dv_move (kernels/integrate.py)
+        bound = _energy_bound(model, h, q0.ravel(), v0.ravel(), v_new, dv_move,
+                              q1.ravel() - q0.ravel() - h * v_new, f + f_alone, rotors)
+        if bound is None or np.abs(v1.ravel() - (v_new + bound[0] * dv_move)).max() > speed_tol:
+            raise _not_covered("an end velocity other than (q1 - q) / h that the position "
+                               "correction's energy bound does not explain (its velocity "
+                               "change paid for by the motion)")
     # differentials as linear maps of (dq, dv, du): matrices of 2 nq + n_act columns
     nu = model.n_act
     eye = np.eye(nq)
@@ -457,6 +609,14 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         proj = eye
     dq1 = proj @ (base + h * dv_new)
     dv1 = (dq1 - d_q) / h
+    if bounded:
+        # v1 = v_new + k dv_move: d v1 = dv_new + k d(dv_move) + dv_move dk
+        d_move = dv1 - dv_new
+        df = np.hstack([K_alone, np.zeros((nq, nq)), F])
+        k, grads = bound
+        dk = _bound_derivative(grads, dv_new, d_move, dq1 - d_q - h * dv_new, df,
+                               np.hstack([np.zeros((nq, nq)), np.eye(nq), np.zeros((nq, nu))]))
+        dv1 = dv_new + k * d_move + np.outer(dv_move, dk)
     A = np.vstack([dq1[:, :2 * nq], dv1[:, :2 * nq]])
     B = np.vstack([dq1[:, 2 * nq:], dv1[:, 2 * nq:]])
     return StepJacobian(A=A, B=B, modes_changed=bool(saturated.any()),

@@ -81,6 +81,9 @@ EPS_FINE = 1e-8
 #: whose end carries its correction's tolerance as noise (1e-12 m over EPS_X is 1e-6: a
 #: step taken in sub-steps ends after more corrections)
 EPS_COARSE = 1e-4
+#: [m, rad, m/s, rad/s] the step between them, where the map bends within EPS_COARSE (the
+#: energy bound's share of the correction kept, changing regime) and is noisy at EPS_X
+EPS_BETWEEN = 1e-5
 
 
 def _agrees(jac, A, i, n):
@@ -93,7 +96,7 @@ def differences_agree(jac, sim, u):
     """The Jacobian against centred differences at EPS_X; a state column that disagrees is
     judged again against Richardson's extrapolation of centred differences at EPS_COARSE and
     half of it (error O(eps^4), the step's noise divided by 5e-5 instead of 1e-6: a step taken
-    in sub-steps), then at EPS_FINE, and only if the step's map bends within EPS_X of the
+    in sub-steps), then centred at EPS_BETWEEN, then at EPS_FINE, and only if the step's map bends within EPS_X of the
     state: its one-sided differences at EPS_X then differ from each other by more than the
     tolerance (a correction opening a pin gap of 1e-6 m whose velocity change the energy bound
     holds back, say). Returns (relative error of A, of B)."""
@@ -111,6 +114,13 @@ def differences_agree(jac, sim, u):
         richardson[:, i] = (4 * coarse[1] - coarse[0]) / 3
         if _agrees(jac, richardson, i, n):
             A[:, i] = richardson[:, i]
+            continue
+        # between them: the correction's noise over 1e-5, a bend of the map beyond it
+        between = A.copy()
+        between[:, i] = (step(x0 + EPS_BETWEEN * e, u) - step(x0 - EPS_BETWEEN * e, u)) / (
+            2 * EPS_BETWEEN)
+        if _agrees(jac, between, i, n):
+            A[:, i] = between[:, i]
             continue
         e[i] = EPS_X
         mid = step(x0, u)
@@ -519,7 +529,8 @@ def test_the_gymnasium_models_step_jacobian_under_torque(name, seed):
     lo, hi = sim.model.arrays.act_range.T
     span = np.where(np.isfinite(hi - lo), hi - lo, 2.0)
     sim.steps(int(rng.integers(2, 10)), np.clip(rng.uniform(-0.5, 0.5, lo.size) * span, lo, hi))
-    u = np.clip(rng.uniform(-0.5, 0.5, lo.size) * span, lo, hi)
+    middle = np.where(np.isfinite(lo + hi), 0.5 * (lo + hi), 0.0)
+    u = middle + rng.uniform(-0.45, 0.45, lo.size) * span   # (differences by EPS_U inside)
     try:
         jac = step_jacobian(sim, u)
     except NotImplementedError as exc:
