@@ -528,7 +528,7 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     if splits > 0:
         raise _not_covered(f"a step taken in {splits} time-of-impact splits")
     if substeps > 1:
-        return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end)
+        return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info)
     gap = np.abs(joint_terms(model, q1)[0]).max(initial=0.0)
     if gap > PINS_CLOSED_TOL:
         raise _not_covered(f"joints left open by {gap:.3g} m at its end (the position "
@@ -628,17 +628,17 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
 SUBSTEPS_TOL = 1e-12
 
 
-def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end) -> StepJacobian:
+def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info) -> StepJacobian:
     """The derivative of a step the engine took in n equal sub-steps (step.turn_substeps: a
     body turning fast), each a whole step of h / n of its own: the chain rule through them,
     A = A_n ... A_1 and B = sum_k A_n ... A_(k+1) B_k, each sub-step's from step_jacobian at
-    StepOptions.dt = h / n. `sim` ends as step_jacobian leaves it; raises where the sub-steps
-    do not end where the step did."""
+    StepOptions.dt = h / n and max_substeps 1 (the engine's sub-steps do not decide again how
+    to split themselves). `sim` ends as step_jacobian leaves it (audit, info: its audit and
+    counters before the step); raises where the sub-steps do not end where the step did."""
     options = sim.options
-    audit, info = sim.ws.audit.copy(), sim.ws.info.copy()
     try:
         sim.restore(start)
-        sim._options = options._replace(dt=sim.dt / n)
+        sim._options = options._replace(dt=sim.dt / n, max_substeps=1)
         sim._new_options()
         parts = [step_jacobian(sim, u, _keep_end=True) for _ in range(n)]
     finally:
@@ -654,7 +654,7 @@ def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end) -> StepJacobian:
     for part in parts[1:]:
         A, B = part.A @ A, part.A @ B + part.B
     if keep_end:
-        sim.step(u)
+        sim.step(u)             # (from the audit and counters before the step: counted once)
     return StepJacobian(A=A, B=B, modes_changed=any(p.modes_changed for p in parts), x1=x1)
 
 

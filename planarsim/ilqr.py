@@ -30,6 +30,9 @@ ALPHAS = 0.5 ** np.arange(10)
 ACCEPT_SHARE = 1e-4
 REG_MIN = 1e-6
 REG_MAX = 1e10
+#: the regularisation at most at which a quadratic model that expects no fall counts as
+#: convergence (a large one shrinks the step whatever the cost's slope)
+CONVERGED_REG = 1e-3
 
 
 @dataclass(frozen=True)
@@ -205,15 +208,17 @@ def ilqr(sim, us, cost, iterations=100, tol=1e-6) -> ILQRResult:
     converged = False
     for _ in range(iterations):
         accepted = None
+        first = True        # (the iteration's first backward pass, before any refused trial)
         while accepted is None and reg <= REG_MAX:
             back = _backward(jacs, xs, us, cost, reg, lo, hi)
             if back is None:
                 reg *= 10.0
                 continue
             ks, trial_gains, (d1, d2) = back
-            if -(d1 + d2) <= tol * abs(total):
+            if first and reg <= CONVERGED_REG and -(d1 + d2) <= tol * abs(total):
                 converged = True        # (the model expects no more than tol of the cost)
                 break
+            first = False
             for alpha in ALPHAS:
                 trial = _rollout(sim, start, us, cost, xs, ks, trial_gains, alpha)
                 if trial is None:

@@ -86,62 +86,92 @@ EPS_COARSE = 1e-4
 EPS_BETWEEN = 1e-5
 
 
-def _agrees(jac, A, i, n):
-    """Column i of jac.A within REL_TOL of A's (positions' and velocities' rows apart)."""
-    return all(np.abs(jac.A[rows, i] - A[rows, i]).max() <= REL_TOL * np.abs(A[rows]).max()
+def _agrees(exact, approx, i, n, blocks):
+    """Column i of exact within REL_TOL of approx's, the positions' and the velocities' rows
+    apart, each against the largest entry of its block of columns (blocks: slices; the
+    velocities' rows' derivatives by the positions are 1 / h those by the velocities)."""
+    cols = next(b for b in blocks if b.start <= i < b.stop)
+    return all(np.abs(exact[rows, i] - approx[rows, i]).max()
+               <= REL_TOL * np.abs(approx[rows, cols]).max()
                for rows in (slice(0, n), slice(n, None)))
 
 
+def _settle_column(exact, approx, i, n, blocks, estimates):
+    """The first of `estimates` (callables giving column i's difference estimate) that agrees
+    with exact's column i replaces approx's; returns whether one did."""
+    for estimate in estimates:
+        trial = approx.copy()
+        trial[:, i] = estimate()
+        if _agrees(exact, trial, i, n, blocks):
+            approx[:, i] = trial[:, i]
+            return True
+    return False
+
+
 def differences_agree(jac, sim, u):
-    """The Jacobian against centred differences at EPS_X; a state column that disagrees is
-    judged again against Richardson's extrapolation of centred differences at EPS_COARSE and
-    half of it (error O(eps^4), the step's noise divided by 5e-5 instead of 1e-6: a step taken
-    in sub-steps), then centred at EPS_BETWEEN, then at EPS_FINE, and only if the step's map bends within EPS_X of the
-    state: its one-sided differences at EPS_X then differ from each other by more than the
-    tolerance (a correction opening a pin gap of 1e-6 m whose velocity change the energy bound
-    holds back, say). Returns (relative error of A, of B)."""
+    """The Jacobian against centred differences at EPS_X (each block of A's columns, the
+    derivatives by the positions and by the velocities, against its own largest entry). A
+    state column that disagrees is judged again against Richardson's extrapolation of centred
+    differences at EPS_COARSE and half of it (error O(eps^4), the step's noise divided by 5e-5
+    instead of 1e-6: a step taken in sub-steps), then centred at EPS_BETWEEN, then at EPS_FINE,
+    and only if the step's map bends within EPS_X of the state: its one-sided differences at
+    EPS_X then differ from each other by more than the tolerance (a correction opening a pin
+    gap of 1e-6 m whose velocity change the energy bound holds back, say). A command's column
+    that disagrees at EPS_U is judged again at 1e-4 (Richardson's pair) and 1e-5. Returns
+    (relative error of A, of B)."""
     A, B = finite_differences(sim, u)
     x0, step = _stepper(sim)
     n = x0.size // 2
+    state_blocks = (slice(0, n), slice(n, 2 * n))
+
+    def centred(i, eps):
+        e = np.zeros_like(x0)
+        e[i] = eps
+        return (step(x0 + e, u) - step(x0 - e, u)) / (2 * eps)
+
     for i in range(x0.size):
-        if _agrees(jac, A, i, n):
+        if _agrees(jac.A, A, i, n, state_blocks):
+            continue
+        if _settle_column(jac.A, A, i, n, state_blocks, (
+                lambda: (4 * centred(i, EPS_COARSE / 2) - centred(i, EPS_COARSE)) / 3,
+                lambda: centred(i, EPS_BETWEEN))):
             continue
         e = np.zeros_like(x0)
-        e[i] = 1.0
-        coarse = [(step(x0 + eps * e, u) - step(x0 - eps * e, u)) / (2 * eps)
-                  for eps in (EPS_COARSE, EPS_COARSE / 2)]
-        richardson = A.copy()
-        richardson[:, i] = (4 * coarse[1] - coarse[0]) / 3
-        if _agrees(jac, richardson, i, n):
-            A[:, i] = richardson[:, i]
-            continue
-        # between them: the correction's noise over 1e-5, a bend of the map beyond it
-        between = A.copy()
-        between[:, i] = (step(x0 + EPS_BETWEEN * e, u) - step(x0 - EPS_BETWEEN * e, u)) / (
-            2 * EPS_BETWEEN)
-        if _agrees(jac, between, i, n):
-            A[:, i] = between[:, i]
-            continue
         e[i] = EPS_X
         mid = step(x0, u)
         right = (step(x0 + e, u) - mid) / EPS_X
         left = (mid - step(x0 - e, u)) / EPS_X
         assert relative_error(right[:, None], left[:, None]) > REL_TOL, (
             f"column {i} disagrees with the differences where the step is smooth")
-        e[i] = EPS_FINE
-        A[:, i] = (step(x0 + e, u) - step(x0 - e, u)) / (2 * EPS_FINE)
-    return relative_error(jac.A, A), relative_error(jac.B, B)
+        A[:, i] = centred(i, EPS_FINE)
+
+    def centred_u(k, eps):
+        e = np.zeros_like(u)
+        e[k] = eps
+        return (step(x0, u + e) - step(x0, u - e)) / (2 * eps)
+
+    command_blocks = (slice(0, u.size),)
+    for k in range(u.size):
+        if not _agrees(jac.B, B, k, n, command_blocks):
+            # the bound's bend within EPS_U: Richardson's pair at 1e-4, then centred at 1e-5
+            _settle_column(jac.B, B, k, n, command_blocks, (
+                lambda: (4 * centred_u(k, 5e-5) - centred_u(k, 1e-4)) / 3,
+                lambda: centred_u(k, 1e-5)))
+    return (relative_error(jac.A, A, state_blocks),
+            relative_error(jac.B, B, command_blocks))
 
 
-def relative_error(exact, approx):
+def relative_error(exact, approx, blocks=None):
     """max |exact - approx| over max |approx|, for the positions' and the velocities' rows
-    apart (the velocities' are 1 / h larger)."""
+    apart (the velocities' are 1 / h larger) and for each block of columns (blocks: slices;
+    None: all columns together)."""
     n = exact.shape[0] // 2
     worst = 0.0
     for rows in (slice(0, n), slice(n, None)):
-        scale = np.abs(approx[rows]).max()
-        if scale > 0.0:
-            worst = max(worst, np.abs(exact[rows] - approx[rows]).max() / scale)
+        for cols in blocks or (slice(None),):
+            scale = np.abs(approx[rows, cols]).max(initial=0.0)
+            if scale > 0.0:
+                worst = max(worst, np.abs(exact[rows, cols] - approx[rows, cols]).max() / scale)
     return worst
 
 
