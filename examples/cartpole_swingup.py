@@ -12,6 +12,8 @@ result is then run closed-loop: each push is iLQR's plus its feedback gain times
 distance from the planned state.
 
     python examples/cartpole_swingup.py [--dt 0.02] [--horizon 4] [--iterations 60]
+
+It reads the model from gymnasium's own files: pip install -e '.[gym]' first.
 """
 import argparse
 import os

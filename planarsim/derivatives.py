@@ -93,6 +93,12 @@ def _not_covered(what):
         f"body torques, body forces and forces along such slides so far; this step has {what}")
 
 
+def inverse_masses(a) -> np.ndarray:
+    """The bodies' inverse masses and inertias per coordinate (3 n_body,) [1/kg, 1/(kg m^2)]
+    of model arrays a (a point mass's turn: 0)."""
+    return np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
+
+
 def _constant_rate_row(a, j) -> bool:
     """Joint j's rate row g is the same at every q: a hinge's (theta_b - theta_a), a free
     hinge's, or a slide's along a world axis (body a the world) whose anchor on body b is its
@@ -135,7 +141,7 @@ def check_covered(model, options, h) -> None:
         raise _not_covered(f"rods ({model.rod_names[0]!r}, ...)")
     if a.fluid_body.shape[0]:
         raise _not_covered("fluid drag")
-    w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
+    w = inverse_masses(a)
     for j, name in enumerate(model.pin_names):
         kind = int(a.pin_kind[j])
         if kind & ~(JOINT_SLIDE_BIT | JOINT_FREE_BIT):
@@ -176,7 +182,7 @@ def rotor_terms(model, q, h):
     spring has a constant rate row (check_covered)."""
     a = model.arrays
     n = model.n_body
-    w = np.column_stack([a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia]).ravel()
+    w = inverse_masses(a)
     A = np.zeros((3 * n, 3 * n))
     D = np.zeros((3 * n, 3 * n))
     K = np.zeros((3 * n, 3 * n))
@@ -471,9 +477,8 @@ def _bound_derivative(grads, dv_s, d_dv, d_move, df, d_v0):
             d_dp = G["Up"] @ (dv_s - d_v0)
             d_owed = (0.5 * h * G["g"] * d_dp if G["owed_lift"]
                       else -G["dp"] / G["total_mass"] * d_dp)
-            d_other = df - 0.0          # (gravity's forces do not move)
             d_gained = ((Mb * v_s) @ dv_s - d_start - h * (G["f"] @ dv_s + v_s @ df)
-                        + 0.5 * h * (G["other"] @ (dv_s - d_v0) + (v_s - G["v0"]) @ d_other)
+                        + 0.5 * h * (G["other"] @ (dv_s - d_v0) + (v_s - G["v0"]) @ df)
                         - d_owed)
             d_share = d_share - d_gained
         d_room = d_room + d_share
