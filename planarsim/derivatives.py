@@ -1,43 +1,50 @@
 """Exact derivatives of one step: step_jacobian(sim, u); along a rollout: rollout_jacobians.
 
-The default step (symplectic Euler with SHAKE, docs/engine.md) of a mechanism held by hinges
-and sliders ends at
+The step is taken once by the engine, on a snapshot (`sim` is restored), and then replayed in
+numpy by planarsim.step_replica under the decisions it took (its contacts' modes and slips,
+the Newton correction's passes, the energy bound's branch, the rows it left out as
+dependent). The replay must end where the engine ended (to FIT_TOL of the step's motion, plus
+rounding), or the step is refused: what it computes is then the engine's map. Within those
+decisions the step is smooth, and the replay is analytic in the state and the commands, so
+it is differentiated by the complex step (a start x + i e dx: the imaginary part of the end
+over e is the directional derivative, exact to rounding, with no difference taken): every
+column of A = d x1 / d x and B = d x1 / d u in one batched replay. The step it replays
+(docs/engine.md):
 
     v_lin = W_D (E_A v + h f(q, u)),          q_pred = q + h v_lin,
-    (P W_D P^T) lam = -c(q_pred) / h,          v_new = v_lin + W_D P^T lam,
-    q1 = q + h v_new + W_A P^T mu,   c(q1) = 0,   v1 = (q1 - q) / h,
+    P W_D F^T lam = -b,   v_new = v_lin + W_D F^T lam,
+    q1 = q + h v_new + W_A P^T mu with every row held at q1 (Newton, along the start's rows),
+    v1 = v_new + the correction's velocity change (its move / h for the joints; nothing along
+         a contact's normal, which moves positions only), as far as its energy bound keeps it,
 
-with c the joints' equality rows (a hinge's x and y, a slider's perpendicular and angle
-rows), P = dc/dq at the step's start, lam the velocity solve's impulses and mu the Newton
-correction's. E_A = M + A is the bodies' masses with the joints' rotors (A = sum a g g^T over
-the joints' armature a and rate rows g), E_D = M + sum (a + h c) g g^T the same with the
-dampers c taken implicitly (kernels/soft.py: the soft rows, solved with the pins and alone
-for the linearisation v_lin); W_A = E_A^-1 and W_D = E_D^-1. f holds gravity, pushes, the
-actuators' commands and the joints' springs, taken at the step's start. Without dampers W_D =
-W_A and only lam h + mu matters; with them the velocity solve and the correction move along
-different directions, so lam is the velocity solve's own (computed here from the equation
-above and checked against the step's answer). Within its modes the step is smooth and the
-implicit function theorem on c(q1) = 0 and on the velocity solve gives its derivative
-exactly: the joints' Jacobians at the start, at q_pred and at q1, and their curvature (each
-row's Hessian) under lam, mu and W_D P^T lam. The step is taken once, on a snapshot (`sim`
-is restored). A step taken in sub-steps (a body turning fast: step.turn_substeps) is the
-chain rule through them, each a step of h / n. Where the correction's energy bound
-(kernels/integrate.py bound_correction_work) kept only a share k of the correction's velocity
-change, v1 = v_new + k (q1 - q - h v_new) / h with k the bound's own root, differentiated with
-the energies it weighs (_energy_bound). A step that did not end as those equations say (the
-bound taking energy from the motion as well, a velocity solve that fell back to its
-first-order target) raises instead of giving a derivative of a different map.
+P the rows at the step's start: the joints' (a hinge's x and y, a slider's perpendicular and
+angle rows) and the touching ground contacts' (a normal row; a sticking contact's tangent
+row), F = P but for a sliding contact's normal row, whose impulse pushes along n - mu s t;
+b the joints' gaps at q_pred / h and the contacts' gaps at the start (a positive one: a
+contact that starts inside the ground only stops approaching) / h. E_A = M + A is the
+bodies' masses with the joints' rotors (armature), W_A its inverse, W_D the same with the
+dampers taken implicitly; f holds gravity, pushes, the actuators' commands and the joints'
+springs. A step taken in sub-steps (a body turning fast: step.turn_substeps) is the chain
+rule through them, each a step of h / n.
+
+A touching contact's gap at the start is a boundary of the step's pieces: a start lifted off
+the ground by dz closes it in the step (its velocity solve aims at the surface), one pushed
+into the ground by dz is moved out by the correction (positions only). The derivative is the
+piece's whose side the start is on (within rounding of the surface: lifted where the gap is
+positive); along the surface (the states a contact keeps) both pieces agree.
 
 Covered so far: bodies held by hinges (pins) and sliders to each other and the world, free
 bodies' coordinates (an MJCF root's slides and hinge), with joint limits the step does not
 reach; armature, dampers and the springs the step resolves on every joint whose rate row g is
 constant (hinges, and slides along a world axis whose anchor is their body's centre of mass:
-MJCF roots, a cart on a rail); under gravity, constant pushes, pin torques, body forces and
+MJCF roots, a cart on a rail); ground contacts of points and round soles on flat or sloped
+ground, sticking or sliding (Coulomb), several sharing a load (the rows the engine leaves out
+as dependent, left out alike); under gravity, constant pushes, pin torques, body forces and
 torques and forces along such slides. Refused with a NotImplementedError naming the feature:
 armature, dampers or springs on a slider whose rate row turns with its bodies (its rotor adds
 velocity-product forces), rods, a limit reached in the step, dry friction, springs too stiff
-for the step, contacts and shape pairs that touch in the step, fluid drag, the other
-actuator kinds, the accurate integrators.
+for the step, contacts on hills, shape pairs that touch, restitution, a step split at a
+time of impact, fluid drag, the other actuator kinds, the accurate integrators.
 """
 from __future__ import annotations
 
@@ -45,15 +52,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kernels.codes import (INTEGRATOR_EULER, JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDE_BIT,
-                            JOINT_SLIDER, MODE_FREE)
+from .kernels.codes import (CONTACT_ARC, CONTACT_POINT, INTEGRATOR_EULER, JOINT_FREE_BIT,
+                            JOINT_SLIDE_BIT, MODE_FREE, MODE_PINNED)
 from .kernels.forces import ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_PIN_TORQUE, ACT_SLIDER_FORCE
 from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
-from .kernels.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
-                           SHAKE_REGIME, VELOCITY_FLOOR)
+from .step_replica import ContactPlan, ReplicaRefused, StepPlan, replica
 
-#: the step's end must satisfy q1 = q + h v* + W P^T L to this share of |q1 - q| (plus
-#: rounding) for its derivative to be this map's
+#: the replay must end where the engine's step ended to this share of the step's motion (plus
+#: rounding) for its derivative to be the engine's map's
 FIT_TOL = 1e-9
 
 _LINEAR_ACTUATORS = {ACT_PIN_TORQUE: "pin torque", ACT_BODY_FORCE: "body force",
@@ -67,8 +73,9 @@ class StepJacobian:
     A : (n_x, n_x) d x1 / d x
     B : (n_x, n_u) d x1 / d u (u: the actuators' commands [N or N m])
     modes_changed : True where an infinitesimal change of x or u would change a mode of the
-        step (here: a command exactly at its saturation bound; B then holds the derivative
-        from inside the range)
+        step (a command exactly at its saturation bound: B then holds the derivative from
+        inside the range; a touching contact at the edge of its mode: _at_mode_boundary);
+        the derivative is then the mode's the step took
     x1 : the state after the step, in the same layout
     """
     A: np.ndarray
@@ -77,20 +84,13 @@ class StepJacobian:
     x1: np.ndarray
 
 
-#: [m, rad] the joints' gap at the step's end below which the step counts as closing them (the
-#: derivative assumes c(q1) = 0; the default correction ends near 1e-15 m)
-PINS_CLOSED_TOL = 1e-10
-#: (G W P^T)'s condition number above which the joints count as dependent (an over-
-#: constrained loop: the step is not smooth there)
-DEPENDENT_COND = 1e10
-
-
 def _not_covered(what):
     return NotImplementedError(
         f"step_jacobian covers mechanisms of hinges, sliders and free bodies' coordinates "
         f"(armature, dampers and the springs the step resolves on joints whose rate row is "
-        f"constant), with limits the step does not reach, under gravity, pushes, pin and "
-        f"body torques, body forces and forces along such slides so far; this step has {what}")
+        f"constant), with limits the step does not reach, and ground contacts of points and "
+        f"round soles on flat or sloped ground, under gravity, pushes, pin and body torques, "
+        f"body forces and forces along such slides so far; this step has {what}")
 
 
 def inverse_masses(a) -> np.ndarray:
@@ -216,133 +216,6 @@ def rotor_terms(model, q, h):
     return W_A, W_D, R, f, K, A, f_alone, K_alone
 
 
-def joint_terms(model, q, impulse=None):
-    """The joints' errors c (2 n_pin,) [m, rad] and Jacobian J (2 n_pin, 3 n_body) at q
-    (n_body, 3): rows 2j and 2j + 1 of joint j, a hinge's x and y (anchor b minus anchor a,
-    as kernels/pin.py), a slider's perpendicular and angle rows (kernels/slider.py); with
-    `impulse` (2 n_pin,) [N s, N m s] also H (3 n_body, 3 n_body) = d (J^T impulse) / dq, the
-    rows' curvature (J is each row's gradient, so H is the impulse-weighted sum of their
-    Hessians)."""
-    a = model.arrays
-    n = q.shape[0]
-    c = np.zeros(2 * model.n_pin)
-    J = np.zeros((2 * model.n_pin, 3 * n))
-    H = np.zeros((3 * n, 3 * n)) if impulse is not None else None
-    _hinge_terms(a, q, np.flatnonzero(a.pin_kind == JOINT_HINGE), c, J, H, impulse)
-    for j in np.flatnonzero(a.pin_kind == JOINT_SLIDER):
-        _slider_terms(a, q, int(j), c, J, H, impulse)
-    return c, J, H
-
-
-def joint_hessians(model, q):
-    """T (2 n_pin, 3 n_body, 3 n_body): the Hessian of each of the joints' rows at q
-    (joint_terms' H for a unit impulse on that row alone): a hinge's x and y rows bend only
-    in their bodies' angles, d^2 (R(theta) r) / dtheta^2 = -R(theta) r; a slider's
-    perpendicular row as _slider_terms says, its angle row not at all."""
-    a = model.arrays
-    n = q.shape[0]
-    T = np.zeros((2 * model.n_pin, 3 * n, 3 * n))
-    hinges = np.flatnonzero(a.pin_kind == JOINT_HINGE)
-    for e, sign in ((0, -1.0), (1, 1.0)):
-        body = a.pin_body[hinges, e]
-        moving = body >= 0
-        j, b = hinges[moving], body[moving]
-        th = q[b, 2]
-        ax, ay = a.pin_anchor[j, e, 0], a.pin_anchor[j, e, 1]
-        rx = np.cos(th) * ax - np.sin(th) * ay
-        ry = np.sin(th) * ax + np.cos(th) * ay
-        T[2 * j, 3 * b + 2, 3 * b + 2] -= sign * rx
-        T[2 * j + 1, 3 * b + 2, 3 * b + 2] -= sign * ry
-    for j in np.flatnonzero(a.pin_kind == JOINT_SLIDER):
-        unit = np.zeros(2 * model.n_pin)
-        unit[2 * j] = 1.0
-        H = np.zeros((3 * n, 3 * n))
-        _slider_terms(a, q, int(j), np.zeros(2 * model.n_pin),
-                      np.zeros((2 * model.n_pin, 3 * n)), H, unit)
-        T[2 * j] = H
-    return T
-
-
-def _hinge_terms(a, q, rows, c, J, H, impulse):
-    """joint_terms' rows of the hinges `rows` (vectorised over them)."""
-    for e, sign in ((0, -1.0), (1, 1.0)):
-        body = a.pin_body[rows, e]
-        ax, ay = a.pin_anchor[rows, e, 0], a.pin_anchor[rows, e, 1]
-        moving = body >= 0
-        b = np.where(moving, body, 0)
-        th = np.where(moving, q[b, 2], 0.0)
-        cs, sn = np.cos(th), np.sin(th)
-        rx = np.where(moving, cs * ax - sn * ay, 0.0)   # the anchor's arm in the world [m]
-        ry = np.where(moving, sn * ax + cs * ay, 0.0)
-        px = np.where(moving, q[b, 0] + rx, ax)         # a world anchor's own coordinates
-        py = np.where(moving, q[b, 1] + ry, ay)
-        c[2 * rows] += sign * px
-        c[2 * rows + 1] += sign * py
-        m = rows[moving]
-        bm = b[moving]
-        np.add.at(J, (2 * m, 3 * bm), sign)
-        np.add.at(J, (2 * m + 1, 3 * bm + 1), sign)
-        np.add.at(J, (2 * m, 3 * bm + 2), -sign * ry[moving])
-        np.add.at(J, (2 * m + 1, 3 * bm + 2), sign * rx[moving])
-        if H is not None:
-            lx, ly = impulse[2 * m], impulse[2 * m + 1]
-            np.add.at(H, (3 * bm + 2, 3 * bm + 2),
-                      -sign * (rx[moving] * lx + ry[moving] * ly))
-
-
-def _turned(theta, x, y):
-    """(x, y) turned by theta [rad]."""
-    cs, sn = np.cos(theta), np.sin(theta)
-    return np.array([cs * x - sn * y, sn * x + cs * y])
-
-
-def _cross(u, w):
-    """z of u x w (2-vectors)."""
-    return u[0] * w[1] - u[1] * w[0]
-
-
-def _slider_terms(a, q, j, c, J, H, impulse):
-    """joint_terms' rows of slider j: c_perp = n.(p_b - p_a) with d = R(theta_a) d0, n = (-d_y,
-    d_x), and c_angle = theta_b - theta_a - ref. n.R(theta_a) r_a is constant, so c_perp =
-    n.(x_b - x_a) + n.R(theta_b) r_b + const: its Hessian has the terms theta_a theta_a
-    -n.(p_b - x_a), theta_a x_b -d, theta_a x_a +d, theta_a theta_b -d.perp(R r_b), theta_b
-    theta_b -n.R r_b (dn / dtheta_a = -d); the angle row is linear."""
-    ba, bb = int(a.pin_body[j, 0]), int(a.pin_body[j, 1])
-    r = 2 * j
-    if ba >= 0:
-        d = _turned(q[ba, 2], *a.pin_axis[j])
-        pa = q[ba, :2] + _turned(q[ba, 2], *a.pin_anchor[j, 0])
-    else:
-        d = np.asarray(a.pin_axis[j], dtype=float)
-        pa = np.asarray(a.pin_anchor[j, 0], dtype=float)
-    nrm = np.array([-d[1], d[0]])
-    arm_b = _turned(q[bb, 2], *a.pin_anchor[j, 1])
-    pb = q[bb, :2] + arm_b
-    c[r] = nrm @ (pb - pa)
-    c[r + 1] = q[bb, 2] - a.pin_ref[j] - (q[ba, 2] if ba >= 0 else 0.0)
-    J[r, 3 * bb:3 * bb + 2] += nrm
-    J[r, 3 * bb + 2] += _cross(pb - q[bb, :2], nrm)
-    J[r + 1, 3 * bb + 2] += 1.0
-    if ba >= 0:
-        J[r, 3 * ba:3 * ba + 2] -= nrm
-        J[r, 3 * ba + 2] -= _cross(pb - q[ba, :2], nrm)
-        J[r + 1, 3 * ba + 2] -= 1.0
-    if H is None:
-        return
-    lam = impulse[r]
-    tb = 3 * bb + 2
-    H[tb, tb] -= lam * (nrm @ arm_b)
-    if ba >= 0:
-        ta = 3 * ba + 2
-        H[ta, ta] -= lam * (nrm @ (pb - q[ba, :2]))
-        perp_b = np.array([-arm_b[1], arm_b[0]])
-        mixed = [(3 * bb, -d[0]), (3 * bb + 1, -d[1]), (3 * ba, d[0]), (3 * ba + 1, d[1]),
-                 (tb, -(d @ perp_b))]
-        for k, value in mixed:
-            H[ta, k] += lam * value
-            H[k, ta] += lam * value
-
-
 def force_terms(model, state, u):
     """(f (3 n_body,) [N, N m] the applied forces under commands u, F (3 n_body, n_act) their
     derivative with respect to u (0 for a command past a bound; for one exactly at a bound,
@@ -380,118 +253,6 @@ def force_terms(model, state, u):
     return f.ravel(), F.reshape(3 * n, model.n_act), at_bound
 
 
-def _energy_bound(model, h, q0, v0, v_s, dv, move, f, rotors):
-    """The share k of the position correction's velocity change dv [m/s, rad/s] that its
-    energy bound keeps (kernels/integrate.py bound_correction_work, its arithmetic in exact
-    terms) after a velocity solve that ended at v_s, for a step of h [s] from (q0, v0) whose
-    correction moved the positions by `move` under the applied forces f (ws.force); rotors:
-    the joints' rotors' inertia A. Returns (k, the partial derivatives of k with respect to
-    the bound's inputs, for _bound_derivative), or None where the bound took more than the
-    correction's velocity change (the motion paid: not covered)."""
-    a_ = model.arrays
-    n = model.n_body
-    Mb = np.column_stack([a_.body_mass, a_.body_mass, a_.body_inertia]).ravel()
-    E = np.diag(Mb) + rotors                # the bodies' and the rotors' kinetic energy
-    Ev, Edv = E @ v_s, E @ dv
-    a = v_s @ Edv
-    b = 0.5 * dv @ Edv
-    kinetic = 0.5 * v_s @ Ev
-    # velocity_stage_gain: the start's kinetic energy and the energy the solve gained
-    gravity = np.asarray(a_.gravity, dtype=float)
-    g = float(np.hypot(*gravity))
-    up = -gravity / g if g > 0.0 else np.zeros(2)
-    f_g = np.zeros(3 * n)
-    f_g[0::3] = a_.body_mass * gravity[0]
-    f_g[1::3] = a_.body_mass * gravity[1]
-    other = f - f_g
-    start = 0.5 * v0 @ (Mb * v0)
-    Up = np.zeros(3 * n)
-    Up[0::3] = a_.body_mass * up[0]
-    Up[1::3] = a_.body_mass * up[1]
-    dp = Up @ (v_s - v0)
-    total_mass = float(a_.body_mass.sum())
-    lift = 0.5 * h * g * dp
-    sink = -dp * dp / (2.0 * total_mass) if total_mass > 0.0 else 0.0
-    owed = max(lift, sink) if total_mass > 0.0 else 0.0
-    gained = (0.5 * v_s @ (Mb * v_s) - start - h * f @ v_s + 0.5 * h * other @ (v_s - v0)
-              - owed)
-    in_regime = b <= SHAKE_REGIME * SHAKE_REGIME * kinetic
-    smaller = min(kinetic, start)
-    share = max(CONSTRAINT_SHARE * smaller - max(gained, 0.0), 0.0)
-    force_work = f @ move
-    dvx = np.abs(dv).reshape(n, 3)[:, :2]
-    vsx = np.abs(v_s).reshape(n, 3)[:, :2]
-    momentum = float(a_.body_mass @ (dvx.sum(axis=1) + vsx.sum(axis=1)))
-    forces = float(np.abs(f.reshape(n, 3)[:, :2]).sum())
-    rounding = (VELOCITY_FLOOR * momentum + CORRECTION_MOVE_FLOOR * forces
-                + RELATIVE_ROUNDING * (kinetic + abs(a) + b))
-    room = (share if in_regime else 0.0) + force_work + rounding
-    if a + b <= room:
-        return 1.0, None
-    if not b > 0.0:
-        return None
-    disc = a * a + 4.0 * b * room
-    root = np.sqrt(disc) if disc >= 0.0 else -1.0
-    k = (-a + root) / (2.0 * b) if disc >= 0.0 else -1.0
-    if k < 0.0 or (disc >= 0.0 and -a - root > 2.0 * b):
-        # no k in [0, 1] keeps the energy within room: the k of least energy, -a / (2 b) in
-        # [0, 1] (the kernel then pays what is left from the motion, which the caller's check
-        # of the end velocity refuses)
-        k = -a / (2.0 * b)
-        if not 0.0 < k < 1.0:
-            return min(max(k, 0.0), 1.0), None      # (clipped: the same k nearby)
-        k_a, k_b, k_room = -1.0 / (2.0 * b), a / (2.0 * b * b), 0.0
-    elif k > 1.0:
-        return None
-    else:
-        # partial derivatives of k = (-a + sqrt(a^2 + 4 b room)) / (2 b)
-        k_a = (-1.0 + a / root) / (2.0 * b)
-        k_b = room / (b * root) - k / b
-        k_room = 1.0 / root
-    grads = dict(k_a=k_a, k_b=k_b, k_room=k_room, E=E, Mb=Mb, v_s=v_s, dv=dv, v0=v0, f=f,
-                 other=other, f_g=f_g, Up=Up, h=h, move=move, in_regime=in_regime,
-                 share_on=in_regime and CONSTRAINT_SHARE * smaller - max(gained, 0.0) > 0.0,
-                 smaller_is_kinetic=kinetic <= start, gained_on=gained > 0.0,
-                 owed_lift=lift >= sink, dp=dp, total_mass=total_mass, g=g,
-                 sign_a=np.sign(a), n=n)
-    return k, grads
-
-
-def _bound_derivative(grads, dv_s, d_dv, d_move, df, d_v0):
-    """dk (a row over the columns of the differentials) of _energy_bound's k from the
-    differentials of its inputs: dv_s of the solve's answer, d_dv of the correction's velocity
-    change, d_move of its move, df of the applied forces, d_v0 of the start's velocity."""
-    if grads is None:                   # (k = 0 or 1 held for every nearby input)
-        return np.zeros(dv_s.shape[1])
-    G = grads
-    E, Mb, v_s, dv, h, n = G["E"], G["Mb"], G["v_s"], G["dv"], G["h"], G["n"]
-    d_a = (E @ dv) @ dv_s + (E @ v_s) @ d_dv
-    d_b = (E @ dv) @ d_dv
-    d_kin = (E @ v_s) @ dv_s
-    d_room = np.zeros_like(d_a)
-    if G["share_on"]:
-        d_start = (Mb * G["v0"]) @ d_v0
-        d_small = d_kin if G["smaller_is_kinetic"] else d_start
-        d_share = CONSTRAINT_SHARE * d_small
-        if G["gained_on"]:
-            d_dp = G["Up"] @ (dv_s - d_v0)
-            d_owed = (0.5 * h * G["g"] * d_dp if G["owed_lift"]
-                      else -G["dp"] / G["total_mass"] * d_dp)
-            d_gained = ((Mb * v_s) @ dv_s - d_start - h * (G["f"] @ dv_s + v_s @ df)
-                        + 0.5 * h * (G["other"] @ (dv_s - d_v0) + (v_s - G["v0"]) @ df)
-                        - d_owed)
-            d_share = d_share - d_gained
-        d_room = d_room + d_share
-    d_room = d_room + G["f"] @ d_move + G["move"] @ df
-    mass = np.repeat(np.asarray(Mb).reshape(n, 3)[:, 0], 3)
-    planar = np.tile([1.0, 1.0, 0.0], n)
-    d_room = d_room + VELOCITY_FLOOR * ((mass * planar * np.sign(dv)) @ d_dv
-                                        + (mass * planar * np.sign(v_s)) @ dv_s)
-    d_room = d_room + CORRECTION_MOVE_FLOOR * ((planar * np.sign(G["f"])) @ df)
-    d_room = d_room + RELATIVE_ROUNDING * (d_kin + G["sign_a"] * d_a + d_b)
-    return G["k_a"] * d_a + G["k_b"] * d_b + G["k_room"] * d_room
-
-
 def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     """The exact derivative of one step of `sim` (as `sim.step(u)` would take it) with respect
     to the state x = (q.ravel(), v.ravel()) and the commands u (module docstring). `sim` is
@@ -506,15 +267,14 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     start = sim.snapshot()
     options = sim.options
     audit, info = sim.ws.audit.copy(), sim.ws.info.copy()
-    q0 = start.q.copy()
-    v0 = start.v.copy()
     ended = False
     try:
         sim.step(u)
         ended = True
         end = sim.state
         q1, v1 = end.q.copy(), end.v.copy()
-        touching = bool((end.contact_mode != MODE_FREE).any())
+        end_modes, end_slips = end.contact_mode.copy(), end.contact_slip.copy()
+        impulses = end.last_contact_impulse.copy()
         substeps = int(sim.ws.info[INFO_TURN_SUBSTEPS])
         splits = int(sim.ws.info[INFO_CCD_SPLITS])
         limits = bool(end.limit_active.any())
@@ -526,106 +286,16 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
                 sim._new_options()
             sim.ws.audit[:] = audit
             sim.ws.info[:] = info
-    if touching:
-        raise _not_covered("a contact that touches in the step")
     if limits:
         raise _not_covered("a joint limit reached in the step")
     if splits > 0:
         raise _not_covered(f"a step taken in {splits} time-of-impact splits")
     if substeps > 1:
         return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info)
-    gap = np.abs(joint_terms(model, q1)[0]).max(initial=0.0)
-    if gap > PINS_CLOSED_TOL:
-        raise _not_covered(f"joints left open by {gap:.3g} m at its end (the position "
-                           f"correction's refine_tol or a stalled correction)")
-    n = model.n_body
-    nq = 3 * n
-    f, F, saturated = force_terms(model, start, u)
-    W_A, W_D, R, f_spring, K, rotors, f_alone, K_alone = rotor_terms(model, q0, h)
-    # the rows of the joints that hold something (a free body's coordinate has none)
-    held = np.flatnonzero(np.repeat((model.arrays.pin_kind & JOINT_FREE_BIT) == 0, 2))
-    P = joint_terms(model, q0)[1][held]
-    # the velocity solve (module docstring): its linearisation, target and impulses
-    v_lin = R @ v0.ravel() + h * (W_D @ (f + f_spring))
-    q_pred = q0.ravel() + h * v_lin
-    c_pred, P_pred, _ = joint_terms(model, q_pred.reshape(n, 3))
-    c_pred, P_pred = c_pred[held], P_pred[held]
-    WdPt = W_D @ P.T
-    WaPt = W_A @ P.T
-    if P.shape[0]:
-        N = P @ WdPt
-        if np.linalg.cond(N) > DEPENDENT_COND:
-            raise _not_covered("dependent joints (an over-constrained loop): the step is not "
-                               "smooth there")
-        lam = -np.linalg.solve(N, c_pred) / h
-    else:
-        lam = np.zeros(0)
-    v_new = v_lin + WdPt @ lam
-    # the correction's total impulse mu from the step's answer: W_A P^T mu = q1 - q - h v_new
-    # (least squares; P has full row rank where the joints are independent, checked above)
-    move = q1.ravel() - q0.ravel() - h * v_new
-    mu = np.linalg.lstsq(WaPt, move, rcond=None)[0] if P.shape[0] else np.zeros(0)
-    eps = np.finfo(float).eps
-    scale = max(np.abs(move).max(initial=0.0), np.abs(q1 - q0).max(), h * np.abs(v0).max())
-    rounding = 64 * eps * (np.abs(q0).max() + np.abs(move).max(initial=0.0))
-    if np.abs(WaPt @ mu - move).max(initial=0.0) > FIT_TOL * scale + rounding:
-        raise _not_covered("an end that is not the joints' SHAKE step q + h v_new + W P^T mu "
-                           "(a velocity solve that took its first-order target)")
-    secant = (q1.ravel() - q0.ravel()) / h
-    speed_tol = FIT_TOL * (np.abs(secant).max() + np.abs(v0).max()) + rounding / h
-    dv_move = secant - v_new            # the correction's velocity change, move / h
-    bounded = np.abs(v1.ravel() - secant).max() > speed_tol
-    if bounded:
-        # the correction's energy bound kept v_new + k dv_move (kernels/integrate.py)
-        bound = _energy_bound(model, h, q0.ravel(), v0.ravel(), v_new, dv_move,
-                              q1.ravel() - q0.ravel() - h * v_new, f + f_alone, rotors)
-        if bound is None or np.abs(v1.ravel() - (v_new + bound[0] * dv_move)).max() > speed_tol:
-            raise _not_covered("an end velocity other than (q1 - q) / h that the position "
-                               "correction's energy bound does not explain (its velocity "
-                               "change paid for by the motion)")
-    # differentials as linear maps of (dq, dv, du): matrices of 2 nq + n_act columns
-    nu = model.n_act
-    eye = np.eye(nq)
-    zero_v = np.zeros((nq, nq + nu))
-    d_q = np.hstack([eye, zero_v])                          # dq itself
-    dv_lin = np.hstack([h * (W_D @ K), R, h * (W_D @ F)])
-    dq_pred = d_q + h * dv_lin
-    dv_new = dv_lin
-    base = d_q
-    if P.shape[0]:
-        T = joint_hessians(model, q0)[held]                # each row's Hessian at q
-        H_lam = np.tensordot(lam, T, axes=1)               # d (P^T lam) / dq
-        H_mu = np.tensordot(mu, T, axes=1)
-        T_x = T @ (WdPt @ lam)                             # d (P x) / dq, x = W_D P^T lam
-        # N lam = -c(q_pred) / h, differentiated (W_D constant: check_covered)
-        rhs = P_pred @ dq_pred / h
-        rhs[:, :nq] += T_x + P @ (W_D @ H_lam)
-        d_lam = -np.linalg.solve(N, rhs)
-        dv_new = dv_lin + WdPt @ d_lam
-        dv_new[:, :nq] += W_D @ H_lam
-        base = d_q + W_A @ np.hstack([H_mu, zero_v])
-        G = joint_terms(model, q1)[1][held]
-        GWP = G @ WaPt
-        if np.linalg.cond(GWP) > DEPENDENT_COND:
-            raise _not_covered("dependent joints (an over-constrained loop): the step is not "
-                               "smooth there")
-        proj = eye - WaPt @ np.linalg.solve(GWP, G)
-    else:
-        proj = eye
-    dq1 = proj @ (base + h * dv_new)
-    dv1 = (dq1 - d_q) / h
-    if bounded:
-        # v1 = v_new + k dv_move: d v1 = dv_new + k d(dv_move) + dv_move dk
-        d_move = dv1 - dv_new
-        df = np.hstack([K_alone, np.zeros((nq, nq)), F])
-        k, grads = bound
-        dk = _bound_derivative(grads, dv_new, d_move, dq1 - d_q - h * dv_new, df,
-                               np.hstack([np.zeros((nq, nq)), np.eye(nq), np.zeros((nq, nu))]))
-        dv1 = dv_new + k * d_move + np.outer(dv_move, dk)
-    A = np.vstack([dq1[:, :2 * nq], dv1[:, :2 * nq]])
-    B = np.vstack([dq1[:, 2 * nq:], dv1[:, 2 * nq:]])
-    return StepJacobian(A=A, B=B, modes_changed=bool(saturated.any()),
-                        x1=np.concatenate([q1.ravel(), v1.ravel()]))
+    jac = _replica_jacobian(sim, u, start, end_modes, end_slips, q1, v1)
+    if not jac.modes_changed and _at_mode_boundary(model, end_modes, impulses, q1, v1, h):
+        jac = StepJacobian(A=jac.A, B=jac.B, modes_changed=True, x1=jac.x1)
+    return jac
 
 
 #: the sub-steps taken one by one must end where the whole step ended, to this share of the
@@ -676,3 +346,165 @@ def rollout_jacobians(sim, us) -> list:
     for u in us:
         out.append(step_jacobian(sim, u, _keep_end=True))   # (the step taken once)
     return out
+
+
+#: a touching contact is at the edge of its mode where its normal impulse, its friction
+#: cone's margin (sticking) or its slip speed (sliding) is within this share of its scale
+MODE_MARGIN = 1e-9
+
+
+def _at_mode_boundary(model, modes, impulses, q1, v1, h) -> bool:
+    """A touching contact at the edge of its mode at the step's end (impulses: the step's
+    normal and tangential impulses [N s] per contact, State.last_contact_impulse): pushing with
+    no impulse (about to leave), sticking at its friction cone's edge, or sliding with no slip
+    (about to stick); an infinitesimal change of the start or the commands then changes the
+    mode."""
+    a = model.arrays
+    touching = np.flatnonzero(modes != MODE_FREE)
+    if not touching.size:
+        return False
+    weight = float(a.body_mass.sum() * np.hypot(*a.gravity) * h)
+    scale = np.abs(impulses[touching]).sum() + weight
+    speed = np.abs(v1[:, :2]).max() + 1e-300
+    for c in touching:
+        lam_n, lam_t = impulses[c]
+        mu = a.contact_mu[c]
+        if lam_n <= MODE_MARGIN * scale:
+            return True
+        if modes[c] == MODE_PINNED and mu > 0.0:
+            if mu * lam_n - abs(lam_t) <= MODE_MARGIN * (lam_n + abs(lam_t)) * max(mu, 1.0):
+                return True
+        elif mu > 0.0:
+            b = a.contact_body[c]
+            th = q1[b, 2]
+            lx, ly = a.contact_local[c]
+            arm = np.array([np.cos(th) * lx - np.sin(th) * ly, np.sin(th) * lx + np.cos(th) * ly])
+            coef = a.terrain_coef
+            tangent = np.array([1.0, coef[1]]) / np.hypot(1.0, coef[1])
+            if a.contact_kind[c] == CONTACT_ARC:        # (the sole's point below its centre)
+                arm += a.contact_radius[c] * np.array([tangent[1], -tangent[0]])
+            slip = tangent @ (v1[b, :2] + v1[b, 2] * np.array([-arm[1], arm[0]]))
+            if abs(slip) <= MODE_MARGIN * speed:
+                return True
+    return False
+
+
+#: [rad] a round sole's lowest direction at least this far inside its span's ends, and its
+#: fallback vertices at least ARC_VERTEX_MARGIN above its point, for the step to be smooth
+ARC_SPAN_MARGIN = 1e-9
+ARC_VERTEX_MARGIN = 1e-9     # [m]
+#: the complex step [m, rad, m/s, rad/s, N]: far below rounding, so the derivative is exact
+COMPLEX_STEP = 1e-20
+
+
+def _touching_contacts(model, start, modes, slips):
+    """ContactPlan of the contacts touching (modes: the step's end modes) at the start q0, or
+    NotImplementedError naming what is not covered (a shape pair, hills, restitution, a sole
+    at the end of its span or level with a fallback vertex)."""
+    a = model.arrays
+    touching = np.flatnonzero(modes != MODE_FREE)
+    coef = np.asarray(a.terrain_coef, dtype=float)
+    if touching.size and coef[2] != 0.0:
+        raise _not_covered("a contact touching hills (terrain with sines)")
+    slope, h0 = float(coef[1]), float(coef[0])
+    nrm = np.array([-slope, 1.0]) / np.hypot(slope, 1.0)
+    q0 = start.q
+    body, local, radius, pinned, mu_slip = [], [], [], [], []
+    for c in touching:
+        name = model.contact_names[c]
+        kind = int(a.contact_kind[c])
+        if kind not in (CONTACT_POINT, CONTACT_ARC):
+            raise _not_covered(f"contact {name!r} of kind {kind} (a shape pair or an edge) "
+                               f"touching")
+        if a.contact_restitution[c] != 0.0:
+            raise _not_covered(f"contact {name!r} with restitution touching")
+        b = int(a.contact_body[c])
+        lc = np.asarray(a.contact_local[c], dtype=float)
+        r = float(a.contact_radius[c]) if kind == CONTACT_ARC else 0.0
+        if kind == CONTACT_ARC:
+            th = q0[b, 2]
+            cs, sn = np.cos(th), np.sin(th)
+            down = np.array([-(cs * nrm[0] + sn * nrm[1]), -(-sn * nrm[0] + cs * nrm[1])])
+            a0, a1 = a.contact_span[c]
+            if a1 - a0 < 2.0 * np.pi:
+                ang = np.arctan2(down[1], down[0])
+                inside = [(ang + 2.0 * np.pi * w - a0, a1 - ang - 2.0 * np.pi * w)
+                          for w in (-1, 0, 1)]
+                if not any(lo > ARC_SPAN_MARGIN and hi > ARC_SPAN_MARGIN for lo, hi in inside):
+                    raise _not_covered(f"round sole {name!r} resting at (or beyond) an end of "
+                                       f"its span")
+            centre = q0[b, :2] + np.array([cs * lc[0] - sn * lc[1], sn * lc[0] + cs * lc[1]])
+            sole_gap = nrm @ centre - h0 * nrm[1] - r
+            adr, num = int(a.contact_vert_adr[c]), int(a.contact_vert_num[c])
+            for vl in a.vert_local[adr:adr + num]:
+                vw = q0[b, :2] + np.array([cs * vl[0] - sn * vl[1], sn * vl[0] + cs * vl[1]])
+                if nrm @ vw - h0 * nrm[1] < sole_gap + ARC_VERTEX_MARGIN:
+                    raise _not_covered(f"round sole {name!r} level with one of its fallback "
+                                       f"vertices")
+        mu = float(a.contact_mu[c])
+        stick = modes[c] == MODE_PINNED and mu > 0.0
+        body.append(b)
+        local.append(lc)
+        radius.append(r)
+        pinned.append(stick)
+        mu_slip.append(0.0 if stick else mu * float(slips[c]))
+    return ContactPlan(index=np.asarray(touching, dtype=np.int64),
+                       body=np.array(body, dtype=np.int64), local=np.array(local).reshape(-1, 2),
+                       radius=np.array(radius), pinned=np.array(pinned, dtype=bool),
+                       mu_slip=np.array(mu_slip), lifted=np.zeros(len(body), bool),
+                       normal=nrm, offset=float(h0 * nrm[1]))
+
+
+def _engine_order(model, held, contacts) -> np.ndarray:
+    """The replica's rows (the held joint rows, then each touching contact's normal and
+    sticking tangent row) in the order kernels/rows.py build_rows makes them: each joint's
+    after the later of its bodies, each contact's after its body, a joint before a contact
+    after the same body."""
+    a = model.arrays
+    keys = [(int(a.pin_body[r // 2].max()), 0, i) for i, r in enumerate(held)]
+    i = len(keys)
+    for k in range(contacts.count):
+        for _ in range(2 if contacts.pinned[k] else 1):
+            keys.append((int(contacts.body[k]), 1, i))
+            i += 1
+    return np.array([key[2] for key in sorted(keys)], dtype=np.int64)
+
+
+def _replica_jacobian(sim, u, start, modes, slips, q1, v1) -> StepJacobian:
+    """step_jacobian of a step the engine took in one piece, ending at (q1, v1): the step's
+    equations replayed (planarsim.step_replica) from the start and from the start moved by
+    i COMPLEX_STEP along each coordinate and command, in one batch whose first row (the start
+    itself) takes the decisions; that row must end where the engine ended."""
+    model = sim.model
+    h = float(sim.dt)
+    nq = 3 * model.n_body
+    q0, v0 = start.q.ravel().copy(), start.v.ravel().copy()
+    f, F, saturated = force_terms(model, start, u)
+    W_A, W_D, R, f_spring, K, rotors, f_alone, K_alone = rotor_terms(model, start.q, h)
+    held = np.flatnonzero(np.repeat((model.arrays.pin_kind & JOINT_FREE_BIT) == 0, 2))
+    contacts = _touching_contacts(model, start, modes, slips)
+    plan = StepPlan(model=model, h=h, q0=q0, u=u.copy(), W_A=W_A, W_D=W_D, R=R, f0=f, F=F,
+                    fs0=f_spring, K=K, f_force0=f + f_alone, K_force=K_alone, rotors=rotors,
+                    held=held, contacts=contacts, order=_engine_order(model, held, contacts),
+                    iters=int(sim.options.refine_iters), tol=float(sim.options.refine_tol))
+    cols = 2 * nq + model.n_act
+    E = np.vstack([np.zeros((1, cols)), np.eye(cols)]) * (COMPLEX_STEP * 1j)
+    try:
+        q_c, v_c = replica(plan, q0[None] + E[:, :nq], v0[None] + E[:, nq:2 * nq],
+                           u[None] + E[:, 2 * nq:])
+    except ReplicaRefused as err:
+        raise _not_covered(str(err)) from None
+    eps = np.finfo(float).eps
+    q_off = np.abs(q_c[0].real - q1.ravel()).max()
+    v_off = np.abs(v_c[0].real - v1.ravel()).max()
+    q_scale = np.abs(q1.ravel() - q0).max() + h * np.abs(v0).max()
+    v_scale = np.abs(v1).max() + np.abs(v0).max()
+    rounding = 64 * eps * (np.abs(q0).max() + 1.0)
+    if q_off > FIT_TOL * q_scale + rounding or v_off > FIT_TOL * v_scale + rounding / h:
+        raise _not_covered(f"an end that the step's equations (the velocity solve, the Newton "
+                           f"correction, the energy bound) do not reproduce: q off by "
+                           f"{q_off:.3g}, v by {v_off:.3g} (a projection, a first-order "
+                           f"target, the motion paying for a lift)")
+    D = np.hstack([q_c[1:].imag, v_c[1:].imag]).T / COMPLEX_STEP      # (2 nq, cols)
+    return StepJacobian(A=D[:, :2 * nq], B=D[:, 2 * nq:], modes_changed=bool(saturated.any()),
+                        x1=np.concatenate([q1.ravel(), v1.ravel()]))
