@@ -34,15 +34,17 @@ piece's whose side the start is on (within rounding of the surface: lifted where
 positive); along the surface (the states a contact keeps) both pieces agree.
 
 Covered so far: bodies held by hinges (pins) and sliders to each other and the world, free
-bodies' coordinates (an MJCF root's slides and hinge), with joint limits the step does not
-reach; armature, dampers and the springs the step resolves on every joint whose rate row g is
+bodies' coordinates (an MJCF root's slides and hinge), with joint limits (a limit row is
+unilateral, as a contact's normal: the same two pieces at its surface; a slider's only where
+its rate row is constant); armature, dampers and the springs the step resolves on every joint whose rate row g is
 constant (hinges, and slides along a world axis whose anchor is their body's centre of mass:
 MJCF roots, a cart on a rail); ground contacts of points and round soles on flat or sloped
 ground, sticking or sliding (Coulomb), several sharing a load (the rows the engine leaves out
 as dependent, left out alike); under gravity, constant pushes, pin torques, body forces and
-torques and forces along such slides. Refused with a NotImplementedError naming the feature:
+torques, forces along such slides, axial forces between two bodies and hip torques (the
+Simple Biped's legs and hip). Refused with a NotImplementedError naming the feature:
 armature, dampers or springs on a slider whose rate row turns with its bodies (its rotor adds
-velocity-product forces), rods, a limit reached in the step, dry friction, springs too stiff
+velocity-product forces), rods, the limit of such a slider reached in the step, dry friction, springs too stiff
 for the step, contacts on hills, shape pairs that touch, restitution, a step split at a
 time of impact, fluid drag, the other actuator kinds, the accurate integrators.
 """
@@ -54,7 +56,8 @@ import numpy as np
 
 from .kernels.codes import (CONTACT_ARC, CONTACT_POINT, INTEGRATOR_EULER, JOINT_FREE_BIT,
                             JOINT_SLIDE_BIT, MODE_FREE, MODE_PINNED)
-from .kernels.forces import ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_PIN_TORQUE, ACT_SLIDER_FORCE
+from .kernels.forces import (ACT_AXIAL, ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_HIP_TORQUE,
+                              ACT_PIN_TORQUE, ACT_SLIDER_FORCE)
 from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
 from .step_replica import ContactPlan, ReplicaRefused, StepPlan, replica
 
@@ -64,6 +67,8 @@ FIT_TOL = 1e-9
 
 _LINEAR_ACTUATORS = {ACT_PIN_TORQUE: "pin torque", ACT_BODY_FORCE: "body force",
                      ACT_BODY_TORQUE: "body torque", ACT_SLIDER_FORCE: "slider force"}
+#: actuators whose force's direction turns with the bodies (computed in the replay)
+_TURNING_ACTUATORS = {ACT_AXIAL: "axial force", ACT_HIP_TORQUE: "hip torque"}
 
 
 @dataclass(frozen=True)
@@ -88,9 +93,9 @@ def _not_covered(what):
     return NotImplementedError(
         f"step_jacobian covers mechanisms of hinges, sliders and free bodies' coordinates "
         f"(armature, dampers and the springs the step resolves on joints whose rate row is "
-        f"constant), with limits the step does not reach, and ground contacts of points and "
-        f"round soles on flat or sloped ground, under gravity, pushes, pin and body torques, "
-        f"body forces and forces along such slides so far; this step has {what}")
+        f"constant) and their limits, and ground contacts of points and round soles on flat "
+        f"or sloped ground, under gravity, pushes, pin, body and hip torques, body forces, "
+        f"axial forces and forces along such slides so far; this step has {what}")
 
 
 def inverse_masses(a) -> np.ndarray:
@@ -166,7 +171,7 @@ def check_covered(model, options, h) -> None:
                                    f"(too stiff for the step)")
     for k, name in enumerate(model.act_names):
         kind = int(a.act_kind[k])
-        if kind not in _LINEAR_ACTUATORS:
+        if kind not in _LINEAR_ACTUATORS and kind not in _TURNING_ACTUATORS:
             raise _not_covered(f"actuator {name!r} of kind {kind}")
         if kind == ACT_SLIDER_FORCE and not _constant_rate_row(a, a.act_ref[k]):
             raise _not_covered(f"actuator {name!r}, a force along a slider whose axis or "
@@ -217,7 +222,8 @@ def rotor_terms(model, q, h):
 
 
 def force_terms(model, state, u):
-    """(f (3 n_body,) [N, N m] the applied forces under commands u, F (3 n_body, n_act) their
+    """(f (3 n_body,) [N, N m] the applied forces under commands u, but the actuators' whose
+    direction turns with the bodies (_TURNING_ACTUATORS), F (3 n_body, n_act) their
     derivative with respect to u (0 for a command past a bound; for one exactly at a bound,
     the derivative from inside the range), at_bound: a bool per actuator, its command exactly
     at a bound)."""
@@ -234,6 +240,8 @@ def force_terms(model, state, u):
     u_sat = np.clip(u, lo, hi)
     for k in range(model.n_act):
         kind = int(a.act_kind[k])
+        if kind in _TURNING_ACTUATORS:
+            continue        # (the replay computes them: step_replica.turning_forces)
         if kind == ACT_PIN_TORQUE:
             j = a.act_ref[k]
             F[a.pin_body[j, 1], 2, k] += 1.0
@@ -275,9 +283,10 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         q1, v1 = end.q.copy(), end.v.copy()
         end_modes, end_slips = end.contact_mode.copy(), end.contact_slip.copy()
         impulses = end.last_contact_impulse.copy()
+        limit_impulses = end.last_pin_impulse[:, 2:4].copy()
         substeps = int(sim.ws.info[INFO_TURN_SUBSTEPS])
         splits = int(sim.ws.info[INFO_CCD_SPLITS])
-        limits = bool(end.limit_active.any())
+        limit_active = end.limit_active.copy()
     finally:
         if not (_keep_end and ended):
             sim.restore(start)
@@ -286,14 +295,13 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
                 sim._new_options()
             sim.ws.audit[:] = audit
             sim.ws.info[:] = info
-    if limits:
-        raise _not_covered("a joint limit reached in the step")
     if splits > 0:
         raise _not_covered(f"a step taken in {splits} time-of-impact splits")
     if substeps > 1:
         return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info)
-    jac = _replica_jacobian(sim, u, start, end_modes, end_slips, q1, v1)
-    if not jac.modes_changed and _at_mode_boundary(model, end_modes, impulses, q1, v1, h):
+    jac = _replica_jacobian(sim, u, start, end_modes, end_slips, limit_active, q1, v1)
+    if not jac.modes_changed and _at_mode_boundary(model, end_modes, impulses, limit_active,
+                                                   limit_impulses, q1, v1, h):
         jac = StepJacobian(A=jac.A, B=jac.B, modes_changed=True, x1=jac.x1)
     return jac
 
@@ -353,18 +361,24 @@ def rollout_jacobians(sim, us) -> list:
 MODE_MARGIN = 1e-9
 
 
-def _at_mode_boundary(model, modes, impulses, q1, v1, h) -> bool:
-    """A touching contact at the edge of its mode at the step's end (impulses: the step's
-    normal and tangential impulses [N s] per contact, State.last_contact_impulse): pushing with
-    no impulse (about to leave), sticking at its friction cone's edge, or sliding with no slip
-    (about to stick); an infinitesimal change of the start or the commands then changes the
-    mode."""
+def _at_mode_boundary(model, modes, impulses, limit_active, limit_impulses, q1, v1,
+                      h) -> bool:
+    """A touching contact or an active joint limit at the edge of its mode at the step's end
+    (impulses: the step's normal and tangential impulses [N s] per contact,
+    State.last_contact_impulse; limit_impulses: its lower and upper limit impulses per joint,
+    State.last_pin_impulse[:, 2:]): a contact or limit pushing with no impulse (about to
+    leave), a contact sticking at its friction cone's edge or sliding with no slip (about to
+    stick); an infinitesimal change of the start or the commands then changes the mode."""
     a = model.arrays
     touching = np.flatnonzero(modes != MODE_FREE)
-    if not touching.size:
+    if not touching.size and not limit_active.any():
         return False
     weight = float(a.body_mass.sum() * np.hypot(*a.gravity) * h)
-    scale = np.abs(impulses[touching]).sum() + weight
+    scale = (np.abs(impulses[touching]).sum() + np.abs(limit_impulses[limit_active != 0]).sum()
+             + weight)
+    for j, side in np.argwhere(limit_active != 0):
+        if abs(limit_impulses[j, side]) <= MODE_MARGIN * scale:
+            return True
     speed = np.abs(v1[:, :2]).max() + 1e-300
     for c in touching:
         lam_n, lam_t = impulses[c]
@@ -451,26 +465,55 @@ def _touching_contacts(model, start, modes, slips):
     return ContactPlan(index=np.asarray(touching, dtype=np.int64),
                        body=np.array(body, dtype=np.int64), local=np.array(local).reshape(-1, 2),
                        radius=np.array(radius), pinned=np.array(pinned, dtype=bool),
-                       mu_slip=np.array(mu_slip), lifted=np.zeros(len(body), bool),
-                       normal=nrm, offset=float(h0 * nrm[1]))
+                       mu_slip=np.array(mu_slip), normal=nrm, offset=float(h0 * nrm[1]))
 
 
-def _engine_order(model, held, contacts) -> np.ndarray:
-    """The replica's rows (the held joint rows, then each touching contact's normal and
-    sticking tangent row) in the order kernels/rows.py build_rows makes them: each joint's
-    after the later of its bodies, each contact's after its body, a joint before a contact
-    after the same body."""
+def _active_limits(model, limit_active) -> np.ndarray:
+    """(k, 2) [joint, side] of the joint limits active at the step's end (limit_active: the
+    State's), or NotImplementedError for a slider's limit whose rate row turns."""
     a = model.arrays
-    keys = [(int(a.pin_body[r // 2].max()), 0, i) for i, r in enumerate(held)]
-    i = len(keys)
+    out = np.argwhere(limit_active != 0).astype(np.int64).reshape(-1, 2)
+    for j, side in out:
+        if not _constant_rate_row(a, j):
+            raise _not_covered(f"a limit reached in the step on slider {model.pin_names[j]!r}, "
+                               f"whose rate row turns with its bodies")
+    return out
+
+
+def _engine_order(model, held, limits, contacts) -> np.ndarray:
+    """The replica's rows (the held joint rows, the active limits' rows, then each touching
+    contact's normal and sticking tangent row) in the order kernels/rows.py build_rows makes
+    them: joint by joint in the model's order (its rows, then its limits' rows), merged with
+    the contacts in theirs, a joint's before a contact whose body is not earlier than the
+    later of the joint's bodies."""
+    a = model.arrays
+    joint_of_row = held // 2
+    index = 0
+    rows_of = {}
+    for j in joint_of_row:
+        rows_of.setdefault(int(j), []).append(index)
+        index += 1
+    for j, _ in limits:
+        rows_of.setdefault(int(j), []).append(index)
+        index += 1
+    contact_rows = []
     for k in range(contacts.count):
-        for _ in range(2 if contacts.pinned[k] else 1):
-            keys.append((int(contacts.body[k]), 1, i))
-            i += 1
-    return np.array([key[2] for key in sorted(keys)], dtype=np.int64)
+        width = 2 if contacts.pinned[k] else 1
+        contact_rows.append((int(contacts.body[k]), list(range(index, index + width))))
+        index += width
+    order, k = [], 0
+    for j in range(model.n_pin):
+        later = int(a.pin_body[j].max())
+        while k < len(contact_rows) and contact_rows[k][0] < later:
+            order += contact_rows[k][1]
+            k += 1
+        order += rows_of.get(j, [])
+    for _, rows in contact_rows[k:]:
+        order += rows
+    return np.array(order, dtype=np.int64)
 
 
-def _replica_jacobian(sim, u, start, modes, slips, q1, v1) -> StepJacobian:
+def _replica_jacobian(sim, u, start, modes, slips, limit_active, q1, v1) -> StepJacobian:
     """step_jacobian of a step the engine took in one piece, ending at (q1, v1): the step's
     equations replayed (planarsim.step_replica) from the start and from the start moved by
     i COMPLEX_STEP along each coordinate and command, in one batch whose first row (the start
@@ -483,9 +526,14 @@ def _replica_jacobian(sim, u, start, modes, slips, q1, v1) -> StepJacobian:
     W_A, W_D, R, f_spring, K, rotors, f_alone, K_alone = rotor_terms(model, start.q, h)
     held = np.flatnonzero(np.repeat((model.arrays.pin_kind & JOINT_FREE_BIT) == 0, 2))
     contacts = _touching_contacts(model, start, modes, slips)
+    limits = _active_limits(model, limit_active)
+    lo, hi = model.arrays.act_range.T
+    turning = np.flatnonzero(np.isin(model.arrays.act_kind, list(_TURNING_ACTUATORS)))
     plan = StepPlan(model=model, h=h, q0=q0, u=u.copy(), W_A=W_A, W_D=W_D, R=R, f0=f, F=F,
-                    fs0=f_spring, K=K, f_force0=f + f_alone, K_force=K_alone, rotors=rotors,
-                    held=held, contacts=contacts, order=_engine_order(model, held, contacts),
+                    fs0=f_spring, K=K, f_alone0=f_alone, K_force=K_alone, rotors=rotors,
+                    held=held, turning=turning, u_held=(u < lo) | (u > hi),
+                    contacts=contacts, limits=limits,
+                    order=_engine_order(model, held, limits, contacts),
                     iters=int(sim.options.refine_iters), tol=float(sim.options.refine_tol))
     cols = 2 * nq + model.n_act
     E = np.vstack([np.zeros((1, cols)), np.eye(cols)]) * (COMPLEX_STEP * 1j)

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .kernels.codes import JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDER
+from .kernels.codes import JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDE_BIT, JOINT_SLIDER
 from .kernels.integrate import STALLED_RATIO
 from .kernels.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
                            SHAKE_REGIME, VELOCITY_FLOOR)
@@ -50,7 +50,6 @@ class ContactPlan:
     radius: np.ndarray          # (k,) [m] 0 for a point
     pinned: np.ndarray          # (k,) bool: sticking (a tangent row); else sliding
     mu_slip: np.ndarray         # (k,) mu s of a sliding contact (its friction along -s t)
-    lifted: np.ndarray          # (k,) bool: its gap at the start is > 0 (the solve's target)
     normal: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0]))
     offset: float = 0.0         # [m] n . (any ground point)
 
@@ -69,21 +68,26 @@ class StepPlan:
     W_A: np.ndarray
     W_D: np.ndarray
     R: np.ndarray
-    f0: np.ndarray              # applied forces at the real start and commands (no springs)
-    F: np.ndarray               # d f / d u (0 past a bound)
+    f0: np.ndarray              # applied forces at the real start and commands (no springs;
+                                # not the actuators of `turning`)
+    F: np.ndarray               # d f / d u (0 past a bound) of the others
     fs0: np.ndarray             # the joints' springs at q0
     K: np.ndarray               # d f_spring / dq
-    f_force0: np.ndarray        # ws.force: f0 plus the springs the step takes as forces
+    f_alone0: np.ndarray        # the springs the step takes as forces (in ws.force), at q0
     K_force: np.ndarray
     rotors: np.ndarray          # the joints' rotors' inertia A (3 n, 3 n)
     held: np.ndarray            # the joints' rows that hold something (a free coordinate: none)
+    turning: np.ndarray         # the actuators whose force turns with the bodies (axial, hip)
+    u_held: np.ndarray          # (n_act,) bool: a command past its bound (held at it)
     contacts: ContactPlan
+    limits: np.ndarray          # (k, 2) int: the active joint limits' [joint, side]
     order: np.ndarray           # the rows (joints' then contacts') in the engine's order
     iters: int
     tol: float
     passes: int | None = None   # Newton passes (None: decide, on the real run)
     extra_pass: bool | None = None
     bound: dict | None = None   # the energy bound's branch (None: decide)
+    lifted: np.ndarray | None = None     # the mode rows whose start is off their surface
     solved: np.ndarray | None = None     # the velocity solve's independent rows
     corrected: np.ndarray | None = None  # the correction's
 
@@ -220,13 +224,98 @@ def contact_unilateral(cp) -> np.ndarray:
     return np.array(out, dtype=bool)
 
 
-def _rows(plan, q, q0):
-    """The held joints' and touching contacts' (c, J) at q (B, 3 n), contacts measured from q0."""
+def limit_rows(model, limits, q):
+    """(c (B, k), J (B, k, 3 n)) of the active joint limits' rows at q (B, n, 3): limits (k, 2)
+    [joint, side]; a hinge's angle theta_b - theta_a - ref, or a world slide's coordinate
+    along its axis, less the lower limit (side 0) or taken from the upper (side 1), as
+    kernels/limit.py writes them (their rate rows g are constant: derivatives.check_covered)."""
+    from .derivatives import rate_row
+    a = model.arrays
+    B, n = q.shape[0], q.shape[1]
+    c = np.zeros((B, limits.shape[0]), dtype=q.dtype)
+    J = np.zeros((B, limits.shape[0], 3 * n))
+    flat = q.reshape(B, 3 * n)
+    for r, (j, side) in enumerate(limits):
+        g = rate_row(a, j, n)
+        coordinate = flat @ g
+        if a.pin_kind[j] & JOINT_SLIDE_BIT:
+            coordinate = coordinate - a.pin_axis[j] @ a.pin_anchor[j, 0]
+        else:
+            coordinate = coordinate - a.pin_ref[j]
+        sign = 1.0 if side == 0 else -1.0
+        c[:, r] = sign * (coordinate - a.pin_limit[j, side])
+        J[:, r] = sign * g
+    return c, J
+
+
+def mode_rows(plan, q, q0):
+    """(c, J, F, unilateral) of the rows with a mode at q (B, 3 n), measured from q0 where
+    they need it: the active limits' rows, then the touching contacts' (contact_rows); the
+    mask marks the unilateral ones (limits, contacts' normals: their correction moves
+    positions only and their velocity target is clipped at the surface)."""
     n = plan.model.n_body
     qq, qq0 = q.reshape(-1, n, 3), q0.reshape(-1, n, 3)
-    cj, Jj = joint_rows(plan.model, qq, plan.held)
-    cc, Jc, _ = contact_rows(plan.contacts, qq, qq0, 3 * n)
-    return np.concatenate([cj, cc], axis=1), np.concatenate([Jj, Jc], axis=1)
+    cl, Jl = limit_rows(plan.model, plan.limits, qq)
+    cc, Jc, Fc = contact_rows(plan.contacts, qq, qq0, 3 * n)
+    Jl = np.broadcast_to(Jl, (qq.shape[0],) + Jl.shape[1:]).astype(Jc.dtype)
+    unilateral = np.concatenate([np.ones(cl.shape[1], bool), contact_unilateral(plan.contacts)])
+    return (np.concatenate([cl, cc], axis=1), np.concatenate([Jl, Jc], axis=1),
+            np.concatenate([Jl, Fc], axis=1), unilateral)
+
+
+def _rows(plan, q, q0):
+    """Every row's (c, J) at q (B, 3 n): the held joints', then mode_rows'."""
+    n = plan.model.n_body
+    cj, Jj = joint_rows(plan.model, q.reshape(-1, n, 3), plan.held)
+    cm, Jm, _, _ = mode_rows(plan, q, q0)
+    return np.concatenate([cj, cm], axis=1), np.concatenate([Jj, Jm], axis=1)
+
+
+def turning_forces(plan, q, u):
+    """(B, 3 n) [N, N m] the forces of the actuators whose direction turns with the bodies
+    (kernels/forces.py apply_actuator): an axial force u along the line from its anchor on
+    body a to its anchor on body b (on b, and its opposite on a, at the anchors), and a hip
+    torque u as forces perpendicular to each leg from the hip body (-u on leg a, +u on leg
+    b); commands past a bound held at it."""
+    from .kernels.forces import ACT_AXIAL
+    model = plan.model
+    a = model.arrays
+    n = model.n_body
+    qq = q.reshape(-1, n, 3)
+    B = qq.shape[0]
+    f = np.zeros((B, n, 3), dtype=np.result_type(q, u))
+    lo, hi = a.act_range[:, 0], a.act_range[:, 1]
+    for k in plan.turning:
+        uk = np.clip(plan.u[k], lo[k], hi[k]) + 0.0 * u[:, k] if plan.u_held[k] else u[:, k]
+        ba, bb = int(a.act_body[k, 0]), int(a.act_body[k, 1])
+        if a.act_kind[k] == ACT_AXIAL:
+            ends = []
+            for body, anchor in ((ba, a.act_anchor[k, 0]), (bb, a.act_anchor[k, 1])):
+                anchor = np.asarray(anchor, dtype=float)
+                if body < 0:
+                    ends.append((body, np.broadcast_to(anchor, (B, 2)), None))
+                else:
+                    arm = _turn(qq, body, anchor)
+                    ends.append((body, qq[:, body, :2] + arm, arm))
+            d = ends[1][1] - ends[0][1]
+            length = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
+            push = (uk / length)[:, None] * d
+            for (body, _, arm), sign in zip(ends, (-1.0, 1.0)):
+                if body < 0:
+                    continue
+                f[:, body, :2] += sign * push
+                f[:, body, 2] += sign * _cross(arm, push)
+        else:                                       # ACT_HIP_TORQUE
+            hip = int(a.act_body[k, 2])
+            for leg, sign in ((ba, -1.0), (bb, 1.0)):
+                d = qq[:, leg, :2] - qq[:, hip, :2]
+                d2 = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]
+                fx, fy = -sign * uk * d[:, 1] / d2, sign * uk * d[:, 0] / d2
+                f[:, leg, 0] += fx
+                f[:, leg, 1] += fy
+                f[:, hip, 0] -= fx
+                f[:, hip, 1] -= fy
+    return f.reshape(B, 3 * n)
 
 
 def _solve(N, b):
@@ -246,6 +335,8 @@ def replica(plan: StepPlan, q0, v0, u):
     deciding = plan.passes is None
     du = u - plan.u
     f = plan.f0 + du @ plan.F.T
+    if plan.turning.size:
+        f = f + turning_forces(plan, q0, u)
     dq0 = q0 - plan.q0
     f_spring = plan.fs0 + dq0 @ plan.K.T
     v_lin = v0 @ plan.R.T + h * ((f + f_spring) @ plan.W_D.T)
@@ -253,27 +344,22 @@ def replica(plan: StepPlan, q0, v0, u):
     # the velocity solve
     cj_pred, _ = joint_rows(model, q_pred.reshape(-1, n, 3), plan.held)
     _, Pj = joint_rows(model, q0.reshape(-1, n, 3), plan.held)
-    cp = plan.contacts
-    cc0, Pc, Fc = contact_rows(cp, q0.reshape(-1, n, 3), q0.reshape(-1, n, 3), 3 * n)
-    unilateral = np.concatenate([np.zeros(Pj.shape[1], bool), contact_unilateral(cp)])
+    cm0, Pm, Fm, unilateral_m = mode_rows(plan, q0, q0)
+    mj = Pj.shape[1]
+    unilateral = np.concatenate([np.zeros(mj, bool), unilateral_m])
     if deciding:
-        cp.lifted = np.array([cc0[0, r].real > 0.0 for r in np.flatnonzero(unilateral[Pj.shape[1]:])],
-                             dtype=bool)
-    target = cc0.copy()
-    normal_rows = np.flatnonzero(unilateral[Pj.shape[1]:])
-    for k, r in enumerate(normal_rows):
-        if not cp.lifted[k]:
-            target[:, r] = 0.0      # a row that starts violated only stops approaching
-    P = np.concatenate([Pj, Pc], axis=1)
-    Fd = np.concatenate([Pj, Fc], axis=1)
+        plan.lifted = cm0[0].real > 0.0
+    # a unilateral row that starts violated only stops approaching (solve.fill_row_b)
+    target = np.where(plan.lifted | ~unilateral_m, cm0, 0.0)
+    P = np.concatenate([Pj, Pm], axis=1)
+    Fd = np.concatenate([Pj, Fm], axis=1)
     m = P.shape[1]
     if m:
         rhs = np.concatenate([-cj_pred / h,
-                              -target / h - np.einsum("brk,bk->br", Pc, v_lin)], axis=1)
+                              -target / h - np.einsum("brk,bk->br", Pm, v_lin)], axis=1)
         WdFt = np.einsum("ij,brj->bir", plan.W_D, Fd)          # (B, 3n, m)
         N = np.einsum("brk,bks->brs", P, WdFt)
         if deciding:
-            mj = Pj.shape[1]
             if mj and independent_rows(N[0, :mj, :mj].real, np.arange(mj)).size < mj:
                 raise ReplicaRefused("dependent joints (an over-constrained loop): the step is "
                                      "not smooth there")
@@ -338,7 +424,8 @@ def replica(plan: StepPlan, q0, v0, u):
     elif deciding:
         plan.passes, plan.extra_pass = 0, False
     if plan.passes > 0:
-        v = _energy_bound(plan, q0, v0, q, v, v_new, u, deciding)
+        v = _energy_bound(plan, q0, v0, q, v, v_new, f + plan.f_alone0 + dq0 @ plan.K_force.T,
+                          deciding)
     return q, v
 
 
@@ -389,10 +476,10 @@ def _sabs(x):
     return x * np.sign(x.real)
 
 
-def _energy_bound(plan, q0, v0, q1, v, v_s, u, deciding):
+def _energy_bound(plan, q0, v0, q1, v, v_s, f, deciding):
     """kernels/integrate.py bound_correction_work: v_s + k (v - v_s), k the largest share in
     [0, 1] of the correction's velocity change that adds no energy beyond its allowance (its
-    branches the plan's)."""
+    branches the plan's); f (B, 3 n) [N, N m]: the step's applied forces (ws.force)."""
     model, h = plan.model, plan.h
     a_ = model.arrays
     n = model.n_body
@@ -400,7 +487,6 @@ def _energy_bound(plan, q0, v0, q1, v, v_s, u, deciding):
     E = np.diag(Mb) + plan.rotors
     dv = v - v_s
     move = q1 - (q0 + h * v_s)
-    f = plan.f_force0 + (u - plan.u) @ plan.F.T + (q0 - plan.q0) @ plan.K_force.T
     Ev, Edv = v_s @ E, dv @ E
     a = np.sum(v_s * Edv, axis=1)
     b = 0.5 * np.sum(dv * Edv, axis=1)
