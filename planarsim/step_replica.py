@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .kernels.codes import JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDE_BIT, JOINT_SLIDER
-from .kernels.integrate import STALLED_RATIO
+from .kernels.integrate import DIVERGED_GROWTH, STALLED_RATIO
 from .kernels.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
                            SHAKE_REGIME, VELOCITY_FLOOR)
 
@@ -50,8 +50,10 @@ class ContactPlan:
     radius: np.ndarray          # (k,) [m] 0 for a point
     pinned: np.ndarray          # (k,) bool: sticking (a tangent row); else sliding
     mu_slip: np.ndarray         # (k,) mu s of a sliding contact (its friction along -s t)
-    normal: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0]))
-    offset: float = 0.0         # [m] n . (any ground point)
+    terrain: np.ndarray         # the terrain's coefficients (kernels/terrain.py)
+    normal: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0]))  # flat or sloped
+    offset: float = 0.0         # [m] n . (any ground point) there
+    point_mass: np.ndarray | None = None   # (k,) bool: on a body without rotational inertia
 
     @property
     def count(self) -> int:
@@ -89,6 +91,9 @@ class StepPlan:
     bound: dict | None = None   # the energy bound's branch (None: decide)
     lifted: np.ndarray | None = None     # the mode rows whose start is off their surface
     solved: np.ndarray | None = None     # the velocity solve's independent rows
+    kept: np.ndarray | None = None       # the rows the correction keeps (none leaving)
+    flip: tuple = ()            # rows whose leaving is judged the other way (derivatives.py)
+    near: np.ndarray | None = None       # rows whose leaving is within rounding of its bound
     corrected: np.ndarray | None = None  # the correction's
 
 
@@ -159,57 +164,98 @@ def joint_rows(model, q, held):
     return c[:, held], J[:, held]
 
 
-def _sole_anchor(cp, q0, k):
-    """The material point (B, 2) [m, body frame] contact k holds for the step: a point's own,
-    a round sole's point below its centre at q0 (kernels/contacts.py find_contact)."""
-    local = cp.local[k]
-    if cp.radius[k] == 0.0:
-        return np.broadcast_to(local, (q0.shape[0], 2))
-    # R(-theta0) n in the body frame
-    th = q0[:, cp.body[k], 2]
-    cs, sn = np.cos(th), np.sin(th)
-    nx, ny = cp.normal
-    down = np.stack([cs * nx + sn * ny, -sn * nx + cs * ny], axis=-1)
-    return local - cp.radius[k] * down
+def ground_point(cp, point):
+    """(g (B, 2) [m], n (B, 2)) the ground point closest to `point` (B, 2) and the unit normal
+    there (kernels/terrain.py closest_point). Flat or sloped ground: the foot of the
+    perpendicular. Hills: the first row's (real) closest point found by the engine's own
+    search, then Newton on (x - px) + (h(x) - py) h'(x) = 0 continued for every row from it
+    (the rows differ from the first by a complex step only, so the root's derivative comes
+    out exact: the implicit function theorem)."""
+    coef = cp.terrain
+    if coef[2] == 0.0:
+        nrm = cp.normal
+        gap = point @ nrm - cp.offset
+        return point - gap[:, None] * nrm, np.broadcast_to(nrm, point.shape)
+    from .kernels.terrain import closest_point
+    px, py = point[:, 0], point[:, 1]
+    x = np.full(point.shape[0], closest_point(coef, float(px[0].real), float(py[0].real))[0],
+                dtype=point.dtype)
+    for _ in range(HILLS_NEWTON):
+        h, dh, ddh = _height_derivs(coef, x)
+        x = x - ((x - px) + (h - py) * dh) / (1.0 + dh * dh + (h - py) * ddh)
+    h, dh, _ = _height_derivs(coef, x)
+    inv = 1.0 / np.sqrt(1.0 + dh * dh)
+    return np.stack([x, h], axis=-1), np.stack([-dh * inv, inv], axis=-1)
+
+
+#: Newton steps continued from the engine's closest point (the first is exact to rounding
+#: for a complex step; the others only confirm it)
+HILLS_NEWTON = 3
+
+
+def _height_derivs(coef, x):
+    """(h, h', h'') of the terrain at x (B,) (kernels/terrain.py height_derivs)."""
+    h = coef[0] + coef[1] * x
+    dh = coef[1] + 0.0 * x
+    ddh = 0.0 * x
+    for k in range(int(coef[2])):
+        amp, w, phase = coef[3 + 3 * k], 2.0 * np.pi / coef[4 + 3 * k], coef[5 + 3 * k]
+        arg = w * x + phase
+        h = h + amp * np.sin(arg)
+        dh = dh + amp * w * np.cos(arg)
+        ddh = ddh - amp * w * w * np.sin(arg)
+    return h, dh, ddh
+
+
+def _perp_tangent(nrm):
+    """The ground tangent t = (n_y, -n_x) (B, 2) of normals (B, 2)."""
+    return np.stack([nrm[:, 1], -nrm[:, 0]], axis=-1)
 
 
 def contact_rows(cp, q, q0, n_coord):
     """(c (B, m), J (B, m, 3 n), F (B, m, 3 n)) of the touching contacts' rows at q, each
-    contact's normal row then (sticking) its tangent row, the tangent rows measured from
-    their material points at q0; F: the rows' impulse directions at q0 (J at q0 but a sliding
-    contact's normal row, along n - mu s t at its point). Rows of kernels/contacts.py
-    ground_row and rows.build_rows."""
+    contact's normal row then (sticking) its tangent row: the normal row the gap of its point
+    (a round sole's centre, less the radius) along the normal at its closest ground point at
+    q; the tangent row its material point's distance along the ground tangent at q0 from the
+    ground point found at q0 (a round sole's material point: below its centre at q0); F: the
+    rows' impulse directions at q0 (J at q0 but a sliding contact's normal row, along
+    n - mu s t at its point). Rows of kernels/contacts.py ground_row and rows.build_rows."""
     B = q.shape[0]
     n_rows = int(cp.count + cp.pinned.sum())
     dtype = np.result_type(q, q0)
     c = np.zeros((B, n_rows), dtype=dtype)
     J = np.zeros((B, n_rows, n_coord), dtype=dtype)
     F = np.zeros((B, n_rows, n_coord), dtype=dtype)
-    nrm = cp.normal
-    tan = np.array([nrm[1], -nrm[0]])
     r = 0
     for k in range(cp.count):
         b = int(cp.body[k])
         cols = slice(3 * b, 3 * b + 2)
         arm_n = _turn(q, b, cp.local[k])
-        c[:, r] = (q[:, b, 0] + arm_n[:, 0]) * nrm[0] + (q[:, b, 1] + arm_n[:, 1]) * nrm[1] \
-            - cp.offset - cp.radius[k]
+        point = q[:, b, :2] + arm_n
+        g, nrm = ground_point(cp, point)
+        c[:, r] = np.sum(nrm * (point - g), axis=-1) - cp.radius[k]
         J[:, r, cols] = nrm
         J[:, r, 3 * b + 2] = _cross(arm_n, nrm)
-        anchor = _sole_anchor(cp, q0, k)
-        arm0 = _turn(q0, b, anchor)
-        d = nrm - cp.mu_slip[k] * tan if not cp.pinned[k] else nrm
+        # the material point held for the step, and the ground's frame, at q0
+        arm0_n = _turn(q0, b, cp.local[k])
+        g0, n0 = ground_point(cp, q0[:, b, :2] + arm0_n)
+        t0 = _perp_tangent(n0)
+        arm0 = arm0_n - cp.radius[k] * n0
+        th0 = q0[:, b, 2]
+        cs, sn = np.cos(th0), np.sin(th0)
+        anchor = np.stack([cs * arm0[:, 0] + sn * arm0[:, 1], -sn * arm0[:, 0] + cs * arm0[:, 1]],
+                          axis=-1)
+        d = n0 - cp.mu_slip[k] * t0 if not cp.pinned[k] else n0
         F[:, r, cols] = d
         F[:, r, 3 * b + 2] = _cross(arm0, d)
         r += 1
         if cp.pinned[k]:
             arm = _turn(q, b, anchor)
-            move = q[:, b, :2] - q0[:, b, :2] + arm - arm0
-            c[:, r] = move[:, 0] * tan[0] + move[:, 1] * tan[1]
-            J[:, r, cols] = tan
-            J[:, r, 3 * b + 2] = _cross(arm, tan)
-            F[:, r, cols] = tan
-            F[:, r, 3 * b + 2] = _cross(arm0, tan)
+            c[:, r] = np.sum(t0 * (q[:, b, :2] + arm - g0), axis=-1)
+            J[:, r, cols] = t0
+            J[:, r, 3 * b + 2] = _cross(arm, t0)
+            F[:, r, cols] = t0
+            F[:, r, 3 * b + 2] = _cross(arm0, t0)
             r += 1
     return c, J, F
 
@@ -318,6 +364,64 @@ def turning_forces(plan, q, u):
     return f.reshape(B, 3 * n)
 
 
+def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
+    """The rows the Newton correction keeps (kernels/integrate.py drop_leaving_rows): all but
+    a unilateral row open at q (the start plus h v_new) by more than the step's turning
+    explains (pull_allowance: the body leaves the surface, a disk rolling over a crest), and
+    the tangent row of a contact whose normal row leaves. c: every row's error at q (real)."""
+    model = plan.model
+    a = model.arrays
+    n = model.n_body
+    qq, vv = q.reshape(n, 3), v.reshape(n, 3)
+    h = plan.h
+
+    scale = 1.0 + np.abs(q).max()
+
+    def allowance(bodies, lever):
+        allow = 0.0
+        for b in bodies:
+            if b < 0:
+                continue
+            d = abs(h * vv[b, 2])
+            allow += (0.5 * d * d + d * d * d / 6.0) * lever
+            allow += PULL_ROUNDING * (1.0 + abs(qq[b, 0]) + abs(qq[b, 1]) + lever)
+        return allow
+
+    leaving = np.zeros(c.shape[0], bool)
+    near = []
+
+    def judge(r, allow):
+        if abs(c[r] - allow) <= NEAR_ALLOWANCE * scale:
+            near.append(r)
+        leaving[r] = (c[r] > allow) != (r in plan.flip)
+
+    r = mj
+    for j, _ in plan.limits:
+        judge(r, allowance(a.pin_body[j], 0.0))
+        r += 1
+    cp = plan.contacts
+    for k in range(cp.count):
+        b = int(cp.body[k])
+        # (the normal row's point: a point contact's own, a round sole's centre)
+        judge(r, allowance([b], float(np.abs(cp.local[k]).sum())))
+        if cp.pinned[k]:
+            leaving[r + 1] = leaving[r]
+            r += 2
+        else:
+            r += 1
+    plan.near = np.array(near, dtype=np.int64)
+    return np.flatnonzero(~leaving)
+
+
+#: [m per m of the coordinates' size] a row opened within this of its pull allowance may have
+#: been judged either way by the engine (its rounding differs from the replay's)
+NEAR_ALLOWANCE = 1e-13
+
+
+#: integrate.ROUNDING: relative rounding of a row evaluated at coordinates of size x
+PULL_ROUNDING = 16 * 2.220446049250313e-16
+
+
 def _solve(N, b):
     """N x = b for a batch (B, m, m), (B, m)."""
     return np.linalg.solve(N, b[..., None])[..., 0]
@@ -344,6 +448,7 @@ def replica(plan: StepPlan, q0, v0, u):
     # the velocity solve
     cj_pred, _ = joint_rows(model, q_pred.reshape(-1, n, 3), plan.held)
     _, Pj = joint_rows(model, q0.reshape(-1, n, 3), plan.held)
+    cp = plan.contacts
     cm0, Pm, Fm, unilateral_m = mode_rows(plan, q0, q0)
     mj = Pj.shape[1]
     unilateral = np.concatenate([np.zeros(mj, bool), unilateral_m])
@@ -377,18 +482,37 @@ def replica(plan: StepPlan, q0, v0, u):
     v = v_new.copy()
     if m:
         D = np.einsum("ij,brj->bir", plan.W_A, P)              # (B, 3n, m)
-        S = (~unilateral).astype(float)
-        any_unilateral = bool(unilateral.any())
+        # on hills a point mass's contact moves along the normal at the configuration being
+        # corrected (integrate.normals_now), not at the start's
+        now = np.zeros(m, bool)
+        if cp.terrain[2] != 0.0:
+            first = mj + plan.limits.shape[0]
+            for k in range(cp.count):
+                now[first] = cp.point_mass[k]
+                first += 2 if cp.pinned[k] else 1
         c, G = _rows(plan, q, q0)
+        if deciding:
+            plan.kept = _kept_rows(plan, c[0].real, unilateral, q[0].real, v[0].real, mj)
+        keep = plan.kept
+        D, now, unilateral_c = D[:, :, keep], now[keep], unilateral[keep]
+        order = np.argsort(np.argsort(keep))     # (positions of the kept rows among themselves)
+        kept_order = np.array([order[np.searchsorted(keep, r)] for r in plan.order
+                               if r in set(keep.tolist())], dtype=np.int64)
+        c, G = c[:, keep], G[:, keep]
+        S = (~unilateral_c).astype(float)
+        any_unilateral = bool(unilateral_c.any())
         worst = np.abs(c[0].real).max(initial=0.0) if deciding else None
-        passes = 0
+        passes, stalled = 0, False
         Nn = None
         for _ in range(plan.iters if deciding else plan.passes):
             if deciding and worst <= plan.tol:
                 break
+            if now.any():
+                D = D.copy()
+                D[:, :, now] = np.einsum("ij,brj->bir", plan.W_A, G[:, now])
             Nn = np.einsum("brk,bks->brs", G, D)
             if plan.corrected is None:
-                plan.corrected = independent_rows(Nn[0].real, plan.order)
+                plan.corrected = independent_rows(Nn[0].real, kept_order)
             K = plan.corrected
             Nn, DK = Nn[:, K][:, :, K], D[:, :, K]
             mu = _solve(Nn, -c[:, K])
@@ -399,19 +523,23 @@ def replica(plan: StepPlan, q0, v0, u):
             else:
                 v = v + np.einsum("bir,br->bi", DK, mu) / h
             c, G = _rows(plan, q, q0)
+            c, G = c[:, keep], G[:, keep]
             passes += 1
             if deciding:
                 after = np.abs(c[0].real).max(initial=0.0)
                 if after > STALLED_RATIO * worst:
-                    raise ReplicaRefused(f"a Newton correction that stalls (its rows' errors "
-                                         f"{worst:.3g} -> {after:.3g})")
+                    # (integrate.correct_positions: a pass that removed less than half the
+                    # error ends the correction, kept; one that grew it tenfold is taken back
+                    # and tried again on looser pivots, which the replay does not follow)
+                    if after > DIVERGED_GROWTH * worst:
+                        raise ReplicaRefused(f"a Newton correction that diverges (its rows' "
+                                             f"errors {worst:.3g} -> {after:.3g})")
+                    worst, stalled = after, True
+                    break
                 worst = after
         if deciding:
             plan.passes = passes
-            plan.extra_pass = passes > 0 and 0.0 < worst <= plan.tol
-            if worst > plan.tol:
-                raise ReplicaRefused(f"a Newton correction that ends with its rows open by "
-                                     f"{worst:.3g} (refine_tol {plan.tol:.3g})")
+            plan.extra_pass = passes > 0 and not stalled and 0.0 < worst <= plan.tol
         if plan.extra_pass:
             # one more pass on the last factorisation (integrate.correct_positions)
             K = plan.corrected

@@ -324,6 +324,7 @@ def test_a_slider_mechanisms_step_jacobian_is_its_derivative(seed, mass_decades,
         raise
     assert np.array_equal(sim.state.q, before.q) and np.array_equal(sim.state.v, before.v)
     assert np.abs(sim.state.v[[0, 2], :2]).max() > 0.0     # (the sliders slide)
+    assume(not jac.modes_changed)
     if limit_reached(sim, u):
         error, kinks, edge = surface_difference_error(sim, u)
         assume(not edge and not kinks)
@@ -404,13 +405,6 @@ def test_what_is_not_covered_yet_is_named():
     assert limit_reached(sim, np.array([50.0]))
     error, kinks, edge = surface_difference_error(sim, np.array([50.0]))
     assert error <= REL_TOL and not kinks and not edge, (error, kinks, edge)
-    b = ps.ModelBuilder(dt=1e-3, terrain=ps.terrain.hills([0.05], [2.0]))
-    box = b.add_body("box", mass=1.0, inertia=0.1, pos=(0.0, 0.2))
-    b.add_box_contacts("feet", box, (0.0, 0.0), 0.2, 0.2)
-    sim = ps.Simulator(b.compile())
-    sim.steps(200)
-    with pytest.raises(NotImplementedError, match="a contact touching hills"):
-        step_jacobian(sim)
     b = ps.ModelBuilder(dt=1e-3)
     link = b.add_body("link", mass=1.0, inertia=1.0 / 12, pos=(0.5, 0.0))
     b.add_pin("hinge", None, link, anchor_world=(0.0, 0.0), frictionloss=0.1)
@@ -577,6 +571,7 @@ def test_the_gymnasium_models_step_jacobian_under_torque(name, seed):
         assume(not any(why in str(exc) for why in NOT_COVERED_STEPS))
         raise
     assert np.abs(jac.B).max() > 0.0
+    assume(not jac.modes_changed)       # (a limit let go in the step: on its surface)
     if limit_reached(sim, u):
         # a limit row is unilateral: the positions moved along its surface only
         error, kinks, edge = surface_difference_error(sim, u)
