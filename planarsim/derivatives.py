@@ -56,8 +56,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kernels.codes import (CONTACT_ARC, CONTACT_POINT, INTEGRATOR_EULER, JOINT_FREE_BIT,
-                            JOINT_SLIDE_BIT, MODE_FREE, MODE_PINNED)
+from .kernels.codes import (CONTACT_ARC, CONTACT_PAIR, CONTACT_POINT, INTEGRATOR_EULER,
+                            JOINT_FREE_BIT, JOINT_SLIDE_BIT, MODE_FREE, MODE_PINNED)
+from .kernels.collide import MAX_CORE_VERTICES
 from .kernels.forces import (ACT_AXIAL, ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_HIP_TORQUE,
                               ACT_PIN_TORQUE, ACT_SLIDER_FORCE)
 from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
@@ -286,6 +287,7 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         q1, v1 = end.q.copy(), end.v.copy()
         end_modes, end_slips = end.contact_mode.copy(), end.contact_slip.copy()
         impulses = end.last_contact_impulse.copy()
+        features = end.contact_feature.copy()
         limit_impulses = end.last_pin_impulse[:, 2:4].copy()
         substeps = int(sim.ws.info[INFO_TURN_SUBSTEPS])
         splits = int(sim.ws.info[INFO_CCD_SPLITS])
@@ -302,7 +304,8 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         raise _not_covered(f"a step taken in {splits} time-of-impact splits")
     if substeps > 1:
         return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info)
-    jac = _replica_jacobian(sim, u, start, end_modes, end_slips, limit_active, q1, v1)
+    jac = _replica_jacobian(sim, u, start, end_modes, end_slips, features, limit_active, q1,
+                            v1)
     # a contact or limit held at the start that the step let go was on its surface: pressed
     # into it by an infinitesimal change of the start, it would have stayed
     released = (((start.contact_mode != MODE_FREE) & (end_modes == MODE_FREE)).any()
@@ -395,7 +398,7 @@ def _at_mode_boundary(model, modes, impulses, limit_active, limit_impulses, q1, 
         if modes[c] == MODE_PINNED and mu > 0.0:
             if mu * lam_n - abs(lam_t) <= MODE_MARGIN * (lam_n + abs(lam_t)) * max(mu, 1.0):
                 return True
-        elif mu > 0.0:
+        elif mu > 0.0 and a.contact_kind[c] != CONTACT_PAIR:
             b = a.contact_body[c]
             th = q1[b, 2]
             lx, ly = a.contact_local[c]
@@ -418,7 +421,7 @@ ARC_VERTEX_MARGIN = 1e-9     # [m]
 COMPLEX_STEP = 1e-20
 
 
-def _touching_contacts(model, start, modes, slips):
+def _touching_contacts(model, start, modes, slips, features):
     """ContactPlan of the ground contacts touching (modes: the step's end modes) at the start
     q0, or NotImplementedError naming what is not covered (a shape pair, a straight edge over
     hills, restitution, a sole at the end of its span or level with a fallback vertex)."""
@@ -429,15 +432,27 @@ def _touching_contacts(model, start, modes, slips):
     slope, h0 = float(coef[1]), float(coef[0])
     flat_normal = np.array([-slope, 1.0]) / np.hypot(slope, 1.0)
     q0 = start.q
-    body, local, radius, pinned, mu_slip = [], [], [], [], []
+    body, local, radius, pinned, mu_slip, pairs = [], [], [], [], [], []
     for c in touching:
         name = model.contact_names[c]
         kind = int(a.contact_kind[c])
-        if kind not in (CONTACT_POINT, CONTACT_ARC):
-            raise _not_covered(f"contact {name!r} of kind {kind} (a shape pair or an edge) "
+        if kind not in (CONTACT_POINT, CONTACT_ARC, CONTACT_PAIR):
+            raise _not_covered(f"contact {name!r} of kind {kind} (a straight edge over hills) "
                                f"touching")
         if a.contact_restitution[c] != 0.0:
             raise _not_covered(f"contact {name!r} with restitution touching")
+        mu = float(a.contact_mu[c])
+        stick = modes[c] == MODE_PINNED and mu > 0.0
+        if kind == CONTACT_PAIR:
+            pair = _pair_features(model, c, int(features[c]))
+            body.append(max(pair[0], pair[1]))
+            local.append(np.zeros(2))
+            radius.append(0.0)
+            pinned.append(stick)
+            mu_slip.append(0.0 if stick else mu * float(slips[c]))
+            pairs.append(pair)
+            continue
+        pairs.append([-2] * 8)
         b = int(a.contact_body[c])
         lc = np.asarray(a.contact_local[c], dtype=float)
         r = float(a.contact_radius[c]) if kind == CONTACT_ARC else 0.0
@@ -461,8 +476,6 @@ def _touching_contacts(model, start, modes, slips):
                 if closest_point(coef, vw[0], vw[1])[4] < centre_gap - r + ARC_VERTEX_MARGIN:
                     raise _not_covered(f"round sole {name!r} level with one of its fallback "
                                        f"vertices")
-        mu = float(a.contact_mu[c])
-        stick = modes[c] == MODE_PINNED and mu > 0.0
         body.append(b)
         local.append(lc)
         radius.append(r)
@@ -473,7 +486,27 @@ def _touching_contacts(model, start, modes, slips):
                        local=np.array(local).reshape(-1, 2), radius=np.array(radius),
                        pinned=np.array(pinned, dtype=bool), mu_slip=np.array(mu_slip),
                        terrain=coef, normal=flat_normal, offset=float(h0 * flat_normal[1]),
-                       point_mass=a.body_inv_inertia[body] == 0.0)
+                       point_mass=a.body_inv_inertia[body] == 0.0,
+                       pair=np.array(pairs, dtype=np.int64).reshape(-1, 8), model=model)
+
+
+def _pair_features(model, c, feature):
+    """ContactPlan.pair's row of shape pair slot c from the feature id its manifold point had
+    (kernels/collide.py): [reference body, incident body, reference shape, incident shape,
+    distance kind, reference edge or vertex, incident vertex or edge, clip side]."""
+    a = model.arrays
+    if feature < 0:
+        raise _not_covered(f"shape pair slot {model.contact_names[c]!r} touching without "
+                           f"features")
+    clip, rest = feature % 4, feature // 4
+    inc, rest = rest % MAX_CORE_VERTICES, rest // MAX_CORE_VERTICES
+    ref, rest = rest % MAX_CORE_VERTICES, rest // MAX_CORE_VERTICES
+    dist, flip = rest % 2, rest // 2
+    slot0 = c - int(a.contact_pair[c, 2])
+    sa, sb = int(a.contact_pair[slot0, 0]), int(a.contact_pair[slot0, 1])
+    s_ref, s_inc = (sa, sb) if flip == 0 else (sb, sa)
+    return [int(a.shape_body[s_ref]), int(a.shape_body[s_inc]), s_ref, s_inc, dist, ref, inc,
+            clip]
 
 
 def _active_limits(model, limit_active) -> np.ndarray:
@@ -521,7 +554,8 @@ def _engine_order(model, held, limits, contacts) -> np.ndarray:
     return np.array(order, dtype=np.int64)
 
 
-def _replica_jacobian(sim, u, start, modes, slips, limit_active, q1, v1) -> StepJacobian:
+def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1,
+                      v1) -> StepJacobian:
     """step_jacobian of a step the engine took in one piece, ending at (q1, v1): the step's
     equations replayed (planarsim.step_replica) from the start and from the start moved by
     i COMPLEX_STEP along each coordinate and command, in one batch whose first row (the start
@@ -533,7 +567,7 @@ def _replica_jacobian(sim, u, start, modes, slips, limit_active, q1, v1) -> Step
     f, F, saturated = force_terms(model, start, u)
     W_A, W_D, R, f_spring, K, rotors, f_alone, K_alone = rotor_terms(model, start.q, h)
     held = np.flatnonzero(np.repeat((model.arrays.pin_kind & JOINT_FREE_BIT) == 0, 2))
-    contacts = _touching_contacts(model, start, modes, slips)
+    contacts = _touching_contacts(model, start, modes, slips, features)
     limits = _active_limits(model, limit_active)
     lo, hi = model.arrays.act_range.T
     turning = np.flatnonzero(np.isin(model.arrays.act_kind, list(_TURNING_ACTUATORS)))

@@ -51,9 +51,13 @@ class ContactPlan:
     pinned: np.ndarray          # (k,) bool: sticking (a tangent row); else sliding
     mu_slip: np.ndarray         # (k,) mu s of a sliding contact (its friction along -s t)
     terrain: np.ndarray         # the terrain's coefficients (kernels/terrain.py)
+    pair: np.ndarray | None = None   # (k, 8) int per shape pair's slot (-1 row: a ground
+                                     # contact): ref body, inc body, ref shape, inc shape,
+                                     # distance kind, ref index, inc index, clip (collide.py)
     normal: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0]))  # flat or sloped
     offset: float = 0.0         # [m] n . (any ground point) there
     point_mass: np.ndarray | None = None   # (k,) bool: on a body without rotational inertia
+    model: object = None
 
     @property
     def count(self) -> int:
@@ -212,6 +216,109 @@ def _perp_tangent(nrm):
     return np.stack([nrm[:, 1], -nrm[:, 0]], axis=-1)
 
 
+def _world(q, body, local):
+    """World point (B, 2) of body-frame point `local` ((2,) or (B, 2)) of body (the world's
+    own coordinates for body < 0)."""
+    if body < 0:
+        return np.broadcast_to(local, (q.shape[0], 2)) + 0.0 * q[:, 0, :2]
+    return q[:, body, :2] + _turn(q, body, local)
+
+
+def _local(q, body, point):
+    """Body-frame coordinates (B, 2) of world point (B, 2) (unchanged for the world)."""
+    if body < 0:
+        return point
+    th = q[:, body, 2]
+    cs, sn = np.cos(th), np.sin(th)
+    d = point - q[:, body, :2]
+    return np.stack([cs * d[:, 0] + sn * d[:, 1], -sn * d[:, 0] + cs * d[:, 1]], axis=-1)
+
+
+def _rotate_by(q, body, vector):
+    """Body-frame direction `vector` (2,) in the world (B, 2)."""
+    if body < 0:
+        return np.broadcast_to(vector, (q.shape[0], 2)) + 0.0 * q[:, 0, :2]
+    return _turn(q, body, vector)
+
+
+def pair_point(model, pair, q0):
+    """The manifold point of a shape pair's slot at q0 (kernels/collide.py, its features held:
+    pair = ContactPlan.pair's row): (p: the incident core's point, g: the reference
+    feature's point, n: the normal from the reference, gap), each (B, 2) or (B,). A FACE point
+    is an incident vertex (clip none) or the incident edge crossing a side line of the
+    reference edge (its start or end), g its foot on the reference edge's line; a DIST point
+    is a vertex pair."""
+    a = model.arrays
+    ref, inc, s_ref, s_inc, dist, i_ref, i_inc, clip = (int(x) for x in pair)
+    vr = a.core_vert[a.shape_vert_adr[s_ref]:a.shape_vert_adr[s_ref] + a.shape_vert_num[s_ref]]
+    nr = a.core_norm[a.shape_vert_adr[s_ref]:a.shape_vert_adr[s_ref] + a.shape_vert_num[s_ref]]
+    vi = a.core_vert[a.shape_vert_adr[s_inc]:a.shape_vert_adr[s_inc] + a.shape_vert_num[s_inc]]
+    radii = a.shape_radius[s_ref] + a.shape_radius[s_inc]
+    if dist:
+        p = _world(q0, inc, vi[i_inc])
+        g = _world(q0, ref, vr[i_ref])
+        d = p - g
+        length = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
+        return p, g, d / length[:, None], length - radii
+    start = _world(q0, ref, vr[i_ref])
+    n = _rotate_by(q0, ref, nr[i_ref])
+    if clip == 0:
+        p = _world(q0, inc, vi[i_inc])
+    else:
+        e0 = _world(q0, inc, vi[i_inc])
+        e1 = _world(q0, inc, vi[(i_inc + 1) % vi.shape[0]])
+        side = start if clip == 1 else _world(q0, ref, vr[(i_ref + 1) % vr.shape[0]])
+        t = np.stack([-n[:, 1], n[:, 0]], axis=-1)
+        frac = np.sum(t * (side - e0), axis=-1) / np.sum(t * (e1 - e0), axis=-1)
+        p = e0 + frac[:, None] * (e1 - e0)
+    depth = np.sum(n * (p - start), axis=-1)
+    return p, p - depth[:, None] * n, n, depth - radii
+
+
+def _pair_rows(model, cp, k, q, q0, c, J, F, r):
+    """contact_rows' rows r (normal) and r + 1 (sticking: tangent) of shape pair slot k:
+    kernels/pair.py pair_row with the features found at q0 (_store_point), acting on the
+    reference body (-) and the incident body (+) at the incident surface point."""
+    a = model.arrays
+    ref, inc, s_ref, s_inc, dist = (int(x) for x in cp.pair[k, :5])
+    r_ref, r_inc = a.shape_radius[s_ref], a.shape_radius[s_inc]
+    p0, g0, n0, _ = pair_point(model, cp.pair[k], q0)
+    anchor = _local(q0, inc, p0)                    # the incident core's point
+    face_n = _local(q0, ref, n0 + q0[:, ref, :2]) if ref >= 0 else n0   # R(-theta0) n0
+    face_g = _local(q0, ref, g0)
+    ref_pt = _local(q0, ref, g0 + r_ref * n0)
+    inc_pt = _local(q0, inc, p0 - r_inc * n0)
+    surface0 = p0 - r_inc * n0
+    # at q
+    p, g = _world(q, inc, anchor), _world(q, ref, face_g)
+    if dist:
+        d = p - g
+        length = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
+        n = d / length[:, None]
+        gap = length - r_ref - r_inc
+    else:
+        n = _turn(q, ref, face_n) if ref >= 0 else face_n
+        gap = np.sum(n * (p - g), axis=-1) - r_ref - r_inc
+    surface = p - r_inc * n
+
+    def put(row, M, d, at, qq):
+        for body, sign in ((ref, -1.0), (inc, 1.0)):
+            if body < 0:
+                continue
+            M[:, row, 3 * body:3 * body + 2] += sign * d
+            M[:, row, 3 * body + 2] += sign * _cross(at - qq[:, body, :2], d)
+
+    c[:, r] = gap
+    put(r, J, n, surface, q)
+    t0 = _perp_tangent(n0)
+    put(r, F, n0 - cp.mu_slip[k] * t0 if not cp.pinned[k] else n0, surface0, q0)
+    if cp.pinned[k]:
+        t = _perp_tangent(n)
+        c[:, r + 1] = np.sum(t * (_world(q, inc, inc_pt) - _world(q, ref, ref_pt)), axis=-1)
+        put(r + 1, J, t, surface, q)
+        put(r + 1, F, t0, surface0, q0)
+
+
 def contact_rows(cp, q, q0, n_coord):
     """(c (B, m), J (B, m, 3 n), F (B, m, 3 n)) of the touching contacts' rows at q, each
     contact's normal row then (sticking) its tangent row: the normal row the gap of its point
@@ -228,6 +335,10 @@ def contact_rows(cp, q, q0, n_coord):
     F = np.zeros((B, n_rows, n_coord), dtype=dtype)
     r = 0
     for k in range(cp.count):
+        if cp.pair is not None and cp.pair[k, 0] > -2:
+            _pair_rows(cp.model, cp, k, q, q0, c, J, F, r)
+            r += 2 if cp.pinned[k] else 1
+            continue
         b = int(cp.body[k])
         cols = slice(3 * b, 3 * b + 2)
         arm_n = _turn(q, b, cp.local[k])
@@ -402,8 +513,10 @@ def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
     cp = plan.contacts
     for k in range(cp.count):
         b = int(cp.body[k])
-        # (the normal row's point: a point contact's own, a round sole's centre)
-        judge(r, allowance([b], float(np.abs(cp.local[k]).sum())))
+        # (the normal row's point: a point contact's own, a round sole's centre; a shape
+        # pair's face turns with its body: no bound, never leaving)
+        if cp.pair is None or cp.pair[k, 0] == -2:
+            judge(r, allowance([b], float(np.abs(cp.local[k]).sum())))
         if cp.pinned[k]:
             leaving[r + 1] = leaving[r]
             r += 2

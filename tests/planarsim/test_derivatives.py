@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 import planarsim as ps
 from planarsim.derivatives import rollout_jacobians, step_jacobian
-from test_derivatives_contact import difference_error as surface_difference_error
+from test_derivatives_contact import difference_error as surface_difference_error, stepper
 
 REL_TOL = 1e-6      # the issue's bound on the relative error against finite differences
 EPS_X = 1e-6        # [m, rad, m/s, rad/s] the state's finite-difference step
@@ -40,28 +40,9 @@ def chain(masses, lengths, dt=1e-3, armature=None, stiffness=None, damping=None)
     return b.compile()
 
 
-def _stepper(sim):
-    """(x0, step(x, u) -> x1): the whole step from state x = (q, v) of sim's snapshot, sim
-    restored after each."""
-    start = sim.snapshot()
-    n = sim.model.n_body
-    x0 = np.concatenate([start.q.ravel(), start.v.ravel()])
-
-    def step(x, uu):
-        s = start.copy()
-        s.q[:] = x[:3 * n].reshape(n, 3)
-        s.v[:] = x[3 * n:].reshape(n, 3)
-        sim.restore(s)
-        sim.step(uu)
-        out = np.concatenate([sim.state.q.ravel(), sim.state.v.ravel()])
-        sim.restore(start)
-        return out
-    return x0, step
-
-
 def finite_differences(sim, u):
     """(A, B) of one step by centred differences, sim restored after each step."""
-    x0, step = _stepper(sim)
+    x0, step = stepper(sim)
     A = np.empty((x0.size, x0.size))
     for i in range(x0.size):
         e = np.zeros_like(x0)
@@ -121,7 +102,7 @@ def differences_agree(jac, sim, u):
     that disagrees at EPS_U is judged again at 1e-4 (Richardson's pair) and 1e-5. Returns
     (relative error of A, of B)."""
     A, B = finite_differences(sim, u)
-    x0, step = _stepper(sim)
+    x0, step = stepper(sim)
     n = x0.size // 2
     state_blocks = (slice(0, n), slice(n, 2 * n))
 
