@@ -29,9 +29,11 @@ rule through them, each a step of h / n.
 
 A touching contact's gap at the start is a boundary of the step's pieces: a start lifted off
 the ground by dz closes it in the step (its velocity solve aims at the surface), one pushed
-into the ground by dz is moved out by the correction (positions only). The derivative is the
-piece's whose side the start is on (within rounding of the surface: lifted where the gap is
-positive); along the surface (the states a contact keeps) both pieces agree.
+into the ground by dz is moved out by the correction (positions only). For a contact resting
+on its surface (within refine_tol) the derivative across it is the one from inside (the
+replay takes one correction pass where the engine took none: it moves the end by at most
+refine_tol); for one lifted off it, the lifted piece's; along the surface (the states a
+contact keeps) both pieces agree.
 
 Covered so far: bodies held by hinges (pins) and sliders to each other and the world, free
 bodies' coordinates (an MJCF root's slides and hinge), with joint limits (a limit row is
@@ -40,14 +42,14 @@ its rate row is constant); armature, dampers and the springs the step resolves o
 constant (hinges, and slides along a world axis whose anchor is their body's centre of mass:
 MJCF roots, a cart on a rail); ground contacts of points and round soles on any terrain
 (on hills the closest ground point is the engine's, continued by Newton for the complex
-step), sticking or sliding (Coulomb), several sharing a load (the rows the engine leaves
-out as dependent, left out alike); under gravity, constant pushes, pin torques, body forces
+step) and shape pairs (the manifold point rebuilt from its features), sticking or sliding
+(Coulomb), several sharing a load (the rows the engine leaves out as dependent, left out
+alike); under gravity, constant pushes, pin torques, body forces
 and torques, forces along such slides, axial forces between two bodies and hip torques (the
 Simple Biped's legs and hip). Refused with a NotImplementedError naming the feature:
 armature, dampers or springs on a slider whose rate row turns with its bodies (its rotor adds
 velocity-product forces), rods, the limit of such a slider reached in the step, dry
-friction, springs too stiff for the step, a box's straight edge on hills, shape pairs that
-touch, restitution, a step split at a time of impact, fluid drag, the other actuator kinds,
+friction, springs too stiff for the step, a box's straight edge on hills, restitution, a step split at a time of impact, fluid drag, the other actuator kinds,
 the accurate integrators.
 """
 from __future__ import annotations
@@ -61,7 +63,7 @@ from .kernels.codes import (CONTACT_ARC, CONTACT_PAIR, CONTACT_POINT, INTEGRATOR
 from .kernels.collide import MAX_CORE_VERTICES
 from .kernels.forces import (ACT_AXIAL, ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_HIP_TORQUE,
                               ACT_PIN_TORQUE, ACT_SLIDER_FORCE)
-from .kernels.info import INFO_CCD_SPLITS, INFO_TURN_SUBSTEPS
+from .kernels.info import INFO_CCD_SPLITS, INFO_PROJECTIONS, INFO_TURN_SUBSTEPS
 from .step_replica import ContactPlan, ReplicaRefused, StepPlan, replica
 
 #: the replay must end where the engine's step ended to this share of the step's motion (plus
@@ -97,9 +99,9 @@ def _not_covered(what):
     return NotImplementedError(
         f"step_jacobian covers mechanisms of hinges, sliders and free bodies' coordinates "
         f"(armature, dampers and the springs the step resolves on joints whose rate row is "
-        f"constant) and their limits, and ground contacts of points and round soles on flat "
-        f"or sloped ground, under gravity, pushes, pin, body and hip torques, body forces, "
-        f"axial forces and forces along such slides so far; this step has {what}")
+        f"constant) and their limits, ground contacts of points and round soles and shape "
+        f"pairs, under gravity, pushes, pin, body and hip torques, body forces, axial forces "
+        f"and forces along such slides so far; this step has {what}")
 
 
 def inverse_masses(a) -> np.ndarray:
@@ -288,10 +290,14 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         end_modes, end_slips = end.contact_mode.copy(), end.contact_slip.copy()
         impulses = end.last_contact_impulse.copy()
         features = end.contact_feature.copy()
+        first_order = int(sim.ws.first_order[0])
+        projections = int(sim.ws.info[INFO_PROJECTIONS])
+        v_lin = sim.ws.v_lin.ravel().copy()
         limit_impulses = end.last_pin_impulse[:, 2:4].copy()
         substeps = int(sim.ws.info[INFO_TURN_SUBSTEPS])
         splits = int(sim.ws.info[INFO_CCD_SPLITS])
         limit_active = end.limit_active.copy()
+        end_enabled = end.contact_enabled.copy()
     finally:
         if not (_keep_end and ended):
             sim.restore(start)
@@ -302,16 +308,22 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
             sim.ws.info[:] = info
     if splits > 0:
         raise _not_covered(f"a step taken in {splits} time-of-impact splits")
+
     if substeps > 1:
         return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info)
-    jac = _replica_jacobian(sim, u, start, end_modes, end_slips, features, limit_active, q1,
-                            v1)
+    jac, plan = _replica_jacobian(sim, u, start, end_modes, end_slips, features, limit_active,
+                                  q1, v1, first_order, projections)
+    if np.abs(plan.v_lin - v_lin).max(initial=0.0) > FIT_TOL * (np.abs(v_lin).max() + 1e-300):
+        raise _not_covered("a velocity solve whose joints' target the step linearized again "
+                           "at its first answer (step.relinearize)")
+    near = plan.near is not None and plan.near.size > 0
     # a contact or limit held at the start that the step let go was on its surface: pressed
     # into it by an infinitesimal change of the start, it would have stayed
     released = (((start.contact_mode != MODE_FREE) & (end_modes == MODE_FREE)).any()
                 or ((start.limit_active != 0) & (limit_active == 0)).any())
-    if not jac.modes_changed and (released or _at_mode_boundary(
-            model, end_modes, impulses, limit_active, limit_impulses, q1, v1, h)):
+    if not jac.modes_changed and (released or near or _at_mode_boundary(
+            model, end_modes, impulses, limit_active, limit_impulses, q1, v1, h,
+            end_enabled)):
         jac = StepJacobian(A=jac.A, B=jac.B, modes_changed=True, x1=jac.x1)
     return jac
 
@@ -366,21 +378,58 @@ def rollout_jacobians(sim, us) -> list:
     return out
 
 
+def _ground_gap(a, q, c) -> float:
+    """Ground contact c's gap [m] at q as kernels/contacts.py find_contact measures it: a
+    point's; a round sole's lowest point where it lies within the sole's span, else the
+    lowest of the span's ends and the fallback vertices."""
+    from .kernels.terrain import closest_point
+    coef = a.terrain_coef
+    b = int(a.contact_body[c])
+    cs, sn = np.cos(q[b, 2]), np.sin(q[b, 2])
+
+    def world(l):
+        return q[b, :2] + np.array([cs * l[0] - sn * l[1], sn * l[0] + cs * l[1]])
+
+    lc = np.asarray(a.contact_local[c], dtype=float)
+    if a.contact_kind[c] == CONTACT_POINT:
+        return float(closest_point(coef, *world(lc))[4])
+    r = float(a.contact_radius[c])
+    *_, nx, ny, centre_gap = closest_point(coef, *world(lc))
+    a0, a1 = a.contact_span[c]
+    down = np.arctan2(-(-sn * nx + cs * ny), -(cs * nx + sn * ny))
+    if a1 - a0 >= 2.0 * np.pi or any(a0 <= down + 2.0 * np.pi * w <= a1 for w in (-1, 0, 1)):
+        candidates = [centre_gap - r]
+    else:
+        candidates = [closest_point(coef, *world(lc + r * np.array([np.cos(t), np.sin(t)])))[4]
+                      for t in (a0, a1)]
+    adr, num = int(a.contact_vert_adr[c]), int(a.contact_vert_num[c])
+    candidates += [closest_point(coef, *world(v))[4] for v in a.vert_local[adr:adr + num]]
+    return float(min(candidates))
+
+
+#: [m] a free ground contact ending within this of the ground is at the edge of touching
+FREE_GAP_EDGE = 1e-10
 #: a touching contact is at the edge of its mode where its normal impulse, its friction
 #: cone's margin (sticking) or its slip speed (sliding) is within this share of its scale
 MODE_MARGIN = 1e-9
 
 
-def _at_mode_boundary(model, modes, impulses, limit_active, limit_impulses, q1, v1,
-                      h) -> bool:
+def _at_mode_boundary(model, modes, impulses, limit_active, limit_impulses, q1, v1, h,
+                      enabled) -> bool:
     """A touching contact or an active joint limit at the edge of its mode at the step's end
     (impulses: the step's normal and tangential impulses [N s] per contact,
     State.last_contact_impulse; limit_impulses: its lower and upper limit impulses per joint,
     State.last_pin_impulse[:, 2:]): a contact or limit pushing with no impulse (about to
     leave), a contact sticking at its friction cone's edge or sliding with no slip (about to
     stick); an infinitesimal change of the start or the commands then changes the mode."""
+    from .kernels.terrain import closest_point
     a = model.arrays
     touching = np.flatnonzero(modes != MODE_FREE)
+    # a free ground contact (enabled) ending on the ground: an infinitesimal change engages it
+    for c in np.flatnonzero((modes == MODE_FREE) & (enabled != 0)):
+        if a.contact_kind[c] in (CONTACT_POINT, CONTACT_ARC) and \
+                abs(_ground_gap(a, q1, c)) <= FREE_GAP_EDGE:
+            return True
     if not touching.size and not limit_active.any():
         return False
     weight = float(a.body_mass.sum() * np.hypot(*a.gravity) * h)
@@ -403,10 +452,11 @@ def _at_mode_boundary(model, modes, impulses, limit_active, limit_impulses, q1, 
             th = q1[b, 2]
             lx, ly = a.contact_local[c]
             arm = np.array([np.cos(th) * lx - np.sin(th) * ly, np.sin(th) * lx + np.cos(th) * ly])
-            coef = a.terrain_coef
-            tangent = np.array([1.0, coef[1]]) / np.hypot(1.0, coef[1])
+            # the ground's tangent at the point closest to the contact's point (centre)
+            nx, ny = closest_point(a.terrain_coef, *(q1[b, :2] + arm))[2:4]
+            tangent = np.array([ny, -nx])
             if a.contact_kind[c] == CONTACT_ARC:        # (the sole's point below its centre)
-                arm += a.contact_radius[c] * np.array([tangent[1], -tangent[0]])
+                arm -= a.contact_radius[c] * np.array([nx, ny])
             slip = tangent @ (v1[b, :2] + v1[b, 2] * np.array([-arm[1], arm[0]]))
             if abs(slip) <= MODE_MARGIN * speed:
                 return True
@@ -554,12 +604,13 @@ def _engine_order(model, held, limits, contacts) -> np.ndarray:
     return np.array(order, dtype=np.int64)
 
 
-def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1,
-                      v1) -> StepJacobian:
-    """step_jacobian of a step the engine took in one piece, ending at (q1, v1): the step's
-    equations replayed (planarsim.step_replica) from the start and from the start moved by
-    i COMPLEX_STEP along each coordinate and command, in one batch whose first row (the start
-    itself) takes the decisions; that row must end where the engine ended."""
+def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1, v1,
+                      first_order=0, projections=0) -> StepJacobian:
+    """(StepJacobian, its StepPlan) of a step the engine took in one piece, ending at (q1,
+    v1): the step's equations replayed (planarsim.step_replica) from the start and from the
+    start moved by i COMPLEX_STEP along each coordinate and command, in one batch whose
+    first row (the start itself) takes the decisions; that row must end where the engine
+    ended."""
     model = sim.model
     h = float(sim.dt)
     nq = 3 * model.n_body
@@ -569,6 +620,12 @@ def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1,
     held = np.flatnonzero(np.repeat((model.arrays.pin_kind & JOINT_FREE_BIT) == 0, 2))
     contacts = _touching_contacts(model, start, modes, slips, features)
     limits = _active_limits(model, limit_active)
+    if first_order:
+        raise _not_covered("a velocity solve that gave up the joints' second-order target "
+                           "(J v = 0: it added energy)")
+    if projections:
+        raise _not_covered("a complementarity projection of the positions after the "
+                           "correction")
     lo, hi = model.arrays.act_range.T
     turning = np.flatnonzero(np.isin(model.arrays.act_kind, list(_TURNING_ACTUATORS)))
     cols = 2 * nq + model.n_act
@@ -587,7 +644,9 @@ def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1,
                         contacts=contacts, limits=limits,
                         order=_engine_order(model, held, limits, contacts),
                         iters=int(sim.options.refine_iters),
-                        tol=float(sim.options.refine_tol), flip=flip)
+                        tol=float(sim.options.refine_tol), flip=flip,
+                        pivot_tol=float(sim.options.pivot_tol),
+                        refine_pivot_tol=float(sim.options.refine_pivot_tol))
         q_c, v_c = replica(plan, q0[None] + E[:, :nq], v0[None] + E[:, nq:2 * nq],
                            u[None] + E[:, 2 * nq:])
         return (q_c, v_c, np.abs(q_c[0].real - q1.ravel()).max(),
@@ -621,4 +680,4 @@ def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1,
                            f"target, the motion paying for a lift)")
     D = np.hstack([q_c[1:].imag, v_c[1:].imag]).T / COMPLEX_STEP      # (2 nq, cols)
     return StepJacobian(A=D[:, :2 * nq], B=D[:, 2 * nq:], modes_changed=bool(saturated.any()),
-                        x1=np.concatenate([q1.ravel(), v1.ravel()]))
+                        x1=np.concatenate([q1.ravel(), v1.ravel()])), plan

@@ -90,6 +90,10 @@ class StepPlan:
     order: np.ndarray           # the rows (joints' then contacts') in the engine's order
     iters: int
     tol: float
+    pivot_tol: float = 1e-11            # StepOptions.pivot_tol, refine_pivot_tol
+    refine_pivot_tol: float = 1e-7
+    resting: bool = False       # a unilateral row starts on its surface (module docstring)
+    v_lin: np.ndarray | None = None     # the first row's v_lin (derivatives checks it)
     passes: int | None = None   # Newton passes (None: decide, on the real run)
     extra_pass: bool | None = None
     bound: dict | None = None   # the energy bound's branch (None: decide)
@@ -479,7 +483,10 @@ def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
     """The rows the Newton correction keeps (kernels/integrate.py drop_leaving_rows): all but
     a unilateral row open at q (the start plus h v_new) by more than the step's turning
     explains (pull_allowance: the body leaves the surface, a disk rolling over a crest), and
-    the tangent row of a contact whose normal row leaves. c: every row's error at q (real)."""
+    the tangent row of a contact whose normal row leaves. A row resting on its surface at the
+    start (not lifted) is held: the engine may judge its opening of a few ulps either way,
+    which moves the end by less than refine_tol, and the derivative across the surface is
+    the one from inside. c: every row's error at q (real)."""
     model = plan.model
     a = model.arrays
     n = model.n_body
@@ -502,6 +509,8 @@ def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
     near = []
 
     def judge(r, allow):
+        if not plan.lifted[r - mj]:
+            return          # resting on its surface: held (its derivative from inside)
         if abs(c[r] - allow) <= NEAR_ALLOWANCE * scale:
             near.append(r)
         leaving[r] = (c[r] > allow) != (r in plan.flip)
@@ -566,7 +575,12 @@ def replica(plan: StepPlan, q0, v0, u):
     mj = Pj.shape[1]
     unilateral = np.concatenate([np.zeros(mj, bool), unilateral_m])
     if deciding:
-        plan.lifted = cm0[0].real > 0.0
+        # a row within refine_tol of its surface rests on it: its derivative across the
+        # surface is taken from inside (pushed in, the correction moves it out), where the
+        # engine's c / h target would add at most refine_tol / h
+        plan.lifted = cm0[0].real > plan.tol
+        plan.resting = bool((unilateral_m & ~plan.lifted).any())
+        plan.v_lin = v_lin[0].real.copy()
     # a unilateral row that starts violated only stops approaching (solve.fill_row_b)
     target = np.where(plan.lifted | ~unilateral_m, cm0, 0.0)
     P = np.concatenate([Pj, Pm], axis=1)
@@ -578,10 +592,11 @@ def replica(plan: StepPlan, q0, v0, u):
         WdFt = np.einsum("ij,brj->bir", plan.W_D, Fd)          # (B, 3n, m)
         N = np.einsum("brk,bks->brs", P, WdFt)
         if deciding:
-            if mj and independent_rows(N[0, :mj, :mj].real, np.arange(mj)).size < mj:
+            if mj and independent_rows(N[0, :mj, :mj].real, np.arange(mj),
+                                       plan.pivot_tol).size < mj:
                 raise ReplicaRefused("dependent joints (an over-constrained loop): the step is "
                                      "not smooth there")
-            plan.solved = independent_rows(N[0].real, plan.order)
+            plan.solved = independent_rows(N[0].real, plan.order, plan.pivot_tol)
         K = plan.solved
         lam = _solve(N[:, K][:, :, K], rhs[:, K])
         v_new = v_lin + np.einsum("bir,br->bi", WdFt[:, :, K], lam)
@@ -615,17 +630,21 @@ def replica(plan: StepPlan, q0, v0, u):
         S = (~unilateral_c).astype(float)
         any_unilateral = bool(unilateral_c.any())
         worst = np.abs(c[0].real).max(initial=0.0) if deciding else None
+        first_worst = worst
         passes, stalled = 0, False
         Nn = None
         for _ in range(plan.iters if deciding else plan.passes):
-            if deciding and worst <= plan.tol:
+            if deciding and worst <= plan.tol and (passes > 0 or not plan.resting):
+                # (a resting row takes one pass even where the engine's takes none: it
+                # moves the end by at most refine_tol, and its derivative is the projection
+                # back onto the surface that a start pushed into it gets)
                 break
             if now.any():
                 D = D.copy()
                 D[:, :, now] = np.einsum("ij,brj->bir", plan.W_A, G[:, now])
             Nn = np.einsum("brk,bks->brs", G, D)
             if plan.corrected is None:
-                plan.corrected = independent_rows(Nn[0].real, kept_order)
+                plan.corrected = independent_rows(Nn[0].real, kept_order, plan.refine_pivot_tol)
             K = plan.corrected
             Nn, DK = Nn[:, K][:, :, K], D[:, :, K]
             mu = _solve(Nn, -c[:, K])
@@ -652,7 +671,8 @@ def replica(plan: StepPlan, q0, v0, u):
                 worst = after
         if deciding:
             plan.passes = passes
-            plan.extra_pass = passes > 0 and not stalled and 0.0 < worst <= plan.tol
+            plan.extra_pass = (passes > 0 and not stalled and 0.0 < worst <= plan.tol
+                               and not (plan.resting and passes == 1 and first_worst <= plan.tol))
         if plan.extra_pass:
             # one more pass on the last factorisation (integrate.correct_positions)
             K = plan.corrected
@@ -670,22 +690,17 @@ def replica(plan: StepPlan, q0, v0, u):
     return q, v
 
 
-#: a row whose pivot keeps less than this share of its diagonal, eliminated in the engine's
-#: order after the rows kept before it, is dependent on them (the engine's factorisations
-#: leave it out; its equation then holds through the others where the targets agree)
-DEPENDENT_PIVOT = 1e-9
 #: the independent rows' matrix's condition number above which the step counts as not smooth
 DEPENDENT_COND = 1e10
 #: [m/s] the left-out rows' equations must hold to this (plus this share of the targets)
 LEFT_OUT_TOL = 1e-9
 
 
-def independent_rows(N, order) -> np.ndarray:
+def independent_rows(N, order, pivot_tol) -> np.ndarray:
     """The rows of N (m, m) kept by elimination in `order` (each row's pivot after the rows
-    kept before it: kept if it keeps more than DEPENDENT_PIVOT of its diagonal), as sorted
-    indices; ReplicaRefused where the kept rows are still ill-conditioned."""
-    if N.shape[0] == 0 or np.linalg.cond(N) <= DEPENDENT_COND:
-        return np.arange(N.shape[0])
+    kept before it, kept if it keeps more than pivot_tol of its diagonal: the engine's
+    StepOptions.pivot_tol for the velocity solve, refine_pivot_tol for the correction), as
+    sorted indices; ReplicaRefused where the kept rows are still ill-conditioned."""
     kept = []
     for r in order:
         d = N[r, r]
@@ -694,7 +709,7 @@ def independent_rows(N, order) -> np.ndarray:
             pivot = d - N[r, k] @ np.linalg.solve(N[np.ix_(k, k)], N[k, r])
         else:
             pivot = d
-        if abs(pivot) > DEPENDENT_PIVOT * abs(d):
+        if abs(pivot) > pivot_tol * abs(d):
             kept.append(int(r))
     kept = np.array(sorted(kept), dtype=np.int64)
     if kept.size and np.linalg.cond(N[np.ix_(kept, kept)]) > DEPENDENT_COND:
