@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import collections
-import math
 import sys
 from pathlib import Path
 
@@ -33,8 +32,8 @@ import planarsim as ps  # noqa: E402
 from planarsim.errors import SimulationDiverged  # noqa: E402
 from planarsim.kernels.codes import MODE_FREE  # noqa: E402
 from planarsim.kernels.terrain import closest_point, height  # noqa: E402
-from test_derivatives_contact import (REL_TOL, STEP_SIZES, box_on_slope,  # noqa: E402
-                                      box_stack, difference_error, disk_on_slope, moved)
+from test_derivatives_contact import (REL_TOL, box_stack, difference_error,  # noqa: E402
+                                      moved, slope_case)
 
 
 def on_hills(rng):
@@ -69,18 +68,9 @@ FAMILIES = ["box", "disk", "hills", "stack"]
 
 def case(family, rng):
     """(sim, commands u, their scale) of one random case of `family`."""
-    angle, mu, mass = rng.uniform(0, 40), rng.uniform(0, 2), 10 ** rng.uniform(-3, 3)
-    dt = float(rng.choice(STEP_SIZES))
-    if family == "box":
-        width = 10 ** rng.uniform(-2, math.log10(2))
-        sim = box_on_slope(angle, mu, mass, width, width * rng.uniform(0.05, 1),
-                           rng.uniform(-10, 10), dt)
-        scale = mass * 9.81
-    elif family == "disk":
-        radius = 10 ** rng.uniform(math.log10(0.005), math.log10(2))
-        sim = disk_on_slope(angle, mu, mass, radius, rng.uniform(-50, 50), dt)
-        scale = min(mass * 9.81 * radius, 0.1 * 0.5 * mass * radius ** 2 / dt ** 2)
-    elif family == "stack":
+    if family in ("box", "disk"):
+        return slope_case(family, rng)
+    if family == "stack":
         count = int(rng.integers(2, 4))
         masses = 10 ** rng.uniform(-2, 2, count)
         sim = box_stack(rng.uniform(0.05, 1.0, count), rng.uniform(0.02, 0.3), masses,

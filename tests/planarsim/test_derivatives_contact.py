@@ -496,6 +496,23 @@ def test_modes_changed_says_where_a_mode_is_at_its_edge():
     assert edges == [True, False, False], edges
 
 
+def slope_case(family, rng):
+    """(sim, commands u, their scale [N or N m]) of a random box ("box") or disk ("disk") on
+    a slope, over the searches' ranges."""
+    angle, mu, mass = rng.uniform(0, 40), rng.uniform(0, 2), 10 ** rng.uniform(-3, 3)
+    dt = float(rng.choice(STEP_SIZES))
+    if family == "box":
+        width = 10 ** rng.uniform(-2, math.log10(2))
+        sim = box_on_slope(angle, mu, mass, width, width * rng.uniform(0.05, 1),
+                           rng.uniform(-10, 10), dt)
+        scale = mass * 9.81
+    else:
+        radius = 10 ** rng.uniform(math.log10(0.005), math.log10(2))
+        sim = disk_on_slope(angle, mu, mass, radius, rng.uniform(-50, 50), dt)
+        scale = min(mass * 9.81 * radius, 0.1 * 0.5 * mass * radius ** 2 / dt ** 2)
+    return sim, np.array([rng.uniform(-1, 1) * scale]), scale
+
+
 def test_most_contact_steps_are_covered():
     """Of 40 seeded boxes on slopes and 40 disks (the searches' ranges), at least 30 of each
     that touch are covered, none at a mode's edge or a kink, within 1e-6 (measured: every box,
@@ -505,18 +522,7 @@ def test_most_contact_steps_are_covered():
         rng = np.random.default_rng(5)
         checked = 0
         for _ in range(40):
-            angle, mu, mass = rng.uniform(0, 40), rng.uniform(0, 2), 10 ** rng.uniform(-3, 3)
-            dt = float(rng.choice(STEP_SIZES))
-            if family == "box":
-                width = 10 ** rng.uniform(-2, math.log10(2))
-                sim = box_on_slope(angle, mu, mass, width, width * rng.uniform(0.05, 1),
-                                   rng.uniform(-10, 10), dt)
-                scale = mass * 9.81
-            else:
-                radius = 10 ** rng.uniform(math.log10(0.005), math.log10(2))
-                sim = disk_on_slope(angle, mu, mass, radius, rng.uniform(-50, 50), dt)
-                scale = min(mass * 9.81 * radius, 0.1 * 0.5 * mass * radius ** 2 / dt ** 2)
-            u = np.array([rng.uniform(-1, 1) * scale])
+            sim, u, scale = slope_case(family, rng)
             sim, settled = moved(sim, int(rng.integers(5, 100)), u)
             if not settled or (sim.state.contact_mode == MODE_FREE).all():
                 continue
