@@ -30,10 +30,10 @@ rule through them, each a step of h / n.
 A touching contact's gap at the start is a boundary of the step's pieces: a start lifted off
 the ground by dz closes it in the step (its velocity solve aims at the surface), one pushed
 into the ground by dz is moved out by the correction (positions only). For a contact resting
-on its surface (within refine_tol) the derivative across it is the one from inside (the
-replay takes one correction pass where the engine took none: it moves the end by at most
-refine_tol); for one lifted off it, the lifted piece's; along the surface (the states a
-contact keeps) both pieces agree.
+on its surface (within refine_tol) the derivative across it is the one from inside: where
+the engine's correction took no pass, the replay adds the projection of the start's push
+into the surface alone (its real part 0: the end is the engine's); for one lifted off it,
+the lifted piece's; along the surface (the states a contact keeps) both pieces agree.
 
 Covered so far: bodies held by hinges (pins) and sliders to each other and the world, free
 bodies' coordinates (an MJCF root's slides and hinge), with joint limits (a limit row is

@@ -581,8 +581,11 @@ def replica(plan: StepPlan, q0, v0, u):
         plan.lifted = cm0[0].real > plan.tol
         plan.resting = bool((unilateral_m & ~plan.lifted).any())
         plan.v_lin = v_lin[0].real.copy()
-    # a unilateral row that starts violated only stops approaching (solve.fill_row_b)
-    target = np.where(plan.lifted | ~unilateral_m, cm0, 0.0)
+    # a unilateral row that starts violated only stops approaching (solve.fill_row_b); one
+    # resting open by at most refine_tol keeps the engine's target as a number (its
+    # derivative is the one from inside)
+    target = np.where(plan.lifted | ~unilateral_m, cm0,
+                      np.where(cm0.real > 0.0, cm0.real, 0.0))
     P = np.concatenate([Pj, Pm], axis=1)
     Fd = np.concatenate([Pj, Fm], axis=1)
     m = P.shape[1]
@@ -630,14 +633,10 @@ def replica(plan: StepPlan, q0, v0, u):
         S = (~unilateral_c).astype(float)
         any_unilateral = bool(unilateral_c.any())
         worst = np.abs(c[0].real).max(initial=0.0) if deciding else None
-        first_worst = worst
         passes, stalled = 0, False
         Nn = None
         for _ in range(plan.iters if deciding else plan.passes):
-            if deciding and worst <= plan.tol and (passes > 0 or not plan.resting):
-                # (a resting row takes one pass even where the engine's takes none: it
-                # moves the end by at most refine_tol, and its derivative is the projection
-                # back onto the surface that a start pushed into it gets)
+            if deciding and worst <= plan.tol:
                 break
             if now.any():
                 D = D.copy()
@@ -671,8 +670,7 @@ def replica(plan: StepPlan, q0, v0, u):
                 worst = after
         if deciding:
             plan.passes = passes
-            plan.extra_pass = (passes > 0 and not stalled and 0.0 < worst <= plan.tol
-                               and not (plan.resting and passes == 1 and first_worst <= plan.tol))
+            plan.extra_pass = passes > 0 and not stalled and 0.0 < worst <= plan.tol
         if plan.extra_pass:
             # one more pass on the last factorisation (integrate.correct_positions)
             K = plan.corrected
@@ -682,6 +680,22 @@ def replica(plan: StepPlan, q0, v0, u):
                 v = v + np.einsum("bir,br->bi", DK, _solve(Nn, -(c * S)[:, K]) / h)
             else:
                 v = v + np.einsum("bir,br->bi", DK, mu) / h
+        if plan.passes == 0 and plan.resting:
+            # no pass (every row held at the step's end): a row resting on its surface, the
+            # start pushed into it by dz (first order: its row at the start times the start's
+            # move) keeps dz after the velocity solve, whose target is clipped there, and the
+            # correction the engine then takes moves it out (positions only). That projection
+            # alone, from inside: the start's other moves give nothing (real part 0)
+            resting = unilateral_c.copy()           # (kept unilateral rows are mode rows)
+            resting[unilateral_c] = ~plan.lifted[keep[unilateral_c] - mj]
+            pushed = np.zeros_like(c)
+            pushed[:, resting] = (q0 - plan.q0) @ P[0, keep[resting]].real.T
+            if now.any():
+                D = D.copy()
+                D[:, :, now] = np.einsum("ij,brj->bir", plan.W_A, G[:, now])
+            Nn = np.einsum("brk,bks->brs", G, D)
+            K = independent_rows(Nn[0].real, kept_order, plan.refine_pivot_tol)
+            q = q + np.einsum("bir,br->bi", D[:, :, K], _solve(Nn[:, K][:, :, K], -pushed[:, K]))
     elif deciding:
         plan.passes, plan.extra_pass = 0, False
     if plan.passes > 0:
