@@ -378,33 +378,47 @@ def rollout_jacobians(sim, us) -> list:
     return out
 
 
-def _ground_gap(a, q, c) -> float:
-    """Ground contact c's gap [m] at q as kernels/contacts.py find_contact measures it: a
-    point's; a round sole's lowest point where it lies within the sole's span, else the
-    lowest of the span's ends and the fallback vertices."""
+def _sole(a, q, c):
+    """Round sole c at q as kernels/contacts.py find_contact measures it: (how far [rad] its
+    lowest direction lies inside its span, inf for a full circle, negative outside; the gap
+    [m] of its lowest point; the gaps of its span's ends; those of its fallback vertices)."""
     from .kernels.terrain import closest_point
     coef = a.terrain_coef
     b = int(a.contact_body[c])
     cs, sn = np.cos(q[b, 2]), np.sin(q[b, 2])
 
-    def world(l):
-        return q[b, :2] + np.array([cs * l[0] - sn * l[1], sn * l[0] + cs * l[1]])
+    def gap(l):
+        return float(closest_point(coef, *(q[b, :2] + np.array([cs * l[0] - sn * l[1],
+                                                                  sn * l[0] + cs * l[1]])))[4])
 
     lc = np.asarray(a.contact_local[c], dtype=float)
-    if a.contact_kind[c] == CONTACT_POINT:
-        return float(closest_point(coef, *world(lc))[4])
     r = float(a.contact_radius[c])
-    *_, nx, ny, centre_gap = closest_point(coef, *world(lc))
+    *_, nx, ny, centre_gap = closest_point(coef, *(q[b, :2] + np.array(
+        [cs * lc[0] - sn * lc[1], sn * lc[0] + cs * lc[1]])))
     a0, a1 = a.contact_span[c]
-    down = np.arctan2(-(-sn * nx + cs * ny), -(cs * nx + sn * ny))
-    if a1 - a0 >= 2.0 * np.pi or any(a0 <= down + 2.0 * np.pi * w <= a1 for w in (-1, 0, 1)):
-        candidates = [centre_gap - r]
-    else:
-        candidates = [closest_point(coef, *world(lc + r * np.array([np.cos(t), np.sin(t)])))[4]
-                      for t in (a0, a1)]
+    inside = np.inf
+    if a1 - a0 < 2.0 * np.pi:
+        down = np.arctan2(-(-sn * nx + cs * ny), -(cs * nx + sn * ny))
+        inside = max(min(down + 2.0 * np.pi * w - a0, a1 - down - 2.0 * np.pi * w)
+                     for w in (-1, 0, 1))
+    ends = [gap(lc + r * np.array([np.cos(t), np.sin(t)])) for t in (a0, a1)]
     adr, num = int(a.contact_vert_adr[c]), int(a.contact_vert_num[c])
-    candidates += [closest_point(coef, *world(v))[4] for v in a.vert_local[adr:adr + num]]
-    return float(min(candidates))
+    return inside, float(centre_gap) - r, ends, [gap(v) for v in a.vert_local[adr:adr + num]]
+
+
+def _ground_gap(a, q, c) -> float:
+    """Ground contact c's gap [m] at q as kernels/contacts.py find_contact measures it: a
+    point's; a round sole's lowest point where it lies within the sole's span, else the
+    lowest of the span's ends; or a fallback vertex's, where lower."""
+    from .kernels.terrain import closest_point
+    if a.contact_kind[c] == CONTACT_POINT:
+        b = int(a.contact_body[c])
+        cs, sn = np.cos(q[b, 2]), np.sin(q[b, 2])
+        lx, ly = a.contact_local[c]
+        return float(closest_point(a.terrain_coef, q[b, 0] + cs * lx - sn * ly,
+                                   q[b, 1] + sn * lx + cs * ly)[4])
+    inside, sole_gap, ends, vertices = _sole(a, q, c)
+    return min([sole_gap if inside >= 0.0 else min(ends)] + vertices)
 
 
 #: [m] a free ground contact ending within this of the ground is at the edge of touching
@@ -475,7 +489,6 @@ def _touching_contacts(model, start, modes, slips, features):
     """ContactPlan of the ground contacts touching (modes: the step's end modes) at the start
     q0, or NotImplementedError naming what is not covered (a shape pair, a straight edge over
     hills, restitution, a sole at the end of its span or level with a fallback vertex)."""
-    from .kernels.terrain import closest_point
     a = model.arrays
     touching = np.flatnonzero(modes != MODE_FREE)
     coef = np.asarray(a.terrain_coef, dtype=float)
@@ -507,25 +520,13 @@ def _touching_contacts(model, start, modes, slips, features):
         lc = np.asarray(a.contact_local[c], dtype=float)
         r = float(a.contact_radius[c]) if kind == CONTACT_ARC else 0.0
         if kind == CONTACT_ARC:
-            th = q0[b, 2]
-            cs, sn = np.cos(th), np.sin(th)
-            centre = q0[b, :2] + np.array([cs * lc[0] - sn * lc[1], sn * lc[0] + cs * lc[1]])
-            *_, nx, ny, centre_gap = closest_point(coef, centre[0], centre[1])
-            down = np.array([-(cs * nx + sn * ny), -(-sn * nx + cs * ny)])
-            a0, a1 = a.contact_span[c]
-            if a1 - a0 < 2.0 * np.pi:
-                ang = np.arctan2(down[1], down[0])
-                inside = [(ang + 2.0 * np.pi * w - a0, a1 - ang - 2.0 * np.pi * w)
-                          for w in (-1, 0, 1)]
-                if not any(lo > ARC_SPAN_MARGIN and hi > ARC_SPAN_MARGIN for lo, hi in inside):
-                    raise _not_covered(f"round sole {name!r} resting at (or beyond) an end of "
-                                       f"its span")
-            adr, num = int(a.contact_vert_adr[c]), int(a.contact_vert_num[c])
-            for vl in a.vert_local[adr:adr + num]:
-                vw = q0[b, :2] + np.array([cs * vl[0] - sn * vl[1], sn * vl[0] + cs * vl[1]])
-                if closest_point(coef, vw[0], vw[1])[4] < centre_gap - r + ARC_VERTEX_MARGIN:
-                    raise _not_covered(f"round sole {name!r} level with one of its fallback "
-                                       f"vertices")
+            inside, sole_gap, _, vertices = _sole(a, q0, c)
+            if inside <= ARC_SPAN_MARGIN:
+                raise _not_covered(f"round sole {name!r} resting at (or beyond) an end of its "
+                                   f"span")
+            if min(vertices, default=np.inf) < sole_gap + ARC_VERTEX_MARGIN:
+                raise _not_covered(f"round sole {name!r} level with one of its fallback "
+                                   f"vertices")
         body.append(b)
         local.append(lc)
         radius.append(r)
@@ -564,7 +565,7 @@ def _active_limits(model, limit_active) -> np.ndarray:
     State's), or NotImplementedError for a slider's limit whose rate row turns."""
     a = model.arrays
     out = np.argwhere(limit_active != 0).astype(np.int64).reshape(-1, 2)
-    for j, side in out:
+    for j in out[:, 0]:
         if not _constant_rate_row(a, j):
             raise _not_covered(f"a limit reached in the step on slider {model.pin_names[j]!r}, "
                                f"whose rate row turns with its bodies")

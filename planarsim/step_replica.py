@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .kernels.codes import JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDE_BIT, JOINT_SLIDER
-from .kernels.integrate import DIVERGED_GROWTH, STALLED_RATIO
+from .kernels.integrate import DIVERGED_GROWTH, ROUNDING, STALLED_RATIO
 from .kernels.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
                            SHAKE_REGIME, VELOCITY_FLOOR)
 
@@ -232,10 +232,17 @@ def _local(q, body, point):
     """Body-frame coordinates (B, 2) of world point (B, 2) (unchanged for the world)."""
     if body < 0:
         return point
+    return _unturn(q, body, point - q[:, body, :2])
+
+
+def _unturn(q, body, vector):
+    """World direction `vector` (B, 2) in body's frame (unchanged for the world)."""
+    if body < 0:
+        return vector
     th = q[:, body, 2]
     cs, sn = np.cos(th), np.sin(th)
-    d = point - q[:, body, :2]
-    return np.stack([cs * d[:, 0] + sn * d[:, 1], -sn * d[:, 0] + cs * d[:, 1]], axis=-1)
+    return np.stack([cs * vector[:, 0] + sn * vector[:, 1],
+                     -sn * vector[:, 0] + cs * vector[:, 1]], axis=-1)
 
 
 def _rotate_by(q, body, vector):
@@ -288,7 +295,7 @@ def _pair_rows(model, cp, k, q, q0, c, J, F, r):
     r_ref, r_inc = a.shape_radius[s_ref], a.shape_radius[s_inc]
     p0, g0, n0, _ = pair_point(model, cp.pair[k], q0)
     anchor = _local(q0, inc, p0)                    # the incident core's point
-    face_n = _local(q0, ref, n0 + q0[:, ref, :2]) if ref >= 0 else n0   # R(-theta0) n0
+    face_n = _unturn(q0, ref, n0)                   # the face's normal in its body's frame
     face_g = _local(q0, ref, g0)
     ref_pt = _local(q0, ref, g0 + r_ref * n0)
     inc_pt = _local(q0, inc, p0 - r_inc * n0)
@@ -502,7 +509,7 @@ def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
                 continue
             d = abs(h * vv[b, 2])
             allow += (0.5 * d * d + d * d * d / 6.0) * lever
-            allow += PULL_ROUNDING * (1.0 + abs(qq[b, 0]) + abs(qq[b, 1]) + lever)
+            allow += ROUNDING * (1.0 + abs(qq[b, 0]) + abs(qq[b, 1]) + lever)
         return allow
 
     leaving = np.zeros(c.shape[0], bool)
@@ -540,8 +547,6 @@ def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
 NEAR_ALLOWANCE = 1e-13
 
 
-#: integrate.ROUNDING: relative rounding of a row evaluated at coordinates of size x
-PULL_ROUNDING = 16 * 2.220446049250313e-16
 
 
 def _solve(N, b):
