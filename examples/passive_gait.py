@@ -43,7 +43,7 @@ def analyse(name, slope, dt=1e-3, beta=1e-3, out=None, eps="auto", quiet=False):
         raise ValueError(f"unknown passive walker {name!r}; choose from {WALKERS}")
     walker = PassiveWalker(params, dt=dt)
     step_map = walker.step_map()
-    fp = find_fixed_point(step_map, initial_guess(name, params), tol=1e-9, eps=1e-4)
+    fp = find_fixed_point(step_map, initial_guess(name, params), tol=1e-9, eps=1e-4, exact=False)
     mult = multipliers_with_error(step_map, fp.x, eps)   # the step chosen from the map's noise
     fp.multipliers = mult.values
     walker.advance(fp.x)

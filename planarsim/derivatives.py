@@ -35,7 +35,7 @@ the engine's correction took no pass, the replay adds the projection of the star
 into the surface alone (its real part 0: the end is the engine's); for one lifted off it,
 the lifted piece's; along the surface (the states a contact keeps) both pieces agree.
 
-Covered so far: bodies held by hinges (pins) and sliders to each other and the world, free
+Covered so far: bodies held by hinges (pins), rods and sliders to each other and the world, free
 bodies' coordinates (an MJCF root's slides and hinge), with joint limits (a limit row is
 unilateral, as a contact's normal: the same two pieces at its surface; a slider's only where
 its rate row is constant); armature, dampers and the springs the step resolves on every joint whose rate row g is
@@ -48,7 +48,7 @@ alike); under gravity, constant pushes, pin torques, body forces
 and torques, forces along such slides, axial forces between two bodies and hip torques (the
 Simple Biped's legs and hip). Refused with a NotImplementedError naming the feature:
 armature, dampers or springs on a slider whose rate row turns with its bodies (its rotor adds
-velocity-product forces), rods, the limit of such a slider reached in the step, dry
+velocity-product forces), the limit of such a slider reached in the step, dry
 friction, springs too stiff for the step, a box's straight edge on hills, restitution, a step split at a time of impact, fluid drag, the other actuator kinds,
 the accurate integrators.
 """
@@ -148,8 +148,6 @@ def check_covered(model, options, h) -> None:
         raise _not_covered(f"the accurate integrator {options.integrator!r}")
     if options.refine_iters <= 0:
         raise _not_covered("no position correction (refine_iters = 0): its pins stay open")
-    if model.n_rod:
-        raise _not_covered(f"rods ({model.rod_names[0]!r}, ...)")
     if a.fluid_body.shape[0]:
         raise _not_covered("fluid drag")
     w = inverse_masses(a)
@@ -272,6 +270,36 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     to the state x = (q.ravel(), v.ravel()) and the commands u (module docstring). `sim` is
     left as it was (its state, options, audit and counters). Raises NotImplementedError for a
     model, option or step outside what is covered, naming it."""
+    return _step_derivative(sim, u, None, _keep_end)
+
+
+@dataclass(frozen=True)
+class StepTangents:
+    """The derivatives of one step along k given directions (step_tangents).
+
+    dx1 : (n_x, k) d x1 along each direction;  modes_changed, x1 : as StepJacobian's
+    """
+    dx1: np.ndarray
+    modes_changed: bool
+    x1: np.ndarray
+
+
+def step_tangents(sim, u, dx, du=None, _keep_end=False) -> StepTangents:
+    """The derivative of one step of `sim` along k directions of its start: dx (n_x, k) of the
+    state x and du (n_u, k) of the commands (default none): forward mode, one replay of
+    k + 1 rows instead of step_jacobian's n_x + n_u + 1. `sim` is left as it was (after the
+    step with _keep_end)."""
+    n_x = 6 * sim.model.n_body
+    dx = np.asarray(dx, dtype=float).reshape(n_x, -1)
+    k = dx.shape[1]
+    du = np.zeros((sim.model.n_act, k)) if du is None else np.asarray(du, dtype=float)
+    if du.shape != (sim.model.n_act, k):
+        raise ValueError(f"du must have shape ({sim.model.n_act}, {k}), got {du.shape}")
+    return _step_derivative(sim, u, (dx, du), _keep_end)
+
+
+def _step_derivative(sim, u, directions, _keep_end):
+    """step_jacobian (directions None) or step_tangents (directions (dx, du))."""
     model = sim.model
     h = float(sim.dt)
     check_covered(model, sim.options, h)
@@ -310,9 +338,10 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
         raise _not_covered(f"a step taken in {splits} time-of-impact splits")
 
     if substeps > 1:
-        return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info)
+        return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info,
+                                  directions)
     jac, plan = _replica_jacobian(sim, u, start, end_modes, end_slips, features, limit_active,
-                                  q1, v1, first_order, projections)
+                                  q1, v1, first_order, projections, directions)
     if np.abs(plan.v_lin - v_lin).max(initial=0.0) > FIT_TOL * (np.abs(v_lin).max() + 1e-300):
         raise _not_covered("a velocity solve whose joints' target the step linearized again "
                            "at its first answer (step.relinearize)")
@@ -324,7 +353,8 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     if not jac.modes_changed and (released or near or _at_mode_boundary(
             model, end_modes, impulses, limit_active, limit_impulses, q1, v1, h,
             end_enabled)):
-        jac = StepJacobian(A=jac.A, B=jac.B, modes_changed=True, x1=jac.x1)
+        jac = (StepJacobian(A=jac.A, B=jac.B, modes_changed=True, x1=jac.x1)
+               if directions is None else StepTangents(jac.dx1, True, jac.x1))
     return jac
 
 
@@ -333,7 +363,7 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
 SUBSTEPS_TOL = 1e-12
 
 
-def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info) -> StepJacobian:
+def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info, directions=None):
     """The derivative of a step the engine took in n equal sub-steps (step.turn_substeps: a
     body turning fast), each a whole step of h / n of its own: the chain rule through them,
     A = A_n ... A_1 and B = sum_k A_n ... A_(k+1) B_k, each sub-step's from step_jacobian at
@@ -345,7 +375,15 @@ def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info) -> StepJ
         sim.restore(start)
         sim._options = options._replace(dt=sim.dt / n, max_substeps=1)
         sim._new_options()
-        parts = [step_jacobian(sim, u, _keep_end=True) for _ in range(n)]
+        if directions is None:
+            parts = [step_jacobian(sim, u, _keep_end=True) for _ in range(n)]
+        else:
+            dx, du = directions
+            changed = False
+            for _ in range(n):
+                part = _step_derivative(sim, u, (dx, du), True)
+                dx, changed = part.dx1, changed or part.modes_changed
+            tangents = StepTangents(dx, changed, part.x1)
     finally:
         sim.restore(start)
         sim._options = options
@@ -353,8 +391,13 @@ def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info) -> StepJ
         sim.ws.audit[:] = audit
         sim.ws.info[:] = info
     x1 = np.concatenate([q1.ravel(), v1.ravel()])
-    if np.abs(parts[-1].x1 - x1).max() > SUBSTEPS_TOL * max(np.abs(x1).max(), 1.0):
+    last = parts[-1] if directions is None else tangents
+    if np.abs(last.x1 - x1).max() > SUBSTEPS_TOL * max(np.abs(x1).max(), 1.0):
         raise _not_covered(f"{n} sub-steps that end elsewhere than steps of h / {n}")
+    if directions is not None:
+        if keep_end:
+            sim.step(u)
+        return tangents
     A, B = parts[0].A, parts[0].B
     for part in parts[1:]:
         A, B = part.A @ A, part.A @ B + part.B
@@ -585,6 +628,8 @@ def _engine_order(model, held, limits, contacts) -> np.ndarray:
     for j in joint_of_row:
         rows_of.setdefault(int(j), []).append(index)
         index += 1
+    rod_rows = list(range(index, index + model.n_rod))
+    index += model.n_rod
     for j, _ in limits:
         rows_of.setdefault(int(j), []).append(index)
         index += 1
@@ -593,20 +638,28 @@ def _engine_order(model, held, limits, contacts) -> np.ndarray:
         width = 2 if contacts.pinned[k] else 1
         contact_rows.append((int(contacts.body[k]), list(range(index, index + width))))
         index += width
-    order, k = [], 0
-    for j in range(model.n_pin):
-        later = int(a.pin_body[j].max())
+    order, k, jp, jr = [], 0, 0, 0
+    big = model.n_body + 1
+    while jp < model.n_pin or jr < model.n_rod:
+        kp = int(a.pin_body[jp].max()) if jp < model.n_pin else big
+        kr = int(a.rod_body[jr].max()) if jr < model.n_rod else big
+        later = min(kp, kr)
         while k < len(contact_rows) and contact_rows[k][0] < later:
             order += contact_rows[k][1]
             k += 1
-        order += rows_of.get(j, [])
+        if kp <= kr:
+            order += rows_of.get(jp, [])
+            jp += 1
+        else:
+            order.append(rod_rows[jr])
+            jr += 1
     for _, rows in contact_rows[k:]:
         order += rows
     return np.array(order, dtype=np.int64)
 
 
 def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1, v1,
-                      first_order=0, projections=0) -> StepJacobian:
+                      first_order=0, projections=0, directions=None):
     """(StepJacobian, its StepPlan) of a step the engine took in one piece, ending at (q1,
     v1): the step's equations replayed (planarsim.step_replica) from the start and from the
     start moved by i COMPLEX_STEP along each coordinate and command, in one batch whose
@@ -630,7 +683,10 @@ def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1, v
     lo, hi = model.arrays.act_range.T
     turning = np.flatnonzero(np.isin(model.arrays.act_kind, list(_TURNING_ACTUATORS)))
     cols = 2 * nq + model.n_act
-    E = np.vstack([np.zeros((1, cols)), np.eye(cols)]) * (COMPLEX_STEP * 1j)
+    if directions is None:
+        E = np.vstack([np.zeros((1, cols)), np.eye(cols)]) * (COMPLEX_STEP * 1j)
+    else:
+        E = np.vstack([np.zeros((1, cols)), np.vstack(directions).T]) * (COMPLEX_STEP * 1j)
     eps = np.finfo(float).eps
     q_scale = np.abs(q1.ravel() - q0).max() + h * np.abs(v0).max()
     v_scale = np.abs(v1).max() + np.abs(v0).max()
@@ -680,5 +736,8 @@ def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1, v
                            f"{q_off:.3g}, v by {v_off:.3g} (a projection, a first-order "
                            f"target, the motion paying for a lift)")
     D = np.hstack([q_c[1:].imag, v_c[1:].imag]).T / COMPLEX_STEP      # (2 nq, cols)
+    x1 = np.concatenate([q1.ravel(), v1.ravel()])
+    if directions is not None:
+        return StepTangents(D, bool(saturated.any()), x1), plan
     return StepJacobian(A=D[:, :2 * nq], B=D[:, 2 * nq:], modes_changed=bool(saturated.any()),
-                        x1=np.concatenate([q1.ravel(), v1.ravel()])), plan
+                        x1=x1), plan

@@ -126,7 +126,7 @@ def joint_rows(model, q, held):
     c = np.zeros((B, 2 * model.n_pin), dtype=q.dtype)
     J = np.zeros((B, 2 * model.n_pin, 3 * n), dtype=q.dtype)
     hinges = np.flatnonzero(a.pin_kind == JOINT_HINGE)
-    for e, sign in ((0, -1.0), (1, 1.0)):
+    for e, sign in ((0, -1.0), (1, 1.0)) if hinges.size else ():
         # every hinge's end e at once (B, k): anchor b minus anchor a
         body = a.pin_body[hinges, e]
         world = hinges[body < 0]
@@ -143,9 +143,9 @@ def joint_rows(model, q, held):
         J[:, 2 * j + 1, 3 * b + 1] += sign
         J[:, 2 * j, 3 * b + 2] += -sign * ry
         J[:, 2 * j + 1, 3 * b + 2] += sign * rx
-    for j in range(model.n_pin):
+    for j in np.flatnonzero(a.pin_kind != JOINT_HINGE):
         kind = int(a.pin_kind[j])
-        if kind & JOINT_FREE_BIT or kind == JOINT_HINGE:
+        if kind & JOINT_FREE_BIT:
             continue
         ba, bb = int(a.pin_body[j, 0]), int(a.pin_body[j, 1])
         r = 2 * j
@@ -169,7 +169,33 @@ def joint_rows(model, q, held):
                 J[:, r + 1, 3 * ba + 2] -= 1.0
         else:
             raise ReplicaRefused(f"joint {model.pin_names[j]!r} of kind {kind}")
-    return c[:, held], J[:, held]
+    if not model.n_rod:
+        return c[:, held], J[:, held]
+    cr, Jr = rod_rows(model, q)
+    return (np.concatenate([c[:, held], cr], axis=1),
+            np.concatenate([J[:, held], Jr.astype(J.dtype)], axis=1))
+
+
+def rod_rows(model, q):
+    """(c (B, k), J (B, k, 3 n)) of the rods' rows at q (B, n, 3): kernels/rod.py's
+    |p_b - p_a| - L along the unit vector a -> b (an end on the world: its anchor there)."""
+    a = model.arrays
+    B, n = q.shape[0], q.shape[1]
+    c = np.zeros((B, model.n_rod), dtype=q.dtype)
+    J = np.zeros((B, model.n_rod, 3 * n), dtype=q.dtype)
+    for o in range(model.n_rod):
+        ends = [(int(a.rod_body[o, e]), np.asarray(a.rod_anchor[o, e], dtype=float))
+                for e in (0, 1)]
+        pa, pb = (_world(q, body, local) for body, local in ends)
+        d = pb - pa
+        length = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
+        e = d / length[:, None]
+        c[:, o] = length - a.rod_length[o]
+        for (body, _), p, sign in zip(ends, (pa, pb), (-1.0, 1.0)):
+            if body >= 0:
+                J[:, o, 3 * body:3 * body + 2] += sign * e
+                J[:, o, 3 * body + 2] += sign * _cross(p - q[:, body, :2], e)
+    return c, J
 
 
 def ground_point(cp, point):
@@ -835,3 +861,30 @@ def _energy_bound(plan, q0, v0, q1, v, v_s, f, deciding):
     else:
         k = (-a + np.sqrt(a * a + 4.0 * b * room)) / (2.0 * b)
     return v_s + k[:, None] * dv
+
+
+def project_velocities_batch(model, q, v, pinned=()):
+    """planarsim.half_step.project_velocities for a batch, complex numbers passing through:
+    velocities v (B, 3 n) made consistent with the rods, the hinge pins and the contacts in
+    `pinned` (their points at rest) at q (B, 3 n) by the mass-weighted projection
+    v - W J^T (J W J^T)^-1 J v (independent rows)."""
+    a = model.arrays
+    n = model.n_body
+    qq = q.reshape(-1, n, 3)
+    held = np.flatnonzero(np.repeat((a.pin_kind & JOINT_FREE_BIT) == 0, 2))
+    _, J = joint_rows(model, qq, held)
+    rows = [J]
+    for c in pinned:
+        b = int(a.contact_body[c])
+        arm = _turn(qq, b, np.asarray(a.contact_local[c], dtype=float))
+        P = np.zeros((qq.shape[0], 2, 3 * n), dtype=J.dtype)
+        P[:, 0, 3 * b], P[:, 1, 3 * b + 1] = 1.0, 1.0
+        P[:, 0, 3 * b + 2], P[:, 1, 3 * b + 2] = -arm[:, 1], arm[:, 0]
+        rows.append(P)
+    J = np.concatenate(rows, axis=1)
+    if J.shape[1] == 0:
+        return v.copy()
+    w = np.c_[a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia].ravel()
+    WJt = w[None, :, None] * np.swapaxes(J, 1, 2)
+    mu = _solve(J @ WJt, np.einsum("brk,bk->br", J, v))
+    return v - np.einsum("bkr,br->bk", WJt, mu)

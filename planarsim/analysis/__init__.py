@@ -11,7 +11,7 @@ from .events import IN_CONTACT, StepEvents, foot_groups, poincare_section, step_
 from .stepmap import (EPS_LADDER, FixedPoint, MultiplierWarning, Multipliers, StepMap, StepMapError,
                       central_jacobian, central_points, find_fixed_point, floquet_multipliers,
                       jacobian, map_noise, match_distance, multipliers_by_fit,
-                      multipliers_with_error, serial_evaluator, sort_multipliers)
+                      multipliers_exact, multipliers_with_error, serial_evaluator, sort_multipliers)
 from .bifurcation import Basin, Diagram, basin_of_attraction, bifurcation_diagram
 from .continuation import (Bifurcation, Branch, BranchPoint, continue_branch, newton_fixed_point,
                            period_doubling_branch, bifurcation_tests, write_csv)
@@ -24,7 +24,8 @@ __all__ = [
     "IN_CONTACT", "StepEvents", "foot_groups", "poincare_section", "step_events", "touchdowns",
     "EPS_LADDER", "FixedPoint", "MultiplierWarning", "Multipliers", "StepMap", "StepMapError",
     "central_jacobian", "central_points", "find_fixed_point", "floquet_multipliers", "jacobian",
-    "map_noise", "match_distance", "multipliers_by_fit", "multipliers_with_error",
+    "map_noise", "match_distance", "multipliers_by_fit", "multipliers_exact",
+    "multipliers_with_error",
     "serial_evaluator", "sort_multipliers",
     "Bifurcation", "Branch", "BranchPoint", "continue_branch", "newton_fixed_point",
     "period_doubling_branch", "bifurcation_tests", "write_csv", "MapPool", "compose",

@@ -40,12 +40,16 @@ class StepMap:
     advance : callable (d,) -> (d,); raises StepMapError when the walker fails
     symmetry : optional (d, d) relabelling S; the map is then x -> S advance(x)
     names : optional coordinate names (for printing)
+    derivative : optional callable (d,) -> (advance(x), d advance / dx (d, d)): the map's
+        exact Jacobian (a passive walker's: walkers.passive.map_jacobian); find_fixed_point
+        and multipliers_exact use it
     """
     advance: Callable[[np.ndarray], np.ndarray]
     dim: int
     symmetry: np.ndarray | None = None
     names: tuple = ()
     evaluations: int = 0
+    derivative: Callable | None = None
 
     def __post_init__(self):
         if self.symmetry is not None:
@@ -55,9 +59,7 @@ class StepMap:
             self.symmetry = S
 
     def __call__(self, x) -> np.ndarray:
-        x = np.asarray(x, dtype=np.float64)
-        if x.shape != (self.dim,):
-            raise ValueError(f"step map state must have shape ({self.dim},), got {x.shape}")
+        x = self._checked(x)
         self.evaluations += 1
         y = np.asarray(self.advance(x.copy()), dtype=np.float64)
         if y.shape != (self.dim,):
@@ -65,6 +67,40 @@ class StepMap:
         if not np.all(np.isfinite(y)):
             raise StepMapError(f"advance returned a non-finite state {y}")
         return y if self.symmetry is None else self.symmetry @ y
+
+    @property
+    def exact(self) -> bool:
+        """The map has an exact Jacobian (derivative)."""
+        return self.derivative is not None
+
+    def value_and_jacobian(self, x):
+        """(P(x), dP/dx (d, d)) from the exact derivative (with the relabelling S: S P and
+        S dP/dx); NotImplementedError where the map has none (multipliers_by_fit then)."""
+        if self.derivative is None:
+            raise NotImplementedError("this step map has no exact Jacobian (derivative); "
+                                      "use multipliers_by_fit or finite differences")
+        x = self._checked(x)
+        self.evaluations += 1
+        y, J = self.derivative(x.copy())
+        y, J = np.asarray(y, dtype=np.float64), np.asarray(J, dtype=np.float64)
+        if y.shape != (self.dim,) or J.shape != (self.dim, self.dim):
+            raise StepMapError(f"derivative returned shapes {y.shape}, {J.shape}, expected "
+                               f"({self.dim},), ({self.dim}, {self.dim})")
+        if not (np.all(np.isfinite(y)) and np.all(np.isfinite(J))):
+            raise StepMapError(f"derivative returned a non-finite state or Jacobian at x={x}")
+        if self.symmetry is not None:
+            return self.symmetry @ y, self.symmetry @ J
+        return y, J
+
+    def jacobian(self, x) -> np.ndarray:
+        """dP/dx (d, d) at x, exact (value_and_jacobian)."""
+        return self.value_and_jacobian(x)[1]
+
+    def _checked(self, x):
+        x = np.asarray(x, dtype=np.float64)
+        if x.shape != (self.dim,):
+            raise ValueError(f"step map state must have shape ({self.dim},), got {x.shape}")
+        return x
 
     def iterate(self, x0, n: int) -> np.ndarray:
         """(n + 1, d) orbit x0, P(x0), ..., P^n(x0) (stops early, shorter, if the walker fails)."""
@@ -181,8 +217,10 @@ def noise_tolerance(tol, noise) -> float:
 
 
 def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
-                     central: bool = True, max_halvings: int = 12) -> FixedPoint:
-    """Newton's method on F(x) = f(x) - x with a finite-difference Jacobian.
+                     central: bool = True, max_halvings: int = 12,
+                     exact: bool | None = None) -> FixedPoint:
+    """Newton's method on F(x) = f(x) - x with the map's exact Jacobian (a StepMap with a
+    derivative, unless exact=False) or a finite-difference one (step eps).
 
     Each step solves (J - I) dx = -F (least squares if singular); the step is halved while the
     new residual is not smaller or the map fails (StepMapError). Stops when |F|_inf <= tol,
@@ -190,10 +228,26 @@ def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
     AUTO_TOL, raised likewise). The returned Jacobian is evaluated at the final x.
     """
     count = [0]
+    has = isinstance(f, StepMap) and f.exact
+    if exact and not has:
+        raise ValueError("exact=True needs a StepMap with a derivative (an exact Jacobian)")
+    exact = has if exact is None else bool(exact)
+    known = {}
 
     def g(x):
         count[0] += 1
         return np.asarray(f(x), dtype=np.float64)
+
+    def jac(x, fx):
+        """dP/dx at x (fx = P(x)): the exact one (one more evaluation) or differences."""
+        if not exact:
+            return jacobian(g, x, eps, central, fx=fx)
+        key = x.tobytes()
+        if key not in known:
+            count[0] += 1
+            known.clear()
+            known[key] = f.value_and_jacobian(x)[1]
+        return known[key]
 
     x = np.asarray(x0, dtype=np.float64).copy()
     try:
@@ -207,7 +261,7 @@ def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
     it = 0
     eye = np.eye(x.size)
     while r > tol and it < max_iter:
-        J = jacobian(g, x, eps, central, fx=F + x)
+        J = jac(x, F + x)
         try:
             dx = np.linalg.solve(J - eye, -F)
         except np.linalg.LinAlgError:
@@ -228,7 +282,7 @@ def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
         x, F, r = xn, Fn, rn
         history.append(r)
         it += 1
-    J = jacobian(g, x, eps, central, fx=F + x)
+    J = jac(x, F + x)
     return FixedPoint(x=x, residual=r, converged=r <= tol, jacobian=J,
                       multipliers=sort_multipliers(np.linalg.eigvals(J)), iterations=it,
                       evaluations=count[0], history=history, noise=noise, tol=tol)
@@ -380,6 +434,15 @@ change keeps falling by more than 4x (truncation regime): the finer rung gives t
     return res
 
 
+def multipliers_exact(f: StepMap, x) -> Multipliers:
+    """Multipliers of the step map f at x (a fixed point) from its exact Jacobian
+    (StepMap.derivative): exact to rounding within the step's contact modes, so error 0 and
+    eps 0 (no difference step); one evaluation of the derivative."""
+    J = f.jacobian(x)
+    lam = sort_multipliers(np.linalg.eigvals(J))
+    return Multipliers(lam, 0.0, 0.0, float("nan"), True, J, [(0.0, lam)], 1)
+
+
 # multipliers from a polynomial fit -----------------------------------------------------------
 FIT_WINDOW = 2e-3   # [units of x] half-width of the samples along each coordinate
 FIT_POINTS = 17     # samples per coordinate (odd: x itself among them)
@@ -407,8 +470,9 @@ def multipliers_by_fit(f: Callable | None, x, window: float = FIT_WINDOW, points
     and strongly curved above ~1e-3 (central differences of the simplest walker near its period
     doubling are off by 1e-2 at eps 1e-3): the fit averages the pieces over the window and
     takes the curvature into its higher terms. The same fit over the inner half of the
-    samples (|s| <= window / 2) gives the error estimate (their multipliers' distance);
-    `noise` is the full fit's rms residual. Multipliers(eps=window, ladder=[(window, values),
+    samples (|s| <= window / 2) gives the error estimate (their multipliers' distance over
+    1 - 2^-p, for an error ~ window^p: p = degree + 1 for an odd degree); `noise` is the full
+    fit's rms residual. Multipliers(eps=window, ladder=[(window, values),
     (window / 2, inner values)]). Samples where the map fails are left out.
     """
     x = np.asarray(x, dtype=np.float64)
@@ -433,7 +497,11 @@ def multipliers_by_fit(f: Callable | None, x, window: float = FIT_WINDOW, points
                                f"around x={x} (window {window:g})")
         J[:, i], Jin[:, i], noise = col, col_in, max(noise, rms)
     lam, lam_in = sort_multipliers(np.linalg.eigvals(J)), sort_multipliers(np.linalg.eigvals(Jin))
-    err = match_distance(lam, lam_in)
+    # the full window's error from the change between the windows (Richardson): a fit's slope
+    # errs by the map's terms above its degree, an odd degree's first one s^(degree + 2)
+    # giving an error ~ window^(degree + 1) (an even degree's: window^degree)
+    order = degree + 1 if degree % 2 else degree
+    err = match_distance(lam, lam_in) / (1.0 - 0.5 ** order)
     res = Multipliers(lam, err, float(window), noise, bool(err <= tol), J,
                       [(float(window), lam), (0.5 * float(window), lam_in)], len(s) * d)
     if warn and not res.converged:

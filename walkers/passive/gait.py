@@ -21,7 +21,7 @@ from planarsim import dense
 from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.half_step import kick, project_velocities, to_instant_velocity, to_step_velocity
+from planarsim.half_step import kick, project_velocities, to_step_velocity
 from planarsim.state import State
 from planarsim.trajectory import Trajectory, make_recorder, record_state
 
@@ -41,6 +41,29 @@ def _cross(a, b):
 def _dup(theta):
     """d leg_up / d theta in slope coordinates (t, n): (-cos theta, -sin theta)."""
     return np.array([-math.cos(theta), -math.sin(theta)])
+
+
+#: positions the step map's touchdown is interpolated through: the crossing step's start and
+#: end and those after the NODES - 2 steps that follow (a polynomial of degree NODES - 1: its
+#: rate at the touchdown is exact to O(dt^(NODES - 1)))
+NODES = 6
+
+
+def lagrange_weights(phi, nodes: int = NODES):
+    """(w (nodes,), dw (nodes,)) of the polynomial through values at 0, 1, ..., nodes - 1
+    (Lagrange), at phi and its derivative in phi; polynomial in phi, so complex numbers pass
+    through."""
+    from functools import reduce
+    from operator import mul
+    at = np.arange(float(nodes))
+    w, dw = [], []
+    for k in range(nodes):
+        others = np.delete(at, k)
+        den = np.prod(at[k] - others)
+        f = [phi - b for b in others]
+        w.append(reduce(mul, f) / den)
+        dw.append(sum(reduce(mul, f[:i] + f[i + 1:]) for i in range(len(f))) / den)
+    return np.array(w), np.array(dw)
 
 
 class PassiveWalker:
@@ -209,9 +232,9 @@ class PassiveWalker:
                                self.hip, self.fall_height, rec, int(record_every), int(k0),
                                self.event_time, self.event_contact)
 
-    def refine_touchdown(self, old: int, instant: bool = False) -> float:
+    def refine_touchdown(self, old: int) -> float:
         """Move the state from the end of a DETECT rollout to the touchdown instant itself and
-        resolve the impact there.
+        resolve the impact there (a walker's run: the engine's velocities as they are).
 
         The rollout stopped after the step in which a foot (contact disabled) crossed the
         ground. This restores the start of that step, finds by root finding the sub-step
@@ -219,63 +242,96 @@ class PassiveWalker:
         velocities onto the constraints there (project_velocities), then enables and pins the
         foot and takes a step of IMPACT_DT, in which the engine resolves the
         impact and (with the "all" strategy) releases the old stance foot `old`.
-        instant: the start of that step has its velocity over the step before (the engine's
-        own); it is first made the velocity at that instant (planarsim.half_step) and the
-        sub-step is a velocity-Verlet one (half kick back, the engine's step of tau, half
-        kick forward and projection), so that the state at the touchdown is second order in
-        dt and smooth in the start state (a symplectic Euler sub-step puts a sawtooth of
-        tau^2 a / 2 into the map, whose slope is first order in dt). The step map starts from
-        to_step_velocity; a walker's run takes the engine's velocities as they are.
         Returns tau [s]."""
         from scipy.optimize import brentq
 
         sim, s, ws = self.sim, self.sim.state, self.sim.ws
         m = self.model.arrays
-        new = int(self.memory[0])
-        c = int(self.feet[new])
+        c = int(self.feet[int(self.memory[0])])
+        pinned = [int(self.feet[old])]
         prev = State(*(a.copy() for a in ws.prev))
         # velocities consistent with the start configuration, so that a sub-step shorter
         # than dt does not read the O(dt) mismatch as the stance foot leaving the ground
-        if instant:
-            to_instant_velocity(self.model, prev, ws, m.dt, self.u0, [int(self.feet[old])])
-        else:
-            prev.v[...] = project_velocities(self.model, prev.q, prev.v, [int(self.feet[old])])
-
-        pinned = [int(self.feet[old])]
+        prev.v[...] = self.project(prev.q, prev.v, pinned)
 
         def sub_step(tau):
             s.restore(prev)
             if tau > 0.0:
-                if instant:
-                    to_step_velocity(self.model, s, ws, tau, self.u0)
                 check_run(step_from_python(m, s, ws, sim.options._replace(dt=tau), self.u0),
                           self.model, ws, sim.options, self.kind)
             p = self.foot_point(c)[0]
             return gap_of_point(m.terrain_coef, p[0], p[1])
 
-        h = m.dt
         tau = 0.0
         if sub_step(0.0) > 0.0:
-            tau = brentq(sub_step, 0.0, h, xtol=1e-16, rtol=1e-15, maxiter=200)
+            tau = brentq(sub_step, 0.0, m.dt, xtol=1e-16, rtol=1e-15, maxiter=200)
         sub_step(tau)
-        if instant and tau > 0.0:
-            to_instant_velocity(self.model, s, ws, tau, self.u0, pinned)
-        else:
-            s.v[...] = project_velocities(self.model, s.q, s.v, pinned)
-        s.contact_enabled[c] = 1
-        s.contact_mode[c] = 1
-        touch = s.q.copy()
-        check_run(step_from_python(m, s, ws, sim.options._replace(dt=IMPACT_DT), self.u0),
-                  self.model, ws, sim.options, self.kind)
-        if instant:
-            # the impact's velocity change at the touchdown itself: the configuration before
-            # the step of IMPACT_DT, less that step's kick of the applied forces (else the
-            # section state is that of IMPACT_DT later: theta off by theta_dot IMPACT_DT)
-            s.q[...] = touch
-            kick(m, s, ws, self.u0, -IMPACT_DT, IMPACT_DT)
-            s.v[...] = project_velocities(self.model, s.q, s.v, [c])
+        s.v[...] = self.project(s.q, s.v, pinned)
+        self.impact(c)
         s.time[0] = prev.time[0] + tau
         return tau
+
+    def impact(self, c: int) -> None:
+        """Enable and pin contact c (at the state's touchdown) and take a step of IMPACT_DT, in
+        which the engine resolves the impact and (with the "all" strategy) releases the old
+        stance foot."""
+        s, ws, sim = self.sim.state, self.sim.ws, self.sim
+        s.contact_enabled[c] = 1
+        s.contact_mode[c] = 1
+        check_run(step_from_python(self.model.arrays, s, ws, sim.options._replace(dt=IMPACT_DT),
+                                   self.u0), self.model, ws, sim.options, self.kind)
+
+    def impact_at_instant(self, c: int) -> None:
+        """impact, read at the touchdown itself: the configuration before the step of
+        IMPACT_DT, the velocity less that step's kick of the applied forces (else the section
+        state is that of IMPACT_DT later: theta off by theta_dot IMPACT_DT), projected onto
+        the constraints with c held."""
+        s = self.sim.state
+        touch = s.q.copy()
+        self.impact(c)
+        s.q[...] = touch
+        kick(self.model.arrays, s, self.sim.ws, self.u0, -IMPACT_DT, IMPACT_DT)
+        s.v[...] = self.project(s.q, s.v, [c])
+
+    def locate_touchdown(self, old: int, extra: np.ndarray) -> float:
+        """The step map's touchdown: from the end of a DETECT rollout (the step in which a
+        foot crossed the ground) and `extra` (NODES - 2, n, 3), the positions after the
+        steps that follow it, the touchdown instant is located on the polynomial through the
+        NODES positions (the crossing step's start and end and those), at phase phi in
+        [0, 1] of the crossing step where the foot's point is on the ground (root finding);
+        the state there is the polynomial's positions and its rate (projected onto the
+        constraints with the old stance foot held), and the impact is resolved at that
+        instant (impact_at_instant). Positions alone: the engine's positions are smooth in
+        time step to step, to its order, where a velocity mixed in (a sub-step of the
+        engine, or a Hermite cubic) carries an error of another order that depends on phi
+        and puts a sawtooth of first order in dt into the map's slope; the interpolation's
+        own, O(dt^(NODES - 1)) in the rate, puts one of O(dt^(NODES - 2)). Returns phi."""
+
+        s, ws = self.sim.state, self.sim.ws
+        c = int(self.feet[int(self.memory[0])])
+        t0 = float(ws.prev.time[0])
+        nodes = np.concatenate([ws.prev.q[None], s.q[None], extra])
+        phi = self.touchdown_phase(nodes, c)
+        weights, rates = lagrange_weights(phi)
+        q = np.tensordot(weights, nodes, axes=1)
+        v = np.tensordot(rates, nodes, axes=1) / self.dt
+        s.q[...] = q
+        s.v[...] = self.project(q, v, [int(self.feet[old])])
+        self.impact_at_instant(c)
+        s.time[0] = t0 + phi * self.dt
+        return phi
+
+    def fell(self) -> bool:
+        """The watched body (hip, hub) came within fall_height [m] of the ground (the
+        rollout's test)."""
+        q = self.sim.state.q
+        return gap_of_point(self.model.arrays.terrain_coef, q[self.hip, 0], q[self.hip, 1]) \
+            < self.fall_height
+
+    def project(self, q, v, pinned) -> np.ndarray:
+        """Velocities v (n, 3) projected onto the constraints at q with contacts `pinned` held
+        (planarsim.half_step.project_velocities)."""
+        return project_velocities(self.model, q, v, pinned)
 
     def advance(self, x, record_every: int = 0) -> np.ndarray:
         """The step-to-step map: coordinates just after the next touchdown (StepMapError if
@@ -298,7 +354,7 @@ class PassiveWalker:
             raise StepMapError(f"{self.kind}: the walker fell from x={x}")
         if code == NO_EVENT:
             raise StepMapError(f"{self.kind}: no touchdown within 20 s from x={x}")
-        self.refine_touchdown(old, instant=True)
+        self.locate_touchdown(old, self.steps_after())
         self.last_release_ok = bool(self.sim.state.contact_mode[self.feet[old]] == 0)
         self.sim.state.contact_enabled[self.feet[old]] = 0
         self.last_period = float(self.sim.state.time[0])
@@ -306,5 +362,45 @@ class PassiveWalker:
         self.last_length = float(dense.dot(end - start, self.t_hat))
         return self.coords()
 
+    def touchdown_phase(self, nodes, c: int) -> float:
+        """The phase phi in [0, 1] of the crossing step at which contact c's point is on the
+        ground, on the polynomial through the positions `nodes` (NODES, n, 3) (root
+        finding; 0 where the foot starts the step on or below the ground)."""
+        from scipy.optimize import brentq
+        coef = self.model.arrays.terrain_coef
+
+        def gap(phi):
+            q = np.tensordot(lagrange_weights(phi)[0], nodes, axes=1)
+            p = self.foot_point(c, q)[0]
+            return gap_of_point(coef, p[0], p[1])
+
+        if gap(0.0) <= 0.0:
+            return 0.0
+        return brentq(gap, 0.0, 1.0, xtol=1e-16, rtol=1e-15, maxiter=200)
+
+    def steps_after(self) -> np.ndarray:
+        """(NODES - 2, n, 3) the positions after that many more steps from the current state
+        (the state and the workspace's start of step restored): locate_touchdown's last
+        nodes."""
+        sim = self.sim
+        start, prev = sim.snapshot(), State(*(a.copy() for a in sim.ws.prev))
+        out = np.empty((NODES - 2,) + sim.state.q.shape)
+        try:
+            for k in range(NODES - 2):
+                check_run(step_from_python(self.model.arrays, sim.state, sim.ws, sim.options,
+                                           self.u0), self.model, sim.ws, sim.options, self.kind)
+                out[k] = sim.state.q
+        finally:
+            sim.state.restore(start)
+            sim.ws.prev.restore(prev)
+        return out
+
     def step_map(self) -> StepMap:
-        return StepMap(self.advance, dim=len(self.names), names=self.names)
+        """The step-to-step map (advance) with its exact Jacobian (map_jacobian)."""
+        return StepMap(self.advance, dim=len(self.names), names=self.names,
+                       derivative=self.advance_with_jacobian)
+
+    def advance_with_jacobian(self, x):
+        """(advance(x), its exact Jacobian (d, d)): walkers.passive.map_jacobian."""
+        from .map_jacobian import map_jacobian
+        return map_jacobian(self, x)

@@ -140,15 +140,16 @@ def _compass_consts(p):
             p.leg_length - p.com_from_foot, p.leg_mass * r * r, p.gravity, p.slope)
 
 
-def compass_rhs(t, y, c):
-    """Swing-phase ODE: y = (th1, th2, th1' , th2') [rad, rad/s] -> y' (c: _compass_consts)."""
+def compass_rhs(t, y, c, lib=math):
+    """Swing-phase ODE: y = (th1, th2, th1' , th2') [rad, rad/s] -> y' (c: _compass_consts;
+    lib: the module of sin and cos, cmath for a complex step)."""
     mH, m, l, a, b, I, g, gam = c
     th1, th2, w1, w2 = y
     D = th1 - th2
-    cD, sD = math.cos(D), math.sin(D)
+    cD, sD = lib.cos(D), lib.sin(D)
     M11, M12, M22 = m * a * a + (mH + m) * l * l + I, -m * l * b * cD, m * b * b + I
-    r1 = m * l * b * sD * w2 * w2 + (m * a + (mH + m) * l) * g * math.sin(th1 - gam)
-    r2 = -m * l * b * sD * w1 * w1 - m * b * g * math.sin(th2 - gam)
+    r1 = m * l * b * sD * w2 * w2 + (m * a + (mH + m) * l) * g * lib.sin(th1 - gam)
+    r2 = -m * l * b * sD * w1 * w1 - m * b * g * lib.sin(th2 - gam)
     det = M11 * M22 - M12 * M12
     return [w1, w2, (M22 * r1 - M12 * r2) / det, (M11 * r2 - M12 * r1) / det]
 
@@ -256,6 +257,61 @@ def compass_step(x, p, rtol=1e-12, atol=1e-13, t_max=10.0, consts=None):
         segs.append((past.t[-1], past.sol))
         t0, y0 = float(past.t[-1]), past.y[:, -1]
     raise RuntimeError(f"compass gait: no heel strike within {t_max} s from x={x}")
+
+
+def _rhs_jacobian(y, c):
+    """d compass_rhs / dy (4, 4) at y, by the complex step (exact to rounding)."""
+    import cmath
+    J = np.empty((4, 4))
+    for k in range(4):
+        yk = np.asarray(y, dtype=complex).copy()
+        yk[k] += 1e-20j
+        J[:, k] = np.array(compass_rhs(0.0, yk, c, cmath)).imag / 1e-20
+    return J
+
+
+def compass_step_jacobian(x, p=None, rtol=1e-12, atol=1e-13, consts=None):
+    """(next x, d next x / dx (4, 4)) of compass_step from the variational equations: the
+    swing phase's state transition matrix Phi' = (df/dy) Phi integrated with the state up to
+    the heel strike time te (DOP853 at rtol), the event-time term (I - f g^T / (g . f)) at the
+    strike (g the gradient of the swing foot's height cos th1 - cos th2, f the flow there:
+    the saltation of a moving event time), then the impact map's derivative (Richardson's
+    extrapolation of centred differences, 1e-5 and 5e-6: error ~1e-11)."""
+    from scipy.integrate import solve_ivp
+    c = _compass_consts(p) if consts is None else consts
+    xn, te, _, _ = compass_step(x, p, rtol, atol, consts=c)
+
+    def augmented(t, z):
+        y, Phi = z[:4], z[4:].reshape(4, 4)
+        return np.concatenate([compass_rhs(t, y, c), (_rhs_jacobian(y, c) @ Phi).ravel()])
+    T_from = np.array([[1.0, 0, 0, 0], [1.0, 0, -1.0, 0], [0, 1.0, 0, 0], [0, 1.0, 0, -1.0]])
+    T_to = np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [1.0, -1.0, 0, 0], [0, 0, 1.0, -1.0]])
+    z0 = np.concatenate([_from_section(x), np.eye(4).ravel()])
+    sol = solve_ivp(augmented, (0.0, te), z0, rtol=rtol, atol=atol, method="DOP853")
+    ye, Phi = sol.y[:4, -1], sol.y[4:, -1].reshape(4, 4)
+    f = np.asarray(compass_rhs(te, ye, c))
+    g = np.array([-math.sin(ye[0]), math.sin(ye[1]), 0.0, 0.0])
+    event = np.eye(4) - np.outer(f, g) / (g @ f)
+
+    def impact(e):
+        D = np.empty((4, 4))
+        for k in range(4):
+            d = np.zeros(4)
+            d[k] = e
+            D[:, k] = (compass_heel_strike(ye + d, c) - compass_heel_strike(ye - d, c)) / (2 * e)
+        return D
+    H = (4.0 * impact(5e-6) - impact(1e-5)) / 3.0
+    return xn, T_to @ H @ event @ Phi @ T_from
+
+
+def simplest_feet_step_jacobian(x, p, rtol=1e-12, atol=1e-13):
+    """(next x, d next x / dx) of simplest_feet_step (compass_step_jacobian's variational
+    equations; rates in units of sqrt(g / l))."""
+    k = math.sqrt(p.gravity / p.leg_length)
+    S = np.diag([1.0, k, 1.0, k])
+    xn, J = compass_step_jacobian(np.asarray(x, float) * np.diag(S), None, rtol, atol,
+                                  consts=simplest_feet_consts(p))
+    return xn / np.diag(S), np.linalg.solve(S, J @ S)
 
 
 def _as_map(step):
