@@ -42,7 +42,7 @@ def speedup():
     fam = WalkerFamily("simplest-walker", "slope", dt=1e-3)
     times = {}
     for workers in (1, 2):
-        with MapPool(fam, workers=workers) as pool:
+        with MapPool(fam, workers=workers, exact=False) as pool:
             pool.evaluate(fam.guess(0.009)[None, :], 0.009)   # numba cache loaded
             t0 = time.perf_counter()
             br = continue_branch(pool, fam.guess(0.009), 0.009, 0.0145, points=8, param="slope")
@@ -54,7 +54,7 @@ def speedup():
     X = np.concatenate([central_points(fam.guess(0.009), h) for h in 1e-4 * 0.5 ** np.arange(16)])
     raw = {}
     for workers in (1, 2):
-        with MapPool(fam, workers=workers) as pool:
+        with MapPool(fam, workers=workers, exact=False) as pool:
             pool.evaluate(X[:3], 0.009)
             t0 = time.perf_counter()
             pool.evaluate(X, 0.009)
@@ -122,7 +122,7 @@ def doubling():
     for dt in DTS:
         t0 = time.perf_counter()
         fam = WalkerFamily("simplest-walker", "slope", dt=dt, base=SimplestParams(foot_mass_ratio=BETA))
-        with MapPool(fam) as pool:
+        with MapPool(fam, exact=False) as pool:
             br = continue_branch(pool, x0, 0.0146, 0.0154, points=3, param="slope", p_tol=1e-8)
             pd = br.first("period-doubling")
             b2 = period_doubling_branch(pool, pd, 0.0180, points=5, param="slope", p_tol=1e-8)
@@ -151,7 +151,7 @@ def acceptance():
         a, b, points = (0.0138, 0.0182, 5) if follow else (0.0138, 0.0156, 4)
         fam = WalkerFamily("simplest-walker", "slope", dt=dt)
         t0 = time.perf_counter()
-        with MapPool(fam) as pool:
+        with MapPool(fam, exact=False) as pool:
             br = continue_branch(pool, fam.guess(a), a, b, points, param="slope")
             pd = br.first("period-doubling")
             p24 = math.nan

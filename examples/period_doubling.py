@@ -31,13 +31,15 @@ def main(argv=None):
     ap.add_argument("--transient", type=int, default=150, help="diagram: steps dropped")
     ap.add_argument("--keep", type=int, default=32, help="diagram: section values kept")
     ap.add_argument("--out", default="out/period_doubling", help="folder for figures and CSV")
+    ap.add_argument("--exact", action="store_true",
+                    help="multipliers from the step map's exact Jacobian instead of fits (slower)")
     a = ap.parse_args(argv)
     lo, hi = (float(v) for v in a.range.split(":"))
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     fam = WalkerFamily("simplest-walker", "slope", dt=a.dt, base=SimplestParams(foot_mass_ratio=a.beta))
     t0 = time.perf_counter()
-    with MapPool(fam) as pool:
+    with MapPool(fam, exact=a.exact) as pool:
         branches = [continue_branch(pool, fam.guess(lo), lo, hi, a.points, param="slope")]
         while branches[-1].first("period-doubling") is not None and branches[-1].period < 4:
             pd = branches[-1].first("period-doubling")

@@ -430,7 +430,7 @@ def cmd_analyze(args):
     progress = None if args.quiet else (lambda done, total: bar(min(done, bar.total)))
     x0 = family.guess(a)
     t0 = time.perf_counter()
-    with MapPool(family, workers=args.workers) as pool:
+    with MapPool(family, workers=args.workers, exact=bool(args.exact)) as pool:
         if args.diagram:
             d = bifurcation_diagram(pool, np.linspace(a, b, args.points), x0, args.transient,
                                     args.keep, param=args.param, progress=progress)
@@ -554,6 +554,9 @@ def make_parser():
                    help="do not follow the period-2 orbit after a period doubling")
     p.add_argument("--dt", type=_positive, default=None, help="step size [s] (default 1e-3)")
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    p.add_argument("--exact", action="store_true",
+                   help="multipliers from the step map's exact Jacobian (slower: seconds a "
+                        "point) instead of polynomial fits")
     p.add_argument("--csv", default=None, help="results .csv")
     p.add_argument("--plot", default=None,
                    help="plot .png | .svg | .pdf (a name ending in _multipliers: the multipliers)")

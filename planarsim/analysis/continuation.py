@@ -33,8 +33,9 @@ import numpy as np
 
 from ..trajectory import atomic_write
 from .parallel import MapPool
-from .stepmap import (FIT_POINTS, FIT_WINDOW, StepMapError, central_jacobian, central_points,
-                      map_noise, multipliers_by_fit, noise_tolerance)
+from .stepmap import (FIT_POINTS, FIT_WINDOW, Multipliers, StepMapError, central_jacobian,
+                      central_points, map_noise, multipliers_by_fit, noise_tolerance,
+                      sort_multipliers)
 
 KINDS = ("period-doubling", "fold", "neimark-sacker")
 
@@ -189,8 +190,13 @@ def newton_fixed_point(pool: MapPool, p, x0, period=1, tol="auto", max_iter=20, 
 
 
 def _multipliers(pool, p, x, period, mult_tol, points=FIT_POINTS):
-    """multipliers_by_fit of P^period at x: the window FIT_WINDOW / period, then half of it
-    if the error exceeds mult_tol; the estimate with the smaller error."""
+    """The multipliers of P^period at x: from its exact Jacobian where the pool takes it
+    (MapPool.exact: error 0), else multipliers_by_fit: the window FIT_WINDOW / period, then
+    half of it if the error exceeds mult_tol; the estimate with the smaller error."""
+    if pool.exact(p):
+        J = pool.jacobian(p, x, period)[1]
+        lam = sort_multipliers(np.linalg.eigvals(J))
+        return Multipliers(lam, 0.0, 0.0, float("nan"), True, J, [(0.0, lam)], period)
     best = None
     for window in (FIT_WINDOW / period, 0.5 * FIT_WINDOW / period):
         m = multipliers_by_fit(None, x, window, points, tol=mult_tol,

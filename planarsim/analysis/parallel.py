@@ -55,6 +55,22 @@ def compose(f, x, period: int):
     return x
 
 
+def jacobian_task(maps: _Maps, item):
+    """(P^period(x), its exact Jacobian (d, d)) at item = (p, x, period), the chain rule
+    through the steps (StepMap.value_and_jacobian), or None where the walker fails."""
+    from .stepmap import StepMapError
+    p, x, period = item
+    f = maps.get(p)
+    y, J = np.asarray(x, dtype=np.float64), np.eye(len(x))
+    try:
+        for _ in range(int(period)):
+            y, Jk = f.value_and_jacobian(y)
+            J = Jk @ J
+    except StepMapError:
+        return None
+    return y, J
+
+
 def evaluate_task(maps: _Maps, item):
     """Worker task: item (p, x, period) -> (P^period(x; p) or None when the walker fails)."""
     p, x, period = item
@@ -106,11 +122,14 @@ class MapPool:
         walker fails; a StepMap, or a walker's ``step_map()``). Called in each worker.
     backend : "process" (default), "thread" or "serial" (see the module docstring).
     cache : maps kept per worker (one per parameter value).
+    exact : the continuation's multipliers from the maps' exact Jacobians (StepMap.derivative)
+        where they have them (None, the default), always (True: an error where one has none)
+        or never (False: polynomial fits).
     Use as a context manager (or call close()).
     """
 
     def __init__(self, family: Callable, workers: int | None = None, backend: str = "process",
-                 cache: int = 8):
+                 cache: int = 8, exact: bool | None = None):
         if backend not in BACKENDS:
             raise ValueError(f"backend={backend!r} must be one of {BACKENDS}")
         self.family, self.cache = family, int(cache)
@@ -123,6 +142,7 @@ class MapPool:
         self._local = _Maps(family, cache)    # the caller's own maps (first task, serial)
         self._pool = None
         self.evaluations = 0
+        self.use_exact = exact
 
     # pools --------------------------------------------------------------------------------
     def _ensure(self):
@@ -212,6 +232,26 @@ class MapPool:
             if r is not None:
                 Y[i] = r
         return Y, ok
+
+    def exact(self, p) -> bool:
+        """Whether the multipliers at p come from the map's exact Jacobian (the pool's
+        `exact` and the map's StepMap.derivative)."""
+        if self.use_exact is False:
+            return False
+        has = bool(getattr(self._local.get(p), "exact", False))
+        if self.use_exact and not has:
+            raise ValueError(f"MapPool(exact=True): the map at p={p} has no exact Jacobian")
+        return has
+
+    def jacobian(self, p, x, period: int = 1):
+        """(P^period(x; p), its exact Jacobian), on a worker; StepMapError where the walker
+        fails."""
+        from .stepmap import StepMapError
+        r = self.run(jacobian_task, [(float(p), np.asarray(x, dtype=np.float64), int(period))])[0]
+        self.evaluations += int(period)
+        if r is None:
+            raise StepMapError(f"the step map fails at p={p}, x={x}")
+        return r
 
     def evaluator(self, p, period: int = 1):
         """evaluate(X) -> (Y, ok) at parameter p (for multipliers_with_error)."""

@@ -57,6 +57,38 @@ def test_logistic_period_doublings_located_and_followed():
         assert rows[0]["period"] == 2 and "mult0_re" in rows[0]
 
 
+def exact_logistic(r):
+    """The logistic map as a StepMap with its exact Jacobian."""
+    from planarsim.analysis import StepMap
+    f = logistic(r)
+    return StepMap(f, dim=1, derivative=lambda x: (f(x), np.array([[r * (1.0 - 2.0 * x[0])]])))
+
+
+def test_the_continuation_takes_the_maps_exact_jacobian():
+    """With a map that has its exact Jacobian (the default: where it has one) the multipliers
+    are exact (error 0) and the doublings at r = 3 and 1 + sqrt(6) are located as with the
+    fits, tighter; exact=True on a map without one is an error, exact=False takes the fits."""
+    with MapPool(exact_logistic, backend="serial") as pool:
+        assert pool.exact(3.0)
+        br = continue_branch(pool, [0.6], 2.65, 3.35, points=8, param="r", tol=1e-12,
+                             p_tol=1e-10)
+        for b in br.points:
+            assert b.error == 0.0 and abs(b.multipliers[0] - (2 - b.p)) < 1e-10
+        pd = br.first("period-doubling")
+        assert pd is not None and abs(pd.p - 3.0) < 1e-8
+        br2 = period_doubling_branch(pool, pd, 3.5, points=8, param="r", tol=1e-12,
+                                     p_tol=1e-10)
+        pd2 = br2.first("period-doubling")
+        assert pd2 is not None and abs(pd2.p - (1 + math.sqrt(6))) < 1e-8
+    with MapPool(exact_logistic, backend="serial", exact=False) as pool:
+        assert not pool.exact(3.0)
+        b = continue_branch(pool, [0.6], 2.65, 2.9, points=3, param="r", tol=1e-12).points[0]
+        assert b.error > 0.0
+    with MapPool(logistic, backend="serial", exact=True) as pool, \
+            pytest.raises(ValueError, match="no exact Jacobian"):
+        pool.exact(3.0)
+
+
 def test_fold_found_by_arclength_which_turns_back():
     # fixed points x = +-sqrt(p) for p > 0; multiplier 1 - 2x: the stable upper branch meets
     # the unstable lower one at the fold p = 0
