@@ -21,7 +21,7 @@ from planarsim import dense
 from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.half_step import kick, project_velocities, to_step_velocity
+from planarsim.half_step import kick, project_velocities, to_instant_velocity, to_step_velocity
 from planarsim.state import State
 from planarsim.trajectory import Trajectory, make_recorder, record_state
 
@@ -43,9 +43,8 @@ def _dup(theta):
     return np.array([-math.cos(theta), -math.sin(theta)])
 
 
-#: positions the step map's touchdown is interpolated through: the crossing step's start and
-#: end and those after the NODES - 2 steps that follow (a polynomial of degree NODES - 1: its
-#: rate at the touchdown is exact to O(dt^(NODES - 1)))
+#: step states the step map's touchdown is interpolated through: the crossing step's start and
+#: end and those after the NODES - 2 steps that follow (polynomials of degree NODES - 1)
 NODES = 6
 
 
@@ -293,33 +292,76 @@ class PassiveWalker:
         kick(self.model.arrays, s, self.sim.ws, self.u0, -IMPACT_DT, IMPACT_DT)
         s.v[...] = self.project(s.q, s.v, [c])
 
-    def locate_touchdown(self, old: int, extra: np.ndarray) -> float:
+    def locate_touchdown(self, old: int, extra) -> float:
         """The step map's touchdown: from the end of a DETECT rollout (the step in which a
-        foot crossed the ground) and `extra` (NODES - 2, n, 3), the positions after the
-        steps that follow it, the touchdown instant is located on the polynomial through the
-        NODES positions (the crossing step's start and end and those), at phase phi in
-        [0, 1] of the crossing step where the foot's point is on the ground (root finding);
-        the state there is the polynomial's positions and its rate (projected onto the
-        constraints with the old stance foot held), and the impact is resolved at that
-        instant (impact_at_instant). Positions alone: the engine's positions are smooth in
-        time step to step, to its order, where a velocity mixed in (a sub-step of the
-        engine, or a Hermite cubic) carries an error of another order that depends on phi
-        and puts a sawtooth of first order in dt into the map's slope; the interpolation's
-        own, O(dt^(NODES - 1)) in the rate, puts one of O(dt^(NODES - 2)). Returns phi."""
-
+        foot crossed the ground) and `extra` (steps_after: the positions and velocities after
+        the NODES - 2 steps that follow it), the touchdown instant is located on the
+        polynomials through the NODES step states (the crossing step's start and end and
+        those), at phase phi in [0, 1] of the crossing step where the foot's point is on the
+        ground (root finding on the positions' polynomial). The state there: the positions'
+        polynomial, and the velocities' through each node's velocity at its instant
+        (half_step.to_instant_velocity: the step's velocity plus half a kick, projected onto
+        the constraints with the old stance foot held), projected again where they are read;
+        the impact is resolved at that instant (impact_at_instant). Each sequence alone is
+        smooth in time from step to step (its error a smooth function of the time), so the
+        map is smooth in x; a velocity mixed into the positions' interpolation (a sub-step of
+        the engine, a Hermite cubic) carries an error of another order that depends on phi
+        and puts a sawtooth of first order in dt into the map's slope. The interpolation's
+        own error is O(dt^NODES) in the positions and O(dt^(NODES - 1)) in the rates, the
+        sawtooth it leaves O(dt^(NODES - 2)). Returns phi."""
         s, ws = self.sim.state, self.sim.ws
         c = int(self.feet[int(self.memory[0])])
+        pinned = [int(self.feet[old])]
         t0 = float(ws.prev.time[0])
-        nodes = np.concatenate([ws.prev.q[None], s.q[None], extra])
+        nodes = np.concatenate([ws.prev.q[None], s.q[None], extra[0]])
+        rates = np.concatenate([ws.prev.v[None], s.v[None], extra[1]])
+        node = s.copy()
+        for k in range(NODES):
+            node.q[...], node.v[...] = nodes[k], rates[k]
+            to_instant_velocity(self.model, node, ws, self.dt, self.u0, pinned)
+            rates[k] = node.v
         phi = self.touchdown_phase(nodes, c)
-        weights, rates = lagrange_weights(phi)
+        weights = lagrange_weights(phi)[0]
         q = np.tensordot(weights, nodes, axes=1)
-        v = np.tensordot(rates, nodes, axes=1) / self.dt
         s.q[...] = q
-        s.v[...] = self.project(q, v, [int(self.feet[old])])
+        s.v[...] = self.project(q, np.tensordot(weights, rates, axes=1), pinned)
         self.impact_at_instant(c)
         s.time[0] = t0 + phi * self.dt
         return phi
+
+    def touchdown_phase(self, nodes, c: int) -> float:
+        """The phase phi in [0, 1] of the crossing step at which contact c's point is on the
+        ground, on the polynomial through the positions `nodes` (NODES, n, 3) (root
+        finding; 0 where the foot starts the step on or below the ground)."""
+        from scipy.optimize import brentq
+        coef = self.model.arrays.terrain_coef
+
+        def gap(phi):
+            q = np.tensordot(lagrange_weights(phi)[0], nodes, axes=1)
+            p = self.foot_point(c, q)[0]
+            return gap_of_point(coef, p[0], p[1])
+
+        if gap(0.0) <= 0.0:
+            return 0.0
+        return brentq(gap, 0.0, 1.0, xtol=1e-16, rtol=1e-15, maxiter=200)
+
+    def steps_after(self):
+        """(positions, velocities), each (NODES - 2, n, 3), after that many more steps from
+        the current state (the state and the workspace's start of step restored):
+        locate_touchdown's last nodes."""
+        sim = self.sim
+        start, prev = sim.snapshot(), State(*(a.copy() for a in sim.ws.prev))
+        q = np.empty((NODES - 2,) + sim.state.q.shape)
+        v = np.empty_like(q)
+        try:
+            for k in range(NODES - 2):
+                check_run(step_from_python(self.model.arrays, sim.state, sim.ws, sim.options,
+                                           self.u0), self.model, sim.ws, sim.options, self.kind)
+                q[k], v[k] = sim.state.q, sim.state.v
+        finally:
+            sim.state.restore(start)
+            sim.ws.prev.restore(prev)
+        return q, v
 
     def fell(self) -> bool:
         """The watched body (hip, hub) came within fall_height [m] of the ground (the
@@ -361,39 +403,6 @@ class PassiveWalker:
         end = self.foot_point(self.feet[self.memory[0]])[0]
         self.last_length = float(dense.dot(end - start, self.t_hat))
         return self.coords()
-
-    def touchdown_phase(self, nodes, c: int) -> float:
-        """The phase phi in [0, 1] of the crossing step at which contact c's point is on the
-        ground, on the polynomial through the positions `nodes` (NODES, n, 3) (root
-        finding; 0 where the foot starts the step on or below the ground)."""
-        from scipy.optimize import brentq
-        coef = self.model.arrays.terrain_coef
-
-        def gap(phi):
-            q = np.tensordot(lagrange_weights(phi)[0], nodes, axes=1)
-            p = self.foot_point(c, q)[0]
-            return gap_of_point(coef, p[0], p[1])
-
-        if gap(0.0) <= 0.0:
-            return 0.0
-        return brentq(gap, 0.0, 1.0, xtol=1e-16, rtol=1e-15, maxiter=200)
-
-    def steps_after(self) -> np.ndarray:
-        """(NODES - 2, n, 3) the positions after that many more steps from the current state
-        (the state and the workspace's start of step restored): locate_touchdown's last
-        nodes."""
-        sim = self.sim
-        start, prev = sim.snapshot(), State(*(a.copy() for a in sim.ws.prev))
-        out = np.empty((NODES - 2,) + sim.state.q.shape)
-        try:
-            for k in range(NODES - 2):
-                check_run(step_from_python(self.model.arrays, sim.state, sim.ws, sim.options,
-                                           self.u0), self.model, sim.ws, sim.options, self.kind)
-                out[k] = sim.state.q
-        finally:
-            sim.state.restore(start)
-            sim.ws.prev.restore(prev)
-        return out
 
     def step_map(self) -> StepMap:
         """The step-to-step map (advance) with its exact Jacobian (map_jacobian)."""

@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from planarsim.derivatives import COMPLEX_STEP, step_tangents
-from planarsim.half_step import kick, to_step_velocity
+from planarsim.half_step import kick, to_instant_velocity, to_step_velocity
 from planarsim.state import State
 from planarsim.step_replica import project_velocities_batch
 
@@ -185,28 +185,39 @@ def map_jacobian(w, x):
     c = int(w.feet[int(w.memory[0])])
     # the nodes: the crossing step's start and end and the steps after it, with tangents
     begin, crossing_end = State(*(a.copy() for a in ws.prev)), s.copy()
-    nodes, tangents = [begin.q.copy(), s.q.copy()], [T[:n3], step.dx1[:n3]]
+    pinned = [int(w.feet[old])]
+    states, tangents = [begin, s.copy()], [T, step.dx1]
     T = step.dx1
     for _ in range(NODES - 2):
         T = step_tangents(sim, u0, T, _keep_end=True).dx1
-        nodes.append(s.q.copy())
-        tangents.append(T[:n3])
+        states.append(s.copy())
+        tangents.append(T)
     s.restore(crossing_end)
     ws.prev.restore(begin)
-    nodes = np.array(nodes).reshape(NODES, n3)
-    Z = np.stack([_batch(q, t) for q, t in zip(nodes, tangents)])     # (NODES, d + 1, n3)
+    nodes = np.array([st.q.ravel() for st in states])
+    Z = np.stack([_batch(st.q.ravel(), t[:n3]) for st, t in zip(states, tangents)])
+    # each node's velocity at its instant (half a kick, projected): (NODES, d + 1, n3)
+    gravity = _applied_velocity(w)
+    R = np.stack([project_velocities_batch(model, Zk, _batch(st.v.ravel(), t[n3:])
+                                           + 0.5 * h * gravity, pinned)
+                  for Zk, st, t in zip(Z, states, tangents)])
     phi = w.touchdown_phase(nodes.reshape((NODES,) + s.q.shape), c)
     # the phase's derivative: the foot's gap on the interpolant held at 0
     along_x = _gap(w, c, np.einsum("k,kbi->bi", lagrange_weights(phi)[0], Z))
     along_phi = _gap(w, c, np.einsum("k,ki->i", lagrange_weights(phi + COMPLEX_STEP * 1j)[0],
                                      nodes)[None])
     dphi = -_tangent(along_x[:, None])[0] / _tangent(np.r_[0.0, along_phi][:, None])[0]
-    weights, rates = lagrange_weights(phi + (COMPLEX_STEP * 1j) * np.r_[0.0, dphi])
+    weights = lagrange_weights(phi + (COMPLEX_STEP * 1j) * np.r_[0.0, dphi])[0]
     Yq = np.einsum("kb,kbi->bi", weights, Z)
-    Yv = project_velocities_batch(model, Yq, np.einsum("kb,kbi->bi", rates, Z) / h,
-                                  [int(w.feet[old])])
-    s.q[...] = Yq[0].real.reshape(s.q.shape)
-    s.v[...] = w.project(s.q, Yv[0].real.reshape(s.v.shape), [int(w.feet[old])])
+    Yv = project_velocities_batch(model, Yq, np.einsum("kb,kbi->bi", weights, R), pinned)
+    # (the real path as locate_touchdown takes it, in the engine's arithmetic)
+    real = [st.copy() for st in states]
+    for st in real:
+        to_instant_velocity(model, st, ws, h, u0, pinned)
+    real_w = lagrange_weights(phi)[0]
+    s.q[...] = np.tensordot(real_w, np.array([st.q for st in real]), axes=1)
+    s.v[...] = w.project(s.q, np.tensordot(real_w, np.array([st.v for st in real]), axes=1),
+                         pinned)
     # the impact, resolved in a step of IMPACT_DT and read at the touchdown (impact_at_instant)
     touch = s.q.copy()
     s.contact_enabled[c] = 1
