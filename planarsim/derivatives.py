@@ -290,9 +290,16 @@ def step_tangents(sim, u, dx, du=None, _keep_end=False) -> StepTangents:
     k + 1 rows instead of step_jacobian's n_x + n_u + 1. `sim` is left as it was (after the
     step with _keep_end)."""
     n_x = 6 * sim.model.n_body
-    dx = np.asarray(dx, dtype=float).reshape(n_x, -1)
+    dx = np.asarray(dx, dtype=float)
+    if dx.ndim == 1:
+        dx = dx[:, None]
+    if dx.ndim != 2 or dx.shape[0] != n_x or not np.all(np.isfinite(dx)):
+        raise ValueError(f"dx must be finite directions of the state, shape ({n_x},) or "
+                         f"({n_x}, k), got shape {np.shape(dx)}")
     k = dx.shape[1]
     du = np.zeros((sim.model.n_act, k)) if du is None else np.asarray(du, dtype=float)
+    if du.ndim == 1 and k == 1:
+        du = du[:, None]
     if du.shape != (sim.model.n_act, k):
         raise ValueError(f"du must have shape ({sim.model.n_act}, {k}), got {du.shape}")
     return _step_derivative(sim, u, (dx, du), _keep_end)

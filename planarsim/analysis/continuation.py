@@ -194,9 +194,13 @@ def _multipliers(pool, p, x, period, mult_tol, points=FIT_POINTS):
     (MapPool.exact: error 0), else multipliers_by_fit: the window FIT_WINDOW / period, then
     half of it if the error exceeds mult_tol; the estimate with the smaller error."""
     if pool.exact(p):
-        J = pool.jacobian(p, x, period)[1]
-        lam = sort_multipliers(np.linalg.eigvals(J))
-        return Multipliers(lam, 0.0, 0.0, float("nan"), True, J, [(0.0, lam)], period)
+        try:
+            J = pool.jacobian(p, x, period)[1]
+            lam = sort_multipliers(np.linalg.eigvals(J))
+            return Multipliers(lam, 0.0, 0.0, float("nan"), True, J, [(0.0, lam)], period)
+        except NotImplementedError:
+            if pool.use_exact:
+                raise                   # (asked for: MapPool(exact=True))
     best = None
     for window in (FIT_WINDOW / period, 0.5 * FIT_WINDOW / period):
         m = multipliers_by_fit(None, x, window, points, tol=mult_tol,

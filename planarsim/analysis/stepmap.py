@@ -231,23 +231,24 @@ def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
     has = isinstance(f, StepMap) and f.exact
     if exact and not has:
         raise ValueError("exact=True needs a StepMap with a derivative (an exact Jacobian)")
-    exact = has if exact is None else bool(exact)
-    known = {}
+    use = {"exact": has if exact is None else bool(exact)}
 
     def g(x):
         count[0] += 1
         return np.asarray(f(x), dtype=np.float64)
 
     def jac(x, fx):
-        """dP/dx at x (fx = P(x)): the exact one (one more evaluation) or differences."""
-        if not exact:
-            return jacobian(g, x, eps, central, fx=fx)
-        key = x.tobytes()
-        if key not in known:
+        """dP/dx at x (fx = P(x)): the exact one (one more evaluation) or differences (also
+        where the exact one is not covered and was not asked for by exact=True)."""
+        if use["exact"]:
             count[0] += 1
-            known.clear()
-            known[key] = f.value_and_jacobian(x)[1]
-        return known[key]
+            try:
+                return f.value_and_jacobian(x)[1]
+            except NotImplementedError:
+                if exact:
+                    raise
+                use["exact"] = False
+        return jacobian(g, x, eps, central, fx=fx)
 
     x = np.asarray(x0, dtype=np.float64).copy()
     try:

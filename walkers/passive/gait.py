@@ -30,7 +30,7 @@ from .params import CompassParams, RimlessParams, SimplestParams
 from .rollout import DETECT, ENGINE, FELL, NO_EVENT, TOGGLE, rollout_passive
 
 
-IMPACT_DT = 1e-6   # [s] the step that resolves an impact at the section (refine_touchdown);
+IMPACT_DT = 1e-6   # [s] the step that resolves an impact at the section (impact);
                    # gravity acts 1e-6 s longer, residuals / IMPACT_DT < 1e-6 m/s
 
 
@@ -405,9 +405,11 @@ class PassiveWalker:
         return self.coords()
 
     def step_map(self) -> StepMap:
-        """The step-to-step map (advance) with its exact Jacobian (map_jacobian)."""
+        """The step-to-step map (advance), with its exact Jacobian (map_jacobian) on flat or
+        sloped ground (on hills: none, the fits and differences then)."""
+        covered = self.model.arrays.terrain_coef[2] == 0.0
         return StepMap(self.advance, dim=len(self.names), names=self.names,
-                       derivative=self.advance_with_jacobian)
+                       derivative=self.advance_with_jacobian if covered else None)
 
     def advance_with_jacobian(self, x):
         """(advance(x), its exact Jacobian (d, d)): walkers.passive.map_jacobian."""

@@ -2,22 +2,24 @@
 
 PassiveWalker.advance maps section coordinates x to those after the next touchdown: set the
 state from x, convert its velocities to the step's (half_step.to_step_velocity), take engine
-steps until a foot crosses the ground, go back to the start of that step, locate the
-touchdown within it (a sub-step of tau found by root finding, between velocity conversions),
-resolve the impact there and read the coordinates back. Each piece is differentiated:
+steps until a foot crosses the ground and NODES - 2 more, locate the touchdown on the
+polynomials through those step states (PassiveWalker.locate_touchdown), resolve the impact
+there and read the coordinates back. Each piece is differentiated:
 
 - the conversions, the projections onto the constraints and the coordinates by the complex
   step through numpy versions of them (section_state, section_coords,
   step_replica.project_velocities_batch);
 - each engine step by planarsim.derivatives.step_tangents (the step replayed under its
   decisions; forward mode along the d directions of x);
-- the touchdown time by the implicit function theorem on the foot's gap g(y(tau, z)) = 0:
-  d tau = -(dg/dy dy/dz dz) / (dg/dy dy/dtau), with dy/dtau from the sub-step replayed at a
-  complex step length. This is the saltation term: without it the Jacobian is the one at a
-  fixed event time.
+- the touchdown's phase phi in its sim step by the implicit function theorem on the foot's
+  gap on the positions' polynomial, g(q(phi, x)) = 0: d phi = -(dg/dq dq/dx) / (dg/dq
+  dq/dphi). This is the saltation term: without it the Jacobian is the one at a fixed
+  event time;
+- the impact's step of IMPACT_DT by step_tangents.
 
 The result is the derivative of the map the engine computes (its steps, its event location),
-exact to rounding within the step's contact modes: its multipliers converge to the
+exact to rounding within the steps' contact modes (a step other than the impact's at the
+edge of its mode is warned of: MapJacobianWarning): its multipliers converge to the
 continuous walker's as dt shrinks at the map's order, with no finite-difference step to
 choose.
 """
@@ -130,17 +132,25 @@ def section_coords(w, q, v, stance):
 
 
 class _Options:
-    """The walker's simulator with steps of dt [s] within the block."""
+    """The walker's simulator with steps of dt [s] within the block (its resolved options
+    otherwise as they are, as step_from_python takes them; restored as they were)."""
 
     def __init__(self, sim, dt):
         self.sim, self.dt = sim, float(dt)
 
     def __enter__(self):
         self.kept = self.sim.options
-        self.sim.options = self.kept._replace(dt=self.dt)
+        self.sim._options = self.kept._replace(dt=self.dt)
+        self.sim._new_options()
 
     def __exit__(self, *exc):
-        self.sim.options = self.kept
+        self.sim._options = self.kept
+        self.sim._new_options()
+
+
+class MapJacobianWarning(UserWarning):
+    """A step of the map other than the impact's sits at the edge of its contact mode
+    (StepJacobian.modes_changed): the Jacobian is that of the mode the step took."""
 
 
 def _batch(x, dx):
@@ -173,8 +183,10 @@ def map_jacobian(w, x):
     old = int(w.memory[0])
     start = w.foot_point(w.feet[old])[0]
     s.contact_enabled[w.feet[1:]] = 0
+    edges = 0
     for _ in range(int(20.0 / h)):
         step = step_tangents(sim, u0, T, _keep_end=True)
+        edges += step.modes_changed
         if update_feet(model.arrays, s, ws, w.feet, w.memory, DETECT, w.min_ahead) >= 0:
             break
         T = step.dx1
@@ -189,7 +201,8 @@ def map_jacobian(w, x):
     states, tangents = [begin, s.copy()], [T, step.dx1]
     T = step.dx1
     for _ in range(NODES - 2):
-        T = step_tangents(sim, u0, T, _keep_end=True).dx1
+        after = step_tangents(sim, u0, T, _keep_end=True)
+        T, edges = after.dx1, edges + after.modes_changed
         states.append(s.copy())
         tangents.append(T)
     s.restore(crossing_end)
@@ -207,6 +220,8 @@ def map_jacobian(w, x):
     along_phi = _gap(w, c, np.einsum("k,ki->i", lagrange_weights(phi + COMPLEX_STEP * 1j)[0],
                                      nodes)[None])
     dphi = -_tangent(along_x[:, None])[0] / _tangent(np.r_[0.0, along_phi][:, None])[0]
+    if phi == 0.0:
+        dphi[:] = 0.0        # (the foot started the step on the ground: phi held at 0)
     weights = lagrange_weights(phi + (COMPLEX_STEP * 1j) * np.r_[0.0, dphi])[0]
     Yq = np.einsum("kb,kbi->bi", weights, Z)
     Yv = project_velocities_batch(model, Yq, np.einsum("kb,kbi->bi", weights, R), pinned)
@@ -232,6 +247,11 @@ def map_jacobian(w, x):
     s.time[0] = begin.time[0] + phi * h
     w.last_release_ok = bool(s.contact_mode[w.feet[old]] == 0)
     s.contact_enabled[w.feet[old]] = 0
+    if edges:
+        import warnings
+        warnings.warn(f"{w.kind}: {edges} step(s) of the map from x={x} at the edge of a "
+                      f"contact mode: the Jacobian is that of the modes the steps took",
+                      MapJacobianWarning, stacklevel=2)
     w.last_period = float(s.time[0])
     w.last_length = float((w.foot_point(c)[0] - start) @ w.t_hat)
     return w.coords(), _tangent(section_coords(w, Yq, Yv, c))
