@@ -270,7 +270,11 @@ def step_jacobian(sim, u=None, _keep_end=False) -> StepJacobian:
     to the state x = (q.ravel(), v.ravel()) and the commands u (module docstring). `sim` is
     left as it was (its state, options, audit and counters). Raises NotImplementedError for a
     model, option or step outside what is covered, naming it."""
-    return _step_derivative(sim, u, None, _keep_end)
+    n_x = 6 * sim.model.n_body
+    eye = np.eye(n_x + sim.model.n_act)
+    t = _step_derivative(sim, u, (eye[:n_x], eye[n_x:]), _keep_end)
+    return StepJacobian(A=t.dx1[:, :n_x], B=t.dx1[:, n_x:], modes_changed=t.modes_changed,
+                        x1=t.x1)
 
 
 @dataclass(frozen=True)
@@ -306,7 +310,8 @@ def step_tangents(sim, u, dx, du=None, _keep_end=False) -> StepTangents:
 
 
 def _step_derivative(sim, u, directions, _keep_end):
-    """step_jacobian (directions None) or step_tangents (directions (dx, du))."""
+    """StepTangents of one step along directions (dx (n_x, k), du (n_u, k)): step_tangents,
+    and step_jacobian's along every coordinate and command."""
     model = sim.model
     h = float(sim.dt)
     check_covered(model, sim.options, h)
@@ -345,9 +350,9 @@ def _step_derivative(sim, u, directions, _keep_end):
         raise _not_covered(f"a step taken in {splits} time-of-impact splits")
 
     if substeps > 1:
-        return _substeps_jacobian(sim, u, substeps, start, q1, v1, _keep_end, audit, info,
+        return _substeps_tangents(sim, u, substeps, start, q1, v1, _keep_end, audit, info,
                                   directions)
-    jac, plan = _replica_jacobian(sim, u, start, end_modes, end_slips, features, limit_active,
+    jac, plan = _replica_tangents(sim, u, start, end_modes, end_slips, features, limit_active,
                                   q1, v1, first_order, projections, directions)
     if np.abs(plan.v_lin - v_lin).max(initial=0.0) > FIT_TOL * (np.abs(v_lin).max() + 1e-300):
         raise _not_covered("a velocity solve whose joints' target the step linearized again "
@@ -360,8 +365,7 @@ def _step_derivative(sim, u, directions, _keep_end):
     if not jac.modes_changed and (released or near or _at_mode_boundary(
             model, end_modes, impulses, limit_active, limit_impulses, q1, v1, h,
             end_enabled)):
-        jac = (StepJacobian(A=jac.A, B=jac.B, modes_changed=True, x1=jac.x1)
-               if directions is None else StepTangents(jac.dx1, True, jac.x1))
+        jac = StepTangents(jac.dx1, True, jac.x1)
     return jac
 
 
@@ -370,10 +374,10 @@ def _step_derivative(sim, u, directions, _keep_end):
 SUBSTEPS_TOL = 1e-12
 
 
-def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info, directions=None):
+def _substeps_tangents(sim, u, n, start, q1, v1, keep_end, audit, info, directions):
     """The derivative of a step the engine took in n equal sub-steps (step.turn_substeps: a
     body turning fast), each a whole step of h / n of its own: the chain rule through them,
-    A = A_n ... A_1 and B = sum_k A_n ... A_(k+1) B_k, each sub-step's from step_jacobian at
+    each sub-step's tangents along the last one's (with the same command directions) at
     StepOptions.dt = h / n and max_substeps 1 (the engine's sub-steps do not decide again how
     to split themselves). `sim` ends as step_jacobian leaves it (audit, info: its audit and
     counters before the step); raises where the sub-steps do not end where the step did."""
@@ -382,15 +386,12 @@ def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info, directio
         sim.restore(start)
         sim._options = options._replace(dt=sim.dt / n, max_substeps=1)
         sim._new_options()
-        if directions is None:
-            parts = [step_jacobian(sim, u, _keep_end=True) for _ in range(n)]
-        else:
-            dx, du = directions
-            changed = False
-            for _ in range(n):
-                part = _step_derivative(sim, u, (dx, du), True)
-                dx, changed = part.dx1, changed or part.modes_changed
-            tangents = StepTangents(dx, changed, part.x1)
+        dx, du = directions
+        changed = False
+        for _ in range(n):
+            part = _step_derivative(sim, u, (dx, du), True)
+            dx, changed = part.dx1, changed or part.modes_changed
+        tangents = StepTangents(dx, changed, part.x1)
     finally:
         sim.restore(start)
         sim._options = options
@@ -398,19 +399,11 @@ def _substeps_jacobian(sim, u, n, start, q1, v1, keep_end, audit, info, directio
         sim.ws.audit[:] = audit
         sim.ws.info[:] = info
     x1 = np.concatenate([q1.ravel(), v1.ravel()])
-    last = parts[-1] if directions is None else tangents
-    if np.abs(last.x1 - x1).max() > SUBSTEPS_TOL * max(np.abs(x1).max(), 1.0):
+    if np.abs(tangents.x1 - x1).max() > SUBSTEPS_TOL * max(np.abs(x1).max(), 1.0):
         raise _not_covered(f"{n} sub-steps that end elsewhere than steps of h / {n}")
-    if directions is not None:
-        if keep_end:
-            sim.step(u)
-        return tangents
-    A, B = parts[0].A, parts[0].B
-    for part in parts[1:]:
-        A, B = part.A @ A, part.A @ B + part.B
     if keep_end:
         sim.step(u)             # (from the audit and counters before the step: counted once)
-    return StepJacobian(A=A, B=B, modes_changed=any(p.modes_changed for p in parts), x1=x1)
+    return tangents
 
 
 def rollout_jacobians(sim, us) -> list:
@@ -665,11 +658,11 @@ def _engine_order(model, held, limits, contacts) -> np.ndarray:
     return np.array(order, dtype=np.int64)
 
 
-def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1, v1,
-                      first_order=0, projections=0, directions=None):
-    """(StepJacobian, its StepPlan) of a step the engine took in one piece, ending at (q1,
+def _replica_tangents(sim, u, start, modes, slips, features, limit_active, q1, v1,
+                      first_order, projections, directions):
+    """(StepTangents, its StepPlan) of a step the engine took in one piece, ending at (q1,
     v1): the step's equations replayed (planarsim.step_replica) from the start and from the
-    start moved by i COMPLEX_STEP along each coordinate and command, in one batch whose
+    start moved by i COMPLEX_STEP along each direction (dx, du), in one batch whose
     first row (the start itself) takes the decisions; that row must end where the engine
     ended."""
     model = sim.model
@@ -689,11 +682,8 @@ def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1, v
                            "correction")
     lo, hi = model.arrays.act_range.T
     turning = np.flatnonzero(np.isin(model.arrays.act_kind, list(_TURNING_ACTUATORS)))
-    cols = 2 * nq + model.n_act
-    if directions is None:
-        E = np.vstack([np.zeros((1, cols)), np.eye(cols)]) * (COMPLEX_STEP * 1j)
-    else:
-        E = np.vstack([np.zeros((1, cols)), np.vstack(directions).T]) * (COMPLEX_STEP * 1j)
+    E = np.vstack([np.zeros((1, 2 * nq + model.n_act)), np.vstack(directions).T]) \
+        * (COMPLEX_STEP * 1j)
     eps = np.finfo(float).eps
     q_scale = np.abs(q1.ravel() - q0).max() + h * np.abs(v0).max()
     v_scale = np.abs(v1).max() + np.abs(v0).max()
@@ -742,9 +732,5 @@ def _replica_jacobian(sim, u, start, modes, slips, features, limit_active, q1, v
                            f"correction, the energy bound) do not reproduce: q off by "
                            f"{q_off:.3g}, v by {v_off:.3g} (a projection, a first-order "
                            f"target, the motion paying for a lift)")
-    D = np.hstack([q_c[1:].imag, v_c[1:].imag]).T / COMPLEX_STEP      # (2 nq, cols)
-    x1 = np.concatenate([q1.ravel(), v1.ravel()])
-    if directions is not None:
-        return StepTangents(D, bool(saturated.any()), x1), plan
-    return StepJacobian(A=D[:, :2 * nq], B=D[:, 2 * nq:], modes_changed=bool(saturated.any()),
-                        x1=x1), plan
+    D = np.hstack([q_c[1:].imag, v_c[1:].imag]).T / COMPLEX_STEP      # (2 nq, k)
+    return StepTangents(D, bool(saturated.any()), np.concatenate([q1.ravel(), v1.ravel()])), plan

@@ -48,21 +48,15 @@ def _dup(theta):
 NODES = 6
 
 
-def lagrange_weights(phi, nodes: int = NODES):
-    """(w (nodes,), dw (nodes,)) of the polynomial through values at 0, 1, ..., nodes - 1
-    (Lagrange), at phi and its derivative in phi; polynomial in phi, so complex numbers pass
+def lagrange_weights(phi, nodes: int = NODES) -> np.ndarray:
+    """(nodes,) weights of the values at 0, 1, ..., nodes - 1 in the polynomial through them
+    (Lagrange), at phi (a number or an array); polynomial in phi, so complex numbers pass
     through."""
     from functools import reduce
     from operator import mul
     at = np.arange(float(nodes))
-    w, dw = [], []
-    for k in range(nodes):
-        others = np.delete(at, k)
-        den = np.prod(at[k] - others)
-        f = [phi - b for b in others]
-        w.append(reduce(mul, f) / den)
-        dw.append(sum(reduce(mul, f[:i] + f[i + 1:]) for i in range(len(f))) / den)
-    return np.array(w), np.array(dw)
+    return np.array([reduce(mul, [phi - b for b in np.delete(at, k)])
+                     / np.prod(at[k] - np.delete(at, k)) for k in range(nodes)])
 
 
 class PassiveWalker:
@@ -311,22 +305,30 @@ class PassiveWalker:
         sawtooth it leaves O(dt^(NODES - 2)). Returns phi."""
         s, ws = self.sim.state, self.sim.ws
         c = int(self.feet[int(self.memory[0])])
-        pinned = [int(self.feet[old])]
         t0 = float(ws.prev.time[0])
-        nodes = np.concatenate([ws.prev.q[None], s.q[None], extra[0]])
-        rates = np.concatenate([ws.prev.v[None], s.v[None], extra[1]])
+        phi = self.touchdown_state(np.concatenate([ws.prev.q[None], s.q[None], extra[0]]),
+                                   np.concatenate([ws.prev.v[None], s.v[None], extra[1]]),
+                                   [int(self.feet[old])], c)
+        self.impact_at_instant(c)
+        s.time[0] = t0 + phi * self.dt
+        return phi
+
+    def touchdown_state(self, nodes, rates, pinned, c: int) -> float:
+        """Set the simulator's state to the touchdown of contact c on the polynomials through
+        the step states (positions `nodes`, step velocities `rates`, each (NODES, n, 3)),
+        each velocity first made its instant's with the contacts `pinned` held
+        (locate_touchdown); returns the touchdown's phase phi."""
+        s, ws = self.sim.state, self.sim.ws
         node = s.copy()
+        instant = np.empty_like(rates)
         for k in range(NODES):
             node.q[...], node.v[...] = nodes[k], rates[k]
             to_instant_velocity(self.model, node, ws, self.dt, self.u0, pinned)
-            rates[k] = node.v
+            instant[k] = node.v
         phi = self.touchdown_phase(nodes, c)
-        weights = lagrange_weights(phi)[0]
-        q = np.tensordot(weights, nodes, axes=1)
-        s.q[...] = q
-        s.v[...] = self.project(q, np.tensordot(weights, rates, axes=1), pinned)
-        self.impact_at_instant(c)
-        s.time[0] = t0 + phi * self.dt
+        weights = lagrange_weights(phi)
+        s.q[...] = np.tensordot(weights, nodes, axes=1)
+        s.v[...] = self.project(s.q, np.tensordot(weights, instant, axes=1), pinned)
         return phi
 
     def touchdown_phase(self, nodes, c: int) -> float:
@@ -337,7 +339,7 @@ class PassiveWalker:
         coef = self.model.arrays.terrain_coef
 
         def gap(phi):
-            q = np.tensordot(lagrange_weights(phi)[0], nodes, axes=1)
+            q = np.tensordot(lagrange_weights(phi), nodes, axes=1)
             p = self.foot_point(c, q)[0]
             return gap_of_point(coef, p[0], p[1])
 

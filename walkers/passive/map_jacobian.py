@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from planarsim.derivatives import COMPLEX_STEP, step_tangents
-from planarsim.half_step import kick, to_instant_velocity, to_step_velocity
+from planarsim.half_step import kick, to_step_velocity
 from planarsim.state import State
 from planarsim.step_replica import project_velocities_batch
 
@@ -214,25 +214,19 @@ def map_jacobian(w, x):
     R = np.stack([project_velocities_batch(model, Zk, _batch(st.v.ravel(), t[n3:])
                                            + 0.5 * h * gravity, pinned)
                   for Zk, st, t in zip(Z, states, tangents)])
-    phi = w.touchdown_phase(nodes.reshape((NODES,) + s.q.shape), c)
+    # the real path as locate_touchdown takes it, in the engine's arithmetic
+    phi = w.touchdown_state(nodes.reshape((NODES,) + s.q.shape),
+                            np.array([st.v for st in states]), pinned, c)
     # the phase's derivative: the foot's gap on the interpolant held at 0
-    along_x = _gap(w, c, np.einsum("k,kbi->bi", lagrange_weights(phi)[0], Z))
-    along_phi = _gap(w, c, np.einsum("k,ki->i", lagrange_weights(phi + COMPLEX_STEP * 1j)[0],
+    along_x = _gap(w, c, np.einsum("k,kbi->bi", lagrange_weights(phi), Z))
+    along_phi = _gap(w, c, np.einsum("k,ki->i", lagrange_weights(phi + COMPLEX_STEP * 1j),
                                      nodes)[None])
     dphi = -_tangent(along_x[:, None])[0] / _tangent(np.r_[0.0, along_phi][:, None])[0]
     if phi == 0.0:
         dphi[:] = 0.0        # (the foot started the step on the ground: phi held at 0)
-    weights = lagrange_weights(phi + (COMPLEX_STEP * 1j) * np.r_[0.0, dphi])[0]
+    weights = lagrange_weights(phi + (COMPLEX_STEP * 1j) * np.r_[0.0, dphi])
     Yq = np.einsum("kb,kbi->bi", weights, Z)
     Yv = project_velocities_batch(model, Yq, np.einsum("kb,kbi->bi", weights, R), pinned)
-    # (the real path as locate_touchdown takes it, in the engine's arithmetic)
-    real = [st.copy() for st in states]
-    for st in real:
-        to_instant_velocity(model, st, ws, h, u0, pinned)
-    real_w = lagrange_weights(phi)[0]
-    s.q[...] = np.tensordot(real_w, np.array([st.q for st in real]), axes=1)
-    s.v[...] = w.project(s.q, np.tensordot(real_w, np.array([st.v for st in real]), axes=1),
-                         pinned)
     # the impact, resolved in a step of IMPACT_DT and read at the touchdown (impact_at_instant)
     touch = s.q.copy()
     s.contact_enabled[c] = 1
