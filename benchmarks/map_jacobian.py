@@ -7,7 +7,8 @@
   and its time against the fits' (multipliers_by_fit: 17 samples per coordinate) and the
   differences' (multipliers_with_error).
 - newton: iterations of find_fixed_point from guesses around the gait, with the exact
-  Jacobian and with central differences (steps 1e-4, as the gait tests take, and 1e-6).
+  Jacobian, with central differences (steps 1e-4, as the gait tests take, and 1e-6) and with
+  the fitted Jacobian (multipliers_by_fit's, the continuation's default).
 - convergence: the multipliers from the exact Jacobian at the gait as dt halves (1e-3, 5e-4,
   2.5e-4 s), against the rimless wheel's closed form eta^2 and the scipy reference's
   variational equations for the simplest walker (foot mass ratio 1e-3), with Richardson's
@@ -24,7 +25,7 @@ import numpy as np
 
 from planarsim.analysis import (find_fixed_point, match_distance, multipliers_by_fit,
                                 multipliers_exact, multipliers_with_error, sort_multipliers)
-from planarsim.analysis.stepmap import jacobian
+from planarsim.analysis.stepmap import StepMap, jacobian
 from walkers.passive import PassiveWalker, RimlessParams, SimplestParams
 from walkers.passive.reference import (simplest_feet_map, simplest_feet_step_jacobian,
                                        simplest_fixed_point)
@@ -74,23 +75,28 @@ def check(refs):
 
 def newton(refs):
     print("== Newton iterations from guesses around the gait (dt 1e-3; tol 1e-12)")
-    print(f"  {'walker':16s} {'guess offset':>28s} {'exact':>6s} {'fd 1e-4':>8s} {'fd 1e-6':>8s}")
+    print(f"  {'walker':16s} {'guess offset':>28s} {'exact':>6s} {'fd 1e-4':>8s} {'fd 1e-6':>8s} "
+          f"{'fit':>6s}")
     rng = np.random.default_rng(7)
     for name, (params, x0, _) in refs.items():
         w = PassiveWalker(params, dt=1e-3)
         f = w.step_map()
+        # Newton on the fitted Jacobian (multipliers_by_fit's, the continuation's default)
+        fit = StepMap(f.advance, f.dim, names=f.names, derivative=lambda x, f=f: (
+            f(x), multipliers_by_fit(f, x, warn=False).jacobian))
         scale = np.full(x0.size, 0.01) if x0.size > 1 else np.array([0.2])
         for _ in range(4):
             d = scale * rng.uniform(-1.0, 1.0, x0.size)
             counts = []
-            for kw in (dict(exact=True), dict(exact=False, eps=1e-4), dict(exact=False, eps=1e-6)):
+            for g, kw in ((f, dict(exact=True)), (f, dict(exact=False, eps=1e-4)),
+                          (f, dict(exact=False, eps=1e-6)), (fit, dict(exact=True))):
                 try:
-                    fp = find_fixed_point(f, x0 + d, tol=1e-12, **kw)
+                    fp = find_fixed_point(g, x0 + d, tol=1e-12, **kw)
                     counts.append(f"{fp.iterations}{'' if fp.converged else '!'}")
                 except Exception as exc:         # (a guess from which the walker falls)
                     counts.append(type(exc).__name__[:6])
             print(f"  {name:16s} {np.array2string(d, precision=3):>28s} "
-                  f"{counts[0]:>6s} {counts[1]:>8s} {counts[2]:>8s}")
+                  f"{counts[0]:>6s} {counts[1]:>8s} {counts[2]:>8s} {counts[3]:>6s}")
     print("  (! not converged)")
 
 

@@ -149,3 +149,12 @@ def test_cartpole_swings_up_from_hanging_and_balances_by_ilqr():
     assert np.abs(ex.upright_error(run[-50:])).max() < 0.05    # the last second at dt 0.02
     assert np.abs(run[:, ex.X_CART]).max() < 2.0
     assert all(b < a for a, b in zip(result.costs, result.costs[1:]))
+
+
+def test_the_gait_gradient_example_tunes_one_gain(capsys):
+    """examples/tune_gait_gradient.py, one gradient on one gain: its exit code says the
+    periodic gait's score rose; both gaits walk 10 s from rest."""
+    ex = load("tune_gait_gradient")
+    assert ex.main(["--names", "ss_kd", "--iterations", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "step 1: score" in out and "fell: start False, tuned False" in out

@@ -40,7 +40,8 @@ EPS = 3e-3      # finite-difference step [m, m/s]
 @jit
 def rollout_to_touchdown(m, s, ws, opt, tab, mem, u, n_events, max_steps):
     """Control + physics until the controller has counted n_events more touchdowns; stops right
-    after the ``control`` call that counted the last one (before its physics step).
+    after the ``control`` call that counted the last one (before its physics step). The
+    actuators' positive work is kept in mem[MEM.work] as the walking run keeps it.
     Returns (code, steps done): 0 ok, 1/2 engine guard, 3 fell, 4 no touchdown in max_steps."""
     p = tab.p
     start = mem[C.MEM.steps]
@@ -51,6 +52,9 @@ def rollout_to_touchdown(m, s, ws, opt, tab, mem, u, n_events, max_steps):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i
+        for a in range(ws.act_power.shape[0]):
+            if ws.act_power[a] > 0.0:
+                mem[C.MEM.work] += ws.act_power[a] * m.dt
         if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[FIELD.fall_height] * p[FIELD.leg_length]
                 or _longest_leg(s.q) > p[FIELD.fall_leg_length] * p[FIELD.leg_length]):
             mem[C.MEM.fallen] = 1.0
@@ -131,10 +135,29 @@ class SimpleBipedGaitMap(GaitMapMixin):
     def advance(self, x) -> np.ndarray:
         """Two touchdowns from section coordinates x; the coordinates at the second one."""
         self.set_section(x)
+        self.advance_from_section()
+        return self.coords(self.s, self.mem)
+
+    def advance_from_section(self) -> None:
+        """The scratch simulation (set_section) run through two touchdowns, back to the stance
+        foot."""
         self._run(self.s, self.ws, self.mem, 2)
         if int(self.mem[C.MEM.stance]) != self.stance:
             raise StepMapError("Simple Biped step map: the two touchdowns did not alternate feet")
-        return self.coords(self.s, self.mem)
 
     def step_map(self) -> StepMap:
         return StepMap(self.advance, dim=len(NAMES), names=NAMES)
+
+    def cycle(self, x) -> dict:
+        """One period of the map from section coordinates x (advance's two touchdowns), measured
+        as the walking run measures a walk: duration [s], distance [m] the hip moved forward,
+        positive_work [J] of the actuators and weight [N] (cost of transport = work / (weight
+        distance))."""
+        self.set_section(x)
+        t0, x_hip, work0 = float(self.s.time[0]), float(self.s.q[0, 0]), float(self.mem[C.MEM.work])
+        self.advance_from_section()
+        model = self.walker.model
+        return {"duration": float(self.s.time[0]) - t0,
+                "distance": float(self.s.q[0, 0]) - x_hip,
+                "positive_work": float(self.mem[C.MEM.work]) - work0,
+                "weight": model.total_mass * float(np.hypot(*model.arrays.gravity))}
