@@ -7,7 +7,6 @@ Any profile h(x) = h0 + s x + sum_k A_k sin(2 pi x / L_k + phi_k) is exact in th
 """
 import argparse
 
-import numpy as np
 
 import planarsim as ps
 import walkers

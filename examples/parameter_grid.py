@@ -7,7 +7,6 @@ import argparse
 import itertools
 from concurrent.futures import ProcessPoolExecutor
 
-import numpy as np
 
 import planarsim as ps
 import walkers

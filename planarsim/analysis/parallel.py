@@ -8,7 +8,9 @@ builds and keeps its own maps (its own walker and simulator), so nothing is shar
 Backends: "process" (forked workers; for maps whose evaluation runs Python between compiled
 rollouts and so holds the GIL, as the passive walkers' touchdown refinement does), "thread"
 (planarsim.batch's thread pool; for maps that run entirely in compiled code, which releases
-the GIL) and "serial". Results do not depend on the backend or the number of workers.
+the GIL), "serial", and a dask cluster (MapPool(family, scheduler="tcp://host:8786") or a
+distributed.Client: the family is pickled to its workers, each of which keeps its own maps,
+as the tuner's dask runs do). Results do not depend on the backend or the number of workers.
 """
 from __future__ import annotations
 
@@ -24,9 +26,10 @@ import numpy as np
 from ..batch import _check_workers
 from .stepmap import StepMapError
 
-BACKENDS = ("process", "thread", "serial")
+BACKENDS = ("process", "thread", "serial", "dask")
 
 _WORKER = {}          # in a forked worker: family and its map cache
+_DASK_MAPS = {}       # in a dask worker: {pool token: its maps}
 _LOCAL = threading.local()
 
 
@@ -115,6 +118,26 @@ def _process_run(args):
     return task(_WORKER["maps"], item)
 
 
+def _dask_run(token, family, cache, task, items):
+    """A chunk of items on a dask worker, on the maps it keeps for the pool `token`."""
+    maps = _DASK_MAPS.get(token)
+    if maps is None:
+        maps = _DASK_MAPS[token] = _Maps(family, cache)
+    return [task(maps, item) for item in items]
+
+
+def _dask_client(scheduler):
+    """A distributed.Client for an address, or the client given."""
+    if not isinstance(scheduler, str):
+        return scheduler, False
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ImportError("MapPool(scheduler=...) needs dask.distributed: "
+                          "pip install 'planarsim[tune]'") from None
+    return Client(scheduler), True
+
+
 class MapPool:
     """Evaluate a family of step maps on `workers` workers (default: every core).
 
@@ -125,16 +148,29 @@ class MapPool:
     exact : the continuation's multipliers from the maps' exact Jacobians (StepMap.derivative)
         where they have them (None, the default), always (True: an error where one has none)
         or never (False: polynomial fits).
+    scheduler : a dask scheduler's address ("tcp://host:8786") or a distributed.Client: the
+        evaluations run on its workers (backend "dask"; workers: the chunks a run is cut
+        into per worker, default 4). The family must pickle.
     Use as a context manager (or call close()).
     """
 
     def __init__(self, family: Callable, workers: int | None = None, backend: str = "process",
-                 cache: int = 8, exact: bool | None = None):
+                 cache: int = 8, exact: bool | None = None, scheduler=None):
         if backend not in BACKENDS:
             raise ValueError(f"backend={backend!r} must be one of {BACKENDS}")
+        if (backend == "dask") != (scheduler is not None) and backend != "process":
+            raise ValueError(f"backend={backend!r} with scheduler={scheduler!r}: a dask pool "
+                             "is made by giving its scheduler (backend 'dask' or left out)")
         self.family, self.cache = family, int(cache)
-        self.workers = _check_workers(workers)
-        if self.workers == 1:
+        self._client, self._own_client = None, False
+        if scheduler is not None:
+            backend = "dask"
+            self._client, self._own_client = _dask_client(scheduler)
+            self.workers = max(1, len(self._client.scheduler_info().get("workers", {})))
+            self._chunks = 4 if workers is None else max(1, int(workers))
+        else:
+            self.workers = _check_workers(workers)
+        if self.workers == 1 and backend != "dask":
             backend = "serial"
         if backend == "process" and "fork" not in mp.get_all_start_methods():
             backend = "thread"   # pragma: no cover (no fork on this platform)
@@ -162,6 +198,9 @@ class MapPool:
         return _LOCAL.maps["maps"]
 
     def close(self):
+        if self._own_client and self._client is not None:
+            self._client.close()
+            self._client = None
         if self._pool is not None:
             if self.backend == "process":
                 self._pool.terminate()
@@ -193,6 +232,8 @@ class MapPool:
         if not n:
             return []
         out = []
+        if self.backend == "dask":
+            return self._run_dask(task, items, progress)
         if self.backend == "serial" or self._pool is None or n == 1:
             out.append(task(self._local, items[0]))   # warms the numba cache before forking
             if progress:
@@ -218,6 +259,26 @@ class MapPool:
             if progress:
                 progress(k0 + i + 1, n)
         return out
+
+    def _run_dask(self, task, items, progress):
+        """run() on the dask cluster: the items in chunks (workers x self._chunks of them),
+        results in order."""
+        from distributed import as_completed
+        n = len(items)
+        size = max(1, -(-n // (self.workers * self._chunks)))
+        chunks = [items[k:k + size] for k in range(0, n, size)]
+        token = f"mappool-{id(self)}"
+        futures = [self._client.submit(_dask_run, token, self.family, self.cache, task, c,
+                                       pure=False) for c in chunks]
+        where = {f.key: i for i, f in enumerate(futures)}
+        parts, done = [None] * len(chunks), 0
+        for f in as_completed(futures):
+            i = where[f.key]
+            parts[i] = f.result()
+            done += len(parts[i])
+            if progress:
+                progress(done, n)
+        return [r for part in parts for r in part]
 
     def evaluate(self, X, p, period: int = 1):
         """P^period(x; p) for every row of X: (Y (n, d) with NaN rows where the walker fell,

@@ -158,3 +158,16 @@ def test_the_gait_gradient_example_tunes_one_gain(capsys):
     assert ex.main(["--names", "ss_kd", "--iterations", "1"]) == 0
     out = capsys.readouterr().out
     assert "step 1: score" in out and "fell: start False, tuned False" in out
+
+
+def test_the_basin_map_example_runs_small(tmp_path, capsys):
+    """examples/basin_map.py on a 6 x 6 grid about the gait: its figure, and the gait's own
+    cell among those that reach it."""
+    ex = load("basin_map")
+    assert ex.main(["--size", "6", "--theta", "0.19:0.21", "--rate=-0.21:-0.19",
+                    "--steps", "15", "--workers", "1", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "6 x 6 cells" in out and "reach the gait" in out
+    share = float(out.split("cells: ")[1].split("%")[0])
+    assert share > 0.0
+    assert (tmp_path / "simplest_basin.png").stat().st_size > 5_000

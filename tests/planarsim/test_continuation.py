@@ -284,3 +284,33 @@ def test_fixed_point_tolerance_follows_the_map_noise():
     smooth_fp = find_fixed_point(logistic(2.8), [0.6], tol=1e-12)
     assert smooth_fp.tol == 1e-12 and smooth_fp.residual <= 1e-12
     assert find_fixed_point(f, [0.6], eps=1e-4).tol == max(1e-9, 4 * fp.noise)   # "auto"
+
+
+def test_a_dask_cluster_gives_the_pools_answers_bit_for_bit():
+    """MapPool(scheduler=...) on a local dask cluster of two worker processes: a basin of the
+    simplest walker and the maps' evaluations equal the serial pool's bit for bit (each worker
+    builds its own walkers from the pickled family)."""
+    distributed = pytest.importorskip("distributed")
+    from walkers.passive.family import WalkerFamily
+    family = WalkerFamily("simplest-walker", "slope", dt=2e-3)
+    x = np.array([0.2002, -0.1999, 0.4003, -0.0158])
+    a, b = np.linspace(0.17, 0.23, 3), np.linspace(-0.23, -0.17, 3)
+
+    def state(u, v):
+        return [u, v, 2 * u, -0.0158]
+
+    with MapPool(family, backend="serial") as serial:
+        want = basin_of_attraction(serial, 0.009, a, b, state, x, n_steps=12, tol=1e-3)
+        Y0, ok0 = serial.evaluate(np.array([x, x + 0.001, x - 0.001]), 0.009)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        with MapPool(family, scheduler=client) as pool:
+            assert pool.backend == "dask" and pool.workers == 2
+            got = basin_of_attraction(pool, 0.009, a, b, state, x, n_steps=12, tol=1e-3)
+            Y, ok = pool.evaluate(np.array([x, x + 0.001, x - 0.001]), 0.009)
+    assert np.array_equal(got.steps, want.steps) and np.array_equal(got.fell, want.fell)
+    assert np.array_equal(got.reached, want.reached)
+    assert np.array_equal(ok, ok0) and np.array_equal(Y[ok], Y0[ok0])
+    with pytest.raises(ValueError, match="scheduler"):
+        MapPool(family, backend="thread", scheduler=client)
