@@ -40,7 +40,8 @@ def main(argv=None) -> int:
     ap.add_argument("--dt", type=float, default=2e-3, help="step size [s]")
     ap.add_argument("--steps", type=int, default=20, help="steps walked from each cell at most")
     ap.add_argument("--tol", type=float, default=1e-3, help="within this of the gait: reached")
-    ap.add_argument("--workers", type=int, default=None, help="processes (default: every core)")
+    ap.add_argument("--workers", type=int, default=None,
+                    help="processes (default: every core); with --scheduler, chunks per dask thread")
     ap.add_argument("--scheduler", default=None, help="dask scheduler address (tcp://host:port)")
     ap.add_argument("--out", default=".", help="directory of the figure")
     a = ap.parse_args(argv)

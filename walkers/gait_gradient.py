@@ -11,7 +11,8 @@ walk of `duration` [s] at that gait, with nothing lost to a start from rest:
 
 speed [m/s] and cost of transport [-] measured over one period of the map from x*(p). A gait
 the map cannot keep (a fall on the way, no fixed point, a Floquet multiplier on or outside the
-unit circle) scores -fall_penalty, as a run that falls at its start would (common.objective).
+unit circle) scores -fall_penalty: below every gait that walks (the tuner's runs that fall
+score lower still, by the distance they did not cover).
 
 The method: gradient ascent in z with a backtracking line search (Armijo's rule), each
 gradient from central differences of J (2 n fixed points, each found from the last one) and
@@ -35,8 +36,12 @@ from planarsim.analysis import StepMapError, find_fixed_point
 #: walker -> (module, class) of its gait map (x0, step_map(), cycle(x), params=...)
 GAIT_MAPS = {"simple-biped": ("walkers.simple_biped.gait_map", "SimpleBipedGaitMap")}
 
-#: [s] walking before the section a fixed point's Newton starts from (then from the last one)
+#: [s] walking before the section each fixed point's Newton starts from (so that J is a
+#: function of the parameters alone, never of the evaluations before it)
 SETTLE = 5.0
+#: residual [m, m/s] a fixed point must reach: the stride map jumps by about 1e-4 between
+#: nearby points (its controller switches on sim steps), which Newton cannot go below
+FIXED_POINT_TOL = 5e-4
 #: central-difference step of the gradient, in units of each parameter's bounds; the gait
 #: map's O(dt) jumps (its controller switches on sim steps) move J by ~1e-4 of itself, so a
 #: step well above that share of the range (the Simple Biped's gains sit at 2-3 % of theirs)
@@ -66,7 +71,9 @@ class GaitScore:
 class GradientTuneResult:
     """A gradient tuning run: best parameters (all fields), their score and the start's, the
     tuned names, per iteration dict(iteration, score, gradient_norm, step, evaluations) and the
-    number of fixed points found (objective evaluations); stopped: why it ended early."""
+    number of fixed points found (objective evaluations); stopped: why it ended early. History
+    keys: iteration, score, gradient_norm (of the gradient projected on the box), largest_move
+    [unit of bounds], evaluations."""
     walker: str
     names: tuple
     best_params: dict
@@ -99,17 +106,25 @@ class GaitObjective:
         self.gait_map = getattr(importlib.import_module(module), cls)
         self.base = base if base is not None else objective.Params()
         tunable = list(self.base.names(True))
+        if isinstance(names, str):
+            names = (names,)
         names = tuple(names) if names is not None else tuple(tunable)
         unknown = [n for n in names if n not in tunable]
         if unknown or not names:
             raise ValueError(f"not tunable parameters of {walker}: {unknown or 'none given'}; "
                              f"tunable: {', '.join(tunable)}")
+        if len(set(names)) != len(names):
+            raise ValueError(f"parameters named twice: {names}")
         self.names = names
         self.bounds = self.base.bounds(True)[[tunable.index(n) for n in names]]
         self.settings = dict(objective.DEFAULT_SETTINGS, **(settings or {}))
+        unused = {k: v for k, v in self.settings.items() if k not in ("duration", "cot_weight",
+                  "fall_penalty") and v != objective.DEFAULT_SETTINGS.get(k)}
+        if unused:
+            raise ValueError(f"settings {unused} are not taken by the periodic gait's objective "
+                             "(its gait map walks flat ground at its own dt)")
         self.settle = float(settle)
         self.evaluations = 0
-        self._x = None          # the last fixed point found: the next Newton's start
 
     def z_of(self, params) -> np.ndarray:
         """Unit coordinates of params' tuned fields."""
@@ -128,11 +143,9 @@ class GaitObjective:
         fail = -float(st["fall_penalty"])
         try:
             gm = self.gait_map(settle=self.settle, params=self.params_at(z))
-            f = gm.step_map()
-            x0 = gm.x0 if self._x is None else self._x
-            fp = find_fixed_point(f, x0, eps=_eps(gm))
-            if not np.all(np.isfinite(fp.x)):
-                return GaitScore(fail, failed="no fixed point")
+            fp = find_fixed_point(gm.step_map(), gm.x0, tol=FIXED_POINT_TOL, eps=_eps(gm))
+            if not fp.converged:
+                return GaitScore(fail, fp.x, failed=f"no fixed point (residual {fp.residual:.2g})")
             radius = float(np.max(np.abs(fp.multipliers)))
             if radius >= 1.0:
                 return GaitScore(fail, fp.x, spectral_radius=radius, failed="unstable gait")
@@ -141,7 +154,6 @@ class GaitObjective:
             return GaitScore(fail, failed=str(e))
         if not (c["duration"] > 0.0 and c["distance"] > 0.0):
             return GaitScore(fail, fp.x, failed="the gait does not move forward")
-        self._x = fp.x
         speed = c["distance"] / c["duration"]
         cot = c["positive_work"] / (c["weight"] * c["distance"])
         score = float(st["duration"]) * speed - float(st["cot_weight"]) * cot
@@ -195,19 +207,26 @@ def tune_gait(walker: str = "simple-biped", names=None, iterations: int = 10, pa
     history, stopped = [], ""
     for it in range(int(iterations)):
         g = J.gradient(z, current)
+        g[((z <= 0.0) & (g < 0.0)) | ((z >= 1.0) & (g > 0.0))] = 0.0   # (onto the box)
         norm = float(np.linalg.norm(g))
         if not norm > 0.0:
-            stopped = "the gradient vanished"
+            stopped = "the gradient vanished (or points out of the box at every parameter)"
             break
         step = FIRST_MOVE / float(np.max(np.abs(g)))
         for _ in range(HALVINGS + 1):
             trial_z = np.clip(z + step * g, 0.0, 1.0)
+            if np.array_equal(trial_z, z):
+                trial = None
+                break
             trial = J(trial_z)
             if not trial.failed and trial.score >= current.score + ARMIJO * float(g @ (trial_z - z)):
                 break
             step *= 0.5
         else:
             stopped = "no ascent along the gradient (the line search gave up)"
+            break
+        if trial is None:
+            stopped = "the step no longer moves the parameters"
             break
         moved = float(np.max(np.abs(trial_z - z)))
         z, current = trial_z, trial

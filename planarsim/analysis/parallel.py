@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import threading
+import uuid
 from collections import OrderedDict
 import signal
 from concurrent.futures import ThreadPoolExecutor
@@ -29,7 +30,7 @@ from .stepmap import StepMapError
 BACKENDS = ("process", "thread", "serial", "dask")
 
 _WORKER = {}          # in a forked worker: family and its map cache
-_DASK_MAPS = {}       # in a dask worker: {pool token: its maps}
+_DASK_MAPS = {}       # in a dask worker: {(pool token, thread): that thread's maps}
 _LOCAL = threading.local()
 
 
@@ -119,11 +120,20 @@ def _process_run(args):
 
 
 def _dask_run(token, family, cache, task, items):
-    """A chunk of items on a dask worker, on the maps it keeps for the pool `token`."""
-    maps = _DASK_MAPS.get(token)
+    """A chunk of items on a dask worker, on the maps its thread keeps for the pool `token`
+    (a walker's simulator is not shared between threads)."""
+    key = (token, threading.get_ident())
+    maps = _DASK_MAPS.get(key)
     if maps is None:
-        maps = _DASK_MAPS[token] = _Maps(family, cache)
+        maps = _DASK_MAPS[key] = _Maps(family, cache)
     return [task(maps, item) for item in items]
+
+
+def _dask_forget(token):
+    """Drop the maps a dask worker keeps for the pool `token` (its close())."""
+    for key in list(_DASK_MAPS):
+        if key[0] == token:
+            _DASK_MAPS.pop(key, None)
 
 
 def _dask_client(scheduler):
@@ -149,25 +159,30 @@ class MapPool:
         where they have them (None, the default), always (True: an error where one has none)
         or never (False: polynomial fits).
     scheduler : a dask scheduler's address ("tcp://host:8786") or a distributed.Client: the
-        evaluations run on its workers (backend "dask"; workers: the chunks a run is cut
-        into per worker, default 4). The family must pickle.
+        evaluations run on its workers' threads (backend "dask"; workers: the chunks a run is
+        cut into per thread, default 4). The family must pickle.
     Use as a context manager (or call close()).
     """
 
-    def __init__(self, family: Callable, workers: int | None = None, backend: str = "process",
+    def __init__(self, family: Callable, workers: int | None = None, backend: str | None = None,
                  cache: int = 8, exact: bool | None = None, scheduler=None):
+        if backend is None:
+            backend = "process" if scheduler is None else "dask"
         if backend not in BACKENDS:
             raise ValueError(f"backend={backend!r} must be one of {BACKENDS}")
-        if (backend == "dask") != (scheduler is not None) and backend != "process":
+        if (backend == "dask") != (scheduler is not None):
             raise ValueError(f"backend={backend!r} with scheduler={scheduler!r}: a dask pool "
                              "is made by giving its scheduler (backend 'dask' or left out)")
         self.family, self.cache = family, int(cache)
         self._client, self._own_client = None, False
         if scheduler is not None:
-            backend = "dask"
+            if workers is not None and int(workers) < 1:
+                raise ValueError(f"workers={workers}: chunks per dask thread must be >= 1")
             self._client, self._own_client = _dask_client(scheduler)
-            self.workers = max(1, len(self._client.scheduler_info().get("workers", {})))
-            self._chunks = 4 if workers is None else max(1, int(workers))
+            info = self._client.scheduler_info().get("workers", {})
+            self.workers = max(1, sum(int(w.get("nthreads", 1)) for w in info.values()))
+            self._chunks = 4 if workers is None else int(workers)
+            self._token = f"mappool-{uuid.uuid4().hex}"
         else:
             self.workers = _check_workers(workers)
         if self.workers == 1 and backend != "dask":
@@ -198,8 +213,13 @@ class MapPool:
         return _LOCAL.maps["maps"]
 
     def close(self):
-        if self._own_client and self._client is not None:
-            self._client.close()
+        if self._client is not None:
+            try:
+                self._client.run(_dask_forget, self._token)
+            except Exception:       # (a cluster already gone keeps nothing)
+                pass
+            if self._own_client:
+                self._client.close()
             self._client = None
         if self._pool is not None:
             if self.backend == "process":
@@ -267,17 +287,20 @@ class MapPool:
         n = len(items)
         size = max(1, -(-n // (self.workers * self._chunks)))
         chunks = [items[k:k + size] for k in range(0, n, size)]
-        token = f"mappool-{id(self)}"
-        futures = [self._client.submit(_dask_run, token, self.family, self.cache, task, c,
-                                       pure=False) for c in chunks]
+        futures = [self._client.submit(_dask_run, self._token, self.family, self.cache, task,
+                                       c, pure=False) for c in chunks]
         where = {f.key: i for i, f in enumerate(futures)}
         parts, done = [None] * len(chunks), 0
-        for f in as_completed(futures):
-            i = where[f.key]
-            parts[i] = f.result()
-            done += len(parts[i])
-            if progress:
-                progress(done, n)
+        try:
+            for f in as_completed(futures):
+                i = where[f.key]
+                parts[i] = f.result()
+                done += len(parts[i])
+                if progress:
+                    progress(done, n)
+        except BaseException:
+            self._client.cancel(futures)      # (an error or Ctrl-C: the rest is not wanted)
+            raise
         return [r for part in parts for r in part]
 
     def evaluate(self, X, p, period: int = 1):

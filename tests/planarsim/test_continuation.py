@@ -302,15 +302,21 @@ def test_a_dask_cluster_gives_the_pools_answers_bit_for_bit():
     with MapPool(family, backend="serial") as serial:
         want = basin_of_attraction(serial, 0.009, a, b, state, x, n_steps=12, tol=1e-3)
         Y0, ok0 = serial.evaluate(np.array([x, x + 0.001, x - 0.001]), 0.009)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=2, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
+        client.wait_for_workers(2)
+        with pytest.raises(ValueError, match="scheduler"):
+            MapPool(family, backend="process", scheduler=client)
         with MapPool(family, scheduler=client) as pool:
-            assert pool.backend == "dask" and pool.workers == 2
+            assert pool.backend == "dask" and pool.workers == 4     # (threads: each its maps)
             got = basin_of_attraction(pool, 0.009, a, b, state, x, n_steps=12, tol=1e-3)
             Y, ok = pool.evaluate(np.array([x, x + 0.001, x - 0.001]), 0.009)
+        # a second pool of another family on the same workers uses its own maps
+        with MapPool(WalkerFamily("simplest-walker", "slope", dt=1e-3), scheduler=client) as other:
+            Y1, _ = other.evaluate(np.array([x]), 0.009)
+        with MapPool(WalkerFamily("simplest-walker", "slope", dt=1e-3), backend="serial") as ref:
+            assert np.array_equal(Y1, ref.evaluate(np.array([x]), 0.009)[0])
     assert np.array_equal(got.steps, want.steps) and np.array_equal(got.fell, want.fell)
     assert np.array_equal(got.reached, want.reached)
     assert np.array_equal(ok, ok0) and np.array_equal(Y[ok], Y0[ok0])
-    with pytest.raises(ValueError, match="scheduler"):
-        MapPool(family, backend="thread", scheduler=client)

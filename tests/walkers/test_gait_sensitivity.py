@@ -77,3 +77,17 @@ def test_the_norm_predicts_the_walkers_response_to_a_tilted_step(params, x0, rel
     assert np.allclose(s.response[:5, :, 0], response[:5], rtol=10 * rel, atol=1e-6 * s.norm)
     if isinstance(params, RimlessParams):
         assert np.max(np.abs(response[:, 1])) < 1e-8
+
+
+@pytest.mark.parametrize("tilt", [0.01, -0.005])
+def test_a_tilted_steps_start_is_the_same_world_state(tilt):
+    """TiltStep's frame: the simplest walker at theta + e on a slope steeper by e stands and
+    moves as the walker at theta on its own slope (the floor turned about the stance foot)."""
+    params = SimplestParams()
+    x = np.array([0.2002, -0.1999, 0.4003, -0.0158])
+    a = PassiveWalker(params)
+    b = PassiveWalker(params.replace(slope=params.slope + tilt))
+    a.set_coords(x)
+    b.set_coords(x + np.array([tilt, 0.0, 0.0, 0.0]))
+    assert np.allclose(a.sim.state.q, b.sim.state.q, rtol=0.0, atol=1e-12)
+    assert np.allclose(a.sim.state.v, b.sim.state.v, rtol=0.0, atol=1e-12)

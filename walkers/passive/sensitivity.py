@@ -3,11 +3,13 @@ ground under one step: the step from the section is walked on a slope steeper by
 (the floor there turned about the stance foot), every later one on the walker's own slope.
 Indicators: the step's period [s] and its length along the ground [m].
 
-The section coordinates measure the stance leg's angle from the slope's normal (gait.py); the
-same leg is e further from the tilted floor's normal, so the disturbed step starts from
-theta + e and its end is told back in the walker's own frame as theta - e (the legs' angle
-between them and the rates are the same in both frames; the rimless wheel's one coordinate,
-its rate, too).
+The two-legged walkers' section coordinates measure the stance leg's angle from the slope's
+normal (gait.py); the same leg is e further from the tilted floor's normal, so the disturbed
+step starts from theta + e (the same world state) and its end is told back in the walker's
+own frame as theta - e (the legs' angle between them and the rates are the same in both
+frames). The rimless wheel's section has no angle (each step starts at its spoke's touchdown
+angle from the floor's normal), so for it the tilt is that of the whole step, gravity turned
+by e for one step: a different disturbance, whose norm is not comparable with the others'.
 
     from walkers.passive.sensitivity import tilt_sensitivity
     gsn = tilt_sensitivity(SimplestParams(), x_star).norm

@@ -21,13 +21,12 @@ from __future__ import annotations
 import numpy as np
 
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, step, height
+from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, step
 
 from walkers.common.section import GaitMapMixin, copy_tuple, restore_tuple
 
 from . import controller as C
-from .params import FIELD
-from .rollout import Run, _longest_leg
+from .rollout import Run, add_positive_work, fell_down
 
 NAMES = ("hip_dx", "hip_dy", "hip_vx", "hip_vy", "rear_dx", "v_top")
 DT = 1e-4       # [s] analysis step: the controller switches at step boundaries, which makes the
@@ -52,11 +51,8 @@ def rollout_to_touchdown(m, s, ws, opt, tab, mem, u, n_events, max_steps):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i
-        for a in range(ws.act_power.shape[0]):
-            if ws.act_power[a] > 0.0:
-                mem[C.MEM.work] += ws.act_power[a] * m.dt
-        if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[FIELD.fall_height] * p[FIELD.leg_length]
-                or _longest_leg(s.q) > p[FIELD.fall_leg_length] * p[FIELD.leg_length]):
+        add_positive_work(m, ws, mem)
+        if fell_down(m, s, p):
             mem[C.MEM.fallen] = 1.0
             return RUN_FELL, i + 1
     return RUN_NO_EVENT, max_steps
@@ -156,8 +152,7 @@ class SimpleBipedGaitMap(GaitMapMixin):
         self.set_section(x)
         t0, x_hip, work0 = float(self.s.time[0]), float(self.s.q[0, 0]), float(self.mem[C.MEM.work])
         self.advance_from_section()
-        model = self.walker.model
         return {"duration": float(self.s.time[0]) - t0,
                 "distance": float(self.s.q[0, 0]) - x_hip,
                 "positive_work": float(self.mem[C.MEM.work]) - work0,
-                "weight": model.total_mass * float(np.hypot(*model.arrays.gravity))}
+                "weight": self.walker.weight()}

@@ -37,6 +37,22 @@ def _longest_leg(q):
 
 
 @jit
+def add_positive_work(m, ws, mem):
+    """The actuators' positive work over the last step [J] into mem[MEM.work]."""
+    for a in range(ws.act_power.shape[0]):
+        if ws.act_power[a] > 0.0:
+            mem[C.MEM.work] += ws.act_power[a] * m.dt
+
+
+@jit
+def fell_down(m, s, p):
+    """The walker has fallen: the hip below fall_height above the ground, or a leg longer than
+    fall_leg_length (p: the parameter table)."""
+    return (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[FIELD.fall_height] * p[FIELD.leg_length]
+            or _longest_leg(s.q) > p[FIELD.fall_leg_length] * p[FIELD.leg_length])
+
+
+@jit
 def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, k0):
     """n steps of control + physics, recording every `every`-th step into rec / lab (memory
     slots `slots`) from frame k0. Stops on a fall (RUN_FELL, mem[MEM.fallen]=1): the hip below
@@ -49,12 +65,9 @@ def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, 
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, k
-        for a in range(ws.act_power.shape[0]):
-            if ws.act_power[a] > 0.0:
-                mem[C.MEM.work] += ws.act_power[a] * m.dt
+        add_positive_work(m, ws, mem)
         k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
-        if (s.q[0, 1] - height(m.terrain_coef, s.q[0, 0]) < p[FIELD.fall_height] * p[FIELD.leg_length]
-                or _longest_leg(s.q) > p[FIELD.fall_leg_length] * p[FIELD.leg_length]):
+        if fell_down(m, s, p):
             mem[C.MEM.fallen] = 1.0
             return RUN_FELL, i + 1, k
     return 0, n, k
@@ -120,13 +133,17 @@ class Run(WalkerRun):
     def gait(self) -> str:
         return C.Gait(int(self.memory[C.MEM.gait])).name.lower()
 
+    def weight(self) -> float:
+        """The walker's weight [N] (cost of transport = positive work / (weight distance))."""
+        return self.model.total_mass * float(np.hypot(*self.model.arrays.gravity))
+
     # the contract -----------------------------------------------------------------------------
     def numbers(self) -> dict:
         """distance [m] and mean_speed [m/s] of the hip since the start, positive actuator work
         [J] and cost of transport (that work per weight and distance [-]), steps, jumps, fell."""
         t = self.time
         dist = float(self.state.q[0, 0]) - self.x_start
-        weight = self.model.total_mass * float(np.hypot(*self.model.arrays.gravity))
+        weight = self.weight()
         work = float(self.memory[C.MEM.work])
         return {"time": t, "distance": dist, "mean_speed": dist / t if t > 0 else 0.0,
                 "positive_work": work,
