@@ -15,8 +15,8 @@ unit circle) scores -fall_penalty: below every gait that walks (the tuner's runs
 score lower still, by the distance they did not cover).
 
 The method: gradient ascent in z with a backtracking line search (Armijo's rule), each
-gradient from central differences of J (2 n fixed points, each found from the last one) and
-each trial kept inside the box. Deterministic: the same start and settings give the same
+gradient from central differences of J (2 n fixed points, each from its own settled walk),
+projected on the box, and each trial kept inside it. Deterministic: the same start and settings give the same
 result.
 
     from walkers.gait_gradient import tune_gait
@@ -70,10 +70,9 @@ class GaitScore:
 @dataclass
 class GradientTuneResult:
     """A gradient tuning run: best parameters (all fields), their score and the start's, the
-    tuned names, per iteration dict(iteration, score, gradient_norm, step, evaluations) and the
-    number of fixed points found (objective evaluations); stopped: why it ended early. History
-    keys: iteration, score, gradient_norm (of the gradient projected on the box), largest_move
-    [unit of bounds], evaluations."""
+    tuned names, per iteration dict(iteration, score, gradient_norm (of the gradient projected
+    on the box), largest_move [unit of bounds], evaluations), the number of fixed points found
+    (objective evaluations); stopped: why it ended early."""
     walker: str
     names: tuple
     best_params: dict
@@ -103,7 +102,10 @@ class GaitObjective:
                              f"gradient tuning takes: {', '.join(sorted(GAIT_MAPS))}")
         self.walker = walker
         module, cls = GAIT_MAPS[walker]
-        self.gait_map = getattr(importlib.import_module(module), cls)
+        module = importlib.import_module(module)
+        self.gait_map = getattr(module, cls)
+        # Newton's difference step where the map has no exact Jacobian: its module's EPS
+        self.eps = float(getattr(module, "EPS", 1e-6))
         self.base = base if base is not None else objective.Params()
         tunable = list(self.base.names(True))
         if isinstance(names, str):
@@ -143,7 +145,7 @@ class GaitObjective:
         fail = -float(st["fall_penalty"])
         try:
             gm = self.gait_map(settle=self.settle, params=self.params_at(z))
-            fp = find_fixed_point(gm.step_map(), gm.x0, tol=FIXED_POINT_TOL, eps=_eps(gm))
+            fp = find_fixed_point(gm.step_map(), gm.x0, tol=FIXED_POINT_TOL, eps=self.eps)
             if not fp.converged:
                 return GaitScore(fail, fp.x, failed=f"no fixed point (residual {fp.residual:.2g})")
             radius = float(np.max(np.abs(fp.multipliers)))
@@ -179,13 +181,6 @@ class GaitObjective:
                 (d, a), = sides
                 g[i] = (a - center.score) / d
         return g
-
-
-def _eps(gm) -> float:
-    """The finite-difference step of a gait map's module (its EPS), for Newton's Jacobian where
-    the map has no exact one."""
-    import sys
-    return float(getattr(sys.modules[type(gm).__module__], "EPS", 1e-6))
 
 
 def tune_gait(walker: str = "simple-biped", names=None, iterations: int = 10, params=None,

@@ -95,8 +95,7 @@ def gait_sensitivity(step: Callable, x, disturbances: int = 1, eps: float = 1e-6
         y, g = step(xx, e)
         return np.asarray(y, dtype=np.float64), np.atleast_1d(np.asarray(g, dtype=np.float64))
 
-    y0, g0 = at(x, zero)
-    p = g0.size
+    p = at(x, zero)[1].size          # (the indicators' count)
     B, D = np.zeros((d, m)), np.zeros((p, m))
     for j in range(m):
         e = np.zeros(m)
