@@ -15,6 +15,8 @@ five-stage composition (accurate_step; kernels/rattle.py).
 """
 import math
 
+import numpy as np
+
 from ..compile import kernel
 from .audit import PIN_GAP_TOL, audit_impulses, audit_total
 from .broad_phase import FLAG_LIVE, widen_for_answer
@@ -236,6 +238,36 @@ def switch_contacts(m, s, ws, only_first):
     return changed
 
 
+@kernel(inline="always")
+def _mix(key, x):
+    """key with the integer x mixed in (splitmix64's finaliser on their sum)."""
+    z = (key ^ np.uint64(x)) + np.uint64(0x9E3779B97F4A7C15)
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@kernel
+def modes_key(s, ws, stall, fewest):
+    """A 64-bit key of what decides switch_rounds' rounds from here: the listed contacts with
+    their modes and slip directions, the limits engaged, the rounds without fewer broken
+    rules (up to SWITCH_STALL: the switching rule) and the fewest so far, and the
+    least-change answers' state (solve_and_check)."""
+    key = _mix(np.uint64(0), ws.n_live[0])
+    key = _mix(key, stall)
+    key = _mix(key, fewest & 0xFFFFFFFF)
+    key = _mix(key, ws.least_change[1])
+    key = _mix(key, min(ws.least_change[2], LEAST_CHANGE_CALLS))
+    for j in range(s.limit_active.shape[0]):
+        key = _mix(key, j * 4 + s.limit_active[j, 0] * 2 + s.limit_active[j, 1])
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
+        slip = s.contact_slip[i]
+        sign = 2 if slip > 0.0 else (0 if slip < 0.0 else 1)
+        key = _mix(key, i * 9 + s.contact_mode[i] * 3 + sign)
+    return key
+
+
 @kernel(inline="never")
 def switch_rounds(m, s, ws, opt, h, include_ccd):
     """After the guess and the alternating check broke a rule: the contacts that break one
@@ -254,9 +286,24 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
     breaks = 1
     fewest = 1 << 62
     stall = 0
-    for _ in range(SWITCH_ROUNDS):
+    # Brent's cycle finding on the rounds' keys (modes_key: what decides the rounds from
+    # there): a key met again means the rounds repeat the same modes to the last without an
+    # answer, so they end at once (the complementarity solve takes the step, as it would
+    # after the last round)
+    marked = np.uint64(0)
+    since = 0
+    span = 1
+    for r in range(SWITCH_ROUNDS):
         if breaks > 0 and switch_contacts(m, s, ws, stall >= SWITCH_STALL) == 0:
             break
+        key = modes_key(s, ws, min(stall, SWITCH_STALL), fewest)
+        if r > 0 and key == marked:
+            break
+        since += 1
+        if since == span:
+            marked = key
+            span *= 2
+            since = 0
         breaks, engaged, more = solve_and_check(m, s, ws, opt, h, include_ccd)
         solves += more
         if ws.room[0] == 1 or (breaks == 0 and engaged == 0):
