@@ -238,7 +238,7 @@ class Simulator:
 
     def steps(self, n: int, u=None) -> None:
         """n steps under constant commands, compiled as one loop."""
-        n = int(n)
+        n = _whole_count("n", n)
         if n < 0:
             raise ValueError(f"n={n} steps must be >= 0")
         self._run_steps(self._commands(u), n)
@@ -256,8 +256,8 @@ class Simulator:
             (only with a controller), stored in Trajectory.labels.
         """
         n = _count_steps(self.dt, duration, n_steps)
-        every = int(record_every)
-        if every < 1 or int(control_every) < 1:
+        every = _whole_count("record_every", record_every)
+        if every < 1 or _whole_count("control_every", control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")
         # frame 0: the start; then the steps whose count is a multiple of `every`
         check_recording(self.model, n // every + 2,
@@ -335,7 +335,14 @@ class Simulator:
         self.state = snap
 
     def set_contact_enabled(self, contact, enabled: bool) -> None:
-        i = self.model.contact(contact) if isinstance(contact, str) else int(contact)
+        """Turn contact `contact` (its name or index 0..n_contact-1) on or off."""
+        if isinstance(contact, str):
+            i = self.model.contact(contact)
+        else:
+            i = _whole_count("contact", contact)
+            if not 0 <= i < self.model.n_contact:
+                raise IndexError(f"contact={contact} is not a contact of the model: it has "
+                                 f"{self.model.n_contact}, indices 0..{self.model.n_contact - 1}")
         self.state.contact_enabled[i] = 1 if enabled else 0
 
     def contact_impulses(self) -> np.ndarray:
@@ -343,16 +350,30 @@ class Simulator:
         return self.ws.contact_impulse.copy()
 
 
+def _whole_count(name, n):
+    """n as an int, refused where it is not a whole number (2.7 steps, NaN)."""
+    try:
+        i = int(n)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{name}={n!r} must be a whole number") from None
+    if i != n:
+        raise ValueError(f"{name}={n!r} must be a whole number")
+    return i
+
+
 def _count_steps(dt, duration, n_steps):
     if (duration is None) == (n_steps is None):
         raise ValueError("give exactly one of duration [s] or n_steps")
     if n_steps is not None:
-        n = int(n_steps)
+        n = _whole_count("n_steps", n_steps)
     else:
         duration = float(duration)
         if not np.isfinite(duration) or duration < 0:
             raise ValueError(f"duration={duration} must be finite and >= 0 seconds")
         n = int(round(duration / dt))
+        if n == 0 and duration > 0:
+            raise ValueError(f"duration={duration:g} s is less than half a step (dt={dt:g} s): "
+                             "the run would take no step")
     if n < 0:
         raise ValueError(f"n_steps={n} must be >= 0")
     return n

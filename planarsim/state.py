@@ -176,11 +176,21 @@ def check_state(state, model: Model | None = None, what: str = "state") -> None:
             raise ValueError(f"{what}.{name}[{', '.join(map(str, i))}]={a[i].item()}{who} {words}")
 
 
+def _body_rows(name, a, n_body):
+    """a as a fresh (n_body, 3) float array: one row per body, exactly that shape (a transposed
+    or flattened array would be read as other bodies' numbers)."""
+    arr = np.array(a, dtype=np.float64)
+    if arr.shape != (n_body, 3):
+        raise ValueError(f"{name} has shape {arr.shape}; it must be ({n_body}, 3): one row "
+                         f"(x, y, theta) per body of the model, in the model's body order")
+    return arr.copy()
+
+
 def make_state(model: Model, q=None, v=None) -> State:
     """Initial State of `model` (build pose and velocities unless q, v are given)."""
     nb, nc, npin = model.n_body, model.n_contact, model.n_pin
-    q = np.array(model.q0 if q is None else q, dtype=np.float64).reshape(nb, 3).copy()
-    v = np.array(model.v0 if v is None else v, dtype=np.float64).reshape(nb, 3).copy()
+    q = _body_rows("q", model.q0 if q is None else q, nb)
+    v = _body_rows("v", model.v0 if v is None else v, nb)
     return State(q=q, v=v, time=np.zeros(1), step=np.zeros(1, np.int64),
                  contact_mode=np.zeros(nc, np.int64), contact_slip=np.ones(nc),
                  contact_enabled=np.ones(nc, np.int64), limit_active=np.zeros((npin, 2), np.int64),

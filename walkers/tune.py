@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -173,6 +174,11 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
     """
     import cma
 
+    if not (math.isfinite(float(sigma0)) and float(sigma0) > 0):
+        raise ValueError(f"sigma0={sigma0} must be a positive number (a fraction of each "
+                         "bound's width)")
+    if popsize is not None and int(popsize) < 2:
+        raise ValueError(f"popsize={popsize} must be at least 2")
     mod = objective_module(walker)
     params0 = x0 if x0 is not None else mod.Params()
     base = params0.as_dict()
@@ -180,7 +186,7 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
     b = params0.bounds(True)
     z0 = (params0.tunable_array() - b[:, 0]) / (b[:, 1] - b[:, 0])
     opts = {"seed": int(seed) + 1, "bounds": [0.0, 1.0], "verbose": -9, "maxfevals": int(budget)}
-    if popsize:
+    if popsize is not None:
         opts["popsize"] = int(popsize)
     es = cma.CMAEvolutionStrategy(z0.tolist(), float(sigma0), opts)
     if int(budget) < es.popsize:
@@ -233,6 +239,22 @@ def tune(walker: str = "simbicon", x0=None, budget: int = 100, popsize: int | No
     return result
 
 
+def _bad_tune_flags(a) -> str | None:
+    """What is wrong with the command line's numbers, before any candidate runs (None: all
+    right)."""
+    if not (math.isfinite(a.sigma0) and a.sigma0 > 0):
+        return f"--sigma0 {a.sigma0} must be a positive number (a fraction of each bound's width)"
+    if a.popsize is not None and a.popsize < 2:
+        return f"--popsize {a.popsize} must be at least 2 (CMA-ES recombines two or more)"
+    if a.workers is not None and a.workers < 1:
+        return f"--workers {a.workers} must be at least 1"
+    if a.budget < 1:
+        return f"--budget {a.budget} must be at least 1"
+    if a.duration is not None and not (math.isfinite(a.duration) and a.duration > 0):
+        return f"--duration {a.duration} must be a positive number of seconds"
+    return None
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="planarsim tune", description="CMA-ES tuning of a walker",
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
@@ -252,13 +274,16 @@ def main(argv=None) -> int:
                     help="simulated seconds per objective run (None: the objective's own)")
     ap.add_argument("--out", default="tuned.json", help="result file, written after every generation")
     a = ap.parse_args(argv)
+    bad = _bad_tune_flags(a)
+    if bad:
+        ap.error(bad)
     try:
         objective_module(a.walker)
     except (KeyError, ValueError) as e:
         print(f"planarsim tune: {e}", file=sys.stderr)
         return 2
     x0 = load_result(a.start).params() if a.start else None
-    settings = {"duration": a.duration} if a.duration else None
+    settings = {"duration": a.duration} if a.duration is not None else None
     try:
         r = tune(a.walker, x0=x0, budget=a.budget, popsize=a.popsize, sigma0=a.sigma0,
                  seed=a.seed, workers=a.workers, scheduler=a.scheduler, out=a.out,

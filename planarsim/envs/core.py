@@ -280,6 +280,9 @@ class PlanarMujocoEnv(gymnasium.Env):
 
     def __init__(self, xml_file: str, frame_skip: int, observation_space=None,
                  render_mode: str | None = None, width: int = 480, height: int = 480, **load_kw):
+        if isinstance(frame_skip, bool) or int(frame_skip) != frame_skip or frame_skip < 1:
+            raise ValueError(f"{type(self).__name__}: frame_skip={frame_skip!r} must be a whole "
+                             "number of physics steps per env step, at least 1")
         unknown = sorted(set(load_kw) - LOAD_KEYWORDS)
         if unknown:
             raise TypeError(f"{type(self).__name__}: unknown keyword(s) {unknown}; it takes its "

@@ -202,3 +202,61 @@ def test_valid_states_still_pass(tmp_path):
     free = ps.ModelBuilder()
     free.add_point_mass("ball", 1.0, radius=0.0)   # a radius of 0 only draws nothing
     assert ps.Simulator(free.compile()).state.mode_cursor[0] == 0
+
+
+def two_bodies():
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_body("a", 1.0, 0.1, pos=(0.0, 1.0))
+    b.add_body("b", 1.0, 0.1, pos=(0.6, 1.0), angle=0.2)
+    return b.compile()
+
+
+@pytest.mark.parametrize("shape", ["transposed", "flat", "short"])
+def test_poses_of_the_wrong_shape_are_refused(shape):
+    """A (3, n_body) or flat q was reshaped into other bodies' numbers (a transposed pose of
+    two bodies read as [[0, 0, 0.2], [0.6, 0, 0]])."""
+    m = two_bodies()
+    q = np.array(m.q0, float)
+    bad = {"transposed": q.T.copy(), "flat": q.ravel(), "short": q.ravel()[:5]}[shape]
+    sim = ps.Simulator(m)
+    with pytest.raises(ValueError, match=r"q has shape .* must be \(2, 3\)"):
+        sim.start_over(q=bad)
+    with pytest.raises(ValueError, match=r"v has shape .* must be \(2, 3\)"):
+        ps.make_state(m, v=bad)
+    assert np.array_equal(sim.state.q, q)          # nothing was put in
+
+
+@pytest.mark.parametrize("index, pattern", [(-1, "not a contact"), (2, "not a contact"),
+                                            (1.7, "whole number"), (NAN, "whole number")])
+def test_contact_switch_names_a_contact(index, pattern):
+    """set_contact_enabled(-1) turned off the last contact and 1.7 the second."""
+    sim = ps.Simulator(resting_rod())
+    before = sim.state.contact_enabled.copy()
+    with pytest.raises((IndexError, ValueError), match=pattern):
+        sim.set_contact_enabled(index, False)
+    assert np.array_equal(sim.state.contact_enabled, before)
+
+
+@pytest.mark.parametrize("call, pattern", [
+    (lambda sim: sim.steps(2.7), r"n=2.7 must be a whole number"),
+    (lambda sim: sim.steps(NAN), "whole number"),
+    (lambda sim: sim.run(n_steps=2.5), r"n_steps=2.5 must be a whole number"),
+    (lambda sim: sim.run(0.01, record_every=2.5), "record_every=2.5"),
+    (lambda sim: sim.run(1e-5), r"less than half a step"),
+])
+def test_step_counts_that_are_not_whole_are_refused(call, pattern):
+    """Fractional counts were truncated, and a run shorter than half a step took none."""
+    sim = ps.Simulator(two_bodies())
+    with pytest.raises(ValueError, match=pattern):
+        call(sim)
+    assert sim.state.step[0] == 0
+    sim.run(0.0)                                   # (an empty run is asked for: fine)
+
+
+@pytest.mark.parametrize("frame_skip", [0, -3, 2.5])
+def test_env_frame_skip_must_be_a_positive_whole_number(frame_skip):
+    """frame_skip=0 divided by zero in the env's render rate; -3 failed at the first step."""
+    gym = pytest.importorskip("gymnasium")
+    import planarsim.envs  # noqa: F401
+    with pytest.raises(ValueError, match="frame_skip"):
+        gym.make("planarsim/InvertedPendulum-v0", frame_skip=frame_skip)

@@ -85,3 +85,26 @@ def test_same_seed_same_result_on_a_dask_cluster(local_run):
 def test_unknown_walker_is_a_clear_error():
     with pytest.raises(KeyError, match="unknown walker 'nope'"):
         tune("nope", budget=1)
+
+
+@pytest.mark.parametrize("flags, culprit", [
+    (["--sigma0", "0"], "--sigma0"), (["--sigma0", "nan"], "--sigma0"),
+    (["--sigma0", "-1"], "--sigma0"), (["--popsize", "1"], "--popsize"),
+    (["--workers", "0"], "--workers"), (["--duration", "0"], "--duration"),
+    (["--budget", "0"], "--budget"),
+])
+def test_bad_numbers_on_the_command_line_stop_before_any_run(flags, culprit, capsys, tmp_path):
+    """--sigma0 0 crashed in CMA-ES after a whole generation; --duration 0 and --workers 0
+    were silently replaced."""
+    from walkers.tune import main
+    out = tmp_path / "t.json"
+    with pytest.raises(SystemExit) as e:
+        main(["simple-biped", "--out", str(out), *flags])
+    assert e.value.code == 2
+    assert culprit in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_tune_refuses_a_zero_step_size():
+    with pytest.raises(ValueError, match="sigma0=0"):
+        tune("simple-biped", budget=4, sigma0=0.0)
