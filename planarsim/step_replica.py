@@ -361,7 +361,8 @@ def contact_rows(cp, q, q0, n_coord):
     contact's normal row then (sticking) its tangent row: the normal row the gap of its point
     (a round sole's centre, less the radius) along the normal at its closest ground point at
     q; the tangent row its material point's distance along the ground tangent at q0 from the
-    ground point found at q0 (a round sole's material point: below its centre at q0); F: the
+    ground point found at q0 (a round sole: its centre's, plus the arc r (theta - theta0) it
+    rolled, the same at q0 as its material point's below the centre); F: the
     rows' impulse directions at q0 (J at q0 but a sliding contact's normal row, along
     n - mu s t at its point). Rows of kernels/contacts.py ground_row and rows.build_rows."""
     B = q.shape[0]
@@ -398,10 +399,18 @@ def contact_rows(cp, q, q0, n_coord):
         F[:, r, 3 * b + 2] = _cross(arm0, d)
         r += 1
         if cp.pinned[k]:
-            arm = _turn(q, b, anchor)
-            c[:, r] = np.sum(t0 * (q[:, b, :2] + arm - g0), axis=-1)
-            J[:, r, cols] = t0
-            J[:, r, 3 * b + 2] = _cross(arm, t0)
+            if cp.radius[k] > 0.0:
+                # a round sole rolls on the ground point without slipping: its centre's move
+                # along t0 plus the arc r dtheta it rolls (ground_row)
+                c[:, r] = (np.sum(t0 * (q[:, b, :2] + arm_n - g0), axis=-1)
+                           + cp.radius[k] * (q[:, b, 2] - th0))
+                J[:, r, cols] = t0
+                J[:, r, 3 * b + 2] = _cross(arm_n, t0) + cp.radius[k]
+            else:
+                arm = _turn(q, b, anchor)
+                c[:, r] = np.sum(t0 * (q[:, b, :2] + arm - g0), axis=-1)
+                J[:, r, cols] = t0
+                J[:, r, 3 * b + 2] = _cross(arm, t0)
             F[:, r, cols] = t0
             F[:, r, 3 * b + 2] = _cross(arm0, t0)
             r += 1

@@ -515,7 +515,8 @@ def ground_row(m, q, cs, ws, o, b, tangent, J, found):
     (tangent False: the exact gap of the material point, or of the sole's centre minus r, along
     the normal of its closest ground point; the same as the start-of-step values at q0 and
     exact on curved ground when the position correction evaluates it at q+) or its tangent row
-    (the material point stays at the ground point found at the step's start). found: this q
+    (the material point stays at the ground point found at the step's start; a rolling sole's
+    arc rolls on it without slipping instead). found: this q
     is the one the contact was found at (stage 2), whose gap and normal are reused."""
     for k in range(3):
         J[0, k] = 0.0
@@ -533,9 +534,22 @@ def ground_row(m, q, cs, ws, o, b, tangent, J, found):
         if ws.contact_on_arc[o] == 1:
             return gap - m.contact_radius[o]
         return gap
-    px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
     tx = ws.contact_normal[o, 1]
     ty = -ws.contact_normal[o, 0]
+    if ws.contact_on_arc[o] == 1:
+        # a rolling sole: no slip holds the arc length it rolls, not its material point (which
+        # would pivot the sole about the start's contact point: r sin(dtheta) a step along
+        # the ground where rolling takes r dtheta). The point under the centre moves along t
+        # by t . dc, and the sole's arc under it by r dtheta: their sum stays t . (p0 - g)
+        # (p0 the start's material point, below the centre), linear in theta; the same row
+        # and error as the material point's at the start's pose (contact_found)
+        cx, cy = world_point(q, cs, b, m.contact_local[o, 0], m.contact_local[o, 1])
+        set_dir(q, b, cx, cy, tx, ty, 1.0, J[1])
+        r = m.contact_radius[o]
+        J[1, 2] += r
+        return (tx * (cx - ws.contact_ground[o, 0]) + ty * (cy - ws.contact_ground[o, 1])
+                + r * (q[b, 2] - ws.contact_found[o, 2]))
+    px, py = world_point(q, cs, b, ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
     set_dir(q, b, px, py, tx, ty, 1.0, J[1])
     return tx * (px - ws.contact_ground[o, 0]) + ty * (py - ws.contact_ground[o, 1])
 
@@ -543,7 +557,8 @@ def ground_row(m, q, cs, ws, o, b, tangent, J, found):
 @kernel
 def ground_lever(m, ws, o, tangent):
     """|x| + |y| [m] from its body's COM of the point ground contact o's row moves: the sole's
-    centre for a rolling sole's normal row, the material point otherwise."""
-    if not tangent and ws.contact_on_arc[o] == 1:
+    centre for a rolling sole's rows (its tangent row's error is linear in the turn about the
+    centre), the material point otherwise."""
+    if ws.contact_on_arc[o] == 1:
         return abs(m.contact_local[o, 0]) + abs(m.contact_local[o, 1])
     return abs(ws.contact_anchor[o, 0]) + abs(ws.contact_anchor[o, 1])
