@@ -61,6 +61,7 @@ import os
 import platform
 import re
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -227,6 +228,16 @@ def _list(text, known, what):
     return items
 
 
+def _writable_folder(folder) -> bool:
+    """Whether folder exists or can be made, and a file can be written in it."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+        return True
+    except OSError:
+        return False
+
+
 def parse_args(argv):
     import walkers
     ap = argparse.ArgumentParser(prog="planarsim bench", description=__doc__,
@@ -262,6 +273,11 @@ def parse_args(argv):
         ap.error(f"unknown scene(s) {unknown}; choose from {list(SCENES)}")
     if args.timing_seconds <= 0:
         ap.error(f"--timing-seconds {args.timing_seconds} must be > 0")
+    for flag in ("csv", "md"):
+        folder = getattr(args, flag)
+        if folder is not None and not _writable_folder(folder):
+            # (checked before the runs, which take minutes, not after them)
+            ap.error(f"--{flag} {folder}: cannot make or write to this folder")
     if args.parts is None:
         args.parts = "scenes,peers" if args.scenes else ",".join(PARTS)
     args.pareto_scenes = [n for n in args.scenes if n in PEER_SCENES] if args.scenes else list(DEFAULT_SCENES)

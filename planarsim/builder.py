@@ -618,6 +618,12 @@ class ModelBuilder:
         length = dist if length is None else _scalar("rod", name, idx, "length", length)
         if not length > 1e-9:
             raise ModelError(f"rod {name!r} ({idx}): length={length} must be > 0")
+        if abs(length - dist) > 1e-9 * max(1.0, length):
+            # the first step would have to close the difference in one move (and then name
+            # the step size, not the rod)
+            raise ModelError(f"rod {name!r} ({idx}): length={length:g} m, but its anchors are "
+                             f"{dist:g} m apart in the build pose; place the bodies so that the "
+                             "rod holds (or leave length out: the build-pose distance)")
         self._rods.append(dict(name=name, body=(a, b), anchor=(la, lb), length=length))
         return idx
 
@@ -744,7 +750,13 @@ class ModelBuilder:
         idx = len(self._acts)
         a = self._body_id("actuator", name, idx, "body_a", body_a)
         b = self._body_id("actuator", name, idx, "body_b", body_b)
+        if a == b:
+            raise ModelError(f"actuator {name!r} ({idx}): body_a and body_b are the same body "
+                             f"({a}): an axial force between a body and itself does nothing")
         la, lb = self._anchors("actuator", name, idx, a, b, None, anchor_a, anchor_b)
+        if not np.hypot(*(self._world(b, lb) - self._world(a, la))) > 0.0:
+            raise ModelError(f"actuator {name!r} ({idx}): its anchors coincide in the build pose, "
+                             "so the force has no direction; place them apart")
         return self._act(name, M.ACT_AXIAL, (a, b, -1), anchors=(la, lb), limit=limit)
 
     def add_hip_torque(self, name, hip, leg_a, leg_b, limit=(-math.inf, math.inf)) -> int:
@@ -755,6 +767,10 @@ class ModelBuilder:
         h = self._body_id("actuator", name, idx, "hip", hip)
         a = self._body_id("actuator", name, idx, "leg_a", leg_a)
         b = self._body_id("actuator", name, idx, "leg_b", leg_b)
+        if len({h, a, b}) < 3:
+            raise ModelError(f"actuator {name!r} ({idx}): hip, leg_a and leg_b must be three "
+                             f"different bodies (got {h}, {a}, {b}): a leg runs from the hip to "
+                             "its own foot")
         return self._act(name, M.ACT_HIP_TORQUE, (a, b, h), limit=limit)
 
     def add_body_force(self, name, body, direction=(1.0, 0.0), limit=(-math.inf, math.inf)) -> int:
@@ -771,6 +787,10 @@ class ModelBuilder:
         """Torque [N m] on one rigid body."""
         idx = len(self._acts)
         bid = self._body_id("actuator", name, idx, "body", body)
+        if self._bodies[bid]["point"]:
+            raise ModelError(f"actuator {name!r} ({idx}): body "
+                             f"{self._bodies[bid]['name']!r} is a point mass, which does not "
+                             "turn: a torque on it does nothing")
         return self._act(name, M.ACT_BODY_TORQUE, (bid, -1, -1), limit=limit)
 
     # colliding shapes -> contacts ------------------------------------------------------------

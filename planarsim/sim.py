@@ -256,6 +256,12 @@ class Simulator:
             (only with a controller), stored in Trajectory.labels.
         """
         n = _count_steps(self.dt, duration, n_steps)
+        if controller is not None and u is not None:
+            raise ValueError("give u (constant commands) or controller, not both: the "
+                             "controller's commands would replace u at every call")
+        if labels is not None and controller is None:
+            raise ValueError("labels are sampled only with a controller (the Python path); "
+                             "without one the steps run compiled and nothing samples them")
         every = _whole_count("record_every", record_every)
         if every < 1 or _whole_count("control_every", control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")

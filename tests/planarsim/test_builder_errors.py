@@ -188,3 +188,34 @@ def test_vectors_in_messages_are_plain_numbers():
         b.add_pin("x", p, q, anchor_world=(0.5, 0.0))
     with pytest.raises(ModelError, match=r"axis=\(0\.0, 0\.0\) must not be zero"):
         b.add_slider("s", None, q, axis=(0.0, 0.0))
+
+
+def test_a_rod_longer_or_shorter_than_its_build_pose_is_refused():
+    """A rod given length 2 between anchors 0.5 m apart compiled, and its first step then
+    stopped, blaming the step size."""
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_point_mass("a", 1.0, pos=(0.0, 1.0))
+    b.add_point_mass("c", 1.0, pos=(0.5, 1.0))
+    with pytest.raises(ModelError, match=r"rod 'r' \(0\): length=2 m, but its anchors are 0.5 m"):
+        b.add_rod("r", "a", "c", length=2.0)
+    b.add_rod("r2", "a", "c", length=0.5)         # (as built: fine)
+
+
+@pytest.mark.parametrize("what, pattern", [
+    ("axial_same", "the same body"), ("axial_coincide", "anchors coincide"),
+    ("hip_same", "three different bodies"), ("torque_point", "is a point mass")])
+def test_actuators_that_cannot_act_are_refused(what, pattern):
+    """Each compiled and its commands did nothing."""
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_point_mass("p", 1.0, pos=(0.0, 1.0))
+    b.add_point_mass("p2", 1.0, pos=(0.0, 1.0))
+    b.add_point_mass("p3", 1.0, pos=(0.3, 0.5))
+    with pytest.raises(ModelError, match=pattern):
+        if what == "axial_same":
+            b.add_axial("ax", "p", "p")
+        elif what == "axial_coincide":
+            b.add_axial("ax", "p", "p2")
+        elif what == "hip_same":
+            b.add_hip_torque("h", "p", "p3", "p3")
+        else:
+            b.add_body_torque("t", "p")

@@ -260,3 +260,13 @@ def test_env_frame_skip_must_be_a_positive_whole_number(frame_skip):
     import planarsim.envs  # noqa: F401
     with pytest.raises(ValueError, match="frame_skip"):
         gym.make("planarsim/InvertedPendulum-v0", frame_skip=frame_skip)
+
+
+def test_run_refuses_arguments_it_would_ignore():
+    """run(u=..., controller=...) dropped u, and labels without a controller were ignored."""
+    sim = ps.Simulator(two_bodies())
+    with pytest.raises(ValueError, match="not both"):
+        sim.run(0.01, u=np.zeros(0), controller=lambda s: np.zeros(0))
+    with pytest.raises(ValueError, match="only with a controller"):
+        sim.run(0.01, labels=lambda s: {"t": s.t})
+    assert sim.state.step[0] == 0
