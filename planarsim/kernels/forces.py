@@ -66,15 +66,22 @@ def pin_angle_rate(m, q, v, j):
 
 @kernel
 def joint_kappa(m, q, cs, j):
-    """g W g^T [1 / (kg m^2) or 1 / kg] of joint j's coordinate row g at q (cs its cos / sin):
-    a hinge's 1 / I_a + 1 / I_b, a slider's along its slide (blocks at anchor b: slider.py)."""
+    """An upper bound [1 / (kg m^2) or 1 / kg] of how fast joint j's coordinate answers a
+    push on it, at q (cs its cos / sin): a hinge to the world turns its body about the hinge,
+    1 / (I + m d^2) (d the anchor's distance from its centre of mass: the pin's rows hold
+    it there); a hinge between two bodies 1 / I_a + 1 / I_b (g W g^T, as if the pin did not
+    hold them: more than it is); a slider's g W g^T along its slide (blocks at anchor b:
+    slider.py). Other joints and contacts only lower it."""
     a = m.pin_body[j, 0]
     b = m.pin_body[j, 1]
     if (m.pin_kind[j] & JOINT_SLIDE_BIT) == 0:
-        kappa = m.body_inv_inertia[b]
-        if a >= 0:
-            kappa += m.body_inv_inertia[a]
-        return kappa
+        if a < 0 or b < 0:
+            e = 1 if a < 0 else 0
+            body = m.pin_body[j, e]
+            d2 = m.pin_anchor[j, e, 0] ** 2 + m.pin_anchor[j, e, 1] ** 2
+            wi = m.body_inv_inertia[body]
+            return wi / (1.0 + wi * d2 / m.body_inv_mass[body])
+        return m.body_inv_inertia[a] + m.body_inv_inertia[b]
     dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, a, b)
     kappa = 0.0
     for e in range(2):

@@ -666,7 +666,16 @@ TURN_TARGET = 1e-3
 
 
 @kernel
-def turn_substeps(m, s, ws, h, most):
+def touching_ground(s, ws):
+    """Some listed ground contact of s is not free (a shape pair's are not judged)."""
+    for k in range(ws.ground_contacts.shape[0]):
+        if s.contact_mode[ws.ground_contacts[k]] != MODE_FREE:
+            return True
+    return False
+
+
+@kernel
+def turn_substeps(m, s, ws, h, most, joints_alone):
     """How many equal sub-steps the step of h [s] is taken in (1..most): a point at lever L
     [m] on a body turning at w [rad/s] leaves the motion its rows linearise by at most
     L (h w)^2 / 2, so where a pin's anchors or a touching (not free) ground contact's point
@@ -674,24 +683,35 @@ def turn_substeps(m, s, ws, h, most):
     within (w and the modes of the state s: the step's start, and again its answer). Taken whole, a
     1.2 t box turning 0.57 rad a step on its corners drove a corner 5 cm into the ground
     and the correction threw the box 2-29 cm farther than its velocities explain
-    (contact_stress mass_ratio:13). A walker (L w ~ 5 m/s at dt 1 ms: 1e-5 m) takes 1."""
+    (contact_stress mass_ratio:13). A walker (L w ~ 5 m/s at dt 1 ms: 1e-5 m) takes 1.
+
+    Where no ground contact touches, the pins count only if joints_alone (a step taken
+    whole that failed): their velocity solve aims at the anchors' second-order drift and the
+    correction holds them, so a mechanism of joints alone is taken whole while that works.
+    A count that followed its turning rate switched a swinging pendulum between h and h / 2
+    as it sped up and slowed down, and each switch moved symplectic Euler's energy by its
+    O(h) term, with the same sign both ways: a rigid pendulum at dt 0.02 lost a quarter of
+    its swing energy in 60 s."""
     curve = 0.0
-    for j in range(m.pin_body.shape[0]):
-        c = 0.0
-        for e in range(2):
-            b = m.pin_body[j, e]
-            if b >= 0:
-                w = s.v[b, 2]
-                c += (abs(m.pin_anchor[j, e, 0]) + abs(m.pin_anchor[j, e, 1])) * w * w
-        curve = max(curve, c)
+    touching = False
     for k in range(ws.ground_contacts.shape[0]):
         i = ws.ground_contacts[k]      # (a shape pair's contacts are not judged here)
         # touching (a contact that touches within the step is seen when the step's answer
         # is judged: _step); its lever bounded by |x| + |y|
         if s.contact_mode[i] == MODE_FREE:
             continue
+        touching = True
         w = s.v[m.contact_body[i], 2]
         curve = max(curve, (abs(m.contact_local[i, 0]) + abs(m.contact_local[i, 1])) * w * w)
+    if touching or joints_alone:
+        for j in range(m.pin_body.shape[0]):
+            c = 0.0
+            for e in range(2):
+                b = m.pin_body[j, e]
+                if b >= 0:
+                    w = s.v[b, 2]
+                    c += (abs(m.pin_anchor[j, e, 0]) + abs(m.pin_anchor[j, e, 1])) * w * w
+            curve = max(curve, c)
     if not curve * h * h > 2.0 * TURN_TARGET:
         return 1
     n = int(math.ceil(h * math.sqrt(curve / (2.0 * TURN_TARGET))))
@@ -775,14 +795,14 @@ def chain_step(m, s, ws, opt, u, step_length):
     if opt.refine_iters == 0 or not 0.0 < opt.refine_tol <= ROWS_HELD_SHARE * PIN_GAP_TOL:
         return CHAIN_GENERAL
     most = opt.max_substeps
-    n = turn_substeps(m, s, ws, step_length, most)
+    n = turn_substeps(m, s, ws, step_length, most, False)
     if n == 1:
         code = chain_part(m, s, ws, opt, u, step_length)
         if code != 0:
             if code == CHAIN_AGAIN:
                 begin_again(s, ws)
             return CHAIN_GENERAL
-        n = turn_substeps(m, s, ws, step_length, most)
+        n = turn_substeps(m, s, ws, step_length, most, False)
         if n == 1:
             ws.info[INFO_TURN_SUBSTEPS] = 1
             keep_step_path(ws, False)
@@ -822,17 +842,26 @@ def _step(m, s, ws, opt, u):
             ws.info[INFO_CHAIN_PATH] = 1
             return 0
         most = opt.max_substeps
-        n = turn_substeps(m, s, ws, step_length, most)
+        # joints alone (no ground contact touching at the start): a step that leaves a pin
+        # open beyond gross_limit is taken again in sub-steps, twice as many each time
+        alone = not touching_ground(s, ws)
+        n = turn_substeps(m, s, ws, step_length, most, False)
         if n == 1:
+            # the joints' own count at the start, for a whole step that fails
+            joints_n = turn_substeps(m, s, ws, step_length, most, True)
             code = step_of_length(m, s, ws, opt, u, step_length, False)
             if code == GUARD_ROOM:
                 put_back(s, ws)
                 return code
             # a body that began turning fast within the step (an impact spinning a light
             # link up) is judged at the step's answer: taken again, in sub-steps; so is a
-            # step whose correction moved a body farther than its velocities explain
-            n = turn_substeps(m, s, ws, step_length, most)
-            if n == 1 and not (code == GUARD_JUMP and most > 1):
+            # step whose correction moved a body farther than its velocities explain, and
+            # a failed step of joints alone by their turns at its start or answer
+            n = turn_substeps(m, s, ws, step_length, most, code != 0)
+            if code != 0:
+                n = max(n, joints_n)
+            if n == 1 and not ((code == GUARD_JUMP or (code == GUARD_GROSS and alone))
+                               and most > 1):
                 ws.info[INFO_TURN_SUBSTEPS] = 1
                 keep_step_path(ws, False)
                 return code
@@ -858,7 +887,7 @@ def _step(m, s, ws, opt, u):
             # over the whole step too: the sub-steps' summed paths plus jump_limit once
             if code == 0 and opt.jump_limit > 0.0:
                 code = check_moves(m, s, ws, ws.start.q, True, opt.jump_limit)
-            if code == GUARD_JUMP and n < most:
+            if (code == GUARD_JUMP or (code == GUARD_GROSS and alone)) and n < most:
                 if ws.room[1] == 1:
                     put_back_from(s, ws, ws.start)       # (the broad phase's pairs too)
                 else:
