@@ -185,11 +185,17 @@ def gross_violation(model, ws, who="simulation"):
     what = ("is open by" if kind == AUDIT_PIN_GAP
             else "is below the ground (or inside another shape) by")
     last = _start_of_step(ws)
+    if model.n_act:
+        why = "actuators too stiff, or an impact too violent, for this step size"
+        fix = "Take a smaller dt, lower the actuators' limits, or raise"
+    else:
+        why = "a motion too fast for this step size: a body turning far in one step, or an " \
+              "impact too violent"
+        fix = "Take a smaller dt, or raise"
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): {_element_name(model, kind, element)} on "
         f"body {body_name!r} ({body}) {what} {value:.3g} m at the end of the step; the step "
-        f"could not hold it (actuators too stiff, or an impact too violent, for this step "
-        f"size). Take a smaller dt, lower the actuators' limits, or raise "
+        f"could not hold it ({why}). {fix} "
         f"StepOptions.gross_limit (0: count it in the audit and go on)",
         step, t, body_name, AUDIT_NAMES[kind], value, last)
 

@@ -229,6 +229,8 @@ def simulation(run_class):
     keywords = [prm.replace(kind=inspect.Parameter.KEYWORD_ONLY) for prm in list(init.parameters.values())[1:]]
 
     def simulate(duration, **kwargs):
+        if kwargs.get("params") is not None:
+            kwargs["params"] = _walker_params(run_class, kwargs["params"])
         bound = init.bind(None, **kwargs)
         bound.apply_defaults()
         run = run_class(**kwargs)
@@ -244,6 +246,25 @@ def simulation(run_class):
     simulate.__doc__ = (f"Run {run_class.NAME} from its start for `duration` [s]; returns (Trajectory, "
                         f"summary dict, Model). Keywords: those of {run_class.__name__}.")
     return simulate
+
+
+def _walker_params(run_class, params):
+    """params as run_class's walker's Params: an instance as it is, a dict of some of its fields
+    over the defaults; anything else (another walker's Params) a TypeError naming both."""
+    import importlib
+    from collections.abc import Mapping
+    module = importlib.import_module(run_class.__module__)
+    cls = getattr(module, "Params", None) or getattr(
+        importlib.import_module(run_class.__module__.rsplit(".", 1)[0]), "Params", None)
+    if cls is None or isinstance(params, cls):
+        return params
+    if isinstance(params, Mapping):
+        unknown = sorted(set(params) - set(cls().as_dict()))
+        if unknown:
+            raise TypeError(f"params: {unknown} are not fields of {cls.__name__}")
+        return cls(**{**cls().as_dict(), **params})
+    raise TypeError(f"params must be a {cls.__name__} (or a dict of its fields), not "
+                    f"{type(params).__name__}")
 
 
 def terrain_of(terrain):

@@ -424,6 +424,12 @@ def cmd_analyze(args):
     family, a, b = _analysis_family(args)
     if args.points < 2:
         raise UsageError(f"--points {args.points} must be at least 2")
+    if args.transient < 0:
+        raise UsageError(f"--transient {args.transient} must be >= 0 (steps dropped before the "
+                         "section values are kept)")
+    if args.keep < 2:
+        raise UsageError(f"--keep {args.keep} must be at least 2 (a period is found among the "
+                         "section values kept)")
     csv = _check_out(args.csv, (".csv",), "--csv")
     plot = _check_out(args.plot, PLOT_EXTS, "--plot")
     bar = TextProgress(args.points, "points")

@@ -9,6 +9,7 @@ outputs: regenerate them with this command rather than committing large media.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -56,6 +57,11 @@ def main(argv=None) -> int:
     import walkers
     if not args.out_dir.is_dir():
         ap.error(f"output folder {str(args.out_dir)!r} does not exist")
+    for flag, value, least in (("--duration", args.duration, 0.0), ("--fps", args.fps, 0.0)):
+        if not (math.isfinite(value) and value > least):
+            ap.error(f"{flag} {value} must be a positive number")
+    if args.width < 16:
+        ap.error(f"--width {args.width} must be at least 16 pixels")
     names = args.walker or sorted(walkers.WALKERS)
     unknown = [n for n in names if n not in walkers.WALKERS]
     if unknown:

@@ -283,6 +283,10 @@ class PlanarMujocoEnv(gymnasium.Env):
         if isinstance(frame_skip, bool) or int(frame_skip) != frame_skip or frame_skip < 1:
             raise ValueError(f"{type(self).__name__}: frame_skip={frame_skip!r} must be a whole "
                              "number of physics steps per env step, at least 1")
+        for key, size in (("width", width), ("height", height)):
+            if isinstance(size, bool) or int(size) != size or size < 16:
+                raise ValueError(f"{type(self).__name__}: {key}={size!r} must be a whole "
+                                 "number of pixels, at least 16")
         unknown = sorted(set(load_kw) - LOAD_KEYWORDS)
         if unknown:
             raise TypeError(f"{type(self).__name__}: unknown keyword(s) {unknown}; it takes its "

@@ -73,6 +73,10 @@ class _Task(PlanarMujocoEnv, utils.EzPickle):
 
     def __init__(self, **kw):
         args = {**self.DEFAULTS, **kw}
+        noise = args.get("reset_noise_scale", 0.0)
+        if not (isinstance(noise, (int, float)) and math.isfinite(noise) and noise >= 0):
+            raise ValueError(f"{type(self).__name__}: reset_noise_scale={noise!r} must be a "
+                             "finite number >= 0")
         utils.EzPickle.__init__(self, **args)
         for key in self.DEFAULTS:
             if key not in ("xml_file", "frame_skip"):

@@ -675,7 +675,7 @@ def touching_ground(s, ws):
 
 
 @kernel
-def turn_substeps(m, s, ws, h, most, joints_alone):
+def turn_substeps(m, s, ws, h, most):
     """How many equal sub-steps the step of h [s] is taken in (1..most): a point at lever L
     [m] on a body turning at w [rad/s] leaves the motion its rows linearise by at most
     L (h w)^2 / 2, so where a pin's anchors or a touching (not free) ground contact's point
@@ -683,35 +683,24 @@ def turn_substeps(m, s, ws, h, most, joints_alone):
     within (w and the modes of the state s: the step's start, and again its answer). Taken whole, a
     1.2 t box turning 0.57 rad a step on its corners drove a corner 5 cm into the ground
     and the correction threw the box 2-29 cm farther than its velocities explain
-    (contact_stress mass_ratio:13). A walker (L w ~ 5 m/s at dt 1 ms: 1e-5 m) takes 1.
-
-    Where no ground contact touches, the pins count only if joints_alone (a step taken
-    whole that failed): their velocity solve aims at the anchors' second-order drift and the
-    correction holds them, so a mechanism of joints alone is taken whole while that works.
-    A count that followed its turning rate switched a swinging pendulum between h and h / 2
-    as it sped up and slowed down, and each switch moved symplectic Euler's energy by its
-    O(h) term, with the same sign both ways: a rigid pendulum at dt 0.02 lost a quarter of
-    its swing energy in 60 s."""
+    (contact_stress mass_ratio:13). A walker (L w ~ 5 m/s at dt 1 ms: 1e-5 m) takes 1."""
     curve = 0.0
-    touching = False
+    for j in range(m.pin_body.shape[0]):
+        c = 0.0
+        for e in range(2):
+            b = m.pin_body[j, e]
+            if b >= 0:
+                w = s.v[b, 2]
+                c += (abs(m.pin_anchor[j, e, 0]) + abs(m.pin_anchor[j, e, 1])) * w * w
+        curve = max(curve, c)
     for k in range(ws.ground_contacts.shape[0]):
         i = ws.ground_contacts[k]      # (a shape pair's contacts are not judged here)
         # touching (a contact that touches within the step is seen when the step's answer
         # is judged: _step); its lever bounded by |x| + |y|
         if s.contact_mode[i] == MODE_FREE:
             continue
-        touching = True
         w = s.v[m.contact_body[i], 2]
         curve = max(curve, (abs(m.contact_local[i, 0]) + abs(m.contact_local[i, 1])) * w * w)
-    if touching or joints_alone:
-        for j in range(m.pin_body.shape[0]):
-            c = 0.0
-            for e in range(2):
-                b = m.pin_body[j, e]
-                if b >= 0:
-                    w = s.v[b, 2]
-                    c += (abs(m.pin_anchor[j, e, 0]) + abs(m.pin_anchor[j, e, 1])) * w * w
-            curve = max(curve, c)
     if not curve * h * h > 2.0 * TURN_TARGET:
         return 1
     n = int(math.ceil(h * math.sqrt(curve / (2.0 * TURN_TARGET))))
@@ -795,14 +784,14 @@ def chain_step(m, s, ws, opt, u, step_length):
     if opt.refine_iters == 0 or not 0.0 < opt.refine_tol <= ROWS_HELD_SHARE * PIN_GAP_TOL:
         return CHAIN_GENERAL
     most = opt.max_substeps
-    n = turn_substeps(m, s, ws, step_length, most, False)
+    n = turn_substeps(m, s, ws, step_length, most)
     if n == 1:
         code = chain_part(m, s, ws, opt, u, step_length)
         if code != 0:
             if code == CHAIN_AGAIN:
                 begin_again(s, ws)
             return CHAIN_GENERAL
-        n = turn_substeps(m, s, ws, step_length, most, False)
+        n = turn_substeps(m, s, ws, step_length, most)
         if n == 1:
             ws.info[INFO_TURN_SUBSTEPS] = 1
             keep_step_path(ws, False)
@@ -845,10 +834,8 @@ def _step(m, s, ws, opt, u):
         # joints alone (no ground contact touching at the start): a step that leaves a pin
         # open beyond gross_limit is taken again in sub-steps, twice as many each time
         alone = not touching_ground(s, ws)
-        n = turn_substeps(m, s, ws, step_length, most, False)
+        n = turn_substeps(m, s, ws, step_length, most)
         if n == 1:
-            # the joints' own count at the start, for a whole step that fails
-            joints_n = turn_substeps(m, s, ws, step_length, most, True)
             code = step_of_length(m, s, ws, opt, u, step_length, False)
             if code == GUARD_ROOM:
                 put_back(s, ws)
@@ -856,10 +843,8 @@ def _step(m, s, ws, opt, u):
             # a body that began turning fast within the step (an impact spinning a light
             # link up) is judged at the step's answer: taken again, in sub-steps; so is a
             # step whose correction moved a body farther than its velocities explain, and
-            # a failed step of joints alone by their turns at its start or answer
-            n = turn_substeps(m, s, ws, step_length, most, code != 0)
-            if code != 0:
-                n = max(n, joints_n)
+            # one of joints alone that left a pin open
+            n = turn_substeps(m, s, ws, step_length, most)
             if n == 1 and not ((code == GUARD_JUMP or (code == GUARD_GROSS and alone))
                                and most > 1):
                 ws.info[INFO_TURN_SUBSTEPS] = 1

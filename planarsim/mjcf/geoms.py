@@ -80,11 +80,19 @@ class BodyPartsReader(ElementReader):
         mass = self.scalar(node, eff, "mass", -1.0)
         if not mass > 0:
             self.fail(node, f"mass={mass} must be > 0")
+        if "fullinertia" in eff and "diaginertia" in eff:
+            self.fail(node, "give diaginertia or fullinertia, not both (MuJoCo refuses both)")
         if "fullinertia" in eff:
             f6 = self.floats(node, eff, "fullinertia", 6)
             tensor = np.array([[f6[0], f6[3], f6[4]], [f6[3], f6[1], f6[5]], [f6[4], f6[5], f6[2]]])
-            tensor = R @ tensor @ R.T
+            what = f"fullinertia=({', '.join(f'{float(x):g}' for x in f6)})"
         else:
             d = self.floats(node, eff, "diaginertia", 3)
-            tensor = R @ np.diag(d) @ R.T
+            tensor = np.diag(d)
+            what = f"diaginertia=({', '.join(f'{float(x):g}' for x in d)})"
+        # as MuJoCo's compiler: the whole tensor positive definite, out-of-plane moments too
+        moments = np.linalg.eigvalsh(tensor) if np.all(np.isfinite(tensor)) else np.array([np.nan])
+        if not np.all(moments > 0):
+            self.fail(node, f"{what} is not positive definite: a body's inertia must be")
+        tensor = R @ tensor @ R.T
         return dict(node=node, mass=mass, pos=pos, tensor=tensor)

@@ -17,6 +17,10 @@ from walkers.cli import main
     (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:nan"], "finite"),
     (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:0.9"], "bounds"),
     (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:0.2", "--points", "1"], "points"),
+    (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:0.2", "--diagram",
+      "--transient", "-5"], "--transient -5"),
+    (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:0.2", "--diagram",
+      "--keep", "0"], "--keep 0"),
 ])
 def test_bad_input_is_one_line_and_exit_2(argv, text, capsys):
     assert main(argv) == 2

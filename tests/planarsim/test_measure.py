@@ -75,3 +75,16 @@ def test_summary_of_a_passive_walk_gives_sin_slope():
     # the energy the walk loses per weight and horizontal distance: tan(slope) horizontally
     assert s["cost_of_transport"] == pytest.approx(math.tan(slope), rel=0.02)
     assert s["distance"] > 0 and s["mean_speed"] > 0
+
+
+@pytest.mark.parametrize("who", ["centre_of_mass", "centre_of_mass_velocity", "energy",
+                                 "summary", "joint_angles", "cost_of_transport"])
+def test_a_measure_of_another_models_recording_names_the_mismatch(who):
+    """A recording of a 2-body model measured with a 1-body model raised numpy's broadcast
+    error from deep inside."""
+    traj = ps.Simulator(_double_pendulum()).run(0.01)
+    b = ps.ModelBuilder(dt=1e-3)
+    b.add_body("only", mass=1.0, inertia=0.1)
+    with pytest.raises(ValueError, match=rf"measure\.{who}: .* 2 bodies per frame but the "
+                                         r"model has 1 .*wrong model"):
+        getattr(measure, who)(traj, b.compile())

@@ -208,3 +208,18 @@ def test_empty_sources_and_zero_sizes_are_named_plainly():
     with pytest.raises(ModelError) as err:
         load_mjcf(xml)
     assert "size=(0.0,)" in str(err.value) and "np.float64" not in str(err.value)
+
+
+@pytest.mark.parametrize("attrs, text", [
+    ('diaginertia="-3 1 -3"', "not positive definite"),
+    ('fullinertia="1 1 1 5 5 5"', "not positive definite"),
+    ('diaginertia="1 1 1" fullinertia="1 1 1 0 0 0"', "not both"),
+])
+def test_inertia_that_mujoco_refuses_is_refused(attrs, text):
+    """Out-of-plane inertia that MuJoCo's compiler refuses was taken silently (only the plane's
+    moment is used, but the file describes no body)."""
+    from planarsim.mjcf import load_mjcf
+    xml = ('<mujoco><worldbody><body name="b" pos="0 0 1"><joint name="j" type="hinge" '
+           f'axis="0 1 0"/><inertial pos="0 0 0" mass="1" {attrs}/></body></worldbody></mujoco>')
+    with pytest.raises(ps.ModelError, match=text):
+        load_mjcf(xml)

@@ -270,3 +270,14 @@ def test_run_refuses_arguments_it_would_ignore():
     with pytest.raises(ValueError, match="only with a controller"):
         sim.run(0.01, labels=lambda s: {"t": s.t})
     assert sim.state.step[0] == 0
+
+
+@pytest.mark.parametrize("kw, text", [(dict(reset_noise_scale=-1.0), "reset_noise_scale"),
+                                      (dict(reset_noise_scale=NAN), "reset_noise_scale"),
+                                      (dict(render_mode="rgb_array", width=0), "width=0")])
+def test_env_settings_that_fail_late_are_refused_when_made(kw, text):
+    """A negative or NaN reset noise failed in numpy at reset; width 0 in the renderer."""
+    gym = pytest.importorskip("gymnasium")
+    import planarsim.envs  # noqa: F401
+    with pytest.raises(ValueError, match=text):
+        gym.make("planarsim/Hopper-v0", **kw)

@@ -2,6 +2,7 @@
 colours."""
 
 import numpy as np
+import pytest
 
 from planarsim.render import Style, export_animation
 
@@ -35,3 +36,16 @@ def test_gif_keeps_the_background_and_ground_colours_exact(sliding_run, tmp_path
     assert (255, 255, 255) in colours                                     # white stays white
     ground = tuple(int(style.ground_fill[i:i + 2], 16) for i in (1, 3, 5))
     assert ground in colours
+
+
+@pytest.mark.parametrize("flags, text", [(["--width", "0"], "--width 0"),
+                                         (["--duration", "0"], "--duration 0"),
+                                         (["--fps", "-1"], "--fps -1")])
+def test_gallery_refuses_sizes_and_times_before_any_run(flags, text, tmp_path, capsys):
+    """--width 0 wrote a 2 x 2 pixel GIF and --duration 0 exited 0; --fps -1 failed after
+    simulating."""
+    from walkers.gallery import main
+    with pytest.raises(SystemExit) as e:
+        main([str(tmp_path), "--walker", "rimless-wheel", *flags])
+    assert e.value.code == 2 and text in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())

@@ -139,3 +139,19 @@ def test_the_contract_check_names_what_is_missing():
     assert any("WalkerRun" in p for p in problems)
     assert any("SUMMARY_EXTRAS['x']" in p for p in problems)
     assert issubclass(walkers.load("ranger").Run, WalkerRun)
+
+
+@pytest.mark.parametrize("name", ["simple-biped", "rimless-wheel"])
+def test_params_as_a_dict_or_of_another_walker(name):
+    """simulate(params={...}) raised AttributeError ('dict' object has no attribute ...), as did
+    another walker's Params; a dict of fields now means those fields over the defaults."""
+    mod = walkers.load(name)
+    field, value = next(iter(mod.Params().as_dict().items()))
+    as_dict = mod.simulate(0.02, params={field: value})
+    as_params = mod.simulate(0.02, params=mod.Params())
+    np.testing.assert_array_equal(as_dict[0].q, as_params[0].q)
+    other = walkers.load("ranger" if name != "ranger" else "simple-biped").Params()
+    with pytest.raises(TypeError, match=f"params must be a {type(mod.Params()).__name__}"):
+        mod.simulate(0.02, params=other)
+    with pytest.raises(TypeError, match="not fields of"):
+        mod.simulate(0.02, params={"no_such_field": 1.0})
