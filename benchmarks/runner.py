@@ -61,11 +61,11 @@ import os
 import platform
 import re
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from planarsim.compile.caches import _writable_folder  # (made or written: the same test)
 from benchmarks.metrics import PEER_SCENES
 from benchmarks.pareto import DEFAULT_SCENES
 from benchmarks.peers import PEER_MODULES, available_peers, measure_scene
@@ -226,16 +226,6 @@ def _list(text, known, what):
     if bad:
         raise SystemExit(f"planarsim bench: unknown {what} {bad}; choose from {list(known)}")
     return items
-
-
-def _writable_folder(folder) -> bool:
-    """Whether folder exists or can be made, and a file can be written in it."""
-    try:
-        os.makedirs(folder, exist_ok=True)
-        tempfile.TemporaryFile(dir=folder).close()
-        return True
-    except OSError:
-        return False
 
 
 def parse_args(argv):
