@@ -25,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import planarsim as ps  # noqa: E402
 from planarsim import compiled  # noqa: E402
 from planarsim.energy import total_energy  # noqa: E402
+from benchmarks.stress_scenes import pin_gap  # noqa: E402
 
 G = 9.81
 
@@ -53,24 +54,6 @@ def chain(rng):
     return b.compile(), float(masses.sum() * G * lengths.sum()), dt, steps
 
 
-def pin_gap(model, q):
-    """The largest pin gap [m] at q."""
-    a = model.arrays
-    worst = 0.0
-    for j in range(model.n_pin):
-        ends = []
-        for e in range(2):
-            body = a.pin_body[j, e]
-            lx, ly = a.pin_anchor[j, e]
-            if body < 0:
-                ends.append((lx, ly))
-            else:
-                c, s = math.cos(q[body, 2]), math.sin(q[body, 2])
-                ends.append((q[body, 0] + c * lx - s * ly, q[body, 1] + s * lx + c * ly))
-        worst = max(worst, math.dist(*ends))
-    return worst
-
-
 def run(seed, count):
     """(stops, bad) lines of `count` chains drawn from `seed`."""
     rng = np.random.default_rng(seed)
@@ -85,7 +68,7 @@ def run(seed, count):
             every = max(1, steps // 50)
             for _ in range(0, steps, every):
                 sim.steps(every)
-                gap = max(gap, pin_gap(model, sim.state.q))
+                gap = max(gap, pin_gap(model, sim.state.q[None]))
                 rise = max(rise, total_energy(model, sim.state.q, sim.state.v) - start)
             audited = sum(compiled.audit_counts(sim.ws).values()) > 0
             if gap > 1e-9 or (rise > 0.02 * scale and not audited):

@@ -20,6 +20,7 @@ import numpy as np
 from .analysis import StepEvents, foot_groups, step_events, step_summary
 from .energy import joint_position_rate
 from .model import ACT_AXIAL
+from .trajectory import check_recorded_by
 
 __all__ = ["centre_of_mass", "centre_of_mass_velocity", "energy", "pin_angle_rate", "summary",
            "joint_angles", "cost_of_transport", "step_events", "step_summary", "StepEvents"]
@@ -27,19 +28,19 @@ __all__ = ["centre_of_mass", "centre_of_mass_velocity", "energy", "pin_angle_rat
 
 def centre_of_mass(traj, model) -> np.ndarray:
     """(K, 2) centre of mass [m] per frame."""
-    _same_model(traj, model, "centre_of_mass")
+    check_recorded_by(traj, model, "measure.centre_of_mass")
     return traj.com(model)
 
 
 def centre_of_mass_velocity(traj, model) -> np.ndarray:
     """(K, 2) centre-of-mass velocity [m/s] per frame."""
-    _same_model(traj, model, "centre_of_mass_velocity")
+    check_recorded_by(traj, model, "measure.centre_of_mass_velocity")
     return traj.com_velocity(model)
 
 
 def energy(traj, model) -> dict:
     """{"kinetic", "potential", "total"}: (K,) [J] per frame."""
-    _same_model(traj, model, "energy")
+    check_recorded_by(traj, model, "measure.energy")
     return traj.energy(model)
 
 
@@ -58,15 +59,6 @@ def pin_angle_rate(model, q, v, pin) -> tuple:
     return float(ang), float(rate)
 
 
-def _same_model(traj, model, who):
-    """ValueError naming `who` where traj was not recorded from a model with model's bodies."""
-    q = np.asarray(traj.q)
-    if q.ndim != 3 or q.shape[1:] != (model.n_body, 3):
-        raise ValueError(f"measure.{who}: the trajectory has {q.shape[1] if q.ndim == 3 else '?'} "
-                         f"bodies per frame but the model has {model.n_body} "
-                         f"({list(model.body_names)}): wrong model for this trajectory?")
-
-
 MIN_STRIDE = 0.02   # [m] a landing is a step when the foot lands this far from where it lifted
 
 
@@ -77,7 +69,7 @@ def summary(traj, model, feet=None, min_air=0.05, together=0.05, min_stride=MIN_
     from where it lifted (a model that stands, rocks or hops in place makes none); feet
     landing within `together` [s] of each other land once. Adds distance [m] and mean_speed
     [m/s] of the centre of mass over the whole recording."""
-    _same_model(traj, model, "summary")
+    check_recorded_by(traj, model, "measure.summary")
     feet = foot_groups(traj.contact_names) if feet is None else feet
     out = step_summary(traj, model, feet=feet, min_air=min_air, together=together,
                        min_stride=min_stride)
@@ -93,7 +85,7 @@ def joint_angles(traj, model) -> dict:
     """{name: (angle (K,) [rad], rate (K,) [rad/s])} for every pin (a slider: slide [m], rate
     [m/s]), else for every rod and
     axial actuator segment (angle from the downward vertical)."""
-    _same_model(traj, model, "joint_angles")
+    check_recorded_by(traj, model, "measure.joint_angles")
     a = model.arrays
     out = {}
     q, v = traj.q, traj.v
@@ -128,7 +120,7 @@ def cost_of_transport(traj, model, power=None):
     `power` (K,) [W]. The average is work / (m g |x_end - x_start|) (nan if the COM did not
     move), the work each frame's power times the time since the frame before (the steps that
     frame ends; exact when every step is recorded)."""
-    _same_model(traj, model, "cost_of_transport")
+    check_recorded_by(traj, model, "measure.cost_of_transport")
     if power is None:
         power = np.clip(traj.act_power, 0.0, None).sum(axis=1) if traj.act_power.size else np.zeros(len(traj.t))
     power = np.asarray(power, float)

@@ -308,3 +308,12 @@ def atomic_write(path, write, binary=True) -> None:
     except BaseException:
         discard(tmp)
         raise
+
+
+def check_recorded_by(traj, model, who):
+    """ValueError naming `who` where traj's frames do not hold model's bodies (n_body, 3)."""
+    q = np.asarray(traj.q)
+    if q.ndim != 3 or q.shape[1:] != (model.n_body, 3):
+        raise ValueError(f"{who}: the trajectory has {q.shape[1] if q.ndim == 3 else '?'} "
+                         f"bodies per frame but the model has {model.n_body} "
+                         f"({list(model.body_names)}): wrong model for this trajectory?")

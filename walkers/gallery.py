@@ -57,8 +57,8 @@ def main(argv=None) -> int:
     import walkers
     if not args.out_dir.is_dir():
         ap.error(f"output folder {str(args.out_dir)!r} does not exist")
-    for flag, value, least in (("--duration", args.duration, 0.0), ("--fps", args.fps, 0.0)):
-        if not (math.isfinite(value) and value > least):
+    for flag, value in (("--duration", args.duration), ("--fps", args.fps)):
+        if not (math.isfinite(value) and value > 0.0):
             ap.error(f"{flag} {value} must be a positive number")
     if args.width < 16:
         ap.error(f"--width {args.width} must be at least 16 pixels")

@@ -21,6 +21,7 @@ import pickle
 
 import numpy as np
 
+from ..trajectory import check_recorded_by
 from .camera import Camera
 from .draw import Scene, make_figure
 
@@ -70,9 +71,7 @@ class FrameRenderer:
 
     def __init__(self, traj, model, fps=30.0, speed=1.0, start=None, duration=None, size=(6.4, 3.6),
                  dpi=100, camera: Camera | None = None, **scene_kw):
-        if traj.q.shape[1:] != (model.n_body, 3):
-            raise ValueError(f"trajectory has {traj.q.shape[1]} bodies per frame but the model has "
-                             f"{model.n_body} ({list(model.body_names)}): wrong model for this trajectory?")
+        check_recorded_by(traj, model, type(self).__name__)
         self.traj, self.model = traj, model
         self.times = frame_times(traj, fps, speed, start, duration)
         self.index = frame_indices(traj, self.times)
