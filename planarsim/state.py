@@ -395,6 +395,8 @@ class Workspace(NamedTuple):
     audit_worst: np.ndarray      # (4,) int the step's largest pin gap or depth violation: step,
                                  #   kind, pin or contact, body (StepOptions.gross_limit)
     audit_worst_value: np.ndarray  # (1,) its size [m] (0: none this step)
+    bounce_scale: np.ndarray     # (1,) the factor of the step's rebound targets (1; less where
+                                 #   the energetic bound scales them: kernels/rebound.py)
     energy_stop: np.ndarray      # (1,) int 1: this step gained energy from nowhere beyond
                                  #   StepOptions.energy_limit (kernels/work.judge_energy)
     first_order: np.ndarray      # (1,) int 1: this step's joint rows aim at J v = 0 (a
@@ -799,7 +801,7 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      audit=z(N_AUDIT, np.int64),
                      audit_last=z(4, np.int64), audit_value=z(1),
                      audit_worst=z(4, np.int64), audit_worst_value=z(1), first_order=z(1, np.int64),
-                     energy_stop=z(1, np.int64),
+                     bounce_scale=np.ones(1), energy_stop=z(1, np.int64),
                      joint_gain=z(3), joint_pivot=np.ones(1), lcp_eps=z(1),
                      impact_time=z(1), audit_keep=z(N_AUDIT, np.int64), path_explained=z((nb, 3)),
                      step_path=z(nb),

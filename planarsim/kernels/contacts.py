@@ -463,12 +463,13 @@ def pair_motion_scale(s, ws, i, vel):
 @kernel(inline="never")
 def bounce_of(m, s, ws, i):
     """The normal velocity [m/s] restitution asks of contact i after an impact: e times its
-    approach speed at the step's start, 0 below BOUNCE_SPEED."""
+    approach speed at the step's start, 0 below BOUNCE_SPEED; times ws.bounce_scale (1 but
+    where the energetic bound scales the step's rebounds down: kernels/rebound.py)."""
     e = m.contact_restitution[i]
     if e == 0.0:
         return 0.0
     vn, vt = contact_velocity(m, s, ws, i, s.v)
-    return e * -vn if -vn > BOUNCE_SPEED else 0.0
+    return ws.bounce_scale[0] * (e * -vn) if -vn > BOUNCE_SPEED else 0.0
 
 
 @kernel

@@ -23,7 +23,7 @@ from .broad_phase import FLAG_LIVE, widen_for_answer
 from .ccd import split_at_impact, stop_at_impact
 from .codes import INTEGRATOR_EULER, MODE_FREE, MODE_PINNED, MODES_ALTERNATING
 from .complementarity import solve_contacts
-from .contacts import find_contacts
+from .contacts import bounce_of, find_contacts
 from .forces import apply_forces, predict_velocity
 from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_ROOM,
                      check_actuator_turns, check_displacements, check_guards, check_moves,
@@ -38,6 +38,7 @@ from .modes import (check_contact, engage_contacts, engage_limits, gather_contac
                     rule_breaks, seed_rule)
 from .pair import PAIR_MARGIN
 from .pin_chain import chain_correct, chain_prediction, chain_rows, chain_velocity_solve
+from .rebound import rebound_gain, rebounding
 from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev
 from .pair_toi import hold_off_fast_pairs
 from .position import ROWS_HELD_SHARE, position_stage
@@ -47,7 +48,7 @@ from .solve import solve_impulses
 from .rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
                      unsupported)
 from .warm_start import remember_impulses
-from .work import NEAR_DEPENDENT, joints_add_energy, prediction_turn
+from .work import NEAR_DEPENDENT, joints_add_energy, kinetic_energy, prediction_turn
 
 
 @kernel(inline="never")
@@ -375,6 +376,84 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
 
 
 @kernel
+def scale_rebounds(m, s, ws, scale):
+    """Every listed contact's rebound target (contacts.bounce_of) at `scale` of its own."""
+    ws.bounce_scale[0] = scale
+    for k in range(ws.n_live[0]):
+        i = ws.live[k]
+        if m.contact_restitution[i] != 0.0:
+            ws.contact_bounce[i] = bounce_of(m, s, ws, i)
+
+
+@kernel
+def rebound_answer(m, s, ws, opt, h, include_ccd, scale):
+    """The step's answer (solve_modes) with the rebounds at `scale`: (whether a linear
+    solve's answer stood, the kinetic energy its contacts add beyond rounding [J])."""
+    scale_rebounds(m, s, ws, scale)
+    answered = solve_modes(m, s, ws, opt, h, include_ccd)
+    return answered, rebound_gain(m, ws, h)
+
+
+# answers bound_rebound tries at most besides the plastic one, and how close below zero
+# (a share of the kinetic energy) the energy the rebounds add must come to end the search
+REBOUND_TRIES = 8
+REBOUND_CLOSE = 1e-6
+
+
+@kernel(inline="never")
+def bound_rebound(m, s, ws, opt, h, include_ccd, answered):
+    """The energetic bound on the step's rebounds (kernels/rebound.py): where the contacts of
+    the answer with the rebounds restitution asks for add kinetic energy, the step's answer
+    is taken again with every rebound scaled by the largest factor that adds none. The
+    energy the contacts add is quadratic in the factor while the contacts keep their modes
+    and piecewise so where they change (a sticking contact begins to slide): its root is
+    bracketed between the plastic answer (factor 0, which adds none) and the full one, and
+    found by regula falsi with Illinois' halving (at most REBOUND_TRIES answers, ending
+    within REBOUND_CLOSE of the kinetic energy below zero); the answer kept is the last one
+    that added none. Where even the plastic answer adds energy the rebounds are not its
+    cause: that answer is kept (the audit judges it). Returns what solve_modes returns for
+    the answer kept."""
+    if not rebounding(m, s, ws):
+        return answered
+    hi_g = rebound_gain(m, ws, h)
+    if hi_g <= 0.0:
+        return answered
+    close = REBOUND_CLOSE * kinetic_energy(m, ws.v_pred)
+    answered, lo_g = rebound_answer(m, s, ws, opt, h, include_ccd, 0.0)
+    if lo_g > 0.0 or ws.room[0] == 1:
+        ws.bounce_scale[0] = 1.0
+        return answered
+    lo = 0.0
+    hi = 1.0
+    last = 0.0                  # the factor of the answer in ws
+    side = 0
+    for _ in range(REBOUND_TRIES):
+        x = (lo * hi_g - hi * lo_g) / (hi_g - lo_g)
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
+        answered, g = rebound_answer(m, s, ws, opt, h, include_ccd, x)
+        last = x
+        if ws.room[0] == 1:
+            break
+        if g <= 0.0:
+            lo, lo_g = x, g
+            if g >= -close:
+                break
+            if side == -1:
+                hi_g *= 0.5         # (Illinois: the end kept twice running is halved)
+            side = -1
+        else:
+            hi, hi_g = x, g
+            if side == 1:
+                lo_g *= 0.5
+            side = 1
+    if last != lo and ws.room[0] == 0:
+        answered, g = rebound_answer(m, s, ws, opt, h, include_ccd, lo)
+    ws.bounce_scale[0] = 1.0
+    return answered
+
+
+@kernel
 def forget_impulses(s, ws):
     """Zero the State's last impulses: a solve repeated with the joints aimed at J v = 0
     starts from zero, so that a row dropped as dependent keeps none (the first solve's
@@ -573,6 +652,8 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
                 predict_configuration(m, s, ws, h)          #    the projection against it)
             ws.first_order[0] = 1                           #    with joint rows at J v = 0,
             forget_impulses(s, ws)                              #    from zero impulses
+        if ws.room[0] == 0:                                 #    rebounds that add energy
+            answered = bound_rebound(m, s, ws, opt, h, not ccd_on, answered)   # scaled down
         if ws.room[0] == 1:                                 #    rows beyond the storage:
             return GUARD_ROOM                               #    again with more (_step)
         if ccd_on and m.n_shape_pair > 0:                   #    shapes the answer moves
