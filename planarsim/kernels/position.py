@@ -15,6 +15,7 @@ from ..compile import kernel, part
 from .audit import (AUDIT_CORRECTION_WORK, DEPTH_TOL, PIN_GAP_TOL, audit_positions,
                     mark_held_contacts, needs_ground_query, note, worst_violation)
 from .complementarity import project_positions
+from .codes import INTEGRATOR_EULER
 from .info import INFO_PROJECTIONS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, rows_hold_within)
@@ -87,7 +88,7 @@ def position_stage(m, s, ws, opt, h, answered):
         settle_positions(m, s, ws, h, opt, held)
         if corrected or ws.info[INFO_PROJECTIONS] > 0:
             # only a correction or a projection changes the velocity the solve gave
-            excess = bound_correction_work(m, s, ws, h)
+            excess = bound_correction_work(m, s, ws, h, opt.integrator != INTEGRATOR_EULER)
             if excess > 0.0:
                 note(ws, s.step[0], AUDIT_CORRECTION_WORK, -1, most_gaining_body(m, s, ws), excess)
                 # bodies lifted out of the ground (a terrain put in) are the depth's

@@ -841,7 +841,7 @@ def chain_part(m, s, ws, opt, u, h):
                               opt.refine_pivot_tol)
         if not (worst >= 0.0 and worst <= opt.refine_tol):
             return CHAIN_AGAIN
-        if bound_correction_work(m, s, ws, h) > 0.0:
+        if bound_correction_work(m, s, ws, h, False) > 0.0:
             return CHAIN_AGAIN
     s.time[0] = ws.prev.time[0] + h
     s.step[0] += 1
