@@ -22,7 +22,7 @@ from . import model as M
 from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT,
                             JOINT_FREE_HINGE, JOINT_FREE_SLIDE, JOINT_HINGE, JOINT_SLIDE_BIT,
                             JOINT_SLIDER)
-from .errors import ModelError
+from .errors import ModelError, plain as _plain
 from .kernels.collide import core_normals
 from .shapes import (collision_core, collision_pairs, combine_masses, shape_area, shape_bounds,
                      shape_who, shifted)
@@ -42,18 +42,6 @@ def _who(kind, name, idx):
     if idx is None:
         return kind
     return f"{kind} ({idx})" if name is None else f"{kind} {name!r} ({idx})"
-
-
-def _plain(value):
-    """`value` as messages print it: numpy numbers and arrays as plain floats and lists
-    (0.0, not np.float64(0.0))."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, (tuple, list)):
-        return type(value)(_plain(v) for v in value)
-    return value
 
 
 def _finite(kind, name, idx, fieldname, value):
@@ -89,6 +77,26 @@ def _length(kind, name, idx, fieldname, value, zero_ok=False):
     if x < 0 or (x == 0 and not zero_ok):
         raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={x} must be {'>= 0' if zero_ok else '> 0'}")
     return x
+
+
+def _pair(kind, name, idx, fieldname, value, parts=("min", "max")):
+    """A (lo, hi) pair as two floats: two numbers, neither NaN, lo < inf and hi > -inf (either
+    may be infinite the other way: no bound). The order of lo and hi is the caller's rule."""
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = None
+    who = _who(kind, name, idx)
+    if arr is None or arr.shape != (2,):
+        raise ModelError(f"{who}: {fieldname}={_plain(value)!r} must be a pair ({', '.join(parts)}) "
+                         "of numbers")
+    lo, hi = float(arr[0]), float(arr[1])
+    if math.isnan(lo) or math.isnan(hi):
+        raise ModelError(f"{who}: {fieldname}=({lo}, {hi}) must not be NaN")
+    if lo == math.inf or hi == -math.inf:
+        raise ModelError(f"{who}: {fieldname}=({lo}, {hi}) must have {parts[0]} < inf and "
+                         f"{parts[1]} > -inf")
+    return lo, hi
 
 
 SHAPE_PARAMS = {"capsule": ("p0", "p1", "radius"), "circle": ("center", "radius"),
@@ -194,6 +202,7 @@ class ModelBuilder:
         pose q, which is always its COM's, at the shapes' centroid: q = pos + R(angle) c. The
         shapes stay where they were given in the world; vel is the COM's velocity."""
         idx = len(self._bodies)
+        shapes = self._shape_list(name, idx, shapes)
         self._register("body", name, idx)
         q = np.r_[_vec2("body", name, idx, "pos", pos), _scalar("body", name, idx, "angle", angle)]
         v = np.r_[_vec2("body", name, idx, "vel", vel), _scalar("body", name, idx, "omega", omega)]
@@ -218,13 +227,36 @@ class ModelBuilder:
             mass, inertia, origin = 0.0, 0.0, np.zeros(2)   # from its shapes' densities
         self._bodies.append(dict(name=name, mass=mass, inertia=inertia, q=q, v=v, point=False,
                                  origin=origin))
-        for s in shapes:
-            s = tuple(s)
-            options = dict(s[-1]) if s and isinstance(s[-1], dict) else {}
-            if density is not None:
-                options.setdefault("density", density)
-            self.add_shape(idx, *(s[:-1] if s and isinstance(s[-1], dict) else s), **options)
+        kept = len(self._shapes), len(self._collide)
+        try:
+            for s in shapes:
+                s = tuple(s)
+                options = dict(s[-1]) if s and isinstance(s[-1], dict) else {}
+                if density is not None:
+                    options.setdefault("density", density)
+                self.add_shape(idx, *(s[:-1] if s and isinstance(s[-1], dict) else s), **options)
+        except ModelError:          # a refused shape: neither the body nor its shapes are kept
+            del self._bodies[idx:], self._shapes[kept[0]:], self._collide[kept[1]:]
+            del self._names["body"][name]
+            raise
         return idx
+
+    @staticmethod
+    def _shape_list(name, idx, shapes) -> list:
+        """add_body's shapes as a list, each checked to be a tuple (kind, *params[, dict])."""
+        try:
+            out = list(shapes) if not isinstance(shapes, (str, bytes, dict)) else None
+        except TypeError:
+            out = None
+        if out is None:
+            raise ModelError(f"body {name!r} ({idx}): shapes={_plain(shapes)!r} must be a list of "
+                             "shapes")
+        for k, s in enumerate(out):
+            if not (isinstance(s, (tuple, list)) and s and isinstance(s[0], str)):
+                raise ModelError(f"body {name!r} ({idx}): shapes[{k}]={_plain(s)!r} must be a tuple "
+                                 "(kind, *params) as add_shape takes them, e.g. "
+                                 "('circle', (0, 0), 0.1)")
+        return out
 
     def _local_point(self, bid, p):
         """A local point [m] given in body bid's frame (origin at its pos) -> the COM frame
@@ -241,14 +273,26 @@ class ModelBuilder:
         out += ["a fluid box" for b, _ in self._fluid if b == bid]
         return out
 
-    def _add_shape_mass(self, bid, who, kind, params, density):
-        """Add a shape's mass (params in the COM frame, density [kg/m^2]) to body bid, then move
-        the body's frame to the new COM: q, the frame's origin and its shapes follow, so that
-        everything stays where it is in the world."""
+    def _with_shape_mass(self, bid, who, kind, params, density) -> tuple:
+        """(mass [kg], shift of the COM (2,) [m], inertia [kg m^2]) of body bid once a shape
+        (params in the COM frame, density [kg/m^2]) joins it; ModelError naming the shape
+        and body where they overflow (are not finite)."""
         body = self._bodies[bid]
         area, c, j = shape_area(kind, params, who)
-        mass, d, inertia = combine_masses([(body["mass"], np.zeros(2), body["inertia"]),
-                                           (density * area, c, density * j)])
+        with np.errstate(over="ignore", invalid="ignore"):
+            mass, d, inertia = combine_masses([(body["mass"], np.zeros(2), body["inertia"]),
+                                               (density * area, c, density * j)])
+        if not (math.isfinite(mass) and math.isfinite(inertia) and np.all(np.isfinite(d))):
+            raise ModelError(f"{who}: density={density:g} kg/m^2 on its {area:g} m^2 gives body "
+                             f"{body['name']!r} a mass of {mass:g} kg and an inertia of "
+                             f"{inertia:g} kg m^2; both must be finite (a smaller density or shape)")
+        return mass, d, inertia
+
+    def _add_shape_mass(self, bid, mass, d, inertia):
+        """Give body bid its new mass and inertia (_with_shape_mass), then move its frame to
+        the new COM (by d): q, the frame's origin and its shapes follow, so that everything
+        stays where it is in the world."""
+        body = self._bodies[bid]
         body["mass"], body["inertia"] = mass, inertia
         th = body["q"][2]
         body["q"][:2] += (math.cos(th) * d[0] - math.sin(th) * d[1],
@@ -313,6 +357,8 @@ class ModelBuilder:
             density = self._shape_density(bid, who, density)
         if bid >= 0 and self._bodies[bid]["origin"] is not None:
             params = shifted(kind, params, -self._bodies[bid]["origin"])
+        if density is not None:     # checked before the shape is kept
+            added = self._with_shape_mass(bid, who, kind, params, density)
         if not isinstance(collide, (bool, np.bool_)):
             raise ModelError(f"{who}: collide={collide!r} must be True or False")
         if bid < 0 and not collide:
@@ -325,7 +371,7 @@ class ModelBuilder:
             self._collide[-1]["ground"] = bool(ground)
         self._shapes.append(M.Shape(bid, kind, tuple(params)))
         if density is not None:
-            self._add_shape_mass(bid, who, kind, params, density)
+            self._add_shape_mass(bid, *added)
         return idx
 
     def _shape_density(self, bid, who, density):
@@ -514,8 +560,11 @@ class ModelBuilder:
         density [kg/m^3] >= 0 (quadratic drag). Returns the box's index."""
         b = self._body_id("fluid box", None, len(self._fluid), "body", body)
         who = f"fluid box on body {self._bodies[b]['name']!r}"
+        if isinstance(size, (str, bytes)) or np.shape(size) != (3,):
+            raise ModelError(f"{_who(who, None, len(self._fluid))}: size={_plain(size)!r} must be "
+                             "three lengths (l1, l2, ln) [m]")
         l1, l2, ln = (_length(who, None, len(self._fluid), f"size[{i}]", x)
-                      for i, x in enumerate(np.asarray(size, dtype=np.float64).reshape(3)))
+                      for i, x in enumerate(size))
         mu = _length(who, None, len(self._fluid), "viscosity", viscosity, zero_ok=True)
         rho = _length(who, None, len(self._fluid), "density", density, zero_ok=True)
         c = self._local_point(b, _vec2(who, None, len(self._fluid), "local", local))
@@ -528,11 +577,8 @@ class ModelBuilder:
 
     @staticmethod
     def _joint_limit(kind, name, idx, limit):
-        lo, hi = (-math.inf, math.inf) if limit is None else limit
-        lo = float(lo)
-        hi = float(hi)
-        if math.isnan(lo) or math.isnan(hi):
-            raise ModelError(f"{kind} {name!r} ({idx}): limit=({lo}, {hi}) must not be NaN")
+        lo, hi = ((-math.inf, math.inf) if limit is None
+                  else _pair(kind, name, idx, "limit", limit, ("lower", "upper")))
         if lo > hi:
             raise ModelError(f"{kind} {name!r} ({idx}): limit lower={lo} > upper={hi}")
         return lo, hi
@@ -671,8 +717,8 @@ class ModelBuilder:
         r = _scalar("contact", name, idx, "radius", radius)
         if not r > 0:
             raise ModelError(f"contact {name!r} ({idx}): radius={r} must be > 0")
-        a0 = _scalar("contact", name, idx, "span[0]", span[0])
-        a1 = _scalar("contact", name, idx, "span[1]", span[1])
+        a0, a1 = _pair("contact", name, idx, "span", span, ("a0", "a1"))
+        _finite("contact", name, idx, "span", (a0, a1))
         if not a1 > a0:
             raise ModelError(f"contact {name!r} ({idx}): span=({a0}, {a1}) must have span[1] > span[0]")
         cid = self._contact(name, body, CONTACT_ARC, center, r, (a0, a1), mu, list(vertices))
@@ -705,10 +751,10 @@ class ModelBuilder:
     def _act(self, name, kind, bodies=(-1, -1, -1), ref=-1, anchors=None, direction=(0.0, 0.0),
              limit=(-math.inf, math.inf)):
         idx = len(self._acts)
-        self._register("actuator", name, idx)
-        lo, hi = float(limit[0]), float(limit[1])
-        if math.isnan(lo) or math.isnan(hi) or lo > hi:
+        lo, hi = _pair("actuator", name, idx, "limit", limit)
+        if lo > hi:
             raise ModelError(f"actuator {name!r} ({idx}): limit=({lo}, {hi}) must have min <= max")
+        self._register("actuator", name, idx)
         self._acts.append(dict(name=name, kind=kind, bodies=bodies, ref=ref,
                                anchors=anchors if anchors is not None else (np.zeros(2), np.zeros(2)),
                                dir=np.asarray(direction, dtype=np.float64), limit=(lo, hi)))

@@ -13,6 +13,8 @@ touch); it names the sizes and what to change.
 """
 import math
 
+import numpy as np
+
 from .capacity import workspace_capacity
 from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_FRICTION,
                             AUDIT_JOINT_WORK,
@@ -24,6 +26,18 @@ from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED
 from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
                              GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_ROOM, GUARD_SPEED,
                              GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
+
+
+def plain(value):
+    """`value` as messages print it: numpy numbers and arrays as plain floats and lists
+    (0.0, not np.float64(0.0)); tuples and lists element by element."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (tuple, list)):
+        return type(value)(plain(v) for v in value)
+    return value
 
 
 class ModelError(ValueError):

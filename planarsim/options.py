@@ -7,6 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .errors import plain
 from .kernels.codes import (INTEGRATOR_EULER, INTEGRATOR_NAMES, MODE_FREE, MODE_PINNED,
                             MODE_SLIDING, MODES_ALL, MODES_ALTERNATING)
 
@@ -147,7 +148,7 @@ def make_options(strategy="alternating", refine=True, integrator="euler", **kw) 
             raise ValueError(f"integrator {integrator!r} unknown; use one of {list(INTEGRATOR_NAMES)}")
         integrator = INTEGRATOR_NAMES.index(integrator)
     kw["integrator"] = integrator
-    return StepOptions(mode_strategy=int(strategy), **kw)
+    return check_options(StepOptions(mode_strategy=strategy, **kw))
 
 
 _OPTION_RULES = {
@@ -182,12 +183,14 @@ def check_options(opt) -> StepOptions:
     out = {}
     for name, (kind, test, rule) in _OPTION_RULES.items():
         value = getattr(opt, name)
+        said = f"StepOptions.{name}={plain(value)!r} {rule}"
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-            raise ValueError(f"StepOptions.{name}={value!r} {rule}")
-        if kind is int and float(value) != int(value):
-            raise ValueError(f"StepOptions.{name}={value!r} {rule}")
+            raise ValueError(said)
+        # an int field: a whole number (NaN and inf are not: int() of them raises)
+        if kind is int and not (math.isfinite(value) and float(value) == int(value)):
+            raise ValueError(said)
         value = kind(value)
         if not test(value):
-            raise ValueError(f"StepOptions.{name}={value!r} {rule}")
+            raise ValueError(said)
         out[name] = value
     return StepOptions(**out)

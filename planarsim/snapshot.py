@@ -11,16 +11,21 @@ from pathlib import Path
 import numpy as np
 
 from .state import State, check_state, with_defaults
-from .trajectory import atomic_write, read_npz
+from .trajectory import atomic_write, file_with_suffix, read_npz
 
 SNAPSHOT_VERSION = 2   # 2: the State holds the last step's impulses
 
 
 def save_snapshot(path, state: State, memory: dict | None = None) -> Path:
-    """Write state (+ memory: name -> array) to a .npz atomically."""
-    path = Path(path)
-    if path.suffix != ".npz":
-        raise ValueError(f"snapshot file {str(path)!r} must end in .npz")
+    """Write state (a State: sim.state) and memory (name -> array) to a .npz atomically."""
+    path = file_with_suffix(path, ".npz", "snapshot")
+    if not isinstance(state, State):
+        hint = " (a Simulator's is sim.state)" if hasattr(state, "state") else ""
+        raise TypeError(f"save_snapshot: state must be a planarsim State{hint}, got "
+                        f"{type(state).__name__}")
+    if memory is not None and not isinstance(memory, dict):
+        raise TypeError(f"save_snapshot: memory must be a dict (name -> array) or None, got "
+                        f"{type(memory).__name__}")
     payload = {f"state__{k}": v for k, v in state.as_dict().items()}
     for k, v in (memory or {}).items():
         payload[f"memory__{k}"] = np.asarray(v)

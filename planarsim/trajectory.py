@@ -178,9 +178,7 @@ class Trajectory:
     # files ------------------------------------------------------------------------------------
     def save(self, path) -> Path:
         """Write a .npz atomically (temporary file, then rename) with a format version."""
-        path = Path(path)
-        if path.suffix != ".npz":
-            raise ValueError(f"trajectory file {str(path)!r} must end in .npz")
+        path = file_with_suffix(path, ".npz", "trajectory")
         payload = {k: getattr(self, k) for k in self._ARRAYS}
         payload["format_version"] = np.array(FORMAT_VERSION)
         payload["body_names"] = np.array(self.body_names, dtype=str)
@@ -220,8 +218,9 @@ class Trajectory:
 
     def to_csv(self, path, model=None) -> Path:
         """One row per frame, SI units in every column name (csv_columns); with the model, each
-        actuator's applied effort is named torque_Nm or force_N by its kind."""
-        path = Path(path)
+        actuator's applied effort is named torque_Nm or force_N by its kind. `path` must end
+        in .csv (as save's in .npz)."""
+        path = file_with_suffix(path, ".csv", "CSV")
         cols, blocks = csv_columns(self, model)
         table = np.hstack([np.asarray(b, dtype=np.float64).reshape(len(self.t), -1) for b in blocks])
         atomic_write(path, lambda f: np.savetxt(f, table, delimiter=",", header=",".join(cols),
@@ -276,6 +275,15 @@ def csv_columns(traj, model=None) -> tuple:
             cols.append(k)
             blocks.append(v)
     return cols, blocks
+
+
+def file_with_suffix(path, suffix: str, what: str) -> Path:
+    """`path` as a Path; a ValueError naming it, `what` file it is and `suffix` unless its
+    name ends in `suffix` (".npz", ".csv")."""
+    path = Path(path)
+    if path.suffix != suffix:
+        raise ValueError(f"{what} file {str(path)!r} must end in {suffix}")
+    return path
 
 
 def read_npz(path, what: str) -> dict:

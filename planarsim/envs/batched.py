@@ -17,10 +17,11 @@ bound, so a step pays no numba type dispatch.
 
 Outside the fast compile mode (plain numba, NUMBA_DISABLE_JIT) phase (2) steps the copies
 one after another from Python, with the same numbers. An action with a NaN or infinite
-entry, or of the wrong shape, sends the step to SyncVectorEnv's own loop (whose copy raises,
-naming it). A copy whose step runs out of solve storage (GUARD_ROOM) or diverges is
-finished or reported from Python as Simulator.steps does; a divergence is raised after
-every copy's physics has run (SyncVectorEnv raises it before the copies after it step).
+entry sends the step to SyncVectorEnv's own loop (whose copy raises, naming it); actions of
+the wrong shape are a ValueError naming the shape wanted, before any copy steps. A copy
+whose step runs out of solve storage (GUARD_ROOM) or diverges is finished or reported from
+Python as Simulator.steps does; a divergence is raised after every copy's physics has run
+(SyncVectorEnv raises it before the copies after it step).
 
 >>> import gymnasium, planarsim.envs
 >>> envs = gymnasium.make_vec("planarsim/Hopper-v0", num_envs=64)     # doctest: +SKIP
@@ -72,6 +73,16 @@ def check_num_envs(num_envs) -> int:
     return int(num_envs)
 
 
+def check_action_shape(actions, shape, num_envs, env_id) -> np.ndarray:
+    """actions as an array; a ValueError naming the shape the num_envs copies of env_id take
+    (the action space's `shape`: num_envs rows of one copy's action) when it has another."""
+    actions = np.asarray(actions)
+    if actions.shape != tuple(shape):
+        raise ValueError(f"actions have shape {actions.shape}; {num_envs} copies of {env_id} "
+                         f"take shape {tuple(shape)}")
+    return actions
+
+
 class BatchedVectorEnv(SyncVectorEnv):
     """``num_envs`` copies of ``gymnasium.make(env_id, **kwargs)`` (each with gymnasium's
     usual wrappers: TimeLimit at max_episode_steps, order enforcing, the passive checker), a
@@ -115,7 +126,9 @@ class BatchedVectorEnv(SyncVectorEnv):
 
     def step(self, actions):
         """One step of every copy (gymnasium's SyncVectorEnv.step, after the copies' physics
-        have advanced together)."""
+        have advanced together). Actions of another shape than action_space's are a
+        ValueError naming it, before any copy steps."""
+        check_action_shape(actions, self.action_space.shape, self.num_envs, self.env_id)
         if self._was_reset and self._load_actions(actions):
             self._advance_physics()
         return super().step(actions)
@@ -123,8 +136,8 @@ class BatchedVectorEnv(SyncVectorEnv):
     def _load_actions(self, actions) -> bool:
         """Phase 1: the actions as float64 (as each copy converts its own) and the copies
         that step (not being autoreset); False (nothing to run: the copies then step one by
-        one and a copy's own step names what is wrong) for actions of the wrong shape or
-        kind, or if a copy's frame_skip was changed (set_attr)."""
+        one and a copy's own step names what is wrong) for actions of the wrong kind, or if a
+        copy's frame_skip was changed (set_attr)."""
         np.logical_not(self._autoreset_envs, out=self._active)
         try:
             actions = np.asarray(actions)

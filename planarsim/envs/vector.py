@@ -29,6 +29,7 @@ import gymnasium
 from gymnasium.vector import AutoresetMode, SyncVectorEnv, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from .batched import check_action_shape
 from .registry import register_all
 
 
@@ -171,10 +172,7 @@ class PlanarVectorEnv(VectorEnv):
         return obs, _merge_infos([p[1] for p in parts], self.sizes, self.num_envs)
 
     def step(self, actions):
-        actions = np.asarray(actions)
-        if actions.shape != self.action_space.shape:
-            raise ValueError(f"actions have shape {actions.shape}; {self.num_envs} copies of "
-                             f"{self.env_id} take shape {self.action_space.shape}")
+        actions = check_action_shape(actions, self.action_space.shape, self.num_envs, self.env_id)
         bad = np.flatnonzero(~np.all(np.isfinite(actions.reshape(self.num_envs, -1)), axis=1))
         if bad.size:     # before any copy steps: all copies stay in step with each other
             raise ValueError(f"actions of copies {bad.tolist()} have NaN or infinite entries: "

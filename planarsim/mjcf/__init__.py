@@ -72,6 +72,7 @@ result.py what load_mjcf returns.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from ..builder import ModelBuilder
@@ -90,6 +91,14 @@ __all__ = ["load_mjcf", "MJCFModel", "JointMap", "ActuatorMap", "LoadReport", "R
            "AXIS_TOL",
            "COLLIDES", "DEFAULT_DENSITY", "DEFAULT_FRICTION", "DEFAULT_GRAVITY", "DEFAULT_TIMESTEP",
            "DRAWN", "DROPPABLE", "SUPPORTED_GEOMS"]
+
+
+def _names(collection) -> list:
+    """The items of `collection` (a list of names), or [None] when it is not a collection."""
+    try:
+        return list(collection)
+    except TypeError:
+        return [None]
 
 
 def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), collide=None,
@@ -114,6 +123,15 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
     was ignored). Raises ModelError naming the element and line for malformed or unsupported
     input.
     """
+    if isinstance(source, os.PathLike):
+        source = Path(source)
+    if not isinstance(source, (str, Path, bytes, bytearray)):
+        raise TypeError(f"load_mjcf: source={source!r} must be a path (str or pathlib.Path) to an "
+                        "MJCF file, or its XML text (str or bytes)")
+    if collide is not None and (isinstance(collide, (str, bytes))
+                                or not all(isinstance(n, str) for n in _names(collide))):
+        raise TypeError(f"load_mjcf: collide={collide!r} must be None or a list of geom names, "
+                        "e.g. ['foot']")
     if isinstance(source, (bytes, bytearray)):   # XML text as bytes (dm_control's swimmer)
         source = decode(source, "load_mjcf: the XML source")
     if isinstance(source, (str, Path)) and not str(source).strip():

@@ -9,6 +9,7 @@ import numpy as np
 
 from .. import mjcf_frames as F
 from .include import origin
+from .plane import vec
 from .result import LoadReport
 from .schema import ATTRIBUTES
 from .xml_tree import element_error
@@ -82,7 +83,8 @@ class ElementReader:
         except ValueError:
             self.fail(node, f"{key}={raw!r} must be numbers separated by spaces")
         if n is not None and vals.size not in ((n,) if isinstance(n, int) else n):
-            self.fail(node, f"{key}={raw!r} must have {n} number(s), got {vals.size}")
+            counts = " or ".join(map(str, (n,) if isinstance(n, int) else n))
+            self.fail(node, f"{key}={raw!r} must have {counts} number(s), got {vals.size}")
         if not np.all(np.isfinite(vals)):
             self.fail(node, f"{key}={raw!r} must be finite")
         return vals
@@ -107,7 +109,7 @@ class ElementReader:
         v = self.floats(node, eff, k, {"quat": 4, "axisangle": 4, "euler": 3, "zaxis": 3,
                                        "xyaxes": 6}[k])
         if k != "euler" and not np.linalg.norm(v[:3] if k != "quat" else v) > 0:
-            self.fail(node, f"{k}={tuple(v)} must be non-zero")
+            self.fail(node, f"{k}={vec(v)} must be non-zero")
         if k == "quat":
             return F.quat_matrix(v)
         if k == "axisangle":

@@ -6,6 +6,7 @@ import numpy as np
 
 from .. import mjcf_frames as F
 from .attributes import ElementReader
+from .plane import vec
 from .schema import DEFAULT_DENSITY, DEFAULT_FRICTION, SUPPORTED_GEOMS
 
 
@@ -23,12 +24,12 @@ class BodyPartsReader(ElementReader):
                         **self.contact_params(g, eff))
         size = self.floats(g, eff, "size", (1, 2, 3))
         if np.any(size <= 0):
-            self.fail(g, f"size={tuple(float(x) for x in size)} must be > 0")
+            self.fail(g, f"size={vec(size)} must be > 0")
         need = {"sphere": 1, "capsule": 1 if "fromto" in eff else 2,
                 "cylinder": 1 if "fromto" in eff else 2, "box": 2 if "fromto" in eff else 3,
                 "ellipsoid": 2 if "fromto" in eff else 3}[kind]
         if size.size < need:
-            self.fail(g, f"{kind} size={tuple(float(x) for x in size)} needs {need} number(s)")
+            self.fail(g, f"{kind} size={vec(size)} needs {need} number(s)")
         if "fromto" in eff and kind != "sphere":
             ft = self.floats(g, eff, "fromto", 6)
             p0, p1 = ft[:3], ft[3:]
@@ -69,7 +70,7 @@ class BodyPartsReader(ElementReader):
             self.fail(g, f"condim={out['condim']} must be 1, 3, 4 or 6")
         fr = self.floats(g, eff, "friction", (1, 2, 3), default=DEFAULT_FRICTION)
         if fr[0] < 0:
-            self.fail(g, f"friction={tuple(fr)} must be >= 0")
+            self.fail(g, f"friction={vec(fr)} must be >= 0")
         out["mu"] = float(fr[0])
         return out
 

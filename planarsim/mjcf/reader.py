@@ -13,6 +13,7 @@ from .description import Body3D, Description, Motor, Tendon
 from .geoms import BodyPartsReader
 from .include import origin
 from .options import Flags, joint_frictionloss, read_flags
+from .plane import vec
 from .schema import CHILDREN, DEFAULT_GRAVITY, DEFAULT_TIMESTEP, DROPPABLE, EMPTY_ONLY, IGNORED_ELEMENTS
 from .xml_tree import Node
 
@@ -197,7 +198,7 @@ class Reader(BodyPartsReader):
             self.fail(j, f"type={kind!r} must be 'hinge' or 'slide'")
         a = self.floats(j, eff, "axis", 3, default=(0.0, 0.0, 1.0))
         if not np.linalg.norm(a) > 0:
-            self.fail(j, f"axis={tuple(a)} must be non-zero")
+            self.fail(j, f"axis={vec(a)} must be non-zero")
         a = a / np.linalg.norm(a)
         p = self.floats(j, eff, "pos", 3, default=(0.0, 0.0, 0.0))
         if not self.global_coords:
@@ -217,7 +218,7 @@ class Reader(BodyPartsReader):
         if v == "true" or (v == "auto" and "range" in eff):
             rng = self.floats(node, eff, "range", 2) * s
             if rng[0] > rng[1]:
-                self.fail(node, f"range={tuple(rng / s)} has lower > upper")
+                self.fail(node, f"range={vec(rng / s)} has lower > upper")
         k = self.scalar(node, eff, "stiffness", 0.0)
         c = self.scalar(node, eff, "damping", 0.0)
         if k < 0 or c < 0:
@@ -296,14 +297,14 @@ class Reader(BodyPartsReader):
                 self.fail(a, f"joint={jname!r} names no joint of the model")
             gear = self.floats(a, eff, "gear", (1, 6), default=(1.0,))
             if np.any(gear[1:] != 0):
-                self.fail(a, f"gear={tuple(gear)}: only the first component acts on a joint")
+                self.fail(a, f"gear={vec(gear)}: only the first component acts on a joint")
             lo, hi = -math.inf, math.inf
             for rng, lim in (("ctrlrange", "ctrllimited"), ("forcerange", "forcelimited")):
                 v = self.flag(a, eff, lim)
                 if v == "true" or (v == "auto" and rng in eff):
                     r = self.floats(a, eff, rng, 2)
                     if r[0] > r[1]:
-                        self.fail(a, f"{rng}={tuple(r)} has lower > upper")
+                        self.fail(a, f"{rng}={vec(r)} has lower > upper")
                     lo, hi = max(lo, r[0]), min(hi, r[1])
             moment = self.tendons[tname].path if tname is not None else ((jname, 1.0),)
             out.append(Motor(a, eff.get("name") or tname or jname, moment, float(gear[0]),

@@ -23,7 +23,7 @@ def make_builder(option, plane_map, ground, report, builder_kw, builder):
     if builder is not None:
         if builder.dt != dt or tuple(np.asarray(builder.gravity, float)) != g:
             report.note(f"the caller's builder keeps dt={builder.dt} s and gravity="
-                        f"{tuple(builder.gravity)}; the file has dt={dt} s, gravity={g}")
+                        f"{vec(builder.gravity)}; the file has dt={dt} s, gravity={g}")
         if ground is not None:
             report.note("the caller's builder keeps its terrain; the file's ground plane "
                         "is not applied")

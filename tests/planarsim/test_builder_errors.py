@@ -219,3 +219,89 @@ def test_actuators_that_cannot_act_are_refused(what, pattern):
             b.add_hip_torque("h", "p", "p3", "p3")
         else:
             b.add_body_torque("t", "p")
+
+
+def motor_rig():
+    """A torso, a leg pinned to it at the hip, and two point masses (a hip and a foot)."""
+    b = base()
+    b.add_body("leg", mass=1.0, inertia=0.1, pos=(0.0, 0.5))
+    b.add_pin("hip", "torso", "leg", anchor_world=(0.0, 0.75))
+    b.add_slider("rail", None, "leg", axis=(0.0, 1.0))
+    b.add_point_mass("h", 1.0, pos=(0.0, 1.5))
+    b.add_point_mass("fa", 1.0, pos=(-0.2, 1.0))
+    b.add_point_mass("fb", 1.0, pos=(0.2, 1.0))
+    return b
+
+
+ACTUATORS = {
+    "add_pin_motor": lambda b, limit: b.add_pin_motor("m", "hip", limit=limit),
+    "add_slider_motor": lambda b, limit: b.add_slider_motor("m", "rail", limit=limit),
+    "add_axial": lambda b, limit: b.add_axial("m", "h", "fa", limit=limit),
+    "add_hip_torque": lambda b, limit: b.add_hip_torque("m", "h", "fa", "fb", limit=limit),
+    "add_body_force": lambda b, limit: b.add_body_force("m", "torso", limit=limit),
+    "add_body_torque": lambda b, limit: b.add_body_torque("m", "torso", limit=limit),
+}
+
+
+@pytest.mark.parametrize("limit, words", [
+    (5, r"limit=5 must be a pair \(min, max\) of numbers"),
+    ((1.0, 2.0, 3.0), r"limit=\(1.0, 2.0, 3.0\) must be a pair"),
+    (None, r"limit=None must be a pair"),
+    ((math.inf, math.inf), r"limit=\(inf, inf\) must have min < inf and max > -inf"),
+    ((-math.inf, -math.inf), r"limit=\(-inf, -inf\) must have min < inf"),
+    ((5, -5), r"limit=\(5.0, -5.0\) must have min <= max"),
+    ((np.float64(math.nan), 1.0), r"limit=\(nan, 1.0\) must not be NaN"),
+])
+@pytest.mark.parametrize("method", sorted(ACTUATORS))
+def test_actuator_limit_that_is_not_an_open_pair(method, limit, words):
+    """limit=5 failed deep inside with "'int' object is not subscriptable", and (inf, inf) or
+    (-inf, -inf) compiled: a motor whose every command saturates to an infinite force."""
+    b = motor_rig()
+    with pytest.raises(ModelError, match=r"^actuator 'm' \(0\): " + words) as err:
+        ACTUATORS[method](b, limit)
+    assert "np.float64" not in str(err.value)
+    ACTUATORS[method](b, (-1.0, 1.0))     # the name was not taken by the refused one
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda b: b.add_arc_contact("sole", "torso", (0.0, 0.0), 0.1, span=5),
+     r"contact 'sole' \(0\): span=5 must be a pair \(a0, a1\) of numbers"),
+    (lambda b: b.add_arc_contact("sole", "torso", (0.0, 0.0), 0.1, span=(1.0,)),
+     r"contact 'sole' \(0\): span=\(1.0,\) must be a pair"),
+    (lambda b: b.add_arc_contact("sole", "torso", (0.0, 0.0), 0.1, span=(0.0, 1.0, 2.0)),
+     r"contact 'sole' \(0\): span=\(0.0, 1.0, 2.0\) must be a pair"),
+    (lambda b: b.add_arc_contact("sole", "torso", (0.0, 0.0), 0.1, span=(1.0, 1.0)),
+     r"contact 'sole' \(0\): span=\(1.0, 1.0\) must have span\[1\] > span\[0\]"),
+    (lambda b: b.add_arc_contact("sole", "torso", (0.0, 0.0), 0.1, span=(-math.inf, 1.0)),
+     r"contact 'sole' \(0\): span=\(-inf, 1.0\) must be finite"),
+    (lambda b: b.add_fluid_box("torso", size=5),
+     r"fluid box on body 'torso' \(0\): size=5 must be three lengths \(l1, l2, ln\) \[m\]"),
+    (lambda b: b.add_fluid_box("torso", size=(0.1, 0.2)), r"size=\(0.1, 0.2\) must be three"),
+    (lambda b: b.add_fluid_box("torso", size=(0.1, 0.0, 0.1)), r"size\[1\]=0.0 must be > 0"),
+    (lambda b: b.add_fluid_box("torso", size=(0.1, 0.1, math.inf)), r"size\[2\]=inf must be finite"),
+    (lambda b: b.add_fluid_box("torso", size=(0.1, 0.1, 0.1), viscosity=-1.0),
+     r"viscosity=-1.0 must be >= 0"),
+    (lambda b: b.add_fluid_box("torso", size=(0.1, 0.1, 0.1), density=-1.0),
+     r"density=-1.0 must be >= 0"),
+    (lambda b: b.add_body("shin", mass=1.0, inertia=0.1, shapes=[5]),
+     r"body 'shin' \(1\): shapes\[0\]=5 must be a tuple \(kind, \*params\)"),
+    (lambda b: b.add_body("shin", mass=1.0, inertia=0.1, shapes=["circle"]),
+     r"body 'shin' \(1\): shapes\[0\]='circle' must be a tuple"),
+    (lambda b: b.add_body("shin", mass=1.0, inertia=0.1, shapes=5),
+     r"body 'shin' \(1\): shapes=5 must be a list of shapes"),
+    (lambda b: b.add_body("shin", shapes=[("circle", (0.0, 0.0), 1.0)], density=1e308),
+     r"circle shape \(0\) of body 'shin': density=1e\+308 kg/m\^2 on its 3.14159 m\^2 gives "
+     r"body 'shin' a mass of inf kg"),
+    (lambda b: b.add_body("shin", shapes=[("circle", (0.0, 0.0), 0.1, {"density": 1e308}),
+                                          ("box", (0.0, 0.0), 2.0, 2.0, {"density": 1e308})]),
+     r"box shape \(1\) of body 'shin': .* a mass of inf kg"),
+])
+def test_arc_span_fluid_box_and_shapes_that_are_not_what_they_must_be(call, words):
+    """A span of 5 or (1,) failed with a raw TypeError/IndexError and (0, 1, 2) was accepted;
+    a fluid box of size 5 failed in numpy's reshape; shapes=[5] with "'int' object is not
+    iterable" and ['circle'] as kind 'c'; a density of 1e308 compiled a body of mass inf."""
+    b = base()
+    with pytest.raises(ModelError, match=words) as err:
+        call(b)
+    assert "np.float64" not in str(err.value)
+    assert b._shapes == [] and len(b._bodies) == 1   # nothing of the refused element kept

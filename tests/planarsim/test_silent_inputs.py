@@ -1,6 +1,7 @@
 """Inputs that were accepted silently now raise an error naming the culprit: ModelError for
 model-building mistakes, ValueError for data files and states."""
 import math
+import re
 
 import numpy as np
 import pytest
@@ -281,3 +282,85 @@ def test_env_settings_that_fail_late_are_refused_when_made(kw, text):
     import planarsim.envs  # noqa: F401
     with pytest.raises(ValueError, match=text):
         gym.make("planarsim/Hopper-v0", **kw)
+
+
+MJCF_PENDULUM = ('<mujoco><worldbody><body name="b"><joint name="j" type="hinge" axis="{axis}" '
+                 '{joint}/><geom name="foot" type="sphere" size="0.1" {geom}/></body></worldbody>'
+                 '<actuator>{motor}</actuator></mujoco>')
+
+
+@pytest.mark.parametrize("kw, error, words", [
+    (dict(source=None), TypeError, r"load_mjcf: source=None must be a path .* or its XML text"),
+    (dict(source=5), TypeError, r"load_mjcf: source=5 must be a path"),
+    (dict(collide="foot"), TypeError, r"load_mjcf: collide='foot' must be None or a list of geom names"),
+    (dict(axis="0 0 0"), ps.ModelError, r"<joint name='j'> \(line 1\): axis=\(0.0, 0.0, 0.0\) must be non-zero"),
+    (dict(joint='range="1 -1"'), ps.ModelError, r"range=\(1.0, -1.0\) has lower > upper"),
+    (dict(geom='friction="-1"'), ps.ModelError, r"friction=\(-1.0,\) must be >= 0"),
+    (dict(motor='<motor joint="j" ctrlrange="1 -1"/>'), ps.ModelError, r"ctrlrange=\(1.0, -1.0\) has lower"),
+    (dict(motor='<motor joint="j" gear="1 2"/>'), ps.ModelError, r"gear='1 2' must have 1 or 6 number"),
+])
+def test_mjcf_source_and_messages(kw, error, words):
+    """load_mjcf(None) and load_mjcf(5) read str(source) as XML ("malformed XML: syntax error");
+    collide='foot' named geoms 'f', 'o' and 't'; messages printed
+    axis=(np.float64(0.0), np.float64(0.0), np.float64(0.0))."""
+    from planarsim.mjcf import load_mjcf
+    parts = dict(axis="0 1 0", joint="", geom="", motor="")
+    parts.update({k: v for k, v in kw.items() if k in parts})
+    source = kw.get("source", MJCF_PENDULUM.format(**parts))
+    with pytest.raises(error, match=words) as err:
+        load_mjcf(source, collide=kw.get("collide"))
+    assert "np.float64" not in str(err.value)
+
+
+@pytest.mark.parametrize("shape", [(3,), (2, 5), (3, 1), (2,)])
+def test_vector_env_action_of_the_wrong_shape(shape):
+    """(3, 1) failed with "zip() argument 2 is shorter than argument 1", and (3,) or (2, 5) with
+    a copy's "action has shape ()": neither said the shape the vector env takes, (2, 1)."""
+    gym = pytest.importorskip("gymnasium")
+    import planarsim.envs  # noqa: F401
+    envs = gym.make_vec("planarsim/InvertedPendulum-v0", num_envs=2,
+                        vectorization_mode="vector_entry_point")
+    try:
+        envs.reset(seed=0)
+        with pytest.raises(ValueError, match=rf"actions have shape {re.escape(str(shape))}; 2 copies "
+                                             r"of planarsim/InvertedPendulum-v0 take shape \(2, 1\)"):
+            envs.step(np.zeros(shape))
+        envs.step(np.zeros((2, 1)))
+    finally:
+        envs.close()
+
+
+@pytest.mark.parametrize("kw, words", [
+    (dict(refine_iters=NAN), r"StepOptions\.refine_iters=nan must be an integer >= 0"),
+    (dict(refine_iters=math.inf), r"StepOptions\.refine_iters=inf must be an integer >= 0"),
+    (dict(max_substeps=np.float64(NAN)), r"StepOptions\.max_substeps=nan must be an integer >= 1"),
+    (dict(integrator=NAN), r"StepOptions\.integrator=nan must be one of 0\.\.3"),
+    (dict(refine_tol=NAN), r"StepOptions\.refine_tol=nan must be finite"),
+    (dict(refine_iters="4"), r"StepOptions\.refine_iters='4' must be an integer"),
+])
+def test_step_options_nan_or_wrong_type(kw, words):
+    """A NaN or infinite integer field failed in int() with "cannot convert float NaN to
+    integer", naming no field; make_options returned the bad options unchecked."""
+    model = two_bodies()
+    with pytest.raises(ValueError, match=words) as err:
+        ps.Simulator(model, options=ps.StepOptions(**kw))
+    assert "np.float64" not in str(err.value)
+    with pytest.raises(ValueError, match=words):
+        ps.make_options(**kw)
+
+
+def test_files_of_the_wrong_kind(tmp_path):
+    """to_csv("out.npz") wrote CSV text into a .npz file; save_snapshot(path, 5) and
+    save_snapshot(path, sim) failed with AttributeError ... 'as_dict'."""
+    sim = ps.Simulator(two_bodies())
+    traj = sim.run(0.01)
+    with pytest.raises(ValueError, match=r"CSV file '.*out\.npz' must end in \.csv"):
+        traj.to_csv(tmp_path / "out.npz")
+    with pytest.raises(TypeError, match=r"save_snapshot: state must be a planarsim State, got int"):
+        ps.save_snapshot(tmp_path / "s.npz", 5)
+    with pytest.raises(TypeError, match=r"must be a planarsim State \(a Simulator's is sim\.state\), "
+                                        r"got Simulator"):
+        ps.save_snapshot(tmp_path / "s.npz", sim)
+    with pytest.raises(TypeError, match=r"memory must be a dict"):
+        ps.save_snapshot(tmp_path / "s.npz", sim.state, memory=5)
+    assert list(tmp_path.iterdir()) == []
