@@ -220,11 +220,13 @@ def run_pareto(args, peers):
     return rows
 
 
-def _list(text, known, what):
+def _list(ap, flag, text, known, what):
+    """The comma list `text` of --flag; a usage error (exit 2) naming the unknown items and
+    the known ones."""
     items = [x for x in text.split(",") if x]
     bad = [x for x in items if x not in known]
     if bad:
-        raise SystemExit(f"planarsim bench: unknown {what} {bad}; choose from {list(known)}")
+        ap.error(f"--{flag} {text}: unknown {what} {bad}; choose from {list(known)}")
     return items
 
 
@@ -272,9 +274,9 @@ def parse_args(argv):
         args.parts = "scenes,peers" if args.scenes else ",".join(PARTS)
     args.pareto_scenes = [n for n in args.scenes if n in PEER_SCENES] if args.scenes else list(DEFAULT_SCENES)
     args.scenes = args.scenes or list(SCENES)
-    args.parts = _list(args.parts, PARTS, "part(s)")
-    args.peers = [] if args.peers == "none" else _list(args.peers, PEER_MODULES, "peer(s)")
-    args.walkers = _list(args.walkers, walkers.WALKERS, "walker(s)")
+    args.parts = _list(ap, "parts", args.parts, PARTS, "part(s)")
+    args.peers = [] if args.peers == "none" else _list(ap, "peers", args.peers, PEER_MODULES, "peer(s)")
+    args.walkers = _list(ap, "walkers", args.walkers, walkers.WALKERS, "walker(s)")
     return args
 
 

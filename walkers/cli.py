@@ -15,12 +15,17 @@ import inspect
 import json
 import math
 import os
+import re
 import sys
 import time
 from pathlib import Path
 
 ANIMATION_EXTS = (".gif", ".mp4", ".html")
 PLOT_EXTS = (".png", ".svg", ".pdf")
+# [s] the largest --dt: the walkers are built and tuned at 1e-3 s; larger steps lose their
+# impacts and motors (at 0.02 s Ranger stops at once, the simplest walker takes 2 of
+# its 4 steps in 5 s; at 0.05 s the Simple Biped falls)
+MAX_DT = 0.01
 
 
 class UsageError(Exception):
@@ -80,6 +85,14 @@ def _check_out(path, exts, what):
     if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
         raise UsageError(f"{what} {str(p)!r}: not writable")
     return p
+
+
+def _check_dt(dt):
+    """UsageError naming --dt when it is above MAX_DT (None: the walker's own)."""
+    if dt is not None and dt > MAX_DT:
+        raise UsageError(f"--dt {dt:g} s is too large; use a step of at most {MAX_DT:g} s (1e-3 "
+                         "is usual): the walkers are tuned at 1e-3 s, and at 0.02 s some "
+                         "already lose their impacts or stop (Ranger at once)")
 
 
 def _positive(text):
@@ -145,8 +158,7 @@ def cmd_run(args):
         ter = T.parse(args.terrain) if args.terrain else None
     except ValueError as e:
         raise UsageError(str(e)) from None
-    if args.dt is not None and args.dt > 0.01:
-        raise UsageError(f"--dt {args.dt} is too large; use a step of at most 0.01 s (1e-3 is usual)")
+    _check_dt(args.dt)
     changed = _walker_params(mod, args)     # bad parameters are refused before anything is made
     if "slope" in changed and args.terrain:
         raise UsageError("--set slope and --terrain both set the slope; give one of them")
@@ -154,8 +166,13 @@ def cmd_run(args):
     summary_path = None
     # --json alone is for scripts: the summary, nothing rendered (ask with --out for a file)
     if out is None and not args.no_animation and not args.json:
-        Path("out").mkdir(exist_ok=True)
         out = f"out/{args.walker}.gif"
+        try:
+            Path("out").mkdir(exist_ok=True)
+        except OSError as e:
+            raise UsageError(f"cannot write the default animation {out!r}: no folder 'out' can be "
+                             f"made in {os.getcwd()!r} ({e.strerror}); run from a writable folder, "
+                             "or give --out FILE.gif, or --no-animation") from None
         summary_path = Path(f"out/{args.walker}_summary.json")
     out = _check_out(out, ANIMATION_EXTS, "--out")
     plot = _check_out(args.plot, PLOT_EXTS, "--plot")
@@ -409,8 +426,7 @@ def _analysis_family(args):
         raise UsageError(f"--range {args.range!r} must be two different finite numbers")
     if not (lo <= min(a, b) and max(a, b) <= hi):
         raise UsageError(f"--range {args.range!r} leaves the bounds of {args.param}: [{lo}, {hi}]")
-    if args.dt is not None and args.dt > 0.01:
-        raise UsageError(f"--dt {args.dt} is too large; use a step of at most 0.01 s (1e-3 is usual)")
+    _check_dt(args.dt)
     return fam.WalkerFamily(args.walker, args.param, dt=args.dt or 1e-3), a, b
 
 
@@ -493,6 +509,12 @@ def cmd_analyze(args):
 class _Parser(argparse.ArgumentParser):
     """argparse, but a bad argument is one line and a pointer to --help (exit 2), not the whole
     usage first."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # "-1e-3" is a (negative) number, not an option, as newer Pythons' argparse reads it:
+        # "--dt -1e-3" is then refused by --dt's own check, naming it
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")

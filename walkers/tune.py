@@ -104,7 +104,14 @@ def load_result(path) -> TuneResult:
         raise ValueError(f"{path}: tuning-result format version {version}; this planarsim reads "
                          f"version {FORMAT_VERSION}")
     data.pop("format_version")
-    data["names"] = tuple(data["names"])
+    missing = [k for k in ("walker", "best_params", "best_score", "start_score") if k not in data]
+    unknown = sorted(k for k in data if k not in TuneResult.__dataclass_fields__)
+    if missing or unknown:
+        raise ValueError(f"{path}: not a tuning result: "
+                         f"{f'missing {missing}' if missing else f'unknown fields {unknown}'}")
+    if not isinstance(data["best_params"], dict):
+        raise ValueError(f"{path}: not a tuning result: best_params is not a dict of parameters")
+    data["names"] = tuple(data.get("names", ()))
     return TuneResult(**data)
 
 
@@ -252,6 +259,9 @@ def _bad_tune_flags(a) -> str | None:
         return f"--budget {a.budget} must be at least 1"
     if a.duration is not None and not (math.isfinite(a.duration) and a.duration > 0):
         return f"--duration {a.duration} must be a positive number of seconds"
+    if a.start is not None and not Path(a.start).is_file():
+        return (f"--start {a.start}: no such file (a JSON result written by 'planarsim tune "
+                "--out FILE.json')")
     return None
 
 

@@ -160,3 +160,56 @@ def test_a_reader_that_leaves_does_not_stop_the_files(tmp_path, monkeypatch, cap
                  str(csv_path), "--plot", str(png), "--workers", "1"])
     assert code == 0, capsys.readouterr().err
     assert csv_path.stat().st_size > 0 and png.stat().st_size > 0
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["tune", "simple-biped", "--start", "/nonexistent.json"],
+     "--start /nonexistent.json: no such file"),
+    (["bench", "--parts", "nosuch"], "--parts nosuch: unknown part(s) ['nosuch']; choose from"),
+    (["run", "simple-biped", "--dt", "-1e-3"], "argument --dt: -1e-3 must be a finite number > 0"),
+    (["run", "simple-biped", "--dt", "0"], "argument --dt: 0 must be a finite number > 0"),
+    (["run", "simple-biped", "--dt", "2.0"], "--dt 2 s is too large; use a step of at most 0.01 s"),
+    (["analyze", "simplest-walker", "--param", "slope", "--range", "0.01:0.02", "--dt", "0.05"],
+     "--dt 0.05 s is too large"),
+])
+def test_bad_flags_exit_2_naming_the_flag(argv, fragment, capsys):
+    """--start of a missing file said only "[Errno 2] No such file or directory"; an unknown
+    --parts exited 1; --dt -1e-3 read as an option ("expected one argument")."""
+    try:
+        code = main(argv)
+    except SystemExit as e:          # argparse's own usage errors
+        code = e.code
+    err = capsys.readouterr().err
+    assert code == 2
+    assert fragment in err, err
+    assert "Traceback" not in err
+
+
+def test_default_animation_in_an_unwritable_folder(tmp_path, monkeypatch, capsys):
+    """A run from a folder where out/ cannot be made said only "[Errno 2] No such file or
+    directory: 'out'" (in /proc)."""
+    import os
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        folder = locked if not os.access(locked, os.W_OK) else "/proc/1"
+        if not os.path.isdir(folder) or os.access(folder, os.W_OK):
+            pytest.skip("no unwritable folder available to this user")
+        monkeypatch.chdir(folder)
+        code, out, err = run_cli(capsys, "run", "simple-biped", "--duration", "1")
+        assert code == 2
+        assert "cannot write the default animation 'out/simple-biped.gif'" in err
+        assert "--out FILE.gif, or --no-animation" in err
+    finally:
+        locked.chmod(0o700)
+
+
+def test_tune_start_file_that_is_not_a_result(tmp_path, capsys):
+    """A --start JSON without the result's fields stopped with a KeyError traceback."""
+    start = tmp_path / "start.json"
+    start.write_text('{"format_version": 1}')
+    code, _, err = run_cli(capsys, "tune", "simple-biped", "--start", str(start), "--budget", "1")
+    assert code == 2
+    assert "start.json: not a tuning result: missing ['walker', 'best_params'" in err
+    assert "Traceback" not in err
