@@ -32,7 +32,7 @@ REBOUND_REL_TOL = 1e-7
 
 
 @kernel
-def rebounding(m, s, ws):
+def rebounding(s, ws):
     """Some touching contact of the step's answer carries a rebound target (restitution)."""
     for k in range(ws.n_live[0]):
         i = ws.live[k]

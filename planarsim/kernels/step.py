@@ -388,7 +388,8 @@ def scale_rebounds(m, s, ws, scale):
 @kernel
 def rebound_answer(m, s, ws, opt, h, include_ccd, scale):
     """The step's answer (solve_modes) with the rebounds at `scale`: (whether a linear
-    solve's answer stood, the kinetic energy its contacts add beyond rounding [J])."""
+    solve's answer stood, the modified energy its contacts add beyond rounding [J]:
+    rebound.rebound_gain)."""
     scale_rebounds(m, s, ws, scale)
     answered = solve_modes(m, s, ws, opt, h, include_ccd)
     return answered, rebound_gain(m, ws, h)
@@ -413,7 +414,7 @@ def bound_rebound(m, s, ws, opt, h, include_ccd, answered):
     that added none. Where even the plastic answer adds energy the rebounds are not its
     cause: that answer is kept (the audit judges it). Returns what solve_modes returns for
     the answer kept."""
-    if not rebounding(m, s, ws):
+    if not rebounding(s, ws):
         return answered
     hi_g = rebound_gain(m, ws, h)
     if hi_g <= 0.0:
