@@ -459,6 +459,9 @@ class Workspace(NamedTuple):
     chain_y: np.ndarray          # (n_pin, 2) scratch of the block substitution
     chain_cs: np.ndarray         # (n_body, 3) cos, sin, angle carried through the path's step
                                  #   (pin_chain.carry_trig; read within a step only)
+    chain_lever: np.ndarray      # (n_pin, 2, 4) [m] each pin's anchors from their bodies' centres
+                                 #   of mass (end a, end b): (x, y) at the step's start, at the
+                                 #   iterate (pin_chain.lever_gaps; read within a step only)
     start: State                 # the step's start while it is taken in sub-steps (GUARD_ROOM
                                  #   puts it back; kernels/step.py)
     prev: State                  # the state at the start of the last step (for guard errors)
@@ -820,4 +823,5 @@ def _chain_arrays(model: Model) -> dict:
                                                     np.full((npin, 2), -1, np.int64))
     return dict(chain_on=np.array([int(found is not None)], np.int64), chain_pin=order,
                 chain_end=ends, chain_factor=np.zeros((npin, 12)), chain_y=np.zeros((npin, 2)),
-                chain_cs=np.full((model.n_body, 3), np.nan))
+                chain_cs=np.full((model.n_body, 3), np.nan),
+                chain_lever=np.zeros((npin, 2, 4)))

@@ -17,6 +17,11 @@ passes reuse the factorisation of an earlier one once every row is within CHORD_
 step: the rows moved by less than that since, so each pass still removes all but a share of
 that order of the error). Both end where the general stages end, to rounding.
 
+The rows are never written out as the general stages' row arrays (ws.row_J and the rest): a
+pin's rows are fixed by its two anchors' levers from their bodies' centres of mass
+(ws.chain_lever, at the step's start and at the iterate), from which each loop forms the few
+products it needs (the blocks, the gaps, the moves, the joints' work).
+
 Within a step the bodies' (cos, sin) are carried from the step's start through each turn
 (carry_trig, in Workspace.chain_cs) rather than computed afresh at every configuration; the
 step ends with them computed afresh at its end (update_trig), so that a step depends on the
@@ -25,11 +30,9 @@ State alone.
 import math
 
 from ..compile import kernel
-from .codes import ROW_PIN_X, ROW_PIN_Y
 from .integrate import STALLED_RATIO
 from .math2d import update_trig
-from .pin import pin_gap, pin_rows
-from .solve import add_impulses
+from .work import VELOCITY_FLOOR, WORK_REL_TOL, fastest
 
 # [m] every row within this after a correction pass: the next reuses the factorisation
 CHORD_TOL = 1e-9
@@ -78,33 +81,125 @@ def carry_trig(q, cs_from, cs_to):
             cs_to[i, 2] = th
 
 
-@kernel(inline="always")
-def _body_share(m, JL, JR, rl, el, rr, er, b):
-    """Body b's share of A[rl:rl + 2, rr:rr + 2] = JL W JR^T (JL's rows rl, rl + 1 at their
-    end el, JR's rows rr, rr + 1 at their end er: pins' x and y rows, whose x row has no y
-    entry and y row no x entry; the products with those zeros are left out), row-major."""
-    wm = m.body_inv_mass[b]
-    wi = m.body_inv_inertia[b]
-    lx = JL[rl, el, 2]
-    ly = JL[rl + 1, el, 2]
-    rx = JR[rr, er, 2]
-    ry = JR[rr + 1, er, 2]
-    return (wm * (JL[rl, el, 0] * JR[rr, er, 0]) + wi * lx * rx, wi * lx * ry, wi * ly * rx,
-            wm * (JL[rl + 1, el, 1] * JR[rr + 1, er, 1]) + wi * ly * ry)
+@kernel
+def chain_solve(ws, rhs, x):
+    """x = A^-1 rhs by the factors of chain_factor (rows 2j, 2j + 1 of pin j in both)."""
+    f = ws.chain_factor
+    y = ws.chain_y
+    n = ws.chain_pin.shape[0]
+    for k in range(n):
+        r = 2 * ws.chain_pin[k]
+        y0 = rhs[r]
+        y1 = rhs[r + 1]
+        if ws.chain_end[k, 0] >= 0:
+            # y_k -= G_k y_{k-1}, G_k = A[k, k-1] P_{k-1}^-1
+            y0 -= f[k, 4] * y[k - 1, 0] + f[k, 5] * y[k - 1, 1]
+            y1 -= f[k, 6] * y[k - 1, 0] + f[k, 7] * y[k - 1, 1]
+        y[k, 0] = y0
+        y[k, 1] = y1
+    for k in range(n - 1, -1, -1):
+        r = 2 * ws.chain_pin[k]
+        t0 = y[k, 0]
+        t1 = y[k, 1]
+        if k + 1 < n and ws.chain_end[k + 1, 0] >= 0:
+            # t -= A[k, k+1] x_{k+1}
+            rn = 2 * ws.chain_pin[k + 1]
+            t0 -= f[k + 1, 8] * x[rn] + f[k + 1, 9] * x[rn + 1]
+            t1 -= f[k + 1, 10] * x[rn] + f[k + 1, 11] * x[rn + 1]
+        x[r] = f[k, 0] * t0 + f[k, 1] * t1
+        x[r + 1] = f[k, 2] * t0 + f[k, 3] * t1
 
 
 @kernel
-def chain_factor(m, ws, JL, JR, symmetric):
-    """The block LU of A = JL W JR^T along the chains into ws.chain_factor (symmetric: JL is
-    JR, so A[k-1, k] is A[k, k-1]^T); returns the smallest share of its own diagonal that a
-    row's pivot kept (each 2 x 2 pivot eliminated x row first, as the general L D L^T does,
-    in the chains' order, which is the rows' where the model lists its pins along its
-    chains; 0: a pivot vanished, the rows are dependent)."""
+def chain_prediction(s, ws, h):
+    """ws.q_pred = q + h v_lin (integrate.predict_configuration) and its cos / sin carried from
+    q's (ws.body_cs) into ws.chain_cs."""
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            ws.q_pred[i, k] = s.q[i, k] + h * ws.v_lin[i, k]
+    carry_trig(ws.q_pred, ws.body_cs, ws.chain_cs)
+
+
+# ---- the pins' rows as levers ----
+# Pin j's anchor on end e (0: body a, 1: body b; -1 bodies are the world) sits at r = R p
+# from its body's centre of mass; ws.chain_lever[j, e] holds (r_x, r_y) at the step's start
+# (q0) and at the iterate. Its rows' Jacobian blocks are sign(e) [[1, 0, -r_y], [0, 1, r_x]]
+# (sign -1 at end a, +1 at end b: the gap is p_b - p_a), so a body's share of the 2 x 2
+# block that couples pin j (end e, lever rL) to pin i (end f, lever rR through the same
+# body) is sign(e) sign(f) (w_m I + w_i (-rL_y, rL_x) (-rR_y, rR_x)^T).
+
+
+@kernel(inline="always")
+def _lever(cs, body, anchor, j, e):
+    """(x, y) [m] of pin j's anchor on end e from its body's centre of mass (cs: the bodies'
+    cos, sin); (0, 0) for the world."""
+    if body < 0:
+        return 0.0, 0.0
+    c = cs[body, 0]
+    sn = cs[body, 1]
+    lx = anchor[j, e, 0]
+    ly = anchor[j, e, 1]
+    return c * lx - sn * ly, sn * lx + c * ly
+
+
+@kernel
+def lever_gaps(m, q, cs, ws, at):
+    """The pins' gaps p_b - p_a at q (cs its cos / sin) as targets ws.rhs = -c, their levers
+    into ws.chain_lever[:, :, at:at + 2]; returns the largest |c| [m]."""
+    worst = 0.0
+    for j in range(m.pin_body.shape[0]):
+        a = m.pin_body[j, 0]
+        b = m.pin_body[j, 1]
+        rax, ray = _lever(cs, a, m.pin_anchor, j, 0)
+        rbx, rby = _lever(cs, b, m.pin_anchor, j, 1)
+        ws.chain_lever[j, 0, at] = rax
+        ws.chain_lever[j, 0, at + 1] = ray
+        ws.chain_lever[j, 1, at] = rbx
+        ws.chain_lever[j, 1, at + 1] = rby
+        if a >= 0:
+            ax = q[a, 0] + rax
+            ay = q[a, 1] + ray
+        else:
+            ax = m.pin_anchor[j, 0, 0]
+            ay = m.pin_anchor[j, 0, 1]
+        if b >= 0:
+            bx = q[b, 0] + rbx
+            by = q[b, 1] + rby
+        else:
+            bx = m.pin_anchor[j, 1, 0]
+            by = m.pin_anchor[j, 1, 1]
+        gx = bx - ax
+        gy = by - ay
+        ws.rhs[2 * j] = -gx
+        ws.rhs[2 * j + 1] = -gy
+        worst = max(worst, abs(gx), abs(gy))
+    return worst
+
+
+@kernel(inline="always")
+def _lever_share(m, ws, jl, el, at, jr, er, b):
+    """Body b's share of the block coupling pin jl (end el, levers at column `at`) to pin jr
+    (end er, levers of the step's start), row-major."""
+    wm = m.body_inv_mass[b]
+    wi = m.body_inv_inertia[b]
+    lx = ws.chain_lever[jl, el, at]
+    ly = ws.chain_lever[jl, el, at + 1]
+    rx = ws.chain_lever[jr, er, 0]
+    ry = ws.chain_lever[jr, er, 1]
+    sg = 1.0 if el == er else -1.0
+    return (sg * (wm + wi * ly * ry), -sg * (wi * ly * rx), -sg * (wi * lx * ry),
+            sg * (wm + wi * lx * rx))
+
+
+@kernel
+def lever_factor(m, ws, at):
+    """chain_factor's block LU of J(levers at column `at`) W J0^T along the chains (at 0: the
+    symmetric matrix of the step's start); returns the smallest share of its own diagonal that
+    a row's pivot kept (0: dependent rows)."""
     f = ws.chain_factor
     smallest = 1.0
     for k in range(ws.chain_pin.shape[0]):
         j = ws.chain_pin[k]
-        r = 2 * j
         d00 = 0.0
         d01 = 0.0
         d10 = 0.0
@@ -112,7 +207,7 @@ def chain_factor(m, ws, JL, JR, symmetric):
         for e in range(2):
             b = m.pin_body[j, e]
             if b >= 0:
-                a00, a01, a10, a11 = _body_share(m, JL, JR, r, e, r, e, b)
+                a00, a01, a10, a11 = _lever_share(m, ws, j, e, at, j, e, b)
                 d00 += a00
                 d01 += a01
                 d10 += a10
@@ -124,14 +219,13 @@ def chain_factor(m, ws, JL, JR, symmetric):
         ej = ws.chain_end[k, 0]
         if ej >= 0:
             ei = ws.chain_end[k, 1]
-            ri = 2 * ws.chain_pin[k - 1]
+            i = ws.chain_pin[k - 1]
             b = m.pin_body[j, ej]
-            e00, e01, e10, e11 = _body_share(m, JL, JR, r, ej, ri, ei, b)     # A[k, k-1]
-            if symmetric:
+            e00, e01, e10, e11 = _lever_share(m, ws, j, ej, at, i, ei, b)     # A[k, k-1]
+            if at == 0:         # (J0 W J0^T is symmetric: A[k-1, k] = A[k, k-1]^T)
                 u00, u01, u10, u11 = e00, e10, e01, e11
             else:
-                u00, u01, u10, u11 = _body_share(m, JL, JR, ri, ei, r, ej, b)  # A[k-1, k]
-            # G = A[k, k-1] P_{k-1}^-1, then P -= G A[k-1, k]
+                u00, u01, u10, u11 = _lever_share(m, ws, i, ei, at, j, ej, b)  # A[k-1, k]
             g00 = e00 * f[k - 1, 0] + e01 * f[k - 1, 2]
             g01 = e00 * f[k - 1, 1] + e01 * f[k - 1, 3]
             g10 = e10 * f[k - 1, 0] + e11 * f[k - 1, 2]
@@ -166,177 +260,121 @@ def chain_factor(m, ws, JL, JR, symmetric):
 
 
 @kernel
-def chain_solve(ws, rhs, x):
-    """x = A^-1 rhs by the factors of chain_factor (rows 2j, 2j + 1 of pin j in both)."""
-    f = ws.chain_factor
-    y = ws.chain_y
-    n = ws.chain_pin.shape[0]
-    for k in range(n):
-        r = 2 * ws.chain_pin[k]
-        y0 = rhs[r]
-        y1 = rhs[r + 1]
-        if ws.chain_end[k, 0] >= 0:
-            # y_k -= G_k y_{k-1}, G_k = A[k, k-1] P_{k-1}^-1
-            y0 -= f[k, 4] * y[k - 1, 0] + f[k, 5] * y[k - 1, 1]
-            y1 -= f[k, 6] * y[k - 1, 0] + f[k, 7] * y[k - 1, 1]
-        y[k, 0] = y0
-        y[k, 1] = y1
-    for k in range(n - 1, -1, -1):
-        r = 2 * ws.chain_pin[k]
-        t0 = y[k, 0]
-        t1 = y[k, 1]
-        if k + 1 < n and ws.chain_end[k + 1, 0] >= 0:
-            # t -= A[k, k+1] x_{k+1}
-            rn = 2 * ws.chain_pin[k + 1]
-            t0 -= f[k + 1, 8] * x[rn] + f[k + 1, 9] * x[rn + 1]
-            t1 -= f[k + 1, 10] * x[rn] + f[k + 1, 11] * x[rn + 1]
-        x[r] = f[k, 0] * t0 + f[k, 1] * t1
-        x[r + 1] = f[k, 2] * t0 + f[k, 3] * t1
-
-
-@kernel
-def chain_rows(m, s, ws):
-    """Stage 3 on the chains: pin j's rows 2j (x) and 2j + 1 (y), their Jacobian blocks and
-    errors at q (ws.body_cs its cos / sin) and their errors at q_pred (ws.chain_cs): the rows
-    rows.build_rows makes for such a model (but row_F, which this path does not read)."""
-    n_pin = m.pin_body.shape[0]
-    for j in range(n_pin):
-        r = 2 * j
-        a = m.pin_body[j, 0]
-        b = m.pin_body[j, 1]
-        ws.row_kind[r] = ROW_PIN_X
-        ws.row_kind[r + 1] = ROW_PIN_Y
-        ws.row_owner[r] = j
-        ws.row_owner[r + 1] = j
-        ws.row_body[r, 0] = a
-        ws.row_body[r, 1] = b
-        ws.row_body[r + 1, 0] = a
-        ws.row_body[r + 1, 1] = b
-        pin_rows(s.q, ws.body_cs, m.pin_anchor, j, a, b, ws.row_J, ws.row_c, r)
-        gx, gy = pin_gap(ws.q_pred, ws.chain_cs, m.pin_anchor, j, a, b)
-        ws.row_c_pred[r] = gx
-        ws.row_c_pred[r + 1] = gy
-    ws.n_row[0] = 2 * n_pin
-
-
-@kernel
-def chain_prediction(s, ws, h):
-    """ws.q_pred = q + h v_lin (integrate.predict_configuration) and its cos / sin carried from
-    q's (ws.body_cs) into ws.chain_cs."""
-    for i in range(s.q.shape[0]):
-        for k in range(3):
-            ws.q_pred[i, k] = s.q[i, k] + h * ws.v_lin[i, k]
-    carry_trig(ws.q_pred, ws.body_cs, ws.chain_cs)
-
-
-@kernel
-def chain_residual(m, s, ws, jacobian):
-    """The pins' errors c at q as the correction's targets, ws.rhs = -c (and, jacobian, their
-    rows' Jacobian blocks into ws.row_Jp); returns the largest |c| [m]. ws.chain_cs must hold
-    q's cos / sin."""
-    worst = 0.0
+def lever_move(m, ws, x, q, q_scale, v, v_scale):
+    """q += q_scale W J0^T x and v += v_scale W J0^T x (x: the pins' impulses, 2 a pin; J0
+    from the levers of the step's start); a scale of 0 leaves its array alone."""
     for j in range(m.pin_body.shape[0]):
-        r = 2 * j
-        a = m.pin_body[j, 0]
-        b = m.pin_body[j, 1]
-        if jacobian:
-            pin_rows(s.q, ws.chain_cs, m.pin_anchor, j, a, b, ws.row_Jp, ws.rhs, r)
-            gx = ws.rhs[r]
-            gy = ws.rhs[r + 1]
-        else:
-            gx, gy = pin_gap(s.q, ws.chain_cs, m.pin_anchor, j, a, b)
-        ws.rhs[r] = -gx
-        ws.rhs[r + 1] = -gy
-        worst = max(worst, abs(gx), abs(gy))
-    return worst
+        px = x[2 * j]
+        py = x[2 * j + 1]
+        for e in range(2):
+            b = m.pin_body[j, e]
+            if b < 0:
+                continue
+            sg = -1.0 if e == 0 else 1.0
+            wm = sg * m.body_inv_mass[b]
+            dx = wm * px
+            dy = wm * py
+            dt = sg * m.body_inv_inertia[b] * (ws.chain_lever[j, e, 0] * py
+                                               - ws.chain_lever[j, e, 1] * px)
+            if q_scale != 0.0:
+                q[b, 0] += q_scale * dx
+                q[b, 1] += q_scale * dy
+                q[b, 2] += q_scale * dt
+            if v_scale != 0.0:
+                v[b, 0] += v_scale * dx
+                v[b, 1] += v_scale * dy
+                v[b, 2] += v_scale * dt
 
 
 @kernel
-def chain_velocity_solve(m, ws, h):
-    """Stage 4 on the chains: lam with J W J^T lam = -c(q_pred) / h (J and W at the step's
-    start, c(q_pred) the pins' gaps at the predicted end, rows.build_rows) and v_new = v* +
-    W J^T lam. Returns the smallest pivot share (chain_factor)."""
-    n = ws.n_row[0]
-    share = chain_factor(m, ws, ws.row_J, ws.row_J, True)
-    for r in range(n):
-        ws.rhs[r] = -ws.row_c_pred[r] / h
+def lever_velocity_solve(m, s, ws, h):
+    """Stage 4 on the chains: lam with J0 W J0^T lam = -c(q_pred) / h (J0 the pins' rows at the
+    step's start, whose cos / sin ws.body_cs holds; c at q_pred with ws.chain_cs), v_new =
+    v* + W J0^T lam; lam into ws.lam (rows 2j, 2j + 1). Returns the smallest pivot share."""
+    lever_gaps(m, ws.q_pred, ws.chain_cs, ws, 2)
+    # the levers at the start (columns 0, 1); the gaps there are not needed
+    for j in range(m.pin_body.shape[0]):
+        for e in range(2):
+            rx, ry = _lever(ws.body_cs, m.pin_body[j, e], m.pin_anchor, j, e)
+            ws.chain_lever[j, e, 0] = rx
+            ws.chain_lever[j, e, 1] = ry
+    share = lever_factor(m, ws, 0)
+    inv_h = 1.0 / h
+    for r in range(2 * m.pin_body.shape[0]):
+        ws.rhs[r] *= inv_h
     chain_solve(ws, ws.rhs, ws.lam)
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
             ws.v_new[i, k] = ws.v_pred[i, k]
-    add_impulses(ws.row_J, ws.row_body, m.body_inv_mass, m.body_inv_inertia, ws.lam, n,
-                 ws.v_new, 1.0)
+    lever_move(m, ws, ws.lam, ws.v_new, 0.0, ws.v_new, 1.0)
     return share
 
 
-@kernel(inline="always")
-def _move_by(m, ws, n, q, v, inv_h):
-    """q += W J(q0)^T mu and v += W J(q0)^T mu / h (mu in ws.lam, J(q0) ws.row_J) in one sweep
-    of the rows: solve.add_impulses' arithmetic for each, the same bits."""
-    for r in range(n):
-        mu = ws.lam[r]
-        if mu == 0.0:
-            continue
-        rate = mu * inv_h
+@kernel
+def lever_joint_work(m, ws, v):
+    """joint_work of the pins' impulses ws.lam at velocity v on the levers of the step's start:
+    (work [J], its rounding [J], the row doing the most work or -1)."""
+    speed = fastest(v) + fastest(ws.v_pred)
+    per = WORK_REL_TOL * speed + VELOCITY_FLOOR
+    total = 0.0
+    rounding = 0.0
+    most = 0.0
+    row = -1
+    for j in range(m.pin_body.shape[0]):
+        rel_x = 0.0
+        rel_y = 0.0
         for e in range(2):
-            b = ws.row_body[r, e]
+            b = m.pin_body[j, e]
             if b < 0:
                 continue
-            wm = m.body_inv_mass[b]
-            wi = m.body_inv_inertia[b]
-            dx = wm * ws.row_J[r, e, 0]
-            dy = wm * ws.row_J[r, e, 1]
-            dt = wi * ws.row_J[r, e, 2]
-            q[b, 0] += dx * mu
-            q[b, 1] += dy * mu
-            q[b, 2] += dt * mu
-            if rate != 0.0:     # (as add_impulses skips a row whose scaled impulse is 0)
-                v[b, 0] += dx * rate
-                v[b, 1] += dy * rate
-                v[b, 2] += dt * rate
-
-
-@kernel(inline="always")
-def _chain_pass(m, s, ws, n, h):
-    """One correction pass on the factors in ws: mu from the targets in ws.rhs, q += W J(q0)^T
-    mu, v += W J(q0)^T mu / h, the bodies' cos / sin at the new q carried (ws.chain_cs)."""
-    chain_solve(ws, ws.rhs, ws.lam)
-    _move_by(m, ws, n, s.q, s.v, 1.0 / h)
-    carry_trig(s.q, ws.chain_cs, ws.chain_cs)
+            sg = -1.0 if e == 0 else 1.0
+            rel_x += sg * (v[b, 0] - ws.chain_lever[j, e, 1] * v[b, 2])
+            rel_y += sg * (v[b, 1] + ws.chain_lever[j, e, 0] * v[b, 2])
+        lx = ws.lam[2 * j]
+        ly = ws.lam[2 * j + 1]
+        wx = lx * rel_x
+        wy = ly * rel_y
+        total += wx + wy
+        rounding += (abs(lx) + abs(ly)) * per
+        if wx > most:
+            most = wx
+            row = 2 * j
+        if wy > most:
+            most = wy
+            row = 2 * j + 1
+    return total, rounding, row
 
 
 @kernel
-def chain_correct(m, s, ws, h, iters, tol, pivot_tol):
-    """Stage 8's Newton-SHAKE on the chains: up to iters passes of J(q) W J(q0)^T mu = -c(q),
-    q += W J(q0)^T mu, v += W J(q0)^T mu / h, until every row is within tol [m]; a pass
-    after one that left every row within CHORD_TOL reuses its factorisation. Returns
-    the largest row error left, or -1 where a pass removed less than half of it or a
-    factorisation kept a pivot share at or below pivot_tol (StepOptions.refine_pivot_tol:
-    the general correction would drop that row; its safeguards then decide, the step is
-    taken by the general stages). ws.body_cs holds the cos / sin of the step's start on entry,
-    of q on a return >= 0 (on -1, still the start's)."""
-    n = ws.n_row[0]
+def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
+    """chain_correct on the levers: Newton-SHAKE passes of J(q) W J0^T mu = -c(q), q += W J0^T
+    mu, v += W J0^T mu / h until every gap is within tol [m] (a pass after one that left every
+    gap within CHORD_TOL reuses its factorisation; one more pass on the last factorisation
+    after the last); returns (the largest gap left, or -1: a pass that removed less than half
+    of it, a pivot share at or below pivot_tol, the general stages take the step; the passes
+    taken). ws.body_cs holds the cos / sin of the step's start on entry, of q on a return with
+    a gap >= 0."""
     carry_trig(s.q, ws.body_cs, ws.chain_cs)
-    worst = chain_residual(m, s, ws, True)
+    worst = lever_gaps(m, s.q, ws.chain_cs, ws, 2)
     fresh = True
     passes = 0
+    inv_h = 1.0 / h
     for _ in range(iters):
         if worst <= tol:
             break
-        if fresh and chain_factor(m, ws, ws.row_Jp, ws.row_J, False) <= pivot_tol:
-            return -1.0
-        _chain_pass(m, s, ws, n, h)
-        after = chain_residual(m, s, ws, False)
+        if fresh and lever_factor(m, ws, 2) <= pivot_tol:
+            return -1.0, passes
+        chain_solve(ws, ws.rhs, ws.lam)
+        lever_move(m, ws, ws.lam, s.q, 1.0, s.v, inv_h)
+        carry_trig(s.q, ws.chain_cs, ws.chain_cs)
+        after = lever_gaps(m, s.q, ws.chain_cs, ws, 2)
         if after > STALLED_RATIO * worst:
-            return -1.0
+            return -1.0, passes
         fresh = after > CHORD_TOL
-        if fresh and after > tol:
-            chain_residual(m, s, ws, True)      # (the next pass factors J at this q)
         worst = after
         passes += 1
     if passes > 0 and 0.0 < worst <= tol:
-        # one more pass on the last factorisation, as integrate.correct_positions takes it
-        # (it says why: the end's derivative becomes the converged correction's)
-        _chain_pass(m, s, ws, n, h)
+        chain_solve(ws, ws.rhs, ws.lam)
+        lever_move(m, ws, ws.lam, s.q, 1.0, s.v, inv_h)
     update_trig(s.q, ws.body_cs)
-    return worst
+    return worst, passes

@@ -30,14 +30,14 @@ from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_R
                      check_speeds, add_part_path, finish_path, keep_step_path, note_start_depths,
                      start_path)
 from .info import INFO_CHAIN_PATH, INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
-from .integrate import (bound_correction_work, integrate_positions, predict_configuration,
-                        rows_hold_within)
+from .integrate import (bound_correction_work, integrate_positions, predict_configuration)
 from .joint_friction import start_joint_friction, stick_all, switch_joint_friction
 from .math2d import update_trig
 from .modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
                     rule_breaks, seed_rule)
 from .pair import PAIR_MARGIN
-from .pin_chain import chain_correct, chain_prediction, chain_rows, chain_velocity_solve
+from .pin_chain import (chain_prediction, lever_correct, lever_joint_work,
+                        lever_velocity_solve)
 from .rebound import rebound_gain, rebounding
 from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev
 from .pair_toi import hold_off_fast_pairs
@@ -48,7 +48,8 @@ from .solve import solve_impulses
 from .rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
                      unsupported)
 from .warm_start import remember_impulses
-from .work import NEAR_DEPENDENT, joints_add_energy, kinetic_energy, prediction_turn
+from .work import (CONSTRAINT_SHARE, JOINT_WORK_SHARE, NEAR_DEPENDENT, SHAKE_REGIME,
+                   joints_add_energy, kinetic_energy, prediction_turn)
 
 
 @kernel(inline="never")
@@ -795,6 +796,37 @@ CHAIN_GENERAL = -100
 CHAIN_AGAIN = -101
 
 
+@kernel
+def chain_joints_gain(m, s, ws, h):
+    """second_order_gains on the chain path (work.joints_add_energy's rule on the pins'
+    levers): True if the velocity solve's impulses added energy beyond their share, or did
+    work so large that its rounding hides the share (the general stages then judge the step,
+    from its velocities); else the excess (<= 0) is kept for the audit (ws.joint_gain)."""
+    work, rounding, row = lever_joint_work(m, ws, ws.v_new)
+    scale = kinetic_energy(m, ws.v_lin)
+    if rounding > CONSTRAINT_SHARE * scale:
+        return True
+    excess = work - CONSTRAINT_SHARE * scale - rounding
+    if (excess > 0.0 and ws.joint_pivot[0] >= NEAR_DEPENDENT
+            and prediction_turn(m, s, ws, h) <= SHAKE_REGIME):
+        excess = work - JOINT_WORK_SHARE * scale - rounding
+    ws.joint_gain[0] = excess
+    ws.joint_gain[1] = row
+    ws.joint_gain[2] = 1.0
+    return excess > 0.0
+
+
+@kernel
+def remember_pin_impulses(s, ws):
+    """warm_start.remember_impulses for a model of pins alone: the velocity solve's impulses
+    (ws.lam, rows 2j and 2j + 1 of pin j) into State.last_pin_impulse, no limit's."""
+    for j in range(s.last_pin_impulse.shape[0]):
+        s.last_pin_impulse[j, 0] = ws.lam[2 * j]
+        s.last_pin_impulse[j, 1] = ws.lam[2 * j + 1]
+        s.last_pin_impulse[j, 2] = 0.0
+        s.last_pin_impulse[j, 3] = 0.0
+
+
 @kernel(inline="never")
 def chain_part(m, s, ws, opt, u, h):
     """One part of h [s] (the step, or a turn sub-step) of a model whose only rows are the
@@ -822,28 +854,24 @@ def chain_part(m, s, ws, opt, u, h):
     predict_velocity(m, s, ws, h)
     soft_prediction(m, s, ws, h)                            #    (v_lin = v*)
     chain_prediction(s, ws, h)
-    ws.joint_gain[2] = 0.0                                  # 3-4. rows, impulses
-    ws.least_change[0] = 0
+    ws.least_change[0] = 0                                  # 3-4. rows, impulses
     ws.least_change[1] = 0
     ws.least_change[2] = 0
-    chain_rows(m, s, ws)
-    ws.joint_pivot[0] = chain_velocity_solve(m, ws, h)
+    ws.joint_pivot[0] = lever_velocity_solve(m, s, ws, h)
     ws.info[INFO_SOLVES] += 1
     if ws.joint_pivot[0] <= opt.pivot_tol:          # (a row the general solve would drop)
         return CHAIN_GENERAL
-    if second_order_gains(m, s, ws, h):
+    if chain_joints_gain(m, s, ws, h):
         return CHAIN_GENERAL
-    remember_impulses(s, ws)
-    if audit_impulses(m, s, ws, opt, h) > 0:                # 7. audit
-        return CHAIN_AGAIN
+    remember_pin_impulses(s, ws)
     integrate_positions(s, ws, ws.v_new, h)                 # 8. positions
-    if not rows_hold_within(m, s, ws, h, 0.5 * opt.refine_tol):
-        worst = chain_correct(m, s, ws, h, opt.refine_iters, opt.refine_tol,
-                              opt.refine_pivot_tol)
-        if not (worst >= 0.0 and worst <= opt.refine_tol):
-            return CHAIN_AGAIN
-        if bound_correction_work(m, s, ws, h, False) > 0.0:
-            return CHAIN_AGAIN
+    worst, passes = lever_correct(m, s, ws, h, opt.refine_iters, opt.refine_tol,
+                                  opt.refine_pivot_tol)
+    if not (worst >= 0.0 and worst <= opt.refine_tol):
+        return CHAIN_AGAIN
+    # (without a pass v is the solve's: the bound has nothing to keep)
+    if passes > 0 and bound_correction_work(m, s, ws, h, False) > 0.0:
+        return CHAIN_AGAIN
     s.time[0] = ws.prev.time[0] + h
     s.step[0] += 1
     code = check_guards(s, ws, opt.guard_limit)             # 9. guards
