@@ -28,7 +28,7 @@ Families (every scene drawn from numpy.random.default_rng(seed); friction mu in 
   random offsets and tilts and thrown down at 1-30 m/s (log-uniform; up to 10 rad/s) onto
   each other and flat ground. --extreme: masses 10^U(-2, 2) (1:10^4) and 1-200 m/s.
 - shape_hills: the same onto sine hills (slopes up to about 30 deg).
-  Depth there is the deepest overlap of any two shapes (the narrow phase, kernels/collide.py,
+  Depth there is the deepest overlap of any two shapes (the narrow phase, kernels/geometry/collide.py,
   tested against an independent reference in tests/physics/test_collide.py) and of any shape
   below the ground (corners and edges sampled every 5 mm, circles by their centre's gap).
 
@@ -74,7 +74,7 @@ before an engine error are judged too, and add three targets: step, the largest 
 of a single step beyond its own gravity term, dE - (dt / 2) g dp_y (the exact change of a step
 without impulses; see energy_bound) and the motors' work, against the run's whole E_tol
 (contacts only take energy out), less the joints' second-order share of the step's kinetic
-energy (CONSTRAINT_SHARE, kernels/work.py: an oscillation the energy target bounds over the
+energy (CONSTRAINT_SHARE, kernels/checks/work.py: an oscillation the energy target bounds over the
 run; or, where more, what the same step gains with no ground, contact_free_gain: a rod
 spinning at w gains (h w)^2 / 4 of its kinetic energy a step by the integrator alone);
 tunnel (hills_fast) above DEPTH_TOL, beyond rod_sag for a point on a rod; speed (stiff_motors). A run the engine stops with an
@@ -128,7 +128,7 @@ from benchmarks.metrics import (energy, kinetic, lowest_point, pin_separation,  
                                      spec_from_model, world_points)
 from benchmarks.scenes import G, biped_collapse  # noqa: E402
 from benchmarks.displacement import SLACK as JUMP_SLACK, parted, step_excess  # noqa: E402
-from planarsim.kernels.work import CONSTRAINT_SHARE  # noqa: E402
+from planarsim.kernels.checks.work import CONSTRAINT_SHARE  # noqa: E402
 
 FAMILIES = ("biped_stance", "biped_collapse", "chain_hills", "mass_ratio", "shape_pile",
             "shape_hills")
@@ -647,7 +647,7 @@ def _overlap_kernel():
     if _OVERLAP is None:
         from numba import njit
         from planarsim.compile import options as compile_options
-        from planarsim.kernels.collide import collide
+        from planarsim.kernels.geometry.collide import collide
 
         @njit(**dict(compile_options(), cache=False))
         def overlap(vert, norm, adr, num, rad, body, pairs, q, out, scratch):
@@ -747,9 +747,9 @@ def energy_bound(spec, ground, q0, v0):
 
 
 def audit_names(n):
-    """Names of the engine's audit counters (kernels.audit.AUDIT_NAMES when it exists)."""
+    """Names of the engine's audit counters (kernels.checks.audit.AUDIT_NAMES when it exists)."""
     try:
-        from planarsim.kernels.audit import AUDIT_NAMES
+        from planarsim.kernels.checks.audit import AUDIT_NAMES
         if len(AUDIT_NAMES) == n:
             return tuple(AUDIT_NAMES)
     except ImportError:
@@ -889,7 +889,7 @@ def tunnel_depth(model, q, v, mode, dt, samples=128):
     """Deepest point [m] below the ground of any point mass's path within a step that began
     and ended clear of the ground with its contact free (mode 0 at both frames) and ended where
     the plain step puts it (q1 = q0 + h v1, no time-of-impact split): the engine's own path
-    model p(tau) = p0 + tau v0 + tau^2 (v1 - v0) / h (kernels/ccd.py), sampled at `samples`
+    model p(tau) = p0 + tau v0 + tau^2 (v1 - v0) / h (kernels/geometry/ccd.py), sampled at `samples`
     points of the step. A point that crosses a crest and comes out again between two frames,
     which no frame's depth shows, is a tunnel."""
     a = model.arrays

@@ -5,7 +5,7 @@
 
 A pile at rest has far more contact rows than its bodies have degrees of freedom (a 45-row
 pyramid: 7,816 rows on 1,035 boxes, rank 3 x 1,035); the solve eliminates them all and drops
-the ones that depend on earlier rows (kernels/sparse_factor.py), whose fill stays in the
+the ones that depend on earlier rows (kernels/solver/sparse_factor.py), whose fill stays in the
 elimination tree. This runs a world of benchmarks/worlds.py a few steps from rest, then
 times the solve's structure (arrange: nested-dissection order and elimination tree), its
 assembly and its factorisation of (a) every row, as the step makes them, and (b) only the
@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps                                            # noqa: E402
 from planarsim.compiled import jit                                # noqa: E402
-from planarsim.kernels.matrix import arrange, assemble, factor_ws  # noqa: E402
+from planarsim.kernels.solver.matrix import arrange, assemble, factor_ws  # noqa: E402
 
 from benchmarks.worlds import WORLDS                             # noqa: E402
 

@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "planarsi
 import planarsim as ps  # noqa: E402
 from planarsim.errors import SimulationDiverged  # noqa: E402
 from planarsim.kernels.codes import MODE_FREE  # noqa: E402
-from planarsim.kernels.terrain import closest_point, height  # noqa: E402
+from planarsim.kernels.geometry.terrain import closest_point, height  # noqa: E402
 from test_derivatives_contact import (REL_TOL, box_stack, difference_error,  # noqa: E402
                                       moved, slope_case)
 

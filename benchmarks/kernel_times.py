@@ -24,17 +24,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import planarsim as ps  # noqa: E402
 from benchmarks.scenes import SCENES  # noqa: E402
 from planarsim.compiled import jit, step  # noqa: E402
-from planarsim.kernels.audit import audit_impulses  # noqa: E402
-from planarsim.kernels.contacts import find_contacts  # noqa: E402
-from planarsim.kernels.guards import check_guards  # noqa: E402
-from planarsim.kernels.integrate import bound_correction_work, max_residual  # noqa: E402
+from planarsim.kernels.checks.audit import audit_impulses  # noqa: E402
+from planarsim.kernels.geometry.contacts import find_contacts  # noqa: E402
+from planarsim.kernels.checks.guards import check_guards  # noqa: E402
+from planarsim.kernels.dynamics.integrate import bound_correction_work, max_residual  # noqa: E402
 from planarsim.kernels.math2d import update_trig  # noqa: E402
-from planarsim.kernels.modes import engage_limits, rule_breaks  # noqa: E402
-from planarsim.kernels.rows import build_rows  # noqa: E402
-from planarsim.kernels.matrix import assemble, factor_solve  # noqa: E402
-from planarsim.kernels.solve import solve_impulses  # noqa: E402
+from planarsim.kernels.solver.modes import engage_limits, rule_breaks  # noqa: E402
+from planarsim.kernels.constraints.rows import build_rows  # noqa: E402
+from planarsim.kernels.solver.matrix import assemble, factor_solve  # noqa: E402
+from planarsim.kernels.solver.solve import solve_impulses  # noqa: E402
 from planarsim.kernels.step import copy_state  # noqa: E402
-from planarsim.kernels.work import joints_add_energy  # noqa: E402
+from planarsim.kernels.checks.work import joints_add_energy  # noqa: E402
 
 KERNELS = (
     ("empty", "the loop alone"),

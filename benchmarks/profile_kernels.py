@@ -65,7 +65,7 @@ def _compiled_functions(dispatchers):
 
 
 def _short(symbol):
-    """planarsim.kernels.solve.factor from numba's mangled _ZN9planarsim7kernels5solve6factor..."""
+    """planarsim.kernels.solver.solve.factor from numba's mangled _ZN9planarsim7kernels6solver5solve6factor..."""
     if not symbol.startswith("_ZN"):
         return symbol
     rest, names = symbol[3:], []

@@ -2,7 +2,7 @@
 file edited (a comment line appended), then the same first steps timed again.
 
     python -m benchmarks.recompile                                   # the default edits below
-    python -m benchmarks.recompile planarsim/kernels/lcp.py          # your own choice of files
+    python -m benchmarks.recompile planarsim/kernels/solver/lcp.py          # your own choice of files
 
 For each edit it prints the time to the first steps (a 2-link chain, then each walker named in
 WALKERS) and the cached compiled functions that compiled again (the engine's step, its parts'
@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-EDITS = ("planarsim/kernels/lcp.py", "planarsim/kernels/terrain.py",
+EDITS = ("planarsim/kernels/solver/lcp.py", "planarsim/kernels/geometry/terrain.py",
          "walkers/simple_biped/controller.py")
 WALKERS = ("simple_biped", "ranger")
 

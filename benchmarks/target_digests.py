@@ -50,7 +50,7 @@ CORPUS = (("biped_stance", 0), ("biped_collapse", 1), ("chain_hills", 2), ("mass
           ("hills_fast", 7), ("ranger_loop", 2))
 
 #: pin chains fingerprinted (benchmarks.scenes.chain: links, steps), whose steps the pin-chain
-#: path takes (kernels/pin_chain.py; the walkers and the corpus runs all have contacts)
+#: path takes (kernels/solver/pin_chain.py; the walkers and the corpus runs all have contacts)
 CHAINS = ((4, 2000), (16, 2000))
 
 

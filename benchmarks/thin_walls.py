@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
 from planarsim.compiled import audit_counts  # noqa: E402
-from planarsim.kernels.audit import DEPTH_TOL  # noqa: E402
+from planarsim.kernels.checks.audit import DEPTH_TOL  # noqa: E402
 from planarsim.kernels.info import INFO_CCD_SPLITS  # noqa: E402
 from tests.physics.test_impenetrability import (  # noqa: E402
     ENERGY_ROUNDING, RUN_TIME, _projectile, build_case, judge, kinetic_energy)

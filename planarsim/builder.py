@@ -23,7 +23,7 @@ from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POI
                             JOINT_FREE_HINGE, JOINT_FREE_SLIDE, JOINT_HINGE, JOINT_SLIDE_BIT,
                             JOINT_SLIDER)
 from .errors import ModelError, plain as _plain
-from .kernels.collide import core_normals
+from .kernels.geometry.collide import core_normals
 from .shapes import (collision_core, collision_pairs, combine_masses, shape_area, shape_bounds,
                      shape_who, shifted)
 from .terrain import Terrain, flat
@@ -155,7 +155,7 @@ class ModelBuilder:
         self.terrain = (terrain if terrain is not None else flat()) if self.ground else None
         self._bodies, self._pins, self._rods, self._contacts, self._acts = [], [], [], [], []
         self._shapes = []
-        self._fluid = []            # (body, fluid_coef row): kernels/fluid.py
+        self._fluid = []            # (body, fluid_coef row): kernels/dynamics/fluid.py
         self._collide = []          # colliding shapes: dicts (shape, body, core, radius, ...)
         self._enabled_pairs = set()
         self._names = {"body": {}, "pin": {}, "rod": {}, "contact": {}, "actuator": {}}
@@ -470,11 +470,11 @@ class ModelBuilder:
         ref_angle defaults to the relative angle at the build pose (pin angle 0 there).
         ``limit=(lower, upper)`` [rad] adds unilateral limits; stiffness [N m/rad] and
         damping [N m s/rad] add a passive spring-damper toward ``rest_angle`` (implicit in the
-        velocity solve, kernels/soft.py; a spring alone that the step resolves is an
-        explicit force, kernels/forces.py spring_as_force); armature [kg m^2] a reflected rotor inertia on the
+        velocity solve, kernels/constraints/soft.py; a spring alone that the step resolves is an
+        explicit force, kernels/dynamics/forces.py spring_as_force); armature [kg m^2] a reflected rotor inertia on the
         pin angle (M_joint += armature, as MuJoCo's); frictionloss [N m] a dry friction on the
         pin angle (MuJoCo's frictionloss: the joint sticks while the torque holding it stays
-        within it, else slips against it; kernels/joint_friction.py).
+        within it, else slips against it; kernels/constraints/joint_friction.py).
         """
         idx, a, b = self._joint_bodies("pin", name, body_a, body_b, world_b=True)
         if a < 0 and b < 0:
@@ -520,7 +520,7 @@ class ModelBuilder:
         spring-damper toward ``rest`` (implicit; a spring alone that the step resolves is an
         explicit force), armature [kg or kg m^2] a reflected inertia on the
         coordinate (as MuJoCo's on a free root's slide or hinge: M_joint += armature),
-        frictionloss [N or N m] a dry friction on it (kernels/joint_friction.py), and
+        frictionloss [N or N m] a dry friction on it (kernels/constraints/joint_friction.py), and
         add_slider_motor / add_pin_motor a force [N] along the axis at the anchor / a torque
         [N m]. An MJCF free root (two slides and a hinge) is three of these on one body.
         It shares the pins' table with kind JOINT_FREE_SLIDE or JOINT_FREE_HINGE.
@@ -554,7 +554,7 @@ class ModelBuilder:
     def add_fluid_box(self, body, size, viscosity=0.0, density=0.0, local=(0.0, 0.0),
                       angle=0.0) -> int:
         """Drag of a still fluid on a box fixed to `body` (MuJoCo's inertia-box fluid model
-        in the plane, kernels/fluid.py): full sides size = (l1, l2, ln) [m] > 0 (l1 along the
+        in the plane, kernels/dynamics/fluid.py): full sides size = (l1, l2, ln) [m] > 0 (l1 along the
         box's first in-plane axis, at ``angle`` [rad] in the body's frame; ln along the plane's
         normal), centre at ``local`` [m]; the fluid's viscosity [Pa s] >= 0 (linear drag) and
         density [kg/m^3] >= 0 (quadratic drag). Returns the box's index."""
@@ -613,10 +613,10 @@ class ModelBuilder:
         Anchor b must lie on the line through anchor a along the axis (within 1e-6 m). The
         slide s = d.(p_b - p_a) [m] (d the axis in the world) is the joint's coordinate:
         ``limit=(lower, upper)`` [m] adds unilateral limits on it, stiffness [N/m] and damping
-        [N s/m] a passive spring-damper toward ``rest`` [m] (implicit, kernels/soft.py; a
+        [N s/m] a passive spring-damper toward ``rest`` [m] (implicit, kernels/constraints/soft.py; a
         spring alone that the step resolves is an explicit force: spring_as_force),
         armature [kg] a reflected rotor inertia on it, frictionloss [N] a dry friction on it
-        (MuJoCo's frictionloss; kernels/joint_friction.py). The relative angle held is
+        (MuJoCo's frictionloss; kernels/constraints/joint_friction.py). The relative angle held is
         theta_b - theta_a = ref_angle [rad] (default: as at the build pose). The slider shares
         the pins' table (names, State.limit_active, State.last_pin_impulse: perpendicular,
         angle, lower, upper impulse) with kind JOINT_SLIDER.
@@ -899,7 +899,7 @@ class ModelBuilder:
         return out
 
     def _shape_arrays(self, ro):
-        """shape_* arrays of the colliding shapes (kernels/collide.py: a core and a radius)."""
+        """shape_* arrays of the colliding shapes (kernels/geometry/collide.py: a core and a radius)."""
         cores = [sh["core"] for sh in self._collide]
         adr = np.cumsum([0] + [len(c) for c in cores])[:-1]
         core = np.concatenate(cores) if cores else np.zeros((0, 2))

@@ -50,14 +50,14 @@ from .compile import jit, jit_inline, kernel
 from .compile.caches import cache_folder
 from .link import caches as _caches
 from .link.step import step, step_from_python
-from .kernels.audit import audit_counts
-from .kernels.forces import pin_angle_rate
-from .kernels.pair import shape_contact_mode
+from .kernels.checks.audit import audit_counts
+from .kernels.dynamics.forces import pin_angle_rate
+from .kernels.geometry.pair import shape_contact_mode
 from .kernels.info import step_info
-from .kernels.guards import (GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE,
-                             GUARD_NONFINITE_COMMAND, GUARD_OK, GUARD_TOO_LARGE)
+from .kernels.checks.guards import (GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_NONFINITE,
+                                    GUARD_NONFINITE_COMMAND, GUARD_OK, GUARD_TOO_LARGE)
 from .kernels.record import record_frame
-from .kernels.terrain import closest_point, gap_of_point, height, height_derivs
+from .kernels.geometry.terrain import closest_point, gap_of_point, height, height_derivs
 from .trajectory import make_recorder
 
 RUN_OK = GUARD_OK
@@ -111,8 +111,8 @@ def record_compile(seconds: float) -> None:
 
 
 def _exported_kernels(names=None) -> set:
-    """Kernel modules (short names) of the compiled functions this module exports (`names` of
-    them; None: all)."""
+    """Kernel modules (named below planarsim.kernels with their folder: "geometry.terrain") of
+    the compiled functions this module exports (`names` of them; None: all)."""
     found = set()
     for name in __all__ if names is None else names:
         fn = globals().get(name)

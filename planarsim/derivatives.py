@@ -60,9 +60,9 @@ import numpy as np
 
 from .kernels.codes import (CONTACT_ARC, CONTACT_PAIR, CONTACT_POINT, INTEGRATOR_EULER,
                             JOINT_FREE_BIT, JOINT_SLIDE_BIT, MODE_FREE, MODE_PINNED)
-from .kernels.collide import MAX_CORE_VERTICES
-from .kernels.forces import (ACT_AXIAL, ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_HIP_TORQUE,
-                              ACT_PIN_TORQUE, ACT_SLIDER_FORCE)
+from .kernels.geometry.collide import MAX_CORE_VERTICES
+from .kernels.dynamics.forces import (ACT_AXIAL, ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_HIP_TORQUE,
+                                      ACT_PIN_TORQUE, ACT_SLIDER_FORCE)
 from .kernels.info import INFO_CCD_SPLITS, INFO_PROJECTIONS, INFO_TURN_SUBSTEPS
 from .step_replica import ContactPlan, ReplicaRefused, StepPlan, replica
 
@@ -213,7 +213,7 @@ def rotor_terms(model, q, h):
             f -= k * (coordinate - a.pin_rest[j]) * g
             K -= k * gg
             if a.pin_armature[j] == 0.0 and a.pin_damping[j] == 0.0:
-                # a spring alone is a force of stage 1 (kernels/forces.py spring_as_force)
+                # a spring alone is a force of stage 1 (kernels/dynamics/forces.py spring_as_force)
                 f_alone -= k * (coordinate - a.pin_rest[j]) * g
                 K_alone -= k * gg
     # (M + X)^-1 = (I + W X)^-1 W, which holds where W has zeros (a point mass's turn); and
@@ -422,10 +422,10 @@ def rollout_jacobians(sim, us) -> list:
 
 
 def _sole(a, q, c):
-    """Round sole c at q as kernels/contacts.py find_contact measures it: (how far [rad] its
+    """Round sole c at q as kernels/geometry/contacts.py find_contact measures it: (how far [rad] its
     lowest direction lies inside its span, inf for a full circle, negative outside; the gap
     [m] of its lowest point; the gaps of its span's ends; those of its fallback vertices)."""
-    from .kernels.terrain import closest_point
+    from .kernels.geometry.terrain import closest_point
     coef = a.terrain_coef
     b = int(a.contact_body[c])
     cs, sn = np.cos(q[b, 2]), np.sin(q[b, 2])
@@ -450,10 +450,10 @@ def _sole(a, q, c):
 
 
 def _ground_gap(a, q, c) -> float:
-    """Ground contact c's gap [m] at q as kernels/contacts.py find_contact measures it: a
+    """Ground contact c's gap [m] at q as kernels/geometry/contacts.py find_contact measures it: a
     point's; a round sole's lowest point where it lies within the sole's span, else the
     lowest of the span's ends; or a fallback vertex's, where lower."""
-    from .kernels.terrain import closest_point
+    from .kernels.geometry.terrain import closest_point
     if a.contact_kind[c] == CONTACT_POINT:
         b = int(a.contact_body[c])
         cs, sn = np.cos(q[b, 2]), np.sin(q[b, 2])
@@ -479,7 +479,7 @@ def _at_mode_boundary(model, modes, impulses, limit_active, limit_impulses, q1, 
     State.last_pin_impulse[:, 2:]): a contact or limit pushing with no impulse (about to
     leave), a contact sticking at its friction cone's edge or sliding with no slip (about to
     stick); an infinitesimal change of the start or the commands then changes the mode."""
-    from .kernels.terrain import closest_point
+    from .kernels.geometry.terrain import closest_point
     a = model.arrays
     touching = np.flatnonzero(modes != MODE_FREE)
     # a free ground contact (enabled) ending on the ground: an infinitesimal change engages it
@@ -586,7 +586,7 @@ def _touching_contacts(model, start, modes, slips, features):
 
 def _pair_features(model, c, feature):
     """ContactPlan.pair's row of shape pair slot c from the feature id its manifold point had
-    (kernels/collide.py): [reference body, incident body, reference shape, incident shape,
+    (kernels/geometry/collide.py): [reference body, incident body, reference shape, incident shape,
     distance kind, reference edge or vertex, incident vertex or edge, clip side]."""
     a = model.arrays
     if feature < 0:
@@ -617,7 +617,7 @@ def _active_limits(model, limit_active) -> np.ndarray:
 
 def _engine_order(model, held, limits, contacts) -> np.ndarray:
     """The replica's rows (the held joint rows, the active limits' rows, then each touching
-    contact's normal and sticking tangent row) in the order kernels/rows.py build_rows makes
+    contact's normal and sticking tangent row) in the order kernels/constraints/rows.py build_rows makes
     them: joint by joint in the model's order (its rows, then its limits' rows), merged with
     the contacts in theirs, a joint's before a contact whose body is not earlier than the
     later of the joint's bodies."""

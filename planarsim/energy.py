@@ -10,7 +10,7 @@ from .kernels.codes import JOINT_SLIDE_BIT
 def joint_position_rate(model, q, v, j):
     """Joint j's coordinate and rate at q, v of shape (..., n_body, 3): a hinge's angle
     theta_b - theta_a - ref [rad] and rate [rad/s]; a slider's slide s = d.(p_b - p_a) [m] and
-    ds/dt [m/s] (kernels/slider.py)."""
+    ds/dt [m/s] (kernels/constraints/slider.py)."""
     a = model.arrays
     q = np.asarray(q)
     v = np.asarray(v)

@@ -4,7 +4,7 @@
 index, field, value and the rule broken. ``SimulationDiverged`` is raised when a guard in the
 compiled step fires (non-finite or huge state); it carries the last finite state.
 ``AuditViolation`` is raised, with StepOptions.audit_raise = 1, when a step breaks a rule of
-its own audit (kernels/audit.py); it names the step, time, rule, contact or pin and body.
+its own audit (kernels/checks/audit.py); it names the step, time, rule, contact or pin and body.
 ``RecordingTooLarge`` is raised before a recording is allocated that would not fit in the
 machine's memory (a duration far too long for its frame interval); it names the frames and
 the memory they would need. ``WorkspaceTooLarge`` is raised before a model's step workspace is
@@ -16,16 +16,16 @@ import math
 import numpy as np
 
 from .capacity import workspace_capacity
-from .kernels.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_FRICTION,
-                            AUDIT_JOINT_WORK,
-                            AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
+from .kernels.checks.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_FRICTION,
+                                   AUDIT_JOINT_WORK, AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP,
+                                   AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.codes import INTEGRATOR_NAMES
-from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
-                             UNSUPPORTED_FRICTION, UNSUPPORTED_SOFT)
-from .kernels.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
-                             GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_ROOM, GUARD_SPEED,
-                             GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
+from .kernels.dynamics.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
+                                      UNSUPPORTED_FRICTION, UNSUPPORTED_SOFT)
+from .kernels.checks.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
+                                    GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_ROOM,
+                                    GUARD_SPEED, GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
 
 
 def plain(value):
@@ -216,7 +216,7 @@ def gross_violation(model, ws, who="simulation"):
 
 def energy_from_nowhere(model, ws, who="simulation"):
     """The SimulationDiverged of a step that gained energy from nowhere beyond
-    StepOptions.energy_limit (kernels/work.judge_energy; the cause in ws.audit_last)."""
+    StepOptions.energy_limit (kernels/checks/work.judge_energy; the cause in ws.audit_last)."""
     step, kind, element, body = (int(x) for x in ws.audit_last)
     rule = AUDIT_NAMES[kind]
     value = float(ws.audit_value[0])
@@ -296,7 +296,7 @@ def stiff_actuator(model, ws, who="simulation"):
         f"no check)", step, t, name, "torque", torque, _start_of_step(ws))
 
 
-# what the accurate integrators cannot step, by kernels/rattle.py's UNSUPPORTED_* code
+# what the accurate integrators cannot step, by kernels/dynamics/rattle.py's UNSUPPORTED_* code
 _UNSUPPORTED = {UNSUPPORTED_CONTACT: "contact", UNSUPPORTED_LIMIT: "joint limit",
                 UNSUPPORTED_SOFT: "joint spring, damper or armature",
                 UNSUPPORTED_FRICTION: "joint friction (frictionloss)",
@@ -304,7 +304,7 @@ _UNSUPPORTED = {UNSUPPORTED_CONTACT: "contact", UNSUPPORTED_LIMIT: "joint limit"
 
 
 def accurate_unsupported(model, what, index, integrator=None, who="simulation"):
-    """The ModelError of a model that an accurate StepOptions.integrator (kernels/rattle.py;
+    """The ModelError of a model that an accurate StepOptions.integrator (kernels/dynamics/rattle.py;
     `integrator` its code, None: not known here) cannot step: `what` an UNSUPPORTED_* code,
     `index` the element."""
     if what == UNSUPPORTED_CONTACT:

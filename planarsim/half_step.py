@@ -19,7 +19,7 @@ to_instant_velocity the velocity over the last step -> v(t_n): v + h/2 M^-1 f, p
                     half kick.
 Applied forces: gravity, pushes (State.ext_force), actuator commands u (saturated), a slider
 rotor's velocity-product forces and the springs a step of h takes as forces, as the step
-applies them (kernels/forces.apply_forces); the joint springs and dampers it solves
+applies them (kernels/dynamics/forces.apply_forces); the joint springs and dampers it solves
 implicitly are not included.
 """
 from __future__ import annotations
@@ -32,13 +32,13 @@ from . import dense
 from .errors import ModelError
 from .compile import jit
 from .kernels.codes import JOINT_FREE_BIT, JOINT_SLIDER
-from .kernels.forces import kick as forces_kick
+from .kernels.dynamics.forces import kick as forces_kick
 
 
 @jit
 def kick(m, s, ws, u, h, step):
     """s.v += h M^-1 f [m/s, rad/s] with f the applied forces at s that a step of `step` [s]
-    applies (kernels/forces.kick), callable from Python."""
+    applies (kernels/dynamics/forces.kick), callable from Python."""
     forces_kick(m, s, ws, u, h, step)
 
 

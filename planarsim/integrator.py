@@ -1,7 +1,7 @@
 """Which models the accurate integrators (StepOptions.integrator 'rattle', 'rattle4', 'rattle6';
-kernels/rattle.py) can step, checked from Python before the first step.
+kernels/dynamics/rattle.py) can step, checked from Python before the first step.
 
-The compiled step makes the same test (kernels/rattle.py unsupported) and stops with
+The compiled step makes the same test (kernels/dynamics/rattle.py unsupported) and stops with
 GUARD_UNSUPPORTED for a caller that did not check; this one names the culprit at once.
 """
 from __future__ import annotations
@@ -10,8 +10,8 @@ import numpy as np
 
 from .errors import accurate_unsupported
 from .kernels.codes import INTEGRATOR_EULER
-from .kernels.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_FRICTION,
-                             UNSUPPORTED_LIMIT, UNSUPPORTED_SOFT)
+from .kernels.dynamics.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_FRICTION,
+                                      UNSUPPORTED_LIMIT, UNSUPPORTED_SOFT)
 
 
 def unsupported_feature(model):

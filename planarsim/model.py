@@ -50,10 +50,10 @@ class ModelArrays(NamedTuple):
     pin_axis: np.ndarray            # (n_pin, 2) a slider's unit axis d in body a's frame (world
                                     #   if a = -1); (0, 0) for a hinge
     pin_armature: np.ndarray        # (n_pin,) reflected rotor inertia on the joint coordinate
-                                    #   [kg m^2 hinge, kg slider] (kernels/soft.py)
+                                    #   [kg m^2 hinge, kg slider] (kernels/constraints/soft.py)
     pin_frictionloss: np.ndarray    # (n_pin,) dry friction on the joint coordinate, MuJoCo's
                                     #   frictionloss [N m hinge, N slider]
-                                    #   (kernels/joint_friction.py)
+                                    #   (kernels/constraints/joint_friction.py)
     rod_body: np.ndarray            # (n_rod, 2) int
     rod_anchor: np.ndarray          # (n_rod, 2, 2) local anchors [m]
     rod_length: np.ndarray          # (n_rod,) [m]
@@ -79,12 +79,12 @@ class ModelArrays(NamedTuple):
     act_anchor: np.ndarray          # (n_act, 2, 2) local anchors for ACT_AXIAL [m]
     act_dir: np.ndarray             # (n_act, 2) world direction for ACT_BODY_FORCE
     act_range: np.ndarray           # (n_act, 2) saturation [min, max] [N or N m]
-    fluid_body: np.ndarray          # (n_fluid,) int body of each fluid-drag box (kernels/fluid.py)
+    fluid_body: np.ndarray          # (n_fluid,) int body of each fluid-drag box (kernels/dynamics/fluid.py)
     fluid_coef: np.ndarray          # (n_fluid, 8) local centre x, y [m], angle of its first
                                     #   in-plane axis in the body frame [rad], linear [N s/m] and
                                     #   angular [N m s] viscous coefficients, quadratic [kg/m]
                                     #   along both in-plane axes, angular quadratic [kg m^2]
-    terrain_coef: np.ndarray        # (3 + 3K,) see kernels/terrain.py
+    terrain_coef: np.ndarray        # (3 + 3K,) see kernels/geometry/terrain.py
     shape_body: np.ndarray          # (n_shape,) int body of each colliding shape (-1: the world)
     shape_vert_adr: np.ndarray      # (n_shape,) int first core vertex (planarsim/shapes.py)
     shape_vert_num: np.ndarray      # (n_shape,) int core vertices: 1 circle, 2 capsule, >= 3 polygon

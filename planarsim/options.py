@@ -32,8 +32,8 @@ class StepOptions(NamedTuple):
     refine_iters : Newton-SHAKE position corrections after integrating (0: off)
     refine_tol : stop refining when every constraint residual is below this [m or rad]
     max_ccd_splits : cap on time-of-impact splits of one step (a point mass reaching the
-        ground, fast shapes touching or turning about a touching point: kernels/ccd.py,
-        kernels/pair_toi.py); the rest of a step beyond it is taken whole, but where a fast
+        ground, fast shapes touching or turning about a touching point: kernels/geometry/ccd.py,
+        kernels/geometry/pair_toi.py); the rest of a step beyond it is taken whole, but where a fast
         shape pair would touch in it, or turn too far about a touching point, it ends there
         (the rest of the step's time dropped; step_info 'ccd_stops'; ccd.stop_at_impact)
     guard_limit : any |q| or |v| component above this stops the run
@@ -49,7 +49,7 @@ class StepOptions(NamedTuple):
         model stays as it is
     audit_raise : 1 turns a violation of the step's audit (a pulling contact, friction outside
         its cone, positive contact work, a pin open by more than 1e-9 m, a contact deeper than
-        1e-8 m, a solve that fell back; kernels/audit.py) into an error naming the step, time,
+        1e-8 m, a solve that fell back; kernels/checks/audit.py) into an error naming the step, time,
         contact or pin and body; 0 (default) only counts them in Workspace.audit
     gross_limit : [m] a pin open or a contact below the ground (or inside another shape) by
         more than this at the end of a step stops the run at once (SimulationDiverged naming
@@ -75,7 +75,7 @@ class StepOptions(NamedTuple):
         other joints and contacts only slow the turn, so an upper bound of it) stops
         the run before that step (SimulationDiverged naming the actuator, its torque, the
         turn, and the dt or torque limit that would do). 0.2 (default): a step resolves
-        turns of about 2 * 0.1 rad (the position correction's regime, kernels/work.py); a
+        turns of about 2 * 0.1 rad (the position correction's regime, kernels/checks/work.py); a
         bang-bang 100-1000 N m motor on a light link at dt 1e-2 turns it 0.3 to 100 rad.
         0: no check
     jump_limit : [m] a body whose centre of mass moves in a step farther than its
@@ -96,7 +96,7 @@ class StepOptions(NamedTuple):
         'rattle6': seven stages (Yoshida), O(h^6) at 7/5 the cost of 'rattle4'. The accurate
         ones take mechanisms of pins, sliders and rods under gravity, pushes and actuators
         only: a model with a contact, a joint limit, a joint spring, damper or armature or a
-        fluid drag is refused (ModelError naming it; kernels/rattle.py)
+        fluid drag is refused (ModelError naming it; kernels/dynamics/rattle.py)
     max_substeps : cap on the equal sub-steps a default (Euler) step is taken in where a
         pin's anchor or a touching ground contact's point would leave the motion its rows
         linearise by more than 1 mm as its body turns, L (h w)^2 / 2 (L its lever [m], w
@@ -108,7 +108,7 @@ class StepOptions(NamedTuple):
         impact keeps its last part's). 16 (default); 1: never
     keep_factors : 1: a pile at rest (1,024 rows or more, the sparse factorisation) keeps
         its velocity solve's factors from step to step while its rows stay the same, and
-        each step's answer is refined against its own matrix to rounding (kernels/solve.py
+        each step's answer is refined against its own matrix to rounding (kernels/solver/solve.py
         refine_on_kept_factors; a 1,035-box pyramid at rest about 1.3x faster). The answer then
         depends, at rounding, on the step the factors were made at, which the State does not
         hold: a restored State continues to rounding, not bit for bit. 0 (default): every

@@ -1,4 +1,4 @@
-"""Which models the step takes by its pin-chain path (kernels/pin_chain.py), and in what order.
+"""Which models the step takes by its pin-chain path (kernels/solver/pin_chain.py), and in what order.
 
 A model qualifies when its only constraint rows are the x and y rows of plain hinge pins
 (no rods, sliders, joint limits, springs, dampers, armature or joint friction, no contacts)
@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels.codes import JOINT_HINGE
-from .kernels.sparse_factor import SPARSE_MIN_ROWS
+from .kernels.solver.sparse_factor import SPARSE_MIN_ROWS
 
 
 def _plain_hinges(a) -> bool:

@@ -5,7 +5,7 @@ Every shape is a convex core plus a radius r >= 0 (its points within r of the co
   capsule   two core vertices (the segment's ends), r > 0
   box       four core vertices (counter-clockwise), r = 0
   polygon   n >= 3 core vertices (convex, counter-clockwise), r = 0
-so one manifold routine (kernels/collide.py) serves every pair. Coordinates are the body's
+so one manifold routine (kernels/geometry/collide.py) serves every pair. Coordinates are the body's
 local frame [m] (the world's for a static shape, body -1).
 
 Which pairs of shapes can touch is decided once, here, when the model is compiled
@@ -206,7 +206,7 @@ def shape_bounds(core, normals, radius):
     """(cx, cy, R, width, lever): the bounding circle (bounding_circle), the shape's width [m]
     (its core's smallest extent across a face, 0 for a point or a segment, plus twice its
     radius) and the largest distance [m] of a core vertex from the frame's origin (the body's:
-    the lever of a turn; kernels/pair_toi.py)."""
+    the lever of a turn; kernels/geometry/pair_toi.py)."""
     core = np.asarray(core, dtype=np.float64).reshape(-1, 2)
     width = 0.0
     if len(core) >= 3:

@@ -20,7 +20,7 @@ from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
 from .start_check import check_overlap, check_start, overlapping
-from .kernels.guards import GUARD_ROOM
+from .kernels.checks.guards import GUARD_ROOM
 from .state import (ArrayCopier, State, Workspace, array_pairs, check_state, forget_ground_queries,
                     forget_kept_factors, forget_pairs, grow_workspace, make_state, make_workspace,
                     refresh_chains, workspace_capacity)

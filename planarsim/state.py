@@ -13,7 +13,7 @@ from numba import njit
 from . import memory
 from .capacity import workspace_capacity, workspace_contacts  # noqa: F401  (public here too)
 from .errors import WorkspaceTooLarge
-from .kernels.audit import N_AUDIT
+from .kernels.checks.audit import N_AUDIT
 from .kernels.info import N_INFO
 from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
 from .model import Model
@@ -36,17 +36,17 @@ class State(NamedTuple):
     last_contact_impulse : (n_contact, 2) [N s]   normal, tangential impulse of the last step
     last_pin_impulse : (n_pin, 4) [N s, N s, N m s, N m s]   x, y, lower, upper limit impulse
     last_rod_impulse : (n_rod,) [N s]     of the last step; the next step's solve starts from
-                                          them (kernels/warm_start.py): a closed loop whose
+                                          them (kernels/solver/warm_start.py): a closed loop whose
                                           load split is not unique keeps the last one
     contact_feature : (n_contact,) int    the features a shape pair's slot touched with in the
-                                          last step (-1: none; kernels/pair.py): a slot keeps its
+                                          last step (-1: none; kernels/geometry/pair.py): a slot keeps its
                                           mode and impulse while they stay the same
     contact_dependent : (n_contact,) int  the contact's rows that the last sparse velocity solve
                                           (of this step or an earlier one) dropped as dependent
                                           on the others, or left out and found held (bit 1: the
                                           normal row, bit 2: the friction row; a pile at rest):
                                           the next sparse solve factors the others only and
-                                          checks these rows' equations (kernels/sparse_factor.py;
+                                          checks these rows' equations (kernels/solver/sparse_factor.py;
                                           a contact without rows keeps its bits)
     """
     q: np.ndarray
@@ -231,7 +231,7 @@ class Workspace(NamedTuple):
     soft_rhs: np.ndarray         # (n_pin,) its right-hand side, then the soft rows' impulses
     friction_slip: np.ndarray    # (n_pin,) a frictional joint's mode this step: 0 stuck (its
                                  #   row in the solve), +-1 slipping that way (its friction
-                                 #   -F h slip in v_pred) (kernels/joint_friction.py)
+                                 #   -F h slip in v_pred) (kernels/constraints/joint_friction.py)
     friction_bound: np.ndarray   # (n_pin,) F h [N m s or N s]: its impulse's bound this step
     friction_J: np.ndarray       # (n_pin, 2, 3) its rate row g at the step's start
     soft_mark: np.ndarray        # (n_body,) int first soft row touching each body (scratch)
@@ -252,7 +252,7 @@ class Workspace(NamedTuple):
                                  #   left unqueried (contact_stale) a lower bound of it
     contact_stale: np.ndarray    # (n_contact,) int 1: a free point contact surely clear of the
                                  #   ground, not queried this step (its ground point and normal
-                                 #   are an earlier step's; kernels/contacts.py)
+                                 #   are an earlier step's; kernels/geometry/contacts.py)
     contact_found: np.ndarray    # (n_contact, 4) its body's pose (x, y, theta) and its gap
                                  #   where it was last queried (gap -inf: never)
     contact_anchor: np.ndarray   # (n_contact, 2) material contact point in the body frame [m]
@@ -273,11 +273,11 @@ class Workspace(NamedTuple):
                                  #   start (each in its body's frame) [m]
     contact_radii: np.ndarray    # (n_contact, 2) radius of the reference and the other shape [m]
     contact_bounce: np.ndarray   # (n_contact,) normal velocity restitution asks for [m/s]
-    manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/collide.py)
+    manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/geometry/collide.py)
     shape_reach: np.ndarray      # (n_shape, 4) each shape's bounding circle in the world (x, y,
                                  #   radius [m]) and a bound on its points' speed [m/s]
     sweep_box: np.ndarray        # (n_shape, 4) each shape's widened bounding box [m]
-                                 #   (left, right, bottom, top; kernels/broad_phase.py)
+                                 #   (left, right, bottom, top; kernels/geometry/broad_phase.py)
     sweep_order: np.ndarray      # (n_shape,) int the shapes by their boxes' left ends
     shape_pair_slot: np.ndarray  # (n_shape, n_shape) int slot-0 contact of the pair of two
                                  #   shapes (-1: they never collide); (0, 0) without pairs
@@ -303,15 +303,15 @@ class Workspace(NamedTuple):
     A_low: np.ndarray            # (P,) the effective-mass matrix J M^-1 F^T, its lower
                                  #   triangle and diagonal inside the rows' envelope: entry
                                  #   (i, j), row_first[i] <= j <= i, at row_start[i] + j -
-                                 #   row_first[i] (kernels/solve.py); P: profile capacity
+                                 #   row_first[i] (kernels/solver/solve.py); P: profile capacity
     A_up: np.ndarray             # (P,) its upper triangle the same way: entry (j, i), j < i,
                                  #   at row_start[i] + j - row_first[i] (column i)
     row_start: np.ndarray        # (R + 1,) int where each row's envelope begins in A_low / A_up
-    factor_kind: np.ndarray      # (1,) int which factorisation holds the rows (kernels/matrix.py:
+    factor_kind: np.ndarray      # (1,) int which factorisation holds the rows (kernels/solver/matrix.py:
                                  #   0 the envelope, 1 sparse; then A_low / A_up hold the
                                  #   factors' columns L and U, at L_index's rows)
     L_index: np.ndarray          # (P,) int the sparse factors' row of each entry
-    sp_perm: np.ndarray          # (R,) int sparse order: place -> row (kernels/sparse_factor.py)
+    sp_perm: np.ndarray          # (R,) int sparse order: place -> row (kernels/solver/sparse_factor.py)
     sp_iperm: np.ndarray         # (R,) int row -> place
     sp_row_key: np.ndarray       # (R,) int each row's part in the nested dissection
     sp_parent: np.ndarray        # (R,) int elimination tree (-1: a root)
@@ -357,7 +357,7 @@ class Workspace(NamedTuple):
     row_b: np.ndarray            # (R,) residual of each row without impulses: w = A lam + b
                                  #   [m/s] (velocity stage) or [m, rad] (position projection)
     row_soft: np.ndarray         # (R, 6) a soft row's armature, stiffness, damping, joint rate
-                                 #   at the step's start, compliance, g W g^T (kernels/soft.py)
+                                 #   at the step's start, compliance, g W g^T (kernels/constraints/soft.py)
     contact_candidate: np.ndarray  # (n_contact,) int 1: in the complementarity problem
     limit_candidate: np.ndarray  # (n_pin, 2) int 1: in the complementarity problem
     lcp_rows: np.ndarray         # (R,) int rows: joints first, then the others
@@ -379,7 +379,7 @@ class Workspace(NamedTuple):
     row_slip: np.ndarray         # (R,) slip speed gamma of a tangent row in the last
                                  #   complementarity solve [m/s] (mixed_lcp.solve_mixed_lcp)
     lcp_nz: np.ndarray           # (L,) int scratch: a column's non-zero rows (lcp.lemke_revised)
-    island_parent: np.ndarray    # (n_body,) int union-find of the bodies (kernels/islands.py)
+    island_parent: np.ndarray    # (n_body,) int union-find of the bodies (kernels/solver/islands.py)
     island_label: np.ndarray     # (n_body,) int island of a representative body (-1: none)
     island_start: np.ndarray     # (n_body + 2,) int first entry of each island in island_rows
     island_fill: np.ndarray      # (n_body + 1,) int scratch cursor of the grouping
@@ -389,16 +389,16 @@ class Workspace(NamedTuple):
     island_fallback: np.ndarray  # (n_body + 1,) int 1: solved by the frictionless rule
     island_scale: np.ndarray     # (n_body + 1,) its problem's largest approach (scaled units)
     audit: np.ndarray            # (N_AUDIT,) int violations counted since the workspace was
-                                 #   made (kernels/audit.py: AUDIT_NAMES)
+                                 #   made (kernels/checks/audit.py: AUDIT_NAMES)
     audit_last: np.ndarray       # (4,) int the last violation: step, kind, contact or pin, body
     audit_value: np.ndarray      # (1,) its size (impulse [N s], work [J], gap or depth [m])
     audit_worst: np.ndarray      # (4,) int the step's largest pin gap or depth violation: step,
                                  #   kind, pin or contact, body (StepOptions.gross_limit)
     audit_worst_value: np.ndarray  # (1,) its size [m] (0: none this step)
     bounce_scale: np.ndarray     # (1,) the factor of the step's rebound targets (1; less where
-                                 #   the energetic bound scales them: kernels/rebound.py)
+                                 #   the energetic bound scales them: kernels/solver/rebound.py)
     energy_stop: np.ndarray      # (1,) int 1: this step gained energy from nowhere beyond
-                                 #   StepOptions.energy_limit (kernels/work.judge_energy)
+                                 #   StepOptions.energy_limit (kernels/checks/work.judge_energy)
     first_order: np.ndarray      # (1,) int 1: this step's joint rows aim at J v = 0 (a
                                  #   projection) after the second-order target added energy
     joint_gain: np.ndarray       # (3,) the joints' energy gain of the step's answer beyond
@@ -448,7 +448,7 @@ class Workspace(NamedTuple):
     n_sync_pairs: np.ndarray     # (1,) int how many
     pair_synced: np.ndarray      # (n_contact,) int a pair's slot 0: 1 while in sync_pairs
     chain_on: np.ndarray         # (1,) int 1: the model's pins form open chains and are its only
-                                 #   rows: the step tries its pin-chain path (kernels/pin_chain.py;
+                                 #   rows: the step tries its pin-chain path (kernels/solver/pin_chain.py;
                                  #   planarsim/pin_chains.py)
     chain_pin: np.ndarray        # (n_pin,) int the pins chain by chain (pin_chain_order)
     chain_end: np.ndarray        # (n_pin, 2) int the ends of pins k and k - 1 at the body they
@@ -522,7 +522,7 @@ def forget_ground_queries(ws: Workspace) -> None:
 
 def forget_pairs(ws: Workspace) -> None:
     """Take every shape pair as listed in the last step, so that the next sweep clears each
-    one it does not find (kernels/broad_phase.py): for a state put in from outside, whose
+    one it does not find (kernels/geometry/broad_phase.py): for a state put in from outside, whose
     pairs' contacts its positions may no longer have."""
     slot0 = np.unique(ws.shape_pair_slot[ws.shape_pair_slot >= 0])
     ws.last_pairs[:] = slot0
@@ -623,7 +623,7 @@ def first_capacity(model: Model, contacts: int) -> tuple[int, int]:
 
 
 def _broad_phase_lists(model: Model) -> dict:
-    """The broad phase's tables and lists (kernels/broad_phase.py): the pair table of the
+    """The broad phase's tables and lists (kernels/geometry/broad_phase.py): the pair table of the
     shapes, every ground contact, and the live list, which holds every contact until the
     first sweep (a model without shapes keeps it so)."""
     arr = model.arrays
@@ -733,7 +733,7 @@ def grow_workspace(model: Model, ws: Workspace) -> Workspace:
 
 
 def soft_envelope_size(model: Model) -> int:
-    """Entries of the soft prediction's envelope (kernels/soft.soft_prediction): its rows are
+    """Entries of the soft prediction's envelope (kernels/constraints/soft.soft_prediction): its rows are
     the joints with a soft row (armature, stiffness or damping; soft.has_soft_row), in order,
     and row t holds columns from the first of them sharing a body with t."""
     a = model.arrays

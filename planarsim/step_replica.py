@@ -14,13 +14,13 @@ batch of starts (B, 3 n) with those decisions held:
     v += W_A P^T mu / h (joints only) or W_A P^T kappa, G W_A P^T kappa = S (-c(q)) / h (S:
     1 on the bilateral rows, 0 on the contacts' normal rows, which move positions only),
     one more pass on the last factorisation where the engine takes one,
-    v1 = v_new + k (v - v_new), k the energy bound's share (kernels/integrate.py).
+    v1 = v_new + k (v - v_new), k the energy bound's share (kernels/dynamics/integrate.py).
 
 P holds the rows at q0: the joints' (a hinge's x and y, a slider's perpendicular and angle)
 and the touching ground contacts' (a normal row: the gap of a point, or of a round sole's
 centre less its radius; a sticking contact's tangent row: its material point's move along the
 ground from where it was at q0); F is P but for a sliding contact's normal row, whose impulse
-pushes along n - mu s t (Coulomb). These are the rows kernels/rows.py builds, in the same
+pushes along n - mu s t (Coulomb). These are the rows kernels/constraints/rows.py builds, in the same
 arithmetic up to rounding. Every operation is analytic in the state (no abs, max or branch on
 it: those are the plan's), so a start q0 + i e dq gives the directional derivative as the
 imaginary part over e, exact to rounding (Squire and Trapp 1998: no difference is taken).
@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .kernels.codes import JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDE_BIT, JOINT_SLIDER
-from .kernels.integrate import DIVERGED_GROWTH, ROUNDING, STALLED_RATIO
-from .kernels.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
-                           SHAKE_REGIME, VELOCITY_FLOOR)
+from .kernels.dynamics.integrate import DIVERGED_GROWTH, ROUNDING, STALLED_RATIO
+from .kernels.checks.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
+                                  SHAKE_REGIME, VELOCITY_FLOOR)
 
 
 class ReplicaRefused(Exception):
@@ -50,7 +50,7 @@ class ContactPlan:
     radius: np.ndarray          # (k,) [m] 0 for a point
     pinned: np.ndarray          # (k,) bool: sticking (a tangent row); else sliding
     mu_slip: np.ndarray         # (k,) mu s of a sliding contact (its friction along -s t)
-    terrain: np.ndarray         # the terrain's coefficients (kernels/terrain.py)
+    terrain: np.ndarray         # the terrain's coefficients (kernels/geometry/terrain.py)
     pair: np.ndarray | None = None   # (k, 8) int per shape pair's slot (-1 row: a ground
                                      # contact): ref body, inc body, ref shape, inc shape,
                                      # distance kind, ref index, inc index, clip (collide.py)
@@ -119,8 +119,8 @@ def _cross(r, d):
 
 
 def joint_rows(model, q, held):
-    """(c (B, m), J (B, m, 3 n)) of the joints' held rows at q (B, n, 3): kernels/pin.py's
-    hinge rows (anchor b minus anchor a) and kernels/slider.py's rows."""
+    """(c (B, m), J (B, m, 3 n)) of the joints' held rows at q (B, n, 3): kernels/constraints/pin.py's
+    hinge rows (anchor b minus anchor a) and kernels/constraints/slider.py's rows."""
     a = model.arrays
     B, n = q.shape[0], q.shape[1]
     c = np.zeros((B, 2 * model.n_pin), dtype=q.dtype)
@@ -177,7 +177,7 @@ def joint_rows(model, q, held):
 
 
 def rod_rows(model, q):
-    """(c (B, k), J (B, k, 3 n)) of the rods' rows at q (B, n, 3): kernels/rod.py's
+    """(c (B, k), J (B, k, 3 n)) of the rods' rows at q (B, n, 3): kernels/constraints/rod.py's
     |p_b - p_a| - L along the unit vector a -> b (an end on the world: its anchor there)."""
     a = model.arrays
     B, n = q.shape[0], q.shape[1]
@@ -200,7 +200,7 @@ def rod_rows(model, q):
 
 def ground_point(cp, point):
     """(g (B, 2) [m], n (B, 2)) the ground point closest to `point` (B, 2) and the unit normal
-    there (kernels/terrain.py closest_point). Flat or sloped ground: the foot of the
+    there (kernels/geometry/terrain.py closest_point). Flat or sloped ground: the foot of the
     perpendicular. Hills: the first row's (real) closest point found by the engine's own
     search, then Newton on (x - px) + (h(x) - py) h'(x) = 0 continued for every row from it
     (the rows differ from the first by a complex step only, so the root's derivative comes
@@ -210,7 +210,7 @@ def ground_point(cp, point):
         nrm = cp.normal
         gap = point @ nrm - cp.offset
         return point - gap[:, None] * nrm, np.broadcast_to(nrm, point.shape)
-    from .kernels.terrain import closest_point
+    from .kernels.geometry.terrain import closest_point
     px, py = point[:, 0], point[:, 1]
     x = np.full(point.shape[0], closest_point(coef, float(px[0].real), float(py[0].real))[0],
                 dtype=point.dtype)
@@ -228,7 +228,7 @@ HILLS_NEWTON = 3
 
 
 def _height_derivs(coef, x):
-    """(h, h', h'') of the terrain at x (B,) (kernels/terrain.py height_derivs)."""
+    """(h, h', h'') of the terrain at x (B,) (kernels/geometry/terrain.py height_derivs)."""
     h = coef[0] + coef[1] * x
     dh = coef[1] + 0.0 * x
     ddh = 0.0 * x
@@ -279,7 +279,7 @@ def _rotate_by(q, body, vector):
 
 
 def pair_point(model, pair, q0):
-    """The manifold point of a shape pair's slot at q0 (kernels/collide.py, its features held:
+    """The manifold point of a shape pair's slot at q0 (kernels/geometry/collide.py, its features held:
     pair = ContactPlan.pair's row): (p: the incident core's point, g: the reference
     feature's point, n: the normal from the reference, gap), each (B, 2) or (B,). A FACE point
     is an incident vertex (clip none) or the incident edge crossing a side line of the
@@ -314,7 +314,7 @@ def pair_point(model, pair, q0):
 
 def _pair_rows(model, cp, k, q, q0, c, J, F, r):
     """contact_rows' rows r (normal) and r + 1 (sticking: tangent) of shape pair slot k:
-    kernels/pair.py pair_row with the features found at q0 (_store_point), acting on the
+    kernels/geometry/pair.py pair_row with the features found at q0 (_store_point), acting on the
     reference body (-) and the incident body (+) at the incident surface point."""
     a = model.arrays
     ref, inc, s_ref, s_inc, dist = (int(x) for x in cp.pair[k, :5])
@@ -364,7 +364,7 @@ def contact_rows(cp, q, q0, n_coord):
     ground point found at q0 (a round sole: its centre's, plus the arc r (theta - theta0) it
     rolled, the same at q0 as its material point's below the centre); F: the
     rows' impulse directions at q0 (J at q0 but a sliding contact's normal row, along
-    n - mu s t at its point). Rows of kernels/contacts.py ground_row and rows.build_rows."""
+    n - mu s t at its point). Rows of kernels/geometry/contacts.py ground_row and rows.build_rows."""
     B = q.shape[0]
     n_rows = int(cp.count + cp.pinned.sum())
     dtype = np.result_type(q, q0)
@@ -431,7 +431,7 @@ def limit_rows(model, limits, q):
     """(c (B, k), J (B, k, 3 n)) of the active joint limits' rows at q (B, n, 3): limits (k, 2)
     [joint, side]; a hinge's angle theta_b - theta_a - ref, or a world slide's coordinate
     along its axis, less the lower limit (side 0) or taken from the upper (side 1), as
-    kernels/limit.py writes them (their rate rows g are constant: derivatives.check_covered)."""
+    kernels/constraints/limit.py writes them (their rate rows g are constant: derivatives.check_covered)."""
     from .derivatives import rate_row
     a = model.arrays
     B, n = q.shape[0], q.shape[1]
@@ -476,11 +476,11 @@ def _rows(plan, q, q0):
 
 def turning_forces(plan, q, u):
     """(B, 3 n) [N, N m] the forces of the actuators whose direction turns with the bodies
-    (kernels/forces.py apply_actuator): an axial force u along the line from its anchor on
+    (kernels/dynamics/forces.py apply_actuator): an axial force u along the line from its anchor on
     body a to its anchor on body b (on b, and its opposite on a, at the anchors), and a hip
     torque u as forces perpendicular to each leg from the hip body (-u on leg a, +u on leg
     b); commands past a bound held at it."""
-    from .kernels.forces import ACT_AXIAL
+    from .kernels.dynamics.forces import ACT_AXIAL
     model = plan.model
     a = model.arrays
     n = model.n_body
@@ -522,7 +522,7 @@ def turning_forces(plan, q, u):
 
 
 def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
-    """The rows the Newton correction keeps (kernels/integrate.py drop_leaving_rows): all but
+    """The rows the Newton correction keeps (kernels/dynamics/integrate.py drop_leaving_rows): all but
     a unilateral row open at q (the start plus h v_new) by more than the step's turning
     explains (pull_allowance: the body leaves the surface, a disk rolling over a crest), and
     the tangent row of a contact whose normal row leaves. A row resting on its surface at the
@@ -787,7 +787,7 @@ def _sabs(x):
 
 
 def _energy_bound(plan, q0, v0, q1, v, v_s, f, deciding):
-    """kernels/integrate.py bound_correction_work: v_s + k (v - v_s), k the largest share in
+    """kernels/dynamics/integrate.py bound_correction_work: v_s + k (v - v_s), k the largest share in
     [0, 1] of the correction's velocity change that adds no energy beyond its allowance (its
     branches the plan's); f (B, 3 n) [N, N m]: the step's applied forces (ws.force)."""
     model, h = plan.model, plan.h

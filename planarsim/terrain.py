@@ -2,7 +2,7 @@
 
 h(x) = h0 + s x + sum_k A_k sin(2 pi x / L_k + phi_k)   [m]
 
-Heights, slopes and normals are exact; the compiled versions live in ``kernels/terrain.py``.
+Heights, slopes and normals are exact; the compiled versions live in ``kernels/geometry/terrain.py``.
 """
 from __future__ import annotations
 

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-# row kinds of the compiled rows (planarsim/kernels/rows.py)
+# row kinds of the compiled rows (planarsim/kernels/constraints/rows.py)
 PIN_X, PIN_Y, ROD, LIMIT_LO, LIMIT_HI, CONTACT_N, CONTACT_T = range(7)
 
 

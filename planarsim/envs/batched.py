@@ -39,7 +39,7 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
 from ..compile import MODE, FAST
 from ..compiled import jit
-from ..kernels.guards import GUARD_ROOM
+from ..kernels.checks.guards import GUARD_ROOM
 from ..link.step import bind, run_steps
 from .core import set_commands
 

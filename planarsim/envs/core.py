@@ -24,7 +24,7 @@ import gymnasium
 from gymnasium import spaces
 
 from ..compiled import jit
-from ..kernels.joints import joint_position_rate
+from ..kernels.constraints.joints import joint_position_rate
 from ..kernels.math2d import update_trig
 from ..link.step import bind
 from ..mjcf import load_mjcf

@@ -217,7 +217,7 @@ class HalfCheetah(_Locomotion):
 class Swimmer(_Locomotion):
     """gymnasium Swimmer-v5 on planarsim (swimmer.xml, frame_skip 4, dt 0.04 s): three links
     in the x-y plane, no gravity, MuJoCo's inertia-box drag (viscosity 0.1, density 4000;
-    kernels/fluid.py) and armature 0.1 on every joint, the root's included. Reward: the
+    kernels/dynamics/fluid.py) and armature 0.1 on every joint, the root's included. Reward: the
     velocity of qpos[0] minus 1e-4 |action|^2. What differs: MuJoCo's file asks for RK4,
     planarsim steps it with its own first-order integrator (the drag explicit, as MuJoCo's
     Euler has it)."""

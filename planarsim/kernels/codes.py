@@ -2,7 +2,7 @@
 # contact kinds (model.contact_kind)
 CONTACT_POINT = 0      # a material point (a point mass, a box corner)
 CONTACT_ARC = 1        # a circular-arc sole that rolls
-CONTACT_PAIR = 2       # one of two slots of a pair of colliding shapes (kernels/pair.py)
+CONTACT_PAIR = 2       # one of two slots of a pair of colliding shapes (kernels/geometry/pair.py)
 CONTACT_EDGE = 3       # a shape's straight edge over curved ground: its deepest point (hills)
 # contact modes (state.contact_mode)
 MODE_FREE = 0
@@ -37,10 +37,10 @@ ROW_JOINT_SOFT = 9     # a joint coordinate's armature and implicit spring-dampe
 ROW_JOINT_FRICTION = 10  # a stuck joint's dry friction: its rate held, |impulse| <= F h (joint_friction.py)
 
 INTEGRATOR_EULER = 0      # StepOptions.integrator: the default step, symplectic Euler with SHAKE
-# 1: RATTLE, second order (kernels/rattle.py)
+# 1: RATTLE, second order (kernels/dynamics/rattle.py)
 INTEGRATOR_RATTLE4 = 2    # RATTLE composed in five stages (Suzuki), fourth order
 INTEGRATOR_RATTLE6 = 3    # RATTLE composed in seven stages (Yoshida), sixth order
 INTEGRATOR_NAMES = ("euler", "rattle", "rattle4", "rattle6")
-# nesting depth of the sparse factorisation's parts (kernels/sparse_factor.py; the workspace's
+# nesting depth of the sparse factorisation's parts (kernels/solver/sparse_factor.py; the workspace's
 # counting sort holds this many keys per body): parts deeper than this share a place
 SPARSE_MAX_DEPTH = 40

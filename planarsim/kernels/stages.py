@@ -3,31 +3,38 @@ step.step_of_length runs them. step.py's numbered comments, the kernel modules' 
 ("Stage N: ...") and the documentation's table of the stages (stage_table) are checked
 against this list (tests/planarsim/test_stages.py). Plain data: no numba here."""
 
-#: (name, what it does, its modules (the first owns it), the functions that run it)
+#: (name, what it does, its modules (the first owns it; "folder.module" is
+#: planarsim/kernels/folder/module.py), the functions that run it)
 STAGES = (
     ("forces", "applied forces and the free velocity v* = v + h M^-1 f",
-     ("forces", "fluid"), ("apply_forces", "apply_fluid", "predict_velocity")),
+     ("dynamics.forces", "dynamics.fluid"),
+     ("apply_forces", "apply_fluid", "predict_velocity")),
     ("contacts", "the contact points: ground queries, the broad phase, shape pairs",
-     ("contacts", "broad_phase", "pair", "collide"),
+     ("geometry.contacts", "geometry.broad_phase", "geometry.pair", "geometry.collide"),
      ("find_contacts", "find_contact", "find_edge", "update_live", "find_pair")),
     ("rows", "the active constraint rows J and their errors c, one module per kind",
-     ("rows", "pin", "slider", "rod", "limit", "soft", "joint_friction", "joints"),
+     ("constraints.rows", "constraints.pin", "constraints.slider", "constraints.rod",
+      "constraints.limit", "constraints.soft", "constraints.joint_friction",
+      "constraints.joints"),
      ("build_rows", "eval_row", "pin_row", "slider_perp_row", "slider_angle_row", "rod_row",
       "limit_row", "soft_row", "friction_row", "ground_row", "pair_row")),
     ("impulses", "the rows' impulses: one linear solve",
-     ("solve", "matrix", "envelope", "sparse_factor"), ("solve_impulses",)),
+     ("solver.solve", "solver.matrix", "solver.envelope", "solver.sparse_factor"),
+     ("solve_impulses",)),
     ("modes", "the contacts' and limits' rules checked, then the guaranteed solve",
-     ("modes", "complementarity", "islands", "mixed_lcp", "lcp"),
+     ("solver.modes", "solver.complementarity", "solver.islands", "solver.mixed_lcp", "solver.lcp"),
      ("rule_breaks", "seed_rule", "check_contact", "solve_contacts")),
     ("impact", "continuous collision: a step split at the time of impact",
-     ("ccd", "pair_toi"), ("split_at_impact", "pair_impact_time", "hold_off_fast_pairs")),
+     ("geometry.ccd", "geometry.pair_toi"),
+     ("split_at_impact", "pair_impact_time", "hold_off_fast_pairs")),
     ("audit", "the step audits its own answer (of the impulses; of the positions at the end "
-     "of stage 8)", ("audit", "work"), ("audit_impulses", "audit_joints")),
+     "of stage 8)", ("checks.audit", "checks.work"),
+     ("audit_impulses", "audit_joints")),
     ("positions", "integrate, correct, settle",
-     ("position", "integrate"),
+     ("dynamics.position", "dynamics.integrate"),
      ("position_stage", "integrate_positions", "correct_positions", "settle_positions",
       "bound_correction_work")),
-    ("guards", "every coordinate finite and within its bound", ("guards",),
+    ("guards", "every coordinate finite and within its bound", ("checks.guards",),
      ("check_guards", "check_speeds")),
 )
 
@@ -46,6 +53,6 @@ def stage_table() -> str:
              "|---|---|---|---|"]
     for k, (name, what, modules, functions) in enumerate(STAGES):
         lines.append(f"| {k + 1}. {name} | {what} | "
-                     + ", ".join(f"`{m}.py`" for m in modules) + " | "
+                     + ", ".join(f"`{m.replace('.', '/')}.py`" for m in modules) + " | "
                      + ", ".join(f"`{f}`" for f in functions) + " |")
     return "\n".join(lines)

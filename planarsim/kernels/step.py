@@ -11,45 +11,45 @@ stages 1-5 for the remainder of the step with the new contact pinned. Each stage
 module (kernels/stages.py lists them); this file only orders them, and
 solve_modes, the guess-check-solve of stages 3-5. StepOptions.integrator other than the default
 wraps the same stages (step_of_length) in RATTLE's half kicks and projection, or in its
-five-stage composition (accurate_step; kernels/rattle.py).
+five-stage composition (accurate_step; kernels/dynamics/rattle.py).
 """
 import math
 
 import numpy as np
 
 from ..compile import kernel
-from .audit import PIN_GAP_TOL, audit_impulses, audit_total
-from .broad_phase import FLAG_LIVE, widen_for_answer
-from .ccd import split_at_impact, stop_at_impact
+from .checks.audit import PIN_GAP_TOL, audit_impulses, audit_total
+from .geometry.broad_phase import FLAG_LIVE, widen_for_answer
+from .geometry.ccd import split_at_impact, stop_at_impact
 from .codes import INTEGRATOR_EULER, MODE_FREE, MODE_PINNED, MODES_ALTERNATING
-from .complementarity import solve_contacts
-from .contacts import bounce_of, find_contacts
-from .forces import apply_forces, predict_velocity
-from .guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_ROOM,
-                     check_actuator_turns, check_displacements, check_guards, check_moves,
-                     check_speeds, add_part_path, finish_path, keep_step_path, note_start_depths,
-                     start_path)
+from .solver.complementarity import solve_contacts
+from .geometry.contacts import bounce_of, find_contacts
+from .dynamics.forces import apply_forces, predict_velocity
+from .checks.guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_ROOM,
+                            check_actuator_turns, check_displacements, check_guards, check_moves,
+                            check_speeds, add_part_path, finish_path, keep_step_path,
+                            note_start_depths, start_path)
 from .info import INFO_CHAIN_PATH, INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
-from .integrate import (bound_correction_work, integrate_positions, predict_configuration)
-from .joint_friction import start_joint_friction, stick_all, switch_joint_friction
+from .dynamics.integrate import (bound_correction_work, integrate_positions, predict_configuration)
+from .constraints.joint_friction import start_joint_friction, stick_all, switch_joint_friction
 from .math2d import update_trig
-from .modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
-                    rule_breaks, seed_rule)
-from .pair import PAIR_MARGIN
-from .pin_chain import (chain_prediction, lever_correct, lever_joint_work,
-                        lever_velocity_solve)
-from .rebound import rebound_gain, rebounding
+from .solver.modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
+                           rule_breaks, seed_rule)
+from .geometry.pair import PAIR_MARGIN
+from .solver.pin_chain import (chain_prediction, lever_correct, lever_joint_work,
+                               lever_velocity_solve)
+from .solver.rebound import rebound_gain, rebounding
 from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev
-from .pair_toi import hold_off_fast_pairs
-from .position import ROWS_HELD_SHARE, position_stage
-from .rows import build_rows
-from .soft import soft_prediction
-from .solve import solve_impulses
-from .rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
-                     unsupported)
-from .warm_start import remember_impulses
-from .work import (CONSTRAINT_SHARE, JOINT_WORK_SHARE, NEAR_DEPENDENT, SHAKE_REGIME,
-                   joints_add_energy, kinetic_energy, prediction_turn)
+from .geometry.pair_toi import hold_off_fast_pairs
+from .dynamics.position import ROWS_HELD_SHARE, position_stage
+from .constraints.rows import build_rows
+from .constraints.soft import soft_prediction
+from .solver.solve import solve_impulses
+from .dynamics.rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
+                              unsupported)
+from .solver.warm_start import remember_impulses
+from .checks.work import (CONSTRAINT_SHARE, JOINT_WORK_SHARE, NEAR_DEPENDENT, SHAKE_REGIME,
+                          joints_add_energy, kinetic_energy, prediction_turn)
 
 
 @kernel(inline="never")
@@ -404,7 +404,7 @@ REBOUND_CLOSE = 1e-6
 
 @kernel(inline="never")
 def bound_rebound(m, s, ws, opt, h, include_ccd, answered):
-    """The energetic bound on the step's rebounds (kernels/rebound.py): where the contacts of
+    """The energetic bound on the step's rebounds (kernels/solver/rebound.py): where the contacts of
     the answer with the rebounds restitution asks for add kinetic energy, the step's answer
     is taken again with every rebound scaled by the largest factor that adds none. The
     energy the contacts add is quadratic in the factor while the contacts keep their modes
@@ -604,7 +604,7 @@ def put_back_from(s, ws, start):
 def step_of_length(m, s, ws, opt, u, step_length, stage):
     """Advance s by one default step of step_length [s] under actuator commands u; return the
     guard code. A call (one copy of its code for the default step and for every stage of the
-    accurate integrators, kernels/rattle.py). stage: a stage of an accurate step, which keeps
+    accurate integrators, kernels/dynamics/rattle.py). stage: a stage of an accurate step, which keeps
     the step's start in ws.prev, has checked the actuators' turns for all its stages and
     counts what they all did (step_info)."""
     if not stage:
@@ -699,7 +699,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
 @kernel(inline="never")
 def accurate_step(m, s, ws, opt, u, step_length):
     """One step of step_length [s] of StepOptions.integrator's RATTLE or its composition
-    (kernels/rattle.py): per stage a half kick back, the default step, a half kick forward;
+    (kernels/dynamics/rattle.py): per stage a half kick back, the default step, a half kick forward;
     the velocity projected onto the joints at the end. The State counts one step. ws.prev
     holds the step's start throughout (an error reports it as the failed step's start); the
     actuators' turns are checked once, before any stage, over the longest stage (a stage of
@@ -832,7 +832,7 @@ def chain_part(m, s, ws, opt, u, h):
     """One part of h [s] (the step, or a turn sub-step) of a model whose only rows are the
     pins of open chains (ws.chain_on; planarsim/pin_chains.py): the stages step_of_length
     runs for such a model, in its order, with the velocity solve and the correction by block
-    elimination along the chains (kernels/pin_chain.py) and every check of the general
+    elimination along the chains (kernels/solver/pin_chain.py) and every check of the general
     step. Where the general step would do more than this (a row its solve would drop as
     dependent, the joints' energy check or the correction's energy bound taking effect, a correction that
     stalls or ends above refine_tol, a guard, an audit) it returns CHAIN_GENERAL or

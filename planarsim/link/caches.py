@@ -55,13 +55,37 @@ def _has_compiled_code(path: Path) -> bool:
     return "@jit" in text or "@kernel" in text or "@part" in text
 
 
+def _kernel_file(name: str):
+    """The source of kernel module `name` (dotted below planarsim.kernels: "codes",
+    "geometry.terrain"; a package's __init__.py), None where there is none."""
+    base = _PLANARSIM.joinpath("kernels", *name.split("."))
+    for path in (base.with_suffix(".py"), base / "__init__.py"):
+        if path.is_file():
+            return path
+    return None
+
+
+def _kernel_modules(module: str, names) -> set:
+    """The kernel modules (dotted below planarsim.kernels) that `from module import names`
+    imports (names None: `import module`): the module itself, and those of `names` that are
+    modules of it (`from planarsim.kernels.geometry import terrain`)."""
+    rest = module[len(_KERNELS) + 1:]
+    found = {rest} if rest else set()
+    for name in names or ():
+        below = f"{rest}.{name}" if rest else name
+        if _kernel_file(below) is not None:
+            found.add(below)
+    return found
+
+
 def caller_sources(folder, exported_kernels) -> tuple:
     """(kernel modules, other files) that compiled functions of the .py files below `folder`
     may inline, besides the folder's own files (fast mode: the step itself is reached by
-    address). Kernel modules (short names: "terrain"): those imported from planarsim.kernels
-    or through planarsim.compiled (`exported_kernels(names)`: the kernel modules of those of
-    its names, None: of all), or by planarsim's modules with compiled code that are imported
-    (planarsim/half_step.py: forces), and in turn every kernel module those import.
+    address). Kernel modules (named below planarsim.kernels with their folder:
+    "geometry.terrain", "codes"): those imported from planarsim.kernels or through
+    planarsim.compiled (`exported_kernels(names)`: the kernel modules of those of its names,
+    None: of all), or by planarsim's modules with compiled code that are imported
+    (planarsim/half_step.py: dynamics.forces), and in turn every kernel module those import.
     Other files: planarsim's modules with compiled code that are imported
     (planarsim/actuators.py), and the modules of the folder's own top-level package outside
     it (walkers/common/pd.py for a walker) with, in turn, what those import."""
@@ -79,10 +103,8 @@ def caller_sources(folder, exported_kernels) -> tuple:
                 kernels |= exported_kernels(names)
             elif module == "planarsim" and names and "compiled" in names:
                 kernels |= exported_kernels(None)
-            elif module == _KERNELS:
-                kernels |= set(names or ())
-            elif module.startswith(_KERNELS + "."):
-                kernels.add(module[len(_KERNELS) + 1:].split(".")[0])
+            elif module == _KERNELS or module.startswith(_KERNELS + "."):
+                kernels |= _kernel_modules(module, names)
             elif module == "planarsim" or any(module == f"planarsim.{layer}" or
                                                module.startswith(f"planarsim.{layer}.")
                                                for layer in _LAYERS):
@@ -102,15 +124,13 @@ def caller_sources(folder, exported_kernels) -> tuple:
     todo, closure = list(kernels), set()
     while todo:
         name = todo.pop()
-        path = _PLANARSIM / "kernels" / f"{name}.py"
-        if name in closure or not path.exists():
+        path = _kernel_file(name)
+        if name in closure or path is None:
             continue
         closure.add(name)
         for module, names in imported_modules(path):
-            if module == _KERNELS:
-                todo += list(names or ())
-            elif module.startswith(_KERNELS + "."):
-                todo.append(module[len(_KERNELS) + 1:].split(".")[0])
+            if module == _KERNELS or module.startswith(_KERNELS + "."):
+                todo += _kernel_modules(module, names)
     return closure, files
 
 
@@ -125,7 +145,7 @@ def _caller_engine_hash(folder: Path, exported_kernels) -> str:
     if MODE != FAST:
         return ENGINE_HASH + others.hexdigest()
     kernels = _PLANARSIM / "kernels"
-    inlined = [kernels / f"{name}.py" for name in sorted(kernel_names)]
+    inlined = [_kernel_file(name) for name in sorted(kernel_names)]
     return _layers_hash(sources_hash(kernels, _mode_tag() + others.hexdigest(), inlined))
 
 

@@ -34,8 +34,10 @@ from numba.extending import intrinsic
 
 from ..compile import parts, refs
 from ..compile.fast import before_compile, code_layout
-from ..kernels import complementarity, pair, position   # noqa: F401  (the parts' modules)
-from ..kernels.guards import GUARD_BAD_COMMANDS, check_commands
+from ..kernels.solver import complementarity  # noqa: F401
+from ..kernels.geometry import pair  # noqa: F401
+from ..kernels.dynamics import position   # noqa: F401  (the parts' modules)
+from ..kernels.checks.guards import GUARD_BAD_COMMANDS, check_commands
 from ..kernels.info import INFO_COMMAND
 from ..kernels.step import _step
 from . import caches
@@ -47,10 +49,10 @@ _LOADING = []     # this thread is compiling the step (see load_step)
 
 # the step's parts, by module and name: its index is its number (compile/parts.py)
 PART_NAMES = (
-    "planarsim.kernels.complementarity.solve_contacts",
-    "planarsim.kernels.complementarity.project_positions",
-    "planarsim.kernels.position._settle_measured",
-    "planarsim.kernels.pair.find_pair",
+    "planarsim.kernels.solver.complementarity.solve_contacts",
+    "planarsim.kernels.solver.complementarity.project_positions",
+    "planarsim.kernels.dynamics.position._settle_measured",
+    "planarsim.kernels.geometry.pair.find_pair",
 )
 
 
@@ -131,7 +133,7 @@ def _load_or_compile():
 def step(typingctx, m, s, ws, opt, u):
     """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0: m.dt)
     under actuator commands u (float64, C-contiguous, one per actuator). Callable from compiled code.
-    Returns 0 ok, 1 non-finite, 2 too large (kernels/guards.py), -1 when u does not have one
+    Returns 0 ok, 1 non-finite, 2 too large (kernels/checks/guards.py), -1 when u does not have one
     entry per actuator, -2 when a command is NaN or infinite (for both nothing is changed;
     planarsim.errors.diverged explains any code)."""
     check_step_types((m, s, ws, opt, u), engine_types())

@@ -15,7 +15,7 @@ from numba import types
 from numba.extending import overload
 
 from ..compile import FAST, MODE, PYTHON, TABLES, jit, kernel, register
-from ..kernels.guards import GUARD_BAD_COMMANDS, check_commands
+from ..kernels.checks.guards import GUARD_BAD_COMMANDS, check_commands
 from ..kernels.info import INFO_COMMAND
 from ..kernels.record import record_frame
 from ..kernels.step import _step
@@ -53,7 +53,7 @@ else:
         def step(m, s, ws, opt, u):
             """step(m, s, ws, opt, u) -> guard code: advance State s by one step of opt.dt (0:
             m.dt) under actuator commands u (one per actuator). Returns 0 ok, 1 non-finite,
-            2 too large (kernels/guards.py), -1 when u does not have one entry per actuator,
+            2 too large (kernels/checks/guards.py), -1 when u does not have one entry per actuator,
             -2 when a command is NaN or infinite (for both nothing is changed)."""
             return _step_checked(m, s, ws, opt, u)
 

@@ -17,7 +17,7 @@ What is read (see ``ATTRIBUTES`` for every attribute and what becomes of it):
   parent (its geoms join the parent's rigid body, or the world's).
 * ``<joint type="hinge|slide" pos axis ref range limited stiffness damping springref armature
   frictionloss>`` (frictionloss [N m or N]: planarsim's exact dry-friction row on the joint,
-  kernels/joint_friction.py, where MuJoCo's is a soft constraint).
+  kernels/constraints/joint_friction.py, where MuJoCo's is a soft constraint).
   A root body with two slides spanning the plane and a hinge about its normal is free in the
   plane, each joint a free coordinate (``add_free_coordinate``: limits, springs, dampers,
   armature and motors act on it, nothing is constrained); without the hinge it translates

@@ -128,7 +128,7 @@ def read_flags(loader, option_node):
 
 def joint_frictionloss(loader, node, eff):
     """(loader: the Reader) A hinge's or slide's frictionloss [N m or N] (MuJoCo's dry joint
-    friction; planarsim's exact friction row, kernels/joint_friction.py); 0, reported as
+    friction; planarsim's exact friction row, kernels/constraints/joint_friction.py); 0, reported as
     ignored, where <flag frictionloss> or <flag constraint> is disabled; a negative one is a
     ModelError naming the joint."""
     raw = eff.get("frictionloss")

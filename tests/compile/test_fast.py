@@ -305,7 +305,7 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
     step is reached by address, so the kernels only the step uses are not among them. It
     hashes too the modules of its own top-level package outside it that it imports (a shared
     helper: walkers/common for a walker) and planarsim's modules with compiled code, with the
-    kernels those import (planarsim/half_step.py inlines kernels/forces.py)."""
+    kernels those import (planarsim/half_step.py inlines kernels/dynamics/forces.py)."""
     from planarsim.compiled import caller_sources
     top = tmp_path / "top"
     own, shared = top / "own", top / "shared"
@@ -313,11 +313,11 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
         package.mkdir(exist_ok=True)
         (package / "__init__.py").write_text("")
     (own / "a.py").write_text("from planarsim.compiled import jit, step, height\n")
-    assert caller_sources(own) == ({"terrain"}, set())
-    (own / "b.py").write_text("from planarsim.kernels.pair import shape_contact_mode\n")
+    assert caller_sources(own) == ({"geometry.terrain"}, set())
+    (own / "b.py").write_text("from planarsim.kernels.geometry.pair import shape_contact_mode\n")
     kernels, _ = caller_sources(own)
-    assert {"terrain", "pair", "collide", "math2d", "codes"} <= kernels    # pair's own imports
-    assert not kernels & {"lcp", "complementarity", "step", "solve", "audit"}
+    assert {"geometry.terrain", "geometry.pair", "geometry.collide", "math2d", "codes"} <= kernels    # pair's own imports
+    assert not kernels & {"solver.lcp", "solver.complementarity", "step", "solver.solve", "checks.audit"}
     (own / "c.py").write_text("from planarsim import compiled\n"
                               "from planarsim.actuators import motor_torque\n"
                               "from planarsim.model import Model\n"
@@ -325,7 +325,7 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
     (shared / "helpers.py").write_text("from .more import LIMIT\n")
     (shared / "more.py").write_text("LIMIT = 2.0\n")
     kernels, files = caller_sources(own)
-    assert {"record", "forces", "terrain", "pair"} <= kernels
+    assert {"record", "dynamics.forces", "geometry.terrain", "geometry.pair"} <= kernels
     import planarsim
     actuators = Path(planarsim.__file__).resolve().parent / "actuators.py"
     assert files == {actuators, shared / "helpers.py", shared / "more.py"}   # not model.py
@@ -335,7 +335,7 @@ def test_a_callers_caches_follow_only_the_sources_its_code_can_inline(tmp_path):
     (other / "__init__.py").write_text("")
     (other / "d.py").write_text("from planarsim.half_step import kick\n")
     kernels, files = caller_sources(other)
-    assert "forces" in kernels and files == {actuators.parent / "half_step.py"}
+    assert "dynamics.forces" in kernels and files == {actuators.parent / "half_step.py"}
 
 
 def test_jit_functions_cache_in_files_of_their_own_which_plain_numba_never_loads():

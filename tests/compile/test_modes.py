@@ -62,7 +62,8 @@ def test_under_numba_disable_jit_the_step_is_python_that_pdb_can_enter():
         import inspect
         from planarsim.compile import MODE
         from planarsim.link import step as link
-        from planarsim.kernels import solve, step
+        from planarsim.kernels.solver import solve
+        from planarsim.kernels import step
         print(MODE, inspect.isfunction(step._step), inspect.isfunction(solve.solve_impulses),
               inspect.isfunction(link.step))
     """)
@@ -103,15 +104,15 @@ def test_break_in_needs_python_mode_and_names_an_unknown_stage():
     from planarsim.link import debug
     if mode.PYTHON != planarsim.compile.MODE:
         with pytest.raises(RuntimeError, match="NUMBA_DISABLE_JIT=1"):
-            debug.break_in("solve.solve_impulses")
+            debug.break_in("solver.solve.solve_impulses")
     code = ("from planarsim.link.debug import break_in\n"
-            "d = break_in('solve.solve_impulses'); print(len(d.get_all_breaks()))\n"
-            "try:\n    break_in('solve.no_such_stage')\nexcept ValueError as e:\n    print(e)\n")
+            "d = break_in('solver.solve.solve_impulses'); print(len(d.get_all_breaks()))\n"
+            "try:\n    break_in('solver.solve.no_such_stage')\nexcept ValueError as e:\n    print(e)\n")
     env = dict(os.environ, PYTHONPATH=os.getcwd(), NUMBA_DISABLE_JIT="1")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert out.returncode == 0, out.stderr[-2000:]
     lines = out.stdout.splitlines()
-    assert lines[0] == "1" and "no function 'no_such_stage' in planarsim/kernels/solve.py" in lines[1]
+    assert lines[0] == "1" and "no function 'no_such_stage' in planarsim/kernels/solver/solve.py" in lines[1]
 
 
 def test_ci_runs_in_the_mode_its_switches_ask_for():

@@ -49,7 +49,7 @@ def test_each_part_takes_its_arguments_in_slots_of_their_kind():
 
 
 def test_a_part_called_with_a_wrong_argument_is_named_when_its_caller_is_typed():
-    from planarsim.kernels.complementarity import project_positions
+    from planarsim.kernels.solver.complementarity import project_positions
 
     @njit(**dict(options(), cache=False))
     def wrong(x):
@@ -66,7 +66,7 @@ def test_a_part_needs_a_slot_and_engine_or_scalar_argument_types():
         part("model", "state", "workspace")(not_listed)
     def solve_contacts(m, x):   # noqa: E306  (a listed name, a bad type)
         return 0
-    solve_contacts.__module__ = "planarsim.kernels.complementarity"
+    solve_contacts.__module__ = "planarsim.kernels.solver.complementarity"
     solve_contacts.__qualname__ = "solve_contacts"
     with pytest.raises(ValueError, match="'array'"):
         part("model", "array")(solve_contacts)

@@ -1,4 +1,4 @@
-"""The accurate integrators (StepOptions.integrator 'rattle', 'rattle4'; kernels/rattle.py):
+"""The accurate integrators (StepOptions.integrator 'rattle', 'rattle4'; kernels/dynamics/rattle.py):
 orders of convergence measured against the conserved energy and a fine reference, pins and
 their velocities held, determinism, MuJoCo RK4 as an oracle, and the models they refuse."""
 import math
@@ -10,7 +10,7 @@ import planarsim as ps
 from planarsim.compiled import RUN_OK, step_from_python, step_info
 from planarsim.energy import total_energy
 from planarsim.errors import ModelError
-from planarsim.kernels.guards import GUARD_UNSUPPORTED
+from planarsim.kernels.checks.guards import GUARD_UNSUPPORTED
 from planarsim.state import make_state, make_workspace
 from tests.conftest import make_chain
 

@@ -1,4 +1,4 @@
-"""An arc sole's span test (kernels/contacts.sole_facing): a direction lies in the span
+"""An arc sole's span test (kernels/geometry/contacts.sole_facing): a direction lies in the span
 (a0, a1), ends included, exactly when its angle, taken within a turn after a0, is at most a1;
 decided by the sides of the span's end directions, with no angle computed."""
 import math
@@ -9,7 +9,7 @@ from numba import njit
 
 import planarsim as ps
 from planarsim.compile import options as compile_options
-from planarsim.kernels.contacts import sole_facing
+from planarsim.kernels.geometry.contacts import sole_facing
 
 
 @njit(**dict(compile_options(), cache=False))

@@ -1,4 +1,4 @@
-"""Joint armature (a reflected rotor inertia on a joint's coordinate, kernels/soft.py) against
+"""Joint armature (a reflected rotor inertia on a joint's coordinate, kernels/constraints/soft.py) against
 MuJoCo's (M_joint += armature) and against its closed form."""
 import math
 

@@ -10,10 +10,10 @@ from numba import njit
 import planarsim as ps
 from planarsim.compiled import audit_counts
 from planarsim.compile import options as compile_options
-from planarsim.kernels.broad_phase import sweep_pairs
+from planarsim.kernels.geometry.broad_phase import sweep_pairs
 from planarsim.kernels.codes import CONTACT_PAIR, MODE_FREE
 from planarsim.kernels.math2d import update_trig
-from planarsim.kernels.pair import SPECULATIVE_FACTOR, place_shapes
+from planarsim.kernels.geometry.pair import SPECULATIVE_FACTOR, place_shapes
 from planarsim.state import make_workspace
 from strategies import decades, matrices, reals, vectors
 

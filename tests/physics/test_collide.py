@@ -1,4 +1,4 @@
-"""The narrow phase (kernels/collide.py) against an independent numpy reference: the smallest
+"""The narrow phase (kernels/geometry/collide.py) against an independent numpy reference: the smallest
 gap of a manifold is the exact distance between the rounded shapes when their cores are apart,
 minus the separating-axis penetration depth when they overlap; the manifold does not depend on
 which shape comes first or where the pair stands; face on face gives two exact points; every
@@ -11,8 +11,9 @@ from hypothesis import assume, given, settings, strategies as st
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.collide import (FLIP_A, FLIP_B, KIND_DIST, KIND_FACE, REFERENCE_TOL, collide,
-                                       core_normals, core_point_world, split_feature_id)
+from planarsim.kernels.geometry.collide import (FLIP_A, FLIP_B, KIND_DIST, KIND_FACE, REFERENCE_TOL,
+                                                collide, core_normals, core_point_world,
+                                                split_feature_id)
 from strategies import angles, reals, vectors
 
 # not cached: numba checks a cached function against its own file only

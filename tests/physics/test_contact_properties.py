@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 import planarsim as ps
 from planarsim import terrain
 from planarsim.kernels.info import INFO_LCP_SOLVES
-from planarsim.kernels.terrain import closest_point
+from planarsim.kernels.geometry.terrain import closest_point
 
 G = 9.81
 ENERGY_TOL = 0.01  # fraction of the initial energy (measured above the lowest ground point)

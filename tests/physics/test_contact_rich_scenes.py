@@ -1,7 +1,7 @@
 """Scenes with many shapes touching at once: their complementarity problems are large and
 degenerate (dominoes leaning on each other, corners on faces), where Lemke's path may end on a
 ray or astray. Such a step keeps the answer of the nearest regularised problem (a compliance
-of at most 1e-6 in scaled units, kernels/mixed_lcp.py) rather than dropping the friction of
+of at most 1e-6 in scaled units, kernels/solver/mixed_lcp.py) rather than dropping the friction of
 the island: the run ends with every audit count 0."""
 import numpy as np
 

@@ -267,7 +267,7 @@ def test_position_correction_at_a_fold_adds_no_energy(strategy):
     import sys
     from pathlib import Path
     from planarsim.energy import total_energy
-    from planarsim.kernels.audit import AUDIT_NAMES
+    from planarsim.kernels.checks.audit import AUDIT_NAMES
     sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
     from benchmarks.contact_stress import build
     from tests.walkers.test_reliability_walkers import joint_residuals

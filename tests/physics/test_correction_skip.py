@@ -9,7 +9,7 @@ from numba import float64, njit
 
 import planarsim as ps
 from planarsim import terrain
-from planarsim.kernels.integrate import max_residual, rows_hold_within
+from planarsim.kernels.dynamics.integrate import max_residual, rows_hold_within
 from planarsim.options import StepOptions
 
 

@@ -1,4 +1,4 @@
-"""The energy audit (kernels/work.py, kernels/audit.py): the joints' and the position
+"""The energy audit (kernels/checks/work.py, kernels/checks/audit.py): the joints' and the position
 correction's work in a step, checked against what the integrator explains, on the corpus's
 extreme scenes (benchmarks/contact_stress.py: folded four-bar loops with inertias 1e-4 to 1e4
 kg m^2, rod-joined point masses thrown at steep hills, stiff bang-bang motors at large steps);
@@ -14,7 +14,7 @@ from numba import njit
 import planarsim as ps
 from planarsim.compile import options as compile_options
 from planarsim.compiled import audit_counts
-from planarsim.kernels.work import joints_add_energy
+from planarsim.kernels.checks.work import joints_add_energy
 
 from benchmarks.folded_loops import gravity_term, step_gains
 
@@ -85,7 +85,7 @@ def test_a_ball_landing_within_its_step_owes_gravity_its_energy_not_h_g_dp(dt, s
 # pins' self-stress of ~1e5 N s did the work): its loop lies folded 1e-5 rad from flat and the
 # joint block's pivot, 1.7e-11 of its diagonal, sits just above the 1e-12 below which a row is
 # dropped. An answer that breaks a rule where rows were dropped is now solved again with the
-# least change of impulses (kernels/solve.py least_change_impulses), which never enters the
+# least change of impulses (kernels/solver/solve.py least_change_impulses), which never enters the
 # dependent directions: the self-stress is not made, and the seed passes on that machine.
 # Seeds 172, 310, 319 and 357 once missed it at the position correction: 310 gained 1 % of
 # the kinetic energy after its solve, more than 1 % of the step's start (the share is now
@@ -304,7 +304,7 @@ def test_a_folded_loops_answers_add_no_kinetic_energy_beyond_the_joints_share():
     the answer's kinetic energy exceeds KE(v*) by no more than the joints' share of it
     (JOINT_WORK_SHARE), or the audit counts the joints' work."""
     from benchmarks.contact_stress import build
-    from planarsim.kernels.work import JOINT_WORK_SHARE
+    from planarsim.kernels.checks.work import JOINT_WORK_SHARE
     model, ground, q0, v0 = build("loop_inertia", 36)
     sim = ps.Simulator(model, ps.make_options(), ps.make_state(model, q0, v0))
     a = model.arrays

@@ -14,7 +14,7 @@ import pytest
 
 import planarsim as ps
 from planarsim.compiled import audit_counts
-from planarsim.kernels.audit import DEPTH_TOL
+from planarsim.kernels.checks.audit import DEPTH_TOL
 from planarsim.kernels.info import INFO_CCD_SPLITS, INFO_CCD_STOPS
 
 T = 0.05                # slab thickness [m]

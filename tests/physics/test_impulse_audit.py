@@ -1,11 +1,11 @@
-"""The audit of a step's contact impulses (kernels/audit.audit_impulses) on impulses put in by
+"""The audit of a step's contact impulses (kernels/checks/audit.audit_impulses) on impulses put in by
 hand: its pull and cone rules allow rounding, and agree on what is rounding."""
 import pytest
 from numba import njit
 
 import planarsim as ps
 from planarsim.compile import options as compile_options
-from planarsim.kernels.audit import AUDIT_NAMES, IMPULSE_FLOOR, audit_impulses
+from planarsim.kernels.checks.audit import AUDIT_NAMES, IMPULSE_FLOOR, audit_impulses
 from planarsim.kernels.codes import MODE_PINNED, MODE_SLIDING
 
 jit = njit(**dict(compile_options(), cache=False))

@@ -3,7 +3,7 @@ for three degrees of freedom, so the contact rows are dependent and the split of
 among them is not fixed by the equations. The elimination's split once hung a box from one
 corner (a pulling contact), which sent the first step of a 21-box pyramid to the
 complementarity solve (445 Lemke pivots; 5 s for 55 boxes). The least change of impulses
-(kernels/solve.py least_change_impulses) spreads the load as the geometry does; where its
+(kernels/solver/solve.py least_change_impulses) spreads the load as the geometry does; where its
 answer still pulls at a corner, or loads a corner with 1e-5 of a box's weight and friction
 beyond its cone (a staggered wall), that contact is released and the least change solved
 again (kernels/step.py least_change_answer). The first step ends with linear solves only."""
@@ -14,8 +14,8 @@ import planarsim as ps
 from benchmarks.worlds import pyramid, wall   # 0.2 m boxes of 4 kg, each on two below
 from planarsim.compiled import audit_counts, step_info
 from planarsim.kernels.codes import CONTACT_PAIR, ROW_CONTACT_N, ROW_CONTACT_T
-from planarsim.kernels.matrix import ENVELOPE, SPARSE
-from planarsim.kernels.sparse_factor import SPARSE_MIN_ROWS
+from planarsim.kernels.solver.matrix import ENVELOPE, SPARSE
+from planarsim.kernels.solver.sparse_factor import SPARSE_MIN_ROWS
 
 G = 9.81
 
@@ -26,7 +26,7 @@ def test_a_pile_from_rest_takes_its_first_step_with_linear_solves_and_stands(pil
     """Pyramids of 21 to 210 boxes and staggered walls of 16 and 64 bricks (half a brick
     over each joint below; 8 rows once sent the first step to Lemke: 634 pivots for 16
     bricks, 3,869 and 94 s for 160). The 210-box pyramid's 1,568 rows go through the sparse
-    factorisation (kernels/sparse_factor.py), the others' through the envelope."""
+    factorisation (kernels/solver/sparse_factor.py), the others' through the envelope."""
     if pile.startswith("pyramid"):
         rows = int(pile[len("pyramid"):])
         model = pyramid(rows)

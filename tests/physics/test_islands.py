@@ -7,7 +7,7 @@ from numba import njit
 import planarsim as ps
 from planarsim.compiled import audit_counts
 from planarsim.compile import options as compile_options
-from planarsim.kernels.islands import group_rows
+from planarsim.kernels.solver.islands import group_rows
 from planarsim.state import make_workspace
 
 jit = njit(**dict(compile_options(), cache=False))

@@ -1,4 +1,4 @@
-"""A joint's dry friction (MuJoCo's frictionloss; kernels/joint_friction.py): an exact Coulomb
+"""A joint's dry friction (MuJoCo's frictionloss; kernels/constraints/joint_friction.py): an exact Coulomb
 row on the joint's rate, |p| <= F h, stuck (rate 0) inside the bound, slipping against the
 motion at it.
 

@@ -1,4 +1,4 @@
-"""Joint springs and dampers, implicit in the velocity solve (kernels/soft.py): stable where
+"""Joint springs and dampers, implicit in the velocity solve (kernels/constraints/soft.py): stable where
 explicit forces diverge, and the damped oscillator's closed form at small steps."""
 import math
 

@@ -1,4 +1,4 @@
-"""The motor turn check (StepOptions.turn_limit, kernels/guards.py turn_gain): a torque
+"""The motor turn check (StepOptions.turn_limit, kernels/checks/guards.py turn_gain): a torque
 actuator whose command alone would turn its hinge by more than turn_limit in one step from
 rest stops the run before that step. The turn is h^2 |u| kappa, kappa the hinge angle's
 inverse inertia with the hinge's own pin holding its two bodies: a link hinged to the world

@@ -1,4 +1,4 @@
-"""The step's pin-chain path (kernels/pin_chain.py, step.chain_step) against the general
+"""The step's pin-chain path (kernels/solver/pin_chain.py, step.chain_step) against the general
 stages: the same answer to rounding and the same checks, on chains of any masses, inertias
 (point masses too), anchors, speeds and ends (free, hanging from the world, a bridge held at
 both ends); and which models take it (planarsim/pin_chains.py)."""

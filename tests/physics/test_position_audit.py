@@ -11,9 +11,9 @@ from numba import njit
 
 import planarsim as ps
 from planarsim import terrain
-from planarsim.kernels.audit import contact_gap, vertices_within_arc
+from planarsim.kernels.checks.audit import contact_gap, vertices_within_arc
 from planarsim.kernels.math2d import update_trig, world_point
-from planarsim.kernels.terrain import ground_point
+from planarsim.kernels.geometry.terrain import ground_point
 
 
 @njit(cache=False)   # a test helper: compiled per run, never a stale cache entry

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 import planarsim as ps
-from planarsim.kernels.audit import AUDIT_NAMES, DEPTH_TOL
+from planarsim.kernels.checks.audit import AUDIT_NAMES, DEPTH_TOL
 from planarsim.kernels.info import INFO_PROJECTIONS
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))

@@ -1,4 +1,4 @@
-"""Restitution with friction adds no energy (the energetic bound, kernels/rebound.py).
+"""Restitution with friction adds no energy (the energetic bound, kernels/solver/rebound.py).
 
 Newton's law of restitution with Coulomb friction can return more energy than an impact
 brought (Kane's paradox): a spinning triangle dropped with e = 1 and mu = 1 gained 25 % of its

@@ -11,7 +11,7 @@ from planarsim.compile import options as compile_options
 from planarsim.compiled import audit_counts
 from planarsim.errors import ModelError
 from planarsim.kernels.codes import CONTACT_EDGE
-from planarsim.kernels.contacts import edge_deepest
+from planarsim.kernels.geometry.contacts import edge_deepest
 from planarsim.kernels.math2d import update_trig
 
 W, H = 0.4, 0.2     # box width, height [m]
@@ -219,7 +219,7 @@ def test_long_shape_rests_on_a_crest_without_sinking_into_it(kind, params):
     """A 1 m long box or capsule dropped flat onto the crest of a hill (radius of curvature
     1.3 m): its corners or end circles hang in the air, the middle of its lower side carries it."""
     from planarsim import terrain
-    from planarsim.kernels.audit import DEPTH_TOL
+    from planarsim.kernels.checks.audit import DEPTH_TOL
     ground = terrain.hills([0.3], [4.0], [math.pi / 2])      # crest at x = 0, height 0.3
     b = ps.ModelBuilder(dt=1e-3, terrain=ground)
     b.add_body("plank", 2.0, 2.0 / 12, pos=(0.0, 0.42), shapes=[(kind, *params)])

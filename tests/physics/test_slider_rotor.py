@@ -1,5 +1,5 @@
 """A slider's rotor (armature) whose row turns with its rail: the velocity-product forces of
-its kinetic energy a (g v)^2 / 2 (kernels/slider.py add_rotor_forces). Without them a cart on
+its kinetic energy a (g v)^2 / 2 (kernels/constraints/slider.py add_rotor_forces). Without them a cart on
 a spinning rail gained energy at any step (0.47 J -> 1.34 J in 2 s, the same at dt / 16).
 Checked against energy conservation, the derivatives of the rate they are built from, and
 MuJoCo (whose armature is M_joint += a on the slide's own coordinate) as the oracle."""
@@ -130,7 +130,8 @@ def test_the_rotor_forces_are_built_from_the_rates_derivatives():
     between two bodies and a free slide off its body's centre of mass (relative error
     <= 1e-6)."""
     from planarsim.compile import jit
-    from planarsim.kernels.slider import _rotor_blocks, slide_position_rate, slider_frame
+    from planarsim.kernels.constraints.slider import (_rotor_blocks, slide_position_rate,
+                                                      slider_frame)
 
     @jit
     def parts(m, q, cs, v, j):

@@ -164,7 +164,7 @@ NOT_COVERED_STEPS = ("sub-steps", "do not reproduce")
 def rotor_chain(masses, lengths, dt, rng):
     """(armature, stiffness) of a chain's hinges: armature 1e-3 to 1e2 times the link's
     inertia and a spring the step resolves (a twentieth of the stiffness at which the step
-    would take it at its end, kernels/soft.py)."""
+    would take it at its end, kernels/constraints/soft.py)."""
     inertia = masses * lengths ** 2 / 12
     armature = inertia * 10 ** rng.uniform(-3, 2, masses.size)
     kappa = 1.0 / inertia + np.concatenate([[0.0], 1.0 / inertia[:-1]])

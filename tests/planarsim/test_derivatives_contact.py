@@ -19,7 +19,7 @@ import planarsim as ps
 from planarsim.derivatives import rate_row, step_jacobian, step_tangents
 from planarsim.derivatives import _touching_contacts
 from planarsim.kernels.codes import CONTACT_PAIR, JOINT_FREE_BIT, MODE_FREE
-from planarsim.kernels.terrain import closest_point
+from planarsim.kernels.geometry.terrain import closest_point
 from planarsim.step_replica import contact_rows, contact_unilateral, joint_rows
 
 REL_TOL = 1e-6      # the issue's bound on the relative error against finite differences
@@ -399,7 +399,7 @@ def test_a_disk_rolling_over_hills():
     """Round soles and point masses on hills: the closest ground point is the engine's,
     continued by Newton in the replay; rolling over a crest the engine leaves the disk's gap
     open (its rows are leaving: integrate.py drop_leaving_rows), in a valley it closes it."""
-    from planarsim.kernels.terrain import height
+    from planarsim.kernels.geometry.terrain import height
     checked = 0
     for seed in range(12):
         rng = np.random.default_rng(seed)

@@ -1,4 +1,4 @@
-"""The complementarity solve's joint block (kernels/mixed_lcp._factor_joints): A = J W J^T of
+"""The complementarity solve's joint block (kernels/solver/mixed_lcp._factor_joints): A = J W J^T of
 joint rows that may be exactly dependent (a closed loop), with bodies whose masses and
 inertias differ by up to 1e8. Its factorization must leave out exactly the dependent rows,
 whatever their order and scale, and solve consistent right-hand sides with impulses bounded
@@ -8,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.mixed_lcp import _factor_joints, _solve_joints
+from planarsim.kernels.solver.mixed_lcp import _factor_joints, _solve_joints
 from strategies import full_rank, vectors
 
 jit = njit(**dict(compile_options(), cache=False))

@@ -1,5 +1,5 @@
 """On hills, free point contacts surely clear of the ground are not queried every step
-(kernels/contacts.py): the step's numbers must be those of querying every contact, and a
+(kernels/geometry/contacts.py): the step's numbers must be those of querying every contact, and a
 skipped contact's kept gap must be a lower bound of its real gap."""
 import numpy as np
 import pytest
@@ -10,8 +10,8 @@ import planarsim as ps
 from planarsim import terrain
 from planarsim.compile import options as compile_options
 from planarsim.kernels.math2d import update_trig
-from planarsim.kernels.modes import engage_contacts
-from planarsim.kernels.terrain import closest_point
+from planarsim.kernels.solver.modes import engage_contacts
+from planarsim.kernels.geometry.terrain import closest_point
 
 
 def _boxes(ter, spin, dt=1e-3, n=4):

@@ -12,7 +12,7 @@ from hypothesis.extra.numpy import arrays
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.lcp import ANSWER_TOL, LCP_INACCURATE, LCP_SOLVED, lemke, polish
+from planarsim.kernels.solver.lcp import ANSWER_TOL, LCP_INACCURATE, LCP_SOLVED, lemke, polish
 from strategies import full_rank, vectors
 
 # not cached: numba checks a cached function against its own file only, and this wrapper

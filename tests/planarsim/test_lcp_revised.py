@@ -9,9 +9,9 @@ import pytest
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.lcp import (ANSWER_TOL, LCP_CAP, LCP_INACCURATE, LCP_SOLVED,
-                                   REVISED_SIZE, _basis_key, _seen_before, lemke, lemke_large,
-                                   lemke_revised)
+from planarsim.kernels.solver.lcp import (ANSWER_TOL, LCP_CAP, LCP_INACCURATE, LCP_SOLVED,
+                                          REVISED_SIZE, _basis_key, _seen_before, lemke,
+                                          lemke_large, lemke_revised)
 
 # not cached: numba checks a cached function against its own file only, and this wrapper
 # must follow the kernels it calls

@@ -12,7 +12,7 @@ import pytest
 
 from planarsim import ModelError
 from planarsim.compiled import jit
-from planarsim.kernels.fluid import apply_fluid
+from planarsim.kernels.dynamics.fluid import apply_fluid
 from planarsim.mjcf import load_mjcf
 
 mujoco = pytest.importorskip("mujoco", reason="mujoco is not installed (pip install planarsim[test])")

@@ -9,11 +9,11 @@ from numba import njit
 
 import planarsim as ps
 from planarsim.compile import options as compile_options
-from planarsim.kernels.contacts import find_contacts
-from planarsim.kernels.lcp import LCP_SOLVED
+from planarsim.kernels.geometry.contacts import find_contacts
+from planarsim.kernels.solver.lcp import LCP_SOLVED
 from planarsim.kernels.math2d import update_trig
-from planarsim.kernels.mixed_lcp import assemble_dense, solve_mixed_lcp
-from planarsim.kernels.rows import build_rows
+from planarsim.kernels.solver.mixed_lcp import assemble_dense, solve_mixed_lcp
+from planarsim.kernels.constraints.rows import build_rows
 from planarsim.state import make_workspace
 
 import reference as ref

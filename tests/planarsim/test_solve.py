@@ -7,8 +7,8 @@ from hypothesis import given, settings, strategies as st
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.envelope import (compute_envelope, factor, factor_symmetric, substitute,
-                                        substitute_symmetric)
+from planarsim.kernels.solver.envelope import (compute_envelope, factor, factor_symmetric,
+                                               substitute, substitute_symmetric)
 from strategies import body_rows, dense_jacobian, vectors
 
 TOL = 1e-11
@@ -79,7 +79,7 @@ def _ldl(A, first, reach, rhs, x, scale, tol, rows):
 
 def _envelope(row_body, n_body):
     """first[r]: first row sharing a body with r; reach[k]: last row whose envelope holds k
-    (the definition of kernels.envelope.compute_envelope)."""
+    (the definition of kernels.solver.envelope.compute_envelope)."""
     n = len(row_body)
     seen = [-1] * n_body
     first = np.arange(n)

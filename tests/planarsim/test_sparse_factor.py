@@ -1,4 +1,4 @@
-"""The sparse factorisation (kernels/sparse_factor.py) that serves piles and walls: on random
+"""The sparse factorisation (kernels/solver/sparse_factor.py) that serves piles and walls: on random
 rows between bodies scattered in the plane (each row touching one or two bodies, as the
 engine's), some exactly dependent (closed loops, redundant contacts), its answers must solve
 A x = rhs and give the velocity change W J^T x of the envelope elimination; on
@@ -12,8 +12,8 @@ from numba import njit
 import planarsim as ps
 from planarsim import state as state_module
 from planarsim.compile import options as compile_options
-from planarsim.kernels import matrix
-from planarsim.kernels import sparse_factor as sf
+from planarsim.kernels.solver import matrix
+from planarsim.kernels.solver import sparse_factor as sf
 from planarsim.kernels.codes import ROW_CONTACT_N
 from strategies import INERTIA, MASS, body_rows, dense_jacobian, reals, vectors
 

@@ -5,7 +5,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 
 from planarsim import terrain
-from planarsim.kernels.terrain import closest_point, height_derivs
+from planarsim.kernels.geometry.terrain import closest_point, height_derivs
 
 amps = st.lists(st.floats(0.0, 0.3), min_size=0, max_size=3)
 

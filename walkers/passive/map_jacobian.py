@@ -264,5 +264,5 @@ def _gap(w, c, q):
     """Contact c's gap [m] above flat or sloped ground (B,) at q (B, 3 n)."""
     p, _ = foot_points(w, c, q, q)
     coef = w.model.arrays.terrain_coef
-    # (kernels/terrain.py: height coef[0] + coef[1] x; the gap along the unit normal)
+    # (kernels/geometry/terrain.py: height coef[0] + coef[1] x; the gap along the unit normal)
     return (p[:, 1] - coef[0] - coef[1] * p[:, 0]) / math.sqrt(1.0 + coef[1] * coef[1])

@@ -18,7 +18,7 @@ Choices (numbers in params.py, each with its reason):
   configuration (sliding friction would drive it into the ground: A_nn < mu A_nt; measured
   A_nn 0.10, A_nt 0.30 [1/kg] at mu 0.8): the step's contact problem then has no answer with
   friction, and the engine's frictionless rule gives the foot a normal impulse for that step
-  (planarsim/kernels/complementarity.py; the audit's `fallback` counts it).
+  (planarsim/kernels/solver/complementarity.py; the audit's `fallback` counts it).
 - Figures: ``python benchmarks/ranger.py --repeats 3 --steps 1000``.
 """
 from pathlib import Path as _Path

@@ -1,0 +1,482 @@
+"""Narrow phase: the contact manifold of two convex rounded cores.
+
+Every collision shape is a convex core grown by a radius r >= 0 [m]: one vertex (a circle),
+two (a capsule: the segment v0 -> v1) or n >= 3 in counter-clockwise order (a polygon or a
+box, usually r = 0). The cores live in shared arrays in their body's frame: `vert (N, 2)` [m]
+the vertices, `norm (N, 2)` the unit outward normal of edge k (vertex k to vertex k+1 mod
+num; see core_normals), shape s using rows adr..adr+num-1. A body's pose is its position
+(x, y) [m] and the cosine and sine (c, s) of its angle: world = (x, y) + R(c, s) local.
+
+The method is the separating axis test followed by clipping, as in Box2D's b2CollidePolygons
+(read for the method, written anew):
+  1. separation of face k of core P against core Q: sep_k = min over Q's vertices q of
+     n_k.(q - p_k). The largest over both cores' faces is the reference face, its core the
+     reference, the other the incident core. sep > margin + r_a + r_b: no contact.
+  2. cores overlapping (sep <= 0): the incident edge (the one whose normal is most opposed
+     to the reference normal n) is clipped to the reference edge's extent (Sutherland-Hodgman
+     against its two side lines); each clipped point p is a FACE point with
+     gap = n.(p - v_ref) - r_a - r_b. The deepest one has gap = sep - r: minus the SAT
+     penetration depth.
+  3. cores apart (sep > 0): where the incident core's vertex closest to the reference line
+     projects onto the reference edge, the cores' distance is sep and the manifold is that
+     of 2. Elsewhere the closest features are found by brute force (every vertex against
+     every edge, both ways): a vertex pair gives one DIST point with
+     gap = |p - g| - r_a - r_b and normal (p - g)/|p - g|; a vertex over an edge's interior
+     is again the clipped manifold of 2, and so is a vertex pair whose distance the clipped
+     manifold reaches (edges face to face with their ends in line, as equal boxes stacked:
+     a vertex pair only by rounding).
+Two segments, or a point and a segment, have a degenerate Minkowski difference whose edge
+normals miss the separating axis along a segment (a circle in line with a capsule, beyond its
+end); for those pairs the segment directions are tested too (_cap_separation).
+
+Output: out (2, 10) float64, one row per manifold point k (see collide). The gaps are signed
+distances along n between the rounded shapes [m], negative where they overlap.
+Cost: O(num_a num_b) (the brute force of 3 only for cores apart whose closest features are
+not over the reference face); no allocation.
+"""
+import math
+
+import numpy as np
+
+from ...compile import kernel
+from ..math2d import rotate
+
+# out[k, 0]: which core holds the reference feature (n points away from it)
+FLIP_A = 0
+FLIP_B = 1
+# out[k, 1]: how the gap is measured
+KIND_FACE = 0   # from the incident core point p to the reference edge's line, along its normal
+KIND_DIST = 1   # vertex to vertex: gap = |p - g| - r_a - r_b
+# the clip side in the feature id of a FACE point
+CLIP_NONE = 0   # p is the incident vertex itself
+CLIP_START = 1  # p: the incident edge crossing the side line through the reference edge's start
+CLIP_END = 2    # ... through its end
+# feature id = ((flip*2 + kind) * MAX_CORE_VERTICES + ref) * (4 * MAX_CORE_VERTICES) + inc*4 + clip
+# ref: the reference edge (FACE) or vertex (DIST); inc: the incident vertex (CLIP_NONE, DIST) or
+# the incident edge (clipped points), all as indices within their core
+MAX_CORE_VERTICES = 1024
+# B's face is the reference only when it separates more than A's best by this [m] plus this
+# share of |sep|: nearly parallel faces (a box resting on a box) then keep the same reference
+# face from step to step instead of flip-flopping on rounding. Within it the smallest gap can
+# be this much below the exact distance (conservative: never above it)
+REFERENCE_TOL = 1e-9
+# [m] an incident vertex this close outside the reference edge's slab counts as inside it
+# (_clip_end): boxes of one width stacked flush keep their corners' names (a renamed contact
+# starts free, and the stack's next solve then lacks a corner: measured, a 40-box column's
+# first steps fell to the complementarity solve with 200-700 pivots each). Far below
+# DEPTH_TOL: the point stands where the clipped one would, to this much
+SLAB_TOL = 1e-12
+
+
+def core_normals(vertices) -> np.ndarray:
+    """Unit outward normals (num, 2) of a core's edges (edge k: vertex k to vertex k+1 mod num).
+
+    One vertex: a zero row (a circle's core has no edge). Two (a segment v0 -> v1): row 0 the
+    right-hand perpendicular ((v1 - v0).y, -(v1 - v0).x) / |v1 - v0|, row 1 its opposite (edge
+    1 runs back v1 -> v0). Three or more (convex, counter-clockwise): (dy, -dx) / |d| of each
+    edge d. Raises ValueError on a zero-length edge, or a polygon that is not convex and
+    counter-clockwise.
+    """
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 2)
+    num = v.shape[0]
+    out = np.zeros((num, 2))
+    if num <= 1:
+        return out
+    d = (np.roll(v, -1, axis=0) - v)[: 1 if num == 2 else num]
+    length = np.hypot(d[:, 0], d[:, 1])
+    if not np.all(length > 0.0):
+        raise ValueError(f"core has a zero-length edge: vertices {v.tolist()}")
+    out[: d.shape[0], 0] = d[:, 1] / length
+    out[: d.shape[0], 1] = -d[:, 0] / length
+    if num == 2:
+        out[1] = -out[0]
+        return out
+    # a left turn (or straight on) at every vertex, within rounding of the edge lengths
+    turn = d[:, 0] * np.roll(d[:, 1], -1) - d[:, 1] * np.roll(d[:, 0], -1)
+    if np.any(turn < -1e-12 * length * np.roll(length, -1)) or not np.sum(turn) > 0.0:
+        raise ValueError(f"polygon core must be convex and counter-clockwise: {v.tolist()}")
+    return out
+
+
+def split_feature_id(fid):
+    """(flip, kind, ref, inc, clip) of a feature id written by collide."""
+    fid = int(fid)
+    inc, clip = divmod(fid % (4 * MAX_CORE_VERTICES), 4)
+    rest = fid // (4 * MAX_CORE_VERTICES)
+    flip_kind, ref = divmod(rest, MAX_CORE_VERTICES)
+    return flip_kind // 2, flip_kind % 2, ref, inc, clip
+
+
+@kernel
+def core_point_world(vert, k, x, y, c, s):
+    """World position [m] of core vertex row k of a body at pose (x, y, c, s)."""
+    wx, wy = rotate(c, s, vert[k, 0], vert[k, 1])
+    return x + wx, y + wy
+
+
+@kernel
+def _feature_id(flip, kind, ref, inc, clip):
+    return float(((flip * 2 + kind) * MAX_CORE_VERTICES + ref) * (4 * MAX_CORE_VERTICES)
+                 + inc * 4 + clip)
+
+
+@kernel
+def _write(out, k, flip, kind, px, py, nx, ny, gx, gy, gap, fid, ox, oy):
+    """Row k of the manifold; p and g are given relative to (ox, oy), A's position."""
+    out[k, 0] = flip
+    out[k, 1] = kind
+    out[k, 2] = ox + px
+    out[k, 3] = oy + py
+    out[k, 4] = nx
+    out[k, 5] = ny
+    out[k, 6] = ox + gx
+    out[k, 7] = oy + gy
+    out[k, 8] = gap
+    out[k, 9] = fid
+
+
+@kernel
+def _direction(dx, dy):
+    """The unit vector along (dx, dy), scaled first so that tiny (subnormal) vectors keep unit
+    length; (0, 1) for the zero vector."""
+    m = max(abs(dx), abs(dy))
+    if m == 0.0:
+        return 0.0, 1.0
+    dx /= m
+    dy /= m
+    h = math.hypot(dx, dy)
+    return dx / h, dy / h
+
+
+@kernel
+def _circle_pair(vert, adr_a, ca, sa, adr_b, xb, yb, cb, sb, r, margin, ox, oy, out):
+    """Two one-vertex cores: one DIST point from A's centre to B's; coincident centres take
+    the normal (0, 1)."""
+    gx, gy = core_point_world(vert, adr_a, 0.0, 0.0, ca, sa)
+    px, py = core_point_world(vert, adr_b, xb, yb, cb, sb)
+    d = math.hypot(px - gx, py - gy)
+    if d - r > margin:
+        return 0
+    nx, ny = _direction(px - gx, py - gy)
+    _write(out, 0, FLIP_A, KIND_DIST, px, py, nx, ny, gx, gy, d - r,
+           _feature_id(FLIP_A, KIND_DIST, 0, 0, CLIP_NONE), ox, oy)
+    return 1
+
+
+@kernel
+def _max_separation(vert, norm, adr_r, num_r, xr, yr, cr, sr, adr_i, num_i, xi, yi, ci, si,
+                    limit):
+    """(sep, face, support): the largest over P's faces k of sep_k = min over Q's vertices q of
+    n_k.(q - p_k) [m], the face and the vertex of Q reaching that minimum. Stops at the first
+    face with sep_k > limit (a separating axis: no contact)."""
+    best = -math.inf
+    face = 0
+    support = 0
+    for k in range(num_r):
+        nx, ny = rotate(cr, sr, norm[adr_r + k, 0], norm[adr_r + k, 1])
+        px, py = core_point_world(vert, adr_r + k, xr, yr, cr, sr)
+        # n in Q's frame: two products per vertex of Q
+        lx, ly = rotate(ci, -si, nx, ny)
+        lo = math.inf
+        arg = 0
+        for j in range(num_i):
+            h = lx * vert[adr_i + j, 0] + ly * vert[adr_i + j, 1]
+            if h < lo:
+                lo = h
+                arg = j
+        sep = lo + nx * (xi - px) + ny * (yi - py)
+        if sep > best:
+            best = sep
+            face = k
+            support = arg
+        if sep > limit:
+            break
+    return best, face, support
+
+
+@kernel
+def _interval(vert, adr, num, x, y, c, s, tx, ty):
+    """(lo, hi): the projections [m] of a core's vertices on the direction (tx, ty)."""
+    lo = math.inf
+    hi = -math.inf
+    for k in range(adr, adr + num):
+        px, py = core_point_world(vert, k, x, y, c, s)
+        h = tx * px + ty * py
+        lo = min(lo, h)
+        hi = max(hi, h)
+    return lo, hi
+
+
+@kernel
+def _cap_separation(vert, norm, adr_a, num_a, xa, ya, ca, sa, adr_b, num_b, xb, yb, cb, sb):
+    """Separation [m] of two cores of one or two vertices along the direction of each segment
+    among them (positive: apart beyond a segment's end, which no edge normal shows)."""
+    best = -math.inf
+    for side in range(2):
+        adr = adr_a if side == 0 else adr_b
+        if (num_a if side == 0 else num_b) != 2:
+            continue
+        c = ca if side == 0 else cb
+        s = sa if side == 0 else sb
+        # the segment's direction: its normal turned a quarter turn counter-clockwise
+        nx, ny = rotate(c, s, norm[adr, 0], norm[adr, 1])
+        lo_a, hi_a = _interval(vert, adr_a, num_a, xa, ya, ca, sa, -ny, nx)
+        lo_b, hi_b = _interval(vert, adr_b, num_b, xb, yb, cb, sb, -ny, nx)
+        best = max(best, lo_b - hi_a, lo_a - hi_b)
+    return best
+
+
+@kernel
+def _segment_point(ax, ay, bx, by, px, py):
+    """(d2, u): squared distance [m^2] from p to the segment a-b, and the closest point's
+    parameter u in [0, 1] (the end points themselves at u = 0 and 1)."""
+    ex = bx - ax
+    ey = by - ay
+    ee = ex * ex + ey * ey
+    u = ((px - ax) * ex + (py - ay) * ey) / ee if ee > 0.0 else 0.0
+    if u <= 0.0:
+        return (px - ax) ** 2 + (py - ay) ** 2, 0.0
+    if u >= 1.0:
+        return (px - bx) ** 2 + (py - by) ** 2, 1.0
+    dx = px - (ax + u * ex)
+    dy = py - (ay + u * ey)
+    return dx * dx + dy * dy, u
+
+
+@kernel
+def _closest_features(vert, adr_r, num_r, xr, yr, cr, sr, adr_i, num_i, xi, yi, ci, si):
+    """(d2, vr, vi, interior): the smallest squared distance [m^2] between two disjoint cores,
+    every vertex of each against every edge of the other; interior: the closest point lies
+    inside an edge (else it is the vertex pair vr of R and vi of I)."""
+    best = math.inf
+    vr = 0
+    vi = 0
+    interior = False
+    for side in range(2):
+        adr_e, num_e, xe, ye, ce, se = (adr_r, num_r, xr, yr, cr, sr) if side == 0 else \
+            (adr_i, num_i, xi, yi, ci, si)
+        adr_v, num_v, xv, yv, cv, sv = (adr_i, num_i, xi, yi, ci, si) if side == 0 else \
+            (adr_r, num_r, xr, yr, cr, sr)
+        # a segment's second edge is its first run backwards
+        n_edge = 0 if num_e < 2 else (1 if num_e == 2 else num_e)
+        for k in range(n_edge):
+            k1 = (k + 1) % num_e
+            ax, ay = core_point_world(vert, adr_e + k, xe, ye, ce, se)
+            bx, by = core_point_world(vert, adr_e + k1, xe, ye, ce, se)
+            for j in range(num_v):
+                px, py = core_point_world(vert, adr_v + j, xv, yv, cv, sv)
+                d2, u = _segment_point(ax, ay, bx, by, px, py)
+                if d2 < best:
+                    best = d2
+                    interior = 0.0 < u < 1.0
+                    ve = k if u < 0.5 else k1
+                    vr = ve if side == 0 else j
+                    vi = j if side == 0 else ve
+    return best, vr, vi, interior
+
+
+@kernel
+def _incident_edge(norm, adr_i, num_i, ci, si, nx, ny):
+    """The incident core's edge whose normal is most opposed to the reference normal n."""
+    lx, ly = rotate(ci, -si, nx, ny)
+    best = math.inf
+    edge = 0
+    for k in range(num_i if num_i >= 2 else 0):
+        h = lx * norm[adr_i + k, 0] + ly * norm[adr_i + k, 1]
+        if h < best:
+            best = h
+            edge = k
+    return edge
+
+
+@kernel
+def _clip_end(px, py, qx, qy, sp, sq, length):
+    """(x, y, clip, kept): the point of the incident edge p -> q nearest to p inside the
+    reference edge's slab 0 <= t.(x - v_ref) <= length (sp, sq: t.(p - v_ref), t.(q - v_ref)).
+    A p within SLAB_TOL of a side line is p itself (CLIP_NONE): a box on a box of its width has
+    its corners on the side lines, and rounding must not rename them from step to step."""
+    if sp < -SLAB_TOL:
+        if sq < 0.0:
+            return px, py, CLIP_NONE, False
+        f = -sp / (sq - sp)
+        return px + f * (qx - px), py + f * (qy - py), CLIP_START, True
+    if sp > length + SLAB_TOL:
+        if sq > length:
+            return px, py, CLIP_NONE, False
+        f = (length - sp) / (sq - sp)
+        return px + f * (qx - px), py + f * (qy - py), CLIP_END, True
+    return px, py, CLIP_NONE, True
+
+
+@kernel
+def _face_point(out, k, flip, face, inc, clip, px, py, nx, ny, ax, ay, r, margin, ox, oy):
+    """Write the FACE point p against the reference line through a with normal n when its gap
+    n.(p - a) - r is within the margin; return the number of points written so far."""
+    h = nx * (px - ax) + ny * (py - ay)
+    if h - r > margin:
+        return k
+    _write(out, k, flip, KIND_FACE, px, py, nx, ny, px - h * nx, py - h * ny, h - r,
+           _feature_id(flip, KIND_FACE, face, inc, clip), ox, oy)
+    return k + 1
+
+
+@kernel
+def _face_manifold(vert, norm, flip, adr_r, num_r, xr, yr, cr, sr, face,
+                   adr_i, num_i, xi, yi, ci, si, r, margin, ox, oy, out):
+    """The incident edge clipped to the reference edge `face` (step 2 of the module docstring):
+    (count, h_min), up to two FACE points written in the order of the incident edge's
+    vertices, and the smallest n.(p - v_ref) [m] of the clipped points, written or not (inf
+    when the incident edge misses the reference edge's slab)."""
+    nx, ny = rotate(cr, sr, norm[adr_r + face, 0], norm[adr_r + face, 1])
+    ax, ay = core_point_world(vert, adr_r + face, xr, yr, cr, sr)
+    bx, by = core_point_world(vert, adr_r + (face + 1) % num_r, xr, yr, cr, sr)
+    # the reference edge runs along t = n turned a quarter turn counter-clockwise
+    tx = -ny
+    ty = nx
+    length = tx * (bx - ax) + ty * (by - ay)
+    e = _incident_edge(norm, adr_i, num_i, ci, si, nx, ny)
+    e1 = (e + 1) % num_i
+    p0x, p0y = core_point_world(vert, adr_i + e, xi, yi, ci, si)
+    p1x, p1y = core_point_world(vert, adr_i + e1, xi, yi, ci, si)
+    s0 = tx * (p0x - ax) + ty * (p0y - ay)
+    s1 = tx * (p1x - ax) + ty * (p1y - ay)
+    # a clipped point is named by the incident edge and the side line that cut it
+    x0, y0, clip0, kept0 = _clip_end(p0x, p0y, p1x, p1y, s0, s1, length)
+    x1, y1, clip1, kept1 = _clip_end(p1x, p1y, p0x, p0y, s1, s0, length)
+    kept1 = kept1 and num_i >= 2
+    # one point when the edge meets the slab at a single point (an end on a side line)
+    kept1 = kept1 and not (kept0 and x1 == x0 and y1 == y0)
+    count = 0
+    if kept0:
+        count = _face_point(out, count, flip, face, e, clip0, x0, y0, nx, ny,
+                            ax, ay, r, margin, ox, oy)
+    if kept1:
+        count = _face_point(out, count, flip, face, e if clip1 else e1, clip1, x1, y1, nx, ny,
+                            ax, ay, r, margin, ox, oy)
+    h_min = math.inf
+    if kept0:
+        h_min = nx * (x0 - ax) + ny * (y0 - ay)
+    if kept1:
+        h_min = min(h_min, nx * (x1 - ax) + ny * (y1 - ay))
+    if not (kept0 or kept1):
+        # the whole incident edge outside the slab (only near a tie of reference faces): its
+        # deeper vertex, measured to the reference line
+        h0 = nx * (p0x - ax) + ny * (p0y - ay)
+        h1 = nx * (p1x - ax) + ny * (p1y - ay)
+        if h1 < h0:
+            count = _face_point(out, 0, flip, face, e1, CLIP_NONE, p1x, p1y, nx, ny, ax, ay,
+                                r, margin, ox, oy)
+        else:
+            count = _face_point(out, 0, flip, face, e, CLIP_NONE, p0x, p0y, nx, ny, ax, ay,
+                                r, margin, ox, oy)
+    return count, h_min
+
+
+@kernel
+def _support_over_face(vert, norm, adr_r, num_r, xr, yr, cr, sr, face,
+                       adr_i, xi, yi, ci, si, support):
+    """The incident vertex `support` projects onto the reference edge `face` (not past its
+    ends): then its distance to that edge is the face's separation."""
+    nx, ny = rotate(cr, sr, norm[adr_r + face, 0], norm[adr_r + face, 1])
+    ax, ay = core_point_world(vert, adr_r + face, xr, yr, cr, sr)
+    bx, by = core_point_world(vert, adr_r + (face + 1) % num_r, xr, yr, cr, sr)
+    px, py = core_point_world(vert, adr_i + support, xi, yi, ci, si)
+    h = -ny * (px - ax) + nx * (py - ay)
+    return 0.0 <= h <= -ny * (bx - ax) + nx * (by - ay)
+
+
+@kernel
+def _manifold(vert, norm, flip, sep, face, support, cap, adr_r, num_r, xr, yr, cr, sr,
+              adr_i, num_i, xi, yi, ci, si, r, margin, ox, oy, out):
+    """Steps 2 and 3 of the module docstring, given the reference face `face` of core R
+    (separation sep [m], the incident vertex `support` reaching it) and cap, the separation
+    along the segments of a pair of one- or two-vertex cores (-inf otherwise)."""
+    # cores apart and the closest incident vertex not over the reference face: the closest
+    # features may be two vertices
+    vertex_pair = False
+    d = 0.0
+    vr = 0
+    vi = 0
+    if cap > 0.0 or (sep > 0.0 and not _support_over_face(
+            vert, norm, adr_r, num_r, xr, yr, cr, sr, face, adr_i, xi, yi, ci, si, support)):
+        d2, vr, vi, interior = _closest_features(vert, adr_r, num_r, xr, yr, cr, sr,
+                                                 adr_i, num_i, xi, yi, ci, si)
+        d = math.sqrt(d2)
+        if d - r > margin:
+            return 0
+        vertex_pair = not interior and d > 0.0
+    count, h_min = _face_manifold(vert, norm, flip, adr_r, num_r, xr, yr, cr, sr, face,
+                                  adr_i, num_i, xi, yi, ci, si, r, margin, ox, oy, out)
+    if not vertex_pair:
+        return count
+    gx, gy = core_point_world(vert, adr_r + vr, xr, yr, cr, sr)
+    px, py = core_point_world(vert, adr_i + vi, xi, yi, ci, si)
+    # the clipped face reaches the distance (a vertex pair only by rounding: edges lying face
+    # to face, their ends in line): keep its points, as for a vertex over the face
+    if h_min <= d + 1e-12 * (d + abs(gx) + abs(gy) + abs(px) + abs(py)):
+        return count
+    d = math.hypot(px - gx, py - gy)
+    if d - r > margin:
+        return 0
+    nx, ny = _direction(px - gx, py - gy)
+    _write(out, 0, flip, KIND_DIST, px, py, nx, ny, gx, gy, d - r,
+           _feature_id(flip, KIND_DIST, vr, vi, CLIP_NONE), ox, oy)
+    return 1
+
+
+@kernel
+def collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
+            adr_b, num_b, r_b, xb, yb, cb, sb, margin, out):
+    """Contact manifold of two rounded cores, A (rows adr_a.., num_a vertices, radius r_a [m],
+    pose xa, ya [m], ca, sa) and B; returns the number of points written to out (0, 1 or 2).
+
+    out[k] = (flip, kind, px, py, nx, ny, gx, gy, gap, id): flip FLIP_A (0) when the reference
+    feature is A's (p on B's core) or FLIP_B (1); kind KIND_FACE (0: n the reference edge's
+    world normal, g the foot of p on its line) or KIND_DIST (1: g the reference vertex,
+    n = (p - g)/|p - g|); p [m] a point of the incident core; n the unit normal from the
+    reference shape to the incident; gap [m] = n.(p - g) - r_a - r_b, the signed distance of
+    the rounded shapes there; id the feature id (see _feature_id and split_feature_id), the
+    same while the same features touch. Only points with gap <= margin [m] are written; two
+    points come in the order of the incident edge's vertices.
+    """
+    r = r_a + r_b
+    # B's position relative to A's: coordinates stay the size of the shapes
+    dx = xb - xa
+    dy = yb - ya
+    if num_a < 2 and num_b < 2:
+        return _circle_pair(vert, adr_a, ca, sa, adr_b, dx, dy, cb, sb, r, margin, xa, ya, out)
+    limit = margin + r
+    sep_a = -math.inf
+    face_a = 0
+    support_a = 0
+    if num_a >= 2:
+        sep_a, face_a, support_a = _max_separation(vert, norm, adr_a, num_a, 0.0, 0.0, ca, sa,
+                                                   adr_b, num_b, dx, dy, cb, sb, limit)
+        if sep_a > limit:
+            return 0
+    sep_b = -math.inf
+    face_b = 0
+    support_b = 0
+    if num_b >= 2:
+        sep_b, face_b, support_b = _max_separation(vert, norm, adr_b, num_b, dx, dy, cb, sb,
+                                                   adr_a, num_a, 0.0, 0.0, ca, sa, limit)
+        if sep_b > limit:
+            return 0
+    cap = -math.inf
+    if num_a <= 2 and num_b <= 2:
+        cap = _cap_separation(vert, norm, adr_a, num_a, 0.0, 0.0, ca, sa,
+                              adr_b, num_b, dx, dy, cb, sb)
+        if cap > limit:
+            return 0
+    # the reference: A's best face unless B's separates clearly more (REFERENCE_TOL); one
+    # call below, so that callers inline the manifold once
+    if num_a < 2 or sep_b > sep_a + REFERENCE_TOL * (1.0 + abs(sep_a)):
+        flip, sep, face, support = FLIP_B, sep_b, face_b, support_b
+        adr_r, num_r, xr, yr, cr, sr = adr_b, num_b, dx, dy, cb, sb
+        adr_i, num_i, xi, yi, ci, si = adr_a, num_a, 0.0, 0.0, ca, sa
+    else:
+        flip, sep, face, support = FLIP_A, sep_a, face_a, support_a
+        adr_r, num_r, xr, yr, cr, sr = adr_a, num_a, 0.0, 0.0, ca, sa
+        adr_i, num_i, xi, yi, ci, si = adr_b, num_b, dx, dy, cb, sb
+    return _manifold(vert, norm, flip, sep, face, support, cap, adr_r, num_r, xr, yr, cr, sr,
+                     adr_i, num_i, xi, yi, ci, si, r, margin, xa, ya, out)
