@@ -24,6 +24,7 @@ from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POI
                             JOINT_SLIDER)
 from .errors import ModelError, plain as _plain
 from .kernels.geometry.collide import core_normals
+from .kernels.solver.modes import SOLVE_REL_TOL
 from .shapes import (collision_core, collision_pairs, combine_masses, shape_area, shape_bounds,
                      shape_who, shifted)
 from .terrain import Terrain, flat
@@ -125,6 +126,25 @@ def _check_shape(kind, who, params):
             _scalar(who, None, None, f, p)
         else:
             _length(who, None, None, f, p, zero_ok=f == "radius")
+
+
+# the smallest friction coefficient a contact may have besides 0: the contact solve checks
+# Coulomb's rule |lambda_t| <= mu lambda_n to SOLVE_REL_TOL of the impulses, so a cone
+# narrower than that is not told from a sticking contact (measured: a box with mu = 1e-15
+# was held sticking and dragged 12 cm along the ground by its position correction)
+MU_RESOLUTION = SOLVE_REL_TOL
+
+
+def _friction(who, mu):
+    """mu checked: 0 (frictionless) or from MU_RESOLUTION up."""
+    if mu < 0:
+        raise ModelError(f"{who}: mu={mu} must be >= 0")
+    if 0.0 < mu < MU_RESOLUTION:
+        raise ModelError(f"{who}: mu={mu} is below {MU_RESOLUTION:g}, the narrowest friction "
+                         f"cone the contact solve resolves (it checks Coulomb's rule to "
+                         f"{SOLVE_REL_TOL:g} of the impulses); use mu=0 for a frictionless "
+                         f"contact")
+    return mu
 
 
 class ModelBuilder:
@@ -397,9 +417,7 @@ class ModelBuilder:
 
     def _collision_shape(self, idx, who, bid, kind, params, mu, restitution, category, mask, name):
         """The record compile() turns into shape_* arrays and contacts (validated here)."""
-        mu = _scalar(who, None, None, "mu", mu)
-        if mu < 0:
-            raise ModelError(f"{who}: mu={mu} must be >= 0")
+        mu = _friction(who, _scalar(who, None, None, "mu", mu))
         e = _scalar(who, None, None, "restitution", restitution)
         if not 0.0 <= e <= 1.0:
             raise ModelError(f"{who}: restitution={e} must be in [0, 1]")
@@ -685,9 +703,7 @@ class ModelBuilder:
         idx = len(self._contacts)
         self._register("contact", name, idx)
         bid = self._body_id("contact", name, idx, "body", body)
-        mu = _scalar("contact", name, idx, "mu", mu)
-        if mu < 0:
-            raise ModelError(f"contact {name!r} ({idx}): mu={mu} must be >= 0")
+        mu = _friction(f"contact {name!r} ({idx})", _scalar("contact", name, idx, "mu", mu))
         local = self._local_point(bid, _vec2("contact", name, idx, "local", local))
         verts = [self._local_point(bid, _vec2("contact", name, idx, f"vertex[{i}]", v))
                  for i, v in enumerate(verts)]
