@@ -301,7 +301,7 @@ class Workspace(NamedTuple):
     row_owner: np.ndarray        # (R,) int pin / rod / contact index
     n_row: np.ndarray            # (1,) int rows in use (the row arrays are the general
                                  #   stages'; a step of the pin-chain path writes none of them:
-                                 #   its rows are ws.chain_lever, its impulses ws.lam)
+                                 #   its rows are ws.chain_lever, its impulses State.last_pin_impulse)
     A_low: np.ndarray            # (P,) the effective-mass matrix J M^-1 F^T, its lower
                                  #   triangle and diagonal inside the rows' envelope: entry
                                  #   (i, j), row_first[i] <= j <= i, at row_start[i] + j -

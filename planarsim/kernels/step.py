@@ -805,6 +805,7 @@ def chain_joints_gain(m, s, ws, h):
     work, rounding, row = lever_joint_work(m, ws, ws.v_new)
     scale = kinetic_energy(m, ws.v_lin)
     if rounding > CONSTRAINT_SHARE * scale:
+        ws.joint_gain[2] = 0.0          # (nothing measured for the audit)
         return True
     excess = work - CONSTRAINT_SHARE * scale - rounding
     if (excess > 0.0 and ws.joint_pivot[0] >= NEAR_DEPENDENT

@@ -193,9 +193,12 @@ def _lever_share(m, ws, jl, el, at, jr, er, b):
 
 @kernel
 def lever_factor(m, ws, at):
-    """chain_factor's block LU of J(levers at column `at`) W J0^T along the chains (at 0: the
-    symmetric matrix of the step's start); returns the smallest share of its own diagonal that
-    a row's pivot kept (0: dependent rows)."""
+    """The block LU of A = J(levers at column `at`) W J0^T along the chains into
+    ws.chain_factor (at 0: the symmetric matrix of the step's start, A[k-1, k] = A[k, k-1]^T):
+    pivot by pivot as the module docstring says, each 2 x 2 pivot eliminated x row first, as
+    the general L D L^T does, in the chains' order, which is the rows' where the model lists
+    its pins along its chains; returns the smallest share of its own diagonal that a row's
+    pivot kept (0: a pivot vanished, the rows are dependent)."""
     f = ws.chain_factor
     smallest = 1.0
     for k in range(ws.chain_pin.shape[0]):
@@ -299,9 +302,8 @@ def lever_velocity_solve(m, s, ws, h):
             ws.chain_lever[j, e, 0] = rx
             ws.chain_lever[j, e, 1] = ry
     share = lever_factor(m, ws, 0)
-    inv_h = 1.0 / h
     for r in range(2 * m.pin_body.shape[0]):
-        ws.rhs[r] *= inv_h
+        ws.rhs[r] /= h              # (the general solve's arithmetic: solve.fill_row_b)
     chain_solve(ws, ws.rhs, ws.lam)
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
@@ -347,10 +349,11 @@ def lever_joint_work(m, ws, v):
 
 @kernel
 def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
-    """chain_correct on the levers: Newton-SHAKE passes of J(q) W J0^T mu = -c(q), q += W J0^T
-    mu, v += W J0^T mu / h until every gap is within tol [m] (a pass after one that left every
-    gap within CHORD_TOL reuses its factorisation; one more pass on the last factorisation
-    after the last); returns (the largest gap left, or -1: a pass that removed less than half
+    """Stage 8's Newton-SHAKE on the levers, integrate.correct_positions' passes: up to iters
+    of J(q) W J0^T mu = -c(q), q += W J0^T mu, v += W J0^T mu / h until every gap is within
+    tol [m] (a pass after one that left every gap within CHORD_TOL reuses its factorisation;
+    one more pass on the last factorisation after the last, as correct_positions takes it:
+    the end's derivative becomes the converged correction's); returns (the largest gap left, or -1: a pass that removed less than half
     of it, a pivot share at or below pivot_tol, the general stages take the step; the passes
     taken). ws.body_cs holds the cos / sin of the step's start on entry, of q on a return with
     a gap >= 0."""
