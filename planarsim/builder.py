@@ -128,23 +128,19 @@ def _check_shape(kind, who, params):
             _length(who, None, None, f, p, zero_ok=f == "radius")
 
 
-# the smallest friction coefficient a contact may have besides 0: the contact solve checks
-# Coulomb's rule |lambda_t| <= mu lambda_n to SOLVE_REL_TOL of the impulses, so a cone
-# narrower than that is not told from a sticking contact (measured: a box with mu = 1e-15
-# was held sticking and dragged 12 cm along the ground by its position correction)
+# the narrowest friction cone the contact solve resolves: it checks Coulomb's rule |lambda_t| <=
+# mu lambda_n to SOLVE_REL_TOL of the impulses, so a contact whose mu is below this is
+# compiled frictionless (no tangential row; its friction, at most mu lambda_n, is below the
+# solve's rounding). Compiled as given, such a cone was not told from a sticking contact: a
+# box with mu = 1e-15 was held sticking and dragged 12 cm along the ground by its position
+# correction
 MU_RESOLUTION = SOLVE_REL_TOL
 
 
-def _friction(who, mu):
-    """mu checked: 0 (frictionless) or from MU_RESOLUTION up."""
-    if mu < 0:
-        raise ModelError(f"{who}: mu={mu} must be >= 0")
-    if 0.0 < mu < MU_RESOLUTION:
-        raise ModelError(f"{who}: mu={mu} is below {MU_RESOLUTION:g}, the narrowest friction "
-                         f"cone the contact solve resolves (it checks Coulomb's rule to "
-                         f"{SOLVE_REL_TOL:g} of the impulses); use mu=0 for a frictionless "
-                         f"contact")
-    return mu
+def resolved_friction(mu):
+    """The friction coefficient a contact of coefficient mu is compiled with: mu, or 0 below
+    MU_RESOLUTION."""
+    return mu if mu >= MU_RESOLUTION else 0.0
 
 
 class ModelBuilder:
@@ -417,7 +413,9 @@ class ModelBuilder:
 
     def _collision_shape(self, idx, who, bid, kind, params, mu, restitution, category, mask, name):
         """The record compile() turns into shape_* arrays and contacts (validated here)."""
-        mu = _friction(who, _scalar(who, None, None, "mu", mu))
+        mu = _scalar(who, None, None, "mu", mu)
+        if mu < 0:
+            raise ModelError(f"{who}: mu={mu} must be >= 0")
         e = _scalar(who, None, None, "restitution", restitution)
         if not 0.0 <= e <= 1.0:
             raise ModelError(f"{who}: restitution={e} must be in [0, 1]")
@@ -703,7 +701,9 @@ class ModelBuilder:
         idx = len(self._contacts)
         self._register("contact", name, idx)
         bid = self._body_id("contact", name, idx, "body", body)
-        mu = _friction(f"contact {name!r} ({idx})", _scalar("contact", name, idx, "mu", mu))
+        mu = _scalar("contact", name, idx, "mu", mu)
+        if mu < 0:
+            raise ModelError(f"contact {name!r} ({idx}): mu={mu} must be >= 0")
         local = self._local_point(bid, _vec2("contact", name, idx, "local", local))
         verts = [self._local_point(bid, _vec2("contact", name, idx, f"vertex[{i}]", v))
                  for i, v in enumerate(verts)]
@@ -1001,7 +1001,7 @@ class ModelBuilder:
             contact_span_dir=ro([(math.cos(c["span"][0]), math.sin(c["span"][0]),
                                   math.cos(c["span"][1]), math.sin(c["span"][1]))
                                  for c in contacts] or np.zeros((0, 4))).reshape(nc, 4),
-            contact_mu=ro([c["mu"] for c in contacts]).reshape(nc),
+            contact_mu=ro([resolved_friction(c["mu"]) for c in contacts]).reshape(nc),
             contact_ccd=ro([c["ccd"] for c in contacts], np.int64).reshape(nc),
             contact_vert_adr=ro(vadr, np.int64).reshape(nc),
             contact_vert_num=ro(vnum, np.int64).reshape(nc),

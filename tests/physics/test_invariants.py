@@ -4,6 +4,7 @@ what the ground does along itself)."""
 import math
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 import planarsim as ps
@@ -121,9 +122,10 @@ def tumbling_shapes(draw):
 
 
 def frictions():
-    """A friction coefficient: 0 (frictionless), or 1e-9 (the narrowest cone the engine
-    takes) to 1.5, spread over the decades."""
-    return st.one_of(st.just(0.0), st.floats(-9.0, math.log10(1.5)).map(lambda u: 10.0 ** u))
+    """A friction coefficient: 0 (frictionless), 0 to 1.5, or 1e-15 to 1.5 spread over the
+    decades (below 1e-9 a contact is compiled frictionless)."""
+    return st.one_of(st.just(0.0), st.floats(0.0, 1.5),
+                     st.floats(-15.0, math.log10(1.5)).map(lambda u: 10.0 ** u))
 
 
 def build_shapes(parts, mirror=False, shift=0.0):
@@ -166,8 +168,27 @@ def test_contacts_translation_and_mirror_invariance(parts, dx):
 # horizontal momentum a body on flat ground gains is at most mu times the normal impulse the
 # ground gave it, whatever the contacts' modes (sticking, sliding, released), and through the
 # position correction too: a sticking contact that the correction holds in place may not drag
-# its body along beyond the cone (a box with mu = 1e-15, before such a mu was refused, was
-# dragged 12 cm).
+# its body along beyond the cone (a box with mu = 1e-15, when such a mu was compiled as
+# given, was dragged 12 cm; below 1e-9 a contact is now compiled frictionless).
+
+
+@pytest.mark.parametrize("mu", [1e-300, 1e-15, 5e-10])
+def test_a_cone_narrower_than_the_solve_resolves_is_frictionless(mu):
+    """Two tilted boxes dropped side by side, the second with a friction coefficient below
+    1e-9: its contacts are compiled frictionless, and with no horizontal force on it its
+    centre stays where it was dropped, mirrored or not (it was dragged 2.6 cm one way round
+    and not the other)."""
+    parts = [dict(kind="box", size=0.25, mass=1.0, x=0.0, y=0.5, angle=0.5, vx=0.0, vy=0.0,
+                  omega=0.0, mu=1.0),
+             dict(kind="box", size=0.25, mass=1.0, x=0.8, y=0.5, angle=1.0, vx=0.0, vy=0.0,
+                  omega=0.0, mu=mu)]
+    for mirror in (False, True):
+        model = build_shapes(parts, mirror=mirror)
+        a = model.arrays
+        assert np.all(np.asarray(a.contact_mu)[np.asarray(a.contact_body) == 1] == 0.0)
+        sim = ps.Simulator(model)
+        sim.steps(400)
+        assert abs(abs(sim.state.q[1, 0]) - 0.8) < 1e-12
 
 
 @SETTINGS
