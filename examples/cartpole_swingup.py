@@ -6,8 +6,8 @@ The model is gymnasium's inverted_pendulum.xml (a 10.5 kg cart on a rail pushed 
 keeps the pole within 90 degrees of upright, and the swing passes through all angles. The
 pole starts hanging at rest; iLQR finds the pushes over the horizon that bring it up and
 hold it there: a cost on the pole's angle from upright (1 - cos theta), the cart's place and
-the pushes, heavier at the end, solved first over the first 2 s from a few swinging pushes,
-then over the whole horizon from those pushes followed by none (swing_up says why). The
+the pushes, heavier at the end, solved over the whole horizon from the pushes of a rough
+hand-written controller (energy pumping, then a PD catch near upright: hand_controller). The
 result is then run closed-loop: each push is iLQR's plus its feedback gain times the
 distance from the planned state.
 
@@ -108,25 +108,56 @@ def upright_error(states):
     return theta - 2.0 * np.pi * np.round(theta / (2.0 * np.pi))
 
 
-def swing_up(dt=0.02, horizon=4.0, iterations=60, pump=100.0, period=1.4, rise=2.0):
+def hand_controller(sim, steps, pump=100.0, catch=0.3):
+    """A first guess (steps, 1) of pushes [N]: a hand-written controller run from the
+    simulator's state (which it leaves as it was). Away from upright it pumps the swing's
+    energy E = J w^2 / 2 + m g l (cos theta - 1) (0 upright) towards 0 by pushing the cart
+    along w cos theta, pump * (-E) w cos theta [N] (energy shaping, Astrom and Furuta 2000),
+    the first push 300 N to set the pole swinging, less a pull of the cart towards its start;
+    within `catch` [rad] of upright a PD law on the angle and the cart holds the pole.
+    Its gains are rough: iLQR does the rest."""
+    model = sim.model
+    a = model.arrays
+    total = 1.0 / a.body_inv_mass[CART] + 1.0 / a.body_inv_mass[POLE]     # [kg]
+    m = 1.0 / a.body_inv_mass[POLE]
+    lever = float(np.hypot(*a.pin_anchor[1, 1]))      # [m] hinge to the pole's centre
+    inertia = 1.0 / a.body_inv_inertia[POLE] + m * lever ** 2    # [kg m^2] about the hinge
+    lo, hi = a.act_range[0]
+    start = sim.state.copy()
+    us = np.zeros((steps, model.n_act))
+    for k in range(steps):
+        s = sim.state
+        theta, w = s.q[POLE, 2], s.v[POLE, 2]
+        x, vx = s.q[CART, 0], s.v[CART, 0]
+        up = np.arctan2(np.sin(theta), np.cos(theta))
+        if abs(up) < catch:
+            u = total * (-40.0 * up - 8.0 * w + 2.0 * x + 3.0 * vx)
+        elif k == 0:
+            u = hi
+        else:
+            energy = 0.5 * inertia * w * w + m * 9.81 * lever * (np.cos(theta) - 1.0)
+            u = -pump * energy * w * np.cos(theta) - total * 4.0 * (x + vx)
+        us[k] = np.clip(u, lo, hi)
+        sim.step(us[k])
+    sim.state = start
+    return us
+
+
+def swing_up(dt=0.02, horizon=4.0, iterations=60):
     """(the ILQRResult, the closed-loop run's states (T + 1, n_x), the simulator, the first
-    stage's ILQRResult) of the swing-up over `horizon` [s] at step dt [s]. By continuation: iLQR first over `rise` [s]
-    from pushes pump sin(2 pi t / period) [N], then over the whole horizon from those pushes
-    followed by none (solved at once over the whole horizon, the plan came up at 1.2 s, held
-    the pole until 2 s, spun it once round and brought it up again at the end: a local
-    minimum the late horizon kept from the first iterations)."""
+    guess's commands) of the swing-up over `horizon` [s] at step dt [s]: iLQR over the whole
+    horizon from the hand-written controller's pushes (hand_controller), which already
+    swing the pole up and hold it. (From pushes pump sin(2 pi t / period) instead, the plan
+    fell into local minima that spin the pole through upright, and which one depended on
+    the period and on the step's rounding.)"""
     model = cart_pole(dt)
     sim = ps.Simulator(model)
     hanging(sim)
-    first = int(round(rise / dt))
     steps = int(round(horizon / dt))
-    t = np.arange(first) * dt
-    guess = (pump * np.sin(2.0 * np.pi * t / period))[:, None]
-    up = ilqr(sim, guess, cost(model, first), iterations=iterations, tol=1e-9)
-    guess = np.vstack([up.us, np.zeros((steps - first, model.n_act))])
+    guess = hand_controller(sim, steps)
     result = ilqr(sim, guess, cost(model, steps), iterations=iterations, tol=1e-9)
     run = follow(sim, result)
-    return result, run, sim, up
+    return result, run, sim, guess
 
 
 def main(argv=None):
@@ -134,16 +165,13 @@ def main(argv=None):
     ap.add_argument("--dt", type=float, default=0.02)
     ap.add_argument("--horizon", type=float, default=4.0)
     ap.add_argument("--iterations", type=int, default=60)
-    ap.add_argument("--pump", type=float, default=100.0)
-    ap.add_argument("--period", type=float, default=1.4)
     args = ap.parse_args(argv)
     start = time.perf_counter()
-    result, run, sim, up = swing_up(args.dt, args.horizon, args.iterations, args.pump,
-                                    args.period)
+    result, run, sim, guess = swing_up(args.dt, args.horizon, args.iterations)
     last = upright_error(run[-int(round(1.0 / args.dt)):])
-    print(f"iLQR: {len(up.costs) - 1} + {len(result.costs) - 1} iterations (the rise, then "
-          f"the whole horizon) in {time.perf_counter() - start:.1f} s, cost over the horizon "
-          f"{result.costs[0]:.4g} -> {result.cost:.4g}")
+    print(f"iLQR: {len(result.costs) - 1} iterations in {time.perf_counter() - start:.1f} s, "
+          f"cost over the horizon {result.costs[0]:.4g} (the hand-written controller's "
+          f"pushes) -> {result.cost:.4g}")
     print(f"closed loop: the pole within {np.abs(last).max():.3g} rad of upright "
           f"over the last second, the cart within {np.abs(run[:, X_CART]).max():.2f} m of "
           f"its start, pushes up to {np.abs(result.us).max():.0f} N")
