@@ -141,3 +141,20 @@ def back_to_prev(s, ws):
         ws.prev_whole[0] = 0
     else:
         _copy_listed(ws.prev, s, ws)
+
+
+@kernel
+def keep_prev_bodies(s, ws):
+    """keep_prev for a step that changes only the bodies' positions and velocities, the clock
+    and the pins' impulses (the pin-chain path: a model of pins alone, without contacts,
+    limits or rods, whose every step, by either path, changes nothing else): those arrays
+    alone, unless ws.prev_whole asks for every one (the State was put in or changed from
+    outside since the last copy)."""
+    if ws.prev_whole[0] == 1:
+        keep_prev(s, ws)
+        return
+    _copy2(s.q, ws.prev.q)
+    _copy2(s.v, ws.prev.v)
+    _copy1(s.time, ws.prev.time)
+    _copy1(s.step, ws.prev.step)
+    _copy2(s.last_pin_impulse, ws.prev.last_pin_impulse)

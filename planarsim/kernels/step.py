@@ -28,7 +28,7 @@ from .dynamics.forces import apply_forces, predict_velocity
 from .checks.guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_ROOM,
                             check_actuator_turns, check_displacements, check_guards, check_moves,
                             check_speeds, add_part_path, finish_path, keep_step_path,
-                            note_start_depths, start_path)
+                            end_checks_alone, note_start_depths, start_path)
 from .info import INFO_CHAIN_PATH, INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
 from .dynamics.integrate import (bound_correction_work, integrate_positions, predict_configuration)
 from .constraints.joint_friction import start_joint_friction, stick_all, switch_joint_friction
@@ -39,7 +39,7 @@ from .geometry.pair import PAIR_MARGIN
 from .solver.pin_chain import (chain_prediction, lever_correct, lever_joint_work,
                                lever_velocity_solve)
 from .solver.rebound import rebound_gain, rebounding
-from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev
+from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev, keep_prev_bodies
 from .geometry.pair_toi import hold_off_fast_pairs
 from .dynamics.position import ROWS_HELD_SHARE, position_stage
 from .constraints.rows import build_rows
@@ -844,7 +844,7 @@ def chain_part(m, s, ws, opt, u, h):
     dependent, the joints' energy check or the correction's energy bound taking effect, a correction that
     stalls or ends above refine_tol, a guard, an audit) it returns CHAIN_GENERAL or
     CHAIN_AGAIN; else 0."""
-    keep_prev(s, ws)
+    keep_prev_bodies(s, ws)
     if check_guards(s, ws, opt.guard_limit) != 0:
         return CHAIN_GENERAL
     reset_counts(ws)
@@ -881,13 +881,8 @@ def chain_part(m, s, ws, opt, u, h):
         return CHAIN_AGAIN
     s.time[0] = ws.prev.time[0] + h
     s.step[0] += 1
-    code = check_guards(s, ws, opt.guard_limit)             # 9. guards
-    if code == 0 and opt.speed_limit > 0.0:
-        code = check_speeds(m, s, ws, opt.speed_limit)
-    if code != 0 or audit_total(ws) > audited:
-        return CHAIN_AGAIN
-    finish_path(s, ws, h)
-    if opt.jump_limit > 0.0 and check_displacements(m, s, ws, opt.jump_limit) != 0:
+    if (end_checks_alone(m, s, ws, h, opt.guard_limit, opt.speed_limit,    # 9. guards
+                         opt.jump_limit) or audit_total(ws) > audited):
         return CHAIN_AGAIN
     return 0
 

@@ -355,6 +355,34 @@ def joined_start_depth(m, ws, start_q, i):
 
 
 @kernel
+def end_checks_alone(m, s, ws, h, guard_limit, speed_limit, jump_limit):
+    """finish_path and the checks at a step's end, check_guards, check_speeds (speed_limit >
+    0) and check_displacements (jump_limit > 0), in one pass over the bodies, for a model
+    without contacts (the pin-chain path: no depth to allow for): True if some check fails.
+    Nothing is recorded: the general stages then take the step again and name the culprit."""
+    bad = False
+    for i in range(s.q.shape[0]):
+        for f in range(3):
+            x = abs(s.q[i, f])
+            y = abs(s.v[i, f])
+            if not (x <= guard_limit and y <= guard_limit) or x == math.inf or y == math.inf:
+                bad = True
+        speed = _speed(s.v, i)
+        ws.path_explained[i, 0] += h * max(ws.path_explained[i, 1], speed)
+        ws.path_explained[i, 1] = speed
+        if speed_limit > 0.0:
+            turning = abs(s.v[i, 2]) * math.sqrt(m.body_inertia[i] * m.body_inv_mass[i])
+            if speed > speed_limit or turning > speed_limit:
+                bad = True
+        if jump_limit > 0.0:
+            dx = s.q[i, 0] - ws.prev.q[i, 0]
+            dy = s.q[i, 1] - ws.prev.q[i, 1]
+            if math.sqrt(dx * dx + dy * dy) > ws.path_explained[i, 0] + jump_limit:
+                bad = True
+    return bad
+
+
+@kernel
 def check_displacements(m, s, ws, slack):
     """GUARD_JUMP if some body's centre of mass moved over the step (from ws.prev, the step's
     start) farther than its velocities explain plus slack [m] (plus the depth its contacts,
