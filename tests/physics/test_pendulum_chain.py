@@ -140,3 +140,38 @@ def test_a_rigid_pendulum_keeps_its_swing_at_coarse_steps(dt, start):
         swing = max(swing, abs(sim.state.q[0, 2] + math.pi / 2))
     assert abs(swing - start) < 0.01 * start, swing
 
+
+def double_rod_pendulum(dt, a1, a2):
+    """Two 1 m, 1 kg uniform rods pinned end to end, the first to the world at its end, at
+    angles a1, a2 [rad] from horizontal, at rest; no ground."""
+    b = ps.ModelBuilder(dt=dt, ground=None)
+    e1 = (math.cos(a1), math.sin(a1))
+    r1 = b.add_body("r1", mass=1.0, inertia=1 / 12, pos=(0.5 * e1[0], 0.5 * e1[1]), angle=a1)
+    r2 = b.add_body("r2", mass=1.0, inertia=1 / 12,
+                    pos=(e1[0] + 0.5 * math.cos(a2), e1[1] + 0.5 * math.sin(a2)), angle=a2)
+    b.add_pin("p0", None, r1, anchor_world=(0.0, 0.0))
+    b.add_pin("p1", r1, r2, anchor_world=e1)
+    return b.compile()
+
+
+def double_pendulum_energy_drift(dt, a1, a2, seconds=60.0):
+    """The largest |E(t) - E(0)| [J] of double_rod_pendulum over `seconds` (sampled every 50
+    steps) as a share of its scale m g L (1/2 + 3/2), and the audit's count."""
+    from planarsim.energy import total_energy
+    model = double_rod_pendulum(dt, a1, a2)
+    sim = ps.Simulator(model)
+    e0 = total_energy(model, sim.state.q, sim.state.v)
+    worst = 0.0
+    for _ in range(int(round(seconds / dt)) // 50):
+        sim.steps(50)
+        worst = max(worst, abs(total_energy(model, sim.state.q, sim.state.v) - e0))
+    return worst / (G * 2.0), int(sim.ws.audit.sum())
+
+
+@pytest.mark.parametrize("a1, a2", [(0.0, 0.0), (0.5, 1.0), (1.2, -0.3)])
+def test_a_chaotic_double_pendulum_keeps_its_energy_at_dt_10_ms(a1, a2):
+    """A double rod pendulum released from rest (chaotic, up to about 12 rad/s) over 60 s at
+    dt 0.01: its energy stays within 5 % of its scale (measured 1.6-3.0 %), with no audit.
+    When turn sub-steps followed the turning rate it lost 35-48 % (11-20 % at dt 0.005)."""
+    drift, audit = double_pendulum_energy_drift(0.01, a1, a2)
+    assert drift < 0.05 and audit == 0, (drift, audit)
