@@ -14,9 +14,8 @@ DEFECTS = {
                     "velocities; each switch of h moves symplectic Euler's energy by its O(h) "
                     "term). With that check off, -15.9 J of -16.6 J is lost in 8 steps: where "
                     "the joints' energy check (work.joints_add_energy, 1-5 times a run, within "
-                    "SHAKE's regime; the impulses' own work measured 4-7 % of KE(v*), so the "
-                    "excess came from its rounding branch, gain_from_velocities) found the "
-                    "velocity solve adding energy beyond its share and the step was solved "
+                    "SHAKE's regime; which of its two measures fired is not yet known) found "
+                    "the velocity solve adding energy beyond its share and the step was solved "
                     "again as a projection, J v = 0; the other 2992 steps kept it within 0.7 J"),
 }
 
