@@ -122,6 +122,7 @@ def hand_controller(sim, steps, pump=100.0, catch=0.3):
     m = 1.0 / a.body_inv_mass[POLE]
     lever = float(np.hypot(*a.pin_anchor[1, 1]))      # [m] hinge to the pole's centre
     inertia = 1.0 / a.body_inv_inertia[POLE] + m * lever ** 2    # [kg m^2] about the hinge
+    g = float(np.hypot(*a.gravity))                    # [m/s^2]
     lo, hi = a.act_range[0]
     start = sim.state.copy()
     us = np.zeros((steps, model.n_act))
@@ -135,7 +136,7 @@ def hand_controller(sim, steps, pump=100.0, catch=0.3):
         elif k == 0:
             u = hi
         else:
-            energy = 0.5 * inertia * w * w + m * 9.81 * lever * (np.cos(theta) - 1.0)
+            energy = 0.5 * inertia * w * w + m * g * lever * (np.cos(theta) - 1.0)
             u = -pump * energy * w * np.cos(theta) - total * 4.0 * (x + vx)
         us[k] = np.clip(u, lo, hi)
         sim.step(us[k])
@@ -167,7 +168,7 @@ def main(argv=None):
     ap.add_argument("--iterations", type=int, default=60)
     args = ap.parse_args(argv)
     start = time.perf_counter()
-    result, run, sim, guess = swing_up(args.dt, args.horizon, args.iterations)
+    result, run, _, _ = swing_up(args.dt, args.horizon, args.iterations)
     last = upright_error(run[-int(round(1.0 / args.dt)):])
     print(f"iLQR: {len(result.costs) - 1} iterations in {time.perf_counter() - start:.1f} s, "
           f"cost over the horizon {result.costs[0]:.4g} (the hand-written controller's "

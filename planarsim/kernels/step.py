@@ -48,8 +48,8 @@ from .solver.solve import solve_impulses
 from .dynamics.rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
                               unsupported)
 from .solver.warm_start import remember_impulses
-from .checks.work import (CONSTRAINT_SHARE, JOINT_WORK_SHARE, NEAR_DEPENDENT, SHAKE_REGIME,
-                          joints_add_energy, kinetic_energy, prediction_turn)
+from .checks.work import (CONSTRAINT_SHARE, NEAR_DEPENDENT, joints_add_energy, joints_excess,
+                          kinetic_energy, prediction_turn)
 
 
 @kernel(inline="never")
@@ -813,10 +813,7 @@ def chain_joints_gain(m, s, ws, h):
     if rounding > CONSTRAINT_SHARE * scale:
         ws.joint_gain[2] = 0.0          # (nothing measured for the audit)
         return True
-    excess = work - CONSTRAINT_SHARE * scale - rounding
-    if (excess > 0.0 and ws.joint_pivot[0] >= NEAR_DEPENDENT
-            and prediction_turn(m, s, ws, h) <= SHAKE_REGIME):
-        excess = work - JOINT_WORK_SHARE * scale - rounding
+    excess = joints_excess(m, s, ws, h, work, rounding, -math.inf, scale)
     ws.joint_gain[0] = excess
     ws.joint_gain[1] = row
     ws.joint_gain[2] = 1.0

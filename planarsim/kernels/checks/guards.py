@@ -39,6 +39,16 @@ GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[INFO_COMM
                                # ws.guard_value: the value); nothing is stepped
 
 
+@kernel(inline="always")
+def _guard_code(x, limit):
+    """GUARD_NONFINITE if x is NaN or infinite, GUARD_TOO_LARGE if |x| > limit, else GUARD_OK."""
+    if not math.isfinite(x):
+        return GUARD_NONFINITE
+    if abs(x) > limit:
+        return GUARD_TOO_LARGE
+    return GUARD_OK
+
+
 @kernel
 def check_guards(s, ws, limit):
     """Return GUARD_*; on failure ws.info[INFO_GUARD_BODY] = body,
@@ -46,11 +56,7 @@ def check_guards(s, ws, limit):
     for i in range(s.q.shape[0]):
         for f in range(6):
             x = s.q[i, f] if f < 3 else s.v[i, f - 3]
-            bad = GUARD_OK
-            if not math.isfinite(x):
-                bad = GUARD_NONFINITE
-            elif abs(x) > limit:
-                bad = GUARD_TOO_LARGE
+            bad = _guard_code(x, limit)
             if bad != GUARD_OK:
                 ws.info[INFO_GUARD_BODY] = i
                 ws.info[INFO_GUARD_FIELD] = f
@@ -77,6 +83,12 @@ def _speed(v, i):
     return math.sqrt(v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1])
 
 
+@kernel(inline="always")
+def _turning_speed(m, v, i):
+    """Body i's turning speed |omega| r_g [m/s] (r_g = sqrt(I / m): check_speeds)."""
+    return abs(v[i, 2]) * math.sqrt(m.body_inertia[i] * m.body_inv_mass[i])
+
+
 @kernel
 def check_speeds(m, s, ws, bound):
     """GUARD_SPEED if some body's speed |v| or turning speed |omega| r_g (r_g = sqrt(I / m),
@@ -86,7 +98,7 @@ def check_speeds(m, s, ws, bound):
     most m bound^2."""
     for i in range(s.v.shape[0]):
         speed = _speed(s.v, i)
-        turning = abs(s.v[i, 2]) * math.sqrt(m.body_inertia[i] * m.body_inv_mass[i])
+        turning = _turning_speed(m, s.v, i)
         if speed > bound or turning > bound:
             ws.info[INFO_GUARD_BODY] = i
             ws.info[INFO_GUARD_FIELD] = FIELD_SPEED if speed > bound else FIELD_TURNING
@@ -307,14 +319,20 @@ def add_part_path(s, ws, tau):
         ws.path_explained[i, 1] = speed
 
 
+@kernel(inline="always")
+def _add_path(ws, i, h, speed):
+    """Body i's part of h [s] ended at speed [m/s]: h max(|v_start|, |v_end|) added to the
+    path its velocities explain; the next part starts at speed (finish_path)."""
+    ws.path_explained[i, 0] += h * max(ws.path_explained[i, 1], speed)
+    ws.path_explained[i, 1] = speed
+
+
 @kernel
 def finish_path(s, ws, h):
     """The step's last part, of h [s], ended: add h max(|v_start|, |v_end|) to the path each
     body's velocities explain (ws.path_explained[:, 0] then holds the whole step's)."""
     for i in range(s.v.shape[0]):
-        speed = _speed(s.v, i)
-        ws.path_explained[i, 0] += h * max(ws.path_explained[i, 1], speed)
-        ws.path_explained[i, 1] = speed
+        _add_path(ws, i, h, _speed(s.v, i))
 
 
 @kernel
@@ -363,22 +381,17 @@ def end_checks_alone(m, s, ws, h, guard_limit, speed_limit, jump_limit):
     bad = False
     for i in range(s.q.shape[0]):
         for f in range(3):
-            x = abs(s.q[i, f])
-            y = abs(s.v[i, f])
-            if not (x <= guard_limit and y <= guard_limit) or x == math.inf or y == math.inf:
+            if (_guard_code(s.q[i, f], guard_limit) != GUARD_OK
+                    or _guard_code(s.v[i, f], guard_limit) != GUARD_OK):
                 bad = True
         speed = _speed(s.v, i)
-        ws.path_explained[i, 0] += h * max(ws.path_explained[i, 1], speed)
-        ws.path_explained[i, 1] = speed
-        if speed_limit > 0.0:
-            turning = abs(s.v[i, 2]) * math.sqrt(m.body_inertia[i] * m.body_inv_mass[i])
-            if speed > speed_limit or turning > speed_limit:
-                bad = True
-        if jump_limit > 0.0:
-            dx = s.q[i, 0] - ws.prev.q[i, 0]
-            dy = s.q[i, 1] - ws.prev.q[i, 1]
-            if math.sqrt(dx * dx + dy * dy) > ws.path_explained[i, 0] + jump_limit:
-                bad = True
+        _add_path(ws, i, h, speed)
+        if speed_limit > 0.0 and (speed > speed_limit
+                                  or _turning_speed(m, s.v, i) > speed_limit):
+            bad = True
+        if jump_limit > 0.0 and (_moved(s.q, ws.prev.q, i)
+                                 > ws.path_explained[i, 0] + jump_limit):
+            bad = True
     return bad
 
 
@@ -400,15 +413,21 @@ def check_displacements(m, s, ws, slack):
     return check_moves(m, s, ws, ws.prev.q, False, slack)
 
 
+@kernel(inline="always")
+def _moved(q, start_q, i):
+    """How far [m] body i's centre of mass is at q from start_q."""
+    dx = q[i, 0] - start_q[i, 0]
+    dy = q[i, 1] - start_q[i, 1]
+    return math.sqrt(dx * dx + dy * dy)
+
+
 @kernel
 def check_moves(m, s, ws, start_q, whole, slack):
     """check_displacements from positions start_q: over the step's last part (whole False:
     ws.path_explained[:, 0], from ws.prev) or over a step taken in sub-steps (whole True:
     their summed paths, ws.step_path, from the step's start)."""
     for i in range(s.q.shape[0]):
-        dx = s.q[i, 0] - start_q[i, 0]
-        dy = s.q[i, 1] - start_q[i, 1]
-        moved = math.sqrt(dx * dx + dy * dy)
+        moved = _moved(s.q, start_q, i)
         explained = ws.step_path[i] if whole else ws.path_explained[i, 0]
         if not moved > explained + slack:
             continue

@@ -139,6 +139,20 @@ def prediction_turn(m, s, ws, h):
 
 
 @kernel
+def joints_excess(m, s, ws, h, work, rounding, gain, scale):
+    """The joints' energy beyond their share [J] (joints_add_energy's rule): their work
+    (its rounding, and gain, a lower bound of it from the velocities or -inf) beyond
+    CONSTRAINT_SHARE of scale, KE(v_lin); beyond JOINT_WORK_SHARE of it where the rows are
+    not nearly dependent and the step ends within SHAKE_REGIME of its prediction."""
+    excess = max(work - CONSTRAINT_SHARE * scale - rounding, gain - CONSTRAINT_SHARE * scale)
+    if (excess > 0.0 and ws.joint_pivot[0] >= NEAR_DEPENDENT
+            and prediction_turn(m, s, ws, h) <= SHAKE_REGIME):
+        excess = max(work - JOINT_WORK_SHARE * scale - rounding,
+                     gain - JOINT_WORK_SHARE * scale)
+    return excess
+
+
+@kernel
 def joints_add_energy(m, s, ws, h):
     """The joints' impulses of the velocity solve (a step of h [s]) added more kinetic energy
     than their second-order target can, beyond rounding: returns the excess [J] (<= 0: none)
@@ -168,11 +182,7 @@ def joints_add_energy(m, s, ws, h):
     gain = -math.inf
     if rounding > CONSTRAINT_SHARE * scale:
         gain = gain_from_velocities(m, ws, h, kinetic)
-    excess = max(work - CONSTRAINT_SHARE * scale - rounding, gain - CONSTRAINT_SHARE * scale)
-    if (excess > 0.0 and ws.joint_pivot[0] >= NEAR_DEPENDENT
-            and prediction_turn(m, s, ws, h) <= SHAKE_REGIME):
-        excess = max(work - JOINT_WORK_SHARE * scale - rounding,
-                     gain - JOINT_WORK_SHARE * scale)
+    excess = joints_excess(m, s, ws, h, work, rounding, gain, scale)
     if excess > 0.0 and row < 0:
         row = largest_joint_impulse(ws)
     return excess, row

@@ -31,7 +31,7 @@ import math
 
 from ...compile import kernel
 from ..dynamics.integrate import STALLED_RATIO
-from ..math2d import update_trig
+from ..math2d import rotate, update_trig
 from ..checks.work import VELOCITY_FLOOR, WORK_REL_TOL, fastest
 
 # [m] every row within this after a correction pass: the next reuses the factorisation
@@ -135,11 +135,20 @@ def _lever(cs, body, anchor, j, e):
     cos, sin); (0, 0) for the world."""
     if body < 0:
         return 0.0, 0.0
-    c = cs[body, 0]
-    sn = cs[body, 1]
-    lx = anchor[j, e, 0]
-    ly = anchor[j, e, 1]
-    return c * lx - sn * ly, sn * lx + c * ly
+    return rotate(cs[body, 0], cs[body, 1], anchor[j, e, 0], anchor[j, e, 1])
+
+
+@kernel(inline="always")
+def _anchor_point(m, q, cs, ws, j, e, at):
+    """World point (x, y) [m] of pin j's anchor on end e at q (cs its cos / sin; the world's
+    anchor as given), its lever into ws.chain_lever[j, e, at:at + 2]."""
+    body = m.pin_body[j, e]
+    rx, ry = _lever(cs, body, m.pin_anchor, j, e)
+    ws.chain_lever[j, e, at] = rx
+    ws.chain_lever[j, e, at + 1] = ry
+    if body < 0:
+        return m.pin_anchor[j, e, 0], m.pin_anchor[j, e, 1]
+    return q[body, 0] + rx, q[body, 1] + ry
 
 
 @kernel
@@ -148,26 +157,8 @@ def lever_gaps(m, q, cs, ws, at):
     into ws.chain_lever[:, :, at:at + 2]; returns the largest |c| [m]."""
     worst = 0.0
     for j in range(m.pin_body.shape[0]):
-        a = m.pin_body[j, 0]
-        b = m.pin_body[j, 1]
-        rax, ray = _lever(cs, a, m.pin_anchor, j, 0)
-        rbx, rby = _lever(cs, b, m.pin_anchor, j, 1)
-        ws.chain_lever[j, 0, at] = rax
-        ws.chain_lever[j, 0, at + 1] = ray
-        ws.chain_lever[j, 1, at] = rbx
-        ws.chain_lever[j, 1, at + 1] = rby
-        if a >= 0:
-            ax = q[a, 0] + rax
-            ay = q[a, 1] + ray
-        else:
-            ax = m.pin_anchor[j, 0, 0]
-            ay = m.pin_anchor[j, 0, 1]
-        if b >= 0:
-            bx = q[b, 0] + rbx
-            by = q[b, 1] + rby
-        else:
-            bx = m.pin_anchor[j, 1, 0]
-            by = m.pin_anchor[j, 1, 1]
+        ax, ay = _anchor_point(m, q, cs, ws, j, 0, at)
+        bx, by = _anchor_point(m, q, cs, ws, j, 1, at)
         gx = bx - ax
         gy = by - ay
         ws.rhs[2 * j] = -gx
