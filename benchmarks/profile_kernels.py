@@ -4,6 +4,7 @@
     python benchmarks/profile_kernels.py walker:simbicon       # a walker's simulate()
     python benchmarks/profile_kernels.py biped_collapse --seconds 20
     python benchmarks/profile_kernels.py world:pyramid45 --seconds 0.2   # benchmarks/worlds.py
+    python benchmarks/profile_kernels.py mjcf:inverted_double_pendulum.xml   # a gymnasium file
 
 numba's machine code has no symbols that perf can see, so this script writes perf's map file
 (/tmp/perf-<pid>.map: address, size, name of every compiled function the run links), samples
@@ -106,6 +107,10 @@ def _workload(target, seconds, skip=0):
         model = WORLDS[target[6:]]()
     elif target.startswith("stress:"):
         model = build_model(ALL_SCENES[target[7:]])
+    elif target.startswith("mjcf:"):
+        from planarsim.envs.core import gym_asset
+        from planarsim.mjcf import load_mjcf
+        model = load_mjcf(gym_asset(target[5:])).compile()
     else:
         model = SCENES[target][0]()
     sim = ps.Simulator(model)
@@ -122,8 +127,9 @@ def _workload(target, seconds, skip=0):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("target", help="a bench scene (chain4, biped_collapse, ...), walker:<name> or "
-                    "world:<name> (benchmarks/worlds.py) or stress:<name> "
-                    "(benchmarks/stress_scenes.py)")
+                    "world:<name> (benchmarks/worlds.py), stress:<name> "
+                    "(benchmarks/stress_scenes.py) or mjcf:<gymnasium's file> (its model at rest, "
+                    "no command)")
     ap.add_argument("--skip", type=int, default=0,
                     help="steps taken before the timed runs start (the scene's later part)")
     ap.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
