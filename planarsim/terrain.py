@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ModelError
+from .errors import ModelError, plain
 
 
 @dataclass(frozen=True)
@@ -123,24 +123,54 @@ def _hills_name(a, lam, phi, grade, height) -> str:
     return name + (f" ({', '.join(extra)})" if extra else "")
 
 
+def _number(what, value, finite=True) -> float:
+    """An argument of flat, slope or hills as a float, or a ModelError naming it and its
+    value (a string, None, a list; NaN or inf unless finite=False)."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"terrain: {what}={plain(value)!r} must be a number") from None
+    if finite and not math.isfinite(x):
+        raise ModelError(f"terrain: {what}={x} must be finite")
+    return x
+
+
+def _numbers(what, values) -> np.ndarray:
+    """hills' amplitudes, wavelengths or phases as a 1-D float array (one number: one
+    sine), or a ModelError naming the argument and the entry that is not a finite number."""
+    try:
+        arr = np.atleast_1d(np.asarray(values, dtype=np.float64))
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.ndim != 1:
+        raise ModelError(f"terrain: {what}={plain(values)!r} must be a number or a list of "
+                         "numbers, one per sine")
+    for i, x in enumerate(arr):
+        if not math.isfinite(x):
+            raise ModelError(f"terrain: {what}[{i}]={x} must be finite")
+    return arr
+
+
 def flat(height: float = 0.0) -> Terrain:
     """Level ground at `height` [m]."""
-    return Terrain(np.array([height, 0.0, 0.0]), name="flat")
+    return Terrain(np.array([_number("height", height), 0.0, 0.0]), name="flat")
 
 
 def slope(angle_deg: float, height: float = 0.0) -> Terrain:
     """Constant slope rising toward +x by `angle_deg` degrees (negative: downhill)."""
+    angle_deg = _number("slope angle", angle_deg, finite=False)
     if not math.isfinite(angle_deg) or abs(angle_deg) >= 89.0:
         raise ModelError(f"terrain: slope angle={angle_deg} deg must be finite and within (-89, 89)")
-    return Terrain(np.array([height, math.tan(math.radians(angle_deg)), 0.0]),
+    return Terrain(np.array([_number("height", height), math.tan(math.radians(angle_deg)), 0.0]),
                    name=f"slope:{_num(angle_deg)}")
 
 
 def hills(amplitudes, wavelengths, phases=None, grade: float = 0.0, height: float = 0.0) -> Terrain:
     """Sum of sines: amplitudes [m], wavelengths [m], phases [rad], plus a constant grade s [-]."""
-    a = np.atleast_1d(np.asarray(amplitudes, dtype=np.float64))
-    lam = np.atleast_1d(np.asarray(wavelengths, dtype=np.float64))
-    phi = np.zeros_like(a) if phases is None else np.atleast_1d(np.asarray(phases, dtype=np.float64))
+    a = _numbers("amplitudes", amplitudes)
+    lam = _numbers("wavelengths", wavelengths)
+    phi = np.zeros_like(a) if phases is None else _numbers("phases", phases)
+    grade, height = _number("grade", grade), _number("height", height)
     if not (a.shape == lam.shape == phi.shape):
         raise ModelError(f"terrain: amplitudes, wavelengths, phases must have one length, got "
                          f"{a.size}, {lam.size}, {phi.size}")
@@ -159,6 +189,9 @@ def parse(spec: str) -> Terrain:
 
     ``flat`` | ``slope:DEG`` | ``hills`` (default hills) | ``hills:A,L[,PHI][;A,L[,PHI]...]``
     """
+    if not isinstance(spec, str):
+        raise ModelError(f"terrain spec {spec!r} must be a string: flat, slope:DEG, hills or "
+                         f"hills:A,L[,PHI][;A,L[,PHI]...] (metres, radians)")
     spec = spec.strip()
     kind, _, arg = spec.partition(":")
     try:

@@ -91,12 +91,31 @@ def test_bad_dt(dt):
 
 
 def test_bad_terrain_coefficients():
-    with pytest.raises(ModelError, match=r"terrain: coef\[3\]=nan must be finite"):
+    with pytest.raises(ModelError, match=r"terrain: amplitudes\[0\]=nan must be finite"):
         terrain.hills([float("nan")], [2.0])
     with pytest.raises(ModelError, match=r"wavelength=0.0 must be > 0"):
         terrain.hills([0.1], [0.0])
     with pytest.raises(ModelError, match=r"terrain spec 'bumpy' not understood"):
         terrain.parse("bumpy")
+
+
+@pytest.mark.parametrize("make, said", [
+    (lambda: terrain.slope("abc"), r"terrain: slope angle='abc' must be a number"),
+    (lambda: terrain.slope(None), r"terrain: slope angle=None must be a number"),
+    (lambda: terrain.slope(3.0, height=float("nan")), r"terrain: height=nan must be finite"),
+    (lambda: terrain.flat("abc"), r"terrain: height='abc' must be a number"),
+    (lambda: terrain.flat(float("inf")), r"terrain: height=inf must be finite"),
+    (lambda: terrain.hills(["a"], [1.0]), r"terrain: amplitudes=\['a'\] must be a number or a list"),
+    (lambda: terrain.hills([[0.1]], [[1.0]]), r"terrain: amplitudes=\[\[0.1\]\] must be a number or a list"),
+    (lambda: terrain.hills([0.1], [1.0], phases=[float("inf")]), r"terrain: phases\[0\]=inf must be finite"),
+    (lambda: terrain.hills([0.1], [1.0], grade="steep"), r"terrain: grade='steep' must be a number"),
+    (lambda: terrain.parse(None), r"terrain spec None must be a string"),
+])
+def test_bad_terrain_arguments_are_named(make, said):
+    """flat, slope, hills and parse name the argument that is not a (finite) number: not
+    Python's or numpy's conversion error, nor an index into the coefficients."""
+    with pytest.raises(ModelError, match=said):
+        make()
 
 
 def test_model_error_is_a_value_error():
