@@ -75,8 +75,10 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from ..builder import ModelBuilder
-from ..errors import ModelError
+from ..errors import ModelError, plain
 from .description import Body3D, Description, Motor, Tendon
 from .emitter import Emitter
 from .include import decode, resolve_includes
@@ -132,6 +134,17 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
                                 or not all(isinstance(n, str) for n in _names(collide))):
         raise TypeError(f"load_mjcf: collide={collide!r} must be None or a list of geom names, "
                         "e.g. ['foot']")
+    if isinstance(drop, (str, bytes)) or not all(isinstance(n, str) for n in _names(drop)):
+        raise TypeError(f"load_mjcf: drop={drop!r} must be a list of names, e.g. ['armature']")
+    if builder is not None and not isinstance(builder, ModelBuilder):
+        raise TypeError(f"load_mjcf: builder={builder!r} must be a planarsim ModelBuilder "
+                        "(or None: a new one from the file's option)")
+    try:
+        offset = np.asarray(offset, dtype=np.float64).reshape(2)
+    except (TypeError, ValueError):
+        raise ModelError(f"load_mjcf: offset={plain(offset)!r} must be a pair (x, y) [m]") from None
+    if not np.all(np.isfinite(offset)):
+        raise ModelError(f"load_mjcf: offset={tuple(offset.tolist())} must be finite")
     if isinstance(source, (bytes, bytearray)):   # XML text as bytes (dm_control's swimmer)
         source = decode(source, "load_mjcf: the XML source")
     if isinstance(source, (str, Path)) and not str(source).strip():

@@ -110,6 +110,9 @@ class ElementReader:
                                        "xyaxes": 6}[k])
         if k != "euler" and not np.linalg.norm(v[:3] if k != "quat" else v) > 0:
             self.fail(node, f"{k}={vec(v)} must be non-zero")
+        if k == "xyaxes" and not np.linalg.norm(np.cross(v[:3], v[3:])) > 0:
+            self.fail(node, f"xyaxes={vec(v)}: its second vector must not be zero or parallel "
+                            "to its first (the frame's x-y plane)")
         if k == "quat":
             return F.quat_matrix(v)
         if k == "axisangle":

@@ -78,7 +78,7 @@ class BodyPartsReader(ElementReader):
         eff = dict(node.attrib)
         self.vet(node, eff)
         pos, R = self.frame(node, eff, body.pos, body.R)
-        mass = self.scalar(node, eff, "mass", -1.0)
+        mass = float(self.floats(node, eff, "mass", 1)[0])   # required, as MuJoCo's
         if not mass > 0:
             self.fail(node, f"mass={mass} must be > 0")
         if "fullinertia" in eff and "diaginertia" in eff:

@@ -226,6 +226,8 @@ class Reader(BodyPartsReader):
         k, c = self.flags.passive(k, c)       # <flag spring|damper="disable">
         springref = self.scalar(node, eff, "springref", 0.0) * s
         armature = self.scalar(node, eff, "armature", 0.0)
+        if armature < 0:
+            self.fail(node, f"armature={armature} must be >= 0")
         dropped = armature != 0.0 and "armature" in self.drop
         return dict(ref=ref, range=rng, stiffness=k, damping=c, springref=springref,
                     armature=0.0 if dropped else armature, armature_dropped=dropped)

@@ -170,10 +170,44 @@ def _rot(th):
      "<joint type='hinge' axis='0 1 0' range='30 10'/>\n<geom type='sphere' size='0.1'/>"
      "</body></worldbody></mujoco>",
      r"line 2.*lower > upper"),
+    # a frame whose xyaxes are parallel: its rotation was NaN (numpy's warning, then "body
+    # 'a' (0): inertia=nan must be finite" with no element nor line)
+    ("<mujoco><worldbody><body name='a'>\n<joint type='hinge' axis='0 1 0'/>\n"
+     "<geom type='box' size='0.1 0.1 0.1' xyaxes='1 0 0 2 0 0'/></body></worldbody></mujoco>",
+     r"<geom> \(line 3\): xyaxes=\(1.0, 0.0, 0.0, 2.0, 0.0, 0.0\): its second vector must not "
+     r"be zero or parallel"),
+    # an <inertial> without mass: was "mass=-1.0 must be > 0", a number the file does not hold
+    ("<mujoco><worldbody><body name='a'>\n<joint type='hinge' axis='0 1 0'/>\n"
+     "<inertial pos='0 0 0' diaginertia='1 1 1'/></body></worldbody></mujoco>",
+     r"<inertial> \(line 3\): attribute 'mass' is required"),
+    # a negative armature: was the builder's "pin 'j' (0)", without the element and line
+    ("<mujoco><worldbody><body name='a'>\n<joint name='j' type='hinge' axis='0 1 0' "
+     "armature='-1'/>\n<geom type='sphere' size='0.1'/></body></worldbody></mujoco>",
+     r"<joint name='j'> \(line 2\): armature=-1.0 must be >= 0"),
 ])
 def test_bad_files_name_element_and_line(xml, match):
     with pytest.raises(ModelError, match=match):
         load_mjcf(xml)
+
+
+LEG = ("<mujoco><worldbody><body name='a' pos='0 0 1'><joint type='hinge' axis='0 1 0'/>"
+       "<geom type='sphere' size='0.1'/></body></worldbody></mujoco>")
+
+
+@pytest.mark.parametrize("kw, error, match", [
+    # offset (1,) was broadcast to (1, 1): the model moved up as well, silently
+    (dict(offset=(1.0,)), ModelError, r"load_mjcf: offset=\(1.0,\) must be a pair \(x, y\)"),
+    (dict(offset=(1.0, 2.0, 3.0)), ModelError, r"load_mjcf: offset=\(1.0, 2.0, 3.0\) must be a pair"),
+    # a NaN offset was named as the first body's pos
+    (dict(offset=(float("nan"), 0.0)), ModelError, r"load_mjcf: offset=\(nan, 0.0\) must be finite"),
+    # drop="armature" was read letter by letter: drop=['a', 'a', 'e', 'm', ...] names [...]
+    (dict(drop="armature"), TypeError, r"load_mjcf: drop='armature' must be a list of names"),
+    # builder=5: AttributeError: 'int' object has no attribute 'dt'
+    (dict(builder=5), TypeError, r"load_mjcf: builder=5 must be a planarsim ModelBuilder"),
+])
+def test_bad_load_arguments_are_named(kw, error, match):
+    with pytest.raises(error, match=match):
+        load_mjcf(LEG, **kw)
 
 
 def test_missing_file_is_a_model_error(tmp_path):
