@@ -81,7 +81,8 @@ def file_mode() -> int:
 
 
 def publish(tmp: str, path) -> None:
-    """Move the finished temporary file `tmp` onto `path` in one step."""
+    """Move the finished temporary file `tmp` onto `path` in one step; an OSError names
+    `path` (not the temporary file) and why it cannot be written there."""
     path = Path(path)
     os.chmod(tmp, file_mode())
     try:
@@ -89,17 +90,29 @@ def publish(tmp: str, path) -> None:
         return
     except OSError as e:
         if e.errno != errno.EXDEV:
-            raise
-    fd, near = _beside(path)
+            raise _cannot_write(path, e) from None
+    try:
+        fd, near = _beside(path)
+    except OSError as e:        # a folder no file can be made in (/proc, a read-only mount)
+        raise _cannot_write(path, e) from None
     os.close(fd)
     try:
         shutil.copyfile(tmp, near)
         os.chmod(near, file_mode())
         os.replace(near, path)
+    except OSError as e:
+        discard(near)
+        raise _cannot_write(path, e) from None
     except BaseException:
         discard(near)
         raise
     discard(tmp)
+
+
+def _cannot_write(path: Path, e: OSError) -> OSError:
+    """The OSError of a file that could not be put at `path`, naming it (the error of the
+    temporary file's move or copy names that file, which the caller never gave)."""
+    return OSError(f"cannot write {str(path)!r}: {e.strerror or e}")
 
 
 def discard(tmp) -> None:

@@ -64,3 +64,25 @@ def test_a_failed_write_leaves_nothing(tmp_path):
     assert os.listdir(tmp_path) == []
     assert not [n for n in os.listdir(tempfile.gettempdir())
                 if n.startswith(f"planarsim-{os.getpid()}-")]
+
+
+@pytest.mark.parametrize("where", ["folder", "proc"])
+def test_a_target_that_cannot_be_written_is_named(tmp_path, where):
+    """A write that fails at the end (the target is a folder; /proc, where the folder
+    checks pass for root but no file can be made) names the target, not the temporary file
+    it was staged in ('/proc/.x.npz.PID.xxxx.part': No such file or directory), and leaves
+    nothing behind."""
+    if where == "proc":
+        if not (sys.platform.startswith("linux") and os.path.isdir("/proc")
+                and os.access("/proc", os.W_OK)):
+            pytest.skip("needs /proc that os.access calls writable (Linux, as root)")
+        target = "/proc/planarsim-test.npz"
+    else:
+        target = tmp_path / "run.npz"
+        target.mkdir()
+    with pytest.raises(OSError) as err:
+        atomic_write(target, lambda f: f.write(b"x"))
+    said = str(err.value)
+    assert said.startswith(f"cannot write {str(target)!r}: ") and ".part" not in said, said
+    assert not [n for n in os.listdir(tempfile.gettempdir())
+                if n.startswith(f"planarsim-{os.getpid()}-")]
