@@ -169,6 +169,9 @@ class WalkerRun:
             raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
         # a walker that fell stays where it fell: its rollout would otherwise take one more step
         n = 0 if self.fell else int(round(seconds / self.dt))
+        if n == 0 and seconds > 0.0 and not self.fell:
+            raise ValueError(f"{self.NAME}: run({seconds:g} s) is less than half a step "
+                             f"(dt={self.dt:g} s): the run would take no step")
         frames = self.frames(n)
         check_recording(self.model, frames,
                         f"{self.NAME}: run({seconds:g} s) at dt={self.dt:g} s, a frame every "

@@ -105,6 +105,17 @@ def _positive(text):
     return x
 
 
+def _seed(text):
+    """--seed: a whole number >= 0 (numpy's generators take no other)."""
+    try:
+        x = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if x < 0:
+        raise argparse.ArgumentTypeError(f"{text} must be a whole number >= 0")
+    return x
+
+
 # commands -------------------------------------------------------------------------------------
 def cmd_list(args):
     from planarsim import terrain
@@ -287,6 +298,9 @@ def _check_duration_fits(mod, kw, duration):
     (checked on the walker's run before anything is compiled or allocated)."""
     from planarsim.errors import RecordingTooLarge
     run = mod.Run(**{k: v for k, v in kw.items() if k != "duration"})
+    if round(duration / run.dt) == 0:
+        raise UsageError(f"--duration {duration:g} s is less than half a step (dt={run.dt:g} s): "
+                         "the run would take no step; give a longer --duration")
     try:
         run.check_memory(duration)
     except RecordingTooLarge as e:
@@ -543,7 +557,8 @@ def make_parser():
     p.add_argument("--plot", default=None, help="summary plot .png | .svg | .pdf")
     p.add_argument("--save", default=None, help="trajectory .npz")
     p.add_argument("--csv", default=None, help="trajectory .csv (SI units in the column names)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=_seed, default=0,
+                   help="seed of the start perturbation of walkers that have one (simple-biped, quadruped), a whole number >= 0 (0: none)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help="change a walker parameter (repeatable; see 'planarsim params WALKER')")

@@ -171,6 +171,11 @@ def test_a_reader_that_leaves_does_not_stop_the_files(tmp_path, monkeypatch, cap
     (["run", "simple-biped", "--dt", "2.0"], "--dt 2 s is too large; use a step of at most 0.01 s"),
     (["analyze", "simplest-walker", "--param", "slope", "--range", "0.01:0.02", "--dt", "0.05"],
      "--dt 0.05 s is too large"),
+    # numpy's own words, naming no flag: "error: expected non-negative integer"
+    (["run", "simple-biped", "--seed", "-5", "--json"], "argument --seed: -5 must be a whole number >= 0"),
+    # a run of no step exited 0 with the summary of a walker that never moved
+    (["run", "simple-biped", "--duration", "1e-6", "--json"],
+     "--duration 1e-06 s is less than half a step (dt=0.001 s): the run would take no step"),
 ])
 def test_bad_flags_exit_2_naming_the_flag(argv, fragment, capsys):
     """--start of a missing file said only "[Errno 2] No such file or directory"; an unknown

@@ -123,6 +123,17 @@ def test_run_rejects_bad_seconds(seconds):
         run.run(seconds)
 
 
+def test_run_of_less_than_half_a_step_is_refused():
+    """run(1e-6) took no step and returned as if it had run (simulate(1e-6) the summary of a
+    walker that never moved), where Simulator.run refuses it; run(0.0) stays a run of none."""
+    run = walkers.load("simple-biped").Run()
+    with pytest.raises(ValueError, match=r"run\(1e-06 s\) is less than half a step \(dt=0.001 s\)"):
+        run.run(1e-6)
+    with pytest.raises(ValueError, match="less than half a step"):
+        walkers.load("simple-biped").simulate(4e-4)
+    assert len(run.run(0.0).t) == 1
+
+
 def test_run_rejects_bad_record_every():
     with pytest.raises(ValueError, match="record_every"):
         walkers.load("quadruped").Run(record_every=-1)
