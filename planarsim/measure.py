@@ -20,6 +20,7 @@ import numpy as np
 from .analysis import StepEvents, foot_groups, step_events, step_summary
 from .energy import joint_position_rate
 from .model import ACT_AXIAL
+from .state import _body_rows
 from .trajectory import check_recorded_by
 
 __all__ = ["centre_of_mass", "centre_of_mass_velocity", "energy", "pin_angle_rate", "summary",
@@ -55,6 +56,10 @@ def pin_angle_rate(model, q, v, pin) -> tuple:
         pin = names.index(pin)
     elif not 0 <= int(pin) < len(names):
         raise IndexError(f"pin index {pin} out of range 0..{len(names) - 1}; pins: {names}")
+    # one state, one row per body: a trajectory's (K, n_body, 3) frames or a transposed array
+    # would be read as other bodies' numbers (or fail inside numpy)
+    q = _body_rows("measure.pin_angle_rate: q", q, model.n_body)
+    v = _body_rows("measure.pin_angle_rate: v", v, model.n_body)
     ang, rate = joint_position_rate(model, q, v, int(pin))
     return float(ang), float(rate)
 

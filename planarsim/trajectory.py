@@ -319,7 +319,15 @@ def atomic_write(path, write, binary=True) -> None:
 
 
 def check_recorded_by(traj, model, who):
-    """ValueError naming `who` where traj's frames do not hold model's bodies (n_body, 3)."""
+    """ValueError naming `who` where traj's frames do not hold model's bodies (n_body, 3);
+    TypeError naming it where model is not a Model or traj not a Trajectory."""
+    from .model import Model
+    if not isinstance(model, Model):
+        raise TypeError(f"{who}: model={model!r} must be the planarsim Model the trajectory was "
+                        "recorded with")
+    if not isinstance(traj, Trajectory):
+        raise TypeError(f"{who}: traj={type(traj).__name__} must be a planarsim Trajectory "
+                        "(Simulator.run, a walker's simulate, Trajectory.load)")
     q = np.asarray(traj.q)
     if q.ndim != 3 or q.shape[1:] != (model.n_body, 3):
         raise ValueError(f"{who}: the trajectory has {q.shape[1] if q.ndim == 3 else '?'} "

@@ -63,6 +63,32 @@ def test_joint_angles_of_a_recording_match_the_links_geometry_at_each_frame():
         measure.pin_angle_rate(model, traj.q[0], traj.v[0], "wrist")
 
 
+def test_pin_angle_rate_of_a_wrong_shaped_state_names_it():
+    """q of one body's row, or a recording's frames (K, n_body, 3), raised numpy's "too many
+    indices for array" or "only 0-dimensional arrays can be converted to Python scalars"."""
+    model = _double_pendulum()
+    with pytest.raises(ValueError, match=r"measure\.pin_angle_rate: q has shape \(3,\); it must "
+                                         r"be \(2, 3\)"):
+        measure.pin_angle_rate(model, np.zeros(3), model.v0, "elbow")
+    frames = np.stack([model.q0] * 4)
+    with pytest.raises(ValueError, match=r"measure\.pin_angle_rate: v has shape \(4, 2, 3\)"):
+        measure.pin_angle_rate(model, model.q0, frames, "elbow")
+
+
+@pytest.mark.parametrize("who", ["centre_of_mass", "energy", "summary", "joint_angles",
+                                 "cost_of_transport"])
+def test_a_measure_without_a_model_or_trajectory_names_it(who):
+    """measure.energy(traj, None) raised "'NoneType' object has no attribute 'n_body'"."""
+    model = _double_pendulum()
+    traj = ps.Simulator(model).run(0.01)
+    with pytest.raises(TypeError, match=rf"measure\.{who}: model=None must be the planarsim "
+                                        r"Model"):
+        getattr(measure, who)(traj, None)
+    with pytest.raises(TypeError, match=rf"measure\.{who}: traj=Model must be a planarsim "
+                                        r"Trajectory"):
+        getattr(measure, who)(model, model)
+
+
 def test_summary_of_a_passive_walk_gives_sin_slope():
     import walkers
     mod = walkers.load("simplest-walker")
