@@ -173,7 +173,11 @@ class Simulator:
                 and u.flags.c_contiguous):
             return u
         # contiguous float64: the bound kernels were compiled for exactly that layout
-        u = np.ascontiguousarray(u, dtype=np.float64)
+        try:
+            u = np.ascontiguousarray(u, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"commands u={u!r} must be numbers, shape ({self.model.n_act},) "
+                             f"(one per actuator: {list(self.model.act_names)})") from None
         if u.shape != (self.model.n_act,):
             raise ValueError(f"commands u must have shape ({self.model.n_act},) "
                              f"(one per actuator: {list(self.model.act_names)}), got {u.shape}")
@@ -373,7 +377,10 @@ def _count_steps(dt, duration, n_steps):
     if n_steps is not None:
         n = _whole_count("n_steps", n_steps)
     else:
-        duration = float(duration)
+        try:
+            duration = float(duration)
+        except (TypeError, ValueError):
+            raise ValueError(f"duration={duration!r} must be a number of seconds") from None
         if not np.isfinite(duration) or duration < 0:
             raise ValueError(f"duration={duration} must be finite and >= 0 seconds")
         n = int(round(duration / dt))

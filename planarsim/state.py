@@ -179,7 +179,11 @@ def check_state(state, model: Model | None = None, what: str = "state") -> None:
 def _body_rows(name, a, n_body):
     """a as a fresh (n_body, 3) float array: one row per body, exactly that shape (a transposed
     or flattened array would be read as other bodies' numbers)."""
-    arr = np.array(a, dtype=np.float64)
+    try:
+        arr = np.array(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}={a!r} must be numbers: one row (x, y, theta) per body of the "
+                         f"model, shape ({n_body}, 3)") from None
     if arr.shape != (n_body, 3):
         raise ValueError(f"{name} has shape {arr.shape}; it must be ({n_body}, 3): one row "
                          f"(x, y, theta) per body of the model, in the model's body order")

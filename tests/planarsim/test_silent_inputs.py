@@ -254,6 +254,32 @@ def test_step_counts_that_are_not_whole_are_refused(call, pattern):
     sim.run(0.0)                                   # (an empty run is asked for: fine)
 
 
+def actuated_pendulum():
+    b = ps.ModelBuilder(dt=1e-3)
+    arm = b.add_body("arm", 1.0, 0.1, pos=(0.5, 1.0))
+    b.add_pin("shoulder", None, arm, anchor_world=(0.0, 1.0))
+    b.add_pin_motor("motor", "shoulder")
+    return b.compile()
+
+
+@pytest.mark.parametrize("call, pattern", [
+    (lambda sim: sim.step("a"), r"commands u='a' must be numbers, shape \(1,\) \(one per "
+                                r"actuator: \['motor'\]\)"),
+    (lambda sim: sim.steps(3, [[1.0], [2.0, 3.0]]), r"commands u=.* must be numbers"),
+    (lambda sim: sim.run("abc"), r"duration='abc' must be a number of seconds"),
+    (lambda sim: sim.start_over(q="abc"), r"q='abc' must be numbers: one row \(x, y, theta\) "
+                                          r"per body of the model, shape \(1, 3\)"),
+    (lambda sim: sim.start_over(v=[[0.0, 0.0, "fast"]]), r"v=.* must be numbers"),
+])
+def test_arguments_that_are_not_numbers_are_named(call, pattern):
+    """Commands, a duration or poses that are not numbers raised numpy's or Python's "could
+    not convert string to float: 'abc'", naming no argument."""
+    sim = ps.Simulator(actuated_pendulum())
+    with pytest.raises(ValueError, match=pattern):
+        call(sim)
+    assert sim.state.step[0] == 0
+
+
 @pytest.mark.parametrize("frame_skip", [0, -3, 2.5])
 def test_env_frame_skip_must_be_a_positive_whole_number(frame_skip):
     """frame_skip=0 divided by zero in the env's render rate; -3 failed at the first step."""
