@@ -7,6 +7,7 @@ termination, reset noise and frame skip.
 from __future__ import annotations
 
 import math
+import numbers
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from gymnasium import utils
 from gymnasium.spaces import Box
 
 from ..compiled import jit
+from ..errors import plain
 from ..mjcf import parse_xml
 from .core import PlanarMujocoEnv, gym_asset
 
@@ -64,6 +66,31 @@ def reacher_obs(q, q0, bodies, local, qpos, qvel, out):
     return vx, vy
 
 
+def check_task_keywords(name, defaults, args) -> None:
+    """ValueError naming the task, the keyword and its value where a task's keyword is not of
+    its default's kind: a weight or reward (a float default) a finite number, a switch (a bool
+    default) True or False, a range (a tuple default) a pair (low, high) with low < high
+    (either may be infinite the other way). A NaN weight gave NaN rewards, a reversed range
+    ended every episode at its first step, a string switch was read as True."""
+    for key, default in defaults.items():
+        value = args[key]
+        said = f"{name}: {key}={plain(value)!r}"
+        if isinstance(default, bool):
+            if not isinstance(value, (bool, np.bool_)):
+                raise ValueError(f"{said} must be True or False")
+        elif isinstance(default, float):
+            if (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)
+                    or not math.isfinite(value)):
+                raise ValueError(f"{said} must be a finite number")
+        elif isinstance(default, tuple):
+            try:
+                lo, hi = (float(x) for x in value)
+            except (TypeError, ValueError):
+                raise ValueError(f"{said} must be a pair (low, high) of numbers") from None
+            if not lo < hi or lo == math.inf or hi == -math.inf:
+                raise ValueError(f"{said} must have low < high (and low < inf, high > -inf)")
+
+
 class _Task(PlanarMujocoEnv, utils.EzPickle):
     """A task's keyword arguments and their defaults are its class's DEFAULTS (gymnasium's
     v5 defaults), each kept as the attribute "_" + name; any other keyword goes to
@@ -73,6 +100,7 @@ class _Task(PlanarMujocoEnv, utils.EzPickle):
 
     def __init__(self, **kw):
         args = {**self.DEFAULTS, **kw}
+        check_task_keywords(type(self).__name__, self.DEFAULTS, args)
         noise = args.get("reset_noise_scale", 0.0)
         if not (isinstance(noise, (int, float)) and math.isfinite(noise) and noise >= 0):
             raise ValueError(f"{type(self).__name__}: reset_noise_scale={noise!r} must be a "

@@ -246,6 +246,27 @@ def test_bad_inputs_name_the_culprit():
     assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
 
 
+@pytest.mark.parametrize("kw, said", [
+    (dict(ctrl_cost_weight=float("nan")), r"Hopper: ctrl_cost_weight=nan must be a finite number"),
+    (dict(forward_reward_weight="abc"), r"Hopper: forward_reward_weight='abc' must be a finite number"),
+    (dict(healthy_reward=True), r"Hopper: healthy_reward=True must be a finite number"),
+    (dict(healthy_z_range=(2.0, 0.7)), r"Hopper: healthy_z_range=\(2.0, 0.7\) must have low < high"),
+    (dict(healthy_z_range=(0.7, 1.0, 3.0)), r"Hopper: healthy_z_range=\(0.7, 1.0, 3.0\) must be a pair"),
+    (dict(healthy_angle_range=(float("nan"), 0.2)), r"Hopper: healthy_angle_range=\(nan, 0.2\) must have low < high"),
+    (dict(terminate_when_unhealthy="no"), r"Hopper: terminate_when_unhealthy='no' must be True or False"),
+    (dict(exclude_current_positions_from_observation="no"),
+     r"Hopper: exclude_current_positions_from_observation='no' must be True or False"),
+])
+def test_bad_task_keywords_name_the_culprit(kw, said):
+    """A NaN weight gave NaN rewards, a reversed healthy range ended every episode at its first
+    step and a string switch was read as True, all silently; exclude_current_positions_from_
+    observation='no' raised int()'s "invalid literal for int() with base 10"."""
+    with pytest.raises(ValueError, match=said):
+        gym.make("planarsim/Hopper-v0", **kw)
+    gym.make("planarsim/Hopper-v0", forward_reward_weight=2, healthy_z_range=[0.5, 3.0],
+             terminate_when_unhealthy=np.bool_(False)).close()      # whole numbers, lists, numpy
+
+
 @pytest.mark.parametrize("name", ["InvertedPendulum", "Reacher"])
 def test_compiled_step_observation_is_the_tasks_own_to_the_bit(name):
     """The compiled observations of step() (tasks.joined_finite, tasks.reacher_obs) give the
