@@ -271,9 +271,25 @@ def _walker_params(run_class, params):
 
 
 def terrain_of(terrain):
-    """A Terrain from a Terrain, a spec string (planarsim.terrain.parse) or None (flat)."""
+    """A Terrain from a Terrain, a spec string (planarsim.terrain.parse) or None (flat); a
+    TypeError naming anything else (terrain=5 failed inside the walker's model builder)."""
     import planarsim as ps
-    return ps.terrain.parse(terrain) if isinstance(terrain, str) else terrain
+    if isinstance(terrain, str):
+        return ps.terrain.parse(terrain)
+    if terrain is not None and not isinstance(terrain, ps.terrain.Terrain):
+        raise TypeError(f"terrain={terrain!r} must be a planarsim.terrain.Terrain, a spec such "
+                        "as 'slope:-3' or 'hills', or None (flat)")
+    return terrain
+
+
+def start_rng(name, seed):
+    """numpy's generator of a walker's start perturbation for `seed`, a whole number >= 0; a
+    ValueError naming the walker and the seed otherwise (numpy said only "expected
+    non-negative integer")."""
+    if (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer))
+            or seed < 0):
+        raise ValueError(f"{name}: seed={seed!r} must be a whole number >= 0")
+    return np.random.default_rng(seed)
 
 
 def contract_problems(name: str, module) -> list:

@@ -134,6 +134,26 @@ def test_run_of_less_than_half_a_step_is_refused():
     assert len(run.run(0.0).t) == 1
 
 
+@pytest.mark.parametrize("name, kw, error, said", [
+    # terrain=5: "'int' object has no attribute 'height'" from inside the model builder
+    ("simple-biped", dict(terrain=5), TypeError, r"terrain=5 must be a planarsim.terrain.Terrain"),
+    ("simplest-walker", dict(terrain=5.0), TypeError, r"terrain=5.0 must be a planarsim.terrain.Terrain"),
+    # numpy's "expected non-negative integer" and "SeedSequence expects int ..."
+    ("simple-biped", dict(seed=-1), ValueError, r"simple-biped: seed=-1 must be a whole number >= 0"),
+    ("quadruped", dict(seed=1.5), ValueError, r"quadruped: seed=1.5 must be a whole number >= 0"),
+    # a longer section state was cut to its first numbers silently; a NaN one diverged at
+    # step 0 naming the hip
+    ("simplest-walker", dict(x0=np.zeros(7)), ValueError,
+     r"simplest-walker: x0=\[0.0, .*\] must be 4 number\(s\), the section state \(theta, theta_dot"),
+    ("compass-gait", dict(x0=[0.1, float("nan"), -0.1, 0.0]), ValueError,
+     r"compass-gait: x0 theta_dot=nan must be finite"),
+    ("rimless-wheel", dict(x0="fast"), ValueError, r"rimless-wheel: x0='fast' must be 1 number"),
+])
+def test_bad_run_keywords_are_named(name, kw, error, said):
+    with pytest.raises(error, match=said):
+        walkers.load(name).Run(**kw)
+
+
 def test_run_rejects_bad_record_every():
     with pytest.raises(ValueError, match="record_every"):
         walkers.load("quadruped").Run(record_every=-1)

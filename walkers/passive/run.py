@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from planarsim import dense
+from planarsim.errors import plain
 from planarsim.analysis import step_summary
 
 from walkers.base import WalkerRun, terrain_of
@@ -74,13 +75,29 @@ class PassiveRun(WalkerRun):
         p = params or self.Params()
         p = self.Params(**{**p.as_dict(), "slope": slope_from_terrain(terrain, p.slope)})
         self.walker = w = PassiveWalker(p, dt=dt)
-        w.set_coords(self.start(p) if x0 is None else x0)
+        w.set_coords(self.start(p) if x0 is None else self._section_state(x0, w.names))
         super().__init__(w.model, p, None, w.memory, state=w.sim.state, ws=w.sim.ws,
                          options=w.sim.options, record_every=record_every)
         self.impacts = impacts
         self.hip0 = self.state.q[w.hip, :2].copy()
         self.steps_asked = 0      # steps asked for by all runs so far
         self.code = 0             # run code of the last chunk (0, or FELL; FELL stays)
+
+    def _section_state(self, x0, names) -> np.ndarray:
+        """x0 as a float array of one finite number per coordinate in `names`; a ValueError
+        naming it otherwise (a longer one was cut silently, a NaN one diverged at step 0
+        naming a body)."""
+        try:
+            x = np.array(x0, dtype=np.float64)
+        except (TypeError, ValueError):
+            x = None
+        if x is None or x.shape != (len(names),):
+            raise ValueError(f"{self.NAME}: x0={plain(x0)!r} must be {len(names)} number(s), "
+                             f"the section state ({', '.join(names)})")
+        for name, value in zip(names, x):
+            if not math.isfinite(value):
+                raise ValueError(f"{self.NAME}: x0 {name}={value} must be finite")
+        return x
 
     def start(self, params) -> np.ndarray:
         """Default section state for `params`."""

@@ -20,7 +20,7 @@ import numpy as np
 from planarsim.compiled import RUN_FELL, jit, step
 import planarsim as ps
 
-from walkers.base import WalkerRun, simulation, terrain_of
+from walkers.base import WalkerRun, simulation, start_rng, terrain_of
 from walkers.common.record import record_labelled
 from walkers.common.slots import label_slots
 
@@ -79,8 +79,9 @@ class Run(WalkerRun):
         params = params if params is not None else QuadrupedParams()
         model = build(params, terrain_of(terrain), dt, extras=extras)
         state = ps.make_state(model)
+        rng = start_rng(self.NAME, seed)
         if seed:
-            state.q[:, 1] += 0.005 * np.random.default_rng(seed).uniform()
+            state.q[:, 1] += 0.005 * rng.uniform()
         memory = C.make_memory(model, params, C.gait_id(gait),
                                params.speed if speed is None else float(speed))
         memory[C.MEM.target + 1:C.MEM.target + 8:2] += state.q[0, 1] - model.q0[0, 1]

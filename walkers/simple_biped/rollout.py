@@ -16,7 +16,7 @@ import numpy as np
 from planarsim.compiled import RUN_FELL, jit, step, height
 import planarsim as ps
 
-from walkers.base import WalkerRun, simulation, terrain_of
+from walkers.base import WalkerRun, simulation, start_rng, terrain_of
 from walkers.common.record import record_labelled
 from walkers.common.slots import label_slots
 
@@ -114,8 +114,9 @@ class Run(WalkerRun):
         memory[C.MEM.gait] = _gait_id(gait)
         super().__init__(model, params, C.make_tables(params), memory, options=options,
                          record_every=record_every)
+        rng = start_rng(self.NAME, seed)
         if seed:
-            self.state.q[0, 0] += 0.01 * params.leg_length * np.random.default_rng(seed).uniform(-1, 1)
+            self.state.q[0, 0] += 0.01 * params.leg_length * rng.uniform(-1, 1)
         self.x_start = float(self.state.q[0, 0])
 
     # run-time switches ------------------------------------------------------------------------
