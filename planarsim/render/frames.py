@@ -21,6 +21,7 @@ import pickle
 
 import numpy as np
 
+from ..errors import plain
 from ..trajectory import check_recorded_by
 from .camera import Camera
 from .draw import Scene, make_figure
@@ -37,7 +38,15 @@ def frame_times(traj, fps: float = 30.0, speed: float = 1.0, start=None, duratio
         raise ValueError("the trajectory has no frames to animate")
     # frame 0 is the run's start: frames at 0, h, .. T cover T
     h = float(np.median(np.diff(traj.t))) if len(traj.t) > 1 else 0.0
-    t0 = float(traj.t[0]) if start is None else float(start)
+    if start is None:
+        t0 = float(traj.t[0])
+    else:
+        try:
+            t0 = float(start)
+        except (TypeError, ValueError):
+            raise ValueError(f"start={start!r} must be a number of seconds") from None
+        if not math.isfinite(t0):
+            raise ValueError(f"start={t0} must be finite [s]")
     t_end = float(traj.t[-1])
     if duration is None:
         duration = t_end - t0
@@ -49,6 +58,25 @@ def frame_times(traj, fps: float = 30.0, speed: float = 1.0, start=None, duratio
                          f"({traj.t[0]:g} .. {traj.t[-1]:g} s, recorded every {h:g} s)")
     n = max(1, int(round(duration * fps / speed)))
     return t0 + np.arange(n) * (speed / fps)
+
+
+def figure_size(size, dpi) -> tuple:
+    """((width, height) [inch], dpi) as floats, or a ValueError naming them: two finite
+    numbers > 0 and a finite dpi > 0 (dpi 0 divided by zero, a NaN one failed in int(), a
+    negative size was drawn 2 pixels wide)."""
+    try:
+        w, h = (float(v) for v in size)
+    except (TypeError, ValueError):
+        raise ValueError(f"size={plain(size)!r} must be (width, height) [inch], two numbers") from None
+    if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
+        raise ValueError(f"size=({w:g}, {h:g}) must be two finite numbers > 0 [inch]")
+    try:
+        dpi = float(dpi)
+    except (TypeError, ValueError):
+        raise ValueError(f"dpi={dpi!r} must be a number (pixels per inch)") from None
+    if not (math.isfinite(dpi) and dpi > 0):
+        raise ValueError(f"dpi={dpi:g} must be finite and > 0 (pixels per inch)")
+    return (w, h), dpi
 
 
 def frame_indices(traj, times) -> np.ndarray:
@@ -76,6 +104,7 @@ class FrameRenderer:
         self.times = frame_times(traj, fps, speed, start, duration)
         self.index = frame_indices(traj, self.times)
         self.shown_times = self.times - float(traj.t[0])
+        size, dpi = figure_size(size, dpi)
         w_px, h_px = (max(2, int(round(float(v) * dpi)) // 2 * 2) for v in size)
         self.fig, self.ax = make_figure((w_px / dpi, h_px / dpi), dpi)
         self.scene = Scene(model, self.ax, **scene_kw)

@@ -67,6 +67,22 @@ def test_unknown_extension_and_unwritable_path_give_clear_errors(sliding_run, tm
     assert sorted(p.name for p in tmp_path.iterdir()) == ["adir.gif"]
 
 
+@pytest.mark.parametrize("kw, said", [
+    (dict(dpi=0), r"dpi=0 must be finite and > 0"),                     # was ZeroDivisionError
+    (dict(dpi=float("nan")), r"dpi=nan must be finite and > 0"),        # was int() of NaN
+    (dict(size=(-6.4, -3.6)), r"size=\(-6.4, -3.6\) must be two finite numbers > 0"),  # was 2 px
+    (dict(size=(6.4, 3.6, 1.0)), r"size=\(6.4, 3.6, 1.0\) must be \(width, height\)"),
+    (dict(start=float("nan")), r"start=nan must be finite"),           # was named duration=nan
+    (dict(start="abc"), r"start='abc' must be a number of seconds"),
+    (dict(bitrate=-5), r"bitrate=-5 must be None .* or a number >= 1"),  # was ffmpeg's broken pipe
+])
+def test_bad_picture_settings_are_named_before_any_frame(sliding_run, tmp_path, kw, said):
+    model, traj = sliding_run
+    with pytest.raises(ValueError, match=said):
+        export_animation(traj, model, tmp_path / "x.mp4", progress=False, workers=1, **kw)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_progress_bar_counts_every_frame(sliding_run, tmp_path, capsys, monkeypatch):
     model, traj = sliding_run
     seen = []
