@@ -737,6 +737,9 @@ class ModelBuilder:
         _finite("contact", name, idx, "span", (a0, a1))
         if not a1 > a0:
             raise ModelError(f"contact {name!r} ({idx}): span=({a0}, {a1}) must have span[1] > span[0]")
+        if isinstance(vertices, (str, bytes, dict)) or not hasattr(vertices, "__iter__"):
+            raise ModelError(f"contact {name!r} ({idx}): vertices={_plain(vertices)!r} must be a "
+                             "list of (x, y) points (heel, toe, ...)")
         cid = self._contact(name, body, CONTACT_ARC, center, r, (a0, a1), mu, list(vertices))
         b = self._contacts[cid]["body"]
         self._shapes.append(M.Shape(b, "arc", (tuple(self._contacts[cid]["local"]), r, (a0, a1),

@@ -293,6 +293,9 @@ def test_actuator_limit_that_is_not_an_open_pair(method, limit, words):
      r"contact 'sole' \(0\): span=\(1.0, 1.0\) must have span\[1\] > span\[0\]"),
     (lambda b: b.add_arc_contact("sole", "torso", (0.0, 0.0), 0.1, span=(-math.inf, 1.0)),
      r"contact 'sole' \(0\): span=\(-inf, 1.0\) must be finite"),
+    # vertices=5: "'int' object is not iterable"
+    (lambda b: b.add_arc_contact("sole", "torso", (0.0, 0.0), 0.1, vertices=5),
+     r"contact 'sole' \(0\): vertices=5 must be a list of \(x, y\) points"),
     (lambda b: b.add_fluid_box("torso", size=5),
      r"fluid box on body 'torso' \(0\): size=5 must be three lengths \(l1, l2, ln\) \[m\]"),
     (lambda b: b.add_fluid_box("torso", size=(0.1, 0.2)), r"size=\(0.1, 0.2\) must be three"),
