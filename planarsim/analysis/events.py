@@ -123,6 +123,15 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
         left: a step, not a foot rocking, chattering or hopping in place, nor a body's first
         touch (0: every landing counts).
     """
+    for name, value in (("min_air", min_air), ("together", together), ("min_stride", min_stride)):
+        if (isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number))
+                or not (np.isfinite(value) and value >= 0)):
+            # NaN compared False everywhere: a NaN min_stride counted every landing
+            raise ValueError(f"{name}={value!r} must be a finite number >= 0")
+    for name, value in (("contacts", contacts), ("feet", feet)):
+        if isinstance(value, (str, bytes)):
+            raise ValueError(f"{name}={value!r} must be a list (of contact names or indices"
+                             f"{', or of such lists' if name == 'feet' else ''}), not a string")
     if min_stride > 0.0 and (feet is None or model is None):
         raise ValueError(f"min_stride={min_stride} m needs feet and the model (the feet's positions)")
     if feet is not None:

@@ -55,6 +55,22 @@ def henon(a=1.4, b=0.3):
     return lambda x: np.array([1.0 - a * x[0] ** 2 + x[1], b * x[0]])
 
 
+@pytest.mark.parametrize("kw, said", [
+    (dict(min_air=math.nan), r"min_air=nan must be a finite number >= 0"),
+    (dict(together=-1.0), r"together=-1.0 must be a finite number >= 0"),
+    (dict(min_air="long"), r"min_air='long' must be a finite number >= 0"),   # was a '>' TypeError
+    (dict(feet="left"), r"feet='left' must be a list .* not a string"),        # was "no contact 'l'"
+])
+def test_step_events_settings_are_checked(kw, said):
+    """A NaN or negative min_air or together compared False and counted every landing (a NaN
+    min_stride gave measure.summary a whole step where 0 gave none), silently."""
+    modes = np.zeros((11, 2), int)
+    modes[3:, 0] = 1
+    traj = SimpleNamespace(contact_mode=modes, contact_names=("left", "right"), t=np.arange(11) * 0.01)
+    with pytest.raises(ValueError, match=said):
+        step_events(traj, **({"feet": [["left"]]} | kw))
+
+
 def test_henon_fixed_point_and_multipliers_match_closed_form():
     a, b = 1.4, 0.3
     xs = (-(1 - b) + math.sqrt((1 - b) ** 2 + 4 * a)) / (2 * a)

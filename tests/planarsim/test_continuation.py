@@ -128,6 +128,24 @@ def test_brute_force_diagram_periods_chaos_and_escape():
     assert len(d.rows()) == 4 * 32 + 1
 
 
+@pytest.mark.parametrize("call, said", [
+    # keep=1 or 0: every orbit read as a fall (period -1), transient=-5 ran silently
+    (lambda pool: bifurcation_diagram(pool, [2.8], [0.3], transient=10, keep=1),
+     r"keep=1 must be a whole number >= 2"),
+    (lambda pool: bifurcation_diagram(pool, [2.8], [0.3], transient=-5, keep=8),
+     r"transient=-5 must be a whole number >= 0"),
+    (lambda pool: bifurcation_diagram(pool, [2.8], [0.3], transient=10, keep=2.5),
+     r"keep=2.5 must be a whole number"),
+    # period 0: the identity, whose every point "converged" as a fixed point
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 3, period=0),
+     r"period=0 must be a whole number >= 1"),
+])
+def test_counts_that_would_give_wrong_answers_are_refused(call, said):
+    with MapPool(logistic, backend="serial") as pool:
+        with pytest.raises(ValueError, match=said):
+            call(pool)
+
+
 def pair(p):
     g = logistic(p)
     return lambda x: np.array([g(x[:1])[0], 0.5 * x[1]])
