@@ -47,6 +47,19 @@ def joint_position_rate(model, q, v, j):
     return slide, dx * (vbx - vax) + dy * (vby - vay)
 
 
+def _body_frames(model, x, name, who):
+    """x as an array of shape (..., n_body, 3), or a ValueError naming `who` and `name` (a
+    state of another model's bodies was broadcast against this one's masses silently)."""
+    try:
+        arr = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: {name}={x!r} must be numbers of shape (..., {model.n_body}, 3)") from None
+    if arr.shape[-2:] != (model.n_body, 3):
+        raise ValueError(f"{who}: {name} has shape {arr.shape}; it must be (..., {model.n_body}, 3): "
+                         f"one row per body of the model ({list(model.body_names)})")
+    return arr
+
+
 def _scalar_or_array(x):
     return float(x) if np.ndim(x) == 0 else x
 
@@ -55,7 +68,8 @@ def kinetic_energy(model, q, v):
     """sum 1/2 m |v|^2 + 1/2 I w^2, plus each joint armature's 1/2 a rate^2 [J]; q, v of
     shape (..., n_body, 3)."""
     a = model.arrays
-    v = np.asarray(v)
+    q = _body_frames(model, q, "q", "kinetic_energy")
+    v = _body_frames(model, v, "v", "kinetic_energy")
     ke = 0.5 * np.sum(a.body_mass * (v[..., 0] ** 2 + v[..., 1] ** 2) + a.body_inertia * v[..., 2] ** 2, axis=-1)
     for j in range(model.n_pin):
         if a.pin_armature[j] > 0.0:
@@ -66,7 +80,7 @@ def kinetic_energy(model, q, v):
 def potential_energy(model, q, v=None):
     """-sum m g.x plus joint-spring energy 1/2 k (coordinate - rest)^2 [J]."""
     a = model.arrays
-    q = np.asarray(q)
+    q = _body_frames(model, q, "q", "potential_energy")
     pe = -np.sum(a.body_mass * (a.gravity[0] * q[..., 0] + a.gravity[1] * q[..., 1]), axis=-1)
     for j in range(model.n_pin):
         k = a.pin_stiffness[j]

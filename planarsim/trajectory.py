@@ -148,9 +148,18 @@ class Trajectory:
         chunks = list(chunks)
         if not chunks:
             raise ValueError("concatenate needs at least one trajectory")
+        first = chunks[0]
+        for k, c in enumerate(chunks):
+            if not isinstance(c, Trajectory):
+                raise TypeError(f"Trajectory.concatenate: chunk {k} is {type(c).__name__}, not a "
+                                "Trajectory")
+            for names in ("body_names", "contact_names", "act_names"):
+                if tuple(getattr(c, names)) != tuple(getattr(first, names)):
+                    raise ValueError(f"Trajectory.concatenate: chunk {k} has {names} "
+                                     f"{list(getattr(c, names))} but chunk 0 has "
+                                     f"{list(getattr(first, names))}: chunks of one run only")
         if len(chunks) == 1:
             return chunks[0]
-        first = chunks[0]
         arrays = {k: np.concatenate([getattr(c, k) for c in chunks]) for k in cls._ARRAYS}
         shared = [k for k in first.labels if all(k in c.labels for c in chunks)]
         labels = {k: np.concatenate([np.asarray(c.labels[k]) for c in chunks]) for k in shared}
@@ -162,15 +171,18 @@ class Trajectory:
 
     def com(self, model) -> np.ndarray:
         """(K, 2) centre of mass [m]."""
+        check_recorded_by(self, model, "Trajectory.com")
         m = model.arrays.body_mass
         return np.einsum("b,kbc->kc", m, self.q[:, :, :2]) / m.sum()
 
     def com_velocity(self, model) -> np.ndarray:
+        check_recorded_by(self, model, "Trajectory.com_velocity")
         m = model.arrays.body_mass
         return np.einsum("b,kbc->kc", m, self.v[:, :, :2]) / m.sum()
 
     def energy(self, model) -> dict:
         """Kinetic, potential and total energy per frame [J]."""
+        check_recorded_by(self, model, "Trajectory.energy")
         ke = kinetic_energy(model, self.q, self.v)
         pe = potential_energy(model, self.q)
         return {"kinetic": ke, "potential": pe, "total": ke + pe}
@@ -221,6 +233,8 @@ class Trajectory:
         actuator's applied effort is named torque_Nm or force_N by its kind. `path` must end
         in .csv (as save's in .npz)."""
         path = file_with_suffix(path, ".csv", "CSV")
+        if model is not None:       # another model's names and kinds would head the columns
+            check_recorded_by(self, model, "Trajectory.to_csv")
         cols, blocks = csv_columns(self, model)
         table = np.hstack([np.asarray(b, dtype=np.float64).reshape(len(self.t), -1) for b in blocks])
         atomic_write(path, lambda f: np.savetxt(f, table, delimiter=",", header=",".join(cols),

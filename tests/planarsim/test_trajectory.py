@@ -43,3 +43,36 @@ def test_python_and_compiled_recordings_of_a_state_are_the_same():
         frames = getattr(rec, name)
         assert np.array_equal(frames[0], frames[1]), name
     assert np.any(rec.contact_impulse[0] != 0) and np.any(rec.act_power[0] != 0)
+
+
+def _bodies(n):
+    b = ps.ModelBuilder(dt=1e-3)
+    for i in range(n):
+        b.add_body(f"b{i}", mass=1.0, inertia=0.01, pos=(float(i), 1.0))
+    return b.compile()
+
+
+def test_another_models_numbers_are_refused_not_computed(tmp_path):
+    """A 2-body recording's energy, centre of mass and CSV with a 1-body model were computed
+    silently (numpy broadcast the one body's mass over both); kinetic_energy of a 1-body v with
+    a 2-body model likewise; concatenating two models' recordings raised numpy's "all the
+    input array dimensions ... must match exactly"."""
+    import pytest
+    one, two = _bodies(1), _bodies(2)
+    traj = ps.Simulator(two).run(0.01)
+    for who in ("energy", "com", "com_velocity"):
+        with pytest.raises(ValueError, match=rf"Trajectory\.{who}: the trajectory has 2 bodies "
+                                             r"per frame but the model has 1"):
+            getattr(traj, who)(one)
+    with pytest.raises(ValueError, match=r"Trajectory\.to_csv: the trajectory has 2 bodies"):
+        traj.to_csv(tmp_path / "t.csv", one)
+    with pytest.raises(ValueError, match=r"kinetic_energy: v has shape \(1, 3\); it must be "
+                                         r"\(\.\.\., 2, 3\)"):
+        ps.kinetic_energy(two, two.q0, np.zeros((1, 3)))
+    with pytest.raises(ValueError, match=r"potential_energy: q has shape \(3,\)"):
+        ps.potential_energy(one, np.zeros(3))
+    with pytest.raises(ValueError, match=r"Trajectory\.concatenate: chunk 1 has body_names "
+                                         r"\['b0'\] but chunk 0 has \['b0', 'b1'\]"):
+        Trajectory.concatenate([traj, ps.Simulator(one).run(0.01)])
+    assert list(tmp_path.iterdir()) == []
+    assert ps.total_energy(two, traj.q, traj.v).shape == (len(traj.t),)   # frames still fine
