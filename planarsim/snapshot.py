@@ -28,7 +28,14 @@ def save_snapshot(path, state: State, memory: dict | None = None) -> Path:
                         f"{type(memory).__name__}")
     payload = {f"state__{k}": v for k, v in state.as_dict().items()}
     for k, v in (memory or {}).items():
-        payload[f"memory__{k}"] = np.asarray(v)
+        arr = np.asarray(v)
+        if not isinstance(k, str) or arr.dtype.kind not in "biufcUS":
+            # an object array is pickled, which load_snapshot (allow_pickle=False) then
+            # refuses as a damaged file: refused here, before anything is written
+            raise TypeError(f"save_snapshot: memory[{k!r}] = {type(v).__name__} must be numbers "
+                            "(an array or a number) under a string name, which load_snapshot "
+                            "reads back")
+        payload[f"memory__{k}"] = arr
     payload["snapshot_version"] = np.array(SNAPSHOT_VERSION)
     atomic_write(path, lambda f: np.savez(f, **payload))
     return path

@@ -389,4 +389,12 @@ def test_files_of_the_wrong_kind(tmp_path):
         ps.save_snapshot(tmp_path / "s.npz", sim)
     with pytest.raises(TypeError, match=r"memory must be a dict"):
         ps.save_snapshot(tmp_path / "s.npz", sim.state, memory=5)
+    # a memory value that is no number was pickled into a file that load_snapshot then called
+    # "truncated or corrupted" (allow_pickle=False)
+    with pytest.raises(TypeError, match=r"save_snapshot: memory\['gains'\] = dict must be numbers"):
+        ps.save_snapshot(tmp_path / "s.npz", sim.state, memory={"gains": {"kp": 1.0}})
+    with pytest.raises(TypeError, match=r"memory\[3\] = float must be numbers .* under a string name"):
+        ps.save_snapshot(tmp_path / "s.npz", sim.state, memory={3: 1.0})
     assert list(tmp_path.iterdir()) == []
+    ps.save_snapshot(tmp_path / "s.npz", sim.state, memory={"gains": [1.0, 2.0], "mode": 3})
+    assert ps.load_snapshot(tmp_path / "s.npz")[1]["gains"].tolist() == [1.0, 2.0]
