@@ -353,6 +353,10 @@ class Simulator:
             if not 0 <= i < self.model.n_contact:
                 raise IndexError(f"contact={contact} is not a contact of the model: it has "
                                  f"{self.model.n_contact}, indices 0..{self.model.n_contact - 1}")
+        if not (isinstance(enabled, (bool, np.bool_)) or (isinstance(enabled, (int, np.integer))
+                                                          and enabled in (0, 1))):
+            # a string such as "off" is true: the contact would have been switched on
+            raise TypeError(f"set_contact_enabled: enabled={enabled!r} must be True or False")
         self.state.contact_enabled[i] = 1 if enabled else 0
 
     def contact_impulses(self) -> np.ndarray:

@@ -238,6 +238,18 @@ def test_contact_switch_names_a_contact(index, pattern):
     assert np.array_equal(sim.state.contact_enabled, before)
 
 
+@pytest.mark.parametrize("flag", ["off", None, 2, 0.5])
+def test_contact_switch_takes_true_or_false(flag):
+    """set_contact_enabled(0, "off") switched the contact on (a non-empty string is true)."""
+    sim = ps.Simulator(resting_rod())
+    sim.set_contact_enabled(0, False)
+    with pytest.raises(TypeError, match=rf"enabled={flag!r} must be True or False"):
+        sim.set_contact_enabled(0, flag)
+    assert sim.state.contact_enabled[0] == 0
+    sim.set_contact_enabled(0, 1)
+    assert sim.state.contact_enabled[0] == 1
+
+
 @pytest.mark.parametrize("call, pattern", [
     (lambda sim: sim.steps(2.7), r"n=2.7 must be a whole number"),
     (lambda sim: sim.steps(NAN), "whole number"),
