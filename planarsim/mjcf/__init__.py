@@ -147,6 +147,8 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
         raise ModelError(f"load_mjcf: offset={tuple(offset.tolist())} must be finite")
     if isinstance(source, (bytes, bytearray)):   # XML text as bytes (dm_control's swimmer)
         source = decode(source, "load_mjcf: the XML source")
+    if isinstance(source, str) and source.startswith("\ufeff"):
+        source = source[1:]     # a byte order mark: the text, not a path starting with one
     if isinstance(source, (str, Path)) and not str(source).strip():
         raise ModelError("load_mjcf: the source is empty (give an MJCF file's path or its XML text)")
     if isinstance(source, (str, Path)) and not str(source).lstrip().startswith("<"):

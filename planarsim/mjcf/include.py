@@ -33,9 +33,10 @@ def _norm(name: str) -> str:
 
 
 def decode(data, what) -> str:
-    """UTF-8 bytes -> str, or a ModelError naming what they are."""
+    """UTF-8 bytes -> str (a byte order mark, as some editors write, dropped), or a
+    ModelError naming what they are."""
     try:
-        return bytes(data).decode("utf-8")
+        return bytes(data).decode("utf-8-sig")
     except UnicodeDecodeError as e:
         raise ModelError(f"{what} is not UTF-8 text: {e}") from None
 

@@ -210,6 +210,19 @@ def test_bad_load_arguments_are_named(kw, error, match):
         load_mjcf(LEG, **kw)
 
 
+def test_xml_text_with_a_byte_order_mark_is_read_as_text(tmp_path):
+    """The bytes of a file saved with a UTF-8 byte order mark (some editors write one), or its
+    text read with encoding='utf-8', were taken for a path: "cannot read MJCF file
+    '\\ufeff<mujoco>...': No such file or directory"."""
+    path = tmp_path / "leg.xml"
+    path.write_text(LEG, encoding="utf-8-sig")
+    for source in (path, path.read_bytes(), path.read_text(encoding="utf-8")):
+        assert load_mjcf(source).compile().n_body == 1
+    xml = LEG.replace("<mujoco>", "<mujoco><include file='more.xml'/>")
+    more = "<mujoco><option timestep='0.002'/></mujoco>".encode("utf-8-sig")
+    assert load_mjcf(xml, assets={"more.xml": more}).compile().arrays.dt == 0.002
+
+
 def test_missing_file_is_a_model_error(tmp_path):
     with pytest.raises(ModelError, match="cannot read MJCF file"):
         load_mjcf(tmp_path / "nope.xml")
