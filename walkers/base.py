@@ -282,6 +282,20 @@ def terrain_of(terrain):
     return terrain
 
 
+def target_speed(name, speed, lo=-math.inf, hi=math.inf) -> float:
+    """A walker's commanded speed [m/s] as a float within [lo, hi]; a ValueError naming the
+    walker and the speed otherwise (a NaN speed stopped the run at its first step naming a
+    leg actuator's command, a string failed in float())."""
+    try:
+        x = float(speed)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not (math.isfinite(x) and lo <= x <= hi):
+        raise ValueError(f"{name}: speed={speed!r} m/s must be a finite number"
+                         + (f" within [{lo:g}, {hi:g}]" if math.isfinite(lo) or math.isfinite(hi) else ""))
+    return x
+
+
 def start_rng(name, seed):
     """numpy's generator of a walker's start perturbation for `seed`, a whole number >= 0; a
     ValueError naming the walker and the seed otherwise (numpy said only "expected

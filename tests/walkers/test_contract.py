@@ -148,10 +148,23 @@ def test_run_of_less_than_half_a_step_is_refused():
     ("compass-gait", dict(x0=[0.1, float("nan"), -0.1, 0.0]), ValueError,
      r"compass-gait: x0 theta_dot=nan must be finite"),
     ("rimless-wheel", dict(x0="fast"), ValueError, r"rimless-wheel: x0='fast' must be 1 number"),
+    # a NaN speed stopped the run at its first step naming actuator 'leg0''s command; 'fast'
+    # failed in float(); 5 m/s (set_speed's bound: [0, 3]) was taken by the constructor
+    ("simple-biped", dict(speed=float("nan")), ValueError,
+     r"simple-biped: speed=nan m/s must be a finite number within \[0, 3\]"),
+    ("simple-biped", dict(speed=5.0), ValueError, r"simple-biped: speed=5.0 m/s must be a finite"),
+    ("quadruped", dict(speed="fast"), ValueError, r"quadruped: speed='fast' m/s must be a finite number"),
 ])
 def test_bad_run_keywords_are_named(name, kw, error, said):
     with pytest.raises(error, match=said):
         walkers.load(name).Run(**kw)
+
+
+def test_a_speed_set_while_running_is_checked_too():
+    with pytest.raises(ValueError, match=r"simple-biped: speed=inf m/s"):
+        walkers.load("simple-biped").Run().set_speed(float("inf"))
+    with pytest.raises(ValueError, match=r"quadruped: speed=nan m/s"):
+        walkers.load("quadruped").Run().set_gait("walk", float("nan"))
 
 
 def test_run_rejects_bad_record_every():

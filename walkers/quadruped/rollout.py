@@ -20,7 +20,7 @@ import numpy as np
 from planarsim.compiled import RUN_FELL, jit, step
 import planarsim as ps
 
-from walkers.base import WalkerRun, simulation, start_rng, terrain_of
+from walkers.base import WalkerRun, simulation, start_rng, target_speed, terrain_of
 from walkers.common.record import record_labelled
 from walkers.common.slots import label_slots
 
@@ -83,7 +83,7 @@ class Run(WalkerRun):
         if seed:
             state.q[:, 1] += 0.005 * rng.uniform()
         memory = C.make_memory(model, params, C.gait_id(gait),
-                               params.speed if speed is None else float(speed))
+                               params.speed if speed is None else target_speed(self.NAME, speed))
         memory[C.MEM.target + 1:C.MEM.target + 8:2] += state.q[0, 1] - model.q0[0, 1]
         super().__init__(model, params, params.to_array(), memory, state=state,
                          options=ps.make_options(strategy), record_every=record_every)
@@ -93,7 +93,7 @@ class Run(WalkerRun):
         """Switch gait ("stand" | "piaffe" | "walk") and optionally the speed [m/s] at run time."""
         self.memory[C.MEM.gait] = C.gait_id(gait)
         if speed is not None:
-            self.memory[C.MEM.speed] = float(speed)
+            self.memory[C.MEM.speed] = target_speed(self.NAME, speed)
 
     @property
     def p(self) -> np.ndarray:

@@ -16,7 +16,7 @@ import numpy as np
 from planarsim.compiled import RUN_FELL, jit, step, height
 import planarsim as ps
 
-from walkers.base import WalkerRun, simulation, start_rng, terrain_of
+from walkers.base import WalkerRun, simulation, start_rng, target_speed, terrain_of
 from walkers.common.record import record_labelled
 from walkers.common.slots import label_slots
 
@@ -110,7 +110,7 @@ class Run(WalkerRun):
         model = build(params, terrain_of(terrain), dt, extras=extras)
         memory = np.zeros(C.N_MEMORY)
         memory[C.MEM.state] = C.ST_STAND
-        memory[C.MEM.speed] = params.speed if speed is None else float(speed)
+        memory[C.MEM.speed] = params.speed if speed is None else target_speed(self.NAME, speed, 0.0, 3.0)
         memory[C.MEM.gait] = _gait_id(gait)
         super().__init__(model, params, C.make_tables(params), memory, options=options,
                          record_every=record_every)
@@ -126,9 +126,7 @@ class Run(WalkerRun):
 
     def set_speed(self, speed: float) -> None:
         """Target walking speed [m/s]."""
-        if not 0.0 <= speed <= 3.0:
-            raise ValueError(f"speed={speed} m/s must be within [0, 3]")
-        self.memory[C.MEM.speed] = float(speed)
+        self.memory[C.MEM.speed] = target_speed(self.NAME, speed, 0.0, 3.0)
 
     @property
     def gait(self) -> str:
