@@ -33,9 +33,9 @@ DEFECTS = {
                      "step at 0.5 rad, worked by hand: SHAKE (the correction along the rod at "
                      "the step's start) ends at L = 50.0 exactly and KE 1339.8 J (+7.2 %: the "
                      "velocity is the step's chord, not tangent at its end); the engine ends at "
-                     "L 49.2 and 1319.7 J, as if the correction's velocity change were cut "
-                     "where it raises the energy (integrate.bound_correction_work cuts rises "
-                     "only; not confirmed)"),
+                     "L 49.2 and 1319.7 J. Not the correction's energy bound: marking where "
+                     "integrate.bound_correction_work cuts beyond SHAKE's regime showed no cut "
+                     "in these steps (a probe, not kept)"),
 }
 
 
