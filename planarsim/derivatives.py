@@ -63,7 +63,7 @@ from .kernels.codes import (CONTACT_ARC, CONTACT_PAIR, CONTACT_POINT, INTEGRATOR
 from .kernels.geometry.collide import MAX_CORE_VERTICES
 from .kernels.dynamics.forces import (ACT_AXIAL, ACT_BODY_FORCE, ACT_BODY_TORQUE, ACT_HIP_TORQUE,
                                       ACT_PIN_TORQUE, ACT_SLIDER_FORCE)
-from .kernels.info import INFO_CCD_SPLITS, INFO_PROJECTIONS, INFO_TURN_SUBSTEPS
+from .kernels.info import INFO_CCD_SPLITS, INFO_PROJECTIONS, INFO_SHAKE_WHOLE, INFO_TURN_SUBSTEPS
 from .step_replica import ContactPlan, ReplicaRefused, StepPlan, replica
 
 #: the replay must end where the engine's step ended to this share of the step's motion (plus
@@ -331,6 +331,7 @@ def _step_derivative(sim, u, directions, _keep_end):
         impulses = end.last_contact_impulse.copy()
         features = end.contact_feature.copy()
         first_order = int(sim.ws.first_order[0])
+        shake_whole = int(sim.ws.info[INFO_SHAKE_WHOLE]) > 0
         projections = int(sim.ws.info[INFO_PROJECTIONS])
         v_lin = sim.ws.v_lin.ravel().copy()
         limit_impulses = end.last_pin_impulse[:, 2:4].copy()
@@ -353,7 +354,7 @@ def _step_derivative(sim, u, directions, _keep_end):
         return _substeps_tangents(sim, u, substeps, start, q1, v1, _keep_end, audit, info,
                                   directions)
     jac, plan = _replica_tangents(sim, u, start, end_modes, end_slips, features, limit_active,
-                                  q1, v1, first_order, projections, directions)
+                                  q1, v1, first_order, projections, directions, shake_whole)
     if np.abs(plan.v_lin - v_lin).max(initial=0.0) > FIT_TOL * (np.abs(v_lin).max() + 1e-300):
         raise _not_covered("a velocity solve whose joints' target the step linearized again "
                            "at its first answer (step.relinearize)")
@@ -659,7 +660,7 @@ def _engine_order(model, held, limits, contacts) -> np.ndarray:
 
 
 def _replica_tangents(sim, u, start, modes, slips, features, limit_active, q1, v1,
-                      first_order, projections, directions):
+                      first_order, projections, directions, shake_whole=False):
     """(StepTangents, its StepPlan) of a step the engine took in one piece, ending at (q1,
     v1): the step's equations replayed (planarsim.step_replica) from the start and from the
     start moved by i COMPLEX_STEP along each direction (dx, du), in one batch whose
@@ -695,7 +696,7 @@ def _replica_tangents(sim, u, start, modes, slips, features, limit_active, q1, v
         plan = StepPlan(model=model, h=h, q0=q0, u=u.copy(), W_A=W_A, W_D=W_D, R=R, f0=f, F=F,
                         fs0=f_spring, K=K, f_alone0=f_alone, K_force=K_alone, rotors=rotors,
                         held=held, turning=turning, u_held=(u < lo) | (u > hi),
-                        contacts=contacts, limits=limits,
+                        contacts=contacts, limits=limits, shake_whole=shake_whole,
                         order=_engine_order(model, held, limits, contacts),
                         iters=int(sim.options.refine_iters),
                         tol=float(sim.options.refine_tol), flip=flip,

@@ -30,6 +30,31 @@ def _plain_hinges(a) -> bool:
                 and not np.any(np.asarray(a.pin_frictionloss)))
 
 
+def joints_form_no_loop(model) -> bool:
+    """The model's joints (pins of every kind, rods) close no loop of bodies, the world
+    counted as one body: a forest hanging from the world. Such joints' rows are independent
+    at any configuration, so a step of these rows alone has SHAKE's correction
+    (position.joints_alone)."""
+    a = model.arrays
+    joints = np.concatenate([np.asarray(a.pin_body).reshape(-1, 2),
+                             np.asarray(a.rod_body).reshape(-1, 2)])
+    parent = list(range(model.n_body + 1))      # node n_body: the world
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for ba, bb in joints:
+        ra = root(int(ba) if ba >= 0 else model.n_body)
+        rb = root(int(bb) if bb >= 0 else model.n_body)
+        if ra == rb:
+            return False
+        parent[ra] = rb
+    return True
+
+
 def pin_chain_order(model) -> tuple[np.ndarray, np.ndarray] | None:
     """(order, ends) if the model qualifies (module docstring), else None.
 

@@ -17,7 +17,7 @@ from .kernels.checks.audit import N_AUDIT
 from .kernels.info import N_INFO
 from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
 from .model import Model
-from .pin_chains import pin_chain_order
+from .pin_chains import joints_form_no_loop, pin_chain_order
 
 
 class State(NamedTuple):
@@ -456,6 +456,8 @@ class Workspace(NamedTuple):
     chain_on: np.ndarray         # (1,) int 1: the model's pins form open chains and are its only
                                  #   rows: the step tries its pin-chain path (kernels/solver/pin_chain.py;
                                  #   planarsim/pin_chains.py)
+    joints_open: np.ndarray      # (1,) int 1: the model's joints close no loop of bodies
+                                 #   (pin_chains.joints_form_no_loop; position.joints_alone)
     chain_pin: np.ndarray        # (n_pin,) int the pins chain by chain (pin_chain_order)
     chain_end: np.ndarray        # (n_pin, 2) int the ends of pins k and k - 1 at the body they
                                  #   share (-1: a chain starts at k)
@@ -827,7 +829,8 @@ def _chain_arrays(model: Model) -> dict:
     found = pin_chain_order(model)
     order, ends = found if found is not None else (np.zeros(npin, np.int64),
                                                     np.full((npin, 2), -1, np.int64))
-    return dict(chain_on=np.array([int(found is not None)], np.int64), chain_pin=order,
+    return dict(chain_on=np.array([int(found is not None)], np.int64),
+                joints_open=np.array([int(joints_form_no_loop(model))], np.int64), chain_pin=order,
                 chain_end=ends, chain_factor=np.zeros((npin, 12)), chain_y=np.zeros((npin, 2)),
                 chain_cs=np.full((model.n_body, 3), np.nan),
                 chain_lever=np.zeros((npin, 2, 4)))

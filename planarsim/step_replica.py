@@ -97,6 +97,7 @@ class StepPlan:
     passes: int | None = None   # Newton passes (None: decide, on the real run)
     extra_pass: bool | None = None
     bound: dict | None = None   # the energy bound's branch (None: decide)
+    shake_whole: bool = False   # the engine kept the correction whole as SHAKE's (its regime)
     lifted: np.ndarray | None = None     # the mode rows whose start is off their surface
     solved: np.ndarray | None = None     # the velocity solve's independent rows
     kept: np.ndarray | None = None       # the rows the correction keeps (none leaving)
@@ -789,7 +790,12 @@ def _sabs(x):
 def _energy_bound(plan, q0, v0, q1, v, v_s, f, deciding):
     """kernels/dynamics/integrate.py bound_correction_work: v_s + k (v - v_s), k the largest share in
     [0, 1] of the correction's velocity change that adds no energy beyond its allowance (its
-    branches the plan's); f (B, 3 n) [N, N m]: the step's applied forces (ws.force)."""
+    branches the plan's); f (B, 3 n) [N, N m]: the step's applied forces (ws.force). Where
+    the engine kept the correction whole as SHAKE's (plan.shake_whole: RATTLE, or joints
+    alone, within SHAKE's regime), v."""
+    if plan.shake_whole:
+        plan.bound = {"branch": "whole"}
+        return v
     model, h = plan.model, plan.h
     a_ = model.arrays
     n = model.n_body

@@ -19,14 +19,17 @@ INFO_CHAIN_PATH = 11       # 1: the step was taken by the pin-chain path (step.c
                            # by the general stages
 INFO_KEPT_FACTORS = 12     # velocity solves on the factors kept from an earlier step's
                            # (solve.refine_on_kept_factors: a pile at rest)
-N_INFO = 13
+INFO_SHAKE_WHOLE = 13     # position corrections kept whole as SHAKE's, within its regime
+                           # (integrate.bound_correction_work: RATTLE, or joints alone)
+N_INFO = 14
 
 INFO_NAMES = ("solves", "ccd_splits", "guard_body", "guard_field", "lcp_solves",
               "newton_taken_back", "lcp_pivots", "projections", "command", "ccd_stops",
-              "turn_substeps", "chain_path", "kept_factors")
+              "turn_substeps", "chain_path", "kept_factors", "shake_whole")
 # counted afresh by every step (the guard slots keep the last failure)
 STEP_COUNTS = (INFO_SOLVES, INFO_CCD_SPLITS, INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK,
-               INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS, INFO_KEPT_FACTORS)
+               INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS, INFO_KEPT_FACTORS,
+               INFO_SHAKE_WHOLE)
 
 
 def step_info(ws) -> dict:

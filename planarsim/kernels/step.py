@@ -874,7 +874,8 @@ def chain_part(m, s, ws, opt, u, h):
     if not (worst >= 0.0 and worst <= opt.refine_tol):
         return CHAIN_AGAIN
     # (without a pass v is the solve's: the bound has nothing to keep)
-    if passes > 0 and bound_correction_work(m, s, ws, h, False) > 0.0:
+    if passes > 0 and bound_correction_work(
+            m, s, ws, h, ws.joints_open[0] == 1 and ws.joint_pivot[0] >= NEAR_DEPENDENT) > 0.0:
         return CHAIN_AGAIN
     s.time[0] = ws.prev.time[0] + h
     s.step[0] += 1

@@ -20,7 +20,7 @@ import math
 
 from ...compile import kernel
 from ..codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED
-from ..info import INFO_NEWTON_TAKEN_BACK
+from ..info import INFO_NEWTON_TAKEN_BACK, INFO_SHAKE_WHOLE
 from ..math2d import update_trig
 from ..constraints.limit import limit_side
 from ..constraints.row_list import move_row
@@ -154,9 +154,11 @@ def bound_correction_work(m, s, ws, h, symplectic):
     M the bodies' masses and the joints' rotors: a a g^T g term per joint with armature a).
 
     symplectic: a stage of the accurate integrators (kernels/dynamics/rattle.py), whose velocity must
-    be the move (q+ - q) / h for RATTLE to stay symplectic: within SHAKE's regime the
-    correction is kept whole (RATTLE's energy oscillates by about (h w)^2 of it and comes
-    back; cutting the rises alone ratcheted a coarse step's energy down, -50 % in 10 s)."""
+    be the move (q+ - q) / h for RATTLE to stay symplectic, or a default step of hard joints
+    alone (position.joints_alone), which is SHAKE: within SHAKE's regime the correction is
+    kept whole (the energy oscillates by about (h w)^2 of it and comes back; cutting the rises
+    alone ratcheted a coarse step's energy down: RATTLE -50 % in 10 s, a double pendulum at
+    dt 0.02 by the default step -22 J of 30 J in 60 s)."""
     a = 0.0
     b = 0.0
     kinetic = 0.0
@@ -185,6 +187,7 @@ def bound_correction_work(m, s, ws, h, symplectic):
         kinetic += 0.5 * arm * rate * rate
     in_regime = b <= SHAKE_REGIME * SHAKE_REGIME * kinetic
     if symplectic and in_regime:
+        ws.info[INFO_SHAKE_WHOLE] += 1
         return 0.0
     start_kinetic, gained = velocity_stage_gain(m, ws, ws.v_solved, h)
     # the step's share: of the smaller kinetic energy, less what its velocity stage gained

@@ -20,7 +20,8 @@ from ..info import INFO_PROJECTIONS
 from .integrate import (bound_correction_work, correct_positions, integrate_positions,
                         keep_correction_rows, rows_hold_within)
 from ..math2d import update_trig
-from ..checks.work import gravity_lift, judge_energy, most_gaining_body
+from ..checks.work import NEAR_DEPENDENT, gravity_lift, judge_energy, most_gaining_body
+from ..constraints.rows import is_joint_row, is_soft_row
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
 PROJECTION_ITERS = 20
@@ -62,6 +63,24 @@ def _settle_measured(m, s, ws, h, opt, rows_held):
     return 0
 
 
+@kernel
+def joints_alone(ws):
+    """The step's rows are hard joint rows alone (pins, sliders, rods: no contact, limit,
+    joint friction, spring, damper or armature row) of joints that close no loop of bodies
+    (ws.joints_open), with pivots not nearly dependent (ws.joint_pivot): its correction is
+    SHAKE's, which keeps the step symplectic within SHAKE's regime
+    (integrate.bound_correction_work keeps it whole there). A closed loop is left to the
+    bound: folded near a dead point, its nearly dependent pins' correction carries huge
+    impulses, and a loop of bodies whose inertias differ by 1e8 turns its heavy body."""
+    if ws.joints_open[0] == 0 or ws.joint_pivot[0] < NEAR_DEPENDENT:
+        return False
+    for r in range(ws.n_row[0]):
+        kind = ws.row_kind[r]
+        if not is_joint_row(kind) or is_soft_row(kind):
+            return False
+    return True
+
+
 @kernel(inline="always")
 def position_stage(m, s, ws, opt, h, answered):
     """Stage 8 (the module's docstring) after a velocity solve over a step of h [s];
@@ -88,7 +107,8 @@ def position_stage(m, s, ws, opt, h, answered):
         settle_positions(m, s, ws, h, opt, held)
         if corrected or ws.info[INFO_PROJECTIONS] > 0:
             # only a correction or a projection changes the velocity the solve gave
-            excess = bound_correction_work(m, s, ws, h, opt.integrator != INTEGRATOR_EULER)
+            excess = bound_correction_work(m, s, ws, h, opt.integrator != INTEGRATOR_EULER
+                                           or joints_alone(ws))
             if excess > 0.0:
                 note(ws, s.step[0], AUDIT_CORRECTION_WORK, -1, most_gaining_body(m, s, ws), excess)
                 # bodies lifted out of the ground (a terrain put in) are the depth's
