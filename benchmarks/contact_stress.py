@@ -76,7 +76,7 @@ without impulses; see energy_bound) and the motors' work, against the run's whol
 (contacts only take energy out), less the joints' second-order share of the step's kinetic
 energy (CONSTRAINT_SHARE, kernels/checks/work.py: an oscillation the energy target bounds over the
 run; or, where more, what the same step gains with no ground, contact_free_gain: a rod
-spinning at w gains (h w)^2 / 4 of its kinetic energy a step by the integrator alone);
+spinning at w gains about (h w)^2 / 4 of its kinetic energy a step by the integrator alone);
 tunnel (hills_fast) above DEPTH_TOL, beyond rod_sag for a point on a rod; speed (stiff_motors). A run the engine stops with an
 error of its own (planarsim's SimulationDiverged or any planarsim error, naming why) is
 "raised"; a run missing a target without one is "silent" (an audit count alone is silent:
@@ -1090,7 +1090,7 @@ def run_extreme_case(family, seed, strategy, seconds=None, max_steps=MAX_STEPS) 
             # of its kinetic energy, up or down (symplectic: it oscillates, the energy target
             # above holds the run's drift). A step beyond that is judged against what the
             # integrator itself gains from its start state with nothing to touch
-            # (contact_free_gain: a rod spinning at w gains (h w)^2 / 4 of it); a gain the
+            # (contact_free_gain: a rod spinning at w gains about (h w)^2 / 4 of it); a gain the
             # contacts add beyond it is a miss
             ke = kinetic(spec.mass, spec.inertia, v[:-1])
             allowance = CONSTRAINT_SHARE * ke

@@ -28,13 +28,16 @@ def test_contact_stress_case_meets_targets(family, seed, strategy):
         f"depth {r['depth']:.3g} m, audit {r['audit']}, diverged {r['diverged']!r}")
 
 
-@pytest.mark.parametrize("h_w", [0.05, 0.1, 0.2])
-def test_a_spinning_rods_own_step_gain_is_a_quarter_of_h_w_squared(h_w):
+@pytest.mark.parametrize("h_w", [0.05, 0.1, 0.2, 0.3])
+def test_a_spinning_rods_own_step_gain_is_shakes(h_w):
     """The corpus judge's yardstick for a step beyond the flat share (contact_free_gain): the
     integrator's own energy change from the step's state with no ground. For two point masses
-    (1 and 2 kg) on a 1 m rod spinning freely at w, one step of 10 ms gains (h w)^2 / 4 of
-    the kinetic energy (the rod's projection of a turn by h w), to 1 %: the step allowance is
-    measured per step, not (h w)^2 of the kinetic energy for every step (4 times this)."""
+    (1 and 2 kg) on a 1 m rod spinning freely at w, one step of 10 ms is SHAKE's: the ends
+    move straight by h w (relative to each other), then along the rod at the step's start
+    back onto its length, so the relative position ends at (sqrt(1 - (h w)^2), h w) in the
+    rod's frame and the velocity is that move over h: the kinetic energy gains
+    (1 - sqrt(1 - (h w)^2))^2 / (h w)^2 of itself, (h w)^2 / 4 to leading order (to
+    1e-9: the correction is kept whole, SHAKE's, where joints alone close no loop)."""
     from benchmarks.contact_stress import contact_free_gain
     dt = 1e-2
     b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0))
@@ -48,16 +51,17 @@ def test_a_spinning_rods_own_step_gain_is_a_quarter_of_h_w_squared(h_w):
     v = np.zeros((2, 3))
     v[0, 1], v[1, 1] = w * (-0.5 - centre), w * (0.5 - centre)
     kinetic = 0.5 * (1.0 * v[0, 1] ** 2 + 2.0 * v[1, 1] ** 2)
-    assert contact_free_gain(model, q, v) / kinetic == pytest.approx(h_w ** 2 / 4.0, rel=0.01)
+    shake = (1.0 - np.sqrt(1.0 - h_w ** 2)) ** 2 / h_w ** 2
+    assert contact_free_gain(model, q, v) / kinetic == pytest.approx(shake, rel=1e-9)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "engine: a 150 m/s rod turning 0.62 rad per step (dt 10 ms) gains 3.5 % of its kinetic "
-    "energy in the step that meets a hill (245 J beyond 1 % of it and E_tol), where the same "
-    "step with no ground gains nothing; the step's own audit counts nothing (the run's "
-    "energy ends within E_tol). Found when the judge's (h w)^2 allowance became the measured "
-    "contact-free gain"))
 def test_no_step_gains_more_than_the_integrator_alone_explains_hills_fast_29():
+    """A 150 m/s rod turning up to 0.8 rad a step (dt 10 ms) over hills: no step gains more
+    than the same step with no ground gains (contact_free_gain) plus E_tol. Once a known
+    defect (a step meeting a hill gained 245 J beyond it, 3.5 % of its kinetic energy); it
+    holds since steps of joints alone keep SHAKE's correction whole (the run's flight steps
+    changed, so the hill is met from another state: its worst step is now 130 J beyond the
+    flat share, within E_tol's 190 J; the contact step's own mechanism was not isolated)."""
     from benchmarks.contact_stress import run_case
     r = run_case("hills_fast", 29, "alternating")
     assert "step" not in r["failed"], (r["step_gain"], r["step_k"], r["e_tol"])
