@@ -8,19 +8,16 @@ from tests.physics.test_pendulum_chain import double_pendulum_energy_drift
 
 DEFECTS = {
     "coarse_whip": ("a double pendulum at dt 0.02 (up to h w = 0.35) loses energy, uncounted: "
-                    "52-119 % of its scale in 60 s (73-147 % at dt 0.04). In one run (release "
-                    "1.2, -0.3 rad, 3000 steps) -23 J net: -10.3 J in the 5 steps taken again "
-                    "in sub-steps by the jump check (the correction moved a rod 1 cm beyond its "
-                    "velocities; each switch of h moves symplectic Euler's energy by its O(h) "
-                    "term). With that check off, -15.9 J of -16.6 J is lost in 8 steps where "
-                    "the joints' energy check (work.joints_add_energy, within SHAKE's regime: "
-                    "the impulses' work 25-30 % of KE(v*) while KE fell 4-15 %) turned the "
-                    "velocity solve into a projection, J v = 0, and the correction's energy "
-                    "bound (integrate.bound_correction_work) cuts every rise and no fall. "
-                    "Tried: keeping a correction of hard joints alone whole within SHAKE's "
-                    "regime (as RATTLE's) and judging the joints by the kinetic energy they "
-                    "add: 4-43 % lost, but a folded loop then gained 0.54 J where 0.32 J is "
-                    "its bound (test_energy_audit's folded loop, seed 310)"),
+                    "24-92 % of its scale in 60 s from the three releases of "
+                    "test_pendulum_chain (52-140 % at dt 0.04). Steps of joints alone keep "
+                    "SHAKE's correction whole within SHAKE's regime (before: 52-119 %, "
+                    "73-147 % at dt 0.04); beyond it the correction's energy bound "
+                    "(integrate.bound_correction_work) allows no rise and cuts every rise and "
+                    "no fall, and the joints' energy check (work.joints_add_energy) turns the "
+                    "velocity solve into a projection, J v = 0, which pushes the correction "
+                    "further out of the regime. Tried: keeping a correction of joints alone "
+                    "that close no loop whole at any size where Newton ends it: 3.8-9.9 % at "
+                    "dt 0.02, but the energy then grew by 200-380 % at dt 0.04, uncounted"),
     "coarse_pair": ("two rigid bodies pinned together, spinning freely beyond half a radian a "
                     "step (the bodies' own turn h w), lose angular momentum, uncounted: two equal "
                     "bodies 1 m apart at dt 1e-3 keep it to 1e-15 at 0.5 rad a step, lose 28 % at "
@@ -30,7 +27,11 @@ DEFECTS = {
                     "/ 2)); the next ones are taken by the general stages with a second solve "
                     "(the joints' energy check beyond SHAKE's regime) and lose it there, until "
                     "the pair turns slowly enough. Pins alone are never cut into turn sub-steps "
-                    "(step.turn_substeps), which a point mass on a rod at 0.8 is"),
+                    "(step.turn_substeps), which a point mass on a rod at 0.8 is. Tried: the "
+                    "correction of joints alone that close no loop kept whole at any size where "
+                    "Newton ends it: kept to 0.8 rad a step, then 10 % lost at 0.9 (second body "
+                    "10x lighter) and 19-23 % at 1.2, where the positions needed a projection; "
+                    "left for coarse_whip's reason"),
 }
 
 
