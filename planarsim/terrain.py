@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .checks import number
 from .errors import ModelError, plain
 
 
@@ -125,14 +126,8 @@ def _hills_name(a, lam, phi, grade, height) -> str:
 
 def _number(what, value, finite=True) -> float:
     """An argument of flat, slope or hills as a float, or a ModelError naming it and its
-    value (a string, None, a list; NaN or inf unless finite=False)."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ModelError(f"terrain: {what}={plain(value)!r} must be a number") from None
-    if finite and not math.isfinite(x):
-        raise ModelError(f"terrain: {what}={x} must be finite")
-    return x
+    value (a string, None, a list, a bool; NaN or inf unless finite=False)."""
+    return number(f"terrain: {what}", value, finite, error=ModelError)
 
 
 def _numbers(what, values) -> np.ndarray:

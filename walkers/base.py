@@ -286,14 +286,8 @@ def target_speed(name, speed, lo=-math.inf, hi=math.inf) -> float:
     """A walker's commanded speed [m/s] as a float within [lo, hi]; a ValueError naming the
     walker and the speed otherwise (a NaN speed stopped the run at its first step naming a
     leg actuator's command, a string failed in float())."""
-    try:
-        x = float(speed)
-    except (TypeError, ValueError):
-        x = math.nan
-    if not (math.isfinite(x) and lo <= x <= hi):
-        raise ValueError(f"{name}: speed={speed!r} m/s must be a finite number"
-                         + (f" within [{lo:g}, {hi:g}]" if math.isfinite(lo) or math.isfinite(hi) else ""))
-    return x
+    from planarsim.checks import finite_number
+    return finite_number(f"{name}: speed", speed, lo, hi, strict=False, unit=" m/s")
 
 
 def start_rng(name, seed):

@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .continuation import whole_at_least, write_csv
+from ..checks import whole
+from .continuation import write_csv
 from .parallel import MapPool, iterate_task
 
 
@@ -61,8 +62,8 @@ def bifurcation_diagram(pool: MapPool, p_values, x0, transient: int = 200, keep:
     """Iterate P(x; p) from x0 (an array, or a callable p -> x0) `transient` steps, keep the
     next `keep` section points, for every p in p_values (in parallel on the pool)."""
     # a period is read among the kept points: fewer than 2 read as a fall (Diagram.periods)
-    transient = whole_at_least("transient", transient, 0)
-    keep = whole_at_least("keep", keep, 2)
+    transient = whole("transient", transient, 0)
+    keep = whole("keep", keep, 2)
     ps = np.asarray(p_values, dtype=np.float64)
     x0f = x0 if callable(x0) else (lambda p: np.asarray(x0, dtype=np.float64))
     n = int(transient) + int(keep)

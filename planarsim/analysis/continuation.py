@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..sim import _whole_count
+from ..checks import whole
 from ..trajectory import atomic_write
 from .parallel import MapPool
 from .stepmap import (FIT_POINTS, FIT_WINDOW, Multipliers, StepMapError, central_jacobian,
@@ -146,16 +146,6 @@ def bifurcation_tests(lam) -> dict:
 
 
 # Newton --------------------------------------------------------------------------------------
-def whole_at_least(name, value, least) -> int:
-    """value as an int, or a ValueError naming it unless it is a whole number >= least (a
-    period 0 made every point a 'fixed point' of the identity, a keep of 1 made every orbit
-    read as a fall)."""
-    n = _whole_count(name, value)
-    if n < least:
-        raise ValueError(f"{name}={value!r} must be a whole number >= {least}")
-    return n
-
-
 def fixed_point_tolerance(pool: MapPool, p, x, period=1, tol="auto") -> float:
     """Newton's tolerance on |P^period(x) - x| at p: tol ("auto": stepmap.AUTO_TOL) raised to
     NOISE_FACTOR x the map's noise measured at x (stepmap.map_noise)."""
@@ -168,7 +158,7 @@ def newton_fixed_point(pool: MapPool, p, x0, period=1, tol="auto", max_iter=20, 
     eps: a simulated map is piecewise smooth below ~1e-5, see multipliers_with_error)
     evaluated in one batch; tol "auto" or a number: fixed_point_tolerance.
     Returns (x, residual, converged, J at the last iterate)."""
-    period = whole_at_least("period", period, 1)
+    period = whole("period", period, 1)
     x = np.asarray(x0, dtype=np.float64).copy()
     if isinstance(tol, str):
         tol = fixed_point_tolerance(pool, p, x, period, tol)
@@ -411,7 +401,7 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
         raise ValueError(f"continuation range {p0}:{p1} must be two different finite numbers")
     if int(points) < 2:
         raise ValueError(f"points={points} must be at least 2")
-    period = whole_at_least("period", period, 1)
+    period = whole("period", period, 1)
     p_tol = 1e-5 * abs(p1 - p0) if p_tol is None else p_tol
     ev0 = pool.evaluations
     branch = Branch(param, int(period))

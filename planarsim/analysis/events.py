@@ -12,6 +12,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from ..checks import finite_number
+
 IN_CONTACT = (1, 2)   # contact modes that touch the ground: pinned, sliding
 
 
@@ -124,10 +126,8 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
         touch (0: every landing counts).
     """
     for name, value in (("min_air", min_air), ("together", together), ("min_stride", min_stride)):
-        if (isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number))
-                or not (np.isfinite(value) and value >= 0)):
-            # NaN compared False everywhere: a NaN min_stride counted every landing
-            raise ValueError(f"{name}={value!r} must be a finite number >= 0")
+        # NaN compared False everywhere: a NaN min_stride counted every landing
+        finite_number(name, value, least=0.0)
     for name, value in (("contacts", contacts), ("feet", feet)):
         if isinstance(value, (str, bytes)):
             raise ValueError(f"{name}={value!r} must be a list (of contact names or indices"

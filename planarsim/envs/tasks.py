@@ -7,13 +7,13 @@ termination, reset noise and frame skip.
 from __future__ import annotations
 
 import math
-import numbers
 from pathlib import Path
 
 import numpy as np
 from gymnasium import utils
 from gymnasium.spaces import Box
 
+from ..checks import finite_number, is_bool, pair
 from ..compiled import jit
 from ..errors import plain
 from ..mjcf import parse_xml
@@ -73,22 +73,14 @@ def check_task_keywords(name, defaults, args) -> None:
     (either may be infinite the other way). A NaN weight gave NaN rewards, a reversed range
     ended every episode at its first step, a string switch was read as True."""
     for key, default in defaults.items():
-        value = args[key]
-        said = f"{name}: {key}={plain(value)!r}"
+        value, said = args[key], f"{name}: {key}"
         if isinstance(default, bool):
-            if not isinstance(value, (bool, np.bool_)):
-                raise ValueError(f"{said} must be True or False")
+            if not is_bool(value):
+                raise ValueError(f"{said}={plain(value)!r} must be True or False")
         elif isinstance(default, float):
-            if (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)
-                    or not math.isfinite(value)):
-                raise ValueError(f"{said} must be a finite number")
+            finite_number(said, value)
         elif isinstance(default, tuple):
-            try:
-                lo, hi = (float(x) for x in value)
-            except (TypeError, ValueError):
-                raise ValueError(f"{said} must be a pair (low, high) of numbers") from None
-            if not lo < hi or lo == math.inf or hi == -math.inf:
-                raise ValueError(f"{said} must have low < high (and low < inf, high > -inf)")
+            pair(said, value, increasing=True)
 
 
 class _Task(PlanarMujocoEnv, utils.EzPickle):

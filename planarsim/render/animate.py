@@ -13,13 +13,12 @@ target. Unknown extensions and unwritable folders are rejected before any frame 
 """
 from __future__ import annotations
 
-import math
-import numbers
 import os
 from pathlib import Path
 
 import numpy as np
 
+from ..checks import finite_number
 from ..files import discard, publish, staging_file
 from ..progress import TextProgress, progress_for  # noqa: F401  (TextProgress: public here too)
 from .camera import Camera
@@ -113,11 +112,10 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
     label_names, style, ...). Returns the path written.
     """
     path, fmt = check_output_path(path)
-    if bitrate is not None and (isinstance(bitrate, bool) or not isinstance(bitrate, numbers.Real)
-                                or not (math.isfinite(bitrate) and bitrate >= 1)):
+    if bitrate is not None:
         # ffmpeg refused it only once started: a broken pipe and its whole command line
-        raise ValueError(f"bitrate={bitrate!r} must be None (ffmpeg's default quality) or a "
-                         "number >= 1 [kbit/s]")
+        finite_number("bitrate", bitrate, least=1.0,
+                      expected="None (ffmpeg's default quality) or a number >= 1 [kbit/s]")
     renderer = FrameRenderer(traj, model, fps, speed, start, duration, size, dpi, camera, **scene_kw)
     report = progress_for(progress, len(renderer), f"frames -> {path.name}")
     tmp = staging_file(path, ".html" if fmt == "html" else path.suffix)

@@ -21,6 +21,7 @@ import pickle
 
 import numpy as np
 
+from ..checks import pair, to_float
 from ..errors import plain
 from ..trajectory import check_recorded_by
 from .camera import Camera
@@ -64,19 +65,15 @@ def figure_size(size, dpi) -> tuple:
     """((width, height) [inch], dpi) as floats, or a ValueError naming them: two finite
     numbers > 0 and a finite dpi > 0 (dpi 0 divided by zero, a NaN one failed in int(), a
     negative size was drawn 2 pixels wide)."""
-    try:
-        w, h = (float(v) for v in size)
-    except (TypeError, ValueError):
-        raise ValueError(f"size={plain(size)!r} must be (width, height) [inch], two numbers") from None
+    w, h = pair("size", size, "(width, height) [inch], two numbers")
     if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
         raise ValueError(f"size=({w:g}, {h:g}) must be two finite numbers > 0 [inch]")
-    try:
-        dpi = float(dpi)
-    except (TypeError, ValueError):
-        raise ValueError(f"dpi={dpi!r} must be a number (pixels per inch)") from None
-    if not (math.isfinite(dpi) and dpi > 0):
-        raise ValueError(f"dpi={dpi:g} must be finite and > 0 (pixels per inch)")
-    return (w, h), dpi
+    x = to_float(dpi)
+    if x is None:
+        raise ValueError(f"dpi={plain(dpi)!r} must be a number (pixels per inch)")
+    if not (math.isfinite(x) and x > 0):
+        raise ValueError(f"dpi={x:g} must be finite and > 0 (pixels per inch)")
+    return (w, h), x
 
 
 def frame_indices(traj, times) -> np.ndarray:

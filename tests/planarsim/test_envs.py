@@ -252,6 +252,7 @@ def test_bad_inputs_name_the_culprit():
     (dict(healthy_reward=True), r"Hopper: healthy_reward=True must be a finite number"),
     (dict(healthy_z_range=(2.0, 0.7)), r"Hopper: healthy_z_range=\(2.0, 0.7\) must have low < high"),
     (dict(healthy_z_range=(0.7, 1.0, 3.0)), r"Hopper: healthy_z_range=\(0.7, 1.0, 3.0\) must be a pair"),
+    (dict(healthy_z_range=(False, True)), r"Hopper: healthy_z_range=\(False, True\) must be a pair"),
     (dict(healthy_angle_range=(float("nan"), 0.2)), r"Hopper: healthy_angle_range=\(nan, 0.2\) must have low < high"),
     (dict(terminate_when_unhealthy="no"), r"Hopper: terminate_when_unhealthy='no' must be True or False"),
     (dict(exclude_current_positions_from_observation="no"),
