@@ -14,6 +14,7 @@ import warnings
 
 import numpy as np
 
+from .checks import MAX_STEPS, callable_or_none, to_float, whole
 from .errors import diverged
 from .integrator import check_integrator
 from .model import Model, ModelArrays
@@ -241,10 +242,9 @@ class Simulator:
         return _link().bind(kernel, args)
 
     def steps(self, n: int, u=None) -> None:
-        """n steps under constant commands, compiled as one loop."""
-        n = _whole_count("n", n)
-        if n < 0:
-            raise ValueError(f"n={n} steps must be >= 0")
+        """n steps under constant commands, compiled as one loop; n a whole number from 0 to
+        MAX_STEPS (planarsim.checks)."""
+        n = _step_count("n", n)
         self._run_steps(self._commands(u), n)
 
     def run(self, duration: float | None = None, u=None, controller=None, n_steps: int | None = None,
@@ -260,14 +260,16 @@ class Simulator:
             (only with a controller), stored in Trajectory.labels.
         """
         n = _count_steps(self.dt, duration, n_steps)
+        callable_or_none("controller", controller, "a function controller(sim) -> u")
+        callable_or_none("labels", labels, "a function labels(sim) -> dict of scalars")
         if controller is not None and u is not None:
             raise ValueError("give u (constant commands) or controller, not both: the "
                              "controller's commands would replace u at every call")
         if labels is not None and controller is None:
             raise ValueError("labels are sampled only with a controller (the Python path); "
                              "without one the steps run compiled and nothing samples them")
-        every = _whole_count("record_every", record_every)
-        if every < 1 or _whole_count("control_every", control_every) < 1:
+        every = whole("record_every", record_every)
+        if every < 1 or whole("control_every", control_every) < 1:
             raise ValueError("record_every and control_every must be >= 1")
         # frame 0: the start; then the steps whose count is a multiple of `every`
         check_recording(self.model, n // every + 2,
@@ -349,7 +351,7 @@ class Simulator:
         if isinstance(contact, str):
             i = self.model.contact(contact)
         else:
-            i = _whole_count("contact", contact)
+            i = whole("contact", contact)
             if not 0 <= i < self.model.n_contact:
                 raise IndexError(f"contact={contact} is not a contact of the model: it has "
                                  f"{self.model.n_contact}, indices 0..{self.model.n_contact - 1}")
@@ -364,33 +366,28 @@ class Simulator:
         return self.ws.contact_impulse.copy()
 
 
-def _whole_count(name, n):
-    """n as an int, refused where it is not a whole number (2.7 steps, NaN)."""
-    try:
-        i = int(n)
-    except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{name}={n!r} must be a whole number") from None
-    if i != n:
-        raise ValueError(f"{name}={n!r} must be a whole number")
-    return i
+def _step_count(said, n) -> int:
+    """n steps as an int: a whole number from 0 to MAX_STEPS, or a ValueError naming it."""
+    return whole(said, n, 0, MAX_STEPS, why="steps in one call; take more in several calls")
 
 
 def _count_steps(dt, duration, n_steps):
     if (duration is None) == (n_steps is None):
         raise ValueError("give exactly one of duration [s] or n_steps")
     if n_steps is not None:
-        n = _whole_count("n_steps", n_steps)
+        n = _step_count("n_steps", n_steps)
     else:
-        try:
-            duration = float(duration)
-        except (TypeError, ValueError):
-            raise ValueError(f"duration={duration!r} must be a number of seconds") from None
+        seconds = to_float(duration)
+        if seconds is None:
+            raise ValueError(f"duration={duration!r} must be a number of seconds")
+        duration = seconds
         if not np.isfinite(duration) or duration < 0:
             raise ValueError(f"duration={duration} must be finite and >= 0 seconds")
         n = int(round(duration / dt))
         if n == 0 and duration > 0:
             raise ValueError(f"duration={duration:g} s is less than half a step (dt={dt:g} s): "
                              "the run would take no step")
-    if n < 0:
-        raise ValueError(f"n_steps={n} must be >= 0")
+        if n > MAX_STEPS:
+            raise ValueError(f"duration={duration:g} s at dt={dt:g} s is {n:,} steps, more than "
+                             f"{MAX_STEPS:,} in one call; run it in several calls")
     return n

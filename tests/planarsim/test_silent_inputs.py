@@ -266,6 +266,44 @@ def test_step_counts_that_are_not_whole_are_refused(call, pattern):
     sim.run(0.0)                                   # (an empty run is asked for: fine)
 
 
+@pytest.mark.parametrize("call, error, pattern", [
+    (lambda sim: sim.steps(10 ** 30), ValueError,
+     r"n=1000000000000000000000000000000 must be a whole number from 0 to 1,000,000,000 "
+     r"\(steps in one call; take more in several calls\)"),
+    (lambda sim: sim.steps(2 ** 63), ValueError, r"n=9223372036854775808 must be a whole number from 0 to"),
+    (lambda sim: sim.steps(1e30), ValueError, r"n=1e\+30 must be a whole number from 0 to 1,000,000,000"),
+    (lambda sim: sim.steps(-1), ValueError, r"n=-1 must be a whole number from 0 to 1,000,000,000$"),
+    (lambda sim: sim.steps(True), ValueError, r"n=True must be a whole number \(not True or False\)"),
+    (lambda sim: sim.run(n_steps=10 ** 12), ValueError,
+     r"n_steps=1000000000000 must be a whole number from 0 to 1,000,000,000"),
+    (lambda sim: sim.run(1e7, record_every=10 ** 9), ValueError,
+     r"duration=1e\+07 s at dt=0.001 s is 10,000,000,000 steps, more than 1,000,000,000 in one call"),
+    (lambda sim: sim.run(True), ValueError, r"duration=True must be a number of seconds"),
+    (lambda sim: sim.run(0.01, record_every=True), ValueError, r"record_every=True must be a whole number"),
+])
+def test_step_counts_beyond_the_compiled_loop_are_refused(call, error, pattern):
+    """steps(10**30) failed inside numba ("int too big to convert"), steps(True) took a step
+    and steps(10**18) would run for ever."""
+    sim = ps.Simulator(two_bodies())
+    with pytest.raises(error, match=pattern):
+        call(sim)
+    assert sim.state.step[0] == 0
+
+
+@pytest.mark.parametrize("kw, pattern", [
+    (dict(controller=5), r"controller=5 must be a function controller\(sim\) -> u, or None"),
+    (dict(controller="pd"), r"controller='pd' must be a function controller\(sim\) -> u"),
+    (dict(controller=lambda s: np.zeros(0), labels=5),
+     r"labels=5 must be a function labels\(sim\) -> dict of scalars"),
+])
+def test_run_controllers_and_labels_must_be_functions(kw, pattern):
+    """run(controller=5) failed at its first call with "'int' object is not callable"."""
+    sim = ps.Simulator(two_bodies())
+    with pytest.raises(TypeError, match=pattern):
+        sim.run(0.01, **kw)
+    assert sim.state.step[0] == 0
+
+
 def actuated_pendulum():
     b = ps.ModelBuilder(dt=1e-3)
     arm = b.add_body("arm", 1.0, 0.1, pos=(0.5, 1.0))
