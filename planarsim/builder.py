@@ -22,6 +22,7 @@ from . import model as M
 from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT,
                             JOINT_FREE_HINGE, JOINT_FREE_SLIDE, JOINT_HINGE, JOINT_SLIDE_BIT,
                             JOINT_SLIDER)
+from .checks import holds_bool, is_bool, number
 from .errors import ModelError, plain as _plain
 from .kernels.geometry.collide import core_normals
 from .kernels.solver.modes import SOLVE_REL_TOL
@@ -46,6 +47,9 @@ def _who(kind, name, idx):
 
 
 def _finite(kind, name, idx, fieldname, value):
+    if holds_bool(value):
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)!r} must be numbers, "
+                         "not True or False")
     arr = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(arr)):
         raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)} must be finite")
@@ -53,6 +57,9 @@ def _finite(kind, name, idx, fieldname, value):
 
 
 def _vec2(kind, name, idx, fieldname, value):
+    if holds_bool(value):
+        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)!r} must be a pair "
+                         "(x, y) of numbers, not True or False")
     try:
         arr = np.asarray(value, dtype=np.float64).reshape(2)
     except (TypeError, ValueError):
@@ -62,14 +69,8 @@ def _vec2(kind, name, idx, fieldname, value):
 
 
 def _scalar(kind, name, idx, fieldname, value):
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={_plain(value)!r} must be a "
-                         "number") from None
-    if not math.isfinite(x):
-        raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={x} must be finite")
-    return x
+    """A finite number (not a bool: mass=True built a 1 kg body), or a ModelError naming it."""
+    return number(f"{_who(kind, name, idx)}: {fieldname}", value, error=ModelError)
 
 
 def _length(kind, name, idx, fieldname, value, zero_ok=False):
@@ -84,7 +85,7 @@ def _pair(kind, name, idx, fieldname, value, parts=("min", "max")):
     """A (lo, hi) pair as two floats: two numbers, neither NaN, lo < inf and hi > -inf (either
     may be infinite the other way: no bound). The order of lo and hi is the caller's rule."""
     try:
-        arr = np.asarray(value, dtype=np.float64)
+        arr = None if holds_bool(value) else np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         arr = None
     who = _who(kind, name, idx)
@@ -192,9 +193,11 @@ class ModelBuilder:
             if body not in self._names["body"]:
                 raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={body!r} names no body")
             return self._names["body"][body]
-        if isinstance(body, (int, np.integer)) and 0 <= body < len(self._bodies):
+        # (True is no body id, though Python takes it for 1: the second body)
+        an_id = isinstance(body, (int, np.integer)) and not is_bool(body)
+        if an_id and 0 <= body < len(self._bodies):
             return int(body)
-        if isinstance(body, (int, np.integer)) and body == -1 and allow_world:
+        if an_id and body == -1 and allow_world:
             return -1
         raise ModelError(f"{_who(kind, name, idx)}: {fieldname}={body!r} is not a body id "
                          f"(0..{len(self._bodies) - 1}){' or None for the world' if allow_world else ''}")
@@ -786,7 +789,7 @@ class ModelBuilder:
             if pin not in self._names["pin"]:
                 raise ModelError(f"actuator {name!r} ({idx}): pin={pin!r} names no pin")
             pin = self._names["pin"][pin]
-        if not (isinstance(pin, (int, np.integer)) and 0 <= pin < len(self._pins)):
+        if is_bool(pin) or not (isinstance(pin, (int, np.integer)) and 0 <= pin < len(self._pins)):
             raise ModelError(f"actuator {name!r} ({idx}): pin={pin!r} is not a pin id")
         if self._pins[pin]["kind"] & JOINT_SLIDE_BIT:
             raise ModelError(f"actuator {name!r} ({idx}): pin={self._pins[pin]['name']!r} is a "
@@ -802,7 +805,7 @@ class ModelBuilder:
             if slider not in self._names["pin"]:
                 raise ModelError(f"actuator {name!r} ({idx}): slider={slider!r} names no slider")
             slider = self._names["pin"][slider]
-        if not (isinstance(slider, (int, np.integer)) and 0 <= slider < len(self._pins)
+        if is_bool(slider) or not (isinstance(slider, (int, np.integer)) and 0 <= slider < len(self._pins)
                 and self._pins[slider]["kind"] & JOINT_SLIDE_BIT):
             raise ModelError(f"actuator {name!r} ({idx}): slider={slider!r} is not a slider id")
         a, b = self._pins[slider]["body"]
@@ -937,16 +940,15 @@ class ModelBuilder:
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:
         """Validate and freeze into a Model."""
-        try:
-            dt = float(self.dt)
-        except (TypeError, ValueError):
-            raise ModelError(f"model: dt={self.dt!r} must be a number") from None
+        dt = number("model: dt", self.dt, finite=False, error=ModelError)
         if not (math.isfinite(dt) and dt > 0):
             raise ModelError(f"model: dt={dt} must be finite and > 0")
         try:
-            g = np.asarray(self.gravity, dtype=np.float64).reshape(2)
+            g = None if holds_bool(self.gravity) else np.asarray(self.gravity, dtype=np.float64).reshape(2)
         except (TypeError, ValueError):
-            raise ModelError(f"model: gravity={self.gravity!r} must be a pair (gx, gy)") from None
+            g = None
+        if g is None:
+            raise ModelError(f"model: gravity={self.gravity!r} must be a pair (gx, gy) of numbers")
         if not np.all(np.isfinite(g)):
             raise ModelError(f"model: gravity={_shown(g)} must be finite")
         if self.ground and not isinstance(self.terrain, Terrain):

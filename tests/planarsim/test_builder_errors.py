@@ -327,3 +327,41 @@ def test_arc_span_fluid_box_and_shapes_that_are_not_what_they_must_be(call, word
         call(b)
     assert "np.float64" not in str(err.value)
     assert b._shapes == [] and len(b._bodies) == 1   # nothing of the refused element kept
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda b: b.add_body("shin", mass=True, inertia=0.1),
+     r"body 'shin' \(2\): mass=True must be a number \(not True or False\)"),
+    (lambda b: b.add_body("shin", mass=1.0, inertia=np.True_),
+     r"body 'shin' \(2\): inertia=True must be a number"),
+    (lambda b: b.add_body("shin", mass=1.0, inertia=0.1, angle=False), r"angle=False must be a number"),
+    (lambda b: b.add_body("shin", mass=1.0, inertia=0.1, pos=(True, 0.0)),
+     r"body 'shin' \(2\): pos=\(True, 0.0\) must be a pair \(x, y\) of numbers, not True or False"),
+    (lambda b: b.add_body("shin", shapes=[("circle", (0.0, 0.0), 0.1)], density=True),
+     r"density=True must be a number"),
+    (lambda b: b.add_point_mass("bob", True), r"body 'bob' \(2\): mass=True must be a number"),
+    (lambda b: b.add_shape("torso", "circle", (0.0, 0.0), True), r"radius=True must be a number"),
+    (lambda b: b.add_shape("torso", "box", (0.0, 0.0), 0.1, True), r"height=True must be a number"),
+    (lambda b: b.add_shape("torso", "circle", (0.0, 0.0), 0.1, mu=True), r"mu=True must be a number"),
+    (lambda b: b.add_fluid_box("torso", size=(0.1, True, 0.1)), r"size\[1\]=True must be a number"),
+    (lambda b: b.add_point_contact("toe", True), r"contact 'toe' \(0\): body=True is not a body id"),
+    (lambda b: b.add_pin("hip", "torso", None, anchor_world=(0.0, 1.0), stiffness=True),
+     r"pin 'hip' \(0\): stiffness=True must be a number"),
+    (lambda b: b.add_pin("hip", "torso", None, anchor_world=(0.0, 1.0), limit=(False, True)),
+     r"pin 'hip' \(0\): limit=\(False, True\) must be a pair \(lower, upper\) of numbers"),
+])
+def test_bools_are_no_numbers(call, words):
+    """float(True) is 1.0: mass=True built a 1 kg body, radius=True a 1 m circle, pos=(True,
+    0) a body at x = 1 m and body=True named the second body, all silently."""
+    b = base()
+    b.add_body("leg", mass=1.0, inertia=0.1, pos=(1.0, 1.0))     # body 1: what True named
+    with pytest.raises(ModelError, match=words):
+        call(b)
+
+
+def test_a_bool_step_is_no_number():
+    """ModelBuilder(dt=True) compiled a model stepping a whole second."""
+    b = base()
+    b.dt = True
+    with pytest.raises(ModelError, match=r"model: dt=True must be a number"):
+        b.compile()
