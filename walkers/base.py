@@ -49,6 +49,9 @@ import math
 import numpy as np
 
 SIMULATE_KEYWORDS = ("gait", "terrain", "dt", "seed", "params", "record_every")
+# the most steps one run takes: at the walkers' 2 to 20 microseconds a step, minutes; a
+# duration at a tiny dt (1e-9 s) would otherwise run for practically ever
+MAX_RUN_STEPS = 10 ** 8
 REQUIRED = ("NAME", "GAITS", "Params", "SUMMARY_EXTRAS", "Run", "simulate")
 
 
@@ -168,10 +171,7 @@ class WalkerRun:
         if not (math.isfinite(seconds) and seconds >= 0.0):
             raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
         # a walker that fell stays where it fell: its rollout would otherwise take one more step
-        n = 0 if self.fell else int(round(seconds / self.dt))
-        if n == 0 and seconds > 0.0 and not self.fell:
-            raise ValueError(f"{self.NAME}: run({seconds:g} s) is less than half a step "
-                             f"(dt={self.dt:g} s): the run would take no step")
+        n = 0 if self.fell else run_steps(seconds, self.dt, f"{self.NAME}: run({seconds:g} s)")
         frames = self.frames(n)
         check_recording(self.model, frames,
                         f"{self.NAME}: run({seconds:g} s) at dt={self.dt:g} s, a frame every "
@@ -288,6 +288,20 @@ def target_speed(name, speed, lo=-math.inf, hi=math.inf) -> float:
     leg actuator's command, a string failed in float())."""
     from planarsim.checks import finite_number
     return finite_number(f"{name}: speed", speed, lo, hi, strict=False, unit=" m/s")
+
+
+def run_steps(seconds: float, dt: float, said: str, too_short: str = "", too_long: str = "") -> int:
+    """Steps a run of `seconds` [s] at `dt` [s] takes; a ValueError beginning with `said` (the
+    run as the caller names it) where that is no step (less than half a step) or more than
+    MAX_RUN_STEPS (naming dt and the steps), ending with too_short or too_long (advice)."""
+    n = int(round(seconds / dt))
+    if n == 0 and seconds > 0.0:
+        raise ValueError(f"{said} is less than half a step (dt={dt:g} s): the run would take no "
+                         f"step{too_short}")
+    if n > MAX_RUN_STEPS:
+        raise ValueError(f"{said} at dt={dt:g} s would take {n:,} steps, more than {MAX_RUN_STEPS:,} "
+                         f"(a run that long would take practically forever){too_long}")
+    return n
 
 
 def start_rng(name, seed):

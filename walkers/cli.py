@@ -294,13 +294,17 @@ def _simulate_in_chunks(mod, kw):
 
 
 def _check_duration_fits(mod, kw, duration):
-    """UsageError naming --duration when its recording cannot fit in this machine's memory
+    """UsageError naming --duration (and --dt) when the run would take no step, more than
+    walkers.base.MAX_RUN_STEPS, or a recording that cannot fit in this machine's memory
     (checked on the walker's run before anything is compiled or allocated)."""
     from planarsim.errors import RecordingTooLarge
+    from walkers.base import run_steps
     run = mod.Run(**{k: v for k, v in kw.items() if k != "duration"})
-    if round(duration / run.dt) == 0:
-        raise UsageError(f"--duration {duration:g} s is less than half a step (dt={run.dt:g} s): "
-                         "the run would take no step; give a longer --duration")
+    try:
+        run_steps(duration, run.dt, f"--duration {duration:g} s", "; give a longer --duration",
+                  "; give a larger --dt or a shorter --duration")
+    except ValueError as e:
+        raise UsageError(str(e)) from None
     try:
         run.check_memory(duration)
     except RecordingTooLarge as e:

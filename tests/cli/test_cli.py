@@ -176,6 +176,10 @@ def test_a_reader_that_leaves_does_not_stop_the_files(tmp_path, monkeypatch, cap
     # a run of no step exited 0 with the summary of a walker that never moved
     (["run", "simple-biped", "--duration", "1e-6", "--json"],
      "--duration 1e-06 s is less than half a step (dt=0.001 s): the run would take no step"),
+    # a step so small that the run would take practically forever (it ran, silently)
+    (["run", "simple-biped", "--dt", "1e-9", "--json"],
+     "--duration 10 s at dt=1e-09 s would take 10,000,000,000 steps, more than 100,000,000 (a run "
+     "that long would take practically forever); give a larger --dt or a shorter --duration"),
 ])
 def test_bad_flags_exit_2_naming_the_flag(argv, fragment, capsys):
     """--start of a missing file said only "[Errno 2] No such file or directory"; an unknown

@@ -134,6 +134,19 @@ def test_run_of_less_than_half_a_step_is_refused():
     assert len(run.run(0.0).t) == 1
 
 
+@pytest.mark.parametrize("name", ["simple-biped", "simplest-walker"])
+def test_a_run_of_too_many_steps_is_refused_naming_dt_and_duration(name):
+    """A run at dt=1e-9 with nothing recorded ran practically forever (1e10 steps for 10 s)."""
+    run = walkers.load(name).Run(dt=1e-9, record_every=0)
+    run.advance = lambda *args: pytest.fail("the run started")      # (it would not end)
+    with pytest.raises(ValueError, match=rf"{name}: run\(10 s\) at dt=1e-09 s would take "
+                                         r"10,000,000,000 steps, more than 100,000,000"):
+        run.run(10.0)
+    with pytest.raises(ValueError, match=r"run\(10 s\) at dt=1e-09 s"):
+        walkers.load(name).simulate(10.0, dt=1e-9)
+    assert run.time == 0.0
+
+
 @pytest.mark.parametrize("name, kw, error, said", [
     # terrain=5: "'int' object has no attribute 'height'" from inside the model builder
     ("simple-biped", dict(terrain=5), TypeError, r"terrain=5 must be a planarsim.terrain.Terrain"),
