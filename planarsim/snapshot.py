@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .model import Model
 from .state import State, check_state, with_defaults
 from .trajectory import atomic_write, file_with_suffix, read_npz
 
@@ -45,7 +46,10 @@ def load_snapshot(path, model=None):
     """Read a snapshot: returns (State, memory dict). Clear errors for damaged files; a state
     whose arrays disagree in shape (or, given `model`, do not fit it), hold NaN or infinite
     numbers or codes out of range raises ValueError naming the file and the field
-    (state.check_state)."""
+    (state.check_state); a `model` that is no Model a TypeError, before the file is read."""
+    if model is not None and not isinstance(model, Model):
+        raise TypeError(f"load_snapshot: model={model!r} must be a planarsim Model (from "
+                        "ModelBuilder.compile()) to check the state against, or None")
     path = Path(path)
     data = read_npz(path, "snapshot")
     version = int(data.get("snapshot_version", -1))

@@ -134,3 +134,14 @@ class Camera:
                                  None if velocities is None else velocities[k])
             prev = times[k]
         return out
+
+
+def camera_or_default(camera) -> Camera:
+    """camera, or a Camera() for None; a TypeError naming anything else (camera=5 failed at
+    the first frame with "'int' object has no attribute 'track'")."""
+    if camera is None:
+        return Camera()
+    if not isinstance(camera, Camera):
+        raise TypeError(f"camera={camera!r} must be a planarsim.render.Camera (e.g. "
+                        "Camera(natural_frequency=3.0)), or None for the default one")
+    return camera

@@ -24,7 +24,7 @@ import numpy as np
 from ..checks import pair, to_float
 from ..errors import plain
 from ..trajectory import check_recorded_by
-from .camera import Camera
+from .camera import Camera, camera_or_default
 from .draw import Scene, make_figure
 
 
@@ -97,6 +97,7 @@ class FrameRenderer:
     def __init__(self, traj, model, fps=30.0, speed=1.0, start=None, duration=None, size=(6.4, 3.6),
                  dpi=100, camera: Camera | None = None, **scene_kw):
         check_recorded_by(traj, model, type(self).__name__)
+        cam = camera_or_default(camera)
         self.traj, self.model = traj, model
         self.times = frame_times(traj, fps, speed, start, duration)
         self.index = frame_indices(traj, self.times)
@@ -105,7 +106,6 @@ class FrameRenderer:
         w_px, h_px = (max(2, int(round(float(v) * dpi)) // 2 * 2) for v in size)
         self.fig, self.ax = make_figure((w_px / dpi, h_px / dpi), dpi)
         self.scene = Scene(model, self.ax, **scene_kw)
-        cam = camera if camera is not None else Camera()
         self.centers = cam.track(self.times, traj.com(model)[self.index], traj.com_velocity(model)[self.index])
 
     def __len__(self):

@@ -31,8 +31,9 @@ import time
 
 import numpy as np
 
+from ..checks import callable_or_none
 from ..errors import SimulationDiverged
-from .camera import Camera
+from .camera import camera_or_default
 from .draw import Scene
 
 DEFAULT_GAIT_KEYS = {"w": "walk", "s": "stand", "j": "jump"}
@@ -116,6 +117,8 @@ class Viewer:
     def __init__(self, sim, controller=None, fps: float = 30.0, speed: float = 1.0, control_every: int = 1,
                  gains=None, gait_keys=None, on_gait=None, labels=None, fig=None, camera=None,
                  clock=time.perf_counter, blit=None, **scene_kw):
+        callable_or_none("controller", controller, "a function controller(sim) -> u")
+        callable_or_none("labels", labels, "a function labels(sim) -> dict of scalars")
         if control_every < 1:
             raise ValueError(f"control_every={control_every} must be >= 1 step")
         if not (math.isfinite(fps) and fps > 0):
@@ -133,7 +136,7 @@ class Viewer:
         self.playing = False
         self.message = ""
         self.timer = FrameTimer(1.0 / float(fps), clock=clock)
-        self.camera = camera if camera is not None else Camera()
+        self.camera = camera_or_default(camera)
         self._carry = 0.0
         self._due = self.timer.period
         self._drawn_t = sim.t

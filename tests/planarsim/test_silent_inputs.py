@@ -425,6 +425,17 @@ def test_step_options_nan_or_wrong_type(kw, words):
         ps.make_options(**kw)
 
 
+@pytest.mark.parametrize("model", ["abc", 5, ps.ModelBuilder])
+def test_load_snapshot_takes_a_model_or_none(tmp_path, model):
+    """load_snapshot(path, model="abc") failed with "'str' object has no attribute 'n_body'"."""
+    sim = ps.Simulator(two_bodies())
+    path = ps.save_snapshot(tmp_path / "s.npz", sim.state)
+    with pytest.raises(TypeError, match=rf"load_snapshot: model={re.escape(repr(model))} must be a "
+                                        r"planarsim Model \(from ModelBuilder.compile\(\)\)"):
+        ps.load_snapshot(path, model=model)
+    ps.load_snapshot(path, model=sim.model)
+
+
 def test_files_of_the_wrong_kind(tmp_path):
     """to_csv("out.npz") wrote CSV text into a .npz file; save_snapshot(path, 5) and
     save_snapshot(path, sim) failed with AttributeError ... 'as_dict'."""

@@ -2,13 +2,14 @@
 progress, interrupted exports."""
 
 import os
+import re
 import subprocess
 from pathlib import Path
 
 import pytest
 
 import planarsim as ps
-from planarsim.render import export_animation
+from planarsim.render import Camera, animation_html, export_animation
 from tests.render.helpers import box_model, default_file_mode, _two_body_model
 
 
@@ -80,6 +81,18 @@ def test_bad_picture_settings_are_named_before_any_frame(sliding_run, tmp_path, 
     model, traj = sliding_run
     with pytest.raises(ValueError, match=said):
         export_animation(traj, model, tmp_path / "x.mp4", progress=False, workers=1, **kw)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("camera", [5, "follow", Camera])
+def test_a_camera_that_is_no_camera_is_named(sliding_run, tmp_path, camera):
+    """camera=5 failed at the first frame with "'int' object has no attribute 'track'"."""
+    model, traj = sliding_run
+    said = rf"camera={re.escape(repr(camera))} must be a planarsim.render.Camera"
+    with pytest.raises(TypeError, match=said):
+        export_animation(traj, model, tmp_path / "x.gif", progress=False, workers=1, camera=camera)
+    with pytest.raises(TypeError, match=said):
+        animation_html(traj, model, camera=camera)
     assert list(tmp_path.iterdir()) == []
 
 

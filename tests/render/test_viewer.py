@@ -80,6 +80,18 @@ def live():
     return viewer, sim, ctrl, clock
 
 
+@pytest.mark.parametrize("kw, error, said", [
+    (dict(controller=5), TypeError, r"controller=5 must be a function controller\(sim\) -> u, or None"),
+    (dict(labels="angle"), TypeError, r"labels='angle' must be a function labels\(sim\)"),
+    (dict(camera=5), TypeError, r"camera=5 must be a planarsim.render.Camera"),
+])
+def test_viewer_names_arguments_of_the_wrong_kind(kw, error, said):
+    """controller=5 and camera=5 failed at the first frame ("'int' object is not callable",
+    "has no attribute 'update'")."""
+    with pytest.raises(error, match=said):
+        Viewer(ps.Simulator(pendulum_model()), clock=FakeClock(7), **kw)
+
+
 @pytest.mark.parametrize("fps,seed", [(30, 0), (60, 1), (24, 2)])
 def test_pi_timer_holds_playback_within_5_ms_of_wall_time(fps, seed):
     clock = FakeClock(seed)
