@@ -95,6 +95,15 @@ def _check_dt(dt):
                          "already lose their impacts or stop (Ranger at once)")
 
 
+def _check_gif_fps(fps):
+    """UsageError naming --fps when a GIF at that rate would play slow (render.gif.MAX_GIF_FPS)."""
+    from planarsim.render.gif import check_gif_fps
+    try:
+        check_gif_fps(fps, "--fps ")
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+
+
 def _positive(text):
     try:
         x = float(text)
@@ -186,6 +195,8 @@ def cmd_run(args):
                              "or give --out FILE.gif, or --no-animation") from None
         summary_path = Path(f"out/{args.walker}_summary.json")
     out = _check_out(out, ANIMATION_EXTS, "--out")
+    if out is not None and out.suffix.lower() == ".gif":
+        _check_gif_fps(args.fps)
     plot = _check_out(args.plot, PLOT_EXTS, "--plot")
     save = _check_out(args.save, (".npz",), "--save")
     csv = _check_out(args.csv, (".csv",), "--csv")

@@ -60,6 +60,11 @@ def main(argv=None) -> int:
     for flag, value in (("--duration", args.duration), ("--fps", args.fps)):
         if not (math.isfinite(value) and value > 0.0):
             ap.error(f"{flag} {value} must be a positive number")
+    from planarsim.render.gif import check_gif_fps
+    try:
+        check_gif_fps(args.fps, "--fps ")
+    except ValueError as e:
+        ap.error(str(e))
     if args.width < 16:
         ap.error(f"--width {args.width} must be at least 16 pixels")
     names = args.walker or sorted(walkers.WALKERS)

@@ -23,6 +23,7 @@ from ..files import discard, publish, staging_file
 from ..progress import TextProgress, progress_for  # noqa: F401  (TextProgress: public here too)
 from .camera import Camera
 from .frames import FrameRenderer, frame_indices, frame_times, map_frames, usable_cores  # noqa: F401
+from .gif import check_gif_fps
 from .html import player_fragment, self_contained  # noqa: F401
 from .writers import GifWriter, HtmlWriter, Mp4Writer
 
@@ -99,7 +100,7 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
                      title=None, summary=None, **scene_kw) -> Path:
     """Write an animation of `traj` to `path` (.gif, .mp4 or .html, by extension).
 
-    fps : video frames per second; speed : simulated seconds per video second (1 real time,
+    fps : video frames per second (a GIF's at most 50: gif.MAX_GIF_FPS); speed : simulated seconds per video second (1 real time,
     0.25 slow motion, 4 faster); start, duration : simulated time window [s] (default: all);
     size : figure size [inch] at `dpi`; camera : a Camera (default Camera()); progress :
     True for a text bar on stderr when stderr is a terminal (nothing in a pipe or a log), a
@@ -112,6 +113,8 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
     label_names, style, ...). Returns the path written.
     """
     path, fmt = check_output_path(path)
+    if fmt == "gif":
+        check_gif_fps(fps)
     if bitrate is not None:
         # ffmpeg refused it only once started: a broken pipe and its whole command line
         finite_number("bitrate", bitrate, least=1.0,

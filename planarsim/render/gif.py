@@ -16,6 +16,8 @@ import struct
 import numpy as np
 from PIL import Image
 
+from ..checks import to_float
+
 
 def palette_from(samples, colors: int = 64, exact: int = 8) -> bytes:
     """RGB bytes of a palette of `colors` entries fitted to RGB arrays (H, W, 3): median cut,
@@ -116,6 +118,23 @@ class FrameEncoder:
         head, body = _encode(part, self.palette)
         body = body[:1] + struct.pack("<HH", x0, y0) + body[5:]     # place the rectangle
         return head, body, self.clear
+
+
+# [frames/s] the fastest GIF that plays on time: its delays are whole 1/100 s, and most
+# viewers (browsers among them) show a delay below 2/100 s as 1/10 s, so 100 fps played at
+# a fifth of its speed
+MAX_GIF_FPS = 50.0
+
+
+def check_gif_fps(fps, flag: str = "fps=") -> None:
+    """ValueError naming fps [frames/s] (as `flag` and its value: "fps=60", "--fps 60") where a
+    GIF at that rate would play slow (above MAX_GIF_FPS); an MP4 or HTML animation has no such
+    bound. What is no number is left to frame_times to refuse."""
+    x = to_float(fps)
+    if x is not None and x > MAX_GIF_FPS:
+        raise ValueError(f"{flag}{x:g} frames/s is too fast for a GIF: its frame delays are whole "
+                         f"1/100 s and most viewers slow those below 2/100 s to 1/10 s; give at "
+                         f"most {MAX_GIF_FPS:g} fps, or write an .mp4")
 
 
 def gif_delays(n: int, fps: float) -> list:

@@ -89,6 +89,18 @@ def test_unwritable_output_path(tmp_path, capsys):
         locked.chmod(0o700)
 
 
+@pytest.mark.parametrize("out", [None, "walk.gif"])
+def test_a_gif_faster_than_50_fps_is_refused_before_the_run(out, tmp_path, monkeypatch, capsys):
+    """--fps 60 wrote a GIF that most viewers play at a sixth of its speed, after the run."""
+    monkeypatch.chdir(tmp_path)
+    mod = walkers.load("simple-biped")
+    monkeypatch.setattr(mod, "Run", lambda *a, **k: pytest.fail("the walker was run"))
+    code, _, err = run_cli(capsys, "run", "simple-biped", "--fps", "60",
+                           *(["--out", out] if out else []))
+    assert code == 2
+    assert "--fps 60 frames/s is too fast for a GIF" in err and "give at most 50 fps" in err
+
+
 @pytest.mark.parametrize("sub", ["list", "run", "view", "bench", "tune", "info"])
 def test_help_of_every_subcommand(sub, capsys):
     with pytest.raises(SystemExit) as e:

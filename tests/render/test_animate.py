@@ -96,6 +96,19 @@ def test_a_camera_that_is_no_camera_is_named(sliding_run, tmp_path, camera):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_gif_faster_than_50_fps_is_refused_naming_fps(sliding_run, tmp_path):
+    """A GIF at 100 fps has 1/100 s delays, which most viewers show as 1/10 s: it played at a
+    tenth of its speed. An MP4 keeps any rate."""
+    model, traj = sliding_run
+    with pytest.raises(ValueError, match=r"fps=60 frames/s is too fast for a GIF: .* give at most "
+                                         r"50 fps, or write an \.mp4"):
+        export_animation(traj, model, tmp_path / "x.gif", fps=60, progress=False, workers=1)
+    assert list(tmp_path.iterdir()) == []
+    kw = dict(duration=0.1, size=(1.6, 0.9), dpi=50, progress=False, workers=1)
+    export_animation(traj, model, tmp_path / "x.gif", fps=50, **kw)
+    assert count_mp4_frames(export_animation(traj, model, tmp_path / "x.mp4", fps=120, **kw))[0] == 12
+
+
 def test_progress_bar_counts_every_frame(sliding_run, tmp_path, capsys, monkeypatch):
     model, traj = sliding_run
     seen = []
@@ -127,7 +140,7 @@ def progress(done, total):
         import time
         time.sleep(60)
 
-export_animation(traj, model, sys.argv[1], fps=100, progress=progress, workers=2)
+export_animation(traj, model, sys.argv[1], fps=50, progress=progress, workers=2)
 """
 
 

@@ -40,7 +40,8 @@ def test_gif_keeps_the_background_and_ground_colours_exact(sliding_run, tmp_path
 
 @pytest.mark.parametrize("flags, text", [(["--width", "0"], "--width 0"),
                                          (["--duration", "0"], "--duration 0"),
-                                         (["--fps", "-1"], "--fps -1")])
+                                         (["--fps", "-1"], "--fps -1"),
+                                         (["--fps", "60"], "--fps 60 frames/s is too fast for a GIF")])
 def test_gallery_refuses_sizes_and_times_before_any_run(flags, text, tmp_path, capsys):
     """--width 0 wrote a 2 x 2 pixel GIF and --duration 0 exited 0; --fps -1 failed after
     simulating."""
