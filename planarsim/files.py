@@ -73,6 +73,19 @@ def _beside(path: Path, suffix: str = ""):
                             dir=parent)
 
 
+def folder_refuses(path) -> str | None:
+    """Why no file can be made in `path`'s folder now (the system's words), or None: a
+    temporary file is made there and removed at once. os.access says yes to root almost
+    everywhere (in /proc too), so an export found out only after minutes of work."""
+    try:
+        fd, probe = _beside(Path(path), ".probe")
+    except OSError as e:
+        return e.strerror or str(e)
+    os.close(fd)
+    discard(probe)
+    return None
+
+
 def file_mode() -> int:
     """rw for everyone the umask allows (mkstemp creates files readable by the owner only)."""
     mask = os.umask(0)

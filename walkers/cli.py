@@ -74,6 +74,9 @@ def _said_compiled(seconds: float) -> None:
 
 
 def _check_out(path, exts, what):
+    """path as a Path, or a UsageError naming `what` (the flag) unless the file can be written
+    there: its extension one of exts, its folder one a file can be made in now."""
+    from planarsim.files import folder_refuses
     if path is None:
         return None
     p = Path(path)
@@ -82,8 +85,13 @@ def _check_out(path, exts, what):
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
         raise UsageError(f"{what} {str(p)!r}: folder {str(parent)!r} does not exist")
+    if p.is_dir():
+        raise UsageError(f"{what} {str(p)!r}: is a folder")
     if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
         raise UsageError(f"{what} {str(p)!r}: not writable")
+    refused = folder_refuses(p)      # (root passes os.access almost everywhere: /proc too)
+    if refused:
+        raise UsageError(f"{what} {str(p)!r}: not writable ({refused.lower()})")
     return p
 
 
@@ -200,6 +208,7 @@ def cmd_run(args):
     plot = _check_out(args.plot, PLOT_EXTS, "--plot")
     save = _check_out(args.save, (".npz",), "--save")
     csv = _check_out(args.csv, (".csv",), "--csv")
+    _check_out(summary_path, (".json",), "the summary")
     kw = dict(duration=args.duration, seed=args.seed)
     if changed:
         kw["params"] = mod.Params(**{**mod.Params().as_dict(), **changed})

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import finite_number
-from ..files import discard, publish, staging_file
+from ..files import discard, folder_refuses, publish, staging_file
 from ..progress import TextProgress, progress_for  # noqa: F401  (TextProgress: public here too)
 from .camera import Camera
 from .frames import FrameRenderer, frame_indices, frame_times, map_frames, usable_cores  # noqa: F401
@@ -41,10 +41,13 @@ def check_output_path(path, formats=VIDEO_FORMATS) -> tuple[Path, str]:
     parent = path.parent if str(path.parent) else Path(".")
     if not parent.is_dir():
         raise OSError(f"cannot write {str(path)!r}: folder {str(parent)!r} does not exist")
-    if not os.access(parent, os.W_OK):
-        raise OSError(f"cannot write {str(path)!r}: folder {str(parent)!r} is not writable")
     if path.is_dir():
         raise OSError(f"cannot write {str(path)!r}: it is a folder")
+    refused = "" if os.access(parent, os.W_OK) else "permission denied"
+    refused = refused or folder_refuses(path)
+    if refused:
+        raise OSError(f"cannot write {str(path)!r}: folder {str(parent)!r} is not writable "
+                      f"({refused.lower()})")
     return path, formats[ext]
 
 

@@ -1,5 +1,6 @@
 """The command line (planarsim = walkers.cli.main). Runs in-process through main."""
 import json
+import os
 
 import numpy as np
 import pytest
@@ -87,6 +88,36 @@ def test_unwritable_output_path(tmp_path, capsys):
         assert code == 2 and "not writable" in err
     finally:
         locked.chmod(0o700)
+
+
+@pytest.mark.parametrize("flag, path, said", [
+    # root passes os.access in /proc; the run took its 10 s, then the export failed
+    ("--out", "/proc/x.gif", "--out '/proc/x.gif': not writable"),
+    ("--plot", "/proc/x.png", "--plot '/proc/x.png': not writable"),
+    ("--csv", "adir.csv", "--csv 'adir.csv': is a folder"),
+    ("--out", "adir.gif", "--out 'adir.gif': is a folder"),
+])
+def test_outputs_that_cannot_be_written_are_refused_before_the_run(flag, path, said, tmp_path,
+                                                                   monkeypatch, capsys):
+    if path.startswith("/proc") and not os.path.isdir("/proc"):
+        pytest.skip("no /proc")
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "adir.csv").mkdir()
+    (tmp_path / "adir.gif").mkdir()
+    monkeypatch.setattr(walkers.load("simple-biped"), "Run",
+                        lambda *a, **k: pytest.fail("the walker was run"))
+    code, _, err = run_cli(capsys, "run", "simple-biped", flag, path, "--json")
+    assert code == 2 and said in err, err
+
+
+def test_a_default_summary_path_that_is_a_folder_is_refused_before_the_run(tmp_path, monkeypatch,
+                                                                           capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "out" / "simple-biped_summary.json").mkdir(parents=True)
+    monkeypatch.setattr(walkers.load("simple-biped"), "Run",
+                        lambda *a, **k: pytest.fail("the walker was run"))
+    code, _, err = run_cli(capsys, "run", "simple-biped")
+    assert code == 2 and "the summary 'out/simple-biped_summary.json': is a folder" in err, err
 
 
 @pytest.mark.parametrize("out", [None, "walk.gif"])

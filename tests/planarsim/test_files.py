@@ -86,3 +86,12 @@ def test_a_target_that_cannot_be_written_is_named(tmp_path, where):
     assert said.startswith(f"cannot write {str(target)!r}: ") and ".part" not in said, said
     assert not [n for n in os.listdir(tempfile.gettempdir())
                 if n.startswith(f"planarsim-{os.getpid()}-")]
+
+
+def test_folder_refuses_says_why_no_file_can_be_made_and_leaves_nothing(tmp_path):
+    """os.access says yes to root in /proc: only making a file there tells."""
+    from planarsim.files import folder_refuses
+    assert folder_refuses(tmp_path / "x.gif") is None
+    assert list(tmp_path.iterdir()) == []
+    if os.path.isdir("/proc"):
+        assert folder_refuses("/proc/x.gif")          # the system's words, e.g. "No such file"

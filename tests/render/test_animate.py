@@ -96,6 +96,18 @@ def test_a_camera_that_is_no_camera_is_named(sliding_run, tmp_path, camera):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="/proc")
+def test_a_folder_no_file_can_be_made_in_is_refused_before_any_frame(sliding_run):
+    """Root passes os.access in /proc: every frame was drawn, then the file could not be put
+    there."""
+    model, traj = sliding_run
+    drawn = []
+    with pytest.raises(OSError, match=r"cannot write '/proc/x.gif': folder '/proc' is not writable"):
+        export_animation(traj, model, "/proc/x.gif", workers=1,
+                         progress=lambda done, total: drawn.append(done))
+    assert drawn == []
+
+
 def test_a_gif_faster_than_50_fps_is_refused_naming_fps(sliding_run, tmp_path):
     """A GIF at 100 fps has 1/100 s delays, which most viewers show as 1/10 s: it played at a
     tenth of its speed. An MP4 keeps any rate."""
