@@ -159,19 +159,23 @@ class WalkerRun:
         self.chunks.append(traj)
         return traj
 
-    def check_memory(self, seconds: float) -> tuple:
+    def check_memory(self, seconds: float, said: str | None = None, too_short: str = "",
+                     too_long: str = "") -> tuple:
         """(steps, frames) that run(seconds) would take and record; ValueError for a bad
-        `seconds`, planarsim.errors.RecordingTooLarge (a ValueError) for frames that cannot
+        `seconds`, run_steps' for a run of no step or too many (said, too_short, too_long:
+        its words), planarsim.errors.RecordingTooLarge (a ValueError) for frames that cannot
         fit in the machine's memory, before anything is allocated or run."""
+        from planarsim.checks import to_float
         from planarsim.trajectory import check_recording
-        try:
-            seconds = float(seconds)
-        except (TypeError, ValueError):
-            raise ValueError(f"seconds={seconds!r} must be a number of seconds") from None
-        if not (math.isfinite(seconds) and seconds >= 0.0):
+        x = to_float(seconds)
+        if x is None:
+            raise ValueError(f"seconds={seconds!r} must be a number of seconds")
+        if not (math.isfinite(x) and x >= 0.0):
             raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
+        seconds = x
         # a walker that fell stays where it fell: its rollout would otherwise take one more step
-        n = 0 if self.fell else run_steps(seconds, self.dt, f"{self.NAME}: run({seconds:g} s)")
+        n = 0 if self.fell else run_steps(seconds, self.dt, said or f"{self.NAME}: run({seconds:g} s)",
+                                          too_short, too_long)
         frames = self.frames(n)
         check_recording(self.model, frames,
                         f"{self.NAME}: run({seconds:g} s) at dt={self.dt:g} s, a frame every "

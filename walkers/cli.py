@@ -318,19 +318,16 @@ def _check_duration_fits(mod, kw, duration):
     walkers.base.MAX_RUN_STEPS, or a recording that cannot fit in this machine's memory
     (checked on the walker's run before anything is compiled or allocated)."""
     from planarsim.errors import RecordingTooLarge
-    from walkers.base import run_steps
     run = mod.Run(**{k: v for k, v in kw.items() if k != "duration"})
     try:
-        run_steps(duration, run.dt, f"--duration {duration:g} s", "; give a longer --duration",
-                  "; give a larger --dt or a shorter --duration")
-    except ValueError as e:
-        raise UsageError(str(e)) from None
-    try:
-        run.check_memory(duration)
+        run.check_memory(duration, f"--duration {duration:g} s", "; give a longer --duration",
+                         "; give a larger --dt or a shorter --duration")
     except RecordingTooLarge as e:
         raise UsageError(f"--duration {duration:g} s would record {e.frames:,} frames, which need "
                          f"{e.nbytes / 2 ** 30:.3g} GiB of memory (this machine has "
                          f"{e.available / 2 ** 30:.3g} GiB); give a shorter --duration") from None
+    except ValueError as e:         # walkers.base.run_steps: no step, or more than MAX_RUN_STEPS
+        raise UsageError(str(e)) from None
 
 
 def _show(v):
