@@ -103,8 +103,9 @@ def export_animation(traj, model, path, fps: float = 30.0, speed: float = 1.0, s
                      title=None, summary=None, **scene_kw) -> Path:
     """Write an animation of `traj` to `path` (.gif, .mp4 or .html, by extension).
 
-    fps : video frames per second (a GIF's at most 50: gif.MAX_GIF_FPS); speed : simulated seconds per video second (1 real time,
-    0.25 slow motion, 4 faster); start, duration : simulated time window [s] (default: all);
+    fps : video frames per second (a GIF's at most 50: gif.MAX_GIF_FPS); speed : simulated
+    seconds per video second (1 real time, 0.25 slow motion, 4 faster); start, duration :
+    simulated time window [s] (default: all);
     size : figure size [inch] at `dpi`; camera : a Camera (default Camera()); progress :
     True for a text bar on stderr when stderr is a terminal (nothing in a pipe or a log), a
     callable(done, total), or False; bitrate : MP4 bitrate

@@ -122,7 +122,7 @@ class FrameEncoder:
 
 # [frames/s] the fastest GIF that plays on time: its delays are whole 1/100 s, and most
 # viewers (browsers among them) show a delay below 2/100 s as 1/10 s, so 100 fps played at
-# a fifth of its speed
+# a tenth of its speed
 MAX_GIF_FPS = 50.0
 
 

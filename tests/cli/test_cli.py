@@ -122,7 +122,8 @@ def test_a_default_summary_path_that_is_a_folder_is_refused_before_the_run(tmp_p
 
 @pytest.mark.parametrize("out", [None, "walk.gif"])
 def test_a_gif_faster_than_50_fps_is_refused_before_the_run(out, tmp_path, monkeypatch, capsys):
-    """--fps 60 wrote a GIF that most viewers play at a sixth of its speed, after the run."""
+    """--fps 60 wrote a GIF, after the run, that most viewers play at about a third of its speed
+    (every other delay of 1/100 s shown as 1/10 s)."""
     monkeypatch.chdir(tmp_path)
     mod = walkers.load("simple-biped")
     monkeypatch.setattr(mod, "Run", lambda *a, **k: pytest.fail("the walker was run"))
