@@ -249,7 +249,8 @@ class Simulator:
 
     def run(self, duration: float | None = None, u=None, controller=None, n_steps: int | None = None,
             record_every: int = 1, control_every: int = 1, labels=None) -> Trajectory:
-        """Run for `duration` [s] (or `n_steps`) and return the recorded Trajectory.
+        """Run for `duration` [s] (or `n_steps`, at most MAX_STEPS in one call) and return the
+        recorded Trajectory.
 
         u : constant commands (n_act,), or
         controller : callable ``controller(sim) -> u`` called every `control_every` steps (the
@@ -274,6 +275,7 @@ class Simulator:
         # frame 0: the start; then the steps whose count is a multiple of `every`
         check_recording(self.model, n // every + 2,
                         f"run of {n:,} steps of {self.dt:g} s, a frame every {every} steps")
+        _within_one_call(self.dt, duration, n_steps, n)
         rec = make_recorder(self.model, n // every + 2)
         record_state(rec, 0, self._state, self._ws)
         k = 1
@@ -375,7 +377,7 @@ def _count_steps(dt, duration, n_steps):
     if (duration is None) == (n_steps is None):
         raise ValueError("give exactly one of duration [s] or n_steps")
     if n_steps is not None:
-        n = _step_count("n_steps", n_steps)
+        n = whole("n_steps", n_steps, 0)
     else:
         seconds = to_float(duration)
         if seconds is None:
@@ -387,7 +389,15 @@ def _count_steps(dt, duration, n_steps):
         if n == 0 and duration > 0:
             raise ValueError(f"duration={duration:g} s is less than half a step (dt={dt:g} s): "
                              "the run would take no step")
-        if n > MAX_STEPS:
-            raise ValueError(f"duration={duration:g} s at dt={dt:g} s is {n:,} steps, more than "
-                             f"{MAX_STEPS:,} in one call; run it in several calls")
     return n
+
+
+def _within_one_call(dt, duration, n_steps, n) -> None:
+    """A ValueError naming n_steps, or duration [s] and dt [s], where a run of n steps would
+    take more than MAX_STEPS (checked after its recording: one that cannot fit in memory is
+    named as such)."""
+    if n_steps is not None:
+        _step_count("n_steps", n_steps)
+    elif n > MAX_STEPS:
+        raise ValueError(f"duration={duration:g} s at dt={dt:g} s is {n:,} steps, more than "
+                         f"{MAX_STEPS:,} in one call; run it in several calls")

@@ -162,9 +162,9 @@ class WalkerRun:
     def check_memory(self, seconds: float, said: str | None = None, too_short: str = "",
                      too_long: str = "") -> tuple:
         """(steps, frames) that run(seconds) would take and record; ValueError for a bad
-        `seconds`, run_steps' for a run of no step or too many (said, too_short, too_long:
-        its words), planarsim.errors.RecordingTooLarge (a ValueError) for frames that cannot
-        fit in the machine's memory, before anything is allocated or run."""
+        `seconds`, planarsim.errors.RecordingTooLarge (a ValueError) for frames that cannot
+        fit in the machine's memory, then run_steps' ValueError for a run of no step or too
+        many (said, too_short, too_long: its words), before anything is allocated or run."""
         from planarsim.checks import to_float
         from planarsim.trajectory import check_recording
         x = to_float(seconds)
@@ -174,12 +174,13 @@ class WalkerRun:
             raise ValueError(f"seconds={seconds!r} must be finite and >= 0")
         seconds = x
         # a walker that fell stays where it fell: its rollout would otherwise take one more step
-        n = 0 if self.fell else run_steps(seconds, self.dt, said or f"{self.NAME}: run({seconds:g} s)",
-                                          too_short, too_long)
+        n = 0 if self.fell else int(round(seconds / self.dt))
         frames = self.frames(n)
         check_recording(self.model, frames,
                         f"{self.NAME}: run({seconds:g} s) at dt={self.dt:g} s, a frame every "
                         f"{self.record_every} steps", extra_columns=len(self.LABELS))
+        if not self.fell:
+            run_steps(seconds, self.dt, said or f"{self.NAME}: run({seconds:g} s)", too_short, too_long)
         return n, frames
 
     def start_frame(self):

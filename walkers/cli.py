@@ -323,7 +323,7 @@ def _check_duration_fits(mod, kw, duration):
         run.check_memory(duration, f"--duration {duration:g} s", "; give a longer --duration",
                          "; give a larger --dt or a shorter --duration")
     except RecordingTooLarge as e:
-        raise UsageError(f"--duration {duration:g} s would record {e.frames:,} frames, which need "
+        raise UsageError(f"--duration {duration:g} s at dt={run.dt:g} s would record {e.frames:,} frames, which need "
                          f"{e.nbytes / 2 ** 30:.3g} GiB of memory (this machine has "
                          f"{e.available / 2 ** 30:.3g} GiB); give a shorter --duration") from None
     except ValueError as e:         # walkers.base.run_steps: no step, or more than MAX_RUN_STEPS
