@@ -462,7 +462,12 @@ def _analysis_family(args):
     if not (lo <= min(a, b) and max(a, b) <= hi):
         raise UsageError(f"--range {args.range!r} leaves the bounds of {args.param}: [{lo}, {hi}]")
     _check_dt(args.dt)
-    return fam.WalkerFamily(args.walker, args.param, dt=args.dt or 1e-3), a, b
+    from walkers.passive.gait import check_map_dt
+    try:       # a step map evaluation runs up to 20 s: at --dt 1e-9 that never ends
+        dt = check_map_dt(args.dt or 1e-3, "--dt")
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+    return fam.WalkerFamily(args.walker, args.param, dt=dt), a, b
 
 
 def cmd_analyze(args):

@@ -21,6 +21,12 @@ from walkers.cli import main
       "--transient", "-5"], "--transient -5"),
     (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:0.2", "--diagram",
       "--keep", "0"], "--keep 0"),
+    # each step-map evaluation runs up to 20 s of steps: at 1e-9 s, 2e10 of them (it ran on
+    # practically forever); refused naming --dt and the bound
+    (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:0.2", "--dt", "1e-9"],
+     "--dt=1e-09 s is too small for the step map"),
+    (["analyze", "rimless-wheel", "--param", "slope", "--range", "0.1:0.2", "--dt", "1e-9"],
+     "more than MAX_RUN_STEPS=100,000,000; use dt >= 2e-07 s"),
 ])
 def test_bad_input_is_one_line_and_exit_2(argv, text, capsys):
     assert main(argv) == 2

@@ -170,6 +170,11 @@ def test_a_run_of_too_many_steps_is_refused_naming_dt_and_duration(name, monkeyp
      r"simple-biped: speed=nan m/s must be a finite number within \[0, 3\]"),
     ("simple-biped", dict(speed=5.0), ValueError, r"simple-biped: speed=5.0 m/s must be a finite"),
     ("quadruped", dict(speed="fast"), ValueError, r"quadruped: speed='fast' m/s must be a finite number"),
+    # the passive walkers' dt: "fast" failed in float(), True was taken for a 1 s step
+    ("simplest-walker", dict(dt="fast"), ValueError,
+     r"simplest-walker: dt='fast' s must be a finite step size > 0 \[s\]"),
+    ("rimless-wheel", dict(dt=True), ValueError, r"rimless-wheel: dt=True s must be a finite step"),
+    ("compass-gait", dict(dt=-1e-3), ValueError, r"compass-gait: dt=-0.001 s must be a finite step"),
 ])
 def test_bad_run_keywords_are_named(name, kw, error, said):
     with pytest.raises(error, match=said):

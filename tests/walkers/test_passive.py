@@ -299,3 +299,42 @@ def test_compass_fixed_point_converges_to_the_map_noise():
     fp = find_fixed_point(w.step_map(), default_start(), tol=1e-16, eps=1e-4, exact=False)
     assert 1e-16 < fp.noise < 1e-8 and fp.tol == pytest.approx(4 * fp.noise)
     assert fp.converged and fp.residual <= fp.tol
+
+
+@pytest.mark.parametrize("dt, said", [
+    ("1e-3", r"dt='1e-3' s must be a finite step size > 0 \[s\]"),
+    (True, r"dt=True s must be a finite step size > 0"),
+    (float("nan"), r"dt=nan s must be a finite step size > 0"),
+    (0.0, r"dt=0.0 s must be a finite step size > 0"),
+    (-1e-3, r"dt=-0.001 s must be a finite step size > 0"),
+    # each evaluation runs up to MAP_HORIZON = 20 s of steps: at 1e-9 s, 2e10 of them
+    (1e-9, r"dt=1e-09 s is too small for the step map: .* 20,000,000,000 steps, more than "
+           r"MAX_RUN_STEPS=100,000,000; use dt >= 2e-07 s"),
+])
+def test_step_map_family_refuses_a_bad_dt_before_building(dt, said):
+    """WalkerFamily (what planarsim analyze builds) and tilt_sensitivity's TiltStep name a bad
+    dt at once; at dt 1e-9 every step-map evaluation ran on practically forever, a string
+    failed in float(), True was taken for a 1 s step."""
+    from walkers.passive.family import WalkerFamily
+    from walkers.passive.sensitivity import TiltStep
+    with pytest.raises(ValueError, match=said):
+        WalkerFamily("simplest-walker", "slope", dt=dt)
+    with pytest.raises(ValueError, match=said):
+        TiltStep(SimplestParams(), dt=dt)
+
+
+def test_a_walker_at_a_tiny_dt_refuses_its_step_map_before_running():
+    """PassiveWalker itself may run at 1e-9 s (a short walk), but its step map, and the map's
+    exact Jacobian, would need 2e10 steps an evaluation: refused before any step is taken."""
+    from walkers.passive.gait import check_map_dt
+    from walkers.passive.simplest import garcia_start
+    assert check_map_dt(2e-7) == 2e-7          # (the bound itself is allowed)
+    with pytest.raises(ValueError, match=r"dt=1e-08 s is too small for the step map"):
+        check_map_dt(1e-8)
+    w = PassiveWalker(SimplestParams(), dt=1e-9)
+    said = r"dt=1e-09 s is too small for the step map"
+    for call in (w.step_map, lambda: w.advance(garcia_start()),
+                 lambda: w.advance_with_jacobian(garcia_start())):
+        with pytest.raises(ValueError, match=said):
+            call()
+    assert w.sim.state.time[0] == 0.0

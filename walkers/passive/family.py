@@ -6,7 +6,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from .gait import PassiveWalker
+from .gait import PassiveWalker, check_map_dt
 from .params import CompassParams, RimlessParams, SimplestParams
 
 PARAMS = {"simplest-walker": SimplestParams, "compass-gait": CompassParams,
@@ -36,14 +36,17 @@ def initial_guess(name: str, params) -> np.ndarray:
 
 class WalkerFamily:
     """p -> the step map of walker `name` with parameter `param` = p (other parameters from
-    `base`, default the walker's defaults), at step size dt [s]. names: section coordinates."""
+    `base`, default the walker's defaults), at step size dt [s]. names: section coordinates.
+    A dt that is no finite number > 0, or at which one evaluation of the map would need more
+    than walkers.base.MAX_RUN_STEPS steps (gait.check_map_dt), is a ValueError naming it,
+    before any walker is built."""
 
     def __init__(self, name: str, param: str, dt: float = 1e-3, base=None):
         if name not in PARAMS:
             raise ValueError(f"no step-map family for walker {name!r}; have {sorted(PARAMS)}")
         if param not in param_names(name):
             raise ValueError(f"{name} has no parameter {param!r}; parameters: {', '.join(param_names(name))}")
-        self.name, self.param, self.dt = name, param, float(dt)
+        self.name, self.param, self.dt = name, param, check_map_dt(dt)
         self.base = base if base is not None else PARAMS[name]()
         self.names = PassiveWalker(self.base, dt=self.dt).names
 

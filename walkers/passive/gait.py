@@ -21,6 +21,8 @@ from planarsim import dense
 from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
+from planarsim.checks import finite_number
+from planarsim.errors import plain
 from planarsim.half_step import kick, project_velocities, to_instant_velocity, to_step_velocity
 from planarsim.state import State
 from planarsim.trajectory import Trajectory, make_recorder, record_state
@@ -32,6 +34,32 @@ from .rollout import DETECT, ENGINE, FELL, NO_EVENT, TOGGLE, rollout_passive
 
 IMPACT_DT = 1e-6   # [s] the step that resolves an impact at the section (impact);
                    # gravity acts 1e-6 s longer, residuals / IMPACT_DT < 1e-6 m/s
+MAP_HORIZON = 20.0  # [s] how long one step-map evaluation waits for the next touchdown
+
+
+def check_dt(dt, said: str = "dt") -> float:
+    """dt [s] as a float; a ValueError naming it (as `said` gives it) unless it is a finite
+    number > 0 (a string failed in float(), True was taken for 1 s, NaN built a model)."""
+    x = finite_number(said, dt, 0.0, unit=" s",
+                      expected="a finite step size > 0 [s]")
+    if x <= 0.0:
+        raise ValueError(f"{said}={plain(dt)!r} s must be a finite step size > 0 [s]")
+    return x
+
+
+def check_map_dt(dt, said: str = "dt") -> float:
+    """check_dt, and a ValueError naming dt and the bound where one step-map evaluation
+    (up to MAP_HORIZON s to the next touchdown: int(MAP_HORIZON / dt) steps) would need more
+    than walkers.base.MAX_RUN_STEPS steps (at dt 1e-9 s, 2e10 steps: practically forever)."""
+    from walkers.base import MAX_RUN_STEPS
+    x = check_dt(dt, said)
+    n = int(MAP_HORIZON / x)
+    if n > MAX_RUN_STEPS:
+        raise ValueError(f"{said}={x:g} s is too small for the step map: one evaluation runs up to "
+                         f"{MAP_HORIZON:g} s to the next touchdown, {n:,} steps, more than "
+                         f"MAX_RUN_STEPS={MAX_RUN_STEPS:,}; use dt >= "
+                         f"{MAP_HORIZON / MAX_RUN_STEPS:g} s (1e-3 is usual)")
+    return x
 
 
 def _cross(a, b):
@@ -71,7 +99,7 @@ class PassiveWalker:
 
     def __init__(self, params, dt: float = 1e-3, strategy: str = "all", terrain=None):
         self.params = params
-        self.dt = float(dt)
+        self.dt = check_dt(dt)
         if isinstance(params, SimplestParams):
             self.kind, self.model = "simplest", build_simplest(params, dt, terrain)
             self.feet = np.array([self.model.contact("foot_a"), self.model.contact("foot_b")])
@@ -380,7 +408,10 @@ class PassiveWalker:
     def advance(self, x, record_every: int = 0) -> np.ndarray:
         """The step-to-step map: coordinates just after the next touchdown (StepMapError if
         the walker falls or takes no step within 20 s). With record_every > 0 the step (up to
-        the end of the sim step containing the touchdown) is kept in self.last_traj."""
+        the end of the sim step containing the touchdown) is kept in self.last_traj.
+        ValueError for a dt at which it would need more than MAX_RUN_STEPS steps
+        (check_map_dt), before anything runs."""
+        check_map_dt(self.dt)
         self.set_coords(x)
         # x holds velocities at the touchdown instant; the step wants them over its first step
         # (planarsim.half_step: with both ends converted the map is second order in dt)
@@ -391,13 +422,13 @@ class PassiveWalker:
         self.toggle = DETECT
         try:
             self.sim.state.contact_enabled[self.feet[1:]] = 0
-            code, done, self.last_traj = self.rollout(int(20.0 / self.dt), 1, record_every)
+            code, done, self.last_traj = self.rollout(int(MAP_HORIZON / self.dt), 1, record_every)
         finally:
             self.toggle = toggle
         if code == FELL:
             raise StepMapError(f"{self.kind}: the walker fell from x={x}")
         if code == NO_EVENT:
-            raise StepMapError(f"{self.kind}: no touchdown within 20 s from x={x}")
+            raise StepMapError(f"{self.kind}: no touchdown within {MAP_HORIZON:g} s from x={x}")
         self.locate_touchdown(old, self.steps_after())
         self.last_release_ok = bool(self.sim.state.contact_mode[self.feet[old]] == 0)
         self.sim.state.contact_enabled[self.feet[old]] = 0
@@ -408,7 +439,9 @@ class PassiveWalker:
 
     def step_map(self) -> StepMap:
         """The step-to-step map (advance), with its exact Jacobian (map_jacobian) on flat or
-        sloped ground (on hills: none, the fits and differences then)."""
+        sloped ground (on hills: none, the fits and differences then). ValueError for a dt too
+        small for it (check_map_dt)."""
+        check_map_dt(self.dt)
         covered = self.model.arrays.terrain_coef[2] == 0.0
         return StepMap(self.advance, dim=len(self.names), names=self.names,
                        derivative=self.advance_with_jacobian if covered else None)

@@ -34,7 +34,7 @@ from planarsim.half_step import kick, to_step_velocity
 from planarsim.state import State
 from planarsim.step_replica import project_velocities_batch
 
-from .gait import IMPACT_DT, NODES, lagrange_weights
+from .gait import IMPACT_DT, MAP_HORIZON, NODES, check_map_dt, lagrange_weights
 from .rollout import DETECT, update_feet
 
 
@@ -166,8 +166,9 @@ def _tangent(Y):
 def map_jacobian(w, x):
     """(P(x), dP/dx (d, d)) of PassiveWalker w's step map at section coordinates x (module
     docstring). Raises StepMapError as advance does, NotImplementedError where a step is
-    not covered by step_tangents."""
+    not covered by step_tangents, ValueError for a dt too small for the map (check_map_dt)."""
     from planarsim.analysis import StepMapError
+    check_map_dt(w.dt)
     x = np.asarray(x, dtype=float)
     d = x.size
     model, sim = w.model, w.sim
@@ -184,7 +185,7 @@ def map_jacobian(w, x):
     start = w.foot_point(w.feet[old])[0]
     s.contact_enabled[w.feet[1:]] = 0
     edges = 0
-    for _ in range(int(20.0 / h)):
+    for _ in range(int(MAP_HORIZON / h)):
         step = step_tangents(sim, u0, T, _keep_end=True)
         edges += step.modes_changed
         if update_feet(model.arrays, s, ws, w.feet, w.memory, DETECT, w.min_ahead) >= 0:
@@ -193,7 +194,7 @@ def map_jacobian(w, x):
         if w.fell():
             raise StepMapError(f"{w.kind}: the walker fell from x={x}")
     else:
-        raise StepMapError(f"{w.kind}: no touchdown within 20 s from x={x}")
+        raise StepMapError(f"{w.kind}: no touchdown within {MAP_HORIZON:g} s from x={x}")
     c = int(w.feet[int(w.memory[0])])
     # the nodes: the crossing step's start and end and the steps after it, with tangents
     begin, crossing_end = State(*(a.copy() for a in ws.prev)), s.copy()

@@ -23,7 +23,7 @@ from planarsim.analysis import step_summary
 from walkers.base import WalkerRun, terrain_of
 from walkers.common.record import record_one
 
-from .gait import PassiveWalker
+from .gait import PassiveWalker, check_dt
 from .rollout import DETECT, FELL, NO_EVENT
 
 GAITS = ("passive",)
@@ -71,6 +71,7 @@ class PassiveRun(WalkerRun):
             raise ValueError(f"{self.NAME}: unknown gait {gait!r}; gaits: {GAITS}")
         if impacts not in IMPACTS:
             raise ValueError(f"impacts={impacts!r} must be 'refined' or 'engine'")
+        dt = check_dt(dt, f"{self.NAME}: dt")
         terrain = terrain_of(terrain)
         p = params or self.Params()
         p = self.Params(**{**p.as_dict(), "slope": slope_from_terrain(terrain, p.slope)})

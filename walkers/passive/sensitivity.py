@@ -20,7 +20,7 @@ import numpy as np
 
 from planarsim.analysis.sensitivity import GaitSensitivity, gait_sensitivity
 
-from .gait import PassiveWalker
+from .gait import PassiveWalker, check_map_dt
 
 #: [rad] central-difference step of the tilt (and of the section coordinates)
 TILT_EPS = 1e-5
@@ -31,7 +31,7 @@ class TiltStep:
     whose next step is on its slope + e[0] (module docstring); walkers per tilt kept."""
 
     def __init__(self, params, dt: float = 1e-3):
-        self.params, self.dt = params, float(dt)
+        self.params, self.dt = params, check_map_dt(dt)
         self.walkers: dict[float, PassiveWalker] = {}
 
     def walker(self, tilt: float) -> PassiveWalker:
