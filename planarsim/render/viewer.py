@@ -31,7 +31,7 @@ import time
 
 import numpy as np
 
-from ..checks import callable_or_none
+from ..checks import callable_or_none, finite_number, whole
 from ..errors import SimulationDiverged
 from .camera import camera_or_default
 from .draw import Scene
@@ -49,10 +49,15 @@ class FrameTimer:
 
     def __init__(self, period: float, kp: float = 0.7, ki: float = 0.2, clock=time.perf_counter,
                  max_lag=None):
-        if not (math.isfinite(period) and period > 0):
-            raise ValueError(f"frame period={period} must be finite and > 0 s")
-        self.period, self.kp, self.ki, self.clock = float(period), float(kp), float(ki), clock
-        self.max_lag = 2.0 * self.period if max_lag is None else float(max_lag)
+        self.period = _positive("FrameTimer: period", period, "the frame interval [s]")
+        self.kp = finite_number("FrameTimer: kp", kp, 0.0)
+        self.ki = finite_number("FrameTimer: ki", ki, 0.0)
+        callable_or_none("FrameTimer: clock", clock, "a function clock() -> seconds")
+        if clock is None:
+            raise TypeError("FrameTimer: clock=None must be a function clock() -> seconds")
+        self.clock = clock
+        self.max_lag = (2.0 * self.period if max_lag is None
+                        else finite_number("FrameTimer: max_lag", max_lag, 0.0))
         self.start()
 
     def start(self) -> None:
@@ -119,23 +124,19 @@ class Viewer:
                  clock=time.perf_counter, blit=None, **scene_kw):
         callable_or_none("controller", controller, "a function controller(sim) -> u")
         callable_or_none("labels", labels, "a function labels(sim) -> dict of scalars")
-        if control_every < 1:
-            raise ValueError(f"control_every={control_every} must be >= 1 step")
-        if not (math.isfinite(fps) and fps > 0):
-            raise ValueError(f"fps={fps} must be finite and > 0 frames per second")
+        callable_or_none("on_gait", on_gait, "a function on_gait(name)")
+        # (a string here failed in a comparison, True was 1 step, NaN fps built the viewer)
+        self.control_every = whole("control_every", control_every, least=1)
+        fps = _positive("fps", fps, "frames per second")
         self.sim, self.controller, self.labels = sim, controller, labels
-        self.control_every = int(control_every)
         self.speed = _check_speed(speed)
-        self.gains = dict(gains or {})
-        for name, spec in self.gains.items():
-            if len(spec) != 4 or not (callable(spec[2]) and callable(spec[3])) or not spec[0] < spec[1]:
-                raise ValueError(f"gain {name!r}: expected (min, max, getter, setter) with min < max")
+        self.gains = _check_gains(gains)
         self.gait_keys = dict(DEFAULT_GAIT_KEYS if gait_keys is None else gait_keys)
         self.on_gait = on_gait
         self.gait = None
         self.playing = False
         self.message = ""
-        self.timer = FrameTimer(1.0 / float(fps), clock=clock)
+        self.timer = FrameTimer(1.0 / fps, clock=clock)
         self.camera = camera_or_default(camera)
         self._carry = 0.0
         self._due = self.timer.period
@@ -223,8 +224,10 @@ class Viewer:
         self.speed = _check_speed(speed)
 
     def set_gravity(self, magnitude, tilt_deg=0.0) -> None:
-        """Gravity of `magnitude` [m/s^2] tilted by `tilt_deg` from straight down (+: toward +x)."""
-        self.gravity, self.tilt_deg = float(magnitude), float(tilt_deg)
+        """Gravity of `magnitude` [m/s^2] (finite, >= 0) tilted by `tilt_deg` (finite) from
+        straight down (+: toward +x)."""
+        self.gravity = finite_number("set_gravity: magnitude", magnitude, 0.0, unit=" m/s^2")
+        self.tilt_deg = finite_number("set_gravity: tilt_deg", tilt_deg, unit=" deg")
         a = math.radians(self.tilt_deg)
         g = np.array([self.gravity * math.sin(a), -self.gravity * math.cos(a)])
         g.setflags(write=False)
@@ -247,7 +250,9 @@ class Viewer:
 
     def advance(self, sim_seconds: float) -> int:
         """Step the simulation by `sim_seconds` [s] (whole steps; the remainder carries over).
-        Returns the number of steps taken. A diverged simulation pauses with a message."""
+        Returns the number of steps taken. A diverged simulation pauses with a message;
+        `sim_seconds` must be a finite number >= 0 (ValueError naming it)."""
+        sim_seconds = finite_number("advance: sim_seconds", sim_seconds, 0.0, unit=" s")
         dt = self.sim.dt
         want = self._carry + sim_seconds / dt
         n = int(math.floor(want + 1e-9))
@@ -391,11 +396,39 @@ def view_walker(module, gait=None, terrain=None, **kw) -> Viewer:
     return view(sim, controller, **spec)
 
 
+def _positive(said, value, what: str) -> float:
+    """value as a float; a ValueError naming it (`said`) unless it is a finite number > 0
+    (not a string, True or False); what: its meaning, for the message."""
+    return finite_number(said, value, least=math.ulp(0.0),
+                         expected=f"a finite number > 0 ({what})")
+
+
 def _check_speed(speed) -> float:
-    speed = float(speed)
-    if not (math.isfinite(speed) and speed > 0):
-        raise ValueError(f"playback speed={speed} must be finite and > 0 (1 real time, <1 slow motion)")
-    return speed
+    """The playback speed as a float (finite, > 0; a string failed in float(), True was 1)."""
+    return _positive("speed", speed, "playback speed: 1 real time, < 1 slow motion")
+
+
+def _check_gains(gains) -> dict:
+    """gains as a dict {name: (min, max, getter, setter)}: a ValueError (TypeError for what
+    is no dict or no function) naming the gain and what is wrong (a string min failed in a
+    comparison, NaN or inf bounds built a slider that could not be drawn)."""
+    try:
+        gains = dict(gains or {})
+    except (TypeError, ValueError):
+        raise TypeError(f"gains={gains!r} must be a dict {{name: (min, max, getter, setter)}}") from None
+    out = {}
+    for name, spec in gains.items():
+        if not isinstance(spec, (tuple, list)) or len(spec) != 4:
+            raise ValueError(f"gain {name!r}: {spec!r} must be (min, max, getter, setter)")
+        lo = finite_number(f"gain {name!r}: min", spec[0])
+        hi = finite_number(f"gain {name!r}: max", spec[1])
+        if not lo < hi:
+            raise ValueError(f"gain {name!r}: min={lo:g} must be < max={hi:g}")
+        for which, f in (("getter", spec[2]), ("setter", spec[3])):
+            if not callable(f):
+                raise TypeError(f"gain {name!r}: {which}={f!r} must be a function")
+        out[name] = (lo, hi, spec[2], spec[3])
+    return out
 
 
 def _headless_figure(w, h):

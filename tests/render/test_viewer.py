@@ -84,12 +84,64 @@ def live():
     (dict(controller=5), TypeError, r"controller=5 must be a function controller\(sim\) -> u, or None"),
     (dict(labels="angle"), TypeError, r"labels='angle' must be a function labels\(sim\)"),
     (dict(camera=5), TypeError, r"camera=5 must be a planarsim.render.Camera"),
+    (dict(on_gait="walk"), TypeError, r"on_gait='walk' must be a function on_gait\(name\)"),
+    # control_every and fps: a string failed in a comparison ("'<' not supported between
+    # instances of 'str' and 'int'"), True was one step, NaN fps built the viewer
+    (dict(control_every="2"), ValueError, r"control_every='2' must be a whole number$"),
+    (dict(control_every=True), ValueError, r"control_every=True must be a whole number \(not True"),
+    (dict(control_every=1.5), ValueError, r"control_every=1.5 must be a whole number$"),
+    (dict(control_every=0), ValueError, r"control_every=0 must be a whole number >= 1"),
+    (dict(control_every=float("nan")), ValueError, r"control_every=nan must be a whole number"),
+    (dict(fps="30"), ValueError, r"fps='30' must be a finite number > 0 \(frames per second\)"),
+    (dict(fps=True), ValueError, r"fps=True must be a finite number > 0"),
+    (dict(fps=float("nan")), ValueError, r"fps=nan must be a finite number > 0"),
+    (dict(fps=0), ValueError, r"fps=0 must be a finite number > 0"),
+    (dict(fps=-30.0), ValueError, r"fps=-30.0 must be a finite number > 0"),
+    # speed: "fast" failed in float() ("could not convert string to float"), True was 1
+    (dict(speed="fast"), ValueError, r"speed='fast' must be a finite number > 0 \(playback speed"),
+    (dict(speed=True), ValueError, r"speed=True must be a finite number > 0"),
+    (dict(speed=-1.0), ValueError, r"speed=-1.0 must be a finite number > 0"),
+    # gains: a bare number failed in len(), string bounds passed the comparison and failed in
+    # the slider, NaN bounds were refused as "min < max" without naming which
+    (dict(gains={"kp": 5}), ValueError, r"gain 'kp': 5 must be \(min, max, getter, setter\)"),
+    (dict(gains={"kp": ("a", "b", float, float)}), ValueError, r"gain 'kp': min='a' must be a finite number"),
+    (dict(gains={"kp": (0.0, float("nan"), float, float)}), ValueError, r"gain 'kp': max=nan must be a finite"),
+    (dict(gains={"kp": (1.0, 0.0, float, float)}), ValueError, r"gain 'kp': min=1 must be < max=0"),
+    (dict(gains={"kp": (0.0, 1.0, 5, float)}), TypeError, r"gain 'kp': getter=5 must be a function"),
+    (dict(gains=5), TypeError, r"gains=5 must be a dict"),
 ])
 def test_viewer_names_arguments_of_the_wrong_kind(kw, error, said):
     """controller=5 and camera=5 failed at the first frame ("'int' object is not callable",
     "has no attribute 'update'")."""
     with pytest.raises(error, match=said):
         Viewer(ps.Simulator(pendulum_model()), clock=FakeClock(7), **kw)
+
+
+def test_viewer_and_timer_name_bad_numbers_given_later():
+    """FrameTimer's period and gains, and the viewer's set_gravity, set_speed and advance, name
+    a bad number: a string failed in math.isfinite() or float(), NaN gravity or a NaN advance
+    went into the simulation (int(nan) then failed raw)."""
+    with pytest.raises(ValueError, match=r"FrameTimer: period='0.1' must be a finite number > 0"):
+        FrameTimer("0.1", clock=FakeClock(7))
+    with pytest.raises(ValueError, match=r"FrameTimer: kp=nan must be a finite number >= 0"):
+        FrameTimer(0.1, kp=float("nan"), clock=FakeClock(7))
+    with pytest.raises(ValueError, match=r"FrameTimer: max_lag=-1.0 must be a finite number >= 0"):
+        FrameTimer(0.1, max_lag=-1.0, clock=FakeClock(7))
+    with pytest.raises(TypeError, match=r"FrameTimer: clock=5 must be a function clock\(\)"):
+        FrameTimer(0.1, clock=5)
+    viewer = Viewer(ps.Simulator(pendulum_model()), clock=FakeClock(7))
+    t = viewer.sim.t
+    with pytest.raises(ValueError, match=r"set_gravity: magnitude=nan m/s\^2 must be a finite number >= 0"):
+        viewer.set_gravity(float("nan"))
+    with pytest.raises(ValueError, match=r"set_gravity: tilt_deg='x' deg must be a finite number"):
+        viewer.set_gravity(9.81, "x")
+    with pytest.raises(ValueError, match=r"speed=0.0 must be a finite number > 0"):
+        viewer.set_speed(0.0)
+    for bad in (float("nan"), -0.1, "0.1"):
+        with pytest.raises(ValueError, match=r"advance: sim_seconds=.* s must be a finite number >= 0"):
+            viewer.advance(bad)
+    assert viewer.sim.t == t and viewer.speed == 1.0
+    assert viewer.sim.model.arrays.gravity[1] == pytest.approx(-9.81)
 
 
 @pytest.mark.parametrize("fps,seed", [(30, 0), (60, 1), (24, 2)])
