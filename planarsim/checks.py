@@ -61,6 +61,13 @@ def finite_number(said, value, least=-math.inf, most=math.inf, strict: bool = Tr
     return x
 
 
+def positive(said, value, what: str = "", unit: str = "", error=ValueError) -> float:
+    """value as a float: `error` naming it ("{said}={value}{unit} must be a finite number > 0
+    ({what})") unless it is a finite real number > 0 (not a string, True or False)."""
+    return finite_number(said, value, least=math.ulp(0.0), unit=unit, error=error,
+                         expected="a finite number > 0" + (f" ({what})" if what else ""))
+
+
 def _bounds(least, most) -> str:
     """" >= 0", " within [0, 3]" or "" as finite_number's words say them."""
     if math.isfinite(least) and math.isfinite(most):

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import whole
+from ..checks import finite_number, whole
 from .continuation import write_csv
 from .parallel import MapPool, iterate_task
 
@@ -109,6 +109,10 @@ def basin_of_attraction(pool: MapPool, p: float, a_values, b_values, state, attr
     state(a, b) -> x0 (d,) the section state of grid point (a, b) (say the stance angle and
     rate, the swing leg from the impact law). Each is iterated up to n_steps steps (in
     parallel), stopping when within tol (max norm) of the attractor or at a fall."""
+    # (a string n_steps failed in int(), 2.5 steps were 2, a NaN tol reached nothing)
+    p = finite_number("p", p)
+    n_steps = whole("n_steps", n_steps, 0)
+    tol = finite_number("tol", tol, 0.0)
     A, B = np.asarray(a_values, float), np.asarray(b_values, float)
     target = np.asarray(attractor, dtype=np.float64)
     items = [(float(p), np.asarray(state(a, b), dtype=np.float64), int(n_steps), 0, target, float(tol))

@@ -31,12 +31,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..checks import whole
+from ..checks import finite_number, positive, whole
 from ..trajectory import atomic_write
 from .parallel import MapPool
 from .stepmap import (FIT_POINTS, FIT_WINDOW, Multipliers, StepMapError, central_jacobian,
-                      central_points, map_noise, multipliers_by_fit, noise_tolerance,
-                      sort_multipliers)
+                      central_points, finite_differences_step, map_noise, multipliers_by_fit,
+                      noise_tolerance, sort_multipliers)
 
 KINDS = ("period-doubling", "fold", "neimark-sacker")
 
@@ -159,6 +159,9 @@ def newton_fixed_point(pool: MapPool, p, x0, period=1, tol="auto", max_iter=20, 
     evaluated in one batch; tol "auto" or a number: fixed_point_tolerance.
     Returns (x, residual, converged, J at the last iterate)."""
     period = whole("period", period, 1)
+    max_iter = whole("max_iter", max_iter, 0)
+    max_halvings = whole("max_halvings", max_halvings, 0)
+    eps = finite_differences_step(eps)
     x = np.asarray(x0, dtype=np.float64).copy()
     if isinstance(tol, str):
         tol = fixed_point_tolerance(pool, p, x, period, tol)
@@ -397,12 +400,19 @@ def continue_branch(pool: MapPool, x0, p0: float, p1: float, points: int = 30,
     """
     if method not in ("natural", "arclength"):
         raise ValueError(f"method={method!r} must be 'natural' or 'arclength'")
-    if not (math.isfinite(p0) and math.isfinite(p1)) or p0 == p1:
+    # (a string p0 failed in math.isfinite(), points="30" in int(), 2.7 points were 2)
+    p0, p1 = finite_number("p0", p0), finite_number("p1", p1)
+    if p0 == p1:
         raise ValueError(f"continuation range {p0}:{p1} must be two different finite numbers")
-    if int(points) < 2:
-        raise ValueError(f"points={points} must be at least 2")
+    points = whole("points", points, 2)
     period = whole("period", period, 1)
-    p_tol = 1e-5 * abs(p1 - p0) if p_tol is None else p_tol
+    mult_tol = positive("mult_tol", mult_tol, "the multipliers' error allowed")
+    if max_points is not None:
+        max_points = whole("max_points", max_points, 2)
+    if subperiod is not None:
+        subperiod = whole("subperiod", subperiod, 1)
+    p_tol = 1e-5 * abs(p1 - p0) if p_tol is None else positive("p_tol", p_tol, "how closely "
+                                                                "a bifurcation is located")
     ev0 = pool.evaluations
     branch = Branch(param, int(period))
     tol = fixed_point_tolerance(pool, p0, np.asarray(x0, dtype=np.float64), period, tol)
@@ -547,7 +557,9 @@ def period_doubling_branch(pool: MapPool, bif: Bifurcation, p1: float, points: i
     P^2n, raised to the map's noise (fixed_point_tolerance); Newton on P^2n is ill-conditioned
     next to the doubling (a multiplier of P^2n near +1), hence 1e-6 by default."""
     n = bif.period
-    dp = (p1 - bif.p) / max(int(points) - 1, 1)
+    p1 = finite_number("p1", p1)
+    points = whole("points", points, 2)
+    dp = (p1 - bif.p) / (points - 1)
     pstart = bif.p + 0.5 * dp
     J = _multipliers(pool, pstart, bif.x, n, 3e-3).jacobian
     lam, V = np.linalg.eig(J)

@@ -173,11 +173,12 @@ class MapPool:
         if (backend == "dask") != (scheduler is not None):
             raise ValueError(f"backend={backend!r} with scheduler={scheduler!r}: a dask pool "
                              "is made by giving its scheduler (backend 'dask' or left out)")
-        self.family, self.cache = family, int(cache)
+        from ..checks import whole       # (cache="8" failed in int() raw, 0 kept no map)
+        self.family, self.cache = family, whole("cache", cache, 1)
         self._client, self._own_client = None, False
         if scheduler is not None:
-            if workers is not None and int(workers) < 1:
-                raise ValueError(f"workers={workers}: chunks per dask thread must be >= 1")
+            if workers is not None:
+                workers = whole("workers", workers, 1, error=ValueError)
             self._client, self._own_client = _dask_client(scheduler)
             info = self._client.scheduler_info().get("workers", {})
             self.workers = max(1, sum(int(w.get("nthreads", 1)) for w in info.values()))

@@ -84,11 +84,13 @@ def gait_sensitivity(step: Callable, x, disturbances: int = 1, eps: float = 1e-6
     undisturbed step): B, C and D by central differences (step eps in e, eps_x in x: default
     eps), A given (the map's exact Jacobian, StepMap.jacobian) or differenced too; response:
     the first `steps` indicator changes of a unit disturbance."""
+    from ..checks import positive, whole
     x = np.asarray(x, dtype=np.float64)
-    d, m = x.size, int(disturbances)
-    if m < 1:
-        raise ValueError(f"disturbances={disturbances} must be >= 1")
-    hx = eps if eps_x is None else eps_x
+    # (a string failed in int(), 1.5 disturbances were 1, a NaN or 0 eps gave NaN matrices)
+    d, m = x.size, whole("disturbances", disturbances, 1)
+    eps = positive("eps", eps, "the disturbance's finite-difference step")
+    hx = eps if eps_x is None else positive("eps_x", eps_x, "the state's finite-difference step")
+    steps = whole("steps", steps, 1)
     zero = np.zeros(m)
 
     def at(xx, e):

@@ -104,8 +104,10 @@ class StepMap:
 
     def iterate(self, x0, n: int) -> np.ndarray:
         """(n + 1, d) orbit x0, P(x0), ..., P^n(x0) (stops early, shorter, if the walker fails)."""
+        from ..checks import whole
+        n = whole("n", n, 0)
         xs = [np.asarray(x0, dtype=np.float64)]
-        for _ in range(int(n)):
+        for _ in range(n):
             try:
                 xs.append(self(xs[-1]))
             except StepMapError:
@@ -118,9 +120,7 @@ def jacobian(f: Callable, x, eps=1e-6, central: bool = True, fx=None) -> np.ndar
     central differences (2d evaluations) or forward (d, reusing fx = f(x) if given)."""
     x = np.asarray(x, dtype=np.float64)
     d = x.size
-    h = np.broadcast_to(np.asarray(eps, dtype=np.float64), (d,))
-    if np.any(h <= 0):
-        raise ValueError(f"finite-difference step eps={eps} must be > 0")
+    h = np.broadcast_to(finite_differences_step(eps), (d,))
     if not central and fx is None:
         fx = np.asarray(f(x))
     J = np.zeros((d, d))
@@ -132,6 +132,22 @@ def jacobian(f: Callable, x, eps=1e-6, central: bool = True, fx=None) -> np.ndar
         else:
             J[:, i] = (np.asarray(f(x + e)) - fx) / h[i]
     return J
+
+
+def finite_differences_step(eps):
+    """eps, a finite-difference step (a number, or one per coordinate), as a float or float
+    array; a ValueError naming it unless every entry is a finite number > 0 (a string failed
+    in numpy's conversion, NaN passed "eps <= 0" and gave a NaN Jacobian, True was 1)."""
+    from ..checks import holds_bool
+    from ..errors import plain
+    try:
+        h = None if holds_bool(eps) or isinstance(eps, (str, bytes)) else np.asarray(eps, dtype=np.float64)
+    except (TypeError, ValueError):
+        h = None
+    if h is None or h.ndim > 1 or not (np.all(np.isfinite(h)) and np.all(h > 0)) or h.size == 0:
+        raise ValueError(f"finite-difference step eps={plain(eps)!r} must be a finite number > 0 "
+                         "(or one per coordinate)")
+    return float(h) if h.ndim == 0 else h
 
 
 def sort_multipliers(lam) -> np.ndarray:
@@ -188,6 +204,8 @@ def map_noise(evaluate, x, probes: int = 3, seed: int = 0) -> float:
     `probes` random steps d of size NOISE_PROBE (a smooth map's second difference there is
     ~1e-16 of its curvature; a simulated map's is its noise: solver tolerances, touchdown
     root finding). evaluate(X) -> (Y, ok) as multipliers_with_error's. NaN if the map fails."""
+    from ..checks import whole
+    probes = whole("probes", probes, 1)
     x = np.asarray(x, dtype=np.float64)
     h = NOISE_PROBE * max(1.0, float(np.max(np.abs(x))))
     D = h * np.random.default_rng(seed).choice([-1.0, 1.0], size=(probes, x.size))
@@ -210,10 +228,8 @@ def noise_tolerance(tol, noise) -> float:
         if tol != "auto":
             raise ValueError(f"tol={tol!r} must be 'auto' or a number")
         return max(floor, AUTO_TOL)
-    tol = float(tol)
-    if not tol > 0:
-        raise ValueError(f"tol={tol} must be > 0")
-    return max(tol, floor)
+    from ..checks import positive       # (inf converged at once, True was 1)
+    return max(positive("tol", tol, "'auto' or the residual a fixed point must reach"), floor)
 
 
 def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
@@ -227,6 +243,10 @@ def find_fixed_point(f: Callable, x0, tol="auto", max_iter: int = 30, eps=1e-6,
     with tol raised to NOISE_FACTOR x the map's noise measured at x0 (map_noise; "auto":
     AUTO_TOL, raised likewise). The returned Jacobian is evaluated at the final x.
     """
+    from ..checks import whole
+    max_iter = whole("max_iter", max_iter, 0)
+    max_halvings = whole("max_halvings", max_halvings, 0)
+    eps = finite_differences_step(eps)
     count = [0]
     has = isinstance(f, StepMap) and f.exact
     if exact and not has:

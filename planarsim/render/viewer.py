@@ -31,7 +31,7 @@ import time
 
 import numpy as np
 
-from ..checks import callable_or_none, finite_number, whole
+from ..checks import callable_or_none, finite_number, positive, whole
 from ..errors import SimulationDiverged
 from .camera import camera_or_default
 from .draw import Scene
@@ -49,7 +49,7 @@ class FrameTimer:
 
     def __init__(self, period: float, kp: float = 0.7, ki: float = 0.2, clock=time.perf_counter,
                  max_lag=None):
-        self.period = _positive("FrameTimer: period", period, "the frame interval [s]")
+        self.period = positive("FrameTimer: period", period, "the frame interval [s]")
         self.kp = finite_number("FrameTimer: kp", kp, 0.0)
         self.ki = finite_number("FrameTimer: ki", ki, 0.0)
         callable_or_none("FrameTimer: clock", clock, "a function clock() -> seconds")
@@ -127,7 +127,7 @@ class Viewer:
         callable_or_none("on_gait", on_gait, "a function on_gait(name)")
         # (a string here failed in a comparison, True was 1 step, NaN fps built the viewer)
         self.control_every = whole("control_every", control_every, least=1)
-        fps = _positive("fps", fps, "frames per second")
+        fps = positive("fps", fps, "frames per second")
         self.sim, self.controller, self.labels = sim, controller, labels
         self.speed = _check_speed(speed)
         self.gains = _check_gains(gains)
@@ -396,16 +396,9 @@ def view_walker(module, gait=None, terrain=None, **kw) -> Viewer:
     return view(sim, controller, **spec)
 
 
-def _positive(said, value, what: str) -> float:
-    """value as a float; a ValueError naming it (`said`) unless it is a finite number > 0
-    (not a string, True or False); what: its meaning, for the message."""
-    return finite_number(said, value, least=math.ulp(0.0),
-                         expected=f"a finite number > 0 ({what})")
-
-
 def _check_speed(speed) -> float:
     """The playback speed as a float (finite, > 0; a string failed in float(), True was 1)."""
-    return _positive("speed", speed, "playback speed: 1 real time, < 1 slow motion")
+    return positive("speed", speed, "playback speed: 1 real time, < 1 slow motion")
 
 
 def _check_gains(gains) -> dict:

@@ -14,6 +14,8 @@ from planarsim.analysis import (MapPool, MultiplierWarning, StepMapError, basin_
                                 bifurcation_diagram, continue_branch, multipliers_with_error,
                                 period_doubling_branch, plot_basin, plot_bifurcation_diagram,
                                 plot_branch_multipliers, bifurcation_tests)
+from planarsim.analysis import StepMap, find_fixed_point
+from planarsim.analysis.stepmap import jacobian, map_noise, serial_evaluator
 from strategies import matrices
 
 
@@ -139,11 +141,73 @@ def test_brute_force_diagram_periods_chaos_and_escape():
     # period 0: the identity, whose every point "converged" as a fixed point
     (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 3, period=0),
      r"period=0 must be a whole number >= 1"),
+    # numbers of the wrong kind: a string p0 failed in math.isfinite() (TypeError), points="3"
+    # in int() raw, 2.7 points were 2, True was taken for 1; a NaN or inf mult_tol or p_tol
+    # passed into the detection
+    (lambda pool: continue_branch(pool, [0.6], "2.8", 2.9, 3), r"p0='2.8' must be a finite number"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, float("nan"), 3), r"p1=nan must be a finite number"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, "3"), r"points='3' must be a whole number"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 2.7), r"points=2.7 must be a whole number"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, True), r"points=True must be a whole number"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 1), r"points=1 must be a whole number >= 2"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 3, mult_tol=float("nan")),
+     r"mult_tol=nan must be a finite number > 0"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 3, p_tol=-1e-6),
+     r"p_tol=-1e-06 must be a finite number > 0"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 3, tol=math.inf),
+     r"tol=inf must be a finite number > 0"),
+    (lambda pool: continue_branch(pool, [0.6], 2.8, 2.9, 3, max_points="many", method="arclength"),
+     r"max_points='many' must be a whole number"),
+    (lambda pool: basin_of_attraction(pool, 2.8, [0.3], [0.0], lambda a, b: [a], [0.64],
+                                      n_steps="50"), r"n_steps='50' must be a whole number"),
+    (lambda pool: basin_of_attraction(pool, 2.8, [0.3], [0.0], lambda a, b: [a], [0.64],
+                                      tol=float("nan")), r"tol=nan must be a finite number >= 0"),
 ])
 def test_counts_that_would_give_wrong_answers_are_refused(call, said):
     with MapPool(logistic, backend="serial") as pool:
         with pytest.raises(ValueError, match=said):
             call(pool)
+
+
+@pytest.mark.parametrize("call, said", [
+    # find_fixed_point: a NaN eps passed "eps <= 0" and gave a NaN Jacobian, a string failed
+    # in numpy's conversion; max_iter="30" failed in range()
+    (lambda f: find_fixed_point(f, [0.6], eps=float("nan")),
+     r"finite-difference step eps=nan must be a finite number > 0"),
+    (lambda f: find_fixed_point(f, [0.6], eps="small"),
+     r"finite-difference step eps='small' must be a finite number > 0"),
+    (lambda f: find_fixed_point(f, [0.6], max_iter="30"), r"max_iter='30' must be a whole number"),
+    (lambda f: find_fixed_point(f, [0.6], max_halvings=-1), r"max_halvings=-1 must be a whole number >= 0"),
+    (lambda f: find_fixed_point(f, [0.6], tol=True), r"tol=True must be a finite number > 0"),
+    (lambda f: jacobian(f, [0.6], eps=[1e-6, float("nan")]), r"eps=\[1e-06, nan\] must be a finite"),
+    (lambda f: StepMap(f, dim=1).iterate([0.6], "5"), r"n='5' must be a whole number"),
+    (lambda f: map_noise(serial_evaluator(f), [0.6], probes=0), r"probes=0 must be a whole number >= 1"),
+])
+def test_step_map_tools_name_bad_numbers(call, said):
+    with pytest.raises(ValueError, match=said):
+        call(logistic(2.8))
+
+
+def test_map_pool_names_a_bad_cache():
+    for cache, said in (("8", r"cache='8' must be a whole number"), (0, r"cache=0 must be a whole number >= 1")):
+        with pytest.raises(ValueError, match=said):
+            MapPool(logistic, backend="serial", cache=cache)
+
+
+def test_newton_and_the_doubling_branch_name_bad_numbers():
+    from planarsim.analysis.continuation import newton_fixed_point
+    with MapPool(logistic, backend="serial") as pool:
+        with pytest.raises(ValueError, match=r"max_iter=2.5 must be a whole number"):
+            newton_fixed_point(pool, 2.8, [0.6], max_iter=2.5)
+        with pytest.raises(ValueError, match=r"eps=0.0 must be a finite number > 0"):
+            newton_fixed_point(pool, 2.8, [0.6], eps=0.0)
+        br = continue_branch(pool, [0.6], 2.65, 3.35, points=8, param="r", tol=1e-12)
+        pd = br.first("period-doubling")
+        with pytest.raises(ValueError, match=r"points='8' must be a whole number"):
+            period_doubling_branch(pool, pd, 3.5, points="8")
+        with pytest.raises(ValueError, match=r"p1=nan must be a finite number"):
+            period_doubling_branch(pool, pd, float("nan"))
+        assert pool.evaluations == br.evaluations
 
 
 def pair(p):

@@ -35,6 +35,15 @@ def test_scalar_closed_form_and_an_unstable_gait():
     assert gait_sensitivity_norm(1.01, b, c, d) == math.inf
     with pytest.raises(ValueError, match="C must be"):
         gait_sensitivity_norm(np.eye(2), np.ones(2), np.ones((1, 3)))
+    # a string disturbances failed in int(), 1.5 was 1; a NaN or 0 eps gave NaN matrices
+    linear = lambda x, e: (0.5 * x, x + e[0])                 # noqa: E731
+    for kw, said in ((dict(disturbances="1"), r"disturbances='1' must be a whole number"),
+                     (dict(disturbances=1.5), r"disturbances=1.5 must be a whole number"),
+                     (dict(eps=float("nan")), r"eps=nan must be a finite number > 0"),
+                     (dict(eps_x=0.0), r"eps_x=0.0 must be a finite number > 0"),
+                     (dict(steps=True), r"steps=True must be a whole number")):
+        with pytest.raises(ValueError, match=said):
+            gait_sensitivity(linear, np.zeros(1), **kw)
     # from a step function: a linear map gives its own matrices back
     A, B, C, D = np.array([[0.3, 0.1], [0.0, -0.4]]), np.array([1.0, 2.0]), np.array([[1.0, -1.0]]), 0.5
     s = gait_sensitivity(lambda x, e: (A @ x + B * e[0], C @ x + D * e[0]), np.zeros(2))

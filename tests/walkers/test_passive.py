@@ -338,3 +338,19 @@ def test_a_walker_at_a_tiny_dt_refuses_its_step_map_before_running():
         with pytest.raises(ValueError, match=said):
             call()
     assert w.sim.state.time[0] == 0.0
+
+
+def test_step_map_keywords_are_named_before_running():
+    """advance's record_every ("10" failed in n_steps // "10", True recorded every step) and
+    tilt_sensitivity's eps and steps (checked only after the map's Jacobian had run)."""
+    from walkers.passive.sensitivity import tilt_sensitivity
+    from walkers.passive.simplest import garcia_start
+    w = PassiveWalker(SimplestParams(), dt=2e-3)
+    for bad in ("10", True, -1, 2.5):
+        with pytest.raises(ValueError, match=r"record_every=.* must be a whole number"):
+            w.advance(garcia_start(), record_every=bad)
+    assert w.sim.state.time[0] == 0.0
+    with pytest.raises(ValueError, match=r"eps=nan must be a finite number > 0"):
+        tilt_sensitivity(SimplestParams(), garcia_start(), eps=float("nan"))
+    with pytest.raises(ValueError, match=r"steps='20' must be a whole number"):
+        tilt_sensitivity(SimplestParams(), garcia_start(), steps="20")

@@ -21,7 +21,7 @@ from planarsim import dense
 from planarsim.compiled import check_run, gap_of_point, step_from_python
 import planarsim as ps
 from planarsim.analysis import StepMap, StepMapError
-from planarsim.checks import finite_number
+from planarsim.checks import finite_number, whole
 from planarsim.errors import plain
 from planarsim.half_step import kick, project_velocities, to_instant_velocity, to_step_velocity
 from planarsim.state import State
@@ -412,6 +412,8 @@ class PassiveWalker:
         ValueError for a dt at which it would need more than MAX_RUN_STEPS steps
         (check_map_dt), before anything runs."""
         check_map_dt(self.dt)
+        # (a string failed in the recorder's size, n_steps // "10"; True was every step)
+        record_every = whole("record_every", record_every, 0)
         self.set_coords(x)
         # x holds velocities at the touchdown instant; the step wants them over its first step
         # (planarsim.half_step: with both ends converted the map is second order in dt)

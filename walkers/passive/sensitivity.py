@@ -57,6 +57,9 @@ def tilt_sensitivity(params, x, dt: float = 1e-3, eps: float = TILT_EPS,
                      steps: int = 20) -> GaitSensitivity:
     """The gait sensitivity norm [s, m per rad] of the passive walker's gait at fixed point x
     for a tilt of one step's ground, its map's Jacobian A exact (StepMap.jacobian)."""
+    from planarsim.checks import positive, whole
+    # (checked before the walker is built and its map's Jacobian run, not after)
+    eps, steps = positive("eps", eps, "the tilt's finite-difference step [rad]"), whole("steps", steps, 1)
     step = TiltStep(params, dt)
     A = step.walker(0.0).step_map().jacobian(np.asarray(x, dtype=np.float64))
     return gait_sensitivity(step, x, 1, eps, A=A, steps=steps)
