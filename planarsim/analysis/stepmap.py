@@ -418,11 +418,12 @@ change keeps falling by more than 4x (truncation regime): the finer rung gives t
         if eps != "auto":
             raise ValueError(f"eps={eps!r} must be 'auto' or a positive number")
         steps = list(EPS_LADDER)
-    else:
-        e = float(eps)
-        if not (e > 0 and np.isfinite(e)):
-            raise ValueError(f"finite-difference step eps={eps} must be > 0")
+    else:                       # (True was a step of 1)
+        from ..checks import positive
+        e = positive("finite-difference step eps", eps, "or 'auto'")
         steps = [2.0 * e, e]
+    from ..checks import positive
+    tol = positive("tol", tol, "the multipliers' error allowed")
     pts = np.concatenate([central_points(x, h) for h in steps])
     Y, ok = evaluate(pts)
     n = 2 * x.size
@@ -496,8 +497,12 @@ def multipliers_by_fit(f: Callable | None, x, window: float = FIT_WINDOW, points
     fit's rms residual. Multipliers(eps=window, ladder=[(window, values),
     (window / 2, inner values)]). Samples where the map fails are left out.
     """
+    from ..checks import positive, whole
     x = np.asarray(x, dtype=np.float64)
-    points, degree = int(points), int(degree)
+    # (points="21" or degree="3" failed in int() raw, 21.5 points were 21; True was 1)
+    points, degree = whole("points", points, 1), whole("degree", degree, 1)
+    window = positive("window", window, "units of x")
+    tol = positive("tol", tol, "the multipliers' error allowed")
     if points < 2 * degree + 3 or points % 2 == 0:
         raise ValueError(f"points={points} must be odd and >= 2 * degree + 3 = {2 * degree + 3} "
                          "(the inner half is fitted too)")

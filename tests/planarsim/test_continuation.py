@@ -15,7 +15,7 @@ from planarsim.analysis import (MapPool, MultiplierWarning, StepMapError, basin_
                                 period_doubling_branch, plot_basin, plot_bifurcation_diagram,
                                 plot_branch_multipliers, bifurcation_tests)
 from planarsim.analysis import StepMap, find_fixed_point
-from planarsim.analysis.stepmap import jacobian, map_noise, serial_evaluator
+from planarsim.analysis.stepmap import jacobian, map_noise, multipliers_by_fit, serial_evaluator
 from strategies import matrices
 
 
@@ -182,6 +182,14 @@ def test_counts_that_would_give_wrong_answers_are_refused(call, said):
     (lambda f: jacobian(f, [0.6], eps=[1e-6, float("nan")]), r"eps=\[1e-06, nan\] must be a finite"),
     (lambda f: StepMap(f, dim=1).iterate([0.6], "5"), r"n='5' must be a whole number"),
     (lambda f: map_noise(serial_evaluator(f), [0.6], probes=0), r"probes=0 must be a whole number >= 1"),
+    # multipliers_with_error took eps=True for a step of 1 and any tol; multipliers_by_fit's
+    # points="21" failed in int(), 21.5 points were 21
+    (lambda f: multipliers_with_error(f, [0.6], eps=True),
+     r"finite-difference step eps=True must be a finite number > 0 \(or 'auto'\)"),
+    (lambda f: multipliers_with_error(f, [0.6], tol=float("nan")), r"tol=nan must be a finite number > 0"),
+    (lambda f: multipliers_by_fit(f, [0.6], points="21"), r"points='21' must be a whole number"),
+    (lambda f: multipliers_by_fit(f, [0.6], points=21.5), r"points=21.5 must be a whole number"),
+    (lambda f: multipliers_by_fit(f, [0.6], window="wide"), r"window='wide' must be a finite number > 0"),
 ])
 def test_step_map_tools_name_bad_numbers(call, said):
     with pytest.raises(ValueError, match=said):
