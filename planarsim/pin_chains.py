@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .disjoint_sets import DisjointSets
 from .kernels.codes import JOINT_HINGE
 from .kernels.solver.sparse_factor import SPARSE_MIN_ROWS
 
@@ -38,21 +39,10 @@ def joints_form_no_loop(model) -> bool:
     a = model.arrays
     joints = np.concatenate([np.asarray(a.pin_body).reshape(-1, 2),
                              np.asarray(a.rod_body).reshape(-1, 2)])
-    parent = list(range(model.n_body + 1))      # node n_body: the world
-
-    def root(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for ba, bb in joints:
-        ra = root(int(ba) if ba >= 0 else model.n_body)
-        rb = root(int(bb) if bb >= 0 else model.n_body)
-        if ra == rb:
-            return False
-        parent[ra] = rb
-    return True
+    world = model.n_body
+    sets = DisjointSets(world + 1)
+    return all(sets.join(int(ba) if ba >= 0 else world, int(bb) if bb >= 0 else world)
+               for ba, bb in joints)
 
 
 def pin_chain_order(model) -> tuple[np.ndarray, np.ndarray] | None:

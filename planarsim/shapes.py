@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from .disjoint_sets import DisjointSets
 from .errors import ModelError
 
 SHAPE_KINDS = ("circle", "capsule", "box", "polygon")
@@ -220,18 +221,11 @@ def shape_bounds(core, normals, radius):
 def mechanism_of(n_body, joints):
     """Component label (n_body,) of the graph whose edges are `joints` (pairs of body ids,
     -1 = the world, which joins nothing): bodies with one label form one mechanism."""
-    parent = list(range(n_body))
-
-    def root(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
+    sets = DisjointSets(n_body)
     for a, b in joints:
         if a >= 0 and b >= 0:
-            parent[root(a)] = root(b)
-    return [root(i) for i in range(n_body)]
+            sets.join(a, b)
+    return [sets.root(i) for i in range(n_body)]
 
 
 def collision_pairs(shapes, n_body, joints, enabled):

@@ -244,3 +244,25 @@ def test_a_model_swapped_in_with_limits_takes_the_general_stages():
         assert step_info(sim.ws)["chain_path"] == 0
     q = sim.state.q
     assert abs(q[1, 2] - q[0, 2]) <= 0.1 + 1e-9 and abs(q[2, 2] - q[1, 2]) <= 0.1 + 1e-9
+
+
+def test_joints_close_a_loop_only_through_a_ring_of_bodies_or_the_world_twice():
+    """pin_chains.joints_form_no_loop: a chain hanging from the world, a rod pendulum and a
+    free pinned pair close no loop; a bridge (a chain pinned to the world at both ends) and
+    a ring of three bodies do (the world counts as one body)."""
+    from planarsim.pin_chains import joints_form_no_loop
+
+    def model(pins, rods=()):
+        b = ps.ModelBuilder(dt=0.01)
+        bodies = [b.add_body(f"b{i}", 1.0, 0.1, pos=(float(i), 1.0)) for i in range(3)]
+        for k, (i, j) in enumerate(pins):
+            x = 0.5 * ((i if i >= 0 else j) + (j if j >= 0 else i))
+            b.add_pin(f"p{k}", None if i < 0 else bodies[i], None if j < 0 else bodies[j],
+                      anchor_world=(x, 1.0))
+        for k, (i, j) in enumerate(rods):
+            b.add_rod(f"r{k}", None if i < 0 else bodies[i], bodies[j])
+        return b.compile()
+    assert joints_form_no_loop(model([(-1, 0), (0, 1), (1, 2)]))
+    assert joints_form_no_loop(model([(0, 1)], rods=[(-1, 2)]))
+    assert not joints_form_no_loop(model([(-1, 0), (0, 1), (1, 2), (2, -1)]))
+    assert not joints_form_no_loop(model([(0, 1), (1, 2)], rods=[(0, 2)]))
