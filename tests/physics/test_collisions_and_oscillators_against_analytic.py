@@ -209,7 +209,7 @@ def test_a_hinge_spring_damper_takes_the_semi_implicit_recurrence_exactly(inerti
 def _scene(kind, shift, mirror, dt):
     """A double pendulum released at 2 rad, or a spinning box thrown at a rolling disk on the
     ground (friction 0.6, restitution 0.3): moved by `shift` along x and mirrored in x
-    (mirror = -1) about x = shift."""
+    (mirror = -1) about x = shift. (The box hits the disk at 0.24 s, at dt 1e-3.)"""
     b = ps.ModelBuilder(dt=dt)
 
     def X(x):
@@ -222,8 +222,8 @@ def _scene(kind, shift, mirror, dt):
         q = b.add_body("q", 0.5, 0.01, pos=(X(elbow[0] + 0.3), elbow[1]), angle=mirror * a0)
         b.add_pin("elbow", p, q, anchor_world=(X(elbow[0]), elbow[1]))
     else:
-        b.add_body("box", 1.0, 0.01, pos=(X(-0.5), 0.5), angle=mirror * 0.3,
-                   vel=(mirror * 3.0, 1.0), omega=mirror * -4.0,
+        b.add_body("box", 1.0, 0.01, pos=(X(-0.5), 0.15), angle=mirror * 0.3,
+                   vel=(mirror * 3.0, 0.5), omega=mirror * -4.0,
                    shapes=[("box", (0, 0), 0.2, 0.2, {"mu": 0.6, "restitution": 0.3})])
         b.add_body("disk", 2.0, 0.02, pos=(X(0.5), 0.1), angle=mirror * 0.1, vel=(mirror * -1.0, 0.0),
                    shapes=[("circle", (0, 0), 0.1, {"mu": 0.6})])
@@ -234,11 +234,13 @@ def _scene(kind, shift, mirror, dt):
 @pytest.mark.parametrize("dt", [1e-3, 1e-2])
 @pytest.mark.parametrize("shift, mirror", [(1e3, 1), (0.0, -1), (-1e3, -1)])
 def test_a_scene_moved_by_a_kilometre_or_mirrored_moves_the_same(kind, dt, shift, mirror):
-    """The same scene 1e3 m away along x, or mirrored in x, over 1 s (the box hits the disk,
-    both land and roll): the motion is the same, mirrored. A mirror is exact in floating point
-    (measured: bit for bit); a shift of 1e3 m costs its positions' rounding, 1e3 eps =
-    2.2e-13 m, which a joint's or contact's correction turns into velocities of that / h:
-    measured up to 1.1e-11 m and 1.8e-10 m/s (dt 1e-3). Bounds: 1e-9 m, and 10 x 1e3 eps / h."""
+    """The same scene 1e3 m away along x, or mirrored in x, over 1 s (the spinning box hits the
+    disk): the motion is the same, mirrored. A mirror is exact but for rounding (measured: bit
+    for bit but the box and disk at dt 0.01, 2e-17 m, 3e-16 m/s); a shift of 1e3 m costs its
+    positions' rounding, 1e3 eps = 2.2e-13 m, which a joint's or contact's correction turns
+    into velocities of that / h, and the box's corner impact amplifies: measured 2.8e-12 m,
+    1.8e-10 m/s (double pendulum, dt 1e-3), 7.9e-10 m, 1.7e-9 m/s (box and disk, dt 1e-3:
+    the closest to the bounds, 1e-9 m and 10 x 1e3 eps / h = 2.2e-9 m/s)."""
     n = int(round(1.0 / dt))
     ref = _scene(kind, 0.0, 1, dt)
     ref.steps(n)
@@ -254,6 +256,6 @@ def test_a_scene_moved_by_a_kilometre_or_mirrored_moves_the_same(kind, dt, shift
     assert dq <= 1e-9
     assert dv <= 10 * (abs(shift) + 1.0) * np.finfo(float).eps / dt
     if shift == 0.0:
-        assert dq == 0.0 and dv == 0.0
+        assert dq <= 1e-15 and dv <= 1e-14
     assert_clean(sim)
     assert_clean(ref)
