@@ -90,8 +90,8 @@ def test_an_oblique_frictional_impact_keeps_both_momenta_and_gains_no_energy(kin
     turned 0.3 rad), restitution 0.5, friction 0.5: each contact's normal and friction
     impulses act on both bodies at one point, equal and opposite, so linear and angular
     momentum are kept to rounding, and energy can only be lost. Measured: both momenta to
-    3e-16, the energy down by 0.1..60 %. (A sticking impact, mu = 2, e = 0, onto a spinning
-    body is not kept: test_a_sticking_impact_keeps_angular_momentum below.)"""
+    3e-16, the energy down by 0.1..60 %. (A plastic impact, e = 0, after which the bodies
+    stay in touch while sliding past each other, is not kept: DEFECTS["plastic_graze"].)"""
     sim, model, n = _pair(kind, m1, m2, u, dt, 0.5, mu=0.5, off=0.08, angle=0.3)
     p0, L0, ke0 = _momenta(sim, model)
     sim.steps(n + 20)
@@ -103,6 +103,50 @@ def test_an_oblique_frictional_impact_keeps_both_momenta_and_gains_no_energy(kin
     assert np.abs(p - p0).max() <= 1e-12 * max(m1, m2) * u
     assert abs(L - L0) <= 1e-12 * max(m1, m2) * u * R
     assert_clean(sim)
+
+
+DEFECTS = {
+    "plastic_graze": (
+        "two free bodies (1 kg, radius 0.1 m circles or 0.2 m squares, zero gravity, no "
+        "ground) in an off-centre plastic impact (e = 0, impact parameter b = 0.12 m) lose or "
+        "gain angular momentum, uncounted, while linear momentum is kept to rounding: after "
+        "the impact the bodies stay in touch sliding past each other, the drift q += h v "
+        "sinks the curved contact by a second-order amount, and the position correction "
+        "(stage 8: contacts move positions only) moves the two bodies apart along the normal "
+        "by mass-weighted amounts without a velocity change, which changes L by "
+        "lambda n x (v_a - v_b) (measured at dt 1e-3: each step's change of L equals sum m dx x v of the "
+        "correction's move dx exactly). Frictionless circles: dL / (m u b) = -4.5e-6, "
+        "-4.3e-4, -1.9e-2 at a travel u h of 1 mm, 1 cm, 10 cm a step (second order in u h; "
+        "u 1..100 m/s, dt 1e-4..1e-2); frictionless squares: +1.4e-4, +1.5e-3, +6.2e-3; a "
+        "circle spinning at -50 rad/s with mu = 2: -2.6e-7, -2.6e-5, -1.1e-3. With e = 0.5 "
+        "(the bodies part) both momenta are kept to 5e-15."),
+}
+
+
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=DEFECTS["plastic_graze"])
+@pytest.mark.parametrize("kind, u, dt, mu, w0", [
+    ("circle", 10.0, 1e-4, 0.0, 0.0), ("circle", 100.0, 1e-4, 0.0, 0.0), ("box", 10.0, 1e-4, 0.0, 0.0),
+    ("box", 100.0, 1e-3, 0.0, 0.0), ("circle", 10.0, 1e-3, 2.0, -50.0)])
+def test_a_plastic_grazing_impact_keeps_angular_momentum(kind, u, dt, mu, w0):
+    """Two free bodies in an off-centre plastic impact (restitution 0, the second body's
+    centre b = 0.12 m off the line of motion): contact impulses are internal, equal and
+    opposite at one point, so the pair keeps its angular momentum (about any point, its
+    linear momentum being kept) to rounding through the impact and the sliding after it."""
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
+    shape = _shape(kind, 0.0, mu)
+    gap = 0.1 + 3.7 * u * dt
+    b.add_body("a", 1.0, 0.5 * R * R, pos=(-R - gap / 2, 0.0), vel=(u, 0.0), omega=w0, shapes=shape)
+    b.add_body("b", 1.0, 0.5 * R * R, pos=(R + gap / 2, 0.12), shapes=shape)
+    model = b.compile()
+    sim = ps.Simulator(model)
+    p0, L0, _ = _momenta(sim, model)
+    sim.steps(int(gap / (u * dt)) + int(0.5 / (u * dt)) + 20)
+    p, L, _ = _momenta(sim, model)
+    print(f"{kind} u={u} dt={dt} mu={mu} w0={w0}: dL / (m u b) {(L - L0) / (u * 0.12):+.2e}, "
+          f"dp / (m u) {np.abs(p - p0).max() / u:.1e}")
+    assert np.abs(p - p0).max() <= 1e-12 * u
+    assert_clean(sim)
+    assert abs(L - L0) <= 1e-12 * u * 0.12
 
 
 def _pendulum(m, Ic, d, dt, a0):
