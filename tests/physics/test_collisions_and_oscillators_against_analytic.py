@@ -259,6 +259,37 @@ def test_a_spinning_pair_on_a_slider_keeps_its_momenta_and_energy(ratio, w, dt):
     assert_clean(sim)
 
 
+@pytest.mark.parametrize("kind, angle", [("circle", 0.0), ("box", 0.3)])
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+@pytest.mark.parametrize("drift", [(3.0, -2.0), (100.0, 0.0)])
+def test_an_oblique_impact_seen_from_a_moving_frame_is_the_same(kind, angle, dt, drift):
+    """Galilean invariance: the oblique impact of test_an_oblique_frictional_impact_keeps_
+    both_momenta_and_gains_no_energy (e = 0.5, mu = 0.5, 10 m/s), made by a pair drifting at
+    `drift`, is the same impact moving along: positions less the drift and velocities less it
+    agree with the pair at rest to 1e-9 (measured: 6.6e-13 m, 1.5e-12 m/s). (A plastic impact
+    and Kane's do not: DEFECTS["drifting_kane"], and the report of this search.)"""
+    u = 10.0
+    runs = []
+    for d in ((0.0, 0.0), drift):
+        b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
+        gap = 0.4 + 3.7 * u * dt
+        b.add_body("a", 1.0, 0.5 * R * R, pos=(-R - gap / 2, 0.0), vel=(u + d[0], d[1]),
+                   shapes=_shape(kind, 0.5, 0.5))
+        b.add_body("b", 1.0, 0.5 * R * R, pos=(R + gap / 2, 0.08), vel=d, angle=angle,
+                   shapes=_shape(kind, 0.5, 0.5))
+        sim = ps.Simulator(b.compile())
+        n = int(gap / (u * dt)) + 60
+        sim.steps(n)
+        q, v = sim.state.q.copy(), sim.state.v.copy()
+        q[:, :2] -= np.array(d) * n * dt
+        v[:, :2] -= np.array(d)
+        runs.append((q, v))
+        assert_clean(sim)
+    dq, dv = np.abs(runs[1][0] - runs[0][0]).max(), np.abs(runs[1][1] - runs[0][1]).max()
+    print(f"{kind} dt={dt} drift={drift}: dq {dq:.1e}, dv {dv:.1e}")
+    assert dq <= 1e-9 and dv <= 1e-9
+
+
 DEFECTS = {
     "plastic_graze": (
         "two free bodies (1 kg, radius 0.1 m circles or 0.2 m squares, zero gravity, no "
@@ -288,7 +319,47 @@ DEFECTS = {
         "motion relative to its centre of mass then differs from the pair at rest by up to "
         "2.3 (m, rad) in 2 s; at 1.1 m/s the loss is -8.7 % instead of -9.6 %. (Measured: "
         "linear momentum kept to rounding; no audit count.)"),
+    "drifting_kane": (
+        "the rebound bound's allowance (kernels/solver/rebound.py REBOUND_REL_TOL, 1e-7 of the "
+        "start and end kinetic energies) is measured in the frame's kinetic energy, the motion "
+        "of the centre of mass included, so a pair drifting fast may gain that share of its "
+        "whole energy in its own frame, uncounted: Kane's impact of "
+        "test_an_elastic_frictional_impact_of_a_spinning_square_gains_at_most_the_rebound_"
+        "allowance (two 1 kg squares, e = 1, mu = 1, 10 m/s, the first spinning at 30 rad/s, "
+        "dt 1e-3) gains +3.8e-7 of the kinetic energy about the centre of mass at rest, "
+        "+7.6e-5 drifting at 100 m/s, +3.5e-3 at 1000 m/s (and loses 2.2e-3 drifting at "
+        "300 m/s sideways); Galilean invariance otherwise holds to 1e-12 for the oblique "
+        "impacts of this file."),
 }
+
+
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=DEFECTS["drifting_kane"])
+@pytest.mark.parametrize("drift", [100.0, 1000.0])
+def test_kanes_impact_drifting_fast_gains_no_energy_in_its_own_frame(drift):
+    """Kane's impact (an elastic frictional impact of a spinning square on another) made by
+    a pair drifting at `drift` m/s: physics does not depend on the frame, so the energy about
+    the centre of mass may rise by no more than it does for the pair at rest (3.8e-7 of it);
+    bound 1e-6."""
+    u, dt = 10.0, 1e-3
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
+    shape = _shape("box", 1.0, 1.0)
+    gap = 0.4 + 3.7 * u * dt
+    b.add_body("a", 1.0, 0.5 * R * R, pos=(-R - gap / 2, 0.0), vel=(u + drift, 0.0), omega=30.0,
+               shapes=shape)
+    b.add_body("b", 1.0, 0.5 * R * R, pos=(R + gap / 2, 0.05), vel=(drift, 0.0), angle=0.3,
+               shapes=shape)
+    sim = ps.Simulator(b.compile())
+
+    def internal():
+        v = sim.state.v.copy()
+        v[:, :2] -= v[:, :2].mean(axis=0)
+        return 0.5 * np.sum(v[:, 0] ** 2 + v[:, 1] ** 2) + 0.5 * 0.5 * R * R * np.sum(v[:, 2] ** 2)
+    start = internal()
+    sim.steps(int(gap / (u * dt)) + 60)
+    gain = internal() / start - 1
+    print(f"drift {drift} m/s: energy about the centre of mass {gain:+.2e}")
+    assert_clean(sim)
+    assert gain <= 1e-6
 
 
 @pytest.mark.xfail(strict=True, raises=AssertionError, reason=DEFECTS["armature_pair"])
