@@ -2,8 +2,11 @@
 test_extremes_against_analytic.py leaves out: two free bodies colliding in zero gravity
 (mass ratio 1e-3..1e3, 0.1..100 m/s, dt 1e-4..1e-2), a small-amplitude pendulum's period
 and energy, a body sliding down a prismatic joint, a joint's spring and damper against
-the discrete recurrence the step takes, and the invariance of a scene under a shift of
-1e3 m and a mirror in x."""
+the discrete recurrence the step takes, a spinning pair on a slider, and the invariance of a
+scene under a shift of 1e3 m, a mirror in x and a drift. Four silent defects found here are
+xfail(strict=True) with their measurements in DEFECTS: a plastic grazing impact's angular
+momentum, a free pinned pair with armature's angular momentum, and two frame dependences
+(the rebound allowance, the time-of-impact split)."""
 import math
 
 import numpy as np
