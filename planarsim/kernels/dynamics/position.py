@@ -21,6 +21,7 @@ from .integrate import (bound_correction_work, correct_positions, integrate_posi
                         keep_correction_rows, rows_hold_within)
 from ..math2d import update_trig
 from ..checks.work import NEAR_DEPENDENT, gravity_lift, judge_energy, most_gaining_body
+from ..constraints.joints import is_slider
 from ..constraints.rows import is_joint_row, is_soft_row
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
@@ -64,11 +65,14 @@ def _settle_measured(m, s, ws, h, opt, rows_held):
 
 
 @kernel
-def joints_alone(ws):
-    """The step's rows are hard joint rows alone (pins, sliders, rods: no contact, limit,
-    joint friction, spring, damper or armature row) of joints that close no loop of bodies
-    (ws.joints_open), with pivots not nearly dependent (ws.joint_pivot): its correction is
-    SHAKE's, which keeps the step symplectic within SHAKE's regime
+def joints_alone(m, ws):
+    """The correction's rows (keep_correction_rows) are hard joint rows alone (pins, sliders,
+    rods) and hinges' rotor rows (armature: the correction moves the bodies and rotors with
+    the constant inertia M + A, a the a g^T g of a hinge's fixed rate row g): no contact or
+    limit row, and no slider's rotor (its g turns with the slider, so its inertia is not
+    constant). The joints close no loop of bodies (ws.joints_open) and their pivots are not
+    nearly dependent (ws.joint_pivot). Its correction is then SHAKE's for the inertia
+    M + A, which keeps the step symplectic and its momenta within SHAKE's regime
     (integrate.bound_correction_work keeps it whole there). A closed loop is left to the
     bound: folded near a dead point, its nearly dependent pins' correction carries huge
     impulses, and a loop of bodies whose inertias differ by 1e8 turns its heavy body."""
@@ -76,7 +80,7 @@ def joints_alone(ws):
         return False
     for r in range(ws.n_row[0]):
         kind = ws.row_kind[r]
-        if not is_joint_row(kind) or is_soft_row(kind):
+        if not is_joint_row(kind) or (is_soft_row(kind) and is_slider(m, ws.row_owner[r])):
             return False
     return True
 
@@ -108,7 +112,7 @@ def position_stage(m, s, ws, opt, h, answered):
         if corrected or ws.info[INFO_PROJECTIONS] > 0:
             # only a correction or a projection changes the velocity the solve gave
             excess = bound_correction_work(m, s, ws, h, opt.integrator != INTEGRATOR_EULER
-                                           or joints_alone(ws))
+                                           or joints_alone(m, ws))
             if excess > 0.0:
                 note(ws, s.step[0], AUDIT_CORRECTION_WORK, -1, most_gaining_body(m, s, ws), excess)
                 # bodies lifted out of the ground (a terrain put in) are the depth's
