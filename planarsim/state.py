@@ -458,6 +458,9 @@ class Workspace(NamedTuple):
                                  #   planarsim/pin_chains.py)
     joints_open: np.ndarray      # (1,) int 1: the model's joints close no loop of bodies
                                  #   (pin_chains.joints_form_no_loop; position.joints_alone)
+    frame_free: np.ndarray       # (1,) int 1: the model touches the world nowhere (no joint to
+                                 #   it, no shape on it, no ground contact): its checks measure
+                                 #   motion about its centre of mass (kernels/checks/frame.py)
     chain_pin: np.ndarray        # (n_pin,) int the pins chain by chain (pin_chain_order)
     chain_end: np.ndarray        # (n_pin, 2) int the ends of pins k and k - 1 at the body they
                                  #   share (-1: a chain starts at k)
@@ -823,6 +826,17 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      **_chain_arrays(model), start=make_state(model), prev=make_state(model))
 
 
+def touches_no_world(model: Model) -> bool:
+    """The model touches the world nowhere: no pin, slider or rod to the world, no shape on
+    it, no contact with the ground (every contact a pair of two bodies' shapes). Its motion
+    as a whole is then free, and its step's checks measure motion about its centre of mass
+    (kernels/checks/frame.py)."""
+    a = model.arrays
+    joints = np.concatenate([np.asarray(a.pin_body).reshape(-1), np.asarray(a.rod_body).reshape(-1)])
+    return bool(model.n_body > 0 and np.all(joints >= 0) and np.all(np.asarray(a.shape_body) >= 0)
+                and np.all(np.asarray(a.contact_kind) == CONTACT_PAIR))
+
+
 def _chain_arrays(model: Model) -> dict:
     """The pin-chain path's arrays (Workspace.chain_*; planarsim/pin_chains.py)."""
     npin = model.n_pin
@@ -830,7 +844,8 @@ def _chain_arrays(model: Model) -> dict:
     order, ends = found if found is not None else (np.zeros(npin, np.int64),
                                                     np.full((npin, 2), -1, np.int64))
     return dict(chain_on=np.array([int(found is not None)], np.int64),
-                joints_open=np.array([int(joints_form_no_loop(model))], np.int64), chain_pin=order,
+                joints_open=np.array([int(joints_form_no_loop(model))], np.int64),
+                frame_free=np.array([int(touches_no_world(model))], np.int64), chain_pin=order,
                 chain_end=ends, chain_factor=np.zeros((npin, 12)), chain_y=np.zeros((npin, 2)),
                 chain_cs=np.full((model.n_body, 3), np.nan),
                 chain_lever=np.zeros((npin, 2, 4)))

@@ -38,6 +38,7 @@ from .solver.modes import (check_contact, engage_contacts, engage_limits, gather
 from .geometry.pair import PAIR_MARGIN
 from .solver.pin_chain import (chain_prediction, lever_correct, lever_joint_work,
                                lever_velocity_solve)
+from .checks.frame import frame_velocity, kinetic_in_frame
 from .solver.rebound import rebound_gain, rebounding
 from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev, keep_prev_bodies
 from .geometry.pair_toi import hold_off_fast_pairs
@@ -49,7 +50,7 @@ from .dynamics.rattle import (longest_stage, rattle_begin, rattle_end, stage_cou
                               unsupported)
 from .solver.warm_start import remember_impulses
 from .checks.work import (CONSTRAINT_SHARE, NEAR_DEPENDENT, joints_add_energy, joints_excess,
-                          kinetic_energy, prediction_turn)
+                          prediction_turn)
 
 
 @kernel(inline="never")
@@ -420,7 +421,8 @@ def bound_rebound(m, s, ws, opt, h, include_ccd, answered):
     hi_g = rebound_gain(m, ws, h)
     if hi_g <= 0.0:
         return answered
-    close = REBOUND_CLOSE * kinetic_energy(m, ws.v_pred)
+    vx, vy = frame_velocity(m, ws, ws.v_pred)
+    close = REBOUND_CLOSE * kinetic_in_frame(m, ws.v_pred, vx, vy)
     answered, lo_g = rebound_answer(m, s, ws, opt, h, include_ccd, 0.0)
     if lo_g > 0.0 or ws.room[0] == 1:
         ws.bounce_scale[0] = 1.0
@@ -615,7 +617,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         return code
     if not stage:
         reset_counts(ws)            # (an accurate step counts over all its stages)
-        start_path(s, ws)           # (the path its velocities explain: check_displacements)
+        start_path(m, s, ws)        # (the path its velocities explain: check_displacements)
     ws.lcp_eps[0] = 0.0
     ws.audit_worst_value[0] = 0.0
     ws.first_order[0] = 0
@@ -664,7 +666,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
             tau = split_at_impact(m, s, ws, h, opt.max_ccd_splits - split)  # 6. impact
             if tau >= 0.0:                                  #    mid-step: the rest again
                 if not stage:
-                    add_part_path(s, ws, tau)
+                    add_part_path(m, s, ws, tau)
                 h -= tau
                 continue
         else:                                               #    splits used up: the part
@@ -690,7 +692,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
     if code == 0 and opt.audit_raise == 1 and audit_total(ws) > audited:
         return GUARD_AUDIT
     if not stage:
-        finish_path(s, ws, h)                               #    h: the last part's
+        finish_path(m, s, ws, h)                            #    h: the last part's
         if code == 0 and opt.jump_limit > 0.0:
             code = check_displacements(m, s, ws, opt.jump_limit)
     return code
@@ -711,7 +713,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
     keep_prev(s, ws)
     begin_step(ws)
     reset_counts(ws)
-    start_path(s, ws)
+    start_path(m, s, ws)
     if opt.turn_limit > 0.0:
         update_trig(s.q, ws.body_cs)
         apply_forces(m, s, ws, u, step_length)
@@ -735,7 +737,7 @@ def accurate_step(m, s, ws, opt, u, step_length):
     s.time[0] = t0 + step_length
     s.step[0] = count + 1
     code = check_guards(s, ws, opt.guard_limit)
-    finish_path(s, ws, step_length)
+    finish_path(m, s, ws, step_length)
     keep_step_path(ws, False)
     if code == 0 and opt.jump_limit > 0.0:
         code = check_displacements(m, s, ws, opt.jump_limit)
@@ -809,7 +811,8 @@ def chain_joints_gain(m, s, ws, h):
     work so large that its rounding hides the share (the general stages then judge the step,
     from its velocities); else the excess (<= 0) is kept for the audit (ws.joint_gain)."""
     work, rounding, row = lever_joint_work(m, ws, ws.v_new)
-    scale = kinetic_energy(m, ws.v_lin)
+    fx, fy = frame_velocity(m, ws, ws.v_pred)       # (checks/frame.py)
+    scale = kinetic_in_frame(m, ws.v_lin, fx, fy)
     if rounding > CONSTRAINT_SHARE * scale:
         ws.joint_gain[2] = 0.0          # (nothing measured for the audit)
         return True
@@ -845,7 +848,7 @@ def chain_part(m, s, ws, opt, u, h):
     if check_guards(s, ws, opt.guard_limit) != 0:
         return CHAIN_GENERAL
     reset_counts(ws)
-    start_path(s, ws)
+    start_path(m, s, ws)
     ws.lcp_eps[0] = 0.0
     ws.audit_worst_value[0] = 0.0
     ws.first_order[0] = 0

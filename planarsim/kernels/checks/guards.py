@@ -8,6 +8,7 @@ from ..dynamics.forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from ..geometry.terrain import ground_point
 from ..info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from ..solver.islands import _root
+from .frame import frame_displacement, frame_velocity, speed_in_frame
 
 GUARD_OK = 0
 GUARD_NONFINITE = 1
@@ -282,12 +283,13 @@ def _touching_contact(m, s, ws, b):
 
 
 @kernel
-def start_path(s, ws):
-    """A step starts: no path yet, each body's part starts at its speed, no depth known yet
-    (ws.path_explained)."""
+def start_path(m, s, ws):
+    """A step starts: no path yet, each body's part starts at its speed (in the frame of the
+    step's checks, checks/frame.py), no depth known yet (ws.path_explained)."""
+    vx, vy = frame_velocity(m, ws, s.v)
     for i in range(s.v.shape[0]):
         ws.path_explained[i, 0] = 0.0
-        ws.path_explained[i, 1] = _speed(s.v, i)
+        ws.path_explained[i, 1] = speed_in_frame(s.v, i, vx, vy)
         ws.path_explained[i, 2] = 0.0
 
 
@@ -308,14 +310,17 @@ def note_start_depths(ws):
 
 
 @kernel
-def add_part_path(s, ws, tau):
+def add_part_path(m, s, ws, tau):
     """A part of tau [s] ended at a time-of-impact split (ccd.advance_to_impact moved each body
     by tau times its velocity at the split, s.v, or its part's solved velocity ws.v_new): add
     tau max(|v_start|, |v_split|, |v_new|) to the path its velocities explain; the next part
-    starts at |v_split|."""
+    starts at |v_split| (speeds in the frame of the step's checks, checks/frame.py)."""
+    vx, vy = frame_velocity(m, ws, s.v)
+    wx, wy = frame_velocity(m, ws, ws.v_new)
     for i in range(s.v.shape[0]):
-        speed = _speed(s.v, i)
-        ws.path_explained[i, 0] += tau * max(ws.path_explained[i, 1], speed, _speed(ws.v_new, i))
+        speed = speed_in_frame(s.v, i, vx, vy)
+        ws.path_explained[i, 0] += tau * max(ws.path_explained[i, 1], speed,
+                                             speed_in_frame(ws.v_new, i, wx, wy))
         ws.path_explained[i, 1] = speed
 
 
@@ -328,11 +333,13 @@ def _add_path(ws, i, h, speed):
 
 
 @kernel
-def finish_path(s, ws, h):
+def finish_path(m, s, ws, h):
     """The step's last part, of h [s], ended: add h max(|v_start|, |v_end|) to the path each
-    body's velocities explain (ws.path_explained[:, 0] then holds the whole step's)."""
+    body's velocities explain (ws.path_explained[:, 0] then holds the whole step's; speeds
+    in the frame of the step's checks, checks/frame.py)."""
+    vx, vy = frame_velocity(m, ws, s.v)
     for i in range(s.v.shape[0]):
-        _add_path(ws, i, h, _speed(s.v, i))
+        _add_path(ws, i, h, speed_in_frame(s.v, i, vx, vy))
 
 
 @kernel
@@ -379,17 +386,19 @@ def end_checks_alone(m, s, ws, h, guard_limit, speed_limit, jump_limit):
     without contacts (the pin-chain path: no depth to allow for): True if some check fails.
     Nothing is recorded: the general stages then take the step again and name the culprit."""
     bad = False
+    vx, vy = frame_velocity(m, ws, s.v)
+    dx, dy = frame_displacement(m, ws, s.q, ws.prev.q)
     for i in range(s.q.shape[0]):
         for f in range(3):
             if (_guard_code(s.q[i, f], guard_limit) != GUARD_OK
                     or _guard_code(s.v[i, f], guard_limit) != GUARD_OK):
                 bad = True
         speed = _speed(s.v, i)
-        _add_path(ws, i, h, speed)
+        _add_path(ws, i, h, speed_in_frame(s.v, i, vx, vy))
         if speed_limit > 0.0 and (speed > speed_limit
                                   or _turning_speed(m, s.v, i) > speed_limit):
             bad = True
-        if jump_limit > 0.0 and (_moved(s.q, ws.prev.q, i)
+        if jump_limit > 0.0 and (_moved(s.q, ws.prev.q, i, dx, dy)
                                  > ws.path_explained[i, 0] + jump_limit):
             bad = True
     return bad
@@ -414,11 +423,12 @@ def check_displacements(m, s, ws, slack):
 
 
 @kernel(inline="always")
-def _moved(q, start_q, i):
-    """How far [m] body i's centre of mass is at q from start_q."""
-    dx = q[i, 0] - start_q[i, 0]
-    dy = q[i, 1] - start_q[i, 1]
-    return math.sqrt(dx * dx + dy * dy)
+def _moved(q, start_q, i, dx, dy):
+    """How far [m] body i's centre of mass is at q from start_q, less the frame's move
+    (dx, dy) [m] (frame.frame_displacement)."""
+    ux = q[i, 0] - start_q[i, 0] - dx
+    uy = q[i, 1] - start_q[i, 1] - dy
+    return math.sqrt(ux * ux + uy * uy)
 
 
 @kernel
@@ -426,8 +436,9 @@ def check_moves(m, s, ws, start_q, whole, slack):
     """check_displacements from positions start_q: over the step's last part (whole False:
     ws.path_explained[:, 0], from ws.prev) or over a step taken in sub-steps (whole True:
     their summed paths, ws.step_path, from the step's start)."""
+    dx, dy = frame_displacement(m, ws, s.q, start_q)
     for i in range(s.q.shape[0]):
-        moved = _moved(s.q, start_q, i)
+        moved = _moved(s.q, start_q, i, dx, dy)
         explained = ws.step_path[i] if whole else ws.path_explained[i, 0]
         if not moved > explained + slack:
             continue

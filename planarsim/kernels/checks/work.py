@@ -27,6 +27,7 @@ from ..dynamics.forces import point_velocity
 from ..math2d import world_point
 from ..constraints.rows import is_joint_row, is_normal_row, is_soft_row, is_tangent_row
 from ..solver.solve import row_dot
+from .frame import frame_velocity, kinetic_in_frame
 
 # SHAKE's regime: the correction's velocity change dv is at most this share of the velocity
 # (mass-weighted norms); it is about h w / 2 there (measured at most 0.02 in smooth motion,
@@ -171,17 +172,19 @@ def joints_add_energy(m, s, ws, h):
     Where the impulses are so large that their work's rounding exceeds that share, the
     velocities' lower bound of that work (gain_from_velocities) is judged too."""
     work, rounding, row = joint_work(m, ws, ws.v_new)
-    kinetic = kinetic_energy(m, ws.v_pred)
+    # energies in the frame of the step's checks (frame.py: a free model's centre of mass)
+    fx, fy = frame_velocity(m, ws, ws.v_pred)
+    kinetic = kinetic_in_frame(m, ws.v_pred, fx, fy)
     # the shares are of the energy of the motion the target was linearized at: KE(v*), but
     # KE(v_lin) where soft rows moved it (v* lets the applied torques spin a light link
     # that its rotors hold back: a yardstick 5x too large passed a target that kicked such
     # a link by 2.7 rad/s a step) or a second linearization did (step.relinearize)
-    scale = kinetic_energy(m, ws.v_lin)
+    scale = kinetic_in_frame(m, ws.v_lin, fx, fy)
     # impulses so large that their work's rounding alone hides the share (a folded loop's
     # self-stress of 1e5 N s at 1e-5 J of motion): the velocities bound what they added
     gain = -math.inf
     if rounding > CONSTRAINT_SHARE * scale:
-        gain = gain_from_velocities(m, ws, h, kinetic)
+        gain = gain_from_velocities(m, ws, h, kinetic, fx, fy)
     excess = joints_excess(m, s, ws, h, work, rounding, gain, scale)
     if excess > 0.0 and row < 0:
         row = largest_joint_impulse(ws)
@@ -189,9 +192,9 @@ def joints_add_energy(m, s, ws, h):
 
 
 @kernel
-def gain_from_velocities(m, ws, h, kinetic):
+def gain_from_velocities(m, ws, h, kinetic, fx, fy):
     """A lower bound [J] of the joints' work at the answer (joint_work), from velocities:
-    KE(v_new) - KE(v*) (kinetic: KE(v*)) less what the other rows' impulses do at v_new.
+    KE(v_new) - KE(v*) (kinetic: KE(v*), both seen from a frame moving at (fx, fy) [m/s]) less what the other rows' impulses do at v_new.
     With v_new - v* = W F^T lam, KE(v_new) - KE(v*) = sum_r lam_r F_r v_new - |v_new - v*|^2 / 2
     (mass-weighted), so the joints do at least the gain less the other rows' work, each
     bounded from above: a contact's normal row or a limit's does -lam c / h <= 0 (a violated
@@ -212,7 +215,7 @@ def gain_from_velocities(m, ws, h, kinetic):
             allowed += row_rounding(ws, r, speed)
             if is_tangent_row(kind):
                 allowed += abs(ws.lam[r] * ws.row_c[r]) / h
-    final = kinetic_energy(m, ws.v_new)
+    final = kinetic_in_frame(m, ws.v_new, fx, fy)
     return final - kinetic - allowed - RELATIVE_ROUNDING * (final + kinetic)
 
 
@@ -303,11 +306,13 @@ def judge_energy(m, ws, opt, h, excess):
     """An energy gain from nowhere of `excess` [J] in this step of h [s] is gross when it
     exceeds StepOptions.energy_limit times the energy the step had to work with: the kinetic
     energy it solved for (ws.v_solved) plus its own error under the forces
-    (force_step_energy). A gross one marks the step (ws.energy_stop): it ends with
+    (force_step_energy), in the frame of the step's checks (frame.py). A gross one marks the step (ws.energy_stop): it ends with
     GUARD_ENERGY, the run stops naming the cause (ws.audit_last)."""
     if opt.energy_limit <= 0.0:
         return
-    if excess > opt.energy_limit * (kinetic_energy(m, ws.v_solved) + force_step_energy(m, ws, h)):
+    fx, fy = frame_velocity(m, ws, ws.v_pred)
+    if excess > opt.energy_limit * (kinetic_in_frame(m, ws.v_solved, fx, fy)
+                                    + force_step_energy(m, ws, h)):
         ws.energy_stop[0] = 1
 
 

@@ -33,7 +33,8 @@ from ..solver.matrix import add_to_diagonal, arrange, assemble, factor_ws, subst
 from ..constraints.soft import SOFT_ARMATURE
 from ..solver.solve import apply_impulses, row_dot
 from ..checks.work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work,
-                           correction_rounding, gravity_work, kinetic_energy, step_energy_of_forces)
+                           correction_rounding, gravity_work, step_energy_of_forces)
+from ..checks.frame import frame_velocity, kinetic_in_frame
 
 
 # relative pivot below which the position correction drops a row after a Newton step diverged:
@@ -163,17 +164,21 @@ def bound_correction_work(m, s, ws, h, symplectic):
     b = 0.0
     kinetic = 0.0
     momentum = 0.0
+    # velocities in the frame of the step's checks (checks/frame.py: a free model's centre of
+    # mass), so that a free model's correction is judged alike however fast it drifts
+    fx, fy = frame_velocity(m, ws, ws.v_pred)
     for i in range(s.v.shape[0]):
         mass = m.body_mass[i]
         inertia = m.body_inertia[i]
         dx = s.v[i, 0] - ws.v_solved[i, 0]
         dy = s.v[i, 1] - ws.v_solved[i, 1]
         dw = s.v[i, 2] - ws.v_solved[i, 2]
-        a += mass * (ws.v_solved[i, 0] * dx + ws.v_solved[i, 1] * dy) + inertia * ws.v_solved[i, 2] * dw
+        ux = ws.v_solved[i, 0] - fx
+        uy = ws.v_solved[i, 1] - fy
+        a += mass * (ux * dx + uy * dy) + inertia * ws.v_solved[i, 2] * dw
         b += 0.5 * (mass * (dx * dx + dy * dy) + inertia * dw * dw)
-        kinetic += 0.5 * (mass * (ws.v_solved[i, 0] ** 2 + ws.v_solved[i, 1] ** 2)
-                          + inertia * ws.v_solved[i, 2] ** 2)
-        momentum += mass * (abs(dx) + abs(dy) + abs(ws.v_solved[i, 0]) + abs(ws.v_solved[i, 1]))
+        kinetic += 0.5 * (mass * (ux ** 2 + uy ** 2) + inertia * ws.v_solved[i, 2] ** 2)
+        momentum += mass * (abs(dx) + abs(dy) + abs(ux) + abs(uy))
     # the joints' rotors (armature): they share the correction's move (correction_compliance)
     # and their kinetic energy a (g v)^2 / 2 is the system's
     for j in range(m.pin_armature.shape[0]):
@@ -224,7 +229,7 @@ def bound_correction_work(m, s, ws, h, symplectic):
             - max(-gained, 0.0) - start_lift(ws) - step_energy_of_forces(m, ws, h, 0.0))
     if left <= 0.0:
         return 0.0
-    return pay_from_motion(m, s, left)
+    return pay_from_motion(m, s, ws, left)
 
 
 @kernel
@@ -238,15 +243,18 @@ def start_lift(ws):
 
 
 @kernel
-def pay_from_motion(m, s, energy):
-    """Take energy [J] out of the bodies' motion, v <- alpha v for every body: every
-    homogeneous velocity constraint (a pin to the world, a sticking contact, J v = 0) is kept
-    as it was. Returns what it could not take (the motion had less)."""
-    kinetic = kinetic_energy(m, s.v)
+def pay_from_motion(m, s, ws, energy):
+    """Take energy [J] out of the bodies' motion, v <- alpha v for every body (v about the
+    frame of the step's checks: a free model keeps its momentum): every homogeneous velocity
+    constraint (a pin to the world, a sticking contact, J v = 0) is kept as it was. Returns
+    what it could not take (the motion had less)."""
+    fx, fy = frame_velocity(m, ws, s.v)
+    kinetic = kinetic_in_frame(m, s.v, fx, fy)
     alpha = math.sqrt(1.0 - energy / kinetic) if kinetic > energy else 0.0
     for i in range(s.v.shape[0]):
-        for c in range(3):
-            s.v[i, c] *= alpha
+        s.v[i, 0] = fx + alpha * (s.v[i, 0] - fx)
+        s.v[i, 1] = fy + alpha * (s.v[i, 1] - fy)
+        s.v[i, 2] *= alpha
     return max(energy - kinetic, 0.0)
 
 
@@ -263,7 +271,9 @@ def velocity_stage_gain(m, ws, vel, h):
     impulses and for a body at rest on the ground; gravity's is G(dp) = max((h / 2) |g| dp,
     -dp^2 / (2 M)) (benchmarks/folded_loops.py gravity_term: a body rising at less than
     |g| h that its contacts stop within the step loses its kinetic energy, at least the
-    centre of mass's dp^2 / (2 M), and gains nothing)."""
+    centre of mass's dp^2 / (2 M), and gains nothing). Velocities and moves are measured in
+    the frame of the step's checks (checks/frame.py), which changes nothing but the rounding
+    and the start's kinetic energy (a share of which the constraints may move)."""
     start = 0.0
     end = 0.0
     power = 0.0
@@ -272,13 +282,15 @@ def velocity_stage_gain(m, ws, vel, h):
     g = math.hypot(m.gravity[0], m.gravity[1])
     ux = -m.gravity[0] / g if g > 0.0 else 0.0
     uy = -m.gravity[1] / g if g > 0.0 else 0.0
+    fx, fy = frame_velocity(m, ws, ws.v_pred)     # (checks/frame.py; zero for most models)
     for i in range(vel.shape[0]):
         mass += m.body_mass[i]
         for k in range(3):
             inertia = m.body_mass[i] if k < 2 else m.body_inertia[i]
             inverse = m.body_inv_mass[i] if k < 2 else m.body_inv_inertia[i]
-            v0 = ws.v_pred[i, k] - h * inverse * ws.force[i, k]
-            v1 = vel[i, k]
+            frame = fx if k == 0 else (fy if k == 1 else 0.0)
+            v0 = ws.v_pred[i, k] - h * inverse * ws.force[i, k] - frame
+            v1 = vel[i, k] - frame
             start += inertia * v0 * v0
             end += inertia * v1 * v1
             # -f . (q1 - q0) = -h f . v1

@@ -32,7 +32,7 @@ import math
 from ...compile import kernel
 from ..codes import MODE_FREE
 from .collide import FLIP_B, collide
-from .pair import clear_slot
+from .pair import clear_slot, relative_speed, shape_lever
 
 # a pair is swept when its shapes can move, relative to each other, more than this share of
 # the thinner one's width in the step (slower pairs: the speculative contact holds them)
@@ -71,14 +71,6 @@ def drift_velocity(ws, b):
     if b < 0:
         return 0.0, 0.0, 0.0
     return ws.v_new[b, 0], ws.v_new[b, 1], ws.v_new[b, 2]
-
-
-@kernel
-def drift_speed(m, ws, k):
-    """A bound [m/s] on the speed of any point of shape k in its body's drift:
-    |v_x| + |v_y| + |omega| L (L: m.shape_bound[k, 4], its core's farthest vertex)."""
-    vx, vy, w = drift_velocity(ws, m.shape_body[k])
-    return abs(vx) + abs(vy) + abs(w) * m.shape_bound[k, 4]
 
 
 @kernel
@@ -167,13 +159,18 @@ def pair_gate(m, i):
 
 
 @kernel
-def fast_before_solve(m, ws, sa, sb, h, gate):
+def fast_before_solve(m, s, ws, sa, sb, h, gate):
     """(fast, width): whether shapes sa and sb may move, relative to each other, more than
-    gate (pair_gate) of the thinner one's width [m] (m.shape_bound[:, 3]) in the step of h [s], by
-    the speed bounds under the step's start and predicted velocities (ws.shape_reach, placed
-    at the sub-step's start: the same answer at stage 2 and stage 6)."""
+    gate (pair_gate) of the thinner one's width [m] (m.shape_bound[:, 3]) in the step of h [s],
+    by the larger of their relative speed bounds (relative_speed, levers to their bounding
+    circles' far sides) under the step's start and predicted velocities, with their bounding
+    circles placed at the sub-step's start (ws.shape_reach): the same answer at stage 2 and
+    stage 6, and in any frame."""
     width = min(m.shape_bound[sa, 3], m.shape_bound[sb, 3])
-    reach = h * (ws.shape_reach[sa, 3] + ws.shape_reach[sb, 3])
+    la = shape_lever(m, sa)
+    lb = shape_lever(m, sb)
+    reach = h * max(relative_speed(m, s.v, sa, sb, la, lb),
+                    relative_speed(m, ws.v_pred, sa, sb, la, lb))
     return reach > gate * width and within_reach(ws, sa, sb, reach), width
 
 
@@ -188,7 +185,7 @@ def hold_off_fast_pairs(m, s, ws, h):
     thin body it stops a point that would have missed, or turns the body through the wall."""
     for k in range(ws.n_live_pairs[0]):
         i = ws.live_pairs[k]
-        fast, width = fast_before_solve(m, ws, m.contact_pair[i, 0], m.contact_pair[i, 1], h,
+        fast, width = fast_before_solve(m, s, ws, m.contact_pair[i, 0], m.contact_pair[i, 1], h,
                                         pair_gate(m, i))
         if fast and min(ws.contact_gap[i], ws.contact_gap[i + 1]) > TOUCH_SHARE * width:
             clear_slot(s, ws, i)
@@ -196,14 +193,15 @@ def hold_off_fast_pairs(m, s, ws, h):
 
 
 @kernel
-def pair_is_fast(m, ws, sa, sb, h, gate):
+def pair_is_fast(m, s, ws, sa, sb, h, gate):
     """(fast, reach, width): whether shapes sa and sb must be swept over h [s]: they can move,
     relative to each other, more than gate (pair_gate) of the thinner width in their drift
-    (reach [m]: that motion's bound), or they were fast before the solve (their speculative
-    contact may have been held off), and their bounding circles are within the reach; and
-    the thinner width [m]."""
-    reach = h * (drift_speed(m, ws, sa) + drift_speed(m, ws, sb))
-    held, width = fast_before_solve(m, ws, sa, sb, h, gate)
+    (reach [m]: that motion's bound, relative_speed under the drift's velocities, so the same
+    in any frame), or they were fast before the solve (their speculative contact may have
+    been held off), and their bounding circles are within the reach; and the thinner width
+    [m]."""
+    reach = h * relative_speed(m, ws.v_new, sa, sb, m.shape_bound[sa, 4], m.shape_bound[sb, 4])
+    held, width = fast_before_solve(m, s, ws, sa, sb, h, gate)
     fast = (held or reach > gate * width) and reach > 0.0
     return fast and within_reach(ws, sa, sb, reach), reach, width
 
@@ -263,7 +261,7 @@ def pair_impact_time(m, s, ws, h, splits_left):
             continue
         sa = m.contact_pair[i, 0]
         sb = m.contact_pair[i, 1]
-        fast, reach, width = pair_is_fast(m, ws, sa, sb, h, pair_gate(m, i))
+        fast, reach, width = pair_is_fast(m, s, ws, sa, sb, h, pair_gate(m, i))
         if fast:
             target = TOUCH_SHARE * width
             best = min(best, turn_horizon(m, s, ws, i, sa, sb, h, splits_left, target))
