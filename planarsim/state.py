@@ -832,7 +832,8 @@ def touches_no_world(model: Model) -> bool:
     as a whole is then free, and its step's checks measure motion about its centre of mass
     (kernels/checks/frame.py)."""
     a = model.arrays
-    joints = np.concatenate([np.asarray(a.pin_body).reshape(-1), np.asarray(a.rod_body).reshape(-1)])
+    joints = np.concatenate([np.asarray(a.pin_body).reshape(-1),
+                             np.asarray(a.rod_body).reshape(-1)])
     return bool(model.n_body > 0 and np.all(joints >= 0) and np.all(np.asarray(a.shape_body) >= 0)
                 and np.all(np.asarray(a.contact_kind) == CONTACT_PAIR))
 

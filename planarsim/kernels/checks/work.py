@@ -194,7 +194,8 @@ def joints_add_energy(m, s, ws, h):
 @kernel
 def gain_from_velocities(m, ws, h, kinetic, fx, fy):
     """A lower bound [J] of the joints' work at the answer (joint_work), from velocities:
-    KE(v_new) - KE(v*) (kinetic: KE(v*), both seen from a frame moving at (fx, fy) [m/s]) less what the other rows' impulses do at v_new.
+    KE(v_new) - KE(v*) (kinetic: KE(v*); both seen from a frame moving at (fx, fy) [m/s])
+    less what the other rows' impulses do at v_new.
     With v_new - v* = W F^T lam, KE(v_new) - KE(v*) = sum_r lam_r F_r v_new - |v_new - v*|^2 / 2
     (mass-weighted), so the joints do at least the gain less the other rows' work, each
     bounded from above: a contact's normal row or a limit's does -lam c / h <= 0 (a violated
@@ -306,8 +307,9 @@ def judge_energy(m, ws, opt, h, excess):
     """An energy gain from nowhere of `excess` [J] in this step of h [s] is gross when it
     exceeds StepOptions.energy_limit times the energy the step had to work with: the kinetic
     energy it solved for (ws.v_solved) plus its own error under the forces
-    (force_step_energy), in the frame of the step's checks (frame.py). A gross one marks the step (ws.energy_stop): it ends with
-    GUARD_ENERGY, the run stops naming the cause (ws.audit_last)."""
+    (force_step_energy), in the frame of the step's checks (frame.py). A gross one marks the
+    step (ws.energy_stop): it ends with GUARD_ENERGY, the run stops naming the cause
+    (ws.audit_last)."""
     if opt.energy_limit <= 0.0:
         return
     fx, fy = frame_velocity(m, ws, ws.v_pred)

@@ -293,7 +293,7 @@ def velocity_stage_gain(m, ws, vel, h):
             v1 = vel[i, k] - frame
             start += inertia * v0 * v0
             end += inertia * v1 * v1
-            # -f . (q1 - q0) = -h f . v1
+            # -f . (q1 - q0) = -h f . v1 (the frame's move taken off both)
             power -= h * ws.force[i, k] * v1
             other = ws.force[i, k] - (m.body_mass[i] * m.gravity[k] if k < 2 else 0.0)
             power += 0.5 * h * other * (v1 - v0)

@@ -68,7 +68,7 @@ def _settle_measured(m, s, ws, h, opt, rows_held):
 def joints_alone(m, ws):
     """The correction's rows (keep_correction_rows) are hard joint rows alone (pins, sliders,
     rods) and hinges' rotor rows (armature: the correction moves the bodies and rotors with
-    the constant inertia M + A, a the a g^T g of a hinge's fixed rate row g): no contact or
+    the constant inertia M + A, A the sum of a g^T g over hinges' fixed rate rows g): no contact or
     limit row, and no slider's rotor (its g turns with the slider, so its inertia is not
     constant). The joints close no loop of bodies (ws.joints_open) and their pivots are not
     nearly dependent (ws.joint_pivot). Its correction is then SHAKE's for the inertia

@@ -221,7 +221,8 @@ def find_pair(m, s, ws, i, h, margin_floor, keep_modes):
     sb = m.contact_pair[i, 1]
     la = shape_lever(m, sa)
     lb = shape_lever(m, sb)
-    speed = max(relative_speed(m, s.v, sa, sb, la, lb), relative_speed(m, ws.v_pred, sa, sb, la, lb))
+    speed = max(relative_speed(m, s.v, sa, sb, la, lb),
+                relative_speed(m, ws.v_pred, sa, sb, la, lb))
     margin = max(PAIR_MARGIN, margin_floor) + SPECULATIVE_FACTOR * h * speed
     n = 0
     if not pair_apart(ws, sa, sb, margin):

@@ -21,8 +21,9 @@ KE(v_new) - KE(v*) - (h/2) f . (v_new - v*), and KE(v_new) - KE(v*) = sum_r lam_
 rows' work (joints, limits, soft rows).
 
 The energies are measured in the frame of the step's checks (checks/frame.py): the world's
-for a model that touches it, else one drifting with the bodies' centre of mass, so that the allowance for rounding (a share of the kinetic energy) and the
-result do not depend on how fast a free pile drifts (measured in the world's frame, a pair
+for a model that touches it, else one drifting with the bodies' centre of mass, so that the
+allowance for rounding (a share of the kinetic energy) and the result do not depend on how
+fast a free pile drifts (measured in the world's frame, a pair
 of squares drifting at 1000 m/s gained 3.5e-3 of its energy about its centre of mass in
 Kane's impact, 3.8e-7 at rest).
 """
