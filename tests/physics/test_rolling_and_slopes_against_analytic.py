@@ -40,12 +40,12 @@ DEFECTS = {
         "period, 0.67 %) and 9.1 % in 50 at dt 1e-3 (1.6 % in 20 at dt 5e-4, 6.2 % at 2e-3: "
         "first order in dt); from 0.7 rad 30 % in 50 periods at dt 1e-3, 72 % in 30 and 85 % "
         "in 50 at dt 1e-2; the loss per period grows as a0^2 (0.1 % in 20 periods from 0.05 "
-        "rad). The step's velocity keeps only 0.0-0.35 of the position correction's move "
-        "(v - v_solved against (q+ - q) / h - v_solved), so the velocity is not the move as "
-        "SHAKE's would be: the correction of the contact's rows is cut by the energy bound "
-        "(integrate.bound_correction_work; shake_whole 0: a contact keeps the bound) or taken "
-        "as a move alone, which ratchets the energy down as in test_known_defects' "
-        "coarse_whip"),
+        "rad). Suspected cause (not confirmed by changing the engine): the correction of a "
+        "contact's rows is not SHAKE's, so the step is not symplectic and its error "
+        "accumulates: the step's velocity keeps only 0.0-0.35 of the position correction's "
+        "move (v - v_solved against (q+ - q) / h - v_solved; shake_whole 0: a contact keeps "
+        "the energy bound, integrate.bound_correction_work), as the joints' did in "
+        "test_known_defects' coarse_whip"),
     "hills_energy": (
         "over the default hills a disk rolling without slip (r 0.1 m, I = m r^2 / 2) and a "
         "point mass sliding without friction, each touching throughout (one mode the whole "
@@ -53,10 +53,12 @@ DEFECTS = {
         "of the last 5 s of 40 s lies 0.41 % (rolling) and 0.70 % (sliding) of the start's "
         "kinetic energy below the first 5 s's, five times the band the energy oscillates in "
         "over those first 5 s (0.08 % and 0.13 %); 4.0 % and 6.7 % at dt 1e-2; halved with "
-        "dt. On a slope the same disk keeps symplectic Euler's energy to rounding: the loss "
-        "comes from the ground's curvature, which the velocity solve meets along the start's "
-        "tangent and the position correction by a move whose velocity change is not kept "
-        "whole (a contact's correction is bounded, integrate.bound_correction_work)"),
+        "dt. On a slope the same disk keeps symplectic Euler's energy to rounding, so the loss "
+        "comes with the ground's curvature. Suspected cause (not confirmed by changing the "
+        "engine), as for rocker_energy: the velocity solve holds the contact along the "
+        "start's tangent, and the position correction that puts it back on the curved ground "
+        "is a move whose velocity change is not kept whole (a contact keeps the energy bound, "
+        "integrate.bound_correction_work), so the step is not symplectic"),
     "crest_hops": (
         "a frictionless point sliding over a crest of a single sine (A = 0.1 m, L = 4 m, "
         "curvature k = 0.247 1/m at the top) from its top at speed v, where the ground still "
