@@ -67,7 +67,7 @@ DEFECTS = {
         "(N = 0.2 m g) at dt 1e-3 and 1e-4 alike, 79-80 % at 0.9 g, 10 % and 1 % at 0.7 g, "
         "none at 0.65 g and below; its hops are 0.75 h^2 v^2 k high (1.4 at 0.9 g), so the "
         "path converges at second order but the contact's mode and impulse record do not. "
-        "The step holds a touching contact's normal velocity along the start's normal; the "
+        "Suspected cause: the step holds a touching contact's normal velocity along the start's normal; the "
         "next start's normal has turned by k v h, so the point leaves at k v^2 h and lies "
         "k v^2 h^2 / 2 above the curved ground, a gap that gravity's kick closes within the "
         "next step only where g - k v^2 is large enough: a rough balance puts the discrete "
