@@ -13,7 +13,8 @@ What is checked, each against what the scheme itself gives:
 - internal actuators (a motor between two free pinned bodies, a slider motor between two
   free bodies, with rotors, mass ratios 1e-3..1e3, spinning or not; hip torques; axial
   forces): linear and angular momentum kept to rounding, and the actuators' recorded work
-  equal to the change of kinetic energy to first order in dt;
+  equal to the change of kinetic energy to first order in dt, there and for motors driving
+  rotors on a turning slider and hinge and a closed four-bar loop;
 - the DC motor model (current command, viscous, Coulomb and load friction): a flywheel spun
   up to its no-load speed G K I / c1 takes the step's recurrence to rounding and the
   exponential with time constant (J + G^2 Jm) / c1 to O(h / T); with Coulomb and load
@@ -295,6 +296,70 @@ def test_hip_torques_and_axial_forces_keep_the_momenta_and_their_work_is_the_ene
     for k in range(2):
         assert mismatch[k, 1e-3] <= 0.02
         assert 7.0 <= mismatch[k, 1e-3] / mismatch[k, 1e-4] <= 13.0, mismatch
+
+
+def _rotor_pairs(dt):
+    """Zero gravity, no ground: two free bodies on a slider (anchor 0.2 m off body b's
+    centre) with a rotor of 0.5 kg on the slide and its motor, turning at 3 rad/s; two free
+    bodies on a hinge with a rotor of 0.5 kg m^2 and its motor, turning at 2 rad/s."""
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
+    pa, pb = np.array([-0.3, 0.0]), np.array([0.3, 0.2])
+    b.add_body("a", 1.0, 0.05, pos=tuple(pa), omega=3.0, vel=(-3.0 * pa[1], 3.0 * pa[0]))
+    b.add_body("b", 0.3, 0.02, pos=tuple(pb), omega=3.0, vel=(-3.0 * pb[1], 3.0 * pb[0]))
+    b.add_slider("rail", "a", "b", axis=(1.0, 0.0), armature=0.5)
+    b.add_slider_motor("push", "rail")
+    b.add_body("c", 1.0, 0.05, pos=(5.0, 0.0), omega=2.0)
+    b.add_body("d", 0.2, 0.01, pos=(5.4, 0.0), vel=(0.0, 0.8), omega=2.0)
+    b.add_pin("hinge", "c", "d", anchor_world=(5.2, 0.0), armature=0.5)
+    b.add_pin_motor("turn", "hinge")
+    return b.compile(), lambda s: np.array([0.5 * math.sin(5 * s.t), 0.1 * math.cos(6 * s.t)])
+
+
+def _four_bar(dt):
+    """A crank-rocker in zero gravity (ground pivots 1 m apart; crank 0.3 m, 0.5 kg; coupler
+    1 m, 1 kg; rocker 0.8 m, 0.8 kg: thin rods), a closed loop, its crank driven by a
+    constant 3 N m from rest up to 92 rad/s in 2 s (0.09 rad a step at dt 1e-3)."""
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
+    A = 0.3 * np.array([math.cos(1.0), math.sin(1.0)])
+    O4 = np.array([1.0, 0.0])
+    d = float(np.linalg.norm(O4 - A))
+    along = (1.0 - 0.64 + d * d) / (2 * d)
+    B = A + along * (O4 - A) / d + math.sqrt(1.0 - along * along) * np.array([A[1], 1.0 - A[0]]) / d
+
+    def link(name, p, q, mass):
+        length = float(np.linalg.norm(q - p))
+        return b.add_body(name, mass, mass * length * length / 12, pos=tuple((p + q) / 2),
+                          angle=math.atan2(q[1] - p[1], q[0] - p[0]))
+    crank = link("crank", np.zeros(2), A, 0.5)
+    coupler = link("coupler", A, B, 1.0)
+    rocker = link("rocker", O4, B, 0.8)
+    b.add_pin("O2", None, crank, anchor_world=(0.0, 0.0))
+    b.add_pin("A", crank, coupler, anchor_world=tuple(A))
+    b.add_pin("B", coupler, rocker, anchor_world=tuple(B))
+    b.add_pin("O4", None, rocker, anchor_world=tuple(O4))
+    b.add_pin_motor("crank", "O2")
+    return b.compile(), lambda s: np.array([3.0])
+
+
+@pytest.mark.parametrize("scene, bound", [(_rotor_pairs, 2e-3), (_four_bar, 2e-2)])
+def test_the_motors_work_is_the_kinetic_energy_with_the_rotors_share_to_first_order(scene, bound):
+    """Motors driving rotors on a turning slider and hinge (their velocity-product forces
+    included) and a closed four-bar loop: the motors' recorded work (power at each step's
+    start velocity, times h) meets the change of kinetic energy, the rotors' a rate^2 / 2
+    included, to first order in dt: the largest mismatch over the run, as a share of the
+    largest kinetic energy, is below `bound` at dt 1e-3 and shrinks at least fivefold at
+    dt 1e-4 (measured 6.6e-4 -> 6.6e-5 and 8.8e-3 -> 1.5e-4)."""
+    mismatch = []
+    for dt in (1e-3, 1e-4):
+        model, control = scene(dt)
+        sim = ps.Simulator(model)
+        traj = sim.run(2.0 if scene is _four_bar else 1.0, controller=control)
+        ke = kinetic_energy(model, traj.q, traj.v)
+        work = np.r_[0.0, dt * np.cumsum(traj.act_power[1:].sum(axis=1))]
+        mismatch.append(np.abs(ke - ke[0] - work).max() / ke.max())
+        assert_clean(sim)
+    assert mismatch[0] <= bound
+    assert mismatch[1] <= mismatch[0] / 5, mismatch
 
 
 # --- the DC motor model ---------------------------------------------------------------------
