@@ -65,7 +65,7 @@ DEFECTS = {
         "only from 0.35 rad a step (22 % short at 4 s). The same per-step scaling at dt "
         "1e-3 gives the same figures. A free pair (1 kg base, a 0.01 kg link of 1e-5 kg "
         "m^2, its centre 0.3 m from the pin) driven by its internal motor gains an angular "
-        "momentum of 39-55 % of tau t from 0.2 rad a step. Suspected cause: the predicted "
+        "momentum of 38-56 % of tau t from 0.2 rad a step. Suspected cause: the predicted "
         "velocity v* = v + h M^-1 f turns the link about its own centre (1/I), not about its "
         "hinge (1/(I + m d^2)): h^2 tau (1/I - 1/J) = 0.27 rad away from where the step "
         "ends, beyond SHAKE_REGIME (0.1), so the joints' energy check "
@@ -73,7 +73,10 @@ DEFECTS = {
         "joints' second-order target; past 0.2 rad a step the target's work exceeds it, the "
         "velocity solve is taken again as a projection (step_info solves = 2, shake_whole "
         "= 0) and the position correction's energy bound cuts the velocity the hinge "
-        "should give. RATTLE keeps L = tau t here but counts joint_work every step"),
+        "should give. The turn check (turn_limit 0.2) passes the motor: it measures the "
+        "hinge's turn h^2 tau / (I + m d^2) = 0.003 rad, where a body torque of the same "
+        "size on the same link is stopped (h^2 tau / I = 0.27 rad). RATTLE keeps L = tau t "
+        "here but counts joint_work every step"),
     "point_mass_hinge": (
         "a pin motor on a hinge between a rigid body and a point mass (which takes no "
         "torque) applies its -tau to the rigid body and drops the +tau: the pair, free in "
@@ -97,9 +100,11 @@ DEFECTS = {
         "positive, into the limit (1.03e-2 m/s at 2 rad/s, dt 1e-2: the rail turned under "
         "the limit's row during the step), and each step loses the same 1.07e-5 N m s of "
         "0.254. Suspected cause: the position correction pulls the slide back onto the limit "
-        "by moving the positions and (a limit keeps the correction's energy bound, "
-        "position.joints_alone) not the velocities with them: an internal move inward along "
-        "a turning rail at an unchanged tangential velocity lowers sum m r x v"),
+        "each step, and with a limit row the step is not one of joints alone "
+        "(position.joints_alone), so integrate.bound_correction_work keeps the move's "
+        "velocity change only as far as it adds no energy: the positions move inward along "
+        "the turning rail while the velocities are not changed with them, which lowers sum "
+        "m r x v"),
     "half_step_armature": (
         "planarsim.half_step's conversions between a state's velocity and its instant's "
         "ignore the hinges' rotors (armature) and take them silently (sliders are refused): "
