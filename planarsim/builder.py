@@ -510,10 +510,27 @@ class ModelBuilder:
         lo, hi = self._joint_limit("pin", name, idx, limit)
         k, c, arm = self._joint_passive("pin", name, idx, stiffness, damping, armature)
         fl = self._joint_friction("pin", name, idx, frictionloss)
+        acting = [f for f, on in (("limit", bool(np.isfinite(lo) or np.isfinite(hi))), ("stiffness", k != 0.0),
+                                  ("damping", c != 0.0), ("armature", arm != 0.0),
+                                  ("frictionloss", fl != 0.0)) if on]
+        if acting:
+            self._pin_angle_turns(f"pin {name!r} ({idx})", a, b, ", ".join(acting))
         self._pins.append(dict(name=name, body=(a, b), anchor=(la, lb), ref=ref, limit=(lo, hi),
                                k=k, c=c, rest=_scalar("pin", name, idx, "rest_angle", rest_angle),
                                kind=JOINT_HINGE, axis=(0.0, 0.0), armature=arm, frictionloss=fl))
         return idx
+
+    def _pin_angle_turns(self, what, a, b, acting):
+        """ModelError if body a or b of a hinge is a point mass: a point mass does not turn, so
+        the hinge's angle theta_b - theta_a is not a relative angle of two bodies, and what
+        acts on it (`acting`: a motor, a spring, a limit, ...) would have no body to react on
+        (an outside torque on the other body, or nothing)."""
+        for body in (a, b):
+            if body >= 0 and self._bodies[body]["point"]:
+                raise ModelError(f"{what}: {acting} on a hinge to point mass "
+                                 f"{self._bodies[body]['name']!r}, which does not turn: no body "
+                                 "would take the reaction (give it an inertia, or drive the "
+                                 "other body with add_body_torque)")
 
     def _joint_bodies(self, kind, name, body_a, body_b, world_b):
         """Register joint `name` in the pin table: (its index, body a, body b) checked (ids;
@@ -795,6 +812,8 @@ class ModelBuilder:
             raise ModelError(f"actuator {name!r} ({idx}): pin={self._pins[pin]['name']!r} is a "
                              f"slider (use add_slider_motor)")
         a, b = self._pins[pin]["body"]
+        self._pin_angle_turns(f"actuator {name!r} ({idx})", a, b,
+                              f"a torque at pin {self._pins[pin]['name']!r}")
         return self._act(name, M.ACT_PIN_TORQUE, (a, b, -1), int(pin), limit=limit)
 
     def add_slider_motor(self, name, slider, limit=(-math.inf, math.inf)) -> int:

@@ -57,16 +57,32 @@ def _no_sliders(model, who):
                              "(rods, hinge pins and pinned contacts only)")
 
 
+def _no_rotors(model, who):
+    """ModelError naming the first joint with a rotor (armature): the half kick and the
+    projection weigh the bodies alone, without the rotor's inertia on the joint's rate (a
+    flywheel with a rotor of its own inertia ended 2 % short of its exact angle)."""
+    a = model.arrays
+    for j in range(model.n_pin):
+        if a.pin_armature[j] != 0.0:
+            raise ModelError(f"{who}: joint {j} ({model.pin_names[j]!r}) has a rotor (armature "
+                             f"{a.pin_armature[j]:g}), which is not supported (joints without "
+                             "armature only)")
+
+
 def to_step_velocity(model, state, ws, h: float, u=None) -> None:
     """State's velocity known at its instant -> the velocity the next step of h [s] expects
-    (in place): v - h/2 M^-1 f (module docstring)."""
+    (in place): v - h/2 M^-1 f (module docstring). Joints with a rotor (armature) are refused
+    (ModelError)."""
+    _no_rotors(model, "to_step_velocity")
     kick(model.arrays, state, ws, _commands(model, u), -0.5 * float(h), float(h))
 
 
 def to_instant_velocity(model, state, ws, h: float, u=None, pinned=()) -> None:
     """State's velocity over the last step of h [s] -> its velocity at its instant (in place):
-    v + h/2 M^-1 f, projected onto the rods, pins and the contacts in `pinned` at its q."""
+    v + h/2 M^-1 f, projected onto the rods, pins and the contacts in `pinned` at its q.
+    Sliders and joints with a rotor (armature) are refused (ModelError)."""
     _no_sliders(model, "to_instant_velocity")
+    _no_rotors(model, "to_instant_velocity")
     kick(model.arrays, state, ws, _commands(model, u), 0.5 * float(h), float(h))
     state.v[...] = project_velocities(model, state.q, state.v, pinned)
 
@@ -86,8 +102,10 @@ def project_velocities(model, q, v, pinned=()) -> np.ndarray:
 
     The step leaves velocities tangent to the constraints of the START of the step, O(h) off
     those at its end; a state read at its instant, or a shorter step taken from it, needs them
-    consistent with its own configuration. Slider joints are refused (ModelError)."""
+    consistent with its own configuration. Slider joints and joints with a rotor (armature)
+    are refused (ModelError)."""
     _no_sliders(model, "project_velocities")
+    _no_rotors(model, "project_velocities")
     a = model.arrays
     nb = model.n_body
     w = np.c_[a.body_inv_mass, a.body_inv_mass, a.body_inv_inertia].ravel()
