@@ -19,7 +19,11 @@ pins held at the step's end), MuJoCo's Euler takes them at the step's start; eac
 error is the sum of a few first-order terms of both signs, and the largest ratios are states
 where MuJoCo's happen to cancel (InvertedDoublePendulum's worst: 6e-4 rad/s, a ninth of its
 median error, against our 9e-3, about our median); measured at dt / 64 on two of
-InvertedDoublePendulum's states the ratio's limit is 2.7 and 6.0. Before the position
+InvertedDoublePendulum's states the ratio's limit is 2.7 and 6.0. Not even a second-order
+scheme meets 3x there: our step read as the leapfrog it is (the start's velocity moved back
+and the end's read on by half a kick), second order without the file's damping, errs 5.7
+times MuJoCo Euler's at the file's dt on the worst of 80 states
+(`python -m benchmarks.torque_parity_orders --no-damping`). Before the position
 correction moved the rotors with their links HalfCheetah reached 6.0 (17 of 250 above 3;
 test_a_heavy_rotor_...). Before the soft rows
 took part in the prediction, the ratio was 47 (Hopper) and Reacher at dt 1e-4 did not
