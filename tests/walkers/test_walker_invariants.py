@@ -204,32 +204,39 @@ def _shift_quadruped(run, dx):
     run.x_start += dx
 
 
-@pytest.mark.parametrize("name", ["simple-biped", "simbicon", "ranger", "quadruped"])
+@pytest.mark.parametrize("name", ["simple-biped", "simbicon", "ranger", "quadruped", *PASSIVE])
 def test_a_walker_started_100_m_further_walks_the_same_gait(name):
-    """Flat ground is the same everywhere: the walker's bodies (and any world position its
-    controller keeps) moved 100 m along it walk the same 3 s gait, every body within 1e-8 m
-    and 1e-8 m/s of the first walk (rounding: x near 100 m carries 1.4e-14 m, which the
-    contacts amplify over 3 s; measured at most 1.7e-10 m), and the common summary's distance,
-    steps and whole-step numbers agree within 1e-8 (relative)."""
+    """Flat ground, or a passive walker's plane slope, is the same everywhere: the walker's
+    bodies (and any world position its controller keeps) moved 100 m along it walk the same
+    3 s (passive: 4 s) gait, every body within 1e-8 m and 1e-8 m/s of the first walk
+    (rounding: x near 100 m carries 1.4e-14 m, which the contacts amplify over the walk;
+    measured at most 1.7e-10 m, the passive walkers 4.0e-12 m), and the common summary's
+    distance, steps and whole-step numbers agree within 1e-8 (relative)."""
     mod = walkers.load(name)
+    gamma = mod.Params().slope if name in PASSIVE else 0.0
+    shift = 100.0 * np.array([math.cos(gamma), -math.sin(gamma)])
+    seconds = 4.0 if name in PASSIVE else 3.0
     a = mod.Run()
     b = mod.Run()
-    b.state.q[:, 0] += 100.0
+    b.state.q[:, :2] += shift
     if name == "quadruped":
         _shift_quadruped(b, 100.0)
-    a.run(3.0)
-    b.run(3.0)
+    a.run(seconds)
+    b.run(seconds)
     assert not a.fell and not b.fell
+    assert b.time == pytest.approx(a.time, abs=1e-9)
     dq = b.state.q - a.state.q
-    dq[:, 0] -= 100.0
+    dq[:, :2] -= shift
     assert np.max(np.abs(dq)) < 1e-8, np.max(np.abs(dq))
     assert np.max(np.abs(b.state.v - a.state.v)) < 1e-8
-    sa = common(name, a.trajectory(), a.summary(), a.model, 3.0)
-    sb = common(name, b.trajectory(), b.summary(), b.model, 3.0)
+    sa = common(name, a.trajectory(), a.summary(), a.model, seconds)
+    sb = common(name, b.trajectory(), b.summary(), b.model, seconds)
     assert sa["steps"] == sb["steps"] and sa["whole_steps"] == sb["whole_steps"] >= 2
     for key in ("distance_m", "mean_speed_m_per_s", "step_period_s", "step_length_m",
                 "step_speed_m_per_s"):
         assert sb[key] == pytest.approx(sa[key], rel=1e-8), key
+    if name in PASSIVE:
+        assert sb["extras"]["cost_of_transport"] == pytest.approx(sa["extras"]["cost_of_transport"], rel=1e-8)
 
 
 # mirror symmetry ------------------------------------------------------------------------------
