@@ -66,7 +66,7 @@ DEFECTS = {
     "simbicon_limp": (
         "SIMBICON's default walk at its default dt 1e-3 s is a period-two limp that the model "
         "does not have: its steps alternate 0.5733 and 0.5671 m (a 1.1 % difference, 6.5e-3 m) "
-        "and 0.366 and 0.365 s, for ever (unchanged from 5 s to 12 s), on whichever side swings "
+        "and 0.366 and 0.365 s, persisting from 5 s to 12 s, on whichever side swings "
         "first; at dt 5e-4 s the same walk settles to equal steps of 0.571725 m and 0.365 s "
         "(differences 1.7e-7 m after 12 s), and at 2.5e-4 s too. The step time alternating by "
         "exactly one dt suggests the four-state machine's strikes, taken at whole steps, "
@@ -492,8 +492,10 @@ def test_the_summary_agrees_with_the_recorded_trajectory(name):
     numbers their first-to-last spans (1e-12). For the passive walkers cost_of_transport is
     the energy lost between the first and last landing over the weight and the distance along
     the slope (1e-9 relative: the energy recomputed here sums in another order); for the
-    Simple Biped the positive work is the actuators' positive power summed step by step
-    (1e-9 relative). Every audit count is 0."""
+    Simple Biped and the robot dog the positive work is the actuators' positive power summed
+    step by step, for SIMBICON the effort the squared torques summed (1e-9 relative), for
+    Ranger its costs of transport the recorded powers summed over its whole steps. Every
+    audit count is 0."""
     mod = walkers.load(name)
     traj, raw, model = quiet_simulate(name, 5.0, record_every=1)
     s = common(name, traj, raw, model, 5.0)
@@ -517,9 +519,43 @@ def test_the_summary_agrees_with_the_recorded_trajectory(name):
         along = float((com[last] - com[first]) @ tangent)
         cot = (energy[first] - energy[last]) / (weight * along)
         assert s["extras"]["cost_of_transport"] == pytest.approx(cot, rel=1e-9)
-    if name == "simple-biped":
-        work = float(np.sum(np.clip(traj.act_power[1:], 0.0, None)) * traj.info["dt"])
-        assert s["extras"]["positive_work_J"] == pytest.approx(work, rel=1e-9)
+    dt = traj.info["dt"]
+    if name in ("simple-biped", "quadruped"):
+        work = float(np.sum(np.clip(traj.act_power[1:], 0.0, None)) * dt)
+        key = "positive_work_J" if name == "simple-biped" else "motor_work_positive_J"
+        assert s["extras"][key] == pytest.approx(work, rel=1e-9)
+    if name == "simbicon":
+        assert s["extras"]["effort_N2m2s"] == pytest.approx(float(np.sum(traj.act_u[1:] ** 2) * dt), rel=1e-9)
+    if name == "ranger":
+        ranger_costs_from_the_recorded_power(traj, raw, model)
+
+
+def ranger_costs_from_the_recorded_power(traj, raw, model):
+    """Ranger's whole-step costs of transport (from its second heel strike to its last, over
+    the hip's travel between them, as its heel-strike log holds them) from the recorded
+    shaft power and the electrical power labels, summed frame by frame (1e-9 relative). The
+    energy logged at a strike holds the recorded power through the frame after it."""
+    import walkers.ranger.tables as T
+    steps = int(raw["steps"])
+    assert steps >= 4
+    mod = walkers.load("ranger")
+    run = mod.Run(record_every=0)
+    run.run(float(traj.t[-1]))
+    log = run.tables.steplog[:steps]
+    t = np.asarray(traj.t)
+    a, b = (int(np.flatnonzero(np.isclose(t, log[k, T.LOG.t], rtol=0, atol=1e-9))[0]) for k in (1, -1))
+    span = slice(a + 2, b + 2)
+    weight = float(np.hypot(*model.arrays.gravity)) * float(model.arrays.body_mass.sum())
+    per = weight * float(log[-1, T.LOG.hip_x] - log[1, T.LOG.hip_x])
+    dt = traj.info["dt"]
+    shaft = traj.act_power[span]
+    elec = np.stack([traj.labels[k][span] for k in ("power_hip", "power_outer_ankle", "power_inner_ankle")], 1)
+    wall = 4.5 * float(log[-1, T.LOG.t] - log[1, T.LOG.t])      # the computers' 4.5 W
+    assert raw["cost_of_transport_mechanical"] == pytest.approx(np.sum(np.clip(shaft, 0, None)) * dt / per, rel=1e-9)
+    assert raw["cost_of_transport_mechanical_net"] == pytest.approx(np.sum(shaft) * dt / per, rel=1e-9)
+    assert raw["cost_of_transport_electrical"] == pytest.approx(np.sum(np.clip(elec, 0, None)) * dt / per, rel=1e-9)
+    assert raw["cost_of_transport_electrical_net"] == pytest.approx(np.sum(elec) * dt / per, rel=1e-9)
+    assert raw["cost_of_transport"] == pytest.approx((np.sum(np.clip(elec, 0, None)) * dt + wall) / per, rel=1e-9)
 
 
 # the command line and the Python API ----------------------------------------------------------
