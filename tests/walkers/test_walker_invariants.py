@@ -4,16 +4,21 @@ walkers as they run (not on the engine alone):
 - a run's summary (the command line's common summary and the walker's own numbers) is the
   same whether the run is made at once or in chunks, and a run continued from a copy of its
   state and controller memory (a snapshot restored mid-run) goes on as one run would;
-- translation: a walker started 100 m further along flat ground walks the same gait;
+- translation: a walker started 100 m further along flat ground (a passive walker: down its
+  slope) walks the same gait;
 - mirror symmetry: the passive walkers' left and right steps on their period-one gait are
-  equal, and SIMBICON started on the other leg walks the mirror image of its walk;
+  equal, SIMBICON started on the other leg walks the mirror image of its walk, and its left
+  and right steps are equal on its gait;
 - the passive walkers' physics: the rimless wheel's impact keeps eta^2 of the kinetic energy
   (closed form), the energy lost at a heel strike is the potential energy released over the
-  step on the limit cycle (to the integrator's first-order error, which shrinks with dt), and
-  the simplest walker's period-one gait at small slopes scales as Garcia et al. (1998) found
-  (stance angle and step length as slope^(1/3), period nearly constant);
-- the summary numbers agree with what is recomputed from the recorded trajectory, and the
-  command line's `run --json` prints the summary the Python API gives for the same run.
+  step on the limit cycle (to the integrator's first-order error, which shrinks with dt), a
+  walk scales with gravity and size as dimensional analysis says, and the simplest walker's
+  period-one gait at small slopes scales as Garcia et al. (1998) found (stance angle and step
+  length as slope^(1/3), period nearly constant);
+- the summary numbers agree with what is recomputed from the recorded trajectory (distance,
+  steps, whole-step spans, work, effort, costs of transport), a run's last frame is where it
+  ended, and the command line's `run --json` prints the summary the Python API gives for the
+  same run, while the API's own numbers measure what the summary replaces them with.
 
 Silent defects found here are strict xfails with their measured figures in DEFECTS.
 """
