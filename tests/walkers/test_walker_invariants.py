@@ -37,15 +37,6 @@ ALL = sorted(walkers.WALKERS)
 PASSIVE = ("compass-gait", "rimless-wheel", "simplest-walker")
 
 DEFECTS = {
-    "passive_restore": (
-        "a passive walker's run(seconds) walks to an absolute step count it keeps in Python "
-        "(PassiveRun.steps_asked, the sum of every run asked for), not `seconds` from the "
-        "state it holds: a snapshot (state and memory) of the simplest walker, compass gait "
-        "or rimless wheel taken at 2 s and restored into a fresh Run does not move on "
-        "run(1.0) (time stays 1.9999 / 1.9997 / 2.0002 s, one frame returned, no error), and "
-        "restored into the run it came from after a further run(1.0) walks 2 s for the next "
-        "run(1.0) (ends at 4.0 s instead of 3.0 s; |q| off by 0.35-1.04 m from one run). The "
-        "actuated walkers continue bit for bit both ways"),
     "replaced_numbers": (
         "the command line's summary replaces a walker's own numbers (REPLACED: 'the same "
         "quantity, measured one way') with other quantities, and the Python API and the "
@@ -132,14 +123,7 @@ def test_the_summary_of_a_run_in_three_chunks_is_that_of_one_run(name):
     assert a["whole_steps"] >= 2 and not a["fell"]     # a walk was compared, not a fall
 
 
-def _restore_cases():
-    for name in ALL:
-        marks = [pytest.mark.xfail(strict=True, raises=AssertionError,
-                                   reason=DEFECTS["passive_restore"])] if name in PASSIVE else []
-        yield pytest.param(name, marks=marks, id=name)
-
-
-@pytest.mark.parametrize("name", list(_restore_cases()))
+@pytest.mark.parametrize("name", ALL)
 def test_a_snapshot_restored_into_a_fresh_run_goes_on_as_one_run(name):
     """The state and controller memory of a walk at 2 s, restored into a fresh Run of the same
     walker, then run(1.0): it ends where one 3 s run ends (the Simple Biped's snapshot test,
@@ -157,7 +141,7 @@ def test_a_snapshot_restored_into_a_fresh_run_goes_on_as_one_run(name):
     assert np.array_equal(again.state.q, ref.state.q)
 
 
-@pytest.mark.parametrize("name", list(_restore_cases()))
+@pytest.mark.parametrize("name", ALL)
 def test_a_run_rewound_to_a_snapshot_walks_the_seconds_asked(name):
     """A run rewound to its own state and memory at 2 s (after walking on to 3 s), then
     run(1.0): it walks 1 s, to where it was at 3 s, bit for bit."""
@@ -187,8 +171,9 @@ FROM_THE_RECORDING = {"simbicon": ("min_clearance",)}
 def test_a_restored_walk_reports_the_numbers_of_one_run(name):
     """After a snapshot of state and controller memory at 2 s is restored into a fresh Run and
     run 3 s, the walker's own summary (distance, steps, work, costs of transport, ...) is that
-    of one 5 s run, bit for bit, as its motion is (the passive walkers do not move on after a
-    restore: test_a_snapshot_restored_into_a_fresh_run_goes_on_as_one_run)."""
+    of one 5 s run, bit for bit, as its motion is (the passive walkers' whole-step numbers
+    are read from the recorded touchdowns, which a restored run has only from the snapshot
+    on; their motion goes on as one run's: test_a_snapshot_restored_into_a_fresh_run_...)."""
     mod = walkers.load(name)
     ref = mod.Run()
     ref.run(2.0)

@@ -5,7 +5,7 @@ Common keys, the same for every walker, units in their names:
   time_s            simulated time reached [s] (less than duration_s after a fall)
   fell              the walker's own fall test fired (or the engine stopped it)
   distance_m        horizontal displacement of the centre of mass [m] from the first
-                    recorded frame (one recording interval after the start) to the last
+                    recorded frame (the start, t = 0) to the last
   mean_speed_m_per_s  distance_m over the time between those frames [m/s]
   steps             foot touchdowns over the run (from the recorded contact modes; a foot
                     is its contacts together, FEET of the walker; a landing counts after

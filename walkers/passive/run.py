@@ -8,7 +8,9 @@ Touchdowns, ``impacts``:
       point feet, the "all" mode strategy releasing the trailing foot), the end-to-end path.
 Either way a recorded run also holds a frame at each touchdown (whole-step summaries start
 and end on them). Chunks end where one run of their total length would be: run(a); run(b)
-walks to step round(a / dt) + round(b / dt) like run(a + b).
+walks to step round(a / dt) + round(b / dt) like run(a + b). A chunk's end is counted from
+the state's own clock (a touchdown moves the clock off the grid of whole steps by less than
+half a step), so a state and memory put back from a snapshot go on from there.
 """
 from __future__ import annotations
 
@@ -81,7 +83,7 @@ class PassiveRun(WalkerRun):
                          options=w.sim.options, record_every=record_every)
         self.impacts = impacts
         self.hip0 = self.state.q[w.hip, :2].copy()
-        self.steps_asked = 0      # steps asked for by all runs so far
+        self.end_step = 0         # the grid step the chunk under way ends at
         self.code = 0             # run code of the last chunk (0, or FELL; FELL stays)
 
     def _section_state(self, x0, names) -> np.ndarray:
@@ -119,7 +121,7 @@ class PassiveRun(WalkerRun):
     def advance(self, n, every, rec, lab):
         if self.fell:
             return FELL, 0        # it stays where it fell (the refined rollout walks to a total)
-        self.steps_asked += n
+        self.end_step = int(round(float(self.state.time[0]) / self.dt)) + n
         code, k = (self._engine if self.impacts == "engine" else self._refined)(n, rec)
         self.code = int(code)
         return code, k
@@ -136,9 +138,10 @@ class PassiveRun(WalkerRun):
         return code, k
 
     def _refined(self, n, rec):
-        """Rollouts from touchdown to touchdown, each touchdown refined, up to step steps_asked."""
+        """Rollouts from touchdown to touchdown, each touchdown refined, up to grid step
+        end_step (the state's clock at the chunk's start in whole steps, plus n)."""
         w, s = self.walker, self.state
-        end = self.steps_asked * self.dt
+        end = self.end_step * self.dt
         k, code = 0, NO_EVENT
         toggle = w.toggle
         w.toggle = DETECT
