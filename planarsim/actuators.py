@@ -7,9 +7,10 @@ A motor is one row of a float array laid out by the MOTOR_* indices below (build
     T = G K I - c1 w - c0 sgn(w) - mu G K |I| sgn(w)                      [N m]
     P = I^2 R + Vc |I| + G K w I                                           [W]
 
-``sgn`` and ``|.|`` are smoothed (Kelly 2014, eq. 15): sgn(w) ~ w / sqrt(w^2 + w0^2),
-|I| ~ I^2 / sqrt(I^2 + I0^2), so the friction is a continuous, bounded-slope function of the
-rate (a discontinuous Coulomb term chatters under an explicit step on a light body).
+``sgn`` is smoothed (Kelly 2014, eq. 15): sgn(w) ~ w / sqrt(w^2 + w0^2), so the friction is
+a continuous, bounded-slope function of the rate (a discontinuous Coulomb term chatters
+under an explicit step on a light body). In the power, |I| is smoothed too,
+|I| ~ I^2 / sqrt(I^2 + I0^2); the torque's load friction takes |I| as it is (continuous in I).
 The rotor inertia (reflected G^2 Jm) is NOT part of the torque here: it is a body property
 (an armature) that the model builder adds; see walkers/ranger/model.py.
 
