@@ -9,7 +9,8 @@ What is checked, each against what the scheme itself gives:
   dead (its angular momentum about the hinge all removed); two coaxial wheels meeting their
   relative limit, and two free bodies meeting their slider's limit (mass ratios 1e-3..1e3),
   end at the plastic impact's common velocity and energy to rounding; a block meeting a
-  slider's limit (1e-3..1e3 kg) stops with the impulse m v0; a joint driven off its limit
+  slider's limit (1e-3..1e3 kg) stops with the impulse m v0, and one sliding down onto it is
+  held there for 10^4 steps with the impulse h m g sin(slope); a joint driven off its limit
   leaves it at once on symplectic Euler's parabola; a limit of zero width locks the joint; a
   limit beyond half a turn holds (the angle is not wrapped); a spring pressing a joint onto
   its limit is held there by an impulse h k (rest - limit);
@@ -301,6 +302,29 @@ def test_a_block_meeting_its_sliders_limit_stops_with_the_impulse_m_v0(m, dt):
     assert far <= 0.5 + 1e-12 and abs(sim.state.q[0, 0] - 0.5) <= 1e-12
     assert np.abs(sim.state.v[0]).max() <= 1e-12
     assert total == pytest.approx(2.0 * m, rel=1e-12)
+    assert_clean(sim)
+
+
+@pytest.mark.parametrize("m, dt", [(1e-3, 1e-2), (1.0, 1e-3), (1e3, 1e-4)])
+def test_a_block_sliding_down_onto_its_limit_is_held_there(m, dt):
+    """A block on a world slider descending at 30 degrees (its anchor on its centre) slides
+    0.05 m down onto the slider's limit, then is held there by gravity for 10^4 steps: never
+    past it, at rest on it, its angle kept, the limit's impulse h m g sin(30 deg) a step.
+    Measured: 9e-17 m past, speed 4e-14 m/s, the impulse to 2.2e-16."""
+    a = math.radians(30.0)
+    b = ps.ModelBuilder(dt=dt)
+    b.add_body("block", m, 0.1 * m, pos=(0.0, 1.0), angle=0.2)
+    b.add_slider("rail", None, "block", axis=(math.cos(a), -math.sin(a)), limit=(-1.0, 0.05))
+    model = b.compile()
+    sim = ps.Simulator(model)
+    far = -math.inf
+    for _ in range(10000 + int(round(0.5 / dt))):
+        sim.step()
+        far = max(far, measure.pin_angle_rate(model, sim.state.q, sim.state.v, "rail")[0])
+    s, rate = measure.pin_angle_rate(model, sim.state.q, sim.state.v, "rail")
+    assert far <= 0.05 + 1e-12 and abs(s - 0.05) <= 1e-12 and abs(rate) <= 1e-12
+    assert np.abs(sim.state.v[0]).max() <= 1e-12 and sim.state.q[0, 2] == 0.2
+    assert sim.state.last_pin_impulse[0, 3] == pytest.approx(dt * m * G * math.sin(a), rel=1e-12)
     assert_clean(sim)
 
 
