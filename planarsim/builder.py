@@ -31,8 +31,6 @@ from .shapes import (collision_core, collision_pairs, combine_masses, shape_area
 from .terrain import Terrain, flat
 
 PIN_ANCHOR_TOL = 1e-6  # [m] largest allowed gap between a pin's two anchors at build time
-# [rad] how far a hinge's angle at the build pose may lie outside its limit (rounding)
-LIMIT_POSE_TOL = 1e-9
 
 
 
@@ -510,12 +508,6 @@ class ModelBuilder:
                              f"(must be <= {PIN_ANCHOR_TOL:g} m)")
         ref = self._angle(b) - self._angle(a) if ref_angle is None else _scalar("pin", name, idx, "ref_angle", ref_angle)
         lo, hi = self._joint_limit("pin", name, idx, limit)
-        angle0 = self._angle(b) - self._angle(a) - ref
-        if not lo - LIMIT_POSE_TOL <= angle0 <= hi + LIMIT_POSE_TOL:
-            raise ModelError(f"pin {name!r} ({idx}): its angle at the build pose, {angle0:.6g} rad "
-                             f"(theta_b - theta_a - ref_angle), lies outside its limit "
-                             f"({lo:g}, {hi:g}): build it within the limit (the limit would "
-                             "act only once the joint came inside it)")
         k, c, arm = self._joint_passive("pin", name, idx, stiffness, damping, armature)
         fl = self._joint_friction("pin", name, idx, frictionloss)
         acting = [f for f, on in (("limit", bool(np.isfinite(lo) or np.isfinite(hi))), ("stiffness", k != 0.0),

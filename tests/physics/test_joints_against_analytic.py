@@ -37,10 +37,9 @@ does a slider whose anchor lies off its body's centre, spring alone or not
 (slider_spring_off_axis), a
 damped chain at rest, or turning rigidly, does not balance its springs against gravity or
 the spin (rest_bias), a chain of rods with a light middle mass straightening loses angular
-momentum and energy (rod_whip), and the recorded impulses of a limit's impact steps are not
-the momentum it removes (limit_impulse_readout). A hinge limit that the build pose violated
-was accepted and ignored until the joint came inside it; the builder now refuses it, naming
-the pin. One loud defect too: a stiff spring released from a stretch is
+momentum and energy (rod_whip), the recorded impulses of a limit's impact steps are not the momentum it removes
+(limit_impulse_readout), and a limit that the build pose violates is accepted and ignored
+(limit_outside_build_pose). One loud defect too: a stiff spring released from a stretch is
 stopped by the speed guard as if it had left physics (stiff_spring_speed_guard).
 """
 import math
@@ -124,6 +123,12 @@ DEFECTS = {
         "is in the velocity solve and the position correction; the latter's velocity "
         "change (cut by the energy bound: a limit keeps the step out of SHAKE's whole "
         "correction, shake_whole 0) is not recorded, and the solve's impulse is"),
+    "limit_outside_build_pose": (
+        "a hinge limit that the build pose violates is accepted without a word (the builder "
+        "refuses a rod whose length the build pose does not meet, and anchors apart): a "
+        "0.5 m rod built 0.5 rad from hanging with limit (-0.2, 0.2) swings freely outside "
+        "its limit, 0.429 rad after 0.1 s, no audit count; the limit acts only once gravity "
+        "has brought the joint inside it"),
     "stiff_spring_speed_guard": (
         "loud, not silent: a wheel (1 kg m^2) on a hinge spring of 1e9 N m/rad released at "
         "0.1 rad at dt 1e-4 stops at its first step with SimulationDiverged ('turning speed "
@@ -382,20 +387,20 @@ def test_a_spring_pressing_a_joint_onto_its_limit_is_held_by_h_k_stretch(inertia
     assert_clean(sim)
 
 
-@pytest.mark.parametrize("a0, limit", [(0.5, (-0.2, 0.2)), (-0.3, (-0.2, 0.2)),
-                                      (2 * math.pi, (-1.0, 1.0))])
-def test_a_limit_the_build_pose_violates_is_refused_naming_the_pin(a0, limit):
-    """A rod built a0 from hanging (its pin's angle a0, ref 0) outside its limit: the builder
-    refuses it naming the pin, as it refuses a rod whose build pose does not meet its length
-    (measured before it did: built at 0.5 rad with limit (-0.2, 0.2) the rod swung freely
-    outside its limit, 0.429 rad after 0.1 s, no audit count). Built on the limit's edge it
-    is accepted and held there."""
-    with pytest.raises(ps.ModelError, match="pin 'hinge' .* outside its limit"):
-        _pendulum(1.0, 0.5, a0, 1e-3, limit=limit)
-    edge = limit[1] if a0 > 0 else limit[0]
-    sim = ps.Simulator(_pendulum(1.0, 0.5, edge, 1e-3, limit=limit))
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=DEFECTS["limit_outside_build_pose"])
+def test_a_limit_the_build_pose_violates_is_refused_or_holds():
+    """A rod built 0.5 rad from hanging with limit (-0.2, 0.2): the builder refuses it naming
+    the pin (as it refuses a rod whose build pose does not meet its length), or the limit
+    holds from the start (within it after a few steps)."""
+    try:
+        model = _pendulum(1.0, 0.5, 0.5, 1e-3, limit=(-0.2, 0.2))
+    except ps.ModelError:
+        return
+    sim = ps.Simulator(model)
     sim.steps(100)
-    assert limit[0] - 1e-9 <= sim.state.q[0, 2] <= limit[1] + 1e-9
+    ang = sim.state.q[0, 2]
+    print(f"angle after 0.1 s: {ang:.3f} rad")
+    assert -0.2 - 1e-9 <= ang <= 0.2 + 1e-9
 
 
 # --- springs and dampers ---------------------------------------------------------------------
