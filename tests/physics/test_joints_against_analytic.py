@@ -128,7 +128,10 @@ DEFECTS = {
         "refuses a rod whose length the build pose does not meet, and anchors apart): a "
         "0.5 m rod built 0.5 rad from hanging with limit (-0.2, 0.2) swings freely outside "
         "its limit, 0.429 rad after 0.1 s, no audit count; the limit acts only once gravity "
-        "has brought the joint inside it"),
+        "has brought the joint inside it. MuJoCo's limit acts on a joint outside its range "
+        "(it pushes the joint back), and an MJCF file may start one there: dm_control's "
+        "hopper builds its knee at 0, outside its range (-150, -5) deg, so the builder "
+        "cannot simply refuse such a pose"),
     "stiff_spring_speed_guard": (
         "loud, not silent: a wheel (1 kg m^2) on a hinge spring of 1e9 N m/rad released at "
         "0.1 rad at dt 1e-4 stops at its first step with SimulationDiverged ('turning speed "
