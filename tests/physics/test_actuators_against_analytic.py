@@ -98,6 +98,18 @@ DEFECTS = {
 }
 
 
+def _driven_for_a_second(model, dt, amp, freq):
+    """model's one actuator commanded amp sin(freq t) for 1 s at step dt [s], 50 frames:
+    (its Simulator, the trajectory, linear and angular momentum per frame, their scale plus
+    amp)."""
+    sim = ps.Simulator(model)
+    n = int(round(1.0 / dt))
+    traj = sim.run(n_steps=n, controller=lambda s: np.array([amp * math.sin(freq * s.t)]),
+                   record_every=max(1, n // 50))
+    p, L = _momenta(traj.q, traj.v, model)
+    return sim, traj, p, L, _momentum_scale(traj.q, traj.v, model) + amp
+
+
 def _momenta(q, v, model):
     """Linear momentum (2,) and angular momentum about the origin of frames q, v."""
     m, inertia = model.arrays.body_mass, model.arrays.body_inertia
@@ -207,14 +219,7 @@ def test_an_internal_pin_motor_keeps_a_free_pairs_momenta(ratio, arm, dt, w0):
     b.add_body("b", ratio, 0.02 * ratio, pos=(0.25, 0.0), vel=(0.0, 0.25 * w0), omega=w0)
     b.add_pin("hinge", "a", "b", anchor_world=(0.0, 0.0), armature=arm)
     b.add_pin_motor("m", "hinge")
-    model = b.compile()
-    sim = ps.Simulator(model)
-    amp = 0.2 * min(1.0, ratio)
-    n = int(round(1.0 / dt))
-    traj = sim.run(n_steps=n, controller=lambda s: np.array([amp * math.sin(7.0 * s.t)]),
-                   record_every=max(1, n // 50))
-    p, L = _momenta(traj.q, traj.v, model)
-    scale = _momentum_scale(traj.q, traj.v, model) + amp
+    sim, traj, p, L, scale = _driven_for_a_second(b.compile(), dt, 0.2 * min(1.0, ratio), 7.0)
     assert np.abs(L - L[0]).max() <= 1e-11 * scale
     assert np.abs(p - p[0]).max() <= 1e-12 * scale
     assert np.abs(traj.v[:, 1, 2] - traj.v[:, 0, 2]).max() > 1e-5   # the motor did turn them
@@ -237,14 +242,7 @@ def test_an_internal_slider_motor_keeps_a_free_pairs_momenta(ratio, arm, off, dt
     b.add_body("b", ratio, 0.05 * ratio, pos=tuple(pb), omega=w0, vel=(-w0 * pb[1], w0 * pb[0]))
     b.add_slider("rail", "a", "b", axis=(1.0, 0.0), armature=arm)
     b.add_slider_motor("f", "rail")
-    model = b.compile()
-    sim = ps.Simulator(model)
-    amp = 0.3 * min(1.0, ratio)
-    n = int(round(1.0 / dt))
-    traj = sim.run(n_steps=n, controller=lambda s: np.array([amp * math.sin(5.0 * s.t)]),
-                   record_every=max(1, n // 50))
-    p, L = _momenta(traj.q, traj.v, model)
-    scale = _momentum_scale(traj.q, traj.v, model) + amp
+    sim, traj, p, L, scale = _driven_for_a_second(b.compile(), dt, 0.3 * min(1.0, ratio), 5.0)
     assert np.abs(L - L[0]).max() <= 1e-12 * scale
     assert np.abs(p - p[0]).max() <= 1e-12 * scale
     assert_clean(sim)

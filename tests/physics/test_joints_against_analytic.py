@@ -146,6 +146,23 @@ def assert_clean(sim):
     assert sum(audit_counts(sim.ws).values()) == 0, audit_counts(sim.ws)
 
 
+def _masses_on_two_rods(ms, pts, vs, dt):
+    """A Simulator of three point masses ms [kg] at pts [m] moving at vs [m/s], joined by rods
+    p0-p1 and p1-p2, in zero gravity without ground, at step dt [s]."""
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
+    for i, (m, p, v) in enumerate(zip(ms, pts, vs)):
+        b.add_point_mass(f"p{i}", m, pos=tuple(p), vel=tuple(v))
+    b.add_rod("r0", "p0", "p1")
+    b.add_rod("r1", "p1", "p2")
+    return ps.Simulator(b.compile())
+
+
+def _point_masses_L(sim, ms):
+    """Angular momentum [N m s] about the origin of point masses ms [kg] in sim's state."""
+    q, v = sim.state.q, sim.state.v
+    return np.sum(ms * (q[:, 0] * v[:, 1] - q[:, 1] * v[:, 0]))
+
+
 def _pendulum(m, length, a0, dt, **pin):
     """A thin rod of mass m [kg] and `length` [m] hanging from a world hinge at its end, at
     a0 [rad] from hanging down (its angle = the pin's, ref 0)."""
@@ -631,6 +648,15 @@ def test_a_spinning_spring_damper_chain_settles_where_its_springs_balance_the_sp
     assert np.abs(off).max() <= 1e-6
 
 
+def _energy_kept(model, steps):
+    """model's total energy after `steps` steps over its start's (its audit clean)."""
+    sim = ps.Simulator(model)
+    e0 = total_energy(model, sim.state.q, sim.state.v)
+    sim.steps(steps)
+    assert_clean(sim)
+    return total_energy(model, sim.state.q, sim.state.v) / e0
+
+
 @pytest.mark.xfail(strict=True, raises=AssertionError, reason=DEFECTS["slider_spring_off_axis"])
 @pytest.mark.parametrize("inertia, k", [(1e-3, 2e4), (1e-2, 1e5)])
 def test_a_slider_spring_anchored_off_the_centre_keeps_its_energy(inertia, k):
@@ -643,12 +669,7 @@ def test_a_slider_spring_anchored_off_the_centre_keeps_its_energy(inertia, k):
         b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, 0.0), ground=None)
         b.add_body("block", 1.0, inertia, vel=(1.0, 0.0))
         b.add_slider("rail", None, "block", axis=(1.0, 0.0), anchor_world=(0.0, off), stiffness=k)
-        model = b.compile()
-        sim = ps.Simulator(model)
-        e0 = total_energy(model, sim.state.q, sim.state.v)
-        sim.steps(1000)
-        assert_clean(sim)
-        return total_energy(model, sim.state.q, sim.state.v) / e0
+        return _energy_kept(b.compile(), 1000)
     centred, off = energy_after(0.0), energy_after(0.3)
     print(f"I {inertia} k {k}: energy after 1 s {centred:.3f} anchored on the centre, {off:.1e} off it")
     assert abs(off - centred) <= 1e-9
@@ -665,12 +686,7 @@ def test_a_negligible_damper_does_not_damp_an_off_centre_hinge_spring(k):
         b = ps.ModelBuilder(dt=1e-3, ground=None, gravity=(0.0, 0.0))
         b.add_body("rod", mass=1.0, inertia=1 / 12, pos=(0.5, 0.0), omega=1.0, vel=(0.0, 0.5))
         b.add_pin("hinge", None, "rod", anchor_world=(0.0, 0.0), stiffness=k, damping=c)
-        model = b.compile()
-        sim = ps.Simulator(model)
-        e0 = total_energy(model, sim.state.q, sim.state.v)
-        sim.steps(1000)
-        assert_clean(sim)
-        return total_energy(model, sim.state.q, sim.state.v) / e0
+        return _energy_kept(b.compile(), 1000)
     free, damped = energy_after(0.0), energy_after(1e-9)
     print(f"k {k}: energy after 1 s {free:.3f} undamped, {damped:.1e} with c = 1e-9")
     assert abs(damped - free) <= 1e-6
@@ -798,17 +814,11 @@ def test_a_rod_chain_of_any_mass_ratio_keeps_its_momenta(masses, dt):
     r0, r1 = pts[1] - pts[0], pts[2] - pts[1]
     vs[0] += 2.0 * np.array([-r0[1], r0[0]])
     vs[2] += -4.0 * np.array([-r1[1], r1[0]])
-    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
-    for i, (m, p, v) in enumerate(zip(ms, pts, vs)):
-        b.add_point_mass(f"p{i}", m, pos=tuple(p), vel=tuple(v))
-    b.add_rod("r0", "p0", "p1")
-    b.add_rod("r1", "p1", "p2")
-    sim = ps.Simulator(b.compile())
+    sim = _masses_on_two_rods(ms, pts, vs, dt)
 
     def momenta():
-        q, v = sim.state.q, sim.state.v
-        return (np.sum(ms * (q[:, 0] * v[:, 1] - q[:, 1] * v[:, 0])),
-                np.array([np.sum(ms * v[:, 0]), np.sum(ms * v[:, 1])]))
+        v = sim.state.v
+        return _point_masses_L(sim, ms), np.array([np.sum(ms * v[:, 0]), np.sum(ms * v[:, 1])])
     L0, p0 = momenta()
     worst = 0.0
     for _ in range(int(round(2.0 / dt))):
@@ -837,16 +847,10 @@ def test_a_rod_chain_snapping_straight_keeps_its_angular_momentum():
     c = (ms[:, None] * pts).sum(0) / ms.sum()
     vs = np.array([(-u, 0.0), (0.0, u * a / h), (u, 0.0)])
     vs += np.array([[-w * (p[1] - c[1]), w * (p[0] - c[0])] for p in pts])
-    b = ps.ModelBuilder(dt=dt, gravity=(0.0, 0.0), ground=None)
-    for i, (m, p, v) in enumerate(zip(ms, pts, vs)):
-        b.add_point_mass(f"p{i}", m, pos=tuple(p), vel=tuple(v))
-    b.add_rod("r0", "p0", "p1")
-    b.add_rod("r1", "p1", "p2")
-    sim = ps.Simulator(b.compile())
+    sim = _masses_on_two_rods(ms, pts, vs, dt)
 
     def momentum():
-        q, v = sim.state.q, sim.state.v
-        return np.sum(ms * (q[:, 0] * v[:, 1] - q[:, 1] * v[:, 0]))
+        return _point_masses_L(sim, ms)
     L0 = momentum()
     sim.steps(1000)
     print(f"L / L0 - 1 = {momentum() / L0 - 1:+.2e}")

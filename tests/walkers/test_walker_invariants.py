@@ -123,20 +123,27 @@ def test_the_summary_of_a_run_in_three_chunks_is_that_of_one_run(name):
     assert a["whole_steps"] >= 2 and not a["fell"]     # a walk was compared, not a fall
 
 
+def _restored(name, seconds):
+    """(a run of walker `name` to 2 s and on for `seconds` [s], a fresh Run given the first's
+    state and controller memory at 2 s and run for `seconds`, that state)."""
+    mod = walkers.load(name)
+    ref = mod.Run()
+    ref.run(2.0)
+    state, memory = ref.state.copy(), ref.memory.copy()
+    ref.run(seconds)
+    again = mod.Run()
+    again.state.restore(state)
+    again.memory[:] = memory
+    again.run(seconds)
+    return ref, again, state
+
+
 @pytest.mark.parametrize("name", ALL)
 def test_a_snapshot_restored_into_a_fresh_run_goes_on_as_one_run(name):
     """The state and controller memory of a walk at 2 s, restored into a fresh Run of the same
     walker, then run(1.0): it ends where one 3 s run ends (the Simple Biped's snapshot test,
     for every walker) and its clock has moved 1 s."""
-    mod = walkers.load(name)
-    ref = mod.Run()
-    ref.run(2.0)
-    state, memory = ref.state.copy(), ref.memory.copy()
-    ref.run(1.0)
-    again = mod.Run()
-    again.state.restore(state)
-    again.memory[:] = memory
-    again.run(1.0)
+    ref, again, state = _restored(name, 1.0)
     assert again.time - float(state.time[0]) == pytest.approx(1.0, abs=2 * again.dt)
     assert np.array_equal(again.state.q, ref.state.q)
 
@@ -174,15 +181,7 @@ def test_a_restored_walk_reports_the_numbers_of_one_run(name):
     of one 5 s run, bit for bit, as its motion is (the passive walkers' whole-step numbers
     are read from the recorded touchdowns, which a restored run has only from the snapshot
     on; their motion goes on as one run's: test_a_snapshot_restored_into_a_fresh_run_...)."""
-    mod = walkers.load(name)
-    ref = mod.Run()
-    ref.run(2.0)
-    state, memory = ref.state.copy(), ref.memory.copy()
-    ref.run(3.0)
-    again = mod.Run()
-    again.state.restore(state)
-    again.memory[:] = memory
-    again.run(3.0)
+    ref, again, _ = _restored(name, 3.0)
     assert np.array_equal(again.state.q, ref.state.q)
     a, b = ref.summary(), again.summary()
     skip = FROM_THE_RECORDING.get(name, ())
