@@ -120,7 +120,7 @@ class PassiveRun(WalkerRun):
 
     def advance(self, n, every, rec, lab):
         if self.fell:
-            return FELL, 0        # it stays where it fell (the refined rollout walks to a total)
+            return FELL, 0        # it stays where it fell
         self.end_step = int(round(float(self.state.time[0]) / self.dt)) + n
         code, k = (self._engine if self.impacts == "engine" else self._refined)(n, rec)
         self.code = int(code)
