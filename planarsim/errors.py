@@ -246,7 +246,7 @@ def too_fast(model, ws, who="simulation"):
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): body {name!r} ({body}) reached a {field} "
         f"of {speed:.4g} m/s{how}, beyond the bound of {bound:.4g} m/s set from the model (100 "
-        f"times the fastest speed its gravity, size, start and actuators explain): the run "
+        f"times the fastest speed its gravity, size, start, actuators and springs explain): the run "
         f"has left physics (a step too large for its actuators or impacts). Take a smaller dt, "
         f"or if such speeds are real, set StepOptions.speed_limit higher (0: no bound)",
         step, t, name, field, speed, last)

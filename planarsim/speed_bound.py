@@ -9,6 +9,9 @@ The speeds the model explains [m/s]:
   start     the fastest body's speed, or turning speed |omega| r_g, at the start
   actuators each actuator's largest force or torque acting for one second on the lightest
             body it moves: F / m, or tau / (m r_g) (r_g = sqrt(I / m))
+  springs   each joint spring's energy at the start, k (x - rest)^2 / 2, all given to the
+            lightest body it moves: sqrt(2 E / m) (as a speed, and as a turning speed
+            |omega| r_g, sqrt(2 E / I) r_g alike)
 A body's speed and its turning speed are both held to the bound (guards.check_speeds).
 """
 from __future__ import annotations
@@ -16,6 +19,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from .energy import joint_position_rate
 
 SPEED_MARGIN = 100.0
 MIN_SPEED = 1.0      # [m/s] the smallest speed scale a model is given
@@ -59,6 +64,13 @@ def speed_bound(model, v=None, q=None) -> float:
             speeds.append(push / mass)
             if r_g > 0.0:
                 speeds.append(push / (mass * r_g))
+    for j in range(model.n_pin):
+        k = float(a.pin_stiffness[j])
+        bodies = [int(b) for b in a.pin_body[j] if b >= 0]
+        if k > 0.0 and bodies:
+            x = joint_position_rate(model, q, np.zeros_like(q), j)[0]
+            stored = 0.5 * k * (float(x) - float(a.pin_rest[j])) ** 2
+            speeds.append(math.sqrt(2.0 * stored / min(float(a.body_mass[b]) for b in bodies)))
     return SPEED_MARGIN * max(speeds)
 
 
