@@ -37,19 +37,6 @@ ALL = sorted(walkers.WALKERS)
 PASSIVE = ("compass-gait", "rimless-wheel", "simplest-walker")
 
 DEFECTS = {
-    "replaced_numbers": (
-        "the command line's summary replaces a walker's own numbers (REPLACED: 'the same "
-        "quantity, measured one way') with other quantities, and the Python API and the "
-        "command line then disagree on one run: the passive walkers' distance and step length "
-        "are the hip's along the slope, the summary's the centre of mass's horizontally; over "
-        "5 s the rimless wheel's step_length 0.76537 m (its spoke chord 2 l sin(pi / N) "
-        "exactly) is printed as step_length_m 0.76154 m (-0.50 %, cos 0.1) and its distance "
-        "5.0195 m as distance_m 4.9937 m (-0.51 %); the compass gait's distance 3.5723 m as "
-        "3.6062 m (+0.95 %), its step length -0.14 %; the extras' cost_of_transport stays per "
-        "distance along the slope. Ranger's own numbers measure its outer legs (body 0) and skip the "
-        "start-up step, the summary's do not: distance -1.1 %, step_length -3.2 %, "
-        "step_period 0.503 s printed as 0.564 s (+12.1 %), step_speed 0.536 m/s as 0.463 m/s "
-        "(-13.6 %) for the same 5 s walk"),
     "ranger_restore_log": (
         "Ranger's heel-strike log, from which its whole-step numbers come, is kept in its "
         "controller table (tables.steplog), not in its memory: a walk restored from a snapshot "
@@ -563,26 +550,32 @@ def test_run_json_prints_the_summary_the_api_gives(name, capsys):
     assert printed == api, {k: (printed[k], api.get(k)) for k in printed if printed[k] != api.get(k)}
 
 
-REPLACED_PAIRS = (("distance", "distance_m"), ("step_length", "step_length_m"),
+REPLACED_PAIRS = (("distance", "distance_m"), ("mean_speed", "mean_speed_m_per_s"),
+                  ("whole_steps", "whole_steps"), ("step_length", "step_length_m"),
                   ("step_period", "step_period_s"), ("step_speed", "step_speed_m_per_s"),
                   ("speed", "step_speed_m_per_s"))
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=DEFECTS["replaced_numbers"])
-@pytest.mark.parametrize("name", ["rimless-wheel", "compass-gait", "ranger"])
+@pytest.mark.parametrize("name", ALL)
 def test_the_summary_replaces_a_walkers_numbers_only_with_the_same_quantities(name):
-    """walkers.common.summary.REPLACED: the common summary replaces a walker's own keys with
-    'the same quantity, measured one way'. So the Python API's numbers and the command line's
-    summary of the same 5 s run agree on them, within 1e-3 relative (the centre of mass and a
-    hip, or landings and heel strikes, may differ by a frame or a few mm)."""
+    """walkers.common.summary.REPLACED: the common summary stands in for a walker's own number
+    only where it is the same quantity, measured the same way; a walker's own measure of
+    another point or other events (a hip along the slope, its own heel strikes) is declared in
+    SUMMARY_EXTRAS and printed there. So on one 5 s run every own number the walker reports
+    is printed: declared ones in extras bit for bit, the others by their common key within
+    1e-6 relative (the same touchdowns give the same whole steps)."""
+    mod = walkers.load(name)
     traj, raw, model = quiet_simulate(name, 5.0)
     s = common(name, traj, raw, model, 5.0)
-    off = {}
-    for own, printed in REPLACED_PAIRS:
-        if own in raw and math.isfinite(raw[own]):
-            off[own] = float(s[printed] / raw[own] - 1)
-    print(name, off)
-    assert off and max(abs(x) for x in off.values()) < 1e-3, off
+    declared = {k: spec[0] for k, spec in mod.SUMMARY_EXTRAS.items() if spec is not None}
+    shown = {k: (raw[k], s["extras"][v]) for k, v in declared.items() if k in raw}
+    assert all(same(json.loads(json.dumps(float(a) if isinstance(a, (float, np.floating)) else a)), b)
+               or (isinstance(a, float) and not math.isfinite(a) and b is None)
+               for a, b in shown.values()), shown
+    off = {own: (raw[own], s[printed]) for own, printed in REPLACED_PAIRS
+           if own in raw and own not in declared and math.isfinite(raw[own])
+           and not raw[own] == pytest.approx(s[printed], rel=1e-6)}
+    assert not off, off
 
 
 def _last_frame_cases():

@@ -30,7 +30,10 @@ from planarsim.analysis import foot_groups, step_events
 from planarsim.measure import summary as measure_summary
 
 MIN_AIR_S = 0.05     # [s] a foot must be off the ground this long for its next landing to count
-# the walkers' own keys that the common part replaces (the same quantity, measured one way)
+# the walkers' own keys that the common part stands in for: the same quantity, measured the same
+# way (the run's time and end, the touchdowns' whole steps). A walker whose own number of that
+# name measures something else (a hip along the slope, its own heel strikes) declares it in its
+# SUMMARY_EXTRAS under a name that says so, and then it is printed there, never replaced
 REPLACED = ("time", "duration", "distance", "fell", "falls", "audit", "walker", "gait", "code",
             "mean_speed", "speed", "step_length", "step_period", "step_speed", "whole_steps")
 
@@ -62,8 +65,9 @@ def _plain(v):
 def walker_summary(mod, traj, model, raw: dict, *, walker, gait, terrain, duration,
                    params_changed=None, wall=None) -> dict:
     """The common summary (module docstring) of one run: `raw` is the walker's own summary
-    (simulate's second result), `mod` its module (FEET, SUMMARY_EXTRAS). A raw key that is
-    neither replaced by a common key nor declared in SUMMARY_EXTRAS is an error naming it."""
+    (simulate's second result), `mod` its module (FEET, SUMMARY_EXTRAS). A raw key declared in
+    SUMMARY_EXTRAS is printed in extras under its declared name (even one that REPLACED lists:
+    the walker's own measure of it); a key neither declared nor in REPLACED is an error naming it."""
     extras_spec = getattr(mod, "SUMMARY_EXTRAS", {})
     unknown = sorted(k for k in raw if k not in REPLACED and k not in extras_spec)
     if unknown:

@@ -7,14 +7,10 @@ from walkers.base import simulation
 
 from .params import RimlessParams
 from .reference import rimless_fixed_point
-from .run import GAIT_DOCS, GAITS, PassiveRun  # noqa: F401
+from .run import GAIT_DOCS, GAITS, PassiveRun, PASSIVE_EXTRAS  # noqa: F401
 
 NAME = "rimless-wheel"
-SUMMARY_EXTRAS = {
-    "cost_of_transport": ("cost_of_transport", "mechanical energy lost per weight and distance along the slope over whole steps: sin(slope) on a steady gait"),
-    "impacts": ("impacts", "how touchdowns were resolved: refined (located and resolved exactly) or engine"),
-    "steps": ("controller_steps", "touchdowns the rollout recorded"),
-}
+SUMMARY_EXTRAS = PASSIVE_EXTRAS
 Params = RimlessParams   # the walker's parameters (planarsim params rimless-wheel)
 
 

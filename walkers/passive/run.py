@@ -49,6 +49,20 @@ def slope_from_terrain(terrain, default):
     return gamma
 
 
+# the passive walkers' own numbers (PassiveRun.numbers) under names that say what they measure:
+# the hip and the centre of mass along the slope, where the common summary measures the centre
+# of mass horizontally
+PASSIVE_EXTRAS = {
+    "distance": ("hip_distance_along_slope_m", "the hip's displacement along the slope since the start"),
+    "mean_speed": ("hip_mean_speed_along_slope_m_per_s", "hip_distance_along_slope_m over the simulated time"),
+    "step_length": ("step_length_along_slope_m", "the centre of mass's advance along the slope per whole step (the cost of transport's distance)"),
+    "speed": ("step_speed_along_slope_m_per_s", "step_length_along_slope_m over the step period"),
+    "cost_of_transport": ("cost_of_transport", "mechanical energy lost per weight and distance along the slope over whole steps: sin(slope) on a steady gait"),
+    "impacts": ("impacts", "how touchdowns were resolved: refined (located and resolved exactly) or engine"),
+    "steps": ("controller_steps", "touchdowns the rollout recorded"),
+}
+
+
 class PassiveRun(WalkerRun):
     """A passive walker walking down its slope. A walker module subclasses it with NAME, Params
     (its parameter class) and ``start(params)`` (the default section state).

@@ -8,14 +8,10 @@ from walkers.base import simulation
 
 from .params import SimplestParams
 from .reference import GARCIA_THETA, GARCIA_THETA_DOT, simplest_heel_strike
-from .run import GAIT_DOCS, GAITS, PassiveRun  # noqa: F401
+from .run import GAIT_DOCS, GAITS, PassiveRun, PASSIVE_EXTRAS  # noqa: F401
 
 NAME = "simplest-walker"
-SUMMARY_EXTRAS = {
-    "cost_of_transport": ("cost_of_transport", "mechanical energy lost per weight and distance along the slope over whole steps: sin(slope) on a steady gait"),
-    "impacts": ("impacts", "how touchdowns were resolved: refined (located and resolved exactly) or engine"),
-    "steps": ("controller_steps", "touchdowns the rollout recorded"),
-}
+SUMMARY_EXTRAS = PASSIVE_EXTRAS
 Params = SimplestParams   # the walker's parameters (planarsim params simplest-walker)
 
 

@@ -18,6 +18,8 @@ from .rollout import GAITS, Run, live, rollout_quadruped, simulate  # noqa: E402
 NAME = "quadruped"
 FEET = (("FL_foot", "RR_foot"), ("FR_foot", "RL_foot"))   # a trot: diagonal pairs land together
 SUMMARY_EXTRAS = {
+    "distance": ("torso_distance_m", "horizontal displacement of the torso since the start"),
+    "mean_speed": ("torso_mean_speed_m_per_s", "torso_distance_m over the simulated time"),
     "motor_work_positive": ("motor_work_positive_J", "positive work of the joint motors over the run"),
     "cost_of_transport": ("cost_of_transport", "positive motor work per weight and distance, over the run"),
     "max_pitch_deg": ("max_pitch_deg", "largest torso pitch"),

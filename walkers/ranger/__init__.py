@@ -56,6 +56,11 @@ from .rollout import GAITS, Run, instantaneous_cot, live, simulate  # noqa: E402
 
 NAME = "ranger"
 SUMMARY_EXTRAS = {
+    "distance": ("outer_legs_distance_m", "horizontal displacement of the outer legs' centre of mass (the model's first body) since the start"),
+    "mean_speed": ("outer_legs_mean_speed_m_per_s", "outer_legs_distance_m over the simulated time"),
+    "step_length": ("heel_strike_step_length_m", "the hip's advance per step between the controller's heel strikes, whole steps after the start-up step (the costs of transport's distance)"),
+    "step_period": ("heel_strike_step_period_s", "time per step between the controller's heel strikes, whole steps after the start-up step"),
+    "step_speed": ("heel_strike_step_speed_m_per_s", "heel_strike_step_length_m over heel_strike_step_period_s"),
     "cost_of_transport": ("cost_of_transport", "electrical energy plus the computers' 4.5 W, per weight and distance, over whole steps (Ranger's figure of merit)"),
     "cost_of_transport_electrical": ("cost_of_transport_electrical", "positive electrical motor energy per weight and distance, whole steps"),
     "cost_of_transport_electrical_net": ("cost_of_transport_electrical_net", "net electrical motor energy per weight and distance, whole steps"),

@@ -12,6 +12,8 @@ from .rollout import GAITS, Run, live, run, simulate  # noqa: E402
 
 NAME = "simbicon"
 SUMMARY_EXTRAS = {
+    "distance": ("torso_distance_m", "horizontal displacement of the torso since the start"),
+    "speed": ("torso_mean_speed_m_per_s", "torso_distance_m over the simulated time"),
     "effort": ("effort_N2m2s", "time integral of the sum of squared joint torques"),
     "glitch": ("glitch", "the run was stopped because the torso moved faster than a walker can"),
     "min_clearance": ("min_clearance_m", "lowest height of a part other than the feet above the ground"),

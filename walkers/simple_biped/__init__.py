@@ -15,6 +15,8 @@ from .rollout import Run, live, rollout_simple_biped, simulate  # noqa: E402
 
 NAME = "simple-biped"
 SUMMARY_EXTRAS = {
+    "distance": ("hip_distance_m", "horizontal displacement of the hip mass since the start"),
+    "mean_speed": ("hip_mean_speed_m_per_s", "hip_distance_m over the simulated time"),
     "positive_work": ("positive_work_J", "positive work of the actuators over the run"),
     "cost_of_transport": ("cost_of_transport", "positive actuator work per weight and distance, over the run"),
     "steps": ("controller_steps", "steps counted by the state machine"),
