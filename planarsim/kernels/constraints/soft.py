@@ -13,7 +13,10 @@ N s/m] and rest x0 gets one row along g whose impulse mu [N m s or N s] is the s
     implicit damping), the spring at a stretch between the step's start and its end,
     mu_s = -h (k (x - x0 + theta h g v_new) + c g v_new), theta = max(0, 1/2 - 1/(4 C)),
     C = h^2 k kappa / (1 + a kappa) the square of the step's angle h omega of the joint's
-    spring on its two bodies and rotor (kappa = g W g^T, their inverse inertia along g).
+    spring on its two bodies and rotor (kappa = forces.joint_kappa, their inverse inertia
+    along g as the joint's other rows leave them free to move: a hinge to the world turns its
+    body about the hinge, not its centre, and a slider's body does not turn; g W g^T of the
+    row alone judged a resolved spring stiff, and its theta damped it).
     Where the spring is resolved (C <= 1/2) it is explicit (theta = 0), the symplectic Euler
     of the rest of the step and of MuJoCo's Euler (taken at the step's end it damped a stiff
     joint by an extra h k: HalfCheetah's springs under torque erred 2.5x MuJoCo's Euler).
@@ -44,7 +47,7 @@ energy with the bodies'.
 """
 from ...compile import kernel
 from ..codes import ROW_JOINT_SOFT
-from ..dynamics.forces import spring_as_force
+from ..dynamics.forces import joint_kappa, spring_as_force
 from .joints import joint_rate_row, rate_along
 from .row_list import add_row
 
@@ -90,18 +93,6 @@ def soft_row(m, q, cs, o, J):
 
 
 @kernel
-def _inverse_inertia_along(m, bodies, J):
-    """g W g^T [1 / (kg m^2) or 1 / kg] of a row g with blocks J (2, 3) on bodies (2,)."""
-    acc = 0.0
-    for e in range(2):
-        b = bodies[e]
-        if b >= 0:
-            acc += (J[e, 0] * J[e, 0] + J[e, 1] * J[e, 1]) * m.body_inv_mass[b]
-            acc += J[e, 2] * J[e, 2] * m.body_inv_inertia[b]
-    return acc
-
-
-@kernel
 def start_soft_row(m, s, ws, r):
     """ws.row_soft[r]: joint's armature, stiffness, damping, and its rate g v at the step's
     start (s.v; row r's J evaluated at s.q)."""
@@ -111,7 +102,7 @@ def start_soft_row(m, s, ws, r):
     ws.row_soft[r, SOFT_DAMPING] = m.pin_damping[o]
     ws.row_soft[r, SOFT_RATE] = rate_along(ws.row_body[r], ws.row_J[r], s.v)
     ws.row_soft[r, SOFT_GAMMA] = 0.0
-    ws.row_soft[r, SOFT_KAPPA] = _inverse_inertia_along(m, ws.row_body[r], ws.row_J[r])
+    ws.row_soft[r, SOFT_KAPPA] = joint_kappa(m, s.q, ws.body_cs, o)
 
 
 @kernel

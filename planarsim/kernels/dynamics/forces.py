@@ -70,8 +70,10 @@ def joint_kappa(m, q, cs, j):
     push on it, at q (cs its cos / sin): a hinge to the world turns its body about the hinge,
     1 / (I + m d^2) (d the anchor's distance from its centre of mass: the pin's rows hold
     it there); a hinge between two bodies 1 / I_a + 1 / I_b (g W g^T, as if the pin did not
-    hold them: more than it is); a slider's g W g^T along its slide (blocks at anchor b:
-    slider.py). Other joints and contacts only lower it."""
+    hold them: more than it is); a slider to the world moves its body along the slide without
+    turning it (its angle row holds the turn), 1 / m; a slider between two bodies g W g^T
+    along its slide (blocks at anchor b: slider.py; as if the angle row did not hold them:
+    more than it is). Other joints and contacts only lower it."""
     a = m.pin_body[j, 0]
     b = m.pin_body[j, 1]
     if (m.pin_kind[j] & JOINT_SLIDE_BIT) == 0:
@@ -82,6 +84,8 @@ def joint_kappa(m, q, cs, j):
             wi = m.body_inv_inertia[body]
             return wi / (1.0 + wi * d2 / m.body_inv_mass[body])
         return m.body_inv_inertia[a] + m.body_inv_inertia[b]
+    if a < 0 or b < 0:
+        return m.body_inv_mass[b if a < 0 else a]
     dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, a, b)
     kappa = 0.0
     for e in range(2):
