@@ -35,9 +35,11 @@ through walkers.common.record.record_labelled.
 
 An actuated walker's compiled controller is ``control(m, s, ws, tab, mem, u)``: model arrays,
 State, Workspace, the walker's read-only table of parameters and constants (a NamedTuple of
-arrays, or the float parameter array itself; Ranger's also carries the heel-strike log its
-controller writes), its float64 memory vector (read and written) and the command vector u
-(written, n_act). Its compiled rollout stops with planarsim.compiled's run
+arrays, or the float parameter array itself; Ranger's also carries the step log, a row per
+heel strike, its controller writes), its float64 memory vector (read and written; the
+numbers ``numbers`` takes from the controller come from it, so a snapshot of state and memory
+restored into a fresh Run reports them as one run does) and the command vector u (written,
+n_act). Its compiled rollout stops with planarsim.compiled's run
 codes: RUN_OK, an engine failure (raised with check_run), or its own reasons from RUN_WALKER up
 (RUN_FELL).
 """

@@ -126,7 +126,7 @@ def test_walk_1000_steps_from_standing(walk_1000):
     assert 0.2 < s["step_length"] < 0.6
     assert 0.3 < s["step_speed"] < 1.0
     # the push-off feedback keeps the mid-stance speed near its target over the last steps
-    log = rs.tables.steplog[rs.steps - 200:rs.steps]
+    log = rs.heel_strikes()[-200:]
     speed = np.diff(log[:, T.LOG.hip_x]) / np.diff(log[:, T.LOG.t])
     assert np.std(speed) < 0.1 * np.mean(speed)
     # costs of transport: finite, positive, electrical above mechanical, total above both

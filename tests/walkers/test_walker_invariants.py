@@ -37,15 +37,6 @@ ALL = sorted(walkers.WALKERS)
 PASSIVE = ("compass-gait", "rimless-wheel", "simplest-walker")
 
 DEFECTS = {
-    "ranger_restore_log": (
-        "Ranger's heel-strike log, from which its whole-step numbers come, is kept in its "
-        "controller table (tables.steplog), not in its memory: a walk restored from a snapshot "
-        "of state and memory at 2 s moves on bit for bit, but its summary after 3 s more reads "
-        "the log's rows before the snapshot as zeros (a heel strike at t = 0, x = 0): "
-        "cost_of_transport_electrical 0.577 against 0.408 for one 5 s run (+41 %), "
-        "cost_of_transport 0.684 against 0.494 (+38 %), step_period 0.779 s against 0.503 s "
-        "(+55 %), step_speed 0.429 against 0.536 m/s (-20 %), push_current_mean 3.01 against "
-        "3.71 A; nothing says so"),
     "simbicon_limp": (
         "SIMBICON's default walk at its default dt 1e-3 s is a period-two limp that the model "
         "does not have: its steps alternate 0.5733 and 0.5671 m (a 1.1 % difference, 6.5e-3 m) "
@@ -158,22 +149,44 @@ def test_a_run_rewound_to_a_snapshot_walks_the_seconds_asked(name):
 FROM_THE_RECORDING = {"simbicon": ("min_clearance",)}
 
 
-@pytest.mark.parametrize("name", [
-    pytest.param(n, marks=[pytest.mark.xfail(strict=True, raises=AssertionError,
-                                             reason=DEFECTS["ranger_restore_log"])] if n == "ranger" else [])
-    for n in ALL if n not in PASSIVE])
+@pytest.mark.parametrize("name", [n for n in ALL if n not in PASSIVE])
 def test_a_restored_walk_reports_the_numbers_of_one_run(name):
     """After a snapshot of state and controller memory at 2 s is restored into a fresh Run and
     run 3 s, the walker's own summary (distance, steps, work, costs of transport, ...) is that
-    of one 5 s run, bit for bit, as its motion is (the passive walkers' whole-step numbers
-    are read from the recorded touchdowns, which a restored run has only from the snapshot
-    on; their motion goes on as one run's: test_a_snapshot_restored_into_a_fresh_run_...)."""
+    of one 5 s run, bit for bit, as its motion is (Ranger's whole-step numbers come from its
+    memory's records of its second and last heel strikes, which the snapshot holds; the
+    passive walkers' whole-step numbers are read from the recorded touchdowns, which a
+    restored run has only from the snapshot on; their motion goes on as one run's:
+    test_a_snapshot_restored_into_a_fresh_run_...)."""
     ref, again, _ = _restored(name, 3.0)
     assert np.array_equal(again.state.q, ref.state.q)
     a, b = ref.summary(), again.summary()
     skip = FROM_THE_RECORDING.get(name, ())
     off = {k: (a[k], b[k]) for k in a if k not in skip and not same(a[k], b[k])}
     assert not off, off
+
+
+def test_ranger_says_a_restored_walk_has_no_log_rows_before_the_snapshot():
+    """Ranger's step log (a row per heel strike, in its controller table) is no part of a
+    snapshot of state and memory: a fresh Run given one at 2 s never logged the strikes before
+    it, and heel_strikes() says so (a ValueError) rather than give them; its unwritten rows
+    read NaN, not a strike at t = 0, x = 0. A run rewound to its own snapshot and walked on
+    gives its strikes as one run (every row, in time order)."""
+    import walkers.ranger.tables as T
+    ref, again, state = _restored("ranger", 1.0)
+    with pytest.raises(ValueError, match="does not hold"):
+        again.heel_strikes()
+    assert np.isnan(again.tables.steplog[0]).all()
+    run = walkers.load("ranger").Run()
+    run.run(2.0)
+    memory = run.memory.copy()
+    run.run(1.0)
+    run.state.restore(state)
+    run.memory[:] = memory
+    run.run(1.0)
+    log, one = run.heel_strikes(), ref.heel_strikes()
+    assert np.array_equal(log, one) and len(log) == run.steps >= 4
+    assert np.all(np.diff(log[:, T.LOG.t]) > 0)
 
 
 # translation ----------------------------------------------------------------------------------
@@ -517,7 +530,8 @@ def ranger_costs_from_the_recorded_power(traj, raw, model):
     mod = walkers.load("ranger")
     run = mod.Run(record_every=0)
     run.run(float(traj.t[-1]))
-    log = run.tables.steplog[:steps]
+    log = run.heel_strikes()
+    assert len(log) == steps
     t = np.asarray(traj.t)
     a, b = (int(np.flatnonzero(np.isclose(t, log[k, T.LOG.t], rtol=0, atol=1e-9))[0]) for k in (1, -1))
     span = slice(a + 2, b + 2)

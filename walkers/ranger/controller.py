@@ -45,8 +45,8 @@ from .params import RangerParams
 # the tables' enums, index layout of k / mem / prog, and table makers (named, not starred)
 from .tables import (
     CONST, FR_ABS, FR_NONE, FR_PUSH, FR_SCISSOR, GAIT_GUI, GAIT_STAND, GAIT_WALK, Gait, MEM,
-    LOG, PC, PH_DOUBLE, PH_FLIGHT, PH_SINGLE, PH_STANDING, PH_START, PR_FLIP, PR_GUI, PR_HOLD,
-    PR_KEEP, PR_LAND, PR_OFF, PR_PUSH, PR_STAND, PR_SWING, make_memory, make_tables,
+    LOG, N_LOG, PC, PH_DOUBLE, PH_FLIGHT, PH_SINGLE, PH_STANDING, PH_START, PR_FLIP, PR_GUI,
+    PR_HOLD, PR_KEEP, PR_LAND, PR_OFF, PR_PUSH, PR_STAND, PR_SWING, make_memory, make_tables,
     set_standing_estimator,
 )
 
@@ -230,7 +230,8 @@ def air_current(s, k, mp, foot, err, derr):
 @jit_inline
 def control(m, s, ws, tab, mem, u):
     """One control step: estimator, FSM, motor programs, motor model -> u (torques [N m]).
-    Also integrates electrical and mechanical energy and logs each heel strike (tab.steplog)."""
+    Also integrates electrical and mechanical energy and records each heel strike
+    (log_heel_strike: in the memory and in tab.steplog)."""
     k = tab.k
     prog = tab.prog
     motor = tab.motor
@@ -284,18 +285,36 @@ def control(m, s, ws, tab, mem, u):
         mem[MEM.e + 1] += dt * pel
         mem[MEM.e + 2] += dt * max(pm, 0.0)
         mem[MEM.e + 3] += dt * pm
-    # fall and step log
+    # fall and heel strike
     hx, hy, vx, vy = hip_state(s, k, 0)
     if hy - height_below(m, hx) < k[CONST.fall_h] or abs(s.q[0, 2]) > 1.2 or abs(s.q[1, 2]) > 1.2:
         mem[MEM.fell] = 1
     if mem[MEM.steps] > steps_before:
-        n = int(mem[MEM.steps]) - 1
+        log_heel_strike(s.time[0], hx, mem, steplog)
+
+
+@kernel
+def log_heel_strike(t, hip_x, mem, steplog):
+    """Record the heel strike just counted, at time t [s] with the hip at x = hip_x [m]: its
+    record (columns LOG: t, hip x, the energies mem[e] [J], the push-off current [A]) becomes
+    memory's last strike, the second strike's also memory's first (whole steps start there),
+    and from the second strike on its push-off current is summed; so the whole-step numbers
+    come from the memory alone, and a snapshot of state and memory carries them. The record is
+    also the strike's row of the step log while the log has room."""
+    n = int(mem[MEM.steps]) - 1                    # this strike's row (0: the start-up strike)
+    last = MEM.strike_last
+    mem[last + LOG.t] = t
+    mem[last + LOG.hip_x] = hip_x
+    for e in range(4):
+        mem[last + LOG.e + e] = mem[MEM.e + e]
+    mem[last + LOG.push_i] = mem[MEM.push_i]
+    if n >= 1:
+        mem[MEM.push_sum] += mem[MEM.push_i]
+    for c in range(N_LOG):
+        if n == 1:
+            mem[MEM.strike_first + c] = mem[last + c]
         if n < steplog.shape[0]:
-            steplog[n, LOG.t] = s.time[0]
-            steplog[n, LOG.hip_x] = hx
-            for e in range(4):
-                steplog[n, LOG.e + e] = mem[MEM.e + e]
-            steplog[n, LOG.push_i] = mem[MEM.push_i]
+            steplog[n, c] = mem[last + c]
 
 
 @kernel
@@ -328,7 +347,7 @@ class Controller:
         set_standing_estimator(self.mem, self.tables.k)      # every run starts standing at rest
         p = self.params
         self.mem[MEM.push_i] = min(p.push_current + p.push_gain * p.target_speed, p.current_max)
-        self.tables.steplog[:] = 0.0
+        self.tables.steplog[:] = np.nan       # no strike logged yet (tables.make_step_log)
 
     def _gait_id(self, gait) -> int:
         if isinstance(gait, str):

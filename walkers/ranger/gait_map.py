@@ -113,7 +113,7 @@ class RangerGaitMap(GaitMapMixin):
         self.rs = rs = Run(params, dt=dt, gait="walk", max_steps=16)
         self.model = rs.model
         self.m = rs.model.arrays
-        self.tables = rs.tables._replace(steplog=np.zeros((16, T.N_LOG)))
+        self.tables = rs.tables._replace(steplog=T.make_step_log(16))
         self.mem_before = np.zeros_like(rs.memory)
         self.max_steps = int(round(3.0 / dt))
         self.stance = int(stance)

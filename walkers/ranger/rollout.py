@@ -4,7 +4,8 @@ uniform ``simulate(...)`` entry point.
 ``rollout_ranger`` runs physics + controller + recording without returning to Python; it stops
 early when the walker falls. ``simulate`` returns (Trajectory, summary, model); the summary holds
 distance, mean speed, steps, step length, fell, and the cost of transport averaged over whole
-steps (first to last heel strike):
+steps (second to last heel strike, from the controller memory's records of them, so a snapshot
+of state and memory carries them; ``Run.heel_strikes()`` gives the step log's row per strike):
     CoT = E / (m g d)      (eq. 17 integrated; m the total mass, d the hip's travel)
 for the electrical energy of the three motors counted positive only (Ranger's drivers do not
 regenerate into the battery), the same plus the 4.5 W overhead ("total", the robot's 0.28 is of
@@ -12,6 +13,8 @@ this kind), the net electrical energy, and the positive mechanical work of the m
 ``instantaneous_cot(traj, model)`` gives eq. 17 frame by frame.
 """
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 
@@ -114,38 +117,91 @@ class Run(WalkerRun):
         return np.array([q[0, 0] - p.leg_com * np.sin(q[0, 2]), q[0, 1] + p.leg_com * np.cos(q[0, 2])])
 
     def numbers(self) -> dict:
-        """Distance, speed, steps and whole-step costs of transport from the step log (see the
-        module doc)."""
-        mem, model, p = self.memory, self.model, self.params
-        n = int(mem[C.MEM.steps])
-        log = self.tables.steplog[:min(n, len(self.tables.steplog))]
+        """Distance, speed, steps and the whole-step numbers (see the module doc), from the
+        state and the controller memory alone: a run restored from a snapshot of state and
+        memory reports what one run does."""
+        mem, model = self.memory, self.model
         weight = _gravity(model) * float(model.arrays.body_mass.sum())
-        out = {"steps": n, "fell": self.fell, "time": self.time,
+        out = {"steps": int(mem[C.MEM.steps]), "fell": self.fell, "time": self.time,
                "distance": float(self.state.q[0, 0] - model.q0[0, 0])}
         out["mean_speed"] = out["distance"] / out["time"] if out["time"] > 0 else 0.0
-        if len(log) >= 3:
-            first, last = 1, len(log) - 1          # skip the start-up step
-            d = log[last, T.LOG.hip_x] - log[first, T.LOG.hip_x]
-            dt = log[last, T.LOG.t] - log[first, T.LOG.t]
-            e = log[last, T.LOG.e:T.LOG.e + 4] - log[first, T.LOG.e:T.LOG.e + 4]
-            # a cost of transport is per distance travelled forward: none (nan) for whole
-            # steps that went nowhere or backwards (energy over a negative distance would read
-            # as a negative cost, and a tuner would take it for a gain)
-            per = weight * d if d > 0.0 else float("nan")
-            out.update(step_speed=d / dt, step_length=d / (last - first), step_period=dt / (last - first),
-                       cost_of_transport_electrical=e[0] / per,
-                       cost_of_transport=(e[0] + p.overhead_power * dt) / per,
-                       cost_of_transport_electrical_net=e[1] / per,
-                       cost_of_transport_mechanical=e[2] / per,
-                       cost_of_transport_mechanical_net=e[3] / per,
-                       push_current_mean=float(log[first:last + 1, 6].mean()))
-        else:
-            out.update({key: float("nan") for key in (
-                "step_speed", "step_length", "step_period", "cost_of_transport",
-                "cost_of_transport_electrical", "cost_of_transport_electrical_net",
-                "cost_of_transport_mechanical", "cost_of_transport_mechanical_net",
-                "push_current_mean")})
+        out.update(whole_step_numbers(mem, weight, self.params.overhead_power))
         return out
+
+    def heel_strikes(self) -> np.ndarray:
+        """The step log's rows of this walk's heel strikes, one per strike in order (columns
+        tables.LOG: time [s], hip x [m], the energies [J], push-off current [A]), at most
+        max_steps of them (a warning says when later strikes are not logged). A ValueError
+        where the log does not hold this walk's strikes: a snapshot of state and memory
+        restored into another Run carries the whole-step numbers (in the memory) but not the
+        rows of the strikes before it, which that Run's log never had."""
+        n = int(self.memory[C.MEM.steps])
+        rows = self.tables.steplog[:min(n, len(self.tables.steplog))]
+        if not log_holds(rows, self.memory):
+            raise ValueError(f"{self.NAME}: the step log does not hold this walk's {n} heel "
+                             "strikes (its memory was restored from another run: a snapshot of "
+                             "state and memory carries the whole-step numbers of summary(), not "
+                             "the log's rows before it)")
+        if n > len(rows):
+            warnings.warn(f"{self.NAME}: the step log holds the first {len(rows)} of {n} heel "
+                          "strikes (Run(max_steps=...) gives it more room)", stacklevel=2)
+        return rows.copy()
+
+
+WHOLE_STEP_KEYS = ("step_speed", "step_length", "step_period", "cost_of_transport",
+                   "cost_of_transport_electrical", "cost_of_transport_electrical_net",
+                   "cost_of_transport_mechanical", "cost_of_transport_mechanical_net",
+                   "push_current_mean")
+
+
+def strike_record(mem, slot: int) -> np.ndarray:
+    """The heel-strike record (columns tables.LOG) at memory slot `slot` (MEM.strike_first or
+    MEM.strike_last)."""
+    return mem[slot:slot + T.N_LOG]
+
+
+def whole_step_numbers(mem, weight: float, overhead_power: float) -> dict:
+    """The numbers over whole steps, from the second heel strike to the last (the start-up
+    step left out), of controller memory `mem`'s records of those strikes, for the robot's
+    weight [N] and the computers' overhead_power [W]: speed [m/s], step length [m] and
+    period [s], the costs of transport (module doc) and the mean push-off current [A] of the
+    strikes from the second on; NaN for fewer than 3 strikes."""
+    n = int(mem[C.MEM.steps])
+    if n < 3:
+        return dict.fromkeys(WHOLE_STEP_KEYS, float("nan"))
+    first, last = strike_record(mem, C.MEM.strike_first), strike_record(mem, C.MEM.strike_last)
+    d = last[T.LOG.hip_x] - first[T.LOG.hip_x]
+    dt = last[T.LOG.t] - first[T.LOG.t]
+    e = last[T.LOG.e:T.LOG.e + 4] - first[T.LOG.e:T.LOG.e + 4]
+    # a cost of transport is per distance travelled forward: none (nan) for whole steps that
+    # went nowhere or backwards (energy over a negative distance would read as a negative
+    # cost, and a tuner would take it for a gain)
+    per = weight * d if d > 0.0 else float("nan")
+    whole = n - 2
+    return dict(step_speed=d / dt, step_length=d / whole, step_period=dt / whole,
+                cost_of_transport_electrical=e[0] / per,
+                cost_of_transport=(e[0] + overhead_power * dt) / per,
+                cost_of_transport_electrical_net=e[1] / per,
+                cost_of_transport_mechanical=e[2] / per,
+                cost_of_transport_mechanical_net=e[3] / per,
+                push_current_mean=float(mem[C.MEM.push_sum] / (n - 1)))
+
+
+def log_holds(rows, mem) -> bool:
+    """Whether the step log's `rows` (its first min(steps, max_steps)) are the heel strikes of
+    memory `mem`'s walk: none left unwritten (NaN), the second and (when logged) the last equal
+    to the memory's records of them, and the logged push-off currents from the second strike
+    on adding up, in order, to the memory's sum."""
+    n = int(mem[C.MEM.steps])
+    if np.isnan(rows).any():
+        return False
+    if n >= 2 and not np.array_equal(rows[1], strike_record(mem, C.MEM.strike_first)):
+        return False
+    if n == 0 or n > len(rows):
+        return True
+    if not np.array_equal(rows[-1], strike_record(mem, C.MEM.strike_last)):
+        return False
+    return n < 2 or np.cumsum(rows[1:, T.LOG.push_i])[-1] == mem[C.MEM.push_sum]
 
 
 simulate = simulation(Run)

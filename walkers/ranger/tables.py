@@ -61,6 +61,14 @@ CONST = slots("RangerConstants", (
 ))
 N_K = size(CONST)
 
+# columns of a heel-strike record (the step log's rows, and memory's first and last strikes),
+# in this order
+LOG = slots("StepLogColumns", (
+    ("t", "time of the heel strike [s]"), ("hip_x", "hip x [m]"),
+    ("e", 4, "the energies of mem's e [J]"), ("push_i", "push-off current [A]"),
+))
+N_LOG = size(LOG)
+
 # controller memory mem[...] (float64 vector), the fields in this order
 MEM = slots("RangerMemory", (
     "gait", "phase", "stance",
@@ -76,16 +84,13 @@ MEM = slots("RangerMemory", (
     ("fell", "fell flag"),
     ("raw", 2, "raw load fraction per foot"),
     ("touch", 2, "estimator touchdowns per foot"),
-    ("strike_x", "hip x at the last heel strike [m]"),
     ("airborne", "1 once the swing foot has been seen in the air this step"),
+    # what the whole-step numbers need, kept here so a snapshot of the memory carries them
+    ("strike_first", N_LOG, "record (columns LOG) of the second heel strike: whole steps start there"),
+    ("strike_last", N_LOG, "record (columns LOG) of the last heel strike"),
+    ("push_sum", "push-off currents [A] of the heel strikes from the second on, summed"),
 ))
 N_MEM = size(MEM)
-# columns of the step log (one row per heel strike), in this order
-LOG = slots("StepLogColumns", (
-    ("t", "time of the heel strike [s]"), ("hip_x", "hip x [m]"),
-    ("e", 4, "the energies of mem's e [J]"), ("push_i", "push-off current [A]"),
-))
-N_LOG = size(LOG)
 
 
 def make_constants(p: RangerParams, dt: float, gravity: float = GRAVITY) -> np.ndarray:
@@ -163,7 +168,8 @@ class Tables(NamedTuple):
     prog: np.ndarray      # (N_PROG, 5) motor programs, columns PC
     motor: np.ndarray     # (3, MOTOR_NPARAM) motor rows: hip, outer ankle, inner ankle
     gui: np.ndarray       # (3, 3) GUI joint target [rad], kp [A/rad], kd [A s/rad] (set at run time)
-    steplog: np.ndarray   # (max_steps, N_LOG) one row per heel strike (columns LOG), written by the controller
+    steplog: np.ndarray   # (max_steps, N_LOG) one row per heel strike (columns LOG), written by the
+                          # controller; NaN where none was written (make_step_log)
 
 
 def make_tables(p: RangerParams, dt: float, max_steps: int = 20000,
@@ -171,4 +177,11 @@ def make_tables(p: RangerParams, dt: float, max_steps: int = 20000,
     """RangerParams, the step length dt [s] and the model's gravity [m/s^2] (its magnitude) ->
     Tables, with room to log max_steps steps."""
     return Tables(k=make_constants(p, dt, gravity), prog=make_programs(p), motor=motor_table(p),
-                  gui=make_gui(p), steplog=np.zeros((int(max_steps), N_LOG)))
+                  gui=make_gui(p), steplog=make_step_log(max_steps))
+
+
+def make_step_log(rows: int) -> np.ndarray:
+    """(rows, N_LOG) heel-strike log, columns LOG, every row NaN until the controller writes
+    it: a row no strike of this run wrote (the strikes before a restored memory's, which a
+    snapshot of state and memory does not carry) reads NaN, never as a strike at t = 0, x = 0."""
+    return np.full((int(rows), N_LOG), np.nan)
