@@ -17,8 +17,8 @@ import numpy as np
 
 from .capacity import workspace_capacity
 from .kernels.checks.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_JOINT_FRICTION,
-                                   AUDIT_JOINT_WORK, AUDIT_LIMIT_WORK, AUDIT_NAMES, AUDIT_PIN_GAP,
-                                   AUDIT_UNSOLVED)
+                                   AUDIT_JOINT_WORK, AUDIT_LIMIT_GAP, AUDIT_LIMIT_WORK,
+                                   AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.codes import INTEGRATOR_NAMES
 from .kernels.dynamics.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
@@ -145,6 +145,7 @@ _AUDIT_TEXT = {
     "correction_work": "the position correction added {v:.3g} J beyond its allowance",
     "joint_friction": "a joint's dry friction outside its bound or pushing the motion "
                       "({v:.3g} N s beyond its bound, or J of positive work)",
+    "limit_gap": "a joint is {v:.3g} rad (or m, a slider) outside its limit",
 }
 
 
@@ -177,7 +178,7 @@ def _element_name(model, kind, element):
     """'pin NAME (j)', 'rod NAME (j)', 'contact NAME (i)' or what else an audit record of rule
     `kind` names."""
     if kind in (AUDIT_PIN_GAP, AUDIT_JOINT_WORK, AUDIT_LIMIT_WORK,
-                AUDIT_JOINT_FRICTION) and element < len(model.pin_names):
+                AUDIT_JOINT_FRICTION, AUDIT_LIMIT_GAP) and element < len(model.pin_names):
         return f"pin {model.pin_names[element]!r} ({element})"
     if kind in (AUDIT_PIN_GAP, AUDIT_JOINT_WORK):
         rod = element - len(model.pin_names)
@@ -190,14 +191,17 @@ def _element_name(model, kind, element):
 
 
 def gross_violation(model, ws, who="simulation"):
-    """The SimulationDiverged of a step that ended with a pin open, or a contact below the
-    ground or inside another shape, by more than StepOptions.gross_limit (ws.audit_worst)."""
+    """The SimulationDiverged of a step that ended with a pin open, a joint outside its limit,
+    or a contact below the ground or inside another shape, by more than
+    StepOptions.gross_limit (ws.audit_worst)."""
     step, kind, element, body = (int(x) for x in ws.audit_worst)
     value = float(ws.audit_worst_value[0])
     t = float(ws.prev.time[0])
     body_name = _body_name(model, body)
     what = ("is open by" if kind == AUDIT_PIN_GAP
+            else "is outside its limit by" if kind == AUDIT_LIMIT_GAP
             else "is below the ground (or inside another shape) by")
+    unit = "rad (m for a slider)" if kind == AUDIT_LIMIT_GAP else "m"
     last = _start_of_step(ws)
     if model.n_act:
         why = "actuators too stiff, or an impact too violent, for this step size"
@@ -208,7 +212,7 @@ def gross_violation(model, ws, who="simulation"):
         fix = "Take a smaller dt, or raise"
     return SimulationDiverged(
         f"{who} stopped at step {step} (t={t:.6g} s): {_element_name(model, kind, element)} on "
-        f"body {body_name!r} ({body}) {what} {value:.3g} m at the end of the step; the step "
+        f"body {body_name!r} ({body}) {what} {value:.3g} {unit} at the end of the step; the step "
         f"could not hold it ({why}). {fix} "
         f"StepOptions.gross_limit (0: count it in the audit and go on)",
         step, t, body_name, AUDIT_NAMES[kind], value, last)

@@ -20,7 +20,7 @@ from .integrator import check_integrator
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
-from .start_check import check_overlap, check_start, overlapping
+from .start_check import check_overlap, check_start, outside_limits, overlapping
 from .kernels.checks.guards import GUARD_ROOM
 from .state import (ArrayCopier, State, Workspace, array_pairs, check_state, forget_ground_queries,
                     forget_kept_factors, forget_pairs, grow_workspace, make_state, make_workspace,
@@ -70,6 +70,9 @@ class Simulator:
             if count:
                 warnings.warn(f"{said}; the first step pushes them apart (allow_overlap=True)",
                               stacklevel=2)
+        count, said = outside_limits(model, self._state)
+        if count:
+            warnings.warn(f"{said}; the first step moves it onto its limit", stacklevel=2)
         self._u0 = np.zeros(model.n_act)
         self._recorded_entry = None
         self._args = None

@@ -21,7 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import ModelError
-from .kernels.codes import CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT
+from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT,
+                           JOINT_SLIDE_BIT)
 from .terrain import from_coef
 
 START_TOLERANCE = 1e-3   # [m] a contact may start this far below the ground (rounding, a foot
@@ -234,3 +235,44 @@ def check_overlap(model, state, tolerance: float = START_TOLERANCE, who: str = "
     if count:
         raise ModelError(f"{said}; the first step would push them apart. Build them apart, or "
                          f"pass allow_overlap=True to start them there")
+
+
+def joint_coordinate(model, q, j) -> float:
+    """Joint j's coordinate at configuration q: a hinge's angle theta_b - theta_a - ref [rad],
+    a slider's slide along its axis d . (p_b - p_a) [m] (kernels/constraints/slider.py)."""
+    a = model.arrays
+    ba, bb = int(a.pin_body[j, 0]), int(a.pin_body[j, 1])
+    if not int(a.pin_kind[j]) & JOINT_SLIDE_BIT:
+        return float(q[bb, 2] - a.pin_ref[j] - (q[ba, 2] if ba >= 0 else 0.0))
+    axis = np.asarray(a.pin_axis[j], dtype=np.float64)
+    if ba >= 0:
+        c, s = np.cos(q[ba, 2]), np.sin(q[ba, 2])
+        axis = np.array([c * axis[0] - s * axis[1], s * axis[0] + c * axis[1]])
+    pa = _world(q, ba, a.pin_anchor[j, 0])[0] if ba >= 0 else np.asarray(a.pin_anchor[j, 0], float)
+    pb = _world(q, bb, a.pin_anchor[j, 1])[0]
+    return float(axis @ (pb - pa))
+
+
+def outside_limits(model, state, who: str = "simulator"):
+    """(how many joints lie outside their limits at `state`, a sentence naming the farthest,
+    where it is and its limit; '' when none). The first step moves such a joint onto its
+    limit (the position projection: a move, no velocity); MuJoCo's files may build a joint
+    there (dm_control's hopper builds its knee at 0, outside (-150, -5) degrees)."""
+    a = model.arrays
+    out = []
+    for j in range(len(model.pin_names)):
+        lo, hi = float(a.pin_limit[j, 0]), float(a.pin_limit[j, 1])
+        if lo == -np.inf and hi == np.inf:
+            continue
+        x = joint_coordinate(model, state.q, j)
+        over = max(lo - x, x - hi)
+        if over > 1e-9:
+            out.append((over, j, x, lo, hi))
+    if not out:
+        return 0, ""
+    over, j, x, lo, hi = max(out)
+    unit = "m" if int(a.pin_kind[j]) & JOINT_SLIDE_BIT else "rad"
+    more = len(out) - 1
+    others = f" (and {more} more joint{'s' if more > 1 else ''})" if more else ""
+    return len(out), (f"{who}: joint {model.pin_names[j]!r} ({j}) starts at {x:.6g} {unit}, "
+                      f"{over:.4g} {unit} outside its limit ({lo:g}, {hi:g}){others}")

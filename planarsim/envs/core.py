@@ -19,6 +19,8 @@ import os
 from collections import namedtuple
 from types import SimpleNamespace
 
+import warnings
+
 import numpy as np
 import gymnasium
 from gymnasium import spaces
@@ -321,7 +323,11 @@ class PlanarMujocoEnv(gymnasium.Env):
                              f"{self.metadata['render_modes']} only")
         self.render_mode = render_mode
         self.width, self.height = int(width), int(height)
-        self.sim = Simulator(self.sim_model, None, make_state(self.sim_model))
+        with warnings.catch_warnings():
+            # a file may build a joint outside its limit (dm_control's hopper): every reset
+            # puts a state of the task's in first
+            warnings.filterwarnings("ignore", message=".*outside its limit")
+            self.sim = Simulator(self.sim_model, None, make_state(self.sim_model))
         # the speed bound (StepOptions.speed_limit) is set once, from the file's pose at rest,
         # so that a reset only copies a state in (Simulator.start_over: microseconds)
         self.sim.options = self.sim.options

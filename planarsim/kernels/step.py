@@ -28,7 +28,8 @@ from .dynamics.forces import apply_forces, predict_velocity
 from .checks.guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_ROOM,
                             check_actuator_turns, check_displacements, check_guards, check_moves,
                             check_speeds, add_part_path, finish_path, keep_step_path,
-                            end_checks_alone, note_start_depths, start_path)
+                            end_checks_alone, note_start_depths, note_start_limits,
+                            start_path)
 from .info import INFO_CHAIN_PATH, INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
 from .dynamics.integrate import (bound_correction_work, integrate_positions, predict_configuration)
 from .constraints.joint_friction import start_joint_friction, stick_all, switch_joint_friction
@@ -640,6 +641,7 @@ def step_of_length(m, s, ws, opt, u, step_length, stage):
         find_contacts(m, s, ws, h)                          # 2. contacts
         if split == 0 and not stage:
             note_start_depths(ws)                           #    (check_displacements)
+            note_start_limits(m, s, ws)
         ccd_on = split < opt.max_ccd_splits
         if m.n_shape_pair > 0:                              #    fast shape pairs apart: left
             hold_off_fast_pairs(m, s, ws, h)                #    to the sweep of stage 6

@@ -98,15 +98,6 @@ DEFECTS = {
         "is in the velocity solve and the position correction; the latter's velocity "
         "change (cut by the energy bound: a limit keeps the step out of SHAKE's whole "
         "correction, shake_whole 0) is not recorded, and the solve's impulse is"),
-    "limit_outside_build_pose": (
-        "a hinge limit that the build pose violates is accepted without a word (the builder "
-        "refuses a rod whose length the build pose does not meet, and anchors apart): a "
-        "0.5 m rod built 0.5 rad from hanging with limit (-0.2, 0.2) swings freely outside "
-        "its limit, 0.429 rad after 0.1 s, no audit count; the limit acts only once gravity "
-        "has brought the joint inside it. MuJoCo's limit acts on a joint outside its range "
-        "(it pushes the joint back), and an MJCF file may start one there: dm_control's "
-        "hopper builds its knee at 0, outside its range (-150, -5) deg, so the builder "
-        "cannot simply refuse such a pose"),
 }
 
 
@@ -375,20 +366,80 @@ def test_a_spring_pressing_a_joint_onto_its_limit_is_held_by_h_k_stretch(inertia
     assert_clean(sim)
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=DEFECTS["limit_outside_build_pose"])
-def test_a_limit_the_build_pose_violates_is_refused_or_holds():
-    """A rod built 0.5 rad from hanging with limit (-0.2, 0.2): the builder refuses it naming
-    the pin (as it refuses a rod whose build pose does not meet its length), or the limit
-    holds from the start (within it after a few steps)."""
-    try:
-        model = _pendulum(1.0, 0.5, 0.5, 1e-3, limit=(-0.2, 0.2))
-    except ps.ModelError:
-        return
-    sim = ps.Simulator(model)
-    sim.steps(100)
+def _kinetic(model, v):
+    """Kinetic energy [J] of the bodies at velocities v."""
+    a = model.arrays
+    return 0.5 * float(np.sum(a.body_mass * (v[:, 0] ** 2 + v[:, 1] ** 2)
+                              + a.body_inertia * v[:, 2] ** 2))
+
+
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+@pytest.mark.parametrize("a0, limit, w0", [
+    (0.5, (-0.2, 0.2), 0.0), (-0.5, (-0.2, 0.2), 0.0), (2.0, (-0.2, 0.2), 0.0),
+    (0.5, (0.6, 1.0), 0.0), (0.5, (-0.2, 0.2), 3.0), (0.5, (-0.2, 0.2), -3.0)])
+def test_a_hinge_built_outside_its_limit_is_put_onto_it_by_the_first_step(a0, limit, w0, dt):
+    """A 0.5 m rod on a world hinge built a0 [rad] from hanging, outside its limit, at rest or
+    turning w0 [rad/s] (away from the limit or towards it): the Simulator warns naming the
+    joint; the first step ends on the limit (within 1e-9 rad) with the pin closed; the
+    move onto it adds no kinetic energy (the step's free motion's, at most: from rest, the
+    fall h g; turning away, the turn is stopped, plastic as a limit is); then the rod stays
+    within its limit for a second with no audit count. (It swung freely outside before:
+    0.429 rad after 0.1 s with limit (-0.2, 0.2), no audit count.)"""
+    m, length, g = 1.0, 0.5, 9.81
+    b = ps.ModelBuilder(dt=dt)
+    d = length / 2
+    b.add_body("rod", m, m * length * length / 12, pos=(d * math.sin(a0), -d * math.cos(a0)),
+               angle=a0, vel=(d * math.cos(a0) * w0, d * math.sin(a0) * w0), omega=w0)
+    b.add_pin("hinge", None, "rod", anchor_world=(0.0, 0.0), ref_angle=0.0, limit=limit)
+    model = b.compile()
+    with pytest.warns(UserWarning, match=r"joint 'hinge' \(0\) starts at .* outside its limit"):
+        sim = ps.Simulator(model)
+    e0 = _kinetic(model, sim.state.v)
+    sim.step()
     ang = sim.state.q[0, 2]
-    print(f"angle after 0.1 s: {ang:.3f} rad")
-    assert -0.2 - 1e-9 <= ang <= 0.2 + 1e-9
+    side = limit[0] if a0 < limit[0] else limit[1]
+    assert abs(ang - side) <= 1e-9, ang
+    free = 0.5 * m * (abs(w0) * d + g * dt) ** 2 + 0.5 * (m * length * length / 12) * w0 ** 2
+    assert _kinetic(model, sim.state.v) <= free * (1.0 + 1e-9) + 1e-15
+    if w0 * (1 if side == limit[1] else -1) > 0:        # turning away: stopped dead
+        assert _kinetic(model, sim.state.v) <= 0.5 * m * (g * dt) ** 2 + 1e-12
+    for _ in range(int(round(1.0 / dt))):
+        sim.step()
+        assert limit[0] - 1e-9 <= sim.state.q[0, 2] <= limit[1] + 1e-9
+    assert_clean(sim)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+def test_a_slider_and_a_chain_built_outside_their_limits_are_put_onto_them(dt):
+    """A block on a world slider whose slide starts 0.2 m below its limit (0.2, 0.5), and a
+    hanging two-link chain whose lower hinge starts 0.4 rad past its upper limit: after one
+    step the slide is on its limit (1e-9 m) and the hinge within its (the projection turns
+    both links: measured 0.180 rad at dt 1e-3), every pin and the slider closed, no
+    kinetic energy beyond the fall's h g; then a second within the limits, no audit count."""
+    b = ps.ModelBuilder(dt=dt, gravity=(0.0, -9.81))
+    b.add_body("block", 2.0, 0.05, pos=(0.0, 1.0))
+    b.add_slider("rail", None, "block", axis=(0.0, 1.0), limit=(0.2, 0.5))
+    b.add_body("upper", 1.0, 0.02, pos=(2.0, 0.75))
+    b.add_pin("top", None, "upper", anchor_world=(2.0, 1.0))
+    a = 0.6
+    b.add_body("lower", 1.0, 0.02, pos=(2.0 + 0.25 * math.sin(a), 0.5 - 0.25 * math.cos(a)),
+               angle=a)
+    b.add_pin("knee", "upper", "lower", anchor_world=(2.0, 0.5), ref_angle=0.0, limit=(-0.2, 0.2))
+    model = b.compile()
+    with pytest.warns(UserWarning, match=r"joint .knee. \(2\) starts at 0.6 rad, 0.4 rad outside its limit .* \(and 1 more joint\)"):
+        sim = ps.Simulator(model)
+    sim.step()
+    q = sim.state.q
+    assert abs((q[0, 1] - 1.0) - 0.2) <= 1e-9, q[0]
+    assert 0.0 < q[2, 2] - q[1, 2] <= 0.2 + 1e-9, q[2, 2] - q[1, 2]
+    free = 0.5 * float(np.sum(model.arrays.body_mass)) * (9.81 * dt) ** 2
+    assert _kinetic(model, sim.state.v) <= free * (1.0 + 1e-9)
+    for _ in range(int(round(1.0 / dt))):
+        sim.step()
+        q = sim.state.q
+        assert 0.2 - 1e-9 <= q[0, 1] - 1.0 <= 0.5 + 1e-9
+        assert -0.2 - 1e-9 <= q[2, 2] - q[1, 2] <= 0.2 + 1e-9
+    assert_clean(sim)
 
 
 # --- springs and dampers ---------------------------------------------------------------------

@@ -23,6 +23,7 @@ After the position stage (the configuration the step ends at):
   pin_gap   a pin joint open, or a rod's length off, by more than PIN_GAP_TOL
   depth     a contact point below the ground, or two shapes overlapping, by more than
             DEPTH_TOL
+  limit_gap a joint outside its limit by more than PIN_GAP_TOL [rad or m]
   correction_work  the position correction or projection added energy (kinetic, less the
             applied forces' work along its move) beyond what bound_correction_work allows
             (kernels/dynamics/integrate.py): rounding only, once it has bounded its velocity change
@@ -48,6 +49,7 @@ from ..constraints.rows import is_limit_row, is_normal_row
 from ..constraints.joint_friction import (FRICTION_REL_TOL, friction_rate, is_joint_friction_row,
                                           slip_reversed)
 from ..constraints.joints import is_free_joint, is_slider
+from ..constraints.limit import limit_overshoot
 from ..constraints.slider import slider_gap
 from ..geometry.terrain import ground_point
 from .work import (VELOCITY_FLOOR, WORK_REL_TOL, fastest, joints_add_energy, judge_energy,
@@ -64,9 +66,10 @@ AUDIT_JOINT_WORK = 7
 AUDIT_LIMIT_WORK = 8
 AUDIT_CORRECTION_WORK = 9
 AUDIT_JOINT_FRICTION = 10
-N_AUDIT = 11
+AUDIT_LIMIT_GAP = 11
+N_AUDIT = 12
 AUDIT_NAMES = ("pull", "cone", "work", "pin_gap", "depth", "fallback", "unsolved",
-               "joint_work", "limit_work", "correction_work", "joint_friction")
+               "joint_work", "limit_work", "correction_work", "joint_friction", "limit_gap")
 
 PIN_GAP_TOL = 1e-9       # [m]
 DEPTH_TOL = 1e-8         # [m]
@@ -96,7 +99,7 @@ def note(ws, step, kind, who, body, value):
     ws.audit_last[2] = who
     ws.audit_last[3] = body
     ws.audit_value[0] = value
-    if (kind == AUDIT_PIN_GAP or kind == AUDIT_DEPTH) and value > ws.audit_worst_value[0]:
+    if (kind == AUDIT_PIN_GAP or kind == AUDIT_DEPTH or kind == AUDIT_LIMIT_GAP) and value > ws.audit_worst_value[0]:
         ws.audit_worst[0] = step
         ws.audit_worst[1] = kind
         ws.audit_worst[2] = who
@@ -430,6 +433,16 @@ def worst_violation(m, s, ws, bounded, rows_held):
 
 
 @kernel
+def worst_limit_overshoot(m, s, ws):
+    """The largest distance [rad or m] of a joint outside its limit at s.q (0: none; ws.body_cs
+    must match s.q where a slider has a limit)."""
+    worst = 0.0
+    for j in range(m.pin_body.shape[0]):
+        worst = max(worst, limit_overshoot(m, s.q, ws.body_cs, s.v, j))
+    return worst
+
+
+@kernel
 def mark_held_contacts(m, ws):
     """ws.contact_held[i] = 1 if contact i's normal row is among the rows 0..n_row-1."""
     for k in range(ws.n_live[0]):
@@ -441,8 +454,9 @@ def mark_held_contacts(m, ws):
 
 @kernel
 def audit_positions(m, s, ws, step):
-    """Pins open by more than PIN_GAP_TOL and contacts deeper than DEPTH_TOL at the current
-    configuration; returns the violations found."""
+    """Pins open by more than PIN_GAP_TOL, joints outside their limits by more than
+    PIN_GAP_TOL and contacts deeper than DEPTH_TOL at the current configuration; returns the
+    violations found."""
     found = 0
     for j in range(m.pin_body.shape[0]):
         g = pin_gap(m, s.q, ws.body_cs, j)
@@ -454,6 +468,11 @@ def audit_positions(m, s, ws, step):
         g = rod_error(m, s.q, ws.body_cs, j)
         if g > PIN_GAP_TOL:
             note(ws, step, AUDIT_PIN_GAP, n_pin + j, m.rod_body[j, 1], g)
+            found += 1
+    for j in range(m.pin_body.shape[0]):
+        g = limit_overshoot(m, s.q, ws.body_cs, s.v, j)
+        if g > PIN_GAP_TOL:
+            note(ws, step, AUDIT_LIMIT_GAP, j, m.pin_body[j, 1], g)
             found += 1
     for k in range(ws.ground_contacts.shape[0]):
         found += _audit_depth(m, s, ws, step, ws.ground_contacts[k])

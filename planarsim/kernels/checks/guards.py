@@ -3,7 +3,9 @@ import math
 
 from ...compile import kernel
 from ..codes import CONTACT_ARC, CONTACT_POINT, JOINT_HINGE, MODE_FREE
-from ..math2d import rotate
+from ..math2d import rotate, world_point
+from ..constraints.joints import is_slider
+from ..constraints.limit import limit_overshoot
 from ..dynamics.forces import ACT_BODY_TORQUE, ACT_PIN_TORQUE
 from ..geometry.terrain import ground_point
 from ..info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
@@ -307,6 +309,31 @@ def note_start_depths(ws):
             b = ws.contact_bodies[i, e]
             if b >= 0 and depth > ws.path_explained[b, 2]:
                 ws.path_explained[b, 2] = depth
+
+
+@kernel
+def note_start_limits(m, s, ws):
+    """After note_start_depths: a joint that starts the step outside its limit (a state put
+    in from outside, a build pose) is moved onto it by the position projection; each of its
+    bodies may then move as far as the joint's overshoot o turns or slides the bodies joined
+    to it: o [m] for a slider, o [rad] times the farthest centre of mass from the hinge for a
+    hinge (ws.path_explained[:, 2], which joined_start_depth spreads over them). ws.body_cs
+    must match s.q."""
+    for j in range(m.pin_body.shape[0]):
+        over = limit_overshoot(m, s.q, ws.body_cs, s.v, j)
+        if not over > 0.0:
+            continue
+        if not is_slider(m, j):
+            px, py = world_point(s.q, ws.body_cs, m.pin_body[j, 1], m.pin_anchor[j, 1, 0],
+                                 m.pin_anchor[j, 1, 1])
+            reach = 0.0
+            for b in range(s.q.shape[0]):
+                reach = max(reach, math.hypot(s.q[b, 0] - px, s.q[b, 1] - py))
+            over *= reach
+        for e in range(2):
+            b = m.pin_body[j, e]
+            if b >= 0 and over > ws.path_explained[b, 2]:
+                ws.path_explained[b, 2] = over
 
 
 @kernel

@@ -2,9 +2,12 @@
 ang = theta_b - theta_a - ref [rad]: ang - lower >= 0 (side 0, ROW_LIMIT_LO) and
 upper - ang >= 0 (side 1, ROW_LIMIT_HI). A side has a row only while it is active
 (State.limit_active; engaged and released by the mode rules, kernels/solver/modes.py)."""
+import math
+
 from ...compile import kernel
 from ..codes import ROW_LIMIT_HI, ROW_LIMIT_LO
 from ..dynamics.forces import pin_angle
+from .joints import joint_position_rate
 from .row_list import add_row
 
 
@@ -37,5 +40,34 @@ def add_limit_rows(m, s, ws, n, j):
     if s.limit_active[j, 0]:
         n = add_row(ws, n, ROW_LIMIT_LO, j, m.pin_body[j, 0], m.pin_body[j, 1])
     if s.limit_active[j, 1]:
+        n = add_row(ws, n, ROW_LIMIT_HI, j, m.pin_body[j, 0], m.pin_body[j, 1])
+    return n
+
+
+@kernel
+def limit_overshoot(m, q, cs, v, j):
+    """How far [rad or m] joint j's coordinate lies outside its limit at q (cs its cos / sin;
+    0 inside it, or without a limit): negative on neither side."""
+    lo = m.pin_limit[j, 0]
+    hi = m.pin_limit[j, 1]
+    if lo == -math.inf and hi == math.inf:
+        return 0.0
+    x = joint_position_rate(m, q, cs, v, j)[0]
+    return max(0.0, lo - x, x - hi)
+
+
+@kernel
+def add_violated_limit_rows(m, s, ws, n, j):
+    """add_limit_rows, and a row for each side of pin j's limit that s.q lies outside of
+    while inactive (a start outside the limit, or a released side the step's end crossed:
+    the position projection puts the joint back onto it); returns the next free slot."""
+    lo = m.pin_limit[j, 0]
+    hi = m.pin_limit[j, 1]
+    if lo == -math.inf and hi == math.inf:
+        return n
+    x = joint_position_rate(m, s.q, ws.body_cs, s.v, j)[0]
+    if s.limit_active[j, 0] or x < lo:
+        n = add_row(ws, n, ROW_LIMIT_LO, j, m.pin_body[j, 0], m.pin_body[j, 1])
+    if s.limit_active[j, 1] or x > hi:
         n = add_row(ws, n, ROW_LIMIT_HI, j, m.pin_body[j, 0], m.pin_body[j, 1])
     return n

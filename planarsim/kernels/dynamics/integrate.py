@@ -49,6 +49,10 @@ DIVERGED_GROWTH = 10.0
 STALLED_RATIO = 0.5
 
 
+# [rad or m] a limit held within this at a step's start stays in the Newton correction
+LIMIT_START_TOL = 1e-9
+
+
 @kernel
 def keep_correction_rows(s, ws):
     """Keep the rows the Newton correction holds: joints, active limits, the normal row of
@@ -59,8 +63,10 @@ def keep_correction_rows(s, ws):
     has no position error) are dropped. A joint's armature row stays: it has no error of
     its own either (its target is 0), but its rotor turns with the joint, so the correction
     moves the bodies and the rotors by (M + A)^-1 J^T mu, A the rotors' inertia
-    (correction_compliance), as the solve moves their velocities. Returns how many were
-    dropped."""
+    (correction_compliance), as the solve moves their velocities. An active limit that the
+    step started outside of by more than LIMIT_START_TOL is dropped too: its joint is put
+    back onto it by the projection (position.settle_positions), which does not turn that move into
+    velocity. Returns how many were dropped."""
     k = 0
     for r in range(ws.n_row[0]):
         kind = ws.row_kind[r]
@@ -71,8 +77,10 @@ def keep_correction_rows(s, ws):
             continue
         if is_contact_row(kind) and ws.contact_bounce[o] > 0.0:
             continue    # rebounding (restitution): it leaves the surface, not held to it
-        if is_limit_row(kind) and s.limit_active[o, limit_side(kind)] == 0:
-            continue
+        if is_limit_row(kind) and (s.limit_active[o, limit_side(kind)] == 0
+                                   or ws.row_c[r] < -LIMIT_START_TOL):
+            continue    # (a joint that started outside its limit: the projection puts it
+                        # back without turning the move into velocity, settle_positions)
         if is_soft_row(kind) and ws.row_soft[r, SOFT_ARMATURE] == 0.0:
             continue    # a joint's spring-damper: no position error and no inertia
         if is_joint_friction_row(kind):

@@ -11,9 +11,12 @@ position_stage(m, s, ws, opt, h, answered):
   5. bound_correction_work: the velocity change of a correction or projection kept only as
      far as it adds no energy beyond its allowance (audited: correction_work).
 """
+import math
+
 from ...compile import kernel, part
 from ..checks.audit import (AUDIT_CORRECTION_WORK, DEPTH_TOL, PIN_GAP_TOL, audit_positions,
-                            mark_held_contacts, needs_ground_query, note, worst_violation)
+                            mark_held_contacts, needs_ground_query, note, worst_limit_overshoot,
+                            worst_violation)
 from ..solver.complementarity import project_positions
 from ..codes import INTEGRATOR_EULER
 from ..info import INFO_PROJECTIONS
@@ -22,6 +25,7 @@ from .integrate import (bound_correction_work, correct_positions, integrate_posi
 from ..math2d import update_trig
 from ..checks.work import NEAR_DEPENDENT, gravity_lift, judge_energy, most_gaining_body
 from ..constraints.joints import is_slider
+from ..constraints.limit import limit_overshoot
 from ..constraints.rows import is_joint_row, is_soft_row
 
 # Newton iterations of the complementarity projection of the positions (quadratic)
@@ -33,6 +37,22 @@ ROWS_HELD_SHARE = 0.05
 
 
 @kernel
+def limits_outside(m, s, ws, tol):
+    """True if a joint lies outside its limit by more than tol [rad or m] at s.q (ws.body_cs
+    brought to s.q first where a slider has a limit)."""
+    fresh = False
+    for j in range(m.pin_body.shape[0]):
+        if m.pin_limit[j, 0] == -math.inf and m.pin_limit[j, 1] == math.inf:
+            continue
+        if is_slider(m, j) and not fresh:
+            update_trig(s.q, ws.body_cs)
+            fresh = True
+        if limit_overshoot(m, s.q, ws.body_cs, s.v, j) > tol:
+            return True
+    return False
+
+
+@kernel
 def settle_positions(m, s, ws, h, opt, rows_held):
     """After the Newton correction: the end-of-step pin gaps and contact depths; where one is
     above a tenth of its audit tolerance, the complementarity projection (it also catches a
@@ -40,7 +60,12 @@ def settle_positions(m, s, ws, h, opt, rows_held):
     proved its rows within a tenth of the tolerances (audit.worst_violation then skips
     them). Returns the violations the audit counts at the configuration the step ends at.
     Where the rows are held and every other contact is surely clear (a body at rest on the
-    ground) that is known without a ground query; the rest is one call (_settle_measured)."""
+    ground) that is known without a ground query; the rest is one call (_settle_measured).
+    A joint outside its limit with that side inactive (a start outside it: the velocity solve
+    only stops a violated side approaching) is a violation too: the projection moves it
+    onto its limit, as it lifts a contact out of the ground."""
+    if rows_held and limits_outside(m, s, ws, 0.1 * PIN_GAP_TOL):
+        rows_held = False
     if rows_held:
         if m.contact_body.shape[0] == 0:
             return 0        # joints held, nothing else to check
@@ -55,11 +80,13 @@ def _settle_measured(m, s, ws, h, opt, rows_held):
     """settle_positions where the ground must be asked (rows_held: contact_held is marked)."""
     update_trig(s.q, ws.body_cs)
     gap, depth = worst_violation(m, s, ws, True, rows_held)
-    if gap > 0.1 * PIN_GAP_TOL or depth > 0.1 * DEPTH_TOL:
+    over = worst_limit_overshoot(m, s, ws)
+    if gap > 0.1 * PIN_GAP_TOL or depth > 0.1 * DEPTH_TOL or over > 0.1 * PIN_GAP_TOL:
         project_positions(m, s, ws, h, PROJECTION_ITERS, opt.refine_tol)
         update_trig(s.q, ws.body_cs)
         gap, depth = worst_violation(m, s, ws, False, False)
-    if gap > PIN_GAP_TOL or depth > DEPTH_TOL:
+        over = worst_limit_overshoot(m, s, ws)
+    if gap > PIN_GAP_TOL or depth > DEPTH_TOL or over > PIN_GAP_TOL:
         return audit_positions(m, s, ws, s.step[0])
     return 0
 

@@ -31,12 +31,12 @@ from .lcp import LCP_SOLVED
 from ..math2d import update_trig
 from .mixed_lcp import assemble_dense, lcp_room, solve_mixed_lcp
 from .modes import engage_contacts, engage_limits, gather_contact_impulses, modes_from_solution
-from ..constraints.limit import add_limit_rows
+from ..constraints.limit import add_violated_limit_rows
 from ..constraints.rod import add_rod_row
 from ..constraints.row_list import move_row
 from ..constraints.rows import (add_contact_rows, add_joint_rows, build_rows, eval_rows,
-                                is_joint_row, is_tangent_row)
-from .solve import apply_impulses, fill_row_b
+                                is_joint_row, is_limit_row, is_tangent_row)
+from .solve import apply_impulses, fill_row_b, row_dot
 
 # Lemke's path is finite; the cap only stops a path that rounding has sent astray
 PIVOTS_PER_VARIABLE = 20
@@ -260,13 +260,14 @@ def _projection_contact(m, s, ws, n, i):
 @kernel
 def _projection_rows(m, s, ws, h):
     """Rows at the current configuration for the position projection: every joint, active
-    limits, the normal row of every enabled contact closer to the ground than the margin
-    (contact points found again here). Returns the number of rows."""
+    limits and the sides of limits the joint lies outside of, the normal row of every
+    enabled contact closer to the ground than the margin (contact points found again here).
+    Returns the number of rows."""
     update_trig(s.q, ws.body_cs)
     n = 0
     for j in range(m.pin_body.shape[0]):
         n = add_joint_rows(m, ws, n, j)
-        n = add_limit_rows(m, s, ws, n, j)
+        n = add_violated_limit_rows(m, s, ws, n, j)
     for j in range(m.rod_body.shape[0]):
         n = add_rod_row(m, ws, n, j)
     n_near = 0
@@ -304,6 +305,34 @@ def _largest_error(ws, n):
     return worst
 
 
+@kernel
+def _limit_pushed(ws, n, tol):
+    """A joint limit's row of the projection violated by more than tol [rad or m]: a joint
+    that started the step outside its limit (add_violated_limit_rows)."""
+    for r in range(n):
+        if is_limit_row(ws.row_kind[r]) and ws.row_c[r] < -tol:
+            return True
+    return False
+
+
+@kernel
+def _project_velocity(m, s, ws, h):
+    """After a projection that pushed a joint onto its limit: the velocity made to keep the
+    joints at the configuration reached, and not to drive the touching contacts and limits
+    in (rows at gap <= 0), by the mass-weighted least change v += W J^T mu (it can only
+    remove kinetic energy): the pins' share of the push became no velocity."""
+    n = _projection_rows(m, s, ws, h)
+    for r in range(n):
+        jv = row_dot(ws, r, ws.row_J, s.v)
+        if is_joint_row(ws.row_kind[r]) or ws.row_c[r] <= 0.0:
+            ws.row_b[r] = jv
+        else:
+            ws.row_b[r] = abs(jv) + 1.0     # apart: not a row of this projection
+    if _solve_by_islands(m, ws, n, 1)[1] > 0:
+        return
+    apply_impulses(m, ws, ws.row_J, ws.lam, n, s.v, 1.0)
+
+
 @part("model", "state", "workspace", "float64", "int64", "float64", returns="float64")
 def project_positions(m, s, ws, h, iters, tol):
     """Project the configuration onto closed joints and contacts not below the ground (see
@@ -315,9 +344,12 @@ def project_positions(m, s, ws, h, iters, tol):
     best = math.inf         # the error where the last move started (q_keep)
     share = 1.0             # of the last move taken
     ws.dq_correction[:] = 0.0   # no move yet (the rows' margin reads the last one)
+    pushed = False          # a joint put back onto its limit: its moves carry no velocity
     for it in range(iters + 1):
         n = _projection_rows(m, s, ws, h)
         worst = _largest_error(ws, n)
+        if it == 0:
+            pushed = _limit_pushed(ws, n, tol)
         if worst <= tol or it == iters:
             break
         if worst > best and share > 0.5 ** PROJECTION_HALVINGS:
@@ -339,9 +371,10 @@ def project_positions(m, s, ws, h, iters, tol):
                 ws.dq_correction[i, k] = 0.0
                 ws.dv_correction[i, k] = 0.0
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
-        # joint corrections change the velocity too (dq / h), contact corrections do not
+        # joint corrections change the velocity too (dq / h), contact and limit corrections
+        # do not; nor does any where a limit was pushed (below)
         for r in range(n):
-            if not is_joint_row(ws.row_kind[r]):
+            if pushed or not is_joint_row(ws.row_kind[r]):
                 ws.lam[r] = 0.0
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
         for i in range(s.q.shape[0]):
@@ -350,4 +383,6 @@ def project_positions(m, s, ws, h, iters, tol):
                 ws.v_keep[i, k] = s.v[i, k]
                 s.q[i, k] += ws.dq_correction[i, k]
                 s.v[i, k] += ws.dv_correction[i, k]
+    if pushed:
+        _project_velocity(m, s, ws, h)
     return worst
