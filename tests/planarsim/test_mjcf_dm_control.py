@@ -24,6 +24,8 @@ pendulum 1.00, 1.00; reacher 1.04, 0.96; swimmer (6 links) 0.99, 1.18; point_mas
 1.00."""
 from pathlib import Path
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -124,7 +126,9 @@ def our_motion(loaded, qp, qv, dt):
     loaded.builder.dt = dt
     model = loaded.compile()
     coords = GeneralizedCoords(loaded, model)
-    sim = ps.Simulator(model, None, make_state(model))
+    with warnings.catch_warnings():     # (hopper's build pose has its knee outside its
+        warnings.filterwarnings("ignore", message=".*outside its limit")   # range; qp is in)
+        sim = ps.Simulator(model, None, make_state(model))
     sim.start_over(*coords.to_maximal(qp, qv))
     touched = False
     for _ in range(int(round(SPAN / dt))):
