@@ -45,16 +45,6 @@ DEFECTS = {
         "(differences 1.7e-7 m after 12 s), and at 2.5e-4 s too. The step time alternating by "
         "exactly one dt suggests the four-state machine's strikes, taken at whole steps, "
         "cannot land on a period of about 365.5 steps and alternate round it"),
-    "passive_last_frame": (
-        "a passive walker's recording (a frame every 10 steps, the default) does not end on the "
-        "state the run ended in, even for a duration of whole frames: each refined touchdown "
-        "takes one engine step more (the impact's 1e-6 s step counts in state.step), and the "
-        "rollout records where state.step is a multiple of 10; after run(4.0) the last frame "
-        "is 8 ms (compass gait), 7 ms (rimless wheel) and 4 ms (simplest walker) before the "
-        "end that time_s reports, and the summary's distance_m and mean speed, read to the "
-        "last frame, cover that much less: distance_m 2.8907 / 4.0280 / 1.2947 m against "
-        "2.8956 / 4.0339 / 1.2959 m recorded every step (-0.17 / -0.15 / -0.09 %). The actuated walkers' last frame is their end "
-        "state"),
 }
 
 
@@ -592,18 +582,15 @@ def test_the_summary_replaces_a_walkers_numbers_only_with_the_same_quantities(na
     assert not off, off
 
 
-def _last_frame_cases():
-    for name in ALL:
-        marks = [pytest.mark.xfail(strict=True, raises=AssertionError,
-                                   reason=DEFECTS["passive_last_frame"])] if name in PASSIVE else []
-        yield pytest.param(name, marks=marks, id=name)
-
-
-@pytest.mark.parametrize("name", list(_last_frame_cases()))
+@pytest.mark.parametrize("name", ALL)
 def test_a_run_of_whole_frames_ends_on_its_last_frame(name):
-    """run(4.0) recorded every 10 steps (400 frames of 10 ms): its last frame is the state the
-    run ended in (the summary's time_s), so distance_m and mean_speed_m_per_s (read from the
-    frames) are those of the same run recorded every step, within 1e-12."""
+    """run(4.0) recorded every 10 steps (400 frames, 10 ms apart, and a passive walker's
+    touchdowns): its last frame is the state the run ended in (the summary's time_s), so
+    distance_m and mean_speed_m_per_s (read from the frames) are those of the same run
+    recorded every step, within 1e-12; both recordings are in time order. A passive walker's
+    refined touchdowns take a step more each (a sub-step and an impact step of 1e-6 s in place
+    of one), so its frames follow the clock's whole steps, not the step count, and the step a
+    touchdown takes back is not recorded."""
     mod = walkers.load(name)
     runs = []
     for every in (10, 1):
@@ -616,5 +603,6 @@ def test_a_run_of_whole_frames_ends_on_its_last_frame(name):
     traj = run.trajectory()
     print(name, run.time - traj.t[-1], s["distance_m"], s1["distance_m"])
     assert traj.t[-1] == run.time and np.array_equal(traj.q[-1], run.state.q)
+    assert all(np.all(np.diff(r.trajectory().t) > 0) for r, _ in runs)
     assert s["distance_m"] == pytest.approx(s1["distance_m"], abs=1e-12)
     assert s["mean_speed_m_per_s"] == pytest.approx(s1["mean_speed_m_per_s"], abs=1e-12)

@@ -84,12 +84,25 @@ def update_feet(m, s, ws, feet, memory, toggle, min_ahead):
 
 
 @jit
+def clock_step(s, dt):
+    """The whole step nearest the state's clock, round(t / dt) with t = s.time [s] and dt the
+    step size [s]: a frame's place on the recording schedule. It is the step count s.step of
+    a run whose every step is dt long (an actuated walker's; a passive one's with the engine's
+    touchdowns); a refined touchdown replaces the step it falls in by a sub-step and an
+    impact step of 1e-6 s, two steps in s.step that move the clock by less than dt, so the
+    count runs ahead of the clock by one a touchdown and a schedule by count would end short
+    of the run's end."""
+    return int(math.floor(s.time[0] / dt + 0.5))
+
+
+@jit
 def rollout_passive(m, s, ws, opt, u, feet, memory, toggle, min_ahead, n, stop_after,
                     fall_body, fall_height, rec, every, k0, event_time, event_contact):
     """Up to n steps; stop after `stop_after` touchdowns in total (memory[1]).
 
-    Records a frame every `every` steps (0: none) into rec from frame k0 and each touchdown's
-    time [s] and contact id into event_time / event_contact (indexed by touchdown count).
+    Records a frame at every `every`-th whole step of the clock (clock_step; 0: none) and at
+    each touchdown (not DETECT's) into rec from frame k0, and each touchdown's time [s] and
+    contact id into event_time / event_contact (indexed by touchdown count).
     Returns (code, steps done, next frame): code 0 stop_after reached, NO_EVENT n steps done,
     FELL body fall_body within fall_height [m] of the ground, else the step's guard code.
     """
@@ -106,7 +119,7 @@ def rollout_passive(m, s, ws, opt, u, feet, memory, toggle, min_ahead, n, stop_a
                 event_contact[e] = feet[hit]
         # touchdowns are recorded too (whole-step summaries start and end on them), except
         # DETECT's, which the step map still has to locate and resolve
-        if every > 0 and (s.step[0] % every == 0 or (hit >= 0 and toggle != DETECT)) \
+        if every > 0 and (clock_step(s, m.dt) % every == 0 or (hit >= 0 and toggle != DETECT)) \
                 and k < rec.t.shape[0]:
             record_frame(s, ws, rec, k)
             k += 1

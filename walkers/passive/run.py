@@ -6,11 +6,15 @@ Touchdowns, ``impacts``:
       (PassiveWalker.refine_touchdown; one Python call per walking step, none per sim step);
   "engine": the engine's contacts find the touchdowns on their own (continuous collision for
       point feet, the "all" mode strategy releasing the trailing foot), the end-to-end path.
-Either way a recorded run also holds a frame at each touchdown (whole-step summaries start
-and end on them). Chunks end where one run of their total length would be: run(a); run(b)
-walks to step round(a / dt) + round(b / dt) like run(a + b). A chunk's end is counted from
-the state's own clock (a touchdown moves the clock off the grid of whole steps by less than
-half a step), so a state and memory put back from a snapshot go on from there.
+Either way a recorded run holds a frame at each whole step of the clock, round(t / dt), that
+is a multiple of record_every (rollout.clock_step: a refined touchdown counts two engine steps
+in state.step where the clock moves less than one, so the schedule follows the clock, and a
+run of whole frames ends on its last frame) and a frame at each touchdown (whole-step
+summaries start and end on them); the step a refined touchdown takes back leaves no frame.
+Chunks end where one run of their total length would be: run(a); run(b) walks to step
+round(a / dt) + round(b / dt) like run(a + b). A chunk's end is counted from the state's own
+clock (a touchdown moves the clock off the grid of whole steps by less than half a step), so a
+state and memory put back from a snapshot go on from there.
 """
 from __future__ import annotations
 
@@ -75,7 +79,7 @@ class PassiveRun(WalkerRun):
     gait : "passive"
     seed : accepted for the common interface (the walker is deterministic)
     x0 : section state to start from (PassiveWalker.coords; default start(params))
-    record_every : steps between recorded frames (0: none)
+    record_every : whole steps of the clock between recorded frames (0: none)
     impacts : "refined" | "engine" (module doc)
     """
 
@@ -128,8 +132,8 @@ class PassiveRun(WalkerRun):
         return int(n * self.dt / MIN_STEP_PERIOD) + 10
 
     def frames(self, n: int) -> int:
-        # sim-step frames, one more per touchdown (its frame; a refined touchdown also takes
-        # one sim step more)
+        # frames on the clock's schedule, one per touchdown, and as many again to spare (the
+        # refined path records the step a foot crosses the ground in before taking it back)
         return n // self.record_every + 2 + 2 * self.max_touchdowns(n) if self.record_every else 0
 
     def advance(self, n, every, rec, lab):
@@ -168,6 +172,7 @@ class PassiveRun(WalkerRun):
                 code, done, k = w.run_compiled(left, int(w.memory[1]) + 1, rec, self.record_every, k)
                 if code != 0:
                     break
+                k = self._unrecord_crossing(rec, k)
                 w.refine_touchdown(old)
                 s.contact_enabled[w.feet[old]] = 0
                 if self.record_every and k < rec.t.shape[0]:
@@ -176,6 +181,12 @@ class PassiveRun(WalkerRun):
         finally:
             w.toggle = toggle
         return (0 if code == NO_EVENT else code), k
+
+    def _unrecord_crossing(self, rec, k: int) -> int:
+        """The next frame k of rec less the frame of the step in which a foot crossed the
+        ground, where the schedule recorded one: refine_touchdown takes that step back (its
+        state lies past the touchdown, its time after the touchdown's frame's)."""
+        return k - 1 if k > 0 and rec.t[k - 1] == self.state.time[0] else k
 
     def numbers(self) -> dict:
         """steps (touchdowns), distance [m] (hip displacement along the slope), mean_speed [m/s]
