@@ -471,15 +471,27 @@ def keep_targets(ws, n):
     unilateral = 0
     for r in range(n):
         ws.row_c[r] = ws.rhs[r]
-        unilateral += is_unilateral(ws.row_kind[r])
+        unilateral += moves_without_velocity(ws.row_kind[r])
     return unilateral
+
+
+@kernel(inline="always")
+def moves_without_velocity(kind):
+    """A contact's normal row: its correction removes overlap, and that move does not become
+    velocity (it would be energy from nowhere). A joint limit's row in the correction is one
+    the step started on (keep_correction_rows), held like a joint's equality: its move
+    (the second-order term of a limited joint turning with its bodies, a slide held out
+    on its limit by a spin) becomes velocity as a pin's does, so that its impulses, which
+    act between the two bodies, keep the momenta as SHAKE's do."""
+    return is_normal_row(kind)
 
 
 @kernel(inline="always")
 def move_by_correction(m, s, ws, h, n, unilateral):
     """Move the bodies by the correction whose matrix ws holds factored and whose targets -c
     are in ws.rhs (ws.row_c: a copy of them): positions by W J^T lam, velocities by the same
-    over h (bilateral rows) or by -c / h on the bilateral rows only (with unilateral ones)."""
+    over h, or, with contact normal rows among them (moves_without_velocity), by -c / h on
+    the other rows and not at all along the normals."""
     substitute_ws(ws, ws.rhs, ws.lam, n, False)
     for i in range(ws.dq_correction.shape[0]):
         for k in range(3):
@@ -490,12 +502,12 @@ def move_by_correction(m, s, ws, h, n, unilateral):
         # velocities by the same correction / h
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
     else:
-        # velocities: bilateral rows change by -c / h, unilateral rows not at all (a
+        # velocities: the other rows change by -c / h, contact normals not at all (a
         # separate solve: zeroing the unilateral impulses of the position solve instead
         # leaves a pinned foot, held by its contact against a rod, moving at rod-fix / h)
         # (same matrix: its factors are reused)
         for r in range(n):
-            ws.rhs[r] = 0.0 if is_unilateral(ws.row_kind[r]) else ws.row_c[r] / h
+            ws.rhs[r] = 0.0 if moves_without_velocity(ws.row_kind[r]) else ws.row_c[r] / h
         substitute_ws(ws, ws.rhs, ws.lam, n, False)
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
     for i in range(s.q.shape[0]):
