@@ -35,7 +35,12 @@ class State(NamedTuple):
     ext_force : (n_body, 3) [N, N, N m]   external force and torque held until changed (pushes)
     last_contact_impulse : (n_contact, 2) [N s]   normal, tangential impulse of the last step
     last_pin_impulse : (n_pin, 4) [N s, N s, N m s, N m s]   x, y, lower, upper limit impulse
-    last_rod_impulse : (n_rod,) [N s]     of the last step; the next step's solve starts from
+    last_rod_impulse : (n_rod,) [N s]     of the last step (the velocity solve's plus the share of
+                                          the position correction's that became velocity, so that
+                                          over a run they add up to the momentum the joint moved;
+                                          a complementarity projection's are not included, and a
+                                          step taken in turn sub-steps keeps its last one's); the
+                                          next step's solve starts from
                                           them (kernels/solver/warm_start.py): a closed loop whose
                                           load split is not unique keeps the last one
     contact_feature : (n_contact,) int    the features a shape pair's slot touched with in the
@@ -245,6 +250,11 @@ class Workspace(NamedTuple):
     v_keep: np.ndarray           #   correction (put back if the step diverges)
     dq_correction: np.ndarray    # (n_body, 3) a position correction's move [m, rad] (Newton, projection)
     dv_correction: np.ndarray    # (n_body, 3) its change of velocity [m/s, rad/s] (joints: move / h)
+    pin_impulse_moved: np.ndarray  # (n_pin, 4) [N s or N m s] the Newton correction's velocity
+    rod_impulse_moved: np.ndarray  # (n_rod,) [N s]   impulses of this step, per joint row as in
+                                 #   State.last_pin_impulse (integrate.record_moved_impulses)
+    correction_kept: np.ndarray  # (1,) share of the correction's velocity change that
+                                 #   bound_correction_work kept (1: all)
     q_solved: np.ndarray         # (n_body, 3) q integrated with v_solved, before the position
                                  #   correction (its work is measured from here)
     v_solved: np.ndarray         # (n_body, 3) velocity the contact solve ended at, before the
@@ -786,6 +796,8 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      friction_slip=z(npin), friction_bound=z(npin), friction_J=z((npin, 2, 3)),
                      q_pred=z((nb, 3)), cs_pred=np.full((nb, 3), np.nan), q_keep=z((nb, 3)),
                      v_keep=z((nb, 3)), dq_correction=z((nb, 3)), dv_correction=z((nb, 3)),
+                     pin_impulse_moved=z((npin, 4)), rod_impulse_moved=z(model.n_rod),
+                     correction_kept=np.ones(1),
                      q_solved=z((nb, 3)), v_solved=z((nb, 3)),
                      contact_point=z((nc, 2)), contact_ground=z((nc, 2)),
                      contact_normal=z((nc, 2)), contact_gap=z(nc), contact_stale=z(nc, np.int64),

@@ -31,7 +31,8 @@ from .checks.guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, 
                             end_checks_alone, note_start_depths, note_start_limits,
                             start_path)
 from .info import INFO_CHAIN_PATH, INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
-from .dynamics.integrate import (bound_correction_work, integrate_positions, predict_configuration)
+from .dynamics.integrate import (bound_correction_work, commit_moved_impulses, integrate_positions,
+                                 predict_configuration)
 from .constraints.joint_friction import start_joint_friction, stick_all, switch_joint_friction
 from .math2d import update_trig
 from .solver.modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
@@ -882,6 +883,7 @@ def chain_part(m, s, ws, opt, u, h):
     if passes > 0 and bound_correction_work(
             m, s, ws, h, ws.joints_open[0] == 1 and ws.joint_pivot[0] >= NEAR_DEPENDENT) > 0.0:
         return CHAIN_AGAIN
+    commit_moved_impulses(s, ws)
     s.time[0] = ws.prev.time[0] + h
     s.step[0] += 1
     if (end_checks_alone(m, s, ws, h, opt.guard_limit, opt.speed_limit,    # 9. guards

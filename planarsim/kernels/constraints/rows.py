@@ -203,35 +203,51 @@ def last_impulse(s, ws, r):
         return s.last_contact_impulse[o, 0]
     if kind == ROW_CONTACT_T:
         return s.last_contact_impulse[o, 1]
-    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-        return s.last_pin_impulse[o, pin_axis(kind)]
-    if kind == ROW_SLIDE_PERP:
-        return s.last_pin_impulse[o, 0]
-    if kind == ROW_SLIDE_ANGLE:
-        return s.last_pin_impulse[o, 1]
-    if is_limit_row(kind):
-        return s.last_pin_impulse[o, 2 + limit_side(kind)]
-    if kind == ROW_ROD:
+    table, o, col = joint_impulse_slot(ws, r)
+    if table == 0:
+        return s.last_pin_impulse[o, col]
+    if table == 1:
         return s.last_rod_impulse[o]
     return 0.0
+
+
+@kernel(inline="always")
+def joint_impulse_slot(ws, r):
+    """Where row r's impulse is kept: (table, owner, column), table 0 for the pins' (State.
+    last_pin_impulse's layout: pins, sliders, limits), 1 for the rods' (column 0), -1 for a
+    row whose impulse is kept per contact (modes.gather_contact_impulses) or not at all (a
+    soft row)."""
+    o = ws.row_owner[r]
+    kind = ws.row_kind[r]
+    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
+        return 0, o, pin_axis(kind)
+    if kind == ROW_SLIDE_PERP:
+        return 0, o, 0
+    if kind == ROW_SLIDE_ANGLE:
+        return 0, o, 1
+    if is_limit_row(kind):
+        return 0, o, 2 + limit_side(kind)
+    if kind == ROW_ROD:
+        return 1, o, 0
+    return -1, o, 0
+
+
+@kernel
+def add_joint_impulse(pins, rods, ws, r, lam, add):
+    """Joint row r's impulse lam [N s or N m s] into its slot (joint_impulse_slot) of pins
+    (n_pin, 4) and rods (n_rod,): added to it (add) or in place of it."""
+    table, o, col = joint_impulse_slot(ws, r)
+    if table == 0:
+        pins[o, col] = pins[o, col] + lam if add else lam
+    elif table == 1:
+        rods[o] = rods[o] + lam if add else lam
 
 
 @kernel
 def store_joint_impulse(s, ws, r, lam):
     """Joint row r's impulse lam [N s] into the State (pins, sliders, limits, rods; a contact's
     are gathered per contact, modes.gather_contact_impulses; a soft row's is not kept)."""
-    o = ws.row_owner[r]
-    kind = ws.row_kind[r]
-    if kind == ROW_PIN_X or kind == ROW_PIN_Y:
-        s.last_pin_impulse[o, pin_axis(kind)] = lam
-    elif kind == ROW_SLIDE_PERP:
-        s.last_pin_impulse[o, 0] = lam
-    elif kind == ROW_SLIDE_ANGLE:
-        s.last_pin_impulse[o, 1] = lam
-    elif is_limit_row(kind):
-        s.last_pin_impulse[o, 2 + limit_side(kind)] = lam
-    elif kind == ROW_ROD:
-        s.last_rod_impulse[o] = lam
+    add_joint_impulse(s.last_pin_impulse, s.last_rod_impulse, ws, r, lam, False)
 
 
 @kernel(inline="never")

@@ -26,9 +26,9 @@ from ..constraints.limit import limit_side
 from ..constraints.row_list import move_row
 from ..constraints.joint_friction import is_joint_friction_row
 from ..constraints.joints import joint_position_rate
-from ..constraints.rows import (eval_rows, is_angular_row, is_contact_row, is_limit_row,
-                                is_normal_row, is_soft_row, is_tangent_row, is_unilateral,
-                                row_lever)
+from ..constraints.rows import (add_joint_impulse, eval_rows, is_angular_row, is_contact_row,
+                                is_limit_row, is_normal_row, is_soft_row, is_tangent_row,
+                                is_unilateral, row_lever)
 from ..solver.matrix import add_to_diagonal, arrange, assemble, factor_ws, substitute_ws
 from ..constraints.soft import SOFT_ARMATURE
 from ..solver.solve import apply_impulses, row_dot
@@ -168,6 +168,7 @@ def bound_correction_work(m, s, ws, h, symplectic):
     kept whole (the energy oscillates by about (h w)^2 of it and comes back; cutting the rises
     alone ratcheted a coarse step's energy down: RATTLE -50 % in 10 s, a double pendulum at
     dt 0.02 by the default step -22 J of 30 J in 60 s)."""
+    ws.correction_kept[0] = 1.0
     a = 0.0
     b = 0.0
     kinetic = 0.0
@@ -219,6 +220,7 @@ def bound_correction_work(m, s, ws, h, symplectic):
     if short:
         k = -a / (2.0 * b) if b > 0.0 else 1.0
     k = min(max(k, 0.0), 1.0)
+    ws.correction_kept[0] = k
     for i in range(s.v.shape[0]):
         for c in range(3):
             s.v[i, c] = ws.v_solved[i, c] + k * (s.v[i, c] - ws.v_solved[i, c])
@@ -510,10 +512,49 @@ def move_by_correction(m, s, ws, h, n, unilateral):
             ws.rhs[r] = 0.0 if moves_without_velocity(ws.row_kind[r]) else ws.row_c[r] / h
         substitute_ws(ws, ws.rhs, ws.lam, n, False)
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
+    record_moved_impulses(ws, n, velocity_share(h, unilateral))
     for i in range(s.q.shape[0]):
         for k in range(3):
             s.q[i, k] += ws.dq_correction[i, k]
             s.v[i, k] += ws.dv_correction[i, k]
+
+
+@kernel(inline="always")
+def velocity_share(h, unilateral):
+    """What move_by_correction's ws.lam is multiplied by to give its velocity impulses [1/s
+    or 1]: 1 / h where the move itself became velocity, 1 where a second solve gave it."""
+    return 1.0 / h if unilateral == 0 else 1.0
+
+
+@kernel
+def record_moved_impulses(ws, n, scale):
+    """The joint rows' impulses ws.lam (rows 0..n-1) times scale added to the step's
+    correction impulses (ws.pin_impulse_moved, ws.rod_impulse_moved): a correction's
+    velocity change (scale -1 / h or -1: one taken back)."""
+    for r in range(n):
+        add_joint_impulse(ws.pin_impulse_moved, ws.rod_impulse_moved, ws, r,
+                          scale * ws.lam[r], True)
+
+
+@kernel
+def clear_moved_impulses(ws):
+    """No correction impulses yet this step (record_moved_impulses)."""
+    ws.pin_impulse_moved[:] = 0.0
+    ws.rod_impulse_moved[:] = 0.0
+    ws.correction_kept[0] = 1.0
+
+
+@kernel
+def commit_moved_impulses(s, ws):
+    """The correction's velocity impulses, at the share of its velocity change that
+    bound_correction_work kept, added to the impulses the step records (State.last_pin_impulse,
+    last_rod_impulse: the velocity solve's), so that they are the joints' whole impulses."""
+    kept = ws.correction_kept[0]
+    for j in range(s.last_pin_impulse.shape[0]):
+        for k in range(4):
+            s.last_pin_impulse[j, k] += kept * ws.pin_impulse_moved[j, k]
+    for j in range(s.last_rod_impulse.shape[0]):
+        s.last_rod_impulse[j] += kept * ws.rod_impulse_moved[j]
 
 
 @kernel(inline="always")
@@ -577,6 +618,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 s.q[i, k] = ws.q_keep[i, k]
                 s.v[i, k] = ws.v_keep[i, k]
+        record_moved_impulses(ws, n, -velocity_share(h, unilateral))    # (ws.lam: its own)
         worst = max_residual(m, s, ws)
         ws.info[INFO_NEWTON_TAKEN_BACK] += 1
         if ptol >= LOOSE_PIVOT_TOL:

@@ -9,7 +9,9 @@ position_stage(m, s, ws, opt, h, answered):
      the complementarity projection where one is above a tenth of its audit tolerance
      (complementarity.project_positions), the audit of what is left;
   5. bound_correction_work: the velocity change of a correction or projection kept only as
-     far as it adds no energy beyond its allowance (audited: correction_work).
+     far as it adds no energy beyond its allowance (audited: correction_work); the share of
+     the correction's impulses kept is added to the joints' recorded impulses
+     (integrate.commit_moved_impulses).
 """
 import math
 
@@ -20,8 +22,9 @@ from ..checks.audit import (AUDIT_CORRECTION_WORK, DEPTH_TOL, PIN_GAP_TOL, audit
 from ..solver.complementarity import project_positions
 from ..codes import INTEGRATOR_EULER
 from ..info import INFO_PROJECTIONS
-from .integrate import (bound_correction_work, correct_positions, integrate_positions,
-                        keep_correction_rows, rows_hold_within)
+from .integrate import (bound_correction_work, clear_moved_impulses, commit_moved_impulses,
+                        correct_positions, integrate_positions, keep_correction_rows,
+                        rows_hold_within)
 from ..math2d import update_trig
 from ..checks.work import NEAR_DEPENDENT, gravity_lift, judge_energy, most_gaining_body
 from ..constraints.joints import is_slider
@@ -117,6 +120,7 @@ def position_stage(m, s, ws, opt, h, answered):
     """Stage 8 (the module's docstring) after a velocity solve over a step of h [s];
     answered: a linear solve's answer stood (its rows' envelope in ws is reused)."""
     integrate_positions(s, ws, ws.v_new, h)
+    clear_moved_impulses(ws)
     kept_all = keep_correction_rows(s, ws) == 0
     # the solve's envelope stands where its rows all stay (no need to compute it again)
     envelope_ready = answered and kept_all
@@ -147,3 +151,5 @@ def position_stage(m, s, ws, opt, h, answered):
                 # which moves a start below the ground to the surface (start_check names it)
                 if s.step[0] > 0:
                     judge_energy(m, ws, opt, h, excess - gravity_lift(m, s, ws))
+        if corrected:
+            commit_moved_impulses(s, ws)

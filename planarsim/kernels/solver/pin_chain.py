@@ -30,7 +30,7 @@ State alone.
 import math
 
 from ...compile import kernel
-from ..dynamics.integrate import STALLED_RATIO
+from ..dynamics.integrate import STALLED_RATIO, clear_moved_impulses
 from ..math2d import rotate, update_trig
 from ..checks.work import VELOCITY_FLOOR, WORK_REL_TOL, fastest
 
@@ -339,15 +339,26 @@ def lever_joint_work(m, ws, v):
 
 
 @kernel
+def record_lever_impulses(ws, inv_h):
+    """integrate.record_moved_impulses on the levers: a correction pass's impulses ws.lam
+    (rows 2j, 2j + 1 of pin j) over h added to the pins' (ws.pin_impulse_moved)."""
+    for j in range(ws.pin_impulse_moved.shape[0]):
+        ws.pin_impulse_moved[j, 0] += inv_h * ws.lam[2 * j]
+        ws.pin_impulse_moved[j, 1] += inv_h * ws.lam[2 * j + 1]
+
+
+@kernel
 def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
     """Stage 8's Newton-SHAKE on the levers, integrate.correct_positions' passes: up to iters
     of J(q) W J0^T mu = -c(q), q += W J0^T mu, v += W J0^T mu / h until every gap is within
     tol [m] (a pass after one that left every gap within CHORD_TOL reuses its factorisation;
     one more pass on the last factorisation after the last, as correct_positions takes it:
-    the end's derivative becomes the converged correction's); returns (the largest gap left, or -1: a pass that removed less than half
+    the end's derivative becomes the converged correction's; each pass's impulses over h into
+    ws.pin_impulse_moved, record_lever_impulses); returns (the largest gap left, or -1: a pass that removed less than half
     of it, a pivot share at or below pivot_tol, the general stages take the step; the passes
     taken). ws.body_cs holds the cos / sin of the step's start on entry, of q on a return with
     a gap >= 0."""
+    clear_moved_impulses(ws)
     carry_trig(s.q, ws.body_cs, ws.chain_cs)
     worst = lever_gaps(m, s.q, ws.chain_cs, ws, 2)
     fresh = True
@@ -360,6 +371,7 @@ def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
             return -1.0, passes
         chain_solve(ws, ws.rhs, ws.lam)
         lever_move(m, ws, ws.lam, s.q, 1.0, s.v, inv_h)
+        record_lever_impulses(ws, inv_h)
         carry_trig(s.q, ws.chain_cs, ws.chain_cs)
         after = lever_gaps(m, s.q, ws.chain_cs, ws, 2)
         if after > STALLED_RATIO * worst:
@@ -370,5 +382,6 @@ def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
     if passes > 0 and 0.0 < worst <= tol:
         chain_solve(ws, ws.rhs, ws.lam)
         lever_move(m, ws, ws.lam, s.q, 1.0, s.v, inv_h)
+        record_lever_impulses(ws, inv_h)
     update_trig(s.q, ws.body_cs)
     return worst, passes

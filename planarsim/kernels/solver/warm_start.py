@@ -6,8 +6,9 @@ ground: a box on two corners, two feet in double stance), the answer is a load s
 many: the linear solve drops a dependent row, and the impulse that row keeps decides the
 split. At zero, that split pulls or leaves friction outside its cone at rest, and every
 resting step went to the complementarity solve. So where the factorisation dropped a row,
-the solve starts from the last step's impulses and finds the change from them: the dropped
-rows keep theirs, and a resting loop, whose change is then zero, keeps its split bit for bit.
+the solve starts from the last step's impulses (as the State records them: the velocity
+solve's and the share of the position correction's that became velocity) and finds the
+change from them: the dropped rows keep theirs, and a resting loop, whose change is then zero, keeps its split bit for bit.
 The impulses live in the State (last_*_impulse), so a restored run continues bit for bit.
 """
 from ...compile import kernel
