@@ -14,8 +14,9 @@ column of A = d x1 / d x and B = d x1 / d u in one batched replay. The step it r
     v_lin = W_D (E_A v + h f(q, u)),          q_pred = q + h v_lin,
     P W_D F^T lam = -b,   v_new = v_lin + W_D F^T lam,
     q1 = q + h v_new + W_A P^T mu with every row held at q1 (Newton, along the start's rows),
-    v1 = v_new + the correction's velocity change (its move / h for the joints; nothing along
-         a contact's normal, which moves positions only), as far as its energy bound keeps it,
+    v1 = v_new + the correction's velocity change (its move / h for the joints and limits;
+         nothing along a contact's normal, which moves positions only), as far as its energy
+         bound keeps it,
 
 P the rows at the step's start: the joints' (a hinge's x and y, a slider's perpendicular and
 angle rows) and the touching ground contacts' (a normal row; a sticking contact's tangent

@@ -11,8 +11,9 @@ batch of starts (B, 3 n) with those decisions held:
     P W_D F^T lam = -b,     b_joint = c(q_pred) / h,     b_contact = c(q0)^+ / h + P v_lin,
     v_new = v_lin + W_D F^T lam,
     q <- q0 + h v_new, then the Newton passes G(q) W_A P^T mu = -c(q), q += W_A P^T mu,
-    v += W_A P^T mu / h (joints only) or W_A P^T kappa, G W_A P^T kappa = S (-c(q)) / h (S:
-    1 on the bilateral rows, 0 on the contacts' normal rows, which move positions only),
+    v += W_A P^T mu / h (joints and limits only) or W_A P^T kappa, G W_A P^T kappa =
+    S (-c(q)) / h (S: 1 on the joints' and limits' rows, 0 on the contacts' normal rows,
+    which move positions only),
     one more pass on the last factorisation where the engine takes one,
     v1 = v_new + k (v - v_new), k the energy bound's share (kernels/dynamics/integrate.py).
 
@@ -671,8 +672,13 @@ def replica(plan: StepPlan, q0, v0, u):
         kept_order = np.array([order[np.searchsorted(keep, r)] for r in plan.order
                                if r in set(keep.tolist())], dtype=np.int64)
         c, G = c[:, keep], G[:, keep]
-        S = (~unilateral_c).astype(float)
-        any_unilateral = bool(unilateral_c.any())
+        # the contacts' normal rows move positions only; a joint limit's row (one the step
+        # started on) is corrected as a joint's: its move becomes velocity
+        # (integrate.moves_without_velocity)
+        still = np.concatenate([np.zeros(mj + plan.limits.shape[0], bool),
+                                contact_unilateral(cp)])[keep]
+        S = (~still).astype(float)
+        any_unilateral = bool(still.any())
         worst = np.abs(c[0].real).max(initial=0.0) if deciding else None
         passes, stalled = 0, False
         Nn = None
