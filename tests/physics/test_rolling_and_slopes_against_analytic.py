@@ -50,8 +50,8 @@ DEFECTS = {
         "same rule (test_map_jacobian, test_frictionless failed), a box-and-disk scene moved 1 "
         "km and mirrored then differed by 1.3e-9 m (bound 1e-9), and SIMBICON at half its dt "
         "walked a limp of steps 1.43e-5 m apart, the same at 12 s and 20 s (1.7e-7 before), "
-        "at a quarter of it steps 4.4e-5 m apart after 12 s: the rule's threshold on the "
-        "start's gap is a discontinuity a foot's contacts cross"),
+        "at a quarter of it steps 4.4e-5 m apart after 12 s (suspected: the rule's threshold on the "
+        "start's gap is a discontinuity a foot's contacts cross)"),
     "hills_energy": (
         "over the default hills a disk rolling without slip (r 0.1 m, I = m r^2 / 2) and a "
         "point mass sliding without friction, each touching throughout (one mode the whole "
