@@ -11,8 +11,9 @@ Safeguards: a Newton step that raises the largest error tenfold (nearly dependen
 closed loop through the ground) is taken back and tried once more with such rows dropped;
 one that removes less than half of it has stalled on a row dropped as dependent, and ends
 the correction.
-Corrections of unilateral rows (contact normals, joint limits) move positions only: pushing a
-body out of the ground must not give it the velocity overlap / h (energy from nowhere).
+Corrections of contact normals move positions only: pushing a body out of the ground must not
+give it the velocity overlap / h (energy from nowhere). A joint limit the step started on is
+corrected as a joint is, its move becoming velocity (moves_without_velocity).
 rows_hold_within proves, from the rows the solve already built, when the correction would
 find nothing to do (bodies at rest or translating), so the step skips it exactly.
 """
@@ -469,12 +470,13 @@ def max_residual(m, s, ws):
 @kernel(inline="always")
 def keep_targets(ws, n):
     """ws.row_c <- the correction's targets -c in ws.rhs (rows 0..n-1; row_c is free then),
-    kept for its velocity solve; returns how many rows are unilateral."""
-    unilateral = 0
+    kept for its velocity solve; returns how many rows move positions only
+    (moves_without_velocity)."""
+    still = 0
     for r in range(n):
         ws.row_c[r] = ws.rhs[r]
-        unilateral += moves_without_velocity(ws.row_kind[r])
-    return unilateral
+        still += moves_without_velocity(ws.row_kind[r])
+    return still
 
 
 @kernel(inline="always")
@@ -489,7 +491,7 @@ def moves_without_velocity(kind):
 
 
 @kernel(inline="always")
-def move_by_correction(m, s, ws, h, n, unilateral):
+def move_by_correction(m, s, ws, h, n, still):
     """Move the bodies by the correction whose matrix ws holds factored and whose targets -c
     are in ws.rhs (ws.row_c: a copy of them): positions by W J^T lam, velocities by the same
     over h, or, with contact normal rows among them (moves_without_velocity), by -c / h on
@@ -500,7 +502,7 @@ def move_by_correction(m, s, ws, h, n, unilateral):
             ws.dq_correction[i, k] = 0.0
             ws.dv_correction[i, k] = 0.0
     apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
-    if unilateral == 0:
+    if still == 0:
         # velocities by the same correction / h
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
     else:
@@ -512,7 +514,7 @@ def move_by_correction(m, s, ws, h, n, unilateral):
             ws.rhs[r] = 0.0 if moves_without_velocity(ws.row_kind[r]) else ws.row_c[r] / h
         substitute_ws(ws, ws.rhs, ws.lam, n, False)
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
-    record_moved_impulses(ws, n, velocity_share(h, unilateral))
+    record_moved_impulses(ws, n, velocity_share(h, still))
     for i in range(s.q.shape[0]):
         for k in range(3):
             s.q[i, k] += ws.dq_correction[i, k]
@@ -520,10 +522,10 @@ def move_by_correction(m, s, ws, h, n, unilateral):
 
 
 @kernel(inline="always")
-def velocity_share(h, unilateral):
+def velocity_share(h, still):
     """What move_by_correction's ws.lam is multiplied by to give its velocity impulses [1/s
     or 1]: 1 / h where the move itself became velocity, 1 where a second solve gave it."""
-    return 1.0 / h if unilateral == 0 else 1.0
+    return 1.0 / h if still == 0 else 1.0
 
 
 @kernel
@@ -592,12 +594,12 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 ws.q_keep[i, k] = s.q[i, k]
                 ws.v_keep[i, k] = s.v[i, k]
-        unilateral = keep_targets(ws, n)
+        still = keep_targets(ws, n)
         normals_now(m, ws, n)
         assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
         correction_compliance(ws, n)
         factor_ws(ws, n, ptol, False)
-        move_by_correction(m, s, ws, h, n, unilateral)
+        move_by_correction(m, s, ws, h, n, still)
         after = max_residual(m, s, ws)
         if after <= STALLED_RATIO * worst:
             worst = after
@@ -618,7 +620,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
             for k in range(3):
                 s.q[i, k] = ws.q_keep[i, k]
                 s.v[i, k] = ws.v_keep[i, k]
-        record_moved_impulses(ws, n, -velocity_share(h, unilateral))    # (ws.lam: its own)
+        record_moved_impulses(ws, n, -velocity_share(h, still))    # (ws.lam: its own)
         worst = max_residual(m, s, ws)
         ws.info[INFO_NEWTON_TAKEN_BACK] += 1
         if ptol >= LOOSE_PIVOT_TOL:
