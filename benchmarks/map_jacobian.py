@@ -12,7 +12,8 @@
 - convergence: the multipliers from the exact Jacobian at the gait as dt halves (1e-3, 5e-4,
   2.5e-4 s), against the rimless wheel's closed form eta^2 and the scipy reference's
   variational equations for the simplest walker (foot mass ratio 1e-3), with Richardson's
-  extrapolation at the map's order (first for the wheel, second for the simplest walker).
+  extrapolation at the map's order (second for both: the wheel's pivot is a held contact,
+  which aims at its gap to second order).
 - doublings: the simplest walker's first three period doublings by continuation with the
   exact Jacobians, and the ratio of their spacings.
 """
@@ -103,7 +104,7 @@ def newton(refs):
 def convergence(refs):
     print("== multipliers from the exact Jacobian against dt, and Richardson's extrapolation")
     for name, (params, x0, truth) in refs.items():
-        order = 1 if name == "rimless-wheel" else 2
+        order = 2
         lams = []
         for dt in DTS:
             t = time.perf_counter()

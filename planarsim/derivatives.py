@@ -583,7 +583,8 @@ def _touching_contacts(model, start, modes, slips, features):
                        pinned=np.array(pinned, dtype=bool), mu_slip=np.array(mu_slip),
                        terrain=coef, normal=flat_normal, offset=float(h0 * flat_normal[1]),
                        point_mass=a.body_inv_inertia[body] == 0.0,
-                       pair=np.array(pairs, dtype=np.int64).reshape(-1, 8), model=model)
+                       pair=np.array(pairs, dtype=np.int64).reshape(-1, 8), model=model,
+                       was_touching=np.asarray(start.contact_mode)[touching] != MODE_FREE)
 
 
 def _pair_features(model, c, feature):

@@ -286,6 +286,8 @@ class Workspace(NamedTuple):
                                  #   material points where the contact touched at the step's
                                  #   start (each in its body's frame) [m]
     contact_radii: np.ndarray    # (n_contact, 2) radius of the reference and the other shape [m]
+    contact_curve: np.ndarray    # (n_contact,) the second-order part of a held contact's normal
+                                 #   velocity target (solve.held_contact_curve) [m/s]
     contact_bounce: np.ndarray   # (n_contact,) normal velocity restitution asks for [m/s]
     manifold: np.ndarray         # (2, 10) the narrow phase's points (kernels/geometry/collide.py)
     shape_reach: np.ndarray      # (n_shape, 4) each shape's bounding circle in the world (x, y,
@@ -809,6 +811,7 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                                              axis=1).reshape(nc, 2).copy(),
                      contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
                      contact_refpt=z((nc, 4)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
+                     contact_curve=z(nc),
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
                      **lists, **_solve_arrays(model, contacts, profile, lcp_rows),
                      n_row=z(1, np.int64), act_u=z(na), act_power=z(na),

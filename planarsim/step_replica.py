@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .kernels.constraints.rows import HELD_GAP
 from .kernels.codes import JOINT_FREE_BIT, JOINT_HINGE, JOINT_SLIDE_BIT, JOINT_SLIDER
 from .kernels.dynamics.integrate import DIVERGED_GROWTH, ROUNDING, STALLED_RATIO
 from .kernels.checks.work import (CONSTRAINT_SHARE, CORRECTION_MOVE_FLOOR, RELATIVE_ROUNDING,
@@ -59,6 +60,7 @@ class ContactPlan:
     offset: float = 0.0         # [m] n . (any ground point) there
     point_mass: np.ndarray | None = None   # (k,) bool: on a body without rotational inertia
     model: object = None
+    was_touching: np.ndarray | None = None  # (k,) bool: its mode at the step's start not free
 
     @property
     def count(self) -> int:
@@ -99,6 +101,7 @@ class StepPlan:
     extra_pass: bool | None = None
     bound: dict | None = None   # the energy bound's branch (None: decide)
     shake_whole: bool = False   # the engine kept the correction whole as SHAKE's (its regime)
+    held_m: np.ndarray | None = None     # the mode rows held from the start (held_rows)
     lifted: np.ndarray | None = None     # the mode rows whose start is off their surface
     solved: np.ndarray | None = None     # the velocity solve's independent rows
     kept: np.ndarray | None = None       # the rows the correction keeps (none leaving)
@@ -419,6 +422,59 @@ def contact_rows(cp, q, q0, n_coord):
     return c, J, F
 
 
+
+
+def ground_second_order(plan, q0, v0, held) -> np.ndarray:
+    """(B, m) over mode_rows' rows: the second-order part [m] of each held ground contact's gap
+    over the step at the start's velocity (kernels/geometry/contacts.py ground_second_order:
+    the turn's n . ((cos t - 1) a + (sin t - t) a_perp), t = h w, and on hills the ground's
+    curvature gap(p + e) - gap(p) - n . e); 0 on the other rows."""
+    cp, h = plan.contacts, plan.h
+    n = plan.model.n_body
+    q, v = q0.reshape(-1, n, 3), v0.reshape(-1, n, 3)
+    out = np.zeros((q.shape[0], held.shape[0]), dtype=np.result_type(q0, v0))
+    r = plan.limits.shape[0]
+    for k in range(cp.count):
+        if held[r]:
+            b = int(cp.body[k])
+            arm = _turn(q, b, cp.local[k])
+            t = h * v[:, b, 2]
+            c1 = -2.0 * np.sin(0.5 * t) ** 2
+            s1 = np.sin(t) - t
+            d = c1[:, None] * arm + s1[:, None] * np.stack([-arm[:, 1], arm[:, 0]], axis=-1)
+            point = q[:, b, :2] + arm
+            g, nrm = ground_point(cp, point)
+            part = np.sum(nrm * d, axis=-1)
+            if cp.terrain[2] != 0.0:
+                e = h * (v[:, b, :2] + v[:, b, 2:3] * np.stack([-arm[:, 1], arm[:, 0]], axis=-1)) + d
+                g1, n1 = ground_point(cp, point + e)
+                part = part + (np.sum(n1 * (point + e - g1), axis=-1)
+                               - np.sum(nrm * (point - g), axis=-1) - np.sum(nrm * e, axis=-1))
+            out[:, r] = part
+        r += 2 if cp.pinned[k] else 1
+    return out
+
+
+def held_rows(plan, c0, approach) -> np.ndarray:
+    """(m,) bool over mode_rows' rows: the normal row of a ground contact held from the step's
+    start (touching then, or within HELD_GAP of its surface and not approaching it:
+    constraints/rows.held_contact), whose velocity target takes its second-order part; a
+    shape pair's never (its target is first order)."""
+    cp = plan.contacts
+    out = [False] * plan.limits.shape[0]
+    r = plan.limits.shape[0]
+    for k in range(cp.count):
+        was = cp.was_touching is not None and bool(cp.was_touching[k])
+        pair = cp.pair is not None and cp.pair[k, 0] > -2
+        out.append(not pair and (was or (abs(float(c0[r])) <= HELD_GAP
+                                         and float(approach[r]) <= HELD_GAP)))
+        r += 1
+        if cp.pinned[k]:
+            out.append(False)
+            r += 1
+    return np.array(out, dtype=bool)
+
+
 def contact_unilateral(cp) -> np.ndarray:
     """(m,) bool over contact_rows' rows: a normal row (moves positions only in the correction)."""
     out = []
@@ -523,7 +579,7 @@ def turning_forces(plan, q, u):
     return f.reshape(B, 3 * n)
 
 
-def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
+def _kept_rows(plan, c, unilateral, q, v, mj, v_start=None) -> np.ndarray:
     """The rows the Newton correction keeps (kernels/dynamics/integrate.py drop_leaving_rows): all but
     a unilateral row open at q (the start plus h v_new) by more than the step's turning
     explains (pull_allowance: the body leaves the surface, a disk rolling over a crest), and
@@ -545,6 +601,8 @@ def _kept_rows(plan, c, unilateral, q, v, mj) -> np.ndarray:
             if b < 0:
                 continue
             d = abs(h * vv[b, 2])
+            if v_start is not None:     # (integrate.pull_allowance: the step's turn too)
+                d += abs(h * (vv[b, 2] - v_start.reshape(n, 3)[b, 2]))
             allow += (0.5 * d * d + d * d * d / 6.0) * lever
             allow += ROUNDING * (1.0 + abs(qq[b, 0]) + abs(qq[b, 1]) + lever)
         return allow
@@ -615,6 +673,10 @@ def replica(plan: StepPlan, q0, v0, u):
     cp = plan.contacts
     cm0, Pm, Fm, unilateral_m = mode_rows(plan, q0, q0)
     mj = Pj.shape[1]
+    if deciding:
+        plan.held_m = held_rows(plan, cm0[0].real,
+                                -h * np.einsum("rk,k->r", Pm[0].real, v0[0].real))
+    held_m = plan.held_m
     unilateral = np.concatenate([np.zeros(mj, bool), unilateral_m])
     if deciding:
         # a row within refine_tol of its surface rests on it: its derivative across the
@@ -632,8 +694,12 @@ def replica(plan: StepPlan, q0, v0, u):
     Fd = np.concatenate([Pj, Fm], axis=1)
     m = P.shape[1]
     if m:
-        rhs = np.concatenate([-cj_pred / h,
-                              -target / h - np.einsum("brk,bk->br", Pm, v_lin)], axis=1)
+        rc = -target / h - np.einsum("brk,bk->br", Pm, v_lin)
+        if held_m.any():
+            # a held ground contact's normal: the second-order part of its gap
+            # (solve.held_contact_curve)
+            rc = rc - ground_second_order(plan, q0, v0, held_m) / h
+        rhs = np.concatenate([-cj_pred / h, rc], axis=1)
         WdFt = np.einsum("ij,brj->bir", plan.W_D, Fd)          # (B, 3n, m)
         N = np.einsum("brk,bks->brs", P, WdFt)
         if deciding:
@@ -665,7 +731,8 @@ def replica(plan: StepPlan, q0, v0, u):
                 first += 2 if cp.pinned[k] else 1
         c, G = _rows(plan, q, q0)
         if deciding:
-            plan.kept = _kept_rows(plan, c[0].real, unilateral, q[0].real, v[0].real, mj)
+            plan.kept = _kept_rows(plan, c[0].real, unilateral, q[0].real, v[0].real, mj,
+                                   v0[0].real)
         keep = plan.kept
         D, now, unilateral_c = D[:, :, keep], now[keep], unilateral[keep]
         order = np.argsort(np.argsort(keep))     # (positions of the kept rows among themselves)

@@ -71,13 +71,15 @@ def test_newton_and_the_multipliers_with_the_exact_jacobian(kind):
         exact.values, fit.values, fit.error)
 
 
-def test_the_rimless_wheels_multiplier_is_smooth_and_first_order():
+def test_the_rimless_wheels_multiplier_is_smooth_and_second_order():
     """The wheel's multiplier from the exact Jacobian: smooth as the touchdown moves through
     its sim step (six starts 2e-4 rad/s apart, more than a sim step's worth: the second
     differences of the multiplier within 1e-7, where the earlier sub-step to the touchdown
-    swung it by 2.5e-3 across each sim step), and first order in dt against its closed form
-    eta^2 (its pivot is a contact, whose correction moves positions only): the error halves
-    with dt within 1 %."""
+    swung it by 2.5e-3 across each sim step), and second order in dt against its closed form
+    eta^2: the pivot, a contact held through the stance, aims its velocity at its gap at the
+    free motion's end as a pin does, and the error falls fourfold per halving of dt within
+    1 % (measured 8.2e-7 at dt 1e-3, 2.1e-7 at 5e-4; when the held contact's target was first
+    order, 6.1e-4 and 3.0e-4)."""
     p = RimlessParams()
     eta2 = closed_form(p)["eta"] ** 2
     w, x = walker("rimless")
@@ -90,7 +92,7 @@ def test_the_rimless_wheels_multiplier_is_smooth_and_first_order():
         f = w.step_map()
         fp = find_fixed_point(f, x, tol=1e-13, exact=False)
         errors.append(multipliers_exact(f, fp.x).values[0].real - eta2)
-    assert 1.98 <= errors[0] / errors[1] <= 2.02, errors
+    assert 3.96 <= errors[0] / errors[1] <= 4.04, errors
 
 
 def test_on_hills_the_map_has_no_exact_jacobian_and_newton_takes_differences():

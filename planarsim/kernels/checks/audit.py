@@ -155,8 +155,9 @@ def audit_impulses(m, s, ws, opt, h):
             note(ws, step, AUDIT_CONE, i, b, abs(lt) - mu * ln)
             found += 1
         vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
-        # restitution's rebound (at most e times the approach speed) is work it may do
-        work = ln * (vn - ws.contact_bounce[i]) + lt * vt
+        # restitution's rebound (at most e times the approach speed) and a held contact's
+        # second-order target (solve.held_contact_curve) are work it may do
+        work = ln * (vn - ws.contact_bounce[i] - ws.contact_curve[i]) + lt * vt
         scale = WORK_REL_TOL * (abs(vn) + abs(vt)) + VELOCITY_FLOOR
         if work > size * scale and floor < 0.0:
             floor = _impulse_floor(ws)

@@ -27,12 +27,12 @@ direction F = n - mu s t carries the Coulomb friction -mu lambda_n s along the t
 import math
 
 from ...compile import kernel
-from ..codes import (CONTACT_PAIR, MODE_PINNED, MODE_SLIDING, ROW_CONTACT_N, ROW_CONTACT_T,
-                     ROW_JOINT_SOFT, ROW_LIMIT_HI, ROW_LIMIT_LO, ROW_PIN_X, ROW_PIN_Y, ROW_ROD,
-                     ROW_SLIDE_ANGLE, ROW_SLIDE_PERP)
+from ..codes import (CONTACT_EDGE, CONTACT_PAIR, MODE_FREE, MODE_PINNED, MODE_SLIDING,
+                     ROW_CONTACT_N, ROW_CONTACT_T, ROW_JOINT_SOFT, ROW_LIMIT_HI, ROW_LIMIT_LO,
+                     ROW_PIN_X, ROW_PIN_Y, ROW_ROD, ROW_SLIDE_ANGLE, ROW_SLIDE_PERP)
 from .joints import is_free_joint, is_slider, joint_rate_row
 from .joint_friction import add_friction_row, friction_row, is_joint_friction_row
-from ..geometry.contacts import ground_lever, ground_row
+from ..geometry.contacts import ground_lever, ground_row, ground_second_order
 from .limit import add_limit_rows, limit_row, limit_side
 from ..math2d import set_dir, world_point
 from ..geometry.pair import pair_row
@@ -283,6 +283,36 @@ def predict_joint_errors(m, ws, n):
         r += 1
 
 
+# [m] a contact free at the step's start but within this of its surface is held through the
+# step (held_contact), unless its start velocity approaches the surface (an impact)
+HELD_GAP = 1e-9
+
+
+@kernel(inline="always")
+def held_contact(m, ws, i):
+    """Ground contact i may be held through the step: touching at its start (its mode then
+    not free) or within HELD_GAP [m] of its surface (solve.held_contact_curve adds: and not
+    approaching it). Never a straight edge over curved ground: its contact is the edge's
+    deepest point, which slides along the edge as it turns, held as a material point for the
+    step only (geometry/contacts.find_edge), so that point's second-order motion is not the
+    edge's. Nor a pair of shapes (not yet: the second-order part of a gap between two turning
+    bodies)."""
+    if m.contact_kind[i] == CONTACT_EDGE or m.contact_kind[i] == CONTACT_PAIR:
+        return False
+    return ws.prev.contact_mode[i] != MODE_FREE or abs(ws.contact_gap[i]) <= HELD_GAP
+
+
+@kernel
+def predict_contact_parts(m, s, ws, n, h):
+    """row_c_pred[r] of a held ground contact's normal row (held_contact): the second-order
+    part of its gap over the step at the start's velocity (contacts.ground_second_order;
+    solve.held_contact_curve makes it part of the target)."""
+    for r in range(n):
+        if is_normal_row(ws.row_kind[r]) and held_contact(m, ws, ws.row_owner[r]):
+            ws.row_c_pred[r] = ground_second_order(m, s.q, ws.body_cs, s.v, ws,
+                                                   ws.row_owner[r], h)
+
+
 @kernel
 def add_contact_rows(ws, n, i, normal, tangent):
     """Append contact i's normal row (if normal) and tangent row (if tangent) at slot n, on
@@ -358,6 +388,8 @@ def build_rows(m, s, ws, h):
     ws.n_row[0] = n
     eval_rows(m, s.q, ws.body_cs, ws, ws.row_J, ws.row_c, n, True)
     predict_joint_errors(m, ws, n)
+    if m.contact_body.shape[0] > 0:
+        predict_contact_parts(m, s, ws, n, h)
     sliding = 0
     for r in range(n):
         if is_soft_row(ws.row_kind[r]):

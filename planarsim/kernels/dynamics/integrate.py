@@ -391,7 +391,9 @@ def pull_allowance(m, s, ws, r, h):
         lever = row_lever(m, ws, r, e)
         if lever == math.inf:
             return math.inf
-        d = abs(h * s.v[b, 2])
+        # and the turn the step added to the start's: a held contact's target takes the
+        # start's turn to second order (contacts.ground_second_order)
+        d = abs(h * s.v[b, 2]) + abs(h * (s.v[b, 2] - ws.prev.v[b, 2]))
         allow += (0.5 * d * d + d * d * d / 6.0) * lever
         allow += ROUNDING * (1.0 + abs(s.q[b, 0]) + abs(s.q[b, 1]) + lever)
     return allow

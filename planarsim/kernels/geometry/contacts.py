@@ -555,6 +555,43 @@ def ground_row(m, q, cs, ws, o, b, tangent, J, found):
     return tx * (px - ws.contact_ground[o, 0]) + ty * (py - ws.contact_ground[o, 1])
 
 
+@kernel(inline="always")
+def turn_less_linear(t):
+    """(cos t - 1, sin t - t) for a turn t [rad]: a turn's second-order parts, exactly 0 at
+    t = 0 (cos t - 1 as -2 sin^2(t / 2), without cancellation)."""
+    half = math.sin(0.5 * t)
+    return -2.0 * half * half, math.sin(t) - t
+
+
+@kernel
+def ground_second_order(m, q, cs, v, ws, o, h):
+    """The second-order part [m] of ground contact o's gap over a step of h [s] at velocity
+    v: gap(p(q + h v)) - gap(p(q)) - h J v, p its normal row's body point (a material point,
+    or a rolling sole's centre) and J the row at q (ground_row). Two parts, each computed
+    from small numbers, so that it is exact, and 0, where the motion is linear: the turn's,
+    n . ((cos t - 1) a + (sin t - t) a_perp) with t = h w and a the point's arm (the arm's
+    chord less its tangent), and on hills the ground's curvature, gap(p + e) - gap(p) - n . e
+    for the point's whole move e (flat and sloped ground have none)."""
+    b = m.contact_body[o]
+    if ws.contact_on_arc[o] == 1:
+        ax, ay = rotate(cs[b, 0], cs[b, 1], m.contact_local[o, 0], m.contact_local[o, 1])
+    else:
+        ax, ay = rotate(cs[b, 0], cs[b, 1], ws.contact_anchor[o, 0], ws.contact_anchor[o, 1])
+    c1, s1 = turn_less_linear(h * v[b, 2])
+    dx = c1 * ax - s1 * ay
+    dy = c1 * ay + s1 * ax
+    px = q[b, 0] + ax
+    py = q[b, 1] + ay
+    _, _, nx, ny, gap0 = ground_point(m.terrain_coef, px, py)
+    part = nx * dx + ny * dy
+    if m.terrain_coef[2] != 0.0:
+        ex = h * (v[b, 0] - v[b, 2] * ay) + dx
+        ey = h * (v[b, 1] + v[b, 2] * ax) + dy
+        gap1 = ground_point(m.terrain_coef, px + ex, py + ey)[4]
+        part += gap1 - gap0 - (nx * ex + ny * ey)
+    return part
+
+
 @kernel
 def ground_lever(m, ws, o, tangent):
     """|x| + |y| [m] from its body's COM of the point ground contact o's row moves: the sole's

@@ -157,7 +157,7 @@ def _lcp_once(m, s, ws, h):
         ws.limit_candidate[j, 1] = s.limit_active[j, 1]
     build_rows(m, s, ws, h)
     n = ws.n_row[0]
-    fill_row_b(ws, h, n)
+    fill_row_b(m, ws, h, n)
     ws.info[INFO_LCP_SOLVES] += 1
     ws.joint_pivot[0] = 1.0         # (the islands' joint blocks: mixed_lcp.solve_mixed_lcp)
     n_island, failed = _solve_by_islands(m, ws, n, 4)
