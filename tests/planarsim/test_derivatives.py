@@ -157,8 +157,10 @@ def relative_error(exact, approx, blocks=None):
     return worst
 
 
-#: the refusals that depend on the step taken, not on the model
-NOT_COVERED_STEPS = ("sub-steps", "do not reproduce")
+#: the refusals that depend on the step taken, not on the model (a projection of the positions
+#: after the correction: Walker2d at hypothesis seed 1987267, its limits hit under random
+#: commands, before and after held contacts' second-order targets alike)
+NOT_COVERED_STEPS = ("sub-steps", "do not reproduce", "a complementarity projection")
 
 
 def rotor_chain(masses, lengths, dt, rng):
