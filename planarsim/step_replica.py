@@ -441,12 +441,13 @@ def ground_second_order(plan, q0, v0, held) -> np.ndarray:
             t = h * v[:, b, 2]
             c1 = -2.0 * np.sin(0.5 * t) ** 2
             s1 = np.sin(t) - t
-            d = c1[:, None] * arm + s1[:, None] * np.stack([-arm[:, 1], arm[:, 0]], axis=-1)
+            perp = np.stack([-arm[:, 1], arm[:, 0]], axis=-1)
+            d = c1[:, None] * arm + s1[:, None] * perp
             point = q[:, b, :2] + arm
             g, nrm = ground_point(cp, point)
             part = np.sum(nrm * d, axis=-1)
             if cp.terrain[2] != 0.0:
-                e = h * (v[:, b, :2] + v[:, b, 2:3] * np.stack([-arm[:, 1], arm[:, 0]], axis=-1)) + d
+                e = h * (v[:, b, :2] + v[:, b, 2:3] * perp) + d
                 g1, n1 = ground_point(cp, point + e)
                 part = part + (np.sum(n1 * (point + e - g1), axis=-1)
                                - np.sum(nrm * (point - g), axis=-1) - np.sum(nrm * e, axis=-1))
@@ -579,14 +580,14 @@ def turning_forces(plan, q, u):
     return f.reshape(B, 3 * n)
 
 
-def _kept_rows(plan, c, unilateral, q, v, mj, v_start=None) -> np.ndarray:
+def _kept_rows(plan, c, unilateral, q, v, mj, v_start) -> np.ndarray:
     """The rows the Newton correction keeps (kernels/dynamics/integrate.py drop_leaving_rows): all but
     a unilateral row open at q (the start plus h v_new) by more than the step's turning
     explains (pull_allowance: the body leaves the surface, a disk rolling over a crest), and
     the tangent row of a contact whose normal row leaves. A row resting on its surface at the
     start (not lifted) is held: the engine may judge its opening of a few ulps either way,
     which moves the end by less than refine_tol, and the derivative across the surface is
-    the one from inside. c: every row's error at q (real)."""
+    the one from inside. c: every row's error at q (real); v_start: the velocity at the step's start."""
     model = plan.model
     a = model.arrays
     n = model.n_body
@@ -601,8 +602,8 @@ def _kept_rows(plan, c, unilateral, q, v, mj, v_start=None) -> np.ndarray:
             if b < 0:
                 continue
             d = abs(h * vv[b, 2])
-            if v_start is not None:     # (integrate.pull_allowance: the step's turn too)
-                d += abs(h * (vv[b, 2] - v_start.reshape(n, 3)[b, 2]))
+            # (integrate.pull_allowance: the step's turn too)
+            d += abs(h * (vv[b, 2] - v_start.reshape(n, 3)[b, 2]))
             allow += (0.5 * d * d + d * d * d / 6.0) * lever
             allow += ROUNDING * (1.0 + abs(qq[b, 0]) + abs(qq[b, 1]) + lever)
         return allow
