@@ -81,33 +81,57 @@ def carry_trig(q, cs_from, cs_to):
             cs_to[i, 2] = th
 
 
+@kernel(inline="always")
+def _forward(ws, rhs, scale, k, linked, p0, p1):
+    """Place k's step of the forward substitution: y_k = scale rhs_k - G_k y_{k-1} (linked:
+    place k - 1 holds the pin before k on its chain; p0, p1: y_{k-1}) into ws.chain_y[k];
+    returns y_k. scale 1 or 1 / h (the general solve's rhs / h, solve.fill_row_b)."""
+    f = ws.chain_factor
+    r = 2 * ws.chain_pin[k]
+    if scale != 1.0:
+        rhs[r] /= scale
+        rhs[r + 1] /= scale
+    y0 = rhs[r]
+    y1 = rhs[r + 1]
+    if linked:
+        y0 -= f[k, 4] * p0 + f[k, 5] * p1
+        y1 -= f[k, 6] * p0 + f[k, 7] * p1
+    ws.chain_y[k, 0] = y0
+    ws.chain_y[k, 1] = y1
+    return y0, y1
+
+
+@kernel(inline="always")
+def _backward(ws, x):
+    """The back substitution from ws.chain_y: x_k = P_k^-1 (y_k - A[k, k+1] x_{k+1}), rows
+    2j, 2j + 1 of pin j in x (each x_{k+1} carried in registers, not read back)."""
+    f = ws.chain_factor
+    n = ws.chain_pin.shape[0]
+    n0 = 0.0
+    n1 = 0.0
+    linked = False
+    for k in range(n - 1, -1, -1):
+        t0 = ws.chain_y[k, 0]
+        t1 = ws.chain_y[k, 1]
+        if linked:
+            t0 -= f[k + 1, 8] * n0 + f[k + 1, 9] * n1
+            t1 -= f[k + 1, 10] * n0 + f[k + 1, 11] * n1
+        n0 = f[k, 0] * t0 + f[k, 1] * t1
+        n1 = f[k, 2] * t0 + f[k, 3] * t1
+        r = 2 * ws.chain_pin[k]
+        x[r] = n0
+        x[r + 1] = n1
+        linked = ws.chain_end[k, 0] >= 0
+
+
 @kernel
 def chain_solve(ws, rhs, x):
-    """x = A^-1 rhs by the factors of chain_factor (rows 2j, 2j + 1 of pin j in both)."""
-    f = ws.chain_factor
-    y = ws.chain_y
-    n = ws.chain_pin.shape[0]
-    for k in range(n):
-        r = 2 * ws.chain_pin[k]
-        y0 = rhs[r]
-        y1 = rhs[r + 1]
-        if ws.chain_end[k, 0] >= 0:
-            # y_k -= G_k y_{k-1}, G_k = A[k, k-1] P_{k-1}^-1
-            y0 -= f[k, 4] * y[k - 1, 0] + f[k, 5] * y[k - 1, 1]
-            y1 -= f[k, 6] * y[k - 1, 0] + f[k, 7] * y[k - 1, 1]
-        y[k, 0] = y0
-        y[k, 1] = y1
-    for k in range(n - 1, -1, -1):
-        r = 2 * ws.chain_pin[k]
-        t0 = y[k, 0]
-        t1 = y[k, 1]
-        if k + 1 < n and ws.chain_end[k + 1, 0] >= 0:
-            # t -= A[k, k+1] x_{k+1}
-            rn = 2 * ws.chain_pin[k + 1]
-            t0 -= f[k + 1, 8] * x[rn] + f[k + 1, 9] * x[rn + 1]
-            t1 -= f[k + 1, 10] * x[rn] + f[k + 1, 11] * x[rn + 1]
-        x[r] = f[k, 0] * t0 + f[k, 1] * t1
-        x[r + 1] = f[k, 2] * t0 + f[k, 3] * t1
+    """x = A^-1 rhs by the factors of lever_factor_solve (rows 2j, 2j + 1 of pin j in both)."""
+    p0 = 0.0
+    p1 = 0.0
+    for k in range(ws.chain_pin.shape[0]):
+        p0, p1 = _forward(ws, rhs, 1.0, k, ws.chain_end[k, 0] >= 0, p0, p1)
+    _backward(ws, x)
 
 
 @kernel
@@ -183,15 +207,23 @@ def _lever_share(m, ws, jl, el, at, jr, er, b):
 
 
 @kernel
-def lever_factor(m, ws, at):
+def lever_factor_solve(m, ws, at, rhs, scale, x):
     """The block LU of A = J(levers at column `at`) W J0^T along the chains into
     ws.chain_factor (at 0: the symmetric matrix of the step's start, A[k-1, k] = A[k, k-1]^T):
     pivot by pivot as the module docstring says, each 2 x 2 pivot eliminated x row first, as
     the general L D L^T does, in the chains' order, which is the rows' where the model lists
-    its pins along its chains; returns the smallest share of its own diagonal that a row's
-    pivot kept (0: a pivot vanished, the rows are dependent)."""
+    its pins along its chains; the forward substitution of rhs / scale (rhs divided in place)
+    taken in the same sweep, then x = A^-1 (rhs / scale). Returns the smallest share of its
+    own diagonal that a row's pivot kept (0: a pivot vanished, the rows are dependent)."""
     f = ws.chain_factor
     smallest = 1.0
+    # P_{k-1}^-1 and y_{k-1}, carried from the last place
+    i00 = 0.0
+    i01 = 0.0
+    i10 = 0.0
+    i11 = 0.0
+    y0 = 0.0
+    y1 = 0.0
     for k in range(ws.chain_pin.shape[0]):
         j = ws.chain_pin[k]
         d00 = 0.0
@@ -220,10 +252,10 @@ def lever_factor(m, ws, at):
                 u00, u01, u10, u11 = e00, e10, e01, e11
             else:
                 u00, u01, u10, u11 = _lever_share(m, ws, i, ei, at, j, ej, b)  # A[k-1, k]
-            g00 = e00 * f[k - 1, 0] + e01 * f[k - 1, 2]
-            g01 = e00 * f[k - 1, 1] + e01 * f[k - 1, 3]
-            g10 = e10 * f[k - 1, 0] + e11 * f[k - 1, 2]
-            g11 = e10 * f[k - 1, 1] + e11 * f[k - 1, 3]
+            g00 = e00 * i00 + e01 * i10
+            g01 = e00 * i01 + e01 * i11
+            g10 = e10 * i00 + e11 * i10
+            g11 = e10 * i01 + e11 * i11
             p00 -= g00 * u00 + g01 * u10
             p01 -= g00 * u01 + g01 * u11
             p10 -= g10 * u00 + g11 * u10
@@ -242,14 +274,22 @@ def lever_factor(m, ws, at):
         smallest = min(smallest, share0, share1)
         det = p00 * p11 - p01 * p10
         if det == 0.0:
-            for c in range(4):
-                f[k, c] = 0.0
+            i00 = 0.0
+            i01 = 0.0
+            i10 = 0.0
+            i11 = 0.0
             smallest = 0.0
-            continue
-        f[k, 0] = p11 / det
-        f[k, 1] = -p01 / det
-        f[k, 2] = -p10 / det
-        f[k, 3] = p00 / det
+        else:
+            i00 = p11 / det
+            i01 = -p01 / det
+            i10 = -p10 / det
+            i11 = p00 / det
+        f[k, 0] = i00
+        f[k, 1] = i01
+        f[k, 2] = i10
+        f[k, 3] = i11
+        y0, y1 = _forward(ws, rhs, scale, k, ej >= 0, y0, y1)
+    _backward(ws, x)
     return smallest
 
 
@@ -285,17 +325,17 @@ def lever_velocity_solve(m, s, ws, h):
     """Stage 4 on the chains: lam with J0 W J0^T lam = -c(q_pred) / h (J0 the pins' rows at the
     step's start, whose cos / sin ws.body_cs holds; c at q_pred with ws.chain_cs), v_new =
     v* + W J0^T lam; lam into ws.lam (rows 2j, 2j + 1). Returns the smallest pivot share."""
-    lever_gaps(m, ws.q_pred, ws.chain_cs, ws, 2)
-    # the levers at the start (columns 0, 1); the gaps there are not needed
+    # the gaps at q_pred (levers into columns 2, 3) and the levers at the start (columns 0, 1)
     for j in range(m.pin_body.shape[0]):
+        ax, ay = _anchor_point(m, ws.q_pred, ws.chain_cs, ws, j, 0, 2)
+        bx, by = _anchor_point(m, ws.q_pred, ws.chain_cs, ws, j, 1, 2)
+        ws.rhs[2 * j] = -(bx - ax)
+        ws.rhs[2 * j + 1] = -(by - ay)
         for e in range(2):
             rx, ry = _lever(ws.body_cs, m.pin_body[j, e], m.pin_anchor, j, e)
             ws.chain_lever[j, e, 0] = rx
             ws.chain_lever[j, e, 1] = ry
-    share = lever_factor(m, ws, 0)
-    for r in range(2 * m.pin_body.shape[0]):
-        ws.rhs[r] /= h              # (the general solve's arithmetic: solve.fill_row_b)
-    chain_solve(ws, ws.rhs, ws.lam)
+    share = lever_factor_solve(m, ws, 0, ws.rhs, h, ws.lam)
     for i in range(ws.v_new.shape[0]):
         for k in range(3):
             ws.v_new[i, k] = ws.v_pred[i, k]
@@ -367,9 +407,11 @@ def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
     for _ in range(iters):
         if worst <= tol:
             break
-        if fresh and lever_factor(m, ws, 2) <= pivot_tol:
-            return -1.0, passes
-        chain_solve(ws, ws.rhs, ws.lam)
+        if fresh:
+            if lever_factor_solve(m, ws, 2, ws.rhs, 1.0, ws.lam) <= pivot_tol:
+                return -1.0, passes
+        else:
+            chain_solve(ws, ws.rhs, ws.lam)
         lever_move(m, ws, ws.lam, s.q, 1.0, s.v, inv_h)
         record_lever_impulses(ws, inv_h)
         carry_trig(s.q, ws.chain_cs, ws.chain_cs)
