@@ -42,6 +42,14 @@ from .solve import apply_impulses, fill_row_b, row_dot
 PIVOTS_PER_VARIABLE = 20
 # a projection move that raised the error is halved at most this many times
 PROJECTION_HALVINGS = 6
+# the projection's trust in its linearisation (a trust region on the move's length): a move
+# that removed less than TRUST_LOW of the error it started from (its rows' curvature at that
+# scale is as large as their slope: a straight edge pivoting on a crest of radius R dips
+# R phi^2 / 2, the next linearisation swings it back, a 2-cycle) has the next move taken at
+# half its length; one that removed more than TRUST_HIGH doubles it again (at most whole:
+# Newton's quadratic end). The shortest move taken is 0.5 ** PROJECTION_HALVINGS of Newton's.
+TRUST_LOW = 0.25
+TRUST_HIGH = 0.75
 
 
 @kernel
@@ -339,10 +347,13 @@ def project_positions(m, s, ws, h, iters, tol):
     the module's docstring). Returns the largest remaining error [m or rad]. A move that
     leaves a larger error than it started from (its linearisation crossed a change of the
     touching features, a light body wedged between heavy ones) is halved, up to
-    PROJECTION_HALVINGS times, before the next one is solved."""
+    PROJECTION_HALVINGS times, before the next one is solved; each move is taken at the
+    length its linearisation last bore out (TRUST_LOW: whole while moves remove what they
+    promise)."""
     worst = 0.0
     best = math.inf         # the error where the last move started (q_keep)
     share = 1.0             # of the last move taken
+    reach = 1.0             # the share of Newton's move the next one takes (TRUST_LOW)
     ws.dq_correction[:] = 0.0   # no move yet (the rows' margin reads the last one)
     pushed = False          # a joint put back onto its limit: its moves carry no velocity
     for it in range(iters + 1):
@@ -359,6 +370,13 @@ def project_positions(m, s, ws, h, iters, tol):
                     s.q[i, k] = ws.q_keep[i, k] + share * ws.dq_correction[i, k]
                     s.v[i, k] = ws.v_keep[i, k] + share * ws.dv_correction[i, k]
             continue
+        if share == 1.0 and best < math.inf:
+            # the last move, taken as solved, against what its linearisation promised (the
+            # share `reach` of the error it started from)
+            if best - worst < TRUST_LOW * reach * best:
+                reach = max(0.5 * reach, 0.5 ** PROJECTION_HALVINGS)
+            elif best - worst > TRUST_HIGH * reach * best:
+                reach = min(2.0 * reach, 1.0)
         best = worst
         share = 1.0
         for r in range(n):
@@ -370,13 +388,13 @@ def project_positions(m, s, ws, h, iters, tol):
             for k in range(3):
                 ws.dq_correction[i, k] = 0.0
                 ws.dv_correction[i, k] = 0.0
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, reach)
         # joint corrections change the velocity too (dq / h), contact and limit corrections
         # do not; nor does any where a limit was pushed (below)
         for r in range(n):
             if pushed or not is_joint_row(ws.row_kind[r]):
                 ws.lam[r] = 0.0
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, reach / h)
         for i in range(s.q.shape[0]):
             for k in range(3):
                 ws.q_keep[i, k] = s.q[i, k]
