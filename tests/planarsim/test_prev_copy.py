@@ -49,10 +49,7 @@ def test_prev_is_the_steps_start_on_every_slot_and_runs_agree_bit_for_bit(case):
         assert np.array_equal(a, b), f"{name} differs between the listed and the whole copies"
     assert listed.model.arrays.n_shape_pair > 0
     checked = 0
-    # three steps, or as many more (from the last down) as it takes to check two taken whole
-    for n, k in enumerate((steps // 3, steps // 2, steps) + tuple(range(steps - 1, 1, -1))):
-        if n >= 3 and checked >= 2:
-            break
+    for k in (steps // 3, steps // 2, steps):
         sim = _run(case, [k])
         if sim.ws.info[INFO_TURN_SUBSTEPS] != 1:    # (a step in sub-steps keeps the last one's)
             continue

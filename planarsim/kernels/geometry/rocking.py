@@ -3,7 +3,7 @@ takes that spring explicitly, so its length is bounded by the rocking's rate (st
 import math
 
 from ...compile import kernel
-from ..codes import CONTACT_EDGE, CONTACT_PAIR, MODE_FREE
+from ..codes import CONTACT_EDGE, MODE_FREE
 from ..math2d import update_trig
 from .contacts import edge_deepest
 from .terrain import ground_point, height_derivs
@@ -34,27 +34,11 @@ def body_has_joint(m, b):
 
 
 @kernel
-def body_touches_a_shape(m, s, b):
-    """Some pair contact of body b's shapes with another's is not free at s (a body resting on
-    it, or it on another)."""
-    for i in range(m.contact_body.shape[0]):
-        if m.contact_kind[i] != CONTACT_PAIR or s.contact_mode[i] == MODE_FREE:
-            continue
-        if m.contact_body[i] == b or m.contact_other[i] == b:
-            return True
-    return False
-
-
-@kernel
 def edge_rocking(m, s, ws):
     """The largest squared rocking rate w^2 [1/s^2] (ROCK_TARGET) of a body free of joints on
     a straight edge touching (not free) a convex hill at the state s; 0 where there is none
-    (flat ground or a slope: no curvature). A body held by joints or touching another's shape
-    is not counted: its rocking moves the bodies it is joined to as well, whose inertia its
-    own would understate, and a body resting on it loads its edge beyond its own weight (a
-    4 kg ball rolling on a 33 g plate: the bound, from the plate's weight, cut that step into
-    sub-steps none of which its projection could end within the depth tolerance; taken
-    whole, it does)."""
+    (flat ground or a slope: no curvature). A body held by joints is not counted: its rocking
+    moves the bodies it is joined to as well, whose inertia its own would understate."""
     coef = m.terrain_coef
     if int(coef[2]) == 0:
         return 0.0
@@ -65,8 +49,7 @@ def edge_rocking(m, s, ws):
         if m.contact_kind[i] != CONTACT_EDGE or s.contact_mode[i] == MODE_FREE:
             continue
         b = m.contact_body[i]
-        if (not m.body_inertia[b] > 0.0 or body_has_joint(m, b)
-                or (m.n_shape_pair > 0 and body_touches_a_shape(m, s, b))):
+        if not m.body_inertia[b] > 0.0 or body_has_joint(m, b):
             continue
         update_trig(s.q, ws.body_cs)
         inside, px, py = edge_deepest(m, s.q, ws.body_cs, i)
