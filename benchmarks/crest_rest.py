@@ -10,11 +10,9 @@ crest has a radius R of 1 to 300 m (log-uniform; slopes under about 30 deg), its
 a quarter of its length of the crest, falling at 0.01-3 m/s and turning at up to 6 rad/s, at
 dt 1, 3 or 10 ms; 0.5 s. A flat edge on a crest rocks like a spring of stiffness m g R (its
 contact point moves R phi along the edge when it turns by phi): w = sqrt(m g R / I), printed
-as h w (h the whole step) for the runs that end audited or stopped and for the rest. The step
-holds the edge at the deepest point of its start, so it takes that spring explicitly, and
-cuts itself to sub-steps of h w <= 1 (planarsim/kernels/geometry/rocking.py); taken whole,
-30 of the 300 runs of the default seeds were audited (h w 1.2 to 3.2), a two-step cycle of a
-settled shape (tests/physics/test_flat_on_a_crest.py).
+as h w for the runs that end audited or stopped and for the rest (the step holds the edge at
+the deepest point of its start, so it takes that spring explicitly; tests/physics/
+test_flat_on_a_crest.py keeps the known defect).
 """
 from __future__ import annotations
 

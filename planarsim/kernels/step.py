@@ -38,7 +38,6 @@ from .math2d import update_trig
 from .solver.modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
                            rule_breaks, seed_rule)
 from .geometry.pair import PAIR_MARGIN
-from .geometry.rocking import ROCK_TARGET, edge_rocking
 from .solver.pin_chain import (chain_prediction, lever_correct, lever_joint_work,
                                lever_velocity_solve)
 from .checks.frame import frame_velocity, kinetic_in_frame
@@ -796,12 +795,9 @@ def turn_substeps(m, s, ws, h, most):
             continue
         w = s.v[m.contact_body[i], 2]
         curve = max(curve, (abs(m.contact_local[i, 0]) + abs(m.contact_local[i, 1])) * w * w)
-    # and a free body rocking on a straight edge over a convex hill (geometry/rocking.py)
-    rock = edge_rocking(m, s, ws)
-    if not (curve * h * h > 2.0 * TURN_TARGET or rock * h * h > ROCK_TARGET * ROCK_TARGET):
+    if not curve * h * h > 2.0 * TURN_TARGET:
         return 1
-    n = int(math.ceil(max(h * math.sqrt(curve / (2.0 * TURN_TARGET)),
-                          h * math.sqrt(rock) / ROCK_TARGET)))
+    n = int(math.ceil(h * math.sqrt(curve / (2.0 * TURN_TARGET))))
     return max(1, min(n, most))
 
 
