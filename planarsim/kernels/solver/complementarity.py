@@ -47,7 +47,8 @@ PROJECTION_HALVINGS = 6
 # scale is as large as their slope: a straight edge pivoting on a crest of radius R dips
 # R phi^2 / 2, the next linearisation swings it back, a 2-cycle) has the next move taken at
 # half its length; one that removed more than TRUST_HIGH doubles it again (at most whole:
-# Newton's quadratic end). The shortest move taken is 0.5 ** PROJECTION_HALVINGS of Newton's.
+# Newton's quadratic end). The next move is at least 0.5 ** PROJECTION_HALVINGS of Newton's,
+# and the back-track's halvings (share) may shorten it as many times again.
 TRUST_LOW = 0.25
 TRUST_HIGH = 0.75
 

@@ -83,9 +83,10 @@ def carry_trig(q, cs_from, cs_to):
 
 @kernel(inline="always")
 def _forward(ws, rhs, scale, k, linked, p0, p1):
-    """Place k's step of the forward substitution: y_k = scale rhs_k - G_k y_{k-1} (linked:
-    place k - 1 holds the pin before k on its chain; p0, p1: y_{k-1}) into ws.chain_y[k];
-    returns y_k. scale 1 or 1 / h (the general solve's rhs / h, solve.fill_row_b)."""
+    """Place k's step of the forward substitution: y_k = rhs_k / scale - G_k y_{k-1} (linked:
+    place k - 1 holds the pin before k on its chain; p0, p1: y_{k-1}) into ws.chain_y[k], rhs_k
+    divided in place; returns y_k. scale 1, or h [s] (the general solve's rhs / h,
+    solve.fill_row_b)."""
     f = ws.chain_factor
     r = 2 * ws.chain_pin[k]
     if scale != 1.0:
