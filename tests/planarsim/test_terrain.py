@@ -2,6 +2,7 @@
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings, strategies as st
 
 from planarsim import terrain
@@ -99,3 +100,24 @@ def test_closest_point_on_tight_hills_is_the_nearest(ter, px, dy):
     assert abs(gap) <= d.min() + 1e-9       # no sampled ground point is closer
     if abs(dy) > 1e-9:
         assert np.sign(gap) == np.sign(dy)
+
+
+@settings(max_examples=200, deadline=None)
+@given(terrains(height=0.0), st.floats(-20, 20), st.floats(-0.2, 0.5),
+       st.sampled_from([1e3, 1e4, 1e5, 1e6]))
+def test_closest_point_far_up_is_the_one_near_the_origin_to_rounding(ter, px, dy, up):
+    """The same hills and point raised by `up` [m]: the same closest point, to the rounding of
+    coordinates that large (a few eps * up), not to the square root of it (a search that
+    compared squared distances without their rounding stalled 4e-7 m short of the closest
+    point of hills 1e4 m up)."""
+    coef = np.array(ter.coef, dtype=float)
+    coef[0] += up                       # (its height h0)
+    raised = terrain.Terrain(coef, name=ter.name)
+    assert raised.height(px) == pytest.approx(ter.height(px) + up, abs=1e-9)
+    py = float(ter.height(px)) + dy
+    near = closest_point(ter.coef, px, py)
+    far = closest_point(raised.coef, px, py + up)
+    tol = 64 * np.finfo(float).eps * up
+    assert abs(far[0] - near[0]) <= tol
+    assert abs(far[4] - near[4]) <= tol
+    assert abs(far[2] - near[2]) <= tol

@@ -86,6 +86,22 @@ def _closest_on_line(h0, slope, px, py):
     return x, h, nx, ny, gap
 
 
+# [-] a few units of rounding: the relative error of a difference of two coordinates, each
+# rounded (and a terrain's height, a sum of sines and its offset, rounded once more)
+D2_ROUNDING = 8.0 * 2.220446049250313e-16
+
+
+@kernel(inline="always")
+def _d2_rounding(px, py, x, h):
+    """The rounding [m^2] of the squared distance from (px, py) to the ground point (x, h):
+    2 |x - px| and 2 |h - py| times their differences' rounding, which grows with the
+    coordinates themselves (a scene 1e4 m up: about 2e-12 m). Far from the origin this is
+    well above the distance's own change near its minimum, (x - x*)^2: a step of Newton's
+    that the rounding alone makes look longer is taken, not halved (halving it stalled the
+    search 4e-7 m from the closest point of hills 1e4 m up)."""
+    return D2_ROUNDING * (abs(x - px) * (abs(x) + abs(px)) + abs(h - py) * (abs(h) + abs(py)))
+
+
 @jit(inline="force")
 def _descend(coef, px, py, x, bound):
     """Newton on f(x) = (x - px) + (h(x) - py) h'(x) = 0 from x, each step at most `bound`
@@ -117,7 +133,7 @@ def _descend(coef, px, py, x, bound):
         for _halving in range(40):
             hn, dhn, ddhn = height_derivs(coef, x + dx)
             d2n = (x + dx - px) * (x + dx - px) + (hn - py) * (hn - py)
-            if d2n <= d2 * (1.0 + 1e-12) + 1e-300:
+            if d2n <= d2 * (1.0 + 1e-12) + _d2_rounding(px, py, x + dx, hn) + 1e-300:
                 break
             dx *= 0.5
         x += dx
