@@ -20,7 +20,8 @@ from .integrator import check_integrator
 from .model import Model, ModelArrays
 from .options import StepOptions, check_options
 from .speed_bound import resolve_speed_limit
-from .start_check import check_overlap, check_start, outside_limits, overlapping
+from .start_check import (check_guard_limit, check_overlap, check_start, outside_limits,
+                          overlapping)
 from .kernels.checks.guards import GUARD_ROOM
 from .state import (ArrayCopier, State, Workspace, array_pairs, check_state, forget_ground_queries,
                     forget_kept_factors, forget_pairs, grow_workspace, make_state, make_workspace,
@@ -85,7 +86,8 @@ class Simulator:
     @model.setter
     def model(self, value: Model) -> None:
         """Swap in a model with the same bodies, pins, contacts and actuators (new gravity,
-        friction, actuator limits, ...); the state carries over."""
+        friction, actuator limits, ...); the state carries over, and a speed limit resolved
+        from the model (StepOptions.speed_limit -1) is resolved again from the new one."""
         if not isinstance(value, Model):
             raise TypeError(f"model must be a Model, got {type(value).__name__}")
         old = self._model
@@ -101,6 +103,10 @@ class Simulator:
         forget_pairs(self._ws)
         forget_kept_factors(self._ws)
         refresh_chains(value, self._ws)
+        if getattr(self, "_speed_from_model", False):
+            # the bound follows the model it was resolved from (its gravity, its actuators)
+            self._options = resolve_speed_limit(self._options._replace(speed_limit=-1.0),
+                                                value, self._state.v, self._state.q)
         self._repack()
         self._recorded_entry = None
 
@@ -126,6 +132,7 @@ class Simulator:
         value = check_options(value)
         check_integrator(self._model, value)
         self._speed_from_model = value.speed_limit == -1.0
+        check_guard_limit(self._model, self._state, value.guard_limit)
         self._options = resolve_speed_limit(value, self._model, self._state.v, self._state.q)
         forget_kept_factors(self._ws)
         self._new_options()
@@ -161,6 +168,8 @@ class Simulator:
         if not isinstance(value, State):
             raise TypeError(f"state must be a planarsim State, got {type(value).__name__}")
         check_state(value, self._model)
+        if hasattr(self, "_options"):
+            check_guard_limit(self._model, value, self._options.guard_limit)
         self._state.restore(value)
         forget_pairs(self._ws)
         forget_kept_factors(self._ws)
@@ -332,6 +341,7 @@ class Simulator:
             if bad.size:
                 raise ValueError(f"start_over: {name} of body {self._model.body_names[bad[0]]!r} "
                                  f"({bad[0]}) is {a[bad[0]].tolist()}; it must be finite")
+        check_guard_limit(self._model, st, self._options.guard_limit)
         fresh = getattr(self, "_fresh_ws", None)
         if fresh is None or fresh[0] is not self._ws:
             # a fresh workspace's arrays and this one's, paired once: a reset copies them all

@@ -160,3 +160,38 @@ def test_simbicon_starts_with_its_soles_on_the_ground_on_hills():
     assert not any("below the ground" in str(w.message) for w in said)
     _, raw, _ = mod.simulate(0.05, terrain="flat")
     assert raw["audit"]["start_below_ground"] == 0
+
+
+def _ball_at(pos, gravity=-9.81):
+    b = ps.ModelBuilder(dt=1e-3, gravity=(0.0, gravity), ground=None)
+    b.add_body("ball", mass=1.0, inertia=0.01, pos=pos, shapes=[("circle", (0, 0), 0.1)])
+    return b.compile()
+
+
+def test_a_start_beyond_the_guard_limit_is_refused_naming_the_body_not_reported_as_a_divergence():
+    from planarsim.errors import ModelError
+    with pytest.raises(ModelError, match=r"body 'ball' starts at x = 1e\+11 m, beyond "
+                                         r"StepOptions.guard_limit 1e\+10"):
+        ps.Simulator(_ball_at((1e11, 0.0)))
+    sim = ps.Simulator(_ball_at((0.0, 0.0)))
+    with pytest.raises(ModelError, match=r"body 'ball' starts at vy = -2e\+10 m/s"):
+        sim.start_over(v=np.array([[0.0, -2e10, 0.0]]))
+    far = sim.state.copy()
+    far.q[0, 1] = 5e10
+    with pytest.raises(ModelError, match=r"starts at y = 5e\+10 m"):
+        sim.state = far
+    near = sim.state.copy()
+    near.q[0, 0] = 20.0
+    sim.state = near
+    with pytest.raises(ModelError, match=r"starts at x = 20 m, beyond StepOptions.guard_limit 10"):
+        sim.options = ps.StepOptions(guard_limit=10.0)
+
+
+def test_a_model_swapped_in_bounds_the_speeds_by_its_own_gravity():
+    """A speed limit resolved from the model (the default) is resolved again from a model
+    swapped in: a ball falling under 100 g is not stopped by the bound of 1e-3 g."""
+    sim = ps.Simulator(_ball_at((0.0, 100.0), gravity=-0.01))
+    sim.model = _ball_at((0.0, 100.0), gravity=-981.0)
+    assert sim.options.speed_limit == ps.Simulator(_ball_at((0.0, 100.0), -981.0)).options.speed_limit
+    sim.run(0.4)                                  # 392 m/s: within the new bound
+    assert sim.state.v[0, 1] == pytest.approx(-981.0 * 0.4, rel=1e-9)
