@@ -57,6 +57,13 @@ MAX_RUN_STEPS = 10 ** 8
 REQUIRED = ("NAME", "GAITS", "Params", "SUMMARY_EXTRAS", "Run", "simulate")
 
 
+# [s] the largest step an actuated walker takes: the walkers are built and tuned at 1e-3 s;
+# larger steps lose their impacts and motors (at 0.02 s Ranger stops at once, the simplest
+# walker takes 2 of its 4 steps in 5 s; at 0.05 s the Simple Biped falls, and at 0.2 s it is
+# thrown 1 m up in 3 steps). The passive walkers, with no controller, take any step.
+MAX_DT = 0.01
+
+
 class WalkerRun:
     """One walker in the world, run in chunks by its compiled rollout.
 
@@ -95,6 +102,10 @@ class WalkerRun:
             # the controllers integrate (work, effort, motor currents, ramps) with the model's dt
             raise ValueError(f"{self.NAME}: options.dt={self.options.dt} s differs from the model's "
                              f"dt={model.dt} s; build the walker with dt={self.options.dt} instead")
+        if model.n_act > 0 and self.dt > MAX_DT:
+            raise ValueError(f"{self.NAME}: dt={self.dt:g} s is too large; use a step of at most "
+                             f"{MAX_DT:g} s (1e-3 is usual): its controller is tuned at 1e-3 s, "
+                             f"and at 0.02 s walkers already lose their impacts or stop")
         self.u = np.zeros(model.n_act)
         self.record_every = int(record_every)
         self.chunks = []

@@ -22,10 +22,7 @@ from pathlib import Path
 
 ANIMATION_EXTS = (".gif", ".mp4", ".html")
 PLOT_EXTS = (".png", ".svg", ".pdf")
-# [s] the largest --dt: the walkers are built and tuned at 1e-3 s; larger steps lose their
-# impacts and motors (at 0.02 s Ranger stops at once, the simplest walker takes 2 of
-# its 4 steps in 5 s; at 0.05 s the Simple Biped falls)
-MAX_DT = 0.01
+from walkers.base import MAX_DT   # [s] the largest --dt (see there)
 
 
 class UsageError(Exception):

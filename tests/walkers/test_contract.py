@@ -220,3 +220,17 @@ def test_params_as_a_dict_or_of_another_walker(name):
         mod.simulate(0.02, params=other)
     with pytest.raises(TypeError, match="not fields of"):
         mod.simulate(0.02, params={"no_such_field": 1.0})
+
+
+@pytest.mark.parametrize("name", ["simple-biped", "ranger", "simbicon", "quadruped"])
+def test_an_actuated_walker_refuses_a_step_its_controller_is_not_tuned_for(name):
+    """As the command line refuses --dt above 0.01 s, so does the Python API for a walker with
+    motors (at 0.2 s the Simple Biped was thrown 1 m up in 3 steps, at 0.05 s it shuffled
+    0.12 m in 2 s, with no error). The passive walkers take any step."""
+    from walkers.base import MAX_DT
+    said = (r"estimator cutoff 15.0 Hz must lie in \(0, 10.0\) Hz \(Nyquist\)" if name == "ranger"
+            else rf"{name}: dt=0.05 s is too large; use a step of at most {MAX_DT:g} s")
+    with pytest.raises(ValueError, match=said):     # (Ranger's sampled estimator says it first)
+        walkers.load(name).Run(dt=0.05)
+    walkers.load(name).Run(dt=MAX_DT)
+    walkers.load("rimless-wheel").Run(dt=0.05)
