@@ -168,8 +168,6 @@ class Simulator:
         if not isinstance(value, State):
             raise TypeError(f"state must be a planarsim State, got {type(value).__name__}")
         check_state(value, self._model)
-        if hasattr(self, "_options"):
-            check_guard_limit(self._model, value, self._options.guard_limit)
         self._state.restore(value)
         forget_pairs(self._ws)
         forget_kept_factors(self._ws)
@@ -341,7 +339,6 @@ class Simulator:
             if bad.size:
                 raise ValueError(f"start_over: {name} of body {self._model.body_names[bad[0]]!r} "
                                  f"({bad[0]}) is {a[bad[0]].tolist()}; it must be finite")
-        check_guard_limit(self._model, st, self._options.guard_limit)
         fresh = getattr(self, "_fresh_ws", None)
         if fresh is None or fresh[0] is not self._ws:
             # a fresh workspace's arrays and this one's, paired once: a reset copies them all
