@@ -282,9 +282,10 @@ class Workspace(NamedTuple):
     contact_face: np.ndarray     # (n_contact, 4) a pair's reference face in its body's frame:
                                  #   unit normal, and a point on the face's core line (or the
                                  #   core vertex where contact_dist) [m]
-    contact_refpt: np.ndarray    # (n_contact, 4) the reference body's and the other body's
+    contact_refpt: np.ndarray    # (n_contact, 5) the reference body's and the other body's
                                  #   material points where the contact touched at the step's
-                                 #   start (each in its body's frame) [m]
+                                 #   start (each in its body's frame) [m], and r_inc times
+                                 #   their angles' difference then [m] (a round side's roll)
     contact_radii: np.ndarray    # (n_contact, 2) radius of the reference and the other shape [m]
     contact_curve: np.ndarray    # (n_contact,) the second-order part of a held contact's normal
                                  #   velocity target (solve.held_contact_curve) [m/s]
@@ -810,7 +811,7 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                                               np.asarray(model.arrays.contact_body, np.int64)],
                                              axis=1).reshape(nc, 2).copy(),
                      contact_dist=z(nc, np.int64), contact_face=z((nc, 4)),
-                     contact_refpt=z((nc, 4)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
+                     contact_refpt=z((nc, 5)), contact_radii=z((nc, 2)), contact_bounce=z(nc),
                      contact_curve=z(nc),
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
                      **lists, **_solve_arrays(model, contacts, profile, lcp_rows),

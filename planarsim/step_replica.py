@@ -259,6 +259,14 @@ def _world(q, body, local):
     return q[:, body, :2] + _turn(q, body, local)
 
 
+def _theta(q, body):
+    """Body's angle (B,) [rad] (0 for the world, body < 0; q's dtype, so that a dual number's
+    derivative parts carry through)."""
+    if body < 0:
+        return 0.0 * q[:, 0, 2]
+    return q[:, body, 2]
+
+
 def _local(q, body, point):
     """Body-frame coordinates (B, 2) of world point (B, 2) (unchanged for the world)."""
     if body < 0:
@@ -356,7 +364,15 @@ def _pair_rows(model, cp, k, q, q0, c, J, F, r):
     put(r, F, n0 - cp.mu_slip[k] * t0 if not cp.pinned[k] else n0, surface0, q0)
     if cp.pinned[k]:
         t = _perp_tangent(n)
-        c[:, r + 1] = np.sum(t * (_world(q, inc, inc_pt) - _world(q, ref, ref_pt)), axis=-1)
+        if not dist and r_inc > 0.0:
+            # a round side rolls on the face: its surface point plus the arc it rolled
+            # (pair.pair_row)
+            c[:, r + 1] = (np.sum(t * (surface - _world(q, ref, ref_pt)), axis=-1)
+                           + r_inc * ((_theta(q, inc) - _theta(q0, inc))
+                                      - (_theta(q, ref) - _theta(q0, ref))))
+        else:
+            c[:, r + 1] = np.sum(t * (_world(q, inc, inc_pt) - _world(q, ref, ref_pt)),
+                                 axis=-1)
         put(r + 1, J, t, surface, q)
         put(r + 1, F, t0, surface0, q0)
 
