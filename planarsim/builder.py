@@ -144,6 +144,43 @@ def resolved_friction(mu):
     return mu if mu >= MU_RESOLUTION else 0.0
 
 
+
+# [-] a straight side over hills is held in pieces of at most this share of the ground's
+# shortest wavelength: a piece then spans one crest at most (of one sine: crests lie a
+# wavelength apart), and each piece's contact holds its crest's point in the velocity solve
+EDGE_PIECE_OF_WAVELENGTH = 0.5
+# [-] each piece searches this share of its length beyond a cut (not beyond the side's ends)
+EDGE_PIECE_REACH = 0.25
+
+
+def edge_pieces(start, end, ground) -> list:
+    """A straight side from `start` to `end` (body frame [m]) as the edge contacts that hold
+    it over `ground`: [(search start, search end, own share)]. One piece (own (0, 0): the whole
+    segment, its ends the shape's corners, whose own contacts hold them) where the side is
+    at most EDGE_PIECE_OF_WAVELENGTH of the shortest wavelength long; else equal pieces, each
+    searching EDGE_PIECE_REACH of its length beyond its cuts and reporting its deepest point
+    only where that lies in its own part [lo, hi) of the search (a crest at a cut belongs to
+    the piece after it). With one contact for the whole side, a plank resting on three crests
+    had one of them in the velocity solve: it fell about it while the position correction
+    held it up, gaining 3 J in 0.25 s with no audit."""
+    coef = ground.coef
+    n_sines = int(coef[2])
+    length = float(np.hypot(*(end - start)))
+    if n_sines == 0 or length == 0.0:
+        return [(start, end, (0.0, 0.0))]
+    shortest = min(float(coef[4 + 3 * j]) for j in range(n_sines))
+    n = int(math.ceil(length / (EDGE_PIECE_OF_WAVELENGTH * shortest)))
+    if n <= 1:
+        return [(start, end, (0.0, 0.0))]
+    out = []
+    for j in range(n):
+        lo = j / n - (EDGE_PIECE_REACH / n if j > 0 else 0.0)
+        hi = (j + 1) / n + (EDGE_PIECE_REACH / n if j + 1 < n else 0.0)
+        span = hi - lo
+        own = ((j / n - lo) / span, ((j + 1) / n - lo) / span)
+        out.append((start + lo * (end - start), start + hi * (end - start), own))
+    return out
+
 class ModelBuilder:
     """Mutable description of a planar model; see the module docstring.
 
@@ -909,12 +946,18 @@ class ModelBuilder:
                     out.append(contact(f"{sh['label']}/ground{k}", sh["body"], CONTACT_ARC, v,
                                        sh["radius"], (-math.pi, math.pi), **common))
             if curved and len(core) >= 2:
-                # each straight side: its point nearest the ground where that is not an end
+                # each straight side: its point nearest the ground where that is not an end;
+                # a side that may span more than one crest, in pieces (edge_pieces)
                 for k in range(len(core) if len(core) > 2 else 1):
-                    c = contact(f"{sh['label']}/edge{k}", sh["body"], CONTACT_EDGE, core[k],
-                                sh["radius"], **common)
-                    c["verts"] = [np.asarray(core[(k + 1) % len(core)], float)]
-                    out.append(c)
+                    start = np.asarray(core[k], float)
+                    end = np.asarray(core[(k + 1) % len(core)], float)
+                    pieces = edge_pieces(start, end, self.terrain)
+                    for j, (a, b, own) in enumerate(pieces):
+                        label = f"edge{k}" if len(pieces) == 1 else f"edge{k}.{j}"
+                        c = contact(f"{sh['label']}/{label}", sh["body"], CONTACT_EDGE, a,
+                                    sh["radius"], span=own, **common)
+                        c["verts"] = [b]
+                        out.append(c)
         # a mechanism: bodies linked by pins, rods or actuators (a leg that is a force)
         joints = [p["body"] for p in self._pins] + [r["body"] for r in self._rods]
         for a in self._acts:

@@ -272,15 +272,28 @@ def edge_deepest(m, q, cs, i):
     in_a, ax, ay = _edge_by_rate(m, q, cs, i)
     in_b, bx, by = _edge_by_samples(m, q, cs, i)
     if not in_b:
-        return in_a, ax, ay
+        return _owned(m, q, cs, i, in_a, ax, ay), ax, ay
     if not in_a:
-        return in_b, bx, by
+        return _owned(m, q, cs, i, in_b, bx, by), bx, by
     rounded = m.contact_radius[i] > 0.0
     fa = _edge_clearance(m.terrain_coef, ax, ay, 0.0, 0.0, 0.0, rounded)
     fb = _edge_clearance(m.terrain_coef, bx, by, 0.0, 0.0, 0.0, rounded)
     if fb < fa:
-        return in_b, bx, by
-    return in_a, ax, ay
+        return _owned(m, q, cs, i, in_b, bx, by), bx, by
+    return _owned(m, q, cs, i, in_a, ax, ay), ax, ay
+
+
+@kernel(inline="always")
+def _owned(m, q, cs, i, inside, px, py):
+    """inside, and for a piece of a side (builder.edge_pieces: contact_span (lo, hi), lo < hi)
+    its point (px, py) in the piece's own part of its segment, lo <= u < hi."""
+    lo = m.contact_span[i, 0]
+    hi = m.contact_span[i, 1]
+    if not inside or not lo < hi:
+        return inside
+    x0, y0, dx, dy, rounded, shortest = _edge_segment(m, q, cs, i)
+    u = ((px - x0) * dx + (py - y0) * dy) / (dx * dx + dy * dy)
+    return lo <= u < hi
 
 
 @kernel(inline="never")
