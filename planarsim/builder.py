@@ -159,10 +159,11 @@ def edge_pieces(start, end, ground) -> list:
     segment, its ends the shape's corners, whose own contacts hold them) where the side is
     at most EDGE_PIECE_OF_WAVELENGTH of the shortest wavelength long; else equal pieces, each
     searching EDGE_PIECE_REACH of its length beyond its cuts and reporting its deepest point
-    only where that lies in its own part [lo, hi) of the search (a crest at a cut belongs to
-    the piece after it). With one contact for the whole side, a plank resting on three crests
-    had one of them in the velocity solve: it fell about it while the position correction
-    held it up, gaining 3 J in 0.25 s with no audit."""
+    only where that lies in its own part [lo, hi) of the search: its share of the side and
+    half its reach past each cut (a crest near a cut is held by both pieces). With one
+    contact for the whole side, a plank resting on three crests had one of them in the
+    velocity solve: it fell about it while the position correction held it up, gaining 3 J
+    in 0.25 s with no audit."""
     coef = ground.coef
     n_sines = int(coef[2])
     length = float(np.hypot(*(end - start)))
@@ -177,7 +178,13 @@ def edge_pieces(start, end, ground) -> list:
         lo = j / n - (EDGE_PIECE_REACH / n if j > 0 else 0.0)
         hi = (j + 1) / n + (EDGE_PIECE_REACH / n if j + 1 < n else 0.0)
         span = hi - lo
-        own = ((j / n - lo) / span, ((j + 1) / n - lo) / span)
+        # its own part, and half its reach past each cut: a crest near a cut is held by
+        # both pieces over that band, so it passes from one to the next with a step or more
+        # of both holding it (each piece finds a flat minimum to about 1e-9 m of its own:
+        # owned parts that met at the cut let a crest within that of it flick between the
+        # two, or neither, each hand-over a new contact starting free)
+        share = 0.5 * EDGE_PIECE_REACH / n
+        own = ((max(j / n - share, 0.0) - lo) / span, (min((j + 1) / n + share, 1.0) - lo) / span)
         out.append((start + lo * (end - start), start + hi * (end - start), own))
     return out
 

@@ -282,15 +282,15 @@ _FIELDS = ("x [m]", "y [m]", "angle [rad]", "vx [m/s]", "vy [m/s]", "omega [rad/
 
 
 def check_guard_limit(model, state, guard_limit: float) -> None:
-    """Raise ModelError naming the body and field if a start's position or velocity is beyond
-    StepOptions.guard_limit (the step stops any state beyond it: such a start would be reported
-    as a divergence at its first step)."""
+    """Raise ModelError naming the body and field if a state's position or velocity is beyond
+    StepOptions.guard_limit (the step stops any state beyond it: a Simulator built on such a
+    state would report a divergence at its first step)."""
     values = np.concatenate([np.asarray(state.q, float), np.asarray(state.v, float)], axis=1)
     beyond = np.argwhere(np.abs(values) > guard_limit)
     if beyond.size:
         b, f = (int(k) for k in beyond[0])
-        raise ModelError(f"body {model.body_names[b]!r} starts at {_FIELDS[f].split()[0]} = "
-                         f"{values[b, f]:g} {_FIELDS[f].split()[1][1:-1]}, beyond "
-                         f"StepOptions.guard_limit {guard_limit:g} (every state the step takes "
-                         f"must stay within it: move the scene nearer the origin, or raise "
-                         f"guard_limit)")
+        field, unit = _FIELDS[f].split()
+        remedy = "move the scene nearer the origin" if f < 3 else "start it slower"
+        raise ModelError(f"body {model.body_names[b]!r} has {field} = {values[b, f]:g} "
+                         f"{unit[1:-1]}, beyond StepOptions.guard_limit {guard_limit:g} (the "
+                         f"step stops any state beyond it: {remedy}, or raise guard_limit)")
