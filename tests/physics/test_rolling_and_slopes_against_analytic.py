@@ -59,6 +59,24 @@ def _on_slope(deg, r):
     return s, n, r * n
 
 
+def _roll_for_a_second(sim, a, k, r, c, s, dt):
+    """1 s of a unit-mass disk (I = k r^2) rolling from rest at c down a slope of a [rad]
+    (down-slope unit vector s): (steps, t, q, v, the rolling acceleration, the distance
+    travelled and symplectic Euler's a t^2 / 2 + a h t / 2, the speed along s, the rolling
+    kinetic energy, the energy from the start)."""
+    steps = int(round(1.0 / dt))
+    sim.steps(steps)
+    t = steps * dt
+    q, v = sim.state.q[0], sim.state.v[0]
+    acc = G * math.sin(a) / (1.0 + k)
+    travelled = float((q[:2] - c) @ s)
+    expected = 0.5 * acc * t * t + 0.5 * acc * dt * t
+    speed = float(v[:2] @ s)
+    kinetic = 0.5 * (1.0 + k) * speed * speed
+    energy = 0.5 * (v[0] ** 2 + v[1] ** 2) + 0.5 * k * r * r * v[2] ** 2 + G * (q[1] - c[1])
+    return steps, t, q, v, acc, travelled, expected, speed, kinetic, energy
+
+
 @pytest.mark.parametrize("kind", ["arc", "circle"])
 @pytest.mark.parametrize("deg, r, k, dt, mu", [
     (10.0, 0.1, 0.5, 1e-3, 1.0), (10.0, 0.1, 1.0, 1e-3, 1.0), (10.0, 1e-3, 0.5, 1e-4, 1.0),
@@ -79,16 +97,8 @@ def test_a_disk_or_hoop_rolls_down_a_slope_at_the_rolling_acceleration_keeping_i
     a = math.radians(deg)
     s, n, c = _on_slope(deg, r)
     sim = _disk(terrain.slope(-deg), r, k, mu, dt, kind, tuple(c))
-    steps = int(round(1.0 / dt))
-    sim.steps(steps)
-    t = steps * dt
-    q, v = sim.state.q[0], sim.state.v[0]
-    acc = G * math.sin(a) / (1.0 + k)
-    travelled = float((q[:2] - c) @ s)
-    expected = 0.5 * acc * t * t + 0.5 * acc * dt * t
-    speed = float(v[:2] @ s)
-    kinetic = 0.5 * (1.0 + k) * speed * speed
-    energy = 0.5 * (v[0] ** 2 + v[1] ** 2) + 0.5 * k * r * r * v[2] ** 2 + G * (q[1] - c[1])
+    steps, t, q, v, acc, travelled, expected, speed, kinetic, energy = _roll_for_a_second(
+        sim, a, k, r, c, s, dt)
     print(f"{kind} {deg} deg r={r} k={k} dt={dt}: distance {travelled / expected - 1:+.1e}, "
           f"speed {speed / (acc * t) - 1:+.1e}, energy {(energy + dt / t * kinetic) / kinetic:+.1e}")
     assert abs(travelled - expected) <= 1e-11 * expected
@@ -120,16 +130,9 @@ def test_a_disk_rolls_down_a_static_box_as_down_the_slope(deg, r, k, dt, mu):
     b.add_body("disk", mass=1.0, inertia=k * r * r, pos=tuple(c),
                shapes=[("circle", (0.0, 0.0), r, {"mu": mu})])
     sim = ps.Simulator(b.compile())
-    steps = int(round(1.0 / dt))
-    sim.steps(steps)
-    t = steps * dt
-    q, v = sim.state.q[0], sim.state.v[0]
-    acc = G * math.sin(a) / (1.0 + k)
-    travelled = float((q[:2] - c) @ s)
-    speed = float(v[:2] @ s)
-    kinetic = 0.5 * (1.0 + k) * speed * speed
-    energy = 0.5 * (v[0] ** 2 + v[1] ** 2) + 0.5 * k * r * r * v[2] ** 2 + G * (q[1] - c[1])
-    assert abs(travelled - (0.5 * acc * t * t + 0.5 * acc * dt * t)) <= 1e-9 * travelled
+    steps, t, q, v, acc, travelled, expected, speed, kinetic, energy = _roll_for_a_second(
+        sim, a, k, r, c, s, dt)
+    assert abs(travelled - expected) <= 1e-9 * travelled
     assert abs(speed - acc * t) <= 1e-9 * acc * t
     assert abs(speed + v[2] * r) <= 1e-9 * speed                       # no slip
     assert abs(energy + dt / t * kinetic) <= 1e-9 * kinetic
