@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import ModelError
+from .errors import FIELD_NAMES, ModelError
 from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT,
                            JOINT_SLIDE_BIT)
 from .terrain import from_coef
@@ -278,7 +278,8 @@ def outside_limits(model, state, who: str = "simulator"):
                       f"{over:.4g} {unit} outside its limit ({lo:g}, {hi:g}){others}")
 
 
-_FIELDS = ("x [m]", "y [m]", "angle [rad]", "vx [m/s]", "vy [m/s]", "omega [rad/s]")
+# the units of a body's coordinates and velocities, in errors.FIELD_NAMES' order
+_FIELD_UNITS = ("m", "m", "rad", "m/s", "m/s", "rad/s")
 
 
 def check_guard_limit(model, state, guard_limit: float) -> None:
@@ -289,8 +290,8 @@ def check_guard_limit(model, state, guard_limit: float) -> None:
     beyond = np.argwhere(np.abs(values) > guard_limit)
     if beyond.size:
         b, f = (int(k) for k in beyond[0])
-        field, unit = _FIELDS[f].split()
+        field, unit = FIELD_NAMES[f], _FIELD_UNITS[f]
         remedy = "move the scene nearer the origin" if f < 3 else "start it slower"
         raise ModelError(f"body {model.body_names[b]!r} has {field} = {values[b, f]:g} "
-                         f"{unit[1:-1]}, beyond StepOptions.guard_limit {guard_limit:g} (the "
+                         f"{unit}, beyond StepOptions.guard_limit {guard_limit:g} (the "
                          f"step stops any state beyond it: {remedy}, or raise guard_limit)")
