@@ -2,6 +2,7 @@
 one, on random constraint rows (each touching at most two bodies, as in the engine), some of
 them exactly dependent (closed loops)."""
 import numpy as np
+import pytest
 from hypothesis import given, settings, strategies as st
 
 from numba import njit
@@ -134,6 +135,23 @@ def test_symmetric_factor_gives_the_velocity_change_of_lu_and_reads_only_the_low
     assert np.abs(dv_ldl - dv_lu).max() <= 1e-6 * (1.0 + np.abs(dv_lu).max())
     for x in (x_lu, x_ldl):
         assert np.abs(A @ x - rhs).max() <= 1e-6 * (1.0 + np.abs(rhs).max())
+
+
+@pytest.mark.parametrize("lever", [7.1e-156, 1e-150, 1e-146])
+def test_a_row_of_vanishing_jacobian_is_dropped_not_divided_by(lever):
+    """A row whose Jacobian entries are of order 1e-155 (hypothesis found it) has a diagonal of
+    1e-310, whose reciprocal overflows: both factorisations gave NaN impulses. It acts on
+    nothing and must be dropped, the other row solved."""
+    J = np.array([[0.0, 0.0, lever], [0.0, 0.0, 1.0]])
+    w = np.array([1.0, 1.0, 3.0])
+    A = (J * w) @ J.T
+    rhs = A @ np.array([1.0, 1.0])
+    first, reach = _envelope([(0, -1), (0, -1)], 1)
+    for solve in (_lu, _ldl):
+        x = np.zeros(2)
+        solve(A.copy(), first, reach, rhs.copy(), x, np.zeros(2), TOL, np.zeros(2, np.int64))
+        assert np.all(np.isfinite(x)), (solve.__name__, x)
+        assert abs((w * (J.T @ x))[2] - (w * (J.T @ np.ones(2)))[2]) <= 1e-12
 
 
 def test_dependent_rows_are_dropped_by_both():

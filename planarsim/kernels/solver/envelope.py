@@ -105,10 +105,16 @@ def diagonal_scale(low, start, first, n, scale):
         scale[k] = abs(low[at(start, first, k, k)])
 
 
+# A diagonal below this is a row of no effect (its Jacobian entries below 1e-145): its pivot's
+# reciprocal would overflow (1 / 5e-309 is inf), so it is dropped as a dependent row is.
+NULL_DIAGONAL = 1e-290
+
+
 @kernel
 def is_dependent(piv, scale, tol):
-    """A row whose pivot fell below tol times its own diagonal depends on earlier rows."""
-    return abs(piv) <= tol * scale or scale == 0.0
+    """A row whose pivot fell below tol times its own diagonal depends on earlier rows; a row
+    whose diagonal is below NULL_DIAGONAL acts on nothing."""
+    return abs(piv) <= tol * scale or scale <= NULL_DIAGONAL
 
 
 @kernel
