@@ -650,7 +650,7 @@ def _overlap_kernel():
         from planarsim.kernels.geometry.collide import collide
 
         @njit(**dict(compile_options(), cache=False))
-        def overlap(vert, norm, adr, num, rad, body, pairs, q, out, scratch):
+        def overlap(vert, norm, cover, adr, num, rad, body, pairs, q, out, scratch):
             for k in range(q.shape[0]):
                 worst = 0.0
                 for p in range(pairs.shape[0]):
@@ -666,7 +666,8 @@ def _overlap_kernel():
                     if bb >= 0:
                         xb, yb = q[k, bb, 0], q[k, bb, 1]
                         cb, snb = np.cos(q[k, bb, 2]), np.sin(q[k, bb, 2])
-                    n = collide(vert, norm, adr[sa], num[sa], rad[sa], xa, ya, ca, sna,
+                    n = collide(vert, norm, cover,
+                                adr[sa], num[sa], rad[sa], xa, ya, ca, sna,
                                 adr[sb], num[sb], rad[sb], xb, yb, cb, snb, 0.0, scratch)
                     for j in range(n):
                         worst = max(worst, -scratch[j, 8])
@@ -685,7 +686,9 @@ def shape_clearance(model, q):
     pairs = a.contact_pair[(a.contact_kind == 2) & (a.contact_pair[:, 2] == 0), :2].copy()
     worst = np.zeros(q.shape[0])
     if len(pairs):
-        _overlap_kernel()(a.core_vert, a.core_norm, a.shape_vert_adr, a.shape_vert_num,
+        # (no covered faces: the judge measures the shapes' true overlap)
+        _overlap_kernel()(a.core_vert, a.core_norm, np.zeros(len(a.core_vert), np.int64),
+                          a.shape_vert_adr, a.shape_vert_num,
                           a.shape_radius, a.shape_body, np.ascontiguousarray(pairs),
                           np.ascontiguousarray(q), worst, np.zeros((2, 10)))
     low = -worst

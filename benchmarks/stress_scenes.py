@@ -341,7 +341,9 @@ def overlap(model, q) -> float:
     pairs = np.unique(pairs, axis=0) if len(pairs) else pairs
     worst = np.zeros(q.shape[0])
     if len(pairs):
-        _overlap_kernel()(a.core_vert, a.core_norm, a.shape_vert_adr, a.shape_vert_num, a.shape_radius,
+        # (no covered faces: the shapes' true overlap)
+        _overlap_kernel()(a.core_vert, a.core_norm, np.zeros(len(a.core_vert), np.int64),
+                          a.shape_vert_adr, a.shape_vert_num, a.shape_radius,
                           a.shape_body, np.ascontiguousarray(pairs), np.ascontiguousarray(q), worst,
                           np.zeros((2, 10)))
     deepest = float(np.max(worst))

@@ -188,6 +188,52 @@ def edge_pieces(start, end, ground) -> list:
         out.append((start + lo * (end - start), start + hi * (end - start), own))
     return out
 
+# [m] a world shape's edge whose ends lie within this of another world shape's core (and the
+# outside of whose midpoint is that shape's) is covered by it
+COVER_TOL = 1e-9
+
+
+def covered_edges(shapes) -> np.ndarray:
+    """(n_core,) int over the shapes' core vertices: 1 where the edge from that vertex is a
+    world shape's face covered by another world shape (kernels/geometry/collide.py: never a
+    reference face, and its ends' vertices touch only along their open faces' normals). A
+    floor of static boxes laid edge to edge has its tiles' upright faces at the seams inside
+    the floor; a body sliding over a seam must not meet them. Polygons of radius 0 only; an
+    edge counts as covered only where one other shape holds it whole (its two ends within
+    COVER_TOL of that core, and the point just outside its midpoint inside it)."""
+    cores = [np.asarray(sh["core"], dtype=np.float64).reshape(-1, 2) for sh in shapes]
+    out = [np.zeros(len(c), np.int64) for c in cores]
+    world = [i for i, sh in enumerate(shapes)
+             if sh["body"] < 0 and len(cores[i]) >= 3 and sh["radius"] == 0.0]
+    if len(world) < 2:
+        return np.concatenate(out) if out else np.zeros(0, np.int64)
+    normals = {i: core_normals(cores[i]) for i in world}
+    # bounding boxes: a shape can hold an edge only if its box holds both ends
+    lo = np.array([cores[i].min(axis=0) for i in world])
+    hi = np.array([cores[i].max(axis=0) for i in world])
+    for i in world:
+        ci, ni = cores[i], normals[i]
+        tol = COVER_TOL + 1e-12 * (1.0 + float(np.abs(ci).max()))
+        for k in range(len(ci)):
+            a, b = ci[k], ci[(k + 1) % len(ci)]
+            ends_lo = np.minimum(a, b) + tol
+            ends_hi = np.maximum(a, b) - tol
+            near = np.flatnonzero(np.all(lo <= ends_lo, axis=1) & np.all(hi >= ends_hi, axis=1))
+            outside = 0.5 * (a + b) + 1e-6 * float(np.hypot(*(b - a))) * ni[k]
+            for v in near:
+                j = world[v]
+                if j == i:
+                    continue
+                cj, nj = cores[j], normals[j]
+                # the largest signed distance of each point to j's faces' lines (<= 0: inside)
+                points = np.stack([a, b, outside])
+                worst = np.einsum("kd,pkd->pk", nj, points[:, None, :] - cj[None]).max(axis=1)
+                if worst[0] <= tol and worst[1] <= tol and worst[2] < 0.0:
+                    out[i][k] = 1
+                    break
+    return np.concatenate(out) if out else np.zeros(0, np.int64)
+
+
 class ModelBuilder:
     """Mutable description of a planar model; see the module docstring.
 
@@ -1004,7 +1050,8 @@ class ModelBuilder:
             shape_bound=ro([shape_bounds(sh["core"], core_normals(sh["core"]), sh["radius"])
                             for sh in self._collide] or np.zeros((0, 5))).reshape(ns, 5),
             core_vert=ro(core).reshape(len(core), 2),
-            core_norm=ro(norm).reshape(len(core), 2))
+            core_norm=ro(norm).reshape(len(core), 2),
+            core_cover=ro(covered_edges(self._collide), np.int64).reshape(len(core)))
 
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:

@@ -21,10 +21,15 @@ jit = njit(**dict(compile_options(), cache=False))
 
 
 @jit
-def _collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
-             adr_b, num_b, r_b, xb, yb, cb, sb, margin, out):
-    return collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
+def _collide_covered(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
+                     adr_b, num_b, r_b, xb, yb, cb, sb, margin, out):
+    return collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
                    adr_b, num_b, r_b, xb, yb, cb, sb, margin, out)
+
+
+def _collide(vert, norm, *args):
+    """collide with no covered edge."""
+    return _collide_covered(vert, norm, np.zeros(vert.shape[0], np.int64), *args)
 
 
 @jit

@@ -66,6 +66,10 @@ REFERENCE_TOL = 1e-9
 # first steps fell to the complementarity solve with 200-700 pivots each). Far below
 # DEPTH_TOL: the point stands where the clipped one would, to this much
 SLAB_TOL = 1e-12
+# 1 - cos of the angle [rad^2 / 2] within which a contact's normal at a floor tile's corner at a
+# seam counts as its open face's (about 4.5e-5 rad): a box lying flat across the seam keeps its
+# own face as the reference
+COVER_PARALLEL = 1e-9
 
 
 def core_normals(vertices) -> np.ndarray:
@@ -164,11 +168,35 @@ def _circle_pair(vert, adr_a, ca, sa, adr_b, xb, yb, cb, sb, r, margin, ox, oy, 
 
 
 @kernel
-def _max_separation(vert, norm, adr_r, num_r, xr, yr, cr, sr, adr_i, num_i, xi, yi, ci, si,
-                    limit):
-    """(sep, face, support): the largest over P's faces k of sep_k = min over Q's vertices q of
-    n_k.(q - p_k) [m], the face and the vertex of Q reaching that minimum. Stops at the first
-    face with sep_k > limit (a separating axis: no contact)."""
+def _cornered(cover, adr, num, j):
+    """Core vertex j (of the core at adr, num vertices) ends a covered edge (builder
+    .covered_edges): a floor tile's corner at a seam."""
+    return cover[adr + j] != 0 or cover[adr + (j - 1) % num] != 0
+
+
+@kernel
+def _normal_admitted(vert, norm, cover, adr, num, c, s, j, ux, uy):
+    """Whether a contact may press on core vertex j along the world direction (ux, uy), the
+    core's outward normal there: at a vertex that ends a covered edge only along its open
+    edge's normal (the floor's surface runs on through the seam); elsewhere any."""
+    if num < 3 or not _cornered(cover, adr, num, j):
+        return True
+    if cover[adr + j] != 0 and cover[adr + (j - 1) % num] != 0:
+        return False            # inside the floor
+    e = j if cover[adr + j] == 0 else (j - 1) % num
+    nx, ny = rotate(c, s, norm[adr + e, 0], norm[adr + e, 1])
+    return nx * ux + ny * uy >= 1.0 - COVER_PARALLEL
+
+
+@kernel
+def _max_separation(vert, norm, cover, adr_r, num_r, xr, yr, cr, sr, adr_i, num_i, xi, yi, ci,
+                    si, limit):
+    """(sep_all, sep, face, support): sep_all the largest over P's faces k of sep_k = min over
+    Q's vertices q of n_k.(q - p_k) [m] (stopping at the first face with sep_k > limit: a
+    separating axis, no contact); sep the largest over the faces that may be a reference
+    (not covered, and Q's vertex reaching the minimum admits n_k: _normal_admitted), the face
+    and the vertex of Q reaching it (-inf, 0, 0: none)."""
+    best_all = -math.inf
     best = -math.inf
     face = 0
     support = 0
@@ -185,13 +213,15 @@ def _max_separation(vert, norm, adr_r, num_r, xr, yr, cr, sr, adr_i, num_i, xi, 
                 lo = h
                 arg = j
         sep = lo + nx * (xi - px) + ny * (yi - py)
-        if sep > best:
+        best_all = max(best_all, sep)
+        if sep > limit:
+            break
+        if (sep > best and cover[adr_r + k] == 0
+                and _normal_admitted(vert, norm, cover, adr_i, num_i, ci, si, arg, -nx, -ny)):
             best = sep
             face = k
             support = arg
-        if sep > limit:
-            break
-    return best, face, support
+    return best_all, best, face, support
 
 
 @kernel
@@ -386,7 +416,7 @@ def _support_over_face(vert, norm, adr_r, num_r, xr, yr, cr, sr, face,
 
 
 @kernel
-def _manifold(vert, norm, flip, sep, face, support, cap, adr_r, num_r, xr, yr, cr, sr,
+def _manifold(vert, norm, cover, flip, sep, face, support, cap, adr_r, num_r, xr, yr, cr, sr,
               adr_i, num_i, xi, yi, ci, si, r, margin, ox, oy, out):
     """Steps 2 and 3 of the module docstring, given the reference face `face` of core R
     (separation sep [m], the incident vertex `support` reaching it) and cap, the separation
@@ -419,16 +449,24 @@ def _manifold(vert, norm, flip, sep, face, support, cap, adr_r, num_r, xr, yr, c
     if d - r > margin:
         return 0
     nx, ny = _direction(px - gx, py - gy)
+    # a floor tile's corner at a seam is no corner of the floor: touched along a direction
+    # its open face does not have, the touch is the neighbouring tile's (or its face's)
+    if not (_normal_admitted(vert, norm, cover, adr_r, num_r, cr, sr, vr, nx, ny)
+            and _normal_admitted(vert, norm, cover, adr_i, num_i, ci, si, vi, -nx, -ny)):
+        return count
     _write(out, 0, flip, KIND_DIST, px, py, nx, ny, gx, gy, d - r,
            _feature_id(flip, KIND_DIST, vr, vi, CLIP_NONE), ox, oy)
     return 1
 
 
 @kernel
-def collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
+def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
             adr_b, num_b, r_b, xb, yb, cb, sb, margin, out):
     """Contact manifold of two rounded cores, A (rows adr_a.., num_a vertices, radius r_a [m],
     pose xa, ya [m], ca, sa) and B; returns the number of points written to out (0, 1 or 2).
+    cover (n_core,) int: the covered edges of world shapes (builder.covered_edges), which
+    are never a reference face and whose end vertices are pressed only along their open
+    face's normal.
 
     out[k] = (flip, kind, px, py, nx, ny, gx, gy, gap, id): flip FLIP_A (0) when the reference
     feature is A's (p on B's core) or FLIP_B (1); kind KIND_FACE (0: n the reference edge's
@@ -450,17 +488,17 @@ def collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
     face_a = 0
     support_a = 0
     if num_a >= 2:
-        sep_a, face_a, support_a = _max_separation(vert, norm, adr_a, num_a, 0.0, 0.0, ca, sa,
-                                                   adr_b, num_b, dx, dy, cb, sb, limit)
-        if sep_a > limit:
+        all_a, sep_a, face_a, support_a = _max_separation(
+            vert, norm, cover, adr_a, num_a, 0.0, 0.0, ca, sa, adr_b, num_b, dx, dy, cb, sb, limit)
+        if all_a > limit:
             return 0
     sep_b = -math.inf
     face_b = 0
     support_b = 0
     if num_b >= 2:
-        sep_b, face_b, support_b = _max_separation(vert, norm, adr_b, num_b, dx, dy, cb, sb,
-                                                   adr_a, num_a, 0.0, 0.0, ca, sa, limit)
-        if sep_b > limit:
+        all_b, sep_b, face_b, support_b = _max_separation(
+            vert, norm, cover, adr_b, num_b, dx, dy, cb, sb, adr_a, num_a, 0.0, 0.0, ca, sa, limit)
+        if all_b > limit:
             return 0
     cap = -math.inf
     if num_a <= 2 and num_b <= 2:
@@ -468,9 +506,11 @@ def collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
                               adr_b, num_b, dx, dy, cb, sb)
         if cap > limit:
             return 0
+    if sep_a == -math.inf and sep_b == -math.inf:
+        return 0                # (no face may be a reference: a shape inside the floor)
     # the reference: A's best face unless B's separates clearly more (REFERENCE_TOL); one
     # call below, so that callers inline the manifold once
-    if num_a < 2 or sep_b > sep_a + REFERENCE_TOL * (1.0 + abs(sep_a)):
+    if num_a < 2 or sep_a == -math.inf or sep_b > sep_a + REFERENCE_TOL * (1.0 + abs(sep_a)):
         flip, sep, face, support = FLIP_B, sep_b, face_b, support_b
         adr_r, num_r, xr, yr, cr, sr = adr_b, num_b, dx, dy, cb, sb
         adr_i, num_i, xi, yi, ci, si = adr_a, num_a, 0.0, 0.0, ca, sa
@@ -478,5 +518,5 @@ def collide(vert, norm, adr_a, num_a, r_a, xa, ya, ca, sa,
         flip, sep, face, support = FLIP_A, sep_a, face_a, support_a
         adr_r, num_r, xr, yr, cr, sr = adr_a, num_a, 0.0, 0.0, ca, sa
         adr_i, num_i, xi, yi, ci, si = adr_b, num_b, dx, dy, cb, sb
-    return _manifold(vert, norm, flip, sep, face, support, cap, adr_r, num_r, xr, yr, cr, sr,
-                     adr_i, num_i, xi, yi, ci, si, r, margin, xa, ya, out)
+    return _manifold(vert, norm, cover, flip, sep, face, support, cap, adr_r, num_r, xr, yr, cr,
+                     sr, adr_i, num_i, xi, yi, ci, si, r, margin, xa, ya, out)

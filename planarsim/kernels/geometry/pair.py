@@ -126,7 +126,7 @@ def manifold(m, q, cs, ws, i, margin):
     sb = m.contact_pair[i, 1]
     xa, ya, ca, sna = body_pose(q, cs, m.shape_body[sa])
     xb, yb, cb, snb = body_pose(q, cs, m.shape_body[sb])
-    return collide(m.core_vert, m.core_norm,
+    return collide(m.core_vert, m.core_norm, m.core_cover,
                    m.shape_vert_adr[sa], m.shape_vert_num[sa], m.shape_radius[sa], xa, ya, ca, sna,
                    m.shape_vert_adr[sb], m.shape_vert_num[sb], m.shape_radius[sb], xb, yb, cb, snb,
                    margin, ws.manifold)

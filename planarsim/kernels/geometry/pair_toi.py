@@ -98,7 +98,7 @@ def core_separation(m, s, ws, adr_a, num_a, r_a, ba, adr_b, num_b, r_b, bb, t, r
     found by the narrow phase within reach [m]; d = inf when nothing is that close."""
     xa, ya, ca, sna = drift_pose(s, ws, ba, t)
     xb, yb, cb, snb = drift_pose(s, ws, bb, t)
-    n = collide(m.core_vert, m.core_norm, adr_a, num_a, r_a, xa, ya, ca, sna,
+    n = collide(m.core_vert, m.core_norm, m.core_cover, adr_a, num_a, r_a, xa, ya, ca, sna,
                 adr_b, num_b, r_b, xb, yb, cb, snb, reach, ws.manifold)
     if n == 0:
         return math.inf, 0.0, 1.0
