@@ -193,45 +193,125 @@ def edge_pieces(start, end, ground) -> list:
 COVER_TOL = 1e-9
 
 
+def _rays_at(core, normals, v, tol):
+    """The boundary rays of a convex core leaving point v on it: (unit direction, outward
+    normal of the face it runs along), two where v is on a face's interior (both ways) or
+    one of its vertices (along its two faces); none where v is off the boundary."""
+    rays = []
+    num = len(core)
+    for k in range(num):
+        a, b = core[k], core[(k + 1) % num]
+        if abs(float(normals[k] @ (v - a))) > tol:
+            continue
+        d = b - a
+        length = math.hypot(d[0], d[1])
+        t = d / length
+        s = float(t @ (v - a))
+        if s < -tol or s > length + tol:
+            continue
+        if s < length - tol:
+            rays.append((t, normals[k]))
+        if s > tol:
+            rays.append((-t, normals[k]))
+    return rays
+
+
+def _cone_bound(n_open, v, toward, core_j, normals_j, tol):
+    """(bound, concave): the far bound of the outward normal cone of the union of two world
+    shapes at vertex v of shape i, whose open face (outward normal n_open) meets its covered
+    edge (running from v toward `toward`), held by shape j: the normal of j's face that
+    carries the surface on from v where the corner they make is flat or convex (the cone
+    spans n_open .. that normal), n_open where it is concave (concave 1: a body meets that
+    corner along the faces, i's open face's line the one it reaches first), n_open too
+    where j's boundary does not pass through v."""
+    e = toward - v
+    e = e / math.hypot(e[0], e[1])
+    for ray, normal in _rays_at(core_j, normals_j, v, tol):
+        if float(ray @ e) > 1.0 - 1e-9:
+            continue                      # j's face along the covered edge itself
+        if float(n_open @ ray) <= 1e-9:
+            return normal, 0.0            # flat or convex
+        return n_open, 1.0                # concave
+    return n_open, 0.0
+
+
 def covered_edges(shapes) -> np.ndarray:
-    """(n_core,) int over the shapes' core vertices: 1 where the edge from that vertex is a
-    world shape's face covered by another world shape (kernels/geometry/collide.py: never a
-    reference face, and its ends' vertices touch only along their open faces' normals). A
-    floor of static boxes laid edge to edge has its tiles' upright faces at the seams inside
-    the floor; a body sliding over a seam must not meet them. Polygons of radius 0 only; an
-    edge counts as covered only where one other shape holds it whole (its two ends within
-    COVER_TOL of that core, and the point just outside its midpoint inside it)."""
+    """(n_core, 4) over the shapes' core vertices: column 0 is 1 where the edge from that
+    vertex is a world shape's face covered by another world shape (never a reference face:
+    kernels/geometry/collide.py); columns 1-2 the far bound of the outward normal cone at a
+    vertex that ends a covered edge (collide._normal_admitted: the cone runs from the open
+    face's normal to it; (0, 0): no normal, the vertex is inside the floor); column 3 is 1
+    where that vertex is a concave corner of the floor (a flat run meeting a ramp up). A floor of
+    static boxes laid edge to edge has its tiles' upright faces at the seams inside the
+    floor; a body sliding over a seam must not meet them, and at a crest between two shapes
+    the cone spans both faces' normals. Polygons of radius 0 only; an edge counts as covered
+    only where one other shape holds it whole (its two ends within COVER_TOL of that core,
+    and the point just outside its midpoint inside it) and collides with what it does
+    (the same category and mask)."""
     cores = [np.asarray(sh["core"], dtype=np.float64).reshape(-1, 2) for sh in shapes]
-    out = [np.zeros(len(c), np.int64) for c in cores]
+    out = [np.zeros((len(c), 4)) for c in cores]
     world = [i for i, sh in enumerate(shapes)
              if sh["body"] < 0 and len(cores[i]) >= 3 and sh["radius"] == 0.0]
     if len(world) < 2:
-        return np.concatenate(out) if out else np.zeros(0, np.int64)
+        return np.concatenate(out) if out else np.zeros((0, 4))
     normals = {i: core_normals(cores[i]) for i in world}
-    # bounding boxes: a shape can hold an edge only if its box holds both ends
-    lo = np.array([cores[i].min(axis=0) for i in world])
-    hi = np.array([cores[i].max(axis=0) for i in world])
+    holder = {}                            # (i, k) -> the shape j covering edge k of i
+    for i, k, j in _covered_pairs(shapes, cores, normals, world):
+        out[i][k, 0] = 1.0
+        holder[(i, k)] = j
+    for (i, k), j in holder.items():
+        ci, ni, num = cores[i], normals[i], len(cores[i])
+        tol = COVER_TOL + 1e-12 * (1.0 + float(np.abs(ci).max()))
+        # the edge's two ends: vertex k (its open face the one before) and k + 1 (the one after)
+        for v_index, open_face, other in ((k, (k - 1) % num, (k + 1) % num),
+                                          ((k + 1) % num, (k + 1) % num, k)):
+            if out[i][open_face, 0] != 0.0:
+                out[i][v_index, 1:] = 0.0  # both faces covered: inside the floor
+                continue
+            bound, concave = _cone_bound(ni[open_face], ci[v_index], ci[other], cores[j],
+                                         normals[j], tol)
+            out[i][v_index, 1:3] = bound
+            out[i][v_index, 3] = concave
+    return np.concatenate(out)
+
+
+def _covered_pairs(shapes, cores, normals, world):
+    """(i, k, j): edge k of world shape i held whole by world shape j (covered_edges' rule).
+    Shapes are binned on a grid of their median size: a shape that holds an edge holds its
+    midpoint, so only the shapes binned at the midpoint's cell are tried."""
+    lo = {i: cores[i].min(axis=0) for i in world}
+    hi = {i: cores[i].max(axis=0) for i in world}
+    cell = float(np.median([max(hi[i][0] - lo[i][0], hi[i][1] - lo[i][1]) for i in world]))
+    cell = max(cell, 1e-6)
+    grid = {}
+    wide = []                              # shapes spanning too many cells: tried everywhere
+    for i in world:
+        x0, y0 = np.floor(lo[i] / cell).astype(np.int64)
+        x1, y1 = np.floor(hi[i] / cell).astype(np.int64)
+        if (x1 - x0 + 1) * (y1 - y0 + 1) > 64:
+            wide.append(i)
+            continue
+        for gx in range(x0, x1 + 1):
+            for gy in range(y0, y1 + 1):
+                grid.setdefault((gx, gy), []).append(i)
     for i in world:
         ci, ni = cores[i], normals[i]
         tol = COVER_TOL + 1e-12 * (1.0 + float(np.abs(ci).max()))
         for k in range(len(ci)):
             a, b = ci[k], ci[(k + 1) % len(ci)]
-            ends_lo = np.minimum(a, b) + tol
-            ends_hi = np.maximum(a, b) - tol
-            near = np.flatnonzero(np.all(lo <= ends_lo, axis=1) & np.all(hi >= ends_hi, axis=1))
-            outside = 0.5 * (a + b) + 1e-6 * float(np.hypot(*(b - a))) * ni[k]
-            for v in near:
-                j = world[v]
-                if j == i:
+            mid = 0.5 * (a + b)
+            outside = mid + 1e-6 * math.hypot(*(b - a)) * ni[k]
+            points = np.stack([a, b, outside])
+            key = tuple(np.floor(mid / cell).astype(np.int64))
+            for j in grid.get(key, []) + wide:
+                if j == i or (shapes[j]["category"], shapes[j]["mask"]) != (
+                        shapes[i]["category"], shapes[i]["mask"]):
                     continue
-                cj, nj = cores[j], normals[j]
-                # the largest signed distance of each point to j's faces' lines (<= 0: inside)
-                points = np.stack([a, b, outside])
-                worst = np.einsum("kd,pkd->pk", nj, points[:, None, :] - cj[None]).max(axis=1)
+                worst = np.einsum("kd,pkd->pk", normals[j],
+                                  points[:, None, :] - cores[j][None]).max(axis=1)
                 if worst[0] <= tol and worst[1] <= tol and worst[2] < 0.0:
-                    out[i][k] = 1
+                    yield i, k, j
                     break
-    return np.concatenate(out) if out else np.zeros(0, np.int64)
 
 
 class ModelBuilder:
@@ -1051,7 +1131,7 @@ class ModelBuilder:
                             for sh in self._collide] or np.zeros((0, 5))).reshape(ns, 5),
             core_vert=ro(core).reshape(len(core), 2),
             core_norm=ro(norm).reshape(len(core), 2),
-            core_cover=ro(covered_edges(self._collide), np.int64).reshape(len(core)))
+            core_cover=ro(covered_edges(self._collide)).reshape(len(core), 4))
 
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:

@@ -70,6 +70,8 @@ SLAB_TOL = 1e-12
 # seam counts as its open face's (about 4.5e-5 rad): a box lying flat across the seam keeps its
 # own face as the reference
 COVER_PARALLEL = 1e-9
+# how far [sin of the angle] a normal may lie outside a crest's cone and count as in it
+COVER_ARC = 1e-9
 
 
 def core_normals(vertices) -> np.ndarray:
@@ -171,21 +173,36 @@ def _circle_pair(vert, adr_a, ca, sa, adr_b, xb, yb, cb, sb, r, margin, ox, oy, 
 def _cornered(cover, adr, num, j):
     """Core vertex j (of the core at adr, num vertices) ends a covered edge (builder
     .covered_edges): a floor tile's corner at a seam."""
-    return cover[adr + j] != 0 or cover[adr + (j - 1) % num] != 0
+    return cover[adr + j, 0] != 0.0 or cover[adr + (j - 1) % num, 0] != 0.0
+
+
+@kernel
+def _concave(cover, adr, num, j):
+    """Core vertex j is a concave corner of the floor its shape belongs to."""
+    return num >= 3 and cover[adr + j, 3] != 0.0
 
 
 @kernel
 def _normal_admitted(vert, norm, cover, adr, num, c, s, j, ux, uy):
     """Whether a contact may press on core vertex j along the world direction (ux, uy), the
-    core's outward normal there: at a vertex that ends a covered edge only along its open
-    edge's normal (the floor's surface runs on through the seam); elsewhere any."""
+    core's outward normal there. At a vertex that ends a covered edge, only within the
+    outward normal cone of the floor it belongs to (builder.covered_edges): from its open
+    face's normal p to the bound q the builder stored, a single direction where the floor
+    runs on flat through the seam (or turns concave there), none inside the floor;
+    elsewhere any."""
     if num < 3 or not _cornered(cover, adr, num, j):
         return True
-    if cover[adr + j] != 0 and cover[adr + (j - 1) % num] != 0:
+    if cover[adr + j, 1] == 0.0 and cover[adr + j, 2] == 0.0:
         return False            # inside the floor
-    e = j if cover[adr + j] == 0 else (j - 1) % num
-    nx, ny = rotate(c, s, norm[adr + e, 0], norm[adr + e, 1])
-    return nx * ux + ny * uy >= 1.0 - COVER_PARALLEL
+    e = j if cover[adr + j, 0] == 0.0 else (j - 1) % num
+    px, py = rotate(c, s, norm[adr + e, 0], norm[adr + e, 1])
+    qx, qy = rotate(c, s, cover[adr + j, 1], cover[adr + j, 2])
+    if px * qx + py * qy >= 1.0 - COVER_PARALLEL:
+        return px * ux + py * uy >= 1.0 - COVER_PARALLEL
+    # the short arc from p to q (a crest between two faces)
+    turn = px * qy - py * qx
+    return ((px * uy - py * ux) * turn >= -COVER_ARC and (ux * qy - uy * qx) * turn >= -COVER_ARC
+            and ux * (px + qx) + uy * (py + qy) > 0.0)
 
 
 @kernel
@@ -216,7 +233,7 @@ def _max_separation(vert, norm, cover, adr_r, num_r, xr, yr, cr, sr, adr_i, num_
         best_all = max(best_all, sep)
         if sep > limit:
             break
-        if (sep > best and cover[adr_r + k] == 0
+        if (sep > best and cover[adr_r + k, 0] == 0.0
                 and _normal_admitted(vert, norm, cover, adr_i, num_i, ci, si, arg, -nx, -ny)):
             best = sep
             face = k
@@ -453,7 +470,13 @@ def _manifold(vert, norm, cover, flip, sep, face, support, cap, adr_r, num_r, xr
     # its open face does not have, the touch is the neighbouring tile's (or its face's)
     if not (_normal_admitted(vert, norm, cover, adr_r, num_r, cr, sr, vr, nx, ny)
             and _normal_admitted(vert, norm, cover, adr_i, num_i, ci, si, vi, -nx, -ny)):
-        return count
+        # the face's points where it has some over its extent; else, at a flat seam, none
+        # (the extended face's stand-in point would duplicate the neighbouring tile's own),
+        # at a concave corner the stand-in (a body about to meet the ramp that rises there)
+        if h_min < math.inf or _concave(cover, adr_r, num_r, vr) or _concave(
+                cover, adr_i, num_i, vi):
+            return count
+        return 0
     _write(out, 0, flip, KIND_DIST, px, py, nx, ny, gx, gy, d - r,
            _feature_id(flip, KIND_DIST, vr, vi, CLIP_NONE), ox, oy)
     return 1
@@ -464,9 +487,9 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
             adr_b, num_b, r_b, xb, yb, cb, sb, margin, out):
     """Contact manifold of two rounded cores, A (rows adr_a.., num_a vertices, radius r_a [m],
     pose xa, ya [m], ca, sa) and B; returns the number of points written to out (0, 1 or 2).
-    cover (n_core,) int: the covered edges of world shapes (builder.covered_edges), which
-    are never a reference face and whose end vertices are pressed only along their open
-    face's normal.
+    cover (n_core, 4): the covered edges of world shapes and their ends' normal cones
+    (builder.covered_edges): a covered edge is never a reference face, and its end vertices
+    are pressed only within the floor's normal cone there.
 
     out[k] = (flip, kind, px, py, nx, ny, gx, gy, gap, id): flip FLIP_A (0) when the reference
     feature is A's (p on B's core) or FLIP_B (1); kind KIND_FACE (0: n the reference edge's
