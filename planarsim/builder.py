@@ -193,107 +193,168 @@ def edge_pieces(start, end, ground) -> list:
 COVER_TOL = 1e-9
 
 
-def _rays_at(core, normals, v, tol):
-    """The boundary rays of a convex core leaving point v on it: (unit direction, outward
-    normal of the face it runs along), two where v is on a face's interior (both ways) or
-    one of its vertices (along its two faces); none where v is off the boundary."""
-    rays = []
+TWO_PI = 2.0 * math.pi
+# [rad] sectors this close are one; a free arc this close to a half turn is a flat run
+COVER_ANGLE_TOL = 1e-9
+
+
+def _angle(d):
+    """The direction of vector d [rad] in [0, 2 pi)."""
+    return math.atan2(d[1], d[0]) % TWO_PI
+
+
+def _sector_at(core, normals, v, tol):
+    """The sector (start, length) [rad] a convex core fills around point v, counter-clockwise
+    from start: its interior angle at a vertex, a half turn on a face's interior, a whole
+    turn inside it (length 2 pi); None off it."""
     num = len(core)
+    depth = max(float(normals[k] @ (v - core[k])) for k in range(num))
+    if depth > tol:
+        return None
     for k in range(num):
-        a, b = core[k], core[(k + 1) % num]
-        if abs(float(normals[k] @ (v - a))) > tol:
-            continue
-        d = b - a
-        length = math.hypot(d[0], d[1])
-        t = d / length
-        s = float(t @ (v - a))
-        if s < -tol or s > length + tol:
-            continue
-        if s < length - tol:
-            rays.append((t, normals[k]))
-        if s > tol:
-            rays.append((-t, normals[k]))
-    return rays
+        if math.hypot(*(core[k] - v)) <= tol:
+            start = _angle(core[(k + 1) % num] - v)
+            return start, (_angle(core[k - 1] - v) - start) % TWO_PI
+    if depth < -tol:
+        return 0.0, TWO_PI
+    for k in range(num):
+        if abs(float(normals[k] @ (v - core[k]))) <= tol:
+            return _angle(core[(k + 1) % num] - core[k]), math.pi
+    return None
 
 
-def _cone_bound(n_open, v, toward, core_j, normals_j, tol):
-    """(bound, concave): the far bound of the outward normal cone of the union of two world
-    shapes at vertex v of shape i, whose open face (outward normal n_open) meets its covered
-    edge (running from v toward `toward`), held by shape j: the normal of j's face that
-    carries the surface on from v where the corner they make is flat or convex (the cone
-    spans n_open .. that normal), n_open where it is concave (concave 1: a body meets that
-    corner along the faces, i's open face's line the one it reaches first), n_open too
-    where j's boundary does not pass through v."""
-    e = toward - v
-    e = e / math.hypot(e[0], e[1])
-    for ray, normal in _rays_at(core_j, normals_j, v, tol):
-        if float(ray @ e) > 1.0 - 1e-9:
-            continue                      # j's face along the covered edge itself
-        if float(n_open @ ray) <= 1e-9:
-            return normal, 0.0            # flat or convex
-        return n_open, 1.0                # concave
-    return n_open, 0.0
+def _free_arcs(sectors):
+    """The arcs (start, length) [rad] around a point that no sector fills."""
+    if any(length >= TWO_PI - COVER_ANGLE_TOL for _, length in sectors):
+        return []
+    # cut the circle at the first sector's start (which that sector fills: no free arc
+    # runs through the cut)
+    base = sectors[0][0]
+    spans = sorted(((a - base) % TWO_PI, (a - base) % TWO_PI + length) for a, length in sectors)
+    free = []
+    reach = 0.0
+    for lo, hi in spans:
+        if lo > reach + COVER_ANGLE_TOL:
+            free.append((reach, lo - reach))
+        reach = max(reach, hi)
+    if reach < TWO_PI - COVER_ANGLE_TOL:
+        free.append((reach, TWO_PI - reach))
+    return [((a + base) % TWO_PI, length) for a, length in free]
+
+
+def _vertex_cone(v, n_open, shapes_here, tol):
+    """(p, q, concave) at a vertex of the floor that several world shapes (shapes_here:
+    (core, normals)) fill around v: the outward normal cone of their union there, from p to
+    q counter-clockwise. A convex corner (the free arc wider than a half turn): the normals
+    of the two faces bounding it; a flat run: p = q, the surface's normal; a concave corner
+    (a flat run meeting a ramp up): p = q = n_open, concave 1 (a body meets it along the
+    faces); inside the floor (no free arc): p = q = 0. Of several free arcs (shapes touching
+    at a corner only), the one bounded by the face whose normal is n_open."""
+    sectors = [sec for core, normals in shapes_here
+               for sec in [_sector_at(core, normals, v, tol)] if sec is not None]
+    free = _free_arcs(sectors) if sectors else []
+    if not free:
+        return np.zeros(2), np.zeros(2), 0.0
+    arc = free[0]
+    for a, length in free:
+        ua = np.array([math.cos(a), math.sin(a)])
+        ub = np.array([math.cos(a + length), math.sin(a + length)])
+        if max(float(n_open @ np.array([-ua[1], ua[0]])),
+               float(n_open @ np.array([ub[1], -ub[0]]))) > 1.0 - 1e-9:
+            arc = (a, length)
+    a, length = arc
+    ua = np.array([math.cos(a), math.sin(a)])
+    ub = np.array([math.cos(a + length), math.sin(a + length)])
+    p = np.array([-ua[1], ua[0]])           # the face along ua: material clockwise of it
+    q = np.array([ub[1], -ub[0]])           # the face along ub: material counter-clockwise
+    if length < math.pi - COVER_ANGLE_TOL:
+        return n_open, n_open, 1.0
+    if length <= math.pi + COVER_ANGLE_TOL:
+        return p, p, 0.0
+    return p, q, 0.0
 
 
 def covered_edges(shapes) -> np.ndarray:
-    """(n_core, 4) over the shapes' core vertices: column 0 is 1 where the edge from that
+    """(n_core, 6) over the shapes' core vertices: column 0 is 1 where the edge from that
     vertex is a world shape's face covered by another world shape (never a reference face:
-    kernels/geometry/collide.py); columns 1-2 the far bound of the outward normal cone at a
-    vertex that ends a covered edge (collide._normal_admitted: the cone runs from the open
-    face's normal to it; (0, 0): no normal, the vertex is inside the floor); column 3 is 1
-    where that vertex is a concave corner of the floor (a flat run meeting a ramp up). A floor of
-    static boxes laid edge to edge has its tiles' upright faces at the seams inside the
-    floor; a body sliding over a seam must not meet them, and at a crest between two shapes
-    the cone spans both faces' normals. Polygons of radius 0 only; an edge counts as covered
-    only where one other shape holds it whole (its two ends within COVER_TOL of that core,
-    and the point just outside its midpoint inside it) and collides with what it does
-    (the same category and mask)."""
+    kernels/geometry/collide.py). At a vertex that ends a covered edge, the outward normal
+    cone of the floor there (collide._normal_admitted), from columns 4-5 counter-clockwise
+    to columns 1-2 ((0, 0): none, the vertex is inside the floor), column 3 is 1 where the
+    vertex is a concave corner of the floor (a flat run meeting a ramp up). The cone is made
+    of every world shape of the same category and mask that fills some of the turn around
+    the vertex (a strip of triangles meets in threes). A floor of static boxes laid edge to
+    edge has its tiles' upright faces at the seams inside the floor; a body sliding over a
+    seam must not meet them, and at a crest the cone spans both faces' normals. Polygons of
+    radius 0 only; an edge counts as covered only where one other shape holds it whole (its
+    two ends within COVER_TOL of that core, and the point just outside its midpoint inside
+    it) and collides with what it does (the same category and mask)."""
     cores = [np.asarray(sh["core"], dtype=np.float64).reshape(-1, 2) for sh in shapes]
-    out = [np.zeros((len(c), 4)) for c in cores]
+    out = [np.zeros((len(c), 6)) for c in cores]
     world = [i for i, sh in enumerate(shapes)
              if sh["body"] < 0 and len(cores[i]) >= 3 and sh["radius"] == 0.0]
     if len(world) < 2:
-        return np.concatenate(out) if out else np.zeros((0, 4))
+        return np.concatenate(out) if out else np.zeros((0, 6))
     normals = {i: core_normals(cores[i]) for i in world}
-    holder = {}                            # (i, k) -> the shape j covering edge k of i
-    for i, k, j in _covered_pairs(shapes, cores, normals, world):
+    grid = _Grid(cores, world)
+    for i, k in _covered_pairs(shapes, cores, normals, world, grid):
         out[i][k, 0] = 1.0
-        holder[(i, k)] = j
-    for (i, k), j in holder.items():
+    for i in world:
         ci, ni, num = cores[i], normals[i], len(cores[i])
         tol = COVER_TOL + 1e-12 * (1.0 + float(np.abs(ci).max()))
-        # the edge's two ends: vertex k (its open face the one before) and k + 1 (the one after)
-        for v_index, open_face, other in ((k, (k - 1) % num, (k + 1) % num),
-                                          ((k + 1) % num, (k + 1) % num, k)):
-            if out[i][open_face, 0] != 0.0:
-                out[i][v_index, 1:] = 0.0  # both faces covered: inside the floor
+        for v_index in range(num):
+            before = (v_index - 1) % num
+            if out[i][v_index, 0] == 0.0 and out[i][before, 0] == 0.0:
                 continue
-            bound, concave = _cone_bound(ni[open_face], ci[v_index], ci[other], cores[j],
-                                         normals[j], tol)
-            out[i][v_index, 1:3] = bound
+            if out[i][v_index, 0] != 0.0 and out[i][before, 0] != 0.0:
+                continue                   # both faces covered: inside the floor
+            open_face = before if out[i][v_index, 0] != 0.0 else v_index
+            v = ci[v_index]
+            here = [(cores[j], normals[j]) for j in grid.near(v, tol)
+                    if _same_filter(shapes[i], shapes[j])]
+            p, q, concave = _vertex_cone(v, ni[open_face], here, tol)
+            out[i][v_index, 1:3] = q
             out[i][v_index, 3] = concave
+            out[i][v_index, 4:6] = p
     return np.concatenate(out)
 
 
-def _covered_pairs(shapes, cores, normals, world):
-    """(i, k, j): edge k of world shape i held whole by world shape j (covered_edges' rule).
-    Shapes are binned on a grid of their median size: a shape that holds an edge holds its
-    midpoint, so only the shapes binned at the midpoint's cell are tried."""
-    lo = {i: cores[i].min(axis=0) for i in world}
-    hi = {i: cores[i].max(axis=0) for i in world}
-    cell = float(np.median([max(hi[i][0] - lo[i][0], hi[i][1] - lo[i][1]) for i in world]))
-    cell = max(cell, 1e-6)
-    grid = {}
-    wide = []                              # shapes spanning too many cells: tried everywhere
-    for i in world:
-        x0, y0 = np.floor(lo[i] / cell).astype(np.int64)
-        x1, y1 = np.floor(hi[i] / cell).astype(np.int64)
-        if (x1 - x0 + 1) * (y1 - y0 + 1) > 64:
-            wide.append(i)
-            continue
-        for gx in range(x0, x1 + 1):
-            for gy in range(y0, y1 + 1):
-                grid.setdefault((gx, gy), []).append(i)
+def _same_filter(a, b):
+    """Two shapes collide with the same shapes (category and mask)."""
+    return (a["category"], a["mask"]) == (b["category"], b["mask"])
+
+
+class _Grid:
+    """World shapes binned on a grid of their median size (covered_edges): near(point) lists
+    the shapes whose bounding box may hold the point."""
+
+    def __init__(self, cores, world):
+        lo = {i: cores[i].min(axis=0) for i in world}
+        hi = {i: cores[i].max(axis=0) for i in world}
+        self.lo, self.hi = lo, hi
+        cell = float(np.median([max(hi[i][0] - lo[i][0], hi[i][1] - lo[i][1]) for i in world]))
+        self.cell = max(cell, 1e-6)
+        self.bins = {}
+        self.wide = []                     # shapes spanning too many cells: tried everywhere
+        for i in world:
+            x0, y0 = np.floor(lo[i] / self.cell).astype(np.int64)
+            x1, y1 = np.floor(hi[i] / self.cell).astype(np.int64)
+            if (x1 - x0 + 1) * (y1 - y0 + 1) > 64:
+                self.wide.append(i)
+                continue
+            for gx in range(x0, x1 + 1):
+                for gy in range(y0, y1 + 1):
+                    self.bins.setdefault((gx, gy), []).append(i)
+
+    def near(self, point, tol):
+        key = tuple(np.floor(point / self.cell).astype(np.int64))
+        return [j for j in self.bins.get(key, []) + self.wide
+                if np.all(self.lo[j] - tol <= point) and np.all(point <= self.hi[j] + tol)]
+
+
+def _covered_pairs(shapes, cores, normals, world, grid):
+    """(i, k): edge k of world shape i held whole by another world shape (covered_edges'
+    rule). A shape that holds an edge holds its midpoint: only the shapes the grid lists
+    there are tried."""
     for i in world:
         ci, ni = cores[i], normals[i]
         tol = COVER_TOL + 1e-12 * (1.0 + float(np.abs(ci).max()))
@@ -302,15 +363,13 @@ def _covered_pairs(shapes, cores, normals, world):
             mid = 0.5 * (a + b)
             outside = mid + 1e-6 * math.hypot(*(b - a)) * ni[k]
             points = np.stack([a, b, outside])
-            key = tuple(np.floor(mid / cell).astype(np.int64))
-            for j in grid.get(key, []) + wide:
-                if j == i or (shapes[j]["category"], shapes[j]["mask"]) != (
-                        shapes[i]["category"], shapes[i]["mask"]):
+            for j in grid.near(mid, tol):
+                if j == i or not _same_filter(shapes[i], shapes[j]):
                     continue
                 worst = np.einsum("kd,pkd->pk", normals[j],
                                   points[:, None, :] - cores[j][None]).max(axis=1)
                 if worst[0] <= tol and worst[1] <= tol and worst[2] < 0.0:
-                    yield i, k, j
+                    yield i, k
                     break
 
 
@@ -1131,7 +1190,7 @@ class ModelBuilder:
                             for sh in self._collide] or np.zeros((0, 5))).reshape(ns, 5),
             core_vert=ro(core).reshape(len(core), 2),
             core_norm=ro(norm).reshape(len(core), 2),
-            core_cover=ro(covered_edges(self._collide)).reshape(len(core), 4))
+            core_cover=ro(covered_edges(self._collide)).reshape(len(core), 6))
 
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:

@@ -93,9 +93,9 @@ class ModelArrays(NamedTuple):
                                     #   width [m] and a turn's lever [m] (shapes.shape_bounds)
     core_vert: np.ndarray           # (n_core, 2) core vertices in the shape's frame [m]
     core_norm: np.ndarray           # (n_core, 2) outward unit normal of the edge from each vertex
-    core_cover: np.ndarray          # (n_core, 4) 1 where the edge from that vertex is a world
+    core_cover: np.ndarray          # (n_core, 6) 1 where the edge from that vertex is a world
                                     #   shape's face covered by another; the vertex's normal
-                                    #   cone bound; 1 at a concave corner (builder.covered_edges)
+                                    #   cone (q; concave flag; p) (builder.covered_edges)
 
 
 @dataclass(frozen=True)

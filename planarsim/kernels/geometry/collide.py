@@ -186,16 +186,14 @@ def _concave(cover, adr, num, j):
 def _normal_admitted(vert, norm, cover, adr, num, c, s, j, ux, uy):
     """Whether a contact may press on core vertex j along the world direction (ux, uy), the
     core's outward normal there. At a vertex that ends a covered edge, only within the
-    outward normal cone of the floor it belongs to (builder.covered_edges): from its open
-    face's normal p to the bound q the builder stored, a single direction where the floor
-    runs on flat through the seam (or turns concave there), none inside the floor;
-    elsewhere any."""
+    outward normal cone of the floor it belongs to (builder.covered_edges): from p to q
+    counter-clockwise, a single direction where the floor runs on flat through the seam
+    (or turns concave there), none inside the floor; elsewhere any."""
     if num < 3 or not _cornered(cover, adr, num, j):
         return True
     if cover[adr + j, 1] == 0.0 and cover[adr + j, 2] == 0.0:
         return False            # inside the floor
-    e = j if cover[adr + j, 0] == 0.0 else (j - 1) % num
-    px, py = rotate(c, s, norm[adr + e, 0], norm[adr + e, 1])
+    px, py = rotate(c, s, cover[adr + j, 4], cover[adr + j, 5])
     qx, qy = rotate(c, s, cover[adr + j, 1], cover[adr + j, 2])
     if px * qx + py * qy >= 1.0 - COVER_PARALLEL:
         return px * ux + py * uy >= 1.0 - COVER_PARALLEL
@@ -487,7 +485,7 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
             adr_b, num_b, r_b, xb, yb, cb, sb, margin, out):
     """Contact manifold of two rounded cores, A (rows adr_a.., num_a vertices, radius r_a [m],
     pose xa, ya [m], ca, sa) and B; returns the number of points written to out (0, 1 or 2).
-    cover (n_core, 4): the covered edges of world shapes and their ends' normal cones
+    cover (n_core, 6): the covered edges of world shapes and their ends' normal cones
     (builder.covered_edges): a covered edge is never a reference face, and its end vertices
     are pressed only within the floor's normal cone there.
 
@@ -508,6 +506,7 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
         return _circle_pair(vert, adr_a, ca, sa, adr_b, dx, dy, cb, sb, r, margin, xa, ya, out)
     limit = margin + r
     sep_a = -math.inf
+    all_a = -math.inf
     face_a = 0
     support_a = 0
     if num_a >= 2:
@@ -516,6 +515,7 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
         if all_a > limit:
             return 0
     sep_b = -math.inf
+    all_b = -math.inf
     face_b = 0
     support_b = 0
     if num_b >= 2:
@@ -529,8 +529,16 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
                               adr_b, num_b, dx, dy, cb, sb)
         if cap > limit:
             return 0
-    if sep_a == -math.inf and sep_b == -math.inf:
-        return 0                # (no face may be a reference: a shape inside the floor)
+    # no face may be a reference (a shape inside the floor); or every face that may would
+    # overstate the pair's penetration, which its largest separation over every axis bounds
+    # (min(all, 0)), by more than the margin: the body is across a covered side, where the
+    # neighbouring shape answers for it (a triangle of a strip whose both upper sides are
+    # covered would measure a disk on its apex from its bottom: a contact 1.1 m deep). Not
+    # at the foot of a ramp, whose face, met a step ahead, is the reference it must be
+    best = max(sep_a, sep_b)
+    if best == -math.inf or best < min(max(all_a, all_b), 0.0) - margin - REFERENCE_TOL * (
+            1.0 + abs(best)):
+        return 0
     # the reference: A's best face unless B's separates clearly more (REFERENCE_TOL); one
     # call below, so that callers inline the manifold once
     if num_a < 2 or sep_a == -math.inf or sep_b > sep_a + REFERENCE_TOL * (1.0 + abs(sep_a)):
