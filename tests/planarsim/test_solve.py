@@ -8,8 +8,9 @@ from hypothesis import given, settings, strategies as st
 from numba import njit
 
 from planarsim.compile import options as compile_options
-from planarsim.kernels.solver.envelope import (compute_envelope, factor, factor_symmetric,
-                                               substitute, substitute_symmetric)
+from planarsim.kernels.solver.envelope import (NULL_DIAGONAL, compute_envelope, factor,
+                                               factor_symmetric, substitute,
+                                               substitute_symmetric)
 from strategies import body_rows, dense_jacobian, vectors
 
 TOL = 1e-11
@@ -177,7 +178,7 @@ def _reference_elimination(A, first, reach, n, tol, symmetric):
     for k in range(n):
         piv = A[k, k]
         below = [i for i in range(k + 1, reach[k] + 1) if first[i] <= k]
-        if abs(piv) <= tol * scale[k] or scale[k] == 0.0:
+        if abs(piv) <= tol * scale[k] or scale[k] <= NULL_DIAGONAL:
             dropped += 1
             for j in below:
                 A[j, k] = 0.0
