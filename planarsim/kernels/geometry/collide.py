@@ -72,6 +72,10 @@ SLAB_TOL = 1e-12
 COVER_PARALLEL = 1e-9
 # how far [sin of the angle] a normal may lie outside a crest's cone and count as in it
 COVER_ARC = 1e-9
+# [m] how far a covered shape's admissible faces may overstate a pair's penetration before
+# the pair is left to its neighbours (a fixed slop: not the speculative margin, which at
+# 50 m/s and dt 1e-2 reaches a metre and kept a slab's bottom as a reference)
+OVERSTATE_TOL = 1e-4
 
 
 def core_normals(vertices) -> np.ndarray:
@@ -531,13 +535,13 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
             return 0
     # no face may be a reference (a shape inside the floor); or every face that may would
     # overstate the pair's penetration, which its largest separation over every axis bounds
-    # (min(all, 0)), by more than the margin: the body is across a covered side, where the
+    # (min(all, 0)), by more than OVERSTATE_TOL: the body is across a covered side, where the
     # neighbouring shape answers for it (a triangle of a strip whose both upper sides are
     # covered would measure a disk on its apex from its bottom: a contact 1.1 m deep). Not
     # at the foot of a ramp, whose face, met a step ahead, is the reference it must be
     best = max(sep_a, sep_b)
-    if best == -math.inf or best < min(max(all_a, all_b), 0.0) - margin - REFERENCE_TOL * (
-            1.0 + abs(best)):
+    slop = OVERSTATE_TOL + REFERENCE_TOL * (1.0 + abs(best))
+    if best == -math.inf or best < min(max(all_a, all_b), 0.0) - slop:
         return 0
     # the reference: A's best face unless B's separates clearly more (REFERENCE_TOL); one
     # call below, so that callers inline the manifold once
