@@ -687,7 +687,7 @@ def shape_clearance(model, q):
     worst = np.zeros(q.shape[0])
     if len(pairs):
         # (no covered faces: the judge measures the shapes' true overlap)
-        _overlap_kernel()(a.core_vert, a.core_norm, np.zeros((len(a.core_vert), 6)),
+        _overlap_kernel()(a.core_vert, a.core_norm, np.zeros((len(a.core_vert), 8)),
                           a.shape_vert_adr, a.shape_vert_num,
                           a.shape_radius, a.shape_body, np.ascontiguousarray(pairs),
                           np.ascontiguousarray(q), worst, np.zeros((2, 10)))

@@ -342,7 +342,7 @@ def overlap(model, q) -> float:
     worst = np.zeros(q.shape[0])
     if len(pairs):
         # (no covered faces: the shapes' true overlap)
-        _overlap_kernel()(a.core_vert, a.core_norm, np.zeros((len(a.core_vert), 6)),
+        _overlap_kernel()(a.core_vert, a.core_norm, np.zeros((len(a.core_vert), 8)),
                           a.shape_vert_adr, a.shape_vert_num, a.shape_radius,
                           a.shape_body, np.ascontiguousarray(pairs), np.ascontiguousarray(q), worst,
                           np.zeros((2, 10)))

@@ -188,8 +188,8 @@ def edge_pieces(start, end, ground) -> list:
         out.append((start + lo * (end - start), start + hi * (end - start), own))
     return out
 
-# [m] a world shape's edge whose ends lie within this of another world shape's core (and the
-# outside of whose midpoint is that shape's) is covered by it
+# [m] a world shape's edge is covered by the other world shapes whose cores, grown by this,
+# hold its pieces end to end (each with the outside of its piece's midpoint in it)
 COVER_TOL = 1e-9
 
 
@@ -275,39 +275,48 @@ def _vertex_cone(v, n_open, shapes_here, tol):
 
 
 def covered_edges(shapes) -> np.ndarray:
-    """(n_core, 6) over the shapes' core vertices: column 0 is 1 where the edge from that
-    vertex is a world shape's face covered by another world shape (never a reference face:
-    kernels/geometry/collide.py). At a vertex that ends a covered edge, the outward normal
-    cone of the floor there (collide._normal_admitted), from columns 4-5 counter-clockwise
-    to columns 1-2 ((0, 0): none, the vertex is inside the floor), column 3 is 1 where the
-    vertex is a concave corner of the floor (a flat run meeting a ramp up). The cone is made
-    of every world shape of the same category and mask that fills some of the turn around
-    the vertex (a strip of triangles meets in threes). A floor of static boxes laid edge to
-    edge has its tiles' upright faces at the seams inside the floor; a body sliding over a
-    seam must not meet them, and at a crest the cone spans both faces' normals. Polygons of
-    radius 0 only; an edge counts as covered only where one other shape holds it whole (its
-    two ends within COVER_TOL of that core, and the point just outside its midpoint inside
-    it) and collides with what it does (the same category and mask)."""
+    """(n_core, 8) over the shapes' core vertices: column 0 is 1 where the edge from that
+    vertex is a world shape's face covered whole by other world shapes (never a reference
+    face: kernels/geometry/collide.py); columns 6 and 7 the shares of its length covered from
+    its start and to its end (a thick tile beside a thin one: the top of its side; 1 and 1
+    where whole), where it is no reference face for a point over that part. At a vertex
+    that ends a covered part, the outward normal cone of the floor there
+    (collide._normal_admitted), from columns 4-5 counter-clockwise to columns 1-2 ((0, 0):
+    none, the vertex is inside the floor), column 3 is 1 where the vertex is a concave corner
+    of the floor (a flat run meeting a ramp up). The cone is made of every world shape of the
+    same category and mask that fills some of the turn around the vertex (a strip of
+    triangles meets in threes). A floor of static boxes laid edge to edge has its tiles'
+    upright faces at the seams inside the floor; a body sliding over a seam must not meet
+    them, and at a crest the cone spans both faces' normals. Polygons of radius 0 only; an
+    edge's part counts as covered where other shapes that collide with what it does (the
+    same category and mask) hold it between them: each the piece of it that lies within
+    COVER_TOL of its core, with the point just outside that piece's midpoint inside it
+    (_covered_spans)."""
     cores = [np.asarray(sh["core"], dtype=np.float64).reshape(-1, 2) for sh in shapes]
-    out = [np.zeros((len(c), 6)) for c in cores]
+    out = [np.zeros((len(c), 8)) for c in cores]
     world = [i for i, sh in enumerate(shapes)
              if sh["body"] < 0 and len(cores[i]) >= 3 and sh["radius"] == 0.0]
     if len(world) < 2:
-        return np.concatenate(out) if out else np.zeros((0, 6))
+        return np.concatenate(out) if out else np.zeros((0, 8))
     normals = {i: core_normals(cores[i]) for i in world}
     grid = _Grid(cores, world)
-    for i, k in _covered_pairs(shapes, cores, normals, world, grid):
-        out[i][k, 0] = 1.0
+    for i, k, head, tail in _covered_spans(shapes, cores, normals, world, grid):
+        out[i][k, 0] = 1.0 if head == 1.0 else 0.0
+        out[i][k, 6] = head
+        out[i][k, 7] = tail
     for i in world:
         ci, ni, num = cores[i], normals[i], len(cores[i])
         tol = COVER_TOL + 1e-12 * (1.0 + float(np.abs(ci).max()))
         for v_index in range(num):
             before = (v_index - 1) % num
-            if out[i][v_index, 0] == 0.0 and out[i][before, 0] == 0.0:
+            # the edge from the vertex covered at its start, the edge into it at its end
+            from_v = out[i][v_index, 6] > 0.0
+            into_v = out[i][before, 7] > 0.0
+            if not from_v and not into_v:
                 continue
-            if out[i][v_index, 0] != 0.0 and out[i][before, 0] != 0.0:
-                continue                   # both faces covered: inside the floor
-            open_face = before if out[i][v_index, 0] != 0.0 else v_index
+            if from_v and into_v:
+                continue                   # both faces covered there: inside the floor
+            open_face = before if from_v else v_index
             v = ci[v_index]
             here = [(cores[j], normals[j]) for j in grid.near(v, tol)
                     if _same_filter(shapes[i], shapes[j])]
@@ -331,6 +340,8 @@ class _Grid:
         lo = {i: cores[i].min(axis=0) for i in world}
         hi = {i: cores[i].max(axis=0) for i in world}
         self.lo, self.hi = lo, hi
+        self.box = {i: (float(lo[i][0]), float(lo[i][1]), float(hi[i][0]), float(hi[i][1]))
+                    for i in world}
         cell = float(np.median([max(hi[i][0] - lo[i][0], hi[i][1] - lo[i][1]) for i in world]))
         self.cell = max(cell, 1e-6)
         self.bins = {}
@@ -345,32 +356,97 @@ class _Grid:
                 for gy in range(y0, y1 + 1):
                     self.bins.setdefault((gx, gy), []).append(i)
 
+    def near_box(self, lo, hi, tol):
+        """The shapes whose bounding box may meet the box lo..hi [m] (grown by tol)."""
+        x0, y0 = math.floor((lo[0] - tol) / self.cell), math.floor((lo[1] - tol) / self.cell)
+        x1, y1 = math.floor((hi[0] + tol) / self.cell), math.floor((hi[1] + tol) / self.cell)
+        if (x1 - x0 + 1) * (y1 - y0 + 1) > 4096:
+            found = set(self.lo)            # a box over many cells: every shape
+        else:
+            found = set(self.wide)
+            for gx in range(x0, x1 + 1):
+                for gy in range(y0, y1 + 1):
+                    found.update(self.bins.get((gx, gy), ()))
+        box = self.box
+        return [j for j in sorted(found)
+                if box[j][0] - tol <= hi[0] and box[j][1] - tol <= hi[1]
+                and lo[0] <= box[j][2] + tol and lo[1] <= box[j][3] + tol]
+
     def near(self, point, tol):
         key = tuple(np.floor(point / self.cell).astype(np.int64))
         return [j for j in self.bins.get(key, []) + self.wide
                 if np.all(self.lo[j] - tol <= point) and np.all(point <= self.hi[j] + tol)]
 
 
-def _covered_pairs(shapes, cores, normals, world, grid):
-    """(i, k): edge k of world shape i held whole by another world shape (covered_edges'
-    rule). A shape that holds an edge holds its midpoint: only the shapes the grid lists
-    there are tried."""
+def _piece_inside(ax, ay, dx, dy, planes, tol):
+    """(t0, t1): the part (ax, ay) + t (dx, dy), t in [0, 1], of a segment [m] that lies within
+    tol [m] of a convex core given by its faces' planes (nx, ny, n . vertex) (t0 >= t1:
+    none). Plain floats: a core has a handful of faces."""
+    t0, t1 = 0.0, 1.0
+    for nx, ny, off in planes:
+        # the face's half-plane n . (a + t d) - off <= tol
+        h = nx * ax + ny * ay - off - tol
+        slope = nx * dx + ny * dy
+        if slope == 0.0:
+            if h > 0.0:
+                return 1.0, 0.0
+        elif slope > 0.0:
+            t1 = min(t1, -h / slope)
+        else:
+            t0 = max(t0, -h / slope)
+        if t0 >= t1:
+            return t0, t1
+    return t0, t1
+
+
+def _covered_spans(shapes, cores, normals, world, grid):
+    """(i, k, head, tail): edge k of world shape i held by other world shapes (covered_edges'
+    rule), from its start to the share `head` of its length and from 1 - `tail` to its end
+    (head = tail = 1: held whole; pieces held in its middle only are not counted). The pieces
+    of it that lie in other shapes of the same filter, each with that shape on the edge's
+    outside (the point just outside the piece's midpoint inside it), are merged: a tall tile
+    beside a column of two stacked ones has its side held by the two together, beside a
+    thinner tile its side's top part."""
+    planes = {i: [(float(n[0]), float(n[1]), float(n @ c)) for n, c in zip(normals[i], cores[i])]
+              for i in world}
     for i in world:
         ci, ni = cores[i], normals[i]
         tol = COVER_TOL + 1e-12 * (1.0 + float(np.abs(ci).max()))
         for k in range(len(ci)):
             a, b = ci[k], ci[(k + 1) % len(ci)]
-            mid = 0.5 * (a + b)
-            outside = mid + 1e-6 * math.hypot(*(b - a)) * ni[k]
-            points = np.stack([a, b, outside])
-            for j in grid.near(mid, tol):
+            ax, ay = float(a[0]), float(a[1])
+            dx, dy = float(b[0] - a[0]), float(b[1] - a[1])
+            length = math.hypot(dx, dy)
+            if length == 0.0:
+                continue
+            ox, oy = 1e-6 * length * float(ni[k][0]), 1e-6 * length * float(ni[k][1])
+            pieces = []
+            for j in grid.near_box(np.minimum(a, b), np.maximum(a, b), tol):
                 if j == i or not _same_filter(shapes[i], shapes[j]):
                     continue
-                worst = np.einsum("kd,pkd->pk", normals[j],
-                                  points[:, None, :] - cores[j][None]).max(axis=1)
-                if worst[0] <= tol and worst[1] <= tol and worst[2] < 0.0:
-                    yield i, k
-                    break
+                t0, t1 = _piece_inside(ax, ay, dx, dy, planes[j], tol)
+                if t1 <= t0:
+                    continue
+                mid = 0.5 * (t0 + t1)
+                px = ax + mid * dx + (t1 - t0) * ox
+                py = ay + mid * dy + (t1 - t0) * oy
+                if max(nx * px + ny * py - off for nx, ny, off in planes[j]) < 0.0:
+                    pieces.append((t0, t1))
+            slack = tol / length
+            merged = []                     # the union of the pieces, as disjoint spans
+            for t0, t1 in sorted(pieces):
+                if merged and t0 <= merged[-1][1] + slack:
+                    merged[-1][1] = max(merged[-1][1], t1)
+                else:
+                    merged.append([t0, t1])
+            if not merged:
+                continue
+            head = merged[0][1] if merged[0][0] <= slack else 0.0
+            tail = 1.0 - merged[-1][0] if merged[-1][1] >= 1.0 - slack else 0.0
+            if head >= 1.0 - slack:
+                head = tail = 1.0
+            if head > 0.0 or tail > 0.0:
+                yield i, k, min(head, 1.0), min(tail, 1.0)
 
 
 class ModelBuilder:
@@ -1190,7 +1266,7 @@ class ModelBuilder:
                             for sh in self._collide] or np.zeros((0, 5))).reshape(ns, 5),
             core_vert=ro(core).reshape(len(core), 2),
             core_norm=ro(norm).reshape(len(core), 2),
-            core_cover=ro(covered_edges(self._collide)).reshape(len(core), 6))
+            core_cover=ro(covered_edges(self._collide)).reshape(len(core), 8))
 
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:

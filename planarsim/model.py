@@ -93,9 +93,11 @@ class ModelArrays(NamedTuple):
                                     #   width [m] and a turn's lever [m] (shapes.shape_bounds)
     core_vert: np.ndarray           # (n_core, 2) core vertices in the shape's frame [m]
     core_norm: np.ndarray           # (n_core, 2) outward unit normal of the edge from each vertex
-    core_cover: np.ndarray          # (n_core, 6) 1 where the edge from that vertex is a world
-                                    #   shape's face covered by another; the vertex's normal
-                                    #   cone (q; concave flag; p) (builder.covered_edges)
+    core_cover: np.ndarray          # (n_core, 8) 1 where the edge from that vertex is a world
+                                    #   shape's face covered by others; the vertex's normal
+                                    #   cone (q; concave flag; p); the shares of the edge
+                                    #   covered from its start and to its end
+                                    #   (builder.covered_edges)
 
 
 @dataclass(frozen=True)

@@ -29,7 +29,7 @@ def _collide_covered(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
 
 def _collide(vert, norm, *args):
     """collide with no covered edge."""
-    return _collide_covered(vert, norm, np.zeros((vert.shape[0], 6)), *args)
+    return _collide_covered(vert, norm, np.zeros((vert.shape[0], 8)), *args)
 
 
 @jit

@@ -70,6 +70,9 @@ SLAB_TOL = 1e-12
 # seam counts as its open face's (about 4.5e-5 rad): a box lying flat across the seam keeps its
 # own face as the reference
 COVER_PARALLEL = 1e-9
+# [m] how far beyond a covered part of an edge the shape facing it may reach and still face
+# that part only (_meets_on_cover)
+COVER_SLAB = 1e-9
 # how far [sin of the angle] a normal may lie outside a crest's cone and count as in it
 COVER_ARC = 1e-9
 # [m] how far a covered shape's admissible faces may overstate a pair's penetration before
@@ -175,9 +178,9 @@ def _circle_pair(vert, adr_a, ca, sa, adr_b, xb, yb, cb, sb, r, margin, ox, oy, 
 
 @kernel
 def _cornered(cover, adr, num, j):
-    """Core vertex j (of the core at adr, num vertices) ends a covered edge (builder
-    .covered_edges): a floor tile's corner at a seam."""
-    return cover[adr + j, 0] != 0.0 or cover[adr + (j - 1) % num, 0] != 0.0
+    """Core vertex j (of the core at adr, num vertices) ends a covered part of an edge
+    (builder.covered_edges): a floor tile's corner at a seam."""
+    return cover[adr + j, 6] != 0.0 or cover[adr + (j - 1) % num, 7] != 0.0
 
 
 @kernel
@@ -208,12 +211,64 @@ def _normal_admitted(vert, norm, cover, adr, num, c, s, j, ux, uy):
 
 
 @kernel
+def _meets_on_cover(vert, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
+    """Edge k of the core at adr (pose x, y [m], c, s) faces the segment g0 -> g1 (world [m];
+    a point where g0 = g1) on its covered part only (builder.covered_edges): the segment's
+    projection onto the edge's line lies within the part covered from its start, or to its
+    end (past that end too: a body beyond a tile's corner). Then no contact there is the
+    edge's: the floor goes on beyond it."""
+    head = cover[adr + k, 6]
+    tail = cover[adr + k, 7]
+    if head == 0.0 and tail == 0.0:
+        return False
+    if cover[adr + k, 0] != 0.0:
+        return True
+    ax, ay = core_point_world(vert, adr + k, x, y, c, s)
+    bx, by = core_point_world(vert, adr + (k + 1) % num, x, y, c, s)
+    ex = bx - ax
+    ey = by - ay
+    e2 = ex * ex + ey * ey
+    u0 = ((gx0 - ax) * ex + (gy0 - ay) * ey) / e2
+    u1 = ((gx1 - ax) * ex + (gy1 - ay) * ey) / e2
+    grow = COVER_SLAB / math.sqrt(e2)
+    lo = min(u0, u1) - grow
+    hi = max(u0, u1) + grow
+    return (head > 0.0 and hi <= head) or (tail > 0.0 and lo >= 1.0 - tail)
+
+
+@kernel
+def _facing_cover(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr, nx, ny,
+                  adr_i, num_i, xi, yi, ci, si, support):
+    """Face k of core R (world normal n) and core I's incident edge (most opposed to n; I's
+    vertex `support` where I has fewer than two) face each other only where one of them is
+    covered (_meets_on_cover): a box sliding over a seam has its front face facing the next
+    tile's side, which a thinner tile before it covers at the top; neither is a surface
+    there. Judged by edges, not by the support vertex alone: the box's front corners, or the
+    side's two ends, are equally far along n, and either may be the support."""
+    if num_i < 2:
+        px, py = core_point_world(vert, adr_i + support, xi, yi, ci, si)
+        return _meets_on_cover(vert, cover, adr_r, num_r, k, xr, yr, cr, sr, px, py, px, py)
+    e = _incident_edge(norm, adr_i, num_i, ci, si, nx, ny)
+    p0x, p0y = core_point_world(vert, adr_i + e, xi, yi, ci, si)
+    p1x, p1y = core_point_world(vert, adr_i + (e + 1) % num_i, xi, yi, ci, si)
+    if _meets_on_cover(vert, cover, adr_r, num_r, k, xr, yr, cr, sr, p0x, p0y, p1x, p1y):
+        return True
+    if num_i < 3:
+        return False
+    ax, ay = core_point_world(vert, adr_r + k, xr, yr, cr, sr)
+    bx, by = core_point_world(vert, adr_r + (k + 1) % num_r, xr, yr, cr, sr)
+    return _meets_on_cover(vert, cover, adr_i, num_i, e, xi, yi, ci, si, ax, ay, bx, by)
+
+
+@kernel
 def _max_separation(vert, norm, cover, adr_r, num_r, xr, yr, cr, sr, adr_i, num_i, xi, yi, ci,
                     si, limit):
     """(sep_all, sep, face, support): sep_all the largest over P's faces k of sep_k = min over
     Q's vertices q of n_k.(q - p_k) [m] (stopping at the first face with sep_k > limit: a
     separating axis, no contact); sep the largest over the faces that may be a reference
-    (not covered, and Q's vertex reaching the minimum admits n_k: _normal_admitted), the face
+    (not covered, Q's vertex reaching the minimum admitting n_k, and the face and Q's
+    incident edge not facing each other on a covered part only: _normal_admitted,
+    _facing_cover), the face
     and the vertex of Q reaching it (-inf, 0, 0: none)."""
     best_all = -math.inf
     best = -math.inf
@@ -236,7 +291,9 @@ def _max_separation(vert, norm, cover, adr_r, num_r, xr, yr, cr, sr, adr_i, num_
         if sep > limit:
             break
         if (sep > best and cover[adr_r + k, 0] == 0.0
-                and _normal_admitted(vert, norm, cover, adr_i, num_i, ci, si, arg, -nx, -ny)):
+                and _normal_admitted(vert, norm, cover, adr_i, num_i, ci, si, arg, -nx, -ny)
+                and not _facing_cover(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr,
+                                      nx, ny, adr_i, num_i, xi, yi, ci, si, arg)):
             best = sep
             face = k
             support = arg
@@ -489,9 +546,10 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
             adr_b, num_b, r_b, xb, yb, cb, sb, margin, out):
     """Contact manifold of two rounded cores, A (rows adr_a.., num_a vertices, radius r_a [m],
     pose xa, ya [m], ca, sa) and B; returns the number of points written to out (0, 1 or 2).
-    cover (n_core, 6): the covered edges of world shapes and their ends' normal cones
-    (builder.covered_edges): a covered edge is never a reference face, and its end vertices
-    are pressed only within the floor's normal cone there.
+    cover (n_core, 8): the covered edges of world shapes and their ends' normal cones
+    (builder.covered_edges): a covered edge is never a reference face (a partly covered one
+    not for a vertex over its covered part), and its end vertices are pressed only within
+    the floor's normal cone there.
 
     out[k] = (flip, kind, px, py, nx, ny, gx, gy, gap, id): flip FLIP_A (0) when the reference
     feature is A's (p on B's core) or FLIP_B (1); kind KIND_FACE (0: n the reference edge's
