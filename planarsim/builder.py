@@ -242,16 +242,17 @@ def _free_arcs(sectors):
     return [((a + base) % TWO_PI, length) for a, length in free]
 
 
-def _vertex_cone(v, n_open, shapes_here, tol):
+def _vertex_cone(v, n_open, shapes_here, tol, more=()):
     """(p, q, concave) at a vertex of the floor that several world shapes (shapes_here:
     (core, normals)) fill around v: the outward normal cone of their union there, from p to
     q counter-clockwise. A convex corner (the free arc wider than a half turn): the normals
     of the two faces bounding it; a flat run: p = q, the surface's normal; a concave corner
     (a flat run meeting a ramp up): p = q = n_open, concave 1 (a body meets it along the
     faces); inside the floor (no free arc): p = q = 0. Of several free arcs (shapes touching
-    at a corner only), the one bounded by the face whose normal is n_open."""
+    at a corner only), the one bounded by the face whose normal is n_open. `more`: further
+    sectors (start, length) [rad] filled there (the analytic ground's: _ground_sector)."""
     sectors = [sec for core, normals in shapes_here
-               for sec in [_sector_at(core, normals, v, tol)] if sec is not None]
+               for sec in [_sector_at(core, normals, v, tol)] if sec is not None] + list(more)
     free = _free_arcs(sectors) if sectors else []
     if not free:
         return np.zeros(2), np.zeros(2), 0.0
@@ -274,7 +275,63 @@ def _vertex_cone(v, n_open, shapes_here, tol):
     return p, q, 0.0
 
 
-def covered_edges(shapes) -> np.ndarray:
+# samples per shortest wavelength of hills when the ground's hold on a side is found by samples
+COVER_GROUND_SAMPLES = 64
+
+
+def _ground_piece(ground, a, b, outward, tol):
+    """The parts of the edge a -> b [m] (outward unit normal `outward`) that the analytic
+    ground holds, as (head, tail): the shares of its length from its start and to its end
+    that lie within tol [m] of the ground or below it, with the ground on the edge's outside
+    there. Exact for flat ground and slopes (a half-plane); by samples over hills."""
+    coef = ground.coef
+    d = b - a
+    length = math.hypot(*d)
+    if int(coef[2]) == 0:
+        # below the line y = h0 + s x: n . p <= n . (0, h0), n = (-s, 1) / |.|
+        norm = math.hypot(coef[1], 1.0)
+        planes = [(-coef[1] / norm, 1.0 / norm, coef[0] / norm)]
+        t0, t1 = _piece_inside(float(a[0]), float(a[1]), float(d[0]), float(d[1]), planes, tol)
+        if t1 <= t0:
+            return 0.0, 0.0
+        mid = a + 0.5 * (t0 + t1) * d + 1e-6 * (t1 - t0) * length * outward
+        if float(ground.height(mid[0])) - float(mid[1]) <= 0.0:
+            return 0.0, 0.0         # the ground is not on its outside
+        slack = tol / length
+        return (t1 if t0 <= slack else 0.0), (1.0 - t0 if t1 >= 1.0 - slack else 0.0)
+    shortest = min(float(coef[4 + 3 * k]) for k in range(int(coef[2])))
+    n = int(min(4096, max(COVER_GROUND_SAMPLES,
+                          math.ceil(COVER_GROUND_SAMPLES * length / shortest))))
+    t = np.linspace(0.0, 1.0, n + 1)
+    points = a[None, :] + t[:, None] * d[None, :]
+    held = points[:, 1] <= ground.height(points[:, 0]) + tol
+    mids = 0.5 * (points[1:] + points[:-1]) + 1e-6 * length / n * outward
+    inside = mids[:, 1] < ground.height(mids[:, 0])
+    good = held[:-1] & held[1:] & inside        # each sample interval held with its outside
+    head = 0.0
+    while head < n and good[int(head)]:
+        head += 1
+    tail = 0
+    while tail < n and good[n - 1 - tail]:
+        tail += 1
+    return head / n, tail / n
+
+
+def _ground_sector(ground, v, tol):
+    """The sector (start, length) [rad] the analytic ground fills around point v [m]: a half
+    turn below its tangent where v lies on it (within tol), a whole turn below it, None
+    above it."""
+    depth = float(ground.height(v[0])) - float(v[1])
+    if depth < -tol:
+        return None
+    if depth > tol:
+        return 0.0, TWO_PI
+    slope = float(ground.slope(v[0]))
+    # walking the surface towards -x, the ground lies on the left
+    return _angle(np.array([-1.0, -slope])), math.pi
+
+
+def covered_edges(shapes, ground=None) -> np.ndarray:
     """(n_core, 8) over the shapes' core vertices: column 0 is 1 where the edge from that
     vertex is a world shape's face covered whole by other world shapes (never a reference
     face: kernels/geometry/collide.py); columns 6 and 7 the shares of its length covered from
@@ -296,11 +353,11 @@ def covered_edges(shapes) -> np.ndarray:
     out = [np.zeros((len(c), 8)) for c in cores]
     world = [i for i, sh in enumerate(shapes)
              if sh["body"] < 0 and len(cores[i]) >= 3 and sh["radius"] == 0.0]
-    if len(world) < 2:
+    if len(world) < (1 if ground is not None else 2):
         return np.concatenate(out) if out else np.zeros((0, 8))
     normals = {i: core_normals(cores[i]) for i in world}
     grid = _Grid(cores, world)
-    for i, k, head, tail in _covered_spans(shapes, cores, normals, world, grid):
+    for i, k, head, tail in _covered_spans(shapes, cores, normals, world, grid, ground):
         out[i][k, 0] = 1.0 if head == 1.0 else 0.0
         out[i][k, 6] = head
         out[i][k, 7] = tail
@@ -320,7 +377,9 @@ def covered_edges(shapes) -> np.ndarray:
             v = ci[v_index]
             here = [(cores[j], normals[j]) for j in grid.near(v, tol)
                     if _same_filter(shapes[i], shapes[j])]
-            p, q, concave = _vertex_cone(v, ni[open_face], here, tol)
+            sector = _ground_sector(ground, v, tol) if ground is not None else None
+            p, q, concave = _vertex_cone(v, ni[open_face], here, tol,
+                                         [] if sector is None else [sector])
             out[i][v_index, 1:3] = q
             out[i][v_index, 3] = concave
             out[i][v_index, 4:6] = p
@@ -399,7 +458,7 @@ def _piece_inside(ax, ay, dx, dy, planes, tol):
     return t0, t1
 
 
-def _covered_spans(shapes, cores, normals, world, grid):
+def _covered_spans(shapes, cores, normals, world, grid, ground=None):
     """(i, k, head, tail): edge k of world shape i held by other world shapes (covered_edges'
     rule), from its start to the share `head` of its length and from 1 - `tail` to its end
     (head = tail = 1: held whole; pieces held in its middle only are not counted). The pieces
@@ -432,6 +491,12 @@ def _covered_spans(shapes, cores, normals, world, grid):
                 py = ay + mid * dy + (t1 - t0) * oy
                 if max(nx * px + ny * py - off for nx, ny, off in planes[j]) < 0.0:
                     pieces.append((t0, t1))
+            if ground is not None:
+                head, tail = _ground_piece(ground, a, b, ni[k], tol)
+                if head > 0.0:
+                    pieces.append((0.0, head))
+                if tail > 0.0:
+                    pieces.append((1.0 - tail, 1.0))
             slack = tol / length
             merged = []                     # the union of the pieces, as disjoint spans
             for t0, t1 in sorted(pieces):
@@ -1266,7 +1331,8 @@ class ModelBuilder:
                             for sh in self._collide] or np.zeros((0, 5))).reshape(ns, 5),
             core_vert=ro(core).reshape(len(core), 2),
             core_norm=ro(norm).reshape(len(core), 2),
-            core_cover=ro(covered_edges(self._collide)).reshape(len(core), 8))
+            core_cover=ro(covered_edges(self._collide, self.terrain if self.ground else None))
+            .reshape(len(core), 8))
 
     # compile --------------------------------------------------------------------------------
     def compile(self, **meta) -> M.Model:
