@@ -230,7 +230,15 @@ def _free_arcs(sectors):
     # cut the circle at the first sector's start (which that sector fills: no free arc
     # runs through the cut)
     base = sectors[0][0]
-    spans = sorted(((a - base) % TWO_PI, (a - base) % TWO_PI + length) for a, length in sectors)
+    spans = []
+    for a, length in sectors:
+        lo = (a - base) % TWO_PI
+        spans.append((lo, lo + length))
+        if lo + length > TWO_PI:
+            # a sector across the cut (one starting a hair before the first) fills the start
+            # of the circle too
+            spans.append((0.0, lo + length - TWO_PI))
+    spans.sort()
     free = []
     reach = 0.0
     for lo, hi in spans:
@@ -432,9 +440,7 @@ class _Grid:
                 and lo[0] <= box[j][2] + tol and lo[1] <= box[j][3] + tol]
 
     def near(self, point, tol):
-        key = tuple(np.floor(point / self.cell).astype(np.int64))
-        return [j for j in self.bins.get(key, []) + self.wide
-                if np.all(self.lo[j] - tol <= point) and np.all(point <= self.hi[j] + tol)]
+        return self.near_box(point, point, tol)
 
 
 def _piece_inside(ax, ay, dx, dy, planes, tol):

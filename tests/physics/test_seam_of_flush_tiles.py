@@ -480,3 +480,108 @@ def test_the_part_of_a_side_inside_a_hill_is_covered():
     assert right - 1 / 64 <= cover[1, 6] <= right and cover[1, 7] == 0
     assert left - 1 / 64 <= cover[3, 7] <= left and cover[3, 6] == 0
     assert cover[0, 0] == 1 and not cover[2, [0, 6, 7]].any()
+
+
+TRIANGLE = (("polygon", [(-0.1, -0.03), (0.1, -0.03), (0.0, 0.06)], {"mu": 0.0}), 1e-3, 0.03)
+
+
+def _outline_runs(floors, shape, inertia, y, speed, x, dt, steps):
+    """The same body slid over each floor in `floors` (lists of static polygons): its final
+    velocities, with no audit on any."""
+    finals = []
+    for polygons in floors:
+        sim = _slide_across(polygons, shape, inertia, y, speed, x, dt, steps)
+        assert sum(audit_counts(sim.ws).values()) == 0
+        finals.append(sim.state.v[0].copy())
+    return finals
+
+
+@pytest.mark.parametrize("speed,dt", [(0.3, 1e-3), (3.0, 1e-3), (10.0, 2e-3)])
+def test_a_side_slanting_back_under_a_thin_tile_is_no_surface(speed, dt):
+    """A thick tile whose right side slants back at 60 degrees under a 2 cm tile lying on it
+    (a wedge-shaped pocket below): the side's open part faces the flat top beyond the seam
+    along its normal, through the thin tile, but is not met from there (the floor at the
+    seam's corner is flat: collide._above_covered_end). A box sliding across keeps its
+    velocity as over one polygon (before, it lost 5 % of it at 3 m/s)."""
+    t = math.tan(math.radians(60))
+    thick = [(-1, -1), (t, -1), (0, 0), (-1, 0)]
+    thin = [(0.02 * t, -0.02), (1.5, -0.02), (1.5, 0), (0, 0)]
+    one = [(-1, -1), (1.5, -1), (1.5, 0), (-1, 0)]
+    shape, inertia, y = SLIDERS["box"]
+    tiles, single = _outline_runs([[thick, thin], [one]], shape, inertia, y, -speed, 0.6, dt,
+                                  int(1.0 / speed / dt))
+    assert np.abs(tiles - single).max() < 1e-9 * (1 + speed), (tiles, single)
+    assert abs(tiles[0] + speed) < 1e-9 * (1 + speed)
+
+
+@pytest.mark.parametrize("speed,dt", [(10.0, 5e-3), (3.0, 1e-2), (20.0, 1e-3)])
+def test_a_disk_over_a_buried_layer_is_not_measured_from_its_slanted_side(speed, dt):
+    """A block of two trapezoid layers with a 45 degree right side: the lower layer's top is
+    covered by the upper, which leaves its slanted side the only face that may be measured
+    from; a disk 3 cm above it was measured 2-5 cm deep from that side and launched at
+    (-4.9, +4.8) m/s. The rounded shapes' gap is at least the separation over every axis
+    less the radius (collide's overstate rule), so the pair is left to the upper layer: the
+    disk slides off the crest as over one polygon."""
+    top = [(0, -0.03), (1.03, -0.03), (1, 0), (0, 0)]
+    low = [(0, -0.06), (1.06, -0.06), (1.03, -0.03), (0, -0.03)]
+    one = [(0, -0.06), (1.06, -0.06), (1, 0), (0, 0)]
+    shape, inertia, y = SLIDERS["circle"]
+    layers, single = _outline_runs([[top, low], [one]], shape, inertia, y, -speed, 0.995, dt,
+                                   int(0.3 / speed / dt))
+    assert np.abs(layers - single).max() < 1e-9 * (1 + speed), (layers, single)
+
+
+def test_free_arcs_do_not_depend_on_the_order_of_the_sectors():
+    """Two sectors starting 1e-15 rad apart fill a half turn between them, whichever comes
+    first (the one starting before the first was cut at 2 pi and its start lost: a flat
+    floor's corner read as a cliff's, and a disk crossing two rotated overlapping tiles
+    there slowed from 5 to 4.89 m/s)."""
+    from planarsim.builder import _free_arcs
+    a = _free_arcs([(1.0, math.pi / 2), (1.0 - 1e-15, math.pi)])
+    b = _free_arcs([(1.0 - 1e-15, math.pi), (1.0, math.pi / 2)])
+    assert len(a) == len(b) == 1
+    assert abs(a[0][1] - math.pi) < 1e-12 and abs(b[0][1] - math.pi) < 1e-12
+
+
+def _slanted_floor(rng):
+    """3-5 columns 0.4-0.8 m wide, tops flush at y = 0, their seams slanting at random
+    (x = seam + k y, |k| <= 1), each 0.02-0.6 m deep (less where its sides would cross) in
+    one to three layers: (polygons, the seams' x at the top)."""
+    ncol = int(rng.integers(3, 6))
+    edges = np.concatenate([[0], np.cumsum(rng.uniform(0.4, 0.8, ncol))])
+    lean = rng.uniform(-1, 1, ncol + 1)
+    lean[0] = lean[-1] = 0.0
+    polygons = []
+    for c in range(ncol):
+        # (no deeper than where its sides would cross: each layer a convex trapezoid)
+        narrowing = max(lean[c + 1] - lean[c], 1e-9)
+        depth = min(rng.uniform(0.02, 0.6), 0.9 * (edges[c + 1] - edges[c]) / narrowing)
+        ys = -np.concatenate([[0], np.sort(rng.uniform(0, depth, int(rng.integers(0, 3)))),
+                              [depth]])
+        for k in range(len(ys) - 1):
+            y0, y1 = ys[k + 1], ys[k]
+            core = [(edges[c] + lean[c] * y0, y0), (edges[c + 1] + lean[c + 1] * y0, y0),
+                    (edges[c + 1] + lean[c + 1] * y1, y1), (edges[c] + lean[c] * y1, y1)]
+            polygons.append(core)
+    return polygons, edges
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_a_body_slides_across_a_floor_of_slanted_seams(seed):
+    """Seeded floors whose layered columns meet along slanted seams (sides held in part, from
+    either side, some leaning under their neighbours): a box, capsule, disk, hexagon or
+    triangle sliding without friction keeps its velocity, with no audit. A fresh-eyed
+    review's sweep of 184 such floors found 177 failing before covers were merged from
+    pieces, 4 after, none now."""
+    rng = np.random.default_rng(1000 + seed)
+    polygons, edges = _slanted_floor(rng)
+    kind = ["box", "capsule", "circle", "hexagon", "triangle"][seed % 5]
+    shape, inertia, y = {"hexagon": HEXAGON, "triangle": TRIANGLE}.get(kind) or SLIDERS[kind]
+    speed = float(rng.choice([-1, 1]) * rng.uniform(0.3, 15))
+    dt = float(rng.choice([1e-3, 2e-3, 5e-3, 1e-2]))
+    x = edges[0] + 0.3 if speed > 0 else edges[-1] - 0.3
+    steps = int((edges[-1] - edges[0] - 0.6) / abs(speed) / dt)
+    sim = _slide_across(polygons, shape, inertia, y, speed, x, dt, steps)
+    assert np.allclose(sim.state.v[0], (speed, 0.0, 0.0), atol=1e-8 * (1 + abs(speed))), \
+        sim.state.v[0]
+    assert sum(audit_counts(sim.ws).values()) == 0

@@ -73,6 +73,9 @@ COVER_PARALLEL = 1e-9
 # [m] how far beyond a covered part of an edge the shape facing it may reach and still face
 # that part only (_meets_on_cover)
 COVER_SLAB = 1e-9
+# [m] how far below the floor's surface at a covered end a point counts as on its open side
+# (_in_free_region): rounding and the solve's tolerances, far below any tile's thickness
+COVER_FREE_TOL = 1e-6
 # how far [sin of the angle] a normal may lie outside a crest's cone and count as in it
 COVER_ARC = 1e-9
 # [m] how far a covered shape's admissible faces may overstate a pair's penetration before
@@ -237,27 +240,77 @@ def _meets_on_cover(vert, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
 
 
 @kernel
+def _in_free_region(cover, adr, v, vx, vy, c, s, gx, gy):
+    """The world point g [m] lies on the open side of the floor at core vertex v (world
+    position vx, vy) that ends a covered part: within COVER_FREE_TOL of the half-planes its
+    normal cone (builder.covered_edges) bounds, on the side the cone points to; never where
+    the vertex is inside the floor."""
+    if cover[adr + v, 1] == 0.0 and cover[adr + v, 2] == 0.0:
+        return False
+    px, py = rotate(c, s, cover[adr + v, 4], cover[adr + v, 5])
+    qx, qy = rotate(c, s, cover[adr + v, 1], cover[adr + v, 2])
+    dx = gx - vx
+    dy = gy - vy
+    return px * dx + py * dy >= -COVER_FREE_TOL or qx * dx + qy * dy >= -COVER_FREE_TOL
+
+
+@kernel
+def _above_covered_end(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
+    """Edge k of the core at adr (pose x, y [m], c, s), covered at an end whose floor does not
+    run on along the edge (the edge's normal outside that vertex's cone), faces the segment
+    g0 -> g1 [m] from the open side of the floor there: the segment lies above the covering
+    shape, not over the edge (a thick tile's side slanting back under a thinner tile: the
+    flat top beyond the seam projects onto the side's open part, through the thin tile)."""
+    head = cover[adr + k, 6]
+    tail = cover[adr + k, 7]
+    nx, ny = rotate(c, s, norm[adr + k, 0], norm[adr + k, 1])
+    for end in range(2):
+        if (head if end == 0 else tail) == 0.0:
+            continue
+        v = k if end == 0 else (k + 1) % num
+        if _normal_admitted(vert, norm, cover, adr, num, c, s, v, nx, ny):
+            continue
+        vx, vy = core_point_world(vert, adr + v, x, y, c, s)
+        if (_in_free_region(cover, adr, v, vx, vy, c, s, gx0, gy0)
+                and _in_free_region(cover, adr, v, vx, vy, c, s, gx1, gy1)):
+            return True
+    return False
+
+
+@kernel
+def _covered_here(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
+    """Edge k faces the segment g0 -> g1 on its covered part only (_meets_on_cover) or from
+    above the floor at a covered end (_above_covered_end)."""
+    if cover[adr + k, 6] == 0.0 and cover[adr + k, 7] == 0.0:
+        return False
+    return (_meets_on_cover(vert, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1)
+            or _above_covered_end(vert, norm, cover, adr, num, k, x, y, c, s,
+                                  gx0, gy0, gx1, gy1))
+
+
+@kernel
 def _facing_cover(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr, nx, ny,
                   adr_i, num_i, xi, yi, ci, si, support):
     """Face k of core R (world normal n) and core I's incident edge (most opposed to n; I's
     vertex `support` where I has fewer than two) face each other only where one of them is
-    covered (_meets_on_cover): a box sliding over a seam has its front face facing the next
+    covered (_covered_here): a box sliding over a seam has its front face facing the next
     tile's side, which a thinner tile before it covers at the top; neither is a surface
     there. Judged by edges, not by the support vertex alone: the box's front corners, or the
     side's two ends, are equally far along n, and either may be the support."""
     if num_i < 2:
         px, py = core_point_world(vert, adr_i + support, xi, yi, ci, si)
-        return _meets_on_cover(vert, cover, adr_r, num_r, k, xr, yr, cr, sr, px, py, px, py)
+        return _covered_here(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr,
+                             px, py, px, py)
     e = _incident_edge(norm, adr_i, num_i, ci, si, nx, ny)
     p0x, p0y = core_point_world(vert, adr_i + e, xi, yi, ci, si)
     p1x, p1y = core_point_world(vert, adr_i + (e + 1) % num_i, xi, yi, ci, si)
-    if _meets_on_cover(vert, cover, adr_r, num_r, k, xr, yr, cr, sr, p0x, p0y, p1x, p1y):
+    if _covered_here(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr, p0x, p0y, p1x, p1y):
         return True
     if num_i < 3:
         return False
     ax, ay = core_point_world(vert, adr_r + k, xr, yr, cr, sr)
     bx, by = core_point_world(vert, adr_r + (k + 1) % num_r, xr, yr, cr, sr)
-    return _meets_on_cover(vert, cover, adr_i, num_i, e, xi, yi, ci, si, ax, ay, bx, by)
+    return _covered_here(vert, norm, cover, adr_i, num_i, e, xi, yi, ci, si, ax, ay, bx, by)
 
 
 @kernel
@@ -593,13 +646,16 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
             return 0
     # no face may be a reference (a shape inside the floor); or every face that may would
     # overstate the pair's penetration, which its largest separation over every axis bounds
-    # (min(all, 0)), by more than OVERSTATE_TOL: the body is across a covered side, where the
-    # neighbouring shape answers for it (a triangle of a strip whose both upper sides are
-    # covered would measure a disk on its apex from its bottom: a contact 1.1 m deep). Not
-    # at the foot of a ramp, whose face, met a step ahead, is the reference it must be
+    # (the gap best - r of rounded shapes is at least all - r: best < min(all, r)), by more
+    # than OVERSTATE_TOL: the body is across a covered side, where the neighbouring shape
+    # answers for it (a triangle of a strip whose both upper sides are covered would
+    # measure a disk on its apex from its bottom: a contact 1.1 m deep; a disk 3 cm above a
+    # buried layer's covered top was measured from its slanted side, 2 to 5 cm deep, and
+    # launched). Not at the foot of a ramp, whose face, met a step ahead, is the reference
+    # it must be
     best = max(sep_a, sep_b)
     slop = OVERSTATE_TOL + REFERENCE_TOL * (1.0 + abs(best))
-    if best == -math.inf or best < min(max(all_a, all_b), 0.0) - slop:
+    if best == -math.inf or best < min(max(all_a, all_b), r) - slop:
         return 0
     # the reference: A's best face unless B's separates clearly more (REFERENCE_TOL); one
     # call below, so that callers inline the manifold once
