@@ -240,26 +240,29 @@ def _meets_on_cover(vert, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
 
 
 @kernel
-def _in_free_region(cover, adr, v, vx, vy, c, s, gx, gy):
-    """The world point g [m] lies on the open side of the floor at core vertex v (world
-    position vx, vy) that ends a covered part: within COVER_FREE_TOL of the half-planes its
-    normal cone (builder.covered_edges) bounds, on the side the cone points to; never where
-    the vertex is inside the floor."""
+def _in_free_region(cover, adr, v, vx, vy, c, s, gx, gy, r):
+    """The world point g [m] and a disk of radius r [m] about it lie on the open side of a
+    flat floor at core vertex v (world position vx, vy), which ends a covered part: above
+    the floor's line there, within COVER_FREE_TOL. Only where the floor runs on flat
+    through v (its normal cone one direction, not concave); at a crest the open side of
+    each face reaches in front of the other's, and no point counts."""
+    if cover[adr + v, 3] != 0.0:
+        return False
     if cover[adr + v, 1] == 0.0 and cover[adr + v, 2] == 0.0:
         return False
     px, py = rotate(c, s, cover[adr + v, 4], cover[adr + v, 5])
     qx, qy = rotate(c, s, cover[adr + v, 1], cover[adr + v, 2])
-    dx = gx - vx
-    dy = gy - vy
-    return px * dx + py * dy >= -COVER_FREE_TOL or qx * dx + qy * dy >= -COVER_FREE_TOL
+    if px * qx + py * qy < 1.0 - COVER_PARALLEL:
+        return False
+    return px * (gx - vx) + py * (gy - vy) >= r - COVER_FREE_TOL
 
 
 @kernel
-def _above_covered_end(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
+def _above_covered_end(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1, r):
     """Edge k of the core at adr (pose x, y [m], c, s), covered at an end whose floor does not
     run on along the edge (the edge's normal outside that vertex's cone), faces the segment
-    g0 -> g1 [m] from the open side of the floor there: the segment lies above the covering
-    shape, not over the edge (a thick tile's side slanting back under a thinner tile: the
+    g0 -> g1 [m], grown by radius r [m], from the open side of a flat floor there: the
+    segment lies above the covering shape, not over the edge (a thick tile's side slanting back under a thinner tile: the
     flat top beyond the seam projects onto the side's open part, through the thin tile)."""
     head = cover[adr + k, 6]
     tail = cover[adr + k, 7]
@@ -271,26 +274,26 @@ def _above_covered_end(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1
         if _normal_admitted(vert, norm, cover, adr, num, c, s, v, nx, ny):
             continue
         vx, vy = core_point_world(vert, adr + v, x, y, c, s)
-        if (_in_free_region(cover, adr, v, vx, vy, c, s, gx0, gy0)
-                and _in_free_region(cover, adr, v, vx, vy, c, s, gx1, gy1)):
+        if (_in_free_region(cover, adr, v, vx, vy, c, s, gx0, gy0, r)
+                and _in_free_region(cover, adr, v, vx, vy, c, s, gx1, gy1, r)):
             return True
     return False
 
 
 @kernel
-def _covered_here(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
+def _covered_here(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1, r):
     """Edge k faces the segment g0 -> g1 on its covered part only (_meets_on_cover) or from
     above the floor at a covered end (_above_covered_end)."""
     if cover[adr + k, 6] == 0.0 and cover[adr + k, 7] == 0.0:
         return False
     return (_meets_on_cover(vert, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1)
             or _above_covered_end(vert, norm, cover, adr, num, k, x, y, c, s,
-                                  gx0, gy0, gx1, gy1))
+                                  gx0, gy0, gx1, gy1, r))
 
 
 @kernel
 def _facing_cover(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr, nx, ny,
-                  adr_i, num_i, xi, yi, ci, si, support):
+                  adr_i, num_i, xi, yi, ci, si, support, r):
     """Face k of core R (world normal n) and core I's incident edge (most opposed to n; I's
     vertex `support` where I has fewer than two) face each other only where one of them is
     covered (_covered_here): a box sliding over a seam has its front face facing the next
@@ -300,22 +303,22 @@ def _facing_cover(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr, nx, ny,
     if num_i < 2:
         px, py = core_point_world(vert, adr_i + support, xi, yi, ci, si)
         return _covered_here(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr,
-                             px, py, px, py)
+                             px, py, px, py, r)
     e = _incident_edge(norm, adr_i, num_i, ci, si, nx, ny)
     p0x, p0y = core_point_world(vert, adr_i + e, xi, yi, ci, si)
     p1x, p1y = core_point_world(vert, adr_i + (e + 1) % num_i, xi, yi, ci, si)
-    if _covered_here(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr, p0x, p0y, p1x, p1y):
+    if _covered_here(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr, p0x, p0y, p1x, p1y, r):
         return True
     if num_i < 3:
         return False
     ax, ay = core_point_world(vert, adr_r + k, xr, yr, cr, sr)
     bx, by = core_point_world(vert, adr_r + (k + 1) % num_r, xr, yr, cr, sr)
-    return _covered_here(vert, norm, cover, adr_i, num_i, e, xi, yi, ci, si, ax, ay, bx, by)
+    return _covered_here(vert, norm, cover, adr_i, num_i, e, xi, yi, ci, si, ax, ay, bx, by, r)
 
 
 @kernel
 def _max_separation(vert, norm, cover, adr_r, num_r, xr, yr, cr, sr, adr_i, num_i, xi, yi, ci,
-                    si, limit):
+                    si, limit, r):
     """(sep_all, sep, face, support): sep_all the largest over P's faces k of sep_k = min over
     Q's vertices q of n_k.(q - p_k) [m] (stopping at the first face with sep_k > limit: a
     separating axis, no contact); sep the largest over the faces that may be a reference
@@ -346,7 +349,7 @@ def _max_separation(vert, norm, cover, adr_r, num_r, xr, yr, cr, sr, adr_i, num_
         if (sep > best and cover[adr_r + k, 0] == 0.0
                 and _normal_admitted(vert, norm, cover, adr_i, num_i, ci, si, arg, -nx, -ny)
                 and not _facing_cover(vert, norm, cover, adr_r, num_r, k, xr, yr, cr, sr,
-                                      nx, ny, adr_i, num_i, xi, yi, ci, si, arg)):
+                                      nx, ny, adr_i, num_i, xi, yi, ci, si, arg, r)):
             best = sep
             face = k
             support = arg
@@ -626,7 +629,8 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
     support_a = 0
     if num_a >= 2:
         all_a, sep_a, face_a, support_a = _max_separation(
-            vert, norm, cover, adr_a, num_a, 0.0, 0.0, ca, sa, adr_b, num_b, dx, dy, cb, sb, limit)
+            vert, norm, cover, adr_a, num_a, 0.0, 0.0, ca, sa, adr_b, num_b, dx, dy, cb, sb, limit,
+            r)
         if all_a > limit:
             return 0
     sep_b = -math.inf
@@ -635,7 +639,8 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
     support_b = 0
     if num_b >= 2:
         all_b, sep_b, face_b, support_b = _max_separation(
-            vert, norm, cover, adr_b, num_b, dx, dy, cb, sb, adr_a, num_a, 0.0, 0.0, ca, sa, limit)
+            vert, norm, cover, adr_b, num_b, dx, dy, cb, sb, adr_a, num_a, 0.0, 0.0, ca, sa, limit,
+            r)
         if all_b > limit:
             return 0
     cap = -math.inf
@@ -646,16 +651,14 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
             return 0
     # no face may be a reference (a shape inside the floor); or every face that may would
     # overstate the pair's penetration, which its largest separation over every axis bounds
-    # (the gap best - r of rounded shapes is at least all - r: best < min(all, r)), by more
-    # than OVERSTATE_TOL: the body is across a covered side, where the neighbouring shape
-    # answers for it (a triangle of a strip whose both upper sides are covered would
-    # measure a disk on its apex from its bottom: a contact 1.1 m deep; a disk 3 cm above a
-    # buried layer's covered top was measured from its slanted side, 2 to 5 cm deep, and
-    # launched). Not at the foot of a ramp, whose face, met a step ahead, is the reference
-    # it must be
+    # (min(all, 0)), by more than OVERSTATE_TOL: the body is across a covered side, where the
+    # neighbouring shape answers for it (a triangle of a strip whose both upper sides are
+    # covered would measure a disk on its apex from its bottom: a contact 1.1 m deep). Not
+    # at the foot of a ramp, whose face, met a step ahead, is the reference it must be
     best = max(sep_a, sep_b)
+    top = max(all_a, all_b)
     slop = OVERSTATE_TOL + REFERENCE_TOL * (1.0 + abs(best))
-    if best == -math.inf or best < min(max(all_a, all_b), r) - slop:
+    if best == -math.inf or best < min(top, 0.0) - slop:
         return 0
     # the reference: A's best face unless B's separates clearly more (REFERENCE_TOL); one
     # call below, so that callers inline the manifold once
@@ -667,5 +670,17 @@ def collide(vert, norm, cover, adr_a, num_a, r_a, xa, ya, ca, sa,
         flip, sep, face, support = FLIP_A, sep_a, face_a, support_a
         adr_r, num_r, xr, yr, cr, sr = adr_a, num_a, 0.0, 0.0, ca, sa
         adr_i, num_i, xi, yi, ci, si = adr_b, num_b, dx, dy, cb, sb
-    return _manifold(vert, norm, cover, flip, sep, face, support, cap, adr_r, num_r, xr, yr, cr,
-                     sr, adr_i, num_i, xi, yi, ci, si, r, margin, xa, ya, out)
+    count = _manifold(vert, norm, cover, flip, sep, face, support, cap, adr_r, num_r, xr, yr,
+                      cr, sr, adr_i, num_i, xi, yi, ci, si, r, margin, xa, ya, out)
+    # the same rule on the manifold's points, where a face short of the largest separation is
+    # the reference (a covered one refused): a rounded pair's gap is at least top - r (a disk
+    # 3 cm above a buried layer's covered top, measured from its slanted side 2 to 5 cm
+    # deep, was launched). The clipped points, not the face's separation: measured from a
+    # vertex beyond the face's extent, that understates a face met truly (a capsule across a
+    # seam above a crest)
+    if best < top - slop:
+        bound = min(top - r, 0.0) - slop
+        for k in range(count):
+            if out[k, 8] < bound:
+                return 0
+    return count
