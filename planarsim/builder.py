@@ -316,8 +316,8 @@ def _ground_piece(ground, a, b, outward, tol):
     mids = 0.5 * (points[1:] + points[:-1]) + 1e-6 * length / n * outward
     inside = mids[:, 1] < ground.height(mids[:, 0])
     good = held[:-1] & held[1:] & inside        # each sample interval held with its outside
-    head = 0.0
-    while head < n and good[int(head)]:
+    head = 0
+    while head < n and good[head]:
         head += 1
     tail = 0
     while tail < n and good[n - 1 - tail]:
@@ -406,7 +406,6 @@ class _Grid:
     def __init__(self, cores, world):
         lo = {i: cores[i].min(axis=0) for i in world}
         hi = {i: cores[i].max(axis=0) for i in world}
-        self.lo, self.hi = lo, hi
         self.box = {i: (float(lo[i][0]), float(lo[i][1]), float(hi[i][0]), float(hi[i][1]))
                     for i in world}
         cell = float(np.median([max(hi[i][0] - lo[i][0], hi[i][1] - lo[i][1]) for i in world]))
@@ -428,7 +427,7 @@ class _Grid:
         x0, y0 = math.floor((lo[0] - tol) / self.cell), math.floor((lo[1] - tol) / self.cell)
         x1, y1 = math.floor((hi[0] + tol) / self.cell), math.floor((hi[1] + tol) / self.cell)
         if (x1 - x0 + 1) * (y1 - y0 + 1) > 4096:
-            found = set(self.lo)            # a box over many cells: every shape
+            found = set(self.box)           # a box over many cells: every shape
         else:
             found = set(self.wide)
             for gx in range(x0, x1 + 1):

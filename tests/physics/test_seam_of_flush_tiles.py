@@ -358,7 +358,8 @@ def _layered_floor(rng, rise=0.0):
     (polygons, column edges, top)."""
     ncol = int(rng.integers(3, 7))
     top = float(rng.uniform(-2, 2))
-    edges = float(rng.uniform(-5, 5)) + np.concatenate([[0], np.cumsum(rng.uniform(0.3, 0.7, ncol))])
+    x0 = float(rng.uniform(-5, 5))
+    edges = x0 + np.concatenate([[0], np.cumsum(rng.uniform(0.3, 0.7, ncol))])
     step_at = int(rng.integers(1, ncol))
     polygons = []
     for c in range(ncol):

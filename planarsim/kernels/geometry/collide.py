@@ -222,8 +222,6 @@ def _meets_on_cover(vert, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1, gy1):
     edge's: the floor goes on beyond it."""
     head = cover[adr + k, 6]
     tail = cover[adr + k, 7]
-    if head == 0.0 and tail == 0.0:
-        return False
     if cover[adr + k, 0] != 0.0:
         return True
     ax, ay = core_point_world(vert, adr + k, x, y, c, s)
@@ -262,8 +260,9 @@ def _above_covered_end(vert, norm, cover, adr, num, k, x, y, c, s, gx0, gy0, gx1
     """Edge k of the core at adr (pose x, y [m], c, s), covered at an end whose floor does not
     run on along the edge (the edge's normal outside that vertex's cone), faces the segment
     g0 -> g1 [m], grown by radius r [m], from the open side of a flat floor there: the
-    segment lies above the covering shape, not over the edge (a thick tile's side slanting back under a thinner tile: the
-    flat top beyond the seam projects onto the side's open part, through the thin tile)."""
+    segment lies above the covering shape, not over the edge (a thick tile's side slanting
+    back under a thinner tile: the flat top beyond the seam projects onto the side's open
+    part, through the thin tile)."""
     head = cover[adr + k, 6]
     tail = cover[adr + k, 7]
     nx, ny = rotate(c, s, norm[adr + k, 0], norm[adr + k, 1])
