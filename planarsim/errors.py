@@ -21,6 +21,7 @@ from .kernels.checks.audit import (AUDIT_CORRECTION_WORK, AUDIT_FALLBACK, AUDIT_
                                    AUDIT_NAMES, AUDIT_PIN_GAP, AUDIT_UNSOLVED)
 from .kernels.info import INFO_COMMAND, INFO_GUARD_BODY, INFO_GUARD_FIELD
 from .kernels.codes import INTEGRATOR_NAMES
+from .kernels.dynamics.forces import ACT_PIN_TORQUE
 from .kernels.dynamics.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
                                       UNSUPPORTED_FRICTION, UNSUPPORTED_SOFT)
 from .kernels.checks.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
@@ -288,16 +289,25 @@ def stiff_actuator(model, ws, who="simulation"):
     torque = float(ws.act_u[k])
     step = int(ws.prev.step[0])
     t = float(ws.prev.time[0])
-    h = math.sqrt(turn / (abs(torque) * kappa))            # turn = h^2 |u| kappa
+    u = abs(torque)
+    h = math.sqrt(turn / (u * kappa))          # turn = h^2 |u| kappa (kappa of this step)
+    # kappa = 1 / (1 / kappa_a + h c): the joint's damper c, implicit, holds the turn back
+    c = 0.0
+    if int(model.arrays.act_kind[k]) == ACT_PIN_TORQUE:
+        c = float(model.arrays.pin_damping[int(model.arrays.act_ref[k])])
+    inertia = 1.0 / kappa - h * c              # [kg m^2] what it drives, its rotor included
+    held = f", {c:.3g} N m s/rad of damping" if c > 0.0 else ""
+    # the largest step that resolves it: h^2 u / (inertia + h c) = limit
+    most = (limit * c + math.sqrt((limit * c) ** 2 + 4.0 * u * limit * inertia)) / (2.0 * u)
     name = model.act_names[k]
     return SimulationDiverged(
         f"{who} stopped before step {step} (t={t:.6g} s): actuator {name!r} commands "
-        f"{torque:.4g} N m, which alone would turn what it drives (inertia {1.0 / kappa:.3g} "
-        f"kg m^2) by {turn:.3g} rad in one step of {h:.3g} s, more than the {limit:g} rad a "
-        f"step resolves (StepOptions.turn_limit): the motor acts faster than the step. Take "
-        f"dt <= {math.sqrt(limit / (abs(torque) * kappa)):.3g} s, or limit its torque to "
-        f"{limit / (h * h * kappa):.3g} N m (or give the joint an armature; turn_limit 0: "
-        f"no check)", step, t, name, "torque", torque, _start_of_step(ws))
+        f"{torque:.4g} N m, which alone would turn what it drives (inertia {inertia:.3g} "
+        f"kg m^2{held}) by {turn:.3g} rad in one step of {h:.3g} s, more than the {limit:g} rad "
+        f"a step resolves (StepOptions.turn_limit): the motor acts faster than the step. Take "
+        f"dt <= {most:.3g} s, or limit its torque to {limit / (h * h * kappa):.3g} N m (or give "
+        f"the joint an armature or damping; turn_limit 0: no check)", step, t, name, "torque",
+        torque, _start_of_step(ws))
 
 
 # what the accurate integrators cannot step, by kernels/dynamics/rattle.py's UNSUPPORTED_* code

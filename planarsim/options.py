@@ -70,9 +70,10 @@ class StepOptions(NamedTuple):
         (0.25 stops 96 of 100 stiff bang-bang motor runs at once, but also a walker started
         below uneven ground, whose first steps lift it out against its controller)
     turn_limit : [rad] a torque actuator whose command (saturated) would by itself turn what
-        it drives by more than this in one step from rest, dt^2 |u| / I (I the joint's
-        effective inertia with its own pin holding its two bodies, armature included: the
-        other joints and contacts only slow the turn, so an upper bound of it) stops
+        it drives by more than this in one step from rest, dt^2 |u| / (I + dt c) (I the
+        joint's effective inertia with its own pin holding its two bodies, armature included;
+        c its damping, implicit in the step: the other joints and contacts only slow the
+        turn, so an upper bound of it) stops
         the run before that step (SimulationDiverged naming the actuator, its torque, the
         turn, and the dt or torque limit that would do). 0.2 (default): a step resolves
         turns of about 2 * 0.1 rad (the position correction's regime, kernels/checks/work.py); a

@@ -499,10 +499,10 @@ DOMAINS = {
                          _reward_point_mass),
     # a two-link finger and a spinner on a hinge with dry friction, no gravity. The motors
     # alone (30 N m on 0.0068 kg m^2) would turn the proximal link 0.44 rad in a step from
-    # rest; its damping (2.5 N m s/rad, implicit as in MuJoCo's Euler) holds that to 0.09 rad:
-    # the motor guard, which leaves damping out, is off
+    # rest; its damping (2.5 N m s/rad, implicit as in MuJoCo's Euler) holds that to 0.09 rad,
+    # within the motor guard (StepOptions.turn_limit), which counts the damper
     "finger": Domain("finger.xml", 0.01, 20, .02, _init_finger, _obs_finger, _reward_finger,
-                     dict(target_radius=None, spin_velocity=15.0), dict(turn_limit=0.0)),
+                     dict(target_radius=None, spin_velocity=15.0)),
 }
 
 # task -> (domain, parameters): dm_control's task functions' arguments

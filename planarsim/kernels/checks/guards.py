@@ -193,13 +193,14 @@ def hinge_turn_gain(m, ws, j):
 
 
 @kernel
-def turn_gain(m, ws, k, held):
-    """1 / [kg m^2]: how fast torque actuator k turns what it drives, from rest: of its
-    hinge's angle with that hinge's pin holding its two bodies where `held` (hinge_turn_gain),
-    else as if they were free (1/I_a + 1/I_b: larger, and cheap); a joint's armature a gives
-    kappa / (1 + a kappa); of its body's angle (1/I); 0 for the actuators that push (forces,
-    point-mass hips, sliders). The other joints and contacts only slow the turn: an upper
-    bound."""
+def turn_gain(m, ws, k, held, h):
+    """1 / [kg m^2]: how fast torque actuator k turns what it drives in a step of h [s] from
+    rest: of its hinge's angle with that hinge's pin holding its two bodies where `held`
+    (hinge_turn_gain), else as if they were free (1/I_a + 1/I_b: larger, and cheap); a
+    joint's armature a and damping c give kappa / (1 + (a + h c) kappa) (the damper is
+    implicit, constraints/soft.py: the step's rate from rest is h u kappa / (1 + (a + h c)
+    kappa)); of its body's angle (1/I); 0 for the actuators that push (forces, point-mass
+    hips, sliders). The other joints and contacts only slow the turn: an upper bound."""
     kind = m.act_kind[k]
     if kind == ACT_BODY_TORQUE:
         return m.body_inv_inertia[m.act_body[k, 0]]
@@ -213,7 +214,7 @@ def turn_gain(m, ws, k, held):
         for e in range(2):
             if m.pin_body[j, e] >= 0:
                 kappa += m.body_inv_inertia[m.pin_body[j, e]]
-    return kappa / (1.0 + m.pin_armature[j] * kappa)
+    return kappa / (1.0 + (m.pin_armature[j] + h * m.pin_damping[j]) * kappa)
 
 
 @kernel
@@ -226,9 +227,9 @@ def check_actuator_turns(m, ws, h, limit):
     The free bodies' gain bounds the held one: only a command that passes the limit by it pays
     for the held one (hinge_turn_gain scans the pins)."""
     for k in range(m.act_kind.shape[0]):
-        if h * h * abs(ws.act_u[k]) * turn_gain(m, ws, k, False) <= limit:
+        if h * h * abs(ws.act_u[k]) * turn_gain(m, ws, k, False, h) <= limit:
             continue
-        kappa = turn_gain(m, ws, k, True)
+        kappa = turn_gain(m, ws, k, True, h)
         turn = h * h * abs(ws.act_u[k]) * kappa
         if turn > limit:
             ws.info[INFO_COMMAND] = k
