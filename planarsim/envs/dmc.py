@@ -615,6 +615,18 @@ class DMCEnv(PlanarMujocoEnv):
         self.geom_size_override, self.site_size_override = {}, {}
         self.target = None
         self._mass = np.asarray(model.arrays.body_mass, float)
+        # the sensors by name, and what each reads that the file fixes (looked up once, not at
+        # every step): a subtree's bodies and masses, a site's body and point
+        self._sensors = {}
+        for kind, name, attrib in self.frames.sensors:
+            fixed = None
+            if kind == "subtreelinvel":
+                ids = sorted({self.loaded.body[b] for b in self.frames.subtree(attrib["body"])
+                              if b in self.loaded.body})
+                fixed = (ids, self._mass[ids], self._mass[ids].sum())
+            elif kind in ("velocimeter", "gyro"):
+                fixed = self.frames.site[attrib["site"]][:2]
+            self._sensors[name] = (kind, attrib, fixed)
 
     def _rigid(self, body):
         if body not in self.loaded.body:
@@ -719,27 +731,31 @@ class DMCEnv(PlanarMujocoEnv):
         """A sensor of the file's <sensor> section, by name: subtreelinvel, velocimeter, gyro,
         framepos of a site or body frame (3D, as MuJoCo's), jointpos, jointvel, touch (a
         float)."""
-        for kind, sname, attrib in self.frames.sensors:
-            if sname == name:
-                break
-        else:
+        found = self._sensors.get(name)
+        if found is None:
             raise KeyError(f"{self.task}: no sensor {name!r} in the file; it has "
                            f"{[s[1] for s in self.frames.sensors]}")
+        kind, attrib, fixed = found
         if kind == "subtreelinvel":
-            ids = sorted({self.loaded.body[b] for b in self.frames.subtree(attrib["body"])
-                          if b in self.loaded.body})
-            m = self._mass[ids]
-            v2 = (m[:, None] * self.sim.state.v[ids, :2]).sum(0) / m.sum()
+            ids, m, total = fixed
+            v2 = (m[:, None] * self.sim.state.v[ids, :2]).sum(0) / total
             out = np.zeros(3)
             out[self.plane_axes[0]], out[self.plane_axes[1]] = v2
             return out
         if kind in ("velocimeter", "gyro"):
-            body, p, _ = self.frames.site[attrib["site"]]
+            body, p = fixed
+            out = np.zeros(3)
             if kind == "gyro":
-                w = np.zeros(3)
-                w[self.normal_axis] = self.ccw_sign * self.sim.state.v[self._rigid(body), 2]
-                return self.xmat(body).T @ w
-            return self.xmat(body).T @ self._velocity_at(body, p)
+                # the site's frame turns about the plane's normal: the rate is the same in it
+                out[self.normal_axis] = self.ccw_sign * self.sim.state.v[self._rigid(body), 2]
+                return out
+            # the velocity in the site's frame: turned back by the body's angle in the plane
+            a0, a1 = self.plane_axes
+            v = self._velocity_at(body, p)
+            phi = self.angle(body)
+            c, s = math.cos(phi), math.sin(phi)
+            out[a0], out[a1] = c * v[a0] + s * v[a1], c * v[a1] - s * v[a0]
+            return out
         if kind == "touch":
             return self._touch(attrib["site"])
         if kind in ("jointpos", "jointvel"):
