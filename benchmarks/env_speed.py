@@ -10,6 +10,10 @@ engines (it makes any registered id: the same machinery, so the ratio is the eng
 copies x calls per second. Repeats interleave the four figures of an environment so that a
 shared machine's drift hits them alike; median and min-max are reported. Nothing here is
 asserted by the tests.
+
+The DeepMind Control Suite's tasks (planarsim/dmc-<domain>-<task>-v0, measure_dmc) go beside
+dm_control's own environments (``suite.load``: MuJoCo's physics and dm_control's Python
+observation and reward), one environment each, interleaved per task; they need dm_control.
 """
 from __future__ import annotations
 
@@ -143,4 +147,87 @@ def print_envs(rows):
           f"that many free cores; load average now {os.getloadavg()[0]:.1f})")
     print("(ratio: planarsim / MuJoCo; planarsim's and MuJoCo's physics differ: hard contacts and "
           "its own integrator against MuJoCo's soft contacts and the files' integrators)", flush=True)
+    print(flush=True)
+
+
+# --- the DeepMind Control Suite's tasks (planarsim/dmc-*-v0) beside dm_control's own ---------
+
+def _dm_control_suite():
+    """dm_control.suite, or None (not installed)."""
+    try:
+        sys.modules.setdefault("imageio", types.ModuleType("imageio"))
+        from dm_control import suite
+    except ImportError:
+        return None
+    return suite
+
+
+def _dmc_rate(gym, task, steps, seed=0):
+    """planarsim's env.step calls/s on dmc task `task` (random actions, resets included)."""
+    from planarsim.envs.dmc import env_id
+    return _single_rate(gym, env_id(task), steps, seed)
+
+
+def _dm_control_rate(suite, task, steps, seed=0):
+    """dm_control's env.step calls/s on the same task (suite.load; random actions in its
+    action_spec, resets included)."""
+    domain, name = task.split("-", 1)
+    env = suite.load(domain, name, task_kwargs={"random": seed})
+    env.reset()
+    spec = env.action_spec()
+    actions = np.random.default_rng(seed).uniform(spec.minimum, spec.maximum,
+                                                  size=(steps, *spec.shape))
+    t0 = time.perf_counter()
+    for a in actions:
+        if env.step(a).last():
+            env.reset()
+    return steps / (time.perf_counter() - t0)
+
+
+def measure_dmc(repeats=3, steps=1000, tasks=None):
+    """Rows (dicts) of env steps/s of planarsim's dmc tasks and dm_control's, single
+    environments, interleaved per task; [] without gymnasium or dm_control."""
+    gym = _gym()
+    suite = _dm_control_suite()
+    if gym is None or suite is None:
+        print("dmc: gymnasium or dm_control is not installed (pip install -e '.[gym]' "
+              "dm_control); skipped\n")
+        return []
+    from planarsim.envs.dmc import TASKS
+    rows = []
+    for task in tasks or TASKS:
+        _dmc_rate(gym, task, 20)                                # warm up: compile or load
+        _dm_control_rate(suite, task, 20)
+        rates = {"planarsim": [], "dm_control": []}
+        for _ in range(repeats):
+            rates["planarsim"].append(_dmc_rate(gym, task, steps))
+            rates["dm_control"].append(_dm_control_rate(suite, task, steps))
+        for engine, r in rates.items():
+            rows.append(dict(scene="dmc", env=task, engine=engine, mode="single",
+                             steps_per_s=statistics.median(r), steps_per_s_min=min(r),
+                             steps_per_s_max=max(r)))
+    return rows
+
+
+def print_dmc(rows):
+    """The table: env steps/s of each dmc task, planarsim's and dm_control's, and their ratio."""
+    if not rows:
+        return
+    print("DeepMind Control Suite tasks: env.step calls/s, one environment (random actions, "
+          "resets included), median (min-max)")
+    print(f"{'task':24s} {'planarsim':>26s} {'dm_control':>26s} {'ratio':>8s}")
+    by = {(r["env"], r["engine"]): r for r in rows}
+    below = []
+    for task in dict.fromkeys(r["env"] for r in rows):
+        ours, theirs = by[(task, "planarsim")], by[(task, "dm_control")]
+        ratio = ours["steps_per_s"] / theirs["steps_per_s"]
+        if ratio < 1.0:
+            below.append(task)
+        cells = [f"{r['steps_per_s']:10,.0f} ({r['steps_per_s_min']:,.0f}-{r['steps_per_s_max']:,.0f})"
+                 for r in (ours, theirs)]
+        print(f"{task:24s} {cells[0]:>26s} {cells[1]:>26s} {ratio:7.2f}x")
+    print(f"{len(below)} of {len(by) // 2} tasks below dm_control's env steps/s"
+          + (f": {', '.join(below)}" if below else ""))
+    print("(ratio: planarsim / dm_control; the motion differs: planarsim's hard contacts and "
+          "integrator against MuJoCo's soft contacts, Euler or RK4)", flush=True)
     print(flush=True)

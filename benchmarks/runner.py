@@ -32,7 +32,8 @@ Parts (each warm after compilation; steps/s = median and min-max of --repeats ru
 - envs: env.step calls per second of every planarsim gymnasium environment, single and
   vectorised (PlanarVectorEnv, --env-copies copies on 2 processes), beside gymnasium's MuJoCo
   environment of the same name in the same run (env_speed.py; needs gymnasium, and mujoco
-  for the MuJoCo figures).
+  for the MuJoCo figures); then every DeepMind Control Suite task (planarsim/dmc-*-v0)
+  beside dm_control's own environment, one environment each (needs dm_control).
 - stress: Box2D's classic stress scenes and the contact-rich scenes (stress_scenes.py: the
   160-plank bridge (sagging, and Box2D's taut one), the chain holding a 100x ball, the card
   house, the 100:1 boxes, the 20-box stack, 20 dominoes, 50 shapes poured into a U, the
@@ -352,6 +353,11 @@ def _run(args):
         results["envs"] = env_rows
         rows += env_rows
         print_envs(env_rows)
+        from benchmarks.env_speed import measure_dmc, print_dmc
+        dmc_rows = measure_dmc(repeats=min(args.repeats, 3))
+        results["dmc"] = dmc_rows
+        rows += dmc_rows
+        print_dmc(dmc_rows)
     if "stress" in parts:
         from benchmarks.stress import run as run_stress
         from benchmarks.stress_scenes import STRESS_SCENES
