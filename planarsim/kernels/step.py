@@ -45,7 +45,8 @@ from .solver.rebound import rebound_gain, rebounding
 from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev, keep_prev_bodies
 from .geometry.pair_toi import hold_off_fast_pairs
 from .dynamics.position import ROWS_HELD_SHARE, position_stage
-from .constraints.rows import build_rows
+from .constraints.limit import limit_side
+from .constraints.rows import build_rows, is_limit_row
 from .constraints.soft import soft_prediction
 from .solver.solve import solve_impulses
 from .dynamics.rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
@@ -232,14 +233,23 @@ SWITCH_STALL = 3
 @kernel
 def switch_contacts(m, s, ws, only_first):
     """Listed contacts re-examined by the rules (modes.check_contact: release if it pulls,
-    slide if its friction leaves the cone, stick if its slip reversed): every one at once,
-    or only_first the first in the list that changes; returns how many changed."""
+    slide if its friction leaves the cone, stick if its slip reversed), then the engaged
+    joint limits (released if its impulse pulls: a limit is a complementarity variable as a
+    contact's normal is): every one at once, or only_first the first in that order that
+    changes; returns how many changed."""
     gather_contact_impulses(m, s, ws)
     changed = 0
     for k in range(ws.n_live[0]):
         changed += check_contact(m, s, ws, ws.live[k])
         if only_first and changed > 0:
-            break
+            return changed
+    for r in range(ws.n_row[0]):
+        kind = ws.row_kind[r]
+        if is_limit_row(kind) and ws.lam[r] < 0.0:
+            s.limit_active[ws.row_owner[r], limit_side(kind)] = 0
+            changed += 1
+            if only_first:
+                break
     return changed
 
 
@@ -323,6 +333,15 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
 
 
 @kernel(inline="always")
+def has_limits(m):
+    """Some joint of the model has a limit."""
+    for j in range(m.pin_limit.shape[0]):
+        if m.pin_limit[j, 0] != -math.inf or m.pin_limit[j, 1] != math.inf:
+            return True
+    return False
+
+
+@kernel(inline="always")
 def solve_modes(m, s, ws, opt, h, include_ccd):
     """Stages 3-5: rows, impulses and contact modes that meet every rule (modes.rule_breaks).
 
@@ -365,7 +384,8 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
         rounds += 1
         breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
         ok = breaks == 0 and engaged == 0
-    if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
+    # (the rounds switch limits too: a model with limits and no contact takes them as well)
+    if not ok and opt.mode_strategy == MODES_ALTERNATING and (nc > 0 or has_limits(m)):
         ok, more = switch_rounds(m, s, ws, opt, h, include_ccd)
         rounds += more
     if ok:

@@ -1,0 +1,60 @@
+"""Joint limits in the mode rounds (kernels/step.py switch_contacts): an engaged limit whose
+impulse pulls is released in the rounds, as a contact that pulls is, so a step where a joint
+leaves its limit is answered by linear solves, not by the complementarity solve, and the
+answer is the complementarity solve's (mode_strategy 'all') to rounding. Before, the rounds
+re-examined contacts only: every step that released a limit ended in Lemke's method (under
+random torques dm_control's cheetah took it at 88 % of its steps, now 3 %)."""
+import numpy as np
+import pytest
+
+import planarsim as ps
+from planarsim.compiled import step_info
+
+
+def arm(with_floor, dt=1e-3):
+    """A 0.4 m, 1 kg link hinged to the world at (0, 1) with limits (-0.3, 0.3) rad and a
+    motor of +-20 N m; a second link hinged to its tip, limits (-0.5, 0.5); with_floor: a 1 kg
+    box resting on the ground beside them (a contact, so the alternating rounds run)."""
+    b = ps.ModelBuilder(dt=dt, ground=True if with_floor else None)
+    b.add_body("upper", 1.0, 1.0 * 0.4 ** 2 / 12, pos=(0.2, 1.0))
+    b.add_pin("shoulder", None, "upper", anchor_world=(0.0, 1.0), limit=(-0.3, 0.3))
+    b.add_body("lower", 0.5, 0.5 * 0.4 ** 2 / 12, pos=(0.6, 1.0))
+    b.add_pin("elbow", "upper", "lower", anchor_world=(0.4, 1.0), limit=(-0.5, 0.5))
+    b.add_pin_motor("shoulder_motor", "shoulder", limit=(-20.0, 20.0))
+    b.add_pin_motor("elbow_motor", "elbow", limit=(-20.0, 20.0))
+    if with_floor:
+        box = b.add_body("box", 1.0, 1.0 * (0.2 ** 2 + 0.2 ** 2) / 12, pos=(2.0, 0.1))
+        b.add_box_contacts("box", box, (0.0, 0.0), 0.2, 0.2, mu=0.8)
+    return b.compile()
+
+
+def drive(model, strategy, pattern):
+    """Steps of the arm under motor commands `pattern` (a list of (steps, (u0, u1))); returns
+    (q and v after each step, how many steps ended in the complementarity solve, how many
+    steps released a limit)."""
+    sim = ps.Simulator(model, ps.make_options(strategy))
+    out, lemke, released = [], 0, 0
+    for n, u in pattern:
+        for _ in range(n):
+            before = sim.state.limit_active.copy()
+            sim.step(np.array(u, float))
+            lemke += step_info(sim.ws)["lcp_solves"] > 0
+            released += int((before > sim.state.limit_active).any())
+            out.append(np.concatenate([sim.state.q.ravel(), sim.state.v.ravel()]))
+    return np.array(out), lemke, released
+
+
+# down onto the limits, up off them, down again, a wiggle
+PATTERN = [(300, (-20.0, -20.0)), (200, (20.0, 20.0)), (200, (-20.0, 20.0)),
+           (300, (20.0, -20.0)), (200, (-5.0, 5.0))]
+
+
+@pytest.mark.parametrize("with_floor", [True, False])
+def test_a_joint_leaving_its_limit_is_answered_by_the_rounds(with_floor):
+    model = arm(with_floor)
+    rounds, lemke, released = drive(model, "alternating", PATTERN)
+    reference, _, released_all = drive(model, "all", PATTERN)
+    assert released >= 4 and released_all >= 4      # limits engaged and left several times
+    assert lemke == 0
+    scale = 1.0 + np.abs(reference).max()
+    assert np.abs(rounds - reference).max() <= 1e-9 * scale
