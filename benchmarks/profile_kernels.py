@@ -5,6 +5,7 @@
     python benchmarks/profile_kernels.py biped_collapse --seconds 20
     python benchmarks/profile_kernels.py world:pyramid45 --seconds 0.2   # benchmarks/worlds.py
     python benchmarks/profile_kernels.py mjcf:inverted_double_pendulum.xml   # a gymnasium file
+    python benchmarks/profile_kernels.py dmc:cheetah-run --seconds 10   # a dmc task, random actions
 
 numba's machine code has no symbols that perf can see, so this script writes perf's map file
 (/tmp/perf-<pid>.map: address, size, name of every compiled function the run links), samples
@@ -102,6 +103,27 @@ def _workload(target, seconds, skip=0):
     from benchmarks.scenes import SCENES
     from benchmarks.worlds import WORLDS
     from planarsim.link.step import run_steps
+    if target.startswith("dmc:"):
+        # a DeepMind Control Suite task under uniformly random actions (seed 0), env.step by
+        # env.step: the observation's and reward's Python shows as the interpreter's symbols
+        import gymnasium
+        import numpy as np
+        import planarsim.envs  # noqa: F401  (registers the environments)
+        from planarsim.envs.dmc import env_id
+        env = gymnasium.make(env_id(target[4:]))
+        env.reset(seed=0)
+        calls = max(1, int(round(seconds / env.unwrapped.dt)))
+        actions = np.random.default_rng(0).uniform(env.action_space.low, env.action_space.high,
+                                                   size=(calls, *env.action_space.shape))
+        for a in actions[:skip]:
+            env.step(a)
+
+        def run_env():
+            env.reset(seed=0)
+            for a in actions:
+                if any(env.step(a)[2:4]):
+                    env.reset()
+        return run_env, [run_steps]
     from benchmarks.stress_scenes import ALL_SCENES, build_model
     if target.startswith("world:"):
         model = WORLDS[target[6:]]()
@@ -128,8 +150,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("target", help="a bench scene (chain4, biped_collapse, ...), walker:<name> or "
                     "world:<name> (benchmarks/worlds.py), stress:<name> "
-                    "(benchmarks/stress_scenes.py) or mjcf:<gymnasium's file> (its model at rest, "
-                    "no command)")
+                    "(benchmarks/stress_scenes.py), mjcf:<gymnasium's file> (its model at rest, "
+                    "no command) or dmc:<task> (planarsim/dmc-<task>-v0 under random actions)")
     ap.add_argument("--skip", type=int, default=0,
                     help="steps taken before the timed runs start (the scene's later part)")
     ap.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
