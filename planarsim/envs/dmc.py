@@ -11,9 +11,12 @@ steps on planarsim's engine; finger draws its joint angles again while two of pl
 colliding shapes overlap, where dm_control asks MuJoCo for a contact: the same geometry, so
 the same draws, and a start that never overlaps).
 
-One class, :class:`DMCEnv`; each domain is a few functions (its initialisation, observation
-and reward, written as dm_control's ``Physics`` / ``Task`` methods are), each task a row of
-``TASKS`` (its domain and parameters: walker stand / walk / run differ by a target speed).
+One class, :class:`DMCEnv`; each domain is a few functions (its initialisation, its readings
+and its reward, written as dm_control's ``Physics`` / ``Task`` methods are), each task a row
+of ``TASKS`` (its domain and parameters: walker stand / walk / run differ by a target speed).
+A domain's readings (its observation entries, then the values its reward reads) are a table
+of operations (:mod:`.readout`) written at a reset and computed by one compiled call per env
+step; the reward combines those values in Python floats.
 The quantities dm_control reads from MuJoCo's data (body frames ``xpos`` / ``xmat``, body
 centres of mass ``xipos``, site and geom positions, the sensors ``subtreelinvel``,
 ``velocimeter``, ``gyro``, ``framepos``, ``jointpos``, ``jointvel``, ``touch``) are
@@ -43,7 +46,9 @@ from gymnasium import spaces
 from ..mjcf import parse_xml
 from ..kernels.codes import CONTACT_PAIR
 from ..start_check import shape_overlaps
+from ..link.step import bind
 from .core import PlanarMujocoEnv
+from .readout import Readout, read
 from .rewards import tolerance
 
 INF = float("inf")
@@ -270,186 +275,195 @@ def _init_finger(env, random, qpos, qvel, params):
     set_random_joint_angles(env, random, qpos)
 
 
-def _obs_position_velocity(env):
-    return collections.OrderedDict(position=env.qpos[1:].copy(), velocity=env.qvel.copy())
+def _qpos_all(env, r, first=0):
+    return [r.qpos(i) for i in range(first, len(env.coords.names))]
 
 
-def _obs_state(env):
-    """physics.position() and physics.velocity(): the whole qpos and qvel."""
-    return collections.OrderedDict(position=env.qpos.copy(), velocity=env.qvel.copy())
+def _qvel_all(env, r):
+    return [r.qvel(i) for i in range(len(env.coords.names))]
 
 
-def _obs_walker(env):
-    return collections.OrderedDict(
-        orientations=np.array([env.xmat(b)[0, [0, 2]] for b in env.frames.body]).ravel(),
-        height=np.array(env.xpos("torso")[2]), velocity=env.qvel.copy())
+def _plan_position_velocity(env, r, first=1):
+    """physics.data.qpos[first:] and physics.velocity()."""
+    r.obs("position", *_qpos_all(env, r, first))
+    r.obs("velocity", *_qvel_all(env, r))
 
 
-def _touch(env):
-    return np.log1p([env.sensor("touch_toe"), env.sensor("touch_heel")])
+def _plan_cheetah(env, r):
+    _plan_position_velocity(env, r)
+    r.value("speed", r.sensor("torso_subtreelinvel", 0))
 
 
-def _obs_hopper(env):
-    obs = _obs_position_velocity(env)
-    obs["touch"] = _touch(env)
-    return obs
+def _reward_cheetah(x, p, ctrl):
+    return tolerance(x["speed"], bounds=(p["run_speed"], INF), margin=p["run_speed"],
+                     value_at_margin=0, sigmoid="linear")
 
 
-def _obs_acrobot(env):
+def _plan_walker(env, r):
+    r.obs("orientations", *[r.xmat(b, 0, j) for b in env.frames.body for j in (0, 2)])
+    r.obs("height", r.point(2, r.body_origin("torso")), scalar=True)
+    r.obs("velocity", *_qvel_all(env, r))
+    r.value("height", r.point(2, r.body_origin("torso")))
+    r.value("upright", r.xmat("torso", 2, 2))
+    r.value("speed", r.sensor("torso_subtreelinvel", 0))
+
+
+def _reward_walker(x, p, ctrl):
+    standing = tolerance(x["height"], bounds=(p["stand_height"], INF),
+                         margin=p["stand_height"] / 2)
+    upright = (1 + x["upright"]) / 2
+    stand_reward = (3 * standing + upright) / 4
+    if p["move_speed"] == 0:
+        return stand_reward
+    move_reward = tolerance(x["speed"], bounds=(p["move_speed"], INF),
+                            margin=p["move_speed"] / 2, value_at_margin=0.5, sigmoid="linear")
+    return stand_reward * (5 * move_reward + 1) / 6
+
+
+def _plan_hopper(env, r):
+    _plan_position_velocity(env, r)
+    r.obs("touch", *[r.sensor(s, log1p=True) for s in ("touch_toe", "touch_heel")])
+    r.value("height", r.point(2, r.body_com("torso"), r.body_com("foot")))
+    r.value("speed", r.sensor("torso_subtreelinvel", 0))
+
+
+def _small_control(ctrl):
+    """dm_control's tolerance(control, margin=1, value_at_margin=0, sigmoid='quadratic')
+    of each control."""
+    return [tolerance(float(c), margin=1, value_at_margin=0, sigmoid="quadratic") for c in ctrl]
+
+
+def _reward_hopper(x, p, ctrl):
+    standing = tolerance(x["height"], (p["stand_height"], 2))
+    if p["hop_speed"]:
+        hopping = tolerance(x["speed"], bounds=(p["hop_speed"], INF), margin=p["hop_speed"] / 2,
+                            value_at_margin=0.5, sigmoid="linear")
+        return standing * hopping
+    small_control = np.mean(_small_control(ctrl))
+    return standing * (small_control + 4) / 5
+
+
+def _plan_acrobot(env, r):
     arms = ("upper_arm", "lower_arm")
-    return collections.OrderedDict(
-        orientations=np.array([env.xmat(b)[0, 2] for b in arms] + [env.xmat(b)[2, 2] for b in arms]),
-        velocity=env.qvel.copy())
+    r.obs("orientations", *([r.xmat(b, 0, 2) for b in arms] + [r.xmat(b, 2, 2) for b in arms]))
+    r.obs("velocity", *_qvel_all(env, r))
+    r.value("distance", r.dist(r.site("target"), r.site("tip")))
+    r.value("radius", r.const(env.frames.site["target"][2][0]))
+
+
+def _reward_acrobot(x, p, ctrl):
+    return tolerance(x["distance"], bounds=(0, x["radius"]), margin=1)
 
 
 def _poles(env):
     return list(env.frames.body)[1:]        # dm_control's xmat[2:]: the bodies after the cart
 
 
-def _obs_cartpole(env):
-    pos = [env.qpos[env.qindex("slider")]]
-    for b in _poles(env):
-        pos += [env.xmat(b)[2, 2], env.xmat(b)[0, 2]]
-    return collections.OrderedDict(position=np.array(pos), velocity=env.qvel.copy())
+def _plan_cartpole(env, r):
+    poles = _poles(env)
+    r.obs("position", r.qpos("slider"), *[r.xmat(b, i, 2) for b in poles for i in (2, 0)])
+    r.obs("velocity", *_qvel_all(env, r))
+    for i, b in enumerate(poles):
+        r.value(f"cos{i}", r.xmat(b, 2, 2))
+    r.value("slider", r.qpos("slider"))
+    for i in range(1, len(env.coords.names)):
+        r.value(f"qvel{i}", r.qvel(i))
 
 
-def _obs_pendulum(env):
-    R = env.xmat("pole")
-    return collections.OrderedDict(orientation=np.array([R[2, 2], R[0, 2]]),
-                                   velocity=env.qvel[[env.qindex("hinge")]].copy())
+def _reward_cartpole(x, p, ctrl):
+    cosines = [v for k, v in x.items() if k.startswith("cos")]
+    upright = np.mean([(c + 1) / 2 for c in cosines])
+    centered = (1 + tolerance(x["slider"], margin=2)) / 2
+    small_control = (4 + _small_control(ctrl[:1])[0]) / 5
+    small_velocity = (1 + min(tolerance(v, margin=5) for k, v in x.items()
+                              if k.startswith("qvel"))) / 2
+    return upright * small_control * small_velocity * centered
 
 
-def _finger_to_target(env):
-    return env.geom_xpos("target")[:2] - env.geom_xpos("finger")[:2]
+def _plan_pendulum(env, r):
+    r.obs("orientation", r.xmat("pole", 2, 2), r.xmat("pole", 0, 2))
+    r.obs("velocity", r.qvel("hinge"))
+    r.value("cos", r.xmat("pole", 2, 2))
 
 
-def _obs_reacher(env):
-    return collections.OrderedDict(position=env.qpos.copy(), to_target=_finger_to_target(env),
-                                   velocity=env.qvel.copy())
+def _reward_pendulum(x, p, ctrl):
+    return tolerance(x["cos"], (np.cos(np.deg2rad(p["angle_bound"])), 1))
 
 
-def _nose_to_target(env):
-    return (env.geom_xpos("target") - env.geom_xpos("nose")).dot(env.xmat("head"))[:2]
+def _plan_reacher(env, r):
+    r.obs("position", *_qpos_all(env, r))
+    r.obs("to_target", *[r.point(k, r.geom("target"), r.geom("finger")) for k in (0, 1)])
+    r.obs("velocity", *_qvel_all(env, r))
+    r.value("distance", r.dist(r.geom("target"), r.geom("finger")))
+    r.value("radii", r.const(env.geom_size("target")[0] + env.geom_size("finger")[0]))
 
 
-def _tip_position(env):
-    """The spinner's tip relative to its hinge, (x, z) [m] (sensors tip - spinner)."""
-    return env.sensor("tip")[[0, 2]] - env.sensor("spinner")[[0, 2]]
+def _reward_reacher(x, p, ctrl):
+    return tolerance(x["distance"], (0, x["radii"]))
 
 
-def _target_position(env):
-    return env.sensor("target")[[0, 2]] - env.sensor("spinner")[[0, 2]]
+def _plan_point_mass(env, r):
+    _plan_position_velocity(env, r, first=0)
+    r.value("distance", r.dist(r.geom("target"), r.geom("pointmass")))
+    r.value("target_size", r.const(env.geom_size("target")[0]))
 
 
-def _dist_to_target(env):
-    """Signed distance [m] of the tip to the target's surface (negative: inside)."""
-    return (np.linalg.norm(_target_position(env) - _tip_position(env))
-            - env.site_size("target")[0])
-
-
-def _obs_finger(env):
-    s = env.sensor
-    obs = collections.OrderedDict(
-        position=np.hstack(([s("proximal"), s("distal")], _tip_position(env))),
-        velocity=np.array([s("proximal_velocity"), s("distal_velocity"), s("hinge_velocity")]),
-        touch=np.log1p([s("touchtop"), s("touchbottom")]))
-    if env.params["target_radius"] is not None:
-        obs["target_position"] = _target_position(env)
-        obs["dist_to_target"] = np.array(_dist_to_target(env))
-    return obs
-
-
-def _obs_swimmer(env):
-    vel = []
-    for kind, name, attrib in env.frames.sensors:     # dm_control: sensordata[12:], (vx, vy, wz)
-        if kind == "velocimeter":
-            vel += list(env.sensor(name)[:2])
-        elif kind == "gyro":
-            vel.append(env.sensor(name)[2])
-    return collections.OrderedDict(joints=env.qpos[3:].copy(), to_target=_nose_to_target(env),
-                                   body_velocities=np.array(vel))
-
-
-def _reward_cheetah(env, p):
-    return tolerance(env.sensor("torso_subtreelinvel")[0], bounds=(p["run_speed"], INF),
-                     margin=p["run_speed"], value_at_margin=0, sigmoid="linear")
-
-
-def _reward_walker(env, p):
-    standing = tolerance(env.xpos("torso")[2], bounds=(p["stand_height"], INF),
-                         margin=p["stand_height"] / 2)
-    upright = (1 + env.xmat("torso")[2, 2]) / 2
-    stand_reward = (3 * standing + upright) / 4
-    if p["move_speed"] == 0:
-        return stand_reward
-    move_reward = tolerance(env.sensor("torso_subtreelinvel")[0], bounds=(p["move_speed"], INF),
-                            margin=p["move_speed"] / 2, value_at_margin=0.5, sigmoid="linear")
-    return stand_reward * (5 * move_reward + 1) / 6
-
-
-def _reward_hopper(env, p):
-    height = env.xipos("torso")[2] - env.xipos("foot")[2]
-    standing = tolerance(height, (p["stand_height"], 2))
-    if p["hop_speed"]:
-        hopping = tolerance(env.sensor("torso_subtreelinvel")[0], bounds=(p["hop_speed"], INF),
-                            margin=p["hop_speed"] / 2, value_at_margin=0.5, sigmoid="linear")
-        return standing * hopping
-    small_control = tolerance(env.control(), margin=1, value_at_margin=0,
-                              sigmoid="quadratic").mean()
-    return standing * (small_control + 4) / 5
-
-
-def _reward_acrobot(env, p):
-    dist = np.linalg.norm(env.site_xpos("target") - env.site_xpos("tip"))
-    return tolerance(dist, bounds=(0, env.frames.site["target"][2][0]), margin=1)
-
-
-def _reward_cartpole(env, p):
-    cosines = np.array([env.xmat(b)[2, 2] for b in _poles(env)])
-    upright = (cosines + 1) / 2
-    centered = (1 + tolerance(env.qpos[env.qindex("slider")], margin=2)) / 2
-    small_control = tolerance(env.control(), margin=1, value_at_margin=0, sigmoid="quadratic")[0]
-    small_control = (4 + small_control) / 5
-    small_velocity = (1 + tolerance(env.qvel[1:], margin=5).min()) / 2
-    return upright.mean() * small_control * small_velocity * centered
-
-
-def _reward_pendulum(env, p):
-    return tolerance(env.xmat("pole")[2, 2], (np.cos(np.deg2rad(p["angle_bound"])), 1))
-
-
-def _reward_reacher(env, p):
-    radii = env.geom_size("target")[0] + env.geom_size("finger")[0]
-    return tolerance(np.linalg.norm(_finger_to_target(env)), (0, radii))
-
-
-def _reward_point_mass(env, p):
-    target_size = env.geom_size("target")[0]
-    dist = np.linalg.norm(env.geom_xpos("target") - env.geom_xpos("pointmass"))
-    near_target = tolerance(dist, bounds=(0, target_size), margin=target_size)
-    control_reward = tolerance(env.control(), margin=1, value_at_margin=0,
-                               sigmoid="quadratic").mean()
-    small_control = (control_reward + 4) / 5
+def _reward_point_mass(x, p, ctrl):
+    size = x["target_size"]
+    near_target = tolerance(x["distance"], bounds=(0, size), margin=size)
+    small_control = (np.mean(_small_control(ctrl)) + 4) / 5
     return near_target * small_control
 
 
-def _reward_swimmer(env, p):
-    target_size = env.geom_size("target")[0]
-    return tolerance(np.linalg.norm(_nose_to_target(env)), bounds=(0, target_size),
-                     margin=5 * target_size, sigmoid="long_tail")
+def _plan_swimmer(env, r):
+    r.obs("joints", *_qpos_all(env, r, 3))
+    r.obs("to_target", *[r.point(k, r.geom("target"), r.geom("nose"), frame="head")
+                         for k in (0, 1)])
+    vel = []              # dm_control: sensordata[12:], (vx, vy) of each velocimeter, wz of a gyro
+    for kind, name, _ in env.frames.sensors:
+        if kind == "velocimeter":
+            vel += [r.sensor(name, 0), r.sensor(name, 1)]
+        elif kind == "gyro":
+            vel.append(r.sensor(name, 2))
+    r.obs("body_velocities", *vel)
+    r.value("distance", r.dist(r.geom("target"), r.geom("nose")))
+    r.value("target_size", r.const(env.geom_size("target")[0]))
 
 
-def _reward_finger(env, p):
+def _reward_swimmer(x, p, ctrl):
+    size = x["target_size"]
+    return tolerance(x["distance"], bounds=(0, size), margin=5 * size, sigmoid="long_tail")
+
+
+def _plan_finger(env, r):
+    tip, spinner, target = (r.sensor_point(s) for s in ("tip", "spinner", "target"))
+    r.obs("position", r.sensor("proximal"), r.sensor("distal"),
+          *[r.point(k, tip, spinner) for k in (0, 2)])
+    r.obs("velocity", *[r.sensor(s) for s in ("proximal_velocity", "distal_velocity",
+                                              "hinge_velocity")])
+    r.obs("touch", *[r.sensor(s, log1p=True) for s in ("touchtop", "touchbottom")])
+    turn = env.params["target_radius"] is not None
+    to_target = r.dist(target, tip, minus=env.site_size("target")[0])
+    if turn:
+        r.obs("target_position", *[r.point(k, target, spinner) for k in (0, 2)])
+        r.obs("dist_to_target", to_target, scalar=True)
+    r.value("hinge_velocity", r.sensor("hinge_velocity"))
+    r.value("dist_to_target", to_target)
+
+
+def _reward_finger(x, p, ctrl):
     if p["target_radius"] is None:          # spin: the hinge turning fast enough [rad/s]
-        return float(env.sensor("hinge_velocity") <= -p["spin_velocity"])
-    return float(_dist_to_target(env) <= 0)
+        return float(x["hinge_velocity"] <= -p["spin_velocity"])
+    return float(x["dist_to_target"] <= 0)
 
 
 @dataclass(frozen=True)
 class Domain:
     """A suite domain: its file, MuJoCo timestep [s] (the file's; checked at load),
     _DEFAULT_TIME_LIMIT [s], _CONTROL_TIMESTEP [s] (None: the timestep), and its functions
-    init(env, random, qpos, qvel, params), observe(env) -> OrderedDict, reward(env, params);
+    init(env, random, qpos, qvel, params); plan(env, readout): its observation entries and
+    the values its reward reads, as readout.Readout ops; reward(values, params, control): the
+    reward from those values (a dict by name) and the last action;
     defaults: the task parameters its module sets as constants; step_options: StepOptions
     fields the domain's simulator takes."""
     xml: str
@@ -457,7 +471,7 @@ class Domain:
     time_limit: float
     control_timestep: float | None
     init: callable
-    observe: callable
+    plan: callable
     reward: callable
     defaults: dict = field(default_factory=dict)
     step_options: dict = field(default_factory=dict)
@@ -480,28 +494,28 @@ class Domain:
 
 
 DOMAINS = {
-    "cheetah": Domain("cheetah.xml", 0.01, 10, None, _init_cheetah, _obs_position_velocity,
+    "cheetah": Domain("cheetah.xml", 0.01, 10, None, _init_cheetah, _plan_cheetah,
                       _reward_cheetah, dict(run_speed=10)),
-    "walker": Domain("walker.xml", 0.0025, 25, .025, _init_randomized, _obs_walker,
+    "walker": Domain("walker.xml", 0.0025, 25, .025, _init_randomized, _plan_walker,
                      _reward_walker, dict(stand_height=1.2)),
-    "hopper": Domain("hopper.xml", 0.005, 20, .02, _init_randomized, _obs_hopper, _reward_hopper,
+    "hopper": Domain("hopper.xml", 0.005, 20, .02, _init_randomized, _plan_hopper, _reward_hopper,
                      dict(stand_height=0.6)),
-    "acrobot": Domain("acrobot.xml", 0.01, 10, None, _init_acrobot, _obs_acrobot, _reward_acrobot),
-    "cartpole": Domain("cartpole.xml", 0.01, 10, None, _init_cartpole, _obs_cartpole,
+    "acrobot": Domain("acrobot.xml", 0.01, 10, None, _init_acrobot, _plan_acrobot, _reward_acrobot),
+    "cartpole": Domain("cartpole.xml", 0.01, 10, None, _init_cartpole, _plan_cartpole,
                        _reward_cartpole),
-    "pendulum": Domain("pendulum.xml", 0.02, 20, None, _init_pendulum, _obs_pendulum,
+    "pendulum": Domain("pendulum.xml", 0.02, 20, None, _init_pendulum, _plan_pendulum,
                        _reward_pendulum, dict(angle_bound=8)),
-    "reacher": Domain("reacher.xml", 0.02, 20, None, _init_reacher, _obs_reacher, _reward_reacher),
-    "swimmer": Domain("swimmer.xml", 0.002, 30, .03, _init_swimmer, _obs_swimmer,
+    "reacher": Domain("reacher.xml", 0.02, 20, None, _init_reacher, _plan_reacher, _reward_reacher),
+    "swimmer": Domain("swimmer.xml", 0.002, 30, .03, _init_swimmer, _plan_swimmer,
                       _reward_swimmer),
     # a mass on two limited, damped slides, each pulled by a motor on a fixed tendon
-    "point_mass": Domain("point_mass.xml", 0.02, 20, None, _init_randomized, _obs_state,
+    "point_mass": Domain("point_mass.xml", 0.02, 20, None, _init_randomized, _plan_point_mass,
                          _reward_point_mass),
     # a two-link finger and a spinner on a hinge with dry friction, no gravity. The motors
     # alone (30 N m on 0.0068 kg m^2) would turn the proximal link 0.44 rad in a step from
     # rest; its damping (2.5 N m s/rad, implicit as in MuJoCo's Euler) holds that to 0.09 rad,
     # within the motor guard (StepOptions.turn_limit), which counts the damper
-    "finger": Domain("finger.xml", 0.01, 20, .02, _init_finger, _obs_finger, _reward_finger,
+    "finger": Domain("finger.xml", 0.01, 20, .02, _init_finger, _plan_finger, _reward_finger,
                      dict(target_radius=None, spin_velocity=15.0)),
 }
 
@@ -583,6 +597,8 @@ class DMCEnv(PlanarMujocoEnv):
         self._random = None
         self.settle = 0
         self._ctrl = np.zeros(len(self._act))
+        self._q0 = np.ascontiguousarray(np.asarray(self.sim_model.q0, float).reshape(-1, 3))
+        self._readout = None
         self._reset_state(np.random.RandomState(0))
         n = self._get_obs().size
         self.observation_space = spaces.Box(-np.inf, np.inf, (n,), np.float64)
@@ -706,15 +722,16 @@ class DMCEnv(PlanarMujocoEnv):
         p = table["target"][1].copy()
         p[self.plane_axes[0]], p[self.plane_axes[1]] = x, y
         self.target = p
+        self._readout = None              # (the readings' table holds the target's place)
 
     def set_control(self, action):
         """Set the control the reward reads (dm_control's physics.set_control), without
         stepping."""
-        self._ctrl = np.array(action, dtype=np.float64).reshape(len(self._act))
+        self._ctrl[:] = np.array(action, dtype=np.float64).reshape(len(self._act))
 
     def control(self):
         """dm_control's physics.control(): the last action as given (before the clamp)."""
-        return self._ctrl
+        return self._ctrl.copy()
 
     def _velocity_at(self, body, file_point):
         b = self._rigid(body)
@@ -802,24 +819,61 @@ class DMCEnv(PlanarMujocoEnv):
                 total += st.last_contact_impulse[k, 0] / self.timestep
         return total
 
+    # the readings: observation and reward, one compiled call ------------------------------
+    def _plan(self):
+        """The task's readings as a table (readout.Readout), written at a reset or when the
+        target moves; the compiled call is bound to it and the simulator's arrays at the
+        next read."""
+        r = Readout(self)
+        self.domain.plan(self, r)
+        self._readout = r
+        self._n_obs = r.n_obs
+        self._tables = r.tables()
+        self._values = np.zeros(r.n_obs + len(r.value_names))
+        self._read_args = None
+
+    def _read(self) -> np.ndarray:
+        """The readings of the current state: the observation's entries, then the reward's
+        values (one compiled call, readout.read)."""
+        if self._readout is None:
+            self._plan()
+        st, ws, d = self.sim.state, self.sim.ws, self.data
+        args = self._read_args
+        if (args is None or args[0] is not st.q or args[6] is not st.last_contact_impulse
+                or args[11] is not ws.contact_bodies or args[3] is not d.qpos):
+            a = self.sim_model.arrays
+            args = (st.q, st.v, self._q0, d.qpos, d.qvel, self._ctrl, st.last_contact_impulse,
+                    a.contact_kind, a.contact_body, a.contact_local, a.contact_radius,
+                    ws.contact_bodies, ws.contact_refpt, *self._tables, self._values)
+            self._read_args = args
+            self._read_call = bind(read, args)
+        self._read_call(*args)
+        return self._values
+
+    def _reward_of(self, values) -> float:
+        named = dict(zip(self._readout.value_names, values[self._n_obs:].tolist()))
+        return float(self.domain.reward(named, self.params, self._ctrl))
+
     # gymnasium -----------------------------------------------------------------------------
     def observation(self) -> collections.OrderedDict:
-        """The task's observation entries (dm_control's get_observation)."""
-        return self.domain.observe(self)
+        """The task's observation entries (dm_control's get_observation), by name."""
+        values = self._read()
+        return collections.OrderedDict(self._readout.entries(values))
 
     def _get_obs(self):
-        return np.concatenate([np.asarray(x, float).ravel() for x in self.observation().values()])
+        return self._read()[:self._n_obs].copy()
 
     def reward(self) -> float:
         """dm_control's get_reward of the current state (and last control)."""
-        return float(self.domain.reward(self, self.params))
+        return self._reward_of(self._read())
 
     def _reset_state(self, random):
         qpos, qvel = self.init_qpos.copy(), np.zeros(self.model.nv)
         self.settle = 0
         self.geom_size_override, self.site_size_override = {}, {}
         self.domain.init(self, random, qpos, qvel, self.params)
-        self._ctrl = np.zeros(len(self._act))
+        self._ctrl[:] = 0.0
+        self._readout = None              # (the target and sizes the init drew)
         self.set_state(qpos, qvel)
         if self.settle:
             self.sim.steps(self.settle, np.zeros(self.sim_model.n_act))
@@ -837,7 +891,8 @@ class DMCEnv(PlanarMujocoEnv):
         return super().reset(seed=seed, options=options)
 
     def step(self, action):
-        a = self.check_action(action)
-        self._ctrl = a.copy()
-        self.do_simulation(a, self.frame_skip)
-        return self._get_obs(), self.reward(), False, False, {}
+        a = np.asarray(action, dtype=np.float64)
+        self.do_simulation(a, self.frame_skip)     # (raises for an action of the wrong shape
+        self._ctrl[:] = a                          # or with a NaN: the control stays)
+        values = self._read()
+        return values[:self._n_obs].copy(), self._reward_of(values), False, False, {}

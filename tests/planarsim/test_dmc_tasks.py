@@ -85,8 +85,16 @@ def test_tolerance_is_dm_controls(kind, margin, value):
     for bounds in ((0.0, 0.0), (-0.5, 1.0), (1.0, np.inf)):
         ours = tolerance(x, bounds, margin, kind, value)
         theirs = rewards.tolerance(x, bounds, margin, kind, value)
+
+        def theirs_at(xi):
+            with np.errstate(invalid="ignore"):          # (theirs at x = inf: inf - inf)
+                return rewards.tolerance(xi, bounds, margin, kind, value)
         assert np.array_equal(ours, theirs), (kind, bounds)
-        assert tolerance(0.7, bounds, margin, kind, value) == rewards.tolerance(0.7, bounds, margin, kind, value)
+        # a float takes math's functions (a dmc step's readings are floats): to an ulp or two
+        for xi in np.append(x[::7] + 0.013, [np.nan, np.inf, -np.inf]):
+            mine, ref = tolerance(float(xi), bounds, margin, kind, value), theirs_at(xi)
+            assert isinstance(mine, float) and (abs(mine - ref) <= 1e-15
+                                                or np.isnan(mine) and np.isnan(ref)), (xi, mine, ref)
     with pytest.raises(ValueError, match="lower bound 1 > upper bound 0"):
         tolerance(0.0, (1, 0))
 
@@ -101,6 +109,11 @@ def test_spaces_and_time_limit_are_dm_controls(task):
     assert np.array_equal(env.action_space.high, aspec.maximum)
     n_obs = sum(int(np.prod(s.shape)) for s in theirs.observation_spec().values())
     assert env.observation_space.shape == (n_obs,)
+    # observation() names its entries as dm_control's get_observation does, in its order and
+    # shapes (a scalar entry a 0-d array)
+    env.reset(seed=0)
+    ours = {k: v.shape for k, v in env.unwrapped.observation().items()}
+    assert list(ours.items()) == [(k, s.shape) for k, s in theirs.observation_spec().items()]
     assert np.all(env.observation_space.low == -np.inf) and np.all(env.observation_space.high == np.inf)
     # dm_control's episode: steps until its count reaches time limit / control step
     assert env.spec.max_episode_steps == int(np.ceil(theirs._step_limit))
