@@ -293,9 +293,11 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
     breaks none but pushes further contacts into touch is solved again with them, as in
     solve_modes. A pile settling with many contacts that start or stop sliding in one step
     (a pour of 50 shapes) finds its modes in linear solves, where the complementarity solve
-    over its island took thousands of pivots. Where no round's answer keeps every rule, the
-    modes are put back as they were (the complementarity solve starts from them). Returns
-    (an answer stands, solves)."""
+    over its island took thousands of pivots. The rounds end early where they stall (the
+    least-index rule) on a solve that dropped dependent rows: the rule's end is promised
+    for a P-matrix only. Where no round's answer keeps every rule, the modes are put back
+    as they were (the complementarity solve starts from them). Returns (an answer stands,
+    solves)."""
     keep_modes(s, ws)
     solves = 0
     breaks = 1
@@ -328,6 +330,12 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
             stall = 0
         else:
             stall += 1
+        if stall >= SWITCH_STALL and ws.least_change[1] > 0:
+            # the least-index rule ends where the problem's matrix is a P-matrix's; rows
+            # dropped as dependent make it singular, and the rounds may cycle through
+            # least-change answers to the last (a cheetah's limits with a foot's
+            # contacts: 48 rounds of 5 solves, then the complementarity solve anyway)
+            break
     restore_modes(s, ws)
     return False, solves
 
@@ -352,7 +360,8 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     solve engages more (at most once per contact and limit: a stack landing or settling
     engages one level per solve, each solve linear in its size). Alternating strategy: an
     answer that breaks a rule has the contact under the cursor re-examined by the
-    alternating rule and is solved once more; one that still breaks a rule has every contact
+    alternating rule and is solved once more (where that changed a mode); one that still
+    breaks a rule has every contact
     that breaks one switched at once, up to SWITCH_ROUNDS times (switch_rounds). An answer
     that still breaks a rule has its frictional joints switched by their rule (friction_rounds),
     then the contacts' strategies; one that still breaks a rule goes to the complementarity
@@ -372,6 +381,7 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
     ok = breaks == 0 and engaged == 0
     if ws.room[0] == 1:
         return True             # (no room: the step begins again with more)
+    more = 0
     if not ok:
         ok, more = friction_rounds(m, s, ws, opt, h, include_ccd)
         rounds += more
@@ -379,11 +389,15 @@ def solve_modes(m, s, ws, opt, h, include_ccd):
             return True
     nc = m.contact_body.shape[0]
     if not ok and opt.mode_strategy == MODES_ALTERNATING and nc > 0:
-        seed_rule(m, s, ws, s.mode_cursor[0] % nc)
-        equalities = build_and_solve(m, s, ws, opt, h)
-        rounds += 1
-        breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
-        ok = breaks == 0 and engaged == 0
+        # the answer in ws is of the modes as they stand where the alternating check changes
+        # none and nothing was engaged since it was solved: solved again, it would be the
+        # same answer, breaking the same rules (a broken limit rule, or a contact away from
+        # the cursor's: the rounds switch those)
+        if seed_rule(m, s, ws, s.mode_cursor[0] % nc) > 0 or engaged > 0 or more > 0:
+            equalities = build_and_solve(m, s, ws, opt, h)
+            rounds += 1
+            breaks, engaged = answer_check(m, s, ws, h, include_ccd, equalities)
+            ok = breaks == 0 and engaged == 0
     # (the rounds switch limits too: a model with limits and no contact takes them as well)
     if not ok and opt.mode_strategy == MODES_ALTERNATING and (nc > 0 or has_limits(m)):
         ok, more = switch_rounds(m, s, ws, opt, h, include_ccd)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import planarsim as ps
-from planarsim.compiled import step_info
+from planarsim.compiled import audit_counts, step_info
 
 
 def arm(with_floor, dt=1e-3):
@@ -58,3 +58,29 @@ def test_a_joint_leaving_its_limit_is_answered_by_the_rounds(with_floor):
     assert lemke == 0
     scale = 1.0 + np.abs(reference).max()
     assert np.abs(rounds - reference).max() <= 1e-9 * scale
+
+
+def test_the_rounds_hand_a_cycling_step_to_the_complementarity_solve():
+    """dm_control's cheetah under random full torques, a foot on the floor and joints on their
+    limits: where the rounds have stalled (the least-index rule) and the solve dropped rows
+    as dependent, the problem's matrix is singular, the rule has no end to promise, and the
+    rounds stop there: the complementarity solve takes the step. Before, such steps cycled
+    through least-change answers for all 48 rounds (116-133 linear solves, then Lemke's
+    method anyway). No step's answer draws an audit."""
+    gym = pytest.importorskip("gymnasium")
+    pytest.importorskip("dm_control", reason="dm_control ships the cheetah's file")
+    import planarsim.envs  # noqa: F401
+    env = gym.make("planarsim/dmc-cheetah-run-v0").unwrapped
+    env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    most, lemke, n = 0, 0, 600
+    before = audit_counts(env.sim.ws)         # (the reset's settling has its own)
+    for _ in range(n):
+        env.step(rng.uniform(env.action_space.low, env.action_space.high))
+        info = step_info(env.sim.ws)
+        most = max(most, info["solves"])
+        lemke += info["lcp_solves"] > 0
+    print(f"cheetah: most solves in a step {most}, steps to Lemke {lemke} of {n}")
+    assert lemke >= 1             # (the case arises in this run)
+    assert most <= 3 * 16, most
+    assert audit_counts(env.sim.ws) == before, (before, audit_counts(env.sim.ws))
