@@ -44,7 +44,6 @@ import numpy as np
 from gymnasium import spaces
 
 from ..mjcf import parse_xml
-from ..kernels.codes import CONTACT_PAIR
 from ..start_check import shape_overlaps
 from ..link.step import bind
 from .core import PlanarMujocoEnv
@@ -550,6 +549,9 @@ def env_id(task: str) -> str:
 
 # --- the environment -----------------------------------------------------------------------
 
+# sensors of one value (the rest are 3D)
+_SCALAR_SENSORS = ("touch", "jointpos", "jointvel")
+
 class DMCEnv(PlanarMujocoEnv):
     """A DeepMind Control Suite task (a key of TASKS, e.g. "walker-walk") on planarsim.
 
@@ -733,91 +735,30 @@ class DMCEnv(PlanarMujocoEnv):
         """dm_control's physics.control(): the last action as given (before the clamp)."""
         return self._ctrl.copy()
 
-    def _velocity_at(self, body, file_point):
-        b = self._rigid(body)
-        p = self.pos3(body, file_point)
-        a0, a1 = self.plane_axes
-        q, v = self.sim.state.q[b], self.sim.state.v[b]
-        w = v[2]
-        r = (p[a0] - q[0], p[a1] - q[1])
-        out = np.zeros(3)
-        out[a0], out[a1] = v[0] - w * r[1], v[1] + w * r[0]
-        return out
-
     def sensor(self, name):
-        """A sensor of the file's <sensor> section, by name: subtreelinvel, velocimeter, gyro,
-        framepos of a site or body frame (3D, as MuJoCo's), jointpos, jointvel, touch (a
-        float)."""
+        """A sensor of the file's <sensor> section, by name, as MuJoCo's sensordata gives it:
+        subtreelinvel, velocimeter, gyro, framepos and frame x / y / z axis of a site, geom or
+        body (3D), jointpos, jointvel, touch (a float). Read by the readings' own operations
+        (readout.Readout)."""
         found = self._sensors.get(name)
         if found is None:
             raise KeyError(f"{self.task}: no sensor {name!r} in the file; it has "
                            f"{[s[1] for s in self.frames.sensors]}")
-        kind, attrib, fixed = found
-        if kind == "subtreelinvel":
-            ids, m, total = fixed
-            v2 = (m[:, None] * self.sim.state.v[ids, :2]).sum(0) / total
-            out = np.zeros(3)
-            out[self.plane_axes[0]], out[self.plane_axes[1]] = v2
-            return out
-        if kind in ("velocimeter", "gyro"):
-            body, p = fixed
-            out = np.zeros(3)
-            if kind == "gyro":
-                # the site's frame turns about the plane's normal: the rate is the same in it
-                out[self.normal_axis] = self.ccw_sign * self.sim.state.v[self._rigid(body), 2]
-                return out
-            # the velocity in the site's frame: turned back by the body's angle in the plane
-            a0, a1 = self.plane_axes
-            v = self._velocity_at(body, p)
-            phi = self.angle(body)
-            c, s = math.cos(phi), math.sin(phi)
-            out[a0], out[a1] = c * v[a0] + s * v[a1], c * v[a1] - s * v[a0]
-            return out
-        if kind == "touch":
-            return self._touch(attrib["site"])
-        if kind in ("jointpos", "jointvel"):
-            values = self.qpos if kind == "jointpos" else self.qvel
-            return float(values[self.qindex(attrib["joint"])])
-        if kind == "framepos" and attrib.get("objtype") in ("site", "xbody", "body"):
-            obj = attrib["objname"]
-            return self.site_xpos(obj) if attrib["objtype"] == "site" else self.xpos(obj)
-        raise NotImplementedError(f"{self.task}: sensor {name!r} of type <{kind}> is not computed")
+        r = Readout(self)
+        scalar = found[0] in _SCALAR_SENSORS
+        for axis in [None] if scalar else range(3):
+            r.value(str(axis), r.sensor(name, axis))
+        values = self._evaluate(r)
+        return float(values[0]) if scalar else values
 
-    def _touch(self, site):
-        """Normal force [N] of the site body's contacts whose point lies in the site's sphere
-        or ellipsoid, over the last physics step (impulse / timestep). A ground contact's
-        point: on an arc, its lowest point; a contact of two shapes': the surface point on
-        the site's body where the step's contact acted."""
-        body, p, size = self.frames.site[site]
-        a0, a1 = self.plane_axes
-        centre = self.point(body, (p[a0], p[a1]))
-        sphere = self.frames.site_type[site] == "sphere"
-        radii = (size[0], size[0]) if sphere else (size[a0], size[a1])
-        b = self._rigid(body)
-        a, st, ws = self.sim_model.arrays, self.sim.state, self.sim.ws
-        phi = self.angle(body)
-        c, s = math.cos(st.q[b, 2]), math.sin(st.q[b, 2])
-        cr, sr = math.cos(phi), math.sin(phi)
-        total = 0.0
-        for k in np.flatnonzero(st.last_contact_impulse[:, 0] > 0.0):
-            if a.contact_kind[k] == CONTACT_PAIR:
-                side = [i for i in (0, 1) if ws.contact_bodies[k, i] == b]
-                if not side:
-                    continue
-                lx, ly = ws.contact_refpt[k, 2 * side[0]:2 * side[0] + 2]
-                drop = 0.0
-            elif a.contact_body[k] == b:
-                lx, ly = a.contact_local[k]
-                drop = a.contact_radius[k]
-            else:
-                continue
-            dx = st.q[b, 0] + c * lx - s * ly - centre[0]
-            dy = st.q[b, 1] + s * lx + c * ly - drop - centre[1]
-            # the offset in the site's frame (the body's at the file's pose)
-            u, w = cr * dx + sr * dy, -sr * dx + cr * dy
-            if (u / radii[0]) ** 2 + (w / radii[1]) ** 2 <= 1.0:
-                total += st.last_contact_impulse[k, 0] / self.timestep
-        return total
+    def _evaluate(self, r):
+        """The values of Readout r's table on the current state (one compiled call)."""
+        st, ws, a = self.sim.state, self.sim.ws, self.sim_model.arrays
+        out = np.zeros(r.n_obs + len(r.value_names))
+        read(st.q, st.v, self._q0, self.data.qpos, self.data.qvel, self._ctrl,
+             st.last_contact_impulse, a.contact_kind, a.contact_body, a.contact_local,
+             a.contact_radius, ws.contact_bodies, ws.contact_refpt, *r.tables(), out)
+        return out
 
     # the readings: observation and reward, one compiled call ------------------------------
     def _plan(self):

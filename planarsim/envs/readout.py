@@ -170,6 +170,11 @@ def read(q, v, q0, qpos, qvel, ctrl, impulse, kind, body, local, radius, bodies,
         out[j] = value
 
 
+# frame sensors read here: their objects, and the xmat column of each axis sensor
+_FRAMES = ("site", "geom", "xbody", "body")
+_AXES = {"framexaxis": 0, "frameyaxis": 1, "framezaxis": 2}
+
+
 class Readout:
     """The table of a task's readings, written by its domain's ``plan(env, readout)``:
     ``obs(name, *ops)`` appends an observation entry (its ops' values, in order),
@@ -286,19 +291,19 @@ class Readout:
                         y2=y2, const=-float(minus))
 
     # named places of the file
-    def site(self, name):
-        env = self.env
-        body, p, _ = env.frames.site[name]
-        if body is None and env.target is not None and name == "target":
-            p = env.target
+    def _place(self, table, name):
+        """(body, 3D position) of a site or geom of `table`; the world's 'target' where the
+        task moved it (env.set_target)."""
+        body, p, _ = table[name]
+        if body is None and self.env.target is not None and name == "target":
+            p = self.env.target
         return body, p
 
+    def site(self, name):
+        return self._place(self.env.frames.site, name)
+
     def geom(self, name):
-        env = self.env
-        body, p, _ = env.frames.geom[name]
-        if body is None and env.target is not None and name == "target":
-            p = env.target
-        return body, p
+        return self._place(self.env.frames.geom, name)
 
     def body_origin(self, name):
         return name, self.env.frames.body[name][1]
@@ -312,11 +317,19 @@ class Readout:
     def sensor_point(self, name):
         """The point a framepos sensor reads: (MJCF body or None, 3D position)."""
         kind, attrib, _ = self.env._sensors[name]
-        if kind != "framepos" or attrib.get("objtype") not in ("site", "xbody", "body"):
+        if kind != "framepos" or attrib.get("objtype") not in _FRAMES:
             raise NotImplementedError(f"{self.env.task}: sensor {name!r} is not the framepos "
-                                      f"of a site or body")
-        obj = attrib["objname"]
-        return self.site(obj) if attrib["objtype"] == "site" else self.body_origin(obj)
+                                      f"of a site, geom or body")
+        return self._frame_place(attrib)
+
+    def _frame_place(self, attrib):
+        """(MJCF body or None, 3D position) of a frame sensor's object."""
+        obj, kind = attrib["objname"], attrib["objtype"]
+        if kind == "site":
+            return self.site(obj)
+        if kind == "geom":
+            return self.geom(obj)
+        return self.body_origin(obj)
 
     def sensor(self, name, axis3=None, log1p=False):
         """An op reading the file's sensor `name` (axis3 for a 3D sensor), as env.sensor."""
@@ -327,6 +340,13 @@ class Readout:
             return make(attrib["joint"])
         if kind == "framepos":
             return self.point(axis3, self.sensor_point(name))
+        if kind in _AXES and attrib.get("objtype") in _FRAMES:
+            # a column of the object's xmat (sites and geoms turn with their body: the
+            # files' are unrotated in it)
+            body = self._frame_place(attrib)[0]
+            if body is None:
+                return self.const(1.0 if axis3 == _AXES[kind] else 0.0)
+            return self.xmat(body, axis3, _AXES[kind])
         if kind == "gyro":
             if axis3 != env.normal_axis:
                 return self.const(0.0)

@@ -277,6 +277,36 @@ def test_reward_and_observation_equal_dm_controls_from_the_same_state(task):
         assert np.any((rewards > 0.01) & (rewards < 0.99)), rewards
 
 
+@pytest.mark.parametrize("task", ["cheetah-run", "walker-walk", "hopper-hop", "swimmer-swimmer6",
+                                  "finger-turn_easy"])
+def test_sensors_equal_dm_controls_from_the_same_state(task):
+    """env.sensor(name) of every sensor of the file but touch (MuJoCo's soft contact force)
+    equals dm_control's physics.named.data.sensordata[name] to 1e-9 from perturbed states:
+    subtreelinvel, velocimeter, gyro, framepos, framexaxis, frameyaxis, jointpos, jointvel."""
+    rng = np.random.default_rng(7)
+    theirs = dm_load(task, 0)
+    theirs.reset()
+    env = dmc.DMCEnv(task)
+    env.reset(seed=0)
+    physics = theirs.physics
+    names = [(kind, name) for kind, name, _ in env.frames.sensors if kind != "touch"]
+    assert names
+    worst = 0.0
+    for qpos, qvel, _ in perturbed_states(task, theirs, 4, rng):
+        physics.data.qpos[:], physics.data.qvel[:] = qpos, qvel
+        physics.forward()
+        if env.target is not None:
+            env.set_target(*dm_target(physics, env))
+        env.set_state(qpos, qvel)
+        for kind, name in names:
+            ours = np.atleast_1d(env.sensor(name))
+            ref = np.asarray(physics.named.data.sensordata[name])
+            assert ours.shape == ref.shape, (name, ours.shape, ref.shape)
+            worst = max(worst, float(np.abs(ours - ref).max()))
+    print(f"{task}: sensors {sorted({k for k, _ in names})} max |diff| {worst:.3g}")
+    assert worst <= TOL, worst
+
+
 def test_point_mass_episode_is_dm_controls_until_a_slide_reaches_its_limit():
     """point_mass-easy has no contacts and moves linearly (a damped mass under constant
     forces): planarsim's step is MuJoCo's Euler step, so an episode away from the slides'
