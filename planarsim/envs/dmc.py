@@ -122,7 +122,9 @@ class FileFrames:
     """Frames of an MJCF file at its own pose (qpos0), for files whose bodies and sites carry
     positions only: each body's origin and parent, each site's and named geom's body,
     position and size (class defaults and childclass applied to sizes), the sensors in order
-    (type, name, attributes). Positions are 3D world coordinates [m]."""
+    (type, name, attributes). Positions are 3D world coordinates [m]. A site or geom may be
+    rotated in its body (`rotated` names those): its position is read, but a reading of its
+    orientation is refused (Readout.sensor)."""
 
     def __init__(self, text: str, source: str):
         root = parse_xml(text, source)
@@ -130,6 +132,7 @@ class FileFrames:
         self.body = collections.OrderedDict()       # name -> (parent name or None, pos)
         self.site, self.geom = {}, {}               # name -> (body or None, pos, size)
         self.site_type = {}                         # site name -> "sphere", "ellipsoid", ...
+        self.rotated = set()                        # names of sites and geoms rotated in their body
         self.sensors = []                           # (type, name, attrib)
         self._defaults = {}
         for node in root.children:
@@ -177,6 +180,8 @@ class FileFrames:
                 size = _vec(self._attr(ch, cls, "size", "0.005" if ch.tag == "site" else "0"))
                 table = self.site if ch.tag == "site" else self.geom
                 table[ch.attrib["name"]] = (body, pos + local, size)
+                if any(self._attr(ch, cls, k, None) is not None for k in _ROTATIONS):
+                    self.rotated.add(ch.attrib["name"])
                 if ch.tag == "site":
                     self.site_type[ch.attrib["name"]] = self._attr(ch, cls, "type", "sphere")
 

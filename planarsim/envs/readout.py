@@ -173,6 +173,9 @@ def read(q, v, q0, qpos, qvel, ctrl, impulse, kind, body, local, radius, bodies,
 # frame sensors read here: their objects, and the xmat column of each axis sensor
 _FRAMES = ("site", "geom", "xbody", "body")
 _AXES = {"framexaxis": 0, "frameyaxis": 1, "framezaxis": 2}
+# sensors whose reading turns with their site's or geom's frame (its axes, or a velocity or
+# size in it)
+_TURNED = set(_AXES) | {"velocimeter", "gyro", "touch", "accelerometer", "framequat"}
 
 
 class Readout:
@@ -335,6 +338,13 @@ class Readout:
         """An op reading the file's sensor `name` (axis3 for a 3D sensor), as env.sensor."""
         env = self.env
         kind, attrib, fixed = env._sensors[name]
+        turned = attrib.get("site") or (attrib.get("objname")
+                                        if attrib.get("objtype") in ("site", "geom") else None)
+        if turned in env.frames.rotated and kind in _TURNED:
+            raise NotImplementedError(
+                f"{env.frames.source}: sensor {name!r} (<{kind}>) reads the frame of "
+                f"{turned!r}, which is rotated in its body; planarsim's dm_control tasks read "
+                f"the orientation of unrotated sites and geoms only")
         if kind in ("jointpos", "jointvel"):
             make = self.qpos if kind == "jointpos" else self.qvel
             return make(attrib["joint"])

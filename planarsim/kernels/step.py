@@ -295,9 +295,10 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
     (a pour of 50 shapes) finds its modes in linear solves, where the complementarity solve
     over its island took thousands of pivots. The rounds end early where they stall (the
     least-index rule) on a solve that dropped dependent rows: the rule's end is promised
-    for a P-matrix only. Where no round's answer keeps every rule, the modes are put back
-    as they were (the complementarity solve starts from them). Returns (an answer stands,
-    solves)."""
+    for a P-matrix only. Where no round's answer keeps every rule, the contacts' modes are
+    put back as they were (the complementarity solve starts from them); a limit the rounds
+    released stays released, and the complementarity solve engages it again where its
+    answer pushes through it. Returns (an answer stands, solves)."""
     keep_modes(s, ws)
     solves = 0
     breaks = 1

@@ -449,3 +449,29 @@ def test_finger_touch_reads_the_fingertips_push_on_the_spinner():
     for _ in range(20):
         obs = env.step(np.array([0.0, -press]))[0]
     assert np.array_equal(obs[7:9], [0.0, 0.0])
+
+
+def test_a_sensor_on_a_rotated_site_is_refused_by_name(tmp_path):
+    """A touch (or velocimeter, gyro, frame axis) sensor reads its site's frame; planarsim's
+    readings take a site's frame to be its body's, so a site rotated in its body is refused,
+    naming the file, the sensor and the site, rather than read wrongly (a velocimeter on a
+    site with euler="0 30 0" read 3 m/s off before)."""
+    import pathlib
+    import shutil
+
+    import dm_control
+    suite = tmp_path / "suite"
+    shutil.copytree(pathlib.Path(dm_control.__file__).parent / "suite", suite)
+    hopper = suite / "hopper.xml"
+    text = hopper.read_text()
+    assert '<site name="touch_toe" pos=".17 0 0"/>' in text
+    hopper.write_text(text.replace('<site name="touch_toe" pos=".17 0 0"/>',
+                                   '<site name="touch_toe" pos=".17 0 0" euler="0 30 0"/>'))
+    with pytest.raises(NotImplementedError, match=r"hopper\.xml.*'touch_toe'.*rotated"):
+        env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
+        env.reset(seed=0)
+    # the same file unrotated loads and reads its touch sensors
+    hopper.write_text(text)
+    env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
+    env.reset(seed=0)
+    assert np.all(np.isfinite(env.sensor("touch_toe")))
