@@ -5,7 +5,8 @@ INFO_CCD_SPLITS = 1        # time-of-impact splits of the step
 INFO_GUARD_BODY = 2        # the guard's body (GUARD_NONFINITE, GUARD_TOO_LARGE)
 INFO_GUARD_FIELD = 3       # the guard's field 0..5 of that body: x y theta vx vy omega
 INFO_LCP_SOLVES = 4        # complementarity (Lemke) solves of the velocity stage
-INFO_NEWTON_TAKEN_BACK = 5  # Newton steps of the position correction taken back (diverged)
+INFO_NEWTON_TAKEN_BACK = 5  # passes of the position correction taken back (a Newton step
+                            # that diverged, a chord step that did not halve the error)
 INFO_LCP_PIVOTS = 6        # Lemke pivots, velocity stage and projections
 INFO_PROJECTIONS = 7       # complementarity projections of the positions
 INFO_COMMAND = 8           # the command the guard names: index of a NaN / inf one
@@ -21,15 +22,18 @@ INFO_KEPT_FACTORS = 12     # velocity solves on the factors kept from an earlier
                            # (solve.refine_on_kept_factors: a pile at rest)
 INFO_SHAKE_WHOLE = 13     # position corrections kept whole as SHAKE's, within its regime
                            # (integrate.bound_correction_work: RATTLE, or joints alone)
-N_INFO = 14
+INFO_SWITCH_ROUNDS = 14    # rounds of the mode switching (step.switch_rounds) the velocity
+                           # stage took
+N_INFO = 15
 
 INFO_NAMES = ("solves", "ccd_splits", "guard_body", "guard_field", "lcp_solves",
               "newton_taken_back", "lcp_pivots", "projections", "command", "ccd_stops",
-              "turn_substeps", "chain_path", "kept_factors", "shake_whole")
+              "turn_substeps", "chain_path", "kept_factors", "shake_whole",
+              "switch_rounds")
 # counted afresh by every step (the guard slots keep the last failure)
 STEP_COUNTS = (INFO_SOLVES, INFO_CCD_SPLITS, INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK,
                INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS, INFO_KEPT_FACTORS,
-               INFO_SHAKE_WHOLE)
+               INFO_SHAKE_WHOLE, INFO_SWITCH_ROUNDS)
 
 
 def step_info(ws) -> dict:

@@ -30,7 +30,8 @@ from .checks.guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, 
                             check_speeds, add_part_path, finish_path, keep_step_path,
                             end_checks_alone, note_start_depths, note_start_limits,
                             start_path)
-from .info import INFO_CHAIN_PATH, INFO_SOLVES, INFO_TURN_SUBSTEPS, STEP_COUNTS
+from .info import (INFO_CHAIN_PATH, INFO_SOLVES, INFO_SWITCH_ROUNDS, INFO_TURN_SUBSTEPS,
+                   STEP_COUNTS)
 from .dynamics.integrate import (bound_correction_work, commit_moved_impulses, integrate_positions,
                                  predict_configuration)
 from .constraints.joint_friction import start_joint_friction, stick_all, switch_joint_friction
@@ -317,6 +318,7 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
         key = modes_key(s, ws, min(stall, SWITCH_STALL), fewest)
         if r > 0 and key == marked:
             break
+        ws.info[INFO_SWITCH_ROUNDS] += 1
         since += 1
         if since == span:
             marked = key

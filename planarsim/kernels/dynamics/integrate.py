@@ -48,6 +48,10 @@ DIVERGED_GROWTH = 10.0
 # Newton converges quadratically: a step that leaves more than this share of the largest
 # error has stalled
 STALLED_RATIO = 0.5
+# [m or rad] every row within this after a correction pass: the next pass reuses that pass's
+# factorisation (a chord step: the rows moved by less than this since it was assembled, so
+# the pass still removes all but a share of that order of the error, as a Newton pass would)
+CHORD_TOL = 1e-9
 
 
 # [rad or m] a limit held within this at a step's start stays in the Newton correction
@@ -563,7 +567,9 @@ def commit_moved_impulses(s, ws):
 
 @kernel(inline="always")
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
-    """Newton-SHAKE; returns the final max residual [m or rad]. envelope_ready: the rows are
+    """Newton-SHAKE; returns the final max residual [m or rad]. A pass after one that left
+    every row within CHORD_TOL reuses that pass's factors (a chord pass; one that does not
+    halve the error is taken back and taken again on a fresh matrix). envelope_ready: the rows are
     those of the velocity solve's envelope (ws.row_first / row_reach): none was dropped since
     and no complementarity solve changed them."""
     if ws.n_row[0] == 0:
@@ -585,6 +591,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     worst = max_residual(m, s, ws) if dropped > 0 else targets_of(ws, n)
     ptol = pivot_tol
     newton = 0        # corrections taken while Newton converged (0: none, or it did not)
+    fresh = True      # the next pass assembles and factors its matrix (else: a chord pass)
     for _ in range(iters):
         if worst <= tol:
             break
@@ -597,15 +604,32 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
                 ws.q_keep[i, k] = s.q[i, k]
                 ws.v_keep[i, k] = s.v[i, k]
         still = keep_targets(ws, n)
-        normals_now(m, ws, n)
-        assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
-        correction_compliance(ws, n)
-        factor_ws(ws, n, ptol, False)
+        chord = not fresh
+        if fresh:
+            normals_now(m, ws, n)
+            assemble(m, ws, ws.row_Jp, ws.row_J, n, False)
+            correction_compliance(ws, n)
+            factor_ws(ws, n, ptol, False)
         move_by_correction(m, s, ws, h, n, still)
         after = max_residual(m, s, ws)
         if after <= STALLED_RATIO * worst:
             worst = after
             newton += 1
+            # every row within CHORD_TOL: the next pass (and the last, below) reuses these
+            # factors, as the pin-chain path does (a walker's second factorisation a step)
+            fresh = after > CHORD_TOL
+            continue
+        if chord:
+            # a chord pass that did not halve the error: taken back, and the pass taken
+            # again on a fresh matrix
+            for i in range(s.q.shape[0]):
+                for k in range(3):
+                    s.q[i, k] = ws.q_keep[i, k]
+                    s.v[i, k] = ws.v_keep[i, k]
+            record_moved_impulses(ws, n, -velocity_share(h, still))
+            worst = max_residual(m, s, ws)
+            ws.info[INFO_NEWTON_TAKEN_BACK] += 1
+            fresh = True
             continue
         newton = 0
         if after <= DIVERGED_GROWTH * worst:

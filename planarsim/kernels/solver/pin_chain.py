@@ -30,12 +30,10 @@ State alone.
 import math
 
 from ...compile import kernel
-from ..dynamics.integrate import STALLED_RATIO, clear_moved_impulses
+from ..dynamics.integrate import CHORD_TOL, STALLED_RATIO, clear_moved_impulses
 from ..math2d import rotate, update_trig
 from ..checks.work import VELOCITY_FLOOR, WORK_REL_TOL, fastest
 
-# [m] every row within this after a correction pass: the next reuses the factorisation
-CHORD_TOL = 1e-9
 # [rad] a body's (cos, sin) is carried through a turn of at most this by turn_by (the series'
 # first left-out terms, d^9 / 9! and d^10 / 10!, are at most 1.4e-21; each carry's rounding,
 # about an ulp, is what remains); beyond, computed afresh
