@@ -22,7 +22,6 @@ from pathlib import Path
 
 ANIMATION_EXTS = (".gif", ".mp4", ".html")
 PLOT_EXTS = (".png", ".svg", ".pdf")
-from walkers.base import MAX_DT   # [s] the largest --dt (see there)
 
 
 class UsageError(Exception):
@@ -93,7 +92,10 @@ def _check_out(path, exts, what):
 
 
 def _check_dt(dt):
-    """UsageError naming --dt when it is above MAX_DT (None: the walker's own)."""
+    """UsageError naming --dt when it is above walkers.base.MAX_DT [s] (None: the walker's
+    own). (Imported here: at the module's top it brought numpy in before main could catch
+    an interrupt.)"""
+    from walkers.base import MAX_DT
     if dt is not None and dt > MAX_DT:
         raise UsageError(f"--dt {dt:g} s is too large; use a step of at most {MAX_DT:g} s (1e-3 "
                          "is usual): the walkers are tuned at 1e-3 s, and at 0.02 s some "
