@@ -132,7 +132,7 @@ class FileFrames:
         self.body = collections.OrderedDict()       # name -> (parent name or None, pos)
         self.site, self.geom = {}, {}               # name -> (body or None, pos, size)
         self.site_type = {}                         # site name -> "sphere", "ellipsoid", ...
-        self.rotated = set()                        # names of sites and geoms rotated in their body
+        self.rotated = set()                        # ("site" or "geom", name) rotated in its body
         self.sensors = []                           # (type, name, attrib)
         self._defaults = {}
         for node in root.children:
@@ -180,8 +180,10 @@ class FileFrames:
                 size = _vec(self._attr(ch, cls, "size", "0.005" if ch.tag == "site" else "0"))
                 table = self.site if ch.tag == "site" else self.geom
                 table[ch.attrib["name"]] = (body, pos + local, size)
-                if any(self._attr(ch, cls, k, None) is not None for k in _ROTATIONS):
-                    self.rotated.add(ch.attrib["name"])
+                # (a fromto turns the frame to its axis as a rotation does)
+                if any(self._attr(ch, cls, k, None) is not None
+                       for k in _ROTATIONS + ("fromto",)):
+                    self.rotated.add((ch.tag, ch.attrib["name"]))
                 if ch.tag == "site":
                     self.site_type[ch.attrib["name"]] = self._attr(ch, cls, "type", "sphere")
 

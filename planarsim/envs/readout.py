@@ -338,12 +338,16 @@ class Readout:
         """An op reading the file's sensor `name` (axis3 for a 3D sensor), as env.sensor."""
         env = self.env
         kind, attrib, fixed = env._sensors[name]
-        turned = attrib.get("site") or (attrib.get("objname")
-                                        if attrib.get("objtype") in ("site", "geom") else None)
-        if turned in env.frames.rotated and kind in _TURNED:
+        if "site" in attrib:
+            turned = ("site", attrib["site"])
+        else:
+            turned = (attrib.get("objtype"), attrib.get("objname"))
+        # (a touch on a sphere reads the same at any rotation)
+        sphere_touch = kind == "touch" and env.frames.site_type.get(turned[1]) == "sphere"
+        if turned in env.frames.rotated and kind in _TURNED and not sphere_touch:
             raise NotImplementedError(
                 f"{env.frames.source}: sensor {name!r} (<{kind}>) reads the frame of "
-                f"{turned!r}, which is rotated in its body; planarsim's dm_control tasks read "
+                f"{turned[0]} {turned[1]!r}, which is rotated in its body (or set by fromto); planarsim's dm_control tasks read "
                 f"the orientation of unrotated sites and geoms only")
         if kind in ("jointpos", "jointvel"):
             make = self.qpos if kind == "jointpos" else self.qvel

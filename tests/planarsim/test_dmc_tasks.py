@@ -465,12 +465,25 @@ def test_a_sensor_on_a_rotated_site_is_refused_by_name(tmp_path):
     hopper = suite / "hopper.xml"
     text = hopper.read_text()
     assert '<site name="touch_toe" pos=".17 0 0"/>' in text
+    # (an ellipsoid: a touch on a sphere reads the same at any rotation and is read)
     hopper.write_text(text.replace('<site name="touch_toe" pos=".17 0 0"/>',
-                                   '<site name="touch_toe" pos=".17 0 0" euler="0 30 0"/>'))
-    with pytest.raises(NotImplementedError, match=r"hopper\.xml.*'touch_toe'.*rotated"):
+                                   '<site name="touch_toe" pos=".17 0 0" euler="0 30 0" '
+                                   'type="ellipsoid" size=".05 .03 .03"/>'))
+    with pytest.raises(NotImplementedError, match=r"hopper\.xml.*site 'touch_toe'.*rotated"):
         env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
         env.reset(seed=0)
-    # the same file unrotated loads and reads its touch sensors
+    # a geom set by fromto is turned to its axis: its frame axes are refused too
+    hopper.write_text(text.replace('<touch name="touch_toe" site="touch_toe"/>',
+                                   '<touch name="touch_toe" site="touch_toe"/>\n    '
+                                   '<framexaxis name="foot_x" objtype="geom" objname="foot"/>'))
+    with pytest.raises(NotImplementedError, match=r"'foot_x'.*geom 'foot'.*fromto"):
+        env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
+        env.reset(seed=0)
+        env.sensor("foot_x")
+    # a rotated sphere reads as an unrotated one; the file as shipped loads and reads
+    hopper.write_text(text.replace('<site name="touch_toe" pos=".17 0 0"/>',
+                                   '<site name="touch_toe" pos=".17 0 0" euler="0 30 0"/>'))
+    dmc.DMCEnv("hopper-hop", suite_dir=str(suite)).reset(seed=0)
     hopper.write_text(text)
     env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
     env.reset(seed=0)
