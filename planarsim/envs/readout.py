@@ -338,6 +338,11 @@ class Readout:
         """An op reading the file's sensor `name` (axis3 for a 3D sensor), as env.sensor."""
         env = self.env
         kind, attrib, fixed = env._sensors[name]
+        if "reftype" in attrib or "refname" in attrib:
+            raise NotImplementedError(
+                f"{env.frames.source}: sensor {name!r} (<{kind}>) is read relative to "
+                f"{attrib.get('reftype', '?')} {attrib.get('refname', '?')!r}; planarsim's "
+                f"dm_control tasks read frame sensors in the world frame only")
         if "site" in attrib:
             turned = ("site", attrib["site"])
         else:

@@ -480,6 +480,15 @@ def test_a_sensor_on_a_rotated_site_is_refused_by_name(tmp_path):
         env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
         env.reset(seed=0)
         env.sensor("foot_x")
+    # a frame read relative to another object is refused too (it was read in the world's)
+    hopper.write_text(text.replace('<touch name="touch_toe" site="touch_toe"/>',
+                                   '<touch name="touch_toe" site="touch_toe"/>\n    '
+                                   '<framepos name="toe_rel" objtype="site" objname="touch_toe" '
+                                   'reftype="body" refname="torso"/>'))
+    with pytest.raises(NotImplementedError, match=r"'toe_rel'.*relative to body 'torso'"):
+        env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
+        env.reset(seed=0)
+        env.sensor("toe_rel")
     # a rotated sphere reads as an unrotated one; the file as shipped loads and reads
     hopper.write_text(text.replace('<site name="touch_toe" pos=".17 0 0"/>',
                                    '<site name="touch_toe" pos=".17 0 0" euler="0 30 0"/>'))
