@@ -451,11 +451,29 @@ def test_finger_touch_reads_the_fingertips_push_on_the_spinner():
     assert np.array_equal(obs[7:9], [0.0, 0.0])
 
 
+# hopper.xml's toe site and touch sensor, and the file changed at one of them
+TOE_SITE = '<site name="touch_toe" pos=".17 0 0"/>'
+TOE_TOUCH = '<touch name="touch_toe" site="touch_toe"/>'
+CHANGED_HOPPER = {
+    # (an ellipsoid: a touch on a sphere reads the same at any rotation and is read)
+    "ellipsoid": (TOE_SITE, '<site name="touch_toe" pos=".17 0 0" euler="0 30 0" '
+                            'type="ellipsoid" size=".05 .03 .03"/>'),
+    "sphere": (TOE_SITE, '<site name="touch_toe" pos=".17 0 0" euler="0 30 0"/>'),
+    # a geom set by fromto is turned to its axis
+    "fromto": (TOE_TOUCH, TOE_TOUCH + '\n    <framexaxis name="foot_x" objtype="geom" '
+                                      'objname="foot"/>'),
+    # a frame read relative to another object (it was read in the world's)
+    "relative": (TOE_TOUCH, TOE_TOUCH + '\n    <framepos name="toe_rel" objtype="site" '
+                                        'objname="touch_toe" reftype="body" refname="torso"/>'),
+}
+
+
 def test_a_sensor_on_a_rotated_site_is_refused_by_name(tmp_path):
     """A touch (or velocimeter, gyro, frame axis) sensor reads its site's frame; planarsim's
-    readings take a site's frame to be its body's, so a site rotated in its body is refused,
-    naming the file, the sensor and the site, rather than read wrongly (a velocimeter on a
-    site with euler="0 30 0" read 3 m/s off before)."""
+    readings take a site's frame to be its body's, so a site rotated in its body (or set by
+    fromto) is refused, naming the file, the sensor and the site, rather than read wrongly
+    (a velocimeter on a site with euler="0 30 0" read 3 m/s off before); so is a frame read
+    relative to another object."""
     import pathlib
     import shutil
 
@@ -464,36 +482,22 @@ def test_a_sensor_on_a_rotated_site_is_refused_by_name(tmp_path):
     shutil.copytree(pathlib.Path(dm_control.__file__).parent / "suite", suite)
     hopper = suite / "hopper.xml"
     text = hopper.read_text()
-    assert '<site name="touch_toe" pos=".17 0 0"/>' in text
-    # (an ellipsoid: a touch on a sphere reads the same at any rotation and is read)
-    hopper.write_text(text.replace('<site name="touch_toe" pos=".17 0 0"/>',
-                                   '<site name="touch_toe" pos=".17 0 0" euler="0 30 0" '
-                                   'type="ellipsoid" size=".05 .03 .03"/>'))
-    with pytest.raises(NotImplementedError, match=r"hopper\.xml.*site 'touch_toe'.*rotated"):
+
+    def read(change, sensor):
+        if change is not None:
+            old, new = CHANGED_HOPPER[change]
+            assert old in text
+        hopper.write_text(text if change is None else text.replace(old, new))
         env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
         env.reset(seed=0)
-    # a geom set by fromto is turned to its axis: its frame axes are refused too
-    hopper.write_text(text.replace('<touch name="touch_toe" site="touch_toe"/>',
-                                   '<touch name="touch_toe" site="touch_toe"/>\n    '
-                                   '<framexaxis name="foot_x" objtype="geom" objname="foot"/>'))
-    with pytest.raises(NotImplementedError, match=r"'foot_x'.*geom 'foot'.*fromto"):
-        env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
-        env.reset(seed=0)
-        env.sensor("foot_x")
-    # a frame read relative to another object is refused too (it was read in the world's)
-    hopper.write_text(text.replace('<touch name="touch_toe" site="touch_toe"/>',
-                                   '<touch name="touch_toe" site="touch_toe"/>\n    '
-                                   '<framepos name="toe_rel" objtype="site" objname="touch_toe" '
-                                   'reftype="body" refname="torso"/>'))
-    with pytest.raises(NotImplementedError, match=r"'toe_rel'.*relative to body 'torso'"):
-        env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
-        env.reset(seed=0)
-        env.sensor("toe_rel")
-    # a rotated sphere reads as an unrotated one; the file as shipped loads and reads
-    hopper.write_text(text.replace('<site name="touch_toe" pos=".17 0 0"/>',
-                                   '<site name="touch_toe" pos=".17 0 0" euler="0 30 0"/>'))
-    dmc.DMCEnv("hopper-hop", suite_dir=str(suite)).reset(seed=0)
-    hopper.write_text(text)
-    env = dmc.DMCEnv("hopper-hop", suite_dir=str(suite))
-    env.reset(seed=0)
-    assert np.all(np.isfinite(env.sensor("touch_toe")))
+        return env.sensor(sensor)
+
+    for change, sensor, refusal in (
+            ("ellipsoid", "touch_toe", r"hopper\.xml.*site 'touch_toe'.*rotated"),
+            ("fromto", "foot_x", r"'foot_x'.*geom 'foot'.*fromto"),
+            ("relative", "toe_rel", r"'toe_rel'.*relative to body 'torso'")):
+        with pytest.raises(NotImplementedError, match=refusal):
+            read(change, sensor)
+    # a rotated sphere reads as an unrotated one, which reads as the file as shipped
+    assert np.all(np.isfinite(read(None, "touch_toe")))
+    assert np.array_equal(read("sphere", "touch_toe"), read(None, "touch_toe"))
