@@ -352,8 +352,9 @@ class Readout:
         if turned in env.frames.rotated and kind in _TURNED and not sphere_touch:
             raise NotImplementedError(
                 f"{env.frames.source}: sensor {name!r} (<{kind}>) reads the frame of "
-                f"{turned[0]} {turned[1]!r}, which is rotated in its body (or set by fromto); planarsim's dm_control tasks read "
-                f"the orientation of unrotated sites and geoms only")
+                f"{turned[0]} {turned[1]!r}, which is rotated in its body (or set by "
+                f"fromto); planarsim's dm_control tasks read the orientation of unrotated "
+                f"sites and geoms only")
         if kind in ("jointpos", "jointvel"):
             make = self.qpos if kind == "jointpos" else self.qvel
             return make(attrib["joint"])

@@ -566,6 +566,20 @@ def commit_moved_impulses(s, ws):
 
 
 @kernel(inline="always")
+def take_back_pass(m, s, ws, h, n, still):
+    """A correction pass taken back: q and v as before it (ws.q_keep, ws.v_keep), its
+    impulses (ws.lam: its own) off the step's, counted in ws.info; returns the largest
+    |c| there (ws.rhs: its targets again)."""
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            s.q[i, k] = ws.q_keep[i, k]
+            s.v[i, k] = ws.v_keep[i, k]
+    record_moved_impulses(ws, n, -velocity_share(h, still))
+    ws.info[INFO_NEWTON_TAKEN_BACK] += 1
+    return max_residual(m, s, ws)
+
+
+@kernel(inline="always")
 def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     """Newton-SHAKE; returns the final max residual [m or rad]. A pass after one that left
     every row within CHORD_TOL reuses that pass's factors (a chord pass; one that does not
@@ -622,13 +636,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         if chord:
             # a chord pass that did not halve the error: taken back, and the pass taken
             # again on a fresh matrix
-            for i in range(s.q.shape[0]):
-                for k in range(3):
-                    s.q[i, k] = ws.q_keep[i, k]
-                    s.v[i, k] = ws.v_keep[i, k]
-            record_moved_impulses(ws, n, -velocity_share(h, still))
-            worst = max_residual(m, s, ws)
-            ws.info[INFO_NEWTON_TAKEN_BACK] += 1
+            worst = take_back_pass(m, s, ws, h, n, still)
             fresh = True
             continue
         newton = 0
@@ -642,13 +650,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         # dead point) whose errors disagree give a huge step. Take it back and try once
         # more with such rows dropped; if that fails too, keep the configuration before it
         # (the next step's solve sees the rest as c / h).
-        for i in range(s.q.shape[0]):
-            for k in range(3):
-                s.q[i, k] = ws.q_keep[i, k]
-                s.v[i, k] = ws.v_keep[i, k]
-        record_moved_impulses(ws, n, -velocity_share(h, still))    # (ws.lam: its own)
-        worst = max_residual(m, s, ws)
-        ws.info[INFO_NEWTON_TAKEN_BACK] += 1
+        worst = take_back_pass(m, s, ws, h, n, still)
         if ptol >= LOOSE_PIVOT_TOL:
             break
         ptol = LOOSE_PIVOT_TOL
