@@ -15,7 +15,7 @@ from .capacity import workspace_capacity, workspace_contacts  # noqa: F401  (pub
 from .errors import WorkspaceTooLarge
 from .kernels.checks.audit import N_AUDIT
 from .kernels.info import N_INFO
-from .kernels.codes import CONTACT_PAIR, SPARSE_MAX_DEPTH
+from .kernels.codes import CONTACT_PAIR, DENSE_MAX_ROWS, SPARSE_MAX_DEPTH
 from .model import Model
 from .pin_chains import joints_form_no_loop, pin_chain_order
 
@@ -326,9 +326,11 @@ class Workspace(NamedTuple):
     A_up: np.ndarray             # (P,) its upper triangle the same way: entry (j, i), j < i,
                                  #   at row_start[i] + j - row_first[i] (column i)
     row_start: np.ndarray        # (R + 1,) int where each row's envelope begins in A_low / A_up
+    A_dense: np.ndarray          # (D, D) the same matrix as a dense square where the rows are
+                                 #   few (D = min(R, DENSE_MAX_ROWS); kernels/solver/dense.py)
     factor_kind: np.ndarray      # (1,) int which factorisation holds the rows (kernels/solver/matrix.py:
-                                 #   0 the envelope, 1 sparse; then A_low / A_up hold the
-                                 #   factors' columns L and U, at L_index's rows)
+                                 #   0 the envelope, 1 sparse, 2 dense; sparse: A_low / A_up hold
+                                 #   the factors' columns L and U, at L_index's rows; dense: A_dense)
     L_index: np.ndarray          # (P,) int the sparse factors' row of each entry
     sp_perm: np.ndarray          # (R,) int sparse order: place -> row (kernels/solver/sparse_factor.py)
     sp_iperm: np.ndarray         # (R,) int row -> place
@@ -696,12 +698,13 @@ def _solve_shapes(model: Model, contacts: int, profile: int, lcp_rows: int) -> d
     the dense complementarity storage's island rows C (`lcp_rows`; L = 2 C variables)."""
     R, P, C = max_rows(model, contacts), max(1, profile), max(1, lcp_rows)
     L = 2 * C
+    D = min(R, DENSE_MAX_ROWS)
     f, i = np.float64, np.int64
     return dict(row_first=((R,), i), row_reach=((R,), i), row_list=((R,), i),
                 row_body=((R, 2), i), row_J=((R, 2, 3), f), row_F=((R, 2, 3), f),
                 row_Jp=((R, 2, 3), f), row_c=((R,), f), row_c_pred=((R,), f),
                 row_kind=((R,), i), row_owner=((R,), i), A_low=((P,), f), A_up=((P,), f),
-                row_start=((R + 1,), i), L_index=((P,), i), sp_perm=((R,), i),
+                row_start=((R + 1,), i), A_dense=((D, D), f), L_index=((P,), i), sp_perm=((R,), i),
                 sp_iperm=((R,), i), sp_row_key=((R,), i), sp_parent=((R,), i),
                 sp_flag=((R,), i), sp_pattern=((R,), i), sp_lcount=((R,), i),
                 sp_lstart=((R + 1,), i), sp_pivot=((R,), f), sp_diag=((R,), f),

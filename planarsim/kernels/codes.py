@@ -44,3 +44,6 @@ INTEGRATOR_NAMES = ("euler", "rattle", "rattle4", "rattle6")
 # nesting depth of the sparse factorisation's parts (kernels/solver/sparse_factor.py; the workspace's
 # counting sort holds this many keys per body): parts deeper than this share a place
 SPARSE_MAX_DEPTH = 40
+# systems of at most this many rows may be eliminated in a dense square (kernels/solver/dense.py,
+# matrix.arrange), whose storage (Workspace.A_dense) is this squared at most
+DENSE_MAX_ROWS = 48

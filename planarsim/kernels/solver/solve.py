@@ -11,8 +11,9 @@ its gap over the step at the start's velocity, c(q + h v0) - c - h J v0 (held_co
 follows a curved ground, or a sole's rolling, to second order as a pin follows its anchor.
 The matrix is assembled and eliminated only where it has entries (matrix.py): inside its
 envelope for chains and trees (rows touch at most two bodies, so a chain's matrix is banded:
-the cost grows linearly with the number of links), in a nested-dissection order for the
-many rows of piles and walls.
+the cost grows linearly with the number of links), in a dense square for a walker's few
+rows that fill most of their envelope (the same factors, vectorised loops), in a
+nested-dissection order for the many rows of piles and walls.
 Closed loops (Ranger in double stance, a box on two corners) make J W F^T singular: Gaussian
 elimination drops a row whose pivot falls below pivot_tol times its own diagonal, i.e. a row
 that is a combination of earlier ones; its impulse is zero and the rows it depends on carry

@@ -1,0 +1,137 @@
+"""The elimination of small systems in a dense square: L U (L D L^T where symmetric) of
+J W F^T in ws.A_dense, row by row.
+
+A walker's or a cheetah's rows (18 to 30: its pins, rotors, limits and contacts) fill most of
+their envelope (envelope.py): a foot's contact rows share bodies with the leg's pins, and the
+envelope's bookkeeping (an index per entry, a list of rows per column) then costs more than
+the arithmetic it saves. Here the same elimination runs over the whole square, whose rows are
+contiguous: its inner loops are runs of one multiply and subtract the compiler vectorises.
+
+Every entry sees the same operations in the same order as in envelope.py (the eliminations
+run over columns in ascending order, each entry's updates in that order, the substitutions'
+sums in the same order): entries outside the envelope are zero at the start and stay zero
+(rows touch at most two bodies, so the envelope holds every fill), and subtracting a product
+with a zero factor leaves an entry as it was. The factors and the solutions are therefore the
+envelope's to the last bit; only the time differs (matrix.py chooses).
+"""
+from ...compile import kernel
+from .envelope import _entry, is_dependent
+
+
+@kernel
+def assemble_dense(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetric):
+    """A[:n, :n] = JL W JR^T: the entries inside the rows' envelope (first: envelope.py),
+    zero elsewhere; symmetric (JL = JR): the lower triangle and diagonal only (all that
+    factor_dense_symmetric reads)."""
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = 0.0
+    for i in range(n):
+        for j in range(first[i], i + 1):
+            A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
+            if j != i and not symmetric:
+                A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
+
+
+@kernel
+def factor_dense(A, n, tol, scale):
+    """LU factorisation of A[:n, :n] in place without pivoting: U on and above the diagonal,
+    the multipliers L below it. A row whose pivot falls below tol times its own diagonal
+    (scale: the diagonal before elimination, written here) depends on earlier rows: it is
+    dropped (zero pivot, zero multipliers and zero U row). Returns #dropped."""
+    dropped = 0
+    for k in range(n):
+        scale[k] = abs(A[k, k])
+    for k in range(n):
+        piv = A[k, k]
+        if is_dependent(piv, scale[k], tol):
+            dropped += 1
+            for i in range(k + 1, n):
+                A[i, k] = 0.0
+                A[k, i] = 0.0
+            A[k, k] = 0.0
+            continue
+        inv = 1.0 / piv
+        for i in range(k + 1, n):
+            fct = A[i, k] * inv
+            A[i, k] = fct
+            if fct == 0.0:
+                continue
+            for j in range(k + 1, n):
+                A[i, j] -= fct * A[k, j]
+    return dropped
+
+
+@kernel
+def factor_dense_symmetric(A, n, tol, scale, column):
+    """As factor_dense for a symmetric A, in half the work: A = L D L^T with the multipliers
+    L below the diagonal and D on it; the upper triangle is neither read nor written.
+    column (n,) is scratch (column k before its division by the pivot). Returns #dropped."""
+    dropped = 0
+    for k in range(n):
+        scale[k] = abs(A[k, k])
+    for k in range(n):
+        piv = A[k, k]
+        if is_dependent(piv, scale[k], tol):
+            dropped += 1
+            for i in range(k + 1, n):
+                A[i, k] = 0.0
+            A[k, k] = 0.0
+            continue
+        inv = 1.0 / piv
+        for j in range(k + 1, n):
+            column[j] = A[j, k]
+        for i in range(k + 1, n):
+            a_ik = column[i]
+            if a_ik == 0.0:
+                continue
+            fct = a_ik * inv
+            for j in range(k + 1, i + 1):
+                A[i, j] -= fct * column[j]
+            A[i, k] = fct
+    return dropped
+
+
+@kernel(inline="always")
+def _forward(A, rhs, n):
+    """rhs <- L^-1 rhs with the unit lower factor below the diagonal (both factorisations);
+    dropped rows (zero pivot) get 0."""
+    for i in range(n):
+        if A[i, i] == 0.0:
+            rhs[i] = 0.0
+            continue
+        acc = rhs[i]
+        for k in range(i):
+            acc -= A[i, k] * rhs[k]
+        rhs[i] = acc
+
+
+@kernel
+def substitute_dense(A, rhs, x, n):
+    """x = A^-1 rhs from the factors of factor_dense (rhs destroyed); dropped rows get 0."""
+    _forward(A, rhs, n)
+    for k in range(n - 1, -1, -1):
+        d = A[k, k]
+        if d == 0.0:
+            x[k] = 0.0
+            continue
+        acc = rhs[k]
+        for j in range(k + 1, n):
+            acc -= A[k, j] * x[j]
+        x[k] = acc / d
+
+
+@kernel
+def substitute_dense_symmetric(A, rhs, x, n):
+    """x = A^-1 rhs from the factors of factor_dense_symmetric (rhs destroyed); dropped rows
+    get 0. Back substitution uses U = D L^T: x_k = y_k / d_k - sum_j L_jk x_j."""
+    _forward(A, rhs, n)
+    for k in range(n - 1, -1, -1):
+        d = A[k, k]
+        if d == 0.0:
+            x[k] = 0.0
+            continue
+        acc = rhs[k] / d
+        for j in range(k + 1, n):
+            acc -= A[j, k] * x[j]
+        x[k] = acc
