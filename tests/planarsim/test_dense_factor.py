@@ -3,7 +3,7 @@ envelope elimination's (envelope.py) factors and answers to the last bit: on ran
 between bodies (each row on one body or two, as the engine's), some exact multiples of
 earlier ones (closed loops: dropped rows), J W J^T (L D L^T) and J W F^T with F != J (LU,
 sliding contacts and the position correction), the same rows dropped, the same pivots and
-the same solution, compared with ==."""
+the same solution, compared with ==; two right-hand sides solved in one pass as each alone."""
 import numpy as np
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
@@ -32,6 +32,17 @@ def _solve(m, q, ws, n, n_body, rhs, x, pivots, symmetric, kind):
         pivots[r] = matrix.diagonal_and_pivot(ws, r)[1]
     matrix.substitute_ws(ws, rhs, x, n, symmetric)
     return dropped
+
+
+@jit
+def _pair(m, q, ws, n, n_body, rhs, x, rhs2, x2):
+    """Rows 0..n-1 (not symmetric) factored dense, both right-hand sides solved in one pass
+    (matrix.substitute_pair_ws)."""
+    matrix.arrange(q, ws, n, n_body, ws.start.contact_dependent, False)
+    ws.factor_kind[0] = matrix.DENSE
+    matrix.assemble(m, ws, ws.row_J, ws.row_F, n, False)
+    matrix.factor_ws(ws, n, TOL, False)
+    matrix.substitute_pair_ws(ws, rhs, x, rhs2, x2, n)
 
 
 @st.composite
@@ -84,6 +95,19 @@ def test_the_dense_elimination_is_the_envelope_elimination_bit_for_bit(system, d
     assert de == dd
     assert np.array_equal(pe, pd)
     assert np.array_equal(xe, xd, equal_nan=True)
+    if move is not None:
+        # two right-hand sides in one pass (the position correction's move and velocity):
+        # each the answer of its own substitution
+        rhs2 = np.array(data.draw(vectors(n_row, -3.0, 3.0), label="rhs2"))
+        ws = _workspace(model, rows, move)
+        x, x2 = np.zeros(n_row), np.zeros(n_row)
+        _pair(model.arrays, q, ws, n_row, model.n_body, rhs.copy(), x, rhs2.copy(), x2)
+        assert np.array_equal(x, xd, equal_nan=True)
+        ws = _workspace(model, rows, move)
+        alone = np.zeros(n_row)
+        _solve(model.arrays, q, ws, n_row, model.n_body, rhs2.copy(), alone, np.zeros(n_row),
+               False, matrix.DENSE)
+        assert np.array_equal(x2, alone, equal_nan=True)
 
 
 def test_a_walkers_rows_are_eliminated_dense():

@@ -30,7 +30,8 @@ from ..constraints.joints import joint_position_rate
 from ..constraints.rows import (add_joint_impulse, eval_rows, is_angular_row, is_contact_row,
                                 is_limit_row, is_normal_row, is_soft_row, is_tangent_row,
                                 is_unilateral, row_lever)
-from ..solver.matrix import add_to_diagonal, arrange, assemble, factor_ws, substitute_ws
+from ..solver.matrix import (add_to_diagonal, arrange, assemble, factor_ws, solves_pairs,
+                             substitute_pair_ws, substitute_ws)
 from ..constraints.soft import SOFT_ARMATURE
 from ..solver.solve import apply_impulses, row_dot
 from ..checks.work import (CONSTRAINT_SHARE, SHAKE_REGIME, correction_force_work,
@@ -502,24 +503,34 @@ def move_by_correction(m, s, ws, h, n, still):
     are in ws.rhs (ws.row_c: a copy of them): positions by W J^T lam, velocities by the same
     over h, or, with contact normal rows among them (moves_without_velocity), by -c / h on
     the other rows and not at all along the normals."""
-    substitute_ws(ws, ws.rhs, ws.lam, n, False)
     for i in range(ws.dq_correction.shape[0]):
         for k in range(3):
             ws.dq_correction[i, k] = 0.0
             ws.dv_correction[i, k] = 0.0
-    apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
-    if still == 0:
-        # velocities by the same correction / h
-        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
-    else:
-        # velocities: the other rows change by -c / h, contact normals not at all (a
-        # separate solve: zeroing the unilateral impulses of the position solve instead
-        # leaves a pinned foot, held by its contact against a rod, moving at rod-fix / h)
-        # (same matrix: its factors are reused)
+    if still > 0 and solves_pairs(ws):
+        # (both solves below in one substitution, the velocity's in ws.sp_x / sp_y)
         for r in range(n):
-            ws.rhs[r] = 0.0 if moves_without_velocity(ws.row_kind[r]) else ws.row_c[r] / h
-        substitute_ws(ws, ws.rhs, ws.lam, n, False)
+            ws.sp_x[r] = 0.0 if moves_without_velocity(ws.row_kind[r]) else ws.row_c[r] / h
+        substitute_pair_ws(ws, ws.rhs, ws.lam, ws.sp_x, ws.sp_y, n)
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
+        for r in range(n):
+            ws.lam[r] = ws.sp_y[r]
         apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
+    else:
+        substitute_ws(ws, ws.rhs, ws.lam, n, False)
+        apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dq_correction, 1.0)
+        if still == 0:
+            # velocities by the same correction / h
+            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0 / h)
+        else:
+            # velocities: the other rows change by -c / h, contact normals not at all (a
+            # separate solve: zeroing the unilateral impulses of the position solve instead
+            # leaves a pinned foot, held by its contact against a rod, moving at rod-fix / h)
+            # (same matrix: its factors are reused)
+            for r in range(n):
+                ws.rhs[r] = 0.0 if moves_without_velocity(ws.row_kind[r]) else ws.row_c[r] / h
+            substitute_ws(ws, ws.rhs, ws.lam, n, False)
+            apply_impulses(m, ws, ws.row_J, ws.lam, n, ws.dv_correction, 1.0)
     record_moved_impulses(ws, n, velocity_share(h, still))
     for i in range(s.q.shape[0]):
         for k in range(3):

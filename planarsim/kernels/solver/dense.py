@@ -96,14 +96,15 @@ def factor_dense_symmetric(A, n, tol, scale, column):
 def _forward(A, rhs, n):
     """rhs <- L^-1 rhs with the unit lower factor below the diagonal (both factorisations);
     dropped rows (zero pivot) get 0."""
-    for i in range(n):
-        if A[i, i] == 0.0:
-            rhs[i] = 0.0
+    for k in range(n):
+        if A[k, k] == 0.0:
+            rhs[k] = 0.0
             continue
-        acc = rhs[i]
-        for k in range(i):
-            acc -= A[i, k] * rhs[k]
-        rhs[i] = acc
+        rk = rhs[k]
+        # (column by column, as envelope.py's: each entry's updates in the same order, and
+        # independent of each other, where a row's sum would wait on each of its terms)
+        for i in range(k + 1, n):
+            rhs[i] -= A[i, k] * rk
 
 
 @kernel
@@ -135,3 +136,35 @@ def substitute_dense_symmetric(A, rhs, x, n):
         for j in range(k + 1, n):
             acc -= A[j, k] * x[j]
         x[k] = acc
+
+
+@kernel
+def substitute_dense_pair(A, rhs, x, rhs2, x2, n):
+    """substitute_dense for two right-hand sides at once (both destroyed): each answer's
+    arithmetic is substitute_dense's, in the same order; the two sums of the back
+    substitution, each waiting on its own last term, run side by side."""
+    for k in range(n):
+        if A[k, k] == 0.0:
+            rhs[k] = 0.0
+            rhs2[k] = 0.0
+            continue
+        rk = rhs[k]
+        rk2 = rhs2[k]
+        for i in range(k + 1, n):
+            a = A[i, k]
+            rhs[i] -= a * rk
+            rhs2[i] -= a * rk2
+    for k in range(n - 1, -1, -1):
+        d = A[k, k]
+        if d == 0.0:
+            x[k] = 0.0
+            x2[k] = 0.0
+            continue
+        acc = rhs[k]
+        acc2 = rhs2[k]
+        for j in range(k + 1, n):
+            u = A[k, j]
+            acc -= u * x[j]
+            acc2 -= u * x2[j]
+        x[k] = acc / d
+        x2[k] = acc2 / d

@@ -11,7 +11,7 @@ scale_diagonal, factor_ws, diagonal_and_pivot, substitute_ws (as often as needed
 """
 from ...compile import kernel
 from .dense import (assemble_dense, factor_dense, factor_dense_symmetric, substitute_dense,
-                    substitute_dense_symmetric)
+                    substitute_dense_pair, substitute_dense_symmetric)
 from .envelope import (assemble_rows, compute_envelope, factor, factor_symmetric, substitute,
                        substitute_symmetric)
 from .sparse_factor import (SPARSE_MIN_ROWS, analyse, assemble_sparse, factor_sparse,
@@ -137,6 +137,21 @@ def substitute_ws(ws, rhs, x, n, symmetric):
         substitute_symmetric(ws.A_low, ws.row_start, ws.row_first, ws.row_reach, rhs, x, n)
     else:
         substitute(ws.A_low, ws.A_up, ws.row_start, ws.row_first, ws.row_reach, rhs, x, n)
+
+
+@kernel(inline="always")
+def solves_pairs(ws):
+    """The factors are the dense square's: substitute_pair_ws may be called (ws.sp_x and
+    ws.sp_y, the sparse factorisation's scratch, are free for its second answer)."""
+    return ws.factor_kind[0] == DENSE
+
+
+@kernel(inline="always")
+def substitute_pair_ws(ws, rhs, x, rhs2, x2, n):
+    """Where solves_pairs: x = A^-1 rhs and x2 = A^-1 rhs2 from the factors of factor_ws (not
+    symmetric; both right-hand sides destroyed), the answers of two substitute_ws calls bit
+    for bit, in one pass."""
+    substitute_dense_pair(ws.A_dense, rhs, x, rhs2, x2, n)
 
 
 @kernel(inline="always")
