@@ -22,7 +22,7 @@ from .envelope import _entry, is_dependent
 def assemble_dense(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetric):
     """A[:n, :n] = JL W JR^T: the entries inside the rows' envelope (first: envelope.py),
     zero elsewhere; symmetric (JL = JR): the lower triangle and diagonal only (all that
-    factor_dense_symmetric reads)."""
+    factor_dense reads where symmetric)."""
     for i in range(n):
         for j in range(n):
             A[i, j] = 0.0
@@ -33,63 +33,71 @@ def assemble_dense(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetr
                 A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
 
 
+@kernel(inline="always")
+def _dropped(A, n, k, tol, scale, upper):
+    """Row k's pivot test (envelope.is_dependent against scale[k], its diagonal before
+    elimination): a dependent row is dropped, its pivot and multipliers (and, upper, its row
+    of U) zeroed. Returns whether it was."""
+    if not is_dependent(A[k, k], scale[k], tol):
+        return False
+    for i in range(k + 1, n):
+        A[i, k] = 0.0
+        if upper:
+            A[k, i] = 0.0
+    A[k, k] = 0.0
+    return True
+
+
 @kernel
-def factor_dense(A, n, tol, scale):
+def factor_dense(A, n, tol, scale, column, symmetric):
     """LU factorisation of A[:n, :n] in place without pivoting: U on and above the diagonal,
-    the multipliers L below it. A row whose pivot falls below tol times its own diagonal
-    (scale: the diagonal before elimination, written here) depends on earlier rows: it is
-    dropped (zero pivot, zero multipliers and zero U row). Returns #dropped."""
+    the multipliers L below it; symmetric: A = L D L^T in half the work, the multipliers L
+    below the diagonal and D on it, the upper triangle neither read nor written (column (n,)
+    is scratch: column k before its division by the pivot). A row whose pivot falls below
+    tol times its own diagonal (scale: the diagonal before elimination, written here)
+    depends on earlier rows: it is dropped (zero pivot, zero multipliers and, LU, zero U
+    row). Returns #dropped."""
     dropped = 0
     for k in range(n):
         scale[k] = abs(A[k, k])
     for k in range(n):
-        piv = A[k, k]
-        if is_dependent(piv, scale[k], tol):
+        if _dropped(A, n, k, tol, scale, not symmetric):
             dropped += 1
-            for i in range(k + 1, n):
-                A[i, k] = 0.0
-                A[k, i] = 0.0
-            A[k, k] = 0.0
             continue
-        inv = 1.0 / piv
-        for i in range(k + 1, n):
-            fct = A[i, k] * inv
-            A[i, k] = fct
-            if fct == 0.0:
-                continue
-            for j in range(k + 1, n):
-                A[i, j] -= fct * A[k, j]
+        inv = 1.0 / A[k, k]
+        if symmetric:
+            _eliminate_symmetric(A, n, k, inv, column)
+        else:
+            _eliminate(A, n, k, inv)
     return dropped
 
 
-@kernel
-def factor_dense_symmetric(A, n, tol, scale, column):
-    """As factor_dense for a symmetric A, in half the work: A = L D L^T with the multipliers
-    L below the diagonal and D on it; the upper triangle is neither read nor written.
-    column (n,) is scratch (column k before its division by the pivot). Returns #dropped."""
-    dropped = 0
-    for k in range(n):
-        scale[k] = abs(A[k, k])
-    for k in range(n):
-        piv = A[k, k]
-        if is_dependent(piv, scale[k], tol):
-            dropped += 1
-            for i in range(k + 1, n):
-                A[i, k] = 0.0
-            A[k, k] = 0.0
+@kernel(inline="always")
+def _eliminate(A, n, k, inv):
+    """LU: column k's multipliers, and the rows below it less their multiple of row k."""
+    for i in range(k + 1, n):
+        fct = A[i, k] * inv
+        A[i, k] = fct
+        if fct == 0.0:
             continue
-        inv = 1.0 / piv
         for j in range(k + 1, n):
-            column[j] = A[j, k]
-        for i in range(k + 1, n):
-            a_ik = column[i]
-            if a_ik == 0.0:
-                continue
-            fct = a_ik * inv
-            for j in range(k + 1, i + 1):
-                A[i, j] -= fct * column[j]
-            A[i, k] = fct
-    return dropped
+            A[i, j] -= fct * A[k, j]
+
+
+@kernel(inline="always")
+def _eliminate_symmetric(A, n, k, inv, column):
+    """L D L^T: the lower triangle below row k less column k's outer product over its pivot,
+    then column k's multipliers."""
+    for j in range(k + 1, n):
+        column[j] = A[j, k]
+    for i in range(k + 1, n):
+        a_ik = column[i]
+        if a_ik == 0.0:
+            continue
+        fct = a_ik * inv
+        for j in range(k + 1, i + 1):
+            A[i, j] -= fct * column[j]
+        A[i, k] = fct
 
 
 @kernel(inline="always")
@@ -124,7 +132,7 @@ def substitute_dense(A, rhs, x, n):
 
 @kernel
 def substitute_dense_symmetric(A, rhs, x, n):
-    """x = A^-1 rhs from the factors of factor_dense_symmetric (rhs destroyed); dropped rows
+    """x = A^-1 rhs from the symmetric factors of factor_dense (rhs destroyed); dropped rows
     get 0. Back substitution uses U = D L^T: x_k = y_k / d_k - sum_j L_jk x_j."""
     _forward(A, rhs, n)
     for k in range(n - 1, -1, -1):

@@ -10,7 +10,7 @@ Order of use: arrange (the rows' structure), assemble, then add_to_diagonal /
 scale_diagonal, factor_ws, diagonal_and_pivot, substitute_ws (as often as needed).
 """
 from ...compile import kernel
-from .dense import (assemble_dense, factor_dense, factor_dense_symmetric, substitute_dense,
+from .dense import (assemble_dense, factor_dense, substitute_dense,
                     substitute_dense_pair, substitute_dense_symmetric)
 from .envelope import (assemble_rows, compute_envelope, factor, factor_symmetric, substitute,
                        substitute_symmetric)
@@ -113,9 +113,7 @@ def factor_ws(ws, n, tol, symmetric):
     if ws.factor_kind[0] == SPARSE:
         return factor_sparse(ws, n, tol, symmetric, ws.lam)
     if ws.factor_kind[0] == DENSE:
-        if symmetric:
-            return factor_dense_symmetric(ws.A_dense, n, tol, ws.lam, ws.sp_y)
-        return factor_dense(ws.A_dense, n, tol, ws.lam)
+        return factor_dense(ws.A_dense, n, tol, ws.lam, ws.sp_y, symmetric)
     if symmetric:
         return factor_symmetric(ws.A_low, ws.row_start, ws.row_first, ws.row_reach, n, tol,
                                 ws.lam, ws.row_list)
