@@ -72,6 +72,9 @@ def _workspace(model, rows, move):
     ws.row_F[:n_row] = ws.row_J[:n_row]
     if move is not None:
         ws.row_F[:n_row] += move * (ws.row_J[:n_row] != 0.0)
+    # the square's storage as a step leaves it, stale: NaN, so that an entry read before it is
+    # written shows in the answer
+    ws.A_dense[:] = np.nan
     return ws
 
 

@@ -24,9 +24,11 @@ def assemble_dense(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetr
     zero elsewhere; symmetric (JL = JR): the lower triangle and diagonal only (all that
     factor_dense reads where symmetric)."""
     for i in range(n):
-        for j in range(n):
+        # (outside the envelope: row i left of it and, for LU, column i above it)
+        for j in range(first[i]):
             A[i, j] = 0.0
-    for i in range(n):
+            if not symmetric:
+                A[j, i] = 0.0
         for j in range(first[i], i + 1):
             A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
             if j != i and not symmetric:
