@@ -12,7 +12,9 @@ run over columns in ascending order, each entry's updates in that order, the sub
 sums in the same order): entries outside the envelope are zero at the start and stay zero
 (rows touch at most two bodies, so the envelope holds every fill), and subtracting a product
 with a zero factor leaves an entry as it was. The factors and the solutions are therefore the
-envelope's to the last bit; only the time differs (matrix.py chooses).
+envelope's to the last bit where every entry and right-hand side is finite (a NaN or inf
+right-hand side entry spreads to rows the envelope leaves alone, as 0 * inf is NaN: a step
+with one ends at the non-finite guard either way); only the time differs (matrix.py chooses).
 """
 from ...compile import kernel
 from .envelope import _entry, is_dependent
