@@ -154,18 +154,10 @@ def substitute_dense_symmetric(A, rhs, x, n):
 def substitute_dense_pair(A, rhs, x, rhs2, x2, n):
     """substitute_dense for two right-hand sides at once (both destroyed): each answer's
     arithmetic is substitute_dense's, in the same order; the two sums of the back
-    substitution, each waiting on its own last term, run side by side."""
-    for k in range(n):
-        if A[k, k] == 0.0:
-            rhs[k] = 0.0
-            rhs2[k] = 0.0
-            continue
-        rk = rhs[k]
-        rk2 = rhs2[k]
-        for i in range(k + 1, n):
-            a = A[i, k]
-            rhs[i] -= a * rk
-            rhs2[i] -= a * rk2
+    substitution, each waiting on its own last term, run side by side (the forward ones'
+    updates are independent already)."""
+    _forward(A, rhs, n)
+    _forward(A, rhs2, n)
     for k in range(n - 1, -1, -1):
         d = A[k, k]
         if d == 0.0:
