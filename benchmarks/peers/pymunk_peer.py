@@ -47,6 +47,27 @@ def version() -> str:
     return pymunk.version
 
 
+def _release(world):
+    """Empty `world`'s old space (if any) before it is dropped: its bodies, shapes and
+    constraints are removed through pymunk's own remove() with the cyclic garbage collector
+    paused. pymunk frees a space by walking its bodies from C and freeing each; a collection
+    that starts inside that walk can free the same body a second time and abort the process
+    (seen under pytest-xdist), so nothing is left in the space for that walk to find."""
+    import gc
+    space = getattr(world, "space", None)
+    if space is None:
+        return
+    paused = gc.isenabled()
+    gc.disable()
+    try:
+        space.remove(*space.constraints, *space.shapes, *space.bodies)
+        world.space, world.bodies, world.step = None, [], None
+        del space
+    finally:
+        if paused:
+            gc.enable()
+
+
 class World:
     """A pymunk space of the scene with run(n) (timed), reset() and record(n)."""
 
@@ -64,6 +85,7 @@ class World:
         self.reset()
 
     def reset(self):
+        _release(self)
         pm, spec = self.pm, self.spec
         space = pm.Space()
         space.gravity = (0.0, -9.81)
@@ -151,6 +173,7 @@ class ShapeWorld:
         return pm.Segment(body, (-shape[1], 0.0), (shape[1], 0.0), shape[2])
 
     def reset(self):
+        _release(self)
         pm, scene = self.pm, self.scene
         space = pm.Space()
         space.gravity = (0.0, -9.81)
