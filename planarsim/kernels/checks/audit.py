@@ -40,7 +40,7 @@ import math
 
 from ...compile import kernel
 from ..info import INFO_CCD_SPLITS
-from ..codes import CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, ROW_ROD
+from ..codes import CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT, ROW_ROD
 from ..geometry.contacts import contact_velocity, edge_deepest, point_reach, sole_facing
 from ..math2d import world_point
 from ..geometry.broad_phase import sweep_pairs
@@ -337,17 +337,39 @@ def near_pairs(m, s, ws):
     return sweep_pairs(ws, 0.0, 0.0, ws.sweep_pairs)
 
 @kernel
+def foot_radius(m, i):
+    """The farthest [m] a material point of arc contact i's foot lies from its body's COM:
+    |centre| + r (its arc), or a fallback vertex's distance where farther."""
+    cx = m.contact_local[i, 0]
+    cy = m.contact_local[i, 1]
+    far = math.sqrt(cx * cx + cy * cy) + m.contact_radius[i]
+    adr = m.contact_vert_adr[i]
+    for k in range(adr, adr + m.contact_vert_num[i]):
+        far = max(far, math.sqrt(m.vert_local[k, 0] ** 2 + m.vert_local[k, 1] ** 2))
+    return far
+
+
+@kernel
 def surely_clear(m, s, ws, i):
-    """Point contact i cannot be below the ground at s.q: its gap at the start of the step
+    """Contact i cannot be below the ground at s.q: its gap at the start of the step
     (ws.contact_gap, found at ws.prev.q or a lower bound of it; no time-of-impact split)
-    exceeds how far the point can have moved since (contacts.point_reach; the signed distance
-    to the ground changes by at most the point's move). Saves the ground query of contacts
-    well clear of it."""
-    if m.contact_kind[i] != CONTACT_POINT or ws.info[INFO_CCD_SPLITS] != 0:
+    exceeds how far its points can have moved since (contacts.point_reach; the signed
+    distance to the ground changes by at most a point's move). A point contact's point; an
+    arc contact's every point (foot_radius from the COM) on flat or sloped ground, where its
+    gap at the start is the lowest of its material points' (its sole's lowest point, arc
+    ends, vertices) and so is contact_gap's at s.q. Saves the ground query of contacts well
+    clear of it."""
+    if ws.info[INFO_CCD_SPLITS] != 0:
         return False
     b = m.contact_body[i]
-    reach = point_reach(s.q, b, ws.prev.q[b, 0], ws.prev.q[b, 1], ws.prev.q[b, 2],
-                        m.contact_local[i, 0], m.contact_local[i, 1])
+    if m.contact_kind[i] == CONTACT_POINT:
+        reach = point_reach(s.q, b, ws.prev.q[b, 0], ws.prev.q[b, 1], ws.prev.q[b, 2],
+                            m.contact_local[i, 0], m.contact_local[i, 1])
+        return ws.contact_gap[i] > reach
+    if m.contact_kind[i] != CONTACT_ARC or m.terrain_coef[2] != 0.0:
+        return False
+    reach = (abs(s.q[b, 0] - ws.prev.q[b, 0]) + abs(s.q[b, 1] - ws.prev.q[b, 1])
+             + abs(s.q[b, 2] - ws.prev.q[b, 2]) * foot_radius(m, i))
     return ws.contact_gap[i] > reach
 
 
