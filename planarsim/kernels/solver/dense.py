@@ -17,7 +17,7 @@ right-hand side entry spreads to rows the envelope leaves alone, as 0 * inf is N
 with one ends at the non-finite guard either way); only the time differs (matrix.py chooses).
 """
 from ...compile import kernel
-from .envelope import _entry, is_dependent
+from .envelope import is_dependent
 
 
 @kernel
@@ -31,10 +31,60 @@ def assemble_dense(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetr
             A[i, j] = 0.0
             if not symmetric:
                 A[j, i] = 0.0
+        # row i's bodies and numbers, read once for its whole row (and, LU, column): the
+        # loads _entry would repeat for every entry, as A's stores may alias them
+        b0 = row_body[i, 0]
+        b1 = row_body[i, 1]
+        m0 = inv_mass[b0] if b0 >= 0 else 0.0
+        i0 = inv_inertia[b0] if b0 >= 0 else 0.0
+        m1 = inv_mass[b1] if b1 >= 0 else 0.0
+        i1 = inv_inertia[b1] if b1 >= 0 else 0.0
+        l00, l01, l02 = JL[i, 0, 0], JL[i, 0, 1], JL[i, 0, 2]
+        l10, l11, l12 = JL[i, 1, 0], JL[i, 1, 1], JL[i, 1, 2]
+        r00, r01, r02 = JR[i, 0, 0], JR[i, 0, 1], JR[i, 0, 2]
+        r10, r11, r12 = JR[i, 1, 0], JR[i, 1, 1], JR[i, 1, 2]
         for j in range(first[i], i + 1):
-            A[i, j] = _entry(JL, JR, row_body, inv_mass, inv_inertia, i, j)
+            c0 = row_body[j, 0]
+            c1 = row_body[j, 1]
+            # (JL W JR^T)[i, j], as _entry sums it: over row i's sides, each against row j's
+            acc = 0.0
+            if b0 >= 0:
+                if c0 == b0:
+                    acc += (l00 * JR[j, 0, 0] + l01 * JR[j, 0, 1]) * m0
+                    acc += l02 * JR[j, 0, 2] * i0
+                if c1 == b0:
+                    acc += (l00 * JR[j, 1, 0] + l01 * JR[j, 1, 1]) * m0
+                    acc += l02 * JR[j, 1, 2] * i0
+            if b1 >= 0:
+                if c0 == b1:
+                    acc += (l10 * JR[j, 0, 0] + l11 * JR[j, 0, 1]) * m1
+                    acc += l12 * JR[j, 0, 2] * i1
+                if c1 == b1:
+                    acc += (l10 * JR[j, 1, 0] + l11 * JR[j, 1, 1]) * m1
+                    acc += l12 * JR[j, 1, 2] * i1
+            A[i, j] = acc
             if j != i and not symmetric:
-                A[j, i] = _entry(JL, JR, row_body, inv_mass, inv_inertia, j, i)
+                # (JL W JR^T)[j, i]: over row j's sides, each against row i's
+                acc = 0.0
+                if c0 >= 0:
+                    mj = inv_mass[c0]
+                    ij = inv_inertia[c0]
+                    if b0 == c0:
+                        acc += (JL[j, 0, 0] * r00 + JL[j, 0, 1] * r01) * mj
+                        acc += JL[j, 0, 2] * r02 * ij
+                    if b1 == c0:
+                        acc += (JL[j, 0, 0] * r10 + JL[j, 0, 1] * r11) * mj
+                        acc += JL[j, 0, 2] * r12 * ij
+                if c1 >= 0:
+                    mj = inv_mass[c1]
+                    ij = inv_inertia[c1]
+                    if b0 == c1:
+                        acc += (JL[j, 1, 0] * r00 + JL[j, 1, 1] * r01) * mj
+                        acc += JL[j, 1, 2] * r02 * ij
+                    if b1 == c1:
+                        acc += (JL[j, 1, 0] * r10 + JL[j, 1, 1] * r11) * mj
+                        acc += JL[j, 1, 2] * r12 * ij
+                A[j, i] = acc
 
 
 @kernel(inline="always")
