@@ -282,7 +282,9 @@ class Reacher(_Task):
         self._q0 = np.ascontiguousarray(self.sim_model.q0, float).reshape(-1, 3)
 
     def obs_size(self):
-        return 10
+        """cos and sin of the two arm angles, the other qpos, the arm's two qvel and fingertip -
+        target: 10 for gymnasium's reacher.xml (reacher_obs writes this many)."""
+        return self.model.nq + 6
 
     def _get_rew(self, action, vec=None):
         """(reward, its terms); vec: fingertip - target [m] if already measured."""
@@ -294,7 +296,7 @@ class Reacher(_Task):
 
     def step(self, action):
         self.do_simulation(action, self.frame_skip)
-        observation = np.empty(10)
+        observation = np.empty(self.obs_size())
         vec = reacher_obs(self.sim.state.q, self._q0, self._ends, self._ends_com, self.data.qpos,
                           self.data.qvel, observation)
         reward, info = self._get_rew(action, vec)
@@ -324,7 +326,9 @@ class InvertedPendulum(_Task):
     DEFAULTS = dict(xml_file="inverted_pendulum.xml", frame_skip=2, reset_noise_scale=0.01)
 
     def obs_size(self):
-        return 4
+        """qpos then qvel: 4 for gymnasium's inverted_pendulum.xml (joined_finite writes this
+        many)."""
+        return self.model.nq + self.model.nv
 
     def step(self, action):
         self.do_simulation(action, self.frame_skip)
