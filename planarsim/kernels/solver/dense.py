@@ -50,41 +50,38 @@ def assemble_dense(JL, JR, row_body, inv_mass, inv_inertia, first, A, n, symmetr
             acc = 0.0
             if b0 >= 0:
                 if c0 == b0:
-                    acc += (l00 * JR[j, 0, 0] + l01 * JR[j, 0, 1]) * m0
-                    acc += l02 * JR[j, 0, 2] * i0
+                    acc = _pair(acc, l00, l01, l02, JR[j, 0, 0], JR[j, 0, 1], JR[j, 0, 2], m0, i0)
                 if c1 == b0:
-                    acc += (l00 * JR[j, 1, 0] + l01 * JR[j, 1, 1]) * m0
-                    acc += l02 * JR[j, 1, 2] * i0
+                    acc = _pair(acc, l00, l01, l02, JR[j, 1, 0], JR[j, 1, 1], JR[j, 1, 2], m0, i0)
             if b1 >= 0:
                 if c0 == b1:
-                    acc += (l10 * JR[j, 0, 0] + l11 * JR[j, 0, 1]) * m1
-                    acc += l12 * JR[j, 0, 2] * i1
+                    acc = _pair(acc, l10, l11, l12, JR[j, 0, 0], JR[j, 0, 1], JR[j, 0, 2], m1, i1)
                 if c1 == b1:
-                    acc += (l10 * JR[j, 1, 0] + l11 * JR[j, 1, 1]) * m1
-                    acc += l12 * JR[j, 1, 2] * i1
+                    acc = _pair(acc, l10, l11, l12, JR[j, 1, 0], JR[j, 1, 1], JR[j, 1, 2], m1, i1)
             A[i, j] = acc
             if j != i and not symmetric:
                 # (JL W JR^T)[j, i]: over row j's sides, each against row i's
                 acc = 0.0
-                if c0 >= 0:
-                    mj = inv_mass[c0]
-                    ij = inv_inertia[c0]
-                    if b0 == c0:
-                        acc += (JL[j, 0, 0] * r00 + JL[j, 0, 1] * r01) * mj
-                        acc += JL[j, 0, 2] * r02 * ij
-                    if b1 == c0:
-                        acc += (JL[j, 0, 0] * r10 + JL[j, 0, 1] * r11) * mj
-                        acc += JL[j, 0, 2] * r12 * ij
-                if c1 >= 0:
-                    mj = inv_mass[c1]
-                    ij = inv_inertia[c1]
-                    if b0 == c1:
-                        acc += (JL[j, 1, 0] * r00 + JL[j, 1, 1] * r01) * mj
-                        acc += JL[j, 1, 2] * r02 * ij
-                    if b1 == c1:
-                        acc += (JL[j, 1, 0] * r10 + JL[j, 1, 1] * r11) * mj
-                        acc += JL[j, 1, 2] * r12 * ij
+                for e in range(2):
+                    c = c0 if e == 0 else c1
+                    if c < 0:
+                        continue
+                    mj = inv_mass[c]
+                    ij = inv_inertia[c]
+                    if b0 == c:
+                        acc = _pair(acc, JL[j, e, 0], JL[j, e, 1], JL[j, e, 2], r00, r01, r02, mj, ij)
+                    if b1 == c:
+                        acc = _pair(acc, JL[j, e, 0], JL[j, e, 1], JL[j, e, 2], r10, r11, r12, mj, ij)
                 A[j, i] = acc
+
+
+@kernel(inline="always")
+def _pair(acc, a0, a1, a2, b0, b1, b2, inv_mass, inv_inertia):
+    """acc plus one shared body's part of an entry, a side (a0, a1, a2) of one row against a
+    side (b0, b1, b2) of the other: the translation's over the mass, then the turn's over the
+    inertia, in _entry's order."""
+    acc += (a0 * b0 + a1 * b1) * inv_mass
+    return acc + a2 * b2 * inv_inertia
 
 
 @kernel(inline="always")
