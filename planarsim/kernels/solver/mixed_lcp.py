@@ -234,6 +234,29 @@ def friction_bound_of(m, ws, r):
     return m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1]
 
 
+@kernel
+def _exact_or_soft(Mx, qx, nv, ws, eps, floor):
+    """After Lemke's path solved M + eps I (eps > 0) into ws.lcp_z on its basis, Mx holding M
+    again: that basis's answer for M itself (lcp.polish), else the nearby answer, which misses
+    the rules of M by eps z (scaled units: a compliance of eps, whose contacts may approach at
+    eps z), kept where that is within SOFT_ANSWER_TOL of the fastest approach max -q (the
+    position stage still ends the step on the surface): far nearer the rules than the
+    frictionless rule's answer, which would drop the island's friction for the step (a
+    20-domino run and a pour of 50 shapes met it). A large z (a load that redundant rows share
+    without bound) is no answer. Returns (LCP_SOLVED or LCP_INACCURATE, the eps the answer
+    kept: 0 where polished)."""
+    if polish(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, floor) == LCP_SOLVED:
+        return LCP_SOLVED, 0.0
+    z_max = 0.0
+    q_neg = 0.0
+    for i in range(nv):
+        z_max = max(z_max, ws.lcp_z[i])
+        q_neg = max(q_neg, -qx[i])
+    if eps * z_max > SOFT_ANSWER_TOL * max(q_neg, floor):
+        return LCP_INACCURATE, 0.0
+    return LCP_SOLVED, eps
+
+
 @kernel(inline="never")
 def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
     """Impulses ws.lam[r] of the rows r in rows[start:start + count] (an island's, in their
@@ -370,30 +393,21 @@ def solve_mixed_lcp(m, ws, rows, start, count, max_pivots, floor):
             pivots += more
             if status == LCP_SOLVED:
                 break
+        if status == LCP_SOLVED and eps > 0.0:
+            for i in range(nv):
+                Mx[i, i] -= eps
+            status, eps = _exact_or_soft(Mx, qx, nv, ws, eps, floor)
         if status == LCP_SOLVED:
             break
-    if status != LCP_SOLVED:
-        return status, pivots, own_scale
-    if eps > 0.0:
+        # this covering vector's paths ended on rays, or at a nearby problem's answer too
+        # far from M's: the second covering vector's path is another path through the same
+        # problem (a pile on hills whose first path went astray at a near tie of two ratios,
+        # 1.7e-6 apart, solved on the second at 1e-8, kept as a soft answer)
         for i in range(nv):
             Mx[i, i] -= eps
-        if polish(Mx, qx, nv, ws.lcp_T, ws.lcp_basis, ws.lcp_z, floor) == LCP_SOLVED:
-            eps = 0.0
-        else:
-            # the nearby problem's answer misses the rules of M by eps z (scaled units): a
-            # compliance of eps, whose contacts may approach at eps z. Kept where that is
-            # within SOFT_ANSWER_TOL of the fastest approach max -q (the position stage
-            # still ends the step on the surface): far nearer the rules than the frictionless
-            # rule's answer, which would drop the island's friction for the step (a 20-domino
-            # run and a pour of 50 shapes met it). A large z (a load that redundant rows share
-            # without bound) is no answer.
-            z_max = 0.0
-            q_neg = 0.0
-            for i in range(nv):
-                z_max = max(z_max, ws.lcp_z[i])
-                q_neg = max(q_neg, -qx[i])
-            if eps * z_max > SOFT_ANSWER_TOL * max(q_neg, floor):
-                return LCP_INACCURATE, pivots, own_scale
+        eps = 0.0
+    if status != LCP_SOLVED:
+        return status, pivots, own_scale
     ws.lcp_eps[0] = max(ws.lcp_eps[0], eps)
     for i in range(nv):
         ws.lcp_z[i] *= d[i]
