@@ -617,6 +617,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
     ptol = pivot_tol
     newton = 0        # corrections taken while Newton converged (0: none, or it did not)
     fresh = True      # the next pass assembles and factors its matrix (else: a chord pass)
+    taken_at = 0.0    # the largest |c| the last pass kept was taken at
     for _ in range(iters):
         if worst <= tol:
             break
@@ -638,6 +639,7 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         move_by_correction(m, s, ws, h, n, still)
         after = max_residual(m, s, ws)
         if after <= STALLED_RATIO * worst:
+            taken_at = worst
             worst = after
             newton += 1
             # every row within CHORD_TOL: the next pass (and the last, below) reuses these
@@ -665,15 +667,17 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         if ptol >= LOOSE_PIVOT_TOL:
             break
         ptol = LOOSE_PIVOT_TOL
-    if newton > 0 and 0.0 < worst <= tol:
+    if newton > 0 and 0.0 < worst <= tol and taken_at > CHORD_TOL:
         # one more step on the last factors (no new matrix, a substitution): the end moves
         # by about the residual left (below tol), and its derivative becomes the converged
-        # correction's. Newton's last step was taken at a residual r of about sqrt(tol);
-        # the end's derivative with respect to the step's start and commands is off by
-        # about r / (the bodies' size) after it (1e-6 at tol 1e-12: what
-        # derivatives.step_jacobian, exact for the converged correction, would disagree by)
-        # and by about the square of that after this one. The residual returned is the one
-        # before this step (it only shrinks).
+        # correction's. A last step taken at a residual r leaves the end's derivative with
+        # respect to the step's start and commands off by about r / (the bodies' size):
+        # 1e-6 where Newton's last step was taken at r ~ sqrt(tol) (tol 1e-12), what
+        # derivatives.step_jacobian, exact for the converged correction, would disagree by,
+        # and about the square of that after this one. After a chord pass taken at
+        # r <= CHORD_TOL (a walker's usual second pass) it is off by 1e-8 at most already,
+        # and this step is left out. The residual returned is the one before this step (it
+        # only shrinks).
         move_by_correction(m, s, ws, h, n, keep_targets(ws, n))
         update_trig(s.q, ws.body_cs)
     return worst
