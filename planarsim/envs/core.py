@@ -394,6 +394,12 @@ class PlanarMujocoEnv(gymnasium.Env):
     _advanced = None
 
     def do_simulation(self, ctrl, n_frames):
+        self._advance(ctrl, n_frames)
+        self._sync()
+
+    def _advance(self, ctrl, n_frames):
+        """do_simulation's physics: the commands of action `ctrl` and n_frames steps (or the
+        steps a batched vector step already took), without writing qpos and qvel."""
         advanced, self._advanced = self._advanced, None
         if advanced is None:
             if not self.load_commands(ctrl):
@@ -402,7 +408,6 @@ class PlanarMujocoEnv(gymnasium.Env):
         elif advanced != int(n_frames):
             raise RuntimeError(f"do_simulation({int(n_frames)} frames) after a batched step of "
                                f"{advanced} frames")
-        self._sync()
 
     def state_vector(self):
         return np.concatenate([self.data.qpos.flat, self.data.qvel.flat])

@@ -16,7 +16,8 @@ and its reward, written as dm_control's ``Physics`` / ``Task`` methods are), eac
 of ``TASKS`` (its domain and parameters: walker stand / walk / run differ by a target speed).
 A domain's readings (its observation entries, then the values its reward reads) are a table
 of operations (:mod:`.readout`) written at a reset and computed by one compiled call per env
-step; the reward combines those values in Python floats.
+step, with the reward (each domain's compiled from those values: dmc_rewards.py, the same float
+as its Python function here).
 The quantities dm_control reads from MuJoCo's data (body frames ``xpos`` / ``xmat``, body
 centres of mass ``xipos``, site and geom positions, the sensors ``subtreelinvel``,
 ``velocimeter``, ``gyro``, ``framepos``, ``jointpos``, ``jointvel``, ``touch``) are
@@ -45,9 +46,15 @@ from gymnasium import spaces
 
 from ..mjcf import parse_xml
 from ..start_check import shape_overlaps
+from ..compile import FAST, MODE, TABLES
 from ..link.step import bind
 from .core import PlanarMujocoEnv
+from .dmc_rewards import reward_params
+from .dmc_step import DMCArrays, dmc_observe
 from .readout import Readout, read
+
+if TABLES:
+    from ..compile.refs import TableHandle
 from .rewards import tolerance
 
 INF = float("inf")
@@ -581,6 +588,7 @@ class DMCEnv(PlanarMujocoEnv):
         self.task = task
         domain_name, params = TASKS[task]
         self.domain = DOMAINS[domain_name]
+        self.domain_name = domain_name
         self.params = {**self.domain.defaults, **params}
         directory = suite_dir or find_suite_dir()
         if domain_name == "swimmer":
@@ -606,7 +614,7 @@ class DMCEnv(PlanarMujocoEnv):
         self._random = None
         self.settle = 0
         self._ctrl = np.zeros(len(self._act))
-        self._q0 = np.ascontiguousarray(np.asarray(self.sim_model.q0, float).reshape(-1, 3))
+        self._q0 = np.array(self.sim_model.q0, float).reshape(-1, 3)     # (our own: writeable)
         self._readout = self._plan_key = None
         self._reset_state(np.random.RandomState(0))
         n = self._get_obs().size
@@ -770,8 +778,8 @@ class DMCEnv(PlanarMujocoEnv):
     # the readings: observation and reward, one compiled call ------------------------------
     def _plan(self):
         """The task's readings as a table (readout.Readout), written at a reset or when the
-        target moves; the compiled call is bound to it and the simulator's arrays at the
-        next read."""
+        target moves, with the compiled reward's parameters (dmc_rewards.reward_params): the
+        environment's arrays for dmc_observe (dmc_step.DMCArrays), bound at the next read."""
         # what a plan reads that a reset or set_target may change: the same as the last
         # plan's, the last table stands (most tasks draw no target: a reset writes nothing)
         key = (None if self.target is None else tuple(self.target.tolist()),
@@ -795,27 +803,44 @@ class DMCEnv(PlanarMujocoEnv):
             return
         self._tables = tables
         self._values = np.zeros(r.n_obs + len(r.value_names))
-        self._read_args = None
+        self._obs_values = self._values[:r.n_obs]
+        code, p, room = reward_params(self.domain_name, self.params, r.value_names,
+                                      len(self._act))
+        c, d = self.coords, self.data
+        self._arrays = DMCArrays(
+            self._q0, d.qpos, d.qvel, np.full((self.sim_model.n_body, 3), np.nan), c.pins,
+            c.sign, c.ref, self._ctrl, self._act_lo, self._act_hi, self._drive_entry,
+            self._drive_id, self._drive_gain, self._u, *tables, self._values, p,
+            np.zeros(room), r.n_obs, code)
+        self._table = TableHandle(self._arrays) if TABLES else self._arrays
+        self._observe_call = None
+
+    def _sim_table(self):
+        """The simulator's StepArgs as compiled code takes it (its handle where TABLES)."""
+        return self.sim._args if TABLES else self.sim._args.obj
+
+    def _observe(self) -> float:
+        """qpos, qvel, the readings (the observation's entries, then the reward's values, in
+        self._values) and the reward of the current state: one compiled call
+        (dmc_step.dmc_observe); returns the reward."""
+        if self._readout is None:
+            self._plan()
+        sim = self._sim_table()
+        call = self._observe_call
+        if call is None or (MODE == FAST and sim.numba_type is not self._observe_type):
+            call = self._observe_call = bind(dmc_observe, (sim, self._table))
+            self._observe_type = sim.numba_type if MODE == FAST else None
+        return call(sim, self._table)
 
     def _read(self) -> np.ndarray:
         """The readings of the current state: the observation's entries, then the reward's
-        values (one compiled call, readout.read)."""
-        if self._readout is None:
-            self._plan()
-        st, ws, d = self.sim.state, self.sim.ws, self.data
-        args = self._read_args
-        if (args is None or args[0] is not st.q or args[6] is not st.last_contact_impulse
-                or args[11] is not ws.contact_bodies or args[3] is not d.qpos):
-            a = self.sim_model.arrays
-            args = (st.q, st.v, self._q0, d.qpos, d.qvel, self._ctrl, st.last_contact_impulse,
-                    a.contact_kind, a.contact_body, a.contact_local, a.contact_radius,
-                    ws.contact_bodies, ws.contact_refpt, *self._tables, self._values)
-            self._read_args = args
-            self._read_call = bind(read, args)
-        self._read_call(*args)
+        values (one compiled call, with the reward: _observe)."""
+        self._observe()
         return self._values
 
     def _reward_of(self, values) -> float:
+        """The reward of the readings `values` and the last control, in Python (the domain's
+        reward function: the compiled one's check)."""
         named = dict(zip(self._readout.value_names, values[self._n_obs:].tolist()))
         return float(self.domain.reward(named, self.params, self._ctrl))
 
@@ -830,7 +855,7 @@ class DMCEnv(PlanarMujocoEnv):
 
     def reward(self) -> float:
         """dm_control's get_reward of the current state (and last control)."""
-        return self._reward_of(self._read())
+        return self._observe()
 
     def _reset_state(self, random):
         qpos, qvel = self.init_qpos.copy(), np.zeros(self.model.nv)
@@ -857,7 +882,7 @@ class DMCEnv(PlanarMujocoEnv):
 
     def step(self, action):
         a = np.asarray(action, dtype=np.float64)
-        self.do_simulation(a, self.frame_skip)     # (raises for an action of the wrong shape
+        self._advance(a, self.frame_skip)          # (raises for an action of the wrong shape
         self._ctrl[:] = a                          # or with a NaN: the control stays)
-        values = self._read()
-        return values[:self._n_obs].copy(), self._reward_of(values), False, False, {}
+        reward = self._observe()
+        return self._obs_values.copy(), reward, False, False, {}

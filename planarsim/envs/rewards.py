@@ -2,13 +2,19 @@
 numpy: 1 inside ``bounds``, falling off outside them over ``margin`` along a sigmoid
 ('gaussian', 'hyperbolic', 'long_tail', 'reciprocal', 'cosine', 'linear', 'quadratic',
 'tanh_squared') to ``value_at_margin`` at distance ``margin``. Same arithmetic, in the same
-order, as dm_control's, so that its values agree bit for bit where numpy's functions do."""
+order, as dm_control's, so that its values agree bit for bit where numpy's functions do.
+
+The same for compiled code (``tolerance_at``, ``float_square``, ``numpy_mean``): the float
+path's arithmetic in its order, so that a task's compiled reward (dmc_rewards.py) is the
+Python one's float bit for bit."""
 from __future__ import annotations
 
 import math
 import warnings
 
 import numpy as np
+
+from ..compile import MODE, PYTHON, kernel
 
 DEFAULT_VALUE_AT_MARGIN = 0.1
 SIGMOIDS = ("gaussian", "hyperbolic", "long_tail", "reciprocal", "cosine", "linear", "quadratic",
@@ -124,3 +130,117 @@ def _scalar_tolerance(x, lower, upper, margin, kind, value_at_margin):
         return 0.0
     d = (lower - x if x < lower else x - upper) / margin     # (NaN for a NaN x)
     return float(_CURVES[kind](d, _SCALES[kind](value_at_margin)))
+
+
+# --- compiled: the float path's tolerance for compiled rewards (dmc_rewards.py) -------------
+
+# sigmoid codes (tolerance_at's kind), SIGMOIDS' order
+GAUSSIAN, HYPERBOLIC, LONG_TAIL, RECIPROCAL, COSINE, LINEAR, QUADRATIC, TANH_SQUARED = range(8)
+
+
+def tolerance_terms(bounds=(0.0, 0.0), margin=0.0, sigmoid="gaussian",
+                    value_at_margin=DEFAULT_VALUE_AT_MARGIN):
+    """[lower, upper, margin, scale] as floats for tolerance_at (checked as tolerance checks
+    them; scale: the sigmoid's, 0 where margin is 0 and the sigmoid never applies)."""
+    lower, upper = bounds
+    _scalar_tolerance(float(lower), lower, upper, margin, sigmoid, value_at_margin)  # (checks)
+    scale = _SCALES[sigmoid](value_at_margin) if margin != 0 else 0.0
+    return [float(lower), float(upper), float(margin), float(scale)]
+
+
+if MODE == PYTHON:
+    def _libm_pow(x, y):
+        return math.pow(x, y)
+else:
+    import ctypes
+
+    import llvmlite.binding as llvm
+    from llvmlite import ir
+    from numba import types
+    from numba.core import cgutils
+    from numba.extending import intrinsic
+
+    # libm's pow (the process's: the one CPython's float power calls) under a name of its own,
+    # published before compiled code that calls it is compiled or loaded: LLVM knows `pow`
+    # and would fold pow(x, 2.0) into x * x; it cannot see into this one
+    _POW = "planarsim_libm_pow"
+    llvm.add_symbol(_POW, ctypes.cast(ctypes.CDLL(None).pow, ctypes.c_void_p).value)
+
+    @intrinsic
+    def _libm_pow(typingctx, x, y):
+        """libm's pow(x, y) (floats), called as it is."""
+        def codegen(context, builder, signature, args):
+            fnty = ir.FunctionType(ir.DoubleType(), [ir.DoubleType(), ir.DoubleType()])
+            fn = cgutils.get_or_insert_function(builder.module, fnty, _POW)
+            return builder.call(fn, args)
+        return types.float64(types.float64, types.float64), codegen
+
+
+@kernel
+def float_square(x):
+    """x ** 2 of a Python float x as CPython computes it: libm's pow(|x|, 2.0), which is not
+    always x * x (glibc's differs in the last bit for about 1 x in 1000). Overflow gives inf
+    (CPython raises OverflowError)."""
+    return _libm_pow(abs(x), 2.0)
+
+
+@kernel
+def _curve(d, s, kind):
+    """The sigmoid `kind` at distance d [margins] with scale s (_CURVES, in their order)."""
+    if kind == GAUSSIAN:
+        return math.exp(-0.5 * float_square(d * s))
+    if kind == HYPERBOLIC:
+        return 1 / math.cosh(d * s)
+    if kind == LONG_TAIL:
+        return 1 / (float_square(d * s) + 1)
+    if kind == RECIPROCAL:
+        return 1 / (abs(d) * s + 1)
+    if kind == COSINE:
+        return (1 + math.cos(math.pi * d * s)) / 2 if abs(d * s) < 1 else 0.0
+    if kind == LINEAR:
+        return 1 - d * s if abs(d * s) < 1 else 0.0
+    if kind == QUADRATIC:
+        return 1 - float_square(d * s) if abs(d * s) < 1 else 0.0
+    return 1 - float_square(math.tanh(d * s))
+
+
+@kernel
+def tolerance_at(x, lower, upper, margin, kind, scale):
+    """tolerance of float x for bounds (lower, upper), margin and sigmoid code `kind` of scale
+    `scale` (tolerance_terms: the parameters checked there, not here)."""
+    if lower <= x <= upper:
+        return 1.0
+    if margin == 0:
+        return 0.0
+    d = (lower - x if x < lower else x - upper) / margin     # (NaN for a NaN x)
+    return _curve(d, scale, kind)
+
+
+@kernel
+def numpy_mean(a, n):
+    """np.mean of a[:n] (n >= 1) bit for bit: 0.0 plus numpy's pairwise sum (a plain sum
+    below 8 entries, eight running sums up to 128), over n. Beyond 128 entries numpy splits
+    the sum in halves first, which this does not (no task has that many)."""
+    if n < 8:
+        total = 0.0
+        for i in range(n):
+            total += a[i]
+        return total / n
+    r0, r1, r2, r3 = a[0], a[1], a[2], a[3]
+    r4, r5, r6, r7 = a[4], a[5], a[6], a[7]
+    i = 8
+    while i < n - n % 8:
+        r0 += a[i]
+        r1 += a[i + 1]
+        r2 += a[i + 2]
+        r3 += a[i + 3]
+        r4 += a[i + 4]
+        r5 += a[i + 5]
+        r6 += a[i + 6]
+        r7 += a[i + 7]
+        i += 8
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        total += a[i]
+        i += 1
+    return (0.0 + total) / n

@@ -1,0 +1,127 @@
+"""planarsim.envs.dmc_rewards: each dm_control task's compiled reward gives the float of its
+Python reward (dmc.py's ``_reward_<domain>``, rewards.tolerance's float path) bit for bit,
+over random values, controls and states; and the compiled tolerance, square and mean are
+Python's and numpy's bit for bit."""
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gymnasium", reason="gymnasium is not installed (pip install -e '.[gym]')")
+pytest.importorskip("dm_control", reason="dm_control is not installed (pip install dm_control): "
+                                         "it ships the suite's model files")
+
+from planarsim.compiled import jit  # noqa: E402
+from planarsim.envs import dmc  # noqa: E402
+from planarsim.envs.dmc_rewards import reward_of_values  # noqa: E402
+from planarsim.envs.rewards import (SIGMOIDS, float_square, numpy_mean, tolerance,  # noqa: E402
+                                    tolerance_at, tolerance_terms)
+
+TASKS = list(dmc.TASKS)
+# the reward values that are sizes (tolerance margins or bounds: never negative)
+SIZES = {"radius", "radii", "target_size"}
+
+
+def same(a, b):
+    """a and b the same float, bit for bit (NaN equal to NaN)."""
+    return np.float64(a).view(np.int64) == np.float64(b).view(np.int64)
+
+
+@jit
+def _tolerances(x, lower, upper, margin, kind, scale, out):
+    for i in range(x.shape[0]):
+        out[i] = tolerance_at(x[i], lower, upper, margin, kind, scale)
+
+
+@jit
+def _squares(x, out):
+    for i in range(x.shape[0]):
+        out[i] = float_square(x[i])
+
+
+@jit
+def _mean(a, n):
+    return numpy_mean(a, n)
+
+
+def _draws(rng, n):
+    """n floats around the tasks' bounds, over many scales, with both signs."""
+    base = rng.choice([0.0, 0.6, 1.0, 1.2, 2.0, 8.0, 10.0, -1.0, 15.0], n)
+    return base + rng.standard_normal(n) * 10.0 ** rng.uniform(-3, 1.3, n)
+
+
+@pytest.mark.parametrize("kind", SIGMOIDS)
+def test_compiled_tolerance_is_the_float_path_bit_for_bit(kind):
+    rng = np.random.default_rng(SIGMOIDS.index(kind))
+    x = np.append(_draws(rng, 20000), [np.nan, np.inf, -np.inf, 0.0, -0.0])
+    value = 0.0 if kind in ("cosine", "linear", "quadratic") else 0.1
+    for bounds, margin, v in (((0.0, 0.0), 1.0, value), ((1.2, np.inf), 0.6, 0.5 if value else 0.0),
+                              ((-0.5, 2.0), 0.0, 0.1), ((0.0, 0.3), 5.0, 0.3)):
+        lower, upper, m, scale = tolerance_terms(bounds, margin, kind, v)
+        out = np.empty_like(x)
+        _tolerances(x, lower, upper, m, SIGMOIDS.index(kind), scale, out)
+        ref = np.array([tolerance(float(xi), bounds, margin, kind, v) for xi in x])
+        bad = ~(out.view(np.int64) == ref.view(np.int64))
+        assert not bad.any(), (kind, bounds, x[bad][:5], out[bad][:5], ref[bad][:5])
+
+
+def test_compiled_square_is_cpythons_not_x_times_x():
+    """x ** 2 of a Python float is libm's pow, which differs from x * x in the last bit now
+    and then: the compiled square is pow's (x * x would miss those)."""
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal(200000) * 10.0 ** rng.integers(-8, 8, 200000)
+    out = np.empty_like(x)
+    _squares(x, out)
+    ref = np.array([xi ** 2 for xi in x.tolist()])
+    assert np.array_equal(out.view(np.int64), ref.view(np.int64))
+    assert not np.array_equal((x * x).view(np.int64), ref.view(np.int64))    # (the case)
+
+
+def test_compiled_mean_is_numpys():
+    rng = np.random.default_rng(4)
+    for n in list(range(1, 40)) + [100, 127, 128]:
+        for _ in range(50):
+            a = rng.standard_normal(n)
+            assert same(_mean(a, n), np.mean(a.tolist())), n
+        for zeros in ([-0.0] * n, [0.0] + [-0.0] * (n - 1)):      # (the sign of a zero sum)
+            assert same(_mean(np.array(zeros), n), np.mean(zeros)), n
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_compiled_reward_is_the_python_reward_bit_for_bit(task):
+    """Over random reward values and controls (the controls beyond ctrlrange too: the
+    reward reads the action as given)."""
+    env = dmc.DMCEnv(task)
+    env.reset(seed=0)
+    e = env._arrays
+    names = env._readout.value_names
+    n_obs = env._n_obs
+    rng = np.random.default_rng(sum(map(ord, task)))
+    values = np.zeros_like(env._values)
+    for i in range(3000):
+        x = _draws(rng, len(names))
+        for j, name in enumerate(names):
+            if name in SIZES:
+                x[j] = abs(x[j])
+        values[n_obs:] = x
+        ctrl = rng.uniform(-1.5, 1.5, len(env._ctrl))
+        ctrl[rng.random(len(ctrl)) < 0.2] = 0.0
+        env._ctrl[:] = ctrl
+        ours = reward_of_values(e.reward_code, values[n_obs:], e.reward_p, env._ctrl, e.scratch)
+        ref = env._reward_of(values)
+        assert same(ours, ref), (task, dict(zip(names, x)), ctrl, ours, ref)
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_an_episodes_rewards_are_the_python_rewards(task):
+    """Along a random-action episode (and after set_control), env.step's and env.reward()'s
+    reward (compiled) equal the Python reward of the same readings."""
+    env = dmc.DMCEnv(task)
+    env.reset(seed=1)
+    rng = np.random.default_rng(1)
+    for _ in range(100):
+        _, r, _, _, _ = env.step(rng.uniform(env.action_space.low, env.action_space.high))
+        assert same(r, env._reward_of(env._values))
+        env.set_control(rng.uniform(-2, 2, len(env._ctrl)))
+        assert same(env.reward(), env._reward_of(env._values))
+    assert math.isfinite(r)
