@@ -15,9 +15,10 @@ One class, :class:`DMCEnv`; each domain is a few functions (its initialisation, 
 and its reward, written as dm_control's ``Physics`` / ``Task`` methods are), each task a row
 of ``TASKS`` (its domain and parameters: walker stand / walk / run differ by a target speed).
 A domain's readings (its observation entries, then the values its reward reads) are a table
-of operations (:mod:`.readout`) written at a reset and computed by one compiled call per env
-step, with the reward (each domain's compiled from those values: dmc_rewards.py, the same float
-as its Python function here).
+of operations (:mod:`.readout`) written at a reset and computed with the reward (each domain's
+compiled from those values: dmc_rewards.py, the same float as its Python function here) by one
+compiled call; in the fast compile mode that call also loads the action's commands and runs
+the physics steps, so that an env step is one compiled call (dmc_step.py).
 The quantities dm_control reads from MuJoCo's data (body frames ``xpos`` / ``xmat``, body
 centres of mass ``xipos``, site and geom positions, the sensors ``subtreelinvel``,
 ``velocimeter``, ``gyro``, ``framepos``, ``jointpos``, ``jointvel``, ``touch``) are
@@ -46,11 +47,13 @@ from gymnasium import spaces
 
 from ..mjcf import parse_xml
 from ..start_check import shape_overlaps
+from ..checks import MAX_STEPS
 from ..compile import FAST, MODE, TABLES
+from ..kernels.checks.guards import GUARD_ROOM
 from ..link.step import bind
 from .core import PlanarMujocoEnv
 from .dmc_rewards import reward_params
-from .dmc_step import DMCArrays, dmc_observe
+from .dmc_step import ACTION_REFUSED, DMCArrays, dmc_observe, dmc_step
 from .readout import Readout, read
 
 if TABLES:
@@ -813,7 +816,7 @@ class DMCEnv(PlanarMujocoEnv):
             self._drive_id, self._drive_gain, self._u, *tables, self._values, p,
             np.zeros(room), r.n_obs, code)
         self._table = TableHandle(self._arrays) if TABLES else self._arrays
-        self._observe_call = None
+        self._observe_call = self._step_call = self._observe_type = None
 
     def _sim_table(self):
         """The simulator's StepArgs as compiled code takes it (its handle where TABLES)."""
@@ -829,7 +832,9 @@ class DMCEnv(PlanarMujocoEnv):
         call = self._observe_call
         if call is None or (MODE == FAST and sim.numba_type is not self._observe_type):
             call = self._observe_call = bind(dmc_observe, (sim, self._table))
-            self._observe_type = sim.numba_type if MODE == FAST else None
+            if MODE == FAST:      # and the whole env step (elsewhere Simulator.steps, then this)
+                self._observe_type = sim.numba_type
+                self._step_call = bind(dmc_step, (sim, self._table, self._ctrl, 1))
         return call(sim, self._table)
 
     def _read(self) -> np.ndarray:
@@ -882,7 +887,31 @@ class DMCEnv(PlanarMujocoEnv):
 
     def step(self, action):
         a = np.asarray(action, dtype=np.float64)
-        self._advance(a, self.frame_skip)          # (raises for an action of the wrong shape
-        self._ctrl[:] = a                          # or with a NaN: the control stays)
-        reward = self._observe()
+        call, n = self._step_call, self.frame_skip
+        if (call is not None and self._readout is not None and self._advanced is None
+                and a.ndim == 1 and a.flags.c_contiguous and type(n) is int and 0 <= n <= MAX_STEPS
+                and self.sim._args.numba_type is self._observe_type):
+            # the fast compile mode: one compiled call (dmc_step.dmc_step)
+            code, done, reward = call(self.sim._args, self._table, a, n)
+            if code:
+                reward = self._finish_step(a, n, code, done)
+        else:
+            self._advance(a, n)                    # (raises for an action of the wrong shape
+            self._ctrl[:] = a                      # or with a NaN: the control stays)
+            reward = self._observe()
         return self._obs_values.copy(), reward, False, False, {}
+
+    def _finish_step(self, a, n, code, done):
+        """The rest of a dmc_step that stopped with `code` after `done` physics steps: an
+        action refused raises naming what is wrong; a step out of solve storage (GUARD_ROOM)
+        grows it and the steps go on as Simulator.steps takes them; any other code raises
+        SimulationDiverged. Returns the reward."""
+        if code == ACTION_REFUSED:
+            self.check_action(a)                   # (raises)
+            raise AssertionError(f"dmc_step refused action {a.tolist()}")
+        if code != GUARD_ROOM:
+            self.sim._raise(code)
+        self.sim._grow()
+        self.sim._run_steps(self._u, n - done)
+        self._ctrl[:] = a
+        return self._observe()

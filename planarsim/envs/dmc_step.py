@@ -81,5 +81,6 @@ def dmc_step(args, e, action, n):
     code, done = run_steps(args, e.u, n)
     if code != 0:
         return code, done, 0.0
-    e.ctrl[:] = action
+    for k in range(action.shape[0]):
+        e.ctrl[k] = action[k]
     return 0, n, dmc_observe(args, e)

@@ -125,3 +125,86 @@ def test_an_episodes_rewards_are_the_python_rewards(task):
         env.set_control(rng.uniform(-2, 2, len(env._ctrl)))
         assert same(env.reward(), env._reward_of(env._values))
     assert math.isfinite(r)
+
+
+# --- the env step as one compiled call (dmc_step) ---------------------------------------
+
+def _episode(env, actions, seed):
+    out = [env.reset(seed=seed)[0]]
+    for a in actions:
+        obs, r, _, _, _ = env.step(a)
+        out.append(np.append(obs, r))
+    return np.concatenate(out)
+
+
+def _unfused(env):
+    """env made to step as outside the fast compile mode: Simulator.steps, then dmc_observe."""
+    env._step_call = None
+    return env
+
+
+@pytest.mark.parametrize("task", ["walker-walk", "hopper-hop", "finger-turn_hard"])
+def test_the_fused_step_is_the_unfused_steps_bit_for_bit(task):
+    rng = np.random.default_rng(5)
+    env = dmc.DMCEnv(task)
+    acts = rng.uniform(env.action_space.low, env.action_space.high, (60, len(env._ctrl)))
+    # actions as lists, float32 and strided arrays: converted as before (a copy if needed)
+    given = [a.tolist() if i % 3 == 0 else a.astype(np.float32) if i % 3 == 1 else a
+             for i, a in enumerate(acts)]
+    wide = np.repeat(acts, 2, axis=1)
+    given[7] = wide[7, ::2]                                 # (not contiguous: the Python path)
+    ours = _episode(env, given, seed=4)
+    ref = _episode(_unfused(dmc.DMCEnv(task)), [np.asarray(a, np.float64) for a in given], 4)
+    assert np.array_equal(ours.view(np.int64), ref.view(np.int64))
+
+
+def test_a_bad_action_is_named_and_changes_nothing():
+    env, ref = dmc.DMCEnv("cheetah-run"), dmc.DMCEnv("cheetah-run")
+    env.reset(seed=0)
+    ref.reset(seed=0)
+    a = np.full(6, 0.3)
+    env.step(a)
+    ref.step(a)
+    for bad, said in ((np.zeros(5), r"action has shape \(5,\).*takes shape \(6,\)"),
+                      (np.zeros((1, 6)), r"action has shape \(1, 6\)"),
+                      ([0.1] * 5 + [np.nan], "has NaN or infinite entries"),
+                      (np.array([np.inf] + [0.0] * 5), "has NaN or infinite entries")):
+        with pytest.raises(ValueError, match=said):
+            env.step(bad)
+    assert np.array_equal(env.control(), a)
+    b = np.full(6, -0.2)
+    assert all(np.array_equal(x, y) for x, y in zip(env.step(b)[:2], ref.step(b)[:2]))
+
+
+def _small_storage(env):
+    """env's simulator with solve storage for one envelope entry and one complementarity row
+    (kept by its resets): the first step with contacts runs out of room."""
+    from planarsim.state import make_workspace
+    sim = env.sim
+    sim._ws = make_workspace(env.sim_model, 1, 1, 1)
+    sim._fresh_ws = None
+    sim._repack()
+    return env
+
+
+def test_a_step_out_of_room_grows_and_keeps_the_bits(monkeypatch):
+    """A fused step that runs out of solve storage is undone, the storage grows and the step
+    finishes from Python (as Simulator.steps does), with the bits of the unfused step (which
+    grows alike)."""
+    from planarsim.compile import FAST, MODE
+    from planarsim.state import workspace_capacity
+    finished = []
+    finish = dmc.DMCEnv._finish_step
+    monkeypatch.setattr(dmc.DMCEnv, "_finish_step",
+                        lambda self, *a: finished.append(a[2:]) or finish(self, *a))
+    rng = np.random.default_rng(2)
+    env = _small_storage(dmc.DMCEnv("walker-walk"))
+    acts = rng.uniform(-1, 1, (100, len(env._ctrl)))
+    ours = _episode(env, acts, seed=1)
+    ref_env = _unfused(_small_storage(dmc.DMCEnv("walker-walk")))
+    ref = _episode(ref_env, acts, seed=1)
+    assert np.array_equal(ours.view(np.int64), ref.view(np.int64))
+    assert workspace_capacity(env.sim_model, env.sim.ws)[1] > 1          # (it grew)
+    assert ref_env._step_call is None
+    if MODE == FAST:
+        assert finished and all(code == dmc.GUARD_ROOM for code, _ in finished)
