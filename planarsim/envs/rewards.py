@@ -164,7 +164,15 @@ else:
     # published before compiled code that calls it is compiled or loaded: LLVM knows `pow`
     # and would fold pow(x, 2.0) into x * x; it cannot see into this one
     _POW = "planarsim_libm_pow"
-    llvm.add_symbol(_POW, ctypes.cast(ctypes.CDLL(None).pow, ctypes.c_void_p).value)
+
+    def _libm():
+        try:
+            return ctypes.CDLL(None)           # the process's symbols (POSIX)
+        except (OSError, TypeError):           # (Windows: the C runtime's)
+            from ctypes.util import find_library
+            return ctypes.CDLL(find_library("m") or find_library("c"))
+
+    llvm.add_symbol(_POW, ctypes.cast(_libm().pow, ctypes.c_void_p).value)
 
     @intrinsic
     def _libm_pow(typingctx, x, y):
