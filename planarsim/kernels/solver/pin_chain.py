@@ -391,8 +391,9 @@ def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
     """Stage 8's Newton-SHAKE on the levers, integrate.correct_positions' passes: up to iters
     of J(q) W J0^T mu = -c(q), q += W J0^T mu, v += W J0^T mu / h until every gap is within
     tol [m] (a pass after one that left every gap within CHORD_TOL reuses its factorisation;
-    one more pass on the last factorisation after the last, as correct_positions takes it:
-    the end's derivative becomes the converged correction's; each pass's impulses over h into
+    one more pass on the last factorisation after the last, as correct_positions takes it
+    (not after a chord pass taken at gaps within CHORD_TOL): the end's derivative becomes the
+    converged correction's; each pass's impulses over h into
     ws.pin_impulse_moved, record_lever_impulses); returns (the largest gap left, or -1: a pass that removed less than half
     of it, a pivot share at or below pivot_tol, the general stages take the step; the passes
     taken). ws.body_cs holds the cos / sin of the step's start on entry, of q on a return with
@@ -402,6 +403,7 @@ def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
     worst = lever_gaps(m, s.q, ws.chain_cs, ws, 2)
     fresh = True
     passes = 0
+    taken_at = 0.0      # the largest gap the last pass was taken at
     inv_h = 1.0 / h
     for _ in range(iters):
         if worst <= tol:
@@ -418,9 +420,10 @@ def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
         if after > STALLED_RATIO * worst:
             return -1.0, passes
         fresh = after > CHORD_TOL
+        taken_at = worst
         worst = after
         passes += 1
-    if passes > 0 and 0.0 < worst <= tol:
+    if passes > 0 and 0.0 < worst <= tol and taken_at > CHORD_TOL:
         chain_solve(ws, ws.rhs, ws.lam)
         lever_move(m, ws, ws.lam, s.q, 1.0, s.v, inv_h)
         record_lever_impulses(ws, inv_h)
