@@ -208,3 +208,25 @@ def test_a_step_out_of_room_grows_and_keeps_the_bits(monkeypatch):
     assert ref_env._step_call is None
     if MODE == FAST:
         assert finished and all(code == dmc.GUARD_ROOM for code, _ in finished)
+
+
+@pytest.mark.parametrize("fused", [True, False])
+def test_a_diverged_step_raises_naming_it(fused):
+    """A physics step that the guards stop (here a speed of 1e200 m/s put in by set_state)
+    raises SimulationDiverged from env.step, fused or not, and leaves the last control and
+    readings as they were."""
+    import planarsim as ps
+    env = dmc.DMCEnv("walker-walk")
+    if not fused:
+        _unfused(env)
+    env.reset(seed=0)
+    a = np.full(len(env._ctrl), 0.25)
+    env.step(a)
+    qpos, qvel = env.data.qpos.copy(), env.data.qvel.copy()
+    qvel[0] = 1e200
+    env.set_state(qpos, qvel)
+    readings = env._obs_values.copy()
+    with pytest.raises(ps.SimulationDiverged, match=r"body .torso.* exceeds 1e\+10"):
+        env.step(np.full(len(env._ctrl), -0.5))
+    assert np.array_equal(env.control(), a)
+    assert np.array_equal(env._obs_values, readings)
