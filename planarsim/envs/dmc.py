@@ -576,7 +576,8 @@ class DMCEnv(PlanarMujocoEnv):
     action: one control per actuator in its ctrlrange (float64, as dm_control's action_spec);
     reward: dm_control's ``get_reward`` of the state after the step; never terminates (the
     registered ids truncate at dm_control's time limit). reset(seed=s) draws the initial
-    state as dm_control's task does from numpy.random.RandomState(s).
+    state as dm_control's task does from numpy.random.RandomState(s). ``env.params`` (the
+    task's parameters: stand_height, move_speed, ...) are read by the reward at each reset.
 
     ``suite_dir``: where the suite's files are (default: the installed dm_control's);
     remaining keywords go to PlanarMujocoEnv (render_mode, width, height, load_mjcf's).
@@ -787,9 +788,16 @@ class DMCEnv(PlanarMujocoEnv):
         # plan's, the last table stands (most tasks draw no target: a reset writes nothing)
         key = (None if self.target is None else tuple(self.target.tolist()),
                sorted(self.geom_size_override.items()), sorted(self.site_size_override.items()))
-        if key == self._plan_key:
+        # the bound arrays stand while they are still this env's own (a batched vector env
+        # gives each copy's commands a row of its array: envs/batched.py) and the reward's
+        # parameters (self.params, read at each plan) fit them
+        bound = getattr(self, "_arrays", None)
+        if bound is not None and bound.u is not self._u:
+            bound = None
+        if key == self._plan_key and bound is not None:
             self._readout = self._planned
-            return
+            if self._reward_params_into(bound, self._planned):
+                return
         r = Readout(self)
         self.domain.plan(self, r)
         tables = r.tables()
@@ -797,7 +805,9 @@ class DMCEnv(PlanarMujocoEnv):
         self._plan_key, self._planned = key, r
         self._readout = r
         self._n_obs = r.n_obs
-        if old is not None and all(a.shape == b.shape for a, b in zip(old, tables)):
+        if (bound is not None and old is not None
+                and all(a.shape == b.shape for a, b in zip(old, tables))
+                and self._reward_params_into(bound, r)):
             # the same table with new numbers (a target drawn, a size set): written into the
             # arrays the compiled call is bound to, which stays bound (binding it again, numba
             # typing its arguments, was most of a reset's time)
@@ -817,6 +827,17 @@ class DMCEnv(PlanarMujocoEnv):
             np.zeros(room), r.n_obs, code)
         self._table = TableHandle(self._arrays) if TABLES else self._arrays
         self._observe_call = self._step_call = self._observe_type = None
+
+    def _reward_params_into(self, bound, readout) -> bool:
+        """The compiled reward's parameters from self.params as they are now, written into
+        the bound DMCArrays `bound`; False (nothing written) where they no longer fit it."""
+        code, p, room = reward_params(self.domain_name, self.params, readout.value_names,
+                                      len(self._act))
+        if (code != bound.reward_code or p.shape != bound.reward_p.shape
+                or room > bound.scratch.shape[0]):
+            return False
+        bound.reward_p[...] = p
+        return True
 
     def _sim_table(self):
         """The simulator's StepArgs as compiled code takes it (its handle where TABLES)."""
@@ -890,7 +911,8 @@ class DMCEnv(PlanarMujocoEnv):
         call, n = self._step_call, self.frame_skip
         if (call is not None and self._readout is not None and self._advanced is None
                 and a.ndim == 1 and a.flags.c_contiguous and type(n) is int and 0 <= n <= MAX_STEPS
-                and self.sim._args.numba_type is self._observe_type):
+                and self.sim._args.numba_type is self._observe_type
+                and self._arrays.u is self._u):
             # the fast compile mode: one compiled call (dmc_step.dmc_step)
             code, done, reward = call(self.sim._args, self._table, a, n)
             if code:

@@ -10,6 +10,7 @@ Python one's float bit for bit."""
 from __future__ import annotations
 
 import math
+import sys
 import warnings
 
 import numpy as np
@@ -166,11 +167,12 @@ else:
     _POW = "planarsim_libm_pow"
 
     def _libm():
-        try:
-            return ctypes.CDLL(None)           # the process's symbols (POSIX)
-        except (OSError, TypeError):           # (Windows: the C runtime's)
-            from ctypes.util import find_library
-            return ctypes.CDLL(find_library("m") or find_library("c"))
+        """The C library whose pow CPython's float power calls: the process's own symbols
+        (POSIX), the Universal C Runtime on Windows (CPython 3.5+ links it; CDLL(None) is
+        refused there and find_library finds no C runtime)."""
+        if sys.platform == "win32":
+            return ctypes.CDLL("ucrtbase")
+        return ctypes.CDLL(None)
 
     llvm.add_symbol(_POW, ctypes.cast(_libm().pow, ctypes.c_void_p).value)
 

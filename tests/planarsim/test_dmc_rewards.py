@@ -230,3 +230,51 @@ def test_a_diverged_step_raises_naming_it(fused):
         env.step(np.full(len(env._ctrl), -0.5))
     assert np.array_equal(env.control(), a)
     assert np.array_equal(env._obs_values, readings)
+
+
+def test_a_batched_copy_stepping_alone_commands_its_own_row(monkeypatch):
+    """A batched vector env gives each copy's commands a row of one array; a copy that then
+    steps alone (its frame_skip set apart: the batched step leaves it to the copy) and runs
+    out of solve storage finishes its step under its own commands, bit for bit the steps of
+    a lone env (before: the fused step wrote the commands to the array the copy had at its
+    making, and the finish ran the row's, the last batched step's)."""
+    from planarsim.compile import FAST, MODE
+    from planarsim.envs.batched import make_batched
+    finished = []
+    finish = dmc.DMCEnv._finish_step
+    monkeypatch.setattr(dmc.DMCEnv, "_finish_step",
+                        lambda self, *a: finished.append(a[2:]) or finish(self, *a))
+    acts = np.random.default_rng(0).uniform(-1, 1, (40, 6))
+    vec = make_batched(dmc.env_id("walker-walk"), num_envs=1)
+    copy = vec._copies[0]
+    ref = dmc.DMCEnv("walker-walk")
+    vec.reset(seed=1)
+    ref.reset(seed=1)
+    for a in acts[:5]:
+        vec.step(a[None])
+        ref.step(a)
+    vec.set_attr("frame_skip", 7)
+    ref.frame_skip = 7
+    _small_storage(copy)
+    _unfused(_small_storage(ref))
+    for a in acts[5:]:
+        ours, theirs = vec.step(a[None])[0][0], ref.step(a)[0]
+        assert np.array_equal(ours.view(np.int64), theirs.view(np.int64))
+    if MODE == FAST:
+        assert finished and all(code == dmc.GUARD_ROOM for code, _ in finished)
+
+
+@pytest.mark.parametrize("task", ["walker-walk", "hopper-stand", "cartpole-swingup"])
+def test_task_parameters_are_read_at_each_reset(task):
+    """env.params changed between episodes: the next reset's compiled reward reads them, and
+    equals the Python reward of the same values."""
+    env = dmc.DMCEnv(task)
+    env.reset(seed=0)
+    key = {"walker-walk": "stand_height", "hopper-stand": "stand_height",
+           "cartpole-swingup": None}[task]
+    if key is not None:
+        env.params[key] = 1.5 * env.params[key]
+    env.reset(seed=0)
+    for a in np.random.default_rng(1).uniform(-1, 1, (20, len(env._ctrl))):
+        reward = env.step(a)[1]
+        assert reward == env._reward_of(env._values)
