@@ -674,10 +674,10 @@ def correct_positions(m, s, ws, h, iters, tol, pivot_tol, envelope_ready):
         # respect to the step's start and commands off by about r / (the bodies' size):
         # 1e-6 where Newton's last step was taken at r ~ sqrt(tol) (tol 1e-12), what
         # derivatives.step_jacobian, exact for the converged correction, would disagree by,
-        # and about the square of that after this one. After a chord pass taken at
-        # r <= CHORD_TOL (a walker's usual second pass) it is off by 1e-8 at most already,
-        # and this step is left out. The residual returned is the one before this step (it
-        # only shrinks).
+        # and about the square of that after this one. After a last pass taken at
+        # r <= CHORD_TOL (a walker's usual second pass, a chord pass; or a fresh pass that
+        # began there) it is off by 1e-8 at most already, and this step is left out. The
+        # residual returned is the one before this step (it only shrinks).
         move_by_correction(m, s, ws, h, n, keep_targets(ws, n))
         update_trig(s.q, ws.body_cs)
     return worst

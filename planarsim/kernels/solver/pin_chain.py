@@ -392,12 +392,12 @@ def lever_correct(m, s, ws, h, iters, tol, pivot_tol):
     of J(q) W J0^T mu = -c(q), q += W J0^T mu, v += W J0^T mu / h until every gap is within
     tol [m] (a pass after one that left every gap within CHORD_TOL reuses its factorisation;
     one more pass on the last factorisation after the last, as correct_positions takes it
-    (not after a chord pass taken at gaps within CHORD_TOL): the end's derivative becomes the
-    converged correction's; each pass's impulses over h into
-    ws.pin_impulse_moved, record_lever_impulses); returns (the largest gap left, or -1: a pass that removed less than half
-    of it, a pivot share at or below pivot_tol, the general stages take the step; the passes
-    taken). ws.body_cs holds the cos / sin of the step's start on entry, of q on a return with
-    a gap >= 0."""
+    (not after a last pass taken at gaps within CHORD_TOL): the end's derivative becomes the
+    converged correction's; each pass's impulses over h into ws.pin_impulse_moved,
+    record_lever_impulses); returns (the largest gap left, or -1: a pass that removed less
+    than half of it, a pivot share at or below pivot_tol, the general stages take the step;
+    the passes taken). ws.body_cs holds the cos / sin of the step's start on entry, of q on
+    a return with a gap >= 0."""
     clear_moved_impulses(ws)
     carry_trig(s.q, ws.body_cs, ws.chain_cs)
     worst = lever_gaps(m, s.q, ws.chain_cs, ws, 2)
