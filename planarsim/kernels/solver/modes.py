@@ -22,6 +22,7 @@ from ..codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED, MODE_SLIDING
 from ..geometry.contacts import contact_velocity, engage_contact, pair_motion_scale, refresh_contact
 from ..geometry.pair import PAIR_ENGAGE_SLACK, pair_speed
 from ..checks.audit import IMPULSE_FLOOR
+from ..checks.work import VELOCITY_FLOOR
 from .mixed_lcp import is_sliding_solution
 from ..constraints.limit import limit_side
 from ..constraints.joints import is_slider, joint_position_rate
@@ -217,12 +218,17 @@ def rule_breaks(m, s, ws, h, equalities):
                 vn, vt = contact_velocity(m, s, ws, o, ws.v_new)
                 vn_free, vt_free = contact_velocity(m, s, ws, o, ws.v_pred)
                 # friction along a reversed slip would add energy: only a reversal at the
-                # rounding level of the contact's free motion passes (of a shape pair, of
-                # both bodies' motion: falling together, their relative motion is rounding)
+                # rounding level passes, the solve's (VELOCITY_FLOOR: a contact velocity
+                # the audit's work rule takes for rounding) and that of the contact's free
+                # motion (of a shape pair, of both bodies' motion: falling together, their
+                # relative motion is rounding). A contact at its cone's edge in a pile at
+                # rest otherwise switched between pinned (friction 1e-6 beyond the cone)
+                # and sliding (its slip reversed at 1e-14 to 1e-11 m/s) at every step, each
+                # step then a complementarity solve of the whole pile
                 scale = abs(vn_free) + abs(vt_free)
                 if m.contact_kind[o] == CONTACT_PAIR:
                     scale += pair_motion_scale(s, ws, o, ws.v_pred)
-                if vt * s.contact_slip[o] < -SLIP_ROUNDING * scale:
+                if vt * s.contact_slip[o] < -(VELOCITY_FLOOR + SLIP_ROUNDING * scale):
                     breaks += 1
         elif is_tangent_row(kind):
             size = abs(ws.lam[r]) + abs(ws.lam[r - 1])
