@@ -36,7 +36,7 @@ from .dynamics.integrate import (bound_correction_work, commit_moved_impulses, i
                                  predict_configuration)
 from .constraints.joint_friction import start_joint_friction, stick_all, switch_joint_friction
 from .math2d import update_trig
-from .solver.modes import (check_contact, engage_contacts, engage_limits, gather_contact_impulses,
+from .solver.modes import (engage_contacts, engage_limits, switch_broken, gather_contact_impulses,
                            rule_breaks, seed_rule)
 from .geometry.pair import PAIR_MARGIN
 from .solver.pin_chain import (chain_prediction, lever_correct, lever_joint_work,
@@ -46,8 +46,7 @@ from .solver.rebound import rebound_gain, rebounding
 from .prev_copy import add_synced, back_to_prev, copy_state, keep_prev, keep_prev_bodies
 from .geometry.pair_toi import hold_off_fast_pairs
 from .dynamics.position import ROWS_HELD_SHARE, position_stage
-from .constraints.limit import limit_side
-from .constraints.rows import build_rows, is_limit_row
+from .constraints.rows import build_rows
 from .constraints.soft import soft_prediction
 from .solver.solve import solve_impulses
 from .dynamics.rattle import (longest_stage, rattle_begin, rattle_end, stage_count, stage_weight,
@@ -233,25 +232,13 @@ SWITCH_STALL = 3
 
 @kernel
 def switch_contacts(m, s, ws, only_first):
-    """Listed contacts re-examined by the rules (modes.check_contact: release if it pulls,
-    slide if its friction leaves the cone, stick if its slip reversed), then the engaged
-    joint limits (released if its impulse pulls: a limit is a complementarity variable as a
-    contact's normal is): every one at once, or only_first the first in that order that
-    changes; returns how many changed."""
+    """The listed contacts and engaged joint limits that break a rule in the last answer
+    switched by the rules (modes.switch_broken: release if it pulls, slide if its friction
+    leaves the cone, stick if its slip reversed; a limit is released if its impulse pulls:
+    a limit is a complementarity variable as a contact's normal is): every one at once, or
+    only_first the first that breaks one; returns how many changed."""
     gather_contact_impulses(m, s, ws)
-    changed = 0
-    for k in range(ws.n_live[0]):
-        changed += check_contact(m, s, ws, ws.live[k])
-        if only_first and changed > 0:
-            return changed
-    for r in range(ws.n_row[0]):
-        kind = ws.row_kind[r]
-        if is_limit_row(kind) and ws.lam[r] < 0.0:
-            s.limit_active[ws.row_owner[r], limit_side(kind)] = 0
-            changed += 1
-            if only_first:
-                break
-    return changed
+    return switch_broken(m, s, ws, only_first)
 
 
 @kernel(inline="always")

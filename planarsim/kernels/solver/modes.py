@@ -167,6 +167,138 @@ def _contact_size(m, s, ws, r):
     return abs(ws.lam[r]) * (1.0 + m.contact_mu[ws.row_owner[r]])
 
 
+# the rule a contact breaks in an answer (contact_rule), each calling for its switch
+RULE_KEPT = 0
+RULE_PULLS = 1      # its normal impulse pulls: released
+RULE_CONE = 2       # pinned, its friction beyond the cone: slides against its friction
+RULE_REVERSED = 3   # sliding, its slip reversed: sticks
+
+
+@kernel
+def impulse_floor(ws):
+    """The rounding [N s] of a contact that carries no load in the last answer (a
+    statically indeterminate pile: a box on two): IMPULSE_FLOOR of its largest normal
+    impulse."""
+    big = 0.0
+    for r in range(ws.n_row[0]):
+        if is_normal_row(ws.row_kind[r]):
+            big = max(big, abs(ws.lam[r]))
+    return IMPULSE_FLOOR * big
+
+
+@kernel
+def _slip_reversed(m, s, ws, o):
+    """Sliding contact o's slip reversed in the answer ws.v_new beyond rounding.
+    Friction along a reversed slip would add energy: only a reversal at the rounding level
+    passes, the solve's (VELOCITY_FLOOR: a contact velocity the audit's work rule takes for
+    rounding) and that of the contact's free motion (of a shape pair, of both bodies'
+    motion: falling together, their relative motion is rounding). A contact at its cone's
+    edge in a pile at rest otherwise switched between pinned (friction 1e-6 beyond the
+    cone) and sliding (its slip reversed at 1e-14 to 1e-11 m/s) at every step, each step
+    then a complementarity solve of the whole pile."""
+    vn, vt = contact_velocity(m, s, ws, o, ws.v_new)
+    vn_free, vt_free = contact_velocity(m, s, ws, o, ws.v_pred)
+    scale = abs(vn_free) + abs(vt_free)
+    if m.contact_kind[o] == CONTACT_PAIR:
+        scale += pair_motion_scale(s, ws, o, ws.v_pred)
+    return vt * s.contact_slip[o] < -(VELOCITY_FLOOR + SLIP_ROUNDING * scale)
+
+
+@kernel
+def _pulls(m, s, ws, r, floor):
+    """The contact of normal row r pulls, judged against its own impulse (as the audit
+    judges it) and floor (impulse_floor)."""
+    return ws.lam[r] < -(SOLVE_REL_TOL * _contact_size(m, s, ws, r) + floor)
+
+
+@kernel
+def _beyond_cone(m, ws, r, floor):
+    """The friction of tangent row r (its normal row r - 1) leaves the cone beyond rounding."""
+    size = abs(ws.lam[r]) + abs(ws.lam[r - 1])
+    return abs(ws.lam[r]) > m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1] + SOLVE_REL_TOL * size + floor
+
+
+@kernel
+def contact_rule(m, s, ws, r, floor):
+    """The rule (RULE_*) the contact of normal row r breaks in the last answer, by
+    rule_breaks' tolerances (floor: impulse_floor), RULE_KEPT if none."""
+    if _pulls(m, s, ws, r, floor):
+        return RULE_PULLS
+    o = ws.row_owner[r]
+    if s.contact_mode[o] == MODE_SLIDING:
+        if _slip_reversed(m, s, ws, o):
+            return RULE_REVERSED
+    elif r + 1 < ws.n_row[0] and is_tangent_row(ws.row_kind[r + 1]):
+        if _beyond_cone(m, ws, r + 1, floor):
+            return RULE_CONE
+    return RULE_KEPT
+
+
+@kernel
+def _switch(s, ws, o, r, rule):
+    """Contact o (normal row r) switched by the rule it breaks (contact_rule)."""
+    if rule == RULE_PULLS:
+        s.contact_mode[o] = MODE_FREE
+    elif rule == RULE_CONE:
+        s.contact_mode[o] = MODE_SLIDING
+        s.contact_slip[o] = -1.0 if ws.lam[r + 1] > 0.0 else 1.0
+    elif rule == RULE_REVERSED:
+        s.contact_mode[o] = MODE_PINNED
+
+
+@kernel
+def switch_broken(m, s, ws, only_first):
+    """The contacts whose rules the last answer breaks (by rule_breaks' tolerances)
+    switched by the rule each breaks, then the engaged limits that pull beyond them: every
+    one, or only_first the contact of least index (else the first such limit). A contact
+    that keeps its rules to those tolerances keeps its mode: switched on any reversal of its
+    slip (rounding: 1e-15 m/s), two contacts at their cones' edges in a pile took turns
+    breaking their cones, round after round, until the complementarity solve of the whole
+    pile. Returns how many changed."""
+    floor = impulse_floor(ws)
+    n = ws.n_row[0]
+    first = -1
+    first_r = -1
+    first_rule = RULE_KEPT
+    changed = 0
+    for r in range(n):
+        if not is_normal_row(ws.row_kind[r]):
+            continue
+        rule = contact_rule(m, s, ws, r, floor)
+        if rule == RULE_KEPT:
+            continue
+        o = ws.row_owner[r]
+        if only_first:
+            if first < 0 or o < first:
+                first = o
+                first_r = r
+                first_rule = rule
+            continue
+        _switch(s, ws, o, r, rule)
+        changed += 1
+    if first >= 0:
+        _switch(s, ws, first, first_r, first_rule)
+        return 1
+    tol_lam = SOLVE_REL_TOL * largest_impulse(ws)
+    for r in range(n):
+        kind = ws.row_kind[r]
+        if is_limit_row(kind) and ws.lam[r] < -tol_lam:
+            s.limit_active[ws.row_owner[r], limit_side(kind)] = 0
+            changed += 1
+            if only_first:
+                break
+    return changed
+
+
+@kernel
+def largest_impulse(ws):
+    """The largest |impulse| [N s or N m s] of the last answer's rows."""
+    big = 0.0
+    for r in range(ws.n_row[0]):
+        big = max(big, abs(ws.lam[r]))
+    return big
+
+
 @kernel
 def rule_breaks(m, s, ws, h, equalities):
     """How many rows of the last solve break a rule of contact and limits (the solve took the
@@ -183,17 +315,11 @@ def rule_breaks(m, s, ws, h, equalities):
     friction = friction_breaks(m, ws)
     if not equalities and not has_mode_rows(ws, n):
         return friction     # joints only, their equations met by the solve
-    big_lam = 0.0
     big_b = 0.0
-    big_normal = 0.0
     for r in range(n):
-        big_lam = max(big_lam, abs(ws.lam[r]))
         big_b = max(big_b, abs(ws.row_b[r]))
-        if is_normal_row(ws.row_kind[r]):
-            big_normal = max(big_normal, abs(ws.lam[r]))
-    tol_lam = SOLVE_REL_TOL * big_lam
-    # rounding of a contact that carries no load (statically indeterminate: a box on two)
-    floor = IMPULSE_FLOOR * big_normal
+    tol_lam = SOLVE_REL_TOL * largest_impulse(ws)
+    floor = impulse_floor(ws)
     tol_w = SOLVE_REL_TOL * (big_b + 1.0)
     breaks = friction
     for r in range(n):
@@ -211,28 +337,12 @@ def rule_breaks(m, s, ws, h, equalities):
             if ws.lam[r] < -tol_lam:
                 breaks += 1
         elif is_normal_row(kind):
-            # a contact's rules are judged against its own impulse (as the audit judges them)
-            if ws.lam[r] < -(SOLVE_REL_TOL * _contact_size(m, s, ws, r) + floor):
+            if _pulls(m, s, ws, r, floor):
                 breaks += 1
-            if s.contact_mode[o] == MODE_SLIDING:
-                vn, vt = contact_velocity(m, s, ws, o, ws.v_new)
-                vn_free, vt_free = contact_velocity(m, s, ws, o, ws.v_pred)
-                # friction along a reversed slip would add energy: only a reversal at the
-                # rounding level passes, the solve's (VELOCITY_FLOOR: a contact velocity
-                # the audit's work rule takes for rounding) and that of the contact's free
-                # motion (of a shape pair, of both bodies' motion: falling together, their
-                # relative motion is rounding). A contact at its cone's edge in a pile at
-                # rest otherwise switched between pinned (friction 1e-6 beyond the cone)
-                # and sliding (its slip reversed at 1e-14 to 1e-11 m/s) at every step, each
-                # step then a complementarity solve of the whole pile
-                scale = abs(vn_free) + abs(vt_free)
-                if m.contact_kind[o] == CONTACT_PAIR:
-                    scale += pair_motion_scale(s, ws, o, ws.v_pred)
-                if vt * s.contact_slip[o] < -(VELOCITY_FLOOR + SLIP_ROUNDING * scale):
-                    breaks += 1
+            if s.contact_mode[o] == MODE_SLIDING and _slip_reversed(m, s, ws, o):
+                breaks += 1
         elif is_tangent_row(kind):
-            size = abs(ws.lam[r]) + abs(ws.lam[r - 1])
-            if abs(ws.lam[r]) > m.contact_mu[o] * ws.lam[r - 1] + SOLVE_REL_TOL * size + floor:
+            if _beyond_cone(m, ws, r, floor):
                 breaks += 1
     return breaks
 
