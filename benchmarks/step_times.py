@@ -3,6 +3,7 @@ compare with the others (not a test).
 
     python benchmarks/step_times.py biped_collapse
     python benchmarks/step_times.py boxes_on_hills --repeats 25 --strategy all
+    python benchmarks/step_times.py stress:pour50 --repeats 1      # a stress scene (stress_scenes.py)
 
 Every step of the scene's bench run is timed on its own (Simulator.steps(1), best of
 --repeats runs from the same start), less the cost of an empty call. Prints the total, the
@@ -22,15 +23,25 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import planarsim as ps  # noqa: E402
 from benchmarks.scenes import SCENES  # noqa: E402
+from benchmarks.stress_scenes import ALL_SCENES, build_model  # noqa: E402
 from planarsim.compiled import step_info  # noqa: E402
+
+
+def _scene(name):
+    """(model, steps) of bench scene `name`, or of stress scene `stress:<name>` (its seconds)."""
+    if name.startswith("stress:") and name[7:] in ALL_SCENES:
+        scene = ALL_SCENES[name[7:]]
+        return build_model(scene), int(round(scene.seconds / scene.dt))
+    if name not in SCENES:
+        raise SystemExit(f"unknown scene {name!r}; scenes: {', '.join(SCENES)}, or "
+                         f"stress:<{'|'.join(ALL_SCENES)}>")
+    build, n = SCENES[name]
+    return build(), n
 
 
 def step_times(name, repeats=15, strategy="alternating"):
     """(best time of each step [ns], bool array: the step ran the complementarity solve)."""
-    if name not in SCENES:
-        raise SystemExit(f"unknown scene {name!r}; scenes: {', '.join(SCENES)}")
-    build, n = SCENES[name]
-    model = build()
+    model, n = _scene(name)
     options = ps.make_options(strategy)
     best = np.full(n, np.inf)
     lcp = np.zeros(n, bool)
@@ -53,7 +64,7 @@ def step_times(name, repeats=15, strategy="alternating"):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("scene", help=", ".join(SCENES))
+    ap.add_argument("scene", help=", ".join(SCENES) + ", or stress:<name> (stress_scenes.py)")
     ap.add_argument("--repeats", type=int, default=15)
     ap.add_argument("--strategy", choices=("alternating", "all"), default="alternating")
     args = ap.parse_args(argv)
