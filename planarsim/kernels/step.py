@@ -236,7 +236,8 @@ def switch_contacts(m, s, ws, only_first):
     switched by the rules (modes.switch_broken: release if it pulls, slide if its friction
     leaves the cone, stick if its slip reversed; a limit is released if its impulse pulls:
     a limit is a complementarity variable as a contact's normal is): every one at once, or
-    only_first the first that breaks one; returns how many changed."""
+    only_first the breaking contact of least index (a limit only where no contact breaks
+    one); returns how many changed."""
     gather_contact_impulses(m, s, ws)
     return switch_broken(m, s, ws, only_first)
 
@@ -276,8 +277,8 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
     """After the guess and the alternating check broke a rule: the contacts that break one
     switched by the rules and solved again, up to SWITCH_ROUNDS times: every one at once
     (block principal pivoting, Judice and Pires 1994), and once SWITCH_STALL rounds in a row
-    did not lower the number of broken rules, one at a time, the first in the list (Murty's
-    least-index rule, which cannot cycle where the problem is a P-matrix's). An answer that
+    did not lower the number of broken rules, one at a time, the breaking contact of least
+    index, then a limit (Murty's least-index rule, which cannot cycle where the problem is a P-matrix's). An answer that
     breaks none but pushes further contacts into touch is solved again with them, as in
     solve_modes. A pile settling with many contacts that start or stop sliding in one step
     (a pour of 50 shapes) finds its modes in linear solves, where the complementarity solve

@@ -10,10 +10,12 @@ meets for every contact and limit at once:
   limits   a limit's impulse pushes; an inactive limit is not passed
   joint friction  a stuck joint's impulse within F h; a slipping joint's rate not reversed
            (joint_friction.py)
-rule_breaks checks a guess's answer (the modes carried over); engage_* bring contacts and
-limits the motion would push through into the problem; seed_rule is the alternating
-strategy's one-contact re-examination (release if it pulls, slide outside the cone, stick on
-reversal); modes_from_solution reads the modes off a complementarity solution.
+rule_breaks checks a guess's answer (the modes carried over), each contact by contact_rule,
+beyond the solve's rounding; switch_broken switches the contacts (and limits) that break a rule
+by those same tolerances (the switching rounds); engage_* bring contacts and limits the motion
+would push through into the problem; seed_rule is the alternating strategy's one-contact
+re-examination by the rules' bare signs (check_contact: release if it pulls, slide outside the
+cone, stick on reversal); modes_from_solution reads the modes off a complementarity solution.
 """
 import math
 
