@@ -274,20 +274,20 @@ def modes_key(s, ws, stall, fewest):
 
 @kernel(inline="never")
 def switch_rounds(m, s, ws, opt, h, include_ccd):
-    """After the guess and the alternating check broke a rule: the contacts that break one
-    switched by the rules and solved again, up to SWITCH_ROUNDS times: every one at once
-    (block principal pivoting, Judice and Pires 1994), and once SWITCH_STALL rounds in a row
-    did not lower the number of broken rules, one at a time, the breaking contact of least
-    index, then a limit (Murty's least-index rule, which cannot cycle where the problem is a P-matrix's). An answer that
-    breaks none but pushes further contacts into touch is solved again with them, as in
-    solve_modes. A pile settling with many contacts that start or stop sliding in one step
-    (a pour of 50 shapes) finds its modes in linear solves, where the complementarity solve
-    over its island took thousands of pivots. The rounds end early where they stall (the
-    least-index rule) on a solve that dropped dependent rows: the rule's end is promised
-    for a P-matrix only. Where no round's answer keeps every rule, the contacts' modes are
-    put back as they were (the complementarity solve starts from them); a limit the rounds
-    released stays released, and the complementarity solve engages it again where its
-    answer pushes through it. Returns (an answer stands, solves)."""
+    """After the guess and the alternating check broke a rule: the contacts that break one switched
+    by the rules and solved again, up to SWITCH_ROUNDS times: every one at once (block principal
+    pivoting, Judice and Pires 1994), and once SWITCH_STALL rounds in a row did not lower the
+    number of broken rules, one at a time, the breaking contact of least index, then a limit
+    (Murty's least-index rule, which cannot cycle where the problem is a P-matrix's). An answer
+    that breaks none but pushes further contacts into touch is solved again with them, as in
+    solve_modes. A pile settling with many contacts that start or stop sliding in one step (a
+    pour of 50 shapes) finds its modes in linear solves, where the complementarity solve over
+    its island took thousands of pivots. The rounds end early where they stall (the least-index
+    rule) on a solve that dropped dependent rows: the rule's end is promised for a P-matrix
+    only. Where no round's answer keeps every rule, the contacts' modes are put back as they
+    were (the complementarity solve starts from them); a limit the rounds released stays
+    released, and the complementarity solve engages it again where its answer pushes through it.
+    Returns (an answer stands, solves)."""
     keep_modes(s, ws)
     solves = 0
     breaks = 1

@@ -217,7 +217,8 @@ def _pulls(m, s, ws, r, floor):
 def _beyond_cone(m, ws, r, floor):
     """The friction of tangent row r (its normal row r - 1) leaves the cone beyond rounding."""
     size = abs(ws.lam[r]) + abs(ws.lam[r - 1])
-    return abs(ws.lam[r]) > m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1] + SOLVE_REL_TOL * size + floor
+    bound = m.contact_mu[ws.row_owner[r]] * ws.lam[r - 1]
+    return abs(ws.lam[r]) > bound + SOLVE_REL_TOL * size + floor
 
 
 @kernel
