@@ -53,7 +53,7 @@ from .dynamics.rattle import (longest_stage, rattle_begin, rattle_end, stage_cou
                               unsupported)
 from .solver.warm_start import remember_impulses
 from .checks.work import (CONSTRAINT_SHARE, NEAR_DEPENDENT, joints_add_energy, joints_excess,
-                          prediction_turn)
+                          kinetic_gain, prediction_turn)
 
 
 @kernel(inline="never")
@@ -839,16 +839,19 @@ CHAIN_AGAIN = -101
 @kernel
 def chain_joints_gain(m, s, ws, h):
     """second_order_gains on the chain path (work.joints_add_energy's rule on the pins'
-    levers): True if the velocity solve's impulses added energy beyond their share, or did
-    work so large that its rounding hides the share (the general stages then judge the step,
-    from its velocities); else the excess (<= 0) is kept for the audit (ws.joint_gain)."""
+    levers): True if the velocity solve's impulses added energy beyond their share (the
+    general stages then take the step, and their remedy); else the excess (<= 0) is kept for
+    the audit (ws.joint_gain). Where the work's rounding hides the share (a free chain
+    falling as one body: no motion in its frame, a share of 0), the velocities' lower bound
+    of that work is judged too, as joints_add_energy judges it (work.kinetic_gain: the pins
+    are the only rows, so nothing else is allowed for)."""
     work, rounding, row = lever_joint_work(m, ws, ws.v_new)
     fx, fy = frame_velocity(m, ws, ws.v_pred)       # (checks/frame.py)
     scale = kinetic_in_frame(m, ws.v_lin, fx, fy)
+    gain = -math.inf
     if rounding > CONSTRAINT_SHARE * scale:
-        ws.joint_gain[2] = 0.0          # (nothing measured for the audit)
-        return True
-    excess = joints_excess(m, s, ws, h, work, rounding, -math.inf, scale)
+        gain = kinetic_gain(m, ws, kinetic_in_frame(m, ws.v_pred, fx, fy), fx, fy, 0.0)
+    excess = joints_excess(m, s, ws, h, work, rounding, gain, scale)
     ws.joint_gain[0] = excess
     ws.joint_gain[1] = row
     ws.joint_gain[2] = 1.0

@@ -216,6 +216,14 @@ def gain_from_velocities(m, ws, h, kinetic, fx, fy):
             allowed += row_rounding(ws, r, speed)
             if is_tangent_row(kind):
                 allowed += abs(ws.lam[r] * ws.row_c[r]) / h
+    return kinetic_gain(m, ws, kinetic, fx, fy, allowed)
+
+
+@kernel(inline="always")
+def kinetic_gain(m, ws, kinetic, fx, fy, allowed):
+    """gain_from_velocities' bound from its parts: KE(v_new) less kinetic (KE(v*)), both in
+    the frame moving at (fx, fy) [m/s], less allowed [J] (what rows other than the joints'
+    may do) and the energies' rounding."""
     final = kinetic_in_frame(m, ws.v_new, fx, fy)
     return final - kinetic - allowed - RELATIVE_ROUNDING * (final + kinetic)
 
