@@ -230,18 +230,6 @@ SWITCH_ROUNDS = 48
 SWITCH_STALL = 3
 
 
-@kernel
-def switch_contacts(m, s, ws, only_first):
-    """The listed contacts and engaged joint limits that break a rule in the last answer
-    switched by the rules (modes.switch_broken: release if it pulls, slide if its friction
-    leaves the cone, stick if its slip reversed; a limit is released if its impulse pulls:
-    a limit is a complementarity variable as a contact's normal is): every one at once, or
-    only_first the breaking contact of least index (a limit only where no contact breaks
-    one); returns how many changed."""
-    gather_contact_impulses(m, s, ws)
-    return switch_broken(m, s, ws, only_first)
-
-
 @kernel(inline="always")
 def _mix(key, x):
     """key with the integer x mixed in (splitmix64's finaliser on their sum)."""
@@ -301,7 +289,8 @@ def switch_rounds(m, s, ws, opt, h, include_ccd):
     since = 0
     span = 1
     for r in range(SWITCH_ROUNDS):
-        if breaks > 0 and switch_contacts(m, s, ws, stall >= SWITCH_STALL) == 0:
+        # (modes.switch_broken reads the answer's rows, not ws.contact_impulse)
+        if breaks > 0 and switch_broken(m, s, ws, stall >= SWITCH_STALL) == 0:
             break
         key = modes_key(s, ws, min(stall, SWITCH_STALL), fewest)
         if r > 0 and key == marked:

@@ -1,4 +1,4 @@
-"""Joint limits in the mode rounds (kernels/step.py switch_contacts): an engaged limit whose
+"""Joint limits in the mode rounds (kernels/solver/modes.py switch_broken): an engaged limit whose
 impulse pulls is released in the rounds, as a contact that pulls is, so a step where a joint
 leaves its limit is answered by linear solves, not by the complementarity solve. On the arm
 below (a unique answer) it is the complementarity solve's (mode_strategy 'all') to rounding;

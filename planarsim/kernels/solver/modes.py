@@ -56,31 +56,44 @@ def gather_contact_impulses(m, s, ws):
             ws.contact_impulse[o, 1] = ws.lam[r]
 
 
+# the rule a contact breaks in an answer (contact_rule), each calling for its switch
+RULE_KEPT = 0
+RULE_PULLS = 1      # its normal impulse pulls: released
+RULE_CONE = 2       # pinned, its friction beyond the cone: slides against its friction
+RULE_REVERSED = 3   # sliding, its slip reversed: sticks
+
+
+@kernel
+def _switch(s, o, rule, lt):
+    """Contact o switched by the rule it breaks (RULE_*; lt [N s] its friction impulse, against
+    which it slides when it leaves the cone)."""
+    if rule == RULE_PULLS:
+        s.contact_mode[o] = MODE_FREE
+    elif rule == RULE_CONE:
+        s.contact_mode[o] = MODE_SLIDING
+        s.contact_slip[o] = -1.0 if lt > 0.0 else 1.0
+    elif rule == RULE_REVERSED:
+        s.contact_mode[o] = MODE_PINNED
+
+
 @kernel
 def check_contact(m, s, ws, i):
-    """Apply the release / slide / stick rules to contact i; return 1 if its mode changed."""
+    """Apply the release / slide / stick rules to contact i by their bare signs (ws.
+    contact_impulse); return 1 if its mode changed."""
     mode = s.contact_mode[i]
     ln = ws.contact_impulse[i, 0]
     lt = ws.contact_impulse[i, 1]
-    if mode == MODE_PINNED:
-        if ln < 0.0:
-            s.contact_mode[i] = MODE_FREE
-            return 1
-        if abs(lt) > m.contact_mu[i] * ln * (1.0 + 1e-12):
-            s.contact_mode[i] = MODE_SLIDING
-            s.contact_slip[i] = -1.0 if lt > 0.0 else 1.0
-            return 1
-    elif mode == MODE_SLIDING:
-        if ln < 0.0:
-            s.contact_mode[i] = MODE_FREE
-            return 1
-        if m.contact_mu[i] == 0.0:
-            return 0        # frictionless: it slides whichever way it moves
-        vn, vt = contact_velocity(m, s, ws, i, ws.v_new)
+    rule = RULE_KEPT
+    if mode != MODE_FREE and ln < 0.0:
+        rule = RULE_PULLS
+    elif mode == MODE_PINNED and abs(lt) > m.contact_mu[i] * ln * (1.0 + 1e-12):
+        rule = RULE_CONE
+    elif mode == MODE_SLIDING and m.contact_mu[i] != 0.0:   # (frictionless: it slides
+        vn, vt = contact_velocity(m, s, ws, i, ws.v_new)    # whichever way it moves)
         if vt * s.contact_slip[i] <= 0.0:
-            s.contact_mode[i] = MODE_PINNED
-            return 1
-    return 0
+            rule = RULE_REVERSED
+    _switch(s, i, rule, lt)
+    return 0 if rule == RULE_KEPT else 1
 
 
 @kernel
@@ -169,13 +182,6 @@ def _contact_size(m, s, ws, r):
     return abs(ws.lam[r]) * (1.0 + m.contact_mu[ws.row_owner[r]])
 
 
-# the rule a contact breaks in an answer (contact_rule), each calling for its switch
-RULE_KEPT = 0
-RULE_PULLS = 1      # its normal impulse pulls: released
-RULE_CONE = 2       # pinned, its friction beyond the cone: slides against its friction
-RULE_REVERSED = 3   # sliding, its slip reversed: sticks
-
-
 @kernel
 def impulse_floor(ws):
     """The rounding [N s] of a contact that carries no load in the last answer (a
@@ -238,18 +244,6 @@ def contact_rule(m, s, ws, r, floor):
 
 
 @kernel
-def _switch(s, ws, o, r, rule):
-    """Contact o (normal row r) switched by the rule it breaks (contact_rule)."""
-    if rule == RULE_PULLS:
-        s.contact_mode[o] = MODE_FREE
-    elif rule == RULE_CONE:
-        s.contact_mode[o] = MODE_SLIDING
-        s.contact_slip[o] = -1.0 if ws.lam[r + 1] > 0.0 else 1.0
-    elif rule == RULE_REVERSED:
-        s.contact_mode[o] = MODE_PINNED
-
-
-@kernel
 def switch_broken(m, s, ws, only_first):
     """The contacts whose rules the last answer breaks (by rule_breaks' tolerances)
     switched by the rule each breaks, then the engaged limits that pull beyond them: every
@@ -261,7 +255,7 @@ def switch_broken(m, s, ws, only_first):
     floor = impulse_floor(ws)
     n = ws.n_row[0]
     first = -1
-    first_r = -1
+    first_lt = 0.0
     first_rule = RULE_KEPT
     changed = 0
     for r in range(n):
@@ -271,16 +265,17 @@ def switch_broken(m, s, ws, only_first):
         if rule == RULE_KEPT:
             continue
         o = ws.row_owner[r]
+        lt = ws.lam[r + 1] if rule == RULE_CONE else 0.0    # (its tangent row follows)
         if only_first:
             if first < 0 or o < first:
                 first = o
-                first_r = r
+                first_lt = lt
                 first_rule = rule
             continue
-        _switch(s, ws, o, r, rule)
+        _switch(s, o, rule, lt)
         changed += 1
     if first >= 0:
-        _switch(s, ws, first, first_r, first_rule)
+        _switch(s, first, first_rule, first_lt)
         return 1
     tol_lam = SOLVE_REL_TOL * largest_impulse(ws)
     for r in range(n):
