@@ -7,8 +7,11 @@ compare with the others (not a test).
 
 Every step of the scene's bench run is timed on its own (Simulator.steps(1), best of
 --repeats runs from the same start), less the cost of an empty call. Prints the total, the
-steps that ran the complementarity (Lemke) solve and their mean, the other steps' mean, and
-the share of the run the complementarity steps take.
+steps that ran the complementarity (Lemke) solve and their mean, the other steps' mean, the
+share of the run the complementarity steps take, and which rules the guess of those steps
+broke (step_info's guess_* counts: equations a dropped dependent row left unmet, contacts
+that pull, sliding contacts whose slip reversed, friction outside its cone, limits that
+pull), i.e. why the linear solves did not do.
 """
 from __future__ import annotations
 
@@ -39,27 +42,36 @@ def _scene(name):
     return build(), n
 
 
+# the rules the guess broke (step_info's guess_*), reported for the complementarity steps
+GUESS_RULES = ("equations", "pulls", "reversals", "cones", "limits")
+
+
 def step_times(name, repeats=15, strategy="alternating"):
-    """(best time of each step [ns], bool array: the step ran the complementarity solve)."""
+    """(best time of each step [ns], bool array: the step ran the complementarity solve,
+    (steps, len(GUESS_RULES)) int array: the rules each step's guess broke, by rule)."""
     model, n = _scene(name)
     options = ps.make_options(strategy)
     best = np.full(n, np.inf)
     lcp = np.zeros(n, bool)
+    guess = np.zeros((n, len(GUESS_RULES)), np.int64)
     clock = time.perf_counter_ns
+    ps.Simulator(model, options=options).steps(1)     # (compiled before the clock runs)
     for _ in range(repeats):
         sim = ps.Simulator(model, options=options)
         for k in range(n):
             t0 = clock()
             sim.steps(1)
             best[k] = min(best[k], clock() - t0)
-            lcp[k] = step_info(sim.ws)["lcp_solves"] > 0
+            info = step_info(sim.ws)
+            lcp[k] = info["lcp_solves"] > 0
+            guess[k] = [info["guess_" + rule] for rule in GUESS_RULES]
     sim = ps.Simulator(model, options=options)
     empty = np.inf
     for _ in range(2000):
         t0 = clock()
         sim.steps(0)
         empty = min(empty, clock() - t0)
-    return best - empty, lcp
+    return best - empty, lcp, guess
 
 
 def main(argv=None):
@@ -68,12 +80,18 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=15)
     ap.add_argument("--strategy", choices=("alternating", "all"), default="alternating")
     args = ap.parse_args(argv)
-    t, lcp = step_times(args.scene, args.repeats, args.strategy)
+    t, lcp, guess = step_times(args.scene, args.repeats, args.strategy)
     us = t / 1e3
     print(f"{args.scene}: {len(t)} steps, {us.sum() / 1e3:.2f} ms in all")
     if lcp.any():
         print(f"  {lcp.sum()} steps with the complementarity solve: {us[lcp].mean():.2f} us "
               f"each, {us[lcp].sum() / us.sum():.0%} of the run")
+        print("  the rules their guess (the first answer, under the last step's modes) broke:")
+        for j, rule in enumerate(GUESS_RULES):
+            broke = guess[lcp, j] > 0
+            if broke.any():
+                print(f"    {rule:<10} in {broke.sum():>4} of them ({guess[lcp, j][broke].mean():.1f} "
+                      f"rows each)")
     else:
         print("  no step needed the complementarity solve")
     if (~lcp).any():

@@ -15,7 +15,7 @@ from .capacity import workspace_capacity, workspace_contacts  # noqa: F401  (pub
 from .errors import WorkspaceTooLarge
 from .kernels.checks.audit import N_AUDIT
 from .kernels.info import N_INFO
-from .kernels.codes import CONTACT_PAIR, DENSE_MAX_ROWS, SPARSE_MAX_DEPTH
+from .kernels.codes import CONTACT_PAIR, DENSE_MAX_ROWS, N_BROKEN, SPARSE_MAX_DEPTH
 from .model import Model
 from .pin_chains import joints_form_no_loop, pin_chain_order
 
@@ -372,6 +372,9 @@ class Workspace(NamedTuple):
     act_power: np.ndarray        # (n_act,) mechanical power [W]
     info: np.ndarray             # (N_INFO,) int: what the last step did, slots named in
                                  #   kernels/info.py (INFO_*; step_info(ws) by name)
+    broken_rules: np.ndarray     # (N_BROKEN + 1,) int: the rules the last checked answer
+                                 #   broke, by rule (kernels/codes.py BROKE_*;
+                                 #   modes.rule_breaks), then GUESS_PENDING
     guard_value: np.ndarray      # (3,) offending value when a guard fired; the speed bound
                                  #   [m/s] when it was a speed (GUARD_SPEED); a torque's turn,
                                  #   inverse inertia and limit (GUARD_STIFF_ACTUATOR)
@@ -819,7 +822,8 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
                      **lists, **_solve_arrays(model, contacts, profile, lcp_rows),
                      n_row=z(1, np.int64), act_u=z(na), act_power=z(na),
-                     info=z(N_INFO, np.int64), guard_value=z(3),
+                     info=z(N_INFO, np.int64), broken_rules=z(N_BROKEN + 1, np.int64),
+                     guard_value=z(3),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),
                      island_parent=z(nb, np.int64), factor_kind=z(1, np.int64),
                      sp_body_start=z(nb + 1, np.int64), sp_body_fill=z(nb, np.int64),

@@ -47,3 +47,14 @@ SPARSE_MAX_DEPTH = 40
 # systems of at most this many rows may be eliminated in a dense square (kernels/solver/dense.py,
 # matrix.arrange), whose storage (Workspace.A_dense) is this squared at most
 DENSE_MAX_ROWS = 48
+
+# the rules an answer can break, as solver/modes.rule_breaks counts them into ws.broken_rules
+BROKE_EQUATION = 0  # a row's equation missed (a dependent row dropped, its target unmet)
+BROKE_PULL = 1      # a contact's normal impulse pulls
+BROKE_REVERSAL = 2  # a sliding contact's slip reversed
+BROKE_CONE = 3      # a pinned contact's friction outside its cone
+BROKE_LIMIT = 4     # a joint limit's impulse pulls
+N_BROKEN = 5
+# ws.broken_rules[GUESS_PENDING] = 1: the next check is of the step's guess (step.solve_modes),
+# whose counts go to the step's INFO_GUESS_* (kernels/info.py) too
+GUESS_PENDING = N_BROKEN

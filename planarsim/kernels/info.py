@@ -24,16 +24,27 @@ INFO_SHAKE_WHOLE = 13     # position corrections kept whole as SHAKE's, within i
                            # (integrate.bound_correction_work: RATTLE, or joints alone)
 INFO_SWITCH_ROUNDS = 14    # rounds of the mode switching (step.switch_rounds) the velocity
                            # stage took
-N_INFO = 15
+# the rules the guess broke: the first answer of the velocity stage, under the modes the
+# last step left (step.solve_modes; summed over a step's parts), counted by rule
+# (modes.rule_breaks): why a step needed more than one solve, or the complementarity solve
+INFO_GUESS_EQUATIONS = 15   # rows whose equation the answer misses (a dependent row dropped
+                            # whose target the others do not meet)
+INFO_GUESS_PULLS = 16       # contact normals that pull
+INFO_GUESS_REVERSALS = 17   # sliding contacts whose slip reversed
+INFO_GUESS_CONES = 18       # pinned contacts' friction outside the cone
+INFO_GUESS_LIMITS = 19      # joint limits that pull
+N_INFO = 20
 
 INFO_NAMES = ("solves", "ccd_splits", "guard_body", "guard_field", "lcp_solves",
               "newton_taken_back", "lcp_pivots", "projections", "command", "ccd_stops",
               "turn_substeps", "chain_path", "kept_factors", "shake_whole",
-              "switch_rounds")
+              "switch_rounds", "guess_equations", "guess_pulls", "guess_reversals",
+              "guess_cones", "guess_limits")
 # counted afresh by every step (the guard slots keep the last failure)
 STEP_COUNTS = (INFO_SOLVES, INFO_CCD_SPLITS, INFO_LCP_SOLVES, INFO_NEWTON_TAKEN_BACK,
                INFO_LCP_PIVOTS, INFO_PROJECTIONS, INFO_CCD_STOPS, INFO_KEPT_FACTORS,
-               INFO_SHAKE_WHOLE, INFO_SWITCH_ROUNDS)
+               INFO_SHAKE_WHOLE, INFO_SWITCH_ROUNDS, INFO_GUESS_EQUATIONS, INFO_GUESS_PULLS,
+               INFO_GUESS_REVERSALS, INFO_GUESS_CONES, INFO_GUESS_LIMITS)
 
 
 def step_info(ws) -> dict:

@@ -20,7 +20,10 @@ cone, stick on reversal); modes_from_solution reads the modes off a complementar
 import math
 
 from ...compile import kernel
-from ..codes import CONTACT_PAIR, MODE_FREE, MODE_PINNED, MODE_SLIDING
+from ..info import INFO_GUESS_EQUATIONS
+from ..codes import (BROKE_CONE, BROKE_EQUATION, BROKE_LIMIT, BROKE_PULL, BROKE_REVERSAL,
+                     CONTACT_PAIR, GUESS_PENDING, MODE_FREE, MODE_PINNED, MODE_SLIDING,
+                     N_BROKEN)
 from ..geometry.contacts import contact_velocity, engage_contact, pair_motion_scale, refresh_contact
 from ..geometry.pair import PAIR_ENGAGE_SLACK, pair_speed
 from ..checks.audit import IMPULSE_FLOOR
@@ -298,6 +301,16 @@ def largest_impulse(ws):
 
 
 @kernel
+def _tally(ws):
+    """The counts of a check of the step's guess (ws.broken_rules[GUESS_PENDING] set by
+    step.solve_modes) added to the step's INFO_GUESS_* (summed over its parts)."""
+    if ws.broken_rules[GUESS_PENDING] == 1:
+        ws.broken_rules[GUESS_PENDING] = 0
+        for k in range(N_BROKEN):
+            ws.info[INFO_GUESS_EQUATIONS + k] += ws.broken_rules[k]
+
+
+@kernel
 def rule_breaks(m, s, ws, h, equalities):
     """How many rows of the last solve break a rule of contact and limits (the solve took the
     modes as given; this checks its answer): an equality row not met (a dependent row dropped
@@ -306,12 +319,16 @@ def rule_breaks(m, s, ws, h, equalities):
     impulses' and velocities' own size (rounding, not physics): a contact's own impulse for
     its pull and cone rules (an answer that passes here passes the audit's). equalities: also
     check every row's equation (needed where the solve dropped a dependent row or had no
-    symmetric factorisation; a backward-stable L D L^T of all rows meets them to rounding)."""
+    symmetric factorisation; a backward-stable L D L^T of all rows meets them to rounding).
+    The count of each rule but the joints' friction goes to ws.broken_rules (BROKE_*)."""
     n = ws.n_row[0]
+    for k in range(N_BROKEN):
+        ws.broken_rules[k] = 0
     # a frictional joint's rule (joint_friction.py): a stuck one's impulse within F h, a
     # slipping one's rate not reversed (a slipping joint has no row)
     friction = friction_breaks(m, ws)
     if not equalities and not has_mode_rows(ws, n):
+        _tally(ws)
         return friction     # joints only, their equations met by the solve
     big_b = 0.0
     for r in range(n):
@@ -330,18 +347,21 @@ def rule_breaks(m, s, ws, h, equalities):
             if is_soft_row(kind):
                 w += soft_compliance(ws, r) * ws.lam[r]
             if abs(w) > tol_w:
-                breaks += 1
+                ws.broken_rules[BROKE_EQUATION] += 1
         if is_limit_row(kind):
             if ws.lam[r] < -tol_lam:
-                breaks += 1
+                ws.broken_rules[BROKE_LIMIT] += 1
         elif is_normal_row(kind):
             if _pulls(m, s, ws, r, floor):
-                breaks += 1
+                ws.broken_rules[BROKE_PULL] += 1
             if s.contact_mode[o] == MODE_SLIDING and _slip_reversed(m, s, ws, o):
-                breaks += 1
+                ws.broken_rules[BROKE_REVERSAL] += 1
         elif is_tangent_row(kind):
             if _beyond_cone(m, ws, r, floor):
-                breaks += 1
+                ws.broken_rules[BROKE_CONE] += 1
+    for k in range(N_BROKEN):
+        breaks += ws.broken_rules[k]
+    _tally(ws)
     return breaks
 
 
