@@ -11,7 +11,8 @@ steps that ran the complementarity (Lemke) solve and their mean, the other steps
 share of the run the complementarity steps take, and which rules the guess of those steps
 broke (step_info's guess_* counts: equations a dropped dependent row left unmet, contacts
 that pull, sliding contacts whose slip reversed, friction outside its cone, limits that
-pull), i.e. why the linear solves did not do.
+pull), i.e. why the linear solves did not do; the other steps are split into those the
+switching rounds answered and the rest.
 """
 from __future__ import annotations
 
@@ -48,12 +49,14 @@ GUESS_RULES = ("equations", "pulls", "reversals", "cones", "limits")
 
 def step_times(name, repeats=15, strategy="alternating"):
     """(best time of each step [ns], bool array: the step ran the complementarity solve,
-    (steps, len(GUESS_RULES)) int array: the rules each step's guess broke, by rule)."""
+    (steps, len(GUESS_RULES)) int array: the rules each step's guess broke, by rule, bool
+    array: the step took switching rounds (step.switch_rounds))."""
     model, n = _scene(name)
     options = ps.make_options(strategy)
     best = np.full(n, np.inf)
     lcp = np.zeros(n, bool)
     guess = np.zeros((n, len(GUESS_RULES)), np.int64)
+    rounds = np.zeros(n, bool)
     clock = time.perf_counter_ns
     ps.Simulator(model, options=options).steps(1)     # (compiled before the clock runs)
     for _ in range(repeats):
@@ -65,13 +68,14 @@ def step_times(name, repeats=15, strategy="alternating"):
             info = step_info(sim.ws)
             lcp[k] = info["lcp_solves"] > 0
             guess[k] = [info["guess_" + rule] for rule in GUESS_RULES]
+            rounds[k] = info["switch_rounds"] > 0
     sim = ps.Simulator(model, options=options)
     empty = np.inf
     for _ in range(2000):
         t0 = clock()
         sim.steps(0)
         empty = min(empty, clock() - t0)
-    return best - empty, lcp, guess
+    return best - empty, lcp, guess, rounds
 
 
 def main(argv=None):
@@ -80,7 +84,7 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=15)
     ap.add_argument("--strategy", choices=("alternating", "all"), default="alternating")
     args = ap.parse_args(argv)
-    t, lcp, guess = step_times(args.scene, args.repeats, args.strategy)
+    t, lcp, guess, rounds = step_times(args.scene, args.repeats, args.strategy)
     us = t / 1e3
     print(f"{args.scene}: {len(t)} steps, {us.sum() / 1e3:.2f} ms in all")
     if lcp.any():
@@ -96,6 +100,15 @@ def main(argv=None):
         print("  no step needed the complementarity solve")
     if (~lcp).any():
         print(f"  {(~lcp).sum()} other steps: {us[~lcp].mean():.2f} us each")
+        answered = rounds & ~lcp
+        if answered.any():
+            rest = ~lcp & ~rounds
+            print(f"    {answered.sum()} answered by the switching rounds: {us[answered].mean():.2f} us "
+                  f"each (median {np.median(us[answered]):.2f}), {us[answered].sum() / us.sum():.0%} "
+                  f"of the run")
+            if rest.any():
+                print(f"    {rest.sum()} without rounds: {us[rest].mean():.2f} us each (median "
+                      f"{np.median(us[rest]):.2f})")
 
 
 if __name__ == "__main__":
