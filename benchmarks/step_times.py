@@ -29,6 +29,7 @@ import planarsim as ps  # noqa: E402
 from benchmarks.scenes import SCENES  # noqa: E402
 from benchmarks.stress_scenes import ALL_SCENES, build_model  # noqa: E402
 from planarsim.compiled import step_info  # noqa: E402
+from planarsim.kernels.info import INFO_NAMES  # noqa: E402
 
 
 def _scene(name):
@@ -43,8 +44,8 @@ def _scene(name):
     return build(), n
 
 
-# the rules the guess broke (step_info's guess_*), reported for the complementarity steps
-GUESS_RULES = ("equations", "pulls", "reversals", "cones", "limits")
+# the rules the guess broke (step_info's guess_* slots), reported for the complementarity steps
+GUESS_RULES = tuple(name[6:] for name in INFO_NAMES if name.startswith("guess_"))
 
 
 def step_times(name, repeats=15, strategy="alternating"):

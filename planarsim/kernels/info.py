@@ -26,7 +26,8 @@ INFO_SWITCH_ROUNDS = 14    # rounds of the mode switching (step.switch_rounds) t
                            # stage took
 # the rules the guess broke: the first answer of the velocity stage, under the modes the
 # last step left (step.solve_modes; summed over a step's parts), counted by rule
-# (modes.rule_breaks): why a step needed more than one solve, or the complementarity solve
+# (modes.rule_breaks): why a step needed more than one solve, or the complementarity solve;
+# in the order of codes.BROKE_* (slot INFO_GUESS_EQUATIONS + BROKE_*)
 INFO_GUESS_EQUATIONS = 15   # rows whose equation the answer misses (a dependent row dropped
                             # whose target the others do not meet)
 INFO_GUESS_PULLS = 16       # contact normals that pull
