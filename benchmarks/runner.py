@@ -264,13 +264,22 @@ def parse_args(argv):
     unknown = [n for n in args.scenes if n not in SCENES]
     if unknown:
         ap.error(f"unknown scene(s) {unknown}; choose from {list(SCENES)}")
-    if args.timing_seconds <= 0:
+    if not args.timing_seconds > 0:
         ap.error(f"--timing-seconds {args.timing_seconds} must be > 0")
-    for flag in ("csv", "md"):
+    # (checked here, before the runs, each naming its flag; not by the part that reads it)
+    for flag, least in (("steps", 1), ("batch_jobs", 1), ("env_copies", 1)):
+        value = getattr(args, flag)
+        if value is not None and value < least:
+            ap.error(f"--{flag.replace('_', '-')} {value} must be >= {least}")
+    for flag in ("accuracy_seconds", "walker_seconds", "batch_seconds"):
+        value = getattr(args, flag)
+        if value is not None and not (math.isfinite(value) and value > 0):
+            ap.error(f"--{flag.replace('_', '-')} {value} must be a finite number of seconds > 0")
+    for flag in ("csv", "md", "pareto_out"):
         folder = getattr(args, flag)
         if folder is not None and not _writable_folder(folder):
             # (checked before the runs, which take minutes, not after them)
-            ap.error(f"--{flag} {folder}: cannot make or write to this folder")
+            ap.error(f"--{flag.replace('_', '-')} {folder}: cannot make or write to this folder")
     if args.parts is None:
         args.parts = "scenes,peers" if args.scenes else ",".join(PARTS)
     args.pareto_scenes = [n for n in args.scenes if n in PEER_SCENES] if args.scenes else list(DEFAULT_SCENES)

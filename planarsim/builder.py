@@ -1343,8 +1343,10 @@ class ModelBuilder:
     def compile(self, **meta) -> M.Model:
         """Validate and freeze into a Model."""
         dt = number("model: dt", self.dt, finite=False, error=ModelError)
-        if not (math.isfinite(dt) and dt > 0):
-            raise ModelError(f"model: dt={dt} must be finite and > 0")
+        if not (math.isfinite(dt) and 0 < dt <= 1.0):
+            # (StepOptions.dt keeps to the same (0, 1] s: a model's own step beyond it built
+            # and stepped where the same step given as an option was refused)
+            raise ModelError(f"model: dt={dt} must be a step in (0, 1] s")
         try:
             g = None if holds_bool(self.gravity) else np.asarray(self.gravity, dtype=np.float64).reshape(2)
         except (TypeError, ValueError):

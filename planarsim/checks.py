@@ -26,6 +26,14 @@ def is_bool(value) -> bool:
     return isinstance(value, (bool, np.bool_))
 
 
+def flag(said, value, error=TypeError) -> bool:
+    """value where it is True or False (Python's or numpy's); else an error naming `said`
+    (a string such as "no" is truthy: taken as True, it did the opposite of what it said)."""
+    if not is_bool(value):
+        raise error(f"{said}={plain(value)!r} must be True or False")
+    return bool(value)
+
+
 def to_float(value, strict: bool = False) -> float | None:
     """value as a float, or None where it is no number: a bool, or what float() refuses (a
     word, None, a list); strict: also a string of digits or a 0-d array (only real numbers)."""

@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 
-from .checks import MAX_STEPS, callable_or_none, to_float, whole
+from .checks import MAX_STEPS, callable_or_none, flag, to_float, whole
 from .errors import diverged
 from .integrator import check_integrator
 from .model import Model, ModelArrays
@@ -57,6 +57,8 @@ class Simulator:
                  allow_below_ground: bool = False, allow_overlap: bool = False):
         if not isinstance(model, Model):
             raise TypeError(f"Simulator needs a Model from ModelBuilder.compile(), got {type(model).__name__}")
+        flag("Simulator: allow_below_ground", allow_below_ground)
+        flag("Simulator: allow_overlap", allow_overlap)
         self._model = model
         self._state = make_state(model)
         self._ws = make_workspace(model)

@@ -21,7 +21,7 @@ WALKERS = {
 
 def load(name: str):
     """Import the walker package registered under `name` (a KeyError names the known ones)."""
-    if name not in WALKERS:
+    if not isinstance(name, str) or name not in WALKERS:
         raise KeyError(f"unknown walker {name!r}; known walkers: {sorted(WALKERS)}")
     return importlib.import_module(WALKERS[name])
 

@@ -64,6 +64,15 @@ REQUIRED = ("NAME", "GAITS", "Params", "SUMMARY_EXTRAS", "Run", "simulate")
 MAX_DT = 0.01
 
 
+def check_controlled_dt(name: str, dt: float) -> None:
+    """ValueError naming dt [s] where a walker with a controller would take steps of more
+    than MAX_DT (called by WalkerRun, and by a walker whose controller is built before it)."""
+    if dt > MAX_DT:
+        raise ValueError(f"{name}: dt={dt:g} s is too large; use a step of at most "
+                         f"{MAX_DT:g} s (1e-3 is usual): its controller is tuned at 1e-3 s, "
+                         f"and at 0.02 s walkers already lose their impacts or stop")
+
+
 class WalkerRun:
     """One walker in the world, run in chunks by its compiled rollout.
 
@@ -102,10 +111,8 @@ class WalkerRun:
             # the controllers integrate (work, effort, motor currents, ramps) with the model's dt
             raise ValueError(f"{self.NAME}: options.dt={self.options.dt} s differs from the model's "
                              f"dt={model.dt} s; build the walker with dt={self.options.dt} instead")
-        if model.n_act > 0 and self.dt > MAX_DT:
-            raise ValueError(f"{self.NAME}: dt={self.dt:g} s is too large; use a step of at most "
-                             f"{MAX_DT:g} s (1e-3 is usual): its controller is tuned at 1e-3 s, "
-                             f"and at 0.02 s walkers already lose their impacts or stop")
+        if model.n_act > 0:
+            check_controlled_dt(self.NAME, self.dt)
         self.u = np.zeros(model.n_act)
         self.record_every = int(record_every)
         self.chunks = []
@@ -300,11 +307,14 @@ def terrain_of(terrain):
     return terrain
 
 
-def target_speed(name, speed, lo=-math.inf, hi=math.inf) -> float:
-    """A walker's commanded speed [m/s] as a float within [lo, hi]; a ValueError naming the
-    walker and the speed otherwise (a NaN speed stopped the run at its first step naming a
-    leg actuator's command, a string failed in float())."""
+def target_speed(name, speed, params) -> float:
+    """A walker's commanded speed [m/s] as a float within the bounds of its params' `speed`
+    field (the same a SimpleBipedParams(speed=...) keeps to); a ValueError naming the walker
+    and the speed otherwise (a NaN speed stopped the run at its first step naming a leg
+    actuator's command, a string failed in float(), 100 m/s ran silently)."""
+    from dataclasses import fields
     from planarsim.checks import finite_number
+    lo, hi = next(f.metadata["bounds"] for f in fields(params) if f.name == "speed")
     return finite_number(f"{name}: speed", speed, lo, hi, strict=False, unit=" m/s")
 
 

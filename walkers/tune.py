@@ -290,7 +290,8 @@ def main(argv=None) -> int:
     try:
         objective_module(a.walker)
     except (KeyError, ValueError) as e:
-        print(f"planarsim tune: {e}", file=sys.stderr)
+        # (a KeyError's str is its message's repr, quotes and all)
+        print(f"planarsim tune: {e.args[0] if e.args else e}", file=sys.stderr)
         return 2
     x0 = load_result(a.start).params() if a.start else None
     settings = {"duration": a.duration} if a.duration is not None else None

@@ -115,7 +115,8 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
     feet : groups of contacts (names or indices) that touch down as one: a foot touches down at
         the frame where one of its contacts is in contact and none was the frame before (a box
         foot landing heel then toe is one event); the event names the group's first contact.
-        Overrides `contacts`.
+        Overrides `contacts`. A name or index in place of a group is a foot of that one
+        contact (feet=["left", "right"]).
     min_air : [s] with feet, a touchdown counts only after the foot was off the ground this
         long (a foot that bounces or chatters for a few frames at landing lands once).
     together : [s] with feet, touchdowns of several feet within this time of the first of
@@ -137,6 +138,10 @@ def step_events(traj, contacts: Sequence | None = None, feet: Sequence | None = 
     if feet is not None:
         frames, which = [], []
         for group in feet:
+            # (a name or an index alone is a foot of one contact: feet=["foot"] is one foot,
+            # not one of four contacts named by its letters)
+            if isinstance(group, str) or np.ndim(group) == 0:
+                group = [group]
             idx = [_contact_index(traj, c) for c in group]
             if not idx:
                 raise ValueError(f"feet={feet!r}: a foot needs at least one contact")

@@ -154,9 +154,13 @@ def load_mjcf(source, builder: ModelBuilder | None = None, offset=(0.0, 0.0), co
     if isinstance(source, (str, Path)) and not str(source).lstrip().startswith("<"):
         path = Path(source)
         try:
-            text = path.read_text()
+            text = path.read_bytes().decode("utf-8")
         except OSError as e:
             raise ModelError(f"cannot read MJCF file {str(path)!r}: {e.strerror}") from None
+        except ValueError as e:     # (not UTF-8; a NUL in the path)
+            what = (f"not UTF-8 text ({e.reason} at byte {e.start})"
+                    if isinstance(e, UnicodeDecodeError) else str(e))
+            raise ModelError(f"cannot read MJCF file {str(path)!r}: {what}") from None
         name, base_dir = str(path), path.parent
     else:
         text, name, base_dir = str(source), "<string>", None

@@ -48,6 +48,10 @@ def test_feet_landing_together_land_once():
     assert step_events(traj, feet=feet).frame.tolist() == [5, 6, 10]
     assert step_events(traj, feet=feet, together=0.02).frame.tolist() == [5, 10]
     assert step_events(traj, feet=feet, together=0.06).frame.tolist() == [5]
+    # a name or an index in place of a group is a foot of that one contact (["left"] was
+    # read as contacts 'l', 'e', 'f', 't'; [0] failed as "'int' object is not iterable")
+    for single in (["left", "right"], [0, 1], [np.int64(0), "right"]):
+        assert step_events(traj, feet=single).frame.tolist() == [5, 6, 10]
 
 
 # fixed points and multipliers ----------------------------------------------------------------

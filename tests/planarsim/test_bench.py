@@ -76,6 +76,25 @@ def test_bad_arguments_name_the_culprit(capsys):
         bench.main(["no_such_scene"])
 
 
+@pytest.mark.parametrize("argv, said", [
+    (["--batch-jobs", "0", "--parts", "batch"], "--batch-jobs 0 must be >= 1"),
+    (["--walker-seconds", "-1", "--parts", "walkers"], "--walker-seconds -1.0 must be"),
+    (["chain2", "--steps", "0"], "--steps 0 must be >= 1"),
+    (["chain2", "--accuracy-seconds", "-1"], "--accuracy-seconds -1.0 must be"),
+    (["--env-copies", "0", "--parts", "envs"], "--env-copies 0 must be >= 1"),
+    (["--batch-seconds", "nan", "--parts", "batch"], "--batch-seconds nan must be"),
+    (["--pareto-out", "/proc/no/such", "--parts", "pareto"], "--pareto-out /proc/no/such: cannot"),
+])
+def test_bad_values_are_refused_before_the_runs(argv, said, capsys):
+    """Values a part would have failed on (a division by zero after the walks), ignored (0
+    steps timed the scene's default) or met only after the header, each refused at once as a
+    usage error naming its flag."""
+    with pytest.raises(SystemExit) as e:
+        bench.main(argv)
+    assert e.value.code == 2
+    assert said in capsys.readouterr().err
+
+
 def test_benchmarks_run_py_is_the_same_command():
     proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "run.py"), "chain2", "--parts", "scenes",
                            "--peers", "none", *TINY], capture_output=True, text=True, timeout=300)

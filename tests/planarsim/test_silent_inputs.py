@@ -459,3 +459,19 @@ def test_files_of_the_wrong_kind(tmp_path):
     assert list(tmp_path.iterdir()) == []
     ps.save_snapshot(tmp_path / "s.npz", sim.state, memory={"gains": [1.0, 2.0], "mode": 3})
     assert ps.load_snapshot(tmp_path / "s.npz")[1]["gains"].tolist() == [1.0, 2.0]
+
+
+def test_mjcf_file_that_is_not_utf8_names_the_file(tmp_path):
+    """A file of other bytes raised UnicodeDecodeError from read_text, naming no file."""
+    from planarsim.mjcf import load_mjcf
+    path = tmp_path / "latin.xml"
+    path.write_bytes(b"\xff\xfe <mujoco/>")
+    with pytest.raises(ModelError, match=r"cannot read MJCF file '.*latin.xml': not UTF-8 text"):
+        load_mjcf(path)
+
+
+@pytest.mark.parametrize("kw", [dict(allow_below_ground="no"), dict(allow_overlap=1)])
+def test_simulator_switches_take_true_or_false(kw):
+    """The string "no" is truthy: allow_below_ground="no" allowed what it said not to."""
+    with pytest.raises(TypeError, match=f"Simulator: {next(iter(kw))}=.* must be True or False"):
+        ps.Simulator(base().compile(), **kw)

@@ -49,6 +49,7 @@ import numpy as np
 
 from planarsim.compiled import jit, jit_inline, kernel, pin_angle_rate, height, height_derivs
 
+from walkers.common.gaits import gait_number
 from walkers.common.pd import clamp
 from walkers.common.slots import size, slots
 
@@ -333,10 +334,4 @@ class Controller:
 
 def gait_id(gait) -> int:
     """Gait number from a name ('stand', 'piaffe', 'walk') or a Gait."""
-    if isinstance(gait, str):
-        try:
-            return int(Gait[gait.upper()])
-        except KeyError:
-            raise ValueError(f"unknown quadruped gait {gait!r}; use one of "
-                             f"{[g.name.lower() for g in Gait]}") from None
-    return int(Gait(gait))
+    return gait_number(Gait, gait, "quadruped")

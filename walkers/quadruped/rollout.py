@@ -83,7 +83,7 @@ class Run(WalkerRun):
         if seed:
             state.q[:, 1] += 0.005 * rng.uniform()
         memory = C.make_memory(model, params, C.gait_id(gait),
-                               params.speed if speed is None else target_speed(self.NAME, speed))
+                               params.speed if speed is None else target_speed(self.NAME, speed, params))
         memory[C.MEM.target + 1:C.MEM.target + 8:2] += state.q[0, 1] - model.q0[0, 1]
         super().__init__(model, params, params.to_array(), memory, state=state,
                          options=ps.make_options(strategy), record_every=record_every)
@@ -93,7 +93,7 @@ class Run(WalkerRun):
         """Switch gait ("stand" | "piaffe" | "walk") and optionally the speed [m/s] at run time."""
         self.memory[C.MEM.gait] = C.gait_id(gait)
         if speed is not None:
-            self.memory[C.MEM.speed] = target_speed(self.NAME, speed)
+            self.memory[C.MEM.speed] = target_speed(self.NAME, speed, self.params)
 
     @property
     def p(self) -> np.ndarray:

@@ -20,9 +20,10 @@ import numpy as np
 
 from planarsim.compiled import jit, step
 import planarsim as ps
+from planarsim.checks import flag
 from planarsim.trajectory import Trajectory
 
-from walkers.base import WalkerRun, simulation, terrain_of
+from walkers.base import WalkerRun, check_controlled_dt, simulation, start_rng, terrain_of
 from walkers.common.record import record_labelled
 from walkers.common.slots import label_slots
 
@@ -94,8 +95,14 @@ class Run(WalkerRun):
                  record_every: int = 10, seed: int = 0):
         if gait not in GAITS:
             raise ValueError(f"Ranger gait {gait!r} unknown; use one of {GAITS}")
+        if not (isinstance(max_steps, (int, np.integer)) and max_steps >= 1):
+            raise ValueError(f"max_steps={max_steps!r} must be an integer >= 1 (the most walking "
+                             "steps the controller keeps a record of)")
+        flag(f"{self.NAME}: suspended", suspended)
+        start_rng(self.NAME, seed)      # (Ranger starts from one pose: checked all the same)
         params = params if params is not None else RangerParams()
         model = build(params, terrain_of(terrain), dt=dt, suspended=suspended)
+        check_controlled_dt(self.NAME, model.dt)      # (before the controller's filters)
         self.controller = Controller(params, dt, max_steps=max_steps, gravity=_gravity(model))
         self.controller.reset(gait)
         super().__init__(model, params, self.controller.tables, self.controller.mem,

@@ -59,18 +59,35 @@ def rollout_simbicon(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, k0, 
     return 0, n, k
 
 
+_PUSH_FORM = "None, (fx [N], start [s], duration [s]) or dict(force=fx or (fx, fy), start=, duration=)"
+_PUSH_KEYS = ("force", "start", "duration")
+
+
 def _push_array(push):
-    """None | (fx, start, duration) | dict(force=fx or (fx, fy), start=, duration=) -> (4,)."""
+    """None | (fx, start, duration) | dict(force=fx or (fx, fy), start=, duration=) -> (4,);
+    any other form, an unknown key, a force of more than two components or a value that is
+    not a finite number is a ValueError naming push."""
     if push is None:
         return np.array([0.0, 0.0, -1.0, 0.0])
-    if isinstance(push, dict):
-        f = np.atleast_1d(np.asarray(push["force"], dtype=np.float64))
-        fx, fy = (f[0], f[1]) if f.size > 1 else (f[0], 0.0)
-        start, dur = push.get("start", 0.0), push.get("duration", 0.2)
-    else:
-        fx, start, dur = push
-        fy = 0.0
-    arr = np.array([fx, fy, start, dur], dtype=np.float64)
+    try:
+        if isinstance(push, dict):
+            unknown = [k for k in push if k not in _PUSH_KEYS]
+            if unknown or "force" not in push:
+                raise ValueError(f"keys {sorted(push)}; the keys are {list(_PUSH_KEYS)}, force "
+                                 "required")
+            f = np.atleast_1d(np.asarray(push["force"], dtype=np.float64))
+            if f.ndim != 1 or not 1 <= f.size <= 2:
+                raise ValueError("force is fx or (fx, fy) [N]")
+            fx, fy = (f[0], f[1]) if f.size > 1 else (f[0], 0.0)
+            start, dur = push.get("start", 0.0), push.get("duration", 0.2)
+        else:
+            if isinstance(push, (str, bytes)) or np.ndim(push) != 1 or len(push) != 3:
+                raise ValueError("a sequence is (fx, start, duration)")
+            fx, start, dur = push
+            fy = 0.0
+        arr = np.array([fx, fy, start, dur], dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"push={push!r}: {e}; a push is {_PUSH_FORM}") from None
     if not np.all(np.isfinite(arr)) or arr[3] < 0:
         raise ValueError(f"push={push!r} must be finite with duration >= 0")
     return arr

@@ -17,6 +17,7 @@ from planarsim.compiled import RUN_FELL, jit, step, height
 import planarsim as ps
 
 from walkers.base import WalkerRun, simulation, start_rng, target_speed, terrain_of
+from walkers.common.gaits import gait_number
 from walkers.common.record import record_labelled
 from walkers.common.slots import label_slots
 
@@ -74,12 +75,7 @@ def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, 
 
 
 def _gait_id(gait) -> int:
-    if isinstance(gait, str):
-        try:
-            return int(C.Gait[gait.upper()])
-        except KeyError:
-            raise ValueError(f"unknown gait {gait!r}; use one of {[g.name.lower() for g in C.Gait]}") from None
-    return int(C.Gait(gait))
+    return gait_number(C.Gait, gait, "simple-biped")
 
 
 class Run(WalkerRun):
@@ -110,7 +106,7 @@ class Run(WalkerRun):
         model = build(params, terrain_of(terrain), dt, extras=extras)
         memory = np.zeros(C.N_MEMORY)
         memory[C.MEM.state] = C.ST_STAND
-        memory[C.MEM.speed] = params.speed if speed is None else target_speed(self.NAME, speed, 0.0, 3.0)
+        memory[C.MEM.speed] = params.speed if speed is None else target_speed(self.NAME, speed, params)
         memory[C.MEM.gait] = _gait_id(gait)
         super().__init__(model, params, C.make_tables(params), memory, options=options,
                          record_every=record_every)
@@ -126,7 +122,7 @@ class Run(WalkerRun):
 
     def set_speed(self, speed: float) -> None:
         """Target walking speed [m/s]."""
-        self.memory[C.MEM.speed] = target_speed(self.NAME, speed, 0.0, 3.0)
+        self.memory[C.MEM.speed] = target_speed(self.NAME, speed, self.params)
 
     @property
     def gait(self) -> str:
