@@ -767,9 +767,16 @@ def accurate_step(m, s, ws, opt, u, step_length):
 
 
 # [m] how far a joint's anchor or a touching ground contact's point may leave its linearised
-# motion in a step by its body's turn (a tenth of StepOptions.jump_limit's default slack);
-# beyond it the step is taken in sub-steps (turn_substeps)
+# motion in a step by its body's turn (a tenth of StepOptions.jump_limit's default slack), or
+# TURN_SHARE of its lever where that is more; beyond it the step is taken in sub-steps
+# (turn_substeps)
 TURN_TARGET = 1e-3
+# a lever's share, L (h w)^2 / 2 <= TURN_SHARE L: a turn of up to 0.1 rad a step, the regime
+# the engine's docs give for a step. Without it a long lever (a 5 m rocker's sole, its centre
+# 4.5 m from the centre of mass) was split at 0.026 rad a step, in the fast part of each swing
+# only, and each switch between h and h / 2 moved symplectic Euler's energy by its O(h) term
+# the same way: it lost a third of its swing's energy in 30 swings at dt 0.01
+TURN_SHARE = 5e-3
 
 
 @kernel
@@ -781,18 +788,26 @@ def touching_ground(s, ws):
     return False
 
 
+@kernel(inline="always")
+def _turn_need(curve, lever, h):
+    """(sub-steps needed)^2 for a point whose linearised motion a step of h [s] misses by
+    curve h^2 / 2 [m] (curve = sum of L w^2 over its levers L [m] and turning rates w
+    [rad/s]) to miss by at most TURN_TARGET, or TURN_SHARE of the lever where that is more."""
+    return curve * h * h / (2.0 * max(TURN_TARGET, TURN_SHARE * lever))
+
+
 @kernel
 def turn_substeps(m, s, ws, h, most):
     """How many equal sub-steps the step of h [s] is taken in (1..most): a point at lever L
     [m] on a body turning at w [rad/s] leaves the motion its rows linearise by at most
     L (h w)^2 / 2, so where a pin's anchors (while a ground contact touches) or a touching
     (not free) ground contact's point
-    would leave it by more than TURN_TARGET the step is cut to sub-steps that keep it
-    within (w and the modes of the state s: the step's start, and again its answer). Taken whole, a
-    1.2 t box turning 0.57 rad a step on its corners drove a corner 5 cm into the ground
+    would leave it by more than TURN_TARGET, or TURN_SHARE of its lever where that is more,
+    the step is cut to sub-steps that keep it within (w and the modes of the state s: the
+    step's start, and again its answer). Taken whole, a 1.2 t box turning 0.57 rad a step on its corners drove a corner 5 cm into the ground
     and the correction threw the box 2-29 cm farther than its velocities explain
     (contact_stress mass_ratio:13). A walker (L w ~ 5 m/s at dt 1 ms: 1e-5 m) takes 1."""
-    curve = 0.0
+    most_need = 0.0        # the largest (sub-steps needed)^2
     # pins alone are not counted: their correction holds them at any turn, and a count that
     # followed a swing's turning rate switched a pendulum between h and h / 2 as it sped up and
     # slowed down, each switch moving symplectic Euler's energy by its O(h) term with the same
@@ -800,12 +815,15 @@ def turn_substeps(m, s, ws, h, most):
     pins = m.pin_body.shape[0] if touching_ground(s, ws) else 0
     for j in range(pins):
         c = 0.0
+        lever = 0.0
         for e in range(2):
             b = m.pin_body[j, e]
             if b >= 0:
                 w = s.v[b, 2]
-                c += (abs(m.pin_anchor[j, e, 0]) + abs(m.pin_anchor[j, e, 1])) * w * w
-        curve = max(curve, c)
+                L = abs(m.pin_anchor[j, e, 0]) + abs(m.pin_anchor[j, e, 1])
+                c += L * w * w
+                lever += L
+        most_need = max(most_need, _turn_need(c, lever, h))
     for k in range(ws.ground_contacts.shape[0]):
         i = ws.ground_contacts[k]      # (a shape pair's contacts are not judged here)
         # touching (a contact that touches within the step is seen when the step's answer
@@ -813,10 +831,11 @@ def turn_substeps(m, s, ws, h, most):
         if s.contact_mode[i] == MODE_FREE:
             continue
         w = s.v[m.contact_body[i], 2]
-        curve = max(curve, (abs(m.contact_local[i, 0]) + abs(m.contact_local[i, 1])) * w * w)
-    if not curve * h * h > 2.0 * TURN_TARGET:
+        L = abs(m.contact_local[i, 0]) + abs(m.contact_local[i, 1])
+        most_need = max(most_need, _turn_need(L * w * w, L, h))
+    if not most_need > 1.0:
         return 1
-    n = int(math.ceil(h * math.sqrt(curve / (2.0 * TURN_TARGET))))
+    n = int(math.ceil(math.sqrt(most_need)))
     return max(1, min(n, most))
 
 

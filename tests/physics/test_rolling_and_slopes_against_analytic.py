@@ -473,8 +473,17 @@ def test_a_rocker_on_a_slope_rocks_about_its_tilted_rest_with_the_closed_form_pe
     assert_clean(sim)
 
 
-@pytest.mark.parametrize("amplitude, dt", [(0.3, 1e-3), (0.7, 1e-2)])
-def test_a_rocker_rocking_without_slip_keeps_its_energy(amplitude, dt):
+@pytest.mark.parametrize("amplitude, dt, R, d, inertia", [
+    (0.3, 1e-3, 0.5, 0.3, 0.02), (0.7, 1e-2, 0.5, 0.3, 0.02),
+    # sub-steps switched on in the fast part of each swing only (a long lever's turn judged
+    # in metres, step.TURN_SHARE): -35 % at the 5 m rocker's dt 1e-2 (band 7 %)
+    (0.6, 1e-2, 5.0, 4.5, 2.025), (0.6, 1e-3, 0.5, 0.45, 0.02025),
+    # with its centre of mass 5 cm over the ground, the 0.5 m rocker's sole is held by a
+    # correction that moves positions only, and its mean drifts as h^3 with no sub-step taken:
+    # -0.06 % at dt 1e-3, -0.46 % at 2e-3, -6.7 % at 5e-3 (band 4.4 %)
+    pytest.param(0.6, 5e-3, 0.5, 0.45, 0.02025, marks=pytest.mark.xfail(
+        strict=True, reason="a held contact's position correction drifts the energy as h^3"))])
+def test_a_rocker_rocking_without_slip_keeps_its_energy(amplitude, dt, R, d, inertia):
     """A rocker rolling without slip on flat ground is conservative (rolling is holonomic
     here: the sole's centre moves -R dtheta). Symplectic Euler's energy oscillates in a band
     of order w h about a modified energy and does not drift: the mean energy over the last of
@@ -482,7 +491,7 @@ def test_a_rocker_rocking_without_slip_keeps_its_energy(amplitude, dt):
     Measured, of the swing energy: -2.7e-6 at a0 0.3, dt 1e-3 (band 6.6e-3) and -1.3e-2 at
     a0 0.7, dt 1e-2 (band 5.5e-2); with a held contact's first-order target -5.5 % and -72 %
     (its correction, which moves a contact's positions only, took the energy)."""
-    R, d, m, inertia = 0.5, 0.3, 1.0, 0.02
+    m = 1.0
     sim = _rocker("arc", R, d, m, inertia, amplitude, dt)
     period = rocker_period(R, d, m, inertia, amplitude)
     traj = sim.run(30 * period, record_every=1)
