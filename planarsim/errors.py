@@ -24,9 +24,10 @@ from .kernels.codes import INTEGRATOR_NAMES
 from .kernels.dynamics.forces import ACT_PIN_TORQUE
 from .kernels.dynamics.rattle import (UNSUPPORTED_CONTACT, UNSUPPORTED_FLUID, UNSUPPORTED_LIMIT,
                                       UNSUPPORTED_FRICTION, UNSUPPORTED_SOFT)
-from .kernels.checks.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_GROSS,
-                                    GUARD_ENERGY, GUARD_JUMP, GUARD_NONFINITE_COMMAND, GUARD_ROOM,
-                                    GUARD_SPEED, GUARD_STIFF_ACTUATOR, GUARD_UNSUPPORTED)
+from .kernels.checks.guards import (FIELD_SPEED, GUARD_AUDIT, GUARD_BAD_COMMANDS, GUARD_BAD_MODE,
+                                    GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_NONFINITE_COMMAND,
+                                    GUARD_ROOM, GUARD_SPEED, GUARD_STIFF_ACTUATOR,
+                                    GUARD_UNSUPPORTED)
 
 
 def plain(value):
@@ -379,6 +380,13 @@ def diverged(model, ws, code, guard_limit, who="simulation"):
         return ValueError(f"{who}: command u[{k}] for actuator {model.act_names[k]!r} is "
                           f"{float(ws.guard_value[0])}; commands must be finite (N or N m); "
                           f"nothing was stepped")
+    if code == GUARD_BAD_MODE:
+        i = int(ws.info[INFO_GUARD_BODY])
+        name = (f" (contact {model.contact_names[i]!r})" if i < len(model.contact_names)
+                else "")
+        return ValueError(f"{who}: state.contact_mode[{i}] = {int(ws.guard_value[0])}{name} "
+                          "must be 0 (free), 1 (pinned) or 2 (sliding): the State was changed "
+                          "in place; nothing was stepped")
     if code == GUARD_SPEED:
         return too_fast(model, ws, who)
     if code == GUARD_ENERGY:

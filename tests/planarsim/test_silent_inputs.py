@@ -475,3 +475,19 @@ def test_simulator_switches_take_true_or_false(kw):
     """The string "no" is truthy: allow_below_ground="no" allowed what it said not to."""
     with pytest.raises(TypeError, match=f"Simulator: {next(iter(kw))}=.* must be True or False"):
         ps.Simulator(base().compile(), **kw)
+
+
+@pytest.mark.parametrize("mode", [7, -1])
+def test_contact_mode_edited_in_place_is_refused(mode):
+    """A mode that is none of free, pinned, sliding written into the State in place (which the
+    state setter's check never sees) was stepped as some mode, silently."""
+    sim = ps.Simulator(resting_rod())
+    sim.step()
+    sim.state.contact_mode[1] = mode
+    q = sim.state.q.copy()
+    with pytest.raises(ValueError, match=rf"state.contact_mode\[1\] = {mode} \(contact "
+                                         r"'right'\) must be 0 \(free\), 1 \(pinned\) or 2"):
+        sim.step()
+    assert np.array_equal(sim.state.q, q)       # nothing was stepped
+    sim.state.contact_mode[1] = 1
+    sim.step()

@@ -2,7 +2,7 @@
 import math
 
 from ...compile import kernel
-from ..codes import CONTACT_ARC, CONTACT_POINT, JOINT_HINGE, MODE_FREE
+from ..codes import CONTACT_ARC, CONTACT_POINT, JOINT_HINGE, MODE_FREE, MODE_PINNED, MODE_SLIDING
 from ..math2d import rotate, world_point
 from ..constraints.joints import is_slider
 from ..constraints.limit import limit_overshoot
@@ -36,6 +36,10 @@ GUARD_JUMP = 9           # a body moved in the step farther than its velocities 
 GUARD_ROOM = 10          # a row or complementarity variable of the step did not fit the
                           # workspace's storage (ws.room): the state is put back at the step's
                           # start, and Simulator grows the storage and takes the step again
+GUARD_BAD_MODE = 11      # a contact's mode in the State is none of free, pinned, sliding (the
+                         # State edited in place: check_state sees only a State put in;
+                         # ws.info[INFO_GUARD_BODY]: the contact, ws.guard_value: the mode);
+                         # nothing is stepped
 GUARD_BAD_COMMANDS = -1   # the commands array does not have one entry per actuator (ws.info[INFO_COMMAND]:
                           # its length); negative, so that no walker's own return code clashes
 GUARD_NONFINITE_COMMAND = -2   # a command is NaN or infinite (ws.info[INFO_COMMAND]: its index,
@@ -55,7 +59,8 @@ def _guard_code(x, limit):
 @kernel
 def check_guards(s, ws, limit):
     """Return GUARD_*; on failure ws.info[INFO_GUARD_BODY] = body,
-    ws.info[INFO_GUARD_FIELD] = field 0..5 (x y th vx vy w)."""
+    ws.info[INFO_GUARD_FIELD] = field 0..5 (x y th vx vy w); or GUARD_BAD_MODE for a
+    contact's mode that is no mode (ws.info[INFO_GUARD_BODY] = the contact)."""
     for i in range(s.q.shape[0]):
         for f in range(6):
             x = s.q[i, f] if f < 3 else s.v[i, f - 3]
@@ -65,6 +70,12 @@ def check_guards(s, ws, limit):
                 ws.info[INFO_GUARD_FIELD] = f
                 ws.guard_value[0] = x
                 return bad
+    for i in range(s.contact_mode.shape[0]):
+        mode = s.contact_mode[i]
+        if mode != MODE_FREE and mode != MODE_PINNED and mode != MODE_SLIDING:
+            ws.info[INFO_GUARD_BODY] = i
+            ws.guard_value[0] = mode
+            return GUARD_BAD_MODE
     return GUARD_OK
 
 
