@@ -294,13 +294,23 @@ def main(argv=None):
     argv = list(sys.argv[1:] if argv is None else argv)
     args = parse_args(argv)
     if args.md is None:
-        _run(args)
-        return 0
+        return _status(_run(args))
     tee = _Tee(sys.stdout)
     with contextlib.redirect_stdout(tee):
         results = _run(args)
     path = write_markdown(results, tee.copy.getvalue(), argv, args.md)
     print(f"wrote {path}")
+    return _status(results)
+
+
+def _status(results) -> int:
+    """The run's exit status: 1 where a walker asked for failed (its figures are missing:
+    the run printed why, and the others), else 0."""
+    failed = results.get("walker_errors") if isinstance(results, dict) else None
+    if failed:
+        print(f"bench: {len(failed)} walker(s) failed: {', '.join(failed)} (exit 1)",
+              file=sys.stderr)
+        return 1
     return 0
 
 

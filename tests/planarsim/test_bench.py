@@ -60,6 +60,19 @@ def test_walkers_batch_and_warm_startup_parts(capsys):
     assert "warm numba cache" in out and "cold numba cache" not in out
 
 
+def test_a_walker_that_fails_makes_the_run_fail(monkeypatch, capsys):
+    """A walker that raised was printed as FAILED and the run exited 0, its figures missing."""
+    import benchmarks.walker_runs as runs
+
+    def broken(name, seconds, repeats):
+        raise RuntimeError("broken on purpose")
+    monkeypatch.setattr(runs, "measure_walker", broken)
+    assert bench.main(["--parts", "walkers", "--walkers", "ranger", "--repeats", "1"]) == 1
+    captured = capsys.readouterr()
+    assert "walker ranger: FAILED with RuntimeError: broken on purpose" in captured.out
+    assert "bench: 1 walker(s) failed: ranger (exit 1)" in captured.err
+
+
 def test_scene_without_peer_version_runs_with_its_default_settings(capsys):
     assert bench.main(["boxes_on_hills", "--parts", "scenes,peers", "--repeats", "1", "--steps", "20"]) == 0
     assert "boxes_on_hills" in capsys.readouterr().out
