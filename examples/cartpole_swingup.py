@@ -17,9 +17,14 @@ It reads the model from gymnasium's own files: pip install -e '.[gym]' first.
 """
 import argparse
 import os
+import sys
 import time
 
-import gymnasium
+try:
+    import gymnasium
+except ImportError:     # (a plain install has no gymnasium: say what to install, not a traceback)
+    sys.exit(f"{__file__}: needs gymnasium: pip install -e '.[gym]'")
+
 import numpy as np
 
 import planarsim as ps

@@ -18,9 +18,14 @@ return of at least 990 on unseen 1000-step episodes in about 10 s on one shared 
     python examples/learn_dmc_cartpole.py [--iterations 8] [--population 24]
 """
 import argparse
+import sys
 import time
 
-import gymnasium
+try:
+    import gymnasium
+except ImportError:     # (a plain install has no gymnasium: say what to install, not a traceback)
+    sys.exit(f"{__file__}: needs gymnasium: pip install -e '.[gym]'")
+
 import numpy as np
 
 import planarsim.envs  # noqa: F401  (registers planarsim/dmc-cartpole-balance-v0)

@@ -13,11 +13,15 @@ noise on `eval_episodes` fresh seeds.
     python examples/learn_swimmer.py [--iterations 40] [--gif docs/gifs/swimmer.gif]
 """
 import argparse
+import sys
 import time
 
-import numpy as np
+try:
+    import gymnasium
+except ImportError:     # (a plain install has no gymnasium: say what to install, not a traceback)
+    sys.exit(f"{__file__}: needs gymnasium: pip install -e '.[gym]'")
 
-import gymnasium
+import numpy as np
 
 import planarsim.envs  # noqa: F401  (registers planarsim/Swimmer-v0)
 from planarsim.envs.vector import PlanarVectorEnv

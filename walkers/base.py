@@ -307,14 +307,17 @@ def terrain_of(terrain):
     return terrain
 
 
-def target_speed(name, speed, params) -> float:
+def target_speed(name, speed, params=None) -> float:
     """A walker's commanded speed [m/s] as a float within the bounds of its params' `speed`
-    field (the same a SimpleBipedParams(speed=...) keeps to); a ValueError naming the walker
-    and the speed otherwise (a NaN speed stopped the run at its first step naming a leg
-    actuator's command, a string failed in float(), 100 m/s ran silently)."""
+    field (the same a SimpleBipedParams(speed=...) keeps to; any finite speed without
+    params); a ValueError naming the walker and the speed otherwise (a NaN speed stopped the
+    run at its first step naming a leg actuator's command, a string failed in float(), the
+    quadruped's 100 m/s ran silently)."""
     from dataclasses import fields
     from planarsim.checks import finite_number
-    lo, hi = next(f.metadata["bounds"] for f in fields(params) if f.name == "speed")
+    lo, hi = -math.inf, math.inf
+    if params is not None:
+        lo, hi = next(f.metadata["bounds"] for f in fields(params) if f.name == "speed")
     return finite_number(f"{name}: speed", speed, lo, hi, strict=False, unit=" m/s")
 
 
