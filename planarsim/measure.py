@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from .analysis import StepEvents, foot_groups, step_events, step_summary
+from .checks import finite_number
 from .energy import joint_position_rate
 from .model import ACT_AXIAL
 from .state import _body_rows
@@ -65,6 +66,7 @@ def pin_angle_rate(model, q, v, pin) -> tuple:
 
 
 MIN_STRIDE = 0.02   # [m] a landing is a step when the foot lands this far from where it lifted
+MIN_TRANSPORT = 0.1     # [m] the least distance a cost of transport is reported for
 
 
 def summary(traj, model, feet=None, min_air=0.05, together=0.05, min_stride=MIN_STRIDE) -> dict:
@@ -120,12 +122,15 @@ def joint_angles(traj, model) -> dict:
     return out
 
 
-def cost_of_transport(traj, model, power=None):
+def cost_of_transport(traj, model, power=None, min_distance=MIN_TRANSPORT):
     """(instantaneous CoT (K,) [-], averaged CoT [-]) from positive actuator power, or from
-    `power` (K,) [W]. The average is work / (m g |x_end - x_start|) (nan if the COM did not
-    move), the work each frame's power times the time since the frame before (the steps that
-    frame ends; exact when every step is recorded)."""
+    `power` (K,) [W]. The average is work / (m g |x_end - x_start|), nan where the COM moved
+    less than min_distance [m] (default MIN_TRANSPORT, 0.1 m, as the walkers' summaries: a
+    gait in place that drifted 3 mm while its motors did 39 J reported a CoT of 117); the
+    work each frame's power times the time since the frame before (the steps that frame
+    ends; exact when every step is recorded)."""
     check_recorded_by(traj, model, "measure.cost_of_transport")
+    finite_number("measure.cost_of_transport: min_distance", min_distance, 0.0, unit=" m")
     if power is None:
         power = np.clip(traj.act_power, 0.0, None).sum(axis=1) if traj.act_power.size else np.zeros(len(traj.t))
     power = np.asarray(power, float)
@@ -137,5 +142,5 @@ def cost_of_transport(traj, model, power=None):
     com = traj.com(model)
     dist = abs(com[-1, 0] - com[0, 0]) if len(com) else 0.0
     work = float(np.sum(power[1:] * np.diff(traj.t))) if len(traj.t) > 1 else 0.0
-    avg = work / (weight * dist) if dist > 1e-12 and weight > 0 else math.nan
+    avg = work / (weight * dist) if dist >= max(min_distance, 1e-12) and weight > 0 else math.nan
     return inst, avg

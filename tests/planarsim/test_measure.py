@@ -114,3 +114,21 @@ def test_a_measure_of_another_models_recording_names_the_mismatch(who):
     with pytest.raises(ValueError, match=rf"measure\.{who}: .* 2 bodies per frame but the "
                                          r"model has 1 .*wrong model"):
         getattr(measure, who)(traj, b.compile())
+
+
+def test_cost_of_transport_of_a_run_in_place_is_nan():
+    """A gait in place (the quadruped's piaffe drifted 3 mm while its motors did 39 J)
+    reported a CoT of 117: below min_distance (0.1 m, as the walkers' summaries) it is nan."""
+    model = _double_pendulum()
+    traj = ps.Simulator(model).run(0.05)
+    com = traj.com(model)
+    moved = abs(com[-1, 0] - com[0, 0])
+    assert 1e-12 < moved < measure.MIN_TRANSPORT
+    power = np.ones(len(traj.t))
+    assert math.isnan(measure.cost_of_transport(traj, model, power)[1])
+    work = float(np.sum(power[1:] * np.diff(traj.t)))
+    weight = model.total_mass * float(np.hypot(*model.arrays.gravity))
+    assert measure.cost_of_transport(traj, model, power, min_distance=0.0)[1] == pytest.approx(
+        work / (weight * moved))
+    with pytest.raises(ValueError, match=r"min_distance=-1.0 m must be a finite number"):
+        measure.cost_of_transport(traj, model, power, min_distance=-1.0)
