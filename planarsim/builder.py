@@ -22,7 +22,7 @@ from . import model as M
 from .kernels.codes import (CONTACT_ARC, CONTACT_EDGE, CONTACT_PAIR, CONTACT_POINT,
                             JOINT_FREE_HINGE, JOINT_FREE_SLIDE, JOINT_HINGE, JOINT_SLIDE_BIT,
                             JOINT_SLIDER)
-from .checks import holds_bool, is_bool, number
+from .checks import flag, holds_bool, is_bool, number
 from .errors import ModelError, plain as _plain
 from .kernels.geometry.collide import core_normals
 from .kernels.solver.modes import SOLVE_REL_TOL
@@ -753,13 +753,11 @@ class ModelBuilder:
             params = shifted(kind, params, -self._bodies[bid]["origin"])
         if density is not None:     # checked before the shape is kept
             added = self._with_shape_mass(bid, who, kind, params, density)
-        if not isinstance(collide, (bool, np.bool_)):
-            raise ModelError(f"{who}: collide={collide!r} must be True or False")
+        flag(f"{who}: collide", collide, ModelError)
         if bid < 0 and not collide:
             raise ModelError(f"{who}: a static shape (body None) must collide")
         if collide:
-            if not isinstance(ground, (bool, np.bool_)):
-                raise ModelError(f"{who}: ground={ground!r} must be True or False")
+            flag(f"{who}: ground", ground, ModelError)
             self._collide.append(self._collision_shape(idx, who, bid, kind, params, mu,
                                                        restitution, category, mask, name))
             self._collide[-1]["ground"] = bool(ground)

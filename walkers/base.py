@@ -313,11 +313,10 @@ def target_speed(name, speed, params=None) -> float:
     params); a ValueError naming the walker and the speed otherwise (a NaN speed stopped the
     run at its first step naming a leg actuator's command, a string failed in float(), the
     quadruped's 100 m/s ran silently)."""
-    from dataclasses import fields
     from planarsim.checks import finite_number
     lo, hi = -math.inf, math.inf
     if params is not None:
-        lo, hi = next(f.metadata["bounds"] for f in fields(params) if f.name == "speed")
+        lo, hi = params.bounds()[params.names().index("speed")]
     return finite_number(f"{name}: speed", speed, lo, hi, strict=False, unit=" m/s")
 
 

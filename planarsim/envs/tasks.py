@@ -13,9 +13,8 @@ import numpy as np
 from gymnasium import utils
 from gymnasium.spaces import Box
 
-from ..checks import finite_number, is_bool, pair
+from ..checks import finite_number, flag, pair
 from ..compiled import jit
-from ..errors import plain
 from ..mjcf import parse_xml
 from .core import PlanarMujocoEnv, gym_asset
 
@@ -75,8 +74,7 @@ def check_task_keywords(name, defaults, args) -> None:
     for key, default in defaults.items():
         value, said = args[key], f"{name}: {key}"
         if isinstance(default, bool):
-            if not is_bool(value):
-                raise ValueError(f"{said}={plain(value)!r} must be True or False")
+            flag(said, value, ValueError)
         elif isinstance(default, float):
             finite_number(said, value)
         elif isinstance(default, tuple):

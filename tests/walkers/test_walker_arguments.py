@@ -28,7 +28,7 @@ def test_simbicon_push_forms_that_stand():
 
 @pytest.mark.parametrize("kw, said", [
     (dict(dt=0.05), r"ranger: dt=0.05 s is too large"),    # was: the estimator's Nyquist cutoff
-    (dict(max_steps=-1), r"max_steps=-1 must be an integer >= 1"),   # was: negative dimensions
+    (dict(max_steps=-1), r"ranger: max_steps=-1 must be a whole number >= 1"),   # was: negative dimensions
     (dict(seed=-1), r"ranger: seed=-1 must be a whole number >= 0"),
 ])
 def test_ranger_arguments_are_named(kw, said):

@@ -20,7 +20,7 @@ import numpy as np
 
 from planarsim.compiled import jit, step
 import planarsim as ps
-from planarsim.checks import flag
+from planarsim.checks import flag, whole
 from planarsim.trajectory import Trajectory
 
 from walkers.base import WalkerRun, check_controlled_dt, simulation, start_rng, terrain_of
@@ -95,9 +95,8 @@ class Run(WalkerRun):
                  record_every: int = 10, seed: int = 0):
         if gait not in GAITS:
             raise ValueError(f"Ranger gait {gait!r} unknown; use one of {GAITS}")
-        if not (isinstance(max_steps, (int, np.integer)) and max_steps >= 1):
-            raise ValueError(f"max_steps={max_steps!r} must be an integer >= 1 (the most walking "
-                             "steps the controller keeps a record of)")
+        whole(f"{self.NAME}: max_steps", max_steps, least=1,
+              why="the most walking steps the controller keeps a record of")
         flag(f"{self.NAME}: suspended", suspended)
         start_rng(self.NAME, seed)      # (Ranger starts from one pose: checked all the same)
         params = params if params is not None else RangerParams()
