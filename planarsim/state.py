@@ -369,7 +369,9 @@ class Workspace(NamedTuple):
                                  #   scratch of the refinement on kept factors
     lam: np.ndarray              # (R,) impulses [N s or N m s]
     act_u: np.ndarray            # (n_act,) applied (saturated) commands
-    act_power: np.ndarray        # (n_act,) mechanical power [W]
+    act_power: np.ndarray        # (n_act,) mechanical power [W] (forces.end_power: the
+                                 #   command times its move over the step / h once a step
+                                 #   stands)
     info: np.ndarray             # (N_INFO,) int: what the last step did, slots named in
                                  #   kernels/info.py (INFO_*; step_info(ws) by name)
     broken_rules: np.ndarray     # (N_BROKEN + 1,) int: the rules the last checked answer

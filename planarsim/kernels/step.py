@@ -24,7 +24,7 @@ from .geometry.ccd import split_at_impact, stop_at_impact
 from .codes import GUESS_PENDING, INTEGRATOR_EULER, MODE_FREE, MODE_PINNED, MODES_ALTERNATING
 from .solver.complementarity import solve_contacts
 from .geometry.contacts import bounce_of, find_contacts
-from .dynamics.forces import apply_forces, predict_velocity
+from .dynamics.forces import apply_forces, end_power, predict_velocity
 from .checks.guards import (GUARD_AUDIT, GUARD_ENERGY, GUARD_GROSS, GUARD_JUMP, GUARD_ROOM,
                             check_actuator_turns, check_displacements, check_guards, check_moves,
                             check_speeds, add_part_path, finish_path, keep_step_path,
@@ -980,7 +980,20 @@ def chain_step(m, s, ws, opt, u, step_length):
 @kernel(inline="always")
 def _step(m, s, ws, opt, u):
     """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u with
-    StepOptions.integrator; return the guard code."""
+    StepOptions.integrator; return the guard code. A symplectic Euler step that stands ends
+    with ws.act_power at its move's mean rates (forces.end_power: h times it is the work of
+    the commands on the step's move)."""
+    code = _advance(m, s, ws, opt, u)
+    if code == 0 and opt.integrator == INTEGRATOR_EULER and m.act_kind.shape[0] > 0:
+        # the step's start: ws.start where it was taken in sub-steps, else ws.prev
+        start = ws.start.q if ws.info[INFO_TURN_SUBSTEPS] > 1 else ws.prev.q
+        end_power(m, s, ws, start, opt.dt if opt.dt > 0.0 else m.dt)
+    return code
+
+
+@kernel(inline="always")
+def _advance(m, s, ws, opt, u):
+    """_step's step, its actuators' power at the step's start rates."""
     step_length = opt.dt if opt.dt > 0.0 else m.dt
     ws.info[INFO_CHAIN_PATH] = 0
     if opt.integrator == INTEGRATOR_EULER:

@@ -513,7 +513,8 @@ def ranger_costs_from_the_recorded_power(traj, raw, model):
     """Ranger's whole-step costs of transport (from its second heel strike to its last, over
     the hip's travel between them, as its heel-strike log holds them) from the recorded
     shaft power and the electrical power labels, summed frame by frame (1e-9 relative). The
-    energy logged at a strike holds the recorded power through the frame after it."""
+    energy logged at a strike holds the recorded power through the strike's own frame (each
+    step is counted once it is taken, its power over its turn)."""
     import walkers.ranger.tables as T
     steps = int(raw["steps"])
     assert steps >= 4
@@ -524,7 +525,7 @@ def ranger_costs_from_the_recorded_power(traj, raw, model):
     assert len(log) == steps
     t = np.asarray(traj.t)
     a, b = (int(np.flatnonzero(np.isclose(t, log[k, T.LOG.t], rtol=0, atol=1e-9))[0]) for k in (1, -1))
-    span = slice(a + 2, b + 2)
+    span = slice(a + 1, b + 1)
     weight = float(np.hypot(*model.arrays.gravity)) * float(model.arrays.body_mass.sum())
     per = weight * float(log[-1, T.LOG.hip_x] - log[1, T.LOG.hip_x])
     dt = traj.info["dt"]

@@ -82,6 +82,7 @@ MEM = slots("QuadrupedMemory", (
     ("goal", 2 * N_LEG, "foot goal (x, y) world, per leg: goal + 2i, + 1"),
     ("qref", 2 * N_LEG, "puppet joint angles (hip, knee) per leg: qref + 2i, + 1"),
     ("flag", N_LEG, "IK flags per leg"),
+    ("work_at", "State.step the motors' work is counted to (count_work; -1: from the next tick)"),
 ))
 N_MEMORY = size(MEM)
 
@@ -235,12 +236,26 @@ def stance_forces(s, p, mem, xc):
     return front / nf, (w - front) / nr
 
 
+@kernel
+def count_work(s, ws, mem, dt):
+    """Add the step that led to s (of dt [s]) to the motors' positive mechanical work mem[work]
+    [J], once (the rollout calls it after each step, control at each tick): the engine's
+    power of each motor over the step (ws.act_power: its command times the joint's turn over
+    dt), its positive part. Only the last step where several were taken since the last
+    count; none where mem[work_at] is -1 (a memory made for this state)."""
+    if mem[MEM.work_at] >= 0.0 and s.step[0] != mem[MEM.work_at]:
+        for k in range(ws.act_power.shape[0]):
+            mem[MEM.work] += max(ws.act_power[k], 0.0) * dt
+    mem[MEM.work_at] = s.step[0]
+
+
 @jit_inline
 def control(m, s, ws, p, mem, u):
     """One control tick (p: the parameter vector, the quadruped's table): fall monitor, the 30 Hz foot update, puppet feet, puppet pose (IK),
     PD + weight feed-forward into u (n_act,) [N m]. Pin/actuator j = 2 leg + (0 hip, 1 knee)."""
     t, dt = s.time[0], m.dt
     tx, ty, th = s.q[0, 0], s.q[0, 1], s.q[0, 2]
+    count_work(s, ws, mem, dt)
     # fall monitor
     if ty - height(m.terrain_coef, tx) < p[FIELD.fall_height] or abs(th) > p[FIELD.fall_pitch]:
         mem[MEM.fell] = 1.0
@@ -286,13 +301,12 @@ def control(m, s, ws, p, mem, u):
             ang, rate = pin_angle_rate(m, s.q, s.v, pin)
             ff = ff_hip if j == 0 else ff_knee
             u[pin] = clamp(kp * (mem[MEM.qref + pin] - ang) - kd * rate + ff, -lim, lim)
-            # positive mechanical work of the motors [J] (power at the start of the step)
-            mem[MEM.work] += max(u[pin] * rate, 0.0) * dt
 
 
 def make_memory(model, params: QuadrupedParams, gait: int, speed: float) -> np.ndarray:
     """Controller memory for a run starting from the model's build pose."""
     mem = np.zeros(N_MEMORY)
+    mem[MEM.work_at] = -1.0
     mem[MEM.gait] = gait
     mem[MEM.speed] = speed
     mem[MEM.weight] = 9.81 * float(np.sum(model.arrays.body_mass))

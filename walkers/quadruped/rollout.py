@@ -48,6 +48,7 @@ def rollout_quadruped(m, s, ws, opt, p, mem, u, n, every, rec, lab, slots, k0):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, k
+        C.count_work(s, ws, mem, m.dt)
         k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
     return 0, n, k
 

@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 
+from planarsim.actuators import motor_power
 from planarsim.compiled import jit_inline, kernel, pin_angle_rate, height as terrain_height
 
 from .estimator import filter_step, hysteresis
@@ -228,6 +229,29 @@ def air_current(s, k, mp, foot, err, derr):
 
 
 @jit_inline
+def count_step_energy(m, s, ws, dt, motor, mem):
+    """Add the step that led to s (of dt [s]) to the energies mem[e..e+3] [J] (electrical
+    positive and net, mechanical positive and net), once (the rollout calls it after each
+    step, control at each tick): each motor's current (mem[cur]) and torque (ws.act_u) held
+    over the step, the torque's work the engine's power over it (ws.act_power: the torque
+    times the joint's turn over dt), the electrical power at the joint's rate at the step's
+    end, which symplectic Euler turns it by (into mem[pel], which the frame after the step
+    records). Only the last step where several were taken since the last count; none where
+    mem[e_at] is -1 (a memory made for this state)."""
+    if mem[MEM.e_at] >= 0.0 and s.step[0] != mem[MEM.e_at]:
+        for j in range(3):
+            rate = pin_angle_rate(m, s.q, s.v, j)[1]
+            pel = motor_power(mem[MEM.cur + j], rate, motor[j])
+            mem[MEM.pel + j] = pel
+            pm = ws.act_power[j]
+            mem[MEM.e] += dt * max(pel, 0.0)
+            mem[MEM.e + 1] += dt * pel
+            mem[MEM.e + 2] += dt * max(pm, 0.0)
+            mem[MEM.e + 3] += dt * pm
+    mem[MEM.e_at] = s.step[0]
+
+
+@jit_inline
 def control(m, s, ws, tab, mem, u):
     """One control step: estimator, FSM, motor programs, motor model -> u (torques [N m]).
     Also integrates electrical and mechanical energy and records each heel strike
@@ -237,6 +261,7 @@ def control(m, s, ws, tab, mem, u):
     motor = tab.motor
     gui = tab.gui
     steplog = tab.steplog
+    count_step_energy(m, s, ws, k[CONST.dt], motor, mem)
     update_estimator(m, s, ws, k, mem)
     gait = int(mem[MEM.gait])
     steps_before = mem[MEM.steps]
@@ -280,11 +305,6 @@ def control(m, s, ws, tab, mem, u):
         u[j] = tau
         mem[MEM.cur + j] = cur
         mem[MEM.pel + j] = pel
-        pm = tau * rate
-        mem[MEM.e] += dt * max(pel, 0.0)
-        mem[MEM.e + 1] += dt * pel
-        mem[MEM.e + 2] += dt * max(pm, 0.0)
-        mem[MEM.e + 3] += dt * pm
     # fall and heel strike
     hx, hy, vx, vy = hip_state(s, k, 0)
     if hy - height_below(m, hx) < k[CONST.fall_h] or abs(s.q[0, 2]) > 1.2 or abs(s.q[1, 2]) > 1.2:

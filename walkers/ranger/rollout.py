@@ -29,7 +29,7 @@ from walkers.common.slots import label_slots
 
 from . import controller as C
 from . import tables as T
-from .controller import Controller, control
+from .controller import Controller, control, count_step_energy
 from .model import build
 from .params import RangerParams
 
@@ -57,6 +57,7 @@ def rollout_ranger(m, s, ws, opt, tab, mem, u, n, every, rec, lab, lab_idx, k0):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, kf
+        count_step_energy(m, s, ws, tab.k[T.CONST.dt], tab.motor, mem)
         kf = record_labelled(s, ws, rec, lab, mem, lab_idx, every, kf)
         if mem[C.MEM.fell] != 0.0:
             return 0, i + 1, kf

@@ -77,6 +77,7 @@ MEM = slots("RangerMemory", (
     ("contact", 2, "estimator flag per foot"),
     "push_i", "v_mid", "mid_done", "steps", "t_strike",
     ("e", 4, "energies [J]: electrical positive, electrical net, mechanical positive, mechanical net"),
+    ("e_at", "State.step the energies are counted to (count_step_energy; -1: from the next tick)"),
     ("prog", 3, "program per motor"),
     ("cur", 3, "current per motor [A]"),
     ("pel", 3, "electrical power per motor [W]"),
@@ -130,6 +131,7 @@ def make_programs(p: RangerParams) -> np.ndarray:
 
 def make_memory(gait: int = GAIT_WALK) -> np.ndarray:
     mem = np.zeros(N_MEM)
+    mem[MEM.e_at] = -1.0
     mem[MEM.gait] = gait
     mem[MEM.phase] = PH_STANDING if gait == GAIT_WALK else PH_SINGLE   # STAND captures on entry
     mem[MEM.stance] = 1

@@ -134,8 +134,9 @@ def add_spring_forces(m, q, cs, f, h):
 
 
 @kernel(inline="always")
-def apply_actuator(m, q, cs, v, f, k, u):
-    """Add actuator k's saturated command u to f; return its mechanical power [W]."""
+def apply_actuator(m, q, cs, v, f, k, u, add=True):
+    """Add actuator k's saturated command u to f (add False: f is left alone); return its
+    mechanical power [W] at velocity v."""
     kind = m.act_kind[k]
     a = m.act_body[k, 0]
     b = m.act_body[k, 1]
@@ -143,9 +144,10 @@ def apply_actuator(m, q, cs, v, f, k, u):
         j = m.act_ref[k]
         pa = m.pin_body[j, 0]
         pb = m.pin_body[j, 1]
-        f[pb, 2] += u
-        if pa >= 0:
-            f[pa, 2] -= u
+        if add:
+            f[pb, 2] += u
+            if pa >= 0:
+                f[pa, 2] -= u
         return u * pin_angle_rate(m, q, v, j)[1]
     if kind == ACT_AXIAL:
         ax, ay = world_point(q, cs, a, m.act_anchor[k, 0, 0], m.act_anchor[k, 0, 1])
@@ -157,8 +159,9 @@ def apply_actuator(m, q, cs, v, f, k, u):
             return 0.0
         ex = dx / L
         ey = dy / L
-        add_point_force(q, f, b, bx, by, u * ex, u * ey)
-        add_point_force(q, f, a, ax, ay, -u * ex, -u * ey)
+        if add:
+            add_point_force(q, f, b, bx, by, u * ex, u * ey)
+            add_point_force(q, f, a, ax, ay, -u * ex, -u * ey)
         vax, vay = point_velocity(q, v, a, ax, ay)
         vbx, vby = point_velocity(q, v, b, bx, by)
         return u * (ex * (vbx - vax) + ey * (vby - vay))
@@ -176,10 +179,11 @@ def apply_actuator(m, q, cs, v, f, k, u):
             # force perpendicular to the leg giving torque sign*u about the hip
             fx = -sign * u * dy / d2
             fy = sign * u * dx / d2
-            f[leg, 0] += fx
-            f[leg, 1] += fy
-            f[h, 0] -= fx
-            f[h, 1] -= fy
+            if add:
+                f[leg, 0] += fx
+                f[leg, 1] += fy
+                f[h, 0] -= fx
+                f[h, 1] -= fy
             w = cross2(dx, dy, v[leg, 0] - v[h, 0], v[leg, 1] - v[h, 1]) / d2
             power += sign * u * w
         return power
@@ -189,15 +193,17 @@ def apply_actuator(m, q, cs, v, f, k, u):
         ja = m.pin_body[j, 0]
         jb = m.pin_body[j, 1]
         dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, ja, jb)
-        add_point_force(q, f, jb, bx, by, u * dx, u * dy)
-        add_point_force(q, f, ja, bx, by, -u * dx, -u * dy)
+        if add:
+            add_point_force(q, f, jb, bx, by, u * dx, u * dy)
+            add_point_force(q, f, ja, bx, by, -u * dx, -u * dy)
         return u * slide_position_rate(m, q, cs, v, j)[1]
     if kind == ACT_BODY_FORCE:
-        f[a, 0] += u * m.act_dir[k, 0]
-        f[a, 1] += u * m.act_dir[k, 1]
+        if add:
+            f[a, 0] += u * m.act_dir[k, 0]
+            f[a, 1] += u * m.act_dir[k, 1]
         return u * (m.act_dir[k, 0] * v[a, 0] + m.act_dir[k, 1] * v[a, 1])
     # ACT_BODY_TORQUE
-    if m.body_inv_inertia[a] > 0.0:
+    if add and m.body_inv_inertia[a] > 0.0:
         f[a, 2] += u
     return u * v[a, 2]
 
@@ -228,6 +234,25 @@ def apply_forces(m, s, ws, u, h):
             uk = m.act_range[k, 1]
         ws.act_u[k] = uk
         ws.act_power[k] = apply_actuator(m, q, ws.body_cs, v, f, k, uk)
+
+
+@kernel
+def end_power(m, s, ws, q_start, h):
+    """ws.act_power [W] of a step of h [s] that has ended, from q_start to s.q: each actuator's
+    saturated command (ws.act_u) times its coordinate's move over the step, divided by h (the
+    bodies' mean velocities (s.q - q_start) / h into the scratch ws.q_keep; the geometry of
+    the step's end). So h times it is the work the command did on the step's move, exactly
+    for a joint torque, a body torque and a body force (sub-steps and splits included);
+    apply_forces' power at the step's start rates, which the step applied the forces with,
+    is not (a walking quadruped's motors did 3 % more positive work than that power
+    counted, and a net work of the opposite sign)."""
+    for i in range(s.q.shape[0]):
+        for k in range(3):
+            ws.q_keep[i, k] = (s.q[i, k] - q_start[i, k]) / h
+    update_trig(s.q, ws.body_cs)
+    for k in range(m.act_kind.shape[0]):
+        ws.act_power[k] = apply_actuator(m, s.q, ws.body_cs, ws.q_keep, ws.force, k,
+                                         ws.act_u[k], False)
 
 
 @kernel
