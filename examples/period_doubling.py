@@ -55,13 +55,9 @@ def main(argv=None):
                 print(f"  {bf.kind} at slope {bf.p:.6f} rad (bracket {bf.bracket:.1e})")
         print(f"  continuation: {time.perf_counter() - t0:.0f} s")
         t1 = time.perf_counter()
-        x1 = branches[0]
-
-        def start(p):   # the period-1 gait nearest in slope (continued, or its last point)
-            i = int(np.argmin(np.abs(x1.p - p)))
-            return x1.x[i]
-        d = bifurcation_diagram(pool, np.linspace(lo, hi, a.slopes), start, a.transient, a.keep,
-                                param="slope")
+        # each slope from the period-1 gait nearest in slope (continued, or its last point)
+        d = bifurcation_diagram(pool, np.linspace(lo, hi, a.slopes), branches[0].nearest,
+                                a.transient, a.keep, param="slope")
         print(f"  brute-force diagram: {a.slopes} slopes x {a.transient + a.keep} steps, "
               f"{time.perf_counter() - t1:.0f} s on {pool.workers} workers")
     per = d.periods(1e-6)

@@ -493,7 +493,14 @@ def cmd_analyze(args):
     t0 = time.perf_counter()
     with MapPool(family, workers=args.workers, exact=bool(args.exact)) as pool:
         if args.diagram:
-            d = bifurcation_diagram(pool, np.linspace(a, b, args.points), x0, args.transient,
+            # each value started from the period-1 gait nearest to it, continued over the range
+            # (from one guess at the range's start, a slope past the first doubling fell)
+            try:
+                start = continue_branch(pool, x0, a, b, args.points, method=args.method,
+                                        param=args.param).nearest
+            except StepMapError:
+                start = family.guess
+            d = bifurcation_diagram(pool, np.linspace(a, b, args.points), start, args.transient,
                                     args.keep, param=args.param, progress=progress)
             periods = d.periods()
             for p, k, fell in zip(d.p, periods, d.fell):

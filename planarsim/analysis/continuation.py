@@ -98,6 +98,12 @@ class Branch:
     def multipliers(self) -> np.ndarray:
         return np.array([b.multipliers for b in self.points])
 
+    def nearest(self, p) -> np.ndarray:
+        """The state of the branch's point nearest in the parameter to p: where to start
+        iterating the map at p (bifurcation_diagram's x0; past the branch's end, its last
+        point)."""
+        return self.points[int(np.argmin(np.abs(self.p - float(p))))].x
+
     def first(self, kind: str):
         """The first bifurcation of `kind` along the branch, or None."""
         return next((b for b in self.bifurcations if b.kind == kind), None)

@@ -110,3 +110,19 @@ def test_analyze_finds_the_period_doublings_at_every_step_size(reference_doublin
             assert err[dt] < 1e-5, (refp, got)      # what the engine reaches (10x the measured)
         for big, small in zip(dts, dts[1:]):
             assert err[small] <= err[big] + 2e-6, (refp, err)
+
+
+def test_the_diagram_starts_each_slope_from_the_continued_gait(capsys):
+    """`analyze --diagram` across the simplest walker's first doubling (0.01494): every slope
+    walks, period 1 before it and period 2 well past it (each slope started from the
+    period-1 gait continued to it; started from the gait at the range's first slope, every
+    slope past 0.0141 fell). Near the doubling the period-2 orbit is reached slowly (its
+    multiplier near -1): 0.015 is not judged."""
+    assert main(["analyze", "simplest-walker", "--param", "slope", "--range", "0.014:0.017",
+                 "--points", "4", "--workers", "1", "--quiet", "--diagram"]) == 0
+    out = capsys.readouterr().out
+    lines = [line for line in out.splitlines() if line.startswith("  slope = ")]
+    assert len(lines) == 4 and not any(line.endswith("fell") for line in lines), out
+    assert lines[0].endswith("period 1"), out
+    assert lines[2].endswith("period 2") and lines[3].endswith("period 2"), out
+    assert "no falls in the range" in out
