@@ -4,9 +4,9 @@ Frame 0 holds the state a run starts from (its impulses, commands and powers are
 step before it, zero for a fresh state); every later frame the state after a recorded step
 (steps whose count is a multiple of record_every). contact_mode is 0 free, 1 pinned, 2 sliding,
 -1 disabled. contact_impulse is (normal, tangential) impulse of the step [N s]; divide by dt
-for a mean force [N]. act_power is the mechanical power of each actuator [W]: its command times
-its coordinate's move over the step, divided by dt (the rate at the step's end, for a step taken
-whole), so that dt times it is the work the command did on the step.
+for a mean force [N]. act_power is the mechanical power of each actuator [W] over the step: its
+command times its coordinate's move in the step (joint angle, anchors' distance, slide, ...)
+divided by dt, so that dt times it is the work the command did in the step.
 """
 from __future__ import annotations
 

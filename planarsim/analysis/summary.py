@@ -42,7 +42,8 @@ def step_summary(traj, model, contacts=None, direction=None, feet=None, min_air=
     Returns whole_steps (touchdowns - 1), step_period [s], step_length [m] (centre-of-mass
     displacement along direction per step), speed [m/s], cost_of_transport [-] (energy spent
     per weight and distance: the mechanical energy lost plus the actuators' net work, over
-    (total mass x |g| x distance); a passive walker on a slope gamma gives sin(gamma)),
+    (total mass x |g| x distance); a passive walker on a slope gamma gives sin(gamma); the
+    work each frame's act_power times the time since the frame before),
     energy_spent [J], first_touchdown, last_touchdown [s]. NaN where fewer than two
     touchdowns (or no forward motion for the cost of transport).
     """
@@ -63,8 +64,10 @@ def step_summary(traj, model, contacts=None, direction=None, feet=None, min_air=
     T = float(t[b] - t[a])
     work = 0.0
     if traj.act_power.shape[1]:
-        power = np.sum(traj.act_power[a:b + 1], axis=1)
-        work = float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(t[a:b + 1])))
+        # a frame's power is over the step that ends at it: the steps of frames a+1..b
+        # (exact when every step is recorded, as measure.cost_of_transport sums it)
+        power = np.sum(traj.act_power[a + 1:b + 1], axis=1)
+        work = float(np.sum(power * np.diff(t[a:b + 1])))
     spent = float(energy[a] - energy[b]) + work
     weight = float(np.sum(model.arrays.body_mass) * np.hypot(*model.arrays.gravity))
     out.update(whole_steps=n, step_period=T / n, step_length=dist / n,

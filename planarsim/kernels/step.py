@@ -980,14 +980,16 @@ def chain_step(m, s, ws, opt, u, step_length):
 @kernel(inline="always")
 def _step(m, s, ws, opt, u):
     """Advance s by one step of opt.dt (0: the model's m.dt) under actuator commands u with
-    StepOptions.integrator; return the guard code. A symplectic Euler step that stands ends
-    with ws.act_power at its move's mean rates (forces.end_power: h times it is the work of
-    the commands on the step's move)."""
+    StepOptions.integrator; return the guard code. A step that stands ends with
+    ws.act_power over its move (forces.end_power: h times it is the work of the commands in
+    the step)."""
     code = _advance(m, s, ws, opt, u)
-    if code == 0 and opt.integrator == INTEGRATOR_EULER and m.act_kind.shape[0] > 0:
-        # the step's start: ws.start where it was taken in sub-steps, else ws.prev
-        start = ws.start.q if ws.info[INFO_TURN_SUBSTEPS] > 1 else ws.prev.q
-        end_power(m, s, ws, start, opt.dt if opt.dt > 0.0 else m.dt)
+    if code == 0 and m.act_kind.shape[0] > 0:
+        # the step's start: ws.start where an Euler step was taken in sub-steps, else ws.prev
+        # (an accurate step's stages keep it there throughout)
+        parts = opt.integrator == INTEGRATOR_EULER and ws.info[INFO_TURN_SUBSTEPS] > 1
+        end_power(m, s, ws, ws.start.q if parts else ws.prev.q,
+                  opt.dt if opt.dt > 0.0 else m.dt)
     return code
 
 

@@ -325,6 +325,9 @@ def make_memory(model, params: QuadrupedParams, gait: int, speed: float) -> np.n
 
 class Controller:
     """Python path: ``u = controller(sim)`` each step (the compiled ``control`` underneath).
+    The memory's motor work counts each step at the call after it (the step that led there):
+    a run's last step is left out, and with a controller called every k steps, only those
+    steps are counted (Run's rollout counts every step as it is taken).
 
     >>> c = Controller(model, QuadrupedParams(), gait="piaffe")     # doctest: +SKIP
     >>> traj = sim.run(5.0, controller=c)

@@ -350,7 +350,10 @@ class Controller:
     ``Controller(params, dt, gravity=model's [m/s^2])``; ``set_gait("walk"|"stand"|"gui")``; ``set_gui(joint, target,
     kp, kd)`` (joint 0 hip, 1 outer ankle, 2 inner ankle; REL pin angles [rad], gains [A/rad],
     [A s/rad]); ``__call__(sim) -> u`` runs one control step on a Simulator (the Python path).
-    ``reset`` refills the memory in place (a run holding it sees the new values).
+    ``reset`` refills the memory in place (a run holding it sees the new values). On the
+    Python path the memory's energies count each step at the call after it (the step that
+    led there): a run's last step is left out, and with a controller called every k steps,
+    only those steps are counted (Run's rollout counts every step as it is taken).
     """
 
     GAITS = {"walk": GAIT_WALK, "stand": GAIT_STAND, "gui": GAIT_GUI}

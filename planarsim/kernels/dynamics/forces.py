@@ -134,9 +134,8 @@ def add_spring_forces(m, q, cs, f, h):
 
 
 @kernel(inline="always")
-def apply_actuator(m, q, cs, v, f, k, u, add=True):
-    """Add actuator k's saturated command u to f (add False: f is left alone); return its
-    mechanical power [W] at velocity v."""
+def apply_actuator(m, q, cs, v, f, k, u):
+    """Add actuator k's saturated command u to f; return its mechanical power [W]."""
     kind = m.act_kind[k]
     a = m.act_body[k, 0]
     b = m.act_body[k, 1]
@@ -144,10 +143,9 @@ def apply_actuator(m, q, cs, v, f, k, u, add=True):
         j = m.act_ref[k]
         pa = m.pin_body[j, 0]
         pb = m.pin_body[j, 1]
-        if add:
-            f[pb, 2] += u
-            if pa >= 0:
-                f[pa, 2] -= u
+        f[pb, 2] += u
+        if pa >= 0:
+            f[pa, 2] -= u
         return u * pin_angle_rate(m, q, v, j)[1]
     if kind == ACT_AXIAL:
         ax, ay = world_point(q, cs, a, m.act_anchor[k, 0, 0], m.act_anchor[k, 0, 1])
@@ -159,9 +157,8 @@ def apply_actuator(m, q, cs, v, f, k, u, add=True):
             return 0.0
         ex = dx / L
         ey = dy / L
-        if add:
-            add_point_force(q, f, b, bx, by, u * ex, u * ey)
-            add_point_force(q, f, a, ax, ay, -u * ex, -u * ey)
+        add_point_force(q, f, b, bx, by, u * ex, u * ey)
+        add_point_force(q, f, a, ax, ay, -u * ex, -u * ey)
         vax, vay = point_velocity(q, v, a, ax, ay)
         vbx, vby = point_velocity(q, v, b, bx, by)
         return u * (ex * (vbx - vax) + ey * (vby - vay))
@@ -179,11 +176,10 @@ def apply_actuator(m, q, cs, v, f, k, u, add=True):
             # force perpendicular to the leg giving torque sign*u about the hip
             fx = -sign * u * dy / d2
             fy = sign * u * dx / d2
-            if add:
-                f[leg, 0] += fx
-                f[leg, 1] += fy
-                f[h, 0] -= fx
-                f[h, 1] -= fy
+            f[leg, 0] += fx
+            f[leg, 1] += fy
+            f[h, 0] -= fx
+            f[h, 1] -= fy
             w = cross2(dx, dy, v[leg, 0] - v[h, 0], v[leg, 1] - v[h, 1]) / d2
             power += sign * u * w
         return power
@@ -193,17 +189,15 @@ def apply_actuator(m, q, cs, v, f, k, u, add=True):
         ja = m.pin_body[j, 0]
         jb = m.pin_body[j, 1]
         dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, ja, jb)
-        if add:
-            add_point_force(q, f, jb, bx, by, u * dx, u * dy)
-            add_point_force(q, f, ja, bx, by, -u * dx, -u * dy)
+        add_point_force(q, f, jb, bx, by, u * dx, u * dy)
+        add_point_force(q, f, ja, bx, by, -u * dx, -u * dy)
         return u * slide_position_rate(m, q, cs, v, j)[1]
     if kind == ACT_BODY_FORCE:
-        if add:
-            f[a, 0] += u * m.act_dir[k, 0]
-            f[a, 1] += u * m.act_dir[k, 1]
+        f[a, 0] += u * m.act_dir[k, 0]
+        f[a, 1] += u * m.act_dir[k, 1]
         return u * (m.act_dir[k, 0] * v[a, 0] + m.act_dir[k, 1] * v[a, 1])
     # ACT_BODY_TORQUE
-    if add and m.body_inv_inertia[a] > 0.0:
+    if m.body_inv_inertia[a] > 0.0:
         f[a, 2] += u
     return u * v[a, 2]
 
@@ -236,23 +230,78 @@ def apply_forces(m, s, ws, u, h):
         ws.act_power[k] = apply_actuator(m, q, ws.body_cs, v, f, k, uk)
 
 
+@kernel(inline="always")
+def _leg_turn(q0, q1, leg, hip):
+    """The angle [rad] a point-mass leg's vector from the hip turned from q0 to q1 (0 for a
+    leg at its hip, as apply_actuator applies it no force)."""
+    ax = q0[leg, 0] - q0[hip, 0]
+    ay = q0[leg, 1] - q0[hip, 1]
+    bx = q1[leg, 0] - q1[hip, 0]
+    by = q1[leg, 1] - q1[hip, 1]
+    if ax * ax + ay * ay < 1e-24 or bx * bx + by * by < 1e-24:
+        return 0.0
+    return math.atan2(cross2(ax, ay, bx, by), ax * bx + ay * by)
+
+
+@kernel(inline="always")
+def _axial_length(m, q, cs, k):
+    """Distance [m] between actuator k's two anchors at q (cs its cos / sin)."""
+    ax, ay = world_point(q, cs, m.act_body[k, 0], m.act_anchor[k, 0, 0], m.act_anchor[k, 0, 1])
+    bx, by = world_point(q, cs, m.act_body[k, 1], m.act_anchor[k, 1, 0], m.act_anchor[k, 1, 1])
+    return math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+
+
+@kernel(inline="always")
+def _slide(m, q, cs, j):
+    """Slider j's slide [m]: anchor b's distance from anchor a along the axis, at q."""
+    dx, dy, ax, ay, bx, by = slider_frame(m, q, cs, j, m.pin_body[j, 0], m.pin_body[j, 1])
+    return dx * (bx - ax) + dy * (by - ay)
+
+
+@kernel
+def actuator_move(m, q0, cs0, q1, cs1, k):
+    """How far actuator k's coordinate moved from q0 to q1 (cs0, cs1 their cos / sin), the
+    coordinate its command pushes along: the joint's angle [rad] (pin torque), the distance
+    between its anchors [m] (axial force), the legs' turns about the hip, the second's less
+    the first's (hip torque), the body's position along the force's direction [m] (body
+    force), its angle (body torque), the slide [m] (slider force). Its command times it is
+    the work [J] the command did."""
+    kind = m.act_kind[k]
+    a = m.act_body[k, 0]
+    if kind == ACT_PIN_TORQUE:
+        j = m.act_ref[k]
+        return pin_angle(m, q1, j) - pin_angle(m, q0, j)
+    if kind == ACT_AXIAL:
+        L0 = _axial_length(m, q0, cs0, k)
+        if L0 < 1e-12:
+            return 0.0
+        return _axial_length(m, q1, cs1, k) - L0
+    if kind == ACT_HIP_TORQUE:
+        hip = m.act_body[k, 2]
+        return _leg_turn(q0, q1, m.act_body[k, 1], hip) - _leg_turn(q0, q1, a, hip)
+    if kind == ACT_SLIDER_FORCE:
+        j = m.act_ref[k]
+        return _slide(m, q1, cs1, j) - _slide(m, q0, cs0, j)
+    if kind == ACT_BODY_FORCE:
+        return (m.act_dir[k, 0] * (q1[a, 0] - q0[a, 0])
+                + m.act_dir[k, 1] * (q1[a, 1] - q0[a, 1]))
+    return q1[a, 2] - q0[a, 2]     # ACT_BODY_TORQUE
+
+
 @kernel
 def end_power(m, s, ws, q_start, h):
-    """ws.act_power [W] of a step of h [s] that has ended, from q_start to s.q: each actuator's
-    saturated command (ws.act_u) times its coordinate's move over the step, divided by h (the
-    bodies' mean velocities (s.q - q_start) / h into the scratch ws.q_keep; the geometry of
-    the step's end). So h times it is the work the command did on the step's move, exactly
-    for a joint torque, a body torque and a body force (sub-steps and splits included);
-    apply_forces' power at the step's start rates, which the step applied the forces with,
-    is not (a walking quadruped's motors did 3 % more positive work than that power
-    counted, and a net work of the opposite sign)."""
-    for i in range(s.q.shape[0]):
-        for k in range(3):
-            ws.q_keep[i, k] = (s.q[i, k] - q_start[i, k]) / h
+    """ws.act_power [W] of a step of h [s] that has ended, from q_start to s.q: each
+    actuator's saturated command (ws.act_u) times its coordinate's move over the step
+    (actuator_move), over h. So h times it is the work the command did in the step, whatever
+    the sub-steps, splits or integrator; apply_forces' power, at the rates the step started
+    with, is not (a walking quadruped's motors did 3 % more positive work than it counted,
+    and a net work of the other sign). The start's cos / sin go into ws.cs_pred (scratch
+    after the step: the next step computes it afresh)."""
     update_trig(s.q, ws.body_cs)
+    update_trig(q_start, ws.cs_pred)
     for k in range(m.act_kind.shape[0]):
-        ws.act_power[k] = apply_actuator(m, s.q, ws.body_cs, ws.q_keep, ws.force, k,
-                                         ws.act_u[k], False)
+        ws.act_power[k] = ws.act_u[k] * actuator_move(m, q_start, ws.cs_pred, s.q,
+                                                      ws.body_cs, k) / h
 
 
 @kernel
