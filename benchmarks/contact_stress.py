@@ -1,7 +1,7 @@
 """A seeded stress corpus of closed contact loops through the ground (not a test); no actuation but in stiff_motors.
 
     python benchmarks/contact_stress.py                       # 6 families x 40 seeds x 2 strategies
-    python benchmarks/contact_stress.py --quick               # seeds 0-4, one strategy each (20 runs)
+    python benchmarks/contact_stress.py --quick               # seeds 0-4, one strategy each (30 runs)
     python benchmarks/contact_stress.py --families chain_hills --runs-per-family 10
     python benchmarks/contact_stress.py --only chain_hills:7:all --only mass_ratio:3:alternating
     python benchmarks/contact_stress.py --families shape_pile shape_hills --extreme   # beyond the targets

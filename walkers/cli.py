@@ -547,7 +547,7 @@ def cmd_analyze(args):
                                              label=f"{family.names[0]} at touchdown",
                                              title=f"{args.walker}: gaits along {args.param}")
     print(f"({time.perf_counter() - t0:.1f} s, {pool.evaluations} step-map evaluations on "
-          f"{pool.workers} workers)" + (f"; wrote {', '.join(str(p) for p in (csv, plot) if p)}" if csv or plot else ""))
+          f"{pool.workers} worker{'s' if pool.workers != 1 else ''})" + (f"; wrote {', '.join(str(p) for p in (csv, plot) if p)}" if csv or plot else ""))
     return 0
 
 

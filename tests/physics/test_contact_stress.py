@@ -1,7 +1,7 @@
 """A fast subset of the contact stress corpus (benchmarks/contact_stress.py), judged by the same
 acceptance targets: energy never above E0 by more than the integrator's own oscillation bound,
 pin gaps <= 1e-9 m and depths below the ground <= 1e-8 m at the end of every step, no
-divergence, no audit violation. The subset is the script's --quick corpus (20 cases: every
+divergence, no audit violation. The subset is the script's --quick corpus (30 cases: every
 family, seeds 0-4, one of each dt, the two strategies in turn), run exactly as the script
 runs them: ``python benchmarks/contact_stress.py --quick`` prints the same cases as a table,
 ``python benchmarks/contact_stress.py`` the full corpus.
