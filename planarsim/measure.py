@@ -127,8 +127,8 @@ def cost_of_transport(traj, model, power=None, min_distance=MIN_TRANSPORT):
     `power` (K,) [W]. The average is work / (m g |x_end - x_start|), nan where the COM moved
     less than min_distance [m] (default MIN_TRANSPORT, 0.1 m, as the walkers' summaries: a
     gait in place that drifted 3 mm while its motors did 39 J reported a CoT of 117); the
-    work each frame's power times the time since the frame before (the steps that frame
-    ends; exact when every step is recorded)."""
+    work each frame's power times the time since the frame before (a frame's power is the
+    mean over the steps since that frame: exact however sparse the frames)."""
     check_recorded_by(traj, model, "measure.cost_of_transport")
     finite_number("measure.cost_of_transport: min_distance", min_distance, 0.0, unit=" m")
     if power is None:

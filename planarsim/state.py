@@ -372,6 +372,10 @@ class Workspace(NamedTuple):
     act_power: np.ndarray        # (n_act,) mechanical power [W] (forces.end_power: the
                                  #   command times its move over the step / h once a step
                                  #   stands)
+    act_work: np.ndarray         # (n_act,) the commands' work [J] in the steps since the
+                                 #   last recorded frame (record_frame divides it by
+                                 #   act_work_time and starts both again)
+    act_work_time: np.ndarray    # (1,) [s] those steps' time
     info: np.ndarray             # (N_INFO,) int: what the last step did, slots named in
                                  #   kernels/info.py (INFO_*; step_info(ws) by name)
     broken_rules: np.ndarray     # (N_BROKEN + 1,) int: the rules the last checked answer
@@ -823,7 +827,8 @@ def make_workspace(model: Model, contacts: int | None = None, profile: int | Non
                      contact_curve=z(nc),
                      manifold=z((2, 10)), shape_reach=z((model.n_shape, 4)),
                      **lists, **_solve_arrays(model, contacts, profile, lcp_rows),
-                     n_row=z(1, np.int64), act_u=z(na), act_power=z(na),
+                     n_row=z(1, np.int64), act_u=z(na), act_power=z(na), act_work=z(na),
+                     act_work_time=z(1),
                      info=z(N_INFO, np.int64), broken_rules=z(N_BROKEN + 1, np.int64),
                      guard_value=z(3),
                      contact_candidate=z(nc, np.int64), limit_candidate=z((model.n_pin, 2), np.int64),

@@ -4,9 +4,10 @@ Frame 0 holds the state a run starts from (its impulses, commands and powers are
 step before it, zero for a fresh state); every later frame the state after a recorded step
 (steps whose count is a multiple of record_every). contact_mode is 0 free, 1 pinned, 2 sliding,
 -1 disabled. contact_impulse is (normal, tangential) impulse of the step [N s]; divide by dt
-for a mean force [N]. act_power is the mechanical power of each actuator [W] over the step: its
-command times its coordinate's move in the step (joint angle, anchors' distance, slide, ...)
-divided by dt, so that dt times it is the work the command did in the step.
+for a mean force [N]. act_power is the mechanical power of each actuator [W]: its command times
+its coordinate's move (joint angle, anchors' distance, slide, ...) over the steps since the frame
+before, divided by their time, so that the time between two frames times it is the work the
+command did in between (every step recorded: the step's own).
 """
 from __future__ import annotations
 
@@ -94,6 +95,9 @@ def record_state(rec: Recorder, k: int, state, ws) -> None:
     """Write State `state` and Workspace `ws` into frame k of rec, as the compiled
     kernels.record.record_frame does after a step (here from Python, for a run's first frame)."""
     sources = {"state": state, "ws": ws}
+    if hasattr(ws, "act_work"):     # (a run's first frame: the work of later frames from here)
+        ws.act_work[:] = 0.0
+        ws.act_work_time[:] = 0.0
     for name, _, _, source in RECORDED:
         owner, attr = source.split(".")
         value = np.asarray(getattr(sources[owner], attr))

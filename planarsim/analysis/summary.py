@@ -64,8 +64,8 @@ def step_summary(traj, model, contacts=None, direction=None, feet=None, min_air=
     T = float(t[b] - t[a])
     work = 0.0
     if traj.act_power.shape[1]:
-        # a frame's power is over the step that ends at it: the steps of frames a+1..b
-        # (exact when every step is recorded, as measure.cost_of_transport sums it)
+        # a frame's power is the mean over the steps since the frame before: the steps of
+        # frames a+1..b (as measure.cost_of_transport sums it)
         power = np.sum(traj.act_power[a + 1:b + 1], axis=1)
         work = float(np.sum(power * np.diff(t[a:b + 1])))
     spent = float(energy[a] - energy[b]) + work

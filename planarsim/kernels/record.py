@@ -4,7 +4,8 @@ from ..compile import kernel
 
 @kernel
 def record_frame(s, ws, rec, k):
-    """Write the state after a step into frame k of rec (see planarsim/trajectory.py)."""
+    """Write the state after a step into frame k of rec (see planarsim/trajectory.py); the
+    actuators' work since the last frame starts again (ws.act_work)."""
     rec.t[k] = s.time[0]
     for i in range(s.q.shape[0]):
         for c in range(3):
@@ -16,6 +17,12 @@ def record_frame(s, ws, rec, k):
             rec.contact_impulse[k, i, c] = ws.contact_impulse[i, c]
             rec.contact_point[k, i, c] = ws.contact_point[i, c]
             rec.contact_normal[k, i, c] = ws.contact_normal[i, c]
+    # a frame's power is the mean over the steps since the frame before (the work they did
+    # over their time): the power times the time between frames is the work, however
+    # sparse the frames
+    span = ws.act_work_time[0]
     for a in range(ws.act_u.shape[0]):
         rec.act_u[k, a] = ws.act_u[a]
-        rec.act_power[k, a] = ws.act_power[a]
+        rec.act_power[k, a] = ws.act_work[a] / span if span > 0.0 else ws.act_power[a]
+        ws.act_work[a] = 0.0
+    ws.act_work_time[0] = 0.0

@@ -929,3 +929,22 @@ def test_the_recorded_power_times_dt_is_the_commands_work_in_the_step(kind, inte
     moved = traj.act_u[1:, 0] * np.diff(coordinate(traj.q))
     assert np.abs(moved).max() > 1e-3
     np.testing.assert_allclose(work, moved, rtol=0.0, atol=1e-12 * np.abs(moved).max())
+
+
+@pytest.mark.parametrize("every", [3, 7])
+def test_sparse_frames_hold_the_mean_power_since_the_frame_before(every):
+    """Recorded every few steps, a frame's act_power is the mean over the steps since the frame
+    before: the time between frames times it is the work of those steps, the same as summed
+    from a run that records every step (a frame holding its last step's power alone made a
+    quadruped's energy spent 17 % high at every tenth step), and a second run continues from
+    its own first frame."""
+    model, command, _ = _actuated("axial", 1e-2)
+    runs = []
+    for k in (1, every):
+        sim = ps.Simulator(model)
+        control = lambda s: np.array([command(s.t)])
+        first = sim.run(n_steps=21 * every, controller=control, record_every=k)
+        second = sim.run(n_steps=21 * every, controller=control, record_every=k)
+        runs.append([float(np.sum(t.act_power[1:, 0] * np.diff(t.t))) for t in (first, second)])
+    assert abs(runs[0][0]) > 0.1 and abs(runs[0][1]) > 0.1
+    np.testing.assert_allclose(runs[1], runs[0], rtol=1e-12)

@@ -296,12 +296,15 @@ def end_power(m, s, ws, q_start, h):
     the sub-steps, splits or integrator; apply_forces' power, at the rates the step started
     with, is not (a walking quadruped's motors did 3 % more positive work than it counted,
     and a net work of the other sign). The start's cos / sin go into ws.cs_pred (scratch
-    after the step: the next step computes it afresh)."""
+    after the step: the next step computes it afresh). The work is also added to
+    ws.act_work, and h to ws.act_work_time, for the next recorded frame (record_frame)."""
     update_trig(s.q, ws.body_cs)
     update_trig(q_start, ws.cs_pred)
     for k in range(m.act_kind.shape[0]):
-        ws.act_power[k] = ws.act_u[k] * actuator_move(m, q_start, ws.cs_pred, s.q,
-                                                      ws.body_cs, k) / h
+        work = ws.act_u[k] * actuator_move(m, q_start, ws.cs_pred, s.q, ws.body_cs, k)
+        ws.act_power[k] = work / h
+        ws.act_work[k] += work
+    ws.act_work_time[0] += h
 
 
 @kernel
