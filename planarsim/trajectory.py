@@ -95,9 +95,8 @@ def record_state(rec: Recorder, k: int, state, ws) -> None:
     """Write State `state` and Workspace `ws` into frame k of rec, as the compiled
     kernels.record.record_frame does after a step (here from Python, for a run's first frame)."""
     sources = {"state": state, "ws": ws}
-    if hasattr(ws, "act_work"):     # (a run's first frame: the work of later frames from here)
-        ws.act_work[:] = 0.0
-        ws.act_work_time[:] = 0.0
+    ws.act_work[:] = 0.0        # (a run's first frame: the work of later frames from here)
+    ws.act_work_time[:] = 0.0
     for name, _, _, source in RECORDED:
         owner, attr = source.split(".")
         value = np.asarray(getattr(sources[owner], attr))

@@ -52,6 +52,7 @@ from planarsim.compiled import jit, jit_inline, kernel, pin_angle_rate, height, 
 from walkers.common.gaits import gait_number
 from walkers.common.pd import clamp
 from walkers.common.slots import size, slots
+from walkers.common.work import add_positive_work, once_per_step
 
 from .model import HIP_SIGN, N_LEG, PAIR
 from .params import FIELD, QuadrupedParams
@@ -239,14 +240,10 @@ def stance_forces(s, p, mem, xc):
 @kernel
 def count_work(s, ws, mem, dt):
     """Add the step that led to s (of dt [s]) to the motors' positive mechanical work mem[work]
-    [J], once (the rollout calls it after each step, control at each tick): the engine's
-    power of each motor over the step (ws.act_power: its command times the joint's turn over
-    dt), its positive part. Only the last step where several were taken since the last
-    count; none where mem[work_at] is -1 (a memory made for this state)."""
-    if mem[MEM.work_at] >= 0.0 and s.step[0] != mem[MEM.work_at]:
-        for k in range(ws.act_power.shape[0]):
-            mem[MEM.work] += max(ws.act_power[k], 0.0) * dt
-    mem[MEM.work_at] = s.step[0]
+    [J], once (walkers/common/work.py: the rollout calls it after each step, control at each
+    tick). Only the last step where several were taken since the last count."""
+    if once_per_step(s, mem, MEM.work_at):
+        add_positive_work(ws, mem, MEM.work, dt)
 
 
 @jit_inline

@@ -37,6 +37,8 @@ import numpy as np
 from planarsim.actuators import motor_power
 from planarsim.compiled import jit_inline, kernel, pin_angle_rate, height as terrain_height
 
+from walkers.common.work import once_per_step
+
 from .estimator import filter_step, hysteresis
 from .motor import drive_motor, torque_constant
 from .model import GRAVITY
@@ -236,9 +238,9 @@ def count_step_energy(m, s, ws, dt, motor, mem):
     over the step, the torque's work the engine's power over it (ws.act_power: the torque
     times the joint's turn over dt), the electrical power at the joint's rate at the step's
     end, which symplectic Euler turns it by (into mem[pel], which the frame after the step
-    records). Only the last step where several were taken since the last count; none where
-    mem[e_at] is -1 (a memory made for this state)."""
-    if mem[MEM.e_at] >= 0.0 and s.step[0] != mem[MEM.e_at]:
+    records). Only the last step where several were taken since the last count
+    (walkers/common/work.py once_per_step)."""
+    if once_per_step(s, mem, MEM.e_at):
         for j in range(3):
             rate = pin_angle_rate(m, s.q, s.v, j)[1]
             pel = motor_power(mem[MEM.cur + j], rate, motor[j])
@@ -248,7 +250,6 @@ def count_step_energy(m, s, ws, dt, motor, mem):
             mem[MEM.e + 1] += dt * pel
             mem[MEM.e + 2] += dt * max(pm, 0.0)
             mem[MEM.e + 3] += dt * pm
-    mem[MEM.e_at] = s.step[0]
 
 
 @jit_inline

@@ -24,9 +24,10 @@ from planarsim.analysis import StepMap, StepMapError
 from planarsim.compiled import RUN_FELL, RUN_NO_EVENT, RUN_OK, check_run, jit, step
 
 from walkers.common.section import GaitMapMixin, copy_tuple, restore_tuple
+from walkers.common.work import add_positive_work
 
 from . import controller as C
-from .rollout import Run, add_positive_work, fell_down
+from .rollout import Run, fell_down
 
 NAMES = ("hip_dx", "hip_dy", "hip_vx", "hip_vy", "rear_dx", "v_top")
 DT = 1e-4       # [s] analysis step: the controller switches at step boundaries, which makes the
@@ -51,7 +52,7 @@ def rollout_to_touchdown(m, s, ws, opt, tab, mem, u, n_events, max_steps):
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i
-        add_positive_work(m, ws, mem)
+        add_positive_work(ws, mem, C.MEM.work, m.dt)
         if fell_down(m, s, p):
             mem[C.MEM.fallen] = 1.0
             return RUN_FELL, i + 1

@@ -20,6 +20,7 @@ from walkers.base import WalkerRun, simulation, start_rng, target_speed, terrain
 from walkers.common.gaits import gait_number
 from walkers.common.record import record_labelled
 from walkers.common.slots import label_slots
+from walkers.common.work import add_positive_work
 
 from . import controller as C
 from .model import build
@@ -35,14 +36,6 @@ def _longest_leg(q):
     a = math.hypot(q[1, 0] - q[0, 0], q[1, 1] - q[0, 1])
     b = math.hypot(q[2, 0] - q[0, 0], q[2, 1] - q[0, 1])
     return max(a, b)
-
-
-@jit
-def add_positive_work(m, ws, mem):
-    """The actuators' positive work over the last step [J] into mem[MEM.work]."""
-    for a in range(ws.act_power.shape[0]):
-        if ws.act_power[a] > 0.0:
-            mem[C.MEM.work] += ws.act_power[a] * m.dt
 
 
 @jit
@@ -66,7 +59,7 @@ def rollout_simple_biped(m, s, ws, opt, tab, mem, u, n, every, rec, lab, slots, 
         code = step(m, s, ws, opt, u)
         if code != 0:
             return code, i, k
-        add_positive_work(m, ws, mem)
+        add_positive_work(ws, mem, C.MEM.work, m.dt)
         k = record_labelled(s, ws, rec, lab, mem, slots, every, k)
         if fell_down(m, s, p):
             mem[C.MEM.fallen] = 1.0

@@ -295,11 +295,15 @@ def end_power(m, s, ws, q_start, h):
     (actuator_move), over h. So h times it is the work the command did in the step, whatever
     the sub-steps, splits or integrator; apply_forces' power, at the rates the step started
     with, is not (a walking quadruped's motors did 3 % more positive work than it counted,
-    and a net work of the other sign). The start's cos / sin go into ws.cs_pred (scratch
-    after the step: the next step computes it afresh). The work is also added to
+    and a net work of the other sign). An axial or slider force's move needs the bodies'
+    cos / sin: the start's go into ws.cs_pred (scratch after the step: the next step
+    computes it afresh). The work is also added to
     ws.act_work, and h to ws.act_work_time, for the next recorded frame (record_frame)."""
-    update_trig(s.q, ws.body_cs)
-    update_trig(q_start, ws.cs_pred)
+    for k in range(m.act_kind.shape[0]):      # (only anchors' and slides' moves turn)
+        if m.act_kind[k] == ACT_AXIAL or m.act_kind[k] == ACT_SLIDER_FORCE:
+            update_trig(s.q, ws.body_cs)
+            update_trig(q_start, ws.cs_pred)
+            break
     for k in range(m.act_kind.shape[0]):
         work = ws.act_u[k] * actuator_move(m, q_start, ws.cs_pred, s.q, ws.body_cs, k)
         ws.act_power[k] = work / h
